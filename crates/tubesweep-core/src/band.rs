@@ -1,0 +1,447 @@
+//! The narrow band: the grid nodes of the computational tube (inner tube and extension layer,
+//! paper Fig. 4), stored sparsely so that memory and work scale with the tube, O(N^(d−1)) nodes,
+//! not with the box, O(N^d).
+//!
+//! Layout (chosen for the sweeping kernel):
+//! * nodes are sorted in C order of their grid index (the last axis varies fastest), so that a
+//!   grid *row* (all nodes sharing every index but the last) is a contiguous slice;
+//! * rows are identified by the linear index of their leading coordinates (`row_keys`, sorted);
+//! * each node has a precomputed neighbour table, two entries (minus, plus) per axis, holding the
+//!   neighbour's position in the band or the sentinel `len()` when the neighbour is not in the
+//!   band (the solver stores the numerical infinity in an extra slot at that position);
+//! * for each of the 2^(d−1) orientations of the leading axes, a permutation of the rows gives the
+//!   Gauss–Seidel sweep order; the last axis is reversed by walking a row backwards.
+//!
+//! Cost per band node: 4 bytes of last-axis coordinate and 8·d bytes of neighbour table.
+
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+
+/// The band nodes and their neighbour table. `D` is the dimension (2 or 3).
+#[derive(Debug, Clone)]
+pub struct NarrowBand<const D: usize> {
+    shape: [usize; D],
+    row_keys: Vec<u64>,
+    row_start: Vec<u32>,
+    last: Vec<u32>,
+    neighbours: Vec<[[u32; 2]; D]>,
+    row_orders: Vec<Vec<u32>>,
+}
+
+impl<const D: usize> NarrowBand<D> {
+    /// Builds the band from the C-order linear indices of its nodes, which must be strictly
+    /// increasing (sorted, no duplicates) and inside the grid of shape `shape`.
+    pub fn from_sorted_linear(shape: [usize; D], linear: &[u64]) -> Result<Self> {
+        check_shape(&shape)?;
+        let total: u64 = shape.iter().map(|&n| n as u64).product();
+        if linear.len() >= u32::MAX as usize {
+            return Err(Error::invalid(
+                "indices",
+                format!("the band has {} nodes; at most {} are supported", linear.len(), u32::MAX - 1),
+            ));
+        }
+        for w in linear.windows(2) {
+            if w[0] >= w[1] {
+                return Err(Error::invalid("indices", "band nodes must be sorted in C order without duplicates"));
+            }
+        }
+        if let Some(&l) = linear.last() {
+            if l >= total {
+                return Err(Error::invalid("indices", "a band node lies outside the grid"));
+            }
+        }
+        let n_last = shape[D - 1] as u64;
+        let mut row_keys = Vec::new();
+        let mut row_start = Vec::new();
+        let mut last = Vec::with_capacity(linear.len());
+        for (pos, &l) in linear.iter().enumerate() {
+            let key = l / n_last;
+            if row_keys.last() != Some(&key) {
+                row_keys.push(key);
+                row_start.push(pos as u32);
+            }
+            last.push((l % n_last) as u32);
+        }
+        row_start.push(linear.len() as u32);
+        Ok(Self::assemble(shape, row_keys, row_start, last))
+    }
+
+    /// The whole box as a band (used by the Euclidean solver of Sect. 2).
+    pub fn full_box(shape: [usize; D]) -> Result<Self> {
+        check_shape(&shape)?;
+        let n_last = shape[D - 1];
+        let n_rows: usize = shape[..D - 1].iter().product();
+        let total = n_rows * n_last;
+        if total >= u32::MAX as usize {
+            return Err(Error::invalid("grid", format!("the grid has {total} nodes; at most {} are supported", u32::MAX - 1)));
+        }
+        let row_keys: Vec<u64> = (0..n_rows as u64).collect();
+        let row_start: Vec<u32> = (0..=n_rows).map(|r| (r * n_last) as u32).collect();
+        let last: Vec<u32> = (0..total).map(|p| (p % n_last) as u32).collect();
+        Ok(Self::assemble(shape, row_keys, row_start, last))
+    }
+
+    fn assemble(shape: [usize; D], row_keys: Vec<u64>, row_start: Vec<u32>, last: Vec<u32>) -> Self {
+        let len = last.len();
+        let mut band = NarrowBand {
+            shape,
+            row_keys,
+            row_start,
+            last,
+            neighbours: vec![[[len as u32; 2]; D]; len],
+            row_orders: Vec::new(),
+        };
+        band.build_neighbours();
+        band.build_row_orders();
+        band
+    }
+
+    /// Number of band nodes.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.last.len()
+    }
+
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.last.is_empty()
+    }
+
+    /// The sentinel neighbour index meaning "not in the band".
+    #[inline]
+    pub fn sentinel(&self) -> u32 {
+        self.len() as u32
+    }
+
+    pub fn shape(&self) -> [usize; D] {
+        self.shape
+    }
+
+    pub fn n_rows(&self) -> usize {
+        self.row_keys.len()
+    }
+
+    /// Neighbour table: `neighbours()[n][k] = [minus, plus]` along axis `k`.
+    #[inline]
+    pub fn neighbours(&self) -> &[[[u32; 2]; D]] {
+        &self.neighbours
+    }
+
+    /// Node range `[start, end)` of row `r`.
+    #[inline]
+    pub fn row_range(&self, r: usize) -> (usize, usize) {
+        (self.row_start[r] as usize, self.row_start[r + 1] as usize)
+    }
+
+    /// Row visiting order for the orientation `signs` of the leading `D − 1` axes (bit `k` set =
+    /// axis `k` walked backwards).
+    #[inline]
+    pub fn row_order(&self, signs: usize) -> &[u32] {
+        &self.row_orders[signs]
+    }
+
+    /// The grid index of band node `n`.
+    pub fn index_of(&self, n: usize) -> [usize; D] {
+        let r = match self.row_start.binary_search(&(n as u32)) {
+            Ok(mut r) => {
+                // empty rows do not exist, but be safe with equal starts
+                while r + 1 < self.row_start.len() && self.row_start[r + 1] as usize == n {
+                    r += 1;
+                }
+                r
+            }
+            Err(r) => r - 1,
+        };
+        let mut idx = [0usize; D];
+        let mut key = self.row_keys[r] as usize;
+        for k in (0..D - 1).rev() {
+            idx[k] = key % self.shape[k];
+            key /= self.shape[k];
+        }
+        idx[D - 1] = self.last[n] as usize;
+        idx
+    }
+
+    /// All grid indices, in band order.
+    pub fn indices(&self) -> Vec<[usize; D]> {
+        let mut out = Vec::with_capacity(self.len());
+        for r in 0..self.n_rows() {
+            let mut key = self.row_keys[r] as usize;
+            let mut lead = [0usize; D];
+            for k in (0..D - 1).rev() {
+                lead[k] = key % self.shape[k];
+                key /= self.shape[k];
+            }
+            let (s, e) = self.row_range(r);
+            for n in s..e {
+                let mut idx = lead;
+                idx[D - 1] = self.last[n] as usize;
+                out.push(idx);
+            }
+        }
+        out
+    }
+
+    /// Position of the node with grid index `idx` in the band, if it is a band node.
+    #[inline]
+    pub fn find(&self, idx: [i64; D]) -> Option<usize> {
+        let mut key: u64 = 0;
+        for k in 0..D - 1 {
+            if idx[k] < 0 || idx[k] as usize >= self.shape[k] {
+                return None;
+            }
+            key = key * self.shape[k] as u64 + idx[k] as u64;
+        }
+        let l = idx[D - 1];
+        if l < 0 || l as usize >= self.shape[D - 1] {
+            return None;
+        }
+        let r = self.row_keys.binary_search(&key).ok()?;
+        let (s, e) = self.row_range(r);
+        self.last[s..e].binary_search(&(l as u32)).ok().map(|p| s + p)
+    }
+
+    fn row_lead(&self, r: usize) -> [usize; D] {
+        let mut key = self.row_keys[r] as usize;
+        let mut lead = [0usize; D];
+        for k in (0..D - 1).rev() {
+            lead[k] = key % self.shape[k];
+            key /= self.shape[k];
+        }
+        lead
+    }
+
+    fn build_neighbours(&mut self) {
+        let len = self.len() as u32;
+        // strides of the leading axes in row-key space
+        let mut stride = [0u64; D];
+        let mut s = 1u64;
+        for k in (0..D - 1).rev() {
+            stride[k] = s;
+            s *= self.shape[k] as u64;
+        }
+        // split the neighbour table into one mutable slice per row
+        let mut slices: Vec<&mut [[[u32; 2]; D]]> = Vec::with_capacity(self.n_rows());
+        let mut rest: &mut [[[u32; 2]; D]] = &mut self.neighbours;
+        for r in 0..self.row_keys.len() {
+            let n = (self.row_start[r + 1] - self.row_start[r]) as usize;
+            let (head, tail) = rest.split_at_mut(n);
+            slices.push(head);
+            rest = tail;
+        }
+        let row_keys = &self.row_keys;
+        let row_start = &self.row_start;
+        let last = &self.last;
+        let shape = self.shape;
+        slices.into_par_iter().enumerate().for_each(|(r, out)| {
+            let s = row_start[r] as usize;
+            let e = row_start[r + 1] as usize;
+            // last axis: consecutive nodes in the row
+            for n in s..e {
+                let slot = &mut out[n - s][D - 1];
+                if n > s && last[n - 1] + 1 == last[n] {
+                    slot[0] = (n - 1) as u32;
+                }
+                if n + 1 < e && last[n + 1] == last[n] + 1 {
+                    slot[1] = (n + 1) as u32;
+                }
+            }
+            // leading axes: merge with the neighbouring rows
+            let mut key = row_keys[r];
+            let mut lead = [0usize; D];
+            for k in (0..D - 1).rev() {
+                lead[k] = (key % shape[k] as u64) as usize;
+                key /= shape[k] as u64;
+            }
+            for k in 0..D - 1 {
+                for side in 0..2 {
+                    let target = if side == 0 {
+                        if lead[k] == 0 {
+                            continue;
+                        }
+                        row_keys[r] - stride[k]
+                    } else {
+                        if lead[k] + 1 >= shape[k] {
+                            continue;
+                        }
+                        row_keys[r] + stride[k]
+                    };
+                    let Ok(rr) = row_keys.binary_search(&target) else { continue };
+                    let (ts, te) = (row_start[rr] as usize, row_start[rr + 1] as usize);
+                    let mut t = ts;
+                    for n in s..e {
+                        while t < te && last[t] < last[n] {
+                            t += 1;
+                        }
+                        if t < te && last[t] == last[n] {
+                            out[n - s][k][side] = t as u32;
+                        }
+                    }
+                }
+            }
+        });
+        debug_assert!(self.neighbours.iter().all(|nb| nb.iter().all(|p| p[0] <= len && p[1] <= len)));
+    }
+
+    fn build_row_orders(&mut self) {
+        let n_orient = 1usize << (D - 1);
+        let mut orders = Vec::with_capacity(n_orient);
+        let leads: Vec<[usize; D]> = (0..self.n_rows()).map(|r| self.row_lead(r)).collect();
+        for signs in 0..n_orient {
+            let mut order: Vec<u32> = (0..self.n_rows() as u32).collect();
+            if signs != 0 {
+                let shape = self.shape;
+                let flipped = |r: u32| -> u64 {
+                    let lead = &leads[r as usize];
+                    let mut key = 0u64;
+                    for k in 0..D - 1 {
+                        let c = if signs & (1 << k) != 0 { shape[k] - 1 - lead[k] } else { lead[k] };
+                        key = key * shape[k] as u64 + c as u64;
+                    }
+                    key
+                };
+                order.par_sort_unstable_by_key(|&r| flipped(r));
+            }
+            orders.push(order);
+        }
+        self.row_orders = orders;
+    }
+
+    /// Bytes held by this structure (for memory reports).
+    pub fn heap_bytes(&self) -> usize {
+        self.row_keys.len() * 8
+            + self.row_start.len() * 4
+            + self.last.len() * 4
+            + self.neighbours.len() * std::mem::size_of::<[[u32; 2]; D]>()
+            + self.row_orders.iter().map(|o| o.len() * 4).sum::<usize>()
+    }
+}
+
+fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
+    if !(2..=3).contains(&D) {
+        return Err(Error::invalid("grid", format!("only 2D and 3D grids are supported, got {D}D")));
+    }
+    for (k, &n) in shape.iter().enumerate() {
+        if n < 3 {
+            return Err(Error::invalid("shape", format!("axis {k} has {n} nodes; at least 3 are needed")));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn linear<const D: usize>(shape: [usize; D], idx: [usize; D]) -> u64 {
+        let mut l = 0u64;
+        for k in 0..D {
+            l = l * shape[k] as u64 + idx[k] as u64;
+        }
+        l
+    }
+
+    #[test]
+    fn full_box_neighbours_match_arithmetic() {
+        let shape = [4usize, 5, 3];
+        let band = NarrowBand::<3>::full_box(shape).unwrap();
+        assert_eq!(band.len(), 60);
+        for n in 0..band.len() {
+            let idx = band.index_of(n);
+            assert_eq!(linear(shape, idx), n as u64);
+            for k in 0..3 {
+                for side in 0..2 {
+                    let mut j = [idx[0] as i64, idx[1] as i64, idx[2] as i64];
+                    j[k] += if side == 0 { -1 } else { 1 };
+                    let expect = band.find(j).map(|p| p as u32).unwrap_or(band.sentinel());
+                    assert_eq!(band.neighbours()[n][k][side], expect);
+                    if let Some(p) = band.find(j) {
+                        assert_eq!(linear(shape, band.index_of(p)), linear(shape, [j[0] as usize, j[1] as usize, j[2] as usize]));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sparse_band_neighbours() {
+        // an annulus-like set of nodes in 2D
+        let shape = [20usize, 20];
+        let mut lin = Vec::new();
+        for i in 0..20usize {
+            for j in 0..20usize {
+                let r = (((i as f64) - 9.5).powi(2) + ((j as f64) - 9.5).powi(2)).sqrt();
+                if (r - 6.0).abs() <= 1.6 {
+                    lin.push(linear(shape, [i, j]));
+                }
+            }
+        }
+        let band = NarrowBand::<2>::from_sorted_linear(shape, &lin).unwrap();
+        assert_eq!(band.len(), lin.len());
+        for n in 0..band.len() {
+            let idx = band.index_of(n);
+            for k in 0..2 {
+                for side in 0..2 {
+                    let mut j = [idx[0] as i64, idx[1] as i64];
+                    j[k] += if side == 0 { -1 } else { 1 };
+                    let inset = j.iter().all(|&c| c >= 0 && c < 20)
+                        && lin.binary_search(&linear(shape, [j[0] as usize, j[1] as usize])).is_ok();
+                    let nb = band.neighbours()[n][k][side];
+                    assert_eq!(nb != band.sentinel(), inset, "node {idx:?} axis {k} side {side}");
+                }
+            }
+        }
+        assert_eq!(band.indices().len(), band.len());
+    }
+
+    #[test]
+    fn rejects_unsorted_and_small_shapes() {
+        assert!(NarrowBand::<2>::from_sorted_linear([5, 5], &[3, 2]).is_err());
+        assert!(NarrowBand::<2>::from_sorted_linear([5, 5], &[3, 3]).is_err());
+        assert!(NarrowBand::<2>::from_sorted_linear([5, 5], &[25]).is_err());
+        assert!(NarrowBand::<2>::full_box([2, 5]).is_err());
+    }
+
+    #[test]
+    fn row_orders_are_permutations_in_the_requested_direction() {
+        let band = NarrowBand::<3>::full_box([3, 4, 3]).unwrap();
+        for signs in 0..4 {
+            let order = band.row_order(signs);
+            let mut sorted = order.to_vec();
+            sorted.sort();
+            assert_eq!(sorted, (0..12).collect::<Vec<u32>>());
+            let first = band.index_of(band.row_range(order[0] as usize).0);
+            assert_eq!(first[0], if signs & 1 != 0 { 2 } else { 0 });
+            assert_eq!(first[1], if signs & 2 != 0 { 3 } else { 0 });
+        }
+    }
+}
+
+impl<const D: usize> NarrowBand<D> {
+    /// Band positions of the selected nodes that lack a neighbour which lies inside the grid but
+    /// not in the band. For the two-layer method every inner-tube node must have all its in-grid
+    /// neighbours in the band (the extension layer must enclose the inner tube).
+    pub fn nodes_missing_neighbours(&self, select: &[bool]) -> Vec<usize> {
+        let sentinel = self.sentinel();
+        let mut out = Vec::new();
+        for r in 0..self.n_rows() {
+            let lead = self.row_lead(r);
+            let (s, e) = self.row_range(r);
+            for n in s..e {
+                if !select[n] {
+                    continue;
+                }
+                let mut idx = lead;
+                idx[D - 1] = self.last[n] as usize;
+                let nb = &self.neighbours[n];
+                let missing = (0..D).any(|k| {
+                    (nb[k][0] == sentinel && idx[k] > 0) || (nb[k][1] == sentinel && idx[k] + 1 < self.shape[k])
+                });
+                if missing {
+                    out.push(n);
+                }
+            }
+        }
+        out
+    }
+}

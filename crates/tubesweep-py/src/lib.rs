@@ -1,0 +1,324 @@
+//! Thin PyO3 bindings of `tubesweep-core`: array conversion, releasing the GIL around solves,
+//! progress and Ctrl-C, and error mapping (in `errors.rs`). All validation a user sees with a
+//! helpful message happens in the Python package; the core re-checks what could break it.
+
+mod errors;
+
+use errors::to_pyerr;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use tubesweep_core::band::NarrowBand;
+use tubesweep_core::interpolate::interpolate;
+use tubesweep_core::sweep::{MissingNeighbour, Slowness};
+use tubesweep_core::{Control, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
+
+enum AnyBand {
+    D2(NarrowBand<2>),
+    D3(NarrowBand<3>),
+}
+
+/// A narrow band of grid nodes with its neighbour table (see `tubesweep_core::band`).
+#[pyclass(module = "tubesweep._native", name = "Band", frozen)]
+struct PyBand {
+    band: AnyBand,
+}
+
+fn shape_array<const D: usize>(shape: &[usize]) -> PyResult<[usize; D]> {
+    shape.try_into().map_err(|_| PyValueError::new_err(format!("shape must have {D} entries")))
+}
+
+fn parse_scheme(name: &str) -> PyResult<u8> {
+    match name {
+        "godunov" => Ok(0),
+        "lxf" => Ok(1),
+        _ => Err(PyValueError::new_err(format!("hamiltonian: unknown scheme {name:?}; use 'godunov' or 'lxf'"))),
+    }
+}
+
+fn parse_missing(name: &str) -> PyResult<MissingNeighbour> {
+    match name {
+        "infinity" => Ok(MissingNeighbour::Infinity),
+        "extrapolate" => Ok(MissingNeighbour::Extrapolate),
+        _ => Err(PyValueError::new_err(format!("missing: unknown policy {name:?}"))),
+    }
+}
+
+fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("iterations", s.iterations)?;
+    d.set_item("sweeps", s.sweeps)?;
+    d.set_item("updates", s.updates)?;
+    d.set_item("converged", s.converged)?;
+    d.set_item("last_change", s.last_change)?;
+    d.set_item("seconds", s.seconds)?;
+    Ok(d)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn solve_generic<'py, const D: usize>(
+    py: Python<'py>,
+    band: &NarrowBand<D>,
+    roles: &[u8],
+    fixed_values: &[f64],
+    spacing: f64,
+    slowness: &Bound<'py, PyAny>,
+    directions: Option<PyReadonlyArray2<'py, f32>>,
+    scheme: u8,
+    missing: MissingNeighbour,
+    options: SolveOptions,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+    let n = band.len();
+    if roles.len() != n || fixed_values.len() != n {
+        return Err(PyValueError::new_err(format!("roles and values must have one entry per band node ({n})")));
+    }
+    let roles: Vec<NodeRole> = roles
+        .iter()
+        .map(|&r| NodeRole::from_u8(r).ok_or_else(|| PyValueError::new_err(format!("roles: invalid role {r}"))))
+        .collect::<PyResult<_>>()?;
+    let slowness_arr: Option<PyReadonlyArray1<'py, f64>>;
+    let constant_slowness: Option<f64>;
+    if let Ok(s) = slowness.extract::<f64>() {
+        constant_slowness = Some(s);
+        slowness_arr = None;
+    } else {
+        slowness_arr = Some(slowness.extract()?);
+        constant_slowness = None;
+    }
+    let slow_slice = match &slowness_arr {
+        Some(a) => Some(a.as_slice()?),
+        None => None,
+    };
+    let dirs: Vec<[f32; D]> = match &directions {
+        Some(d) => {
+            if d.shape() != [n, D] {
+                return Err(PyValueError::new_err(format!("directions must have shape ({n}, {D})")));
+            }
+            let s = d.as_slice()?;
+            s.chunks_exact(D).map(|c| c.try_into().unwrap_or([0.0; D])).collect()
+        }
+        None => Vec::new(),
+    };
+    let mut values = fixed_values.to_vec();
+    let mut py_error: Option<PyErr> = None;
+    let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
+    let result = py.detach(|| {
+        let problem = SweepProblem {
+            band,
+            roles: &roles,
+            spacing,
+            slowness: match (constant_slowness, slow_slice) {
+                (Some(s), _) => Slowness::Constant(s),
+                (None, Some(s)) => Slowness::PerNode(s),
+                (None, None) => Slowness::Constant(1.0),
+            },
+            directions: &dirs,
+            scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
+            missing,
+        };
+        let mut callback = |r: &IterationReport| -> Control {
+            Python::attach(|py| {
+                if let Err(e) = py.check_signals() {
+                    py_error = Some(e);
+                    return Control::Stop;
+                }
+                if let Some(cb) = &progress_ref {
+                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
+                        py_error = Some(e);
+                        return Control::Stop;
+                    }
+                }
+                Control::Continue
+            })
+        };
+        problem.solve(&mut values, &options, &mut callback)
+    });
+    if let Some(e) = py_error {
+        return Err(e);
+    }
+    let stats = result.map_err(to_pyerr)?;
+    Ok((values.into_pyarray(py), stats_dict(py, &stats)?))
+}
+
+macro_rules! with_band {
+    ($self:expr, $b:ident, $body:expr) => {
+        match &$self.band {
+            AnyBand::D2($b) => $body,
+            AnyBand::D3($b) => $body,
+        }
+    };
+}
+
+#[pymethods]
+impl PyBand {
+    /// Band from sorted C-order linear node indices of a grid of `shape`.
+    #[staticmethod]
+    fn from_linear(py: Python<'_>, shape: Vec<usize>, linear: PyReadonlyArray1<'_, u64>) -> PyResult<Self> {
+        let lin = linear.as_slice()?;
+        let band = py
+            .detach(|| match shape.len() {
+                2 => NarrowBand::<2>::from_sorted_linear(shape[..].try_into().unwrap(), lin).map(AnyBand::D2),
+                3 => NarrowBand::<3>::from_sorted_linear(shape[..].try_into().unwrap(), lin).map(AnyBand::D3),
+                d => Err(tubesweep_core::Error::invalid("grid", format!("only 2D and 3D grids are supported, got {d}D"))),
+            })
+            .map_err(to_pyerr)?;
+        Ok(PyBand { band })
+    }
+
+    /// The whole box as a band.
+    #[staticmethod]
+    fn full_box(py: Python<'_>, shape: Vec<usize>) -> PyResult<Self> {
+        let band = py
+            .detach(|| match shape.len() {
+                2 => shape_array::<2>(&shape).ok().map(|s| NarrowBand::<2>::full_box(s).map(AnyBand::D2)),
+                3 => shape_array::<3>(&shape).ok().map(|s| NarrowBand::<3>::full_box(s).map(AnyBand::D3)),
+                _ => None,
+            })
+            .ok_or_else(|| PyValueError::new_err("grid: only 2D and 3D grids are supported"))?
+            .map_err(to_pyerr)?;
+        Ok(PyBand { band })
+    }
+
+    fn __len__(&self) -> usize {
+        with_band!(self, b, b.len())
+    }
+
+    #[getter]
+    fn ndim(&self) -> usize {
+        match &self.band {
+            AnyBand::D2(_) => 2,
+            AnyBand::D3(_) => 3,
+        }
+    }
+
+    #[getter]
+    fn n_rows(&self) -> usize {
+        with_band!(self, b, b.n_rows())
+    }
+
+    /// Bytes held by the band structure (nodes, rows, neighbour table, sweep orders).
+    #[getter]
+    fn nbytes(&self) -> usize {
+        with_band!(self, b, b.heap_bytes())
+    }
+
+    /// Grid indices of the band nodes, shape (K, d), in band order.
+    fn indices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let (flat, d): (Vec<i64>, usize) = with_band!(self, b, {
+            let idx = b.indices();
+            let d = idx.first().map(|i| i.len()).unwrap_or(self.ndim());
+            (idx.iter().flat_map(|i| i.iter().map(|&c| c as i64)).collect(), d)
+        });
+        let k = flat.len() / d.max(1);
+        Ok(numpy::ndarray::Array2::from_shape_vec((k, d), flat)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?
+            .into_pyarray(py))
+    }
+
+    /// Neighbour table, shape (K, d, 2): band position of the minus/plus neighbour along each
+    /// axis, or K when that neighbour is not in the band.
+    fn neighbours<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<i64>>> {
+        let (flat, k, d): (Vec<i64>, usize, usize) = with_band!(self, b, {
+            let nb = b.neighbours();
+            let d = self.ndim();
+            (nb.iter().flat_map(|n| n.iter().flat_map(|p| [p[0] as i64, p[1] as i64])).collect(), nb.len(), d)
+        });
+        Ok(numpy::ndarray::Array3::from_shape_vec((k, d, 2), flat)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?
+            .into_pyarray(py))
+    }
+
+    /// Band positions of grid indices (M, d); -1 where the node is not in the band.
+    fn find<'py>(&self, py: Python<'py>, indices: PyReadonlyArray2<'py, i64>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let d = self.ndim();
+        if indices.shape()[1] != d {
+            return Err(PyValueError::new_err(format!("indices must have shape (M, {d})")));
+        }
+        let s = indices.as_slice()?;
+        let out: Vec<i64> = with_band!(self, b, {
+            s.chunks_exact(d)
+                .map(|c| {
+                    let idx = c.try_into().unwrap();
+                    b.find(idx).map(|p| p as i64).unwrap_or(-1)
+                })
+                .collect()
+        });
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Band positions of the selected nodes that lack an in-grid neighbour in the band.
+    fn nodes_missing_neighbours<'py>(&self, py: Python<'py>, select: PyReadonlyArray1<'py, bool>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let sel = select.as_slice()?;
+        if sel.len() != self.__len__() {
+            return Err(PyValueError::new_err("select must have one entry per band node"));
+        }
+        let out: Vec<i64> = with_band!(self, b, b.nodes_missing_neighbours(sel).into_iter().map(|n| n as i64).collect());
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Multilinear interpolation of `values` at `points` (M, d); NaN where the stencil leaves
+    /// the band.
+    fn interpolate<'py>(
+        &self,
+        py: Python<'py>,
+        values: PyReadonlyArray1<'py, f64>,
+        lower: Vec<f64>,
+        spacing: f64,
+        points: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let d = self.ndim();
+        if points.shape()[1] != d || lower.len() != d {
+            return Err(PyValueError::new_err(format!("points must have shape (M, {d})")));
+        }
+        let vals = values.as_slice()?;
+        if vals.len() != self.__len__() {
+            return Err(PyValueError::new_err("values must have one entry per band node"));
+        }
+        let pts = points.as_slice()?;
+        let out = py.detach(|| match &self.band {
+            AnyBand::D2(b) => interpolate(b, vals, [lower[0], lower[1]], spacing, pts),
+            AnyBand::D3(b) => interpolate(b, vals, [lower[0], lower[1], lower[2]], spacing, pts),
+        });
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Runs the sweeps. See `tubesweep_core::sweep`.
+    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn solve<'py>(
+        &self,
+        py: Python<'py>,
+        roles: PyReadonlyArray1<'py, u8>,
+        fixed_values: PyReadonlyArray1<'py, f64>,
+        spacing: f64,
+        slowness: Bound<'py, PyAny>,
+        directions: Option<PyReadonlyArray2<'py, f32>>,
+        scheme: &str,
+        missing: &str,
+        tol: f64,
+        max_iterations: usize,
+        infinity: f64,
+        progress: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+        let scheme = parse_scheme(scheme)?;
+        let missing = parse_missing(missing)?;
+        let options = SolveOptions { tol, max_iterations, infinity };
+        let roles = roles.as_slice()?;
+        let fixed = fixed_values.as_slice()?;
+        match &self.band {
+            AnyBand::D2(b) => solve_generic(py, b, roles, fixed, spacing, &slowness, directions, scheme, missing, options, progress),
+            AnyBand::D3(b) => solve_generic(py, b, roles, fixed, spacing, &slowness, directions, scheme, missing, options, progress),
+        }
+    }
+}
+
+/// The compiled core of tubesweep. Use the `tubesweep` package, not this module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyBand>()?;
+    m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

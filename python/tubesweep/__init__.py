@@ -1,0 +1,27 @@
+"""tubesweep — distances and first-arrival times on implicit curves and surfaces.
+
+Implements the fast sweeping method of T. Wong and S. Leung, *A Fast Sweeping Method for Eikonal
+Equations on Implicit Surfaces*, J. Sci. Comput. (2016), with a Rust core.
+
+Quick start::
+
+    import numpy as np, tubesweep as ts
+    grid = ts.Grid(lower=(-1, -1, -1), upper=(1, 1, 1), shape=(101, 101, 101))
+    sphere = lambda p: np.linalg.norm(p, axis=1) - 0.5
+    sol = ts.solve(sphere, grid, sources=[(-0.5, 0, 0)])
+    sol([(0.5, 0, 0)])            # ≈ π/2 · 0.5
+
+Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :func:`travel_time` (the whole
+box, Algorithm 1), :class:`Grid`, :class:`LevelSet`.
+"""
+
+from ._native import __version__ as _core_version
+from .euclidean import travel_time
+from .grid import Grid
+from .solve import Solution, solve
+from .stats import SolveStats
+from .surface import LevelSet, Surface
+
+__version__ = "0.1.0"
+
+__all__ = ["Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "travel_time", "__version__"]

@@ -1,0 +1,43 @@
+"""Type stubs of the compiled core (private; use the tubesweep package)."""
+
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+DEFAULT_INFINITY: float
+__version__: str
+
+class Band:
+    @staticmethod
+    def from_linear(shape: List[int], linear: npt.NDArray[np.uint64]) -> "Band": ...
+    @staticmethod
+    def full_box(shape: List[int]) -> "Band": ...
+    def __len__(self) -> int: ...
+    @property
+    def ndim(self) -> int: ...
+    @property
+    def n_rows(self) -> int: ...
+    @property
+    def nbytes(self) -> int: ...
+    def indices(self) -> npt.NDArray[np.int64]: ...
+    def neighbours(self) -> npt.NDArray[np.int64]: ...
+    def find(self, indices: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
+    def nodes_missing_neighbours(self, select: npt.NDArray[np.bool_]) -> npt.NDArray[np.int64]: ...
+    def interpolate(
+        self, values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
+    ) -> npt.NDArray[np.float64]: ...
+    def solve(
+        self,
+        roles: npt.NDArray[np.uint8],
+        fixed_values: npt.NDArray[np.float64],
+        spacing: float,
+        slowness: Union[float, npt.NDArray[np.float64]],
+        directions: Optional[npt.NDArray[np.float32]],
+        scheme: str,
+        missing: str,
+        tol: float,
+        max_iterations: int,
+        infinity: float,
+        progress: Optional[Callable[[int, float, int], Any]] = None,
+    ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...

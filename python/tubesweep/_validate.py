@@ -1,0 +1,145 @@
+"""Input checks shared by the solvers. Every error names the argument and says how to fix it."""
+
+from __future__ import annotations
+
+import os
+import warnings
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from .grid import Grid
+
+HAMILTONIANS = ("godunov", "lxf")
+
+
+def as_grid(grid: Any) -> Grid:
+    if not isinstance(grid, Grid):
+        raise TypeError(f"grid must be a tubesweep.Grid, got {type(grid).__name__}; build one with ts.Grid(lower, upper, shape)")
+    return grid
+
+
+def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
+    """Converts to a float (M, ndim) array; rejects NaN/inf and wrong shapes."""
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array-like of shape (M, {ndim}) of numbers") from None
+    if p.ndim == 1 and p.size == ndim:
+        p = p.reshape(1, ndim)
+    if p.ndim != 2 or p.shape[1] != ndim:
+        raise ValueError(f"{name} must have shape (M, {ndim}) for a {ndim}D grid; got shape {p.shape}")
+    if not np.all(np.isfinite(p)):
+        bad = np.flatnonzero(~np.all(np.isfinite(p), axis=1))
+        raise ValueError(f"{name} contains NaN or inf (row {bad[0]}); every coordinate must be finite")
+    return np.ascontiguousarray(p)
+
+
+def as_sources(sources: Any, grid: Grid) -> np.ndarray:
+    s = as_points(sources, grid.ndim, "sources")
+    if s.shape[0] == 0:
+        raise ValueError("sources is empty; give at least one source point")
+    inside = grid.contains(s)
+    if not np.all(inside):
+        i = int(np.flatnonzero(~inside)[0])
+        raise ValueError(
+            f"sources[{i}] = {tuple(float(x) for x in s[i])} lies outside the grid "
+            f"[{tuple(float(x) for x in grid.lower)}, {tuple(float(x) for x in grid.upper)}]; move it inside or enlarge the grid"
+        )
+    return s
+
+
+def check_hamiltonian(hamiltonian: str) -> str:
+    if not isinstance(hamiltonian, str) or hamiltonian.lower() not in HAMILTONIANS:
+        raise ValueError(f"hamiltonian must be 'godunov' (Eq. 3) or 'lxf' (Eq. 4); got {hamiltonian!r}")
+    return hamiltonian.lower()
+
+
+def check_tolerance(tol: float, max_iterations: int) -> None:
+    if not (isinstance(tol, (int, float, np.floating)) and np.isfinite(tol) and tol >= 0):
+        raise ValueError(f"tol must be a non-negative finite number; got {tol!r}")
+    if not (isinstance(max_iterations, (int, np.integer)) and max_iterations >= 1):
+        raise ValueError(f"max_iterations must be a positive integer; got {max_iterations!r}")
+
+
+def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np.ndarray]) -> "float | np.ndarray":
+    """Speed F at the given nodes: a positive float, or an array of one value per node.
+
+    ``speed`` may be a scalar, an array of ``grid.shape`` (indexed at ``linear``), or a vectorised
+    callable ``f(points (M, d)) -> (M,)``.
+    """
+    if callable(speed):
+        vals = np.asarray(speed(points), dtype=float)
+        if vals.shape != (points.shape[0],):
+            raise ValueError(
+                f"speed callable must map points of shape (M, {grid.ndim}) to values of shape (M,); "
+                f"returned shape {vals.shape} for M = {points.shape[0]}"
+            )
+    elif np.ndim(speed) == 0:
+        try:
+            f = float(speed)
+        except (TypeError, ValueError):
+            raise TypeError(f"speed must be a number, an array of grid.shape or a callable; got {type(speed).__name__}") from None
+        if not np.isfinite(f) or f <= 0:
+            raise ValueError(f"speed must be positive and finite; got {f}. The speed F(x) > 0 is the wave speed in |∇u| = 1/F")
+        return f
+    else:
+        arr = np.asarray(speed, dtype=float)
+        if arr.shape != grid.shape:
+            raise ValueError(f"speed array must have the grid's shape {grid.shape}; got {arr.shape}")
+        vals = arr.reshape(-1)[linear] if linear is not None else arr.reshape(-1)
+    bad = ~np.isfinite(vals)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"speed is NaN or inf at {tuple(float(x) for x in points[i])}; it must be finite everywhere")
+    nonpos = vals <= 0
+    if np.any(nonpos):
+        i = int(np.flatnonzero(nonpos)[0])
+        raise ValueError(
+            f"speed must be positive; got {vals[i]:.6g} at {tuple(float(x) for x in points[i])}. "
+            "A zero or negative speed means the wave never arrives there"
+        )
+    return np.ascontiguousarray(vals)
+
+
+def available_memory_bytes() -> Optional[int]:
+    """Memory the machine can still give us, from /proc/meminfo (None when unknown)."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_memory(nbytes: float, what: str, fix: str) -> None:
+    """Raises MemoryError before an allocation that would not fit in the machine's memory."""
+    avail = available_memory_bytes()
+    if avail is not None and nbytes > 0.9 * avail:
+        raise MemoryError(
+            f"{what} needs about {nbytes / 2**30:.1f} GiB but only {avail / 2**30:.1f} GiB is available; {fix}"
+        )
+
+
+def warn_unconverged(stats: dict, tol: float, max_iterations: int) -> None:
+    if not stats["converged"]:
+        warnings.warn(
+            f"the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
+            f"iteration was {stats['last_change']:.3g} (tol={tol:g}). Increase max_iterations or tol; "
+            "the values returned are the last iterate",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+
+
+def progress_callback(progress: Any) -> Optional[Callable[[int, float, int], None]]:
+    if progress is None or progress is False:
+        return None
+    if not callable(progress):
+        raise TypeError("progress must be a callable (iteration, max_change, updates) -> None, or None")
+    return progress

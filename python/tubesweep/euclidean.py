@@ -1,0 +1,177 @@
+"""First-arrival times in the whole box: the fast sweeping method of Sect. 2 (Algorithm 1)."""
+
+from __future__ import annotations
+
+import time
+from functools import lru_cache
+from typing import Any, Callable, Literal, Optional, Tuple, Union, overload
+
+import numpy as np
+
+from . import _native
+from ._validate import (
+    as_grid,
+    as_sources,
+    check_hamiltonian,
+    check_memory,
+    check_tolerance,
+    progress_callback,
+    speed_values,
+    warn_unconverged,
+)
+from .grid import Grid
+from .stats import SolveStats
+
+__all__ = ["travel_time", "SOURCE_RADIUS"]
+
+#: Nodes within this many grid spacings of a point source are initialised with the exact local
+#: travel time |x − x_s| times the mean slowness (trapezoidal rule), so the source singularity
+#: costs no O(1) error (scikit-fmm's 1.707 instead of √2 one cell off a source).
+SOURCE_RADIUS = 2.0
+
+_BYTES_PER_BOX_NODE = 8 + 4 + 1 + 8 + 8  # values + last index + role + fixed values + output copy
+
+
+@lru_cache(maxsize=2)
+def _box_band(shape: Tuple[int, ...]) -> Any:
+    return _native.Band.full_box(list(shape))
+
+
+def _source_nodes(grid: Grid, sources: np.ndarray, slowness_at: Callable[[np.ndarray], np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
+    """Linear indices and exact local travel times of the nodes near the sources."""
+    h = grid.spacing
+    r = int(np.ceil(SOURCE_RADIUS))
+    offsets = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * grid.ndim), indexing="ij"), axis=-1).reshape(-1, grid.ndim)
+    best: dict = {}
+    for s in sources:
+        base = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64)
+        idx = base + offsets
+        ok = np.all((idx >= 0) & (idx < np.asarray(grid.shape)), axis=1)
+        idx = idx[ok]
+        x = grid.points(idx)
+        dist = np.linalg.norm(x - s, axis=1)
+        near = dist <= SOURCE_RADIUS * h + 1e-12 * h
+        idx, x, dist = idx[near], x[near], dist[near]
+        slow = 0.5 * (slowness_at(x) + slowness_at(s[None])[0])
+        t = dist * slow
+        for lin, val in zip(grid.linear_index(idx), t):
+            if lin not in best or val < best[lin]:
+                best[lin] = val
+    lin = np.fromiter(best.keys(), dtype=np.int64, count=len(best))
+    val = np.fromiter(best.values(), dtype=float, count=len(best))
+    return lin, val
+
+
+@overload
+def travel_time(grid: Grid, sources: Any, *, speed: Any = ..., hamiltonian: str = ..., tol: float = ...,
+                max_iterations: int = ..., return_stats: Literal[False] = ..., progress: Any = ...) -> np.ndarray: ...
+@overload
+def travel_time(grid: Grid, sources: Any, *, speed: Any = ..., hamiltonian: str = ..., tol: float = ...,
+                max_iterations: int = ..., return_stats: Literal[True], progress: Any = ...) -> Tuple[np.ndarray, SolveStats]: ...
+
+
+def travel_time(
+    grid: Grid,
+    sources: Any,
+    *,
+    speed: Union[float, np.ndarray, Callable[[np.ndarray], np.ndarray]] = 1.0,
+    hamiltonian: str = "godunov",
+    tol: float = 1e-10,
+    max_iterations: int = 1000,
+    return_stats: bool = False,
+    progress: Optional[Callable[[int, float, int], None]] = None,
+) -> Union[np.ndarray, Tuple[np.ndarray, SolveStats]]:
+    """First-arrival time ``u`` with ``|∇u| = 1/F`` in the whole box, from point sources.
+
+    The fast sweeping method (paper Sect. 2, Algorithm 1): Gauss–Seidel sweeps in the 2^d
+    alternating orders with the Godunov update (Eq. 3 and its 3D form) or the Lax–Friedrichs update
+    (Eq. 4, values only ever decrease). Nodes within ``SOURCE_RADIUS`` grid spacings of a source
+    start at the exact local travel time, so point sources anywhere in the box (not only on nodes)
+    are accurate.
+
+    Parameters
+    ----------
+    grid : Grid
+    sources : array-like (K, d)
+        Source points anywhere in the box.
+    speed : float, ndarray of ``grid.shape``, or callable ``f(points (M, d)) -> (M,)``
+        Wave speed F > 0.
+    hamiltonian : {"godunov", "lxf"}
+    tol : float
+        Stop when the largest change in one iteration (2^d sweeps) is below ``tol``.
+    max_iterations : int
+        A ``RuntimeWarning`` is issued if the sweeps have not converged by then.
+    return_stats : bool
+        Also return a :class:`SolveStats`.
+    progress : callable, optional
+        Called after every iteration as ``progress(iteration, max_change, updates)``.
+
+    Returns
+    -------
+    ndarray of ``grid.shape`` (and :class:`SolveStats` if ``return_stats``)
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> grid = ts.Grid((-1, -1), (1, 1), (201, 201))
+    >>> u = ts.travel_time(grid, [(0.013, -0.2)], speed=2.0)
+    """
+    t0 = time.perf_counter()
+    grid = as_grid(grid)
+    src = as_sources(sources, grid)
+    scheme = check_hamiltonian(hamiltonian)
+    check_tolerance(tol, max_iterations)
+    cb = progress_callback(progress)
+    check_memory(grid.size * _BYTES_PER_BOX_NODE, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver")
+
+    if callable(speed) or np.ndim(speed) > 0:
+        pts = np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1) if callable(speed) else np.empty((grid.size, grid.ndim))
+        f = speed_values(speed, grid, pts, None)
+        slowness: Any = 1.0 / f
+        del pts
+    else:
+        slowness = 1.0 / speed_values(speed, grid, np.empty((0, grid.ndim)), None)
+
+    def slowness_at(x: np.ndarray) -> np.ndarray:
+        if callable(speed):
+            return 1.0 / np.asarray(speed(x), dtype=float)
+        if np.ndim(slowness) == 0:
+            return np.full(len(x), float(slowness))
+        # multilinear interpolation of the slowness array
+        return _interp_dense(np.asarray(slowness).reshape(grid.shape), grid, x)
+
+    lin, val = _source_nodes(grid, src, slowness_at)
+    band = _box_band(grid.shape)
+    roles = np.ones(grid.size, dtype=np.uint8)
+    roles[lin] = 0
+    fixed = np.zeros(grid.size)
+    fixed[lin] = val
+    setup = time.perf_counter() - t0
+    values, st = band.solve(
+        roles, fixed, grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
+        _native.DEFAULT_INFINITY, cb,
+    )
+    warn_unconverged(st, tol, max_iterations)
+    u = values.reshape(grid.shape)
+    if not return_stats:
+        return u
+    stats = SolveStats(
+        iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
+        last_change=st["last_change"], seconds=st["seconds"], band_points=grid.size, inner_points=grid.size - len(lin),
+        outer_points=0, fixed_points=len(lin), setup_seconds=setup, band_bytes=band.nbytes + grid.size * 18,
+    )
+    return u, stats
+
+
+def _interp_dense(arr: np.ndarray, grid: Grid, x: np.ndarray) -> np.ndarray:
+    """Multilinear interpolation of a dense array of grid.shape at points x (M, d)."""
+    t = grid.continuous_index(x)
+    base = np.clip(np.floor(t), 0, np.asarray(grid.shape) - 2).astype(np.int64)
+    frac = np.clip(t - base, 0.0, 1.0)
+    out = np.zeros(len(x))
+    d = grid.ndim
+    for corner in range(1 << d):
+        bits = np.array([(corner >> k) & 1 for k in range(d)])
+        w = np.prod(np.where(bits == 1, frac, 1 - frac), axis=1)
+        out += w * arr[tuple((base + bits).T)]
+    return out

@@ -1,0 +1,309 @@
+"""The surface eikonal solver: the two-layer tube method (Algorithm 3) and the naive single tube
+(Algorithm 2) on a sparse narrow band."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from typing import Any, Callable, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+from ._validate import (
+    as_grid,
+    as_points,
+    as_sources,
+    check_hamiltonian,
+    check_tolerance,
+    progress_callback,
+    speed_values,
+    warn_unconverged,
+)
+from .grid import Grid
+from .stats import SolveStats
+from .surface import BandGeometry, Surface, as_surface
+
+__all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
+
+METHODS = ("two-layer", "naive")
+SOURCE_INITS = ("exact", "node")
+
+#: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
+#: tolerance makes nodes that sit exactly on the inner radius (up to rounding, common on
+#: symmetric grids) consistently inner.
+ROLE_RTOL = 1e-9
+
+#: With ``source_init="exact"``, inner-tube nodes whose closest point lies within this many grid
+#: spacings of a source are fixed to the exact local distance ``|cp(x) − x_s|`` times the mean
+#: slowness.
+SOURCE_RADIUS = 2.0
+
+ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
+
+_MAX_WIDENINGS = 4
+
+
+class Solution:
+    """The result of :func:`solve`: first-arrival times on the band nodes.
+
+    Attributes
+    ----------
+    grid : Grid
+    indices : (K, d) int64 — grid indices of the band nodes
+    values : (K,) float — the solution at the band nodes (``inf`` where never reached)
+    roles : (K,) uint8 — 0 fixed (source), 1 inner tube, 2 extension layer
+    phi : (K,) float — φ (level set) or ``|x − cp(x)|`` (closest point) at the band nodes
+    stats : SolveStats
+    sources : (S, d) float
+    """
+
+    def __init__(self, grid: Grid, band: Any, linear: np.ndarray, values: np.ndarray, roles: np.ndarray,
+                 phi: np.ndarray, stats: SolveStats, sources: np.ndarray, surface: Surface,
+                 hamiltonian: str, method: str, inner: float, outer: float):
+        self.grid = grid
+        self._band = band
+        self.linear = linear
+        self.values = values
+        self.roles = roles
+        self.phi = phi
+        self.stats = stats
+        self.sources = sources
+        self.surface = surface
+        self.hamiltonian = hamiltonian
+        self.method = method
+        self.inner = inner
+        self.outer = outer
+
+    def __repr__(self) -> str:
+        s = self.stats
+        return (
+            f"Solution({self.method}, {self.hamiltonian}, band_points={s.band_points}, iterations={s.iterations}, "
+            f"converged={s.converged})"
+        )
+
+    @property
+    def indices(self) -> np.ndarray:
+        return self.grid.unravel(self.linear)
+
+    @property
+    def points(self) -> np.ndarray:
+        """Coordinates (K, d) of the band nodes."""
+        return self.grid.points(self.indices)
+
+    @property
+    def inner_mask(self) -> np.ndarray:
+        return self.roles != ROLE_OUTER
+
+    def __call__(self, points: Any) -> np.ndarray:
+        """Multilinear interpolation at points (M, d); NaN where the stencil leaves the band."""
+        p = as_points(points, self.grid.ndim, "points")
+        return self._band.interpolate(self.values, list(self.grid.lower), self.grid.spacing, p)
+
+    def to_dense(self, fill: float = np.nan) -> np.ndarray:
+        """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
+        out = np.full(self.grid.size, fill, dtype=float)
+        out[self.linear] = self.values
+        return out.reshape(self.grid.shape)
+
+
+def _roles_and_band(geom: BandGeometry, grid: Grid, inner_width: float, method: str) -> Tuple[Any, np.ndarray]:
+    band = _native.Band.from_linear(list(grid.shape), geom.linear.astype(np.uint64))
+    roles = np.where(geom.distance <= inner_width * (1 + ROLE_RTOL), ROLE_INNER, ROLE_OUTER).astype(np.uint8)
+    if method == "naive":
+        roles[:] = ROLE_INNER
+    return band, roles
+
+
+def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, sources: np.ndarray,
+                 slowness_at: Callable[[np.ndarray], np.ndarray], source_init: str, inner_width: float
+                 ) -> Tuple[np.ndarray, np.ndarray]:
+    """Positions in the band and values of the nodes fixed by the point sources."""
+    h = grid.spacing
+    d = grid.ndim
+    dist, proj = surface.project(sources, grid)
+    for i, (dd, s) in enumerate(zip(dist, sources)):
+        if dd > inner_width * (1 + 1e-6):
+            raise ValueError(
+                f"sources[{i}] = {tuple(float(x) for x in s)} is {dd:.4g} from the surface, farther than the inner tube "
+                f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
+            )
+    best: dict = {}
+    r = int(np.ceil(SOURCE_RADIUS + inner_width / h)) + 1
+    offsets = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+    for i, (s, sp) in enumerate(zip(sources, proj)):
+        if source_init == "node":
+            idx = grid.nearest_index(s[None])
+            pos = int(band.find(idx)[0])
+            if pos < 0 or roles[pos] != ROLE_INNER:
+                raise ValueError(
+                    f"sources[{i}]: the grid node nearest to the source is not in the inner tube; "
+                    "move the source onto the surface, refine the grid or increase `inner`"
+                )
+            best[pos] = 0.0
+            continue
+        idx = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64) + offsets
+        pos = band.find(np.ascontiguousarray(idx))
+        ok = pos >= 0
+        pos = pos[ok]
+        pos = pos[roles[pos] == ROLE_INNER]
+        if pos.size == 0:
+            raise ValueError(f"sources[{i}] has no inner-tube node near it; refine the grid or increase `inner`")
+        x = grid.points(grid.unravel(linear[pos]))
+        _, cp = surface.project(x, grid)
+        geo = np.linalg.norm(cp - sp, axis=1)
+        near = geo <= SOURCE_RADIUS * h
+        if not np.any(near):
+            near = geo <= geo.min()
+        slow = 0.5 * (slowness_at(cp[near]) + slowness_at(sp[None])[0])
+        for p, v in zip(pos[near], geo[near] * slow):
+            if p not in best or v < best[p]:
+                best[p] = v
+    positions = np.fromiter(best.keys(), dtype=np.int64, count=len(best))
+    values = np.fromiter(best.values(), dtype=float, count=len(best))
+    return positions, values
+
+
+def solve(
+    surface: Any,
+    grid: Grid,
+    sources: Any,
+    *,
+    hamiltonian: str = "godunov",
+    speed: Any = 1.0,
+    inner: float = 2.0,
+    outer: float = 4.0,
+    method: str = "two-layer",
+    source_init: str = "exact",
+    tol: float = 1e-10,
+    max_iterations: int = 10000,
+    progress: Optional[Callable[[int, float, int], None]] = None,
+) -> Solution:
+    """First-arrival time (geodesic distance for ``speed=1``) on an implicit curve or surface.
+
+    Solves ``|∇_Σ u| = 1/F`` on Σ by the embedding of the paper: the eikonal equation
+    ``|∇u| = 1/F`` in the inner tube ``|φ| ≤ inner·Δx`` (Godunov, Eq. 3, or Lax–Friedrichs, Eq. 4)
+    and, for ``method="two-layer"`` (Algorithm 3), the extension equation (8)
+    ``[sgn(φ) n]·∇u = 0`` in the layer ``inner·Δx < |φ| ≤ outer·Δx`` with the upwind update (5).
+    ``method="naive"`` is Algorithm 2 (one tube ``|φ| ≤ inner·Δx``, numerical infinity outside);
+    it is kept as the baseline that does not converge for a tube of width O(Δx) (Sect. 3).
+
+    Only the band nodes are stored and swept; for a callable φ the band is found coarse-to-fine,
+    so memory and work are O(N^(d−1)).
+
+    Parameters
+    ----------
+    surface : LevelSet, ClosestPoint, library surface, φ array of ``grid.shape`` or callable φ
+    grid : Grid
+    sources : array-like (K, d)
+        Points on the surface (within the inner tube).
+    hamiltonian : {"godunov", "lxf"}
+    speed : float, ndarray of ``grid.shape``, or callable ``F(points) -> (M,)``
+    inner, outer : float
+        Tube half-widths in grid spacings (paper: 2 and 4; 5 for the bunny).
+    method : {"two-layer", "naive"}
+    source_init : {"exact", "node"}
+        ``"node"`` is the paper's choice (u = 0 at the grid node nearest each source);
+        ``"exact"`` fixes the inner nodes whose closest point is within ``SOURCE_RADIUS``·Δx of a
+        source to the exact local distance. ``"exact"`` is the default: it is more accurate (see
+        ``docs/source-initialisation.md`` and ``tests/test_solve.py``).
+    tol, max_iterations : stopping rule (largest change in one iteration of 2^d sweeps).
+    progress : callable ``(iteration, max_change, updates)``, optional.
+
+    Returns
+    -------
+    Solution
+    """
+    t0 = time.perf_counter()
+    grid = as_grid(grid)
+    surf = as_surface(surface)
+    surf.check_grid(grid)
+    src = as_sources(sources, grid)
+    scheme = check_hamiltonian(hamiltonian)
+    check_tolerance(tol, max_iterations)
+    cb = progress_callback(progress)
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}; got {method!r}")
+    if source_init not in SOURCE_INITS:
+        raise ValueError(f"source_init must be one of {SOURCE_INITS}; got {source_init!r}")
+    for name, val in (("inner", inner), ("outer", outer)):
+        if not (isinstance(val, (int, float, np.floating, np.integer)) and np.isfinite(val)):
+            raise ValueError(f"{name} must be a finite number of grid spacings; got {val!r}")
+    if inner < 1.0:
+        raise ValueError(
+            f"inner = {inner} grid spacings is thinner than the grid can resolve: the inner tube needs at least 1 "
+            "(the paper uses 2)"
+        )
+    if method == "two-layer" and outer < inner + 1.0:
+        raise ValueError(
+            f"outer = {outer} must exceed inner = {inner} by at least 1 grid spacing so that the extension layer "
+            "holds every neighbour of the inner tube (the paper uses inner=2, outer=4)"
+        )
+    h = grid.spacing
+    inner_width = inner * h
+    outer_eff = float(outer) if method == "two-layer" else float(inner)
+
+    for attempt in range(_MAX_WIDENINGS + 1):
+        geom = surf.band(grid, outer_eff * h)
+        if geom.linear.size == 0:
+            raise ValueError(
+                "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
+                "and that φ is in the grid's units"
+            )
+        band, roles = _roles_and_band(geom, grid, inner_width, method)
+        if method == "naive":
+            break
+        missing = band.nodes_missing_neighbours(roles == ROLE_INNER)
+        if missing.size == 0:
+            break
+        if attempt == _MAX_WIDENINGS:
+            raise ValueError(
+                f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
+                "inner nodes lack a neighbour. φ is far from a distance function; re-distance it"
+            )
+        warnings.warn(
+            f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
+            f"close to a distance function there. Widening the extension layer to outer = {outer_eff + 1}",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        outer_eff += 1.0
+
+    idx = grid.unravel(geom.linear)
+    x = grid.points(idx)
+    del idx
+    speed_nodes = speed_values(speed, grid, x, geom.linear)
+    slowness: Any = 1.0 / speed_nodes
+
+    def slowness_at(p: np.ndarray) -> np.ndarray:
+        if callable(speed):
+            return 1.0 / np.asarray(speed(p), dtype=float)
+        if np.ndim(speed) == 0:
+            return np.full(len(p), 1.0 / float(speed))
+        from .euclidean import _interp_dense
+
+        return 1.0 / _interp_dense(np.asarray(speed, dtype=float), grid, p)
+
+    positions, fixed_vals = _fix_sources(surf, grid, band, geom.linear, roles, src, slowness_at, source_init, inner_width)
+    roles[positions] = ROLE_FIXED
+    fixed = np.zeros(len(roles))
+    fixed[positions] = fixed_vals
+    del x
+    missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
+    setup = time.perf_counter() - t0
+    values, st = band.solve(
+        roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
+        float(tol), int(max_iterations), _native.DEFAULT_INFINITY, cb,
+    )
+    warn_unconverged(st, tol, max_iterations)
+    values[values >= 0.5 * _native.DEFAULT_INFINITY] = np.inf
+    n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
+    per_node = 8 + 8 + 1 + 8 + 4 * grid.ndim + 8  # linear, values, role, phi, direction, slowness
+    stats = SolveStats(
+        iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
+        last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
+        inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
+        setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles),
+    )
+    return Solution(grid, band, geom.linear, values, roles, geom.signed, stats, src, surf, scheme, method,
+                    float(inner), outer_eff)

@@ -1,0 +1,55 @@
+"""Statistics of one solve."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, asdict
+from typing import Any, Dict
+
+
+@dataclass(frozen=True)
+class SolveStats:
+    """What a solve did.
+
+    Attributes
+    ----------
+    iterations : int
+        Full passes of the 2^d sweep orders.
+    sweeps : int
+        Directional sweeps (2^d per iteration).
+    updates : int
+        Local updates performed.
+    converged : bool
+        Whether the largest change in the last iteration fell below ``tol``.
+    last_change : float
+        Largest change of any value during the last iteration.
+    seconds : float
+        Wall-clock time of the sweeps (band construction excluded; see ``setup_seconds``).
+    band_points, inner_points, outer_points, fixed_points : int
+        Nodes in the band, in the inner tube, in the extension layer, and held fixed (sources).
+    setup_seconds : float
+        Time spent finding the band, evaluating the surface and initialising the sources.
+    band_bytes : int
+        Memory held by the band structure and the per-node arrays of the solve.
+    """
+
+    iterations: int
+    sweeps: int
+    updates: int
+    converged: bool
+    last_change: float
+    seconds: float
+    band_points: int
+    inner_points: int
+    outer_points: int
+    fixed_points: int
+    setup_seconds: float = 0.0
+    band_bytes: int = 0
+
+    @property
+    def updates_per_second(self) -> float:
+        return self.updates / self.seconds if self.seconds > 0 else float("nan")
+
+    def as_dict(self) -> Dict[str, Any]:
+        d = asdict(self)
+        d["updates_per_second"] = self.updates_per_second
+        return d

@@ -1,0 +1,264 @@
+"""Implicit surfaces as the solver sees them.
+
+A surface hands the solver, for the grid nodes within a half-width of it (the band):
+
+* an unsigned distance-like value (``|φ|`` for a level set, ``|x − cp(x)|`` for a closest-point
+  surface) that decides inner tube versus extension layer;
+* the outward extension direction ``sgn(φ) n`` (paper Eq. (8)), or ``(x − cp(x)) / |x − cp(x)|``
+  for a closest-point surface (Sect. 5.2);
+* closest points on the surface, used to initialise point sources.
+
+:class:`LevelSet` is defined here; ``ClosestPoint`` and the library surfaces of
+``tubesweep.surfaces`` subclass :class:`Surface` the same way.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Tuple, Union
+
+import numpy as np
+
+from .grid import Grid
+
+__all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
+
+#: Evaluate user callables on at most this many points at a time.
+EVAL_CHUNK = 1 << 20
+
+# |∇φ| outside [GRAD_ERROR_LOW, GRAD_ERROR_HIGH] on the inner tube is an error, outside
+# [GRAD_WARN_LOW, GRAD_WARN_HIGH] a warning: the method needs φ close to a signed distance.
+GRAD_ERROR_LOW, GRAD_ERROR_HIGH = 1.0 / 3.0, 3.0
+GRAD_WARN_LOW, GRAD_WARN_HIGH = 0.6, 1.8
+
+
+@dataclass
+class BandGeometry:
+    """What a surface tells the solver about the nodes within ``half_width`` of it.
+
+    Attributes
+    ----------
+    linear : (K,) int64, sorted C-order linear node indices
+    distance : (K,) float, unsigned distance to the surface (``|φ|`` or ``|x − cp(x)|``)
+    signed : (K,) float, ``φ`` for level sets, equal to ``distance`` for closest-point surfaces
+    direction : (K, d) float32, outward unit extension direction (zero where undefined)
+    """
+
+    linear: np.ndarray
+    distance: np.ndarray
+    signed: np.ndarray
+    direction: np.ndarray
+
+
+class Surface:
+    """Base class for implicit surfaces. Subclasses implement :meth:`band` and
+    :meth:`project`."""
+
+    #: dimension of the embedding space, or None if it follows the grid
+    ndim: Optional[int] = None
+
+    def band(self, grid: Grid, half_width: float) -> BandGeometry:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:  # pragma: no cover
+        """Unsigned distance (M,) of points to the surface and their closest points (M, d)."""
+        raise NotImplementedError
+
+    def check_grid(self, grid: Grid) -> None:
+        if self.ndim is not None and self.ndim != grid.ndim:
+            raise ValueError(f"surface is {self.ndim}D but the grid is {grid.ndim}D")
+
+
+def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, out_shape: Tuple[int, ...] = ()) -> np.ndarray:
+    """Calls a user's vectorised function in chunks and checks what comes back."""
+    m = points.shape[0]
+    out = np.empty((m,) + out_shape)
+    for s in range(0, m, EVAL_CHUNK):
+        chunk = points[s : s + EVAL_CHUNK]
+        v = np.asarray(fn(chunk), dtype=float)
+        if v.shape != (chunk.shape[0],) + out_shape:
+            raise ValueError(
+                f"{name} must map points of shape (M, {points.shape[1]}) to an array of shape (M{''.join(', ' + str(n) for n in out_shape)}); "
+                f"it returned shape {v.shape} for M = {chunk.shape[0]}"
+            )
+        out[s : s + EVAL_CHUNK] = v
+    if not np.all(np.isfinite(out)):
+        bad = np.flatnonzero(~np.isfinite(out.reshape(m, -1)).all(axis=1))[0]
+        raise ValueError(f"{name} returned NaN or inf at {tuple(float(x) for x in points[bad])}; it must be finite near the surface")
+    return out
+
+
+def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
+                  name: str = "surface") -> Tuple[np.ndarray, np.ndarray]:
+    """Grid nodes with ``|fn| ≤ half_width``, found coarse-to-fine without visiting the box.
+
+    Blocks of 2^L × … nodes are kept only if ``|fn(centre)| ≤ half_width + lipschitz · radius``
+    (exact when ``fn`` is ``lipschitz``-Lipschitz, as a distance function is with constant 1),
+    then split in 2^d children, down to single nodes. Work and memory are O(N^(d−1) log N).
+
+    Returns sorted linear indices and the values of ``fn`` there.
+    """
+    shape = np.asarray(grid.shape)
+    d = grid.ndim
+    h = grid.spacing
+    block = 1 << max(0, int(np.floor(np.log2(max(grid.shape) / 4))))
+    origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(-1, d)
+    corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+    while block > 1:
+        last = np.minimum(origins + block, shape) - 1
+        centre = 0.5 * (origins + last)
+        radius = 0.5 * h * np.linalg.norm(last - origins, axis=1)
+        v = _evaluate(fn, grid.points(centre), name)
+        keep = np.abs(v) <= half_width + lipschitz * radius + 1e-12
+        origins = origins[keep]
+        block //= 2
+        children = (origins[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
+        origins = children[np.all(children < shape, axis=1)]
+    v = _evaluate(fn, grid.points(origins), name)
+    keep = np.abs(v) <= half_width
+    lin = grid.linear_index(origins[keep])
+    order = np.argsort(lin, kind="stable")
+    return lin[order], v[keep][order]
+
+
+def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    norm = np.linalg.norm(g, axis=1)
+    safe = np.where(norm > 1e-12, norm, 1.0)
+    return g / safe[:, None], norm
+
+
+class LevelSet(Surface):
+    """A curve or surface given as the zero level set of φ, close to a signed distance function.
+
+    Parameters
+    ----------
+    phi : ndarray of ``grid.shape`` or callable ``phi(points (M, d)) -> (M,)``
+        The level set function sampled on the grid, or a vectorised function. Only the band is
+        evaluated for a callable (found coarse-to-fine, never the whole box).
+    lipschitz : float
+        Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
+        default leaves room for near-distance functions).
+
+    The outward normal ``n = ∇φ / |∇φ|`` comes from central differences of φ at the band nodes, as
+    in the paper (Sect. 4). The method needs φ close to a signed distance function (``|∇φ| ≈ 1``
+    near the surface); far from it the solver raises an error that says so.
+    """
+
+    def __init__(self, phi: Union[np.ndarray, Callable[[np.ndarray], np.ndarray]], *, lipschitz: float = 1.5):
+        if callable(phi):
+            self._fn: Optional[Callable[[np.ndarray], np.ndarray]] = phi
+            self._array: Optional[np.ndarray] = None
+        else:
+            arr = np.asarray(phi, dtype=float)
+            if arr.ndim not in (2, 3):
+                raise ValueError(f"phi array must be 2D or 3D (the grid's shape); got {arr.ndim} dimensions")
+            if not np.all(np.isfinite(arr)):
+                i = np.unravel_index(int(np.flatnonzero(~np.isfinite(arr))[0]), arr.shape)
+                raise ValueError(f"phi contains NaN or inf (first at index {tuple(int(x) for x in i)}); φ must be finite")
+            self._fn = None
+            self._array = arr
+            self.ndim = arr.ndim
+        if not (np.isfinite(lipschitz) and lipschitz >= 1.0):
+            raise ValueError(f"lipschitz must be >= 1 (a distance function has |∇φ| = 1); got {lipschitz}")
+        self.lipschitz = float(lipschitz)
+
+    @property
+    def is_dense(self) -> bool:
+        return self._array is not None
+
+    def check_grid(self, grid: Grid) -> None:
+        super().check_grid(grid)
+        if self._array is not None and self._array.shape != grid.shape:
+            raise ValueError(f"phi has shape {self._array.shape} but the grid has shape {grid.shape}; sample φ on the grid's nodes")
+
+    def phi(self, points: np.ndarray, grid: Grid) -> np.ndarray:
+        """φ at arbitrary points (multilinear interpolation for a sampled φ)."""
+        if self._fn is not None:
+            return _evaluate(self._fn, points, "surface")
+        from .euclidean import _interp_dense
+
+        assert self._array is not None
+        return _interp_dense(self._array, grid, points)
+
+    def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray) -> np.ndarray:
+        h = grid.spacing
+        idx = grid.unravel(linear)
+        d = grid.ndim
+        g = np.empty((len(linear), d))
+        if self._array is not None:
+            flat = self._array.reshape(-1)
+            strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)])
+            for k in range(d):
+                lo_ok = idx[:, k] > 0
+                hi_ok = idx[:, k] < grid.shape[k] - 1
+                up = np.where(hi_ok, flat[np.where(hi_ok, linear + strides[k], linear)], values)
+                dn = np.where(lo_ok, flat[np.where(lo_ok, linear - strides[k], linear)], values)
+                width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
+                g[:, k] = (up - dn) / width
+        else:
+            x = grid.points(idx)
+            for k in range(d):
+                e = np.zeros(d)
+                e[k] = h
+                g[:, k] = (_evaluate(self._fn, x + e, "surface") - _evaluate(self._fn, x - e, "surface")) / (2 * h)  # type: ignore[arg-type]
+        return g
+
+    def band(self, grid: Grid, half_width: float) -> BandGeometry:
+        self.check_grid(grid)
+        if self._array is not None:
+            flat = self._array.reshape(-1)
+            linear = np.flatnonzero(np.abs(flat) <= half_width).astype(np.int64)
+            values = flat[linear]
+        else:
+            linear, values = discover_band(self._fn, grid, half_width, self.lipschitz)  # type: ignore[arg-type]
+        if linear.size == 0:
+            return BandGeometry(linear, values, values, np.zeros((0, grid.ndim), np.float32))
+        grad = self._gradient_at_nodes(grid, linear, values)
+        n, norm = _unit(grad)
+        self._check_distance_like(norm, np.abs(values), half_width, grid)
+        direction = (np.sign(values)[:, None] * n).astype(np.float32)
+        return BandGeometry(linear, np.abs(values), values, direction)
+
+    def _check_distance_like(self, norm: np.ndarray, dist: np.ndarray, half_width: float, grid: Grid) -> None:
+        near = dist <= 0.5 * half_width
+        g = norm[near] if np.any(near) else norm
+        lo, hi = float(np.min(g)), float(np.max(g))
+        if lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH:
+            raise ValueError(
+                f"surface: φ is not close to a signed distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the "
+                "surface (it should be ≈ 1). Divide φ by |∇φ| or re-distance it (e.g. with ts.travel_time or scikit-fmm) "
+                "before solving; the tube widths are measured in units of φ"
+            )
+        if lo < GRAD_WARN_LOW or hi > GRAD_WARN_HIGH:
+            warnings.warn(
+                f"φ is only roughly a distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the surface; "
+                "the tube is measured in units of φ, so its real width varies accordingly",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+
+    def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        phi = self.phi(points, grid)
+        h = grid.spacing
+        d = points.shape[1]
+        g = np.empty_like(points)
+        for k in range(d):
+            e = np.zeros(d)
+            e[k] = h
+            g[:, k] = (self.phi(points + e, grid) - self.phi(points - e, grid)) / (2 * h)
+        n2 = np.maximum(np.sum(g * g, axis=1), 1e-24)
+        closest = points - (phi / n2)[:, None] * g
+        return np.abs(phi), closest
+
+
+def as_surface(surface: Any) -> Surface:
+    """Accepts a Surface, a φ array, or a φ callable."""
+    if isinstance(surface, Surface):
+        return surface
+    if callable(surface) or isinstance(surface, np.ndarray):
+        return LevelSet(surface)
+    raise TypeError(
+        "surface must be a tubesweep.LevelSet / ClosestPoint / library surface, a φ array of grid.shape, "
+        f"or a callable phi(points) -> values; got {type(surface).__name__}"
+    )
