@@ -1,0 +1,234 @@
+"""The ``tubesweep`` command line.
+
+Sub-commands: ``solve`` (a curve or surface), ``travel-time`` (the whole box), ``demo``,
+``reproduce`` (the paper's experiments) and ``info``. Run ``tubesweep COMMAND --help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import List, Optional, Sequence
+
+import numpy as np
+
+from . import __version__
+from ._progress import make_progress
+
+EPILOG = """examples:
+  tubesweep solve --surface sphere --n 101 --png
+  tubesweep solve --surface star --n 401 --hamiltonian lxf --source 0.5 0 --out out/star
+  tubesweep solve --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0
+  tubesweep travel-time --n 201 --dim 2 --source 0 0 --png
+  tubesweep reproduce all --quick
+"""
+
+
+def _surface_names() -> List[str]:
+    from .surfaces import REGISTRY
+
+    return sorted(REGISTRY)
+
+
+def _add_solver_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--hamiltonian", choices=["godunov", "lxf"], default="godunov",
+                   help="numerical Hamiltonian: Godunov (Eq. 3) or Lax-Friedrichs (Eq. 4) (default: godunov)")
+    p.add_argument("--tol", type=float, default=1e-10, help="stop when the largest change in an iteration is below this")
+    p.add_argument("--max-iterations", type=int, default=10000)
+    p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: ./out)")
+    p.add_argument("--png", action="store_true", help="also write a picture (needs matplotlib)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="tubesweep",
+        description="Distances and first-arrival times on implicit curves and surfaces by the fast sweeping "
+        "method of Wong & Leung (2016): the eikonal equation in a thin tube around the surface, an "
+        "extension equation in an outer layer, only O(N^(d-1)) grid nodes.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=f"tubesweep {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    p = sub.add_parser("solve", help="first-arrival time on a curve/surface (two-layer tube, Algorithm 3)",
+                       description="Solve |grad_S u| = 1/F on an implicit curve or surface and write the band values "
+                       "(solution.npz: indices, values, roles, phi, grid) and optionally a PNG.")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--surface", choices=_surface_names(), help="a built-in curve or surface")
+    src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
+    p.add_argument("--n", type=int, default=101, help="nodes per axis for --surface (default: 101)")
+    p.add_argument("--lower", type=float, nargs="+", help="grid lower corner (with --phi; default for --surface: the surface's box)")
+    p.add_argument("--upper", type=float, nargs="+", help="grid upper corner")
+    p.add_argument("--source", type=float, nargs="+", action="append",
+                   help="a source point on the surface (repeat for several; default: the surface's own)")
+    p.add_argument("--speed", type=float, default=1.0, help="constant speed F (default 1)")
+    p.add_argument("--method", choices=["two-layer", "naive"], default="two-layer",
+                   help="two-layer = Algorithm 3 (default); naive = Algorithm 2, the baseline that does not converge")
+    p.add_argument("--inner", type=float, default=2.0, help="inner tube half-width in grid spacings (default 2)")
+    p.add_argument("--outer", type=float, default=4.0, help="outer tube half-width in grid spacings (default 4)")
+    p.add_argument("--source-init", choices=["exact", "node"], default="exact")
+    p.add_argument("--dense", action="store_true", help="also write the dense array solution_dense.npy (NaN off the band)")
+    _add_solver_options(p)
+
+    t = sub.add_parser("travel-time", help="first-arrival time in the whole box (Algorithm 1)",
+                       description="Travel times from point sources in [-1,1]^d with constant speed; writes travel_time.npy.")
+    t.add_argument("--n", type=int, default=201)
+    t.add_argument("--dim", type=int, choices=[2, 3], default=2)
+    t.add_argument("--source", type=float, nargs="+", action="append", help="a source point (repeatable; default: origin)")
+    t.add_argument("--speed", type=float, default=1.0)
+    _add_solver_options(t)
+
+    d = sub.add_parser("demo", help="run the built-in examples, print a table and write pictures")
+    d.add_argument("--out", type=Path, default=Path("out/demo"))
+    d.add_argument("--quick", action="store_true", help="smaller grids")
+
+    r = sub.add_parser("reproduce", help="reproduce the paper's tables and figures",
+                       description="Reproduce the numerical experiments of Wong & Leung (2016). Writes CSV, Markdown "
+                       "and PNG files per experiment.")
+    r.add_argument("names", nargs="+", help="experiment names or 'all' (see 'tubesweep reproduce list')")
+    r.add_argument("--quick", action="store_true", help="small grids only (under two minutes in all)")
+    r.add_argument("--out", type=Path, default=Path("out/reproduce"))
+
+    sub.add_parser("info", help="version and build information")
+    return parser
+
+
+def _grid_for(surface, n: int, lower: Optional[Sequence[float]], upper: Optional[Sequence[float]]):
+    from .grid import Grid
+
+    if lower is None or upper is None:
+        box = getattr(surface, "default_box", None)
+        if box is None:
+            raise SystemExit("give --lower and --upper for this surface")
+        lower, upper = box
+    return Grid(lower, upper, (n,) * len(lower))
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    from .grid import Grid
+    from .solve import solve
+    from .surface import LevelSet
+
+    if args.surface:
+        from .surfaces import REGISTRY
+
+        surface = REGISTRY[args.surface]()
+        grid = _grid_for(surface, args.n, args.lower, args.upper)
+        name = args.surface
+    else:
+        phi = np.load(args.phi)
+        if args.lower is None or args.upper is None:
+            raise SystemExit("--phi needs --lower and --upper (the grid's corners)")
+        grid = Grid(args.lower, args.upper, phi.shape)
+        surface = LevelSet(phi)
+        name = args.phi.stem
+    if args.source:
+        sources = np.array(args.source, dtype=float)
+    elif hasattr(surface, "default_source"):
+        sources = np.atleast_2d(surface.default_source)
+    else:
+        raise SystemExit("give --source")
+    progress = make_progress(f"solve {name}", args.quiet)
+    t0 = time.perf_counter()
+    try:
+        sol = solve(surface, grid, sources, hamiltonian=args.hamiltonian, speed=args.speed, inner=args.inner,
+                    outer=args.outer, method=args.method, source_init=args.source_init, tol=args.tol,
+                    max_iterations=args.max_iterations, progress=progress)
+    finally:
+        if progress is not None:
+            progress.close()  # type: ignore[attr-defined]
+    wall = time.perf_counter() - t0
+    out: Path = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(out / "solution.npz", indices=sol.indices, values=sol.values, roles=sol.roles, phi=sol.phi,
+                        lower=grid.lower, upper=grid.upper, shape=np.array(grid.shape), sources=sol.sources)
+    s = sol.stats
+    print(f"{name}: grid {grid.shape}, band {s.band_points} nodes ({s.inner_points} inner, {s.outer_points} outer), "
+          f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, sweeps {s.seconds:.3f} s, total {wall:.3f} s")
+    print(f"wrote {out / 'solution.npz'}")
+    if args.dense:
+        np.save(out / "solution_dense.npy", sol.to_dense())
+        print(f"wrote {out / 'solution_dense.npy'}")
+    if args.png:
+        from ._figures import solution_png
+
+        print(f"wrote {solution_png(sol, out / 'solution.png', title=f'{name}, {args.hamiltonian}, N={grid.shape[0]}')}")
+    return 0
+
+
+def cmd_travel_time(args: argparse.Namespace) -> int:
+    from .euclidean import travel_time
+    from .grid import Grid
+
+    grid = Grid((-1.0,) * args.dim, (1.0,) * args.dim, (args.n,) * args.dim)
+    sources = np.array(args.source, dtype=float) if args.source else np.zeros((1, args.dim))
+    progress = make_progress("travel-time", args.quiet)
+    try:
+        u, s = travel_time(grid, sources, speed=args.speed, hamiltonian=args.hamiltonian, tol=args.tol,
+                           max_iterations=args.max_iterations, return_stats=True, progress=progress)
+    finally:
+        if progress is not None:
+            progress.close()  # type: ignore[attr-defined]
+    args.out.mkdir(parents=True, exist_ok=True)
+    np.save(args.out / "travel_time.npy", u)
+    print(f"grid {grid.shape}: {s.iterations} iterations, {s.updates} updates, {s.seconds:.3f} s; wrote {args.out / 'travel_time.npy'}")
+    if args.png:
+        from ._figures import field_png
+
+        print(f"wrote {field_png(grid, u, args.out / 'travel_time.png', sources, title='travel time')}")
+    return 0
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from . import reproduce
+
+    if args.names == ["list"]:
+        for n in reproduce.experiments():
+            print(n)
+        return 0
+    reproduce.run(args.names, args.out, quick=args.quick)
+    return 0
+
+
+def cmd_info(_: argparse.Namespace) -> int:
+    from . import _native
+
+    print(f"tubesweep {__version__} (core {_native.__version__}), numpy {np.__version__}, python {sys.version.split()[0]}")
+    return 0
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 0
+    try:
+        if args.command == "solve":
+            return cmd_solve(args)
+        if args.command == "travel-time":
+            return cmd_travel_time(args)
+        if args.command == "demo":
+            from .demo import run_demo
+
+            return run_demo(args.out, quick=args.quick)
+        if args.command == "reproduce":
+            return cmd_reproduce(args)
+        if args.command == "info":
+            return cmd_info(args)
+    except KeyboardInterrupt:
+        print("\ninterrupted", file=sys.stderr)
+        return 130
+    except (ValueError, TypeError, MemoryError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    parser.print_help()
+    return 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
