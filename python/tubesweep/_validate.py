@@ -143,3 +143,14 @@ def progress_callback(progress: Any) -> Optional[Callable[[int, float, int], Non
     if not callable(progress):
         raise TypeError("progress must be a callable (iteration, max_change, updates) -> None, or None")
     return progress
+
+
+def check_infinity(infinity: Optional[float]) -> float:
+    """The numerical infinity to use: the default, or a user value that must be large and finite."""
+    from . import _native
+
+    if infinity is None:
+        return float(_native.DEFAULT_INFINITY)
+    if not (isinstance(infinity, (int, float, np.floating)) and np.isfinite(infinity) and infinity > 0):
+        raise ValueError(f"infinity must be a positive finite number (a 'numerical infinity'); got {infinity!r}")
+    return float(infinity)

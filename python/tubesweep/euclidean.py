@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_infinity as _infinity,
     as_grid,
     as_sources,
     check_hamiltonian,
@@ -80,6 +81,7 @@ def travel_time(
     max_iterations: int = 1000,
     return_stats: bool = False,
     progress: Optional[Callable[[int, float, int], None]] = None,
+    infinity: Optional[float] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, SolveStats]]:
     """First-arrival time ``u`` with ``|∇u| = 1/F`` in the whole box, from point sources.
 
@@ -105,6 +107,10 @@ def travel_time(
         Also return a :class:`SolveStats`.
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
+    infinity : float, optional
+        The finite "numerical infinity" that unknown values start at (default
+        ``tubesweep._native.DEFAULT_INFINITY`` = 1e6). It only matters for Lax–Friedrichs, whose
+        update averages neighbours: a larger value costs a few more iterations.
 
     Returns
     -------
@@ -149,7 +155,7 @@ def travel_time(
     setup = time.perf_counter() - t0
     values, st = band.solve(
         roles, fixed, grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
-        _native.DEFAULT_INFINITY, cb,
+        _infinity(infinity), cb,
     )
     warn_unconverged(st, tol, max_iterations)
     u = values.reshape(grid.shape)

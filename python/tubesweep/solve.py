@@ -11,6 +11,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_infinity as _infinity,
     as_grid,
     as_points,
     as_sources,
@@ -178,6 +179,7 @@ def solve(
     tol: float = 1e-10,
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
+    infinity: Optional[float] = None,
 ) -> Solution:
     """First-arrival time (geodesic distance for ``speed=1``) on an implicit curve or surface.
 
@@ -209,6 +211,9 @@ def solve(
         ``docs/source-initialisation.md`` and ``tests/test_solve.py``).
     tol, max_iterations : stopping rule (largest change in one iteration of 2^d sweeps).
     progress : callable ``(iteration, max_change, updates)``, optional.
+    infinity : float, optional
+        The finite numerical infinity unknown values start at (default 1e6); it only affects the
+        Lax–Friedrichs iteration count.
 
     Returns
     -------
@@ -293,10 +298,10 @@ def solve(
     setup = time.perf_counter() - t0
     values, st = band.solve(
         roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
-        float(tol), int(max_iterations), _native.DEFAULT_INFINITY, cb,
+        float(tol), int(max_iterations), _infinity(infinity), cb,
     )
     warn_unconverged(st, tol, max_iterations)
-    values[values >= 0.5 * _native.DEFAULT_INFINITY] = np.inf
+    values[values >= 0.5 * _infinity(infinity)] = np.inf
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
     per_node = 8 + 8 + 1 + 8 + 4 * grid.ndim + 8  # linear, values, role, phi, direction, slowness
     stats = SolveStats(
