@@ -109,8 +109,9 @@ def travel_time(
         Called after every iteration as ``progress(iteration, max_change, updates)``.
     infinity : float, optional
         The finite "numerical infinity" that unknown values start at (default
-        ``tubesweep._native.DEFAULT_INFINITY`` = 1e6). It only matters for Lax–Friedrichs, whose
-        update averages neighbours: a larger value costs a few more iterations.
+        derived from the band: twice the cost of the longest grid path from a source, a safe upper
+        bound on every travel time). It only matters for Lax–Friedrichs, whose update averages
+        neighbours: a larger value costs more iterations.
 
     Returns
     -------
@@ -158,6 +159,7 @@ def travel_time(
         _infinity(infinity), cb,
     )
     warn_unconverged(st, tol, max_iterations)
+    values[values >= st["infinity"]] = np.inf
     u = values.reshape(grid.shape)
     if not return_stats:
         return u

@@ -212,8 +212,8 @@ def solve(
     tol, max_iterations : stopping rule (largest change in one iteration of 2^d sweeps).
     progress : callable ``(iteration, max_change, updates)``, optional.
     infinity : float, optional
-        The finite numerical infinity unknown values start at (default 1e6); it only affects the
-        Lax–Friedrichs iteration count.
+        The finite numerical infinity unknown values start at (default: derived from the band, a
+        safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
 
     Returns
     -------
@@ -301,7 +301,7 @@ def solve(
         float(tol), int(max_iterations), _infinity(infinity), cb,
     )
     warn_unconverged(st, tol, max_iterations)
-    values[values >= 0.5 * _infinity(infinity)] = np.inf
+    values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
     per_node = 8 + 8 + 1 + 8 + 4 * grid.ndim + 8  # linear, values, role, phi, direction, slowness
     stats = SolveStats(

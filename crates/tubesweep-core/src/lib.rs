@@ -26,6 +26,7 @@ pub mod godunov;
 pub mod hamiltonian;
 pub mod interpolate;
 pub mod lax_friedrichs;
+pub mod schedule;
 pub mod sweep;
 
 pub use band::NarrowBand;

@@ -53,6 +53,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     d.set_item("converged", s.converged)?;
     d.set_item("last_change", s.last_change)?;
     d.set_item("seconds", s.seconds)?;
+    d.set_item("infinity", s.infinity)?;
     Ok(d)
 }
 
@@ -285,7 +286,7 @@ impl PyBand {
     }
 
     /// Runs the sweeps. See `tubesweep_core::sweep`.
-    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None))]
+    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
@@ -299,12 +300,14 @@ impl PyBand {
         missing: &str,
         tol: f64,
         max_iterations: usize,
-        infinity: f64,
+        infinity: Option<f64>,
         progress: Option<Bound<'py, PyAny>>,
+        threads: usize,
+        skip_inactive: bool,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let scheme = parse_scheme(scheme)?;
         let missing = parse_missing(missing)?;
-        let options = SolveOptions { tol, max_iterations, infinity };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive };
         let roles = roles.as_slice()?;
         let fixed = fixed_values.as_slice()?;
         match &self.band {
