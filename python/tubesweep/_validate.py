@@ -153,3 +153,9 @@ def check_infinity(infinity: Optional[float]) -> Optional[float]:
     if not (isinstance(infinity, (int, float, np.floating)) and np.isfinite(infinity) and infinity > 0):
         raise ValueError(f"infinity must be a positive finite number (a 'numerical infinity'); got {infinity!r}")
     return float(infinity)
+
+
+def check_threads(threads: int) -> int:
+    if not (isinstance(threads, (int, np.integer)) and threads >= 0):
+        raise ValueError(f"threads must be a non-negative integer (0 = all cores); got {threads!r}")
+    return int(threads)

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_threads as _threads,
     check_infinity as _infinity,
     as_grid,
     as_sources,
@@ -82,6 +83,7 @@ def travel_time(
     return_stats: bool = False,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
+    threads: int = 0,
 ) -> Union[np.ndarray, Tuple[np.ndarray, SolveStats]]:
     """First-arrival time ``u`` with ``|∇u| = 1/F`` in the whole box, from point sources.
 
@@ -107,6 +109,9 @@ def travel_time(
         Also return a :class:`SolveStats`.
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
+    threads : int
+        Worker threads for the sweeps (0: all cores, 1: sequential). The result does not depend
+        on it: parallel sweeps are bit-identical to sequential ones.
     infinity : float, optional
         The finite "numerical infinity" that unknown values start at (default
         derived from the band: twice the cost of the longest grid path from a source, a safe upper
@@ -156,7 +161,7 @@ def travel_time(
     setup = time.perf_counter() - t0
     values, st = band.solve(
         roles, fixed, grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
-        _infinity(infinity), cb,
+        _infinity(infinity), cb, _threads(threads),
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf

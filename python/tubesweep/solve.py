@@ -11,6 +11,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_threads as _threads,
     check_infinity as _infinity,
     as_grid,
     as_points,
@@ -180,6 +181,7 @@ def solve(
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
+    threads: int = 0,
 ) -> Solution:
     """First-arrival time (geodesic distance for ``speed=1``) on an implicit curve or surface.
 
@@ -211,6 +213,9 @@ def solve(
         ``docs/source-initialisation.md`` and ``tests/test_solve.py``).
     tol, max_iterations : stopping rule (largest change in one iteration of 2^d sweeps).
     progress : callable ``(iteration, max_change, updates)``, optional.
+    threads : int
+        Worker threads for the sweeps (0: all cores, 1: sequential); the result does not depend
+        on it (parallel sweeps are bit-identical to sequential ones).
     infinity : float, optional
         The finite numerical infinity unknown values start at (default: derived from the band, a
         safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
@@ -298,7 +303,7 @@ def solve(
     setup = time.perf_counter() - t0
     values, st = band.solve(
         roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
-        float(tol), int(max_iterations), _infinity(infinity), cb,
+        float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads),
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
