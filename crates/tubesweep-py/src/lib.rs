@@ -286,7 +286,7 @@ impl PyBand {
     }
 
     /// Runs the sweeps. See `tubesweep_core::sweep`.
-    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true))]
+    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
@@ -304,10 +304,14 @@ impl PyBand {
         progress: Option<Bound<'py, PyAny>>,
         threads: usize,
         skip_inactive: bool,
+        activation_threshold: f64,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let scheme = parse_scheme(scheme)?;
         let missing = parse_missing(missing)?;
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive };
+        if !(activation_threshold >= 0.0) {
+            return Err(PyValueError::new_err("activation_threshold must be non-negative"));
+        }
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold };
         let roles = roles.as_slice()?;
         let fixed = fixed_values.as_slice()?;
         match &self.band {
