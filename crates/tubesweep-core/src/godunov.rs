@@ -19,42 +19,77 @@
 pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
     let mut a = mins;
     sort_small(&mut a);
-    let mut u = a[0] + f;
-    if D == 1 || u <= a[1] {
-        return u;
+    let u1 = a[0] + f;
+    if D == 1 || u1 <= a[1] {
+        return u1;
     }
-    let mut sum = a[0];
-    let mut sum_sq = a[0] * a[0];
-    let f2 = f * f;
-    let mut m = 1usize;
-    while m < D {
+    // two terms: (u − a0)^2 + (u − a1)^2 = f^2  (second branch of Eq. (3))
+    let d = a[0] - a[1];
+    let u2 = 0.5 * (a[0] + a[1] + nonneg(2.0 * f * f - d * d).sqrt());
+    if D == 2 || u2 <= a[2] {
+        return u2;
+    }
+    if D == 3 {
+        // three terms: 3u^2 − 2 s u + (q − f^2) = 0
+        let s = a[0] + a[1] + a[2];
+        let q = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        let disc = s * s - 3.0 * (q - f * f);
+        return (s + nonneg(disc).sqrt()) * (1.0 / 3.0);
+    }
+    // general D (not used by the solvers, kept for completeness)
+    let mut sum = a[0] + a[1];
+    let mut sum_sq = a[0] * a[0] + a[1] * a[1];
+    let mut u = u2;
+    for m in 2..D {
         sum += a[m];
         sum_sq += a[m] * a[m];
-        m += 1;
-        let mf = m as f64;
-        // roots of m ū^2 − 2 sum ū + (sum_sq − f^2) = 0
-        let disc = sum * sum - mf * (sum_sq - f2);
+        let mf = (m + 1) as f64;
+        let disc = sum * sum - mf * (sum_sq - f * f);
         u = (sum + disc.max(0.0).sqrt()) / mf;
-        if m == D || u <= a[m] {
+        if m + 1 == D || u <= a[m + 1] {
             return u;
         }
     }
     u
 }
 
+/// `max(x, 0)` as a plain compare-select (the values here are never NaN; `f64::max` spends
+/// extra instructions on NaN handling).
+#[inline(always)]
+fn nonneg(x: f64) -> f64 {
+    if x > 0.0 {
+        x
+    } else {
+        0.0
+    }
+}
+
+/// The smaller of two values as a plain compare-select (no NaN handling: the solver never holds
+/// NaN, it uses a finite numerical infinity).
+#[inline(always)]
+pub fn fmin(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
 /// Sorts at most three values with a branchy network (faster than a general sort here).
 #[inline(always)]
 fn sort_small<const D: usize>(a: &mut [f64; D]) {
-    if D >= 2 && a[0] > a[1] {
-        a.swap(0, 1);
+    if D >= 2 {
+        let (x, y) = (a[0], a[1]);
+        a[0] = fmin(x, y);
+        a[1] = if x < y { y } else { x };
     }
     if D >= 3 {
-        if a[1] > a[2] {
-            a.swap(1, 2);
-        }
-        if a[0] > a[1] {
-            a.swap(0, 1);
-        }
+        let (y, z) = (a[1], a[2]);
+        a[1] = fmin(y, z);
+        a[2] = if y < z { z } else { y };
+        let (x, y) = (a[0], a[1]);
+        a[0] = fmin(x, y);
+        a[1] = if x < y { y } else { x };
     }
     if D > 3 {
         a.sort_by(|x, y| x.partial_cmp(y).unwrap_or(std::cmp::Ordering::Equal));

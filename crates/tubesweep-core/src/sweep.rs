@@ -14,8 +14,8 @@
 
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
-use crate::extension::extension_update;
-use crate::godunov::godunov_update;
+use crate::extension::{extension_apply, extension_weights};
+use crate::godunov::{fmin, godunov_update};
 use crate::hamiltonian::InnerScheme;
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
@@ -279,6 +279,36 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .collect();
         let shared = SharedValues { ptr: u.as_mut_ptr(), len: u.len() };
         let all_active = !options.skip_inactive;
+        // Upwind weights of the extension update, once per solve (the band does not change).
+        // Outer nodes without an upwind neighbour keep their value: they are never activated.
+        let sentinel = self.band.sentinel();
+        let weights: Vec<[f32; D]> = if self.roles.iter().any(|&r| r == NodeRole::Outer) {
+            self.roles
+                .par_iter()
+                .enumerate()
+                .map(|(n, &r)| {
+                    if r != NodeRole::Outer {
+                        return [0.0; D];
+                    }
+                    let nb = &self.band.neighbours()[n];
+                    let mut pm = [true; D];
+                    let mut pp = [true; D];
+                    for k in 0..D {
+                        pm[k] = nb[k][0] != sentinel;
+                        pp[k] = nb[k][1] != sentinel;
+                    }
+                    extension_weights(self.directions[n], pm, pp).unwrap_or([f32::NAN; D])
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        for (n, w) in weights.iter().enumerate() {
+            if w[0].is_nan() {
+                active[n].store(0, Ordering::Relaxed);
+            }
+        }
+        let ctx = SweepContext { u: &shared, active: &active, weights: &weights };
         let n_orient = 1usize << D;
         let inf = options.infinity.unwrap_or(crate::DEFAULT_INFINITY);
         let pool = if options.threads == 1 {
@@ -296,13 +326,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             for s in 0..n_orient {
                 let dir = s ^ (s >> 1); // Gray code
                 if all_active {
-                    for a in &active[..self.roles.len()] {
-                        a.store(1, Ordering::Relaxed);
+                    for (n, a) in active[..self.roles.len()].iter().enumerate() {
+                        if weights.get(n).map_or(true, |w| !w[0].is_nan()) {
+                            a.store(1, Ordering::Relaxed);
+                        }
                     }
                 }
                 let acc = match &pool {
-                    Some(p) => p.install(|| self.sweep(&shared, &active, dir, inf, options.activation_threshold, true)),
-                    None => self.sweep(&shared, &active, dir, inf, options.activation_threshold, false),
+                    Some(p) => p.install(|| self.sweep(&ctx, dir, inf, options.activation_threshold, true)),
+                    None => self.sweep(&ctx, dir, inf, options.activation_threshold, false),
                 };
                 max_change = max_change.max(acc.max_change);
                 updates += acc.updates;
@@ -324,7 +356,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// One Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked backwards):
     /// waves in order, the tiles of a wave in parallel, the rows of a tile in order.
-    fn sweep(&self, u: &SharedValues, active: &[AtomicU8], dir: usize, inf: f64, threshold: f64, parallel: bool) -> Accumulator {
+    fn sweep(&self, ctx: &SweepContext<'_, D>, dir: usize, inf: f64, threshold: f64, parallel: bool) -> Accumulator {
         let band = self.band;
         let lead = dir & ((1usize << (D - 1)) - 1);
         let backwards = dir >> (D - 1) & 1 == 1;
@@ -338,11 +370,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 let (s, e) = band.row_range(r as usize);
                 if backwards {
                     for n in (s..e).rev() {
-                        self.visit(u, active, n, inf, threshold, &mut acc);
+                        self.visit(ctx, n, inf, threshold, &mut acc);
                     }
                 } else {
                     for n in s..e {
-                        self.visit(u, active, n, inf, threshold, &mut acc);
+                        self.visit(ctx, n, inf, threshold, &mut acc);
                     }
                 }
             }
@@ -368,20 +400,21 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 
     #[inline(always)]
-    fn visit(&self, u: &SharedValues, active: &[AtomicU8], n: usize, inf: f64, threshold: f64, acc: &mut Accumulator) {
-        // SAFETY: n < band.len(); roles, active and the neighbour table have at least that length
-        // (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`/`active`.
-        let role = unsafe { *self.roles.get_unchecked(n) };
-        if role == NodeRole::Fixed {
-            return;
-        }
+    fn visit(&self, ctx: &SweepContext<'_, D>, n: usize, inf: f64, threshold: f64, acc: &mut Accumulator) {
+        let (u, active) = (ctx.u, ctx.active);
+        // SAFETY: n < band.len(); roles, active, weights and the neighbour table have at least
+        // that length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of
+        // `u` and `active`.
         let flag = unsafe { active.get_unchecked(n) };
         if flag.load(Ordering::Relaxed) == 0 {
             return;
         }
+        let role = unsafe { *self.roles.get_unchecked(n) };
+        if role == NodeRole::Fixed {
+            return;
+        }
         flag.store(0, Ordering::Relaxed);
         let nb = unsafe { self.band.neighbours().get_unchecked(n) };
-        let sentinel = self.band.sentinel();
         let mut minus = [0.0; D];
         let mut plus = [0.0; D];
         for k in 0..D {
@@ -391,21 +424,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         acc.updates += 1;
         let old = u.get(n);
         let new = if role == NodeRole::Outer {
-            // Neighbours still at the numerical infinity stay in the convex combination, as in
-            // the paper: the extended value then approaches the solution from above like the
-            // inner values do. Dropping them would let a too-small value into the layer, which
-            // the monotone Godunov update could never undo.
-            let mut pm = [true; D];
-            let mut pp = [true; D];
-            for k in 0..D {
-                pm[k] = nb[k][0] != sentinel;
-                pp[k] = nb[k][1] != sentinel;
+            // Eq. (5) with the precomputed upwind weights. Neighbours still at the numerical
+            // infinity stay in the convex combination, as in the paper: the extended value then
+            // approaches the solution from above like the inner values do. Dropping them would
+            // let a too-small value into the layer, which the monotone Godunov update could
+            // never undo.
+            let w = unsafe { *ctx.weights.get_unchecked(n) };
+            let v = extension_apply(w, minus, plus);
+            if v == old {
+                return;
             }
-            let dir = unsafe { *self.directions.get_unchecked(n) };
-            match extension_update(dir, minus, plus, pm, pp) {
-                Some(v) if v != old => v,
-                _ => return,
-            }
+            v
         } else {
             let h = self.spacing;
             let slow = match self.slowness {
@@ -417,19 +446,19 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 InnerScheme::Godunov => {
                     let mut mins = [0.0; D];
                     for k in 0..D {
-                        mins[k] = minus[k].min(plus[k]);
+                        mins[k] = fmin(minus[k], plus[k]);
                     }
                     godunov_update(mins, h * slow)
                 }
                 InnerScheme::LaxFriedrichs => {
                     if self.missing == MissingNeighbour::Extrapolate {
-                        self_dependent = fill_missing(nb, sentinel, old, inf, &mut minus, &mut plus);
+                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, &mut minus, &mut plus);
                     }
                     lxf_eikonal_update(minus, plus, h * slow)
                 }
                 InnerScheme::General(ham) => {
                     if self.missing == MissingNeighbour::Extrapolate {
-                        self_dependent = fill_missing(nb, sentinel, old, inf, &mut minus, &mut plus);
+                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, &mut minus, &mut plus);
                     }
                     let p = central_gradient(minus, plus, h);
                     lxf_general_update(minus, plus, ham.viscosity(n), ham.value(n, p), h)
@@ -444,7 +473,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
             candidate
         };
-        let c = (new - old).abs();
+        let c = if new > old { new - old } else { old - new };
         if c > acc.max_change {
             acc.max_change = c;
         }
@@ -459,6 +488,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
         }
     }
+}
+
+/// What the threads of a sweep share.
+struct SweepContext<'a, const D: usize> {
+    u: &'a SharedValues,
+    active: &'a [AtomicU8],
+    weights: &'a [[f32; D]],
 }
 
 /// Smallest number of rows in a wave worth splitting across threads.
