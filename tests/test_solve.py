@@ -237,3 +237,12 @@ def test_band_memory_scales_with_the_tube_not_the_box():
     assert bands[1] / bands[0] < 4.5  # O(N^2) band
     assert peaks[1] / peaks[0] < 5.0, peaks  # an N^3 allocation would give 8
     assert peaks[1] < 8 * 201**3
+
+
+def test_lxf_with_a_source_in_a_grid_corner_stays_positive_and_converges():
+    """Regression: extrapolating an absent neighbour from one still mixed with the numerical
+    infinity produced large negative values (Prop. 4.1 says values stay positive)."""
+    for n in (50, 100, 200):
+        sol, _ = line_solution(n, "two-layer", inner=2.0, ham="lxf")
+        assert sol.values.min() >= 0.0
+        assert abs(sol([(1.0, 1.0)])[0] - np.sqrt(2)) < 1e-3

@@ -452,13 +452,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 }
                 InnerScheme::LaxFriedrichs => {
                     if self.missing == MissingNeighbour::Extrapolate {
-                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, &mut minus, &mut plus);
+                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, h * slow, &mut minus, &mut plus);
                     }
                     lxf_eikonal_update(minus, plus, h * slow)
                 }
                 InnerScheme::General(ham) => {
                     if self.missing == MissingNeighbour::Extrapolate {
-                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, &mut minus, &mut plus);
+                        let f = h * ham.slowness_bound().unwrap_or(f64::INFINITY);
+                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, f, &mut minus, &mut plus);
                     }
                     let p = central_gradient(minus, plus, h);
                     lxf_general_update(minus, plus, ham.viscosity(n), ham.value(n, p), h)
@@ -537,18 +538,38 @@ impl SharedValues {
     }
 }
 
-/// Replaces the values of absent neighbours by a linear extrapolation through the node
-/// (`2 u − u_opposite`), or by the opposite value when the node is still at infinity.
+/// Replaces the values of absent neighbours by a linear extrapolation through the node,
+/// `2 u − u_opposite`, limited to `[u − f, u + f]` with `f = h · s` the largest change a solution
+/// of `|∇u| = s` can have over one grid step (without the limit, an opposite neighbour that still
+/// holds a value mixed with the numerical infinity extrapolates to a large negative value, which
+/// the monotone acceptance would then keep). Where the node itself is still at infinity the
+/// opposite value is copied. Returns whether any neighbour was absent (the update then depends on
+/// the node's own value).
 #[inline(always)]
 fn fill_missing<const D: usize>(
     nb: &[[u32; 2]; D],
     sentinel: u32,
     centre: f64,
     inf: f64,
+    f: f64,
     minus: &mut [f64; D],
     plus: &mut [f64; D],
 ) -> bool {
     let mut any = false;
+    let extrapolate = |other: f64| -> f64 {
+        if centre < inf && other < inf {
+            let v = 2.0 * centre - other;
+            if v < centre - f {
+                centre - f
+            } else if v > centre + f {
+                centre + f
+            } else {
+                v
+            }
+        } else {
+            other
+        }
+    };
     for k in 0..D {
         let m_absent = nb[k][0] == sentinel;
         let p_absent = nb[k][1] == sentinel;
@@ -557,9 +578,9 @@ fn fill_missing<const D: usize>(
             minus[k] = centre;
             plus[k] = centre;
         } else if m_absent {
-            minus[k] = if centre < inf && plus[k] < inf { 2.0 * centre - plus[k] } else { plus[k] };
+            minus[k] = extrapolate(plus[k]);
         } else if p_absent {
-            plus[k] = if centre < inf && minus[k] < inf { 2.0 * centre - minus[k] } else { minus[k] };
+            plus[k] = extrapolate(minus[k]);
         }
     }
     any
