@@ -183,6 +183,10 @@ def run_fig7(out_dir: Path, quick: bool) -> dict:
     R.write_markdown(out_dir / "fig7.md", "Fig. 7 — sphere" + (" (quick)" if quick else ""), [
         ("", "fig7.png: (a) the LxF solution (source_init='node') on the sphere at N = 81 with the source (red) and the "
              "circle x = 0 where the error is measured (black dotted); (b) error against Δx. Numbers: table3.md."),
+        ("Fitted orders of panel (b)", R.markdown_table(
+            ["series", "order (ours)", "paper LxF order, same N"],
+            [[label, R.fit_order(dx, [r["error"] for r in res[label]]),
+              R.fit_order(dx, PAPER_T3[: len(ns)])] for label, _, _ in CONFIGS])),
         ("Solution of panel (a)", f"{sol.stats.band_points} band points, {sol.stats.iterations} iterations, "
                                   f"max u on the sphere {float(np.nanmax(u)):.4f} (exact π/2 = {math.pi / 2:.4f})."),
     ])
