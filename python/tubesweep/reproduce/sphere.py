@@ -174,6 +174,8 @@ def run_fig7(out_dir: Path, quick: bool) -> dict:
     from matplotlib.ticker import NullFormatter
 
     ax2.xaxis.set_minor_formatter(NullFormatter())
+    ax2.set_xticks(dxp)
+    ax2.set_xticklabels([f"{d:.4f}\nN={n}" for d, n in zip(dxp, NS)], fontsize=7)
     fig.tight_layout()
     fig.savefig(out_dir / "fig7.png", dpi=100)
     p.close(fig)

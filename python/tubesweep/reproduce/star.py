@@ -333,6 +333,10 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
 
     for a in axs[1:]:
         a.xaxis.set_minor_formatter(NullFormatter())
+    axs[1].set_xticks(dx_paper)
+    axs[1].set_xticklabels([f"{d:.4g}\nN={n}" for d, n in zip(dx_paper, NS)], fontsize=7)
+    axs[2].set_xticks(list(NS))
+    axs[2].set_xticklabels([str(n) for n in NS], fontsize=8)
     fig.tight_layout()
     fig.savefig(out_dir / "fig6.png", dpi=100)
     p.close(fig)
