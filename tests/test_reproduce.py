@@ -7,7 +7,6 @@ that the files exist."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -23,10 +23,9 @@ the evidence.
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Sequence, Tuple
 
 import numpy as np
 
@@ -195,6 +194,11 @@ def run_table1(out_dir: Path, quick: bool) -> dict:
              f"infinity={MATCH['infinity']:g}, inner 2Δx, outer 4Δx, grid [−1,1]² with N nodes per axis. Error: "
              f"max over {N_SAMPLES} curve points equally spaced in θ of |u_h − arclength|."),
         ("Ours vs the paper", R.markdown_table(head, body) + "\n\n" + note_order),
+        ("Local orders between consecutive N (ours vs the paper's own numbers)", R.markdown_table(
+            ["Hamiltonian", "series"] + [f"{a}→{b}" for a, b in zip(ns, ns[1:])],
+            [[LABEL[h], w] + R.local_orders([2.0 / (n - 1) for n in ns], e)
+             for h in HAMS for w, e in (("ours", [r["error_curve"] for r in main[h]]),
+                                        ("paper", PAPER_T1[h][: len(ns)]))])),
         ("All φ / source-initialisation variants", R.markdown_table(vhead, vbody)),
         ("Error measure: curve samples vs nodes next to the curve (matching configuration)", R.markdown_table(mhead, mbody)),
         ("Cost of every run", cost),
