@@ -77,6 +77,11 @@ class Disc(ClosestPoint):
     """Flat disc of ``radius`` in the plane z = c_z about ``center`` — an open surface with a
     circular boundary.
 
+    Parameters
+    ----------
+    radius : float (default 0.6)
+    center : (3,) float
+
     Closest point: drop z, then clip the in-plane offset to the radius. :meth:`geodesic_distance`
     is the Euclidean distance between closest points (exact: the disc is convex).
     """
