@@ -200,3 +200,60 @@ def test_mobius_solution_is_continuous_across_the_half_twist(mobius_reference):
     e = np.abs(sol(V) - ref)
     assert near_seam.sum() > 50
     assert e[near_seam].max() <= e.max() + 1e-12 and e[near_seam].max() < 0.05
+
+
+# ------------------------------------------------------------------------- cut tube ends in 2D
+_A, _B = np.array([-0.5, -0.5]), np.array([0.5, 0.5])
+
+
+def _segment_cp(x):
+    t = np.clip(((x - _A) @ (_B - _A)) / np.dot(_B - _A, _B - _A), 0.0, 1.0)
+    return _A + t[:, None] * (_B - _A)
+
+
+def _cut_line():
+    """The infinite line y = x as a level set: the grid box cuts its tube at both ends."""
+    return ts.LevelSet(lambda p: (p[:, 0] - p[:, 1]) / np.sqrt(2), lipschitz=1.0)
+
+
+@pytest.mark.parametrize("ham", ["godunov", "lxf"])
+@pytest.mark.parametrize("pad", [0.02, 0.1, 0.3])
+def test_open_curve_and_cut_line_in_2d(ham, pad):
+    """The issue's case: a diagonal of length √2 whose tube ends a few nodes inside the box (cp of a
+    segment: a rounded end) or is cut by the box (a level-set line). u at the far end is √2."""
+    lo, hi = -0.5 - pad, 0.5 + pad
+    grid = ts.Grid((lo, lo), (hi, hi), (101, 101))
+    for surf in (ts.ClosestPoint(_segment_cp, ndim=2), _cut_line()):
+        sol = ts.solve(surf, grid, [_A], hamiltonian=ham)
+        assert sol.stats.converged
+        assert sol([_B])[0] == pytest.approx(np.sqrt(2), abs=1e-3)
+        assert np.max(sol.values[np.isfinite(sol.values)]) < np.sqrt(2) * (1 + pad) + 0.45
+
+
+def test_without_extrapolation_lax_friedrichs_leaks_at_a_cut_end(monkeypatch):
+    """Counter-check that the test above has teeth: forcing the 'infinity' policy for absent
+    neighbours (what Algorithm 2 does) makes LxF read the numerical infinity through its central
+    difference at the cut end, and the value at the far end is ruined (measured: 144 instead of 1.41)."""
+    import sys
+    import types
+
+    mod = sys.modules["tubesweep.solve"]
+    real = mod._native
+
+    class Wrapped:
+        def __init__(self, band):
+            self._band = band
+
+        def __getattr__(self, name):
+            return getattr(self._band, name)
+
+        def solve(self, roles, fixed, h, slow, dirs, scheme, missing, *rest):
+            return self._band.solve(roles, fixed, h, slow, dirs, scheme, "infinity", *rest)
+
+    fake = types.SimpleNamespace(Band=types.SimpleNamespace(from_linear=lambda *a: Wrapped(real.Band.from_linear(*a))))
+    grid = ts.Grid((-0.55,) * 2, (0.55,) * 2, (56, 56))
+    good = ts.solve(_cut_line(), grid, [_A], hamiltonian="lxf")([_B])[0]
+    monkeypatch.setattr(mod, "_native", fake)
+    bad = ts.solve(_cut_line(), grid, [_A], hamiltonian="lxf")([_B])[0]
+    assert good == pytest.approx(np.sqrt(2), abs=1e-6)
+    assert bad > 10
