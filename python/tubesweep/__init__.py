@@ -12,16 +12,19 @@ Quick start::
     sol([(0.5, 0, 0)])            # ≈ π/2 · 0.5
 
 Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :func:`travel_time` (the whole
-box, Algorithm 1), :class:`Grid`, :class:`LevelSet`.
+box, Algorithm 1), :class:`Grid`, :class:`LevelSet`, :class:`ClosestPoint` (open and non-orientable surfaces,
+Sect. 5.2) and the library :mod:`tubesweep.surfaces`.
 """
 
 from ._native import __version__ as _core_version
+from .closest_point import ClosestPoint
 from .euclidean import travel_time
 from .grid import Grid
 from .solve import Solution, solve
 from .stats import SolveStats
 from .surface import LevelSet, Surface
+from . import surfaces
 
 __version__ = "0.1.0"
 
-__all__ = ["Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "travel_time", "__version__"]
+__all__ = ["ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "surfaces", "travel_time", "__version__"]

@@ -273,7 +273,7 @@ def solve(
         if attempt == _MAX_WIDENINGS:
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
-                "inner nodes lack a neighbour. φ is far from a distance function; re-distance it"
+                "inner nodes lack a neighbour. φ is far from a distance function; use ts.LevelSet(phi, redistance=True)"
             )
         warnings.warn(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "

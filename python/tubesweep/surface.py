@@ -136,16 +136,24 @@ class LevelSet(Surface):
     phi : ndarray of ``grid.shape`` or callable ``phi(points (M, d)) -> (M,)``
         The level set function sampled on the grid, or a vectorised function. Only the band is
         evaluated for a callable (found coarse-to-fine, never the whole box).
-    lipschitz : float
+    lipschitz : float, optional
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
-        default leaves room for near-distance functions).
+        default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
+        is estimated from |∇φ| on a coarse lattice of the grid box.
+    redistance : bool
+        For φ that is *not* a distance function (e.g. ``x² + y² − r²``): in the band only, replace
+        φ by the signed distance to its zero level set — first ``φ/|∇φ|`` (a Newton step onto the
+        surface), then closest-point projection iterations (:mod:`tubesweep.redistance`). The tube
+        widths are then true distances and the extension direction is ``(x − cp(x))/|x − cp(x)|``.
+        Costs a few dozen φ evaluations per band node.
 
     The outward normal ``n = ∇φ / |∇φ|`` comes from central differences of φ at the band nodes, as
     in the paper (Sect. 4). The method needs φ close to a signed distance function (``|∇φ| ≈ 1``
     near the surface); far from it the solver raises an error that says so.
     """
 
-    def __init__(self, phi: Union[np.ndarray, Callable[[np.ndarray], np.ndarray]], *, lipschitz: float = 1.5):
+    def __init__(self, phi: Union[np.ndarray, Callable[[np.ndarray], np.ndarray]], *, lipschitz: Optional[float] = None,
+                 redistance: bool = False):
         if callable(phi):
             self._fn: Optional[Callable[[np.ndarray], np.ndarray]] = phi
             self._array: Optional[np.ndarray] = None
@@ -159,9 +167,17 @@ class LevelSet(Surface):
             self._fn = None
             self._array = arr
             self.ndim = arr.ndim
-        if not (np.isfinite(lipschitz) and lipschitz >= 1.0):
-            raise ValueError(f"lipschitz must be >= 1 (a distance function has |∇φ| = 1); got {lipschitz}")
-        self.lipschitz = float(lipschitz)
+        self.redistance = bool(redistance)
+        if lipschitz is None:
+            self.lipschitz: Optional[float] = None if self.redistance else 1.5
+        elif self.redistance:
+            if not (np.isfinite(lipschitz) and lipschitz > 0):
+                raise ValueError(f"lipschitz must be a positive bound on |∇φ|; got {lipschitz}")
+            self.lipschitz = float(lipschitz)
+        else:
+            if not (np.isfinite(lipschitz) and lipschitz >= 1.0):
+                raise ValueError(f"lipschitz must be >= 1 (a distance function has |∇φ| = 1); got {lipschitz}")
+            self.lipschitz = float(lipschitz)
 
     @property
     def is_dense(self) -> bool:
@@ -220,6 +236,10 @@ class LevelSet(Surface):
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)
+        if self.redistance:
+            from .redistance import redistanced_band
+
+            return redistanced_band(self, grid, half_width)
         if self._array is not None:
             flat = self._array.reshape(-1)
             linear = np.flatnonzero(np.abs(flat) <= half_width).astype(np.int64)
@@ -241,8 +261,8 @@ class LevelSet(Surface):
         if lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH:
             raise ValueError(
                 f"surface: φ is not close to a signed distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the "
-                "surface (it should be ≈ 1). Divide φ by |∇φ| or re-distance it (e.g. with ts.travel_time or scikit-fmm) "
-                "before solving; the tube widths are measured in units of φ"
+                "surface (it should be ≈ 1). Use ts.LevelSet(phi, redistance=True), which re-distances φ in the band, "
+                "or pass a signed distance function; the tube widths are measured in units of φ"
             )
         if lo < GRAD_WARN_LOW or hi > GRAD_WARN_HIGH:
             warnings.warn(
@@ -253,6 +273,10 @@ class LevelSet(Surface):
             )
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        if self.redistance:
+            from .redistance import redistanced_project
+
+            return redistanced_project(self, points, grid)
         phi = self.phi(points, grid)
         h = grid.spacing
         d = points.shape[1]

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Callable, Dict, Sequence, Tuple
+from typing import Sequence, Tuple
 
 import numpy as np
 
 from ..surface import LevelSet
+from ._mesh import grid_mesh, polyline
 
-__all__ = ["Circle", "Sphere", "Star", "REGISTRY"]
+__all__ = ["Circle", "Sphere", "Star"]
 
 
 class Circle(LevelSet):
@@ -42,6 +43,10 @@ class Circle(LevelSet):
         t = np.linspace(0, 2 * np.pi, n, endpoint=False)
         return self.center + self.radius * np.stack([np.cos(t), np.sin(t)], axis=1)
 
+    def triangulation(self, n: int = 400) -> Tuple[np.ndarray, np.ndarray]:
+        """The curve as a closed polyline: vertices (n, 2) and segments (n, 2)."""
+        return polyline(self.sample(n))
+
 
 class Sphere(LevelSet):
     """Sphere of ``radius`` about ``center``; φ = |x − c| − r (exact signed distance)."""
@@ -70,6 +75,12 @@ class Sphere(LevelSet):
         b = np.asarray(source, dtype=float) - self.center
         b = b / np.linalg.norm(b)
         return self.radius * np.arccos(np.clip(a @ b, -1.0, 1.0))
+
+    def triangulation(self, n: int = 64) -> Tuple[np.ndarray, np.ndarray]:
+        """Latitude–longitude triangulation (n rings, 2n sectors, poles merged): ``(V, F)``."""
+        th, ph = np.meshgrid(np.linspace(0, np.pi, n + 1), np.linspace(0, 2 * np.pi, 2 * n + 1), indexing="ij")
+        P = self.radius * np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1) + self.center
+        return grid_mesh(P)
 
 
 class Star(LevelSet):
@@ -200,9 +211,6 @@ class Star(LevelSet):
     def sample(self, n: int = 2000) -> np.ndarray:
         return self.curve(np.linspace(0, 2 * np.pi, n, endpoint=False))
 
-
-REGISTRY: Dict[str, Callable[[], LevelSet]] = {
-    "circle": Circle,
-    "star": Star,
-    "sphere": Sphere,
-}
+    def triangulation(self, n: int = 600) -> Tuple[np.ndarray, np.ndarray]:
+        """The curve as a closed polyline: vertices (n, 2) and segments (n, 2)."""
+        return polyline(self.sample(n))

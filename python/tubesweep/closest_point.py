@@ -1,0 +1,133 @@
+"""Surfaces given by a closest-point function (paper Sect. 5.2).
+
+A closest-point function ``cp(x) = argmin_{y ∈ Σ} |x − y|`` represents any reasonable surface,
+including open surfaces (a hemisphere, a disc) and non-orientable ones (the Möbius band), for which
+no signed distance function exists. The paper builds the two tubes from ``F(x) = |x − cp(x)|``,
+
+    Γ_in = {F ≤ inner·Δx},   Γ_out = {inner·Δx < F ≤ outer·Δx},
+
+and extends the solution in ``Γ_out`` along ``(x − cp(x)) / |x − cp(x)|`` (the replacement of
+``sgn(φ) n`` in Eq. (8)). That vector needs no global orientation: it always points away from the
+surface, which is all the upwind extension (Eq. (5)) uses.
+
+**Open surfaces.** Near the boundary curve ∂Σ, ``cp(x)`` is a point of ∂Σ for grid nodes beyond the
+rim, so the tube closes around the rim in a half-cylinder and the extension direction there points
+away from ∂Σ: the extension carries the rim value outwards and no node of the band lacks a
+neighbour, so nothing special is needed at ∂Σ — the tests (``tests/test_closest_point.py``) check
+first-order convergence up to the rim for both Hamiltonians. Where the *grid box* cuts the tube, the
+sweep treats a missing neighbour of an inner node by linear extrapolation for Lax–Friedrichs
+(one-sided differences, ``MissingNeighbour::Extrapolate`` in the Rust core) and as infinity for
+Godunov (upwind), so large values cannot leak inwards from a cut tube end either.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Optional, Tuple
+
+import numpy as np
+
+from .grid import Grid
+from .surface import EVAL_CHUNK, BandGeometry, Surface, discover_band
+
+__all__ = ["ClosestPoint", "DIRECTION_EPS"]
+
+#: Nodes closer than this fraction of Δx to their closest point get a zero extension direction
+#: (they are inner nodes; only extension-layer nodes read the direction).
+DIRECTION_EPS = 1e-9
+
+
+def _evaluate_cp(cp: Callable[[np.ndarray], np.ndarray], points: np.ndarray) -> np.ndarray:
+    m, d = points.shape
+    out = np.empty((m, d))
+    for s in range(0, m, EVAL_CHUNK):
+        chunk = points[s : s + EVAL_CHUNK]
+        v = np.asarray(cp(chunk), dtype=float)
+        if v.shape != chunk.shape:
+            raise ValueError(
+                f"cp must map points of shape (M, {d}) to closest points of shape (M, {d}); it returned shape {v.shape} "
+                f"for M = {chunk.shape[0]}"
+            )
+        out[s : s + EVAL_CHUNK] = v
+    if not np.all(np.isfinite(out)):
+        bad = int(np.flatnonzero(~np.isfinite(out).all(axis=1))[0])
+        raise ValueError(
+            f"cp returned NaN or inf at {tuple(float(x) for x in points[bad])}; it must be finite at every point near the surface"
+        )
+    return out
+
+
+class ClosestPoint(Surface):
+    """A curve or surface given by its closest-point function (paper Sect. 5.2).
+
+    Parameters
+    ----------
+    cp : callable ``cp(points (M, d)) -> (M, d)``
+        Vectorised closest-point function: the point of Σ nearest to each input point. It must be
+        accurate (well below Δx) in the band ``|x − cp(x)| ≤ outer·Δx``. The coarse-to-fine band
+        search also calls it at the centres of coarse blocks, up to a block diagonal away from Σ:
+        there a returned point that is *not* the nearest one over-estimates the distance and could
+        drop a block — if your cp is only reliable close to Σ, raise ``lipschitz``.
+    ndim : int, optional
+        2 or 3; by default the grid's dimension.
+    lipschitz : float
+        Lipschitz bound of ``x ↦ |x − cp(x)|`` used by the coarse-to-fine band search
+        (:func:`tubesweep.surface.discover_band`). A distance function has constant 1; a larger
+        value only makes the search visit more blocks.
+
+    The tube is ``{|x − cp(x)| ≤ h}``; the extension direction at an extension-layer node is
+    ``(x − cp(x)) / |x − cp(x)|``. ``BandGeometry.signed`` equals the unsigned distance (a
+    closest-point surface has no inside).
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> def cp(x):  # the upper hemisphere of radius 0.5
+    ...     y = x / np.linalg.norm(x, axis=1, keepdims=True) * 0.5
+    ...     rim = np.c_[x[:, :2] / np.linalg.norm(x[:, :2], axis=1, keepdims=True) * 0.5, 0 * x[:, 2]]
+    ...     return np.where(x[:, 2:] >= 0, y, rim)
+    >>> surf = ts.ClosestPoint(cp)
+    """
+
+    def __init__(self, cp: Callable[[np.ndarray], np.ndarray], *, ndim: Optional[int] = None, lipschitz: float = 1.0):
+        if not callable(cp):
+            raise TypeError(f"cp must be a callable cp(points (M, d)) -> (M, d); got {type(cp).__name__}")
+        if ndim is not None and ndim not in (2, 3):
+            raise ValueError(f"ndim must be 2 or 3; got {ndim}")
+        if not (np.isfinite(lipschitz) and lipschitz >= 1.0):
+            raise ValueError(f"lipschitz must be >= 1 (|x − cp(x)| is 1-Lipschitz for an exact cp); got {lipschitz}")
+        self._cp = cp
+        self.ndim = ndim
+        self.lipschitz = float(lipschitz)
+
+    def closest_point(self, points: np.ndarray) -> np.ndarray:
+        """``cp(points)`` with shape and finiteness checked."""
+        p = np.asarray(points, dtype=float)
+        if p.ndim != 2:
+            raise ValueError(f"points must have shape (M, d); got {p.shape}")
+        return _evaluate_cp(self._cp, p)
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Unsigned distance ``|x − cp(x)|`` (the paper's ``F``)."""
+        p = np.asarray(points, dtype=float)
+        return np.linalg.norm(p - self.closest_point(p), axis=1)
+
+    def band(self, grid: Grid, half_width: float) -> BandGeometry:
+        """Band nodes with ``|x − cp(x)| ≤ half_width`` (found coarse-to-fine) and their outward
+        directions ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2)."""
+        self.check_grid(grid)
+        linear, dist = discover_band(self.distance, grid, half_width, self.lipschitz, name="cp")
+        d = grid.ndim
+        if linear.size == 0:
+            return BandGeometry(linear, dist, dist, np.zeros((0, d), np.float32))
+        x = grid.points(grid.unravel(linear))
+        diff = x - self.closest_point(x)
+        norm = np.linalg.norm(diff, axis=1)
+        ok = norm > DIRECTION_EPS * grid.spacing
+        direction = np.zeros((len(linear), d))
+        direction[ok] = diff[ok] / norm[ok, None]
+        return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32))
+
+    def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        p = np.asarray(points, dtype=float)
+        c = self.closest_point(p)
+        return np.linalg.norm(p - c, axis=1), c

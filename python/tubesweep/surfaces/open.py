@@ -1,0 +1,292 @@
+"""Open and non-orientable surfaces in the closest-point representation (paper Sect. 5.2):
+hemisphere, disc, square plane patch and the Möbius band. Each is a
+:class:`tubesweep.ClosestPoint`; none has a signed distance function (the Möbius band is not even
+orientable), so φ is not defined — the tube is ``{|x − cp(x)| ≤ h}``."""
+
+from __future__ import annotations
+
+from typing import Sequence, Tuple
+
+import numpy as np
+
+from ..closest_point import ClosestPoint
+from ._mesh import grid_mesh
+
+__all__ = ["Hemisphere", "Disc", "PlanePatch", "MobiusBand"]
+
+_CUBE = ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
+
+
+def _safe_unit(v: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=1, keepdims=True)
+    return np.where(n > 1e-300, v / np.where(n > 1e-300, n, 1.0), fallback)
+
+
+class Hemisphere(ClosestPoint):
+    """The upper hemisphere ``{|x − c| = radius, z ≥ c_z}`` — an open surface bounded by the
+    equator circle (the "rim").
+
+    Parameters
+    ----------
+    radius : float (default 0.5)
+    center : (3,) float
+
+    Closest point: the radial projection when it lands on the upper half, else the nearest point of
+    the rim circle. :meth:`geodesic_distance` is the great-circle distance, exact because a closed
+    hemisphere is geodesically convex (the shorter great-circle arc between two of its points stays
+    in it). The default source sits at polar angle π/4 in the x–z plane, so that distances up to
+    the rim take every value from 0.39 to 1.18.
+    """
+
+    default_box = _CUBE
+
+    def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0, 0.0)):
+        if not radius > 0:
+            raise ValueError(f"radius must be positive; got {radius}")
+        self.radius = float(radius)
+        self.center = np.asarray(center, dtype=float).reshape(3)
+        super().__init__(self._cp, ndim=3)
+
+    def _cp(self, p: np.ndarray) -> np.ndarray:
+        q = np.asarray(p, dtype=float) - self.center
+        up = _safe_unit(q, np.array([0.0, 0.0, 1.0])) * self.radius
+        h = np.c_[q[:, :2], np.zeros(len(q))]
+        rim = _safe_unit(h, np.array([1.0, 0.0, 0.0])) * self.radius
+        return np.where(q[:, 2:3] >= 0.0, up, rim) + self.center
+
+    @property
+    def default_source(self) -> np.ndarray:
+        s = np.sqrt(0.5)
+        return self.center + self.radius * np.array([-s, 0.0, s])
+
+    def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
+        """Great-circle distance between the closest points of ``points`` and of ``source``."""
+        a = self._cp(np.asarray(points, dtype=float).reshape(-1, 3)) - self.center
+        b = self._cp(np.asarray(source, dtype=float).reshape(1, 3))[0] - self.center
+        c = (a @ b) / self.radius**2
+        return self.radius * np.arccos(np.clip(c, -1.0, 1.0))
+
+    def triangulation(self, n: int = 48) -> Tuple[np.ndarray, np.ndarray]:
+        """Latitude–longitude triangulation (n rings, 4n sectors): ``(V, F)``."""
+        th, ph = np.meshgrid(np.linspace(0, 0.5 * np.pi, n + 1), np.linspace(0, 2 * np.pi, 4 * n + 1), indexing="ij")
+        P = self.radius * np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1) + self.center
+        return grid_mesh(P)
+
+
+class Disc(ClosestPoint):
+    """Flat disc of ``radius`` in the plane z = c_z about ``center`` — an open surface with a
+    circular boundary.
+
+    Parameters
+    ----------
+    radius : float (default 0.6)
+    center : (3,) float
+
+    Closest point: drop z, then clip the in-plane offset to the radius. :meth:`geodesic_distance`
+    is the Euclidean distance between closest points (exact: the disc is convex).
+    """
+
+    default_box = _CUBE
+
+    def __init__(self, radius: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
+        if not radius > 0:
+            raise ValueError(f"radius must be positive; got {radius}")
+        self.radius = float(radius)
+        self.center = np.asarray(center, dtype=float).reshape(3)
+        super().__init__(self._cp, ndim=3)
+
+    def _cp(self, p: np.ndarray) -> np.ndarray:
+        q = np.asarray(p, dtype=float) - self.center
+        r = np.hypot(q[:, 0], q[:, 1])
+        f = np.where(r > self.radius, self.radius / np.where(r > 0, r, 1.0), 1.0)
+        return np.c_[q[:, 0] * f, q[:, 1] * f, np.zeros(len(q))] + self.center
+
+    @property
+    def default_source(self) -> np.ndarray:
+        return self.center + np.array([-0.5 * self.radius, 0.0, 0.0])
+
+    def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
+        """Euclidean distance between the closest points (exact on a convex flat surface)."""
+        return np.linalg.norm(self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
+                              - self._cp(np.asarray(source, dtype=float).reshape(1, 3)), axis=1)
+
+    def triangulation(self, n: int = 32) -> Tuple[np.ndarray, np.ndarray]:
+        """Polar-grid triangulation (n rings, 4n sectors): ``(V, F)``."""
+        rr, ph = np.meshgrid(np.linspace(0, self.radius, n + 1), np.linspace(0, 2 * np.pi, 4 * n + 1), indexing="ij")
+        P = np.stack([rr * np.cos(ph), rr * np.sin(ph), np.zeros_like(rr)], -1) + self.center
+        return grid_mesh(P)
+
+
+class PlanePatch(ClosestPoint):
+    """Square plane patch ``[−s, s]² × {0}`` about ``center`` (open, with corners).
+
+    Closest point: drop z and clip x, y to ``[−s, s]``. :meth:`geodesic_distance` is Euclidean
+    (exact: the square is convex).
+
+    Parameters
+    ----------
+    half_size : float (default 0.6)
+    center : (3,) float
+    """
+
+    default_box = _CUBE
+
+    def __init__(self, half_size: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
+        if not half_size > 0:
+            raise ValueError(f"half_size must be positive; got {half_size}")
+        self.half_size = float(half_size)
+        self.center = np.asarray(center, dtype=float).reshape(3)
+        super().__init__(self._cp, ndim=3)
+
+    def _cp(self, p: np.ndarray) -> np.ndarray:
+        q = np.asarray(p, dtype=float) - self.center
+        s = self.half_size
+        return np.c_[np.clip(q[:, 0], -s, s), np.clip(q[:, 1], -s, s), np.zeros(len(q))] + self.center
+
+    @property
+    def default_source(self) -> np.ndarray:
+        return self.center + np.array([-0.5 * self.half_size, -0.5 * self.half_size, 0.0])
+
+    def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
+        """Euclidean distance between the closest points."""
+        return np.linalg.norm(self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
+                              - self._cp(np.asarray(source, dtype=float).reshape(1, 3)), axis=1)
+
+    def triangulation(self, n: int = 32) -> Tuple[np.ndarray, np.ndarray]:
+        """Regular (n × n quads) triangulation: ``(V, F)``."""
+        s = self.half_size
+        x, y = np.meshgrid(np.linspace(-s, s, n + 1), np.linspace(-s, s, n + 1), indexing="ij")
+        return grid_mesh(np.stack([x, y, np.zeros_like(x)], -1) + self.center)
+
+
+class MobiusBand(ClosestPoint):
+    """The Möbius band ``X(θ, s) = ((R + s cos(θ/2)) cos θ, (R + s cos(θ/2)) sin θ, s sin(θ/2))``,
+    ``θ ∈ [0, 2π)``, ``|s| ≤ w`` — open (its boundary is one closed curve, ``s = ±w``) and
+    non-orientable, so it has no signed distance; the extension direction ``(x − cp(x)) / |x − cp(x)|``
+    of Sect. 5.2 needs no orientation.
+
+    Parameters
+    ----------
+    R : float
+        Radius of the centre circle (default 0.6).
+    w : float
+        Half-width of the band (default 0.3), ``0 < w < R``.
+    newton_iterations : int
+        At most this many Newton steps per candidate (each point stops when its step falls below
+        1e-13; near the band 4–6 steps suffice).
+
+    Closest point by numerical projection, vectorised: the interior critical point of
+    ``½|X(θ, s) − x|²`` by Newton's method in (θ, s) from θ₀ = atan2(y, x) and s₀ the projection
+    on the ruling, and the nearest point of the boundary curve by Newton's method in θ with
+    s = ±w; the nearer admissible candidate wins (a minimum over a closed band is either an
+    interior critical point or on the boundary). There is no closed-form geodesic distance; the
+    tests compare with exact polyhedral geodesics on a fine :meth:`triangulation` (pygeodesic).
+    """
+
+    default_box = _CUBE
+
+    def __init__(self, R: float = 0.6, w: float = 0.3, newton_iterations: int = 60):
+        if not (0 < w < R):
+            raise ValueError(f"need 0 < w < R; got R={R}, w={w}")
+        self.R = float(R)
+        self.w = float(w)
+        self.newton_iterations = int(newton_iterations)
+        super().__init__(self._cp, ndim=3)
+
+    # --- parametrisation and derivatives ----------------------------------------------------
+    def point(self, th: np.ndarray, s: np.ndarray) -> np.ndarray:
+        th, s = np.broadcast_arrays(np.asarray(th, float), np.asarray(s, float))
+        rho = self.R + s * np.cos(0.5 * th)
+        return np.stack([rho * np.cos(th), rho * np.sin(th), s * np.sin(0.5 * th)], -1)
+
+    def _derivs(self, th: np.ndarray, s: np.ndarray):
+        c2, s2 = np.cos(0.5 * th), np.sin(0.5 * th)
+        c, si = np.cos(th), np.sin(th)
+        rho = self.R + s * c2
+        X = np.stack([rho * c, rho * si, s * s2], -1)
+        Xt = np.stack([-0.5 * s * s2 * c - rho * si, -0.5 * s * s2 * si + rho * c, 0.5 * s * c2], -1)
+        Xs = np.stack([c2 * c, c2 * si, s2], -1)
+        Xtt = np.stack([-0.25 * s * c2 * c + s * s2 * si - rho * c, -0.25 * s * c2 * si - s * s2 * c - rho * si,
+                        -0.25 * s * s2], -1)
+        Xts = np.stack([-0.5 * s2 * c - c2 * si, -0.5 * s2 * si + c2 * c, 0.5 * c2], -1)
+        return X, Xt, Xs, Xtt, Xts
+
+    def _interior(self, x: np.ndarray, th: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """Newton's method for the critical point of ½|X(θ, s) − x|² (steps clipped to 0.2),
+        iterated on the points that have not yet converged."""
+        _, _, Xs, _, _ = self._derivs(th, np.zeros_like(th))
+        s = np.sum((x - self.point(th, 0.0)) * Xs, axis=1)
+        active = np.arange(len(x))
+        for _ in range(self.newton_iterations):
+            if active.size == 0:
+                break
+            ta, sa, xa = th[active], s[active], x[active]
+            X, Xt, Xs, Xtt, Xts = self._derivs(ta, sa)
+            D = X - xa
+            g1 = np.sum(D * Xt, 1)
+            g2 = np.sum(D * Xs, 1)
+            h11 = np.sum(Xt * Xt, 1) + np.sum(D * Xtt, 1)
+            h12 = np.sum(Xt * Xs, 1) + np.sum(D * Xts, 1)
+            h22 = np.sum(Xs * Xs, 1)
+            det = h11 * h22 - h12 * h12
+            ok = (det > 1e-14) & (h11 > 0)
+            safe = np.where(ok, det, 1.0)
+            # Newton where the Hessian is positive definite, gradient descent elsewhere
+            dth = np.where(ok, (h22 * g1 - h12 * g2) / safe, g1 / np.maximum(np.sum(Xt * Xt, 1), 1e-14))
+            ds = np.where(ok, (h11 * g2 - h12 * g1) / safe, g2)
+            dth = np.clip(dth, -0.2, 0.2)
+            ds = np.clip(ds, -0.2, 0.2)
+            th[active] = ta - dth
+            s[active] = sa - ds
+            active = active[np.maximum(np.abs(dth), np.abs(ds)) > 1e-13]
+        return th, s
+
+    def _boundary(self, x: np.ndarray, th: np.ndarray, sb: float) -> np.ndarray:
+        """Newton's method in θ for the nearest point of the boundary curve s = sb."""
+        active = np.arange(len(x))
+        for _ in range(self.newton_iterations):
+            if active.size == 0:
+                break
+            ta, xa = th[active], x[active]
+            X, Xt, _, Xtt, _ = self._derivs(ta, np.full_like(ta, sb))
+            D = X - xa
+            g = np.sum(D * Xt, 1)
+            h = np.sum(Xt * Xt, 1) + np.sum(D * Xtt, 1)
+            step = np.where(h > 1e-14, g / np.where(h > 1e-14, h, 1.0), g / np.maximum(np.sum(Xt * Xt, 1), 1e-14))
+            step = np.clip(step, -0.2, 0.2)
+            th[active] = ta - step
+            active = active[np.abs(step) > 1e-13]
+        return th
+
+    def closest_parameters(self, p: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """Parameters (θ, s) of the closest point of the band to each point of p (M, 3)."""
+        x = np.asarray(p, dtype=float).reshape(-1, 3)
+        th0 = np.arctan2(x[:, 1], x[:, 0])
+        best_th = np.empty(len(x))
+        best_s = np.empty(len(x))
+        best_d = np.full(len(x), np.inf)
+        ti, si = self._interior(x, th0.copy())
+        cands = [(ti, si, np.abs(si) <= self.w)]
+        for sb in (-self.w, self.w):
+            tb = self._boundary(x, th0.copy(), sb)
+            cands.append((tb, np.full_like(tb, sb), np.ones(len(x), bool)))
+        for th, s, ok in cands:
+            d = np.linalg.norm(self.point(th, s) - x, axis=1)
+            better = ok & (d < best_d)
+            best_d = np.where(better, d, best_d)
+            best_th = np.where(better, th, best_th)
+            best_s = np.where(better, s, best_s)
+        return best_th, best_s
+
+    def _cp(self, p: np.ndarray) -> np.ndarray:
+        th, s = self.closest_parameters(p)
+        return self.point(th, s)
+
+    @property
+    def default_source(self) -> np.ndarray:
+        return np.array([self.R, 0.0, 0.0])
+
+    def triangulation(self, n: int = 48) -> Tuple[np.ndarray, np.ndarray]:
+        """Parameter-grid triangulation (8n × n quads) with the half-twist seam merged: ``(V, F)``."""
+        th, s = np.meshgrid(np.linspace(0, 2 * np.pi, 8 * n + 1), np.linspace(-self.w, self.w, n + 1), indexing="ij")
+        return grid_mesh(self.point(th, s))

@@ -1,0 +1,148 @@
+"""The surface library (tubesweep.surfaces) and LevelSet(redistance=True)."""
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.surfaces import REGISTRY, Circle, DoubleTorus, Ellipse, Ellipsoid, Sphere, Torus
+
+
+def _order(a, b):
+    return float(np.log2(a / b))
+
+
+@pytest.mark.parametrize("name", sorted(REGISTRY))
+def test_registry_entry_is_complete(name):
+    s = REGISTRY[name]()
+    lo, hi = (np.asarray(b, float) for b in s.default_box)
+    ext = hi - lo
+    assert np.allclose(ext, ext[0]), "default_box must be a cube so that (N,)*d gives a uniform grid"
+    grid = ts.Grid(lo, hi, (21,) * len(lo))
+    src = np.atleast_2d(s.default_source)
+    d, cp = s.project(src, grid)
+    assert d[0] < 1e-3 * grid.spacing
+    V, F = s.triangulation(16)
+    assert V.shape[1] == len(lo) and F.min() >= 0 and F.max() < len(V)
+    dv, _ = s.project(V, grid)
+    tol = 1e-6 if name not in ("rounded-cube", "double-torus") else 0.02  # marching cubes: O(cell²)
+    assert np.max(dv) < tol
+    assert s.__doc__ and "Parameters" in (s.__doc__ + (type(s).__init__.__doc__ or "")) or name in ("circle", "sphere")
+
+
+def test_ellipse_distance_and_arclength_are_exact():
+    e = Ellipse(0.6, 0.35)
+    t = np.linspace(0, 2 * np.pi, 20001)
+    C = e.curve(t)
+    rng = np.random.default_rng(0)
+    P = rng.uniform(-0.8, 0.8, (300, 2))
+    brute = np.array([np.min(np.linalg.norm(C - p, axis=1)) for p in P])
+    np.testing.assert_allclose(np.abs(e.signed_distance(P)), brute, atol=1e-6)
+    seg = np.sum(np.linalg.norm(np.diff(C, axis=0), axis=1))
+    assert abs(e.perimeter - seg) < 1e-7
+    q = e.curve(np.array([np.pi / 2]))
+    assert abs(e.geodesic_distance(q, e.default_source)[0] - e.perimeter / 4) < 1e-12
+
+
+def test_ellipse_converges_at_first_order_and_is_symmetric():
+    e = Ellipse()
+    pts = e.sample(400)
+    err = []
+    for n in (101, 201, 401):
+        sol = ts.solve(e, ts.Grid(*e.default_box, (n, n)), [e.default_source])
+        err.append(np.max(np.abs(sol(pts) - e.geodesic_distance(pts, e.default_source))))
+        mirrored = pts * np.array([1.0, -1.0])
+        np.testing.assert_allclose(sol(pts), sol(mirrored), atol=1e-12)
+    assert _order(err[0], err[1]) > 0.8 and _order(err[1], err[2]) > 0.8, err
+    assert err[2] < 0.01
+
+
+def test_ellipsoid_closest_point_is_a_foot_point():
+    el = Ellipsoid()
+    rng = np.random.default_rng(2)
+    P = rng.uniform(-0.9, 0.9, (2000, 3))
+    y = el.closest_point(P)
+    assert np.max(np.abs(np.sum((y / el.axes) ** 2, axis=1) - 1)) < 1e-9  # on the surface
+    n = y / el.axes**2
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    r = P - y
+    cross = np.linalg.norm(np.cross(r, n), axis=1)
+    assert np.max(cross) < 1e-8  # x − cp(x) is normal
+    assert el.signed_distance(np.zeros((1, 3)))[0] == pytest.approx(-0.3)
+
+
+def test_ellipsoid_symmetry_and_convergence_to_a_fine_grid_reference():
+    el = Ellipsoid()
+    src = el.default_source  # (−a, 0, 0): u is even in y and in z
+    V, _ = el.triangulation(16)
+    sols = {n: ts.solve(el, ts.Grid(*el.default_box, (n,) * 3), [src]) for n in (41, 81, 161)}
+    for n, sol in sols.items():
+        u = sol(V)
+        assert not np.any(np.isnan(u))
+        np.testing.assert_allclose(u, sol(V * [1, -1, 1]), atol=1e-9)
+        np.testing.assert_allclose(u, sol(V * [1, 1, -1]), atol=1e-9)
+    ref = sols[161](V)
+    e41 = np.max(np.abs(sols[41](V) - ref))
+    e81 = np.max(np.abs(sols[81](V) - ref))
+    # measured against N=161: with errors O(Δx), e(41)/e(81) ≈ (1/40 − 1/160)/(1/80 − 1/160) = 3
+    assert e81 < e41 / 2
+    assert e81 < 0.05
+
+
+def test_torus_outer_equator_is_exact():
+    tor = Torus()
+    src = tor.default_source
+    a = np.linspace(-1, 1, 81) * tor.conjugate_arclength / (tor.R + tor.r) * 0.9
+    P = (tor.R + tor.r) * np.c_[np.cos(a), np.sin(a), np.zeros_like(a)]
+    exact = tor.geodesic_distance(P, src)
+    assert not np.any(np.isnan(exact))
+    err = []
+    for n in (41, 81, 161):
+        sol = ts.solve(tor, ts.Grid(*tor.default_box, (n,) * 3), [src])
+        err.append(np.max(np.abs(sol(P) - exact)))
+    assert err[2] < 0.01
+    assert _order(err[0], err[1]) > 0.8 and _order(err[1], err[2]) > 0.8, err
+    assert np.isnan(tor.geodesic_distance(np.array([[0.0, 0.0, 0.2]]), src)[0])
+
+
+def test_double_torus_runs_and_is_symmetric():
+    dt = DoubleTorus()
+    sol = ts.solve(dt, ts.Grid(*dt.default_box, (81,) * 3), [dt.default_source])
+    assert sol.stats.converged
+    V, _ = dt.triangulation(48)
+    u = sol(V)
+    assert np.all(np.isfinite(u))
+    np.testing.assert_allclose(u, sol(V * [1, -1, 1]), atol=1e-9)
+    # the far end of the other torus is farther than the straight line
+    far = sol(np.array([[dt.offset + dt.R + dt.r, 0.0, 0.0]]))[0]
+    assert far > 2 * (dt.offset + dt.R + dt.r)
+
+
+# ------------------------------------------------------------------------------ redistancing
+def test_non_distance_level_set_is_rejected_with_a_pointer_to_redistance():
+    f = lambda p: 4 * (p[:, 0] ** 2 + p[:, 1] ** 2 - 0.25)  # noqa: E731
+    with pytest.raises(ValueError, match=r"redistance=True"):
+        ts.solve(f, ts.Grid((-1, -1), (1, 1), (51, 51)), [(-0.5, 0)])
+
+
+def test_redistance_reproduces_the_exact_distance_solution_2d_and_3d():
+    f = lambda p: 4 * (p[:, 0] ** 2 + p[:, 1] ** 2 - 0.25)  # noqa: E731
+    grid = ts.Grid((-1, -1), (1, 1), (101, 101))
+    ls = ts.LevelSet(f, redistance=True)
+    geom = ls.band(grid, 4 * grid.spacing)
+    x = grid.points(grid.unravel(geom.linear))
+    np.testing.assert_allclose(geom.signed, np.linalg.norm(x, axis=1) - 0.5, atol=1e-10)
+    a = ts.solve(ls, grid, [(-0.5, 0)])
+    b = ts.solve(Circle(), grid, [(-0.5, 0)])
+    pts = Circle().sample(200)
+    assert np.max(np.abs(a(pts) - b(pts))) < 1e-4
+    # sampled φ (a dense array) too
+    X = np.stack(np.meshgrid(*[np.linspace(-1, 1, 101)] * 2, indexing="ij"), -1).reshape(-1, 2)
+    c = ts.solve(ts.LevelSet(f(X).reshape(101, 101), redistance=True), grid, [(-0.5, 0)])
+    assert np.max(np.abs(c(pts) - b(pts))) < 2e-3
+    # 3D: a squashed, scaled quadric with |∇φ| between 0.6 and 3.4 near the surface
+    g3 = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    q = lambda p: 3 * (np.sum(p**2, axis=1) - 0.25) * (1 + 0.5 * p[:, 0])  # noqa: E731
+    s3 = ts.solve(ts.LevelSet(q, redistance=True), g3, [(-0.5, 0, 0)])
+    r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)])
+    V, _ = Sphere().triangulation(12)
+    assert np.max(np.abs(s3(V) - r3(V))) < 1e-3
