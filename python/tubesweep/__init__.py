@@ -16,6 +16,7 @@ box, Algorithm 1), :class:`Grid`, :class:`LevelSet`.
 """
 
 from ._native import __version__ as _core_version
+from . import flows, hamiltonians
 from .euclidean import travel_time
 from .grid import Grid
 from .solve import Solution, solve
@@ -24,4 +25,4 @@ from .surface import LevelSet, Surface
 
 __version__ = "0.1.0"
 
-__all__ = ["Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "travel_time", "__version__"]
+__all__ = ["flows", "hamiltonians", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "travel_time", "__version__"]
