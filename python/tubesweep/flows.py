@@ -17,14 +17,19 @@ Flow = Callable[[np.ndarray], np.ndarray]
 def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
     """The N-point vortex flow on a sphere centred at the origin (paper Sect. 6.3, after Newton 2001)::
 
-        v(x) = (1/2π) Σ_j s_j (x_j × x) / (|x_j − x|² + δ²)
+        v(x) = (1/2π) Σ_j s_j (x_j × x) / |x_j − x|² · (1 − exp(−|x_j − x|²/δ²))
 
     ``x_j × x`` is orthogonal to ``x``, so the flow is tangent to every sphere about the origin.
     On a sphere (any radius) one vortex alone moves points on circles about ``x_j`` at speed
-    ``|v| = (s/4π) cot(θ/2)`` (θ = angle from ``x_j``) for ``δ = 0``: it grows without bound near
-    the centre. With F = 3 and s = 4 (Figs. 10–11) ``|v| ≥ F`` within an angle θ ≈ 0.21 of each
-    centre. The optional vortex core ``δ = core`` (a length, Krasny-type smoothing) bounds the
-    speed by about ``|s|/(4πδ)``; ``δ > |s|/(4πF)`` keeps a single vortex subsonic.
+    ``|v| = (s/4π) cot(θ/2)`` (θ = angle from ``x_j``) for ``δ = 0`` (the paper's flow): it grows
+    without bound near the centre. With F = 3 and s = 4 (Figs. 10–11) ``|v| ≥ F`` within an angle
+    θ ≈ 0.21 of each centre.
+
+    The optional vortex core ``δ = core`` (a length; a Lamb–Oseen core) leaves the flow unchanged
+    to within ``exp(−r²/δ²)`` at chord distances ``r ≫ δ`` from the centres and makes it a solid
+    rotation inside; on a sphere of radius ``R ≫ δ`` a single vortex then peaks at
+    ``|v| ≈ 0.638·|s|R/(2πδ)``, so ``δ > 0.102·|s|R/F`` keeps it subsonic (0.068 for s = 4,
+    R = 0.5, F = 3).
 
     Parameters
     ----------
@@ -32,7 +37,7 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
     strengths : (N,) or scalar vortex strengths ``s_j`` (positive = counter-clockwise about ``x_j``)
     core : float, vortex core radius δ ≥ 0 (0 = the singular flow of the paper)
 
-    At ``x = x_j`` with ``δ = 0`` the singular term is taken as 0 (its principal value).
+    At ``x = x_j`` the term is taken as 0 (its principal value for δ = 0, its limit for δ > 0).
     """
     c = np.asarray(centers, dtype=float)
     if c.ndim == 1:
@@ -52,8 +57,11 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
             raise ValueError(f"point_vortices flow is defined for points of shape (M, 3); got {x.shape}")
         v = np.zeros_like(x)
         for xj, sj in zip(c, s):
-            r2 = np.sum((x - xj) ** 2, axis=1) + delta2
-            w = np.where(r2 > 1e-300, sj / (2 * np.pi) / np.where(r2 > 1e-300, r2, 1.0), 0.0)
+            r2 = np.sum((x - xj) ** 2, axis=1)
+            safe = np.where(r2 > 1e-300, r2, 1.0)
+            w = np.where(r2 > 1e-300, sj / (2 * np.pi) / safe, 0.0)
+            if delta2 > 0:
+                w = w * -np.expm1(-r2 / delta2)
             v += w[:, None] * np.cross(xj, x)
         return v
 
