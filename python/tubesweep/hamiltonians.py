@@ -18,6 +18,7 @@ See ``docs/hamiltonians.md`` for the derivations and measured convergence.
 
 from __future__ import annotations
 
+import copy
 import warnings
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Optional, Sequence
@@ -101,6 +102,36 @@ def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail:
 
 def _fmt(p: np.ndarray) -> str:
     return "(" + ", ".join(f"{float(c):.4g}" for c in p) + ")"
+
+
+def _regions(linear: np.ndarray, grid: Grid, select: np.ndarray) -> list:
+    """Connected components (grid-axis neighbours) of the selected band nodes, as arrays of band
+    positions."""
+    pos = np.flatnonzero(select)
+    lookup = {int(l): int(i) for i, l in zip(pos, linear[pos])}
+    strides = [int(np.prod(grid.shape[k + 1:])) for k in range(grid.ndim)]
+    idx = grid.unravel(linear[pos])
+    index_of = {int(l): j for j, l in enumerate(linear[pos])}
+    seen = np.zeros(len(pos), dtype=bool)
+    out = []
+    for start in range(len(pos)):
+        if seen[start]:
+            continue
+        seen[start] = True
+        stack, comp = [start], []
+        while stack:
+            j = stack.pop()
+            comp.append(lookup[int(linear[pos[j]])])
+            for k, st in enumerate(strides):
+                for step in (-1, 1):
+                    c = idx[j, k] + step
+                    if 0 <= c < grid.shape[k]:
+                        q = index_of.get(int(linear[pos[j]]) + step * st)
+                        if q is not None and not seen[q]:
+                            seen[q] = True
+                            stack.append(q)
+        out.append(np.asarray(comp, dtype=np.int64))
+    return out
 
 
 class Hamiltonian:
@@ -210,16 +241,20 @@ class MovingMedium(Hamiltonian):
         if np.any(bad):
             j = int(np.flatnonzero(bad)[np.argmax(ratio[bad])])
             nb = int(np.count_nonzero(bad))
+            regions = sorted(_regions(linear, grid, bad), key=lambda r: -float(ratio[r].max()))
+            where = "; ".join(
+                f"around {_fmt(x[r].mean(axis=0))} ({len(r)} nodes, up to {float(ratio[r].max()):.3g})" for r in regions[:5]
+            ) + ("; …" if len(regions) > 5 else "")
             msg = (
                 f"flow: |v| ≥ F at {nb} of {int(np.count_nonzero(active))} inner-tube nodes — the medium outruns the wave "
                 f"there and the first-arrival problem changes character (the paper assumes |v| ≪ F). Worst at "
-                f"{_fmt(x[j])}: |v| = {speed_v[j]:.4g} vs F = {f[j]:.4g} (|v|/F = {ratio[j]:.3g}); the supersonic nodes "
-                f"span {_fmt(x[bad].min(axis=0))} to {_fmt(x[bad].max(axis=0))}."
+                f"{_fmt(x[j])}: |v| = {speed_v[j]:.4g} vs F = {f[j]:.4g} (|v|/F = {ratio[j]:.3g}). "
+                f"{len(regions)} supersonic region(s), with their max |v|/F: {where}."
             )
             if not self.allow_supersonic:
                 raise ValueError(
                     msg + " Pass allow_supersonic=True to compute the Lax–Friedrichs solution of the equation as written "
-                    "anyway, or make the flow subsonic (e.g. ts.flows.point_vortices(..., core=δ) with δ > s/(4πF))"
+                    "anyway, or make the flow subsonic (e.g. a vortex core: ts.flows.point_vortices(..., core=δ))"
                 )
             warnings.warn(msg + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway", RuntimeWarning, stacklevel=4)
         return _Prepared(self.kind, slowness, flow=v, sigma=self._sigma(d),
@@ -312,6 +347,7 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
         if allow_supersonic:
             if not isinstance(hamiltonian, MovingMedium):
                 raise ValueError("allow_supersonic only applies to the moving-medium equation (flow=...)")
+            hamiltonian = copy.copy(hamiltonian)  # leave the caller's object as it is
             hamiltonian.allow_supersonic = True
         return hamiltonian
     if flow is not None:
