@@ -52,9 +52,12 @@ class Band:
         missing: str,
         tol: float,
         max_iterations: int,
-        infinity: float,
+        infinity: Optional[float],
         flow: Optional[npt.NDArray[np.float64]] = None,
         metric: Optional[npt.NDArray[np.float64]] = None,
         sigma: Optional[npt.NDArray[np.float64]] = None,
         progress: Optional[Callable[[int, float, int], Any]] = None,
+        threads: int = 0,
+        skip_inactive: bool = True,
+        activation_threshold: float = 0.0,
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...

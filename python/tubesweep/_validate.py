@@ -145,12 +145,17 @@ def progress_callback(progress: Any) -> Optional[Callable[[int, float, int], Non
     return progress
 
 
-def check_infinity(infinity: Optional[float]) -> float:
-    """The numerical infinity to use: the default, or a user value that must be large and finite."""
-    from . import _native
-
+def check_infinity(infinity: Optional[float]) -> Optional[float]:
+    """The numerical infinity to use: None (derived from the band by the core), or a user value
+    that must be positive and finite."""
     if infinity is None:
-        return float(_native.DEFAULT_INFINITY)
+        return None
     if not (isinstance(infinity, (int, float, np.floating)) and np.isfinite(infinity) and infinity > 0):
         raise ValueError(f"infinity must be a positive finite number (a 'numerical infinity'); got {infinity!r}")
     return float(infinity)
+
+
+def check_threads(threads: int) -> int:
+    if not (isinstance(threads, (int, np.integer)) and threads >= 0):
+        raise ValueError(f"threads must be a non-negative integer (0 = all cores); got {threads!r}")
+    return int(threads)

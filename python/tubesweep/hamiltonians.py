@@ -361,8 +361,9 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
 
 def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any, roles: np.ndarray,
                fixed: np.ndarray, positions: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
-               source_radius: float, tol: float, max_iterations: int, infinity: float,
-               progress: Optional[Callable[[int, float, int], None]]) -> tuple:
+               source_radius: float, tol: float, max_iterations: int, infinity: Optional[float],
+               progress: Optional[Callable[[int, float, int], None]], threads: int = 0,
+               activation_threshold: float = 0.0) -> tuple:
     """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
     travel time (for ``exact_sources``), and runs the general Lax–Friedrichs sweeps (Sect. 5.1)."""
     x = grid.points(grid.unravel(geom.linear))
@@ -382,8 +383,9 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
         fixed[positions] = np.where(np.isfinite(best), best, fixed[positions])
     values, st = band.solve_general(
         roles, fixed, grid.spacing, prep.kind, prep.slowness, np.ascontiguousarray(geom.direction, dtype=np.float32),
-        "extrapolate", float(tol), int(max_iterations), float(infinity),
-        flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress,
+        "extrapolate", float(tol), int(max_iterations), None if infinity is None else float(infinity),
+        flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress, threads=int(threads),
+        skip_inactive=True, activation_threshold=float(activation_threshold),
     )
     st = dict(st)
     st.update(prep.extra if "inverse" not in prep.extra else {})

@@ -197,11 +197,25 @@ class LevelSet(Surface):
                 width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
                 g[:, k] = (up - dn) / width
         else:
-            x = grid.points(idx)
+            # φ at a neighbour that is itself a band node is already known: look it up in the
+            # sorted band, evaluate the callable only at the others (the band's outer rim).
+            strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
             for k in range(d):
-                e = np.zeros(d)
-                e[k] = h
-                g[:, k] = (_evaluate(self._fn, x + e, "surface") - _evaluate(self._fn, x - e, "surface")) / (2 * h)  # type: ignore[arg-type]
+                side_vals = []
+                for sign in (1, -1):
+                    nb = linear + sign * strides[k]
+                    inside = (idx[:, k] + sign >= 0) & (idx[:, k] + sign < grid.shape[k])
+                    pos = np.minimum(np.searchsorted(linear, nb), len(linear) - 1)
+                    known = inside & (linear[pos] == nb)
+                    vals = np.empty(len(linear))
+                    vals[known] = values[pos[known]]
+                    todo = ~known
+                    if np.any(todo):
+                        x = grid.points(idx[todo])
+                        x[:, k] += sign * h
+                        vals[todo] = _evaluate(self._fn, x, "surface")  # type: ignore[arg-type]
+                    side_vals.append(vals)
+                g[:, k] = (side_vals[0] - side_vals[1]) / (2 * h)
         return g
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:

@@ -15,6 +15,7 @@
 //! Cost per band node: 4 bytes of last-axis coordinate and 8·d bytes of neighbour table.
 
 use crate::error::{Error, Result};
+use crate::schedule::SweepSchedule;
 use rayon::prelude::*;
 
 /// The band nodes and their neighbour table. `D` is the dimension (2 or 3).
@@ -25,7 +26,7 @@ pub struct NarrowBand<const D: usize> {
     row_start: Vec<u32>,
     last: Vec<u32>,
     neighbours: Vec<[[u32; 2]; D]>,
-    row_orders: Vec<Vec<u32>>,
+    schedule: SweepSchedule,
 }
 
 impl<const D: usize> NarrowBand<D> {
@@ -89,10 +90,11 @@ impl<const D: usize> NarrowBand<D> {
             row_start,
             last,
             neighbours: vec![[[len as u32; 2]; D]; len],
-            row_orders: Vec::new(),
+            schedule: SweepSchedule::default(),
         };
         band.build_neighbours();
-        band.build_row_orders();
+        let leads: Vec<[usize; D]> = (0..band.n_rows()).map(|r| band.row_lead(r)).collect();
+        band.schedule = SweepSchedule::new(&leads, band.shape);
         band
     }
 
@@ -134,10 +136,16 @@ impl<const D: usize> NarrowBand<D> {
     }
 
     /// Row visiting order for the orientation `signs` of the leading `D − 1` axes (bit `k` set =
-    /// axis `k` walked backwards).
+    /// axis `k` walked backwards), grouped in tiles and waves (see [`SweepSchedule`]).
     #[inline]
     pub fn row_order(&self, signs: usize) -> &[u32] {
-        &self.row_orders[signs]
+        self.schedule.rows(signs)
+    }
+
+    /// The parallel sweep schedule.
+    #[inline]
+    pub fn schedule(&self) -> &SweepSchedule {
+        &self.schedule
     }
 
     /// The grid index of band node `n`.
@@ -283,37 +291,13 @@ impl<const D: usize> NarrowBand<D> {
         debug_assert!(self.neighbours.iter().all(|nb| nb.iter().all(|p| p[0] <= len && p[1] <= len)));
     }
 
-    fn build_row_orders(&mut self) {
-        let n_orient = 1usize << (D - 1);
-        let mut orders = Vec::with_capacity(n_orient);
-        let leads: Vec<[usize; D]> = (0..self.n_rows()).map(|r| self.row_lead(r)).collect();
-        for signs in 0..n_orient {
-            let mut order: Vec<u32> = (0..self.n_rows() as u32).collect();
-            if signs != 0 {
-                let shape = self.shape;
-                let flipped = |r: u32| -> u64 {
-                    let lead = &leads[r as usize];
-                    let mut key = 0u64;
-                    for k in 0..D - 1 {
-                        let c = if signs & (1 << k) != 0 { shape[k] - 1 - lead[k] } else { lead[k] };
-                        key = key * shape[k] as u64 + c as u64;
-                    }
-                    key
-                };
-                order.par_sort_unstable_by_key(|&r| flipped(r));
-            }
-            orders.push(order);
-        }
-        self.row_orders = orders;
-    }
-
     /// Bytes held by this structure (for memory reports).
     pub fn heap_bytes(&self) -> usize {
         self.row_keys.len() * 8
             + self.row_start.len() * 4
             + self.last.len() * 4
             + self.neighbours.len() * std::mem::size_of::<[[u32; 2]; D]>()
-            + self.row_orders.iter().map(|o| o.len() * 4).sum::<usize>()
+            + self.schedule.heap_bytes()
     }
 }
 

@@ -9,6 +9,12 @@ pub trait Hamiltonian<const D: usize>: Sync {
     fn value(&self, node: usize, p: [f64; D]) -> f64;
     /// Artificial viscosities `σ_k ≥ max |∂H/∂p_k|` at band node `node` (Sect. 5.1).
     fn viscosity(&self, node: usize) -> [f64; D];
+    /// An upper bound on the travel time per unit length (the largest `|∇u|` a solution can
+    /// have), used to choose a tight numerical infinity. `None` (the default) falls back to
+    /// [`crate::DEFAULT_INFINITY`].
+    fn slowness_bound(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// The local solver used in the inner tube (or the whole box for the Euclidean solver).
@@ -37,5 +43,8 @@ impl<'a, const D: usize> Hamiltonian<D> for IsotropicEikonal<'a> {
     #[inline]
     fn viscosity(&self, _node: usize) -> [f64; D] {
         [1.0; D]
+    }
+    fn slowness_bound(&self) -> Option<f64> {
+        Some(self.slowness.iter().cloned().fold(0.0, f64::max))
     }
 }

@@ -28,6 +28,7 @@ pub mod hamiltonian;
 pub mod hamiltonians;
 pub mod interpolate;
 pub mod lax_friedrichs;
+pub mod schedule;
 pub mod sweep;
 
 pub use band::NarrowBand;

@@ -54,6 +54,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     d.set_item("converged", s.converged)?;
     d.set_item("last_change", s.last_change)?;
     d.set_item("seconds", s.seconds)?;
+    d.set_item("infinity", s.infinity)?;
     Ok(d)
 }
 
@@ -412,7 +413,7 @@ impl PyBand {
     }
 
     /// Runs the sweeps. See `tubesweep_core::sweep`.
-    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None))]
+    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
@@ -426,12 +427,18 @@ impl PyBand {
         missing: &str,
         tol: f64,
         max_iterations: usize,
-        infinity: f64,
+        infinity: Option<f64>,
         progress: Option<Bound<'py, PyAny>>,
+        threads: usize,
+        skip_inactive: bool,
+        activation_threshold: f64,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let scheme = parse_scheme(scheme)?;
         let missing = parse_missing(missing)?;
-        let options = SolveOptions { tol, max_iterations, infinity };
+        if !(activation_threshold >= 0.0) {
+            return Err(PyValueError::new_err("activation_threshold must be non-negative"));
+        }
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold };
         let roles = roles.as_slice()?;
         let fixed = fixed_values.as_slice()?;
         match &self.band {
@@ -444,7 +451,7 @@ impl PyBand {
     /// Hamiltonian: `"isotropic"` (`|p| − s`), `"moving_medium"` (`|p| − s|1 − v·p|`, needs
     /// `flow` (K, d)) or `"metric"` (`sqrt(pᵀMp) − s`, needs `metric` (K, d, d)). `slowness` has
     /// 1 or K entries; `sigma` (d,) overrides the automatic per-node viscosities.
-    #[pyo3(signature = (roles, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None))]
+    #[pyo3(signature = (roles, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn solve_general<'py>(
         &self,
@@ -458,14 +465,20 @@ impl PyBand {
         missing: &str,
         tol: f64,
         max_iterations: usize,
-        infinity: f64,
+        infinity: Option<f64>,
         flow: Option<PyReadonlyArray2<'py, f64>>,
         metric: Option<PyReadonlyArray3<'py, f64>>,
         sigma: Option<PyReadonlyArray1<'py, f64>>,
         progress: Option<Bound<'py, PyAny>>,
+        threads: usize,
+        skip_inactive: bool,
+        activation_threshold: f64,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let missing = parse_missing(missing)?;
-        let options = SolveOptions { tol, max_iterations, infinity };
+        if !(activation_threshold >= 0.0) {
+            return Err(PyValueError::new_err("activation_threshold must be non-negative"));
+        }
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold };
         let inputs = GeneralInputs {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,

@@ -26,6 +26,11 @@ impl<'a, const D: usize> Hamiltonian<D> for Isotropic<'a> {
             None => [1.0; D],
         }
     }
+
+    /// `max s`: no path costs more than its length times the largest slowness.
+    fn slowness_bound(&self) -> Option<f64> {
+        Some(self.slowness.iter().cloned().fold(0.0, f64::max))
+    }
 }
 
 #[cfg(test)]

@@ -51,6 +51,46 @@ impl<'a, const D: usize> Hamiltonian<D> for Metric<'a, D> {
             }
         }
     }
+
+    /// `max s / sqrt(λ_min(M))` (a path in direction `e` costs `s sqrt(eᵀM⁻¹e) ≤ s/sqrt(λ_min)` per
+    /// unit length), with the safe lower bound `λ_min ≥ det M / (tr M)^(D−1)`. `None` if some `M`
+    /// is not positive definite.
+    fn slowness_bound(&self) -> Option<f64> {
+        let mut bound = 0.0f64;
+        for (n, m) in self.metric.iter().enumerate() {
+            let tr: f64 = (0..D).map(|k| m[k][k]).sum();
+            let det = determinant(*m);
+            if !(det > 0.0 && tr > 0.0) {
+                return None;
+            }
+            let lam_min = det / tr.powi(D as i32 - 1);
+            bound = bound.max(slowness_at(self.slowness, n) / lam_min.sqrt());
+        }
+        bound.is_finite().then_some(bound)
+    }
+}
+
+/// Determinant by Gaussian elimination with partial pivoting.
+fn determinant<const D: usize>(mut a: [[f64; D]; D]) -> f64 {
+    let mut det = 1.0;
+    for c in 0..D {
+        let p = (c..D).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap_or(c);
+        if a[p][c] == 0.0 {
+            return 0.0;
+        }
+        if p != c {
+            a.swap(p, c);
+            det = -det;
+        }
+        det *= a[c][c];
+        for r in c + 1..D {
+            let f = a[r][c] / a[c][c];
+            for k in c..D {
+                a[r][k] -= f * a[c][k];
+            }
+        }
+    }
+    det
 }
 
 #[cfg(test)]
@@ -64,6 +104,18 @@ mod tests {
         let h = Metric { slowness: &s, metric: &m, sigma: None };
         assert!((h.value(0, [3.0, 4.0]) - 4.0).abs() < 1e-14);
         assert_eq!(h.viscosity(0), [1.0, 1.0]);
+        // λ_min ≥ det/tr = 1/2: a safe (here loose by √2) bound on the true value 1
+        assert!((h.slowness_bound().unwrap() - 2f64.sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn slowness_bound_covers_the_slowest_direction() {
+        let s = [0.5];
+        let m = [[[2.0, 0.6], [0.6, 0.5]]];
+        let h = Metric { slowness: &s, metric: &m, sigma: None };
+        let lam_min = (2.5 - ((1.5f64).powi(2) + 4.0 * 0.36).sqrt()) / 2.0;
+        assert!(h.slowness_bound().unwrap() >= 0.5 / lam_min.sqrt());
+        assert!((determinant([[2.0, 0.6, 0.0], [0.6, 0.5, 0.0], [0.0, 0.0, 3.0]]) - 3.0 * 0.64).abs() < 1e-14);
     }
 
     #[test]

@@ -48,6 +48,21 @@ impl<'a, const D: usize> Hamiltonian<D> for MovingMedium<'a, D> {
             }
         }
     }
+
+    /// `max 1/(F − |v|)`: a front never moves slower than `F − |v|` along any direction. `None`
+    /// (the fixed default infinity) when the flow is supersonic somewhere.
+    fn slowness_bound(&self) -> Option<f64> {
+        let mut bound = 0.0f64;
+        for (n, v) in self.flow.iter().enumerate() {
+            let s = slowness_at(self.slowness, n);
+            let sv = s * norm(v);
+            if !(sv < 1.0) {
+                return None;
+            }
+            bound = bound.max(s / (1.0 - sv));
+        }
+        Some(bound)
+    }
 }
 
 #[cfg(test)]
@@ -73,6 +88,9 @@ mod tests {
         assert!(h.value(0, [1.0 / (f + v), 0.0]).abs() < 1e-15);
         assert!(h.value(0, [-1.0 / (f - v), 0.0]).abs() < 1e-15);
         assert_eq!(h.viscosity(0), [1.0 + v / f, 1.0]);
+        assert!((h.slowness_bound().unwrap() - 1.0 / (f - v)).abs() < 1e-15);
+        let fast = [[4.0, 0.0]];
+        assert!(MovingMedium { slowness: &s, flow: &fast, sigma: None }.slowness_bound().is_none());
     }
 
     #[test]

@@ -1,0 +1,109 @@
+//! The order in which a sweep visits the band's rows, arranged so that sweeps run in parallel and
+//! still give *bit-identical* results to the sequential Gauss–Seidel sweep.
+//!
+//! A row (all nodes sharing the leading `d − 1` indices) reads only its own nodes and the nodes
+//! of the rows next to it along each leading axis. In the sequential lexicographic sweep of a
+//! given orientation, row `r` is processed after its "lower" neighbour rows and before its
+//! "upper" ones. Group the rows into square *tiles* of `TILE` × `TILE` rows (in the sweep's
+//! orientation) and the tiles into *waves* by the sum of their tile coordinates: tiles of one
+//! wave never touch each other, every lower neighbour of a row lies in its own tile (earlier in
+//! lexicographic order) or in an earlier wave, and every upper neighbour in its own tile (later)
+//! or a later wave. Processing the waves in order, the tiles of a wave in parallel and the rows
+//! of a tile lexicographically therefore reads exactly the same neighbour values as the
+//! sequential sweep (a 2D band has one leading axis: its waves hold one tile, it runs
+//! sequentially).
+
+/// Leading-axis rows per tile side.
+pub const TILE: usize = 16;
+
+/// The wave/tile/row order for each orientation of the leading axes.
+#[derive(Debug, Clone, Default)]
+pub struct SweepSchedule {
+    /// Per orientation: rows in processing order.
+    rows: Vec<Vec<u32>>,
+    /// Per orientation: boundaries of the tiles in `rows` (one more than the tiles).
+    tiles: Vec<Vec<u32>>,
+    /// Per orientation: boundaries of the waves in `tiles` (one more than the waves).
+    waves: Vec<Vec<u32>>,
+}
+
+impl SweepSchedule {
+    /// Builds the schedule from the leading indices of the rows (`lead[r][k]` for `k < lead_dims`)
+    /// and the grid shape.
+    pub fn new<const D: usize>(leads: &[[usize; D]], shape: [usize; D]) -> Self {
+        let lead_dims = D - 1;
+        let n_orient = 1usize << lead_dims;
+        let mut sched = SweepSchedule::default();
+        for signs in 0..n_orient {
+            // key: (wave, tile coords, row coords) in this orientation
+            let mut keyed: Vec<(u64, u64, u64, u32)> = leads
+                .iter()
+                .enumerate()
+                .map(|(r, lead)| {
+                    let mut wave = 0u64;
+                    let mut tile = 0u64;
+                    let mut row = 0u64;
+                    for k in 0..lead_dims {
+                        let c = if signs & (1 << k) != 0 { shape[k] - 1 - lead[k] } else { lead[k] };
+                        let t = (c / TILE) as u64;
+                        wave += t;
+                        tile = tile * (shape[k] / TILE + 1) as u64 + t;
+                        row = row * shape[k] as u64 + c as u64;
+                    }
+                    if lead_dims == 1 {
+                        // one leading axis: no two tiles are independent, run them in sequence
+                        wave = row;
+                        tile = row;
+                    }
+                    (wave, tile, row, r as u32)
+                })
+                .collect();
+            keyed.sort_unstable();
+            let mut rows = Vec::with_capacity(keyed.len());
+            let mut tiles = vec![0u32];
+            let mut waves = vec![0u32];
+            for (i, &(wave, tile, _, r)) in keyed.iter().enumerate() {
+                if i > 0 {
+                    let (pw, pt, _, _) = keyed[i - 1];
+                    if pt != tile || pw != wave {
+                        tiles.push(i as u32);
+                    }
+                    if pw != wave {
+                        waves.push((tiles.len() - 1) as u32);
+                    }
+                }
+                rows.push(r);
+            }
+            tiles.push(keyed.len() as u32);
+            waves.push((tiles.len() - 1) as u32);
+            sched.rows.push(rows);
+            sched.tiles.push(tiles);
+            sched.waves.push(waves);
+        }
+        sched
+    }
+
+    /// Rows in processing order for orientation `signs`.
+    #[inline]
+    pub fn rows(&self, signs: usize) -> &[u32] {
+        &self.rows[signs]
+    }
+
+    /// Tile boundaries (indices into [`rows`](Self::rows)) for orientation `signs`.
+    #[inline]
+    pub fn tiles(&self, signs: usize) -> &[u32] {
+        &self.tiles[signs]
+    }
+
+    /// Wave boundaries (indices into [`tiles`](Self::tiles)) for orientation `signs`.
+    #[inline]
+    pub fn waves(&self, signs: usize) -> &[u32] {
+        &self.waves[signs]
+    }
+
+    pub fn heap_bytes(&self) -> usize {
+        self.rows.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.tiles.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.waves.iter().map(|v| v.len() * 4).sum::<usize>()
+    }
+}

@@ -1,0 +1,76 @@
+"""The tubesweep command line."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tubesweep.cli import main
+
+
+def test_help_explains_itself(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--help"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    for word in ("solve", "travel-time", "reproduce", "demo", "Wong & Leung"):
+        assert word in out
+
+
+def test_solve_builtin_circle_writes_band_and_picture(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    assert main(["solve", "--surface", "circle", "--n", "101", "--out", str(tmp_path), "--png", "--dense", "--quiet"]) == 0
+    data = np.load(tmp_path / "solution.npz")
+    idx, vals = data["indices"], data["values"]
+    assert idx.shape[1] == 2 and len(vals) == len(idx)
+    # the node nearest the far side of the circle (0.5, 0) holds ≈ π/2 · 0.5
+    h = 0.02
+    pts = -1 + h * idx
+    far = np.argmin(np.linalg.norm(pts - [0.5, 0.0], axis=1))
+    assert vals[far] == pytest.approx(np.pi / 2, abs=0.05)
+    assert (tmp_path / "solution.png").stat().st_size > 10_000
+    dense = np.load(tmp_path / "solution_dense.npy")
+    assert dense.shape == (101, 101)
+    assert "iterations" in capsys.readouterr().out
+
+
+def test_solve_phi_file(tmp_path):
+    x = np.linspace(-1, 1, 61)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    np.save(tmp_path / "phi.npy", np.hypot(X, Y) - 0.5)
+    rc = main(["solve", "--phi", str(tmp_path / "phi.npy"), "--lower", "-1", "-1", "--upper", "1", "1",
+               "--source", "0.5", "0", "--hamiltonian", "lxf", "--out", str(tmp_path / "o"), "--quiet"])
+    assert rc == 0
+    assert (tmp_path / "o" / "solution.npz").exists()
+
+
+def test_bad_input_is_a_clear_error_with_exit_code_2(tmp_path, capsys):
+    rc = main(["solve", "--surface", "circle", "--n", "51", "--source", "0", "0", "--out", str(tmp_path), "--quiet"])
+    assert rc == 2
+    assert "farther than the inner tube" in capsys.readouterr().err
+
+
+def test_travel_time(tmp_path):
+    assert main(["travel-time", "--n", "41", "--dim", "2", "--source", "0.1", "0", "--out", str(tmp_path), "--quiet"]) == 0
+    u = np.load(tmp_path / "travel_time.npy")
+    assert u[20, 20] == pytest.approx(0.1, abs=1e-12)
+
+
+def test_reproduce_lists_experiments(capsys):
+    assert main(["reproduce", "list"]) == 0
+    assert "source-init" in capsys.readouterr().out
+
+
+def test_module_entry_point():
+    r = subprocess.run([sys.executable, "-m", "tubesweep", "info"], capture_output=True, text=True, check=True)
+    assert "tubesweep" in r.stdout
+
+
+def test_demo_quick(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    assert main(["demo", "--quick", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "sphere" in out and "star" in out
+    for name in ("sphere.png", "star.png", "layered.png"):
+        assert (tmp_path / name).stat().st_size > 10_000

@@ -1,0 +1,52 @@
+"""The private native module rejects malformed calls with exceptions: no panic crosses into
+Python."""
+
+import numpy as np
+import pytest
+
+from tubesweep import _native
+
+
+def test_band_construction_errors():
+    with pytest.raises(ValueError, match="sorted"):
+        _native.Band.from_linear([5, 5], np.array([3, 2], dtype=np.uint64))
+    with pytest.raises(ValueError, match="outside"):
+        _native.Band.from_linear([5, 5], np.array([30], dtype=np.uint64))
+    with pytest.raises(ValueError, match="2D and 3D"):
+        _native.Band.from_linear([5, 5, 5, 5], np.array([0], dtype=np.uint64))
+    with pytest.raises(ValueError, match="at least 3"):
+        _native.Band.full_box([2, 9])
+
+
+def test_solve_argument_errors():
+    band = _native.Band.full_box([5, 5])
+    roles = np.ones(25, np.uint8)
+    fixed = np.zeros(25)
+    ok = dict(spacing=0.25, slowness=1.0, directions=None, scheme="godunov", missing="infinity", tol=1e-9,
+              max_iterations=10, infinity=None)
+    with pytest.raises(ValueError, match="one entry per band node"):
+        band.solve(roles[:-1], fixed, **ok)
+    with pytest.raises(ValueError, match="role"):
+        band.solve(np.full(25, 7, np.uint8), fixed, **ok)
+    with pytest.raises(ValueError, match="scheme"):
+        band.solve(roles, fixed, **{**ok, "scheme": "weno"})
+    with pytest.raises(ValueError, match="infinity"):
+        band.solve(roles, fixed, **{**ok, "infinity": -1.0})
+    with pytest.raises(ValueError, match="speed"):
+        band.solve(roles, fixed, **{**ok, "slowness": np.ones(3)})
+    r2 = roles.copy()
+    r2[3] = 2
+    with pytest.raises(ValueError, match="directions"):
+        band.solve(r2, fixed, **ok)
+    with pytest.raises(ValueError, match="points"):
+        band.interpolate(np.zeros(25), [0.0, 0.0], 0.25, np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="values"):
+        band.interpolate(np.zeros(24), [0.0, 0.0], 0.25, np.zeros((3, 2)))
+
+
+def test_unreached_nodes_report_the_infinity_used():
+    band = _native.Band.from_linear([5, 5], np.array([0, 1, 20, 21], dtype=np.uint64))  # two pieces
+    roles = np.array([0, 1, 1, 1], np.uint8)
+    vals, st = band.solve(roles, np.zeros(4), 1.0, 1.0, None, "godunov", "infinity", 1e-12, 10, None)
+    assert vals[1] == 1.0
+    assert vals[2] == st["infinity"] and vals[3] == st["infinity"]
