@@ -9,7 +9,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-__all__ = ["point_vortices", "solid_body_rotation", "Flow"]
+__all__ = ["point_vortices", "solid_body_rotation", "rotation_travel_time_circle", "rotation_travel_time_sphere", "Flow"]
 
 Flow = Callable[[np.ndarray], np.ndarray]
 
