@@ -17,6 +17,7 @@ Sect. 5.2) and the library :mod:`tubesweep.surfaces`.
 """
 
 from ._native import __version__ as _core_version
+from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .euclidean import travel_time
 from .grid import Grid
@@ -27,4 +28,7 @@ from . import surfaces
 
 __version__ = "0.1.0"
 
-__all__ = ["ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "surfaces", "travel_time", "__version__"]
+__all__ = [
+    "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "flows", "hamiltonians", "solve",
+    "surfaces", "travel_time", "__version__",
+]

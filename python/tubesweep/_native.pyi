@@ -41,3 +41,23 @@ class Band:
         infinity: float,
         progress: Optional[Callable[[int, float, int], Any]] = None,
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
+    def solve_general(
+        self,
+        roles: npt.NDArray[np.uint8],
+        fixed_values: npt.NDArray[np.float64],
+        spacing: float,
+        hamiltonian: str,
+        slowness: npt.NDArray[np.float64],
+        directions: Optional[npt.NDArray[np.float32]],
+        missing: str,
+        tol: float,
+        max_iterations: int,
+        infinity: Optional[float],
+        flow: Optional[npt.NDArray[np.float64]] = None,
+        metric: Optional[npt.NDArray[np.float64]] = None,
+        sigma: Optional[npt.NDArray[np.float64]] = None,
+        progress: Optional[Callable[[int, float, int], Any]] = None,
+        threads: int = 0,
+        skip_inactive: bool = True,
+        activation_threshold: float = 0.0,
+    ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...

@@ -175,8 +175,10 @@ def solve(
     grid: Grid,
     sources: Any,
     *,
-    hamiltonian: str = "godunov",
+    hamiltonian: Any = "godunov",
     speed: Any = 1.0,
+    flow: Any = None,
+    allow_supersonic: bool = False,
     inner: float = 2.0,
     outer: float = 4.0,
     method: str = "two-layer",
@@ -205,8 +207,16 @@ def solve(
     grid : Grid
     sources : array-like (K, d)
         Points on the surface (within the inner tube).
-    hamiltonian : {"godunov", "lxf"}
+    hamiltonian : {"godunov", "lxf"} or a ``ts.hamiltonians`` object
+        A :class:`tubesweep.hamiltonians.Hamiltonian` (``Isotropic()``, ``MovingMedium(v)``,
+        ``Metric(M)``) solves ``H(x, ∇u) = 0`` with the general Lax–Friedrichs update of Sect. 5.1.
     speed : float, ndarray of ``grid.shape``, or callable ``F(points) -> (M,)``
+    flow : callable ``v(points (M, d)) -> (M, d)`` or array of ``grid.shape + (d,)``, optional
+        Ambient flow of a moving medium: solves ``|∇u| = |1 − v·∇u| / F`` (Sect. 6.3) with the
+        Lax–Friedrichs update of Sect. 5.1 (shorthand for ``hamiltonian=ts.hamiltonians.MovingMedium(flow)``).
+        ``|v| ≥ F`` anywhere in the inner tube is a ``ValueError``; see ``allow_supersonic``.
+    allow_supersonic : bool
+        Compute the moving-medium solution even where ``|v| ≥ F`` (with a warning).
     inner, outer : float
         Tube half-widths in grid spacings (paper: 2 and 4; 5 for the bunny).
     method : {"two-layer", "naive"}
@@ -233,7 +243,10 @@ def solve(
     surf = as_surface(surface)
     surf.check_grid(grid)
     src = as_sources(sources, grid)
-    scheme = check_hamiltonian(hamiltonian)
+    from . import hamiltonians as _hams
+
+    general = _hams.resolve(hamiltonian, flow, allow_supersonic)
+    scheme = check_hamiltonian(hamiltonian) if general is None else general.label
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     if method not in METHODS:
@@ -305,10 +318,15 @@ def solve(
     del x
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
     setup = time.perf_counter() - t0
-    values, st = band.solve(
-        roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
-        float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
-    )
+    if general is None:
+        values, st = band.solve(
+            roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
+            float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
+        )
+    else:
+        values, st = _hams.solve_band(general, surf, grid, geom, band, roles, fixed, positions, src, speed_nodes,
+                                      source_init == "exact", SOURCE_RADIUS, tol, max_iterations, _infinity(infinity), cb,
+                                      _threads(threads), ACTIVATION_FRACTION * float(tol))
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))

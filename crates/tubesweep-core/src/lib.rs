@@ -10,6 +10,7 @@
 //! |---|---|---|
 //! | the Godunov local solver | [`godunov`] | Eq. (3) and its 3D form |
 //! | the Lax–Friedrichs local solver | [`lax_friedrichs`] | Eq. (4), Sect. 5.1 |
+//! | built-in Hamiltonians (isotropic, moving medium, metric) | [`hamiltonians`] | Sect. 5.1, 6.3 |
 //! | the upwind extension update | [`extension`] | Eq. (5) applied to Eq. (8) |
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
@@ -24,6 +25,7 @@ pub mod error;
 pub mod extension;
 pub mod godunov;
 pub mod hamiltonian;
+pub mod hamiltonians;
 pub mod interpolate;
 pub mod lax_friedrichs;
 pub mod schedule;

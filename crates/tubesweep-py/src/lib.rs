@@ -5,14 +5,15 @@
 mod errors;
 
 use errors::to_pyerr;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
 use tubesweep_core::interpolate::interpolate;
 use tubesweep_core::sweep::{MissingNeighbour, Slowness};
-use tubesweep_core::{Control, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
+use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
+use tubesweep_core::{Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
 
 enum AnyBand {
     D2(NarrowBand<2>),
@@ -117,6 +118,132 @@ fn solve_generic<'py, const D: usize>(
             },
             directions: &dirs,
             scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
+            missing,
+        };
+        let mut callback = |r: &IterationReport| -> Control {
+            Python::attach(|py| {
+                if let Err(e) = py.check_signals() {
+                    py_error = Some(e);
+                    return Control::Stop;
+                }
+                if let Some(cb) = &progress_ref {
+                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
+                        py_error = Some(e);
+                        return Control::Stop;
+                    }
+                }
+                Control::Continue
+            })
+        };
+        problem.solve(&mut values, &options, &mut callback)
+    });
+    if let Some(e) = py_error {
+        return Err(e);
+    }
+    let stats = result.map_err(to_pyerr)?;
+    Ok((values.into_pyarray(py), stats_dict(py, &stats)?))
+}
+
+/// Per-node data of a built-in general Hamiltonian (Sect. 5.1), borrowed from NumPy arrays.
+struct GeneralInputs<'s> {
+    kind: String,
+    slowness: &'s [f64],
+    flow: Option<&'s [f64]>,
+    metric: Option<&'s [f64]>,
+    sigma: Option<&'s [f64]>,
+}
+
+/// Sweeps with the general Lax–Friedrichs update of Sect. 5.1 and a built-in Hamiltonian.
+#[allow(clippy::too_many_arguments)]
+fn solve_general_generic<'py, const D: usize>(
+    py: Python<'py>,
+    band: &NarrowBand<D>,
+    roles: &[u8],
+    fixed_values: &[f64],
+    spacing: f64,
+    inputs: GeneralInputs<'_>,
+    directions: Option<PyReadonlyArray2<'py, f32>>,
+    missing: MissingNeighbour,
+    options: SolveOptions,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+    let n = band.len();
+    if roles.len() != n || fixed_values.len() != n {
+        return Err(PyValueError::new_err(format!("roles and values must have one entry per band node ({n})")));
+    }
+    if inputs.slowness.len() != n && inputs.slowness.len() != 1 {
+        return Err(PyValueError::new_err(format!("slowness must have 1 or {n} entries, got {}", inputs.slowness.len())));
+    }
+    if let Some(s) = inputs.sigma {
+        if s.len() != D || !s.iter().all(|x| x.is_finite() && *x > 0.0) {
+            return Err(PyValueError::new_err(format!("sigma must hold {D} positive finite numbers")));
+        }
+    }
+    let roles: Vec<NodeRole> = roles
+        .iter()
+        .map(|&r| NodeRole::from_u8(r).ok_or_else(|| PyValueError::new_err(format!("roles: invalid role {r}"))))
+        .collect::<PyResult<_>>()?;
+    let dirs: Vec<[f32; D]> = match &directions {
+        Some(d) => {
+            if d.shape() != [n, D] {
+                return Err(PyValueError::new_err(format!("directions must have shape ({n}, {D})")));
+            }
+            d.as_slice()?.chunks_exact(D).map(|c| c.try_into().unwrap_or([0.0; D])).collect()
+        }
+        None => Vec::new(),
+    };
+    let flow: Vec<[f64; D]> = match inputs.flow {
+        Some(f) if f.len() == n * D => f.chunks_exact(D).map(|c| c.try_into().unwrap_or([0.0; D])).collect(),
+        Some(_) => return Err(PyValueError::new_err(format!("flow must have shape ({n}, {D})"))),
+        None => Vec::new(),
+    };
+    let metric: Vec<[[f64; D]; D]> = match inputs.metric {
+        Some(m) if m.len() == n * D * D => m
+            .chunks_exact(D * D)
+            .map(|c| core::array::from_fn(|i| core::array::from_fn(|j| c[i * D + j])))
+            .collect(),
+        Some(_) => return Err(PyValueError::new_err(format!("metric must have shape ({n}, {D}, {D})"))),
+        None => Vec::new(),
+    };
+    let iso;
+    let mm;
+    let met;
+    let ham: &dyn Hamiltonian<D> = match inputs.kind.as_str() {
+        "isotropic" => {
+            iso = Isotropic { slowness: inputs.slowness, sigma: inputs.sigma };
+            &iso
+        }
+        "moving_medium" => {
+            if flow.is_empty() && n > 0 {
+                return Err(PyValueError::new_err("hamiltonian 'moving_medium' needs flow (K, d)"));
+            }
+            mm = MovingMedium { slowness: inputs.slowness, flow: &flow, sigma: inputs.sigma };
+            &mm
+        }
+        "metric" => {
+            if metric.is_empty() && n > 0 {
+                return Err(PyValueError::new_err("hamiltonian 'metric' needs metric (K, d, d)"));
+            }
+            met = Metric { slowness: inputs.slowness, metric: &metric, sigma: inputs.sigma };
+            &met
+        }
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "hamiltonian: unknown built-in {other:?}; use 'isotropic', 'moving_medium' or 'metric'"
+            )))
+        }
+    };
+    let mut values = fixed_values.to_vec();
+    let mut py_error: Option<PyErr> = None;
+    let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
+    let result = py.detach(|| {
+        let problem = SweepProblem {
+            band,
+            roles: &roles,
+            spacing,
+            slowness: Slowness::Constant(1.0), // unused by InnerScheme::General
+            directions: &dirs,
+            scheme: InnerScheme::General(ham),
             missing,
         };
         let mut callback = |r: &IterationReport| -> Control {
@@ -317,6 +444,62 @@ impl PyBand {
         match &self.band {
             AnyBand::D2(b) => solve_generic(py, b, roles, fixed, spacing, &slowness, directions, scheme, missing, options, progress),
             AnyBand::D3(b) => solve_generic(py, b, roles, fixed, spacing, &slowness, directions, scheme, missing, options, progress),
+        }
+    }
+
+    /// Runs the sweeps with the general Lax–Friedrichs update of Sect. 5.1 and a built-in
+    /// Hamiltonian: `"isotropic"` (`|p| − s`), `"moving_medium"` (`|p| − s|1 − v·p|`, needs
+    /// `flow` (K, d)) or `"metric"` (`sqrt(pᵀMp) − s`, needs `metric` (K, d, d)). `slowness` has
+    /// 1 or K entries; `sigma` (d,) overrides the automatic per-node viscosities.
+    #[pyo3(signature = (roles, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn solve_general<'py>(
+        &self,
+        py: Python<'py>,
+        roles: PyReadonlyArray1<'py, u8>,
+        fixed_values: PyReadonlyArray1<'py, f64>,
+        spacing: f64,
+        hamiltonian: &str,
+        slowness: PyReadonlyArray1<'py, f64>,
+        directions: Option<PyReadonlyArray2<'py, f32>>,
+        missing: &str,
+        tol: f64,
+        max_iterations: usize,
+        infinity: Option<f64>,
+        flow: Option<PyReadonlyArray2<'py, f64>>,
+        metric: Option<PyReadonlyArray3<'py, f64>>,
+        sigma: Option<PyReadonlyArray1<'py, f64>>,
+        progress: Option<Bound<'py, PyAny>>,
+        threads: usize,
+        skip_inactive: bool,
+        activation_threshold: f64,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+        let missing = parse_missing(missing)?;
+        if !(activation_threshold >= 0.0) {
+            return Err(PyValueError::new_err("activation_threshold must be non-negative"));
+        }
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold };
+        let inputs = GeneralInputs {
+            kind: hamiltonian.to_string(),
+            slowness: slowness.as_slice()?,
+            flow: match &flow {
+                Some(f) => Some(f.as_slice()?),
+                None => None,
+            },
+            metric: match &metric {
+                Some(m) => Some(m.as_slice()?),
+                None => None,
+            },
+            sigma: match &sigma {
+                Some(s) => Some(s.as_slice()?),
+                None => None,
+            },
+        };
+        let roles = roles.as_slice()?;
+        let fixed = fixed_values.as_slice()?;
+        match &self.band {
+            AnyBand::D2(b) => solve_general_generic(py, b, roles, fixed, spacing, inputs, directions, missing, options, progress),
+            AnyBand::D3(b) => solve_general_generic(py, b, roles, fixed, spacing, inputs, directions, missing, options, progress),
         }
     }
 }

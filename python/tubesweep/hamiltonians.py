@@ -1,0 +1,392 @@
+"""General static Hamilton–Jacobi equations ``H(x, ∇_Σ u) = 0`` on surfaces, solved with the
+Lax–Friedrichs sweeping update of the paper's Sect. 5.1 in the inner tube and the usual
+extension (Eq. 5 applied to Eq. 8) in the outer layer.
+
+Pass one of these objects as ``ts.solve(..., hamiltonian=...)``:
+
+* :class:`Isotropic` — ``|∇u| = 1/F`` (agrees with ``hamiltonian="lxf"``, Eq. 4);
+* :class:`MovingMedium` — ``|∇u| = |1 − v·∇u| / F``, the anisotropic eikonal equation in a
+  moving medium of Sect. 6.3 (also reached with ``ts.solve(..., flow=v)``);
+* :class:`Metric` — ``sqrt(∇uᵀ M(x) ∇u) = 1/F`` with ``M`` symmetric positive definite.
+
+Following Sect. 5.1, the intrinsic gradient is replaced by the extrinsic one in the tube. Each
+Hamiltonian gets artificial viscosities ``σ_k ≥ max_p |∂H/∂p_k|`` computed exactly per node by the
+Rust core (``1`` isotropic, ``1 + |v_k|/F`` moving medium, ``sqrt(M_kk)`` metric); ``sigma=``
+overrides them with constants (they must be at least as large, or the update is not monotone).
+See ``docs/hamiltonians.md`` for the derivations and measured convergence.
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, Optional, Sequence
+
+import numpy as np
+
+from .grid import Grid
+
+__all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
+
+#: Warn when the flow's normal component exceeds this fraction of its largest magnitude.
+NORMAL_FLOW_RTOL = 1e-2
+
+
+@dataclass
+class _Prepared:
+    """Per-node inputs of the native general solver, and per-node local travel-time data."""
+
+    kind: str
+    slowness: np.ndarray
+    flow: Optional[np.ndarray] = None
+    metric: Optional[np.ndarray] = None
+    sigma: Optional[np.ndarray] = None
+    extra: Dict[str, Any] = field(default_factory=dict)
+
+
+def _check_sigma(sigma: Any, d: Optional[int] = None) -> Optional[np.ndarray]:
+    if sigma is None:
+        return None
+    s = np.atleast_1d(np.asarray(sigma, dtype=float))
+    if d is not None and s.size == 1:
+        s = np.full(d, float(s[0]))
+    if not np.all(np.isfinite(s)) or np.any(s <= 0):
+        raise ValueError(f"sigma must be positive finite viscosities σ_k ≥ max|∂H/∂p_k| (Sect. 5.1); got {sigma!r}")
+    if d is not None and s.size != d:
+        raise ValueError(f"sigma must be a number or {d} numbers (one per axis); got {s.size}")
+    return np.ascontiguousarray(s)
+
+
+def _normals(surface: Any, grid: Grid, x: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Unit normals at the band nodes: the band's extension direction ``sgn(φ) n`` (its sign does
+    not matter here), or, on nodes where φ = 0 exactly, central differences of φ."""
+    n = np.asarray(direction, dtype=float)
+    zero = np.linalg.norm(n, axis=1) < 0.5
+    if np.any(zero) and hasattr(surface, "phi"):
+        h = grid.spacing
+        xz = x[zero]
+        g = np.empty_like(xz)
+        for k in range(grid.ndim):
+            e = np.zeros(grid.ndim)
+            e[k] = h
+            g[:, k] = surface.phi(xz + e, grid) - surface.phi(xz - e, grid)
+        g /= np.maximum(np.linalg.norm(g, axis=1, keepdims=True), 1e-300)
+        n = n.copy()
+        n[zero] = g
+    return n
+
+
+def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail: tuple, name: str) -> np.ndarray:
+    """A per-node field from a constant, an array of ``grid.shape + tail``, or a callable on points."""
+    want = (len(linear),) + tail
+    if callable(value):
+        out = np.asarray(value(points), dtype=float)
+        if out.shape != want:
+            raise ValueError(f"{name} callable must map points (M, {grid.ndim}) to an array of shape (M,)+{tail}; "
+                             f"returned {out.shape} for M = {len(linear)}")
+    else:
+        arr = np.asarray(value, dtype=float)
+        if arr.shape == tail:
+            out = np.broadcast_to(arr, want).copy()
+        elif arr.shape == tuple(grid.shape) + tail:
+            out = arr.reshape((-1,) + tail)[linear]
+        else:
+            raise ValueError(f"{name} must be a constant of shape {tail}, an array of shape grid.shape + {tail} = "
+                             f"{tuple(grid.shape) + tail}, or a callable; got shape {arr.shape}")
+    if not np.all(np.isfinite(out)):
+        i = int(np.flatnonzero(~np.all(np.isfinite(out.reshape(len(out), -1)), axis=1))[0])
+        raise ValueError(f"{name} is NaN or inf at {tuple(float(c) for c in points[i])}; it must be finite on the band")
+    return np.ascontiguousarray(out)
+
+
+def _fmt(p: np.ndarray) -> str:
+    return "(" + ", ".join(f"{float(c):.4g}" for c in p) + ")"
+
+
+def _regions(linear: np.ndarray, grid: Grid, select: np.ndarray) -> list:
+    """Connected components (grid-axis neighbours) of the selected band nodes, as arrays of band
+    positions."""
+    pos = np.flatnonzero(select)
+    lookup = {int(l): int(i) for i, l in zip(pos, linear[pos])}
+    strides = [int(np.prod(grid.shape[k + 1:])) for k in range(grid.ndim)]
+    idx = grid.unravel(linear[pos])
+    index_of = {int(l): j for j, l in enumerate(linear[pos])}
+    seen = np.zeros(len(pos), dtype=bool)
+    out = []
+    for start in range(len(pos)):
+        if seen[start]:
+            continue
+        seen[start] = True
+        stack, comp = [start], []
+        while stack:
+            j = stack.pop()
+            comp.append(lookup[int(linear[pos[j]])])
+            for k, st in enumerate(strides):
+                for step in (-1, 1):
+                    c = idx[j, k] + step
+                    if 0 <= c < grid.shape[k]:
+                        q = index_of.get(int(linear[pos[j]]) + step * st)
+                        if q is not None and not seen[q]:
+                            seen[q] = True
+                            stack.append(q)
+        out.append(np.asarray(comp, dtype=np.int64))
+    return out
+
+
+class Hamiltonian:
+    """Base class of the built-in Hamiltonians (the equation is defined by the Rust core; this
+    class prepares its per-node data). ``label`` names the solver in ``Solution.hamiltonian``."""
+
+    kind: str = ""
+    label: str = ""
+
+    def __init__(self, sigma: Any = None):
+        self.sigma = _check_sigma(sigma)
+
+    def prepare(self, surface: Any, grid: Grid, linear: np.ndarray, x: np.ndarray, direction: np.ndarray,
+                slowness: np.ndarray, roles: np.ndarray) -> _Prepared:  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
+        """Travel time from a source to band ``nodes`` at small displacements ``disp`` (M, d)
+        (closest point minus source), for a locally constant Hamiltonian. Used to fix the
+        nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``)."""
+        return np.linalg.norm(disp, axis=1) * prep.slowness[nodes]
+
+    def _sigma(self, d: int) -> Optional[np.ndarray]:
+        return None if self.sigma is None else _check_sigma(self.sigma, d)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+class Isotropic(Hamiltonian):
+    """``H(x, p) = |p| − 1/F(x)``: the eikonal equation (1) through the general update of
+    Sect. 5.1 (σ_k = 1), identical to ``hamiltonian="lxf"`` (Eq. 4). Mainly a reference."""
+
+    kind = "isotropic"
+    label = "isotropic"
+
+    def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+        return _Prepared(self.kind, slowness, sigma=self._sigma(grid.ndim))
+
+
+class MovingMedium(Hamiltonian):
+    """The anisotropic eikonal equation in a moving medium (paper Sect. 6.3)::
+
+        |∇_Σ u| = |1 − v(x)·∇u| / F(x)
+
+    ``u`` is the first-arrival time of a wave with speed ``F`` relative to a medium moving with
+    velocity ``v``: a front with unit normal ``n`` advances at ``F + v·n``.
+
+    Parameters
+    ----------
+    flow : callable ``v(points (M, d)) -> (M, d)`` (e.g. :func:`tubesweep.flows.point_vortices`),
+        an array of ``grid.shape + (d,)``, or a constant vector. A callable is evaluated at the
+        closest points ``cp(x)`` of the band nodes (the flow lives on the surface and is extended
+        constantly along normals); an array is read at the nodes.
+    allow_supersonic : bool
+        The paper assumes ``|v| ≪ F``. Where ``|v| ≥ F`` the medium outruns the wave and the
+        first-arrival problem changes character (the equation loses the monotone front
+        propagation). By default that is a ``ValueError`` saying where and by how much;
+        ``True`` computes the Lax–Friedrichs solution of the equation as written anyway, with a
+        ``RuntimeWarning``.
+    sigma : optional constant viscosities overriding the per-node ``1 + |v_k|/F``.
+
+    The paper assumes ``v·n = 0``. The normal component of ``v`` (with the band's normal) is always
+    removed — ``v ← v − (v·n) n`` — and a ``RuntimeWarning`` is raised when it is larger than
+    ``NORMAL_FLOW_RTOL`` times the largest ``|v|``.
+    """
+
+    kind = "moving_medium"
+    label = "moving-medium"
+
+    def __init__(self, flow: Any, *, allow_supersonic: bool = False, sigma: Any = None):
+        super().__init__(sigma)
+        if flow is None:
+            raise ValueError("MovingMedium needs a flow: a callable v(points) -> (M, d), an array of grid.shape + (d,) or a vector")
+        self.flow = flow
+        self.allow_supersonic = bool(allow_supersonic)
+
+    def __repr__(self) -> str:
+        return f"MovingMedium(flow={getattr(self.flow, '__name__', type(self.flow).__name__)}, allow_supersonic={self.allow_supersonic})"
+
+    def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+        d = grid.ndim
+        if callable(self.flow):
+            _, cp = surface.project(x, grid)
+            v = _field(self.flow, grid, linear, cp, (d,), "flow")
+        else:
+            v = _field(self.flow, grid, linear, x, (d,), "flow")
+        n = _normals(surface, grid, x, direction)
+        vn = np.sum(v * n, axis=1)
+        speed_v = np.linalg.norm(v, axis=1)
+        vmax = float(speed_v.max()) if speed_v.size else 0.0
+        i = int(np.argmax(np.abs(vn))) if vn.size else 0
+        if vn.size and abs(vn[i]) > NORMAL_FLOW_RTOL * vmax and vmax > 0:
+            warnings.warn(
+                f"flow has a normal component up to |v·n| = {abs(vn[i]):.3g} (at {_fmt(x[i])}, {abs(vn[i]) / vmax:.1%} of "
+                f"max |v| = {vmax:.3g}); the moving-medium equation (Sect. 6.3) assumes v·n = 0. The normal component "
+                "is removed: v is projected onto the tangent plane with the band's normal",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+        v = np.ascontiguousarray(v - vn[:, None] * n)
+        speed_v = np.linalg.norm(v, axis=1)
+        f = 1.0 / slowness
+        ratio = speed_v / f
+        active = roles != 2
+        bad = active & (ratio >= 1.0)
+        if np.any(bad):
+            j = int(np.flatnonzero(bad)[np.argmax(ratio[bad])])
+            nb = int(np.count_nonzero(bad))
+            regions = sorted(_regions(linear, grid, bad), key=lambda r: -float(ratio[r].max()))
+            where = "; ".join(
+                f"around {_fmt(x[r].mean(axis=0))} ({len(r)} nodes, up to {float(ratio[r].max()):.3g})" for r in regions[:5]
+            ) + ("; …" if len(regions) > 5 else "")
+            msg = (
+                f"flow: |v| ≥ F at {nb} of {int(np.count_nonzero(active))} inner-tube nodes — the medium outruns the wave "
+                f"there and the first-arrival problem changes character (the paper assumes |v| ≪ F). Worst at "
+                f"{_fmt(x[j])}: |v| = {speed_v[j]:.4g} vs F = {f[j]:.4g} (|v|/F = {ratio[j]:.3g}). "
+                f"{len(regions)} supersonic region(s), with their max |v|/F: {where}."
+            )
+            if not self.allow_supersonic:
+                raise ValueError(
+                    msg + " Pass allow_supersonic=True to compute the Lax–Friedrichs solution of the equation as written "
+                    "anyway, or make the flow subsonic (e.g. a vortex core: ts.flows.point_vortices(..., core=δ))"
+                )
+            warnings.warn(msg + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway", RuntimeWarning, stacklevel=4)
+        return _Prepared(self.kind, slowness, flow=v, sigma=self._sigma(d),
+                         extra={"max_mach": float(ratio[active].max()) if np.any(active) else 0.0,
+                                "supersonic_nodes": int(np.count_nonzero(bad))})
+
+    def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
+        """Arrival time at displacement ``d`` from a point source in a uniform flow ``v``: the front
+        is the circle ``|y − v t| = F t``, so ``t = (−d·v + sqrt((d·v)² + (F² − |v|²)|d|²)) / (F² − |v|²)``."""
+        assert prep.flow is not None
+        v = prep.flow[nodes]
+        f = 1.0 / prep.slowness[nodes]
+        a = f * f - np.sum(v * v, axis=1)
+        dv = np.sum(disp * v, axis=1)
+        r2 = np.sum(disp * disp, axis=1)
+        ok = a > 1e-12 * f * f
+        safe_a = np.where(ok, a, 1.0)
+        t = (-dv + np.sqrt(np.maximum(dv * dv + safe_a * r2, 0.0))) / safe_a
+        return np.where(ok, t, np.sqrt(r2) / f)
+
+
+class Metric(Hamiltonian):
+    """A Riemannian (anisotropic) eikonal equation ``sqrt(∇uᵀ M(x) ∇u) = 1/F(x)``.
+
+    ``M`` (symmetric positive definite, acting on gradients) is the inverse of the length metric:
+    for constant ``M`` the solution from ``x_s`` is ``u = sqrt((x − x_s)ᵀ M⁻¹ (x − x_s)) / F``.
+
+    Parameters
+    ----------
+    M : (d, d) constant, array of ``grid.shape + (d, d)``, or callable ``M(points (K, d)) -> (K, d, d)``
+        (evaluated at the closest points of the band nodes).
+    tangential : bool
+        On a surface only the tangential block of ``M`` matters. With ``True`` (default) the
+        normal–tangent coupling is removed, ``M ← P M P + (nᵀMn) n nᵀ`` with ``P = I − n nᵀ``, so
+        that the small normal component of the extrinsic gradient cannot leak into the tangential
+        metric. ``False`` uses ``M`` as given (right for a full-box solve).
+    sigma : optional constant viscosities overriding the per-node ``sqrt(M_kk)``.
+    """
+
+    kind = "metric"
+    label = "metric"
+
+    def __init__(self, M: Any, *, tangential: bool = True, sigma: Any = None):
+        super().__init__(sigma)
+        self.M = M
+        self.tangential = bool(tangential)
+
+    def __repr__(self) -> str:
+        return f"Metric(tangential={self.tangential})"
+
+    def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+        d = grid.ndim
+        if callable(self.M):
+            _, cp = surface.project(x, grid)
+            m = _field(self.M, grid, linear, cp, (d, d), "M")
+        else:
+            m = _field(self.M, grid, linear, x, (d, d), "M")
+        asym = np.abs(m - np.swapaxes(m, 1, 2)).max(axis=(1, 2))
+        scale = np.abs(m).max(axis=(1, 2))
+        if np.any(asym > 1e-10 * np.maximum(scale, 1e-300)):
+            i = int(np.argmax(asym))
+            raise ValueError(f"M must be symmetric; at {_fmt(x[i])} |M − Mᵀ| = {asym[i]:.3g}. Use (M + Mᵀ)/2")
+        lam = np.linalg.eigvalsh(m)[:, 0]
+        if np.any(lam <= 0):
+            i = int(np.argmin(lam))
+            raise ValueError(f"M must be positive definite; at {_fmt(x[i])} its smallest eigenvalue is {lam[i]:.3g}")
+        if self.tangential:
+            n = _normals(surface, grid, x, direction)
+            has = np.linalg.norm(n, axis=1) > 0.5
+            P = np.eye(d)[None] - n[:, :, None] * n[:, None, :]
+            mnn = np.einsum("ki,kij,kj->k", n, m, n)
+            mt = P @ m @ P + mnn[:, None, None] * n[:, :, None] * n[:, None, :]
+            m = np.where(has[:, None, None], mt, m)
+        m = np.ascontiguousarray(m)
+        return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), extra={"inverse": np.linalg.inv(m)})
+
+    def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
+        """``s · sqrt(dᵀ M⁻¹ d)`` with the node's (tangential) metric."""
+        inv = prep.extra["inverse"][nodes]
+        return prep.slowness[nodes] * np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", disp, inv, disp), 0.0))
+
+
+def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Hamiltonian]:
+    """The general Hamiltonian a ``solve`` call asks for, or None for the eikonal schemes
+    (``"godunov"``, ``"lxf"``). ``flow`` selects :class:`MovingMedium`."""
+    if isinstance(hamiltonian, Hamiltonian):
+        if flow is not None:
+            raise ValueError("pass either flow= or a Hamiltonian object as hamiltonian=, not both "
+                             "(use hamiltonian=ts.hamiltonians.MovingMedium(flow) for full control)")
+        if allow_supersonic:
+            if not isinstance(hamiltonian, MovingMedium):
+                raise ValueError("allow_supersonic only applies to the moving-medium equation (flow=...)")
+            hamiltonian = copy.copy(hamiltonian)  # leave the caller's object as it is
+            hamiltonian.allow_supersonic = True
+        return hamiltonian
+    if flow is not None:
+        if not (isinstance(hamiltonian, str) and hamiltonian.lower() in ("godunov", "lxf")):
+            raise ValueError(f"hamiltonian must be 'godunov', 'lxf' or a ts.hamiltonians object; got {hamiltonian!r}")
+        return MovingMedium(flow, allow_supersonic=allow_supersonic)
+    if allow_supersonic:
+        raise ValueError("allow_supersonic=True needs a flow (the moving-medium equation); pass flow=v")
+    return None
+
+
+def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any, roles: np.ndarray,
+               fixed: np.ndarray, positions: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
+               source_radius: float, tol: float, max_iterations: int, infinity: Optional[float],
+               progress: Optional[Callable[[int, float, int], None]], threads: int = 0,
+               activation_threshold: float = 0.0) -> tuple:
+    """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
+    travel time (for ``exact_sources``), and runs the general Lax–Friedrichs sweeps (Sect. 5.1)."""
+    x = grid.points(grid.unravel(geom.linear))
+    slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
+    prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
+    fixed = fixed.copy()
+    if exact_sources and positions.size:
+        _, cp = surface.project(x[positions], grid)
+        _, sp = surface.project(sources, grid)
+        best = np.full(len(positions), np.inf)
+        reach = (source_radius + 4.0) * grid.spacing
+        for s in sp:
+            disp = cp - s
+            near = np.linalg.norm(disp, axis=1) <= reach
+            t = ham.local_time(prep, positions, disp)
+            best = np.where(near, np.minimum(best, t), best)
+        fixed[positions] = np.where(np.isfinite(best), best, fixed[positions])
+    values, st = band.solve_general(
+        roles, fixed, grid.spacing, prep.kind, prep.slowness, np.ascontiguousarray(geom.direction, dtype=np.float32),
+        "extrapolate", float(tol), int(max_iterations), None if infinity is None else float(infinity),
+        flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress, threads=int(threads),
+        skip_inactive=True, activation_threshold=float(activation_threshold),
+    )
+    st = dict(st)
+    st.update(prep.extra if "inverse" not in prep.extra else {})
+    return values, st
