@@ -12,16 +12,20 @@ Quick start::
     sol([(0.5, 0, 0)])            # ≈ π/2 · 0.5
 
 Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :func:`travel_time` (the whole
-box, Algorithm 1), :class:`Grid`, :class:`LevelSet`.
+box, Algorithm 1), :class:`Grid`, :class:`LevelSet`; meshes in, results out:
+:func:`surfaces.from_mesh`, :func:`triangulate`, :func:`export`, :func:`plot`.
 """
 
 from ._native import __version__ as _core_version
 from .euclidean import travel_time
 from .grid import Grid
+from .output import export, plot, triangulate
 from .solve import Solution, solve
 from .stats import SolveStats
 from .surface import LevelSet, Surface
+from . import surfaces
 
 __version__ = "0.1.0"
 
-__all__ = ["Grid", "LevelSet", "Solution", "SolveStats", "Surface", "solve", "travel_time", "__version__"]
+__all__ = ["Grid", "LevelSet", "Solution", "SolveStats", "Surface", "export", "plot", "solve", "surfaces", "travel_time",
+           "triangulate", "__version__"]

@@ -7,5 +7,6 @@ Every surface here is a :class:`tubesweep.Surface` and can be passed straight to
 """
 
 from .analytic import Circle, Sphere, Star, REGISTRY
+from .mesh import from_mesh, MeshSurface
 
 __all__ = ["Circle", "Sphere", "Star", "REGISTRY"]
