@@ -250,7 +250,7 @@ def _orientation(f: np.ndarray, v: np.ndarray) -> float:
 
 def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, levels: Union[int, Sequence[float]] = 12,
          cmap: str = "viridis", views: Sequence[Tuple[float, float]] = ((20.0, -60.0), (20.0, 120.0)),
-         title: Optional[str] = None, sources: bool = True, colorbar: bool = True) -> Any:
+         title: Optional[str] = None, sources: bool = True, colorbar: bool = True, up: str = "z") -> Any:
     """A picture of a solution: a matplotlib :class:`~matplotlib.figure.Figure`.
 
     2D: the band coloured by ``u``, iso-distance lines, the curve φ = 0 (white) and the sources
@@ -266,6 +266,8 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     mesh : (vertices, faces), optional — the surface mesh to draw (3D)
     levels : int or sequence — number of iso-lines, or their values
     cmap, title, sources, colorbar : as usual
+    up : {"x", "y", "z"}
+        The axis drawn vertically in 3D (many mesh files, the bunny and spot among them, are "y").
 
     Returns the Figure (``fig.savefig("u.png")`` to save; it displays inline in notebooks).
     """
@@ -314,8 +316,14 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
 
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
+    if up not in ("x", "y", "z"):
+        raise ValueError(f"up must be 'x', 'y' or 'z'; got {up!r}")
     v, f = triangulate(sol, mesh=mesh)
     u = sol.on_mesh(v)
+    # a cyclic permutation of the axes (keeps orientation) puts `up` last, mplot3d's vertical
+    perm = {"x": [1, 2, 0], "y": [2, 0, 1], "z": [0, 1, 2]}[up]
+    v = v[:, perm]
+    src = sol.sources[:, perm]
     tri = v[f]
     uface = np.nanmean(np.where(np.isfinite(u[f]), u[f], np.nan), axis=1)
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -349,11 +357,11 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
             a.add_collection3d(Line3DCollection(seg_all[seen], colors="k", linewidths=0.6, zorder=2))
         if sources:
             # a source on the far side of an oriented mesh is drawn faint
-            near = np.argmin(((sol.sources[:, None, :] - tri.mean(1)[None, :, :]) ** 2).sum(-1), axis=1)
+            near = np.argmin(((src[:, None, :] - tri.mean(1)[None, :, :]) ** 2).sum(-1), axis=1)
             front = (n[near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(near), bool)
             for sel, alpha in ((front, 1.0), (~front, 0.3)):
                 if np.any(sel):
-                    a.scatter(*sol.sources[sel].T, c="r", marker="*", s=160, edgecolors="k", linewidths=0.5,
+                    a.scatter(*src[sel].T, c="r", marker="*", s=160, edgecolors="k", linewidths=0.5,
                               depthshade=False, zorder=3, alpha=alpha)
         lo, hi = v.min(0), v.max(0)
         a.set_xlim(lo[0], hi[0])
