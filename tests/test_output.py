@@ -155,3 +155,9 @@ def test_plot_returns_figures(sphere_sol, circle_sol, tmp_path):
     assert ts.plot(sphere_sol, ax=ax, colorbar=False, up="y") is f2
     with pytest.raises(ValueError, match="up must be"):
         ts.plot(sphere_sol, up="w")
+
+
+def test_fig8_is_registered():
+    from tubesweep import reproduce
+
+    assert "fig8" in reproduce.experiments()

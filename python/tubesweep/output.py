@@ -211,6 +211,8 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
     kind = "triangle" if cells.shape[1] == 3 else "line"
     if suffix == ".ply" and kind == "line":
         raise ValueError("export: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
+    if suffix == ".ply" and len(pts) < 2**31:
+        cells = cells.astype(np.int32)  # PLY has no 64-bit integers
     m = meshio.Mesh(pts, [(kind, cells)], point_data={} if suffix == ".obj" else data)
     meshio.write(str(path), m, file_format={".vtk": "vtk", ".vtu": "vtu", ".ply": "ply", ".obj": "obj"}[suffix])
     return path
