@@ -13,7 +13,8 @@ Quick start::
 
 Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :func:`travel_time` (the whole
 box, Algorithm 1), :class:`Grid`, :class:`LevelSet`, :class:`ClosestPoint` (open and non-orientable surfaces,
-Sect. 5.2) and the library :mod:`tubesweep.surfaces`.
+Sect. 5.2) and the library :mod:`tubesweep.surfaces`; meshes in, results out: :func:`surfaces.from_mesh`,
+:func:`triangulate`, :func:`export`, :func:`plot`.
 """
 
 from ._native import __version__ as _core_version
@@ -21,6 +22,7 @@ from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .euclidean import travel_time
 from .grid import Grid
+from .output import export, plot, triangulate
 from .solve import Solution, solve
 from .stats import SolveStats
 from .surface import LevelSet, Surface
@@ -29,6 +31,6 @@ from . import surfaces
 __version__ = "0.1.0"
 
 __all__ = [
-    "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "flows", "hamiltonians", "solve",
-    "surfaces", "travel_time", "__version__",
+    "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "export", "flows", "hamiltonians", "plot",
+    "solve", "surfaces", "travel_time", "triangulate", "__version__",
 ]

@@ -19,6 +19,8 @@ from ._progress import make_progress
 
 EPILOG = """examples:
   tubesweep solve --surface sphere --n 101 --png
+  tubesweep solve --mesh ../shared/data/stanford-bunny.obj --n 200 --outer 5 --export out/bunny.vtu --png
+  tubesweep solve --mesh spot.obj --source-vertex 0 --export out/spot.ply
   tubesweep solve --surface star --n 401 --hamiltonian lxf --source 0.5 0 --out out/star
   tubesweep solve --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0
   tubesweep travel-time --n 201 --dim 2 --source 0 0 --png
@@ -60,7 +62,18 @@ def build_parser() -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=_surface_names(), help="a built-in curve or surface")
     src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
-    p.add_argument("--n", type=int, default=101, help="nodes per axis for --surface (default: 101)")
+    src.add_argument("--mesh", type=Path, help="a triangle mesh (.obj .ply .stl .off), used in the closest-point "
+                     "representation (Sect. 5.2): open and scanned meshes with holes are fine")
+    p.add_argument("--n", type=int, default=None,
+                   help="nodes per axis for --surface (default: 101); for --mesh, nodes along the longest side of the "
+                   "mesh's bounding box, padding included (default: 200)")
+    p.add_argument("--padding", type=float, default=8.0, help="--mesh: empty grid spacings around the mesh (default 8)")
+    p.add_argument("--normalize", action="store_true",
+                   help="--mesh: centre the mesh at the origin and scale its longest side to 1 (sources are then in "
+                   "the new coordinates)")
+    p.add_argument("--source-vertex", type=int, action="append",
+                   help="--mesh: a source at this vertex (0-based; repeat for several; default: the vertex farthest "
+                   "from the centroid)")
     p.add_argument("--lower", type=float, nargs="+", help="grid lower corner (with --phi; default for --surface: the surface's box)")
     p.add_argument("--upper", type=float, nargs="+", help="grid upper corner")
     p.add_argument("--source", type=float, nargs="+", action="append",
@@ -72,6 +85,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--outer", type=float, default=4.0, help="outer tube half-width in grid spacings (default 4)")
     p.add_argument("--source-init", choices=["exact", "node"], default="exact")
     p.add_argument("--dense", action="store_true", help="also write the dense array solution_dense.npy (NaN off the band)")
+    p.add_argument("--up", choices=["x", "y", "z"], help="the vertical axis of 3D pictures (default: y for --mesh, "
+                   "as in most mesh files, z otherwise)")
+    p.add_argument("--export", type=Path, action="append", metavar="FILE",
+                   help="write the surface mesh with u as point data for ParaView: .vtu .vtp .vtk .ply (repeatable)")
     _add_solver_options(p)
 
     t = sub.add_parser("travel-time", help="first-arrival time in the whole box (Algorithm 1)",
@@ -113,11 +130,23 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from .solve import solve
     from .surface import LevelSet
 
-    if args.surface:
+    if args.source_vertex and not args.mesh:
+        raise SystemExit("--source-vertex needs --mesh")
+    if args.mesh:
+        from .surfaces.mesh import from_mesh
+
+        surface = from_mesh(args.mesh, normalize=args.normalize)
+        n = 200 if args.n is None else args.n
+        if args.lower is not None or args.upper is not None:
+            raise SystemExit("--mesh picks its grid from --n and --padding; do not give --lower/--upper")
+        grid = surface.grid(n, padding=args.padding)
+        name = args.mesh.stem
+        print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
+    elif args.surface:
         from .surfaces import REGISTRY
 
         surface = REGISTRY[args.surface]()
-        grid = _grid_for(surface, args.n, args.lower, args.upper)
+        grid = _grid_for(surface, 101 if args.n is None else args.n, args.lower, args.upper)
         name = args.surface
     else:
         phi = np.load(args.phi)
@@ -126,7 +155,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
         grid = Grid(args.lower, args.upper, phi.shape)
         surface = LevelSet(phi)
         name = args.phi.stem
-    if args.source:
+    if args.source_vertex:
+        nv = len(surface.vertices)
+        bad = [i for i in args.source_vertex if not 0 <= i < nv]
+        if bad:
+            raise SystemExit(f"--source-vertex {bad[0]}: the mesh has vertices 0..{nv - 1}")
+        sources = surface.vertices[np.array(args.source_vertex)]
+        if args.source:
+            sources = np.vstack([sources, np.array(args.source, dtype=float)])
+    elif args.source:
         sources = np.array(args.source, dtype=float)
     elif hasattr(surface, "default_source"):
         sources = np.atleast_2d(surface.default_source)
@@ -153,10 +190,18 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.dense:
         np.save(out / "solution_dense.npy", sol.to_dense())
         print(f"wrote {out / 'solution_dense.npy'}")
-    if args.png:
-        from ._figures import solution_png
+    for path in args.export or []:
+        from .output import export
 
-        print(f"wrote {solution_png(sol, out / 'solution.png', title=f'{name}, {args.hamiltonian}, N={grid.shape[0]}')}")
+        t1 = time.perf_counter()
+        print(f"wrote {export(sol, path)} ({time.perf_counter() - t1:.2f} s)")
+    if args.png:
+        from .output import plot
+
+        up = args.up or ("y" if args.mesh else "z")
+        fig = plot(sol, up=up, title=f"{name}, {args.hamiltonian}, grid {'x'.join(map(str, grid.shape))}")
+        fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
+        print(f"wrote {out / 'solution.png'}")
     return 0
 
 
@@ -223,7 +268,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     except KeyboardInterrupt:
         print("\ninterrupted", file=sys.stderr)
         return 130
-    except (ValueError, TypeError, MemoryError) as e:
+    except (ValueError, TypeError, MemoryError, ImportError, FileNotFoundError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     parser.print_help()

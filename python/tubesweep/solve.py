@@ -106,6 +106,40 @@ class Solution:
         p = as_points(points, self.grid.ndim, "points")
         return self._band.interpolate(self.values, list(self.grid.lower), self.grid.spacing, p)
 
+    def on_mesh(self, vertices: Any) -> np.ndarray:
+        """The solution at the vertices (M, d) of a mesh of the surface (e.g. for display or export).
+
+        Multilinear interpolation (:meth:`__call__`); where its stencil leaves the band or meets an
+        unreached node, the value of the nearest reached band node within ``outer`` grid spacings
+        (the band values are constant along the normals, Eq. (8), so this is first-order
+        accurate). NaN only for vertices farther than that from every reached band node.
+        """
+        p = as_points(vertices, self.grid.ndim, "vertices")
+        out = self(p)
+        bad = np.flatnonzero(~np.isfinite(out))
+        if bad.size:
+            d = self.grid.ndim
+            r = int(np.ceil(self.outer)) + 1
+            offs = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+            offs = offs[np.argsort((offs * offs).sum(1), kind="stable")]
+            ci = self.grid.continuous_index(p[bad])
+            base = np.rint(ci).astype(np.int64)
+            best = np.full(bad.size, np.nan)
+            best_d = np.full(bad.size, np.inf)
+            for o in offs:
+                idx = base + o
+                pos = self._band.find(np.ascontiguousarray(idx))
+                ok = pos >= 0
+                if not np.any(ok):
+                    continue
+                vals = np.where(ok, self.values[np.maximum(pos, 0)], np.inf)
+                dist = np.linalg.norm(idx - ci, axis=1)
+                take = ok & np.isfinite(vals) & (dist < best_d) & (dist <= self.outer + 1)
+                best[take] = vals[take]
+                best_d[take] = dist[take]
+            out[bad] = best
+        return out
+
     def to_dense(self, fill: float = np.nan) -> np.ndarray:
         """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
         out = np.full(self.grid.size, fill, dtype=float)

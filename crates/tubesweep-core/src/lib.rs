@@ -15,6 +15,7 @@
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
 //! | multilinear interpolation in the band | [`interpolate`] | — |
+//! | exact closest points on triangle meshes (AABB tree) | [`mesh`] | Sect. 5.2 |
 //!
 //! Grids are uniform with spacing `h` in every axis; node `(i, j[, k])` sits at
 //! `lower + h * (i, j[, k])`, and nodes are numbered in C order (the last axis varies fastest),
@@ -28,6 +29,7 @@ pub mod hamiltonian;
 pub mod hamiltonians;
 pub mod interpolate;
 pub mod lax_friedrichs;
+pub mod mesh;
 pub mod schedule;
 pub mod sweep;
 

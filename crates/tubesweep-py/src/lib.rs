@@ -505,9 +505,95 @@ impl PyBand {
 }
 
 /// The compiled core of tubesweep. Use the `tubesweep` package, not this module.
+/// Exact closest points on a triangle mesh (AABB tree, see `tubesweep_core::mesh`).
+#[pyclass(module = "tubesweep._native", name = "TriangleTree", frozen)]
+struct PyTriangleTree {
+    tree: tubesweep_core::mesh::TriangleTree,
+}
+
+#[pymethods]
+impl PyTriangleTree {
+    /// Builds the tree over triangles `faces` (m, 3) of `vertices` (n, 3).
+    #[new]
+    fn new(vertices: PyReadonlyArray2<'_, f64>, faces: PyReadonlyArray2<'_, i64>) -> PyResult<Self> {
+        if vertices.shape()[1] != 3 || faces.shape()[1] != 3 {
+            return Err(PyValueError::new_err("vertices and faces must have shape (n, 3) and (m, 3)"));
+        }
+        let v = vertices.as_slice()?;
+        let f = faces.as_slice()?;
+        let n = v.len() / 3;
+        if f.is_empty() {
+            return Err(PyValueError::new_err("faces is empty"));
+        }
+        let mut tris = Vec::with_capacity(f.len() / 3);
+        for t in f.chunks_exact(3) {
+            let mut tri = [[0.0; 3]; 3];
+            for (k, &i) in t.iter().enumerate() {
+                if i < 0 || i as usize >= n {
+                    return Err(PyValueError::new_err(format!("faces: vertex index {i} out of range 0..{n}")));
+                }
+                let i = i as usize;
+                tri[k] = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
+            }
+            tris.push(tri);
+        }
+        Ok(PyTriangleTree { tree: tubesweep_core::mesh::TriangleTree::new(tris) })
+    }
+
+    fn __len__(&self) -> usize {
+        self.tree.len()
+    }
+
+    #[getter]
+    fn nbytes(&self) -> usize {
+        self.tree.heap_bytes()
+    }
+
+    /// Closest points of `points` (M, 3) searched within `max_distance`: returns distance (M,)
+    /// (inf where nothing is that close), closest point (M, 3), triangle (M,) (-1 where none) and
+    /// feature code (M,) (0 face, 1-3 vertex a/b/c, 4 edge ab, 5 ac, 6 bc).
+    #[allow(clippy::type_complexity)]
+    fn closest<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+        max_distance: f64,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<u8>>)> {
+        if points.shape()[1] != 3 {
+            return Err(PyValueError::new_err("points must have shape (M, 3)"));
+        }
+        let p = points.as_slice()?;
+        let res = py.detach(|| self.tree.closest_many(p, max_distance));
+        let m = res.len();
+        let mut dist = Vec::with_capacity(m);
+        let mut cp = Vec::with_capacity(3 * m);
+        let mut tri = Vec::with_capacity(m);
+        let mut feat = Vec::with_capacity(m);
+        for r in res {
+            match r {
+                Some(c) => {
+                    dist.push(c.distance);
+                    cp.extend_from_slice(&c.point);
+                    tri.push(c.triangle as i64);
+                    feat.push(c.feature as u8);
+                }
+                None => {
+                    dist.push(f64::INFINITY);
+                    cp.extend_from_slice(&[f64::NAN; 3]);
+                    tri.push(-1);
+                    feat.push(0);
+                }
+            }
+        }
+        let cp = numpy::ndarray::Array2::from_shape_vec((m, 3), cp).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok((dist.into_pyarray(py), cp.into_pyarray(py), tri.into_pyarray(py), feat.into_pyarray(py)))
+    }
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
+    m.add_class::<PyTriangleTree>()?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -33,6 +33,7 @@ from ..surface import Surface
 from .analytic import Circle, Sphere, Star
 from .closed import DoubleTorus, Ellipsoid, RoundedCube, Torus
 from .curves import Ellipse
+from .mesh import MeshSurface, from_mesh
 from .open import Disc, Hemisphere, MobiusBand, PlanePatch
 
 REGISTRY: Dict[str, Callable[[], Surface]] = {
@@ -51,4 +52,4 @@ REGISTRY: Dict[str, Callable[[], Surface]] = {
 }
 
 __all__ = ["Circle", "Star", "Ellipse", "Sphere", "Ellipsoid", "Torus", "RoundedCube", "DoubleTorus", "Hemisphere",
-           "Disc", "PlanePatch", "MobiusBand", "REGISTRY"]
+           "Disc", "PlanePatch", "MobiusBand", "MeshSurface", "from_mesh", "REGISTRY"]

@@ -1,0 +1,163 @@
+"""Results out: Solution.on_mesh, triangulate (marching cubes / squares, a surface's own mesh),
+export (meshio round trips, VTK XML PolyData) and plot (matplotlib figures, 2D and 3D)."""
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.output import read_vtp
+from tubesweep.surface import Surface
+
+
+@pytest.fixture(scope="module")
+def sphere_sol():
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    return ts.solve(ts.surfaces.Sphere(), grid, [(-0.5, 0, 0)])
+
+
+@pytest.fixture(scope="module")
+def circle_sol():
+    grid = ts.Grid((-1, -1), (1, 1), (81, 81))
+    return ts.solve(ts.surfaces.Circle(), grid, [(-0.5, 0)])
+
+
+def test_marching_cubes_of_the_level_set(sphere_sol):
+    pytest.importorskip("skimage")
+    v, f = ts.triangulate(sphere_sol)
+    h = sphere_sol.grid.spacing
+    r = np.linalg.norm(v, axis=1)
+    assert np.abs(r - 0.5).max() < 0.05 * h  # linear interpolation of an exact distance: ≪ h
+    assert f.shape[1] == 3 and f.max() < len(v)
+    # one closed surface: Euler characteristic 2
+    e = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1), axis=0)
+    assert len(v) - len(e) + len(f) == 2
+
+
+def test_marching_squares_of_a_curve(circle_sol):
+    pytest.importorskip("skimage")
+    v, e = ts.triangulate(circle_sol)
+    assert e.shape[1] == 2
+    assert np.abs(np.linalg.norm(v, axis=1) - 0.5).max() < 0.1 * circle_sol.grid.spacing
+    deg = np.bincount(e.reshape(-1), minlength=len(v))
+    assert np.all(deg == 2)  # a closed loop
+
+
+def test_on_mesh_is_finite_on_the_surface_and_falls_back_near_the_band_edge(sphere_sol):
+    sol = sphere_sol
+    h = sol.grid.spacing
+    rng = np.random.default_rng(0)
+    d = rng.normal(size=(500, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    on = 0.5 * d
+    u = sol.on_mesh(on)
+    exact = ts.surfaces.Sphere().geodesic_distance(on, (-0.5, 0, 0))
+    assert np.all(np.isfinite(u)) and np.abs(u - exact).max() < 4 * h
+    assert np.array_equal(u, sol(on))  # interpolation where the stencil is in the band
+    # 3.7 h off the surface the multilinear stencil leaves the band (outer = 4): fallback values
+    off = (0.5 + 3.7 * h) * d
+    plain = sol(off)
+    assert np.any(np.isnan(plain))
+    fb = sol.on_mesh(off)
+    assert np.all(np.isfinite(fb))
+    assert np.abs(fb - exact).max() < 5 * h  # the band values are constant along normals
+    # far from the band: NaN
+    assert np.isnan(sol.on_mesh([[0.0, 0.0, 0.0]]))[0]
+
+
+@pytest.mark.parametrize("suffix", [".vtu", ".vtk", ".ply"])
+def test_export_round_trip_with_meshio(sphere_sol, tmp_path, suffix):
+    meshio = pytest.importorskip("meshio")
+    v, f = ts.triangulate(sphere_sol)
+    path = ts.export(sphere_sol, tmp_path / f"s{suffix}")
+    m = meshio.read(str(path))
+    assert np.allclose(m.points, v, atol=1e-6)
+    assert np.array_equal(m.cells_dict["triangle"], f)
+    assert np.allclose(m.point_data["u"], sphere_sol.on_mesh(v), atol=1e-6, equal_nan=True)
+
+
+def test_export_vtp_and_curves(sphere_sol, circle_sol, tmp_path):
+    meshio = pytest.importorskip("meshio")
+    v, f = ts.triangulate(sphere_sol)
+    p, cells, data = read_vtp(ts.export(sphere_sol, tmp_path / "s.vtp", point_data={"x": v[:, 0]}))
+    assert np.allclose(p, v) and np.array_equal(cells, f)
+    assert np.allclose(data["u"], sphere_sol.on_mesh(v)) and np.allclose(data["x"], v[:, 0])
+    # a 2D curve: line cells, z = 0
+    v2, e2 = ts.triangulate(circle_sol)
+    m = meshio.read(str(ts.export(circle_sol, tmp_path / "c.vtu")))
+    assert np.array_equal(m.cells_dict["line"], e2) and np.allclose(m.points[:, 2], 0.0)
+    p2, c2, d2 = read_vtp(ts.export(circle_sol, tmp_path / "c.vtp"))
+    assert np.array_equal(c2, e2) and np.allclose(p2[:, :2], v2)
+    with pytest.raises(ValueError, match="unknown format"):
+        ts.export(sphere_sol, tmp_path / "s.xyz")
+    with pytest.raises(ValueError, match="surfaces only"):
+        ts.export(circle_sol, tmp_path / "c.ply")
+    with pytest.raises(ValueError, match="point_data"):
+        ts.export(sphere_sol, tmp_path / "s.vtu", point_data={"bad": np.zeros(3)})
+
+
+def test_export_uses_the_meshs_own_triangulation(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    from test_mesh import icosphere
+
+    v, f = icosphere(2)
+    m = ts.surfaces.from_mesh((v, f))
+    sol = ts.solve(m, m.grid(41), [v[0]])
+    out = meshio.read(str(ts.export(sol, tmp_path / "ico.vtu")))
+    assert np.array_equal(out.points, v) and np.array_equal(out.cells_dict["triangle"], f)
+
+
+class _CpSphere(Surface):
+    """A closest-point sphere with no triangulation (to check the error message)."""
+
+    ndim = 3
+
+    def band(self, grid, half_width):
+        from tubesweep.surface import BandGeometry
+
+        x = grid.points(grid.unravel(np.arange(grid.size)))
+        r = np.linalg.norm(x, axis=1)
+        keep = np.abs(r - 0.5) <= half_width
+        d = np.abs(r - 0.5)[keep]
+        direction = (np.sign(r - 0.5)[keep, None] * x[keep] / r[keep, None]).astype(np.float32)
+        return BandGeometry(np.flatnonzero(keep).astype(np.int64), d, d, direction)
+
+    def project(self, points, grid):
+        r = np.linalg.norm(points, axis=1)
+        return np.abs(r - 0.5), 0.5 * points / r[:, None]
+
+
+def test_triangulate_needs_a_mesh_for_bare_closest_point_surfaces(tmp_path):
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (25, 25, 25))
+    sol = ts.solve(_CpSphere(), grid, [(-0.5, 0, 0)])
+    with pytest.raises(ValueError, match="mesh=\\(vertices, faces\\)"):
+        ts.triangulate(sol)
+    from test_mesh import icosphere
+
+    v, f = icosphere(1)
+    vv, ff = ts.triangulate(sol, mesh=(v, f))
+    assert vv.shape == v.shape and np.array_equal(ff, f)
+
+
+def test_plot_returns_figures(sphere_sol, circle_sol, tmp_path):
+    pytest.importorskip("matplotlib")
+    from matplotlib.figure import Figure
+
+    fig = ts.plot(circle_sol, title="circle")
+    assert isinstance(fig, Figure) and len(fig.axes) == 2  # the plot and its colour bar
+    fig.savefig(tmp_path / "c.png")
+    fig = ts.plot(sphere_sol, levels=[0.2, 0.4, 0.6])
+    assert isinstance(fig, Figure) and len(fig.axes) == 3  # two views and a colour bar
+    fig.savefig(tmp_path / "s.png")
+    assert (tmp_path / "s.png").stat().st_size > 10_000
+    # into a given 3D axes, y up
+    f2 = Figure()
+    ax = f2.add_subplot(projection="3d")
+    assert ts.plot(sphere_sol, ax=ax, colorbar=False, up="y") is f2
+    with pytest.raises(ValueError, match="up must be"):
+        ts.plot(sphere_sol, up="w")
+
+
+def test_fig8_is_registered():
+    from tubesweep import reproduce
+
+    assert "fig8" in reproduce.experiments()
