@@ -206,10 +206,14 @@ def plan(preset: str, cases: Optional[Dict[str, List[int]]] = None, methods: Opt
             for m in names:
                 if not avail[m] or PROBLEM_DIMS[prob] not in METHODS[m].dims:
                     continue
+                if prob == "bunny" and m == "mmp":
+                    continue  # MMP on the input mesh is the bunny's exact reference
                 cap = caps.get(f"{m}@{prob}", caps.get(m))
                 if cap is not None and n > cap:
                     continue
                 todo.append((prob, n, m))
+    if "bunny" in sizes and "mmp" in names:
+        notes.append("mmp is not listed on the bunny: MMP on the input mesh is the exact reference there")
     if any(PROBLEM_DIMS[p] == 2 for p in sizes):
         notes.append("heat and mmp need a triangle mesh of a surface: not run on the 2D star")
     for m, cap in caps.items():
