@@ -1,0 +1,100 @@
+"""Kernel throughput through the public API: local updates per second (per core) from
+``sol.stats`` (issue 7 target: ≥ 100 M updates/s per core in the 3D Godunov tube kernel,
+parallel speed-up ≥ 1.7× on 2 cores).
+
+For each scheme and grid size it solves the sphere (radius 0.5, source (−0.5, 0, 0)) with
+``ts.solve`` in child processes with ``RAYON_NUM_THREADS`` = 1 and = the number of cores, and
+reports ``stats.updates / stats.seconds`` (sweeps only, band construction excluded), that rate
+divided by the thread count, and the speed-up of the sweeps. With a single-threaded kernel the
+two thread counts give the same time (speed-up ≈ 1).
+
+    .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def _child(n: int, hamiltonian: str, repeats: int) -> Dict[str, Any]:
+    import tubesweep as ts
+    import tubesweep.surfaces as tss
+
+    grid = ts.Grid(lower=(-1, -1, -1), upper=(1, 1, 1), shape=(n, n, n))
+    sphere = tss.Sphere(radius=0.5)
+    secs: List[float] = []
+    st = None
+    for _ in range(repeats):
+        sol = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], hamiltonian=hamiltonian)
+        st = sol.stats
+        secs.append(st.seconds)
+    assert st is not None
+    med = statistics.median(secs)
+    return dict(n=n, hamiltonian=hamiltonian, band_points=st.band_points, iterations=st.iterations,
+                updates=st.updates, sweep_s=med, updates_per_s=st.updates / med if med > 0 else float("nan"),
+                converged=bool(st.converged), seconds=[float(s) for s in secs])
+
+
+def measure(n: int, hamiltonian: str, threads: int, repeats: int) -> Dict[str, Any]:
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", str(n), hamiltonian, str(repeats)]
+    cp = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=str(REPO))
+    for line in reversed(cp.stdout.splitlines()):
+        if line.startswith("RESULT "):
+            rec = json.loads(line[7:])
+            rec["threads"] = threads
+            return rec
+    raise RuntimeError(f"child failed: {cp.stderr.strip()[-500:]}")
+
+
+def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", "lxf"), repeats: int = 3,
+        threads: Optional[Sequence[int]] = None) -> List[Dict[str, Any]]:
+    cores = os.cpu_count() or 1
+    tlist = sorted(set(threads or (1, cores)))
+    rows = []
+    print(f"sphere r=0.5, two-layer, sol.stats (sweeps only), median of {repeats}; {cores} cores")
+    print(f"{'scheme':8} {'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} "
+          f"{'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8}")
+    for h in schemes:
+        for n in sizes:
+            base = None
+            for t in tlist:
+                r = measure(n, h, t, repeats)
+                if base is None:
+                    base = r["sweep_s"]
+                r["per_core"] = r["updates_per_s"] / t
+                r["speedup"] = base / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
+                rows.append(r)
+                print(f"{h:8} {n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
+                      f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
+                      f"{r['speedup']:8.2f}", flush=True)
+    return rows
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    ap = argparse.ArgumentParser(description="updates per second per core of the sweep kernel, via ts.solve")
+    ap.add_argument("--sizes", default="101,201", help="grid sizes N, comma-separated (default 101,201)")
+    ap.add_argument("--schemes", default="godunov,lxf")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--threads", help="thread counts to compare (default: 1 and all cores)")
+    ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.child:
+        print("RESULT " + json.dumps(_child(int(a.child[0]), a.child[1], int(a.child[2]))))
+        return 0
+    th = [int(x) for x in a.threads.split(",")] if a.threads else None
+    run([int(x) for x in a.sizes.split(",")], a.schemes.split(","), a.repeats, th)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

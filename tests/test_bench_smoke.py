@@ -1,0 +1,137 @@
+"""A small, fast run of the benchmark harness (benches/run.py) on the smallest sizes, with
+whichever peers are installed. Checks the output's structure and that tubesweep's errors
+against the exact answers are finite and small; no timing assertions (the machine is shared)."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+BENCHES = Path(__file__).resolve().parents[1] / "benches"
+sys.path.insert(0, str(BENCHES))
+
+import run as bench  # noqa: E402
+from problems import Spheroid, Torus, ellipse_closest  # noqa: E402
+
+HAVE = {m: importlib.util.find_spec(m) is not None for m in ("skfmm", "potpourri3d", "pygeodesic", "geographiclib", "skimage")}
+PEER_MODULE = {"skfmm-tube": "skfmm", "heat": "potpourri3d", "mmp": "pygeodesic"}
+
+# Max error bounds for tubesweep (Godunov) at these sizes: about twice what is measured.
+GODUNOV_MAX = {("sphere", 21): 0.5, ("star", 101): 0.2, ("ellipsoid", 21): 0.5}
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    cases = {"sphere": [21], "star": [101]}
+    if HAVE["geographiclib"]:
+        cases["ellipsoid"] = [21]
+    out = tmp_path_factory.mktemp("bench")
+    methods = ["tubesweep-godunov", "skfmm-tube", "heat", "mmp"]  # LxF: see tests/test_solve.py
+    res = bench.run_bench("quick", cases=cases, repeats=1, methods=methods, out=out, verbose=False)
+    res["out"] = out
+    res["cases"] = cases
+    return res
+
+
+def test_every_applicable_case_ran(result):
+    recs = result["records"]
+    for prob, ns in result["cases"].items():
+        for n in ns:
+            got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
+            assert got["tubesweep-godunov"]["status"] == "ok"
+            assert "tubesweep-lxf" not in got
+            for m, mod in PEER_MODULE.items():
+                needs_mesh = m in ("heat", "mmp")
+                if HAVE[mod] and not (needs_mesh and (prob == "star" or not HAVE["skimage"])):
+                    assert got[m]["status"] == "ok", got[m]
+                else:
+                    assert m not in got
+
+
+def test_table_structure(result):
+    lines = result["table"].splitlines()
+    header = [c.strip() for c in lines[0].strip("|").split("|")]
+    assert header == [c[0] for c in bench.COLUMNS]
+    assert all(line.startswith("|") and line.count("|") == len(header) + 1 for line in lines)
+    assert len(lines) == 2 + len(result["records"])
+    saved = json.loads((result["out"] / "results.json").read_text())
+    assert len(saved["records"]) == len(result["records"])
+    assert (result["out"] / "results.md").read_text().count("| tubesweep-godunov |") == sum(map(len, result["cases"].values()))
+
+
+def test_tubesweep_errors_are_finite_and_small(result):
+    for r in result["records"]:
+        if not r["method"].startswith("tubesweep"):
+            continue
+        assert r["n_nan"] == 0
+        assert math.isfinite(r["max_err"]) and 0 <= r["mean_err"] <= r["max_err"]
+        assert r["converged"] and r["updates"] > 0 and r["band_points"] > 0 and r["iterations"] >= 2
+        if r["method"] == "tubesweep-godunov":
+            assert r["max_err"] < GODUNOV_MAX[(r["problem"], r["n"])], r
+            assert r["ratio"] == pytest.approx(1.0)
+        assert r["delta_rss_mb"] >= 0 and r["peak_rss_mb"] > 0
+
+
+def test_peers_give_finite_errors(result):
+    for r in result["records"]:
+        if r["method"] in PEER_MODULE and r["status"] == "ok":
+            assert math.isfinite(r["max_err"]) and r["max_err"] < 0.5, r
+            assert r["ratio"] > 0
+
+
+@pytest.mark.skipif(not HAVE["geographiclib"], reason="geographiclib not installed")
+def test_geographiclib_matches_integrated_geodesics_on_the_spheroid():
+    """The ellipsoid's exact reference: geographiclib's series at flattening 0.2 agree with a
+    direct integration of the geodesic equations x'' = −(x'·H x' / |∇g|²) ∇g to < 1e-7."""
+    from geographiclib.geodesic import Geodesic
+    from scipy.integrate import solve_ivp
+
+    s = Spheroid()
+    a, c = s.a, s.c
+    geod = Geodesic(a, 1 - c / a)
+    hd = np.array([2 / a**2, 2 / a**2, 2 / c**2])
+
+    def rhs(_, y):
+        x, v = y[:3], y[3:]
+        g = hd * x
+        return np.concatenate([v, -(v @ (hd * v)) / (g @ g) * g])
+
+    def on_surface(lat_deg, lon_deg):
+        lat, lon = np.radians(lat_deg), np.radians(lon_deg)
+        k = 1 / np.hypot(a * np.cos(lat), c * np.sin(lat))
+        return np.array([a * a * np.cos(lat) * k * np.cos(lon), a * a * np.cos(lat) * k * np.sin(lon), c * c * np.sin(lat) * k])
+
+    for lat0, az, dist in [(0.0, 30.0, 1.2), (20.0, 10.0, 2.0), (-40.0, 120.0, 1.0)]:
+        lat = np.radians(lat0)
+        azr = np.radians(az)
+        v0 = np.sin(azr) * np.array([0, 1, 0]) + np.cos(azr) * np.array([-np.sin(lat), 0, np.cos(lat)])
+        sol = solve_ivp(rhs, (0, dist), np.concatenate([on_surface(lat0, 0.0), v0]), rtol=1e-12, atol=1e-14, method="DOP853")
+        r = geod.Direct(lat0, 0.0, az, dist)
+        assert np.linalg.norm(sol.y[:3, -1] - on_surface(r["lat2"], r["lon2"])) < 1e-7
+
+
+def test_exact_distances_of_the_benchmark_surfaces():
+    rng = np.random.default_rng(1)
+    p = rng.uniform(-1, 1, (5000, 3))
+    s = Spheroid()
+    cp = s.closest(p)
+    assert np.abs((cp[:, 0] ** 2 + cp[:, 1] ** 2) / s.a**2 + cp[:, 2] ** 2 / s.c**2 - 1).max() < 1e-12
+    assert np.abs(np.abs(s.signed_distance(p)) - np.linalg.norm(p - cp, axis=1)).max() < 1e-12
+    # the closest point is a local minimum: no better point among nearby surface points
+    q = s.closest(cp + 1e-3 * rng.normal(size=cp.shape))
+    assert np.all(np.linalg.norm(p - q, axis=1) >= np.abs(s.signed_distance(p)) - 1e-12)
+    # ellipse: closed form on the axes
+    x0, x1 = ellipse_closest(np.array([0.0, 2.0]), np.array([2.0, 0.0]), 0.5, 0.4)
+    assert np.allclose(x0, [0.0, 0.5]) and np.allclose(x1, [0.4, 0.0])
+    # torus: along the outer equator the distance is the arclength (R + r)|Δθ|
+    t = Torus()
+    th = np.array([0.3, -1.2])
+    eq = np.stack([0.75 * np.cos(th), 0.75 * np.sin(th), 0 * th], 1)
+    assert np.allclose(t.equator_distance(eq, (0.75, 0, 0)), 0.75 * np.abs(th))
+    assert np.isnan(t.equator_distance(eq, (0.5, 0, 0.25))).all()
