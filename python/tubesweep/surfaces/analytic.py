@@ -7,7 +7,7 @@ from typing import Sequence, Tuple
 import numpy as np
 
 from ..surface import LevelSet
-from ._mesh import grid_mesh, polyline
+from ._triangulation import grid_mesh, polyline
 
 __all__ = ["Circle", "Sphere", "Star"]
 

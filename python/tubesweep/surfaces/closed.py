@@ -9,7 +9,7 @@ from typing import Sequence, Tuple
 import numpy as np
 
 from ..surface import LevelSet
-from ._mesh import grid_mesh, marching_cubes
+from ._triangulation import grid_mesh, marching_cubes
 
 __all__ = ["Ellipsoid", "Torus", "RoundedCube", "DoubleTorus"]
 

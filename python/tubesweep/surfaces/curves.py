@@ -7,7 +7,7 @@ from typing import Sequence, Tuple
 import numpy as np
 
 from ..surface import LevelSet
-from ._mesh import polyline
+from ._triangulation import polyline
 
 __all__ = ["Ellipse"]
 

@@ -10,7 +10,7 @@ from typing import Sequence, Tuple
 import numpy as np
 
 from ..closest_point import ClosestPoint
-from ._mesh import grid_mesh
+from ._triangulation import grid_mesh
 
 __all__ = ["Hemisphere", "Disc", "PlanePatch", "MobiusBand"]
 
