@@ -308,7 +308,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 active[n].store(0, Ordering::Relaxed);
             }
         }
-        let ctx = SweepContext { u: &shared, active: &active, weights: &weights };
+        // the largest slowness of a general Hamiltonian bounds the extrapolation of absent
+        // neighbours (see `fill_missing`); computed once, it may scan every node
+        let general_slowness = match self.scheme {
+            InnerScheme::General(ham) => ham.slowness_bound().unwrap_or(f64::INFINITY),
+            _ => f64::INFINITY,
+        };
+        let ctx = SweepContext { u: &shared, active: &active, weights: &weights, general_slowness };
         let n_orient = 1usize << D;
         let inf = options.infinity.unwrap_or(crate::DEFAULT_INFINITY);
         let pool = if options.threads == 1 {
@@ -458,7 +464,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 }
                 InnerScheme::General(ham) => {
                     if self.missing == MissingNeighbour::Extrapolate {
-                        let f = h * ham.slowness_bound().unwrap_or(f64::INFINITY);
+                        let f = h * ctx.general_slowness;
                         self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, f, &mut minus, &mut plus);
                     }
                     let p = central_gradient(minus, plus, h);
@@ -496,6 +502,7 @@ struct SweepContext<'a, const D: usize> {
     u: &'a SharedValues,
     active: &'a [AtomicU8],
     weights: &'a [[f32; D]],
+    general_slowness: f64,
 }
 
 /// Smallest number of rows in a wave worth splitting across threads.
