@@ -14,7 +14,7 @@
 //! sequentially).
 
 /// Leading-axis rows per tile side.
-pub const TILE: usize = 16;
+pub const TILE: usize = 8;
 
 /// The wave/tile/row order for each orientation of the leading axes.
 #[derive(Debug, Clone, Default)]
