@@ -58,68 +58,51 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     Ok(d)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn solve_generic<'py, const D: usize>(
+/// Node roles as the core's enum, without copying: validates that every byte is a role.
+fn node_roles(roles: &[u8]) -> PyResult<&[NodeRole]> {
+    if let Some(&bad) = roles.iter().find(|&&r| NodeRole::from_u8(r).is_none()) {
+        return Err(PyValueError::new_err(format!("roles: invalid role {bad}")));
+    }
+    // SAFETY: NodeRole is #[repr(u8)] and every byte was just checked to be one of its values.
+    Ok(unsafe { std::slice::from_raw_parts(roles.as_ptr() as *const NodeRole, roles.len()) })
+}
+
+/// A flat (n·D) array viewed as n D-vectors, without copying.
+fn node_vectors<'a, T, const D: usize>(flat: &'a [T], n: usize, name: &str) -> PyResult<&'a [[T; D]]> {
+    if flat.len() != n * D {
+        return Err(PyValueError::new_err(format!("{name} must have shape ({n}, {D})")));
+    }
+    // SAFETY: [T; D] has the layout of D consecutive T and the alignment of T.
+    Ok(unsafe { std::slice::from_raw_parts(flat.as_ptr() as *const [T; D], n) })
+}
+
+/// The per-node outward directions (K, D), borrowed from NumPy.
+fn direction_view<'a, const D: usize>(directions: &'a Option<PyReadonlyArray2<'_, f32>>, n: usize) -> PyResult<&'a [[f32; D]]> {
+    match directions {
+        Some(d) => node_vectors::<f32, D>(d.as_slice()?, n, "directions"),
+        None => Ok(&[]),
+    }
+}
+
+/// Runs `problem` with the GIL released; after every iteration re-acquires it to honour Ctrl-C
+/// and call the Python progress callback. Returns the solution and the statistics dict.
+fn run_sweeps<'py, const D: usize>(
     py: Python<'py>,
-    band: &NarrowBand<D>,
-    roles: &[u8],
+    problem: &SweepProblem<'_, D>,
     fixed_values: &[f64],
-    spacing: f64,
-    slowness: &Bound<'py, PyAny>,
-    directions: Option<PyReadonlyArray2<'py, f32>>,
-    scheme: u8,
-    missing: MissingNeighbour,
-    options: SolveOptions,
+    options: &SolveOptions,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
-    let n = band.len();
-    if roles.len() != n || fixed_values.len() != n {
-        return Err(PyValueError::new_err(format!("roles and values must have one entry per band node ({n})")));
+    if fixed_values.len() != problem.band.len() {
+        return Err(PyValueError::new_err(format!(
+            "roles and values must have one entry per band node ({})",
+            problem.band.len()
+        )));
     }
-    let roles: Vec<NodeRole> = roles
-        .iter()
-        .map(|&r| NodeRole::from_u8(r).ok_or_else(|| PyValueError::new_err(format!("roles: invalid role {r}"))))
-        .collect::<PyResult<_>>()?;
-    let slowness_arr: Option<PyReadonlyArray1<'py, f64>>;
-    let constant_slowness: Option<f64>;
-    if let Ok(s) = slowness.extract::<f64>() {
-        constant_slowness = Some(s);
-        slowness_arr = None;
-    } else {
-        slowness_arr = Some(slowness.extract()?);
-        constant_slowness = None;
-    }
-    let slow_slice = match &slowness_arr {
-        Some(a) => Some(a.as_slice()?),
-        None => None,
-    };
-    let dirs: Vec<[f32; D]> = match &directions {
-        Some(d) => {
-            if d.shape() != [n, D] {
-                return Err(PyValueError::new_err(format!("directions must have shape ({n}, {D})")));
-            }
-            let s = d.as_slice()?;
-            s.chunks_exact(D).map(|c| c.try_into().unwrap_or([0.0; D])).collect()
-        }
-        None => Vec::new(),
-    };
     let mut values = fixed_values.to_vec();
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
-        let problem = SweepProblem {
-            band,
-            roles: &roles,
-            spacing,
-            slowness: match (constant_slowness, slow_slice) {
-                (Some(s), _) => Slowness::Constant(s),
-                (None, Some(s)) => Slowness::PerNode(s),
-                (None, None) => Slowness::Constant(1.0),
-            },
-            directions: &dirs,
-            scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
-            missing,
-        };
         let mut callback = |r: &IterationReport| -> Control {
             Python::attach(|py| {
                 if let Err(e) = py.check_signals() {
@@ -135,13 +118,61 @@ fn solve_generic<'py, const D: usize>(
                 Control::Continue
             })
         };
-        problem.solve(&mut values, &options, &mut callback)
+        problem.solve(&mut values, options, &mut callback)
     });
     if let Some(e) = py_error {
         return Err(e);
     }
     let stats = result.map_err(to_pyerr)?;
     Ok((values.into_pyarray(py), stats_dict(py, &stats)?))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn solve_generic<'py, const D: usize>(
+    py: Python<'py>,
+    band: &NarrowBand<D>,
+    roles: &[u8],
+    fixed_values: &[f64],
+    spacing: f64,
+    slowness: &Bound<'py, PyAny>,
+    directions: Option<PyReadonlyArray2<'py, f32>>,
+    scheme: u8,
+    missing: MissingNeighbour,
+    options: SolveOptions,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
+    let n = band.len();
+    if roles.len() != n {
+        return Err(PyValueError::new_err(format!("roles and values must have one entry per band node ({n})")));
+    }
+    let roles = node_roles(roles)?;
+    let slowness_arr: Option<PyReadonlyArray1<'py, f64>>;
+    let constant_slowness: Option<f64>;
+    if let Ok(s) = slowness.extract::<f64>() {
+        constant_slowness = Some(s);
+        slowness_arr = None;
+    } else {
+        slowness_arr = Some(slowness.extract()?);
+        constant_slowness = None;
+    }
+    let slow_slice = match &slowness_arr {
+        Some(a) => Some(a.as_slice()?),
+        None => None,
+    };
+    let problem = SweepProblem {
+        band,
+        roles,
+        spacing,
+        slowness: match (constant_slowness, slow_slice) {
+            (Some(s), _) => Slowness::Constant(s),
+            (None, Some(s)) => Slowness::PerNode(s),
+            (None, None) => Slowness::Constant(1.0),
+        },
+        directions: direction_view::<D>(&directions, n)?,
+        scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
+        missing,
+    };
+    run_sweeps(py, &problem, fixed_values, &options, progress)
 }
 
 /// Per-node data of a built-in general Hamiltonian (Sect. 5.1), borrowed from NumPy arrays.
@@ -179,23 +210,11 @@ fn solve_general_generic<'py, const D: usize>(
             return Err(PyValueError::new_err(format!("sigma must hold {D} positive finite numbers")));
         }
     }
-    let roles: Vec<NodeRole> = roles
-        .iter()
-        .map(|&r| NodeRole::from_u8(r).ok_or_else(|| PyValueError::new_err(format!("roles: invalid role {r}"))))
-        .collect::<PyResult<_>>()?;
-    let dirs: Vec<[f32; D]> = match &directions {
-        Some(d) => {
-            if d.shape() != [n, D] {
-                return Err(PyValueError::new_err(format!("directions must have shape ({n}, {D})")));
-            }
-            d.as_slice()?.chunks_exact(D).map(|c| c.try_into().unwrap_or([0.0; D])).collect()
-        }
-        None => Vec::new(),
-    };
-    let flow: Vec<[f64; D]> = match inputs.flow {
-        Some(f) if f.len() == n * D => f.chunks_exact(D).map(|c| c.try_into().unwrap_or([0.0; D])).collect(),
-        Some(_) => return Err(PyValueError::new_err(format!("flow must have shape ({n}, {D})"))),
-        None => Vec::new(),
+    let roles = node_roles(roles)?;
+    let dirs = direction_view::<D>(&directions, n)?;
+    let flow: &[[f64; D]] = match inputs.flow {
+        Some(f) => node_vectors::<f64, D>(f, n, "flow")?,
+        None => &[],
     };
     let metric: Vec<[[f64; D]; D]> = match inputs.metric {
         Some(m) if m.len() == n * D * D => m
@@ -217,7 +236,7 @@ fn solve_general_generic<'py, const D: usize>(
             if flow.is_empty() && n > 0 {
                 return Err(PyValueError::new_err("hamiltonian 'moving_medium' needs flow (K, d)"));
             }
-            mm = MovingMedium { slowness: inputs.slowness, flow: &flow, sigma: inputs.sigma };
+            mm = MovingMedium { slowness: inputs.slowness, flow, sigma: inputs.sigma };
             &mm
         }
         "metric" => {
@@ -233,41 +252,16 @@ fn solve_general_generic<'py, const D: usize>(
             )))
         }
     };
-    let mut values = fixed_values.to_vec();
-    let mut py_error: Option<PyErr> = None;
-    let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
-    let result = py.detach(|| {
-        let problem = SweepProblem {
-            band,
-            roles: &roles,
-            spacing,
-            slowness: Slowness::Constant(1.0), // unused by InnerScheme::General
-            directions: &dirs,
-            scheme: InnerScheme::General(ham),
-            missing,
-        };
-        let mut callback = |r: &IterationReport| -> Control {
-            Python::attach(|py| {
-                if let Err(e) = py.check_signals() {
-                    py_error = Some(e);
-                    return Control::Stop;
-                }
-                if let Some(cb) = &progress_ref {
-                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
-                        py_error = Some(e);
-                        return Control::Stop;
-                    }
-                }
-                Control::Continue
-            })
-        };
-        problem.solve(&mut values, &options, &mut callback)
-    });
-    if let Some(e) = py_error {
-        return Err(e);
-    }
-    let stats = result.map_err(to_pyerr)?;
-    Ok((values.into_pyarray(py), stats_dict(py, &stats)?))
+    let problem = SweepProblem {
+        band,
+        roles,
+        spacing,
+        slowness: Slowness::Constant(1.0), // unused by InnerScheme::General
+        directions: dirs,
+        scheme: InnerScheme::General(ham),
+        missing,
+    };
+    run_sweeps(py, &problem, fixed_values, &options, progress)
 }
 
 macro_rules! with_band {
