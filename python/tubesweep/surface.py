@@ -89,15 +89,17 @@ def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, ou
     return out
 
 
-def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
-                  name: str = "surface") -> Tuple[np.ndarray, np.ndarray]:
-    """Grid nodes with ``|fn| ≤ half_width``, found coarse-to-fine without visiting the box.
+def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
+                              distance: Callable[[np.ndarray, float], np.ndarray]) -> np.ndarray:
+    """Grid node indices (M, d) that may lie within ``half_width`` of a surface, found without
+    visiting the box.
 
-    Blocks of 2^L × … nodes are kept only if ``|fn(centre)| ≤ half_width + lipschitz · radius``
-    (exact when ``fn`` is ``lipschitz``-Lipschitz, as a distance function is with constant 1),
-    then split in 2^d children, down to single nodes. Work and memory are O(N^(d−1) log N).
-
-    Returns sorted linear indices and the values of ``fn`` there.
+    Blocks of 2^L × … nodes are kept only if ``distance(centre) ≤ half_width + lipschitz · radius``
+    (exact when the distance is ``lipschitz``-Lipschitz, as a distance function is with constant
+    1), then split in 2^d children, down to single nodes. ``distance(points, reach)`` returns the
+    unsigned distance of the points; it may return anything larger than ``reach`` for points
+    farther than ``reach`` (a spatial index can stop its search there). Work and memory are
+    O(N^(d−1) log N).
     """
     shape = np.asarray(grid.shape)
     d = grid.ndim
@@ -109,12 +111,22 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
         last = np.minimum(origins + block, shape) - 1
         centre = 0.5 * (origins + last)
         radius = 0.5 * h * np.linalg.norm(last - origins, axis=1)
-        v = _evaluate(fn, grid.points(centre), name)
-        keep = np.abs(v) <= half_width + lipschitz * radius + 1e-12
-        origins = origins[keep]
+        reach = half_width + lipschitz * float(radius.max(initial=0.0)) + 1e-12
+        dist = distance(grid.points(centre), reach)
+        origins = origins[dist <= half_width + lipschitz * radius + 1e-12]
         block //= 2
         children = (origins[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
         origins = children[np.all(children < shape, axis=1)]
+    return origins
+
+
+def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
+                  name: str = "surface") -> Tuple[np.ndarray, np.ndarray]:
+    """Grid nodes with ``|fn| ≤ half_width`` for a level set function ``fn``, found coarse-to-fine
+    (:func:`coarse_to_fine_candidates`). Returns sorted linear indices and the values of ``fn``
+    there."""
+    origins = coarse_to_fine_candidates(grid, half_width, lipschitz,
+                                        lambda p, reach: np.abs(_evaluate(fn, p, name)))
     v = _evaluate(fn, grid.points(origins), name)
     keep = np.abs(v) <= half_width
     lin = grid.linear_index(origins[keep])

@@ -29,7 +29,7 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ..grid import Grid
-from ..surface import BandGeometry, Surface
+from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
 
 __all__ = ["from_mesh", "MeshSurface", "read_mesh", "closest_points_on_triangles"]
 
@@ -297,22 +297,8 @@ class MeshSurface(Surface):
         undefined, the face normal.
         """
         self.check_grid(grid)
-        shape = np.asarray(grid.shape)
-        d = 3
         h = grid.spacing
-        block = 1 << max(0, int(np.floor(np.log2(max(grid.shape) / 4))))
-        origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(-1, d)
-        corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
-        while block > 1:
-            last = np.minimum(origins + block, shape) - 1
-            centre = 0.5 * (origins + last)
-            radius = 0.5 * h * np.linalg.norm(last - origins, axis=1)
-            reach = half_width + float(radius.max(initial=0.0)) + 1e-12
-            dist, _, _, _ = self.closest(grid.points(centre), reach)
-            origins = origins[dist <= half_width + radius + 1e-12]
-            block //= 2
-            children = (origins[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
-            origins = children[np.all(children < shape, axis=1)]
+        origins = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0])
         if origins.size == 0:
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
         lin = np.sort(grid.linear_index(origins))  # leaf blocks are disjoint: no duplicates
