@@ -38,8 +38,11 @@ class Band:
         missing: str,
         tol: float,
         max_iterations: int,
-        infinity: float,
+        infinity: Optional[float],
         progress: Optional[Callable[[int, float, int], Any]] = None,
+        threads: int = 0,
+        skip_inactive: bool = True,
+        activation_threshold: float = 0.0,
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
     def solve_general(
         self,
