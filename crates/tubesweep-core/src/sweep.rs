@@ -370,21 +370,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let rows = sched.rows(lead);
         let tiles = sched.tiles(lead);
         let waves = sched.waves(lead);
+        // one specialised row loop per (scheme, speed) pair: no dispatch inside the hot loop
+        let per_node = matches!(self.slowness, Slowness::PerNode(_));
         let run_tile = |t: usize| -> Accumulator {
-            let mut acc = Accumulator::default();
-            for &r in &rows[tiles[t] as usize..tiles[t + 1] as usize] {
-                let (s, e) = band.row_range(r as usize);
-                if backwards {
-                    for n in (s..e).rev() {
-                        self.visit(ctx, n, inf, threshold, &mut acc);
-                    }
-                } else {
-                    for n in s..e {
-                        self.visit(ctx, n, inf, threshold, &mut acc);
-                    }
-                }
+            let tile_rows = &rows[tiles[t] as usize..tiles[t + 1] as usize];
+            match (self.scheme, per_node) {
+                (InnerScheme::Godunov, false) => self.run_rows::<GODUNOV, false>(ctx, tile_rows, backwards, inf, threshold),
+                (InnerScheme::Godunov, true) => self.run_rows::<GODUNOV, true>(ctx, tile_rows, backwards, inf, threshold),
+                (InnerScheme::LaxFriedrichs, false) => self.run_rows::<LXF, false>(ctx, tile_rows, backwards, inf, threshold),
+                (InnerScheme::LaxFriedrichs, true) => self.run_rows::<LXF, true>(ctx, tile_rows, backwards, inf, threshold),
+                (InnerScheme::General(_), _) => self.run_rows::<GENERAL, false>(ctx, tile_rows, backwards, inf, threshold),
             }
-            acc
         };
         let mut total = Accumulator::default();
         for w in 0..waves.len() - 1 {
@@ -405,8 +401,34 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         total
     }
 
+    /// The rows of one tile, in order, with the update specialised for scheme `S` and a
+    /// constant (`P = false`) or per-node (`P = true`) slowness.
+    fn run_rows<const S: u8, const P: bool>(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        rows: &[u32],
+        backwards: bool,
+        inf: f64,
+        threshold: f64,
+    ) -> Accumulator {
+        let mut acc = Accumulator::default();
+        for &r in rows {
+            let (s, e) = self.band.row_range(r as usize);
+            if backwards {
+                for n in (s..e).rev() {
+                    self.visit::<S, P>(ctx, n, inf, threshold, &mut acc);
+                }
+            } else {
+                for n in s..e {
+                    self.visit::<S, P>(ctx, n, inf, threshold, &mut acc);
+                }
+            }
+        }
+        acc
+    }
+
     #[inline(always)]
-    fn visit(&self, ctx: &SweepContext<'_, D>, n: usize, inf: f64, threshold: f64, acc: &mut Accumulator) {
+    fn visit<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, inf: f64, threshold: f64, acc: &mut Accumulator) {
         let (u, active) = (ctx.u, ctx.active);
         // SAFETY: n < band.len(); roles, active, weights and the neighbour table have at least
         // that length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of
@@ -443,33 +465,31 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             v
         } else {
             let h = self.spacing;
-            let slow = match self.slowness {
-                Slowness::Constant(s) => s,
-                Slowness::PerNode(s) => unsafe { *s.get_unchecked(n) },
+            let slow = match (P, self.slowness) {
+                (true, Slowness::PerNode(s)) => unsafe { *s.get_unchecked(n) },
+                (_, Slowness::Constant(s)) => s,
+                (false, Slowness::PerNode(s)) => unsafe { *s.get_unchecked(n) },
             };
             let mut self_dependent = false;
-            let candidate = match self.scheme {
-                InnerScheme::Godunov => {
-                    let mut mins = [0.0; D];
-                    for k in 0..D {
-                        mins[k] = fmin(minus[k], plus[k]);
-                    }
-                    godunov_update(mins, h * slow)
+            let candidate = if S == GODUNOV {
+                let mut mins = [0.0; D];
+                for k in 0..D {
+                    mins[k] = fmin(minus[k], plus[k]);
                 }
-                InnerScheme::LaxFriedrichs => {
-                    if self.missing == MissingNeighbour::Extrapolate {
-                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, h * slow, &mut minus, &mut plus);
-                    }
-                    lxf_eikonal_update(minus, plus, h * slow)
+                godunov_update(mins, h * slow)
+            } else if S == LXF {
+                if self.missing == MissingNeighbour::Extrapolate {
+                    self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, h * slow, &mut minus, &mut plus);
                 }
-                InnerScheme::General(ham) => {
-                    if self.missing == MissingNeighbour::Extrapolate {
-                        let f = h * ctx.general_slowness;
-                        self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, f, &mut minus, &mut plus);
-                    }
-                    let p = central_gradient(minus, plus, h);
-                    lxf_general_update(minus, plus, ham.viscosity(n), ham.value(n, p), h)
+                lxf_eikonal_update(minus, plus, h * slow)
+            } else {
+                let InnerScheme::General(ham) = self.scheme else { return };
+                if self.missing == MissingNeighbour::Extrapolate {
+                    let f = h * ctx.general_slowness;
+                    self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, f, &mut minus, &mut plus);
                 }
+                let p = central_gradient(minus, plus, h);
+                lxf_general_update(minus, plus, ham.viscosity(n), ham.value(n, p), h)
             };
             // monotone acceptance: keep the smaller value (Sect. 4, proof of Corollary 1)
             if !(candidate < old) {
@@ -504,6 +524,10 @@ struct SweepContext<'a, const D: usize> {
     weights: &'a [[f32; D]],
     general_slowness: f64,
 }
+
+const GODUNOV: u8 = 0;
+const LXF: u8 = 1;
+const GENERAL: u8 = 2;
 
 /// Smallest number of rows in a wave worth splitting across threads.
 const MIN_PARALLEL_ROWS: u32 = 64;
