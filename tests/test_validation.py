@@ -85,3 +85,12 @@ def test_progress_callback_sees_every_iteration_and_can_interrupt():
 def test_memory_guard():
     with pytest.raises(MemoryError, match="GiB"):
         ts.travel_time(ts.Grid((0, 0, 0), (1, 1, 1), (5001, 5001, 5001)), [(0.5, 0.5, 0.5)])
+
+
+def test_bad_speed_array_error_names_the_node():
+    speed = np.ones((21, 21))
+    speed[15, 10] = -1.0
+    for call in (lambda: ts.travel_time(G2, [(0, 0)], speed=speed),
+                 lambda: ts.solve(circle, G2, [(0.5, 0)], speed=speed)):
+        with pytest.raises(ValueError, match=r"at \(0\.5, 0\.0\)"):
+            call()

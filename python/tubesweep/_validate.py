@@ -88,15 +88,23 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
         if arr.shape != grid.shape:
             raise ValueError(f"speed array must have the grid's shape {grid.shape}; got {arr.shape}")
         vals = arr.reshape(-1)[linear] if linear is not None else arr.reshape(-1)
+    def where(i: int) -> tuple:
+        if points.shape[1] == grid.ndim and len(points) > i:
+            p = points[i]
+        else:  # coordinates not built (speed given as an array): recover them from the index
+            idx = linear[i] if linear is not None else i
+            p = grid.points(grid.unravel(np.array([idx])))[0]
+        return tuple(float(x) for x in p)
+
     bad = ~np.isfinite(vals)
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"speed is NaN or inf at {tuple(float(x) for x in points[i])}; it must be finite everywhere")
+        raise ValueError(f"speed is NaN or inf at {where(i)}; it must be finite everywhere")
     nonpos = vals <= 0
     if np.any(nonpos):
         i = int(np.flatnonzero(nonpos)[0])
         raise ValueError(
-            f"speed must be positive; got {vals[i]:.6g} at {tuple(float(x) for x in points[i])}. "
+            f"speed must be positive; got {vals[i]:.6g} at {where(i)}. "
             "A zero or negative speed means the wave never arrives there"
         )
     return np.ascontiguousarray(vals)

@@ -141,7 +141,7 @@ def travel_time(
     check_memory(grid.size * _BYTES_PER_BOX_NODE, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver")
 
     if callable(speed) or np.ndim(speed) > 0:
-        pts = np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1) if callable(speed) else np.empty((grid.size, grid.ndim))
+        pts = np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1) if callable(speed) else np.empty((0, grid.ndim))
         f = speed_values(speed, grid, pts, None)
         slowness: Any = 1.0 / f
         del pts

@@ -332,9 +332,8 @@ def solve(
         )
         outer_eff += 1.0
 
-    idx = grid.unravel(geom.linear)
-    x = grid.points(idx)
-    del idx
+    # node coordinates only for a speed given as a callable (an array is read at the nodes)
+    x = grid.points(grid.unravel(geom.linear)) if callable(speed) else np.empty((len(geom.linear), 0))
     speed_nodes = speed_values(speed, grid, x, geom.linear)
     slowness: Any = 1.0 / speed_nodes
 

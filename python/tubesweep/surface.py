@@ -91,23 +91,26 @@ def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, ou
 
 def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
                               distance: Callable[[np.ndarray, float], np.ndarray]) -> np.ndarray:
-    """Grid node indices (M, d) that may lie within ``half_width`` of a surface, found without
-    visiting the box.
+    """Sorted C-order linear indices of the grid nodes that may lie within ``half_width`` of a
+    surface, found without visiting the box.
 
     Blocks of 2^L × … nodes are kept only if ``distance(centre) ≤ half_width + lipschitz · radius``
     (exact when the distance is ``lipschitz``-Lipschitz, as a distance function is with constant
     1), then split in 2^d children, down to single nodes. ``distance(points, reach)`` returns the
     unsigned distance of the points; it may return anything larger than ``reach`` for points
     farther than ``reach`` (a spatial index can stop its search there). Work and memory are
-    O(N^(d−1) log N).
+    O(N^(d−1) log N); the single nodes of the last level are produced in chunks as linear indices
+    (8 bytes each), so the candidate list is the largest array this allocates.
     """
     shape = np.asarray(grid.shape)
     d = grid.ndim
     h = grid.spacing
     block = 1 << max(0, int(np.floor(np.log2(max(grid.shape) / 4))))
     origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(-1, d)
+    if block == 1:  # a tiny grid: every node is a candidate
+        return np.sort(grid.linear_index(origins))
     corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
-    while block > 1:
+    while True:
         last = np.minimum(origins + block, shape) - 1
         centre = 0.5 * (origins + last)
         radius = 0.5 * h * np.linalg.norm(last - origins, axis=1)
@@ -115,9 +118,20 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
         dist = distance(grid.points(centre), reach)
         origins = origins[dist <= half_width + lipschitz * radius + 1e-12]
         block //= 2
+        if block == 1:
+            break
         children = (origins[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
         origins = children[np.all(children < shape, axis=1)]
-    return origins
+    # the last split (blocks of 2 nodes per axis → single nodes), chunk by chunk, straight to
+    # linear indices
+    parts = []
+    chunk = max(1, EVAL_CHUNK // len(corners))
+    for s0 in range(0, len(origins), chunk):
+        children = (origins[s0 : s0 + chunk, None, :] + corners[None, :, :]).reshape(-1, d)
+        parts.append(grid.linear_index(children[np.all(children < shape, axis=1)]))
+    linear = np.concatenate(parts) if parts else np.zeros(0, np.int64)
+    linear.sort()
+    return linear
 
 
 def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
@@ -125,13 +139,18 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
     """Grid nodes with ``|fn| ≤ half_width`` for a level set function ``fn``, found coarse-to-fine
     (:func:`coarse_to_fine_candidates`). Returns sorted linear indices and the values of ``fn``
     there."""
-    origins = coarse_to_fine_candidates(grid, half_width, lipschitz,
-                                        lambda p, reach: np.abs(_evaluate(fn, p, name)))
-    v = _evaluate(fn, grid.points(origins), name)
-    keep = np.abs(v) <= half_width
-    lin = grid.linear_index(origins[keep])
-    order = np.argsort(lin, kind="stable")
-    return lin[order], v[keep][order]
+    candidates = coarse_to_fine_candidates(grid, half_width, lipschitz,
+                                           lambda p, reach: np.abs(_evaluate(fn, p, name)))
+    keep_lin, keep_val = [], []
+    for s0 in range(0, len(candidates), EVAL_CHUNK):
+        lin = candidates[s0 : s0 + EVAL_CHUNK]
+        v = _evaluate(fn, grid.points(grid.unravel(lin)), name)
+        keep = np.abs(v) <= half_width
+        keep_lin.append(lin[keep])
+        keep_val.append(v[keep])
+    if not keep_lin:
+        return np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(keep_lin), np.concatenate(keep_val)  # sorted, as the candidates are
 
 
 def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
@@ -211,15 +230,19 @@ class LevelSet(Surface):
 
     def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray) -> np.ndarray:
         h = grid.spacing
-        idx = grid.unravel(linear)
         d = grid.ndim
         g = np.empty((len(linear), d))
+        strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
+
+        def coordinate(k: int) -> np.ndarray:  # index along axis k, without a (K, d) array
+            return (linear // strides[k]) % grid.shape[k]
+
         if self._array is not None:
             flat = self._array.reshape(-1)
-            strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)])
             for k in range(d):
-                lo_ok = idx[:, k] > 0
-                hi_ok = idx[:, k] < grid.shape[k] - 1
+                c = coordinate(k)
+                lo_ok = c > 0
+                hi_ok = c < grid.shape[k] - 1
                 up = np.where(hi_ok, flat[np.where(hi_ok, linear + strides[k], linear)], values)
                 dn = np.where(lo_ok, flat[np.where(lo_ok, linear - strides[k], linear)], values)
                 width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
@@ -227,19 +250,19 @@ class LevelSet(Surface):
         else:
             # φ at a neighbour that is itself a band node is already known: look it up in the
             # sorted band, evaluate the callable only at the others (the band's outer rim).
-            strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
             for k in range(d):
+                c = coordinate(k)
                 side_vals = []
                 for sign in (1, -1):
                     nb = linear + sign * strides[k]
-                    inside = (idx[:, k] + sign >= 0) & (idx[:, k] + sign < grid.shape[k])
+                    inside = (c + sign >= 0) & (c + sign < grid.shape[k])
                     pos = np.minimum(np.searchsorted(linear, nb), len(linear) - 1)
                     known = inside & (linear[pos] == nb)
                     vals = np.empty(len(linear))
                     vals[known] = values[pos[known]]
                     todo = ~known
                     if np.any(todo):
-                        x = grid.points(idx[todo])
+                        x = grid.points(grid.unravel(linear[todo]))
                         x[:, k] += sign * h
                         vals[todo] = _evaluate(self._fn, x, "surface")  # type: ignore[arg-type]
                     side_vals.append(vals)

@@ -298,10 +298,9 @@ class MeshSurface(Surface):
         """
         self.check_grid(grid)
         h = grid.spacing
-        origins = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0])
-        if origins.size == 0:
+        lin = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0])
+        if lin.size == 0:
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
-        lin = np.sort(grid.linear_index(origins))  # leaf blocks are disjoint: no duplicates
         x = grid.points(grid.unravel(lin))
         dist, cp, face, code = self.closest(x, half_width * (1 + 1e-12))
         keep = dist <= half_width
