@@ -6,6 +6,10 @@ import numpy as np
 import numpy.typing as npt
 
 DEFAULT_INFINITY: float
+
+def shifted_positions(
+    linear: npt.NDArray[np.uint64], offset: int, start: int = 0, stop: Optional[int] = None
+) -> npt.NDArray[np.int64]: ...
 __version__: str
 
 class Band:
@@ -20,6 +24,7 @@ class Band:
     def n_rows(self) -> int: ...
     @property
     def nbytes(self) -> int: ...
+    def linear(self) -> npt.NDArray[np.int64]: ...
     def indices(self) -> npt.NDArray[np.int64]: ...
     def neighbours(self) -> npt.NDArray[np.int64]: ...
     def find(self, indices: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
@@ -33,7 +38,7 @@ class Band:
         fixed_values: npt.NDArray[np.float64],
         spacing: float,
         slowness: Union[float, npt.NDArray[np.float64]],
-        directions: Optional[npt.NDArray[np.float32]],
+        directions: Optional[npt.NDArray[np.float32]],  # (K, d) C-contiguous; overwritten with the extension weights
         scheme: str,
         missing: str,
         tol: float,
@@ -43,6 +48,7 @@ class Band:
         threads: int = 0,
         skip_inactive: bool = True,
         activation_threshold: float = 0.0,
+        coupled: bool = True,
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
     def solve_general(
         self,
@@ -51,7 +57,7 @@ class Band:
         spacing: float,
         hamiltonian: str,
         slowness: npt.NDArray[np.float64],
-        directions: Optional[npt.NDArray[np.float32]],
+        directions: Optional[npt.NDArray[np.float32]],  # (K, d) C-contiguous; overwritten with the extension weights
         missing: str,
         tol: float,
         max_iterations: int,

@@ -56,17 +56,16 @@ class Solution:
     indices : (K, d) int64 — grid indices of the band nodes
     values : (K,) float — the solution at the band nodes (``inf`` where never reached)
     roles : (K,) uint8 — 0 fixed (source), 1 inner tube, 2 extension layer
-    phi : (K,) float — φ (level set) or ``|x − cp(x)|`` (closest point) at the band nodes
+    phi : (K,) float32 — φ (level set) or ``|x − cp(x)|`` (closest point) at the band nodes
     stats : SolveStats
     sources : (S, d) float
     """
 
-    def __init__(self, grid: Grid, band: Any, linear: np.ndarray, values: np.ndarray, roles: np.ndarray,
+    def __init__(self, grid: Grid, band: Any, values: np.ndarray, roles: np.ndarray,
                  phi: np.ndarray, stats: SolveStats, sources: np.ndarray, surface: Surface,
                  hamiltonian: str, method: str, inner: float, outer: float):
         self.grid = grid
         self._band = band
-        self.linear = linear
         self.values = values
         self.roles = roles
         self.phi = phi
@@ -84,6 +83,12 @@ class Solution:
             f"Solution({self.method}, {self.hamiltonian}, band_points={s.band_points}, iterations={s.iterations}, "
             f"converged={s.converged})"
         )
+
+    @property
+    def linear(self) -> np.ndarray:
+        """C-order linear grid indices (K,) of the band nodes, increasing (computed from the band on
+        each access: the solution does not hold them)."""
+        return self._band.linear()
 
     @property
     def indices(self) -> np.ndarray:
@@ -219,6 +224,7 @@ def solve(
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
     threads: int = 0,
+    coupled: bool = True,
 ) -> Solution:
     """First-arrival time (geodesic distance for ``speed=1``) on an implicit curve or surface.
 
@@ -266,6 +272,12 @@ def solve(
     infinity : float, optional
         The finite numerical infinity unknown values start at (default: derived from the band, a
         safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
+    coupled : bool
+        Godunov, two-layer only: update each inner-tube node together with the extension-layer
+        neighbours whose update (5) reads it (a block Gauss–Seidel step). The discrete equations,
+        and so the solution to about ``tol``, are the same; on curved surfaces it saves about a
+        third of the iterations at large N (sphere N=1001: 38 instead of 55). ``False`` runs the
+        paper's pointwise sweeps, whose iteration counts are the paper's Table 2.
 
     Returns
     -------
@@ -349,25 +361,36 @@ def solve(
     fixed[positions] = fixed_vals
     del x
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
+    # What the solution keeps is φ in single precision; the band's linear indices, |φ| and the float64 φ
+    # are dropped before the sweeps (memory is per band node: see docs/architecture.md).
+    phi = geom.signed.astype(np.float32)
     setup = time.perf_counter() - t0
     if general is None:
+        # the directions are converted to the extension weights in place (no second K×d buffer)
+        directions = np.ascontiguousarray(geom.direction, dtype=np.float32)
+        geom = None  # type: ignore[assignment]
         values, st = band.solve(
-            roles, fixed, h, slowness, np.ascontiguousarray(geom.direction, dtype=np.float32), scheme, missing_policy,
+            roles, fixed, h, slowness, directions, scheme, missing_policy,
             float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
+            bool(coupled),
         )
+        del directions
     else:
         values, st = _hams.solve_band(general, surf, grid, geom, band, roles, fixed, positions, src, speed_nodes,
                                       source_init == "exact", SOURCE_RADIUS, tol, max_iterations, _infinity(infinity), cb,
                                       _threads(threads), ACTIVATION_FRACTION * float(tol))
+    del fixed
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
-    per_node = 8 + 8 + 1 + 8 + 4 * grid.ndim + 8  # linear, values, role, phi, direction, slowness
+    # held per node during the sweeps: values and the fixed values (f64), role and active flag, φ (f32),
+    # extension weights (d × f32), per-node slowness (f64) when the speed varies
+    per_node = 8 + 8 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
     stats = SolveStats(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
         inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
         setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles),
     )
-    return Solution(grid, band, geom.linear, values, roles, geom.signed, stats, src, surf, scheme, method,
+    return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
                     float(inner), outer_eff)

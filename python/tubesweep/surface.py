@@ -25,7 +25,7 @@ from .grid import Grid
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
 
 #: Evaluate user callables on at most this many points at a time.
-EVAL_CHUNK = 1 << 20
+EVAL_CHUNK = 1 << 18
 
 # |∇φ| outside [GRAD_ERROR_LOW, GRAD_ERROR_HIGH] on the inner tube is an error, outside
 # [GRAD_WARN_LOW, GRAD_WARN_HIGH] a warning: the method needs φ close to a signed distance.
@@ -228,14 +228,17 @@ class LevelSet(Surface):
         assert self._array is not None
         return _interp_dense(self._array, grid, points)
 
-    def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray) -> np.ndarray:
+    def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int) -> np.ndarray:
+        """Central differences of φ at band nodes ``lo:hi`` (one-sided at the box boundary), (hi − lo, d)."""
         h = grid.spacing
         d = grid.ndim
-        g = np.empty((len(linear), d))
+        lin = linear[lo:hi]
+        val = values[lo:hi]
+        g = np.empty((len(lin), d))
         strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
 
         def coordinate(k: int) -> np.ndarray:  # index along axis k, without a (K, d) array
-            return (linear // strides[k]) % grid.shape[k]
+            return (lin // strides[k]) % grid.shape[k]
 
         if self._array is not None:
             flat = self._array.reshape(-1)
@@ -243,26 +246,29 @@ class LevelSet(Surface):
                 c = coordinate(k)
                 lo_ok = c > 0
                 hi_ok = c < grid.shape[k] - 1
-                up = np.where(hi_ok, flat[np.where(hi_ok, linear + strides[k], linear)], values)
-                dn = np.where(lo_ok, flat[np.where(lo_ok, linear - strides[k], linear)], values)
+                up = np.where(hi_ok, flat[np.where(hi_ok, lin + strides[k], lin)], val)
+                dn = np.where(lo_ok, flat[np.where(lo_ok, lin - strides[k], lin)], val)
                 width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
                 g[:, k] = (up - dn) / width
         else:
             # φ at a neighbour that is itself a band node is already known: look it up in the
-            # sorted band, evaluate the callable only at the others (the band's outer rim).
+            # sorted band (one merge pass in Rust), evaluate the callable only at the others (the
+            # band's outer rim).
+            from . import _native
+
+            ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
             for k in range(d):
                 c = coordinate(k)
                 side_vals = []
                 for sign in (1, -1):
-                    nb = linear + sign * strides[k]
                     inside = (c + sign >= 0) & (c + sign < grid.shape[k])
-                    pos = np.minimum(np.searchsorted(linear, nb), len(linear) - 1)
-                    known = inside & (linear[pos] == nb)
-                    vals = np.empty(len(linear))
+                    pos = _native.shifted_positions(ulinear, int(sign * strides[k]), lo, hi)
+                    known = inside & (pos >= 0)
+                    vals = np.empty(len(lin))
                     vals[known] = values[pos[known]]
                     todo = ~known
                     if np.any(todo):
-                        x = grid.points(grid.unravel(linear[todo]))
+                        x = grid.points(grid.unravel(lin[todo]))
                         x[:, k] += sign * h
                         vals[todo] = _evaluate(self._fn, x, "surface")  # type: ignore[arg-type]
                     side_vals.append(vals)
@@ -283,16 +289,25 @@ class LevelSet(Surface):
             linear, values = discover_band(self._fn, grid, half_width, self.lipschitz)  # type: ignore[arg-type]
         if linear.size == 0:
             return BandGeometry(linear, values, values, np.zeros((0, grid.ndim), np.float32))
-        grad = self._gradient_at_nodes(grid, linear, values)
-        n, norm = _unit(grad)
-        self._check_distance_like(norm, np.abs(values), half_width, grid)
-        direction = (np.sign(values)[:, None] * n).astype(np.float32)
+        # the outward direction sgn(φ) ∇φ/|∇φ|, chunk by chunk (temporaries stay O(chunk))
+        direction = np.empty((len(linear), grid.ndim), np.float32)
+        near_lo, near_hi, all_lo, all_hi = np.inf, -np.inf, np.inf, -np.inf
+        for lo in range(0, len(linear), EVAL_CHUNK):
+            hi = min(len(linear), lo + EVAL_CHUNK)
+            n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
+            direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
+            near = np.abs(values[lo:hi]) <= 0.5 * half_width
+            all_lo, all_hi = min(all_lo, float(norm.min())), max(all_hi, float(norm.max()))
+            if np.any(near):
+                near_lo, near_hi = min(near_lo, float(norm[near].min())), max(near_hi, float(norm[near].max()))
+        if np.isfinite(near_lo):
+            self._check_distance_like(near_lo, near_hi)
+        else:
+            self._check_distance_like(all_lo, all_hi)
         return BandGeometry(linear, np.abs(values), values, direction)
 
-    def _check_distance_like(self, norm: np.ndarray, dist: np.ndarray, half_width: float, grid: Grid) -> None:
-        near = dist <= 0.5 * half_width
-        g = norm[near] if np.any(near) else norm
-        lo, hi = float(np.min(g)), float(np.max(g))
+    def _check_distance_like(self, lo: float, hi: float) -> None:
+        """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface."""
         if lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH:
             raise ValueError(
                 f"surface: φ is not close to a signed distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the "

@@ -16,7 +16,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput};
 use std::time::Duration;
-use tubesweep_core::sweep::{MissingNeighbour, Slowness};
+use tubesweep_core::sweep::{Extension, MissingNeighbour, Slowness};
 use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SweepProblem};
 
 /// The sphere band of radius 0.5 in `[-1, 1]^3` with `n` nodes per axis.
@@ -68,7 +68,7 @@ fn problem<'a>(b: &'a SphereBand, scheme: InnerScheme<'a, 3>) -> SweepProblem<'a
         roles: &b.roles,
         spacing: b.h,
         slowness: Slowness::Constant(1.0),
-        directions: &b.directions,
+        extension: Extension::Directions(&b.directions),
         scheme,
         missing: MissingNeighbour::Extrapolate,
     }

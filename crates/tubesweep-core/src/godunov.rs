@@ -53,6 +53,49 @@ pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
     u
 }
 
+/// The Godunov update for a node coupled to extension-layer neighbours: the largest root `ū` of
+///
+/// ```text
+///     Σ_k c_k^2 [(ū − a_k)^+]^2 = f^2 ,     0 < c_k ≤ 1 .
+/// ```
+///
+/// This is Eq. (3) with the neighbour along axis `k` replaced by its own (affine) dependence on
+/// the node: an extension-layer neighbour `O` whose update (5) reads the node with weight `w`
+/// holds `u_O = w ū + r`, so `ū − u_O = (1 − w)(ū − r/(1 − w))`, i.e. `c_k = 1 − w` and
+/// `a_k = r / (1 − w)`; axes without such a neighbour have `c_k = 1`. Solving the two equations
+/// together (block Gauss–Seidel) removes the slowly contracting node ↔ layer cycle that plain
+/// Gauss–Seidel iterates by a factor `w` per pass; the fixed point is the same.
+#[inline(always)]
+pub fn godunov_update_coupled<const D: usize>(a: [f64; D], c: [f64; D], f: f64) -> f64 {
+    // order the axes by a_k (insertion sort of at most three pairs)
+    let mut p: [(f64, f64); D] = [(0.0, 0.0); D];
+    for k in 0..D {
+        p[k] = (a[k], c[k] * c[k]);
+    }
+    for i in 1..D {
+        let mut j = i;
+        while j > 0 && p[j].0 < p[j - 1].0 {
+            p.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+    // add axes while the root exceeds the next a_k: A ū² − 2 B ū + C = 0
+    let (mut sa, mut sb, mut sc) = (0.0f64, 0.0f64, -f * f);
+    let mut u = p[0].0;
+    for m in 0..D {
+        let (ak, ck2) = p[m];
+        sa += ck2;
+        sb += ck2 * ak;
+        sc += ck2 * ak * ak;
+        let disc = sb * sb - sa * sc;
+        u = (sb + nonneg(disc).sqrt()) / sa;
+        if m + 1 == D || u <= p[m + 1].0 {
+            return u;
+        }
+    }
+    u
+}
+
 /// `max(x, 0)` as a plain compare-select (the values here are never NaN; `f64::max` spends
 /// extra instructions on NaN handling).
 #[inline(always)]
@@ -132,6 +175,35 @@ mod tests {
         let a = u0 - h / 2f64.sqrt();
         let u = godunov_update([a, a], h);
         assert!((u - u0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn coupled_update_with_unit_coefficients_is_the_plain_update() {
+        for a in [[0.1, 0.12, 0.15], [0.5, 0.1, 0.9], [0.0, 5.0, 7.0], [0.3, 0.3, 0.3]] {
+            let f = 0.2;
+            let x = godunov_update(a, f);
+            let y = godunov_update_coupled(a, [1.0; 3], f);
+            assert!((x - y).abs() < 1e-14, "{x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn coupled_update_is_the_fixed_point_of_the_node_layer_cycle() {
+        // node n with neighbours a_x = 0.3 (fixed) and, along y, an extension node O = w u_n + r
+        let (ax, w, r, f) = (0.3f64, 0.7f64, 0.12f64, 0.1f64);
+        // plain Gauss–Seidel on the cycle, from above
+        let mut u = 10.0f64;
+        for _ in 0..2000 {
+            let o = w * u + r;
+            u = u.min(godunov_update([ax, o], f));
+        }
+        let c = 1.0 - w;
+        let v = godunov_update_coupled([ax, r / c], [1.0, c], f);
+        assert!((u - v).abs() < 1e-12, "{u} vs {v}");
+        // and the discrete equation holds with O at its consistent value
+        let o = w * v + r;
+        let res = (v - ax).max(0.0).powi(2) + (v - o).max(0.0).powi(2);
+        assert!((res - f * f).abs() < 1e-14);
     }
 
     #[test]

@@ -5,13 +5,13 @@
 mod errors;
 
 use errors::to_pyerr;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
 use tubesweep_core::interpolate::interpolate;
-use tubesweep_core::sweep::{MissingNeighbour, Slowness};
+use tubesweep_core::sweep::{extension_weights_in_place, Extension, MissingNeighbour, Slowness};
 use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
 use tubesweep_core::{Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
 
@@ -76,11 +76,26 @@ fn node_vectors<'a, T, const D: usize>(flat: &'a [T], n: usize, name: &str) -> P
     Ok(unsafe { std::slice::from_raw_parts(flat.as_ptr() as *const [T; D], n) })
 }
 
-/// The per-node outward directions (K, D), borrowed from NumPy.
-fn direction_view<'a, const D: usize>(directions: &'a Option<PyReadonlyArray2<'_, f32>>, n: usize) -> PyResult<&'a [[f32; D]]> {
+/// The per-node outward directions (K, D), borrowed mutably from NumPy and overwritten with the
+/// upwind weights of the extension update (Eq. (5)): the solve then needs no second K×D buffer.
+fn extension_in_place<'a, const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    directions: &'a mut Option<PyReadwriteArray2<'_, f32>>,
+    n: usize,
+) -> PyResult<Extension<'a, D>> {
     match directions {
-        Some(d) => node_vectors::<f32, D>(d.as_slice()?, n, "directions"),
-        None => Ok(&[]),
+        Some(d) => {
+            let flat = d.as_slice_mut()?;
+            if flat.len() != n * D {
+                return Err(PyValueError::new_err(format!("directions must have shape ({n}, {D})")));
+            }
+            // SAFETY: [f32; D] has the layout of D consecutive f32 and the alignment of f32.
+            let v: &mut [[f32; D]] = unsafe { std::slice::from_raw_parts_mut(flat.as_mut_ptr() as *mut [f32; D], n) };
+            extension_weights_in_place(band, roles, v);
+            Ok(Extension::Weights(v))
+        }
+        None => Ok(Extension::None),
     }
 }
 
@@ -135,7 +150,7 @@ fn solve_generic<'py, const D: usize>(
     fixed_values: &[f64],
     spacing: f64,
     slowness: &Bound<'py, PyAny>,
-    directions: Option<PyReadonlyArray2<'py, f32>>,
+    mut directions: Option<PyReadwriteArray2<'py, f32>>,
     scheme: u8,
     missing: MissingNeighbour,
     options: SolveOptions,
@@ -168,7 +183,7 @@ fn solve_generic<'py, const D: usize>(
             (None, Some(s)) => Slowness::PerNode(s),
             (None, None) => Slowness::Constant(1.0),
         },
-        directions: direction_view::<D>(&directions, n)?,
+        extension: extension_in_place::<D>(band, roles, &mut directions, n)?,
         scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
         missing,
     };
@@ -193,7 +208,7 @@ fn solve_general_generic<'py, const D: usize>(
     fixed_values: &[f64],
     spacing: f64,
     inputs: GeneralInputs<'_>,
-    directions: Option<PyReadonlyArray2<'py, f32>>,
+    mut directions: Option<PyReadwriteArray2<'py, f32>>,
     missing: MissingNeighbour,
     options: SolveOptions,
     progress: Option<Bound<'py, PyAny>>,
@@ -211,7 +226,7 @@ fn solve_general_generic<'py, const D: usize>(
         }
     }
     let roles = node_roles(roles)?;
-    let dirs = direction_view::<D>(&directions, n)?;
+    let extension = extension_in_place::<D>(band, roles, &mut directions, n)?;
     let flow: &[[f64; D]] = match inputs.flow {
         Some(f) => node_vectors::<f64, D>(f, n, "flow")?,
         None => &[],
@@ -257,7 +272,7 @@ fn solve_general_generic<'py, const D: usize>(
         roles,
         spacing,
         slowness: Slowness::Constant(1.0), // unused by InnerScheme::General
-        directions: dirs,
+        extension,
         scheme: InnerScheme::General(ham),
         missing,
     };
@@ -324,6 +339,12 @@ impl PyBand {
     #[getter]
     fn nbytes(&self) -> usize {
         with_band!(self, b, b.heap_bytes())
+    }
+
+    /// C-order linear grid indices of the band nodes, shape (K,), in band order (increasing).
+    fn linear<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let v: Vec<i64> = with_band!(self, b, b.linear_indices().into_iter().map(|x| x as i64).collect());
+        v.into_pyarray(py)
     }
 
     /// Grid indices of the band nodes, shape (K, d), in band order.
@@ -407,7 +428,7 @@ impl PyBand {
     }
 
     /// Runs the sweeps. See `tubesweep_core::sweep`.
-    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0))]
+    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
@@ -416,7 +437,7 @@ impl PyBand {
         fixed_values: PyReadonlyArray1<'py, f64>,
         spacing: f64,
         slowness: Bound<'py, PyAny>,
-        directions: Option<PyReadonlyArray2<'py, f32>>,
+        directions: Option<PyReadwriteArray2<'py, f32>>,
         scheme: &str,
         missing: &str,
         tol: f64,
@@ -426,13 +447,14 @@ impl PyBand {
         threads: usize,
         skip_inactive: bool,
         activation_threshold: f64,
+        coupled: bool,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let scheme = parse_scheme(scheme)?;
         let missing = parse_missing(missing)?;
         if !(activation_threshold >= 0.0) {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled };
         let roles = roles.as_slice()?;
         let fixed = fixed_values.as_slice()?;
         match &self.band {
@@ -455,7 +477,7 @@ impl PyBand {
         spacing: f64,
         hamiltonian: &str,
         slowness: PyReadonlyArray1<'py, f64>,
-        directions: Option<PyReadonlyArray2<'py, f32>>,
+        directions: Option<PyReadwriteArray2<'py, f32>>,
         missing: &str,
         tol: f64,
         max_iterations: usize,
@@ -472,7 +494,8 @@ impl PyBand {
         if !(activation_threshold >= 0.0) {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold };
+        // the coupled update is Godunov's; the general Hamiltonians use Lax–Friedrichs
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false };
         let inputs = GeneralInputs {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,
@@ -584,10 +607,35 @@ impl PyTriangleTree {
     }
 }
 
+/// Position in `linear` (sorted, strictly increasing) of `linear[i] + offset` for `i` in
+/// `start..stop` (default: all), or −1: one merge pass (finite differences of φ at the band nodes).
+#[pyfunction]
+#[pyo3(signature = (linear, offset, start=0, stop=None))]
+fn shifted_positions<'py>(
+    py: Python<'py>,
+    linear: PyReadonlyArray1<'py, u64>,
+    offset: i64,
+    start: usize,
+    stop: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let lin = linear.as_slice()?;
+    let stop = stop.unwrap_or(lin.len());
+    if start > stop || stop > lin.len() {
+        return Err(PyValueError::new_err(format!("start..stop = {start}..{stop} is not a range of the {} indices", lin.len())));
+    }
+    // checked on the queried part only (the whole array is checked when it is queried whole)
+    if lin[start..stop].windows(2).any(|w| w[0] >= w[1]) {
+        return Err(PyValueError::new_err("linear must be strictly increasing"));
+    }
+    let out = py.detach(|| tubesweep_core::band::shifted_positions(lin, offset, start..stop));
+    Ok(out.into_pyarray(py))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     m.add_class::<PyTriangleTree>()?;
+    m.add_function(wrap_pyfunction!(shifted_positions, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
