@@ -49,6 +49,7 @@ class Band:
         skip_inactive: bool = True,
         activation_threshold: float = 0.0,
         coupled: bool = True,
+        defer_outer_rim: bool = True,
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
     def solve_general(
         self,
@@ -69,6 +70,7 @@ class Band:
         threads: int = 0,
         skip_inactive: bool = True,
         activation_threshold: float = 0.0,
+        defer_outer_rim: bool = True,
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
 
 class TriangleTree:

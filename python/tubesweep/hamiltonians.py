@@ -363,7 +363,7 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
                fixed: np.ndarray, positions: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
                source_radius: float, tol: float, max_iterations: int, infinity: Optional[float],
                progress: Optional[Callable[[int, float, int], None]], threads: int = 0,
-               activation_threshold: float = 0.0) -> tuple:
+               activation_threshold: float = 0.0, defer_outer_rim: bool = True) -> tuple:
     """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
     travel time (for ``exact_sources``), and runs the general Lax–Friedrichs sweeps (Sect. 5.1)."""
     x = grid.points(grid.unravel(geom.linear))
@@ -385,7 +385,7 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
         roles, fixed, grid.spacing, prep.kind, prep.slowness, np.ascontiguousarray(geom.direction, dtype=np.float32),
         "extrapolate", float(tol), int(max_iterations), None if infinity is None else float(infinity),
         flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress, threads=int(threads),
-        skip_inactive=True, activation_threshold=float(activation_threshold),
+        skip_inactive=True, activation_threshold=float(activation_threshold), defer_outer_rim=bool(defer_outer_rim),
     )
     st = dict(st)
     st.update(prep.extra if "inverse" not in prep.extra else {})

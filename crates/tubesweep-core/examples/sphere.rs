@@ -16,6 +16,7 @@ fn main() {
     };
     let threads: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
     let coupled = args.get(4).map_or(true, |s| s != "pointwise");
+    let defer_outer_rim = std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
     let h = 2.0 / (n - 1) as f64;
     let mut lin = Vec::new();
     let mut roles = Vec::new();
@@ -52,7 +53,7 @@ fn main() {
     let mut u = vec![0.0; band.len()];
     let thr: f64 = std::env::var("THR").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-12);
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
-    let opts = SolveOptions { threads, activation_threshold: thr, tol, coupled, ..Default::default() };
+    let opts = SolveOptions { threads, activation_threshold: thr, tol, coupled, defer_outer_rim, ..Default::default() };
     let verbose = std::env::var_os("VERBOSE").is_some();
     let st = p
         .solve(&mut u, &opts, &mut |r| {
@@ -64,7 +65,7 @@ fn main() {
         .unwrap();
     let far = band.find([(3 * (n - 1) / 4) as i64, ((n - 1) / 2) as i64, ((n - 1) / 2) as i64]).unwrap();
     println!(
-        "N={n} coupled={coupled} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5}",
+        "N={n} coupled={coupled} rim_last={defer_outer_rim} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5}",
         band.len(),
         st.iterations,
         st.updates,

@@ -428,7 +428,7 @@ impl PyBand {
     }
 
     /// Runs the sweeps. See `tubesweep_core::sweep`.
-    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true))]
+    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true, defer_outer_rim=true))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
@@ -448,13 +448,14 @@ impl PyBand {
         skip_inactive: bool,
         activation_threshold: f64,
         coupled: bool,
+        defer_outer_rim: bool,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let scheme = parse_scheme(scheme)?;
         let missing = parse_missing(missing)?;
         if !(activation_threshold >= 0.0) {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim };
         let roles = roles.as_slice()?;
         let fixed = fixed_values.as_slice()?;
         match &self.band {
@@ -467,7 +468,7 @@ impl PyBand {
     /// Hamiltonian: `"isotropic"` (`|p| − s`), `"moving_medium"` (`|p| − s|1 − v·p|`, needs
     /// `flow` (K, d)) or `"metric"` (`sqrt(pᵀMp) − s`, needs `metric` (K, d, d)). `slowness` has
     /// 1 or K entries; `sigma` (d,) overrides the automatic per-node viscosities.
-    #[pyo3(signature = (roles, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0))]
+    #[pyo3(signature = (roles, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, defer_outer_rim=true))]
     #[allow(clippy::too_many_arguments)]
     fn solve_general<'py>(
         &self,
@@ -489,13 +490,14 @@ impl PyBand {
         threads: usize,
         skip_inactive: bool,
         activation_threshold: f64,
+        defer_outer_rim: bool,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let missing = parse_missing(missing)?;
         if !(activation_threshold >= 0.0) {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
         // the coupled update is Godunov's; the general Hamiltonians use Lax–Friedrichs
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false, defer_outer_rim };
         let inputs = GeneralInputs {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,

@@ -62,7 +62,7 @@ def sphere_run(n: int, hamiltonian: str, source_init: str = "node", keep: bool =
     grid = Grid((-1.0,) * 3, (1.0,) * 3, (n,) * 3)
     t = time.perf_counter()
     sol = solve(Sphere(0.5), grid, [SOURCE], hamiltonian=hamiltonian, inner=2.0, outer=4.0, method="two-layer",
-                source_init=source_init, tol=TOL, infinity=INFINITY, coupled=False)
+                source_init=source_init, tol=TOL, infinity=INFINITY, paper_sweeps=True)
     wall = time.perf_counter() - t
     u = sol(circle_points())
     rec: Dict[str, Any] = {"N": n, "dx": grid.spacing, "hamiltonian": hamiltonian, "source_init": source_init,

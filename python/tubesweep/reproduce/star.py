@@ -96,7 +96,7 @@ def star_run(n: int, hamiltonian: str, phi: str = "simple", source_init: str = "
     t = time.perf_counter()
     sol = solve(_star(phi), grid, [SOURCE], hamiltonian=hamiltonian, inner=2.0, outer=4.0, method="two-layer",
                 source_init=source_init, tol=tol, infinity=infinity, max_iterations=20000,
-                progress=lambda it, ch, up: trace.append(ch), coupled=False)
+                progress=lambda it, ch, up: trace.append(ch), paper_sweeps=True)
     wall = time.perf_counter() - t
     pts, exact = _curve_samples()
     u = sol(pts)
@@ -302,7 +302,7 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
     star = _star(MATCH["phi"])
     grid = Grid((-1.0, -1.0), (1.0, 1.0), (41, 41))
     sol = solve(star, grid, [SOURCE], hamiltonian="godunov", source_init="node", tol=MATCH["tol"],
-                infinity=MATCH["infinity"], coupled=False)
+                infinity=MATCH["infinity"], paper_sweeps=True)
     ax = axs[0]
     pts = sol.points
     ax.scatter(pts[sol.roles == 1, 0], pts[sol.roles == 1, 1], s=9, c="tab:green", label="inner tube |φ| ≤ 2Δx")
