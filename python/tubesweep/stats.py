@@ -13,7 +13,8 @@ class SolveStats:
     Attributes
     ----------
     iterations : int
-        Full passes of the 2^d sweep orders.
+        Full passes of the 2^d sweep orders (with the outer rim swept last, the default, this
+        includes the rim's own passes, usually two).
     sweeps : int
         Directional sweeps (2^d per iteration).
     updates : int
