@@ -600,11 +600,19 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         for w in 0..waves.len() - 1 {
             let (t0, t1) = (waves[w] as usize, waves[w + 1] as usize);
             let work = tiles[t1] - tiles[t0];
-            if parallel && t1 - t0 > 2 && work >= MIN_PARALLEL_ROWS {
+            if parallel && t1 - t0 >= 4 && work >= MIN_PARALLEL_ROWS {
+                // pairs of tiles, interleaved, in parallel
                 let acc = (t0..t1)
                     .into_par_iter()
                     .step_by(2)
                     .map(|t| run_pair(t, t1))
+                    .reduce(Accumulator::default, Accumulator::merge);
+                total = total.merge(acc);
+            } else if parallel && t1 - t0 > 1 && work >= MIN_PARALLEL_ROWS {
+                // too few tiles to pair up across the threads: one tile per task
+                let acc = (t0..t1)
+                    .into_par_iter()
+                    .map(|t| run_pair(t, t + 1))
                     .reduce(Accumulator::default, Accumulator::merge);
                 total = total.merge(acc);
             } else {
