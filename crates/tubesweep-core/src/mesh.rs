@@ -203,11 +203,30 @@ impl TriangleTree {
     }
 
     /// The exact closest point on the mesh to `p`, searching only within `max_distance`
-    /// (`None` when nothing is that close; use `f64::INFINITY` for no limit).
+    /// (`None` when nothing is that close; use `f64::INFINITY` for no limit). Among triangles at
+    /// exactly the same distance the one with the smallest index is reported, so the answer does
+    /// not depend on the order of the search.
     pub fn closest(&self, p: V3, max_distance: f64) -> Option<Closest> {
+        self.closest_from(p, max_distance, None, &mut Vec::with_capacity(64))
+    }
+
+    /// [`closest`](Self::closest), starting from triangle `hint` (typically the answer for a
+    /// nearby point): its distance bounds the search from the start, which then only opens the
+    /// boxes that can hold something closer. The answer is the same with or without a hint.
+    fn closest_from(&self, p: V3, max_distance: f64, hint: Option<usize>, stack: &mut Vec<(u32, f64)>) -> Option<Closest> {
         let mut best2 = if max_distance.is_finite() { max_distance * max_distance } else { f64::INFINITY };
         let mut best: Option<(V3, usize, Feature)> = None;
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
+        if let Some(t) = hint {
+            let tri = &self.tris[t];
+            let (q, f) = closest_point_on_triangle(p, tri[0], tri[1], tri[2]);
+            let dd = sub(p, q);
+            let e2 = dot(dd, dd);
+            if e2 <= best2 {
+                best2 = e2;
+                best = Some((q, t, f));
+            }
+        }
+        stack.clear();
         let root_d = box_dist2(p, self.nodes[0].lo, self.nodes[0].hi);
         if root_d <= best2 {
             stack.push((0, root_d));
@@ -223,7 +242,11 @@ impl TriangleTree {
                     let (q, f) = closest_point_on_triangle(p, tri[0], tri[1], tri[2]);
                     let dd = sub(p, q);
                     let e2 = dot(dd, dd);
-                    if e2 < best2 || (best.is_none() && e2 <= best2) {
+                    let better = match best {
+                        None => e2 <= best2,
+                        Some((_, bt, _)) => e2 < best2 || (e2 == best2 && (t as usize) < bt),
+                    };
+                    if better {
                         best2 = e2;
                         best = Some((q, t as usize, f));
                     }
@@ -254,9 +277,30 @@ impl TriangleTree {
         best.map(|(q, t, f)| Closest { distance: best2.sqrt(), point: q, triangle: t, feature: f })
     }
 
-    /// [`closest`](Self::closest) for many points `(M, 3)` (row-major), in parallel.
+    /// [`closest`](Self::closest) for many points `(M, 3)` (row-major), in parallel. Points are
+    /// taken in blocks in their given order and each query starts from the previous point's
+    /// triangle ([`closest_from`](Self::closest_from)): for grid nodes in C order, consecutive
+    /// points are neighbours and the bound prunes most of the tree.
     pub fn closest_many(&self, points: &[f64], max_distance: f64) -> Vec<Option<Closest>> {
-        points.par_chunks_exact(3).map(|c| self.closest([c[0], c[1], c[2]], max_distance)).collect()
+        const BLOCK: usize = 2048;
+        let blocks: Vec<Vec<Option<Closest>>> = points
+            .par_chunks(3 * BLOCK)
+            .map(|block| {
+                let mut stack = Vec::with_capacity(64);
+                let mut hint = None;
+                block
+                    .chunks_exact(3)
+                    .map(|c| {
+                        let r = self.closest_from([c[0], c[1], c[2]], max_distance, hint, &mut stack);
+                        if let Some(ref a) = r {
+                            hint = Some(a.triangle);
+                        }
+                        r
+                    })
+                    .collect()
+            })
+            .collect();
+        blocks.concat()
     }
 }
 
@@ -296,6 +340,31 @@ mod tests {
         let (q, f) = closest_point_on_triangle([1.0, 1.0, 0.0], a, b, c);
         assert_eq!(f, Feature::EdgeBC);
         assert!(close(q, [0.5, 0.5, 0.0]));
+    }
+
+    #[test]
+    fn warm_started_batches_give_the_answers_of_single_queries() {
+        // a small closed mesh (octahedron) and a line of nearby points, as grid nodes come
+        let v: [V3; 6] = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+        let f = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+        let tris: Vec<[V3; 3]> = f.iter().map(|t| [v[t[0]], v[t[1]], v[t[2]]]).collect();
+        let tree = TriangleTree::new(tris);
+        let mut state = 7u64;
+        let mut pts = Vec::new();
+        for i in 0..5000 {
+            let t = i as f64 / 5000.0;
+            pts.extend_from_slice(&[1.5 * (6.0 * t).cos(), 1.5 * (6.0 * t).sin(), 2.0 * t - 1.0 + 0.01 * lcg(&mut state)]);
+            // exact ties too: points on the axes are equidistant from several faces
+            if i % 97 == 0 {
+                pts.extend_from_slice(&[0.0, 0.0, 3.0 * lcg(&mut state) - 1.5]);
+            }
+        }
+        for max_d in [f64::INFINITY, 0.9] {
+            let batch = tree.closest_many(&pts, max_d);
+            for (i, c) in pts.chunks_exact(3).enumerate() {
+                assert_eq!(batch[i], tree.closest([c[0], c[1], c[2]], max_d), "point {i}");
+            }
+        }
     }
 
     #[test]
