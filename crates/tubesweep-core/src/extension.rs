@@ -89,6 +89,19 @@ pub fn extension_apply<const D: usize>(weights: [f32; D], minus: [f64; D], plus:
     acc
 }
 
+/// The extension update (5) with precomputed [`extension_weights`], reading only the upwind
+/// neighbour along each axis: `neighbours[k] = [minus, plus]`, `value(i)` the value of node `i`.
+/// Bit-identical to [`extension_apply`] (the terms it adds for the downwind side are exact zeros).
+#[inline(always)]
+pub fn extension_apply_upwind<const D: usize>(weights: [f32; D], neighbours: &[[u32; 2]; D], value: impl Fn(u32) -> f64) -> f64 {
+    let mut acc = 0.0;
+    for k in 0..D {
+        let w = weights[k] as f64;
+        acc += w.abs() * value(neighbours[k][(w < 0.0) as usize]);
+    }
+    acc
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,7 +14,7 @@
 
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
-use crate::extension::{extension_apply, extension_weights};
+use crate::extension::{extension_apply_upwind, extension_weights};
 use crate::godunov::{fmin, godunov_update, godunov_update_coupled};
 use crate::hamiltonian::InnerScheme;
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
@@ -740,22 +740,22 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`.
         let role = unsafe { *self.roles.get_unchecked(n) };
         let nb = unsafe { self.band.neighbours().get_unchecked(n) };
+        let old = u.get(n);
+        if role == NodeRole::Outer {
+            // Eq. (5) with the precomputed upwind weights, reading only the upwind neighbours.
+            // Neighbours still at the numerical infinity stay in the convex combination, as in
+            // the paper: the extended value then approaches the solution from above like the
+            // inner values do. Dropping them would let a too-small value into the layer, which
+            // the monotone Godunov update could never undo.
+            let w = unsafe { *ctx.weights.get_unchecked(n) };
+            let v = extension_apply_upwind(w, nb, |i| u.get(i as usize));
+            return if v == old { None } else { Some(LocalUpdate { old, new: v, self_dependent: false }) };
+        }
         let mut minus = [0.0; D];
         let mut plus = [0.0; D];
         for k in 0..D {
             minus[k] = u.get(nb[k][0] as usize);
             plus[k] = u.get(nb[k][1] as usize);
-        }
-        let old = u.get(n);
-        if role == NodeRole::Outer {
-            // Eq. (5) with the precomputed upwind weights. Neighbours still at the numerical
-            // infinity stay in the convex combination, as in the paper: the extended value then
-            // approaches the solution from above like the inner values do. Dropping them would
-            // let a too-small value into the layer, which the monotone Godunov update could
-            // never undo.
-            let w = unsafe { *ctx.weights.get_unchecked(n) };
-            let v = extension_apply(w, minus, plus);
-            return if v == old { None } else { Some(LocalUpdate { old, new: v, self_dependent: false }) };
         }
         let h = self.spacing;
         let slow = match (P, self.slowness) {
