@@ -45,6 +45,7 @@ SOURCE_RADIUS = 2.0
 ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
 
 _MAX_WIDENINGS = 4
+_ROLE_CHUNK = 1 << 18
 
 
 class Solution:
@@ -150,10 +151,15 @@ class Solution:
 
 
 def _roles_and_band(geom: BandGeometry, grid: Grid, inner_width: float, method: str) -> Tuple[Any, np.ndarray]:
-    band = _native.Band.from_linear(list(grid.shape), geom.linear.astype(np.uint64))
-    roles = np.where(geom.distance <= inner_width * (1 + ROLE_RTOL), ROLE_INNER, ROLE_OUTER).astype(np.uint8)
-    if method == "naive":
-        roles[:] = ROLE_INNER
+    linear = np.ascontiguousarray(geom.linear, dtype=np.int64).view(np.uint64)  # non-negative: the same bits
+    band = _native.Band.from_linear(list(grid.shape), linear)
+    # |φ| ≤ inner·Δx: inner tube, else extension layer; chunk by chunk (no K-sized temporaries)
+    roles = np.full(len(geom.linear), ROLE_INNER if method == "naive" else ROLE_OUTER, np.uint8)
+    if method != "naive":
+        limit = inner_width * (1 + ROLE_RTOL)
+        for lo in range(0, len(roles), _ROLE_CHUNK):
+            part = roles[lo : lo + _ROLE_CHUNK]
+            part[geom.unsigned(lo, lo + _ROLE_CHUNK) <= limit] = ROLE_INNER
     return band, roles
 
 
@@ -357,35 +363,37 @@ def solve(
 
     positions, fixed_vals = _fix_sources(surf, grid, band, geom.linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
-    fixed = np.zeros(len(roles))
-    fixed[positions] = fixed_vals
     del x
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
-    # What the solution keeps is φ in single precision; the band's linear indices, |φ| and the float64 φ
-    # are dropped before the sweeps (memory is per band node: see docs/architecture.md).
-    phi = geom.signed.astype(np.float32)
-    setup = time.perf_counter() - t0
     if general is None:
-        # the directions are converted to the extension weights in place (no second K×d buffer)
+        # What the solution keeps is φ in single precision; the band's linear indices and the
+        # float64 φ are dropped before the sweeps, the linear indices before φ is converted (memory
+        # is per band node: see docs/architecture.md). The fixed nodes go to the solver sparsely.
+        # The directions are converted to the extension weights in place (no second K×d buffer).
         directions = np.ascontiguousarray(geom.direction, dtype=np.float32)
+        signed = geom.signed
         geom = None  # type: ignore[assignment]
+        phi = signed.astype(np.float32)
+        del signed
+        setup = time.perf_counter() - t0
         values, st = band.solve(
-            roles, fixed, h, slowness, directions, scheme, missing_policy,
+            roles, positions, fixed_vals, h, slowness, directions, scheme, missing_policy,
             float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
             bool(coupled),
         )
         del directions
     else:
-        values, st = _hams.solve_band(general, surf, grid, geom, band, roles, fixed, positions, src, speed_nodes,
+        phi = geom.signed.astype(np.float32)
+        setup = time.perf_counter() - t0
+        values, st = _hams.solve_band(general, surf, grid, geom, band, roles, positions, fixed_vals, src, speed_nodes,
                                       source_init == "exact", SOURCE_RADIUS, tol, max_iterations, _infinity(infinity), cb,
                                       _threads(threads), ACTIVATION_FRACTION * float(tol))
-    del fixed
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
-    # held per node during the sweeps: values and the fixed values (f64), role and active flag, φ (f32),
-    # extension weights (d × f32), per-node slowness (f64) when the speed varies
-    per_node = 8 + 8 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
+    # held per node during the sweeps: values (f64), role and active flag, φ (f32), extension weights
+    # (d × f32), per-node slowness (f64) when the speed varies; the fixed values are sparse
+    per_node = 8 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
     stats = SolveStats(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),

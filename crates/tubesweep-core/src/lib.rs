@@ -13,6 +13,7 @@
 //! | built-in Hamiltonians (isotropic, moving medium, metric) | [`hamiltonians`] | Sect. 5.1, 6.3 |
 //! | the upwind extension update | [`extension`] | Eq. (5) applied to Eq. (8) |
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
+//! | the last split of the coarse-to-fine band search | [`discovery`] | — |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
 //! | multilinear interpolation in the band | [`interpolate`] | — |
 //! | exact closest points on triangle meshes (AABB tree) | [`mesh`] | Sect. 5.2 |
@@ -22,6 +23,7 @@
 //! like a NumPy array of the grid's shape.
 
 pub mod band;
+pub mod discovery;
 pub mod error;
 pub mod extension;
 pub mod godunov;
