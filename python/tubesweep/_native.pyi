@@ -11,6 +11,19 @@ def shifted_positions(
     linear: npt.NDArray[np.uint64], offset: int, start: int = 0, stop: Optional[int] = None
 ) -> npt.NDArray[np.int64]: ...
 def split_pair_blocks(shape: List[int], origins: npt.NDArray[np.int64]) -> npt.NDArray[np.uint64]: ...
+def rim_nodes(
+    shape: List[int], linear: npt.NDArray[np.uint64], start: int, stop: int
+) -> Tuple[npt.NDArray[np.int64], List[int]]: ...
+def outward_directions(
+    shape: List[int],
+    spacing: float,
+    linear: npt.NDArray[np.uint64],
+    phi: npt.NDArray[np.float64],
+    start: int,
+    stop: int,
+    rim_phi: npt.NDArray[np.float64],
+    direction: npt.NDArray[np.float32],  # (stop − start, d) C-contiguous, written
+) -> npt.NDArray[np.float64]: ...
 __version__: str
 
 class Band:

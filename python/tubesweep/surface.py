@@ -239,51 +239,47 @@ class LevelSet(Surface):
         return _interp_dense(self._array, grid, points)
 
     def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int) -> np.ndarray:
-        """Central differences of φ at band nodes ``lo:hi`` (one-sided at the box boundary), (hi − lo, d)."""
+        """Central differences of a sampled φ at band nodes ``lo:hi`` (one-sided at the box
+        boundary), (hi − lo, d)."""
         h = grid.spacing
         d = grid.ndim
         lin = linear[lo:hi]
         val = values[lo:hi]
         g = np.empty((len(lin), d))
         strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
-
-        def coordinate(k: int) -> np.ndarray:  # index along axis k, without a (K, d) array
-            return (lin // strides[k]) % grid.shape[k]
-
-        if self._array is not None:
-            flat = self._array.reshape(-1)
-            for k in range(d):
-                c = coordinate(k)
-                lo_ok = c > 0
-                hi_ok = c < grid.shape[k] - 1
-                up = np.where(hi_ok, flat[np.where(hi_ok, lin + strides[k], lin)], val)
-                dn = np.where(lo_ok, flat[np.where(lo_ok, lin - strides[k], lin)], val)
-                width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
-                g[:, k] = (up - dn) / width
-        else:
-            # φ at a neighbour that is itself a band node is already known: look it up in the
-            # sorted band (one merge pass in Rust), evaluate the callable only at the others (the
-            # band's outer rim).
-            from . import _native
-
-            ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-            for k in range(d):
-                c = coordinate(k)
-                side_vals = []
-                for sign in (1, -1):
-                    inside = (c + sign >= 0) & (c + sign < grid.shape[k])
-                    pos = _native.shifted_positions(ulinear, int(sign * strides[k]), lo, hi)
-                    known = inside & (pos >= 0)
-                    vals = np.empty(len(lin))
-                    vals[known] = values[pos[known]]
-                    todo = ~known
-                    if np.any(todo):
-                        x = grid.points(grid.unravel(lin[todo]))
-                        x[:, k] += sign * h
-                        vals[todo] = _evaluate(self._fn, x, "surface")  # type: ignore[arg-type]
-                    side_vals.append(vals)
-                g[:, k] = (side_vals[0] - side_vals[1]) / (2 * h)
+        assert self._array is not None
+        flat = self._array.reshape(-1)
+        for k in range(d):
+            c = (lin // strides[k]) % grid.shape[k]  # index along axis k, without a (K, d) array
+            lo_ok = c > 0
+            hi_ok = c < grid.shape[k] - 1
+            up = np.where(hi_ok, flat[np.where(hi_ok, lin + strides[k], lin)], val)
+            dn = np.where(lo_ok, flat[np.where(lo_ok, lin - strides[k], lin)], val)
+            width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
+            g[:, k] = (up - dn) / width
         return g
+
+    def _outward_directions(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int,
+                            direction: np.ndarray) -> np.ndarray:
+        """For a callable φ: ``sgn(φ) ∇φ/|∇φ|`` at band nodes ``lo:hi`` into ``direction`` (float32)
+        by central differences, in Rust (:func:`tubesweep._native.outward_directions`); returns
+        ``|∇φ|``. φ at a neighbour that is itself a band node is already known; the callable is
+        evaluated only at the others (the band's outer rim), one batch per axis and side."""
+        from . import _native
+
+        h = grid.spacing
+        ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
+        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi)
+        parts = []
+        start = 0
+        for group, count in enumerate(counts):
+            if count:
+                x = grid.points(grid.unravel(linear[pos[start : start + count]]))
+                x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
+                parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
+            start += count
+        rim_phi = np.concatenate(parts) if parts else np.zeros(0)
+        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)
@@ -304,8 +300,11 @@ class LevelSet(Surface):
         near_lo, near_hi, all_lo, all_hi = np.inf, -np.inf, np.inf, -np.inf
         for lo in range(0, len(linear), EVAL_CHUNK):
             hi = min(len(linear), lo + EVAL_CHUNK)
-            n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
-            direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
+            if self._array is not None:
+                n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
+                direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
+            else:
+                norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi])
             near = np.abs(values[lo:hi]) <= 0.5 * half_width
             all_lo, all_hi = min(all_lo, float(norm.min())), max(all_hi, float(norm.max()))
             if np.any(near):

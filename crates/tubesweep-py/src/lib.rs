@@ -684,12 +684,56 @@ fn split_pair_blocks<'py>(py: Python<'py>, shape: Vec<usize>, origins: PyReadonl
     Ok(out.into_pyarray(py))
 }
 
+/// The places where central differences of φ at band nodes `start..stop` need φ off the band:
+/// `(positions, counts)`, the band positions for each group (axis k = 0, 1, …; side +1 then −1)
+/// concatenated, and the size of each group (2·d). See `tubesweep_core::normals::rim_nodes`.
+#[pyfunction]
+fn rim_nodes<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    linear: PyReadonlyArray1<'py, u64>,
+    start: usize,
+    stop: usize,
+) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
+    let lin = linear.as_slice()?;
+    let (nodes, counts) = py.detach(|| tubesweep_core::normals::rim_nodes(&shape, lin, start..stop)).map_err(to_pyerr)?;
+    let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
+    Ok((nodes.into_pyarray(py), counts))
+}
+
+/// The outward directions sgn(φ)∇φ/|∇φ| at band nodes `start..stop` by central differences,
+/// written to `direction` ((stop − start, d) float32, C-contiguous); φ at band nodes from `phi`,
+/// off the band from `rim_phi` (in the order of `rim_nodes`). Returns |∇φ| there. See
+/// `tubesweep_core::normals::outward_directions`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn outward_directions<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    spacing: f64,
+    linear: PyReadonlyArray1<'py, u64>,
+    phi: PyReadonlyArray1<'py, f64>,
+    start: usize,
+    stop: usize,
+    rim_phi: PyReadonlyArray1<'py, f64>,
+    mut direction: PyReadwriteArray2<'py, f32>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (lin, ph, rim) = (linear.as_slice()?, phi.as_slice()?, rim_phi.as_slice()?);
+    let dir = direction.as_slice_mut()?;
+    let norms = py
+        .detach(|| tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir))
+        .map_err(to_pyerr)?;
+    Ok(norms.into_pyarray(py))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     m.add_class::<PyTriangleTree>()?;
     m.add_function(wrap_pyfunction!(shifted_positions, m)?)?;
     m.add_function(wrap_pyfunction!(split_pair_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
+    m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
