@@ -150,17 +150,16 @@ class Solution:
         return out.reshape(self.grid.shape)
 
 
-def _roles_and_band(geom: BandGeometry, grid: Grid, inner_width: float, method: str) -> Tuple[Any, np.ndarray]:
-    linear = np.ascontiguousarray(geom.linear, dtype=np.int64).view(np.uint64)  # non-negative: the same bits
-    band = _native.Band.from_linear(list(grid.shape), linear)
-    # |φ| ≤ inner·Δx: inner tube, else extension layer; chunk by chunk (no K-sized temporaries)
+def _tube_roles(geom: BandGeometry, inner_width: float, method: str) -> np.ndarray:
+    """Roles of the band nodes: inner tube where ``|φ| ≤ inner·Δx`` (every node for the naive
+    method), else extension layer; chunk by chunk, without K-sized temporaries."""
     roles = np.full(len(geom.linear), ROLE_INNER if method == "naive" else ROLE_OUTER, np.uint8)
     if method != "naive":
         limit = inner_width * (1 + ROLE_RTOL)
         for lo in range(0, len(roles), _ROLE_CHUNK):
             part = roles[lo : lo + _ROLE_CHUNK]
             part[geom.unsigned(lo, lo + _ROLE_CHUNK) <= limit] = ROLE_INNER
-    return band, roles
+    return roles
 
 
 def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, sources: np.ndarray,
@@ -328,7 +327,16 @@ def solve(
                 "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
                 "and that φ is in the grid's units"
             )
-        band, roles = _roles_and_band(geom, grid, inner_width, method)
+        roles = _tube_roles(geom, inner_width, method)
+        linear = geom.linear
+        if general is None:
+            # The float64 φ (and |φ| where stored) only decide the roles: from here on the solver
+            # keeps φ in single precision, and the band is built without them (memory is per band
+            # node: see docs/architecture.md).
+            phi = geom.signed.astype(np.float32)
+            direction = geom.direction
+            geom = None  # type: ignore[assignment]
+        band = _native.Band.from_linear(list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64))
         if method == "naive":
             break
         missing = band.nodes_missing_neighbours(roles == ROLE_INNER)
@@ -348,8 +356,8 @@ def solve(
         outer_eff += 1.0
 
     # node coordinates only for a speed given as a callable (an array is read at the nodes)
-    x = grid.points(grid.unravel(geom.linear)) if callable(speed) else np.empty((len(geom.linear), 0))
-    speed_nodes = speed_values(speed, grid, x, geom.linear)
+    x = grid.points(grid.unravel(linear)) if callable(speed) else np.empty((len(linear), 0))
+    speed_nodes = speed_values(speed, grid, x, linear)
     slowness: Any = 1.0 / speed_nodes
 
     def slowness_at(p: np.ndarray) -> np.ndarray:
@@ -361,20 +369,17 @@ def solve(
 
         return 1.0 / _interp_dense(np.asarray(speed, dtype=float), grid, p)
 
-    positions, fixed_vals = _fix_sources(surf, grid, band, geom.linear, roles, src, slowness_at, source_init, inner_width)
+    positions, fixed_vals = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
     del x
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
     if general is None:
-        # What the solution keeps is φ in single precision; the band's linear indices and the
-        # float64 φ are dropped before the sweeps, the linear indices before φ is converted (memory
-        # is per band node: see docs/architecture.md). The fixed nodes go to the solver sparsely.
-        # The directions are converted to the extension weights in place (no second K×d buffer).
-        directions = np.ascontiguousarray(geom.direction, dtype=np.float32)
-        signed = geom.signed
-        geom = None  # type: ignore[assignment]
-        phi = signed.astype(np.float32)
-        del signed
+        # The linear indices are dropped before the sweeps and the fixed nodes go to the solver
+        # sparsely; the directions are converted to the extension weights in place (no second
+        # K×d buffer).
+        del linear
+        directions = np.ascontiguousarray(direction, dtype=np.float32)
+        del direction
         setup = time.perf_counter() - t0
         values, st = band.solve(
             roles, positions, fixed_vals, h, slowness, directions, scheme, missing_policy,

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any, Callable, Optional, Tuple, Union
+from typing import Any, Callable, Iterator, Optional, Tuple, Union
 
 import numpy as np
 
@@ -120,18 +120,36 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     if block == 1:  # a tiny grid: every node is a candidate
         return np.sort(grid.linear_index(origins))
     corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+    # each level is generated and tested slice by slice, so that its temporaries (children,
+    # centres, radii, points, the callable's own) stay O(slice); only the kept blocks are stored
+    step = max(1, EVAL_CHUNK >> d)
+    parents: Optional[np.ndarray] = None  # the kept blocks of the previous level (twice the size)
+
+    def level() -> Iterator[np.ndarray]:
+        if parents is None:
+            for s0 in range(0, len(origins), step):
+                yield origins[s0 : s0 + step]
+            return
+        for s0 in range(0, len(parents), max(1, step >> d)):
+            children = (parents[s0 : s0 + max(1, step >> d), None, :] + block * corners[None, :, :]).reshape(-1, d)
+            yield children[np.all(children < shape, axis=1)]
+
     while True:
-        last = np.minimum(origins + block, shape) - 1
-        centre = 0.5 * (origins + last)
-        radius = 0.5 * h * np.linalg.norm(last - origins, axis=1)
-        reach = half_width + lipschitz * float(radius.max(initial=0.0)) + 1e-12
-        dist = distance(grid.points(centre), reach)
-        origins = origins[dist <= half_width + lipschitz * radius + 1e-12]
+        radius_max = 0.0
+        for o in level():
+            radius_max = max(radius_max, float(np.linalg.norm(np.minimum(o + block, shape) - 1 - o, axis=1).max(initial=0.0)))
+        reach = half_width + lipschitz * (0.5 * h * radius_max) + 1e-12
+        kept = []
+        for o in level():
+            last = np.minimum(o + block, shape) - 1
+            radius = 0.5 * h * np.linalg.norm(last - o, axis=1)
+            dist = distance(grid.points(0.5 * (o + last)), reach)
+            kept.append(o[dist <= half_width + lipschitz * radius + 1e-12])
+        parents = np.concatenate(kept) if kept else origins[:0]
         block //= 2
         if block == 1:
             break
-        children = (origins[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
-        origins = children[np.all(children < shape, axis=1)]
+    origins = parents
     # the last split (blocks of 2 nodes per axis → single nodes), in Rust: straight to sorted
     # linear indices (8 bytes per candidate, no sort, no (M, 2^d, d) temporaries)
     from . import _native
