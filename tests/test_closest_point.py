@@ -247,8 +247,8 @@ def test_without_extrapolation_lax_friedrichs_leaks_at_a_cut_end(monkeypatch):
         def __getattr__(self, name):
             return getattr(self._band, name)
 
-        def solve(self, roles, fixed, h, slow, dirs, scheme, missing, *rest):
-            return self._band.solve(roles, fixed, h, slow, dirs, scheme, "infinity", *rest)
+        def solve(self, roles, fixed_positions, fixed_values, h, slow, dirs, scheme, missing, *rest):
+            return self._band.solve(roles, fixed_positions, fixed_values, h, slow, dirs, scheme, "infinity", *rest)
 
     fake = types.SimpleNamespace(Band=types.SimpleNamespace(from_linear=lambda *a: Wrapped(real.Band.from_linear(*a))))
     grid = ts.Grid((-0.55,) * 2, (0.55,) * 2, (56, 56))

@@ -21,23 +21,23 @@ def test_band_construction_errors():
 def test_solve_argument_errors():
     band = _native.Band.full_box([5, 5])
     roles = np.ones(25, np.uint8)
-    fixed = np.zeros(25)
+    fixed = (np.zeros(0, np.int64), np.zeros(0))
     ok = dict(spacing=0.25, slowness=1.0, directions=None, scheme="godunov", missing="infinity", tol=1e-9,
               max_iterations=10, infinity=None)
     with pytest.raises(ValueError, match="one entry per band node"):
-        band.solve(roles[:-1], fixed, **ok)
+        band.solve(roles[:-1], *fixed, **ok)
     with pytest.raises(ValueError, match="role"):
-        band.solve(np.full(25, 7, np.uint8), fixed, **ok)
+        band.solve(np.full(25, 7, np.uint8), *fixed, **ok)
     with pytest.raises(ValueError, match="scheme"):
-        band.solve(roles, fixed, **{**ok, "scheme": "weno"})
+        band.solve(roles, *fixed, **{**ok, "scheme": "weno"})
     with pytest.raises(ValueError, match="infinity"):
-        band.solve(roles, fixed, **{**ok, "infinity": -1.0})
+        band.solve(roles, *fixed, **{**ok, "infinity": -1.0})
     with pytest.raises(ValueError, match="speed"):
-        band.solve(roles, fixed, **{**ok, "slowness": np.ones(3)})
+        band.solve(roles, *fixed, **{**ok, "slowness": np.ones(3)})
     r2 = roles.copy()
     r2[3] = 2
     with pytest.raises(ValueError, match="directions"):
-        band.solve(r2, fixed, **ok)
+        band.solve(r2, *fixed, **ok)
     with pytest.raises(ValueError, match="points"):
         band.interpolate(np.zeros(25), [0.0, 0.0], 0.25, np.zeros((3, 3)))
     with pytest.raises(ValueError, match="values"):
@@ -47,6 +47,6 @@ def test_solve_argument_errors():
 def test_unreached_nodes_report_the_infinity_used():
     band = _native.Band.from_linear([5, 5], np.array([0, 1, 20, 21], dtype=np.uint64))  # two pieces
     roles = np.array([0, 1, 1, 1], np.uint8)
-    vals, st = band.solve(roles, np.zeros(4), 1.0, 1.0, None, "godunov", "infinity", 1e-12, 10, None)
+    vals, st = band.solve(roles, np.array([0]), np.zeros(1), 1.0, 1.0, None, "godunov", "infinity", 1e-12, 10, None)
     assert vals[1] == 1.0
     assert vals[2] == st["infinity"] and vals[3] == st["infinity"]

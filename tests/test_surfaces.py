@@ -146,3 +146,50 @@ def test_redistance_reproduces_the_exact_distance_solution_2d_and_3d():
     r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)])
     V, _ = Sphere().triangulation(12)
     assert np.max(np.abs(s3(V) - r3(V))) < 1e-3
+
+
+# ------------------------------------------------------------------------------ band set-up in Rust
+def _numpy_outward_directions(fn, grid, linear, phi):
+    """The NumPy central differences the Rust set-up replaced: φ at band neighbours looked up,
+    the callable evaluated elsewhere (the same points, bit for bit)."""
+    h, d = grid.spacing, grid.ndim
+    idx = grid.unravel(linear)
+    g = np.empty((len(linear), d))
+    for k in range(d):
+        side = []
+        for sign in (1, -1):
+            nb = idx.copy()
+            nb[:, k] += sign
+            inside = (nb[:, k] >= 0) & (nb[:, k] < grid.shape[k])
+            pos = np.searchsorted(linear, grid.linear_index(np.clip(nb, 0, np.array(grid.shape) - 1)))
+            pos = np.minimum(pos, len(linear) - 1)
+            known = inside & (linear[pos] == grid.linear_index(np.clip(nb, 0, np.array(grid.shape) - 1)))
+            vals = np.where(known, phi[pos], 0.0)
+            x = grid.points(idx[~known])
+            x[:, k] += sign * h
+            vals[~known] = fn(x)
+            side.append(vals)
+        g[:, k] = (side[0] - side[1]) / (2 * h)
+    norm = np.linalg.norm(g, axis=1)
+    return (np.sign(phi)[:, None] * (g / np.where(norm > 1e-12, norm, 1.0)[:, None])).astype(np.float32)
+
+
+@pytest.mark.parametrize("surface, n", [(Sphere(0.97), 33), (Torus(), 41), (Ellipse(), 161)])
+def test_rust_outward_directions_are_the_numpy_central_differences_bit_for_bit(surface, n):
+    grid = ts.Grid(*surface.default_box, (n,) * surface.ndim)
+    geom = surface.band(grid, 4 * grid.spacing)
+    want = _numpy_outward_directions(surface._fn, grid, geom.linear, geom.signed)
+    assert geom.direction.dtype == np.float32
+    assert np.array_equal(geom.direction, want)
+
+
+def test_candidates_of_the_coarse_to_fine_search_are_sorted_and_cover_the_band():
+    from tubesweep.surface import coarse_to_fine_candidates
+
+    s = Sphere(0.6, center=(0.1, -0.05, 0.0))
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (37, 37, 37))  # odd: blocks cut at the upper edge
+    hw = 3 * grid.spacing
+    cand = coarse_to_fine_candidates(grid, hw, 1.0, lambda p, reach: np.abs(s.signed_distance(p)))
+    assert cand.dtype == np.int64 and np.all(np.diff(cand) > 0)
+    every = np.abs(s.signed_distance(grid.points(grid.unravel(np.arange(grid.size)))))
+    assert np.isin(np.flatnonzero(every <= hw), cand).all()

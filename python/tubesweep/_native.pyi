@@ -10,6 +10,20 @@ DEFAULT_INFINITY: float
 def shifted_positions(
     linear: npt.NDArray[np.uint64], offset: int, start: int = 0, stop: Optional[int] = None
 ) -> npt.NDArray[np.int64]: ...
+def split_pair_blocks(shape: List[int], origins: npt.NDArray[np.int64]) -> npt.NDArray[np.uint64]: ...
+def rim_nodes(
+    shape: List[int], linear: npt.NDArray[np.uint64], start: int, stop: int
+) -> Tuple[npt.NDArray[np.int64], List[int]]: ...
+def outward_directions(
+    shape: List[int],
+    spacing: float,
+    linear: npt.NDArray[np.uint64],
+    phi: npt.NDArray[np.float64],
+    start: int,
+    stop: int,
+    rim_phi: npt.NDArray[np.float64],
+    direction: npt.NDArray[np.float32],  # (stop − start, d) C-contiguous, written
+) -> npt.NDArray[np.float64]: ...
 __version__: str
 
 class Band:
@@ -35,7 +49,8 @@ class Band:
     def solve(
         self,
         roles: npt.NDArray[np.uint8],
-        fixed_values: npt.NDArray[np.float64],
+        fixed_positions: npt.NDArray[np.int64],  # (F,) band positions of the fixed nodes
+        fixed_values: npt.NDArray[np.float64],  # (F,) their values (a fixed node not listed starts from 0)
         spacing: float,
         slowness: Union[float, npt.NDArray[np.float64]],
         directions: Optional[npt.NDArray[np.float32]],  # (K, d) C-contiguous; overwritten with the extension weights
@@ -54,7 +69,8 @@ class Band:
     def solve_general(
         self,
         roles: npt.NDArray[np.uint8],
-        fixed_values: npt.NDArray[np.float64],
+        fixed_positions: npt.NDArray[np.int64],  # (F,) band positions of the fixed nodes
+        fixed_values: npt.NDArray[np.float64],  # (F,) their values (a fixed node not listed starts from 0)
         spacing: float,
         hamiltonian: str,
         slowness: npt.NDArray[np.float64],

@@ -32,7 +32,7 @@ __all__ = ["travel_time", "SOURCE_RADIUS"]
 #: costs no O(1) error (scikit-fmm's 1.707 instead of √2 one cell off a source).
 SOURCE_RADIUS = 2.0
 
-_BYTES_PER_BOX_NODE = 8 + 4 + 1 + 8 + 8  # values + last index + role + fixed values + output copy
+_BYTES_PER_BOX_NODE = 8 + 4 + 1 + 8  # values + last index + role + output copy (the fixed values are sparse)
 
 
 @lru_cache(maxsize=2)
@@ -157,11 +157,9 @@ def travel_time(
     band = _box_band(grid.shape)
     roles = np.ones(grid.size, dtype=np.uint8)
     roles[lin] = 0
-    fixed = np.zeros(grid.size)
-    fixed[lin] = val
     setup = time.perf_counter() - t0
     values, st = band.solve(
-        roles, fixed, grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
+        roles, np.ascontiguousarray(lin, dtype=np.int64), np.ascontiguousarray(val, dtype=float), grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
         _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
     )
     warn_unconverged(st, tol, max_iterations)
@@ -172,7 +170,7 @@ def travel_time(
     stats = SolveStats(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=grid.size, inner_points=grid.size - len(lin),
-        outer_points=0, fixed_points=len(lin), setup_seconds=setup, band_bytes=band.nbytes + grid.size * 18,
+        outer_points=0, fixed_points=len(lin), setup_seconds=setup, band_bytes=band.nbytes + grid.size * 10,  # values, role, active flag
     )
     return u, stats
 

@@ -360,7 +360,7 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
 
 
 def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any, roles: np.ndarray,
-               fixed: np.ndarray, positions: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
+               positions: np.ndarray, fixed_values: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
                source_radius: float, tol: float, max_iterations: int, infinity: Optional[float],
                progress: Optional[Callable[[int, float, int], None]], threads: int = 0,
                activation_threshold: float = 0.0, defer_outer_rim: bool = True) -> tuple:
@@ -369,7 +369,7 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
     x = grid.points(grid.unravel(geom.linear))
     slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
     prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
-    fixed = fixed.copy()
+    fixed = np.array(fixed_values, dtype=float)
     if exact_sources and positions.size:
         _, cp = surface.project(x[positions], grid)
         _, sp = surface.project(sources, grid)
@@ -380,9 +380,9 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
             near = np.linalg.norm(disp, axis=1) <= reach
             t = ham.local_time(prep, positions, disp)
             best = np.where(near, np.minimum(best, t), best)
-        fixed[positions] = np.where(np.isfinite(best), best, fixed[positions])
+        fixed = np.where(np.isfinite(best), best, fixed)
     values, st = band.solve_general(
-        roles, fixed, grid.spacing, prep.kind, prep.slowness, np.ascontiguousarray(geom.direction, dtype=np.float32),
+        roles, positions, fixed, grid.spacing, prep.kind, prep.slowness, np.ascontiguousarray(geom.direction, dtype=np.float32),
         "extrapolate", float(tol), int(max_iterations), None if infinity is None else float(infinity),
         flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress, threads=int(threads),
         skip_inactive=True, activation_threshold=float(activation_threshold), defer_outer_rim=bool(defer_outer_rim),

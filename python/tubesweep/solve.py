@@ -45,6 +45,7 @@ SOURCE_RADIUS = 2.0
 ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
 
 _MAX_WIDENINGS = 4
+_ROLE_CHUNK = 1 << 18
 
 
 class Solution:
@@ -149,12 +150,16 @@ class Solution:
         return out.reshape(self.grid.shape)
 
 
-def _roles_and_band(geom: BandGeometry, grid: Grid, inner_width: float, method: str) -> Tuple[Any, np.ndarray]:
-    band = _native.Band.from_linear(list(grid.shape), geom.linear.astype(np.uint64))
-    roles = np.where(geom.distance <= inner_width * (1 + ROLE_RTOL), ROLE_INNER, ROLE_OUTER).astype(np.uint8)
-    if method == "naive":
-        roles[:] = ROLE_INNER
-    return band, roles
+def _tube_roles(geom: BandGeometry, inner_width: float, method: str) -> np.ndarray:
+    """Roles of the band nodes: inner tube where ``|φ| ≤ inner·Δx`` (every node for the naive
+    method), else extension layer; chunk by chunk, without K-sized temporaries."""
+    roles = np.full(len(geom.linear), ROLE_INNER if method == "naive" else ROLE_OUTER, np.uint8)
+    if method != "naive":
+        limit = inner_width * (1 + ROLE_RTOL)
+        for lo in range(0, len(roles), _ROLE_CHUNK):
+            part = roles[lo : lo + _ROLE_CHUNK]
+            part[geom.unsigned(lo, lo + _ROLE_CHUNK) <= limit] = ROLE_INNER
+    return roles
 
 
 def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, sources: np.ndarray,
@@ -324,7 +329,16 @@ def solve(
                 "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
                 "and that φ is in the grid's units"
             )
-        band, roles = _roles_and_band(geom, grid, inner_width, method)
+        roles = _tube_roles(geom, inner_width, method)
+        linear = geom.linear
+        if general is None:
+            # The float64 φ (and |φ| where stored) only decide the roles: from here on the solver
+            # keeps φ in single precision, and the band is built without them (memory is per band
+            # node: see docs/architecture.md).
+            phi = geom.signed.astype(np.float32)
+            direction = geom.direction
+            geom = None  # type: ignore[assignment]
+        band = _native.Band.from_linear(list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64))
         if method == "naive":
             break
         missing = band.nodes_missing_neighbours(roles == ROLE_INNER)
@@ -344,8 +358,8 @@ def solve(
         outer_eff += 1.0
 
     # node coordinates only for a speed given as a callable (an array is read at the nodes)
-    x = grid.points(grid.unravel(geom.linear)) if callable(speed) else np.empty((len(geom.linear), 0))
-    speed_nodes = speed_values(speed, grid, x, geom.linear)
+    x = grid.points(grid.unravel(linear)) if callable(speed) else np.empty((len(linear), 0))
+    speed_nodes = speed_values(speed, grid, x, linear)
     slowness: Any = 1.0 / speed_nodes
 
     def slowness_at(p: np.ndarray) -> np.ndarray:
@@ -357,37 +371,36 @@ def solve(
 
         return 1.0 / _interp_dense(np.asarray(speed, dtype=float), grid, p)
 
-    positions, fixed_vals = _fix_sources(surf, grid, band, geom.linear, roles, src, slowness_at, source_init, inner_width)
+    positions, fixed_vals = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
-    fixed = np.zeros(len(roles))
-    fixed[positions] = fixed_vals
     del x
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
-    # What the solution keeps is φ in single precision; the band's linear indices, |φ| and the float64 φ
-    # are dropped before the sweeps (memory is per band node: see docs/architecture.md).
-    phi = geom.signed.astype(np.float32)
-    setup = time.perf_counter() - t0
     if general is None:
-        # the directions are converted to the extension weights in place (no second K×d buffer)
-        directions = np.ascontiguousarray(geom.direction, dtype=np.float32)
-        geom = None  # type: ignore[assignment]
+        # The linear indices are dropped before the sweeps and the fixed nodes go to the solver
+        # sparsely; the directions are converted to the extension weights in place (no second
+        # K×d buffer).
+        del linear
+        directions = np.ascontiguousarray(direction, dtype=np.float32)
+        del direction
+        setup = time.perf_counter() - t0
         values, st = band.solve(
-            roles, fixed, h, slowness, directions, scheme, missing_policy,
+            roles, positions, fixed_vals, h, slowness, directions, scheme, missing_policy,
             float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
             not paper_sweeps, not paper_sweeps,
         )
         del directions
     else:
-        values, st = _hams.solve_band(general, surf, grid, geom, band, roles, fixed, positions, src, speed_nodes,
+        phi = geom.signed.astype(np.float32)
+        setup = time.perf_counter() - t0
+        values, st = _hams.solve_band(general, surf, grid, geom, band, roles, positions, fixed_vals, src, speed_nodes,
                                       source_init == "exact", SOURCE_RADIUS, tol, max_iterations, _infinity(infinity), cb,
                                       _threads(threads), ACTIVATION_FRACTION * float(tol), not paper_sweeps)
-    del fixed
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
-    # held per node during the sweeps: values and the fixed values (f64), role and active flag, φ (f32),
-    # extension weights (d × f32), per-node slowness (f64) when the speed varies
-    per_node = 8 + 8 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
+    # held per node during the sweeps: values (f64), role and active flag, φ (f32), extension weights
+    # (d × f32), per-node slowness (f64) when the speed varies; the fixed values are sparse
+    per_node = 8 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
     stats = SolveStats(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),

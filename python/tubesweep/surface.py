@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any, Callable, Optional, Tuple, Union
+from typing import Any, Callable, Iterator, Optional, Tuple, Union
 
 import numpy as np
 
@@ -40,15 +40,24 @@ class BandGeometry:
     Attributes
     ----------
     linear : (K,) int64, sorted C-order linear node indices
-    distance : (K,) float, unsigned distance to the surface (``|φ|`` or ``|x − cp(x)|``)
+    distance : (K,) float, unsigned distance to the surface (``|φ|`` or ``|x − cp(x)|``), or None
+        where it is ``|signed|`` (level sets: not stored, 8 bytes per node less; see
+        :meth:`unsigned`)
     signed : (K,) float, ``φ`` for level sets, equal to ``distance`` for closest-point surfaces
     direction : (K, d) float32, outward unit extension direction (zero where undefined)
     """
 
     linear: np.ndarray
-    distance: np.ndarray
+    distance: Optional[np.ndarray]
     signed: np.ndarray
     direction: np.ndarray
+
+    def unsigned(self, lo: int = 0, hi: Optional[int] = None) -> np.ndarray:
+        """The unsigned distance at band nodes ``lo:hi`` (computed from ``signed`` where
+        ``distance`` is not stored)."""
+        if self.distance is not None:
+            return self.distance[lo:hi]
+        return np.abs(self.signed[lo:hi])
 
 
 class Surface:
@@ -99,8 +108,9 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     1), then split in 2^d children, down to single nodes. ``distance(points, reach)`` returns the
     unsigned distance of the points; it may return anything larger than ``reach`` for points
     farther than ``reach`` (a spatial index can stop its search there). Work and memory are
-    O(N^(d−1) log N); the single nodes of the last level are produced in chunks as linear indices
-    (8 bytes each), so the candidate list is the largest array this allocates.
+    O(N^(d−1) log N); the single nodes of the last level are produced in C order as linear indices
+    (8 bytes each, :func:`tubesweep._native.split_pair_blocks`), so the candidate list is the
+    largest array this allocates.
     """
     shape = np.asarray(grid.shape)
     d = grid.ndim
@@ -110,28 +120,42 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     if block == 1:  # a tiny grid: every node is a candidate
         return np.sort(grid.linear_index(origins))
     corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+    # each level is generated and tested slice by slice, so that its temporaries (children,
+    # centres, radii, points, the callable's own) stay O(slice); only the kept blocks are stored
+    step = max(1, EVAL_CHUNK >> d)
+    parents: Optional[np.ndarray] = None  # the kept blocks of the previous level (twice the size)
+
+    def level() -> Iterator[np.ndarray]:
+        if parents is None:
+            for s0 in range(0, len(origins), step):
+                yield origins[s0 : s0 + step]
+            return
+        for s0 in range(0, len(parents), max(1, step >> d)):
+            children = (parents[s0 : s0 + max(1, step >> d), None, :] + block * corners[None, :, :]).reshape(-1, d)
+            yield children[np.all(children < shape, axis=1)]
+
     while True:
-        last = np.minimum(origins + block, shape) - 1
-        centre = 0.5 * (origins + last)
-        radius = 0.5 * h * np.linalg.norm(last - origins, axis=1)
-        reach = half_width + lipschitz * float(radius.max(initial=0.0)) + 1e-12
-        dist = distance(grid.points(centre), reach)
-        origins = origins[dist <= half_width + lipschitz * radius + 1e-12]
+        radius_max = 0.0
+        for o in level():
+            radius_max = max(radius_max, float(np.linalg.norm(np.minimum(o + block, shape) - 1 - o, axis=1).max(initial=0.0)))
+        reach = half_width + lipschitz * (0.5 * h * radius_max) + 1e-12
+        kept = []
+        for o in level():
+            last = np.minimum(o + block, shape) - 1
+            radius = 0.5 * h * np.linalg.norm(last - o, axis=1)
+            dist = distance(grid.points(0.5 * (o + last)), reach)
+            kept.append(o[dist <= half_width + lipschitz * radius + 1e-12])
+        parents = np.concatenate(kept) if kept else origins[:0]
         block //= 2
         if block == 1:
             break
-        children = (origins[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
-        origins = children[np.all(children < shape, axis=1)]
-    # the last split (blocks of 2 nodes per axis → single nodes), chunk by chunk, straight to
-    # linear indices
-    parts = []
-    chunk = max(1, EVAL_CHUNK // len(corners))
-    for s0 in range(0, len(origins), chunk):
-        children = (origins[s0 : s0 + chunk, None, :] + corners[None, :, :]).reshape(-1, d)
-        parts.append(grid.linear_index(children[np.all(children < shape, axis=1)]))
-    linear = np.concatenate(parts) if parts else np.zeros(0, np.int64)
-    linear.sort()
-    return linear
+    origins = parents
+    # the last split (blocks of 2 nodes per axis → single nodes), in Rust: straight to sorted
+    # linear indices (8 bytes per candidate, no sort, no (M, 2^d, d) temporaries)
+    from . import _native
+
+    linear = _native.split_pair_blocks(list(grid.shape), np.ascontiguousarray(origins, dtype=np.int64))
+    return linear.view(np.int64)  # below 2^63: the same bits
 
 
 def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
@@ -142,15 +166,19 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
     candidates = coarse_to_fine_candidates(grid, half_width, lipschitz,
                                            lambda p, reach: np.abs(_evaluate(fn, p, name)))
     keep_lin, keep_val = [], []
+    lin = candidates[:0]
     for s0 in range(0, len(candidates), EVAL_CHUNK):
         lin = candidates[s0 : s0 + EVAL_CHUNK]
         v = _evaluate(fn, grid.points(grid.unravel(lin)), name)
         keep = np.abs(v) <= half_width
         keep_lin.append(lin[keep])
         keep_val.append(v[keep])
+    del candidates, lin  # (lin is a view of them) before the parts are joined: the largest array here
     if not keep_lin:
         return np.zeros(0, np.int64), np.zeros(0)
-    return np.concatenate(keep_lin), np.concatenate(keep_val)  # sorted, as the candidates are
+    linear = np.concatenate(keep_lin)  # sorted, as the candidates are
+    del keep_lin
+    return linear, np.concatenate(keep_val)
 
 
 def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
@@ -229,51 +257,47 @@ class LevelSet(Surface):
         return _interp_dense(self._array, grid, points)
 
     def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int) -> np.ndarray:
-        """Central differences of φ at band nodes ``lo:hi`` (one-sided at the box boundary), (hi − lo, d)."""
+        """Central differences of a sampled φ at band nodes ``lo:hi`` (one-sided at the box
+        boundary), (hi − lo, d)."""
         h = grid.spacing
         d = grid.ndim
         lin = linear[lo:hi]
         val = values[lo:hi]
         g = np.empty((len(lin), d))
         strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
-
-        def coordinate(k: int) -> np.ndarray:  # index along axis k, without a (K, d) array
-            return (lin // strides[k]) % grid.shape[k]
-
-        if self._array is not None:
-            flat = self._array.reshape(-1)
-            for k in range(d):
-                c = coordinate(k)
-                lo_ok = c > 0
-                hi_ok = c < grid.shape[k] - 1
-                up = np.where(hi_ok, flat[np.where(hi_ok, lin + strides[k], lin)], val)
-                dn = np.where(lo_ok, flat[np.where(lo_ok, lin - strides[k], lin)], val)
-                width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
-                g[:, k] = (up - dn) / width
-        else:
-            # φ at a neighbour that is itself a band node is already known: look it up in the
-            # sorted band (one merge pass in Rust), evaluate the callable only at the others (the
-            # band's outer rim).
-            from . import _native
-
-            ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-            for k in range(d):
-                c = coordinate(k)
-                side_vals = []
-                for sign in (1, -1):
-                    inside = (c + sign >= 0) & (c + sign < grid.shape[k])
-                    pos = _native.shifted_positions(ulinear, int(sign * strides[k]), lo, hi)
-                    known = inside & (pos >= 0)
-                    vals = np.empty(len(lin))
-                    vals[known] = values[pos[known]]
-                    todo = ~known
-                    if np.any(todo):
-                        x = grid.points(grid.unravel(lin[todo]))
-                        x[:, k] += sign * h
-                        vals[todo] = _evaluate(self._fn, x, "surface")  # type: ignore[arg-type]
-                    side_vals.append(vals)
-                g[:, k] = (side_vals[0] - side_vals[1]) / (2 * h)
+        assert self._array is not None
+        flat = self._array.reshape(-1)
+        for k in range(d):
+            c = (lin // strides[k]) % grid.shape[k]  # index along axis k, without a (K, d) array
+            lo_ok = c > 0
+            hi_ok = c < grid.shape[k] - 1
+            up = np.where(hi_ok, flat[np.where(hi_ok, lin + strides[k], lin)], val)
+            dn = np.where(lo_ok, flat[np.where(lo_ok, lin - strides[k], lin)], val)
+            width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
+            g[:, k] = (up - dn) / width
         return g
+
+    def _outward_directions(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int,
+                            direction: np.ndarray) -> np.ndarray:
+        """For a callable φ: ``sgn(φ) ∇φ/|∇φ|`` at band nodes ``lo:hi`` into ``direction`` (float32)
+        by central differences, in Rust (:func:`tubesweep._native.outward_directions`); returns
+        ``|∇φ|``. φ at a neighbour that is itself a band node is already known; the callable is
+        evaluated only at the others (the band's outer rim), one batch per axis and side."""
+        from . import _native
+
+        h = grid.spacing
+        ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
+        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi)
+        parts = []
+        start = 0
+        for group, count in enumerate(counts):
+            if count:
+                x = grid.points(grid.unravel(linear[pos[start : start + count]]))
+                x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
+                parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
+            start += count
+        rim_phi = np.concatenate(parts) if parts else np.zeros(0)
+        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)
@@ -294,8 +318,11 @@ class LevelSet(Surface):
         near_lo, near_hi, all_lo, all_hi = np.inf, -np.inf, np.inf, -np.inf
         for lo in range(0, len(linear), EVAL_CHUNK):
             hi = min(len(linear), lo + EVAL_CHUNK)
-            n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
-            direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
+            if self._array is not None:
+                n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
+                direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
+            else:
+                norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi])
             near = np.abs(values[lo:hi]) <= 0.5 * half_width
             all_lo, all_hi = min(all_lo, float(norm.min())), max(all_hi, float(norm.max()))
             if np.any(near):
@@ -304,7 +331,7 @@ class LevelSet(Surface):
             self._check_distance_like(near_lo, near_hi)
         else:
             self._check_distance_like(all_lo, all_hi)
-        return BandGeometry(linear, np.abs(values), values, direction)
+        return BandGeometry(linear, None, values, direction)  # distance = |φ|, not stored
 
     def _check_distance_like(self, lo: float, hi: float) -> None:
         """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface."""

@@ -13,6 +13,8 @@
 //! | built-in Hamiltonians (isotropic, moving medium, metric) | [`hamiltonians`] | Sect. 5.1, 6.3 |
 //! | the upwind extension update | [`extension`] | Eq. (5) applied to Eq. (8) |
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
+//! | the last split of the coarse-to-fine band search | [`discovery`] | — |
+//! | extension directions sgn(φ)∇φ/|∇φ| by central differences | [`normals`] | Eq. (8), Sect. 4 |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
 //! | multilinear interpolation in the band | [`interpolate`] | — |
 //! | exact closest points on triangle meshes (AABB tree) | [`mesh`] | Sect. 5.2 |
@@ -22,6 +24,7 @@
 //! like a NumPy array of the grid's shape.
 
 pub mod band;
+pub mod discovery;
 pub mod error;
 pub mod extension;
 pub mod godunov;
@@ -30,6 +33,7 @@ pub mod hamiltonians;
 pub mod interpolate;
 pub mod lax_friedrichs;
 pub mod mesh;
+pub mod normals;
 pub mod schedule;
 pub mod sweep;
 

@@ -752,6 +752,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             // inner values do. Dropping them would let a too-small value into the layer, which
             // the monotone Godunov update could never undo.
             let w = unsafe { *ctx.weights.get_unchecked(n) };
+            if w[0].is_nan() {
+                // no upwind neighbour (or a vanishing normal, e.g. on a medial axis): the node
+                // keeps its value even when a neighbour re-activates it
+                return None;
+            }
             let v = extension_apply_upwind(w, nb, |i| u.get(i as usize));
             return if v == old { None } else { Some(LocalUpdate { old, new: v, self_dependent: false }) };
         }

@@ -99,22 +99,44 @@ fn extension_in_place<'a, const D: usize>(
     }
 }
 
+/// The fixed nodes' values as the solver's starting vector: zero everywhere, `fixed.values[i]` at
+/// band position `fixed.positions[i]` (the solver overwrites the non-fixed nodes with the numerical
+/// infinity). One spare slot for the sentinel the solver appends, so that push does not reallocate.
+fn starting_values(n: usize, fixed: &FixedNodes<'_>) -> PyResult<Vec<f64>> {
+    if fixed.positions.len() != fixed.values.len() {
+        return Err(PyValueError::new_err(format!(
+            "fixed_positions and fixed_values must have the same length, got {} and {}",
+            fixed.positions.len(),
+            fixed.values.len()
+        )));
+    }
+    let mut values = Vec::with_capacity(n + 1);
+    values.resize(n, 0.0);
+    for (&p, &v) in fixed.positions.iter().zip(fixed.values) {
+        if p < 0 || p as usize >= n {
+            return Err(PyValueError::new_err(format!("fixed_positions: {p} is not a position in the band of {n} nodes")));
+        }
+        values[p as usize] = v;
+    }
+    Ok(values)
+}
+
+/// The nodes fixed by the sources, given sparsely: band positions and their values.
+struct FixedNodes<'s> {
+    positions: &'s [i64],
+    values: &'s [f64],
+}
+
 /// Runs `problem` with the GIL released; after every iteration re-acquires it to honour Ctrl-C
 /// and call the Python progress callback. Returns the solution and the statistics dict.
 fn run_sweeps<'py, const D: usize>(
     py: Python<'py>,
     problem: &SweepProblem<'_, D>,
-    fixed_values: &[f64],
+    fixed: &FixedNodes<'_>,
     options: &SolveOptions,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
-    if fixed_values.len() != problem.band.len() {
-        return Err(PyValueError::new_err(format!(
-            "roles and values must have one entry per band node ({})",
-            problem.band.len()
-        )));
-    }
-    let mut values = fixed_values.to_vec();
+    let mut values = starting_values(problem.band.len(), fixed)?;
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
@@ -147,7 +169,7 @@ fn solve_generic<'py, const D: usize>(
     py: Python<'py>,
     band: &NarrowBand<D>,
     roles: &[u8],
-    fixed_values: &[f64],
+    fixed: &FixedNodes<'_>,
     spacing: f64,
     slowness: &Bound<'py, PyAny>,
     mut directions: Option<PyReadwriteArray2<'py, f32>>,
@@ -158,7 +180,7 @@ fn solve_generic<'py, const D: usize>(
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
     let n = band.len();
     if roles.len() != n {
-        return Err(PyValueError::new_err(format!("roles and values must have one entry per band node ({n})")));
+        return Err(PyValueError::new_err(format!("roles must have one entry per band node ({n})")));
     }
     let roles = node_roles(roles)?;
     let slowness_arr: Option<PyReadonlyArray1<'py, f64>>;
@@ -187,7 +209,7 @@ fn solve_generic<'py, const D: usize>(
         scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
         missing,
     };
-    run_sweeps(py, &problem, fixed_values, &options, progress)
+    run_sweeps(py, &problem, fixed, &options, progress)
 }
 
 /// Per-node data of a built-in general Hamiltonian (Sect. 5.1), borrowed from NumPy arrays.
@@ -205,7 +227,7 @@ fn solve_general_generic<'py, const D: usize>(
     py: Python<'py>,
     band: &NarrowBand<D>,
     roles: &[u8],
-    fixed_values: &[f64],
+    fixed: &FixedNodes<'_>,
     spacing: f64,
     inputs: GeneralInputs<'_>,
     mut directions: Option<PyReadwriteArray2<'py, f32>>,
@@ -214,8 +236,8 @@ fn solve_general_generic<'py, const D: usize>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
     let n = band.len();
-    if roles.len() != n || fixed_values.len() != n {
-        return Err(PyValueError::new_err(format!("roles and values must have one entry per band node ({n})")));
+    if roles.len() != n {
+        return Err(PyValueError::new_err(format!("roles must have one entry per band node ({n})")));
     }
     if inputs.slowness.len() != n && inputs.slowness.len() != 1 {
         return Err(PyValueError::new_err(format!("slowness must have 1 or {n} entries, got {}", inputs.slowness.len())));
@@ -276,7 +298,7 @@ fn solve_general_generic<'py, const D: usize>(
         scheme: InnerScheme::General(ham),
         missing,
     };
-    run_sweeps(py, &problem, fixed_values, &options, progress)
+    run_sweeps(py, &problem, fixed, &options, progress)
 }
 
 macro_rules! with_band {
@@ -427,13 +449,16 @@ impl PyBand {
         Ok(out.into_pyarray(py))
     }
 
-    /// Runs the sweeps. See `tubesweep_core::sweep`.
-    #[pyo3(signature = (roles, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true, defer_outer_rim=true))]
+    /// Runs the sweeps. See `tubesweep_core::sweep`. The fixed nodes (role 0) start from
+    /// `fixed_values` at the band positions `fixed_positions` (both (F,); a fixed node not listed
+    /// starts from 0).
+    #[pyo3(signature = (roles, fixed_positions, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true, defer_outer_rim=true))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
         py: Python<'py>,
         roles: PyReadonlyArray1<'py, u8>,
+        fixed_positions: PyReadonlyArray1<'py, i64>,
         fixed_values: PyReadonlyArray1<'py, f64>,
         spacing: f64,
         slowness: Bound<'py, PyAny>,
@@ -457,23 +482,25 @@ impl PyBand {
         }
         let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim };
         let roles = roles.as_slice()?;
-        let fixed = fixed_values.as_slice()?;
+        let fixed = FixedNodes { positions: fixed_positions.as_slice()?, values: fixed_values.as_slice()? };
         match &self.band {
-            AnyBand::D2(b) => solve_generic(py, b, roles, fixed, spacing, &slowness, directions, scheme, missing, options, progress),
-            AnyBand::D3(b) => solve_generic(py, b, roles, fixed, spacing, &slowness, directions, scheme, missing, options, progress),
+            AnyBand::D2(b) => solve_generic(py, b, roles, &fixed, spacing, &slowness, directions, scheme, missing, options, progress),
+            AnyBand::D3(b) => solve_generic(py, b, roles, &fixed, spacing, &slowness, directions, scheme, missing, options, progress),
         }
     }
 
     /// Runs the sweeps with the general Lax–Friedrichs update of Sect. 5.1 and a built-in
     /// Hamiltonian: `"isotropic"` (`|p| − s`), `"moving_medium"` (`|p| − s|1 − v·p|`, needs
     /// `flow` (K, d)) or `"metric"` (`sqrt(pᵀMp) − s`, needs `metric` (K, d, d)). `slowness` has
-    /// 1 or K entries; `sigma` (d,) overrides the automatic per-node viscosities.
-    #[pyo3(signature = (roles, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, defer_outer_rim=true))]
+    /// 1 or K entries; `sigma` (d,) overrides the automatic per-node viscosities. Fixed nodes as in
+    /// `solve`.
+    #[pyo3(signature = (roles, fixed_positions, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, defer_outer_rim=true))]
     #[allow(clippy::too_many_arguments)]
     fn solve_general<'py>(
         &self,
         py: Python<'py>,
         roles: PyReadonlyArray1<'py, u8>,
+        fixed_positions: PyReadonlyArray1<'py, i64>,
         fixed_values: PyReadonlyArray1<'py, f64>,
         spacing: f64,
         hamiltonian: &str,
@@ -515,10 +542,10 @@ impl PyBand {
             },
         };
         let roles = roles.as_slice()?;
-        let fixed = fixed_values.as_slice()?;
+        let fixed = FixedNodes { positions: fixed_positions.as_slice()?, values: fixed_values.as_slice()? };
         match &self.band {
-            AnyBand::D2(b) => solve_general_generic(py, b, roles, fixed, spacing, inputs, directions, missing, options, progress),
-            AnyBand::D3(b) => solve_general_generic(py, b, roles, fixed, spacing, inputs, directions, missing, options, progress),
+            AnyBand::D2(b) => solve_general_generic(py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress),
+            AnyBand::D3(b) => solve_general_generic(py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress),
         }
     }
 }
@@ -633,11 +660,82 @@ fn shifted_positions<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// The last split of the coarse-to-fine band search: the C-order linear indices (sorted) of the
+/// nodes of the 2 × … × 2 blocks with lowest corners `origins` (M, d) (even grid indices, no
+/// repeats, any order), cut to the grid of `shape`. See `tubesweep_core::discovery`.
+#[pyfunction]
+fn split_pair_blocks<'py>(py: Python<'py>, shape: Vec<usize>, origins: PyReadonlyArray2<'py, i64>) -> PyResult<Bound<'py, PyArray1<u64>>> {
+    let d = shape.len();
+    if origins.shape()[1] != d {
+        return Err(PyValueError::new_err(format!("origins must have shape (M, {d})")));
+    }
+    let flat = origins.as_slice()?;
+    if let Some(&bad) = flat.iter().find(|&&c| c < 0) {
+        return Err(PyValueError::new_err(format!("origins: negative grid index {bad}")));
+    }
+    fn blocks<const D: usize>(flat: &[i64]) -> Vec<[u64; D]> {
+        flat.chunks_exact(D).map(|c| core::array::from_fn(|k| c[k] as u64)).collect()
+    }
+    let out = py
+        .detach(|| match d {
+            2 => tubesweep_core::discovery::split_pair_blocks::<2>(shape_array(&shape).unwrap(), &blocks::<2>(flat)),
+            3 => tubesweep_core::discovery::split_pair_blocks::<3>(shape_array(&shape).unwrap(), &blocks::<3>(flat)),
+            _ => Err(tubesweep_core::Error::invalid("grid", format!("only 2D and 3D grids are supported, got {d}D"))),
+        })
+        .map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
+/// The places where central differences of φ at band nodes `start..stop` need φ off the band:
+/// `(positions, counts)`, the band positions for each group (axis k = 0, 1, …; side +1 then −1)
+/// concatenated, and the size of each group (2·d). See `tubesweep_core::normals::rim_nodes`.
+#[pyfunction]
+fn rim_nodes<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    linear: PyReadonlyArray1<'py, u64>,
+    start: usize,
+    stop: usize,
+) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
+    let lin = linear.as_slice()?;
+    let (nodes, counts) = py.detach(|| tubesweep_core::normals::rim_nodes(&shape, lin, start..stop)).map_err(to_pyerr)?;
+    let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
+    Ok((nodes.into_pyarray(py), counts))
+}
+
+/// The outward directions sgn(φ)∇φ/|∇φ| at band nodes `start..stop` by central differences,
+/// written to `direction` ((stop − start, d) float32, C-contiguous); φ at band nodes from `phi`,
+/// off the band from `rim_phi` (in the order of `rim_nodes`). Returns |∇φ| there. See
+/// `tubesweep_core::normals::outward_directions`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn outward_directions<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    spacing: f64,
+    linear: PyReadonlyArray1<'py, u64>,
+    phi: PyReadonlyArray1<'py, f64>,
+    start: usize,
+    stop: usize,
+    rim_phi: PyReadonlyArray1<'py, f64>,
+    mut direction: PyReadwriteArray2<'py, f32>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let (lin, ph, rim) = (linear.as_slice()?, phi.as_slice()?, rim_phi.as_slice()?);
+    let dir = direction.as_slice_mut()?;
+    let norms = py
+        .detach(|| tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir))
+        .map_err(to_pyerr)?;
+    Ok(norms.into_pyarray(py))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     m.add_class::<PyTriangleTree>()?;
     m.add_function(wrap_pyfunction!(shifted_positions, m)?)?;
+    m.add_function(wrap_pyfunction!(split_pair_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
+    m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
