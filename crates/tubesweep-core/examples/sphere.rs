@@ -55,10 +55,17 @@ fn main() {
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
     let opts = SolveOptions { threads, activation_threshold: thr, tol, coupled, defer_outer_rim, ..Default::default() };
     let verbose = std::env::var_os("VERBOSE").is_some();
+    let t0 = Instant::now();
     let st = p
         .solve(&mut u, &opts, &mut |r| {
             if verbose {
-                println!("  iteration {:3}  largest change {:.3e}  updates {}", r.iteration, r.max_change, r.updates);
+                println!(
+                    "  iteration {:3} at {:7.3} s  largest change {:.3e}  updates {}",
+                    r.iteration,
+                    t0.elapsed().as_secs_f64(),
+                    r.max_change,
+                    r.updates
+                );
             }
             Control::Continue
         })

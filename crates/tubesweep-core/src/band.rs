@@ -8,11 +8,15 @@
 //! * rows are identified by the linear index of their leading coordinates (`row_keys`, sorted);
 //! * each node has a precomputed neighbour table, two entries (minus, plus) per axis, holding the
 //!   neighbour's position in the band or the sentinel `len()` when the neighbour is not in the
-//!   band (the solver stores the numerical infinity in an extra slot at that position);
+//!   band (the solver stores the numerical infinity in an extra slot at that position). Only the
+//!   leading axes are stored as positions; along the last axis the neighbours are the next and
+//!   previous node of the row, so two presence bits say whether they are there
+//!   ([`NarrowBand::neighbours_of`]);
 //! * for each of the 2^(d−1) orientations of the leading axes, a permutation of the rows gives the
 //!   Gauss–Seidel sweep order; the last axis is reversed by walking a row backwards.
 //!
-//! Cost per band node: 4 bytes of last-axis coordinate and 8·d bytes of neighbour table.
+//! Cost per band node: 4 bytes of last-axis coordinate and 8·(d − 1) + 1 bytes of neighbour table
+//! (17 in 3D).
 
 use crate::error::{Error, Result};
 use crate::schedule::SweepSchedule;
@@ -25,7 +29,11 @@ pub struct NarrowBand<const D: usize> {
     row_keys: Vec<u64>,
     row_start: Vec<u32>,
     last: Vec<u32>,
-    neighbours: Vec<[[u32; 2]; D]>,
+    /// Per node, `2 (D − 1)` entries: the minus and plus neighbours along each leading axis.
+    lead: Vec<u32>,
+    /// Per node: bit 0 set when the previous node of the row is its minus neighbour along the last
+    /// axis, bit 1 when the next node is its plus neighbour.
+    along_row: Vec<u8>,
     schedule: SweepSchedule,
 }
 
@@ -89,7 +97,8 @@ impl<const D: usize> NarrowBand<D> {
             row_keys,
             row_start,
             last,
-            neighbours: vec![[[len as u32; 2]; D]; len],
+            lead: vec![len as u32; len * 2 * (D - 1)],
+            along_row: vec![0; len],
             schedule: SweepSchedule::default(),
         };
         band.build_neighbours();
@@ -123,10 +132,37 @@ impl<const D: usize> NarrowBand<D> {
         self.row_keys.len()
     }
 
-    /// Neighbour table: `neighbours()[n][k] = [minus, plus]` along axis `k`.
+    /// The neighbours of node `n`: `[k] = [minus, plus]` along axis `k`, each a band position or
+    /// [`sentinel`](Self::sentinel). Panics if `n` is not a node.
     #[inline]
-    pub fn neighbours(&self) -> &[[[u32; 2]; D]] {
-        &self.neighbours
+    pub fn neighbours_of(&self, n: usize) -> [[u32; 2]; D] {
+        assert!(n < self.len(), "node {n} is not in the band of {} nodes", self.len());
+        // SAFETY: checked just above
+        unsafe { self.neighbours_of_unchecked(n) }
+    }
+
+    /// [`neighbours_of`](Self::neighbours_of) without the bounds check, for the sweep kernel.
+    ///
+    /// # Safety
+    /// `n < self.len()`.
+    #[inline(always)]
+    pub unsafe fn neighbours_of_unchecked(&self, n: usize) -> [[u32; 2]; D] {
+        debug_assert!(n < self.len());
+        let sentinel = self.last.len() as u32;
+        let mut nb = [[sentinel; 2]; D];
+        let base = n * 2 * (D - 1);
+        for k in 0..D - 1 {
+            nb[k][0] = *self.lead.get_unchecked(base + 2 * k);
+            nb[k][1] = *self.lead.get_unchecked(base + 2 * k + 1);
+        }
+        let bits = *self.along_row.get_unchecked(n);
+        if bits & 1 != 0 {
+            nb[D - 1][0] = n as u32 - 1;
+        }
+        if bits & 2 != 0 {
+            nb[D - 1][1] = n as u32 + 1;
+        }
+        nb
     }
 
     /// Node range `[start, end)` of row `r`.
@@ -240,31 +276,36 @@ impl<const D: usize> NarrowBand<D> {
             stride[k] = s;
             s *= self.shape[k] as u64;
         }
-        // split the neighbour table into one mutable slice per row
-        let mut slices: Vec<&mut [[[u32; 2]; D]]> = Vec::with_capacity(self.n_rows());
-        let mut rest: &mut [[[u32; 2]; D]] = &mut self.neighbours;
+        // split the tables into one mutable slice per row
+        let per = 2 * (D - 1);
+        let mut slices: Vec<(&mut [u32], &mut [u8])> = Vec::with_capacity(self.n_rows());
+        let mut rest: &mut [u32] = &mut self.lead;
+        let mut rest_row: &mut [u8] = &mut self.along_row;
         for r in 0..self.row_keys.len() {
             let n = (self.row_start[r + 1] - self.row_start[r]) as usize;
-            let (head, tail) = rest.split_at_mut(n);
-            slices.push(head);
+            let (head, tail) = rest.split_at_mut(n * per);
+            let (head_row, tail_row) = rest_row.split_at_mut(n);
+            slices.push((head, head_row));
             rest = tail;
+            rest_row = tail_row;
         }
         let row_keys = &self.row_keys;
         let row_start = &self.row_start;
         let last = &self.last;
         let shape = self.shape;
-        slices.into_par_iter().enumerate().for_each(|(r, out)| {
+        slices.into_par_iter().enumerate().for_each(|(r, (out, out_row))| {
             let s = row_start[r] as usize;
             let e = row_start[r + 1] as usize;
             // last axis: consecutive nodes in the row
             for n in s..e {
-                let slot = &mut out[n - s][D - 1];
+                let mut bits = 0u8;
                 if n > s && last[n - 1] + 1 == last[n] {
-                    slot[0] = (n - 1) as u32;
+                    bits |= 1;
                 }
                 if n + 1 < e && last[n + 1] == last[n] + 1 {
-                    slot[1] = (n + 1) as u32;
+                    bits |= 2;
                 }
+                out_row[n - s] = bits;
             }
             // leading axes: merge with the neighbouring rows
             let mut key = row_keys[r];
@@ -294,13 +335,13 @@ impl<const D: usize> NarrowBand<D> {
                             t += 1;
                         }
                         if t < te && last[t] == last[n] {
-                            out[n - s][k][side] = t as u32;
+                            out[(n - s) * per + 2 * k + side] = t as u32;
                         }
                     }
                 }
             }
         });
-        debug_assert!(self.neighbours.iter().all(|nb| nb.iter().all(|p| p[0] <= len && p[1] <= len)));
+        debug_assert!(self.lead.iter().all(|&p| p <= len));
     }
 
     /// Bytes held by this structure (for memory reports).
@@ -308,7 +349,8 @@ impl<const D: usize> NarrowBand<D> {
         self.row_keys.len() * 8
             + self.row_start.len() * 4
             + self.last.len() * 4
-            + self.neighbours.len() * std::mem::size_of::<[[u32; 2]; D]>()
+            + self.lead.len() * 4
+            + self.along_row.len()
             + self.schedule.heap_bytes()
     }
 }
@@ -393,7 +435,7 @@ mod tests {
                     let mut j = [idx[0] as i64, idx[1] as i64, idx[2] as i64];
                     j[k] += if side == 0 { -1 } else { 1 };
                     let expect = band.find(j).map(|p| p as u32).unwrap_or(band.sentinel());
-                    assert_eq!(band.neighbours()[n][k][side], expect);
+                    assert_eq!(band.neighbours_of(n)[k][side], expect);
                     if let Some(p) = band.find(j) {
                         assert_eq!(linear(shape, band.index_of(p)), linear(shape, [j[0] as usize, j[1] as usize, j[2] as usize]));
                     }
@@ -425,7 +467,7 @@ mod tests {
                     j[k] += if side == 0 { -1 } else { 1 };
                     let inset = j.iter().all(|&c| c >= 0 && c < 20)
                         && lin.binary_search(&linear(shape, [j[0] as usize, j[1] as usize])).is_ok();
-                    let nb = band.neighbours()[n][k][side];
+                    let nb = band.neighbours_of(n)[k][side];
                     assert_eq!(nb != band.sentinel(), inset, "node {idx:?} axis {k} side {side}");
                 }
             }
@@ -472,7 +514,7 @@ impl<const D: usize> NarrowBand<D> {
                 }
                 let mut idx = lead;
                 idx[D - 1] = self.last[n] as usize;
-                let nb = &self.neighbours[n];
+                let nb = self.neighbours_of(n);
                 let missing = (0..D).any(|k| {
                     (nb[k][0] == sentinel && idx[k] > 0) || (nb[k][1] == sentinel && idx[k] + 1 < self.shape[k])
                 });

@@ -83,13 +83,12 @@ pub enum Extension<'a, const D: usize> {
 /// per band node.
 pub fn extension_weights_in_place<const D: usize>(band: &NarrowBand<D>, roles: &[NodeRole], directions: &mut [[f32; D]]) {
     let sentinel = band.sentinel();
-    let nbrs = band.neighbours();
     directions.par_iter_mut().zip(roles.par_iter()).enumerate().for_each(|(n, (v, &r))| {
         if r != NodeRole::Outer {
             *v = [0.0; D];
             return;
         }
-        let nb = &nbrs[n];
+        let nb = band.neighbours_of(n);
         let mut pm = [true; D];
         let mut pp = [true; D];
         for k in 0..D {
@@ -260,12 +259,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
         }
         let mut max_hops = 0u32;
-        let nbrs = self.band.neighbours();
         while let Some(i) = queue.pop_front() {
             let next = hops[i] + 1;
+            let nb = self.band.neighbours_of(i);
             for k in 0..D {
                 for side in 0..2 {
-                    let m = nbrs[i][k][side] as usize;
+                    let m = nb[k][side] as usize;
                     if m != sentinel && hops[m] == u32::MAX {
                         hops[m] = next;
                         max_hops = max_hops.max(next);
@@ -368,7 +367,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             return Vec::new();
         }
         let sentinel = self.band.sentinel();
-        let nbrs = self.band.neighbours();
         let roles = self.roles;
         (0..roles.len())
             .into_par_iter()
@@ -376,10 +374,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 if roles[n] != NodeRole::Inner {
                     return 0u8;
                 }
+                let nb = self.band.neighbours_of(n);
                 let mut mask = 0u8;
                 for k in 0..D {
                     for side in 0..2 {
-                        let q = nbrs[n][k][side];
+                        let q = nb[k][side];
                         if q == sentinel || roles[q as usize] != NodeRole::Outer {
                             continue;
                         }
@@ -402,7 +401,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     fn outer_rim(&self, weights: &[[f32; D]]) -> Vec<bool> {
         let n = self.roles.len();
         let sentinel = self.band.sentinel();
-        let nbrs = self.band.neighbours();
         let roles = self.roles;
         let mut needed = vec![false; n];
         let mut stack: Vec<u32> = Vec::new();
@@ -414,20 +412,22 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         };
         for i in 0..n {
             if roles[i] == NodeRole::Inner {
+                let nb = self.band.neighbours_of(i);
                 for k in 0..D {
-                    need(nbrs[i][k][0], &mut needed, &mut stack);
-                    need(nbrs[i][k][1], &mut needed, &mut stack);
+                    need(nb[k][0], &mut needed, &mut stack);
+                    need(nb[k][1], &mut needed, &mut stack);
                 }
             }
         }
         while let Some(q) = stack.pop() {
             let w = weights[q as usize];
+            let nb = self.band.neighbours_of(q as usize);
             for k in 0..D {
                 // the upwind neighbour the update (5) reads along axis k (none for w_k = 0 or NaN)
                 if w[k] > 0.0 {
-                    need(nbrs[q as usize][k][0], &mut needed, &mut stack);
+                    need(nb[k][0], &mut needed, &mut stack);
                 } else if w[k] < 0.0 {
-                    need(nbrs[q as usize][k][1], &mut needed, &mut stack);
+                    need(nb[k][1], &mut needed, &mut stack);
                 }
             }
         }
@@ -725,7 +725,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if c <= threshold {
             return;
         }
-        let nb = unsafe { self.band.neighbours().get_unchecked(n) };
+        // SAFETY: n < band.len()
+        let nb = unsafe { self.band.neighbours_of_unchecked(n) };
         for k in 0..D {
             unsafe {
                 active.get_unchecked(nb[k][0] as usize).store(1, Ordering::Relaxed);
@@ -743,7 +744,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // SAFETY: n < band.len(); roles, weights and the neighbour table have at least that
         // length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`.
         let role = unsafe { *self.roles.get_unchecked(n) };
-        let nb = unsafe { self.band.neighbours().get_unchecked(n) };
+        let nb = &unsafe { self.band.neighbours_of_unchecked(n) };
         let old = u.get(n);
         if role == NodeRole::Outer {
             // Eq. (5) with the precomputed upwind weights, reading only the upwind neighbours.
@@ -1151,7 +1152,7 @@ mod tests {
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let w = p.derive_extension_weights();
         let rim = p.outer_rim(&w);
-        let nbrs = band.neighbours();
+
         let n_rim = rim.iter().filter(|&&b| b).count();
         let n_outer = roles.iter().filter(|&&r| r == NodeRole::Outer).count();
         // with inner 2h and outer 4h a good part of the layer, but not all of it
@@ -1164,7 +1165,7 @@ mod tests {
             if roles[i] == NodeRole::Inner {
                 for k in 0..3 {
                     for side in 0..2 {
-                        let q = nbrs[i][k][side];
+                        let q = band.neighbours_of(i)[k][side];
                         assert!(q == band.sentinel() || !rim[q as usize]);
                     }
                 }
@@ -1173,7 +1174,7 @@ mod tests {
             if roles[i] == NodeRole::Outer && !rim[i] && !w[i][0].is_nan() {
                 for k in 0..3 {
                     let side = if w[i][k] > 0.0 { 0 } else if w[i][k] < 0.0 { 1 } else { continue };
-                    let q = nbrs[i][k][side];
+                    let q = band.neighbours_of(i)[k][side];
                     assert!(q == band.sentinel() || !rim[q as usize]);
                 }
             }

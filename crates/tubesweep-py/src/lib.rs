@@ -386,9 +386,9 @@ impl PyBand {
     /// axis, or K when that neighbour is not in the band.
     fn neighbours<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<i64>>> {
         let (flat, k, d): (Vec<i64>, usize, usize) = with_band!(self, b, {
-            let nb = b.neighbours();
             let d = self.ndim();
-            (nb.iter().flat_map(|n| n.iter().flat_map(|p| [p[0] as i64, p[1] as i64])).collect(), nb.len(), d)
+            let flat = (0..b.len()).flat_map(|n| b.neighbours_of(n).into_iter().flat_map(|p| [p[0] as i64, p[1] as i64])).collect();
+            (flat, b.len(), d)
         });
         Ok(numpy::ndarray::Array3::from_shape_vec((k, d, 2), flat)
             .map_err(|e| PyValueError::new_err(e.to_string()))?
