@@ -50,3 +50,26 @@ def test_unreached_nodes_report_the_infinity_used():
     vals, st = band.solve(roles, np.array([0]), np.zeros(1), 1.0, 1.0, None, "godunov", "infinity", 1e-12, 10, None)
     assert vals[1] == 1.0
     assert vals[2] == st["infinity"] and vals[3] == st["infinity"]
+
+
+def test_a_failing_solve_leaves_the_directions_as_they_were_and_fortran_order_is_refused():
+    band = _native.Band.full_box([5, 5])
+    roles = np.ones(25, np.uint8)
+    roles[3] = 2  # one extension-layer node
+    fixed = (np.zeros(0, np.int64), np.zeros(0))
+    ok = dict(spacing=0.25, slowness=1.0, scheme="godunov", missing="infinity", tol=1e-9, max_iterations=10,
+              infinity=None)
+    directions = np.tile(np.float32([0.6, 0.8]), (25, 1))
+    before = directions.copy()
+    for bad in ({"spacing": -1.0}, {"infinity": -1.0}, {"tol": -1.0}, {"slowness": np.ones(3)}):
+        with pytest.raises(ValueError):
+            band.solve(roles, *fixed, directions=directions, **{**ok, **bad})
+        np.testing.assert_array_equal(directions, before)
+    with pytest.raises(ValueError, match="fixed_positions"):
+        band.solve(roles, np.array([99], np.int64), np.zeros(1), directions=directions, **ok)
+    np.testing.assert_array_equal(directions, before)
+    # a Fortran-ordered (K, d) array would be read with its axes swapped: refused, by name
+    with pytest.raises(ValueError, match="directions must be a C-ordered"):
+        band.solve(roles, *fixed, directions=np.asfortranarray(directions), **ok)
+    with pytest.raises(ValueError, match="points must be a C-ordered"):
+        band.interpolate(np.zeros(25), [0.0, 0.0], 0.25, np.asfortranarray(np.zeros((4, 2))))

@@ -270,6 +270,42 @@ def test_accelerated_sweeps_give_the_papers_solution_with_less_work(dim, ham):
     np.testing.assert_array_equal(fast.indices, paper.indices)
     assert np.max(np.abs(fast.values - paper.values)) < 1e-9
     assert fast.stats.updates < 0.8 * paper.stats.updates
-    if ham == "godunov" and dim == 3:
-        # the coupled update saves whole iterations (the rim adds two short ones at the end)
-        assert fast.stats.iterations < paper.stats.iterations + 2
+    if ham == "godunov":
+        # the coupled update saves whole iterations, more than the rim's two passes at the end
+        # (measured: circle N=201 16 against 37, sphere N=81 12 against 13)
+        assert fast.stats.iterations <= paper.stats.iterations
+
+
+def test_a_surface_that_caches_its_band_geometry_is_not_modified_by_the_solver():
+    """The solver overwrites the extension directions with its weights only for geometry made
+    for that solve (``consumable``); a user's Surface.band may return cached arrays."""
+    from tubesweep.surface import Surface
+
+    class CachedSphere(Surface):
+        ndim = 3
+
+        def __init__(self):
+            self.inner, self.cache = Sphere(0.5), {}
+
+        def band(self, grid, half_width):
+            key = (grid.shape, half_width)
+            if key not in self.cache:
+                g = self.inner.band(grid, half_width)
+                g.consumable = False
+                self.cache[key] = g
+            return self.cache[key]
+
+        def project(self, points, grid):
+            return self.inner.project(points, grid)
+
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    cached = CachedSphere()
+    geom = cached.band(g, 4.0 * g.spacing)  # the geometry solve() will get, cached
+    before = geom.direction.copy()
+    first = ts.solve(cached, g, [(-0.5, 0, 0)])
+    second = ts.solve(cached, g, [(-0.5, 0, 0)], inner=1.5)
+    assert len(cached.cache) == 1
+    np.testing.assert_array_equal(geom.direction, before)
+    fresh = ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)], inner=1.5)
+    np.testing.assert_array_equal(second.values, fresh.values)
+    np.testing.assert_array_equal(first.values, ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)]).values)

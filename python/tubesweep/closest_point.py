@@ -125,7 +125,7 @@ class ClosestPoint(Surface):
         ok = norm > DIRECTION_EPS * grid.spacing
         direction = np.zeros((len(linear), d))
         direction[ok] = diff[ok] / norm[ok, None]
-        return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32))
+        return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
         p = np.asarray(points, dtype=float)

@@ -382,7 +382,7 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
             best = np.where(near, np.minimum(best, t), best)
         fixed = np.where(np.isfinite(best), best, fixed)
     values, st = band.solve_general(
-        roles, positions, fixed, grid.spacing, prep.kind, prep.slowness, np.ascontiguousarray(geom.direction, dtype=np.float32),
+        roles, positions, fixed, grid.spacing, prep.kind, prep.slowness, geom.directions_for_solver(),
         "extrapolate", float(tol), int(max_iterations), None if infinity is None else float(infinity),
         flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress, threads=int(threads),
         skip_inactive=True, activation_threshold=float(activation_threshold), defer_outer_rim=bool(defer_outer_rim),

@@ -128,7 +128,7 @@ def redistanced_band(surface, grid, half_width: float):
     good = norm > 1e-9 * grid.spacing
     direction = np.zeros((len(lin), d))
     direction[good] = diff[good] / norm[good, None]
-    return BandGeometry(lin, norm, signed, direction.astype(np.float32))
+    return BandGeometry(lin, norm, signed, direction.astype(np.float32), consumable=True)
 
 
 def redistanced_project(surface, points: np.ndarray, grid):

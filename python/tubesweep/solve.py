@@ -278,8 +278,9 @@ def solve(
         The finite numerical infinity unknown values start at (default: derived from the band, a
         safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
     paper_sweeps : bool
-        ``True`` runs the paper's plain sweeps: every band node updated pointwise in every
-        iteration (this reproduces its iteration counts, Table 2). The default solves the same
+        ``True`` runs the paper's plain sweeps: pointwise Gauss–Seidel updates over the whole band
+        in every iteration (nodes none of whose neighbours changed are still skipped, which changes
+        nothing); this reproduces its iteration counts (Table 2). The default solves the same
         discrete equations, to the same solution within about ``tol``, with two accelerations
         (docs/architecture.md): with Godunov, each inner-tube node is updated together with the
         extension-layer nodes that copy it (block Gauss–Seidel; sphere N=1001: 38 instead of 55
@@ -336,7 +337,7 @@ def solve(
             # keeps φ in single precision, and the band is built without them (memory is per band
             # node: see docs/architecture.md).
             phi = geom.signed.astype(np.float32)
-            direction = geom.direction
+            direction = geom.directions_for_solver()
             geom = None  # type: ignore[assignment]
         band = _native.Band.from_linear(list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64))
         if method == "naive":
@@ -380,7 +381,7 @@ def solve(
         # sparsely; the directions are converted to the extension weights in place (no second
         # K×d buffer).
         del linear
-        directions = np.ascontiguousarray(direction, dtype=np.float32)
+        directions = direction  # overwritten by the solver (a copy unless the geometry is consumable)
         del direction
         setup = time.perf_counter() - t0
         values, st = band.solve(
@@ -398,9 +399,11 @@ def solve(
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
-    # held per node during the sweeps: values (f64), role and active flag, φ (f32), extension weights
-    # (d × f32), per-node slowness (f64) when the speed varies; the fixed values are sparse
-    per_node = 8 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
+    # held per node during the sweeps: values (f64), role, active flag and coupling mask, φ (f32),
+    # extension weights (d × f32), per-node slowness (f64) when the speed varies; the fixed values
+    # are sparse. (With the rim swept last the core also holds two role copies and a rim mask,
+    # 3 bytes per node, while it runs.)
+    per_node = 8 + 1 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
     stats = SolveStats(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),

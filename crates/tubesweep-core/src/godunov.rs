@@ -96,6 +96,27 @@ pub fn godunov_update_coupled<const D: usize>(a: [f64; D], c: [f64; D], f: f64) 
     u
 }
 
+/// One axis of [`godunov_update_coupled`]: the axis's smaller neighbour holds `a` and is an
+/// extension-layer node that reads this node with weight `w` in its update (5), so its value is
+/// `w ū + r` with `r = a − w·old` (`old`: this node's current value, at most the value the
+/// neighbour last read, so `r` over-estimates the rest of its combination and the update stays an
+/// upper bound). Returns the axis value `r / (1 − w)` and coefficient `1 − w`; when `1 − w` is
+/// below `COUPLING_MIN` the neighbour is a copy of this node and the axis carries no derivative:
+/// `(inf, 1)` drops it (`inf` is the numerical infinity).
+#[inline(always)]
+pub fn coupled_axis(a: f64, w: f64, old: f64, inf: f64) -> (f64, f64) {
+    let c = 1.0 - w;
+    if c > COUPLING_MIN {
+        ((a - w * old) / c, c)
+    } else {
+        (inf, 1.0)
+    }
+}
+
+/// Below this `1 − w`, an extension neighbour that reads the node with weight `w` is treated as a
+/// copy of it (the axis is dropped from the coupled update).
+pub const COUPLING_MIN: f64 = 1e-6;
+
 /// `max(x, 0)` as a plain compare-select (the values here are never NaN; `f64::max` spends
 /// extra instructions on NaN handling).
 #[inline(always)]
@@ -204,6 +225,19 @@ mod tests {
         let o = w * v + r;
         let res = (v - ax).max(0.0).powi(2) + (v - o).max(0.0).powi(2);
         assert!((res - f * f).abs() < 1e-14);
+    }
+
+    #[test]
+    fn a_neighbour_that_copies_the_node_drops_its_axis() {
+        let inf = 1e6;
+        // w = 1/2: a = w·old + r with r = 0.1 gives the axis value r/(1 − w) = 0.2
+        let (a, c) = coupled_axis(0.5 * 0.4 + 0.1, 0.5, 0.4, inf);
+        assert!((a - 0.2).abs() < 1e-15 && (c - 0.5).abs() < 1e-15);
+        // a near-copy (1 − w below COUPLING_MIN) leaves the axis out: the update is the 1D one
+        let (a, c) = coupled_axis(0.4, 1.0 - 1e-9, 0.4, inf);
+        assert_eq!((a, c), (inf, 1.0));
+        let u = godunov_update_coupled([0.3, a, 0.9], [1.0, c, 1.0], 0.1);
+        assert!((u - 0.4).abs() < 1e-15, "{u}");
     }
 
     #[test]

@@ -15,7 +15,7 @@
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::extension::{extension_apply_upwind, extension_weights};
-use crate::godunov::{fmin, godunov_update, godunov_update_coupled};
+use crate::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
 use crate::hamiltonian::InnerScheme;
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
@@ -168,7 +168,8 @@ impl Default for SolveOptions {
 /// What a solve did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveStats {
-    /// Full passes of the 2^d sweep orders.
+    /// Full passes of the 2^d sweep orders (with [`SolveOptions::defer_outer_rim`], the rim's own
+    /// passes, usually two, are included).
     pub iterations: usize,
     /// Single directional sweeps (2^d per iteration).
     pub sweeps: usize,
@@ -476,13 +477,26 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         self.with_roles(&without_rim, weights).iterate(u, options, progress, stats)?;
         drop(without_rim);
         let rim_only: Vec<NodeRole> = rim.iter().map(|&b| if b { NodeRole::Outer } else { NodeRole::Fixed }).collect();
+        // The rim shares the iteration budget (at least one pass, so that it gets values even
+        // when the first phase used it all) and reports its passes after the first phase's.
+        let base = stats.iterations;
+        let rim_options = SolveOptions { max_iterations: options.max_iterations.saturating_sub(base).max(1), ..*options };
         let mut rim_stats = SolveStats::default();
-        self.with_roles(&rim_only, weights).iterate(u, options, &mut |_| Control::Continue, &mut rim_stats)?;
+        let result = self.with_roles(&rim_only, weights).iterate(
+            u,
+            &rim_options,
+            &mut |r| progress(&IterationReport { iteration: base + r.iteration, ..*r }),
+            &mut rim_stats,
+        );
         stats.iterations += rim_stats.iterations;
         stats.sweeps += rim_stats.sweeps;
         stats.updates += rim_stats.updates;
         stats.converged &= rim_stats.converged;
-        Ok(())
+        stats.last_change = stats.last_change.max(rim_stats.last_change);
+        result.map_err(|e| match e {
+            Error::Interrupted { iterations } => Error::Interrupted { iterations: base + iterations },
+            other => other,
+        })
     }
 
     fn iterate(
@@ -493,10 +507,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         stats: &mut SolveStats,
     ) -> Result<()> {
         // Active flags ("locking"): a node is updated only if a neighbour changed since its last
-        // update. An update is a function of the neighbour values alone (and of the node's own
-        // value for Lax–Friedrichs next to an absent neighbour, which re-activates itself), so the
-        // skipped updates could not have changed anything: the result is bit-identical to the
-        // plain sweep. One extra slot for the sentinel keeps the activation branch-free.
+        // update. An update is a function of the neighbour values (and of the node's own value for
+        // Lax–Friedrichs next to an absent neighbour, which re-activates itself), so the skipped
+        // updates could not have changed anything: the result is bit-identical to the plain sweep.
+        // The coupled Godunov update also reads the node's own value; re-evaluated with unchanged
+        // neighbours it can only return its value again, up to the last bit of rounding. One extra slot for the sentinel keeps the activation branch-free.
         let active: Vec<AtomicU8> = self
             .roles
             .iter()
@@ -796,14 +811,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                         // SAFETY: the mask only marks neighbours in the band
                         let q = nb[k][side] as usize;
                         let w = unsafe { ctx.weights.get_unchecked(q)[k] }.abs() as f64;
-                        let c = 1.0 - w;
-                        if c > COUPLING_MIN {
-                            mins[k] = (a - w * old) / c;
-                            coef[k] = c;
-                        } else {
-                            // O copies this node: the axis carries no derivative
-                            mins[k] = inf;
-                        }
+                        (mins[k], coef[k]) = coupled_axis(a, w, old, inf);
                     }
                 }
                 godunov_update_coupled(mins, coef, h * slow)
@@ -867,10 +875,6 @@ struct SweepContext<'a, const D: usize> {
 const GODUNOV: u8 = 0;
 const LXF: u8 = 1;
 const GENERAL: u8 = 2;
-
-/// Below this `1 − w`, an extension neighbour that reads the node with weight `w` is treated as a
-/// copy of it (the axis is dropped from the coupled update).
-const COUPLING_MIN: f64 = 1e-6;
 
 /// Smallest number of rows in a wave worth splitting across threads.
 const MIN_PARALLEL_ROWS: u32 = 64;
@@ -1179,6 +1183,29 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn paired_tiles_in_parallel_give_the_sequential_bits() {
+        // a band large enough for waves of at least 4 tiles per thread (the paired branch)
+        let (band, roles, dirs, h) = sphere_band(181);
+        let sched = band.schedule();
+        let widest = (0..4)
+            .map(|lead| sched.waves(lead).windows(2).map(|w| (w[1] - w[0]) as usize).max().unwrap_or(0))
+            .max()
+            .unwrap();
+        assert!(widest >= 4 * 2, "widest wave has {widest} tiles");
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+        let run = |threads: usize| {
+            let mut u = vec![0.0; band.len()];
+            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged);
+            (u, st.iterations)
+        };
+        let (a, ia) = run(1);
+        let (b, ib) = run(2);
+        assert_eq!(ia, ib);
+        assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 
     #[test]

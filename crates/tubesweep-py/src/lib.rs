@@ -58,6 +58,23 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     Ok(d)
 }
 
+/// The data of a C-ordered (row-major) NumPy array. `as_slice` also accepts Fortran order, whose
+/// data would then be read with the axes swapped: that is an error here, naming the argument.
+fn c_slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(a: &'a numpy::PyReadonlyArray<'_, T, D>, name: &str) -> PyResult<&'a [T]> {
+    if !a.is_c_contiguous() {
+        return Err(PyValueError::new_err(format!("{name} must be a C-ordered array; pass np.ascontiguousarray({name})")));
+    }
+    Ok(a.as_slice()?)
+}
+
+/// [`c_slice`] for an array the solver writes.
+fn c_slice_mut<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(a: &'a mut numpy::PyReadwriteArray<'_, T, D>, name: &str) -> PyResult<&'a mut [T]> {
+    if !a.is_c_contiguous() {
+        return Err(PyValueError::new_err(format!("{name} must be a C-ordered array; pass np.ascontiguousarray({name})")));
+    }
+    Ok(a.as_slice_mut()?)
+}
+
 /// Node roles as the core's enum, without copying: validates that every byte is a role.
 fn node_roles(roles: &[u8]) -> PyResult<&[NodeRole]> {
     if let Some(&bad) = roles.iter().find(|&&r| NodeRole::from_u8(r).is_none()) {
@@ -86,7 +103,7 @@ fn extension_in_place<'a, const D: usize>(
 ) -> PyResult<Extension<'a, D>> {
     match directions {
         Some(d) => {
-            let flat = d.as_slice_mut()?;
+            let flat = c_slice_mut(d, "directions")?;
             if flat.len() != n * D {
                 return Err(PyValueError::new_err(format!("directions must have shape ({n}, {D})")));
             }
@@ -119,6 +136,38 @@ fn starting_values(n: usize, fixed: &FixedNodes<'_>) -> PyResult<Vec<f64>> {
         values[p as usize] = v;
     }
     Ok(values)
+}
+
+/// Everything the solve would reject, checked before `directions` is overwritten with the
+/// extension weights: a call that fails leaves the caller's array as it was.
+fn check_before_consuming(n: usize, spacing: f64, options: &SolveOptions, slowness_len: Option<usize>, fixed: &FixedNodes<'_>) -> PyResult<()> {
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Err(PyValueError::new_err(format!("spacing must be positive and finite, got {spacing}")));
+    }
+    if !(options.tol >= 0.0) {
+        return Err(PyValueError::new_err(format!("tol must be non-negative, got {}", options.tol)));
+    }
+    if let Some(v) = options.infinity {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(PyValueError::new_err(format!("infinity must be positive and finite, got {v}")));
+        }
+    }
+    if let Some(len) = slowness_len {
+        if len != n {
+            return Err(PyValueError::new_err(format!("speed: the slowness must have one entry per band node ({n}), got {len}")));
+        }
+    }
+    if fixed.positions.len() != fixed.values.len() {
+        return Err(PyValueError::new_err(format!(
+            "fixed_positions and fixed_values must have the same length, got {} and {}",
+            fixed.positions.len(),
+            fixed.values.len()
+        )));
+    }
+    if let Some(&p) = fixed.positions.iter().find(|&&p| p < 0 || p as usize >= n) {
+        return Err(PyValueError::new_err(format!("fixed_positions: {p} is not a position in the band of {n} nodes")));
+    }
+    Ok(())
 }
 
 /// The nodes fixed by the sources, given sparsely: band positions and their values.
@@ -196,6 +245,7 @@ fn solve_generic<'py, const D: usize>(
         Some(a) => Some(a.as_slice()?),
         None => None,
     };
+    check_before_consuming(n, spacing, &options, slow_slice.map(|s| s.len()), fixed)?;
     let problem = SweepProblem {
         band,
         roles,
@@ -248,7 +298,7 @@ fn solve_general_generic<'py, const D: usize>(
         }
     }
     let roles = node_roles(roles)?;
-    let extension = extension_in_place::<D>(band, roles, &mut directions, n)?;
+    check_before_consuming(n, spacing, &options, None, fixed)?;
     let flow: &[[f64; D]] = match inputs.flow {
         Some(f) => node_vectors::<f64, D>(f, n, "flow")?,
         None => &[],
@@ -289,6 +339,8 @@ fn solve_general_generic<'py, const D: usize>(
             )))
         }
     };
+    // every input checked: now the directions may be overwritten with the extension weights
+    let extension = extension_in_place::<D>(band, roles, &mut directions, n)?;
     let problem = SweepProblem {
         band,
         roles,
@@ -401,7 +453,7 @@ impl PyBand {
         if indices.shape()[1] != d {
             return Err(PyValueError::new_err(format!("indices must have shape (M, {d})")));
         }
-        let s = indices.as_slice()?;
+        let s = c_slice(&indices, "indices")?;
         let out: Vec<i64> = with_band!(self, b, {
             s.chunks_exact(d)
                 .map(|c| {
@@ -441,7 +493,7 @@ impl PyBand {
         if vals.len() != self.__len__() {
             return Err(PyValueError::new_err("values must have one entry per band node"));
         }
-        let pts = points.as_slice()?;
+        let pts = c_slice(&points, "points")?;
         let out = py.detach(|| match &self.band {
             AnyBand::D2(b) => interpolate(b, vals, [lower[0], lower[1]], spacing, pts),
             AnyBand::D3(b) => interpolate(b, vals, [lower[0], lower[1], lower[2]], spacing, pts),
@@ -529,11 +581,11 @@ impl PyBand {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,
             flow: match &flow {
-                Some(f) => Some(f.as_slice()?),
+                Some(f) => Some(c_slice(f, "flow")?),
                 None => None,
             },
             metric: match &metric {
-                Some(m) => Some(m.as_slice()?),
+                Some(m) => Some(c_slice(m, "metric")?),
                 None => None,
             },
             sigma: match &sigma {
@@ -565,8 +617,8 @@ impl PyTriangleTree {
         if vertices.shape()[1] != 3 || faces.shape()[1] != 3 {
             return Err(PyValueError::new_err("vertices and faces must have shape (n, 3) and (m, 3)"));
         }
-        let v = vertices.as_slice()?;
-        let f = faces.as_slice()?;
+        let v = c_slice(&vertices, "vertices")?;
+        let f = c_slice(&faces, "faces")?;
         let n = v.len() / 3;
         if f.is_empty() {
             return Err(PyValueError::new_err("faces is empty"));
@@ -608,7 +660,7 @@ impl PyTriangleTree {
         if points.shape()[1] != 3 {
             return Err(PyValueError::new_err("points must have shape (M, 3)"));
         }
-        let p = points.as_slice()?;
+        let p = c_slice(&points, "points")?;
         let res = py.detach(|| self.tree.closest_many(p, max_distance));
         let m = res.len();
         let mut dist = Vec::with_capacity(m);
@@ -669,7 +721,7 @@ fn split_pair_blocks<'py>(py: Python<'py>, shape: Vec<usize>, origins: PyReadonl
     if origins.shape()[1] != d {
         return Err(PyValueError::new_err(format!("origins must have shape (M, {d})")));
     }
-    let flat = origins.as_slice()?;
+    let flat = c_slice(&origins, "origins")?;
     if let Some(&bad) = flat.iter().find(|&&c| c < 0) {
         return Err(PyValueError::new_err(format!("origins: negative grid index {bad}")));
     }
@@ -721,7 +773,7 @@ fn outward_directions<'py>(
     mut direction: PyReadwriteArray2<'py, f32>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (lin, ph, rim) = (linear.as_slice()?, phi.as_slice()?, rim_phi.as_slice()?);
-    let dir = direction.as_slice_mut()?;
+    let dir = c_slice_mut(&mut direction, "direction")?;
     let norms = py
         .detach(|| tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir))
         .map_err(to_pyerr)?;

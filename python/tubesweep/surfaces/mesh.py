@@ -315,7 +315,7 @@ class MeshSurface(Surface):
             signed = np.where(s < 0, -dist, dist)
         else:
             signed = dist.copy()
-        return BandGeometry(lin.astype(np.int64), dist, signed, direction.astype(np.float32))
+        return BandGeometry(lin.astype(np.int64), dist, signed, direction.astype(np.float32), consumable=True)
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
         d, cp, _, _ = self.closest(points)
