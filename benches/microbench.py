@@ -8,6 +8,12 @@ reports ``stats.updates / stats.seconds`` (sweeps only, band construction exclud
 divided by the thread count, and the speed-up of the sweeps. With a single-threaded kernel the
 two thread counts give the same time (speed-up ≈ 1).
 
+Each case runs twice: with the paper's plain sweeps (``paper_sweeps=True``) and with the default
+sweeps (the coupled Godunov update, the outer rim swept last), which solve the same equations with
+fewer local updates; "× paper" is the paper sweeps' time over the default's at the same thread
+count (> 1: the default is faster). The default's updates are fewer and dearer (the cheap ones are
+the ones it skips), so its updates per second are lower while its time is shorter: compare times.
+
     .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3]
 """
 
@@ -25,7 +31,7 @@ from typing import Any, Dict, List, Optional, Sequence
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _child(n: int, hamiltonian: str, repeats: int) -> Dict[str, Any]:
+def _child(n: int, hamiltonian: str, repeats: int, paper: bool) -> Dict[str, Any]:
     import tubesweep as ts
     import tubesweep.surfaces as tss
 
@@ -34,7 +40,7 @@ def _child(n: int, hamiltonian: str, repeats: int) -> Dict[str, Any]:
     secs: List[float] = []
     st = None
     for _ in range(repeats):
-        sol = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], hamiltonian=hamiltonian)
+        sol = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], hamiltonian=hamiltonian, paper_sweeps=paper)
         st = sol.stats
         secs.append(st.seconds)
     assert st is not None
@@ -44,14 +50,15 @@ def _child(n: int, hamiltonian: str, repeats: int) -> Dict[str, Any]:
                 converged=bool(st.converged), seconds=[float(s) for s in secs])
 
 
-def measure(n: int, hamiltonian: str, threads: int, repeats: int) -> Dict[str, Any]:
+def measure(n: int, hamiltonian: str, threads: int, repeats: int, paper: bool = False) -> Dict[str, Any]:
     env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", str(n), hamiltonian, str(repeats)]
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", str(n), hamiltonian, str(repeats), str(int(paper))]
     cp = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=str(REPO))
     for line in reversed(cp.stdout.splitlines()):
         if line.startswith("RESULT "):
             rec = json.loads(line[7:])
             rec["threads"] = threads
+            rec["sweeps"] = "paper" if paper else "default"
             return rec
     raise RuntimeError(f"child failed: {cp.stderr.strip()[-500:]}")
 
@@ -62,21 +69,26 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
     tlist = sorted(set(threads or (1, cores)))
     rows = []
     print(f"sphere r=0.5, two-layer, sol.stats (sweeps only), median of {repeats}; {cores} cores")
-    print(f"{'scheme':8} {'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} "
-          f"{'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8}")
+    print(f"{'scheme':8} {'N':>5} {'sweeps':>7} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} "
+          f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8}")
     for h in schemes:
         for n in sizes:
-            base = None
-            for t in tlist:
-                r = measure(n, h, t, repeats)
-                if base is None:
-                    base = r["sweep_s"]
-                r["per_core"] = r["updates_per_s"] / t
-                r["speedup"] = base / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
-                rows.append(r)
-                print(f"{h:8} {n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
-                      f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
-                      f"{r['speedup']:8.2f}", flush=True)
+            paper_time: Dict[int, float] = {}
+            for paper in (True, False):
+                base = None
+                for t in tlist:
+                    r = measure(n, h, t, repeats, paper)
+                    if base is None:
+                        base = r["sweep_s"]
+                    r["per_core"] = r["updates_per_s"] / t
+                    r["speedup"] = base / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
+                    if paper:
+                        paper_time[t] = r["sweep_s"]
+                    r["vs_paper"] = paper_time[t] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
+                    rows.append(r)
+                    print(f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
+                          f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
+                          f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f}", flush=True)
     return rows
 
 
@@ -86,10 +98,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--schemes", default="godunov,lxf")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", help="thread counts to compare (default: 1 and all cores)")
-    ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.child:
-        print("RESULT " + json.dumps(_child(int(a.child[0]), a.child[1], int(a.child[2]))))
+        print("RESULT " + json.dumps(_child(int(a.child[0]), a.child[1], int(a.child[2]), a.child[3] == "1")))
         return 0
     th = [int(x) for x in a.threads.split(",")] if a.threads else None
     run([int(x) for x in a.sizes.split(",")], a.schemes.split(","), a.repeats, th)

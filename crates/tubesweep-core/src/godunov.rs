@@ -56,40 +56,42 @@ pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
 /// The Godunov update for a node coupled to extension-layer neighbours: the largest root `ū` of
 ///
 /// ```text
-///     Σ_k c_k^2 [(ū − a_k)^+]^2 = f^2 ,     0 < c_k ≤ 1 .
+///     Σ_k [(c_k ū − r_k)^+]^2 = f^2 ,     0 < c_k ≤ 1 ,
 /// ```
 ///
-/// This is Eq. (3) with the neighbour along axis `k` replaced by its own (affine) dependence on
-/// the node: an extension-layer neighbour `O` whose update (5) reads the node with weight `w`
-/// holds `u_O = w ū + r`, so `ū − u_O = (1 − w)(ū − r/(1 − w))`, i.e. `c_k = 1 − w` and
-/// `a_k = r / (1 − w)`; axes without such a neighbour have `c_k = 1`. Solving the two equations
-/// together (block Gauss–Seidel) removes the slowly contracting node ↔ layer cycle that plain
-/// Gauss–Seidel iterates by a factor `w` per pass; the fixed point is the same.
+/// the terms taken where `c_k ū > r_k`. This is Eq. (3) with the neighbour along axis `k` replaced
+/// by its own (affine) dependence on the node: an extension-layer neighbour `O` whose update (5)
+/// reads the node with weight `w` holds `u_O = w ū + r`, so `ū − u_O = (1 − w) ū − r`, i.e.
+/// `c_k = 1 − w`; axes without such a neighbour have `c_k = 1` and `r_k` the neighbour's value.
+/// Solving the two equations together (block Gauss–Seidel) removes the slowly contracting node ↔
+/// layer cycle that plain Gauss–Seidel iterates by a factor `w` per pass; the fixed point is the
+/// same. The axes are ordered by `r_k / c_k` by cross-multiplying, so the only division is the
+/// root's (it sits on the Gauss–Seidel chain of the sweep).
 #[inline(always)]
-pub fn godunov_update_coupled<const D: usize>(a: [f64; D], c: [f64; D], f: f64) -> f64 {
-    // order the axes by a_k (insertion sort of at most three pairs)
+pub fn godunov_update_coupled<const D: usize>(r: [f64; D], c: [f64; D], f: f64) -> f64 {
+    // order the axes by r_k / c_k (insertion sort of at most three pairs; c_k > 0)
     let mut p: [(f64, f64); D] = [(0.0, 0.0); D];
     for k in 0..D {
-        p[k] = (a[k], c[k] * c[k]);
+        p[k] = (r[k], c[k]);
     }
     for i in 1..D {
         let mut j = i;
-        while j > 0 && p[j].0 < p[j - 1].0 {
+        while j > 0 && p[j].0 * p[j - 1].1 < p[j - 1].0 * p[j].1 {
             p.swap(j, j - 1);
             j -= 1;
         }
     }
-    // add axes while the root exceeds the next a_k: A ū² − 2 B ū + C = 0
+    // add axes while the root exceeds the next r_k / c_k: A ū² − 2 B ū + C = 0
     let (mut sa, mut sb, mut sc) = (0.0f64, 0.0f64, -f * f);
     let mut u = p[0].0;
     for m in 0..D {
-        let (ak, ck2) = p[m];
-        sa += ck2;
-        sb += ck2 * ak;
-        sc += ck2 * ak * ak;
+        let (rk, ck) = p[m];
+        sa += ck * ck;
+        sb += ck * rk;
+        sc += rk * rk;
         let disc = sb * sb - sa * sc;
         u = (sb + nonneg(disc).sqrt()) / sa;
-        if m + 1 == D || u <= p[m + 1].0 {
+        if m + 1 == D || p[m + 1].1 * u <= p[m + 1].0 {
             return u;
         }
     }
@@ -100,14 +102,14 @@ pub fn godunov_update_coupled<const D: usize>(a: [f64; D], c: [f64; D], f: f64) 
 /// extension-layer node that reads this node with weight `w` in its update (5), so its value is
 /// `w ū + r` with `r = a − w·old` (`old`: this node's current value, at most the value the
 /// neighbour last read, so `r` over-estimates the rest of its combination and the update stays an
-/// upper bound). Returns the axis value `r / (1 − w)` and coefficient `1 − w`; when `1 − w` is
-/// below `COUPLING_MIN` the neighbour is a copy of this node and the axis carries no derivative:
-/// `(inf, 1)` drops it (`inf` is the numerical infinity).
+/// upper bound). Returns `(r, 1 − w)`; when `1 − w` is below [`COUPLING_MIN`] the neighbour is a
+/// copy of this node and the axis carries no derivative: `(inf, 1)` drops it (`inf` is the
+/// numerical infinity).
 #[inline(always)]
 pub fn coupled_axis(a: f64, w: f64, old: f64, inf: f64) -> (f64, f64) {
     let c = 1.0 - w;
     if c > COUPLING_MIN {
-        ((a - w * old) / c, c)
+        (a - w * old, c)
     } else {
         (inf, 1.0)
     }
@@ -219,7 +221,7 @@ mod tests {
             u = u.min(godunov_update([ax, o], f));
         }
         let c = 1.0 - w;
-        let v = godunov_update_coupled([ax, r / c], [1.0, c], f);
+        let v = godunov_update_coupled([ax, r], [1.0, c], f);
         assert!((u - v).abs() < 1e-12, "{u} vs {v}");
         // and the discrete equation holds with O at its consistent value
         let o = w * v + r;
@@ -230,9 +232,9 @@ mod tests {
     #[test]
     fn a_neighbour_that_copies_the_node_drops_its_axis() {
         let inf = 1e6;
-        // w = 1/2: a = w·old + r with r = 0.1 gives the axis value r/(1 − w) = 0.2
-        let (a, c) = coupled_axis(0.5 * 0.4 + 0.1, 0.5, 0.4, inf);
-        assert!((a - 0.2).abs() < 1e-15 && (c - 0.5).abs() < 1e-15);
+        // w = 1/2: a = w·old + r with r = 0.1
+        let (r, c) = coupled_axis(0.5 * 0.4 + 0.1, 0.5, 0.4, inf);
+        assert!((r - 0.1).abs() < 1e-15 && (c - 0.5).abs() < 1e-15);
         // a near-copy (1 − w below COUPLING_MIN) leaves the axis out: the update is the 1D one
         let (a, c) = coupled_axis(0.4, 1.0 - 1e-9, 0.4, inf);
         assert_eq!((a, c), (inf, 1.0));
