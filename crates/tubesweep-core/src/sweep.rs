@@ -1209,6 +1209,29 @@ mod tests {
     }
 
     #[test]
+    fn the_rim_phase_reports_progress_and_can_be_stopped() {
+        let (band, roles, dirs, h) = sphere_band(41);
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+        let opts = SolveOptions::default();
+        let mut seen = Vec::new();
+        let mut u = vec![0.0; band.len()];
+        let st = p
+            .solve(&mut u, &opts, &mut |r| {
+                seen.push(r.iteration);
+                Control::Continue
+            })
+            .unwrap();
+        // one report per iteration of both phases, numbered on
+        assert_eq!(seen, (1..=st.iterations).collect::<Vec<_>>());
+        // stopping in the rim's last pass ends the solve there
+        let mut u = vec![0.0; band.len()];
+        let err = p
+            .solve(&mut u, &opts, &mut |r| if r.iteration == st.iterations { Control::Stop } else { Control::Continue })
+            .unwrap_err();
+        assert_eq!(err, Error::Interrupted { iterations: st.iterations });
+    }
+
+    #[test]
     fn progress_can_stop_the_solve() {
         let band = NarrowBand::<2>::full_box([11, 11]).unwrap();
         let mut roles = vec![NodeRole::Inner; band.len()];
