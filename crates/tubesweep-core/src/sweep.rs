@@ -336,6 +336,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         }
     }
 
+    /// The upwind weights of Eq. (5): borrowed when handed in (or empty without a layer),
+    /// derived from the directions otherwise.
+    fn upwind_weights(&self) -> std::borrow::Cow<'a, [[f32; D]]> {
+        match self.extension_weights_needed() {
+            Some(w) => std::borrow::Cow::Borrowed(w),
+            None => std::borrow::Cow::Owned(self.derive_extension_weights()),
+        }
+    }
+
     /// The upwind weights of Eq. (5) derived from [`Extension::Directions`] (a copy).
     fn derive_extension_weights(&self) -> Vec<[f32; D]> {
         match self.extension {
@@ -460,14 +469,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         progress: &mut dyn FnMut(&IterationReport) -> Control,
         stats: &mut SolveStats,
     ) -> Result<()> {
-        let derived: Vec<[f32; D]>;
-        let weights: &[[f32; D]] = match self.extension_weights_needed() {
-            Some(w) => w,
-            None => {
-                derived = self.derive_extension_weights();
-                &derived
-            }
-        };
+        let weights = self.upwind_weights();
+        let weights: &[[f32; D]] = &weights;
         let rim = if weights.is_empty() { Vec::new() } else { self.outer_rim(weights) };
         if !rim.iter().any(|&b| b) {
             return self.with_roles(self.roles, weights).iterate(u, options, progress, stats);
@@ -522,14 +525,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let all_active = !options.skip_inactive;
         // Upwind weights of the extension update, once per solve (the band does not change).
         // Outer nodes without an upwind neighbour keep their value: they are never activated.
-        let derived: Vec<[f32; D]>;
-        let weights: &[[f32; D]] = match self.extension_weights_needed() {
-            Some(w) => w,
-            None => {
-                derived = self.derive_extension_weights();
-                &derived
-            }
-        };
+        let weights = self.upwind_weights();
+        let weights: &[[f32; D]] = &weights;
         for (n, w) in weights.iter().enumerate() {
             if w[0].is_nan() {
                 active[n].store(0, Ordering::Relaxed);
@@ -1105,20 +1102,26 @@ mod tests {
         }
     }
 
+    /// Solves `p` to convergence with `opts` (tol 1e-13).
+    fn converged(p: &SweepProblem<'_, 3>, opts: SolveOptions) -> (Vec<f64>, SolveStats) {
+        let mut u = vec![0.0; p.band.len()];
+        let st = p.solve(&mut u, &SolveOptions { tol: 1e-13, ..opts }, &mut |_| Control::Continue).unwrap();
+        assert!(st.converged);
+        (u, st)
+    }
+
+    fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    }
+
     #[test]
     fn coupled_update_reaches_the_pointwise_fixed_point_with_fewer_updates() {
         let (band, roles, dirs, h) = sphere_band(41);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let run = |coupled: bool, threads: usize| {
-            let opts = SolveOptions { coupled, threads, tol: 1e-13, ..Default::default() };
-            let mut u = vec![0.0; band.len()];
-            let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
-            assert!(st.converged);
-            (u, st)
-        };
+        let run = |coupled: bool, threads: usize| converged(&p, SolveOptions { coupled, threads, ..Default::default() });
         let (a, sa) = run(true, 1);
         let (b, sb) = run(false, 1);
-        let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let diff = max_difference(&a, &b);
         assert!(diff < 1e-10, "coupled and pointwise differ by {diff}");
         assert!(sa.updates < sb.updates, "{} vs {}", sa.updates, sb.updates);
         assert!(sa.iterations <= sb.iterations);
@@ -1133,16 +1136,10 @@ mod tests {
         let (band, roles, dirs, h) = sphere_band(41);
         for scheme in [InnerScheme::Godunov, InnerScheme::LaxFriedrichs] {
             let p = sphere_problem(&band, &roles, &dirs, h, scheme);
-            let run = |defer_outer_rim: bool, threads: usize| {
-                let opts = SolveOptions { defer_outer_rim, threads, tol: 1e-13, ..Default::default() };
-                let mut u = vec![0.0; band.len()];
-                let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
-                assert!(st.converged);
-                (u, st)
-            };
+            let run = |defer_outer_rim: bool, threads: usize| converged(&p, SolveOptions { defer_outer_rim, threads, ..Default::default() });
             let (a, sa) = run(true, 1);
             let (b, sb) = run(false, 1);
-            let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            let diff = max_difference(&a, &b);
             assert!(diff < 1e-10, "rim last and rim in every sweep differ by {diff}");
             assert!((sa.updates as f64) < 0.85 * sb.updates as f64, "{} vs {}", sa.updates, sb.updates);
             let (c, _) = run(true, 3);
