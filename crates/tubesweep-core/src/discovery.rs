@@ -1,13 +1,100 @@
-//! Band discovery helpers: the last step of the coarse-to-fine search for the band of a surface
-//! given by a distance-like function (`tubesweep.surface.coarse_to_fine_candidates`).
+//! Band discovery helpers: the block bookkeeping of the coarse-to-fine search for the band of a
+//! surface given by a distance-like function (`tubesweep.surface.coarse_to_fine_candidates`).
 //!
 //! The search keeps blocks of 2^L nodes per axis near the surface and splits them level by level;
-//! the level-set function itself is a Python callable, so the search loop stays in Python. Its
-//! last split, of the kept 2 × … × 2 blocks into single nodes, produces the candidate list, the
-//! largest array of the search (O(N^(d−1)) entries): [`split_pair_blocks`] does it here, straight
-//! into sorted C-order linear indices, without a K-sized temporary or a sort.
+//! the level-set function itself is a Python callable, so the loop over levels stays in Python and
+//! only calls it. Here: the children of the kept blocks with their centres and radii
+//! ([`block_children`], [`children_radius_max`]), which the caller tests with φ at the centres,
+//! and the last split, of the kept 2 × … × 2 blocks into single nodes, which produces the
+//! candidate list, the largest array of the search (O(N^(d−1)) entries): [`split_pair_blocks`]
+//! does it straight into sorted C-order linear indices, without a K-sized temporary or a sort.
 
 use crate::error::{Error, Result};
+
+/// Checks that every parent block origin is a multiple of `2 · block` inside the grid.
+fn check_parents<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block: u64) -> Result<()> {
+    if block == 0 {
+        return Err(Error::invalid("block", "the child block size must be positive"));
+    }
+    for o in parents {
+        for k in 0..D {
+            if o[k] % (2 * block) != 0 || o[k] >= shape[k] as u64 {
+                return Err(Error::invalid(
+                    "parents",
+                    format!("block origin {o:?} is not a multiple of {} inside the grid {shape:?}", 2 * block),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Calls `f(child origin, child's last node)` for every child of blocks of `2 · block` nodes per
+/// axis with lowest corners `parents`: the 2^d blocks of `block` nodes per axis that start inside
+/// the grid, parent by parent, the corners in C order (axis 0 slowest). A block at the upper edge
+/// of the grid is cut to it (its last node is the grid's last along that axis).
+#[inline]
+fn for_children<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block: u64, mut f: impl FnMut(&[u64; D], &[u64; D])) {
+    for p in parents {
+        'corner: for corner in 0..(1usize << D) {
+            let mut o = [0u64; D];
+            let mut last = [0u64; D];
+            for k in 0..D {
+                o[k] = p[k] + block * ((corner >> (D - 1 - k)) & 1) as u64;
+                if o[k] >= shape[k] as u64 {
+                    continue 'corner;
+                }
+                last[k] = (o[k] + block).min(shape[k] as u64) - 1;
+            }
+            f(&o, &last);
+        }
+    }
+}
+
+/// `|last − o|` in grid spacings: twice a block's radius (its centre to a corner) over `Δx`.
+#[inline]
+fn diagonal<const D: usize>(o: &[u64; D], last: &[u64; D]) -> f64 {
+    let mut sq = 0.0f64;
+    for k in 0..D {
+        let e = (last[k] - o[k]) as f64;
+        sq += e * e;
+    }
+    sq.sqrt()
+}
+
+/// The largest `|last − o|` (in grid spacings) over the children [`block_children`] makes of
+/// `parents`: the caller's search reach for the level. 0 without children.
+pub fn children_radius_max<const D: usize>(shape: [usize; D], parents: &[[u64; D]], block: u64) -> Result<f64> {
+    check_parents(&shape, parents, block)?;
+    let mut best = 0.0f64;
+    for_children(&shape, parents, block, |o, last| best = best.max(diagonal(o, last)));
+    Ok(best)
+}
+
+/// The children of the blocks of `2 · block` nodes per axis with lowest corners `parents` (each a
+/// multiple of `2 · block` inside the grid): the blocks of `block` nodes per axis that start
+/// inside the grid, parent by parent, corners in C order. Returns their origins, their centres
+/// `lower + Δx · (o + last)/2` in world coordinates and their radii `Δx/2 · |last − o|` (centre to
+/// a corner node), with the arithmetic of the NumPy code it replaces, so the same bits: a block is
+/// kept when `|φ(centre)| ≤ half_width + lipschitz · radius`, exact for a `lipschitz`-Lipschitz φ.
+#[allow(clippy::type_complexity)]
+pub fn block_children<const D: usize>(
+    shape: [usize; D],
+    parents: &[[u64; D]],
+    block: u64,
+    lower: [f64; D],
+    spacing: f64,
+) -> Result<(Vec<[u64; D]>, Vec<[f64; D]>, Vec<f64>)> {
+    check_parents(&shape, parents, block)?;
+    let cap = parents.len() << D;
+    let (mut origins, mut centres, mut radii) = (Vec::with_capacity(cap), Vec::with_capacity(cap), Vec::with_capacity(cap));
+    for_children(&shape, parents, block, |o, last| {
+        origins.push(*o);
+        centres.push(core::array::from_fn(|k| lower[k] + spacing * (0.5 * (o[k] + last[k]) as f64)));
+        radii.push(0.5 * spacing * diagonal(o, last));
+    });
+    Ok((origins, centres, radii))
+}
 
 /// The C-order linear indices, strictly increasing, of the grid nodes of the blocks of 2 nodes
 /// per axis whose lowest corners are `origins`, cut to the grid of shape `shape` (a block at the
@@ -41,6 +128,29 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
     let mut out = Vec::with_capacity(count);
     emit(&shape, &stride, &sorted, 0, 0, &mut |l| out.push(l));
     Ok(out)
+}
+
+/// The world coordinates `lower + Δx · index` of the grid nodes with C-order linear indices
+/// `linear` (each inside the grid of `shape`), with the arithmetic of `Grid.points`, so the same
+/// bits: the points at which the caller evaluates φ for the candidates of the band.
+pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f64; D], spacing: f64) -> Result<Vec<[f64; D]>> {
+    let total: u64 = shape.iter().map(|&n| n as u64).product();
+    if let Some(&bad) = linear.iter().find(|&&l| l >= total) {
+        return Err(Error::invalid("linear", format!("linear index {bad} is outside the grid {shape:?}")));
+    }
+    Ok(linear
+        .iter()
+        .map(|&l| {
+            let mut key = l;
+            let mut p = [0.0f64; D];
+            for k in (0..D).rev() {
+                let n = shape[k] as u64;
+                p[k] = lower[k] + spacing * (key % n) as f64;
+                key /= n;
+            }
+            p
+        })
+        .collect())
 }
 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along
