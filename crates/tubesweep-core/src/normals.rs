@@ -73,7 +73,7 @@ pub fn rim_nodes(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>)
     for k in 0..shape.len() {
         for sign in [1i64, -1] {
             let before = nodes.len();
-            let pos = shifted_positions(linear, sign * stride[k] as i64, range.clone());
+            let pos = neighbour_positions(linear, stride[k], sign, range.clone());
             for (o, i) in range.clone().enumerate() {
                 if !neighbour_known(&coords[o], &pos, o, k, sign, shape) {
                     nodes.push(i as u64);
@@ -83,6 +83,24 @@ pub fn rim_nodes(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>)
         }
     }
     Ok((nodes, counts))
+}
+
+/// The band position of `linear[i] + sign · stride` for `i` in `range`, or −1 (as
+/// [`shifted_positions`]). Along the last axis (`stride` 1) the neighbour of a band node, if it is
+/// one, is the next or previous entry of the sorted `linear`: no merge pass is needed.
+fn neighbour_positions(linear: &[u64], stride: u64, sign: i64, range: std::ops::Range<usize>) -> Vec<i64> {
+    if stride != 1 {
+        return shifted_positions(linear, sign * stride as i64, range);
+    }
+    range
+        .map(|i| {
+            let j = if sign > 0 { i + 1 } else { i.wrapping_sub(1) };
+            match linear.get(j) {
+                Some(&l) if l as i128 == linear[i] as i128 + sign as i128 => j as i64,
+                _ => -1,
+            }
+        })
+        .collect()
 }
 
 /// Whether the neighbour along axis `k` on side `sign` of the node with grid index `c` is a band
@@ -125,7 +143,7 @@ pub fn outward_directions(
     let mut next_rim = 0usize;
     for k in 0..d {
         for sign in [1i64, -1] {
-            let pos = shifted_positions(linear, sign * stride[k] as i64, range.clone());
+            let pos = neighbour_positions(linear, stride[k], sign, range.clone());
             for o in 0..m {
                 let v = if neighbour_known(&coords[o], &pos, o, k, sign, shape) {
                     phi[pos[o] as usize]
