@@ -295,7 +295,9 @@ class LevelSet(Surface):
 
         h = grid.spacing
         ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi)
+        # one neighbour table (merge passes) for both calls
+        table = _native.neighbour_table(list(grid.shape), ulinear, lo, hi)
+        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi, table)
         parts = []
         start = 0
         for group, count in enumerate(counts):
@@ -305,7 +307,7 @@ class LevelSet(Surface):
                 parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
             start += count
         rim_phi = np.concatenate(parts) if parts else np.zeros(0)
-        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction)
+        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction, table)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)

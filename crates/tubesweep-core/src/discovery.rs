@@ -122,11 +122,15 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
     for k in (0..D.saturating_sub(1)).rev() {
         stride[k] = stride[k + 1] * shape[k + 1] as u64;
     }
-    // count first, so the output is allocated once at its final size
-    let mut count = 0usize;
-    emit(&shape, &stride, &sorted, 0, 0, &mut |_| count += 1);
+    // count first (a block has 2 nodes along an axis, 1 where the grid ends after its origin), so
+    // the output is allocated once at its final size
+    let count: usize = sorted
+        .iter()
+        .map(|o| (0..D).map(|k| if o[k] + 1 < shape[k] as u64 { 2 } else { 1 }).product::<usize>())
+        .sum();
     let mut out = Vec::with_capacity(count);
-    emit(&shape, &stride, &sorted, 0, 0, &mut |l| out.push(l));
+    emit(&shape, &stride, &sorted, 0, 0, &mut out);
+    debug_assert_eq!(out.len(), count);
     Ok(out)
 }
 
@@ -155,13 +159,13 @@ pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f6
 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along
 /// the axes before `axis`, whose contribution to the linear index is `base`).
-fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut dyn FnMut(u64)) {
+fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut Vec<u64>) {
     if axis + 1 == D {
         let n = shape[axis] as u64;
         for o in group {
-            out(base + o[axis]);
+            out.push(base + o[axis]);
             if o[axis] + 1 < n {
-                out(base + o[axis] + 1);
+                out.push(base + o[axis] + 1);
             }
         }
         return;

@@ -9,6 +9,7 @@
 //! the Python package evaluates, so the two halves are separate calls.)
 
 use crate::band::shifted_positions;
+use rayon::prelude::*;
 use crate::error::{Error, Result};
 
 /// Linear-index strides of the axes of a C-order grid of `shape`.
@@ -60,27 +61,60 @@ fn check(shape: &[usize], linear: &[u64], range: &std::ops::Range<usize>) -> Res
     Ok(())
 }
 
+/// The neighbour table of band nodes `range` (`m` of them): for every group `(axis k, side)` in
+/// the order `k = 0, 1, …`, side `+1` then `−1`, `m` entries, the band position of the neighbour
+/// `x ± Δx e_k` of each node, or −1 where that neighbour is not a band node or lies outside the
+/// grid (the places where φ must come from the caller). The groups' passes are independent and
+/// run in parallel; one table serves both [`rim_nodes_of`] and [`outward_directions_with`].
+pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>) -> Result<Vec<i64>> {
+    check(shape, linear, &range)?;
+    let stride = strides(shape);
+    let coords = node_coordinates(shape, linear, range.clone());
+    let m = range.len();
+    let mut table = vec![-1i64; 2 * shape.len() * m];
+    if m == 0 {
+        return Ok(table);
+    }
+    table.par_chunks_mut(m).enumerate().for_each(|(group, out)| {
+        let (k, sign) = (group / 2, if group % 2 == 0 { 1i64 } else { -1 });
+        let pos = neighbour_positions(linear, stride[k], sign, range.clone());
+        for (o, (t, &p)) in out.iter_mut().zip(pos.iter()).enumerate() {
+            if neighbour_known(&coords[o], p, k, sign, shape) {
+                *t = p;
+            }
+        }
+    });
+    Ok(table)
+}
+
 /// For every group `(axis k, side)` in the order `k = 0, 1, …`, side `+1` then `−1`: the band
 /// positions `i` in `range` whose neighbour `linear[i] ± stride_k` is not a band node (or lies
 /// outside the grid along axis `k`), in increasing order. Returns the positions of all groups
 /// concatenated and the size of each group (2·d entries).
 pub fn rim_nodes(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>) -> Result<(Vec<u64>, Vec<usize>)> {
-    check(shape, linear, &range)?;
-    let stride = strides(shape);
-    let coords = node_coordinates(shape, linear, range.clone());
+    let table = neighbour_table(shape, linear, range.clone())?;
+    rim_nodes_of(&table, shape.len(), range)
+}
+
+/// [`rim_nodes`] from the [`neighbour_table`] of band nodes `range` of a `d`-dimensional grid.
+pub fn rim_nodes_of(table: &[i64], d: usize, range: std::ops::Range<usize>) -> Result<(Vec<u64>, Vec<usize>)> {
+    let m = range.len();
+    if table.len() != 2 * d * m {
+        return Err(Error::invalid("neighbours", format!("expected shape ({}, {m})", 2 * d)));
+    }
+    if m == 0 {
+        return Ok((Vec::new(), vec![0; 2 * d]));
+    }
     let mut nodes = Vec::new();
-    let mut counts = Vec::with_capacity(2 * shape.len());
-    for k in 0..shape.len() {
-        for sign in [1i64, -1] {
-            let before = nodes.len();
-            let pos = neighbour_positions(linear, stride[k], sign, range.clone());
-            for (o, i) in range.clone().enumerate() {
-                if !neighbour_known(&coords[o], &pos, o, k, sign, shape) {
-                    nodes.push(i as u64);
-                }
+    let mut counts = Vec::with_capacity(2 * d);
+    for group in table.chunks_exact(m) {
+        let before = nodes.len();
+        for (&p, i) in group.iter().zip(range.clone()) {
+            if p < 0 {
+                nodes.push(i as u64);
             }
-            counts.push(nodes.len() - before);
         }
+        counts.push(nodes.len() - before);
     }
     Ok((nodes, counts))
 }
@@ -104,11 +138,11 @@ fn neighbour_positions(linear: &[u64], stride: u64, sign: i64, range: std::ops::
 }
 
 /// Whether the neighbour along axis `k` on side `sign` of the node with grid index `c` is a band
-/// node (`pos[o]`, from the merge) inside the grid.
+/// node (`pos`, from the merge) inside the grid.
 #[inline]
-fn neighbour_known(c: &[u32; 3], pos: &[i64], o: usize, k: usize, sign: i64, shape: &[usize]) -> bool {
+fn neighbour_known(c: &[u32; 3], pos: i64, k: usize, sign: i64, shape: &[usize]) -> bool {
     let c = c[k] as i64 + sign;
-    pos[o] >= 0 && c >= 0 && c < shape[k] as i64
+    pos >= 0 && c >= 0 && c < shape[k] as i64
 }
 
 /// The outward unit directions `sgn(φ) g/|g|` (as f32, written to `direction`, `range.len()`
@@ -126,7 +160,30 @@ pub fn outward_directions(
     rim_phi: &[f64],
     direction: &mut [f32],
 ) -> Result<Vec<f64>> {
+    let table = neighbour_table(shape, linear, range.clone())?;
+    outward_directions_with(shape, spacing, linear, phi, range, &table, rim_phi, direction)
+}
+
+/// [`outward_directions`] with the [`neighbour_table`] of band nodes `range` already made (for
+/// [`rim_nodes_of`]): no second set of merge passes.
+#[allow(clippy::too_many_arguments)]
+pub fn outward_directions_with(
+    shape: &[usize],
+    spacing: f64,
+    linear: &[u64],
+    phi: &[f64],
+    range: std::ops::Range<usize>,
+    table: &[i64],
+    rim_phi: &[f64],
+    direction: &mut [f32],
+) -> Result<Vec<f64>> {
     check(shape, linear, &range)?;
+    if table.len() != 2 * shape.len() * range.len() {
+        return Err(Error::invalid("neighbours", format!("expected shape ({}, {})", 2 * shape.len(), range.len())));
+    }
+    if table.iter().any(|&p| p < -1 || p >= linear.len() as i64) {
+        return Err(Error::invalid("neighbours", "entries must be band positions or −1"));
+    }
     let d = shape.len();
     let m = range.len();
     if phi.len() != linear.len() {
@@ -135,17 +192,15 @@ pub fn outward_directions(
     if direction.len() != m * d {
         return Err(Error::invalid("direction", format!("expected shape ({m}, {d})")));
     }
-    let stride = strides(shape);
-    let coords = node_coordinates(shape, linear, range.clone());
     // g accumulates φ(x + Δx e_k), then φ(x − Δx e_k) is subtracted: both sides are needed
     let mut up = vec![0.0f64; m];
     let mut g = vec![0.0f64; m * d];
     let mut next_rim = 0usize;
     for k in 0..d {
         for sign in [1i64, -1] {
-            let pos = neighbour_positions(linear, stride[k], sign, range.clone());
+            let pos = &table[(2 * k + usize::from(sign < 0)) * m..][..m];
             for o in 0..m {
-                let v = if neighbour_known(&coords[o], &pos, o, k, sign, shape) {
+                let v = if pos[o] >= 0 {
                     phi[pos[o] as usize]
                 } else {
                     let v = *rim_phi.get(next_rim).ok_or_else(|| {

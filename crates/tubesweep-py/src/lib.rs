@@ -825,29 +825,56 @@ fn node_points<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1
     }
 }
 
+/// The neighbour table of band nodes `start..stop`: (2·d, stop − start) int64, for each group (axis
+/// k = 0, 1, …; side +1 then −1) the band position of each node's neighbour, or −1 where φ there
+/// must be supplied (off the band or outside the grid). See
+/// `tubesweep_core::normals::neighbour_table`.
+#[pyfunction]
+fn neighbour_table<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i64>>> {
+    let lin = linear.as_slice()?;
+    let table = py.detach(|| tubesweep_core::normals::neighbour_table(&shape, lin, start..stop)).map_err(to_pyerr)?;
+    let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len(), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py))
+}
+
+fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i64>>) -> PyResult<Option<&'a [i64]>> {
+    table.as_ref().map(|t| c_slice(t, "neighbours")).transpose()
+}
+
 /// The places where central differences of φ at band nodes `start..stop` need φ off the band:
 /// `(positions, counts)`, the band positions for each group (axis k = 0, 1, …; side +1 then −1)
-/// concatenated, and the size of each group (2·d). See `tubesweep_core::normals::rim_nodes`.
+/// concatenated, and the size of each group (2·d). From `neighbours` (their `neighbour_table`)
+/// when given. See `tubesweep_core::normals::rim_nodes`.
 #[pyfunction]
+#[pyo3(signature = (shape, linear, start, stop, neighbours=None))]
 fn rim_nodes<'py>(
     py: Python<'py>,
     shape: Vec<usize>,
     linear: PyReadonlyArray1<'py, u64>,
     start: usize,
     stop: usize,
+    neighbours: Option<PyReadonlyArray2<'py, i64>>,
 ) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
     let lin = linear.as_slice()?;
-    let (nodes, counts) = py.detach(|| tubesweep_core::normals::rim_nodes(&shape, lin, start..stop)).map_err(to_pyerr)?;
+    let table = table_slice(&neighbours)?;
+    let (nodes, counts) = py
+        .detach(|| match table {
+            Some(t) => tubesweep_core::normals::rim_nodes_of(t, shape.len(), start..stop),
+            None => tubesweep_core::normals::rim_nodes(&shape, lin, start..stop),
+        })
+        .map_err(to_pyerr)?;
     let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
     Ok((nodes.into_pyarray(py), counts))
 }
 
 /// The outward directions sgn(φ)∇φ/|∇φ| at band nodes `start..stop` by central differences,
 /// written to `direction` ((stop − start, d) float32, C-contiguous); φ at band nodes from `phi`,
-/// off the band from `rim_phi` (in the order of `rim_nodes`). Returns |∇φ| there. See
+/// off the band from `rim_phi` (in the order of `rim_nodes`); the neighbours from `neighbours`
+/// (their `neighbour_table`) when given. Returns |∇φ| there. See
 /// `tubesweep_core::normals::outward_directions`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (shape, spacing, linear, phi, start, stop, rim_phi, direction, neighbours=None))]
 fn outward_directions<'py>(
     py: Python<'py>,
     shape: Vec<usize>,
@@ -858,11 +885,16 @@ fn outward_directions<'py>(
     stop: usize,
     rim_phi: PyReadonlyArray1<'py, f64>,
     mut direction: PyReadwriteArray2<'py, f32>,
+    neighbours: Option<PyReadonlyArray2<'py, i64>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (lin, ph, rim) = (linear.as_slice()?, phi.as_slice()?, rim_phi.as_slice()?);
+    let table = table_slice(&neighbours)?;
     let dir = c_slice_mut(&mut direction, "direction")?;
     let norms = py
-        .detach(|| tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir))
+        .detach(|| match table {
+            Some(t) => tubesweep_core::normals::outward_directions_with(&shape, spacing, lin, ph, start..stop, t, rim, dir),
+            None => tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir),
+        })
         .map_err(to_pyerr)?;
     Ok(norms.into_pyarray(py))
 }
@@ -876,6 +908,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(children_radius_max, m)?)?;
     m.add_function(wrap_pyfunction!(block_children, m)?)?;
     m.add_function(wrap_pyfunction!(node_points, m)?)?;
+    m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
