@@ -20,13 +20,13 @@ def node_points(
 ) -> npt.NDArray[np.float64]: ...
 def neighbour_table(
     shape: List[int], linear: npt.NDArray[np.uint64], start: int, stop: int
-) -> npt.NDArray[np.int64]: ...  # (2·d, stop − start)
+) -> npt.NDArray[np.int32]: ...  # (2·(d − 1), stop − start)
 def rim_nodes(
     shape: List[int],
     linear: npt.NDArray[np.uint64],
     start: int,
     stop: int,
-    neighbours: Optional[npt.NDArray[np.int64]] = None,
+    neighbours: Optional[npt.NDArray[np.int32]] = None,
 ) -> Tuple[npt.NDArray[np.int64], List[int]]: ...
 def outward_directions(
     shape: List[int],
@@ -37,7 +37,7 @@ def outward_directions(
     stop: int,
     rim_phi: npt.NDArray[np.float64],
     direction: npt.NDArray[np.float32],  # (stop − start, d) C-contiguous, written
-    neighbours: Optional[npt.NDArray[np.int64]] = None,  # neighbour_table(shape, linear, start, stop)
+    neighbours: Optional[npt.NDArray[np.int32]] = None,  # neighbour_table(shape, linear, start, stop)
 ) -> npt.NDArray[np.float64]: ...
 __version__: str
 

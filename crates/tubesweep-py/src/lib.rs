@@ -825,19 +825,19 @@ fn node_points<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1
     }
 }
 
-/// The neighbour table of band nodes `start..stop`: (2·d, stop − start) int64, for each group (axis
-/// k = 0, 1, …; side +1 then −1) the band position of each node's neighbour, or −1 where φ there
-/// must be supplied (off the band or outside the grid). See
+/// The neighbour table of band nodes `start..stop`: (2·(d − 1), stop − start) int32, for each
+/// group (axis k = 0, …, d − 2; side +1 then −1) the band position of each node's neighbour less
+/// the node's, or −2^31 where φ there must be supplied (off the band or outside the grid). See
 /// `tubesweep_core::normals::neighbour_table`.
 #[pyfunction]
-fn neighbour_table<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i64>>> {
+fn neighbour_table<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i32>>> {
     let lin = linear.as_slice()?;
     let table = py.detach(|| tubesweep_core::normals::neighbour_table(&shape, lin, start..stop)).map_err(to_pyerr)?;
-    let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len(), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len().saturating_sub(1), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py))
 }
 
-fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i64>>) -> PyResult<Option<&'a [i64]>> {
+fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Option<&'a [i32]>> {
     table.as_ref().map(|t| c_slice(t, "neighbours")).transpose()
 }
 
@@ -853,13 +853,13 @@ fn rim_nodes<'py>(
     linear: PyReadonlyArray1<'py, u64>,
     start: usize,
     stop: usize,
-    neighbours: Option<PyReadonlyArray2<'py, i64>>,
+    neighbours: Option<PyReadonlyArray2<'py, i32>>,
 ) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
     let lin = linear.as_slice()?;
     let table = table_slice(&neighbours)?;
     let (nodes, counts) = py
         .detach(|| match table {
-            Some(t) => tubesweep_core::normals::rim_nodes_of(t, shape.len(), start..stop),
+            Some(t) => tubesweep_core::normals::rim_nodes_of(&shape, lin, start..stop, t),
             None => tubesweep_core::normals::rim_nodes(&shape, lin, start..stop),
         })
         .map_err(to_pyerr)?;
@@ -885,7 +885,7 @@ fn outward_directions<'py>(
     stop: usize,
     rim_phi: PyReadonlyArray1<'py, f64>,
     mut direction: PyReadwriteArray2<'py, f32>,
-    neighbours: Option<PyReadonlyArray2<'py, i64>>,
+    neighbours: Option<PyReadonlyArray2<'py, i32>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (lin, ph, rim) = (linear.as_slice()?, phi.as_slice()?, rim_phi.as_slice()?);
     let table = table_slice(&neighbours)?;
