@@ -136,25 +136,34 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
 
 /// The world coordinates `lower + Δx · index` of the grid nodes with C-order linear indices
 /// `linear` (each inside the grid of `shape`), with the arithmetic of `Grid.points`, so the same
-/// bits: the points at which the caller evaluates φ for the candidates of the band.
-pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f64; D], spacing: f64) -> Result<Vec<[f64; D]>> {
+/// bits: the points at which the caller evaluates φ for the candidates of the band, as `D`
+/// coordinates per node, one node after another.
+pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f64; D], spacing: f64) -> Result<Vec<f64>> {
     let total: u64 = shape.iter().map(|&n| n as u64).product();
     if let Some(&bad) = linear.iter().find(|&&l| l >= total) {
         return Err(Error::invalid("linear", format!("linear index {bad} is outside the grid {shape:?}")));
     }
-    Ok(linear
-        .iter()
-        .map(|&l| {
-            let mut key = l;
-            let mut p = [0.0f64; D];
-            for k in (0..D).rev() {
+    // one division per node for the last axis; the leading coordinates only when the row changes
+    // (the candidates come in C order, many to a row)
+    let n_last = shape[D - 1] as u64;
+    let mut out = Vec::with_capacity(linear.len() * D);
+    let mut row = u64::MAX;
+    let mut lead = [0.0f64; D];
+    for &l in linear {
+        let r = l / n_last;
+        if r != row {
+            row = r;
+            let mut key = r;
+            for k in (0..D - 1).rev() {
                 let n = shape[k] as u64;
-                p[k] = lower[k] + spacing * (key % n) as f64;
+                lead[k] = lower[k] + spacing * (key % n) as f64;
                 key /= n;
             }
-            p
-        })
-        .collect())
+        }
+        lead[D - 1] = lower[D - 1] + spacing * (l - r * n_last) as f64;
+        out.extend_from_slice(&lead);
+    }
+    Ok(out)
 }
 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along

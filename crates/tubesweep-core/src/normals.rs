@@ -139,10 +139,15 @@ fn neighbour_at(
         let delta = table[(2 * k + usize::from(sign < 0)) * m + o];
         return (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize);
     }
-    let n = shape[d - 1] as u64;
-    let c = c[d - 1] as u64;
+    last_axis_neighbour(linear, i, c[d - 1], shape[d - 1], sign)
+}
+
+/// The band position of the neighbour along the last axis (`n` nodes) on side `sign` of band node
+/// `i` (index `c` along that axis): the adjacent entry of the sorted band, if it is that node.
+#[inline]
+fn last_axis_neighbour(linear: &[u64], i: usize, c: u32, n: usize, sign: i64) -> Option<usize> {
     if sign > 0 {
-        (c + 1 < n && linear.get(i + 1) == Some(&(linear[i] + 1))).then_some(i + 1)
+        ((c as usize) + 1 < n && linear.get(i + 1) == Some(&(linear[i] + 1))).then_some(i + 1)
     } else {
         (c > 0 && i > 0 && linear[i - 1] == linear[i] - 1).then(|| i - 1)
     }
@@ -226,11 +231,12 @@ pub fn outward_directions_with(
         return Err(Error::invalid("neighbours", format!("expected shape ({}, {})", 2 * (shape.len() - 1), range.len())));
     }
     let m = range.len();
-    let inside = |(e, &delta): (usize, &i32)| {
-        let p = (range.start + e % m.max(1)) as i64 + delta as i64;
-        delta == NO_NEIGHBOUR || (0..linear.len() as i64).contains(&p)
+    let leads_inside = |row: &[i32]| {
+        row.iter()
+            .zip(range.clone())
+            .all(|(&delta, i)| delta == NO_NEIGHBOUR || (0..linear.len() as i64).contains(&(i as i64 + delta as i64)))
     };
-    if !table.iter().enumerate().all(inside) {
+    if m > 0 && !table.chunks_exact(m).all(leads_inside) {
         return Err(Error::invalid("neighbours", "entries must lead to band positions"));
     }
     let d = shape.len();
@@ -245,9 +251,16 @@ pub fn outward_directions_with(
     let mut g = vec![0.0f64; m * d];
     let mut next_rim = 0usize;
     for k in 0..d {
-        for sign in [1i64, -1] {
+        for (side, sign) in [(0usize, 1i64), (1, -1)] {
+            let row = if k + 1 < d { &table[(2 * k + side) * m..][..m] } else { &[][..] };
             for (o, i) in range.clone().enumerate() {
-                let v = match neighbour_at(table, shape, linear, m, o, i, &coords[o], k, sign) {
+                let neighbour = if k + 1 < d {
+                    let delta = row[o];
+                    (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize)
+                } else {
+                    last_axis_neighbour(linear, i, coords[o][k], shape[k], sign)
+                };
+                let v = match neighbour {
                     Some(p) => phi[p],
                     None => {
                         let v = *rim_phi.get(next_rim).ok_or_else(|| {

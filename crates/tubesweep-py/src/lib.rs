@@ -816,7 +816,8 @@ fn node_points<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1
     fn run<'py, const D: usize>(py: Python<'py>, shape: &[usize], lin: &[u64], lower: &[f64], spacing: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
         let p = py.detach(|| tubesweep_core::discovery::node_points::<D>(shape, lin, lower, spacing)).map_err(to_pyerr)?;
-        flat_2d(py, p)
+        let a = numpy::ndarray::Array2::from_shape_vec((lin.len(), D), p).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py))
     }
     match shape.len() {
         2 => run::<2>(py, &shape, lin, &lower, spacing),
