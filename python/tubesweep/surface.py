@@ -172,21 +172,25 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
     from . import _native
 
     shape, lower = list(grid.shape), [float(x) for x in grid.lower]
-    keep_lin, keep_val = [], []
+    # the kept nodes are written straight to arrays of the candidates' length and then cut to
+    # size in place (a shrinking realloc: no copy, and only the pages written are ever touched)
+    linear = np.empty(len(candidates), np.int64)
+    values = np.empty(len(candidates))
+    kept = 0
     lin = candidates[:0]
     for s0 in range(0, len(candidates), EVAL_CHUNK):
         lin = candidates[s0 : s0 + EVAL_CHUNK]
         # the node coordinates in Rust (the bits of Grid.points, without the (M, d) int64 indices)
         v = _evaluate(fn, _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing), name)
         keep = np.abs(v) <= half_width
-        keep_lin.append(lin[keep])
-        keep_val.append(v[keep])
-    del candidates, lin  # (lin is a view of them) before the parts are joined: the largest array here
-    if not keep_lin:
-        return np.zeros(0, np.int64), np.zeros(0)
-    linear = np.concatenate(keep_lin)  # sorted, as the candidates are
-    del keep_lin
-    return linear, np.concatenate(keep_val)
+        n = int(np.count_nonzero(keep))
+        np.compress(keep, lin, out=linear[kept : kept + n])
+        np.compress(keep, v, out=values[kept : kept + n])
+        kept += n
+    del candidates, lin  # (lin is a view of them)
+    linear.resize(kept, refcheck=False)  # sorted, as the candidates are
+    values.resize(kept, refcheck=False)
+    return linear, values
 
 
 def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
