@@ -247,6 +247,44 @@ mod tests {
     }
 
     #[test]
+    fn children_cover_their_parents_and_are_cut_to_the_grid() {
+        // 2D, shape 7 × 10, parents of 4 × 4 nodes: children of 2 × 2, cut at the upper edges
+        let shape = [7usize, 10];
+        let parents = [[4u64, 8], [0, 0], [4, 4]];
+        let (o, c, r) = block_children(shape, &parents, 2, [-1.0, 0.5], 0.25).unwrap();
+        // parent by parent, corners in C order, only those starting inside the grid
+        let want: Vec<[u64; 2]> = vec![[4, 8], [6, 8], [0, 0], [0, 2], [2, 0], [2, 2], [4, 4], [4, 6], [6, 4], [6, 6]];
+        assert_eq!(o, want);
+        for ((o, c), r) in o.iter().zip(&c).zip(&r) {
+            let last = [(o[0] + 2).min(7) - 1, (o[1] + 2).min(10) - 1];
+            for k in 0..2 {
+                let lower = [-1.0, 0.5][k];
+                assert_eq!(c[k], lower + 0.25 * (0.5 * (o[k] + last[k]) as f64));
+            }
+            let e = [(last[0] - o[0]) as f64, (last[1] - o[1]) as f64];
+            assert_eq!(*r, 0.5 * 0.25 * (e[0] * e[0] + e[1] * e[1]).sqrt());
+        }
+        assert_eq!(children_radius_max(shape, &parents, 2).unwrap(), 2f64.sqrt());
+        assert_eq!(children_radius_max(shape, &[[6, 8]], 1).unwrap(), 0.0);
+        assert!(block_children(shape, &[[2, 0]], 2, [0.0; 2], 1.0).is_err()); // not a multiple of 4
+        assert!(block_children(shape, &[[8, 0]], 2, [0.0; 2], 1.0).is_err()); // outside
+    }
+
+    #[test]
+    fn node_points_are_lower_plus_spacing_times_index() {
+        let shape = [3usize, 4, 5];
+        let linear: Vec<u64> = vec![0, 4, 5, 19, 20, 59];
+        let p = node_points(shape, &linear, [0.5, -1.0, 2.0], 0.1).unwrap();
+        for (n, &l) in linear.iter().enumerate() {
+            let idx = [l / 20, (l / 5) % 4, l % 5];
+            for k in 0..3 {
+                assert_eq!(p[3 * n + k], [0.5, -1.0, 2.0][k] + 0.1 * idx[k] as f64);
+            }
+        }
+        assert!(node_points(shape, &[60], [0.0; 3], 1.0).is_err());
+    }
+
+    #[test]
     fn rejects_odd_outside_and_repeated_origins() {
         assert!(split_pair_blocks([6usize, 6], &[[1, 0]]).is_err());
         assert!(split_pair_blocks([6usize, 6], &[[6, 0]]).is_err());
