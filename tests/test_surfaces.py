@@ -193,3 +193,101 @@ def test_candidates_of_the_coarse_to_fine_search_are_sorted_and_cover_the_band()
     assert cand.dtype == np.int64 and np.all(np.diff(cand) > 0)
     every = np.abs(s.signed_distance(grid.points(grid.unravel(np.arange(grid.size)))))
     assert np.isin(np.flatnonzero(every <= hw), cand).all()
+
+
+def _reference_candidates(grid, half_width, lipschitz, distance):
+    """The coarse-to-fine search written out in NumPy, level by level (the code the Rust block
+    bookkeeping replaced): keep a block when |φ(centre)| ≤ half_width + lipschitz · radius, split
+    it in 2^d children, down to single nodes."""
+    shape = np.asarray(grid.shape)
+    d = grid.ndim
+    h = grid.spacing
+    block = 1 << max(0, int(np.floor(np.log2(max(grid.shape) / 4))))
+    origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(-1, d)
+    if block == 1:
+        return np.sort(grid.linear_index(origins))
+    corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+    o = origins
+    while block > 1:
+        last = np.minimum(o + block, shape) - 1
+        radius = 0.5 * h * np.linalg.norm(last - o, axis=1)
+        reach = half_width + lipschitz * (0.5 * h * float(np.linalg.norm(last - o, axis=1).max(initial=0.0))) + 1e-12
+        dist = distance(grid.points(0.5 * (o + last)), reach)
+        o = o[dist <= half_width + lipschitz * radius + 1e-12]
+        block //= 2
+        o = (o[:, None, :] + block * corners[None, :, :]).reshape(-1, d)
+        o = o[np.all(o < shape, axis=1)]
+    return np.sort(grid.linear_index(o))
+
+
+@pytest.mark.parametrize(
+    "shape",
+    [(37, 50), (9, 23), (64, 33), (3, 3), (37, 41, 29), (13, 8, 21), (32, 32, 32), (65, 17, 40)],
+)
+def test_coarse_to_fine_candidates_match_the_straightforward_search(shape):
+    """Same candidates, φ asked at the same points (bit for bit) with the same reach per level, on
+    odd and even grid shapes in 2D and 3D (blocks cut at the upper edges)."""
+    from tubesweep.surface import coarse_to_fine_candidates
+
+    d = len(shape)
+    grid = ts.Grid((-1.0,) * d, tuple(-1.0 + 0.07 * (n - 1) for n in shape), shape)
+    centre = np.array([0.3, 0.9, 0.5][:d]) * np.asarray(grid.upper - grid.lower) * 0.5 + grid.lower + 0.011
+    radius = 0.3 * float(np.min(grid.upper - grid.lower))
+
+    def phi(p):
+        return np.linalg.norm(p - centre, axis=1) - radius
+
+    for hw, lip in ((2.5 * grid.spacing, 1.0), (4.0 * grid.spacing, 1.5)):
+        calls = {"new": [], "ref": []}
+
+        def recorder(key):
+            def distance(p, reach):
+                calls[key].append((np.array(p), reach))
+                return np.abs(phi(p))
+            return distance
+
+        got = coarse_to_fine_candidates(grid, hw, lip, recorder("new"))
+        want = _reference_candidates(grid, hw, lip, recorder("ref"))
+        assert got.dtype == np.int64 and np.array_equal(got, want)
+        # the same points (as a set of bit patterns) and the same reaches
+        pts = {k: np.concatenate([p for p, _ in v]) if v else np.zeros((0, d)) for k, v in calls.items()}
+        rows = {k: np.unique(v.view(np.uint64), axis=0) for k, v in pts.items()}
+        assert len(pts["new"]) == len(pts["ref"]) and np.array_equal(rows["new"], rows["ref"])
+        assert sorted({r for _, r in calls["new"]}) == sorted({r for _, r in calls["ref"]})
+
+
+@pytest.mark.parametrize("shape", [(9, 23), (13, 8, 21)])
+def test_native_node_points_and_neighbour_table(shape):
+    from tubesweep import _native
+
+    grid = ts.Grid((-0.3,) * len(shape), tuple(-0.3 + 0.11 * (n - 1) for n in shape), shape)
+    rng = np.random.default_rng(1)
+    lin = np.sort(rng.choice(grid.size, grid.size // 3, replace=False)).astype(np.uint64)
+    lower = [float(x) for x in grid.lower]
+    assert np.array_equal(_native.node_points(list(shape), lin, lower, grid.spacing), grid.points(grid.unravel(lin)))
+    lo, hi = 5, len(lin) - 7
+    table = _native.neighbour_table(list(shape), lin, lo, hi)
+    d = len(shape)
+    assert table.dtype == np.int32 and table.shape == (2 * (d - 1), hi - lo)
+    idx = grid.unravel(lin[lo:hi])
+    for k in range(d - 1):  # the last axis needs no table (adjacent entries of the band)
+        for side, sign in enumerate((1, -1)):
+            nb = idx.copy()
+            nb[:, k] += sign
+            inside = (nb[:, k] >= 0) & (nb[:, k] < shape[k])
+            want = np.full(hi - lo, np.iinfo(np.int32).min, dtype=np.int64)
+            nl = grid.linear_index(np.where(inside[:, None], nb, 0))
+            at = np.searchsorted(lin, nl)
+            found = inside & (at < len(lin)) & (lin[np.minimum(at, len(lin) - 1)] == nl)
+            want[found] = at[found] - np.arange(lo, hi)[found]
+            assert np.array_equal(table[2 * k + side], want)
+    pos, counts = _native.rim_nodes(list(shape), lin, lo, hi)
+    pos2, counts2 = _native.rim_nodes(list(shape), lin, lo, hi, table)
+    assert counts == counts2 and np.array_equal(pos, pos2)
+    with pytest.raises(ValueError):
+        _native.rim_nodes(list(shape), lin, lo, hi, table[:, 1:].copy())
+    bad = table.copy()
+    bad[0, 0] = len(lin)  # leads outside the band
+    with pytest.raises(ValueError):
+        _native.outward_directions(list(shape), grid.spacing, lin, np.zeros(len(lin)), lo, hi, np.zeros(sum(counts)),
+                                   np.zeros((hi - lo, d), np.float32), bad)

@@ -11,8 +11,22 @@ def shifted_positions(
     linear: npt.NDArray[np.uint64], offset: int, start: int = 0, stop: Optional[int] = None
 ) -> npt.NDArray[np.int64]: ...
 def split_pair_blocks(shape: List[int], origins: npt.NDArray[np.int64]) -> npt.NDArray[np.uint64]: ...
-def rim_nodes(
+def children_radius_max(shape: List[int], parents: npt.NDArray[np.int64], block: int) -> float: ...
+def block_children(
+    shape: List[int], parents: npt.NDArray[np.int64], block: int, lower: List[float], spacing: float
+) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def node_points(
+    shape: List[int], linear: npt.NDArray[np.uint64], lower: List[float], spacing: float
+) -> npt.NDArray[np.float64]: ...
+def neighbour_table(
     shape: List[int], linear: npt.NDArray[np.uint64], start: int, stop: int
+) -> npt.NDArray[np.int32]: ...  # (2·(d − 1), stop − start)
+def rim_nodes(
+    shape: List[int],
+    linear: npt.NDArray[np.uint64],
+    start: int,
+    stop: int,
+    neighbours: Optional[npt.NDArray[np.int32]] = None,
 ) -> Tuple[npt.NDArray[np.int64], List[int]]: ...
 def outward_directions(
     shape: List[int],
@@ -23,6 +37,7 @@ def outward_directions(
     stop: int,
     rim_phi: npt.NDArray[np.float64],
     direction: npt.NDArray[np.float32],  # (stop − start, d) C-contiguous, written
+    neighbours: Optional[npt.NDArray[np.int32]] = None,  # neighbour_table(shape, linear, start, stop)
 ) -> npt.NDArray[np.float64]: ...
 __version__: str
 

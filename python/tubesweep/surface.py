@@ -126,49 +126,39 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     (8 bytes each, :func:`tubesweep._native.split_pair_blocks`), so the candidate list is the
     largest array this allocates.
     """
-    shape = np.asarray(grid.shape)
+    from . import _native
+
+    shape = list(grid.shape)
     d = grid.ndim
     h = grid.spacing
+    lower = [float(x) for x in grid.lower]
     block = 1 << max(0, int(np.floor(np.log2(max(grid.shape) / 4))))
-    origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(-1, d)
     if block == 1:  # a tiny grid: every node is a candidate
-        return np.sort(grid.linear_index(origins))
-    corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
-    # each level is generated and tested slice by slice, so that its temporaries (children,
-    # centres, radii, points, the callable's own) stay O(slice); only the kept blocks are stored
-    step = max(1, EVAL_CHUNK >> d)
-    parents: Optional[np.ndarray] = None  # the kept blocks of the previous level (twice the size)
-
-    def level() -> Iterator[np.ndarray]:
-        if parents is None:
-            for s0 in range(0, len(origins), step):
-                yield origins[s0 : s0 + step]
-            return
-        for s0 in range(0, len(parents), max(1, step >> d)):
-            children = (parents[s0 : s0 + max(1, step >> d), None, :] + block * corners[None, :, :]).reshape(-1, d)
-            yield children[np.all(children < shape, axis=1)]
-
+        return np.arange(grid.size, dtype=np.int64)
+    # the first level, blocks of `block` nodes on the lattice of that spacing, is made as the
+    # children of the lattice of twice the spacing; every level is then the children of the blocks
+    # the previous one kept. The children, their centres and radii come from Rust
+    # (:func:`tubesweep._native.block_children`), a slice of parents at a time so that the
+    # temporaries (and the callable's own) stay O(EVAL_CHUNK); only the kept blocks are stored.
+    parents = np.stack(np.meshgrid(*[np.arange(0, n, 2 * block) for n in grid.shape], indexing="ij"),
+                       axis=-1).reshape(-1, d).astype(np.int64)
+    step = max(1, EVAL_CHUNK >> d)  # parents per slice: at most EVAL_CHUNK children
     while True:
-        radius_max = 0.0
-        for o in level():
-            radius_max = max(radius_max, float(np.linalg.norm(np.minimum(o + block, shape) - 1 - o, axis=1).max(initial=0.0)))
-        reach = half_width + lipschitz * (0.5 * h * radius_max) + 1e-12
+        radius_max = 0.5 * h * _native.children_radius_max(shape, parents, block)
+        reach = half_width + lipschitz * radius_max + 1e-12
         kept = []
-        for o in level():
-            last = np.minimum(o + block, shape) - 1
-            radius = 0.5 * h * np.linalg.norm(last - o, axis=1)
-            dist = distance(grid.points(0.5 * (o + last)), reach)
+        for s0 in range(0, len(parents), step):
+            o, centres, radius = _native.block_children(shape, parents[s0 : s0 + step], block, lower, h)
+            dist = distance(centres, reach)
             kept.append(o[dist <= half_width + lipschitz * radius + 1e-12])
-        parents = np.concatenate(kept) if kept else origins[:0]
+        parents = kept[0] if len(kept) == 1 else np.concatenate(kept) if kept else parents[:0]
         block //= 2
         if block == 1:
             break
-    origins = parents
     # the last split (blocks of 2 nodes per axis → single nodes), in Rust: straight to sorted
     # linear indices (8 bytes per candidate, no sort, no (M, 2^d, d) temporaries)
-    from . import _native
-
-    linear = _native.split_pair_blocks(list(grid.shape), np.ascontiguousarray(origins, dtype=np.int64))
+    origins = np.ascontiguousarray(parents, dtype=np.int64)
+    linear = _native.split_pair_blocks(shape, origins)
     return linear.view(np.int64)  # below 2^63: the same bits
 
 
@@ -179,20 +169,28 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
     there."""
     candidates = coarse_to_fine_candidates(grid, half_width, lipschitz,
                                            lambda p, reach: np.abs(_evaluate(fn, p, name)))
-    keep_lin, keep_val = [], []
+    from . import _native
+
+    shape, lower = list(grid.shape), [float(x) for x in grid.lower]
+    # the kept nodes are written straight to arrays of the candidates' length and then cut to
+    # size in place (a shrinking realloc: no copy, and only the pages written are ever touched)
+    linear = np.empty(len(candidates), np.int64)
+    values = np.empty(len(candidates))
+    kept = 0
     lin = candidates[:0]
     for s0 in range(0, len(candidates), EVAL_CHUNK):
         lin = candidates[s0 : s0 + EVAL_CHUNK]
-        v = _evaluate(fn, grid.points(grid.unravel(lin)), name)
+        # the node coordinates in Rust (the bits of Grid.points, without the (M, d) int64 indices)
+        v = _evaluate(fn, _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing), name)
         keep = np.abs(v) <= half_width
-        keep_lin.append(lin[keep])
-        keep_val.append(v[keep])
-    del candidates, lin  # (lin is a view of them) before the parts are joined: the largest array here
-    if not keep_lin:
-        return np.zeros(0, np.int64), np.zeros(0)
-    linear = np.concatenate(keep_lin)  # sorted, as the candidates are
-    del keep_lin
-    return linear, np.concatenate(keep_val)
+        n = int(np.count_nonzero(keep))
+        np.compress(keep, lin, out=linear[kept : kept + n])
+        np.compress(keep, v, out=values[kept : kept + n])
+        kept += n
+    del candidates, lin  # (lin is a view of them)
+    linear.resize(kept, refcheck=False)  # sorted, as the candidates are
+    values.resize(kept, refcheck=False)
+    return linear, values
 
 
 def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
@@ -301,17 +299,19 @@ class LevelSet(Surface):
 
         h = grid.spacing
         ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi)
+        # one neighbour table (merge passes) for both calls
+        table = _native.neighbour_table(list(grid.shape), ulinear, lo, hi)
+        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi, table)
         parts = []
         start = 0
         for group, count in enumerate(counts):
             if count:
-                x = grid.points(grid.unravel(linear[pos[start : start + count]]))
+                x = _native.node_points(list(grid.shape), ulinear[pos[start : start + count]], [float(c) for c in grid.lower], h)
                 x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
                 parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
             start += count
         rim_phi = np.concatenate(parts) if parts else np.zeros(0)
-        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction)
+        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction, table)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)

@@ -1,13 +1,100 @@
-//! Band discovery helpers: the last step of the coarse-to-fine search for the band of a surface
-//! given by a distance-like function (`tubesweep.surface.coarse_to_fine_candidates`).
+//! Band discovery helpers: the block bookkeeping of the coarse-to-fine search for the band of a
+//! surface given by a distance-like function (`tubesweep.surface.coarse_to_fine_candidates`).
 //!
 //! The search keeps blocks of 2^L nodes per axis near the surface and splits them level by level;
-//! the level-set function itself is a Python callable, so the search loop stays in Python. Its
-//! last split, of the kept 2 × … × 2 blocks into single nodes, produces the candidate list, the
-//! largest array of the search (O(N^(d−1)) entries): [`split_pair_blocks`] does it here, straight
-//! into sorted C-order linear indices, without a K-sized temporary or a sort.
+//! the level-set function itself is a Python callable, so the loop over levels stays in Python and
+//! only calls it. Here: the children of the kept blocks with their centres and radii
+//! ([`block_children`], [`children_radius_max`]), which the caller tests with φ at the centres,
+//! and the last split, of the kept 2 × … × 2 blocks into single nodes, which produces the
+//! candidate list, the largest array of the search (O(N^(d−1)) entries): [`split_pair_blocks`]
+//! does it straight into sorted C-order linear indices, without a K-sized temporary or a sort.
 
 use crate::error::{Error, Result};
+
+/// Checks that every parent block origin is a multiple of `2 · block` inside the grid.
+fn check_parents<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block: u64) -> Result<()> {
+    if block == 0 {
+        return Err(Error::invalid("block", "the child block size must be positive"));
+    }
+    for o in parents {
+        for k in 0..D {
+            if o[k] % (2 * block) != 0 || o[k] >= shape[k] as u64 {
+                return Err(Error::invalid(
+                    "parents",
+                    format!("block origin {o:?} is not a multiple of {} inside the grid {shape:?}", 2 * block),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Calls `f(child origin, child's last node)` for every child of blocks of `2 · block` nodes per
+/// axis with lowest corners `parents`: the 2^d blocks of `block` nodes per axis that start inside
+/// the grid, parent by parent, the corners in C order (axis 0 slowest). A block at the upper edge
+/// of the grid is cut to it (its last node is the grid's last along that axis).
+#[inline]
+fn for_children<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block: u64, mut f: impl FnMut(&[u64; D], &[u64; D])) {
+    for p in parents {
+        'corner: for corner in 0..(1usize << D) {
+            let mut o = [0u64; D];
+            let mut last = [0u64; D];
+            for k in 0..D {
+                o[k] = p[k] + block * ((corner >> (D - 1 - k)) & 1) as u64;
+                if o[k] >= shape[k] as u64 {
+                    continue 'corner;
+                }
+                last[k] = (o[k] + block).min(shape[k] as u64) - 1;
+            }
+            f(&o, &last);
+        }
+    }
+}
+
+/// `|last − o|` in grid spacings: twice a block's radius (its centre to a corner) over `Δx`.
+#[inline]
+fn diagonal<const D: usize>(o: &[u64; D], last: &[u64; D]) -> f64 {
+    let mut sq = 0.0f64;
+    for k in 0..D {
+        let e = (last[k] - o[k]) as f64;
+        sq += e * e;
+    }
+    sq.sqrt()
+}
+
+/// The largest `|last − o|` (in grid spacings) over the children [`block_children`] makes of
+/// `parents`: the caller's search reach for the level. 0 without children.
+pub fn children_radius_max<const D: usize>(shape: [usize; D], parents: &[[u64; D]], block: u64) -> Result<f64> {
+    check_parents(&shape, parents, block)?;
+    let mut best = 0.0f64;
+    for_children(&shape, parents, block, |o, last| best = best.max(diagonal(o, last)));
+    Ok(best)
+}
+
+/// The children of the blocks of `2 · block` nodes per axis with lowest corners `parents` (each a
+/// multiple of `2 · block` inside the grid): the blocks of `block` nodes per axis that start
+/// inside the grid, parent by parent, corners in C order. Returns their origins, their centres
+/// `lower + Δx · (o + last)/2` in world coordinates and their radii `Δx/2 · |last − o|` (centre to
+/// a corner node), with the arithmetic of the NumPy code it replaces, so the same bits: a block is
+/// kept when `|φ(centre)| ≤ half_width + lipschitz · radius`, exact for a `lipschitz`-Lipschitz φ.
+#[allow(clippy::type_complexity)]
+pub fn block_children<const D: usize>(
+    shape: [usize; D],
+    parents: &[[u64; D]],
+    block: u64,
+    lower: [f64; D],
+    spacing: f64,
+) -> Result<(Vec<[u64; D]>, Vec<[f64; D]>, Vec<f64>)> {
+    check_parents(&shape, parents, block)?;
+    let cap = parents.len() << D;
+    let (mut origins, mut centres, mut radii) = (Vec::with_capacity(cap), Vec::with_capacity(cap), Vec::with_capacity(cap));
+    for_children(&shape, parents, block, |o, last| {
+        origins.push(*o);
+        centres.push(core::array::from_fn(|k| lower[k] + spacing * (0.5 * (o[k] + last[k]) as f64)));
+        radii.push(0.5 * spacing * diagonal(o, last));
+    });
+    Ok((origins, centres, radii))
+}
 
 /// The C-order linear indices, strictly increasing, of the grid nodes of the blocks of 2 nodes
 /// per axis whose lowest corners are `origins`, cut to the grid of shape `shape` (a block at the
@@ -35,23 +122,59 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
     for k in (0..D.saturating_sub(1)).rev() {
         stride[k] = stride[k + 1] * shape[k + 1] as u64;
     }
-    // count first, so the output is allocated once at its final size
-    let mut count = 0usize;
-    emit(&shape, &stride, &sorted, 0, 0, &mut |_| count += 1);
+    // count first (a block has 2 nodes along an axis, 1 where the grid ends after its origin), so
+    // the output is allocated once at its final size
+    let count: usize = sorted
+        .iter()
+        .map(|o| (0..D).map(|k| if o[k] + 1 < shape[k] as u64 { 2 } else { 1 }).product::<usize>())
+        .sum();
     let mut out = Vec::with_capacity(count);
-    emit(&shape, &stride, &sorted, 0, 0, &mut |l| out.push(l));
+    emit(&shape, &stride, &sorted, 0, 0, &mut out);
+    debug_assert_eq!(out.len(), count);
+    Ok(out)
+}
+
+/// The world coordinates `lower + Δx · index` of the grid nodes with C-order linear indices
+/// `linear` (each inside the grid of `shape`), with the arithmetic of `Grid.points`, so the same
+/// bits: the points at which the caller evaluates φ for the candidates of the band, as `D`
+/// coordinates per node, one node after another.
+pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f64; D], spacing: f64) -> Result<Vec<f64>> {
+    let total: u64 = shape.iter().map(|&n| n as u64).product();
+    if let Some(&bad) = linear.iter().find(|&&l| l >= total) {
+        return Err(Error::invalid("linear", format!("linear index {bad} is outside the grid {shape:?}")));
+    }
+    // one division per node for the last axis; the leading coordinates only when the row changes
+    // (the candidates come in C order, many to a row)
+    let n_last = shape[D - 1] as u64;
+    let mut out = Vec::with_capacity(linear.len() * D);
+    let mut row = u64::MAX;
+    let mut lead = [0.0f64; D];
+    for &l in linear {
+        let r = l / n_last;
+        if r != row {
+            row = r;
+            let mut key = r;
+            for k in (0..D - 1).rev() {
+                let n = shape[k] as u64;
+                lead[k] = lower[k] + spacing * (key % n) as f64;
+                key /= n;
+            }
+        }
+        lead[D - 1] = lower[D - 1] + spacing * (l - r * n_last) as f64;
+        out.extend_from_slice(&lead);
+    }
     Ok(out)
 }
 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along
 /// the axes before `axis`, whose contribution to the linear index is `base`).
-fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut dyn FnMut(u64)) {
+fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut Vec<u64>) {
     if axis + 1 == D {
         let n = shape[axis] as u64;
         for o in group {
-            out(base + o[axis]);
+            out.push(base + o[axis]);
             if o[axis] + 1 < n {
-                out(base + o[axis] + 1);
+                out.push(base + o[axis] + 1);
             }
         }
         return;
@@ -121,6 +244,44 @@ mod tests {
         let origins2: Vec<[u64; 2]> = vec![[4, 10], [0, 0], [2, 4], [0, 8], [4, 0], [2, 2]];
         assert_eq!(split_pair_blocks(shape2, &origins2).unwrap(), reference(shape2, &origins2));
         assert!(split_pair_blocks(shape2, &[]).unwrap().is_empty());
+    }
+
+    #[test]
+    fn children_cover_their_parents_and_are_cut_to_the_grid() {
+        // 2D, shape 7 × 10, parents of 4 × 4 nodes: children of 2 × 2, cut at the upper edges
+        let shape = [7usize, 10];
+        let parents = [[4u64, 8], [0, 0], [4, 4]];
+        let (o, c, r) = block_children(shape, &parents, 2, [-1.0, 0.5], 0.25).unwrap();
+        // parent by parent, corners in C order, only those starting inside the grid
+        let want: Vec<[u64; 2]> = vec![[4, 8], [6, 8], [0, 0], [0, 2], [2, 0], [2, 2], [4, 4], [4, 6], [6, 4], [6, 6]];
+        assert_eq!(o, want);
+        for ((o, c), r) in o.iter().zip(&c).zip(&r) {
+            let last = [(o[0] + 2).min(7) - 1, (o[1] + 2).min(10) - 1];
+            for k in 0..2 {
+                let lower = [-1.0, 0.5][k];
+                assert_eq!(c[k], lower + 0.25 * (0.5 * (o[k] + last[k]) as f64));
+            }
+            let e = [(last[0] - o[0]) as f64, (last[1] - o[1]) as f64];
+            assert_eq!(*r, 0.5 * 0.25 * (e[0] * e[0] + e[1] * e[1]).sqrt());
+        }
+        assert_eq!(children_radius_max(shape, &parents, 2).unwrap(), 2f64.sqrt());
+        assert_eq!(children_radius_max(shape, &[[6, 8]], 1).unwrap(), 0.0);
+        assert!(block_children(shape, &[[2, 0]], 2, [0.0; 2], 1.0).is_err()); // not a multiple of 4
+        assert!(block_children(shape, &[[8, 0]], 2, [0.0; 2], 1.0).is_err()); // outside
+    }
+
+    #[test]
+    fn node_points_are_lower_plus_spacing_times_index() {
+        let shape = [3usize, 4, 5];
+        let linear: Vec<u64> = vec![0, 4, 5, 19, 20, 59];
+        let p = node_points(shape, &linear, [0.5, -1.0, 2.0], 0.1).unwrap();
+        for (n, &l) in linear.iter().enumerate() {
+            let idx = [l / 20, (l / 5) % 4, l % 5];
+            for k in 0..3 {
+                assert_eq!(p[3 * n + k], [0.5, -1.0, 2.0][k] + 0.1 * idx[k] as f64);
+            }
+        }
+        assert!(node_points(shape, &[60], [0.0; 3], 1.0).is_err());
     }
 
     #[test]

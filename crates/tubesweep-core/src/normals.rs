@@ -2,14 +2,15 @@
 //! Eq. (8)), with `∇φ` by central differences (Sect. 4), for a φ known at the band nodes.
 //!
 //! The band nodes are given by their sorted C-order linear indices and φ there. The neighbour
-//! `x ± Δx e_k` of a node is looked up in the band (one merge pass per axis and side, see
-//! [`crate::band::shifted_positions`]); where it is not a band node (the band's outer rim, or
+//! `x ± Δx e_k` of a node is looked up in the band (the adjacent entry along the last axis, one
+//! merge pass per other axis and side as in [`crate::band::shifted_positions`], kept in a
+//! [`neighbour_table`]); where it is not a band node (the band's outer rim, or
 //! outside the grid) φ there must be supplied by the caller: [`rim_nodes`] lists those places
 //! and [`outward_directions`] takes φ at them, in the same order. (φ is a user's function that
 //! the Python package evaluates, so the two halves are separate calls.)
 
-use crate::band::shifted_positions;
 use crate::error::{Error, Result};
+use rayon::prelude::*;
 
 /// Linear-index strides of the axes of a C-order grid of `shape`.
 fn strides(shape: &[usize]) -> Vec<u64> {
@@ -60,22 +61,122 @@ fn check(shape: &[usize], linear: &[u64], range: &std::ops::Range<usize>) -> Res
     Ok(())
 }
 
+/// Entry of a [`neighbour_table`] where the neighbour is not a band node or lies outside the grid.
+pub const NO_NEIGHBOUR: i32 = i32::MIN;
+
+/// The neighbour table of band nodes `range` (`m` of them) along the axes but the last: for every
+/// group `(axis k < d − 1, side)` in the order `k = 0, 1, …`, side `+1` then `−1`, `m` entries,
+/// the position in the band of the neighbour `x ± Δx e_k` of node `i` less `i` (as i32: 4 bytes
+/// per node and group), or [`NO_NEIGHBOUR`] where that neighbour is not a band node or lies
+/// outside the grid (a place where φ must come from the caller). Along the last axis the
+/// neighbours are the adjacent entries of the sorted band and need no table. The groups' merge
+/// passes are independent and run in parallel; one table serves both [`rim_nodes_of`] and
+/// [`outward_directions_with`]. An error if a neighbour is 2^31 or more band nodes away from a
+/// node (a band of billions of nodes within one stride of axis 0).
+pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>) -> Result<Vec<i32>> {
+    check(shape, linear, &range)?;
+    let stride = strides(shape);
+    let coords = node_coordinates(shape, linear, range.clone());
+    let m = range.len();
+    let mut table = vec![NO_NEIGHBOUR; 2 * (shape.len() - 1) * m];
+    if m == 0 {
+        return Ok(table);
+    }
+    let fits: Vec<bool> = table
+        .par_chunks_mut(m)
+        .enumerate()
+        .map(|(group, out)| {
+            let (k, sign) = (group / 2, if group % 2 == 0 { 1i64 } else { -1 });
+            // the merge pass of `shifted_positions`, written straight into the table
+            let offset = sign * stride[k] as i64;
+            let target = |x: u64| -> Option<u64> { u64::try_from(x as i128 + offset as i128).ok() };
+            let mut j = match target(linear[range.start]) {
+                Some(t) => linear.partition_point(|&y| y < t),
+                None => 0,
+            };
+            for (o, i) in range.clone().enumerate() {
+                let Some(t) = target(linear[i]) else { continue };
+                while j < linear.len() && linear[j] < t {
+                    j += 1;
+                }
+                if j == linear.len() {
+                    break;
+                }
+                if linear[j] == t && in_grid(&coords[o], k, sign, shape) {
+                    match i32::try_from(j as i64 - i as i64) {
+                        Ok(delta) if delta != NO_NEIGHBOUR => out[o] = delta,
+                        _ => return false,
+                    }
+                }
+            }
+            true
+        })
+        .collect();
+    if fits.contains(&false) {
+        return Err(Error::invalid("linear", "a neighbour is 2^31 or more band nodes away: too large a band for a neighbour table"));
+    }
+    Ok(table)
+}
+
+/// The band position of the neighbour `x ± Δx e_k` of band node `i` (`o`-th of the range whose
+/// [`neighbour_table`] is `table`, `m` entries per group; `c` its grid index), if it is a band
+/// node inside the grid.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn neighbour_at(
+    table: &[i32],
+    shape: &[usize],
+    linear: &[u64],
+    m: usize,
+    o: usize,
+    i: usize,
+    c: &[u32; 3],
+    k: usize,
+    sign: i64,
+) -> Option<usize> {
+    let d = shape.len();
+    if k + 1 < d {
+        let delta = table[(2 * k + usize::from(sign < 0)) * m + o];
+        return (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize);
+    }
+    last_axis_neighbour(linear, i, c[d - 1], shape[d - 1], sign)
+}
+
+/// The band position of the neighbour along the last axis (`n` nodes) on side `sign` of band node
+/// `i` (index `c` along that axis): the adjacent entry of the sorted band, if it is that node.
+#[inline]
+fn last_axis_neighbour(linear: &[u64], i: usize, c: u32, n: usize, sign: i64) -> Option<usize> {
+    if sign > 0 {
+        ((c as usize) + 1 < n && linear.get(i + 1) == Some(&(linear[i] + 1))).then_some(i + 1)
+    } else {
+        (c > 0 && i > 0 && linear[i - 1] == linear[i] - 1).then(|| i - 1)
+    }
+}
+
 /// For every group `(axis k, side)` in the order `k = 0, 1, …`, side `+1` then `−1`: the band
 /// positions `i` in `range` whose neighbour `linear[i] ± stride_k` is not a band node (or lies
 /// outside the grid along axis `k`), in increasing order. Returns the positions of all groups
 /// concatenated and the size of each group (2·d entries).
 pub fn rim_nodes(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>) -> Result<(Vec<u64>, Vec<usize>)> {
+    let table = neighbour_table(shape, linear, range.clone())?;
+    rim_nodes_of(shape, linear, range, &table)
+}
+
+/// [`rim_nodes`] from the [`neighbour_table`] of band nodes `range`.
+pub fn rim_nodes_of(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>, table: &[i32]) -> Result<(Vec<u64>, Vec<usize>)> {
     check(shape, linear, &range)?;
-    let stride = strides(shape);
+    let (d, m) = (shape.len(), range.len());
+    if table.len() != 2 * (d - 1) * m {
+        return Err(Error::invalid("neighbours", format!("expected shape ({}, {m})", 2 * (d - 1))));
+    }
     let coords = node_coordinates(shape, linear, range.clone());
     let mut nodes = Vec::new();
-    let mut counts = Vec::with_capacity(2 * shape.len());
-    for k in 0..shape.len() {
+    let mut counts = Vec::with_capacity(2 * d);
+    for k in 0..d {
         for sign in [1i64, -1] {
             let before = nodes.len();
-            let pos = shifted_positions(linear, sign * stride[k] as i64, range.clone());
             for (o, i) in range.clone().enumerate() {
-                if !neighbour_known(&coords[o], &pos, o, k, sign, shape) {
+                if neighbour_at(table, shape, linear, m, o, i, &coords[o], k, sign).is_none() {
                     nodes.push(i as u64);
                 }
             }
@@ -85,12 +186,12 @@ pub fn rim_nodes(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>)
     Ok((nodes, counts))
 }
 
-/// Whether the neighbour along axis `k` on side `sign` of the node with grid index `c` is a band
-/// node (`pos[o]`, from the merge) inside the grid.
+/// Whether the neighbour along axis `k` on side `sign` of the node with grid index `c` lies
+/// inside the grid.
 #[inline]
-fn neighbour_known(c: &[u32; 3], pos: &[i64], o: usize, k: usize, sign: i64, shape: &[usize]) -> bool {
+fn in_grid(c: &[u32; 3], k: usize, sign: i64, shape: &[usize]) -> bool {
     let c = c[k] as i64 + sign;
-    pos[o] >= 0 && c >= 0 && c < shape[k] as i64
+    c >= 0 && c < shape[k] as i64
 }
 
 /// The outward unit directions `sgn(φ) g/|g|` (as f32, written to `direction`, `range.len()`
@@ -108,38 +209,72 @@ pub fn outward_directions(
     rim_phi: &[f64],
     direction: &mut [f32],
 ) -> Result<Vec<f64>> {
+    let table = neighbour_table(shape, linear, range.clone())?;
+    outward_directions_with(shape, spacing, linear, phi, range, &table, rim_phi, direction)
+}
+
+/// [`outward_directions`] with the [`neighbour_table`] of band nodes `range` already made (for
+/// [`rim_nodes_of`]): no second set of merge passes.
+#[allow(clippy::too_many_arguments)]
+pub fn outward_directions_with(
+    shape: &[usize],
+    spacing: f64,
+    linear: &[u64],
+    phi: &[f64],
+    range: std::ops::Range<usize>,
+    table: &[i32],
+    rim_phi: &[f64],
+    direction: &mut [f32],
+) -> Result<Vec<f64>> {
     check(shape, linear, &range)?;
-    let d = shape.len();
+    if table.len() != 2 * (shape.len() - 1) * range.len() {
+        return Err(Error::invalid("neighbours", format!("expected shape ({}, {})", 2 * (shape.len() - 1), range.len())));
+    }
     let m = range.len();
+    let leads_inside = |row: &[i32]| {
+        row.iter()
+            .zip(range.clone())
+            .all(|(&delta, i)| delta == NO_NEIGHBOUR || (0..linear.len() as i64).contains(&(i as i64 + delta as i64)))
+    };
+    if m > 0 && !table.chunks_exact(m).all(leads_inside) {
+        return Err(Error::invalid("neighbours", "entries must lead to band positions"));
+    }
+    let d = shape.len();
     if phi.len() != linear.len() {
         return Err(Error::invalid("phi", format!("expected {} values (one per band node), got {}", linear.len(), phi.len())));
     }
     if direction.len() != m * d {
         return Err(Error::invalid("direction", format!("expected shape ({m}, {d})")));
     }
-    let stride = strides(shape);
     let coords = node_coordinates(shape, linear, range.clone());
-    // g accumulates φ(x + Δx e_k), then φ(x − Δx e_k) is subtracted: both sides are needed
-    let mut up = vec![0.0f64; m];
+    // g holds φ(x + Δx e_k) until φ(x − Δx e_k) is known, then the central difference
     let mut g = vec![0.0f64; m * d];
     let mut next_rim = 0usize;
     for k in 0..d {
-        for sign in [1i64, -1] {
-            let pos = shifted_positions(linear, sign * stride[k] as i64, range.clone());
-            for o in 0..m {
-                let v = if neighbour_known(&coords[o], &pos, o, k, sign, shape) {
-                    phi[pos[o] as usize]
+        for (side, sign) in [(0usize, 1i64), (1, -1)] {
+            let row = if k + 1 < d { &table[(2 * k + side) * m..][..m] } else { &[][..] };
+            for (o, i) in range.clone().enumerate() {
+                let neighbour = if k + 1 < d {
+                    let delta = row[o];
+                    (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize)
                 } else {
-                    let v = *rim_phi.get(next_rim).ok_or_else(|| {
-                        Error::invalid("rim_phi", format!("too few values: the rim has more than {} places", rim_phi.len()))
-                    })?;
-                    next_rim += 1;
-                    v
+                    last_axis_neighbour(linear, i, coords[o][k], shape[k], sign)
                 };
+                let v = match neighbour {
+                    Some(p) => phi[p],
+                    None => {
+                        let v = *rim_phi.get(next_rim).ok_or_else(|| {
+                            Error::invalid("rim_phi", format!("too few values: the rim has more than {} places", rim_phi.len()))
+                        })?;
+                        next_rim += 1;
+                        v
+                    }
+                };
+                let gk = &mut g[o * d + k];
                 if sign == 1 {
-                    up[o] = v;
+                    *gk = v;
                 } else {
-                    g[o * d + k] = (up[o] - v) / (2.0 * spacing);
+                    *gk = (*gk - v) / (2.0 * spacing);
                 }
             }
         }

@@ -738,29 +738,144 @@ fn split_pair_blocks<'py>(py: Python<'py>, shape: Vec<usize>, origins: PyReadonl
     Ok(out.into_pyarray(py))
 }
 
+fn blocks_of<const D: usize>(flat: &[i64]) -> Vec<[u64; D]> {
+    flat.chunks_exact(D).map(|c| core::array::from_fn(|k| c[k] as u64)).collect()
+}
+
+/// Block origins (M, d) as a C-ordered int64 array with no negative entry.
+fn block_origins<'a>(origins: &'a PyReadonlyArray2<'_, i64>, d: usize, name: &str) -> PyResult<&'a [i64]> {
+    if origins.shape()[1] != d {
+        return Err(PyValueError::new_err(format!("{name} must have shape (M, {d})")));
+    }
+    let flat = c_slice(origins, name)?;
+    if let Some(&bad) = flat.iter().find(|&&c| c < 0) {
+        return Err(PyValueError::new_err(format!("{name}: negative grid index {bad}")));
+    }
+    Ok(flat)
+}
+
+fn flat_2d<'py, T: numpy::Element, const D: usize>(py: Python<'py>, rows: Vec<[T; D]>) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let m = rows.len();
+    let flat: Vec<T> = rows.into_iter().flatten().collect();
+    let a = numpy::ndarray::Array2::from_shape_vec((m, D), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py))
+}
+
+fn coords_array<const D: usize>(v: &[f64], name: &str) -> PyResult<[f64; D]> {
+    v.try_into().map_err(|_| PyValueError::new_err(format!("{name} must have {D} entries")))
+}
+
+/// The largest `|last − o|` (grid spacings) over the children of blocks of `2·block` nodes per
+/// axis with lowest corners `parents` (M, d). See `tubesweep_core::discovery::children_radius_max`.
+#[pyfunction]
+fn children_radius_max(py: Python<'_>, shape: Vec<usize>, parents: PyReadonlyArray2<'_, i64>, block: u64) -> PyResult<f64> {
+    let flat = block_origins(&parents, shape.len(), "parents")?;
+    py.detach(|| match shape.len() {
+        2 => tubesweep_core::discovery::children_radius_max::<2>(shape_array(&shape).unwrap(), &blocks_of::<2>(flat), block),
+        3 => tubesweep_core::discovery::children_radius_max::<3>(shape_array(&shape).unwrap(), &blocks_of::<3>(flat), block),
+        d => Err(tubesweep_core::Error::invalid("grid", format!("only 2D and 3D grids are supported, got {d}D"))),
+    })
+    .map_err(to_pyerr)
+}
+
+type Children<'py> = (Bound<'py, PyArray2<i64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// The children (blocks of `block` nodes per axis) of the blocks of `2·block` with lowest corners
+/// `parents` (M, d): `(origins (C, d) int64, centres (C, d), radii (C,))`, centres in world
+/// coordinates. See `tubesweep_core::discovery::block_children`.
+#[pyfunction]
+fn block_children<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    parents: PyReadonlyArray2<'py, i64>,
+    block: u64,
+    lower: Vec<f64>,
+    spacing: f64,
+) -> PyResult<Children<'py>> {
+    let flat = block_origins(&parents, shape.len(), "parents")?;
+    fn run<'py, const D: usize>(py: Python<'py>, shape: &[usize], flat: &[i64], block: u64, lower: &[f64], spacing: f64) -> PyResult<Children<'py>> {
+        let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
+        let (o, c, r) = py
+            .detach(|| tubesweep_core::discovery::block_children::<D>(shape, &blocks_of::<D>(flat), block, lower, spacing))
+            .map_err(to_pyerr)?;
+        let o: Vec<[i64; D]> = o.into_iter().map(|b| b.map(|x| x as i64)).collect();
+        Ok((flat_2d(py, o)?, flat_2d(py, c)?, r.into_pyarray(py)))
+    }
+    match shape.len() {
+        2 => run::<2>(py, &shape, flat, block, &lower, spacing),
+        3 => run::<3>(py, &shape, flat, block, &lower, spacing),
+        d => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+    }
+}
+
+/// World coordinates (M, d) of the nodes with C-order linear indices `linear` (the arithmetic of
+/// `Grid.points`). See `tubesweep_core::discovery::node_points`.
+#[pyfunction]
+fn node_points<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, lower: Vec<f64>, spacing: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let lin = c_slice(&linear, "linear")?;
+    fn run<'py, const D: usize>(py: Python<'py>, shape: &[usize], lin: &[u64], lower: &[f64], spacing: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
+        let p = py.detach(|| tubesweep_core::discovery::node_points::<D>(shape, lin, lower, spacing)).map_err(to_pyerr)?;
+        let a = numpy::ndarray::Array2::from_shape_vec((lin.len(), D), p).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py))
+    }
+    match shape.len() {
+        2 => run::<2>(py, &shape, lin, &lower, spacing),
+        3 => run::<3>(py, &shape, lin, &lower, spacing),
+        d => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+    }
+}
+
+/// The neighbour table of band nodes `start..stop`: (2·(d − 1), stop − start) int32, for each
+/// group (axis k = 0, …, d − 2; side +1 then −1) the band position of each node's neighbour less
+/// the node's, or −2^31 where φ there must be supplied (off the band or outside the grid). See
+/// `tubesweep_core::normals::neighbour_table`.
+#[pyfunction]
+fn neighbour_table<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i32>>> {
+    let lin = linear.as_slice()?;
+    let table = py.detach(|| tubesweep_core::normals::neighbour_table(&shape, lin, start..stop)).map_err(to_pyerr)?;
+    let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len().saturating_sub(1), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(a.into_pyarray(py))
+}
+
+fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Option<&'a [i32]>> {
+    table.as_ref().map(|t| c_slice(t, "neighbours")).transpose()
+}
+
 /// The places where central differences of φ at band nodes `start..stop` need φ off the band:
 /// `(positions, counts)`, the band positions for each group (axis k = 0, 1, …; side +1 then −1)
-/// concatenated, and the size of each group (2·d). See `tubesweep_core::normals::rim_nodes`.
+/// concatenated, and the size of each group (2·d). From `neighbours` (their `neighbour_table`)
+/// when given. See `tubesweep_core::normals::rim_nodes`.
 #[pyfunction]
+#[pyo3(signature = (shape, linear, start, stop, neighbours=None))]
 fn rim_nodes<'py>(
     py: Python<'py>,
     shape: Vec<usize>,
     linear: PyReadonlyArray1<'py, u64>,
     start: usize,
     stop: usize,
+    neighbours: Option<PyReadonlyArray2<'py, i32>>,
 ) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
     let lin = linear.as_slice()?;
-    let (nodes, counts) = py.detach(|| tubesweep_core::normals::rim_nodes(&shape, lin, start..stop)).map_err(to_pyerr)?;
+    let table = table_slice(&neighbours)?;
+    let (nodes, counts) = py
+        .detach(|| match table {
+            Some(t) => tubesweep_core::normals::rim_nodes_of(&shape, lin, start..stop, t),
+            None => tubesweep_core::normals::rim_nodes(&shape, lin, start..stop),
+        })
+        .map_err(to_pyerr)?;
     let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
     Ok((nodes.into_pyarray(py), counts))
 }
 
 /// The outward directions sgn(φ)∇φ/|∇φ| at band nodes `start..stop` by central differences,
 /// written to `direction` ((stop − start, d) float32, C-contiguous); φ at band nodes from `phi`,
-/// off the band from `rim_phi` (in the order of `rim_nodes`). Returns |∇φ| there. See
+/// off the band from `rim_phi` (in the order of `rim_nodes`); the neighbours from `neighbours`
+/// (their `neighbour_table`) when given. Returns |∇φ| there. See
 /// `tubesweep_core::normals::outward_directions`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (shape, spacing, linear, phi, start, stop, rim_phi, direction, neighbours=None))]
 fn outward_directions<'py>(
     py: Python<'py>,
     shape: Vec<usize>,
@@ -771,11 +886,16 @@ fn outward_directions<'py>(
     stop: usize,
     rim_phi: PyReadonlyArray1<'py, f64>,
     mut direction: PyReadwriteArray2<'py, f32>,
+    neighbours: Option<PyReadonlyArray2<'py, i32>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (lin, ph, rim) = (linear.as_slice()?, phi.as_slice()?, rim_phi.as_slice()?);
+    let table = table_slice(&neighbours)?;
     let dir = c_slice_mut(&mut direction, "direction")?;
     let norms = py
-        .detach(|| tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir))
+        .detach(|| match table {
+            Some(t) => tubesweep_core::normals::outward_directions_with(&shape, spacing, lin, ph, start..stop, t, rim, dir),
+            None => tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir),
+        })
         .map_err(to_pyerr)?;
     Ok(norms.into_pyarray(py))
 }
@@ -786,6 +906,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTriangleTree>()?;
     m.add_function(wrap_pyfunction!(shifted_positions, m)?)?;
     m.add_function(wrap_pyfunction!(split_pair_blocks, m)?)?;
+    m.add_function(wrap_pyfunction!(children_radius_max, m)?)?;
+    m.add_function(wrap_pyfunction!(block_children, m)?)?;
+    m.add_function(wrap_pyfunction!(node_points, m)?)?;
+    m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
