@@ -7,9 +7,6 @@ import numpy.typing as npt
 
 DEFAULT_INFINITY: float
 
-def shifted_positions(
-    linear: npt.NDArray[np.uint64], offset: int, start: int = 0, stop: Optional[int] = None
-) -> npt.NDArray[np.int64]: ...
 def split_pair_blocks(shape: List[int], origins: npt.NDArray[np.int64]) -> npt.NDArray[np.uint64]: ...
 def children_radius_max(shape: List[int], parents: npt.NDArray[np.int64], block: int) -> float: ...
 def block_children(

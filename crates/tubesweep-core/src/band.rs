@@ -355,34 +355,6 @@ impl<const D: usize> NarrowBand<D> {
     }
 }
 
-/// For strictly increasing linear indices `linear` and an `offset`, the position in `linear` of
-/// `linear[i] + offset` for every `i` in `range`, or −1 where that index is not in `linear`: one
-/// binary search, then a merge pass, O(len(range) + log K), instead of a binary search per node.
-/// (Where `linear[i] + offset` leaves the grid along some axis is the caller's business: the
-/// linear index alone cannot tell.)
-pub fn shifted_positions(linear: &[u64], offset: i64, range: std::ops::Range<usize>) -> Vec<i64> {
-    let mut out = vec![-1i64; range.len()];
-    let target = |x: u64| -> Option<u64> { u64::try_from(x as i128 + offset as i128).ok() };
-    let Some(first) = range.clone().next() else { return out };
-    let mut j = match target(linear[first]) {
-        Some(t) => linear.partition_point(|&y| y < t),
-        None => 0,
-    };
-    for (o, i) in range.enumerate() {
-        let Some(t) = target(linear[i]) else { continue };
-        while j < linear.len() && linear[j] < t {
-            j += 1;
-        }
-        if j == linear.len() {
-            break;
-        }
-        if linear[j] == t {
-            out[o] = j as i64;
-        }
-    }
-    out
-}
-
 fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
     if !(2..=3).contains(&D) {
         return Err(Error::invalid("grid", format!("only 2D and 3D grids are supported, got {D}D")));
@@ -398,21 +370,6 @@ fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn shifted_positions_match_a_binary_search() {
-        let lin: Vec<u64> = vec![0, 3, 4, 7, 8, 12, 20];
-        for off in [-8i64, -4, -1, 0, 1, 4, 8] {
-            for range in [0..lin.len(), 2..5, 3..3, 6..7] {
-                let got = shifted_positions(&lin, off, range.clone());
-                for (o, i) in range.enumerate() {
-                    let t = lin[i] as i64 + off;
-                    let want = if t < 0 { -1 } else { lin.binary_search(&(t as u64)).map(|p| p as i64).unwrap_or(-1) };
-                    assert_eq!(got[o], want, "offset {off} at {i}");
-                }
-            }
-        }
-    }
 
     fn linear<const D: usize>(shape: [usize; D], idx: [usize; D]) -> u64 {
         let mut l = 0u64;

@@ -3,8 +3,8 @@
 //!
 //! The band nodes are given by their sorted C-order linear indices and φ there. The neighbour
 //! `x ± Δx e_k` of a node is looked up in the band (the adjacent entry along the last axis, one
-//! merge pass per other axis and side as in [`crate::band::shifted_positions`], kept in a
-//! [`neighbour_table`]); where it is not a band node (the band's outer rim, or
+//! merge pass per other axis and side: the shifted index `linear[i] + offset` is found by
+//! walking the sorted indices once, kept in a [`neighbour_table`]); where it is not a band node (the band's outer rim, or
 //! outside the grid) φ there must be supplied by the caller: [`rim_nodes`] lists those places
 //! and [`outward_directions`] takes φ at them, in the same order. (φ is a user's function that
 //! the Python package evaluates, so the two halves are separate calls.)
@@ -87,7 +87,7 @@ pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<u
         .enumerate()
         .map(|(group, out)| {
             let (k, sign) = (group / 2, if group % 2 == 0 { 1i64 } else { -1 });
-            // the merge pass of `shifted_positions`, written straight into the table
+            // one merge pass over the sorted indices for this offset, written straight into the table
             let offset = sign * stride[k] as i64;
             let target = |x: u64| -> Option<u64> { u64::try_from(x as i128 + offset as i128).ok() };
             let mut j = match target(linear[range.start]) {

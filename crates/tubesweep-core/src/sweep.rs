@@ -324,36 +324,20 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         result.map(|_| stats)
     }
 
-    /// The extension weights when no derivation is needed: `Some(&[])` without an extension
-    /// layer, `Some(w)` when they were handed in as [`Extension::Weights`]; `None` when they must
-    /// be derived from directions ([`derive_extension_weights`](Self::derive_extension_weights)).
-    fn extension_weights_needed(&self) -> Option<&'a [[f32; D]]> {
-        match self.extension {
-            _ if !self.roles.iter().any(|&r| r == NodeRole::Outer) => Some(&[]),
-            Extension::None => Some(&[]),
-            Extension::Weights(w) => Some(w),
-            Extension::Directions(_) => None,
-        }
-    }
-
-    /// The upwind weights of Eq. (5): borrowed when handed in (or empty without a layer),
-    /// derived from the directions otherwise.
+    /// The upwind weights of Eq. (5), per node: empty without an extension layer, borrowed when
+    /// handed in as [`Extension::Weights`], derived from [`Extension::Directions`] (a copy)
+    /// otherwise.
     fn upwind_weights(&self) -> std::borrow::Cow<'a, [[f32; D]]> {
-        match self.extension_weights_needed() {
-            Some(w) => std::borrow::Cow::Borrowed(w),
-            None => std::borrow::Cow::Owned(self.derive_extension_weights()),
-        }
-    }
-
-    /// The upwind weights of Eq. (5) derived from [`Extension::Directions`] (a copy).
-    fn derive_extension_weights(&self) -> Vec<[f32; D]> {
+        use std::borrow::Cow;
         match self.extension {
+            _ if !self.roles.iter().any(|&r| r == NodeRole::Outer) => Cow::Borrowed(&[]),
+            Extension::None => Cow::Borrowed(&[]),
+            Extension::Weights(w) => Cow::Borrowed(w),
             Extension::Directions(d) => {
                 let mut w = d.to_vec();
                 extension_weights_in_place(self.band, self.roles, &mut w);
-                w
+                Cow::Owned(w)
             }
-            _ => Vec::new(),
         }
     }
 
@@ -1151,7 +1135,7 @@ mod tests {
     fn the_outer_rim_is_the_layer_that_no_inner_node_depends_on() {
         let (band, roles, dirs, h) = sphere_band(41);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let w = p.derive_extension_weights();
+        let w = p.upwind_weights().into_owned();
         let rim = p.outer_rim(&w);
 
         let n_rim = rim.iter().filter(|&&b| b).count();

@@ -120,6 +120,17 @@ fn extension_in_place<'a, const D: usize>(
 /// band position `fixed.positions[i]` (the solver overwrites the non-fixed nodes with the numerical
 /// infinity). One spare slot for the sentinel the solver appends, so that push does not reallocate.
 fn starting_values(n: usize, fixed: &FixedNodes<'_>) -> PyResult<Vec<f64>> {
+    check_fixed(n, fixed)?;
+    let mut values = Vec::with_capacity(n + 1);
+    values.resize(n, 0.0);
+    for (&p, &v) in fixed.positions.iter().zip(fixed.values) {
+        values[p as usize] = v;
+    }
+    Ok(values)
+}
+
+/// The fixed nodes are as many positions as values, each a position in the band of `n` nodes.
+fn check_fixed(n: usize, fixed: &FixedNodes<'_>) -> PyResult<()> {
     if fixed.positions.len() != fixed.values.len() {
         return Err(PyValueError::new_err(format!(
             "fixed_positions and fixed_values must have the same length, got {} and {}",
@@ -127,15 +138,10 @@ fn starting_values(n: usize, fixed: &FixedNodes<'_>) -> PyResult<Vec<f64>> {
             fixed.values.len()
         )));
     }
-    let mut values = Vec::with_capacity(n + 1);
-    values.resize(n, 0.0);
-    for (&p, &v) in fixed.positions.iter().zip(fixed.values) {
-        if p < 0 || p as usize >= n {
-            return Err(PyValueError::new_err(format!("fixed_positions: {p} is not a position in the band of {n} nodes")));
-        }
-        values[p as usize] = v;
+    if let Some(&p) = fixed.positions.iter().find(|&&p| p < 0 || p as usize >= n) {
+        return Err(PyValueError::new_err(format!("fixed_positions: {p} is not a position in the band of {n} nodes")));
     }
-    Ok(values)
+    Ok(())
 }
 
 /// Everything the solve would reject, checked before `directions` is overwritten with the
@@ -157,17 +163,7 @@ fn check_before_consuming(n: usize, spacing: f64, options: &SolveOptions, slowne
             return Err(PyValueError::new_err(format!("speed: the slowness must have one entry per band node ({n}), got {len}")));
         }
     }
-    if fixed.positions.len() != fixed.values.len() {
-        return Err(PyValueError::new_err(format!(
-            "fixed_positions and fixed_values must have the same length, got {} and {}",
-            fixed.positions.len(),
-            fixed.values.len()
-        )));
-    }
-    if let Some(&p) = fixed.positions.iter().find(|&&p| p < 0 || p as usize >= n) {
-        return Err(PyValueError::new_err(format!("fixed_positions: {p} is not a position in the band of {n} nodes")));
-    }
-    Ok(())
+    check_fixed(n, fixed)
 }
 
 /// The nodes fixed by the sources, given sparsely: band positions and their values.
@@ -688,30 +684,6 @@ impl PyTriangleTree {
     }
 }
 
-/// Position in `linear` (sorted, strictly increasing) of `linear[i] + offset` for `i` in
-/// `start..stop` (default: all), or −1: one merge pass (finite differences of φ at the band nodes).
-#[pyfunction]
-#[pyo3(signature = (linear, offset, start=0, stop=None))]
-fn shifted_positions<'py>(
-    py: Python<'py>,
-    linear: PyReadonlyArray1<'py, u64>,
-    offset: i64,
-    start: usize,
-    stop: Option<usize>,
-) -> PyResult<Bound<'py, PyArray1<i64>>> {
-    let lin = linear.as_slice()?;
-    let stop = stop.unwrap_or(lin.len());
-    if start > stop || stop > lin.len() {
-        return Err(PyValueError::new_err(format!("start..stop = {start}..{stop} is not a range of the {} indices", lin.len())));
-    }
-    // checked on the queried part only (the whole array is checked when it is queried whole)
-    if lin[start..stop].windows(2).any(|w| w[0] >= w[1]) {
-        return Err(PyValueError::new_err("linear must be strictly increasing"));
-    }
-    let out = py.detach(|| tubesweep_core::band::shifted_positions(lin, offset, start..stop));
-    Ok(out.into_pyarray(py))
-}
-
 /// The last split of the coarse-to-fine band search: the C-order linear indices (sorted) of the
 /// nodes of the 2 × … × 2 blocks with lowest corners `origins` (M, d) (even grid indices, no
 /// repeats, any order), cut to the grid of `shape`. See `tubesweep_core::discovery`.
@@ -904,7 +876,6 @@ fn outward_directions<'py>(
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     m.add_class::<PyTriangleTree>()?;
-    m.add_function(wrap_pyfunction!(shifted_positions, m)?)?;
     m.add_function(wrap_pyfunction!(split_pair_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(children_radius_max, m)?)?;
     m.add_function(wrap_pyfunction!(block_children, m)?)?;
