@@ -283,10 +283,10 @@ def solve(
         nothing); this reproduces its iteration counts (Table 2). The default solves the same
         discrete equations, to the same solution within about ``tol``, with two accelerations
         (docs/architecture.md): with Godunov, each inner-tube node is updated together with the
-        extension-layer nodes that copy it (block Gauss–Seidel; sphere N=1001: 40 instead of 57
-        iterations, 28% less time; at N=201 about 10% more time), and the *outer rim* (layer nodes
-        no inner node depends on) is swept only after the rest has converged (about 30% fewer local
-        updates).
+        extension-layer nodes that copy it (block Gauss–Seidel; sphere N=1001: 38 instead of 55
+        iterations), and the *outer rim* (layer nodes no inner node depends on) is swept only after
+        the rest has converged (about 30% fewer local updates). Together: 1.23× faster at N=1001,
+        about even at N ≤ 401 (``benches/sweep_variants.py``).
 
     Returns
     -------

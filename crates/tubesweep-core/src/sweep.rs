@@ -138,7 +138,8 @@ pub struct SolveOptions {
     /// whose update (5) reads it ([`crate::godunov::godunov_update_coupled`], a block
     /// Gauss–Seidel step). The discrete equations and so the solution (to about `tol`) are the
     /// same; the pointwise node ↔ layer cycle that contracts only by the extension weight per
-    /// pass is solved at once, saving 20–30% of the updates on curved surfaces. `false` runs the
+    /// pass is solved at once: on the sphere 22% fewer updates at N = 201, 36% at N = 1001
+    /// (`benches/sweep_variants.py`). `false` runs the
     /// paper's pointwise sweeps (its Table 2 iteration counts).
     pub coupled: bool,
     /// Sweep the *outer rim* last: the extension-layer nodes that no inner-tube node depends on
@@ -594,8 +595,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         };
         let mut total = Accumulator::default();
         // Pairing halves the number of tasks: only where a wave has enough tiles for every thread
-        // to get several pairs (the load-balance bound for 2 threads on the sphere at N = 101 is
-        // 1.84× with single tiles, 1.70× when every wave is paired, 1.84× with this rule).
+        // to get several pairs (the load-balance bound this leaves, from the schedule itself:
+        // `cargo run --release --example schedule_balance`).
         let pair_from = 4 * rayon::current_num_threads();
         for w in 0..waves.len() - 1 {
             let (t0, t1) = (waves[w] as usize, waves[w + 1] as usize);
