@@ -370,6 +370,7 @@ fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::schedule::NO_TILE;
 
     fn linear<const D: usize>(shape: [usize; D], idx: [usize; D]) -> u64 {
         let mut l = 0u64;
@@ -451,6 +452,107 @@ mod tests {
             let first = band.index_of(band.row_range(order[0] as usize).0);
             assert_eq!(first[0], if signs & 1 != 0 { 2 } else { 0 });
             assert_eq!(first[1], if signs & 2 != 0 { 3 } else { 0 });
+        }
+    }
+
+    /// The strip pipeline's dependencies give every row the values of the sequential sweep: a
+    /// row's lower neighbour rows (in the sweep's orientation) are done before it starts, its
+    /// upper ones cannot have started. In tile terms: the neighbour row lies in the same tile
+    /// (ordered inside it) or in a tile that is reached from the row's tile by following the
+    /// strip order and the `upstream` links (lower), or one from which the row's tile is reached
+    /// (upper). Checked on a spherical shell, where strips and tiles have gaps.
+    #[test]
+    fn strip_pipeline_orders_every_pair_of_neighbour_rows() {
+        let n = 61usize;
+        let h = 2.0 / (n - 1) as f64;
+        let mut lin = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
+                    let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                    if (r - 0.6).abs() <= 4.0 * h {
+                        lin.push(((i * n + j) * n + k) as u64);
+                    }
+                }
+            }
+        }
+        let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
+        let sched = band.schedule();
+        for signs in 0..4 {
+            let (rows, tiles) = (sched.rows(signs), sched.tiles(signs));
+            let (strip_tiles, strips, upstream) = (sched.strip_tiles(signs), sched.strips(signs), sched.upstream(signs));
+            assert!(strips.len() > 4, "{} strips", strips.len() - 1);
+            let mut sorted = strip_tiles.to_vec();
+            sorted.sort();
+            assert_eq!(sorted, (0..tiles.len() as u32 - 1).collect::<Vec<_>>());
+            // tile of each row, position of each row in its tile, strip and place of each tile
+            let mut tile_of = vec![0usize; band.n_rows()];
+            let mut place = vec![0usize; band.n_rows()];
+            for t in 0..tiles.len() - 1 {
+                for (i, &r) in rows[tiles[t] as usize..tiles[t + 1] as usize].iter().enumerate() {
+                    tile_of[r as usize] = t;
+                    place[r as usize] = i;
+                }
+            }
+            let mut strip_of = vec![0usize; tiles.len() - 1];
+            let mut in_strip = vec![0usize; tiles.len() - 1];
+            for s in 0..strips.len() - 1 {
+                for (i, &t) in strip_tiles[strips[s] as usize..strips[s + 1] as usize].iter().enumerate() {
+                    strip_of[t as usize] = s;
+                    in_strip[t as usize] = i;
+                }
+            }
+            // `before(x, y)`: tile x is done before tile y starts
+            let before = |x: usize, y: usize| -> bool {
+                // y waits for the tiles before it in its strip; a tile reached through an
+                // upstream link is itself done
+                let (mut t, mut strict) = (y, true);
+                loop {
+                    if strip_of[t] == strip_of[x] {
+                        return in_strip[x] < in_strip[t] || (!strict && in_strip[x] == in_strip[t]);
+                    }
+                    // walk back along the strip to a tile with an upstream link
+                    let s = strip_of[t];
+                    let mut found = None;
+                    for &c in strip_tiles[strips[s] as usize..strips[s] as usize + in_strip[t] + 1].iter().rev() {
+                        if upstream[c as usize] != NO_TILE {
+                            found = Some(upstream[c as usize] as usize);
+                            break;
+                        }
+                    }
+                    match found {
+                        Some(u) if strip_of[u] >= strip_of[x] => (t, strict) = (u, false),
+                        _ => return false,
+                    }
+                }
+            };
+            let row_of = |lead: [usize; 2]| (0..band.n_rows()).find(|&r| band.row_lead(r)[..2] == lead);
+            for r in 0..band.n_rows() {
+                let lead = band.row_lead(r);
+                for k in 0..2 {
+                    for step in [-1i64, 1] {
+                        let c = lead[k] as i64 + step;
+                        if c < 0 || c >= n as i64 {
+                            continue;
+                        }
+                        let mut other = [lead[0], lead[1]];
+                        other[k] = c as usize;
+                        let Some(q) = row_of(other) else { continue };
+                        // lower in this orientation: the coordinate walked first
+                        let lower = (step < 0) != (signs & (1 << k) != 0);
+                        let (ta, tb) = (tile_of[q], tile_of[r]);
+                        let ok = if ta == tb {
+                            (place[q] < place[r]) == lower
+                        } else if lower {
+                            before(ta, tb)
+                        } else {
+                            before(tb, ta)
+                        };
+                        assert!(ok, "orientation {signs}: rows {lead:?} and {other:?}");
+                    }
+                }
+            }
         }
     }
 }

@@ -12,6 +12,15 @@
 //! of a tile lexicographically therefore reads exactly the same neighbour values as the
 //! sequential sweep (a 2D band has one leading axis: its waves hold one tile, it runs
 //! sequentially).
+//!
+//! The same dependencies can also be met without a barrier after every wave. In 3D, call the
+//! tiles with the same first tile coordinate `a` a *strip*, ordered by the second coordinate
+//! `b`. Tile `(a, b)` may run as soon as `(a − 1, b)` (the previous strip) and `(a, b − 1)` (its
+//! own strip, earlier) are done: then every lower neighbour is final, and no upper neighbour can
+//! have started, since `(a + 1, b)` waits for `(a, b)` and `(a, b + 1)` follows it in its strip.
+//! Two tiles that run at the same time are never face neighbours. Threads take whole strips in
+//! order and wait for the one tile of the previous strip they depend on (a pipelined
+//! wavefront): one synchronisation per tile instead of a barrier per wave, the same values.
 
 /// Leading-axis rows per tile side.
 pub const TILE: usize = 8;
@@ -25,7 +34,17 @@ pub struct SweepSchedule {
     tiles: Vec<Vec<u32>>,
     /// Per orientation: boundaries of the waves in `tiles` (one more than the waves).
     waves: Vec<Vec<u32>>,
+    /// Per orientation: the tiles (indices into [`tiles`](Self::tiles)) strip by strip, each strip
+    /// in the order of its second tile coordinate (empty unless there are two leading axes).
+    strip_tiles: Vec<Vec<u32>>,
+    /// Per orientation: boundaries of the strips in `strip_tiles` (one more than the strips).
+    strips: Vec<Vec<u32>>,
+    /// Per orientation and tile: the tile of the previous strip it waits for, or [`NO_TILE`].
+    upstream: Vec<Vec<u32>>,
 }
+
+/// No tile (see [`SweepSchedule::upstream`]).
+pub const NO_TILE: u32 = u32::MAX;
 
 impl SweepSchedule {
     /// Builds the schedule from the leading indices of the rows (`lead[r][k]` for `k < lead_dims`)
@@ -76,6 +95,35 @@ impl SweepSchedule {
             }
             tiles.push(keyed.len() as u32);
             waves.push((tiles.len() - 1) as u32);
+            // strips: the tiles by (a, b), with a tile's key `a·stride + b` (two leading axes)
+            let (mut strip_tiles, mut strips, mut upstream) = (Vec::new(), Vec::new(), Vec::new());
+            if lead_dims == 2 {
+                let stride = (shape[1] / TILE + 1) as u64;
+                let mut by_coords: Vec<(u64, u64, u32)> = (0..tiles.len() - 1)
+                    .map(|t| {
+                        let key = keyed[tiles[t] as usize].1;
+                        (key / stride, key % stride, t as u32)
+                    })
+                    .collect();
+                by_coords.sort_unstable();
+                upstream = vec![NO_TILE; tiles.len() - 1];
+                strips.push(0u32);
+                for (i, &(a, b, t)) in by_coords.iter().enumerate() {
+                    if i > 0 && by_coords[i - 1].0 != a {
+                        strips.push(i as u32);
+                    }
+                    strip_tiles.push(t);
+                    if a > 0 {
+                        if let Ok(j) = by_coords.binary_search_by(|&(x, y, _)| (x, y).cmp(&(a - 1, b))) {
+                            upstream[t as usize] = by_coords[j].2;
+                        }
+                    }
+                }
+                strips.push(strip_tiles.len() as u32);
+            }
+            sched.strip_tiles.push(strip_tiles);
+            sched.strips.push(strips);
+            sched.upstream.push(upstream);
             sched.rows.push(rows);
             sched.tiles.push(tiles);
             sched.waves.push(waves);
@@ -101,9 +149,32 @@ impl SweepSchedule {
         &self.waves[signs]
     }
 
+    /// Tiles strip by strip for orientation `signs` (see the module documentation); empty when
+    /// the band has fewer than two leading axes.
+    #[inline]
+    pub fn strip_tiles(&self, signs: usize) -> &[u32] {
+        &self.strip_tiles[signs]
+    }
+
+    /// Strip boundaries (indices into [`strip_tiles`](Self::strip_tiles)) for orientation `signs`.
+    #[inline]
+    pub fn strips(&self, signs: usize) -> &[u32] {
+        &self.strips[signs]
+    }
+
+    /// Per tile, the tile of the previous strip that must be done before it starts, or
+    /// [`NO_TILE`].
+    #[inline]
+    pub fn upstream(&self, signs: usize) -> &[u32] {
+        &self.upstream[signs]
+    }
+
     pub fn heap_bytes(&self) -> usize {
         self.rows.iter().map(|v| v.len() * 4).sum::<usize>()
             + self.tiles.iter().map(|v| v.len() * 4).sum::<usize>()
             + self.waves.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.strip_tiles.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.strips.iter().map(|v| v.len() * 4).sum::<usize>()
+            + self.upstream.iter().map(|v| v.len() * 4).sum::<usize>()
     }
 }

@@ -19,7 +19,8 @@ use crate::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled}
 use crate::hamiltonian::InnerScheme;
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU8, Ordering};
+use crate::schedule::NO_TILE;
+use std::sync::atomic::{AtomicU32, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// What the sweep does at a node.
@@ -521,10 +522,27 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // neighbours (see `fill_missing`); computed once, it may scan every node
         let general_slowness = self.general_slowness();
         let coupling = self.coupling_mask(weights, options.coupled);
-        let ctx = SweepContext { u: &shared, active: &active, weights, coupling: &coupling, general_slowness };
+        // per tile, the last parallel sweep that finished it (see `sweep_strips`)
+        let tiles_done: Vec<AtomicU32> = if options.threads == 1 || D < 3 {
+            Vec::new()
+        } else {
+            let sched = self.band.schedule();
+            let most = (0..1usize << (D - 1)).map(|o| sched.tiles(o).len()).max().unwrap_or(0);
+            (0..most).map(|_| AtomicU32::new(0)).collect()
+        };
+        let ctx = SweepContext {
+            u: &shared,
+            active: &active,
+            weights,
+            coupling: &coupling,
+            general_slowness,
+            tiles_done: &tiles_done,
+            sweep_id: AtomicU32::new(0),
+        };
         let n_orient = 1usize << D;
         let inf = options.infinity.unwrap_or(crate::DEFAULT_INFINITY);
-        let pool = if options.threads == 1 {
+        // only a 3D band has independent tiles (a 2D band's waves hold one tile each)
+        let pool = if options.threads == 1 || ctx.tiles_done.is_empty() {
             None
         } else {
             let mut b = rayon::ThreadPoolBuilder::new();
@@ -568,7 +586,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 
     /// One Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked backwards):
-    /// waves in order, the tiles of a wave in parallel, the rows of a tile in order.
+    /// in parallel (3D), strips of tiles in a pipeline ([`Self::sweep_strips`]); sequentially,
+    /// the waves in order and the tiles of a wave two at a time; the rows of a tile in order.
     fn sweep(&self, ctx: &SweepContext<'_, D>, dir: usize, inf: f64, threshold: f64, parallel: bool) -> Accumulator {
         let band = self.band;
         let lead = dir & ((1usize << (D - 1)) - 1);
@@ -579,7 +598,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let waves = sched.waves(lead);
         // one specialised row loop per (scheme, speed) pair: no dispatch inside the hot loop
         let per_node = matches!(self.slowness, Slowness::PerNode(_));
-        // Two tiles of one wave are independent, so one thread interleaves them node by node:
+        // Two tiles of one wave are independent, so the sequential sweep interleaves them node by node:
         // the Gauss–Seidel chain along a row (each node reads the one just written) is latency
         // bound, and two independent chains keep the core busy while either waits.
         let run_pair = |t: usize, t_end: usize| -> Accumulator {
@@ -593,36 +612,64 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 (InnerScheme::General(_), _) => self.run_rows_interleaved::<GENERAL, false>(ctx, a, b, backwards, inf, threshold),
             }
         };
+        if parallel && !ctx.tiles_done.is_empty() && !sched.strips(lead).is_empty() {
+            return self.sweep_strips(ctx, lead, &run_pair);
+        }
+        // sequentially: the waves in order, two tiles of a wave interleaved at a time
         let mut total = Accumulator::default();
-        // Pairing halves the number of tasks: only where a wave has enough tiles for every thread
-        // to get several pairs (the load-balance bound this leaves, from the schedule itself:
-        // `cargo run --release --example schedule_balance`).
-        let pair_from = 4 * rayon::current_num_threads();
         for w in 0..waves.len() - 1 {
             let (t0, t1) = (waves[w] as usize, waves[w + 1] as usize);
-            let work = tiles[t1] - tiles[t0];
-            if parallel && t1 - t0 >= pair_from && work >= MIN_PARALLEL_ROWS {
-                // pairs of tiles, interleaved, in parallel
-                let acc = (t0..t1)
-                    .into_par_iter()
-                    .step_by(2)
-                    .map(|t| run_pair(t, t1))
-                    .reduce(Accumulator::default, Accumulator::merge);
-                total = total.merge(acc);
-            } else if parallel && t1 - t0 > 1 && work >= MIN_PARALLEL_ROWS {
-                // too few tiles to pair up: one tile per task
-                let acc = (t0..t1)
-                    .into_par_iter()
-                    .map(|t| run_pair(t, t + 1))
-                    .reduce(Accumulator::default, Accumulator::merge);
-                total = total.merge(acc);
-            } else {
-                for t in (t0..t1).step_by(2) {
-                    total = total.merge(run_pair(t, t1));
-                }
+            for t in (t0..t1).step_by(2) {
+                total = total.merge(run_pair(t, t1));
             }
         }
         total
+    }
+
+    /// The parallel sweep as a pipelined wavefront over strips of tiles (see [`crate::schedule`]):
+    /// every thread of the pool takes the next strip, runs its tiles in order and, before each,
+    /// waits until the tile of the previous strip it depends on is done. The values are those of
+    /// the sequential sweep; the cost is one wait per tile instead of a barrier per wave.
+    fn sweep_strips(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        lead: usize,
+        run_tile_pair: &(dyn Fn(usize, usize) -> Accumulator + Sync),
+    ) -> Accumulator {
+        let sched = self.band.schedule();
+        let (strip_tiles, strips, upstream) = (sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead));
+        let id = ctx.sweep_id.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
+        let next_strip = AtomicUsize::new(0);
+        let n_strips = strips.len() - 1;
+        let work = || {
+            let mut acc = Accumulator::default();
+            loop {
+                let s = next_strip.fetch_add(1, Ordering::Relaxed);
+                if s >= n_strips {
+                    break;
+                }
+                for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
+                    let up = upstream[t as usize];
+                    if up != NO_TILE {
+                        // the previous strip was taken earlier by a running thread
+                        let done = &ctx.tiles_done[up as usize];
+                        let mut spins = 0u32;
+                        while done.load(Ordering::Acquire) != id {
+                            spins += 1;
+                            if spins < 2048 {
+                                std::hint::spin_loop();
+                            } else {
+                                std::thread::yield_now();
+                            }
+                        }
+                    }
+                    acc = acc.merge(run_tile_pair(t as usize, t as usize + 1));
+                    ctx.tiles_done[t as usize].store(id, Ordering::Release);
+                }
+            }
+            acc
+        };
+        rayon::broadcast(|_| work()).into_iter().fold(Accumulator::default(), Accumulator::merge)
     }
 
     /// The rows of two independent tiles `a` and `b` (of one wave), each in order, with the
@@ -852,14 +899,16 @@ struct SweepContext<'a, const D: usize> {
     /// the coupled Godunov update is not used.
     coupling: &'a [u8],
     general_slowness: f64,
+    /// Per tile, the id of the last parallel sweep that finished it (empty when sequential).
+    tiles_done: &'a [AtomicU32],
+    /// The id of the last parallel sweep (ids start at 1, the flags at 0).
+    sweep_id: AtomicU32,
 }
 
 const GODUNOV: u8 = 0;
 const LXF: u8 = 1;
 const GENERAL: u8 = 2;
 
-/// Smallest number of rows in a wave worth splitting across threads.
-const MIN_PARALLEL_ROWS: u32 = 64;
 
 /// Per-sweep totals.
 #[derive(Debug, Clone, Copy, Default)]
@@ -1168,26 +1217,28 @@ mod tests {
     }
 
     #[test]
-    fn paired_tiles_in_parallel_give_the_sequential_bits() {
-        // a band large enough for waves of at least 4 tiles per thread (the paired branch)
-        let (band, roles, dirs, h) = sphere_band(181);
+    fn the_strip_pipeline_gives_the_bits_of_the_paired_sequential_sweep() {
+        // large enough for many strips per orientation and waves of several tiles (the paired
+        // sequential sweep); 3 threads take strips out of step with the 2 leading axes
+        let (band, roles, dirs, h) = sphere_band(121);
         let sched = band.schedule();
-        let widest = (0..4)
-            .map(|lead| sched.waves(lead).windows(2).map(|w| (w[1] - w[0]) as usize).max().unwrap_or(0))
-            .max()
-            .unwrap();
-        assert!(widest >= 4 * 2, "widest wave has {widest} tiles");
+        for lead in 0..4 {
+            assert!(sched.strips(lead).len() > 6);
+            assert!(sched.waves(lead).windows(2).any(|w| w[1] - w[0] >= 4));
+        }
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let run = |threads: usize| {
             let mut u = vec![0.0; band.len()];
             let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
             assert!(st.converged);
-            (u, st.iterations)
+            (u, st.iterations, st.updates)
         };
-        let (a, ia) = run(1);
-        let (b, ib) = run(2);
-        assert_eq!(ia, ib);
-        assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        let (a, ia, ua) = run(1);
+        for threads in [2, 3] {
+            let (b, ib, ub) = run(threads);
+            assert_eq!((ia, ua), (ib, ub));
+            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
     }
 
     #[test]
