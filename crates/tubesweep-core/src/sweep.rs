@@ -749,15 +749,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let active = ctx.active;
         // SAFETY: n < band.len(); active has that length plus the sentinel slot.
         let flag = unsafe { active.get_unchecked(n) };
-        if flag.load(Ordering::Relaxed) == 0 {
-            return;
-        }
-        if unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed {
+        // fixed nodes get activated by their neighbours too: one test for both (no short circuit)
+        let fixed = unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed;
+        if (flag.load(Ordering::Relaxed) == 0) | fixed {
             return;
         }
         flag.store(0, Ordering::Relaxed);
         acc.updates += 1;
-        let Some(up) = self.local_update::<S, P>(ctx, n, inf) else { return };
+        // SAFETY: n < band.len()
+        let nb = unsafe { self.band.neighbours_of_unchecked(n) };
+        let Some(up) = self.local_update::<S, P>(ctx, n, &nb, inf) else { return };
         if up.self_dependent {
             flag.store(1, Ordering::Relaxed);
         }
@@ -769,8 +770,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if c <= threshold {
             return;
         }
-        // SAFETY: n < band.len()
-        let nb = unsafe { self.band.neighbours_of_unchecked(n) };
         for k in 0..D {
             unsafe {
                 active.get_unchecked(nb[k][0] as usize).store(1, Ordering::Relaxed);
@@ -783,12 +782,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// update (5) in the layer, the scheme's local solver with monotone acceptance in the inner
     /// tube. `None` when the value would not change. Nothing is written.
     #[inline(always)]
-    fn local_update<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, inf: f64) -> Option<LocalUpdate> {
+    fn local_update<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, nb: &[[u32; 2]; D], inf: f64) -> Option<LocalUpdate> {
         let u = ctx.u;
         // SAFETY: n < band.len(); roles, weights and the neighbour table have at least that
         // length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`.
         let role = unsafe { *self.roles.get_unchecked(n) };
-        let nb = &unsafe { self.band.neighbours_of_unchecked(n) };
         let old = u.get(n);
         if role == NodeRole::Outer {
             // Eq. (5) with the precomputed upwind weights, reading only the upwind neighbours.
