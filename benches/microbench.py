@@ -5,7 +5,10 @@ parallel speed-up ≥ 1.7× on 2 cores).
 For each scheme and grid size it solves the sphere (radius 0.5, source (−0.5, 0, 0)) with
 ``ts.solve`` in child processes with ``RAYON_NUM_THREADS`` = 1 and = the number of cores, and
 reports ``stats.updates / stats.seconds`` (sweeps only, band construction excluded), that rate
-divided by the thread count, and the speed-up of the sweeps. With a single-threaded kernel the
+divided by the thread count, and the speed-up of the sweeps. Every case runs once per round (the
+second of two solves in a fresh process), ``--repeats`` rounds; times are medians over the rounds
+and the ratios medians of the per-round ratios, so that this shared machine's drift, which moves
+single timings by 20–40%, cancels out of them. With a single-threaded kernel the
 two thread counts give the same time (speed-up ≈ 1).
 
 Each case runs twice: with the paper's plain sweeps (``paper_sweeps=True``) and with the default
@@ -65,30 +68,35 @@ def measure(n: int, hamiltonian: str, threads: int, repeats: int, paper: bool = 
 
 def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", "lxf"), repeats: int = 3,
         threads: Optional[Sequence[int]] = None) -> List[Dict[str, Any]]:
+    """Runs every (sweeps, threads) case of a scheme and size once per round, ``repeats`` rounds,
+    so that the machine's drift affects all cases alike; the speed-up and "× paper" are medians
+    of the per-round ratios (the two times of a ratio come from the same round)."""
     cores = os.cpu_count() or 1
     tlist = sorted(set(threads or (1, cores)))
     rows = []
-    print(f"sphere r=0.5, two-layer, sol.stats (sweeps only), median of {repeats}; {cores} cores")
+    print(f"sphere r=0.5, two-layer, sol.stats (sweeps only), {repeats} interleaved rounds (medians); {cores} cores")
     print(f"{'scheme':8} {'N':>5} {'sweeps':>7} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} "
           f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8}")
     for h in schemes:
         for n in sizes:
-            paper_time: Dict[int, float] = {}
-            for paper in (True, False):
-                base = None
-                for t in tlist:
-                    r = measure(n, h, t, repeats, paper)
-                    if base is None:
-                        base = r["sweep_s"]
-                    r["per_core"] = r["updates_per_s"] / t
-                    r["speedup"] = base / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
-                    if paper:
-                        paper_time[t] = r["sweep_s"]
-                    r["vs_paper"] = paper_time[t] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
-                    rows.append(r)
-                    print(f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
-                          f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
-                          f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f}", flush=True)
+            cases = [(paper, t) for paper in (True, False) for t in tlist]
+            runs: Dict[Any, List[Dict[str, Any]]] = {c: [] for c in cases}
+            for _ in range(repeats):
+                for paper, t in cases:
+                    runs[(paper, t)].append(measure(n, h, t, 2, paper))
+            secs = {c: [r["seconds"][-1] for r in runs[c]] for c in cases}  # the warm (second) solve
+            for paper, t in cases:
+                r = dict(runs[(paper, t)][0])
+                med = statistics.median(secs[(paper, t)])
+                r["sweep_s"] = med
+                r["updates_per_s"] = r["updates"] / med if med > 0 else float("nan")
+                r["per_core"] = r["updates_per_s"] / t
+                r["speedup"] = statistics.median(a / b for a, b in zip(secs[(paper, tlist[0])], secs[(paper, t)]))
+                r["vs_paper"] = statistics.median(a / b for a, b in zip(secs[(True, t)], secs[(paper, t)]))
+                rows.append(r)
+                print(f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
+                      f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
+                      f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f}", flush=True)
     return rows
 
 

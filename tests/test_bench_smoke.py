@@ -135,3 +135,23 @@ def test_exact_distances_of_the_benchmark_surfaces():
     eq = np.stack([0.75 * np.cos(th), 0.75 * np.sin(th), 0 * th], 1)
     assert np.allclose(t.equator_distance(eq, (0.75, 0, 0)), 0.75 * np.abs(th))
     assert np.isnan(t.equator_distance(eq, (0.5, 0, 0.25))).all()
+
+
+def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_thread_count():
+    import microbench
+
+    rows = microbench.run(sizes=(31,), schemes=("godunov",), repeats=2, threads=(1, 2))
+    assert [(r["sweeps"], r["threads"]) for r in rows] == [("paper", 1), ("paper", 2), ("default", 1), ("default", 2)]
+    by = {(r["sweeps"], r["threads"]): r for r in rows}
+    for sweeps in ("paper", "default"):
+        # bit-identical sweeps for any thread count: the same iterations and local updates
+        assert by[(sweeps, 1)]["updates"] == by[(sweeps, 2)]["updates"] > 0
+        assert by[(sweeps, 1)]["iterations"] == by[(sweeps, 2)]["iterations"]
+        assert by[(sweeps, 1)]["speedup"] == 1.0
+        for t in (1, 2):
+            r = by[(sweeps, t)]
+            assert r["sweep_s"] > 0 and math.isfinite(r["speedup"]) and r["speedup"] > 0
+            assert r["per_core"] == pytest.approx(r["updates"] / r["sweep_s"] / t)
+    # the default sweeps solve the same equations with fewer local updates
+    assert by[("default", 1)]["updates"] < by[("paper", 1)]["updates"]
+    assert by[("paper", 2)]["vs_paper"] == 1.0
