@@ -20,7 +20,7 @@ use crate::hamiltonian::InnerScheme;
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
 use crate::schedule::NO_TILE;
-use std::sync::atomic::{AtomicU32, AtomicU8, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// What the sweep does at a node.
@@ -637,39 +637,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         run_tile_pair: &(dyn Fn(usize, usize) -> Accumulator + Sync),
     ) -> Accumulator {
         let sched = self.band.schedule();
-        let (strip_tiles, strips, upstream) = (sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead));
         let id = ctx.sweep_id.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
-        let next_strip = AtomicUsize::new(0);
-        let n_strips = strips.len() - 1;
-        let work = || {
-            let mut acc = Accumulator::default();
-            loop {
-                let s = next_strip.fetch_add(1, Ordering::Relaxed);
-                if s >= n_strips {
-                    break;
-                }
-                for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
-                    let up = upstream[t as usize];
-                    if up != NO_TILE {
-                        // the previous strip was taken earlier by a running thread
-                        let done = &ctx.tiles_done[up as usize];
-                        let mut spins = 0u32;
-                        while done.load(Ordering::Acquire) != id {
-                            spins += 1;
-                            if spins < 2048 {
-                                std::hint::spin_loop();
-                            } else {
-                                std::thread::yield_now();
-                            }
-                        }
-                    }
-                    acc = acc.merge(run_tile_pair(t as usize, t as usize + 1));
-                    ctx.tiles_done[t as usize].store(id, Ordering::Release);
-                }
-            }
-            acc
-        };
-        rayon::broadcast(|_| work()).into_iter().fold(Accumulator::default(), Accumulator::merge)
+        run_strip_pipeline(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), ctx.tiles_done, id, &|t| {
+            run_tile_pair(t, t + 1)
+        })
     }
 
     /// The rows of two independent tiles `a` and `b` (of one wave), each in order, with the
@@ -864,6 +835,66 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             None
         }
     }
+}
+
+/// The strip pipeline of [`SweepProblem::sweep_strips`] on the current rayon pool: every thread
+/// takes the next strip and runs its tiles in order (`run_tile`), each once its upstream tile is
+/// done in sweep `id`, and marks it done. If a tile panics, the threads waiting for it give up,
+/// so that the panic reaches the caller instead of leaving them spinning.
+fn run_strip_pipeline(
+    strip_tiles: &[u32],
+    strips: &[u32],
+    upstream: &[u32],
+    tiles_done: &[AtomicU32],
+    id: u32,
+    run_tile: &(dyn Fn(usize) -> Accumulator + Sync),
+) -> Accumulator {
+    /// Raises `abandoned` when dropped by a panic.
+    struct RaiseOnPanic<'a>(&'a AtomicBool);
+    impl Drop for RaiseOnPanic<'_> {
+        fn drop(&mut self) {
+            if std::thread::panicking() {
+                self.0.store(true, Ordering::Release);
+            }
+        }
+    }
+    let next_strip = AtomicUsize::new(0);
+    let abandoned = AtomicBool::new(false);
+    let n_strips = strips.len().saturating_sub(1);
+    let work = || {
+        let _raise = RaiseOnPanic(&abandoned);
+        let mut acc = Accumulator::default();
+        loop {
+            let s = next_strip.fetch_add(1, Ordering::Relaxed);
+            if s >= n_strips {
+                break;
+            }
+            for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
+                let up = upstream[t as usize];
+                if up != NO_TILE {
+                    // the previous strip was taken earlier by a running thread: wait, spinning
+                    // briefly, then yielding the core (its thread may have been descheduled)
+                    let done = &tiles_done[up as usize];
+                    let mut spins = 0u32;
+                    while done.load(Ordering::Acquire) != id {
+                        if abandoned.load(Ordering::Acquire) {
+                            return acc;
+                        }
+                        spins += 1;
+                        if spins < 2048 {
+                            std::hint::spin_loop();
+                        } else {
+                            std::thread::yield_now();
+                        }
+                    }
+                }
+                acc = acc.merge(run_tile(t as usize));
+                tiles_done[t as usize].store(id, Ordering::Release);
+            }
+        }
+        acc
+    };
+    rayon::broadcast(|_| work()).into_iter().fold(Accumulator::default(), Accumulator::merge)
 }
 
 /// A value change proposed by [`SweepProblem::local_update`].
@@ -1237,6 +1268,40 @@ mod tests {
             assert_eq!((ia, ua), (ib, ub));
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
         }
+    }
+
+    #[test]
+    fn a_panic_in_a_tile_of_the_strip_pipeline_reaches_the_caller_instead_of_hanging() {
+        // two strips of three tiles, each tile of the second waiting for the one above it
+        let strip_tiles = [0u32, 1, 2, 3, 4, 5];
+        let strips = [0u32, 3, 6];
+        let upstream = [NO_TILE, NO_TILE, NO_TILE, 0, 1, 2];
+        let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        // a clean run visits every tile once
+        let acc = pool.install(|| {
+            run_strip_pipeline(&strip_tiles, &strips, &upstream, &done, 1, &|_| Accumulator { max_change: 0.0, updates: 1 })
+        });
+        assert_eq!(acc.updates, 6);
+        assert!(done.iter().all(|d| d.load(Ordering::Relaxed) == 1));
+        // tile 1 panics: the thread waiting for it must give up, and the panic come out
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool.install(|| {
+                    run_strip_pipeline(&strip_tiles, &strips, &upstream, &done, 1, &|t| {
+                        if t == 1 {
+                            panic!("tile 1");
+                        }
+                        Accumulator::default()
+                    })
+                })
+            }));
+            tx.send(r.is_err()).unwrap();
+        });
+        let panicked = rx.recv_timeout(std::time::Duration::from_secs(20)).expect("the pipeline hung");
+        assert!(panicked);
     }
 
     #[test]
