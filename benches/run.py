@@ -71,7 +71,7 @@ CAPS: Dict[str, Dict[str, int]] = {
 }
 #: dimension of each problem (the mesh peers apply to surfaces in 3D only)
 PROBLEM_DIMS = {"sphere": 3, "ellipsoid": 3, "star": 2, "torus": 3, "bunny": 3}
-METHOD_ORDER = ["tubesweep-godunov", "tubesweep-lxf", "skfmm-tube", "heat", "mmp"]
+METHOD_ORDER = ["tubesweep-godunov", "tubesweep-godunov-tolh", "tubesweep-lxf", "skfmm-tube", "heat", "mmp"]
 SCALE_SIZES = [1001, 2001]
 
 
@@ -286,7 +286,8 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
     problems = [p for p in PRESETS["full"] if any(r["problem"] == p for r in ok)]
     if not problems:
         return None
-    style = {"tubesweep-godunov": ("C0", "o", "-"), "tubesweep-lxf": ("C0", "s", "--"), "skfmm-tube": ("C1", "^", "-"),
+    style = {"tubesweep-godunov": ("C0", "o", "-"), "tubesweep-godunov-tolh": ("C4", "o", ":"),
+             "tubesweep-lxf": ("C0", "s", "--"), "skfmm-tube": ("C1", "^", "-"),
              "heat": ("C2", "D", "-"), "mmp": ("C3", "v", "-")}
     ncol = min(3, len(problems))
     nrow = math.ceil(len(problems) / ncol)
@@ -386,25 +387,27 @@ def run_bench(preset: str = "default", cases: Optional[Dict[str, List[int]]] = N
 # --------------------------------------------------------------------------------------------
 # scale runs
 # --------------------------------------------------------------------------------------------
-def run_scale(sizes: Sequence[int] = SCALE_SIZES, out: Path = OUT, timeout: float = 3600.0) -> List[Dict[str, Any]]:
-    """Sphere at large N with tubesweep (Godunov), one run each in a child process: time, peak
-    memory, band points and bytes per band point."""
+def run_scale(sizes: Sequence[int] = SCALE_SIZES, out: Path = OUT, timeout: float = 3600.0,
+              methods: Sequence[str] = ("tubesweep-godunov",)) -> List[Dict[str, Any]]:
+    """Sphere at large N with tubesweep (Godunov; ``methods`` may add ``tubesweep-godunov-tolh``),
+    one run each in a child process: time, peak memory, band points and bytes per band point."""
     print("scale runs: sphere r=0.5, source (-0.5,0,0), Godunov two-layer, one run per N (child process)")
     print(machine())
     recs = []
-    for n in sizes:
+    for n, m in [(n, m) for n in sizes for m in methods]:
         t1 = time.perf_counter()
-        r = run_child("sphere", n, "tubesweep-godunov", 1, timeout)
+        r = run_child("sphere", n, m, 1, timeout)
+        label = n if len(methods) == 1 else f"{n} {m}"
         if r.get("status") == "ok":
             r["bytes_per_band_point"] = r["delta_rss_mb"] * 1024 * 1024 / r["band_points"]
             r["band_bytes_per_point"] = r["band_bytes"] / r["band_points"]
-            print(f"N={n}: wall {r['wall_s']:.2f} s (sweeps {r['sweep_s']:.2f} s, set-up {r['setup_s']:.2f} s), "
+            print(f"N={label}: wall {r['wall_s']:.2f} s (sweeps {r['sweep_s']:.2f} s, set-up {r['setup_s']:.2f} s), "
                   f"{r['band_points']:,} band points, {r['iterations']} iterations, {r['updates']:,} updates "
                   f"({r['updates_per_s'] / 1e6:.1f} M/s), peak ΔRSS {r['delta_rss_mb']:.0f} MB "
                   f"= {r['bytes_per_band_point']:.0f} B/point (solver-held arrays {r['band_bytes_per_point']:.0f} B/point), "
                   f"max err {r['max_err']:.2e}  ({time.perf_counter() - t1:.0f} s)", flush=True)
         else:
-            print(f"N={n}: {r.get('status')}: {r.get('note')}", flush=True)
+            print(f"N={label}: {r.get('status')}: {r.get('note')}", flush=True)
         recs.append(r)
     out.mkdir(parents=True, exist_ok=True)
     (out / "scale.json").write_text(json.dumps(dict(machine=machine(), records=recs), indent=1, default=float))
@@ -447,7 +450,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         raise SystemExit("--repeats must be at least 1")
     if a.scale:
         sizes = parse_cases(a.cases).get("sphere", SCALE_SIZES) if a.cases else SCALE_SIZES
-        run_scale(sizes, a.out, timeout=max(a.timeout, 3600.0))
+        methods = [m.strip() for m in a.methods.split(",")] if a.methods else ["tubesweep-godunov"]
+        bad = [m for m in methods if not m.startswith("tubesweep-godunov")]
+        if bad:
+            raise SystemExit(f"--scale runs tubesweep-godunov and tubesweep-godunov-tolh only, not {bad}")
+        run_scale(sizes, a.out, timeout=max(a.timeout, 3600.0), methods=methods)
         return 0
     preset = "quick" if a.quick else "full" if a.full else "default"
     cases = parse_cases(a.cases) if a.cases else None

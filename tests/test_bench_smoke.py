@@ -32,7 +32,7 @@ def result(tmp_path_factory):
     if HAVE["geographiclib"]:
         cases["ellipsoid"] = [21]
     out = tmp_path_factory.mktemp("bench")
-    methods = ["tubesweep-godunov", "skfmm-tube", "heat", "mmp"]  # LxF: see tests/test_solve.py
+    methods = ["tubesweep-godunov", "tubesweep-godunov-tolh", "skfmm-tube", "heat", "mmp"]  # LxF: see tests/test_solve.py
     res = bench.run_bench("quick", cases=cases, repeats=1, methods=methods, out=out, verbose=False)
     res["out"] = out
     res["cases"] = cases
@@ -45,6 +45,7 @@ def test_every_applicable_case_ran(result):
         for n in ns:
             got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
             assert got["tubesweep-godunov"]["status"] == "ok"
+            assert got["tubesweep-godunov-tolh"]["status"] == "ok"
             assert "tubesweep-lxf" not in got
             for m, mod in PEER_MODULE.items():
                 needs_mesh = m in ("heat", "mmp")
@@ -76,6 +77,19 @@ def test_tubesweep_errors_are_finite_and_small(result):
             assert r["max_err"] < GODUNOV_MAX[(r["problem"], r["n"])], r
             assert r["ratio"] == pytest.approx(1.0)
         assert r["delta_rss_mb"] >= 0 and r["peak_rss_mb"] > 0
+
+
+def test_a_tolerance_tied_to_the_grid_stops_earlier_at_the_same_accuracy(result):
+    # tol = 1e-3·Δx: fewer or as many iterations and updates, and errors against the exact answer
+    # that differ from the converged solve's by about tol (far below the scheme's O(Δx) error)
+    recs = result["records"]
+    for prob, ns in result["cases"].items():
+        for n in ns:
+            got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
+            full, loose = got["tubesweep-godunov"], got["tubesweep-godunov-tolh"]
+            h = 2.0 / (n - 1)  # every benchmark grid spans [-1, 1]^d
+            assert loose["iterations"] <= full["iterations"] and loose["updates"] <= full["updates"]
+            assert abs(loose["max_err"] - full["max_err"]) <= 3e-3 * h, (prob, n, loose["max_err"], full["max_err"])
 
 
 def test_peers_give_finite_errors(result):
