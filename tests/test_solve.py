@@ -309,3 +309,26 @@ def test_a_surface_that_caches_its_band_geometry_is_not_modified_by_the_solver()
     fresh = ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)], inner=1.5)
     np.testing.assert_array_equal(second.values, fresh.values)
     np.testing.assert_array_equal(first.values, ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)]).values)
+
+
+def test_a_tolerance_tied_to_the_grid_stops_earlier_within_a_few_tol_of_the_converged_solution():
+    """The stopping test bounds how far the answer is from the converged one: with
+    tol = 1e-3·Δx (far below the scheme's O(Δx) error) the sweeps stop iterations earlier, and
+    the values differ from the tol = 1e-10 solve by at most a few tol (the skipped changes are
+    below tol and the activation threshold is tol/100)."""
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81))
+    sphere = Sphere(radius=0.5)
+    full = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)])
+    tol = 1e-3 * grid.spacing
+    loose = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], tol=tol)
+    assert loose.stats.converged and loose.stats.last_change < tol
+    assert loose.stats.iterations < full.stats.iterations and loose.stats.updates < full.stats.updates
+    dev = np.max(np.abs(loose.values - full.values))
+    assert 0 < dev <= 3 * tol, dev
+    # and the error against the exact distance is the same to well below the error itself
+    d = np.random.default_rng(7).normal(size=(200, 3))
+    pts = 0.5 * d / np.linalg.norm(d, axis=1, keepdims=True)
+    exact = sphere.geodesic_distance(pts, (-0.5, 0.0, 0.0))
+    e_full = np.max(np.abs(full(pts) - exact))
+    e_loose = np.max(np.abs(loose(pts) - exact))
+    assert abs(e_loose - e_full) <= 3 * tol < 0.01 * e_full
