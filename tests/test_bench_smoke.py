@@ -151,21 +151,33 @@ def test_exact_distances_of_the_benchmark_surfaces():
     assert np.isnan(t.equator_distance(eq, (0.5, 0, 0.25))).all()
 
 
-def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_thread_count():
+def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_thread_count(monkeypatch):
     import microbench
 
+    # the cases of a round run one after the other, round after round
+    calls = []
+    real = microbench.measure
+
+    def spy(n, h, t, repeats, paper=False):
+        calls.append(("paper" if paper else "default", t))
+        return real(n, h, t, repeats, paper)
+
+    monkeypatch.setattr(microbench, "measure", spy)
     rows = microbench.run(sizes=(31,), schemes=("godunov",), repeats=2, threads=(1, 2))
-    assert [(r["sweeps"], r["threads"]) for r in rows] == [("paper", 1), ("paper", 2), ("default", 1), ("default", 2)]
+    one_round = [("paper", 1), ("paper", 2), ("default", 1), ("default", 2)]
+    assert calls == one_round * 2
+    assert [(r["sweeps"], r["threads"]) for r in rows] == one_round
     by = {(r["sweeps"], r["threads"]): r for r in rows}
     for sweeps in ("paper", "default"):
         # bit-identical sweeps for any thread count: the same iterations and local updates
         assert by[(sweeps, 1)]["updates"] == by[(sweeps, 2)]["updates"] > 0
         assert by[(sweeps, 1)]["iterations"] == by[(sweeps, 2)]["iterations"]
-        assert by[(sweeps, 1)]["speedup"] == 1.0
-        for t in (1, 2):
-            r = by[(sweeps, t)]
-            assert r["sweep_s"] > 0 and math.isfinite(r["speedup"]) and r["speedup"] > 0
-            assert r["per_core"] == pytest.approx(r["updates"] / r["sweep_s"] / t)
+        r1, r2 = by[(sweeps, 1)], by[(sweeps, 2)]
+        # the ratios are medians of per-round ratios of the warm solves' times
+        assert r2["speedup"] > 0 and math.isfinite(r2["speedup"])
+        for r in (r1, r2):
+            assert r["sweep_s"] > 0
+            assert r["per_core"] == pytest.approx(r["updates"] / r["sweep_s"] / r["threads"])
     # the default sweeps solve the same equations with fewer local updates
     assert by[("default", 1)]["updates"] < by[("paper", 1)]["updates"]
-    assert by[("paper", 2)]["vs_paper"] == 1.0
+    assert by[("default", 2)]["vs_paper"] > 0

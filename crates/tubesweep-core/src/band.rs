@@ -434,6 +434,21 @@ mod tests {
     }
 
     #[test]
+    fn an_empty_band_has_an_empty_schedule() {
+        let band = NarrowBand::<3>::from_sorted_linear([5, 5, 5], &[]).unwrap();
+        assert_eq!(band.len(), 0);
+        for signs in 0..4 {
+            let sched = band.schedule();
+            assert!(sched.rows(signs).is_empty());
+            let (strips, strip_tiles) = (sched.strips(signs), sched.strip_tiles(signs));
+            assert_eq!(strips.first(), Some(&0));
+            assert_eq!(*strips.last().unwrap() as usize, strip_tiles.len());
+            assert_eq!(strip_tiles.len(), sched.tiles(signs).len() - 1);
+        }
+        assert_eq!(NarrowBand::<2>::from_sorted_linear([5, 5], &[]).unwrap().len(), 0);
+    }
+
+    #[test]
     fn rejects_unsorted_and_small_shapes() {
         assert!(NarrowBand::<2>::from_sorted_linear([5, 5], &[3, 2]).is_err());
         assert!(NarrowBand::<2>::from_sorted_linear([5, 5], &[3, 3]).is_err());

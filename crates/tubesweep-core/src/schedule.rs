@@ -97,7 +97,13 @@ impl SweepSchedule {
             waves.push((tiles.len() - 1) as u32);
             // strips: the tiles by (a, b), with a tile's key `a·stride + b` (two leading axes)
             let (mut strip_tiles, mut strips, mut upstream) = (Vec::new(), Vec::new(), Vec::new());
-            if lead_dims == 2 {
+            if lead_dims == 2 && keyed.is_empty() {
+                // no rows: one empty strip over the one empty tile
+                strips = vec![0u32, 0];
+                upstream = vec![NO_TILE; tiles.len() - 1];
+                strip_tiles = (0..tiles.len() as u32 - 1).collect();
+                strips[1] = strip_tiles.len() as u32;
+            } else if lead_dims == 2 {
                 let stride = (shape[1] / TILE + 1) as u64;
                 let mut by_coords: Vec<(u64, u64, u32)> = (0..tiles.len() - 1)
                     .map(|t| {

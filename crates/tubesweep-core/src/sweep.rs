@@ -549,7 +549,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             if options.threads > 1 {
                 b = b.num_threads(options.threads);
             }
-            b.build().ok()
+            // a pool of one thread (threads = 0 on one core, or RAYON_NUM_THREADS=1) runs the
+            // sequential sweep, which interleaves two tiles
+            b.build().ok().filter(|p| p.current_num_threads() > 1)
         };
         while stats.iterations < options.max_iterations {
             let mut max_change = 0.0f64;
@@ -1267,6 +1269,77 @@ mod tests {
             let (b, ib, ub) = run(threads);
             assert_eq!((ia, ua), (ib, ub));
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
+    }
+
+    #[test]
+    fn the_strip_pipeline_gives_the_sequential_bits_across_missing_strips_and_on_an_empty_band() {
+        // two spheres apart along the first axis: whole strips of tiles between them are empty,
+        // so the tiles next to the gap have no upstream tile
+        let n = 97usize;
+        let h = 2.0 / (n - 1) as f64;
+        let (r0, centres) = (0.22, [-0.55, 0.55]);
+        let mut lin = Vec::new();
+        let mut roles = Vec::new();
+        let mut dirs = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
+                    let c = if x[0] < 0.0 { centres[0] } else { centres[1] };
+                    let d = [x[0] - c, x[1], x[2]];
+                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    let phi = r - r0;
+                    if phi.abs() <= 4.0 * h {
+                        lin.push(((i * n + j) * n + k) as u64);
+                        roles.push(if phi.abs() <= 2.0 * h { NodeRole::Inner } else { NodeRole::Outer });
+                        let s = phi.signum() / r;
+                        dirs.push([(d[0] * s) as f32, (d[1] * s) as f32, (d[2] * s) as f32]);
+                    }
+                }
+            }
+        }
+        let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
+        for c in centres {
+            let i = ((c - r0 + 1.0) / h).round() as i64;
+            let src = band.find([i, (n / 2) as i64, (n / 2) as i64]).unwrap();
+            roles[src] = NodeRole::Fixed;
+        }
+        // the gap: some strip follows a strip that is not its neighbour along the first axis
+        let sched = band.schedule();
+        let (strip_tiles, strips, upstream) = (sched.strip_tiles(0), sched.strips(0), sched.upstream(0));
+        let strips_without_upstream =
+            (0..strips.len() - 1).filter(|&s| strip_tiles[strips[s] as usize..strips[s + 1] as usize].iter().all(|&t| upstream[t as usize] == NO_TILE)).count();
+        assert!(strips_without_upstream >= 2, "{strips_without_upstream}");
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+        let run = |threads: usize| {
+            let mut u = vec![0.0; band.len()];
+            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged);
+            (u, st.iterations, st.updates)
+        };
+        let (a, ia, ua) = run(1);
+        assert!(a.iter().all(|v| v.is_finite() && *v < 2.0));
+        for threads in [2, 3] {
+            let (b, ib, ub) = run(threads);
+            assert_eq!((ia, ua), (ib, ub));
+            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
+        // an empty band solves to nothing, in parallel too
+        let empty = NarrowBand::<3>::from_sorted_linear([9, 9, 9], &[]).unwrap();
+        let p = SweepProblem {
+            band: &empty,
+            roles: &[],
+            spacing: 0.25,
+            slowness: Slowness::Constant(1.0),
+            extension: Extension::None,
+            scheme: InnerScheme::Godunov,
+            missing: MissingNeighbour::Extrapolate,
+        };
+        for threads in [1, 2] {
+            let mut u = Vec::new();
+            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged && u.is_empty());
         }
     }
 
