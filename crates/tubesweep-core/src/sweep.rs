@@ -522,7 +522,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // neighbours (see `fill_missing`); computed once, it may scan every node
         let general_slowness = self.general_slowness();
         let coupling = self.coupling_mask(weights, options.coupled);
-        // per tile, the last parallel sweep that finished it (see `sweep_strips`)
+        // per tile, the last parallel sweep that finished it (see `strip_worker`)
         let tiles_done: Vec<AtomicU32> = if options.threads == 1 || D < 3 {
             Vec::new()
         } else {
@@ -556,22 +556,43 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         while stats.iterations < options.max_iterations {
             let mut max_change = 0.0f64;
             let mut updates = 0u64;
-            for s in 0..n_orient {
-                let dir = s ^ (s >> 1); // Gray code
-                if all_active {
-                    for (n, a) in active[..self.roles.len()].iter().enumerate() {
-                        if weights.get(n).map_or(true, |w| !w[0].is_nan()) {
-                            a.store(1, Ordering::Relaxed);
-                        }
+            let activate_all = || {
+                for (n, a) in active[..self.roles.len()].iter().enumerate() {
+                    if weights.get(n).map_or(true, |w| !w[0].is_nan()) {
+                        a.store(1, Ordering::Relaxed);
                     }
                 }
-                let acc = match &pool {
-                    Some(p) => p.install(|| self.sweep(&ctx, dir, inf, options.activation_threshold, true)),
-                    None => self.sweep(&ctx, dir, inf, options.activation_threshold, false),
-                };
-                max_change = max_change.max(acc.max_change);
-                updates += acc.updates;
-                stats.sweeps += 1;
+            };
+            if let Some(p) = &pool {
+                // all 2^d sweeps of the iteration in one visit to the pool's threads, with a
+                // barrier between sweeps (waking the threads once per sweep costs more than a
+                // small sweep's work)
+                let acc = p.install(|| {
+                    let per_sweep = |s: usize, next_strip: &AtomicUsize, abandoned: &AtomicBool| {
+                        let dir = s ^ (s >> 1); // Gray code
+                        self.strip_worker(&ctx, dir, next_strip, abandoned, inf, options.activation_threshold)
+                    };
+                    let between = |_s: usize| {
+                        if all_active {
+                            activate_all();
+                        }
+                    };
+                    run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep, &between)
+                });
+                max_change = acc.max_change;
+                updates = acc.updates;
+                stats.sweeps += n_orient;
+            } else {
+                for s in 0..n_orient {
+                    let dir = s ^ (s >> 1); // Gray code
+                    if all_active {
+                        activate_all();
+                    }
+                    let acc = self.sweep(&ctx, dir, inf, options.activation_threshold);
+                    max_change = max_change.max(acc.max_change);
+                    updates += acc.updates;
+                    stats.sweeps += 1;
+                }
             }
             stats.iterations += 1;
             stats.updates += updates;
@@ -587,10 +608,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         Ok(())
     }
 
-    /// One Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked backwards):
-    /// in parallel (3D), strips of tiles in a pipeline ([`Self::sweep_strips`]); sequentially,
-    /// the waves in order and the tiles of a wave two at a time; the rows of a tile in order.
-    fn sweep(&self, ctx: &SweepContext<'_, D>, dir: usize, inf: f64, threshold: f64, parallel: bool) -> Accumulator {
+    /// One sequential Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked
+    /// backwards): the waves in order, the tiles of a wave two at a time, the rows of a tile in
+    /// order. (In parallel, the threads run [`Self::strip_worker`].)
+    fn sweep(&self, ctx: &SweepContext<'_, D>, dir: usize, inf: f64, threshold: f64) -> Accumulator {
         let band = self.band;
         let lead = dir & ((1usize << (D - 1)) - 1);
         let backwards = dir >> (D - 1) & 1 == 1;
@@ -614,9 +635,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 (InnerScheme::General(_), _) => self.run_rows_interleaved::<GENERAL, false>(ctx, a, b, backwards, inf, threshold),
             }
         };
-        if parallel && !ctx.tiles_done.is_empty() && !sched.strips(lead).is_empty() {
-            return self.sweep_strips(ctx, lead, &run_pair);
-        }
         // sequentially: the waves in order, two tiles of a wave interleaved at a time
         let mut total = Accumulator::default();
         for w in 0..waves.len() - 1 {
@@ -628,21 +646,36 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         total
     }
 
-    /// The parallel sweep as a pipelined wavefront over strips of tiles (see [`crate::schedule`]):
-    /// every thread of the pool takes the next strip, runs its tiles in order and, before each,
-    /// waits until the tile of the previous strip it depends on is done. The values are those of
-    /// the sequential sweep; the cost is one wait per tile instead of a barrier per wave.
-    fn sweep_strips(
+    /// This thread's share of the parallel sweep in orientation `dir`, a pipelined wavefront over
+    /// strips of tiles (see [`crate::schedule`]): it takes the next strip (`next_strip`) and runs
+    /// its tiles in order, each once the tile of the previous strip it depends on is done in this
+    /// sweep (id `ctx.sweep_id`). The values are those of the sequential sweep.
+    fn strip_worker(
         &self,
         ctx: &SweepContext<'_, D>,
-        lead: usize,
-        run_tile_pair: &(dyn Fn(usize, usize) -> Accumulator + Sync),
+        dir: usize,
+        next_strip: &AtomicUsize,
+        abandoned: &AtomicBool,
+        inf: f64,
+        threshold: f64,
     ) -> Accumulator {
+        let lead = dir & ((1usize << (D - 1)) - 1);
+        let backwards = dir >> (D - 1) & 1 == 1;
         let sched = self.band.schedule();
-        let id = ctx.sweep_id.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
-        run_strip_pipeline(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), ctx.tiles_done, id, &|t| {
-            run_tile_pair(t, t + 1)
-        })
+        let (rows, tiles) = (sched.rows(lead), sched.tiles(lead));
+        let per_node = matches!(self.slowness, Slowness::PerNode(_));
+        let run_tile = |t: usize| -> Accumulator {
+            let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
+            match (self.scheme, per_node) {
+                (InnerScheme::Godunov, false) => self.run_rows::<GODUNOV, false>(ctx, a, backwards, inf, threshold),
+                (InnerScheme::Godunov, true) => self.run_rows::<GODUNOV, true>(ctx, a, backwards, inf, threshold),
+                (InnerScheme::LaxFriedrichs, false) => self.run_rows::<LXF, false>(ctx, a, backwards, inf, threshold),
+                (InnerScheme::LaxFriedrichs, true) => self.run_rows::<LXF, true>(ctx, a, backwards, inf, threshold),
+                (InnerScheme::General(_), _) => self.run_rows::<GENERAL, false>(ctx, a, backwards, inf, threshold),
+            }
+        };
+        let id = ctx.sweep_id.load(Ordering::Relaxed);
+        strip_worker(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), ctx.tiles_done, id, next_strip, abandoned, &run_tile)
     }
 
     /// The rows of two independent tiles `a` and `b` (of one wave), each in order, with the
@@ -839,17 +872,73 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 }
 
-/// The strip pipeline of [`SweepProblem::sweep_strips`] on the current rayon pool: every thread
-/// takes the next strip and runs its tiles in order (`run_tile`), each once its upstream tile is
-/// done in sweep `id`, and marks it done. If a tile panics, the threads waiting for it give up,
-/// so that the panic reaches the caller instead of leaving them spinning.
-fn run_strip_pipeline(
+/// One thread's share of a pipelined sweep: take the next strip (`next_strip`) until none is
+/// left, run its tiles in order (`run_tile`), each once its upstream tile is done in sweep `id`,
+/// and mark it done. Gives up (returns early) when `abandoned` is raised, so that a panic on
+/// another thread reaches the caller instead of leaving this one spinning.
+#[allow(clippy::too_many_arguments)]
+fn strip_worker(
     strip_tiles: &[u32],
     strips: &[u32],
     upstream: &[u32],
     tiles_done: &[AtomicU32],
     id: u32,
-    run_tile: &(dyn Fn(usize) -> Accumulator + Sync),
+    next_strip: &AtomicUsize,
+    abandoned: &AtomicBool,
+    run_tile: &dyn Fn(usize) -> Accumulator,
+) -> Accumulator {
+    let mut acc = Accumulator::default();
+    let n_strips = strips.len().saturating_sub(1);
+    loop {
+        let s = next_strip.fetch_add(1, Ordering::Relaxed);
+        if s >= n_strips {
+            break;
+        }
+        for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
+            let up = upstream[t as usize];
+            if up != NO_TILE {
+                // the previous strip was taken earlier by a running thread
+                let done = &tiles_done[up as usize];
+                if !spin_until(|| done.load(Ordering::Acquire) == id, abandoned) {
+                    return acc;
+                }
+            }
+            acc = acc.merge(run_tile(t as usize));
+            tiles_done[t as usize].store(id, Ordering::Release);
+        }
+    }
+    acc
+}
+
+/// Spins until `ready()` (briefly, then yielding the core: the thread it waits for may have been
+/// descheduled); `false` if `abandoned` is raised first.
+#[inline]
+fn spin_until(ready: impl Fn() -> bool, abandoned: &AtomicBool) -> bool {
+    let mut spins = 0u32;
+    while !ready() {
+        if abandoned.load(Ordering::Acquire) {
+            return false;
+        }
+        spins += 1;
+        if spins < 2048 {
+            std::hint::spin_loop();
+        } else {
+            std::thread::yield_now();
+        }
+    }
+    true
+}
+
+/// `n_sweeps` pipelined sweeps on every thread of the current rayon pool in one broadcast: sweep
+/// `s` is `per_sweep(s, next_strip, abandoned)` on every thread, with its own strip counter and
+/// sweep id (the ids `ids` hands out), and a barrier after it; `between(s)` runs on one thread
+/// before sweep `s` (with a barrier after it). A panic on one thread raises `abandoned`, which
+/// makes the others leave their waits, so the panic reaches the caller.
+fn run_sweeps_in_one_broadcast(
+    n_sweeps: usize,
+    ids: &AtomicU32,
+    per_sweep: &(dyn Fn(usize, &AtomicUsize, &AtomicBool) -> Accumulator + Sync),
+    between: &(dyn Fn(usize) + Sync),
 ) -> Accumulator {
     /// Raises `abandoned` when dropped by a panic.
     struct RaiseOnPanic<'a>(&'a AtomicBool);
@@ -860,43 +949,57 @@ fn run_strip_pipeline(
             }
         }
     }
-    let next_strip = AtomicUsize::new(0);
+    let threads = rayon::current_num_threads();
+    let next_strip: Vec<AtomicUsize> = (0..n_sweeps).map(|_| AtomicUsize::new(0)).collect();
     let abandoned = AtomicBool::new(false);
-    let n_strips = strips.len().saturating_sub(1);
-    let work = || {
+    let barrier = SpinBarrier::new(threads);
+    rayon::broadcast(|b| {
         let _raise = RaiseOnPanic(&abandoned);
         let mut acc = Accumulator::default();
-        loop {
-            let s = next_strip.fetch_add(1, Ordering::Relaxed);
-            if s >= n_strips {
-                break;
+        for s in 0..n_sweeps {
+            if b.index() == 0 {
+                between(s);
+                // the sweep's id: one past the last (ids start at 1, the done flags at 0)
+                ids.fetch_add(1, Ordering::Relaxed);
             }
-            for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
-                let up = upstream[t as usize];
-                if up != NO_TILE {
-                    // the previous strip was taken earlier by a running thread: wait, spinning
-                    // briefly, then yielding the core (its thread may have been descheduled)
-                    let done = &tiles_done[up as usize];
-                    let mut spins = 0u32;
-                    while done.load(Ordering::Acquire) != id {
-                        if abandoned.load(Ordering::Acquire) {
-                            return acc;
-                        }
-                        spins += 1;
-                        if spins < 2048 {
-                            std::hint::spin_loop();
-                        } else {
-                            std::thread::yield_now();
-                        }
-                    }
-                }
-                acc = acc.merge(run_tile(t as usize));
-                tiles_done[t as usize].store(id, Ordering::Release);
+            if !barrier.wait(&abandoned) {
+                return acc;
+            }
+            acc = acc.merge(per_sweep(s, &next_strip[s], &abandoned));
+            // every tile of this sweep is done before any of the next starts
+            if !barrier.wait(&abandoned) {
+                return acc;
             }
         }
         acc
-    };
-    rayon::broadcast(|_| work()).into_iter().fold(Accumulator::default(), Accumulator::merge)
+    })
+    .into_iter()
+    .fold(Accumulator::default(), Accumulator::merge)
+}
+
+/// A barrier for the threads of one broadcast that spins instead of sleeping.
+struct SpinBarrier {
+    threads: usize,
+    arrived: AtomicUsize,
+    generation: AtomicUsize,
+}
+
+impl SpinBarrier {
+    fn new(threads: usize) -> Self {
+        SpinBarrier { threads, arrived: AtomicUsize::new(0), generation: AtomicUsize::new(0) }
+    }
+
+    /// Waits until all threads arrived; what each did before is visible to all after.
+    /// `false` if `abandoned` is raised first.
+    fn wait(&self, abandoned: &AtomicBool) -> bool {
+        let generation = self.generation.load(Ordering::Acquire);
+        if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.threads {
+            self.arrived.store(0, Ordering::Relaxed);
+            self.generation.fetch_add(1, Ordering::AcqRel);
+            return true;
+        }
+        spin_until(|| self.generation.load(Ordering::Acquire) != generation, abandoned)
+    }
 }
 
 /// A value change proposed by [`SweepProblem::local_update`].
@@ -1345,32 +1448,45 @@ mod tests {
 
     #[test]
     fn a_panic_in_a_tile_of_the_strip_pipeline_reaches_the_caller_instead_of_hanging() {
-        // two strips of three tiles, each tile of the second waiting for the one above it
+        // two strips of three tiles, each tile of the second waiting for the one above it; three
+        // sweeps in one broadcast, with the ids the sweeps hand out
         let strip_tiles = [0u32, 1, 2, 3, 4, 5];
         let strips = [0u32, 3, 6];
         let upstream = [NO_TILE, NO_TILE, NO_TILE, 0, 1, 2];
-        let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-        // a clean run visits every tile once
-        let acc = pool.install(|| {
-            run_strip_pipeline(&strip_tiles, &strips, &upstream, &done, 1, &|_| Accumulator { max_change: 0.0, updates: 1 })
-        });
-        assert_eq!(acc.updates, 6);
-        assert!(done.iter().all(|d| d.load(Ordering::Relaxed) == 1));
-        // tile 1 panics: the thread waiting for it must give up, and the panic come out
+        let run = move |panic_in: Option<(usize, usize)>| -> (Accumulator, Vec<u32>, usize) {
+            let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
+            let ids = AtomicU32::new(0);
+            let between_calls = AtomicUsize::new(0);
+            let acc = pool.install(|| {
+                run_sweeps_in_one_broadcast(
+                    3,
+                    &ids,
+                    &|s, next, abandoned| {
+                        let id = ids.load(Ordering::Relaxed);
+                        strip_worker(&strip_tiles, &strips, &upstream, &done, id, next, abandoned, &|t| {
+                            if panic_in == Some((s, t)) {
+                                panic!("sweep {s}, tile {t}");
+                            }
+                            Accumulator { max_change: 0.0, updates: 1 }
+                        })
+                    },
+                    &|_| {
+                        between_calls.fetch_add(1, Ordering::Relaxed);
+                    },
+                )
+            });
+            (acc, done.iter().map(|d| d.load(Ordering::Relaxed)).collect(), between_calls.load(Ordering::Relaxed))
+        };
+        // a clean run visits every tile once per sweep, the last sweep's id is 3
+        let (acc, done, between) = run(None);
+        assert_eq!((acc.updates, between), (18, 3));
+        assert!(done.iter().all(|&d| d == 3), "{done:?}");
+        // a tile of the second sweep panics: the threads waiting for it (at the tile or the
+        // barrier) must give up, and the panic come out
         let (tx, rx) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
-            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool.install(|| {
-                    run_strip_pipeline(&strip_tiles, &strips, &upstream, &done, 1, &|t| {
-                        if t == 1 {
-                            panic!("tile 1");
-                        }
-                        Accumulator::default()
-                    })
-                })
-            }));
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(Some((1, 1)))));
             tx.send(r.is_err()).unwrap();
         });
         let panicked = rx.recv_timeout(std::time::Duration::from_secs(20)).expect("the pipeline hung");
