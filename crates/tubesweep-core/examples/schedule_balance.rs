@@ -5,6 +5,9 @@
 //! by event; and, for comparison, waves separated by barriers with the tiles of a wave spread
 //! greedily, largest first. Deterministic: no timing.
 //!   cargo run --release --example schedule_balance -- 101 201 401
+#[path = "common/shell.rs"]
+mod shell;
+
 use tubesweep_core::NarrowBand;
 
 /// Largest-first assignment of `items` (work per task) to `threads`: the busiest thread's work.
@@ -44,19 +47,7 @@ fn main() {
     let sizes: Vec<usize> = std::env::args().skip(1).filter_map(|s| s.parse().ok()).collect();
     let sizes = if sizes.is_empty() { vec![101, 201, 401] } else { sizes };
     for n in sizes {
-        let h = 2.0 / (n - 1) as f64;
-        let mut lin = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
-                    let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                    if (r - 0.5).abs() <= 4.0 * h {
-                        lin.push(((i * n + j) * n + k) as u64);
-                    }
-                }
-            }
-        }
+        let lin = shell::sphere_shell(n).0;
         let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
         let sched = band.schedule();
         for threads in [2usize, 4] {

@@ -3,6 +3,9 @@
 //!   cargo run --release --example sphere -- 101 godunov 1 [coupled|pointwise]
 //!   (VERBOSE=1 prints every iteration; THR and TOL set the activation threshold and tolerance)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
+#[path = "common/shell.rs"]
+mod shell;
+
 use std::time::Instant;
 use tubesweep_core::sweep::{Extension, MissingNeighbour, Slowness};
 use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SweepProblem};
@@ -17,25 +20,7 @@ fn main() {
     let threads: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
     let coupled = args.get(4).map_or(true, |s| s != "pointwise");
     let defer_outer_rim = std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
-    let h = 2.0 / (n - 1) as f64;
-    let mut lin = Vec::new();
-    let mut roles = Vec::new();
-    let mut dirs = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            for k in 0..n {
-                let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
-                let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                let phi = r - 0.5;
-                if phi.abs() <= 4.0 * h {
-                    lin.push(((i * n + j) * n + k) as u64);
-                    roles.push(if phi.abs() <= 2.0 * h { NodeRole::Inner } else { NodeRole::Outer });
-                    let s = phi.signum() / r;
-                    dirs.push([(x[0] * s) as f32, (x[1] * s) as f32, (x[2] * s) as f32]);
-                }
-            }
-        }
-    }
+    let (lin, mut roles, dirs, h) = shell::sphere_shell(n);
     let t = Instant::now();
     let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
     let build = t.elapsed().as_secs_f64();

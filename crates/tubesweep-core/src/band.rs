@@ -479,20 +479,7 @@ mod tests {
     #[test]
     fn strip_pipeline_orders_every_pair_of_neighbour_rows() {
         let n = 61usize;
-        let h = 2.0 / (n - 1) as f64;
-        let mut lin = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
-                    let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                    if (r - 0.6).abs() <= 4.0 * h {
-                        lin.push(((i * n + j) * n + k) as u64);
-                    }
-                }
-            }
-        }
-        let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
+        let band = crate::test_bands::shell_band(n, 0.6, &[0.0]).0;
         let sched = band.schedule();
         for signs in 0..4 {
             let (rows, tiles) = (sched.rows(signs), sched.tiles(signs));

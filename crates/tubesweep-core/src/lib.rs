@@ -36,6 +36,8 @@ pub mod mesh;
 pub mod normals;
 pub mod schedule;
 pub mod sweep;
+#[cfg(test)]
+mod test_bands;
 
 pub use band::NarrowBand;
 pub use error::{Error, Result};

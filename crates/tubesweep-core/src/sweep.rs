@@ -1132,6 +1132,7 @@ fn fill_missing<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_bands::shell_band;
     use crate::hamiltonian::IsotropicEikonal;
 
     fn box_problem<'a>(band: &'a NarrowBand<2>, roles: &'a [NodeRole], scheme: InnerScheme<'a, 2>, h: f64) -> SweepProblem<'a, 2> {
@@ -1186,32 +1187,30 @@ mod tests {
         assert!(diff < 1e-9, "diff {diff}");
     }
 
-    /// A sphere of radius 0.5 in [−1,1]^3: nodes with ||x|−0.5| ≤ 4h, inner within 2h, radial
-    /// extension directions, source node nearest (−0.5, 0, 0).
+    /// A sphere of radius 0.5 in [−1,1]^3 (`shell_band`), source node nearest (−0.5, 0, 0).
     fn sphere_band(n: usize) -> (NarrowBand<3>, Vec<NodeRole>, Vec<[f32; 3]>, f64) {
-        let h = 2.0 / (n - 1) as f64;
-        let mut lin = Vec::new();
-        let mut roles = Vec::new();
-        let mut dirs = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
-                    let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                    let phi = r - 0.5;
-                    if phi.abs() <= 4.0 * h {
-                        lin.push(((i * n + j) * n + k) as u64);
-                        roles.push(if phi.abs() <= 2.0 * h { NodeRole::Inner } else { NodeRole::Outer });
-                        let s = phi.signum() / r;
-                        dirs.push([(x[0] * s) as f32, (x[1] * s) as f32, (x[2] * s) as f32]);
-                    }
-                }
-            }
-        }
-        let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
+        let (band, mut roles, dirs, h) = shell_band(n, 0.5, &[0.0]);
         let src = band.find([(n / 4) as i64, (n / 2) as i64, (n / 2) as i64]).unwrap();
         roles[src] = NodeRole::Fixed;
         (band, roles, dirs, h)
+    }
+
+    /// Solves `p` with 1 thread and with each of `threads`, asserting the same iterations, local
+    /// updates and bits; returns the one-thread solution.
+    fn assert_same_bits_for_threads(p: &SweepProblem<'_, 3>, threads: &[usize]) -> Vec<f64> {
+        let run = |threads: usize| {
+            let mut u = vec![0.0; p.band.len()];
+            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged);
+            (u, st.iterations, st.updates)
+        };
+        let (a, ia, ua) = run(1);
+        for &t in threads {
+            let (b, ib, ub) = run(t);
+            assert_eq!((ia, ua), (ib, ub));
+            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
+        a
     }
 
     fn sphere_problem<'a>(
@@ -1361,18 +1360,7 @@ mod tests {
             assert!(sched.waves(lead).windows(2).any(|w| w[1] - w[0] >= 4));
         }
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let run = |threads: usize| {
-            let mut u = vec![0.0; band.len()];
-            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
-            assert!(st.converged);
-            (u, st.iterations, st.updates)
-        };
-        let (a, ia, ua) = run(1);
-        for threads in [2, 3] {
-            let (b, ib, ub) = run(threads);
-            assert_eq!((ia, ua), (ib, ub));
-            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
-        }
+        assert_same_bits_for_threads(&p, &[2, 3]);
     }
 
     #[test]
@@ -1380,29 +1368,8 @@ mod tests {
         // two spheres apart along the first axis: whole strips of tiles between them are empty,
         // so the tiles next to the gap have no upstream tile
         let n = 97usize;
-        let h = 2.0 / (n - 1) as f64;
         let (r0, centres) = (0.22, [-0.55, 0.55]);
-        let mut lin = Vec::new();
-        let mut roles = Vec::new();
-        let mut dirs = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
-                    let c = if x[0] < 0.0 { centres[0] } else { centres[1] };
-                    let d = [x[0] - c, x[1], x[2]];
-                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    let phi = r - r0;
-                    if phi.abs() <= 4.0 * h {
-                        lin.push(((i * n + j) * n + k) as u64);
-                        roles.push(if phi.abs() <= 2.0 * h { NodeRole::Inner } else { NodeRole::Outer });
-                        let s = phi.signum() / r;
-                        dirs.push([(d[0] * s) as f32, (d[1] * s) as f32, (d[2] * s) as f32]);
-                    }
-                }
-            }
-        }
-        let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
+        let (band, mut roles, dirs, h) = shell_band(n, r0, &centres);
         for c in centres {
             let i = ((c - r0 + 1.0) / h).round() as i64;
             let src = band.find([i, (n / 2) as i64, (n / 2) as i64]).unwrap();
@@ -1415,19 +1382,8 @@ mod tests {
             (0..strips.len() - 1).filter(|&s| strip_tiles[strips[s] as usize..strips[s + 1] as usize].iter().all(|&t| upstream[t as usize] == NO_TILE)).count();
         assert!(strips_without_upstream >= 2, "{strips_without_upstream}");
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let run = |threads: usize| {
-            let mut u = vec![0.0; band.len()];
-            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
-            assert!(st.converged);
-            (u, st.iterations, st.updates)
-        };
-        let (a, ia, ua) = run(1);
+        let a = assert_same_bits_for_threads(&p, &[2, 3]);
         assert!(a.iter().all(|v| v.is_finite() && *v < 2.0));
-        for threads in [2, 3] {
-            let (b, ib, ub) = run(threads);
-            assert_eq!((ia, ua), (ib, ub));
-            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
-        }
         // an empty band solves to nothing, in parallel too
         let empty = NarrowBand::<3>::from_sorted_linear([9, 9, 9], &[]).unwrap();
         let p = SweepProblem {
