@@ -1,5 +1,6 @@
 """The sweep variants side by side: the paper's pointwise sweeps, the outer rim swept last, the
-coupled Godunov update, and both (the default), on the Rust sphere example.
+coupled Godunov update, both, and both behind the front window (the default), on the Rust sphere
+example.
 
 The variants solve the same discrete equations; this measures what each costs. Runs are
 interleaved (one run of every variant, then the next round), so that a drift in the machine's
@@ -9,7 +10,8 @@ paper sweeps' median over each variant's median ("× paper" > 1: faster than the
     .venv/bin/python benches/sweep_variants.py [--sizes 201,401] [--threads 1,2] [--repeats 5]
 
 It builds and runs ``cargo run --release --example sphere -- N godunov THREADS [coupled|pointwise]``
-(``RIM_IN_EVERY_SWEEP=1`` sweeps the rim in every iteration).
+(``RIM_IN_EVERY_SWEEP=1`` sweeps the rim in every iteration; ``WINDOW=c`` sets
+``SolveOptions::front_window``, 0 switches it off).
 """
 
 from __future__ import annotations
@@ -26,20 +28,22 @@ from typing import Dict, List, Optional, Sequence, Tuple
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "target" / "release" / "examples" / "sphere"
 
-#: name -> (coupled, rim swept last)
-VARIANTS: Dict[str, Tuple[bool, bool]] = {
-    "paper": (False, False),
-    "rim last": (False, True),
-    "coupled": (True, False),
-    "default": (True, True),
+#: name -> (coupled, rim swept last, front window)
+VARIANTS: Dict[str, Tuple[bool, bool, float]] = {
+    "paper": (False, False, 0.0),
+    "rim last": (False, True, 0.0),
+    "coupled": (True, False, 0.0),
+    "both": (True, True, 0.0),
+    "default": (True, True, 3.0),
 }
 
 LINE = re.compile(r"iterations=(\d+) updates=(\d+) sweeps=([0-9.]+)s")
 
 
-def run_once(n: int, threads: int, coupled: bool, rim_last: bool) -> Tuple[int, int, float]:
+def run_once(n: int, threads: int, coupled: bool, rim_last: bool, window: float) -> Tuple[int, int, float]:
     env = dict(os.environ)
     env.pop("RIM_IN_EVERY_SWEEP", None)
+    env["WINDOW"] = repr(window)
     if not rim_last:
         env["RIM_IN_EVERY_SWEEP"] = "1"
     cmd = [str(EXAMPLE), str(n), "godunov", str(threads), "coupled" if coupled else "pointwise"]
@@ -65,8 +69,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             times: Dict[str, List[float]] = {v: [] for v in VARIANTS}
             work: Dict[str, Tuple[int, int]] = {}
             for _ in range(a.repeats):
-                for name, (coupled, rim_last) in VARIANTS.items():
-                    it, up, sec = run_once(n, t, coupled, rim_last)
+                for name, (coupled, rim_last, window) in VARIANTS.items():
+                    it, up, sec = run_once(n, t, coupled, rim_last, window)
                     times[name].append(sec)
                     work[name] = (it, up)
             paper = statistics.median(times["paper"])

@@ -257,9 +257,9 @@ def test_lxf_with_a_source_in_a_grid_corner_stays_positive_and_converges():
 
 @pytest.mark.parametrize("dim,ham", [(2, "godunov"), (3, "godunov"), (3, "lxf")])
 def test_accelerated_sweeps_give_the_papers_solution_with_less_work(dim, ham):
-    """The default sweeps (the coupled Godunov update, the outer rim swept last) solve the same
-    discrete equations as the paper's plain sweeps: the same solution to about tol, with fewer
-    local updates."""
+    """The default sweeps (the coupled Godunov update, the outer rim swept last and, with Godunov,
+    the front window) solve the same discrete equations as the paper's plain sweeps: the same
+    solution to about tol, with fewer local updates."""
     if dim == 2:
         surf, grid, src = Circle(0.5), ts.Grid((-1, -1), (1, 1), (201, 201)), [(-0.5, 0.0)]
     else:
@@ -271,9 +271,10 @@ def test_accelerated_sweeps_give_the_papers_solution_with_less_work(dim, ham):
     assert np.max(np.abs(fast.values - paper.values)) < 1e-9
     assert fast.stats.updates < 0.8 * paper.stats.updates
     if ham == "godunov":
-        # the coupled update saves whole iterations, more than the rim's two passes at the end
-        # (measured: circle N=201 16 against 37, sphere N=81 12 against 13)
-        assert fast.stats.iterations <= paper.stats.iterations
+        # The front window trades iterations (cheap ones, over a part of the band) for updates:
+        # measured 0.16 of the paper's updates on the circle at N=201, 0.41 on the sphere at N=81
+        # (the coupled update and the rim alone: 0.6–0.8).
+        assert fast.stats.updates < 0.5 * paper.stats.updates
 
 
 def test_a_surface_that_caches_its_band_geometry_is_not_modified_by_the_solver():

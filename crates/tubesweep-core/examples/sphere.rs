@@ -1,7 +1,8 @@
 //! Solves the two-layer problem on a sphere of radius 0.5 in [−1,1]^3 and prints the work done.
 //! Used for profiling the sweep kernel:
 //!   cargo run --release --example sphere -- 101 godunov 1 [coupled|pointwise]
-//!   (VERBOSE=1 prints every iteration; THR and TOL set the activation threshold and tolerance)
+//!   (VERBOSE=1 prints every iteration; THR, TOL and WINDOW set the activation threshold, the
+//!   tolerance and the front window, `SolveOptions::front_window`)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
 #[path = "common/shell.rs"]
 mod shell;
@@ -38,7 +39,9 @@ fn main() {
     let mut u = vec![0.0; band.len()];
     let thr: f64 = std::env::var("THR").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-12);
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
-    let opts = SolveOptions { threads, activation_threshold: thr, tol, coupled, defer_outer_rim, ..Default::default() };
+    let front_window: f64 =
+        std::env::var("WINDOW").ok().and_then(|s| s.parse().ok()).unwrap_or(tubesweep_core::sweep::DEFAULT_FRONT_WINDOW);
+    let opts = SolveOptions { threads, activation_threshold: thr, tol, coupled, defer_outer_rim, front_window, ..Default::default() };
     let verbose = std::env::var_os("VERBOSE").is_some();
     let t0 = Instant::now();
     let st = p
@@ -57,7 +60,7 @@ fn main() {
         .unwrap();
     let far = band.find([(3 * (n - 1) / 4) as i64, ((n - 1) / 2) as i64, ((n - 1) / 2) as i64]).unwrap();
     println!(
-        "N={n} coupled={coupled} rim_last={defer_outer_rim} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5}",
+        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5}",
         band.len(),
         st.iterations,
         st.updates,

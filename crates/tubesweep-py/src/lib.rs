@@ -500,7 +500,7 @@ impl PyBand {
     /// Runs the sweeps. See `tubesweep_core::sweep`. The fixed nodes (role 0) start from
     /// `fixed_values` at the band positions `fixed_positions` (both (F,); a fixed node not listed
     /// starts from 0).
-    #[pyo3(signature = (roles, fixed_positions, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true, defer_outer_rim=true))]
+    #[pyo3(signature = (roles, fixed_positions, fixed_values, spacing, slowness, directions, scheme, missing, tol, max_iterations, infinity, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, coupled=true, defer_outer_rim=true, front_window=0.0))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &self,
@@ -522,13 +522,17 @@ impl PyBand {
         activation_threshold: f64,
         coupled: bool,
         defer_outer_rim: bool,
+        front_window: f64,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let scheme = parse_scheme(scheme)?;
         let missing = parse_missing(missing)?;
         if !(activation_threshold >= 0.0) {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim };
+        if !(front_window >= 0.0 && front_window.is_finite()) {
+            return Err(PyValueError::new_err("front_window must be a non-negative finite number (0 switches the window off)"));
+        }
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim, front_window };
         let roles = roles.as_slice()?;
         let fixed = FixedNodes { positions: fixed_positions.as_slice()?, values: fixed_values.as_slice()? };
         match &self.band {
@@ -572,7 +576,7 @@ impl PyBand {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
         // the coupled update is Godunov's; the general Hamiltonians use Lax–Friedrichs
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false, defer_outer_rim };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false, defer_outer_rim, front_window: 0.0 };
         let inputs = GeneralInputs {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,
