@@ -405,15 +405,16 @@ def solve(
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
     # held per node during the sweeps: values (f64), role, active flag and coupling mask, φ (f32),
-    # extension weights (d × f32), per-node slowness (f64) when the speed varies; the fixed values
-    # are sparse. (With the rim swept last the core also holds two role copies and a rim mask,
-    # 3 bytes per node, while it runs.)
+    # extension weights (d × f32), per-node slowness (f64) when the speed varies; per row a lower
+    # bound of its values (f64, for the front window); the fixed values are sparse. (With the rim
+    # swept last the core also holds two role copies and a rim mask, 3 bytes per node, while it
+    # runs.)
     per_node = 8 + 1 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0)
     stats = SolveStats(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
         inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
-        setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles),
+        setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
                     float(inner), outer_eff)
