@@ -257,6 +257,39 @@ impl<const D: usize> NarrowBand<D> {
         self.last[s..e].binary_search(&(l as u32)).ok().map(|p| s + p)
     }
 
+    /// The rows next to each row along the leading axes: `2 (D − 1)` entries per row, the minus
+    /// and plus neighbour row along each leading axis, [`n_rows`](Self::n_rows) where there is
+    /// none. A node's neighbours along the leading axes lie in these rows (its neighbours along
+    /// the last axis in its own row). One merge pass over the sorted row keys per direction.
+    pub fn row_neighbours(&self) -> Vec<u32> {
+        let rows = self.n_rows();
+        let per = 2 * (D - 1);
+        let mut out = vec![rows as u32; rows * per];
+        let mut stride = 1u64;
+        for k in (0..D - 1).rev() {
+            // the lead coordinate k of a row key is (key / stride) % shape[k]
+            let extent = self.shape[k] as u64;
+            // plus neighbours: key + stride, searched with a pointer that only moves forward
+            let mut q = 0usize;
+            for r in 0..rows {
+                let key = self.row_keys[r];
+                if (key / stride) % extent + 1 >= extent {
+                    continue;
+                }
+                let want = key + stride;
+                while q < rows && self.row_keys[q] < want {
+                    q += 1;
+                }
+                if q < rows && self.row_keys[q] == want {
+                    out[r * per + 2 * k + 1] = q as u32;
+                    out[q * per + 2 * k] = r as u32;
+                }
+            }
+            stride *= extent;
+        }
+        out
+    }
+
     fn row_lead(&self, r: usize) -> [usize; D] {
         let mut key = self.row_keys[r] as usize;
         let mut lead = [0usize; D];
@@ -400,6 +433,53 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Every neighbour of a node along a leading axis lies in the row `row_neighbours` names for
+    /// the node's row, and each named row is the one whose lead differs by one along that axis.
+    fn assert_row_neighbours_hold<const D: usize>(band: &NarrowBand<D>) {
+        let rows = band.row_neighbours();
+        let per = 2 * (D - 1);
+        assert_eq!(rows.len(), band.n_rows() * per);
+        let mut row_of = vec![0usize; band.len()];
+        for r in 0..band.n_rows() {
+            let (s, e) = band.row_range(r);
+            row_of[s..e].iter_mut().for_each(|x| *x = r);
+        }
+        for r in 0..band.n_rows() {
+            let lead = band.row_lead(r);
+            for k in 0..D - 1 {
+                for side in 0..2 {
+                    let q = rows[r * per + 2 * k + side] as usize;
+                    let mut want = [0i64; D];
+                    for j in 0..D - 1 {
+                        want[j] = lead[j] as i64;
+                    }
+                    want[k] += if side == 0 { -1 } else { 1 };
+                    let exists = (0..band.n_rows()).find(|&p| (0..D - 1).all(|j| band.row_lead(p)[j] as i64 == want[j]));
+                    assert_eq!(exists.unwrap_or(band.n_rows()), q, "row {r} axis {k} side {side}");
+                }
+            }
+            let (s, e) = band.row_range(r);
+            for n in s..e {
+                let nb = band.neighbours_of(n);
+                for k in 0..D - 1 {
+                    for side in 0..2 {
+                        if nb[k][side] != band.sentinel() {
+                            assert_eq!(row_of[nb[k][side] as usize], rows[r * per + 2 * k + side] as usize);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn row_neighbours_name_the_rows_of_the_lead_neighbours() {
+        assert_row_neighbours_hold(&NarrowBand::<3>::full_box([4, 5, 3]).unwrap());
+        assert_row_neighbours_hold(&NarrowBand::<2>::full_box([6, 4]).unwrap());
+        let (shell, ..) = crate::test_bands::shell_band(21, 0.5, &[-0.45, 0.45]);
+        assert_row_neighbours_hold(&shell);
     }
 
     #[test]

@@ -553,6 +553,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             })
             .collect();
         let row_low_shared = SharedValues { ptr: row_low.as_mut_ptr(), len: row_low.len() };
+        // per row: may a node be active (all at the start; the last slot stands for "no row")
+        let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
+        let row_neighbours = self.band.row_neighbours();
         let shared = SharedValues { ptr: u.as_mut_ptr(), len: u.len() };
         let all_active = !options.skip_inactive;
         // Upwind weights of the extension update, once per solve (the band does not change).
@@ -578,6 +581,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         };
         let ctx = SweepContext {
             row_low: &row_low_shared,
+            row_dirty: &row_dirty,
+            row_neighbours: &row_neighbours,
             u: &shared,
             active: &active,
             weights,
@@ -614,6 +619,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     if weights.get(n).map_or(true, |w| !w[0].is_nan()) {
                         a.store(1, Ordering::Relaxed);
                     }
+                }
+                for d in &row_dirty {
+                    d.store(1, Ordering::Relaxed);
                 }
             };
             if let Some(p) = &pool {
@@ -765,41 +773,44 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let common = a.len().min(b.len());
         for i in 0..common {
             let (ra, rb) = (a[i] as usize, b[i] as usize);
-            if ctx.row_low.get(ra) > lim.window || ctx.row_low.get(rb) > lim.window {
-                // a row beyond the front window is skipped whole: run the other alone
+            if !ctx.row_runs(ra, lim) || !ctx.row_runs(rb, lim) {
+                // a row with nothing to do is skipped whole: run the other alone
                 self.run_row::<S, P>(ctx, ra, backwards, lim, &mut acc);
                 self.run_row::<S, P>(ctx, rb, backwards, lim, &mut acc);
                 continue;
             }
+            ctx.take_row(ra, lim);
+            ctx.take_row(rb, lim);
             let (sa, ea) = self.band.row_range(ra);
             let (sb, eb) = self.band.row_range(rb);
             let m = (ea - sa).min(eb - sb);
             let (mut low_a, mut low_b) = (f64::INFINITY, f64::INFINITY);
+            let (mut marks_a, mut marks_b) = (0u8, 0u8);
             if backwards {
                 for j in 1..=m {
-                    self.visit::<S, P>(ctx, ea - j, lim, &mut acc, &mut low_a);
-                    self.visit::<S, P>(ctx, eb - j, lim, &mut acc, &mut low_b);
+                    self.visit::<S, P>(ctx, ea - j, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P>(ctx, eb - j, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
                 for n in (sa..ea - m).rev() {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_a);
+                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
                 }
                 for n in (sb..eb - m).rev() {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_b);
+                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
             } else {
                 for j in 0..m {
-                    self.visit::<S, P>(ctx, sa + j, lim, &mut acc, &mut low_a);
-                    self.visit::<S, P>(ctx, sb + j, lim, &mut acc, &mut low_b);
+                    self.visit::<S, P>(ctx, sa + j, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P>(ctx, sb + j, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
                 for n in sa + m..ea {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_a);
+                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
                 }
                 for n in sb + m..eb {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_b);
+                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
             }
-            ctx.lower_row_low(ra, low_a);
-            ctx.lower_row_low(rb, low_b);
+            ctx.finish_row(ra, low_a, marks_a);
+            ctx.finish_row(rb, low_b, marks_b);
         }
         acc.merge(self.run_rows::<S, P>(ctx, &a[common..], backwards, lim))
             .merge(self.run_rows::<S, P>(ctx, &b[common..], backwards, lim))
@@ -821,30 +832,34 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         acc
     }
 
-    /// One row, in sweep order; skipped whole when all its values lie beyond the front window.
+    /// One row, in sweep order; skipped whole when none of its nodes is active (its dirty flag
+    /// is clear) or all its values lie beyond the front window.
     #[inline(always)]
     fn run_row<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
-        if ctx.row_low.get(r) > lim.window {
+        if !ctx.take_row(r, lim) {
             return;
         }
         let (s, e) = self.band.row_range(r);
         let mut low = f64::INFINITY;
+        let mut marks = 0u8;
         if backwards {
             for n in (s..e).rev() {
-                self.visit::<S, P>(ctx, n, lim, acc, &mut low);
+                self.visit::<S, P>(ctx, n, lim, acc, &mut low, &mut marks);
             }
         } else {
             for n in s..e {
-                self.visit::<S, P>(ctx, n, lim, acc, &mut low);
+                self.visit::<S, P>(ctx, n, lim, acc, &mut low, &mut marks);
             }
         }
-        ctx.lower_row_low(r, low);
+        ctx.finish_row(r, low, marks);
     }
 
     #[inline(always)]
     /// Updates node `n` if it is active (and within the front window), re-activates its
     /// neighbours when it changed by more than the threshold, and lowers `low` to its new value.
-    fn visit<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64) {
+    /// `row` collects what the row's dirty flags need: [`KEEP_ROW`] when the node stays active,
+    /// [`WAKE_ROWS`] when it activated its neighbours.
+    fn visit<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
         let active = ctx.active;
         // SAFETY: n < band.len(); active has that length plus the sentinel slot.
         let flag = unsafe { active.get_unchecked(n) };
@@ -855,6 +870,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         }
         // beyond the front window: stays active for a later iteration (see `Limits::window`)
         if ctx.u.get(n) > lim.window {
+            *row |= KEEP_ROW;
             return;
         }
         flag.store(0, Ordering::Relaxed);
@@ -864,6 +880,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let Some(up) = self.local_update::<S, P>(ctx, n, &nb, lim.inf) else { return };
         if up.self_dependent {
             flag.store(1, Ordering::Relaxed);
+            *row |= KEEP_ROW;
         }
         let c = up.change();
         if c > acc.max_change {
@@ -879,6 +896,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if c <= lim.threshold {
             return;
         }
+        *row |= WAKE_ROWS;
         for k in 0..D {
             unsafe {
                 active.get_unchecked(nb[k][0] as usize).store(1, Ordering::Relaxed);
@@ -1158,13 +1176,56 @@ struct SweepContext<'a, const D: usize> {
     /// decrease with Godunov): a row above the front window is skipped whole. Written only by the
     /// thread that runs the row, like the row's values.
     row_low: &'a SharedValues,
+    /// Per row (and a last slot for "no row"), set while a node of the row may be active: a row
+    /// whose flag is clear is skipped whole. Set for every row at the start; cleared when the row
+    /// is run; set again for the row when a node stays active, and for the row and the rows next
+    /// to it along the leading axes ([`NarrowBand::row_neighbours`]) when a node activates its
+    /// neighbours. Those rows are never run at the same time as the row (see
+    /// [`crate::schedule`]), so no activation is missed.
+    row_dirty: &'a [AtomicU8],
+    /// [`NarrowBand::row_neighbours`].
+    row_neighbours: &'a [u32],
 }
 
+/// A node of the row stays active: the row stays dirty.
+const KEEP_ROW: u8 = 1;
+/// A node of the row activated its neighbours: the row and the rows next to it become dirty.
+const WAKE_ROWS: u8 = 2;
+
 impl<const D: usize> SweepContext<'_, D> {
+    /// Whether row `r` has anything to do: a node may be active and not all its values lie
+    /// beyond the front window.
     #[inline(always)]
-    fn lower_row_low(&self, r: usize, low: f64) {
+    fn row_runs(&self, r: usize, lim: Limits) -> bool {
+        // SAFETY: r < n_rows; row_dirty has n_rows + 1 entries
+        unsafe { self.row_dirty.get_unchecked(r) }.load(Ordering::Relaxed) != 0 && self.row_low.get(r) <= lim.window
+    }
+
+    /// [`row_runs`](Self::row_runs), clearing the row's dirty flag when it does.
+    #[inline(always)]
+    fn take_row(&self, r: usize, lim: Limits) -> bool {
+        if !self.row_runs(r, lim) {
+            return false;
+        }
+        unsafe { self.row_dirty.get_unchecked(r) }.store(0, Ordering::Relaxed);
+        true
+    }
+
+    /// After row `r` ran: lowers its bound to `low` and sets the dirty flags `marks` asks for.
+    #[inline(always)]
+    fn finish_row(&self, r: usize, low: f64, marks: u8) {
         if low < self.row_low.get(r) {
             self.row_low.set(r, low);
+        }
+        if marks != 0 {
+            unsafe { self.row_dirty.get_unchecked(r) }.store(1, Ordering::Relaxed);
+        }
+        if marks & WAKE_ROWS != 0 {
+            let per = 2 * (D - 1);
+            for &q in &self.row_neighbours[r * per..(r + 1) * per] {
+                // SAFETY: entries are < n_rows or the last slot n_rows
+                unsafe { self.row_dirty.get_unchecked(q as usize) }.store(1, Ordering::Relaxed);
+            }
         }
     }
 }
