@@ -270,10 +270,13 @@ def test_accelerated_sweeps_give_the_papers_solution_with_less_work(dim, ham):
     np.testing.assert_array_equal(fast.indices, paper.indices)
     assert np.max(np.abs(fast.values - paper.values)) < 1e-9
     assert fast.stats.updates < 0.8 * paper.stats.updates
-    if ham == "godunov":
-        # The front window trades iterations (cheap ones, over a part of the band) for updates:
-        # measured 0.16 of the paper's updates on the circle at N=201, 0.41 on the sphere at N=81
-        # (the coupled update and the rim alone: 0.6–0.8).
+    if ham == "godunov" and dim == 2:
+        # the coupled update saves whole iterations, more than the rim's two passes at the end
+        # (measured: circle N=201 16 against 37)
+        assert fast.stats.iterations <= paper.stats.iterations
+    if ham == "godunov" and dim == 3:
+        # on surfaces the front window trades iterations (cheap ones, over a part of the band) for
+        # updates: measured 0.41 of the paper's updates on the sphere at N=81
         assert fast.stats.updates < 0.5 * paper.stats.updates
 
 
@@ -333,3 +336,20 @@ def test_a_tolerance_tied_to_the_grid_stops_earlier_within_a_few_tol_of_the_conv
     e_full = np.max(np.abs(full(pts) - exact))
     e_loose = np.max(np.abs(loose(pts) - exact))
     assert abs(e_loose - e_full) <= 3 * tol < 0.01 * e_full
+
+
+def test_a_solve_stopped_before_the_front_window_opened_says_so():
+    """With Godunov on a surface the sweeps follow the converged region out from the source; a
+    solve cut short by max_iterations reports where that front window stood, and the warning
+    says that the values beyond it are unconverged."""
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81))
+    with pytest.warns(RuntimeWarning, match="front window had reached u = "):
+        sol = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], max_iterations=4)
+    assert not sol.stats.converged
+    assert 0.0 < sol.stats.window_edge < np.pi * 0.5
+    full = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)])
+    assert full.stats.converged and full.stats.window_edge == np.inf
+    # below the edge (minus a window's width) the cut-short values are already close
+    settled = full.values < sol.stats.window_edge - 0.5
+    assert settled.any()
+    assert np.max(np.abs(sol.values[settled] - full.values[settled])) < 1e-6

@@ -146,9 +146,15 @@ def check_memory(nbytes: float, what: str, fix: str) -> None:
 
 def warn_unconverged(stats: dict, tol: float, max_iterations: int) -> None:
     if not stats["converged"]:
+        edge = stats.get("window_edge", float("inf"))
+        behind = (
+            f"; the sweeps' front window had reached u = {edge:.4g}, and values above it are still "
+            "those of the second iteration"
+            if edge < float("inf") else ""
+        )
         warnings.warn(
             f"the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
-            f"iteration was {stats['last_change']:.3g} (tol={tol:g}). Increase max_iterations or tol; "
+            f"iteration was {stats['last_change']:.3g} (tol={tol:g}){behind}. Increase max_iterations or tol; "
             "the values returned are the last iterate",
             RuntimeWarning,
             stacklevel=3,

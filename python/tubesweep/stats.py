@@ -31,6 +31,11 @@ class SolveStats:
         Time spent finding the band, evaluating the surface and initialising the sources.
     band_bytes : int
         Memory held by the band structure and the per-node arrays of the solve.
+    window_edge : float
+        Where the sweeps' front window stood when the solve ended (Godunov on surfaces,
+        docs/architecture.md): ``inf`` when it had opened, always so for a converged solve. After
+        a solve stopped by ``max_iterations``, values above it are still those of the second
+        iteration.
     """
 
     iterations: int
@@ -45,6 +50,7 @@ class SolveStats:
     fixed_points: int
     setup_seconds: float = 0.0
     band_bytes: int = 0
+    window_edge: float = float("inf")
 
     @property
     def updates_per_second(self) -> float:

@@ -55,6 +55,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     d.set_item("last_change", s.last_change)?;
     d.set_item("seconds", s.seconds)?;
     d.set_item("infinity", s.infinity)?;
+    d.set_item("window_edge", s.window_edge)?;
     Ok(d)
 }
 
