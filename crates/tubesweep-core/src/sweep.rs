@@ -197,7 +197,8 @@ pub const DEFAULT_FRONT_WINDOW: f64 = 3.0;
 /// The iterations run over the whole band before the front window starts
 /// ([`SolveOptions::front_window`]): the first gives every node a value, the second corrects the
 /// values the first brought round the far side of the surface by long detours. With one, the
-/// window starts from those and takes about twice the updates.
+/// window starts from those: on the sphere at N = 401, 134 iterations and 37 M updates instead of
+/// 36 and 29 M, 1.8× the time (N = 201: 54 iterations instead of 24, 1.5× the time).
 const UNWINDOWED_ITERATIONS: usize = 2;
 
 /// What a solve did.
