@@ -597,10 +597,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let most = (0..1usize << (D - 1)).map(|o| sched.tiles(o).len()).max().unwrap_or(0);
             (0..most).map(|_| AtomicU32::new(0)).collect()
         };
+        let windowed = D == 3 && options.front_window > 0.0 && options.skip_inactive && matches!(self.scheme, InnerScheme::Godunov);
         let ctx = SweepContext {
             row_low: &row_low_shared,
             row_dirty: &row_dirty,
             row_neighbours: &row_neighbours,
+            windowed,
             u: &shared,
             active: &active,
             weights,
@@ -623,7 +625,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             // sequential sweep, which interleaves two tiles
             b.build().ok().filter(|p| p.current_num_threads() > 1)
         };
-        let windowed = D == 3 && options.front_window > 0.0 && options.skip_inactive && matches!(self.scheme, InnerScheme::Godunov);
         let mut window = f64::INFINITY;
         // once the window runs: its width and the largest value reached when it started
         let mut window_width: Option<(f64, f64)> = None;
@@ -738,12 +739,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let run_pair = |t: usize, t_end: usize| -> Accumulator {
             let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
             let b: &[u32] = if t + 1 < t_end { &rows[tiles[t + 1] as usize..tiles[t + 2] as usize] } else { &[] };
-            match (self.scheme, per_node) {
-                (InnerScheme::Godunov, false) => self.run_rows_interleaved::<GODUNOV, false>(ctx, a, b, backwards, lim),
-                (InnerScheme::Godunov, true) => self.run_rows_interleaved::<GODUNOV, true>(ctx, a, b, backwards, lim),
-                (InnerScheme::LaxFriedrichs, false) => self.run_rows_interleaved::<LXF, false>(ctx, a, b, backwards, lim),
-                (InnerScheme::LaxFriedrichs, true) => self.run_rows_interleaved::<LXF, true>(ctx, a, b, backwards, lim),
-                (InnerScheme::General(_), _) => self.run_rows_interleaved::<GENERAL, false>(ctx, a, b, backwards, lim),
+            match (self.scheme, per_node, ctx.windowed) {
+                (InnerScheme::Godunov, false, false) => self.run_rows_interleaved::<GODUNOV, false, false>(ctx, a, b, backwards, lim),
+                (InnerScheme::Godunov, true, false) => self.run_rows_interleaved::<GODUNOV, true, false>(ctx, a, b, backwards, lim),
+                (InnerScheme::Godunov, false, true) => self.run_rows_interleaved::<GODUNOV, false, true>(ctx, a, b, backwards, lim),
+                (InnerScheme::Godunov, true, true) => self.run_rows_interleaved::<GODUNOV, true, true>(ctx, a, b, backwards, lim),
+                (InnerScheme::LaxFriedrichs, false, _) => self.run_rows_interleaved::<LXF, false, false>(ctx, a, b, backwards, lim),
+                (InnerScheme::LaxFriedrichs, true, _) => self.run_rows_interleaved::<LXF, true, false>(ctx, a, b, backwards, lim),
+                (InnerScheme::General(_), _, _) => self.run_rows_interleaved::<GENERAL, false, false>(ctx, a, b, backwards, lim),
             }
         };
         // sequentially: the waves in order, two tiles of a wave interleaved at a time
@@ -776,12 +779,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let per_node = matches!(self.slowness, Slowness::PerNode(_));
         let run_tile = |t: usize| -> Accumulator {
             let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
-            match (self.scheme, per_node) {
-                (InnerScheme::Godunov, false) => self.run_rows::<GODUNOV, false>(ctx, a, backwards, lim),
-                (InnerScheme::Godunov, true) => self.run_rows::<GODUNOV, true>(ctx, a, backwards, lim),
-                (InnerScheme::LaxFriedrichs, false) => self.run_rows::<LXF, false>(ctx, a, backwards, lim),
-                (InnerScheme::LaxFriedrichs, true) => self.run_rows::<LXF, true>(ctx, a, backwards, lim),
-                (InnerScheme::General(_), _) => self.run_rows::<GENERAL, false>(ctx, a, backwards, lim),
+            match (self.scheme, per_node, ctx.windowed) {
+                (InnerScheme::Godunov, false, false) => self.run_rows::<GODUNOV, false, false>(ctx, a, backwards, lim),
+                (InnerScheme::Godunov, true, false) => self.run_rows::<GODUNOV, true, false>(ctx, a, backwards, lim),
+                (InnerScheme::Godunov, false, true) => self.run_rows::<GODUNOV, false, true>(ctx, a, backwards, lim),
+                (InnerScheme::Godunov, true, true) => self.run_rows::<GODUNOV, true, true>(ctx, a, backwards, lim),
+                (InnerScheme::LaxFriedrichs, false, _) => self.run_rows::<LXF, false, false>(ctx, a, backwards, lim),
+                (InnerScheme::LaxFriedrichs, true, _) => self.run_rows::<LXF, true, false>(ctx, a, backwards, lim),
+                (InnerScheme::General(_), _, _) => self.run_rows::<GENERAL, false, false>(ctx, a, backwards, lim),
             }
         };
         let id = ctx.sweep_id.load(Ordering::Relaxed);
@@ -791,7 +796,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// The rows of two independent tiles `a` and `b` (of one wave), each in order, with the
     /// nodes of the i-th rows of both interleaved: two independent Gauss–Seidel chains for the
     /// out-of-order core to overlap. The result is that of running `a`, then `b`.
-    fn run_rows_interleaved<const S: u8, const P: bool>(
+    fn run_rows_interleaved<const S: u8, const P: bool, const W: bool>(
         &self,
         ctx: &SweepContext<'_, D>,
         a: &[u32],
@@ -804,14 +809,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         for i in 0..common {
             let (ra, rb) = (a[i] as usize, b[i] as usize);
             let mut probe = Accumulator::default();
-            if !ctx.row_runs(ra, lim, &mut probe) || !ctx.row_runs(rb, lim, &mut probe) {
+            if !ctx.row_runs::<W>(ra, lim, &mut probe) || !ctx.row_runs::<W>(rb, lim, &mut probe) {
                 // a row with nothing to do is skipped whole: run the other alone
-                self.run_row::<S, P>(ctx, ra, backwards, lim, &mut acc);
-                self.run_row::<S, P>(ctx, rb, backwards, lim, &mut acc);
+                self.run_row::<S, P, W>(ctx, ra, backwards, lim, &mut acc);
+                self.run_row::<S, P, W>(ctx, rb, backwards, lim, &mut acc);
                 continue;
             }
-            ctx.take_row(ra, lim, &mut acc);
-            ctx.take_row(rb, lim, &mut acc);
+            ctx.take_row::<W>(ra, lim, &mut acc);
+            ctx.take_row::<W>(rb, lim, &mut acc);
             let (sa, ea) = self.band.row_range(ra);
             let (sb, eb) = self.band.row_range(rb);
             let m = (ea - sa).min(eb - sb);
@@ -819,37 +824,37 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let (mut marks_a, mut marks_b) = (0u8, 0u8);
             if backwards {
                 for j in 1..=m {
-                    self.visit::<S, P>(ctx, ea - j, lim, &mut acc, &mut low_a, &mut marks_a);
-                    self.visit::<S, P>(ctx, eb - j, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W>(ctx, ea - j, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W>(ctx, eb - j, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
                 for n in (sa..ea - m).rev() {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
                 }
                 for n in (sb..eb - m).rev() {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
             } else {
                 for j in 0..m {
-                    self.visit::<S, P>(ctx, sa + j, lim, &mut acc, &mut low_a, &mut marks_a);
-                    self.visit::<S, P>(ctx, sb + j, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W>(ctx, sa + j, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W>(ctx, sb + j, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
                 for n in sa + m..ea {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
                 }
                 for n in sb + m..eb {
-                    self.visit::<S, P>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
             }
-            ctx.finish_row(ra, low_a, marks_a);
-            ctx.finish_row(rb, low_b, marks_b);
+            ctx.finish_row::<W>(ra, low_a, marks_a);
+            ctx.finish_row::<W>(rb, low_b, marks_b);
         }
-        acc.merge(self.run_rows::<S, P>(ctx, &a[common..], backwards, lim))
-            .merge(self.run_rows::<S, P>(ctx, &b[common..], backwards, lim))
+        acc.merge(self.run_rows::<S, P, W>(ctx, &a[common..], backwards, lim))
+            .merge(self.run_rows::<S, P, W>(ctx, &b[common..], backwards, lim))
     }
 
     /// The rows of one tile, in order, with the update specialised for scheme `S` and a
     /// constant (`P = false`) or per-node (`P = true`) slowness.
-    fn run_rows<const S: u8, const P: bool>(
+    fn run_rows<const S: u8, const P: bool, const W: bool>(
         &self,
         ctx: &SweepContext<'_, D>,
         rows: &[u32],
@@ -858,7 +863,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     ) -> Accumulator {
         let mut acc = Accumulator::default();
         for &r in rows {
-            self.run_row::<S, P>(ctx, r as usize, backwards, lim, &mut acc);
+            self.run_row::<S, P, W>(ctx, r as usize, backwards, lim, &mut acc);
         }
         acc
     }
@@ -866,8 +871,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// One row, in sweep order; skipped whole when none of its nodes is active (its dirty flag
     /// is clear) or all its values lie beyond the front window.
     #[inline(always)]
-    fn run_row<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
-        if !ctx.take_row(r, lim, acc) {
+    fn run_row<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+        if !ctx.take_row::<W>(r, lim, acc) {
             return;
         }
         let (s, e) = self.band.row_range(r);
@@ -875,14 +880,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let mut marks = 0u8;
         if backwards {
             for n in (s..e).rev() {
-                self.visit::<S, P>(ctx, n, lim, acc, &mut low, &mut marks);
+                self.visit::<S, P, W>(ctx, n, lim, acc, &mut low, &mut marks);
             }
         } else {
             for n in s..e {
-                self.visit::<S, P>(ctx, n, lim, acc, &mut low, &mut marks);
+                self.visit::<S, P, W>(ctx, n, lim, acc, &mut low, &mut marks);
             }
         }
-        ctx.finish_row(r, low, marks);
+        ctx.finish_row::<W>(r, low, marks);
     }
 
     #[inline(always)]
@@ -890,7 +895,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// neighbours when it changed by more than the threshold, and lowers `low` to its new value.
     /// `row` collects what the row's dirty flags need: [`KEEP_ROW`] when the node stays active,
     /// [`WAKE_ROWS`] when it activated its neighbours.
-    fn visit<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
+    fn visit<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
         let active = ctx.active;
         // SAFETY: n < band.len(); active has that length plus the sentinel slot.
         let flag = unsafe { active.get_unchecked(n) };
@@ -900,13 +905,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             return;
         }
         // beyond the front window: stays active for a later iteration (see `Limits::window`)
-        let value = ctx.u.get(n);
-        if value > lim.window {
-            *row |= KEEP_ROW;
-            if value < acc.waiting {
-                acc.waiting = value;
+        if W {
+            let value = ctx.u.get(n);
+            if value > lim.window {
+                *row |= KEEP_ROW;
+                if value < acc.waiting {
+                    acc.waiting = value;
+                }
+                return;
             }
-            return;
         }
         flag.store(0, Ordering::Relaxed);
         acc.updates += 1;
@@ -922,11 +929,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             acc.max_change = c;
         }
         ctx.u.set(n, up.new);
-        if up.new < *low {
-            *low = up.new;
-        }
-        if c > lim.settled && up.new < acc.front {
-            acc.front = up.new;
+        if W {
+            if up.new < *low {
+                *low = up.new;
+            }
+            if c > lim.settled && up.new < acc.front {
+                acc.front = up.new;
+            }
         }
         if c <= lim.threshold {
             return;
@@ -1230,6 +1239,10 @@ struct SweepContext<'a, const D: usize> {
     row_dirty: &'a [AtomicU8],
     /// [`NarrowBand::row_neighbours`].
     row_neighbours: &'a [u32],
+    /// The solve runs a front window at some point: the sweeps track the row bounds, the front
+    /// and the nodes waiting beyond the window (from the first iteration, so that the row bounds
+    /// hold when the window starts); otherwise they skip that bookkeeping.
+    windowed: bool,
 }
 
 /// A node of the row stays active: the row stays dirty.
@@ -1242,10 +1255,13 @@ impl<const D: usize> SweepContext<'_, D> {
     /// beyond the front window (a dirty row that does lie beyond it lowers `acc.waiting` to its
     /// bound).
     #[inline(always)]
-    fn row_runs(&self, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
+    fn row_runs<const W: bool>(&self, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
         // SAFETY: r < n_rows; row_dirty has n_rows + 1 entries
         if unsafe { self.row_dirty.get_unchecked(r) }.load(Ordering::Relaxed) == 0 {
             return false;
+        }
+        if !W {
+            return true;
         }
         let low = self.row_low.get(r);
         if low > lim.window {
@@ -1259,8 +1275,8 @@ impl<const D: usize> SweepContext<'_, D> {
 
     /// [`row_runs`](Self::row_runs), clearing the row's dirty flag when it does.
     #[inline(always)]
-    fn take_row(&self, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
-        if !self.row_runs(r, lim, acc) {
+    fn take_row<const W: bool>(&self, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
+        if !self.row_runs::<W>(r, lim, acc) {
             return false;
         }
         unsafe { self.row_dirty.get_unchecked(r) }.store(0, Ordering::Relaxed);
@@ -1269,8 +1285,8 @@ impl<const D: usize> SweepContext<'_, D> {
 
     /// After row `r` ran: lowers its bound to `low` and sets the dirty flags `marks` asks for.
     #[inline(always)]
-    fn finish_row(&self, r: usize, low: f64, marks: u8) {
-        if low < self.row_low.get(r) {
+    fn finish_row<const W: bool>(&self, r: usize, low: f64, marks: u8) {
+        if W && low < self.row_low.get(r) {
             self.row_low.set(r, low);
         }
         if marks != 0 {
