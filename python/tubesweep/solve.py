@@ -278,6 +278,8 @@ def solve(
     infinity : float, optional
         The finite numerical infinity unknown values start at (default: derived from the band, a
         safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
+        A user value must exceed every travel time: values within a millionth of it count as
+        never reached and are returned as ``inf``.
     paper_sweeps : bool
         ``True`` runs the paper's plain sweeps: pointwise Gauss–Seidel updates over the whole band
         in every iteration (nodes none of whose neighbours changed are still skipped, which changes

@@ -683,6 +683,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             stats.iterations += 1;
             stats.updates += updates;
             stats.last_change = max_change;
+            // the window this iteration ran with (what a solve stopped here leaves behind)
+            stats.window_edge = lim.window;
             if progress(&IterationReport { iteration: stats.iterations, max_change, updates }) == Control::Stop {
                 return Err(Error::Interrupted { iterations: stats.iterations });
             }
@@ -710,12 +712,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 };
             }
             if let Some((_, top)) = window_width {
-                // past every value reached (or with only unreached nodes waiting): open it
-                if window >= top || unreached(waiting, inf) && front == f64::INFINITY {
+                // past every value reached: open it (`top` leaves out the unreached nodes, so a
+                // window that jumped to one of them opens here too)
+                if window >= top {
                     window = f64::INFINITY;
                 }
             }
-            stats.window_edge = window;
         }
         Ok(())
     }
@@ -868,10 +870,28 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         acc
     }
 
+    /// The dirty-row invariant, checked in the unit tests whenever a row is reached: a row whose
+    /// flag is clear holds no active node (fixed nodes, which are never updated, aside).
+    #[cfg(test)]
+    fn assert_clean_row_is_idle(&self, ctx: &SweepContext<'_, D>, r: usize) {
+        if ctx.row_dirty[r].load(Ordering::Relaxed) != 0 {
+            return;
+        }
+        let (s, e) = self.band.row_range(r);
+        for n in s..e {
+            assert!(
+                ctx.active[n].load(Ordering::Relaxed) == 0 || self.roles[n] == NodeRole::Fixed,
+                "row {r} is clean but its node {n} is active"
+            );
+        }
+    }
+
     /// One row, in sweep order; skipped whole when none of its nodes is active (its dirty flag
     /// is clear) or all its values lie beyond the front window.
     #[inline(always)]
     fn run_row<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+        #[cfg(test)]
+        self.assert_clean_row_is_idle(ctx, r);
         if !ctx.take_row::<W>(r, lim, acc) {
             return;
         }
@@ -1623,7 +1643,9 @@ mod tests {
             let (a, sa) = run(0.0);
             let (b, sb) = run(DEFAULT_FRONT_WINDOW);
             assert!(max_difference(&a, &b) < 1e-11);
-            assert!(sb.iterations <= 2 * sa.iterations + 4, "{infinity:?}: {} iterations against {}", sb.iterations, sa.iterations);
+            // measured: 11 iterations against 9 for every infinity, and fewer updates
+            assert!(sb.iterations <= sa.iterations + 4, "{infinity:?}: {} iterations against {}", sb.iterations, sa.iterations);
+            assert!(sb.updates <= sa.updates, "{infinity:?}: {} updates against {}", sb.updates, sa.updates);
         }
     }
 
@@ -1686,6 +1708,37 @@ mod tests {
         }
         assert_eq!(work[0], work[1]);
         assert!(u[0].iter().zip(&u[1]).all(|(x, y)| x.to_bits() == y.to_bits()));
+    }
+
+    #[test]
+    fn lax_friedrichs_nodes_that_read_themselves_keep_their_rows_awake() {
+        // no extension layer: the tube's edge nodes extrapolate their absent neighbours from
+        // their own value and re-activate themselves; with a threshold, a change too small to
+        // wake the neighbours must still keep the node's row dirty (the clean-row check in
+        // `run_row` asserts it), and the result must not depend on the threads
+        let (band, roles, _, h) = sphere_band(41);
+        let roles: Vec<NodeRole> = roles.iter().map(|&r| if r == NodeRole::Outer { NodeRole::Inner } else { r }).collect();
+        let p = SweepProblem {
+            band: &band,
+            roles: &roles,
+            spacing: h,
+            slowness: Slowness::Constant(1.0),
+            extension: Extension::None,
+            scheme: InnerScheme::LaxFriedrichs,
+            missing: MissingNeighbour::Extrapolate,
+        };
+        let mut first: Option<Vec<f64>> = None;
+        for threads in [1, 2, 3] {
+            let mut u = vec![0.0; band.len()];
+            // (a tube without its layer need not converge, Sect. 3: a fixed budget)
+            let opts = SolveOptions { threads, activation_threshold: 1e-3, max_iterations: 40, ..Default::default() };
+            let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+            assert_eq!(st.iterations, 40);
+            match &first {
+                None => first = Some(u),
+                Some(a) => assert!(a.iter().zip(&u).all(|(x, y)| x.to_bits() == y.to_bits())),
+            }
+        }
     }
 
     #[test]
