@@ -181,3 +181,16 @@ def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_th
     # the default sweeps solve the same equations with fewer local updates
     assert by[("default", 1)]["updates"] < by[("paper", 1)]["updates"]
     assert by[("default", 2)]["vs_paper"] > 0
+
+
+def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):
+    """benches/front_window_surfaces.py at a small size: every surface prints a row, the two
+    solutions agree to far below the tolerance's scale, and the window is left at its default."""
+    import front_window_surfaces
+
+    default = sys.modules["tubesweep.solve"].FRONT_WINDOW
+    assert front_window_surfaces.main(["--n", "41", "--repeats", "1"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines()[2:] if line.strip()]
+    assert [r.split()[0] for r in rows] == list(front_window_surfaces.NAMES)
+    assert all(float(r.split()[-1]) < 1e-9 for r in rows)
+    assert sys.modules["tubesweep.solve"].FRONT_WINDOW == default
