@@ -190,7 +190,7 @@ impl Default for SolveOptions {
 }
 
 /// The default [`SolveOptions::front_window`]: the window is 3 front steps `sqrt(range · h · s̄)`
-/// wide. 2–4 measured within about 15% of each other on the sphere from N = 51 to 1001
+/// wide. 2–4 measured within about 20% of each other (single runs) on the sphere from N = 51 to 1001
 /// (`VERBOSE=1 WINDOW=c cargo run --release --example sphere -- N godunov 2`).
 pub const DEFAULT_FRONT_WINDOW: f64 = 3.0;
 
