@@ -8,7 +8,7 @@
 #[path = "common/shell.rs"]
 mod shell;
 
-use tubesweep_core::NarrowBand;
+use tubesweep_core::{NarrowBand, NodeRole};
 
 /// Largest-first assignment of `items` (work per task) to `threads`: the busiest thread's work.
 fn critical_path(items: &[usize], threads: usize) -> usize {
