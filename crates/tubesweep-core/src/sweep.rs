@@ -810,15 +810,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let common = a.len().min(b.len());
         for i in 0..common {
             let (ra, rb) = (a[i] as usize, b[i] as usize);
-            let mut probe = Accumulator::default();
-            if !ctx.row_runs::<W>(ra, lim, &mut probe) || !ctx.row_runs::<W>(rb, lim, &mut probe) {
+            let (run_a, run_b) = (self.claim_row::<W>(ctx, ra, lim, &mut acc), self.claim_row::<W>(ctx, rb, lim, &mut acc));
+            if !(run_a && run_b) {
                 // a row with nothing to do is skipped whole: run the other alone
-                self.run_row::<S, P, W>(ctx, ra, backwards, lim, &mut acc);
-                self.run_row::<S, P, W>(ctx, rb, backwards, lim, &mut acc);
+                if run_a {
+                    self.run_claimed_row::<S, P, W>(ctx, ra, backwards, lim, &mut acc);
+                }
+                if run_b {
+                    self.run_claimed_row::<S, P, W>(ctx, rb, backwards, lim, &mut acc);
+                }
                 continue;
             }
-            ctx.take_row::<W>(ra, lim, &mut acc);
-            ctx.take_row::<W>(rb, lim, &mut acc);
             let (sa, ea) = self.band.row_range(ra);
             let (sb, eb) = self.band.row_range(rb);
             let m = (ea - sa).min(eb - sb);
@@ -890,11 +892,23 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// is clear) or all its values lie beyond the front window.
     #[inline(always)]
     fn run_row<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+        if self.claim_row::<W>(ctx, r, lim, acc) {
+            self.run_claimed_row::<S, P, W>(ctx, r, backwards, lim, acc);
+        }
+    }
+
+    /// Whether row `r` has anything to do ([`SweepContext::take_row`], which clears its dirty
+    /// flag when it has); in the unit tests, also checks the dirty-row invariant.
+    #[inline(always)]
+    fn claim_row<const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
         #[cfg(test)]
         self.assert_clean_row_is_idle(ctx, r);
-        if !ctx.take_row::<W>(r, lim, acc) {
-            return;
-        }
+        ctx.take_row::<W>(r, lim, acc)
+    }
+
+    /// The nodes of row `r`, which [`claim_row`](Self::claim_row) let through, in sweep order.
+    #[inline(always)]
+    fn run_claimed_row<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
         let (s, e) = self.band.row_range(r);
         let mut low = f64::INFINITY;
         let mut marks = 0u8;
@@ -1273,33 +1287,24 @@ const WAKE_ROWS: u8 = 2;
 impl<const D: usize> SweepContext<'_, D> {
     /// Whether row `r` has anything to do: a node may be active and not all its values lie
     /// beyond the front window (a dirty row that does lie beyond it lowers `acc.waiting` to its
-    /// bound).
-    #[inline(always)]
-    fn row_runs<const W: bool>(&self, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
-        // SAFETY: r < n_rows; row_dirty has n_rows + 1 entries
-        if unsafe { self.row_dirty.get_unchecked(r) }.load(Ordering::Relaxed) == 0 {
-            return false;
-        }
-        if !W {
-            return true;
-        }
-        let low = self.row_low.get(r);
-        if low > lim.window {
-            if low < acc.waiting {
-                acc.waiting = low;
-            }
-            return false;
-        }
-        true
-    }
-
-    /// [`row_runs`](Self::row_runs), clearing the row's dirty flag when it does.
+    /// bound). Clears the row's dirty flag when it has.
     #[inline(always)]
     fn take_row<const W: bool>(&self, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
-        if !self.row_runs::<W>(r, lim, acc) {
+        // SAFETY: r < n_rows; row_dirty has n_rows + 1 entries
+        let dirty = unsafe { self.row_dirty.get_unchecked(r) };
+        if dirty.load(Ordering::Relaxed) == 0 {
             return false;
         }
-        unsafe { self.row_dirty.get_unchecked(r) }.store(0, Ordering::Relaxed);
+        if W {
+            let low = self.row_low.get(r);
+            if low > lim.window {
+                if low < acc.waiting {
+                    acc.waiting = low;
+                }
+                return false;
+            }
+        }
+        dirty.store(0, Ordering::Relaxed);
         true
     }
 
