@@ -146,7 +146,7 @@ def check_memory(nbytes: float, what: str, fix: str) -> None:
 
 def warn_unconverged(stats: dict, tol: float, max_iterations: int) -> None:
     if not stats["converged"]:
-        edge = stats.get("window_edge", float("inf"))
+        edge = stats["window_edge"]
         behind = (
             f"; the sweeps' front window had reached u = {edge:.4g}, and values above it are still "
             "those of the second iteration"

@@ -417,7 +417,7 @@ def solve(
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
         inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
         setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
-        window_edge=st.get("window_edge", float("inf")),
+        window_edge=st["window_edge"],
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
                     float(inner), outer_eff)
