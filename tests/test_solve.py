@@ -276,8 +276,8 @@ def test_accelerated_sweeps_give_the_papers_solution_with_less_work(dim, ham):
         assert fast.stats.iterations <= paper.stats.iterations
     if ham == "godunov" and dim == 3:
         # on surfaces the front window trades iterations (cheap ones, over a part of the band) for
-        # updates: measured 0.41 of the paper's updates on the sphere at N=81
-        assert fast.stats.updates < 0.5 * paper.stats.updates
+        # updates: measured 0.32 of the paper's updates on the sphere at N=81
+        assert fast.stats.updates < 0.45 * paper.stats.updates
 
 
 def test_a_surface_that_caches_its_band_geometry_is_not_modified_by_the_solver():
@@ -339,17 +339,46 @@ def test_a_tolerance_tied_to_the_grid_stops_earlier_within_a_few_tol_of_the_conv
 
 
 def test_a_solve_stopped_before_the_front_window_opened_says_so():
-    """With Godunov on a surface the sweeps follow the converged region out from the source; a
-    solve cut short by max_iterations reports where that front window stood, and the warning
-    says that the values beyond it are unconverged."""
+    """With Godunov on a surface the sweeps fill the band from the source outwards, behind a
+    front window; a solve cut short by max_iterations reports where the window stood, leaves the
+    nodes beyond it unreached (inf), and the warning says so."""
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81))
-    with pytest.warns(RuntimeWarning, match="front window had reached u = "):
+    with pytest.warns(RuntimeWarning, match="front window had reached u = .*not reached yet"):
         sol = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], max_iterations=4)
     assert not sol.stats.converged
-    assert 0.0 < sol.stats.window_edge < np.pi * 0.5
+    edge = sol.stats.window_edge
+    assert 0.0 < edge < np.pi * 0.5
     full = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)])
     assert full.stats.converged and full.stats.window_edge == np.inf
-    # below the edge (minus a window's width) the cut-short values are already close
-    settled = full.values < sol.stats.window_edge - 0.5
-    assert settled.any()
-    assert np.max(np.abs(sol.values[settled] - full.values[settled])) < 1e-6
+    reached = np.isfinite(sol.values)
+    assert 0.05 < reached.mean() < 0.5
+    assert np.all(sol.values[reached] <= edge)
+    assert not np.any(reached & (full.values > edge))
+    # well below the edge the cut-short values are already close (measured: 2e-11)
+    settled = full.values < edge - 0.2
+    assert settled.any() and np.all(reached[settled])
+    assert np.max(np.abs(sol.values[settled] - full.values[settled])) < 1e-8
+
+
+def test_the_front_window_also_pays_on_a_non_orientable_surface(monkeypatch):
+    """On the Möbius band the extension directions from the two sides of the surface meet, and
+    pairs of layer nodes read each other (upwind 2-cycles): the window lets them through instead
+    of holding them back until it passes the infinity mixed into their values. The same solution,
+    with fewer updates than without the window (measured at N=81: 0.61 of them; 1.33 when the
+    window held the pairs back)."""
+    import sys
+
+    from tubesweep.surfaces import MobiusBand
+
+    solve_module = sys.modules["tubesweep.solve"]  # the package's `solve` is the function
+    surf = MobiusBand()
+    lo, hi = surf.default_box
+    grid = ts.Grid(lo, hi, (81, 81, 81))
+    on = ts.solve(surf, grid, [surf.default_source])
+    monkeypatch.setattr(solve_module, "FRONT_WINDOW", 0.0)
+    off = ts.solve(surf, grid, [surf.default_source])
+    assert on.stats.converged and off.stats.converged
+    reached = np.isfinite(off.values)
+    np.testing.assert_array_equal(np.isfinite(on.values), reached)
+    assert np.max(np.abs(on.values[reached] - off.values[reached])) < 1e-10
+    assert on.stats.updates < 0.8 * off.stats.updates

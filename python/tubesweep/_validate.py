@@ -18,9 +18,9 @@ ACTIVATION_FRACTION = 0.01
 
 #: Godunov sweeps on surfaces (3D bands) run behind a front window this many front steps wide
 #: (the Rust ``SolveOptions::front_window``, docs/architecture.md): the same solution to about
-#: ``tol`` with 1.9× (N = 201) to 3.4× (N = 1001) fewer local updates on the sphere.
+#: ``tol`` with 3× (N = 201) to 5× (N = 1001) fewer local updates on the sphere.
 #: ``paper_sweeps=True`` switches it off.
-FRONT_WINDOW = 3.0
+FRONT_WINDOW = 2.0
 
 
 def as_grid(grid: Any) -> Grid:
@@ -148,8 +148,8 @@ def warn_unconverged(stats: dict, tol: float, max_iterations: int) -> None:
     if not stats["converged"]:
         edge = stats["window_edge"]
         behind = (
-            f"; the sweeps' front window had reached u = {edge:.4g}, and values above it are still "
-            "those of the second iteration"
+            f"; the sweeps' front window had reached u = {edge:.4g}: the nodes above it are not reached "
+            "yet (inf), and the values just below it are not converged"
             if edge < float("inf") else ""
         )
         warnings.warn(

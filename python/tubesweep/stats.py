@@ -34,8 +34,8 @@ class SolveStats:
     window_edge : float
         Where the sweeps' front window stood when the solve ended (Godunov on surfaces,
         docs/architecture.md): ``inf`` when it had opened, always so for a converged solve. After
-        a solve stopped by ``max_iterations``, values above it are still those of the second
-        iteration.
+        a solve stopped by ``max_iterations``, the nodes above it are not reached yet (``inf``)
+        and the values just below it are not converged.
     """
 
     iterations: int

@@ -20,7 +20,7 @@ use crate::hamiltonian::InnerScheme;
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
 use crate::schedule::NO_TILE;
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// What the sweep does at a node.
@@ -154,22 +154,28 @@ pub struct SolveOptions {
     /// converge from the sources outwards: a region settles only once the region upwind of it
     /// has, and on the sphere the settled region grows by a roughly fixed step per iteration
     /// (the value changes binned by distance from the source show it). Updates far ahead of
-    /// that front are redone later anyway. So, after two iterations over the whole band, only
-    /// the nodes whose value is at most `front + w` are updated, where `front` is the smallest
-    /// value that changed by more than `tol` in the previous iteration and
-    /// `w = front_window · sqrt(range · h · s̄)` (`range`: the spread of the values then, `h`
-    /// the spacing, `s̄` the mean slowness; the front's step shrinks like the square root of
-    /// the spacing). Nodes beyond it stay active for later, and rows entirely beyond it are
-    /// skipped whole. The window only widens: to `front + w` when something in it moved, else
-    /// past the nearest active node waiting beyond it (by at least `w`); it opens fully once it
-    /// passes the largest value reached after the second iteration, or when only unreached
-    /// nodes wait. The stopping test only counts iterations over the whole band, so the fixed
+    /// that front are redone later anyway. So only the nodes whose value is at most the window's
+    /// edge `front + w` are updated, from the first iteration on: `front` is the smallest source
+    /// value at the start, then the smallest value that changed by more than `tol` in the
+    /// previous iteration, and `w = front_window · h s̄ · sqrt(H)` (`h` the spacing, `s̄` the mean
+    /// slowness, `H` the longest grid path from a source in steps, so that `H h s̄` bounds the
+    /// range of the values; the front's step shrinks like the square root of the spacing). A
+    /// node still at the numerical infinity is updated but takes the new value only if it lies
+    /// within the window; so every value set lies within it, and the band fills from the sources
+    /// outwards like a wave, without the first iterations' long detours round the surface. Nodes
+    /// beyond it stay active for later, and rows entirely beyond it are skipped whole. The window
+    /// only widens: to `front + w` when something in it moved, else past the nearest node waiting
+    /// beyond it (by at least `w`); it opens fully when no node waits beyond it. Extension-layer
+    /// nodes in an upwind 2-cycle (two layer nodes that read each other, where the directions from
+    /// two sheets of the surface meet: edges of open surfaces, the Möbius band's twist) are not
+    /// held back: they would wait until the window passed the numerical infinity mixed into
+    /// their values. The stopping test only counts iterations over the whole band, so the fixed
     /// point is the same to about `tol`. A solve stopped earlier (`max_iterations`, interrupted)
-    /// holds values from the second iteration beyond the window
-    /// ([`SolveStats::window_edge`]). On the sphere at N = 1001, 3.4× fewer local updates. 0
-    /// switches it off. Lax–Friedrichs has no such front (its values near the sources keep moving, and a
-    /// window there multiplied the iterations); on curves (2D bands, a few ms) it saved little on
-    /// a circle and cost 1–3× the time on the six-fold star, whose front stalls at the arms.
+    /// leaves the nodes beyond the window unreached ([`SolveStats::window_edge`]). On the sphere at
+    /// N = 1001, 5× fewer local updates than without it (`benches/sweep_variants.py`). 0 switches
+    /// it off. Lax–Friedrichs has no such front (its values near the sources keep moving, and a
+    /// window there multiplied the iterations); on curves (2D bands, a few ms) it saved little on a
+    /// circle and cost 1–3× the time on the six-fold star, whose front stalls at the arms.
     pub front_window: f64,
 }
 
@@ -189,17 +195,12 @@ impl Default for SolveOptions {
     }
 }
 
-/// The default [`SolveOptions::front_window`]: the window is 3 front steps `sqrt(range · h · s̄)`
-/// wide. 2–4 measured within about 20% of each other (single runs) on the sphere from N = 51 to 1001
-/// (`VERBOSE=1 WINDOW=c cargo run --release --example sphere -- N godunov 2`).
-pub const DEFAULT_FRONT_WINDOW: f64 = 3.0;
-
-/// The iterations run over the whole band before the front window starts
-/// ([`SolveOptions::front_window`]): the first gives every node a value, the second corrects the
-/// values the first brought round the far side of the surface by long detours. With one, the
-/// window starts from those: on the sphere at N = 401, 134 iterations and 37 M updates instead of
-/// 36 and 29 M, 1.8× the time (N = 201: 54 iterations instead of 24, 1.5× the time).
-const UNWINDOWED_ITERATIONS: usize = 2;
+/// The default [`SolveOptions::front_window`]: the window is `2 h s̄ sqrt(H)` wide. From 1.5 to 3
+/// the sweep times measured within about 20% of each other on the sphere from N = 161 to 1001 and
+/// on the library's surfaces at N = 161 (`benches/front_window_surfaces.py --windows 1,1.5,2,3`;
+/// `WINDOW=c cargo run --release --example sphere -- N godunov 2`); narrower windows take more
+/// iterations, wider ones more updates.
+pub const DEFAULT_FRONT_WINDOW: f64 = 2.0;
 
 /// What a solve did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -221,8 +222,9 @@ pub struct SolveStats {
     pub infinity: f64,
     /// Where the front window ([`SolveOptions::front_window`]) stood when the solve ended:
     /// infinite when it was off or had opened (always so for a converged solve). When the solve
-    /// stopped earlier (`max_iterations`, or interrupted), values above it are still those of
-    /// the second iteration.
+    /// stopped earlier (`max_iterations`, or interrupted), the nodes above it are reported
+    /// unreached (they hold the numerical infinity), and the values just below it are not
+    /// converged yet.
     pub window_edge: f64,
 }
 
@@ -274,12 +276,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// A numerical infinity that is safe and tight: `2 (H + 2) h s_max + max fixed value`, where
     /// `H` is the largest number of grid steps from a fixed node to any band node it can reach
-    /// (breadth-first search over the neighbour table) and `s_max` the largest slowness. Every
-    /// value the Godunov update produces is at most the cost of such a grid path, so real values
-    /// stay below it; Lax–Friedrichs, whose update averages neighbours, then spends far fewer
+    /// ([`Self::grid_hops_from_sources`]) and `s_max` the largest slowness. Every value the
+    /// Godunov update produces is at most the cost of such a grid path, so real values stay
+    /// below it; Lax–Friedrichs, whose update averages neighbours, then spends far fewer
     /// iterations draining the initial "infinity" out of the tube than with a fixed 1e6. For a
     /// general Hamiltonian without a slowness bound the fixed [`crate::DEFAULT_INFINITY`] is used.
     pub fn auto_infinity(&self, fixed_values: &[f64]) -> f64 {
+        self.infinity_from_hops(&|| self.grid_hops_from_sources(), fixed_values)
+    }
+
+    /// [`Self::auto_infinity`] with the breadth-first search `hops` (called only when needed).
+    fn infinity_from_hops(&self, hops: &dyn Fn() -> u32, fixed_values: &[f64]) -> f64 {
         let s_max = match (self.scheme, self.slowness) {
             (InnerScheme::General(ham), _) => match ham.slowness_bound() {
                 Some(s) => s,
@@ -288,16 +295,31 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             (_, Slowness::Constant(s)) => s,
             (_, Slowness::PerNode(s)) => s.iter().cloned().fold(0.0, f64::max),
         };
+        let max_fixed = self
+            .roles
+            .iter()
+            .zip(fixed_values)
+            .filter(|(&r, _)| r == NodeRole::Fixed)
+            .fold(0.0f64, |m, (_, &v)| m.max(v));
+        let bound = 2.0 * (hops() as f64 + 2.0) * self.spacing * s_max + max_fixed;
+        if bound.is_finite() && bound > 0.0 {
+            bound.max(1e-300)
+        } else {
+            crate::DEFAULT_INFINITY
+        }
+    }
+
+    /// The largest number of grid steps from a fixed node to any band node it reaches
+    /// (breadth-first search over the neighbour table; 0 without fixed nodes).
+    pub fn grid_hops_from_sources(&self) -> u32 {
         let n = self.band.len();
         let sentinel = self.band.sentinel() as usize;
         let mut hops = vec![u32::MAX; n];
         let mut queue = std::collections::VecDeque::new();
-        let mut max_fixed = 0.0f64;
         for (i, &r) in self.roles.iter().enumerate() {
             if r == NodeRole::Fixed {
                 hops[i] = 0;
                 queue.push_back(i);
-                max_fixed = max_fixed.max(fixed_values[i]);
             }
         }
         let mut max_hops = 0u32;
@@ -315,12 +337,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 }
             }
         }
-        let bound = 2.0 * (max_hops as f64 + 2.0) * self.spacing * s_max + max_fixed;
-        if bound.is_finite() && bound > 0.0 {
-            bound.max(1e-300)
-        } else {
-            crate::DEFAULT_INFINITY
-        }
+        max_hops
+    }
+
+    /// Whether these options run the front window ([`SolveOptions::front_window`]).
+    fn windowed(&self, options: &SolveOptions) -> bool {
+        D == 3 && options.front_window > 0.0 && options.skip_inactive && matches!(self.scheme, InnerScheme::Godunov)
     }
 
     /// Runs the sweeps. `values` holds the fixed nodes' values on entry (other entries are
@@ -334,6 +356,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         progress: &mut dyn FnMut(&IterationReport) -> Control,
     ) -> Result<SolveStats> {
         self.check(values)?;
+        // the grid-path search is shared by the infinity and the window's width, and run at most once
+        let hops = std::cell::OnceCell::new();
+        let hops = || *hops.get_or_init(|| self.grid_hops_from_sources());
         let inf = match options.infinity {
             Some(v) => {
                 if !(v.is_finite() && v > 0.0) {
@@ -341,7 +366,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 }
                 v
             }
-            None => self.auto_infinity(values),
+            None => self.infinity_from_hops(&hops, values),
+        };
+        // the front window's width: `front_window · sqrt(range · h · s̄)` with the range bounded by
+        // the longest grid path `H h s̄`
+        let window_width = if self.windowed(options) {
+            let hs = self.spacing * self.mean_slowness();
+            options.front_window * hs * (hops() as f64).sqrt()
+        } else {
+            0.0
         };
         let options = &SolveOptions { infinity: Some(inf), ..*options };
         if !(options.tol >= 0.0) {
@@ -356,11 +389,22 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         values.push(inf); // the sentinel slot read for absent neighbours
         let mut stats = SolveStats { infinity: inf, ..Default::default() };
         let result = if options.defer_outer_rim {
-            self.iterate_rim_last(values, options, progress, &mut stats)
+            self.iterate_rim_last(values, options, window_width, progress, &mut stats)
         } else {
-            self.iterate(values, options, progress, &mut stats)
+            self.iterate(values, options, window_width, progress, &mut stats)
         };
         values.pop();
+        if stats.window_edge < f64::INFINITY {
+            // Stopped before the front window opened: the values set lie within it, except those
+            // of layer nodes that read a node not reached yet (the rim, swept last, and the nodes
+            // in upwind 2-cycles), which hold a mixture with the infinity. They are not reached
+            // either.
+            for (v, &r) in values.iter_mut().zip(self.roles) {
+                if r != NodeRole::Fixed && *v > stats.window_edge {
+                    *v = inf;
+                }
+            }
+        }
         // Extension-layer nodes of a component no source reaches hold convex combinations of the
         // infinity, which f32 weights can round a hair off it: snap them back, so that every
         // unreached node holds exactly `inf`.
@@ -486,6 +530,36 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         roles.iter().zip(&needed).map(|(&r, &nd)| r == NodeRole::Outer && !nd).collect()
     }
 
+    /// The extension-layer nodes in an upwind 2-cycle: two layer nodes next to each other along
+    /// an axis whose updates (5) read each other (their directions point at each other along
+    /// that axis, as where the directions from two sheets of the surface meet). `1` marks them.
+    fn upwind_two_cycles(&self, weights: &[[f32; D]]) -> Vec<u8> {
+        let n = self.roles.len();
+        let mut marks = vec![0u8; n];
+        if weights.is_empty() {
+            return marks;
+        }
+        let sentinel = self.band.sentinel();
+        for a in 0..n {
+            if self.roles[a] != NodeRole::Outer {
+                continue;
+            }
+            let nb = self.band.neighbours_of(a);
+            for k in 0..D {
+                let b = nb[k][1];
+                if b == sentinel || self.roles[b as usize] != NodeRole::Outer {
+                    continue;
+                }
+                // a reads its plus neighbour b when w_a[k] < 0; b reads its minus neighbour a when w_b[k] > 0
+                if weights[a][k] < 0.0 && weights[b as usize][k] > 0.0 {
+                    marks[a] = 1;
+                    marks[b as usize] = 1;
+                }
+            }
+        }
+        marks
+    }
+
     /// This problem with other roles and the extension weights already derived.
     fn with_roles<'b>(&self, roles: &'b [NodeRole], weights: &'b [[f32; D]]) -> SweepProblem<'b, D>
     where
@@ -508,6 +582,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         &self,
         u: &mut [f64],
         options: &SolveOptions,
+        window_width: f64,
         progress: &mut dyn FnMut(&IterationReport) -> Control,
         stats: &mut SolveStats,
     ) -> Result<()> {
@@ -515,11 +590,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let weights: &[[f32; D]] = &weights;
         let rim = if weights.is_empty() { Vec::new() } else { self.outer_rim(weights) };
         if !rim.iter().any(|&b| b) {
-            return self.with_roles(self.roles, weights).iterate(u, options, progress, stats);
+            return self.with_roles(self.roles, weights).iterate(u, options, window_width, progress, stats);
         }
         let without_rim: Vec<NodeRole> =
             self.roles.iter().zip(&rim).map(|(&r, &b)| if b { NodeRole::Fixed } else { r }).collect();
-        self.with_roles(&without_rim, weights).iterate(u, options, progress, stats)?;
+        self.with_roles(&without_rim, weights).iterate(u, options, window_width, progress, stats)?;
         drop(without_rim);
         let rim_only: Vec<NodeRole> = rim.iter().map(|&b| if b { NodeRole::Outer } else { NodeRole::Fixed }).collect();
         // The rim shares the iteration budget (at least one pass, so that it gets values even
@@ -530,6 +605,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let result = self.with_roles(&rim_only, weights).iterate(
             u,
             &rim_options,
+            0.0,
             &mut |r| progress(&IterationReport { iteration: base + r.iteration, ..*r }),
             &mut rim_stats,
         );
@@ -544,10 +620,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         })
     }
 
+    /// The sweeps to convergence; `window_width` > 0 runs the front window
+    /// ([`SolveOptions::front_window`]) with that width.
     fn iterate(
         &self,
         u: &mut [f64],
         options: &SolveOptions,
+        window_width: f64,
         progress: &mut dyn FnMut(&IterationReport) -> Control,
         stats: &mut SolveStats,
     ) -> Result<()> {
@@ -563,14 +642,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .map(|&r| AtomicU8::new((r != NodeRole::Fixed) as u8))
             .chain(std::iter::once(AtomicU8::new(0)))
             .collect();
-        // per row, the smallest value it holds (the fixed values and the infinity at the start)
-        let mut row_low: Vec<f64> = (0..self.band.n_rows())
+        // per row, the smallest value it holds (the fixed values and the infinity at the start;
+        // the last slot stands for "no row")
+        let row_low: Vec<AtomicU64> = (0..self.band.n_rows())
             .map(|r| {
                 let (s, e) = self.band.row_range(r);
                 u[s..e].iter().fold(f64::INFINITY, |m, &v| m.min(v))
             })
+            .chain(std::iter::once(f64::INFINITY))
+            .map(|v| AtomicU64::new(order_key(v)))
             .collect();
-        let row_low_shared = SharedValues { ptr: row_low.as_mut_ptr(), len: row_low.len() };
         // per row: may a node be active (all at the start; the last slot stands for "no row")
         let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
         let row_neighbours = self.band.row_neighbours();
@@ -597,9 +678,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let most = (0..1usize << (D - 1)).map(|o| sched.tiles(o).len()).max().unwrap_or(0);
             (0..most).map(|_| AtomicU32::new(0)).collect()
         };
-        let windowed = D == 3 && options.front_window > 0.0 && options.skip_inactive && matches!(self.scheme, InnerScheme::Godunov);
+        // the front window starts at the smallest source value (none without a source)
+        let first_front = self.roles.iter().zip(u.iter()).filter(|(&r, _)| r == NodeRole::Fixed).fold(f64::INFINITY, |m, (_, &v)| m.min(v));
+        let windowed = window_width > 0.0 && window_width.is_finite() && first_front < f64::INFINITY;
+        let cyclic = if windowed { self.upwind_two_cycles(weights) } else { Vec::new() };
         let ctx = SweepContext {
-            row_low: &row_low_shared,
+            cyclic: &cyclic,
+            row_low: &row_low,
             row_dirty: &row_dirty,
             row_neighbours: &row_neighbours,
             windowed,
@@ -625,12 +710,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             // sequential sweep, which interleaves two tiles
             b.build().ok().filter(|p| p.current_num_threads() > 1)
         };
-        let mut window = f64::INFINITY;
-        // once the window runs: its width and the largest value reached when it started
-        let mut window_width: Option<(f64, f64)> = None;
+        let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
-            let lim = Limits { inf, threshold: options.activation_threshold, window, settled: options.tol };
+            let lim = Limits { inf, threshold: options.activation_threshold, window, window_key: order_key(window), settled: options.tol };
             let mut max_change = 0.0f64;
             let mut front = f64::INFINITY;
             let mut waiting = f64::INFINITY;
@@ -694,29 +777,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 stats.converged = true;
                 break;
             }
-            if windowed && stats.iterations == UNWINDOWED_ITERATIONS {
-                // the values reached so far span [lo, top] (they only decrease from here)
-                let (lo, hi) = value_span(&shared, inf);
-                let width = options.front_window * ((hi - lo) * self.spacing * self.mean_slowness()).sqrt();
-                if width > 0.0 && width.is_finite() {
-                    window_width = Some((width, hi));
-                    window = front + width;
-                }
-            } else if let Some((width, _)) = window_width {
-                window = if front < f64::INFINITY {
-                    window.max(front + width)
+            if window < f64::INFINITY {
+                window = if waiting == f64::INFINITY {
+                    // no node waits beyond the window: the rest of the solve runs over the whole band
+                    f64::INFINITY
+                } else if front < f64::INFINITY {
+                    window.max(front + window_width)
                 } else {
                     // nothing in the window moved: everything up to its edge has settled, and the
                     // window moves on to the nearest node still waiting beyond it
-                    (window + width).max(waiting + width)
+                    (window + window_width).max(waiting + window_width)
                 };
-            }
-            if let Some((_, top)) = window_width {
-                // past every value reached: open it (`top` leaves out the unreached nodes, so a
-                // window that jumped to one of them opens here too)
-                if window >= top {
-                    window = f64::INFINITY;
-                }
             }
         }
         Ok(())
@@ -938,15 +1009,21 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if (flag.load(Ordering::Relaxed) == 0) | fixed {
             return;
         }
-        // beyond the front window: stays active for a later iteration (see `Limits::window`)
+        // beyond the front window (see `Limits::window`): a node that holds a value there stays
+        // active for a later iteration; an unreached one is updated, but takes the new value only
+        // if it lies within the window
+        let mut unreached_beyond = false;
         if W {
             let value = ctx.u.get(n);
-            if value > lim.window {
-                *row |= KEEP_ROW;
-                if value < acc.waiting {
-                    acc.waiting = value;
+            if value > lim.window && (ctx.cyclic.is_empty() || unsafe { *ctx.cyclic.get_unchecked(n) } == 0) {
+                if !unreached(value, lim.inf) {
+                    *row |= KEEP_ROW;
+                    if value < acc.waiting {
+                        acc.waiting = value;
+                    }
+                    return;
                 }
-                return;
+                unreached_beyond = true;
             }
         }
         flag.store(0, Ordering::Relaxed);
@@ -954,6 +1031,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // SAFETY: n < band.len()
         let nb = unsafe { self.band.neighbours_of_unchecked(n) };
         let Some(up) = self.local_update::<S, P>(ctx, n, &nb, lim.inf) else { return };
+        if W && unreached_beyond && up.new > lim.window {
+            flag.store(1, Ordering::Relaxed);
+            *row |= KEEP_ROW;
+            if up.new < acc.waiting {
+                acc.waiting = up.new;
+            }
+            return;
+        }
         if up.self_dependent {
             flag.store(1, Ordering::Relaxed);
             *row |= KEEP_ROW;
@@ -1201,21 +1286,6 @@ impl SpinBarrier {
     }
 }
 
-/// The smallest and largest values of the nodes reached, i.e. not [`unreached`] (`(inf, -inf)`
-/// if none).
-fn value_span(u: &SharedValues, inf: f64) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    // the last slot is the sentinel
-    for i in 0..u.len.saturating_sub(1) {
-        let v = u.get(i);
-        if !unreached(v, inf) {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    (lo, hi)
-}
-
 /// Whether `v` is the numerical infinity `inf`, up to the rounding of an extension update whose
 /// upwind neighbours all hold it (its f32 weights sum to 1 only to about 1e-7). Every travel time
 /// lies well below `inf` (twice the longest grid path, by default).
@@ -1263,7 +1333,10 @@ struct SweepContext<'a, const D: usize> {
     /// given since (never raised, so a bound even where an extension update raises a value): a
     /// row above the front window is skipped whole. Written only by the thread that runs the row,
     /// like the row's values.
-    row_low: &'a SharedValues,
+    row_low: &'a [AtomicU64],
+    /// Per node, 1 for the extension-layer nodes in an upwind cycle, which the front window does
+    /// not hold back (empty without the window).
+    cyclic: &'a [u8],
     /// Per row (and a last slot for "no row"), set while a node of the row may be active: a row
     /// whose flag is clear is skipped whole. Set for every row at the start; cleared when the row
     /// is run; set again for the row when a node stays active, and for the row and the rows next
@@ -1296,8 +1369,10 @@ impl<const D: usize> SweepContext<'_, D> {
             return false;
         }
         if W {
-            let low = self.row_low.get(r);
-            if low > lim.window {
+            // SAFETY: r < n_rows; row_low has n_rows + 1 entries
+            let key = unsafe { self.row_low.get_unchecked(r) }.load(Ordering::Relaxed);
+            if key > lim.window_key {
+                let low = from_order_key(key);
                 if low < acc.waiting {
                     acc.waiting = low;
                 }
@@ -1311,8 +1386,9 @@ impl<const D: usize> SweepContext<'_, D> {
     /// After row `r` ran: lowers its bound to `low` and sets the dirty flags `marks` asks for.
     #[inline(always)]
     fn finish_row<const W: bool>(&self, r: usize, low: f64, marks: u8) {
-        if W && low < self.row_low.get(r) {
-            self.row_low.set(r, low);
+        let key = order_key(low);
+        if W {
+            self.lower_row(r, key);
         }
         if marks != 0 {
             unsafe { self.row_dirty.get_unchecked(r) }.store(1, Ordering::Relaxed);
@@ -1322,9 +1398,46 @@ impl<const D: usize> SweepContext<'_, D> {
             for &q in &self.row_neighbours[r * per..(r + 1) * per] {
                 // SAFETY: entries are < n_rows or the last slot n_rows
                 unsafe { self.row_dirty.get_unchecked(q as usize) }.store(1, Ordering::Relaxed);
+                // the nodes this row woke take values of at least the smallest value it gave
+                // (a Godunov or extension update never falls below all the values it reads)
+                if W {
+                    self.lower_row(q as usize, key);
+                }
             }
         }
     }
+}
+
+impl<const D: usize> SweepContext<'_, D> {
+    /// Lowers the bound of row `r` (or the "no row" slot) to the value with [`order_key`] `key`.
+    /// Rows next to each other may finish at the same time on different threads, so this is an
+    /// atomic minimum.
+    #[inline(always)]
+    fn lower_row(&self, r: usize, key: u64) {
+        // SAFETY: r ≤ n_rows; row_low has n_rows + 1 entries
+        let slot = unsafe { self.row_low.get_unchecked(r) };
+        if slot.load(Ordering::Relaxed) > key {
+            slot.fetch_min(key, Ordering::Relaxed);
+        }
+    }
+}
+
+/// A key for `v` whose unsigned order is the order of the values (for every non-NaN `v`), so
+/// that an [`AtomicU64`] holds a lower bound that threads can lower with `fetch_min`.
+#[inline(always)]
+fn order_key(v: f64) -> u64 {
+    let b = v.to_bits();
+    if b >> 63 == 1 {
+        !b
+    } else {
+        b | 1 << 63
+    }
+}
+
+/// The value whose [`order_key`] is `k`.
+#[inline(always)]
+fn from_order_key(k: u64) -> f64 {
+    f64::from_bits(if k >> 63 == 1 { k & !(1 << 63) } else { !k })
 }
 
 const GODUNOV: u8 = 0;
@@ -1373,6 +1486,8 @@ struct Limits {
     /// Nodes holding more than this are left for a later iteration (and stay active); infinite
     /// unless [`SolveOptions::front_window`] is on.
     window: f64,
+    /// [`order_key`] of `window`.
+    window_key: u64,
     /// A change larger than this (the tolerance) counts towards [`Accumulator::front`].
     settled: f64,
 }
@@ -1604,6 +1719,43 @@ mod tests {
     }
 
     #[test]
+    fn layer_nodes_that_read_each_other_are_not_held_back_by_the_front_window() {
+        // two overlapping spheres of radius 0.3 about x = ±0.2: inside both, next to the plane
+        // x = 0 where the nearest centre changes, the layer nodes' directions point at each other;
+        // the source lies on the circle where the spheres meet, next to those nodes
+        let n = 81;
+        let (band, mut roles, dirs, h) = shell_band(n, 0.3, &[-0.2, 0.2]);
+        let src = band.find([(n / 2) as i64, 49, (n / 2) as i64]).unwrap();
+        roles[src] = NodeRole::Fixed;
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+        let weights = p.upwind_weights();
+        let cyclic = p.upwind_two_cycles(&weights);
+        let marked: Vec<usize> = (0..band.len()).filter(|&i| cyclic[i] == 1).collect();
+        assert!(!marked.is_empty());
+        for &i in &marked {
+            // only layer nodes, each next to a marked node that it reads and that reads it
+            assert_eq!(roles[i], NodeRole::Outer);
+            let nb = band.neighbours_of(i);
+            let w = weights[i][0];
+            let partner = if w < 0.0 { nb[0][1] } else { nb[0][0] };
+            assert!(partner != band.sentinel() && cyclic[partner as usize] == 1, "node {i}");
+            let wp = weights[partner as usize][0];
+            assert!(w * wp < 0.0, "node {i}: {w} and {wp}");
+        }
+        // a single sphere has none
+        let (one, one_roles, one_dirs, h1) = sphere_band(n);
+        let q = sphere_problem(&one, &one_roles, &one_dirs, h1, InnerScheme::Godunov);
+        assert!(q.upwind_two_cycles(&q.upwind_weights()).iter().all(|&c| c == 0));
+        // the window reaches the same fixed point with fewer updates
+        let run = |front_window: f64| converged(&p, SolveOptions { front_window, ..Default::default() });
+        let (a, sa) = run(0.0);
+        let (b, sb) = run(DEFAULT_FRONT_WINDOW);
+        assert!(max_difference(&a, &b) < 1e-11);
+        // measured: 0.62 of the updates; 1.34 when the window held the 2-cycles back
+        assert!((sb.updates as f64) < 0.8 * sa.updates as f64, "{} vs {}", sb.updates, sa.updates);
+    }
+
+    #[test]
     fn the_front_window_reaches_the_same_fixed_point_with_fewer_updates() {
         let (band, roles, dirs, h) = sphere_band(81);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
@@ -1637,6 +1789,12 @@ mod tests {
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let second: Vec<usize> = band.indices().iter().enumerate().filter(|(_, idx)| idx[0] > n / 2).map(|(i, _)| i).collect();
         assert!(!second.is_empty());
+        let (band1, mut roles1, dirs1, _) = shell_band(n, 0.25, &[-0.5]);
+        roles1[band1.find([10, (n / 2) as i64, (n / 2) as i64]).unwrap()] = NodeRole::Fixed;
+        let mut u1 = vec![0.0; band1.len()];
+        let alone = sphere_problem(&band1, &roles1, &dirs1, h, InnerScheme::Godunov)
+            .solve(&mut u1, &SolveOptions::default(), &mut |_| Control::Continue)
+            .unwrap();
         for infinity in [None, Some(1e3), Some(1e5)] {
             let run = |front_window: f64| {
                 let mut u = vec![0.0; band.len()];
@@ -1648,8 +1806,9 @@ mod tests {
             let (a, sa) = run(0.0);
             let (b, sb) = run(DEFAULT_FRONT_WINDOW);
             assert!(max_difference(&a, &b) < 1e-11);
-            // measured: 11 iterations against 9 for every infinity, and fewer updates
-            assert!(sb.iterations <= sa.iterations + 4, "{infinity:?}: {} iterations against {}", sb.iterations, sa.iterations);
+            // the window runs as on the first sphere alone; then one pass finds the second
+            // component's nodes unreached (measured: 15 iterations for every infinity, 14 alone)
+            assert!(sb.iterations <= alone.iterations + 2, "{infinity:?}: {} iterations against {}", sb.iterations, alone.iterations);
             assert!(sb.updates <= sa.updates, "{infinity:?}: {} updates against {}", sb.updates, sa.updates);
         }
     }
@@ -1662,12 +1821,10 @@ mod tests {
         let st = p.solve(&mut u, &SolveOptions { max_iterations: 4, ..Default::default() }, &mut |_| Control::Continue).unwrap();
         assert!(!st.converged);
         assert!(st.window_edge.is_finite() && st.window_edge > 0.0, "{}", st.window_edge);
-        // the nodes beyond the edge were last updated in the second iteration
-        let mut v = vec![0.0; band.len()];
-        p.solve(&mut v, &SolveOptions { max_iterations: 2, ..Default::default() }, &mut |_| Control::Continue).unwrap();
-        let beyond: Vec<usize> = (0..band.len()).filter(|&i| v[i] > st.window_edge + 1e-9 && roles[i] == NodeRole::Inner).collect();
-        assert!(!beyond.is_empty());
-        assert!(beyond.iter().all(|&i| u[i] == v[i]));
+        // every value set lies within the window; the nodes beyond it are not reached yet
+        let reached = (0..band.len()).filter(|&i| u[i] < st.infinity).count();
+        assert!(reached > 0 && reached < band.len() / 2, "{reached} of {} reached", band.len());
+        assert!(u.iter().all(|&v| v <= st.window_edge || v == st.infinity));
         // with the window off, the same budget leaves no edge
         let st = p.solve(&mut u, &SolveOptions { max_iterations: 4, front_window: 0.0, ..Default::default() }, &mut |_| Control::Continue).unwrap();
         assert_eq!(st.window_edge, f64::INFINITY);
