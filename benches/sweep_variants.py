@@ -28,22 +28,25 @@ from typing import Dict, List, Optional, Sequence, Tuple
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "target" / "release" / "examples" / "sphere"
 
-#: name -> (coupled, rim swept last, front window)
-VARIANTS: Dict[str, Tuple[bool, bool, float]] = {
+#: name -> (coupled, rim swept last, front window; None: the example's default,
+#: ``DEFAULT_FRONT_WINDOW``)
+VARIANTS: Dict[str, Tuple[bool, bool, Optional[float]]] = {
     "paper": (False, False, 0.0),
     "rim last": (False, True, 0.0),
     "coupled": (True, False, 0.0),
     "both": (True, True, 0.0),
-    "default": (True, True, 3.0),
+    "default": (True, True, None),
 }
 
 LINE = re.compile(r"iterations=(\d+) updates=(\d+) sweeps=([0-9.]+)s")
 
 
-def run_once(n: int, threads: int, coupled: bool, rim_last: bool, window: float) -> Tuple[int, int, float]:
+def run_once(n: int, threads: int, coupled: bool, rim_last: bool, window: Optional[float]) -> Tuple[int, int, float]:
     env = dict(os.environ)
     env.pop("RIM_IN_EVERY_SWEEP", None)
-    env["WINDOW"] = repr(window)
+    env.pop("WINDOW", None)
+    if window is not None:
+        env["WINDOW"] = repr(window)
     if not rim_last:
         env["RIM_IN_EVERY_SWEEP"] = "1"
     cmd = [str(EXAMPLE), str(n), "godunov", str(threads), "coupled" if coupled else "pointwise"]

@@ -77,7 +77,7 @@ class Band:
         activation_threshold: float = 0.0,
         coupled: bool = True,
         defer_outer_rim: bool = True,
-        front_window: float = 0.0,  # Godunov: sweep behind a front window this many front steps wide; 0: off
+        front_window: float = 0.0,  # Godunov on 3D bands: sweep behind a front window front_window·h·s̄·sqrt(H) wide; 0: off
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
     def solve_general(
         self,

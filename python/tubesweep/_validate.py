@@ -16,8 +16,9 @@ HAMILTONIANS = ("godunov", "lxf")
 #: docs/architecture.md): 20–25% fewer local updates, results within 1e-2·tol of plain sweeps.
 ACTIVATION_FRACTION = 0.01
 
-#: Godunov sweeps on surfaces (3D bands) run behind a front window this many front steps wide
-#: (the Rust ``SolveOptions::front_window``, docs/architecture.md): the same solution to about
+#: Godunov sweeps on surfaces (3D bands) run behind a front window ``FRONT_WINDOW·h·s̄·sqrt(H)``
+#: wide (``H``: the longest grid path from a source in steps; the Rust
+#: ``SolveOptions::front_window``, docs/architecture.md): the same solution to about
 #: ``tol`` with 3× (N = 201) to 5× (N = 1001) fewer local updates on the sphere.
 #: ``paper_sweeps=True`` switches it off.
 FRONT_WINDOW = 2.0
