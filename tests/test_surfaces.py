@@ -291,3 +291,18 @@ def test_native_node_points_and_neighbour_table(shape):
     with pytest.raises(ValueError):
         _native.outward_directions(list(shape), grid.spacing, lin, np.zeros(len(lin)), lo, hi, np.zeros(sum(counts)),
                                    np.zeros((hi - lo, d), np.float32), bad)
+
+
+def test_row_norms_are_numpys_bits():
+    """The set-up's row norms (``tubesweep._linalg.row_norms``) give exactly the bits of
+    ``np.linalg.norm(v, axis=1)`` (the surfaces' distances, and so the bands, are unchanged)."""
+    from tubesweep._linalg import row_norms
+
+    rng = np.random.default_rng(7)
+    for d in (1, 2, 3, 4, 6):
+        v = rng.standard_normal((5000, d)) * 10.0 ** rng.uniform(-150, 150, (5000, 1))
+        np.testing.assert_array_equal(row_norms(v), np.linalg.norm(v, axis=1))
+        with np.errstate(over="ignore"):
+            w = v.astype(np.float32)
+            np.testing.assert_array_equal(row_norms(w), np.linalg.norm(w, axis=1))
+    assert row_norms(np.zeros((3, 0))).shape == (3,)

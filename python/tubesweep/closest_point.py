@@ -26,6 +26,7 @@ from typing import Callable, Optional, Tuple
 
 import numpy as np
 
+from ._linalg import row_norms
 from .grid import Grid
 from .surface import EVAL_CHUNK, BandGeometry, Surface, discover_band
 
@@ -109,7 +110,7 @@ class ClosestPoint(Surface):
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Unsigned distance ``|x − cp(x)|`` (the paper's ``F``)."""
         p = np.asarray(points, dtype=float)
-        return np.linalg.norm(p - self.closest_point(p), axis=1)
+        return row_norms(p - self.closest_point(p))
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """Band nodes with ``|x − cp(x)| ≤ half_width`` (found coarse-to-fine) and their outward
@@ -121,7 +122,7 @@ class ClosestPoint(Surface):
             return BandGeometry(linear, dist, dist, np.zeros((0, d), np.float32))
         x = grid.points(grid.unravel(linear))
         diff = x - self.closest_point(x)
-        norm = np.linalg.norm(diff, axis=1)
+        norm = row_norms(diff)
         ok = norm > DIRECTION_EPS * grid.spacing
         direction = np.zeros((len(linear), d))
         direction[ok] = diff[ok] / norm[ok, None]
@@ -130,4 +131,4 @@ class ClosestPoint(Surface):
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
         p = np.asarray(points, dtype=float)
         c = self.closest_point(p)
-        return np.linalg.norm(p - c, axis=1), c
+        return row_norms(p - c), c

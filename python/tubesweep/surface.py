@@ -20,6 +20,7 @@ from typing import Any, Callable, Iterator, Optional, Tuple, Union
 
 import numpy as np
 
+from ._linalg import row_norms
 from .grid import Grid
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
@@ -194,7 +195,7 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
 
 
 def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-    norm = np.linalg.norm(g, axis=1)
+    norm = row_norms(g)
     safe = np.where(norm > 1e-12, norm, 1.0)
     return g / safe[:, None], norm
 

@@ -6,6 +6,7 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
+from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import grid_mesh, polyline
 
@@ -26,7 +27,7 @@ class Circle(LevelSet):
         self.ndim = 2
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(np.asarray(p) - self.center, axis=1) - self.radius
+        return row_norms(np.asarray(p) - self.center) - self.radius
 
     @property
     def default_source(self) -> np.ndarray:
@@ -62,7 +63,7 @@ class Sphere(LevelSet):
         self.ndim = 3
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(np.asarray(p) - self.center, axis=1) - self.radius
+        return row_norms(np.asarray(p) - self.center) - self.radius
 
     @property
     def default_source(self) -> np.ndarray:
@@ -175,7 +176,7 @@ class Star(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         p = np.asarray(p, dtype=float)
         t = self.closest_parameter(p)
-        dist = np.linalg.norm(p - self.curve(t), axis=1)
+        dist = row_norms(p - self.curve(t))
         inside = np.hypot(p[:, 0], p[:, 1]) < self.r(np.arctan2(p[:, 1], p[:, 0]))
         return np.where(inside, -dist, dist)
 

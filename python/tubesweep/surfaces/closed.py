@@ -8,6 +8,7 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
+from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import grid_mesh, marching_cubes
 
@@ -49,7 +50,7 @@ class Ellipsoid(LevelSet):
         a2 = ax * ax
         kmin = int(np.argmin(ax))
         lo = np.full(len(x), -a2[kmin])
-        hi = np.max(ax) * np.linalg.norm(x, axis=1) + 1e-300
+        hi = np.max(ax) * row_norms(x) + 1e-300
         hi = np.maximum(hi, 0.0)
         ax_x = ax * x
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -86,7 +87,7 @@ class Ellipsoid(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         p = np.asarray(p, dtype=float)
         y = self.closest_point(p)
-        dist = np.linalg.norm(p - y, axis=1)
+        dist = row_norms(p - y)
         inside = np.sum(((p - self.center) / self.axes) ** 2, axis=1) < 1.0
         return np.where(inside, -dist, dist)
 
@@ -196,7 +197,7 @@ class RoundedCube(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         q = np.abs(np.asarray(p, dtype=float) - self.center) - (self.half_size - self.radius)
-        return np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(np.max(q, axis=1), 0.0) - self.radius
+        return row_norms(np.maximum(q, 0.0)) + np.minimum(np.max(q, axis=1), 0.0) - self.radius
 
     @property
     def default_source(self) -> np.ndarray:

@@ -6,6 +6,7 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
+from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import polyline
 
@@ -68,7 +69,7 @@ class Ellipse(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         p = np.asarray(p, dtype=float)
         t = self.closest_parameter(p)
-        dist = np.linalg.norm(p - self.curve(t), axis=1)
+        dist = row_norms(p - self.curve(t))
         q = p - self.center
         inside = (q[:, 0] / self.a) ** 2 + (q[:, 1] / self.b) ** 2 < 1.0
         return np.where(inside, -dist, dist)
