@@ -21,22 +21,26 @@ fn main() {
     let threads: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
     let coupled = args.get(4).map_or(true, |s| s != "pointwise");
     let defer_outer_rim = std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
-    let (lin, mut roles, dirs, h) = shell::sphere_shell(n);
+    let (lin, mut roles, mut dirs, h) = shell::sphere_shell(n);
     let t = Instant::now();
     let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
     let build = t.elapsed().as_secs_f64();
     let src = band.find([((n - 1) / 4) as i64, ((n - 1) / 2) as i64, ((n - 1) / 2) as i64]).unwrap();
     roles[src] = NodeRole::Fixed;
+    // as the Python layer does: the upwind weights in place of the directions, and room for the
+    // solver's sentinel slot in the values (no copies of band-sized arrays)
+    tubesweep_core::sweep::extension_weights_in_place(&band, &roles, &mut dirs);
     let p = SweepProblem {
         band: &band,
         roles: &roles,
         spacing: h,
         slowness: Slowness::Constant(1.0),
-        extension: Extension::Directions(&dirs),
+        extension: Extension::Weights(&dirs),
         scheme,
         missing: MissingNeighbour::Extrapolate,
     };
-    let mut u = vec![0.0; band.len()];
+    let mut u = Vec::with_capacity(band.len() + 1);
+    u.resize(band.len(), 0.0);
     let thr: f64 = std::env::var("THR").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-12);
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
     let front_window: f64 =

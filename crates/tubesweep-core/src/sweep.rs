@@ -536,29 +536,32 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// that axis, as where the directions from two sheets of the surface meet). `1` marks them.
     fn upwind_two_cycles(&self, weights: &[[f32; D]]) -> Vec<u8> {
         let n = self.roles.len();
-        let mut marks = vec![0u8; n];
         if weights.is_empty() {
-            return marks;
+            return vec![0u8; n];
         }
         let sentinel = self.band.sentinel();
-        for a in 0..n {
-            if self.roles[a] != NodeRole::Outer {
-                continue;
-            }
-            let nb = self.band.neighbours_of(a);
-            for k in 0..D {
-                let b = nb[k][1];
-                if b == sentinel || self.roles[b as usize] != NodeRole::Outer {
-                    continue;
+        let roles = self.roles;
+        (0..n)
+            .into_par_iter()
+            .map(|a| {
+                if roles[a] != NodeRole::Outer {
+                    return 0u8;
                 }
-                // a reads its plus neighbour b when w_a[k] < 0; b reads its minus neighbour a when w_b[k] > 0
-                if weights[a][k] < 0.0 && weights[b as usize][k] > 0.0 {
-                    marks[a] = 1;
-                    marks[b as usize] = 1;
-                }
-            }
-        }
-        marks
+                let nb = self.band.neighbours_of(a);
+                let reads_back = |b: u32, k: usize, b_reads_minus: bool| {
+                    b != sentinel
+                        && roles[b as usize] == NodeRole::Outer
+                        && if b_reads_minus { weights[b as usize][k] > 0.0 } else { weights[b as usize][k] < 0.0 }
+                };
+                // a reads its plus neighbour when w_a[k] < 0, its minus neighbour when w_a[k] > 0;
+                // the plus neighbour reads a (its minus neighbour) when its w[k] > 0, and so on
+                let cyclic = (0..D).any(|k| {
+                    let w = weights[a][k];
+                    (w < 0.0 && reads_back(nb[k][1], k, true)) || (w > 0.0 && reads_back(nb[k][0], k, false))
+                });
+                cyclic as u8
+            })
+            .collect()
     }
 
     /// This problem with other roles and the extension weights already derived.
