@@ -158,8 +158,8 @@ pub struct SolveOptions {
     /// edge `front + w` are updated, from the first iteration on: `front` is the smallest source
     /// value at the start, then the smallest value that changed by more than `tol` in the
     /// previous iteration, and `w = front_window · h s̄ · sqrt(H)` (`h` the spacing, `s̄` the mean
-    /// slowness, `H` the longest grid path from a source in steps, so that `H h s̄` bounds the
-    /// range of the values; the front's step shrinks like the square root of the spacing). A
+    /// slowness, `H` the longest grid path from a source in steps, so that `H h s̄` estimates
+    /// the range of the values; the front's step shrinks like the square root of the spacing). A
     /// node still at the numerical infinity is updated but takes the new value only if it lies
     /// within the window; so every value set lies within it, and the band fills from the sources
     /// outwards like a wave, without the first iterations' long detours round the surface. Nodes
@@ -1349,8 +1349,8 @@ struct SweepContext<'a, const D: usize> {
     /// skipped whole. Lowered by the thread that runs the row or a row next to it; two rows next
     /// to the same row can run at once, hence the atomic minimum ([`SweepContext::lower_row`]).
     row_low: &'a [AtomicU64],
-    /// Per node, 1 for the extension-layer nodes in an upwind cycle, which the front window does
-    /// not hold back (empty without the window).
+    /// Per node, 1 for the extension-layer nodes in an upwind 2-cycle, which the front window
+    /// does not hold back (empty without the window).
     cyclic: &'a [u8],
     /// Per row (and a last slot for "no row"), set while a node of the row may be active: a row
     /// whose flag is clear is skipped whole. Set for every row at the start; cleared when the row
