@@ -725,7 +725,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
-            let lim = Limits { inf, threshold: options.activation_threshold, window, window_key: order_key(window), settled: options.tol };
+            let lim = Limits {
+                inf,
+                threshold: options.activation_threshold,
+                window,
+                window_key: order_key(window),
+                settled: options.tol,
+                refused: REFUSED + (stats.iterations % 250) as u8,
+            };
             let mut max_change = 0.0f64;
             let mut front = f64::INFINITY;
             let mut waiting = f64::INFINITY;
@@ -1018,7 +1025,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let flag = unsafe { active.get_unchecked(n) };
         // fixed nodes get activated by their neighbours too: one test for both (no short circuit)
         let fixed = unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed;
-        if (flag.load(Ordering::Relaxed) == 0) | fixed {
+        let state = flag.load(Ordering::Relaxed);
+        if (state == 0) | fixed {
             return;
         }
         // beyond the front window (see `Limits::window`): a node that holds a value there stays
@@ -1035,6 +1043,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     }
                     return;
                 }
+                if state == lim.refused {
+                    // refused earlier in this iteration, and no neighbour has changed since (that
+                    // would have set the flag to 1): the same window, the same candidate, which
+                    // already lowered this iteration's `waiting`
+                    *row |= KEEP_ROW;
+                    return;
+                }
                 unreached_beyond = true;
             }
         }
@@ -1044,7 +1059,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let nb = unsafe { self.band.neighbours_of_unchecked(n) };
         let Some(up) = self.local_update::<S, P>(ctx, n, &nb, lim.inf) else { return };
         if W && unreached_beyond && up.new > lim.window {
-            flag.store(1, Ordering::Relaxed);
+            flag.store(lim.refused, Ordering::Relaxed);
             *row |= KEEP_ROW;
             if up.new < acc.waiting {
                 acc.waiting = up.new;
@@ -1366,6 +1381,10 @@ struct SweepContext<'a, const D: usize> {
     windowed: bool,
 }
 
+/// The smallest active-flag value that marks a node refused by the front window (0: inactive,
+/// 1: active; see [`Limits::refused`]).
+const REFUSED: u8 = 2;
+
 /// A node of the row stays active: the row stays dirty.
 const KEEP_ROW: u8 = 1;
 /// A node of the row activated its neighbours: the row and the rows next to it become dirty.
@@ -1503,6 +1522,10 @@ struct Limits {
     window: f64,
     /// [`order_key`] of `window`.
     window_key: u64,
+    /// The active-flag value of an unreached node whose new value lay beyond the window in this
+    /// iteration ([`REFUSED`] plus the iteration number modulo 250): it stays active, but is
+    /// not updated again in this iteration unless a neighbour changes (which sets its flag to 1).
+    refused: u8,
     /// A change larger than this (the tolerance) counts towards [`Accumulator::front`].
     settled: f64,
 }
