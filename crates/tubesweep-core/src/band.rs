@@ -165,6 +165,27 @@ impl<const D: usize> NarrowBand<D> {
         nb
     }
 
+    /// Asks the processor to fetch the neighbour-table entries of node `n` into cache ahead of
+    /// [`neighbours_of`](Self::neighbours_of); a hint only (nothing happens for `n` out of range
+    /// or on other architectures than x86-64). Pays where nodes are visited out of memory order,
+    /// as in a breadth-first search.
+    #[inline(always)]
+    pub fn prefetch_neighbours(&self, n: usize) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            if let (Some(lead), Some(row)) = (self.lead.get(n * 2 * (D - 1)), self.along_row.get(n)) {
+                // SAFETY: prefetching is a hint with no effect on memory; both pointers are valid
+                unsafe {
+                    _mm_prefetch::<_MM_HINT_T0>((lead as *const u32).cast());
+                    _mm_prefetch::<_MM_HINT_T0>((row as *const u8).cast());
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = n;
+    }
+
     /// Node range `[start, end)` of row `r`.
     #[inline]
     pub fn row_range(&self, r: usize) -> (usize, usize) {

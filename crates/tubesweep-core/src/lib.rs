@@ -15,6 +15,7 @@
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the last split of the coarse-to-fine band search | [`discovery`] | — |
 //! | extension directions sgn(φ)∇φ/|∇φ| by central differences | [`normals`] | Eq. (8), Sect. 4 |
+//! | the longest grid path from the sources (numerical infinity, front window) | [`grid_hops`] | — |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
 //! | multilinear interpolation in the band | [`interpolate`] | — |
 //! | exact closest points on triangle meshes (AABB tree) | [`mesh`] | Sect. 5.2 |
@@ -28,6 +29,7 @@ pub mod discovery;
 pub mod error;
 pub mod extension;
 pub mod godunov;
+pub mod grid_hops;
 pub mod hamiltonian;
 pub mod hamiltonians;
 pub mod interpolate;

@@ -312,32 +312,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// The largest number of grid steps from a fixed node to any band node it reaches
     /// (breadth-first search over the neighbour table; 0 without fixed nodes).
     pub fn grid_hops_from_sources(&self) -> u32 {
-        let n = self.band.len();
-        let sentinel = self.band.sentinel() as usize;
-        let mut hops = vec![u32::MAX; n];
-        let mut queue = std::collections::VecDeque::new();
-        for (i, &r) in self.roles.iter().enumerate() {
-            if r == NodeRole::Fixed {
-                hops[i] = 0;
-                queue.push_back(i);
-            }
-        }
-        let mut max_hops = 0u32;
-        while let Some(i) = queue.pop_front() {
-            let next = hops[i] + 1;
-            let nb = self.band.neighbours_of(i);
-            for k in 0..D {
-                for side in 0..2 {
-                    let m = nb[k][side] as usize;
-                    if m != sentinel && hops[m] == u32::MAX {
-                        hops[m] = next;
-                        max_hops = max_hops.max(next);
-                        queue.push_back(m);
-                    }
-                }
-            }
-        }
-        max_hops
+        let sources = self.roles.iter().enumerate().filter(|(_, &r)| r == NodeRole::Fixed).map(|(i, _)| i);
+        crate::grid_hops::max_grid_hops(self.band, sources)
     }
 
     /// Whether these options run the front window ([`SolveOptions::front_window`]).
