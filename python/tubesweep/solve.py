@@ -287,8 +287,8 @@ def solve(
         discrete equations, to the same solution within about ``tol``, with three accelerations
         (docs/architecture.md): with Godunov, each inner-tube node is updated together with the
         extension-layer nodes that copy it (block Gauss–Seidel; sphere N=1001: 38 instead of 55
-        iterations); the *outer rim* (layer nodes no inner node depends on) is swept only after
-        the rest has converged (about 30% fewer local updates); and, with Godunov on surfaces,
+        iterations); the *outer rim* (layer nodes no inner node depends on) is left out until
+        the rest has converged, then evaluated once in dependency order; and, with Godunov on surfaces,
         the sweeps run behind a *front window* (only nodes within a few front steps of the
         smallest still-changing value are updated, and the band fills from the sources outwards):
         3× fewer local updates on the sphere at N=201, 5× at N=1001, and 2–4× less time
@@ -410,8 +410,8 @@ def solve(
     # extension weights (d × f32), per-node slowness (f64) when the speed varies; per row a lower
     # bound of its values (8 bytes, for the front window), and with the window a byte per node
     # marking the layer nodes in upwind 2-cycles; the fixed values are sparse. (With the rim
-    # swept last the core also holds two role copies and a rim mask, 3 bytes per node, while it
-    # runs.)
+    # left to the end the core also holds a role copy and a rim mask, then the rim mask and a
+    # byte of dependency counts, 2 bytes per node.)
     windowed = grid.ndim == 3 and scheme == "godunov" and not paper_sweeps and FRONT_WINDOW > 0
     per_node = 8 + 1 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0) + (1 if windowed else 0)
     stats = SolveStats(

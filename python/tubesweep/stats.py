@@ -13,10 +13,11 @@ class SolveStats:
     Attributes
     ----------
     iterations : int
-        Full passes of the 2^d sweep orders (with the outer rim swept last, the default, this
-        includes the rim's own passes, usually two).
+        Full passes of the 2^d sweep orders; with the outer rim left to the end (the default),
+        one more for the rim, whose values are set once the rest of the band has converged.
     sweeps : int
-        Directional sweeps (2^d per iteration).
+        Directional sweeps (2^d per iteration), and the rim's passes (one in dependency order,
+        a few more where rim nodes read each other in a cycle).
     updates : int
         Local updates performed.
     converged : bool

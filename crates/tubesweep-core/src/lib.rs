@@ -15,6 +15,7 @@
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the last split of the coarse-to-fine band search | [`discovery`] | — |
 //! | extension directions sgn(φ)∇φ/|∇φ| by central differences | [`normals`] | Eq. (8), Sect. 4 |
+//! | the outer rim of the layer, extended into last in one pass | [`rim`] | Eq. (5) |
 //! | the longest grid path from the sources (numerical infinity, front window) | [`grid_hops`] | — |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
 //! | multilinear interpolation in the band | [`interpolate`] | — |
@@ -36,6 +37,7 @@ pub mod interpolate;
 pub mod lax_friedrichs;
 pub mod mesh;
 pub mod normals;
+pub mod rim;
 pub mod schedule;
 pub mod sweep;
 #[cfg(test)]

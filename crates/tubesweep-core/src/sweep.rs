@@ -143,12 +143,13 @@ pub struct SolveOptions {
     /// (`benches/sweep_variants.py`). `false` runs the
     /// paper's pointwise sweeps (its Table 2 iteration counts).
     pub coupled: bool,
-    /// Sweep the *outer rim* last: the extension-layer nodes that no inner-tube node depends on
-    /// (not read by an inner node, nor by a layer node that one reads, and so on) cannot change
-    /// the inner tube, so the sweeps first converge the rest of the band with the rim held
-    /// still, then extend the converged values into the rim. The same equations and fixed point;
-    /// the rim (about a third of the layer with the paper's widths) is swept for a few iterations
-    /// instead of all of them.
+    /// Leave the *outer rim* to the end: the extension-layer nodes that no inner-tube node
+    /// depends on (not read by an inner node, nor by a layer node that one reads, and so on)
+    /// cannot change the inner tube, so the sweeps first converge the rest of the band with the
+    /// rim held still, then the converged values are extended into the rim in one pass in
+    /// dependency order ([`crate::rim`]). The same equations and fixed point; the rim (about a
+    /// third of the layer with the paper's widths) is evaluated about once per node instead of
+    /// being swept in every iteration.
     pub defer_outer_rim: bool,
     /// Godunov on 3D bands only, with `skip_inactive`: sweep behind a moving *front window*. The sweeps
     /// converge from the sources outwards: a region settles only once the region upwind of it
@@ -205,10 +206,11 @@ pub const DEFAULT_FRONT_WINDOW: f64 = 2.0;
 /// What a solve did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveStats {
-    /// Full passes of the 2^d sweep orders (with [`SolveOptions::defer_outer_rim`], the rim's own
-    /// passes, usually two, are included).
+    /// Full passes of the 2^d sweep orders; with [`SolveOptions::defer_outer_rim`], one more
+    /// for the rim (its values set from the converged rest of the band, [`crate::rim`]).
     pub iterations: usize,
-    /// Single directional sweeps (2^d per iteration).
+    /// Single directional sweeps (2^d per iteration), and the rim's passes (one in dependency
+    /// order, more where rim nodes read each other in a cycle).
     pub sweeps: usize,
     /// Local updates performed (one per visited non-fixed node and sweep).
     pub updates: u64,
@@ -467,46 +469,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .collect()
     }
 
-    /// The extension-layer nodes that no inner-tube node depends on (see
-    /// [`SolveOptions::defer_outer_rim`]): every layer neighbour of an inner node is needed, and
-    /// so is every layer node that a needed layer node reads in its update (5); the rest is the
-    /// rim. `true` marks a rim node.
-    fn outer_rim(&self, weights: &[[f32; D]]) -> Vec<bool> {
-        let n = self.roles.len();
-        let sentinel = self.band.sentinel();
-        let roles = self.roles;
-        let mut needed = vec![false; n];
-        let mut stack: Vec<u32> = Vec::new();
-        let need = |q: u32, needed: &mut Vec<bool>, stack: &mut Vec<u32>| {
-            if q != sentinel && roles[q as usize] == NodeRole::Outer && !needed[q as usize] {
-                needed[q as usize] = true;
-                stack.push(q);
-            }
-        };
-        for i in 0..n {
-            if roles[i] == NodeRole::Inner {
-                let nb = self.band.neighbours_of(i);
-                for k in 0..D {
-                    need(nb[k][0], &mut needed, &mut stack);
-                    need(nb[k][1], &mut needed, &mut stack);
-                }
-            }
-        }
-        while let Some(q) = stack.pop() {
-            let w = weights[q as usize];
-            let nb = self.band.neighbours_of(q as usize);
-            for k in 0..D {
-                // the upwind neighbour the update (5) reads along axis k (none for w_k = 0 or NaN)
-                if w[k] > 0.0 {
-                    need(nb[k][0], &mut needed, &mut stack);
-                } else if w[k] < 0.0 {
-                    need(nb[k][1], &mut needed, &mut stack);
-                }
-            }
-        }
-        roles.iter().zip(&needed).map(|(&r, &nd)| r == NodeRole::Outer && !nd).collect()
-    }
-
     /// The extension-layer nodes in an upwind 2-cycle: two layer nodes next to each other along
     /// an axis whose updates (5) read each other (their directions point at each other along
     /// that axis, as where the directions from two sheets of the surface meet). `1` marks them.
@@ -557,7 +519,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 
     /// [`iterate`](Self::iterate) in two phases: the band without its outer rim (held at the
-    /// numerical infinity, read by nobody), then the rim alone (everything else held fixed).
+    /// numerical infinity, read by nobody), then the rim's values in one pass in dependency order
+    /// ([`crate::rim`]).
     fn iterate_rim_last(
         &self,
         u: &mut [f64],
@@ -568,36 +531,30 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     ) -> Result<()> {
         let weights = self.upwind_weights();
         let weights: &[[f32; D]] = &weights;
-        let rim = if weights.is_empty() { Vec::new() } else { self.outer_rim(weights) };
+        let rim = if weights.is_empty() { Vec::new() } else { crate::rim::outer_rim(self.band, self.roles, weights) };
         if !rim.iter().any(|&b| b) {
             return self.with_roles(self.roles, weights).iterate(u, options, window_width, progress, stats);
         }
         let without_rim: Vec<NodeRole> =
-            self.roles.iter().zip(&rim).map(|(&r, &b)| if b { NodeRole::Fixed } else { r }).collect();
+            self.roles.par_iter().zip(rim.par_iter()).map(|(&r, &b)| if b { NodeRole::Fixed } else { r }).collect();
         self.with_roles(&without_rim, weights).iterate(u, options, window_width, progress, stats)?;
         drop(without_rim);
-        let rim_only: Vec<NodeRole> = rim.iter().map(|&b| if b { NodeRole::Outer } else { NodeRole::Fixed }).collect();
-        // The rim shares the iteration budget (at least one pass, so that it gets values even
-        // when the first phase used it all) and reports its passes after the first phase's.
+        // The rim counts as one iteration, reported after the first phase's; its passes (one,
+        // and those over its cyclic part) count as sweeps and share the budget of sweeps left
+        // (at least one pass, so that it gets values even when the first phase used it all).
         let base = stats.iterations;
-        let rim_options = SolveOptions { max_iterations: options.max_iterations.saturating_sub(base).max(1), front_window: 0.0, ..*options };
-        let mut rim_stats = SolveStats::default();
-        let result = self.with_roles(&rim_only, weights).iterate(
-            u,
-            &rim_options,
-            0.0,
-            &mut |r| progress(&IterationReport { iteration: base + r.iteration, ..*r }),
-            &mut rim_stats,
-        );
-        stats.iterations += rim_stats.iterations;
-        stats.sweeps += rim_stats.sweeps;
-        stats.updates += rim_stats.updates;
-        stats.converged &= rim_stats.converged;
-        stats.last_change = stats.last_change.max(rim_stats.last_change);
-        result.map_err(|e| match e {
-            Error::Interrupted { iterations } => Error::Interrupted { iterations: base + iterations },
-            other => other,
-        })
+        let budget = options.max_iterations.saturating_sub(base).max(1).saturating_mul(1 << D);
+        let passes = crate::rim::extend_into_rim(self.band, &rim, weights, u, options.tol, budget);
+        stats.iterations += 1;
+        stats.sweeps += passes.passes;
+        stats.updates += passes.updates;
+        stats.converged &= passes.converged;
+        stats.last_change = stats.last_change.max(passes.last_change);
+        let report = IterationReport { iteration: stats.iterations, max_change: passes.first_change, updates: passes.updates };
+        if progress(&report) == Control::Stop {
+            return Err(Error::Interrupted { iterations: stats.iterations });
+        }
+        Ok(())
     }
 
     /// The sweeps to convergence; `window_width` > 0 runs the front window
@@ -2010,11 +1967,32 @@ mod tests {
     }
 
     #[test]
+    fn the_rim_s_one_pass_leaves_every_rim_node_at_its_fixed_point() {
+        // the rim is evaluated once, in dependency order: another evaluation of Eq. (5) at any
+        // rim node gives back its value to the bit
+        let (band, roles, dirs, h) = sphere_band(61);
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+        let w = p.upwind_weights().into_owned();
+        let rim = crate::rim::outer_rim(&band, &roles, &w);
+        let (u, st) = converged(&p, SolveOptions::default());
+        assert!(st.converged && st.last_change == 0.0, "{st:?}");
+        let mut checked = 0;
+        for q in (0..band.len()).filter(|&q| rim[q] && !w[q][0].is_nan()) {
+            let again = crate::extension::extension_apply_upwind(w[q], &band.neighbours_of(q), |i| {
+                if i == band.sentinel() { st.infinity } else { u[i as usize] }
+            });
+            assert_eq!(again.to_bits(), u[q].to_bits(), "rim node {q}");
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked} rim nodes");
+    }
+
+    #[test]
     fn the_outer_rim_is_the_layer_that_no_inner_node_depends_on() {
         let (band, roles, dirs, h) = sphere_band(41);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let w = p.upwind_weights().into_owned();
-        let rim = p.outer_rim(&w);
+        let rim = crate::rim::outer_rim(&band, &roles, &w);
 
         let n_rim = rim.iter().filter(|&&b| b).count();
         let n_outer = roles.iter().filter(|&&r| r == NodeRole::Outer).count();
