@@ -20,6 +20,7 @@ use crate::band::NarrowBand;
 use crate::extension::extension_apply_upwind;
 use crate::sweep::NodeRole;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 /// The upwind neighbour that the update (5) of a layer node with weights `w` reads along each
 /// axis: `Some(band position)` for `w_k ≠ 0` (a neighbour in the band: the weights of absent
@@ -122,6 +123,15 @@ pub struct RimPasses {
     pub converged: bool,
 }
 
+/// Roots per parallel task of the pass in dependency order.
+const ROOTS_PER_TASK: usize = 1024;
+
+/// The values, written by the threads of the pass in dependency order (each node by one).
+struct SharedValues(*mut f64);
+// SAFETY: the pass in dependency order writes each node from one thread and orders every read
+// after that write (see `extend_into_rim`)
+unsafe impl Sync for SharedValues {}
+
 /// How many root nodes ahead their weights and neighbour entries are prefetched.
 const PREFETCH_AHEAD: usize = 16;
 
@@ -162,11 +172,11 @@ pub fn extend_into_rim<const D: usize>(
     // most one per axis); in bit 2 + 2k + side, whether its neighbour `nb[k][side]` is a rim node
     // that reads it (the plus neighbour along k reads its minus neighbour when its weight
     // w_k > 0, the minus neighbour its plus neighbour when w_k < 0)
-    let mut pending: Vec<u8> = (0..n)
+    let pending: Vec<AtomicU8> = (0..n)
         .into_par_iter()
         .map(|q| {
             if !rim[q] {
-                return 0;
+                return AtomicU8::new(0);
             }
             let nb = band.neighbours_of(q);
             let reads = upwind_reads(weights[q], &nb).into_iter().flatten().filter(|&m| is_rim(m)).count() as u8;
@@ -181,56 +191,69 @@ pub fn extend_into_rim<const D: usize>(
                     }
                 }
             }
-            reads | read_by << 2
+            AtomicU8::new(reads | read_by << 2)
         })
         .collect();
     // the rim nodes that read no rim node, in band order; each is followed at once by the rim
     // nodes it completes (depth first: they are its neighbours, so their data is still in cache)
-    let roots: Vec<u32> = (0..n as u32).into_par_iter().filter(|&q| rim[q as usize] && pending[q as usize] & 3 == 0).collect();
-    let mut stats = RimPasses { passes: 1, converged: true, ..Default::default() };
+    let roots: Vec<u32> =
+        (0..n as u32).into_par_iter().filter(|&q| rim[q as usize] && pending[q as usize].load(Ordering::Relaxed) & 3 == 0).collect();
     // Eq. (5) at rim node q from the current values (a node without upwind neighbour keeps its
     // value)
-    let candidate = |q: usize, u: &[f64]| -> f64 {
+    let candidate = |q: usize, value: &dyn Fn(usize) -> f64| -> f64 {
         let w = weights[q];
         if w[0].is_nan() {
-            return u[q];
+            return value(q);
         }
-        extension_apply_upwind(w, &band.neighbours_of(q), |i| u[i as usize])
+        extension_apply_upwind(w, &band.neighbours_of(q), |i| value(i as usize))
     };
-    let evaluate = |q: usize, u: &mut [f64]| -> f64 {
-        let v = candidate(q, u);
-        let change = (u[q] - v).abs();
-        u[q] = v;
-        change
-    };
-    let mut stack = Vec::new();
-    for (j, &root) in roots.iter().enumerate() {
-        if let Some(&ahead) = roots.get(j + PREFETCH_AHEAD) {
-            prefetch(&weights[ahead as usize]);
-            band.prefetch_neighbours(ahead as usize);
-        }
-        stack.push(root);
-        while let Some(q) = stack.pop() {
-            stats.updates += 1;
-            stats.first_change = stats.first_change.max(evaluate(q as usize, u));
-            let nb = band.neighbours_of(q as usize);
-            let read_by = pending[q as usize] >> 2;
-            for k in 0..D {
-                for side in 0..2 {
-                    if read_by >> (2 * k + side) & 1 == 1 {
-                        let p = nb[k][side] as usize;
-                        pending[p] -= 1;
-                        if pending[p] & 3 == 0 {
-                            stack.push(p as u32);
+    // Runs of roots go to the threads. A node is evaluated by the one thread that takes its
+    // count to zero (or as a root), after every rim node it reads was evaluated: that thread's
+    // decrement (acquire) follows the others' (release), which follow their writes. So every
+    // value is set once, from final values, whatever the threads' timing: the same bits.
+    let shared = SharedValues(u.as_mut_ptr());
+    let (updates, first_change) = roots
+        .par_chunks(ROOTS_PER_TASK)
+        .map(|chunk| {
+            let shared = &shared;
+            // SAFETY: see above: a value is read only after its one write, ordered by `pending`
+            let value = |i: usize| unsafe { *shared.0.add(i) };
+            let mut stack = Vec::new();
+            let (mut updates, mut first_change) = (0u64, 0.0f64);
+            for (j, &root) in chunk.iter().enumerate() {
+                if let Some(&ahead) = chunk.get(j + PREFETCH_AHEAD) {
+                    prefetch(&weights[ahead as usize]);
+                    band.prefetch_neighbours(ahead as usize);
+                }
+                stack.push(root);
+                while let Some(q) = stack.pop() {
+                    let q = q as usize;
+                    let v = candidate(q, &value);
+                    updates += 1;
+                    first_change = first_change.max((value(q) - v).abs());
+                    // SAFETY: only this thread writes q (see above)
+                    unsafe { *shared.0.add(q) = v };
+                    let nb = band.neighbours_of(q);
+                    let read_by = pending[q].load(Ordering::Relaxed) >> 2;
+                    for k in 0..D {
+                        for side in 0..2 {
+                            if read_by >> (2 * k + side) & 1 == 1 {
+                                let p = nb[k][side];
+                                if pending[p as usize].fetch_sub(1, Ordering::AcqRel) & 3 == 1 {
+                                    stack.push(p);
+                                }
+                            }
                         }
                     }
                 }
             }
-        }
-    }
+            (updates, first_change)
+        })
+        .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+    let mut stats = RimPasses { passes: 1, converged: true, updates, first_change, ..Default::default() };
     // the cycles and what lies downwind of them: still waiting for a rim node they read
     let cyclic: Vec<u32> =
-        (0..n as u32).into_par_iter().filter(|&q| rim[q as usize] && pending[q as usize] & 3 != 0).collect();
+        (0..n as u32).into_par_iter().filter(|&q| rim[q as usize] && pending[q as usize].load(Ordering::Relaxed) & 3 != 0).collect();
     if cyclic.is_empty() {
         return stats;
     }
@@ -259,10 +282,10 @@ pub fn extend_into_rim<const D: usize>(
     drop(position);
     while stats.passes < max_passes {
         for &q in &order {
-            evaluate(q as usize, u);
+            u[q as usize] = candidate(q as usize, &|i| u[i]);
         }
         // how far another pass would move the nodes where cycles close (evaluated, not written)
-        let residual = closing.iter().map(|&q| (candidate(q as usize, u) - u[q as usize]).abs()).fold(0.0f64, f64::max);
+        let residual = closing.iter().map(|&q| (candidate(q as usize, &|i| u[i]) - u[q as usize]).abs()).fold(0.0f64, f64::max);
         stats.passes += 1;
         stats.updates += (order.len() + closing.len()) as u64;
         stats.last_change = residual;

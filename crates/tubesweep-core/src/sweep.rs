@@ -123,8 +123,9 @@ pub struct SolveOptions {
     /// The finite "numerical infinity" that non-fixed nodes start at; `None` derives a safe,
     /// tight one from the band (see [`SweepProblem::auto_infinity`]).
     pub infinity: Option<f64>,
-    /// Worker threads for the sweeps: 0 = rayon's default (all cores), 1 = sequential. The result
-    /// does not depend on it (see [`crate::schedule`]).
+    /// Worker threads for the solve (the sweeps and their preparation), in a pool of its own: 0 =
+    /// rayon's default (all cores, or `RAYON_NUM_THREADS`), 1 = sequential. The result does not depend on it (see
+    /// [`crate::schedule`]).
     pub threads: usize,
     /// Skip nodes none of whose neighbours changed since their last update (default true). The
     /// result is bit-identical either way for the pointwise updates, and identical to rounding
@@ -366,11 +367,21 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
         }
         values.push(inf); // the sentinel slot read for absent neighbours
+        // Every parallel step of the solve (the preparation, the sweeps and the rim) runs on a
+        // pool of `threads` threads of its own (rayon's default number for 0), never on the
+        // caller's: the sweeps hold all the pool's threads at their barriers, which a caller's
+        // pool busy with other work (or with another solve) could not give. The progress
+        // callback runs on the caller's thread.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(options.threads)
+            .build()
+            .map_err(|e| Error::invalid("threads", format!("could not start {} threads: {e}", options.threads)))?;
+        let pool = &pool;
         let mut stats = SolveStats { infinity: inf, ..Default::default() };
         let result = if options.defer_outer_rim {
-            self.iterate_rim_last(values, options, window_width, progress, &mut stats)
+            self.iterate_rim_last(values, options, window_width, pool, progress, &mut stats)
         } else {
-            self.iterate(values, options, window_width, progress, &mut stats)
+            self.iterate(values, options, window_width, pool, progress, &mut stats)
         };
         values.pop();
         if stats.window_edge < f64::INFINITY {
@@ -526,25 +537,26 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         u: &mut [f64],
         options: &SolveOptions,
         window_width: f64,
+        pool: &rayon::ThreadPool,
         progress: &mut dyn FnMut(&IterationReport) -> Control,
         stats: &mut SolveStats,
     ) -> Result<()> {
         let weights = self.upwind_weights();
         let weights: &[[f32; D]] = &weights;
-        let rim = if weights.is_empty() { Vec::new() } else { crate::rim::outer_rim(self.band, self.roles, weights) };
+        let rim = if weights.is_empty() { Vec::new() } else { pool.install(|| crate::rim::outer_rim(self.band, self.roles, weights)) };
         if !rim.iter().any(|&b| b) {
-            return self.with_roles(self.roles, weights).iterate(u, options, window_width, progress, stats);
+            return self.with_roles(self.roles, weights).iterate(u, options, window_width, pool, progress, stats);
         }
         let without_rim: Vec<NodeRole> =
-            self.roles.par_iter().zip(rim.par_iter()).map(|(&r, &b)| if b { NodeRole::Fixed } else { r }).collect();
-        self.with_roles(&without_rim, weights).iterate(u, options, window_width, progress, stats)?;
+            pool.install(|| self.roles.par_iter().zip(rim.par_iter()).map(|(&r, &b)| if b { NodeRole::Fixed } else { r }).collect());
+        self.with_roles(&without_rim, weights).iterate(u, options, window_width, pool, progress, stats)?;
         drop(without_rim);
         // The rim counts as one iteration, reported after the first phase's; its passes (one,
         // and those over its cyclic part) count as sweeps and share the budget of sweeps left
         // (at least one pass, so that it gets values even when the first phase used it all).
         let base = stats.iterations;
         let budget = options.max_iterations.saturating_sub(base).max(1).saturating_mul(1 << D);
-        let passes = crate::rim::extend_into_rim(self.band, &rim, weights, u, options.tol, budget);
+        let passes = pool.install(|| crate::rim::extend_into_rim(self.band, &rim, weights, u, options.tol, budget));
         stats.iterations += 1;
         stats.sweeps += passes.passes;
         stats.updates += passes.updates;
@@ -564,6 +576,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         u: &mut [f64],
         options: &SolveOptions,
         window_width: f64,
+        pool: &rayon::ThreadPool,
         progress: &mut dyn FnMut(&IterationReport) -> Control,
         stats: &mut SolveStats,
     ) -> Result<()> {
@@ -573,20 +586,39 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // updates could not have changed anything: the result is bit-identical to the plain sweep.
         // The coupled Godunov update also reads the node's own value; re-evaluated with unchanged
         // neighbours it can only return its value again, up to the last bit of rounding. One extra slot for the sentinel keeps the activation branch-free.
-        let active: Vec<AtomicU8> = self
-            .roles
-            .iter()
-            .map(|&r| AtomicU8::new((r != NodeRole::Fixed) as u8))
-            .chain(std::iter::once(AtomicU8::new(0)))
-            .collect();
-        // per row, the smallest value it holds (the fixed values and the infinity at the start;
-        // the last slot stands for "no row")
-        let start_low: Vec<f64> = (0..self.band.n_rows())
-            .map(|r| {
-                let (s, e) = self.band.row_range(r);
-                u[s..e].iter().fold(f64::INFINITY, |m, &v| m.min(v))
-            })
-            .collect();
+        // Upwind weights of the extension update, once per solve (the band does not change).
+        // Outer nodes without an upwind neighbour keep their value: they are never activated.
+        let weights = self.upwind_weights();
+        let weights: &[[f32; D]] = &weights;
+        let n = self.roles.len();
+        let values: &[f64] = u;
+        let (active, start_low, coupling, first_front) = pool.install(|| {
+            let active: Vec<AtomicU8> = (0..=n)
+                .into_par_iter()
+                .map(|i| {
+                    let updated = i < n && self.roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan());
+                    AtomicU8::new(updated as u8)
+                })
+                .collect();
+            // per row, the smallest value it holds (the fixed values and the infinity at the start)
+            let start_low: Vec<f64> = (0..self.band.n_rows())
+                .into_par_iter()
+                .map(|r| {
+                    let (s, e) = self.band.row_range(r);
+                    values[s..e].iter().fold(f64::INFINITY, |m, &v| m.min(v))
+                })
+                .collect();
+            let coupling = self.coupling_mask(weights, options.coupled);
+            // the front window starts at the smallest source value (none without a source)
+            let first_front = self
+                .roles
+                .par_iter()
+                .zip(values[..n].par_iter())
+                .filter(|(&r, _)| r == NodeRole::Fixed)
+                .map(|(_, &v)| v)
+                .reduce(|| f64::INFINITY, f64::min);
+            (active, start_low, coupling, first_front)
+        });
         let row_low: Vec<AtomicU64> =
             start_low.iter().chain(std::iter::once(&f64::INFINITY)).map(|&v| AtomicU64::new(order_key(v))).collect();
         let row_neighbours = self.band.row_neighbours();
@@ -602,31 +634,21 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
         let shared = SharedValues { ptr: u.as_mut_ptr(), len: u.len() };
         let all_active = !options.skip_inactive;
-        // Upwind weights of the extension update, once per solve (the band does not change).
-        // Outer nodes without an upwind neighbour keep their value: they are never activated.
-        let weights = self.upwind_weights();
-        let weights: &[[f32; D]] = &weights;
-        for (n, w) in weights.iter().enumerate() {
-            if w[0].is_nan() {
-                active[n].store(0, Ordering::Relaxed);
-            }
-        }
+
         // the largest slowness of a general Hamiltonian bounds the extrapolation of absent
         // neighbours (see `fill_missing`); computed once, it may scan every node
         let general_slowness = self.general_slowness();
-        let coupling = self.coupling_mask(weights, options.coupled);
         // per tile, the last parallel sweep that finished it (see `strip_worker`)
-        let tiles_done: Vec<AtomicU32> = if options.threads == 1 || D < 3 {
+        let threads = pool.current_num_threads();
+        let tiles_done: Vec<AtomicU32> = if threads == 1 || D < 3 {
             Vec::new()
         } else {
             let sched = self.band.schedule();
             let most = (0..1usize << (D - 1)).map(|o| sched.tiles(o).len()).max().unwrap_or(0);
             (0..most).map(|_| AtomicU32::new(0)).collect()
         };
-        // the front window starts at the smallest source value (none without a source)
-        let first_front = self.roles.iter().zip(u.iter()).filter(|(&r, _)| r == NodeRole::Fixed).fold(f64::INFINITY, |m, (_, &v)| m.min(v));
         let windowed = window_width > 0.0 && window_width.is_finite() && first_front < f64::INFINITY;
-        let cyclic = if windowed { self.upwind_two_cycles(weights) } else { Vec::new() };
+        let cyclic = if windowed { pool.install(|| self.upwind_two_cycles(weights)) } else { Vec::new() };
         let ctx = SweepContext {
             cyclic: &cyclic,
             row_low: &row_low,
@@ -643,18 +665,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         };
         let n_orient = 1usize << D;
         let inf = options.infinity.unwrap_or(crate::DEFAULT_INFINITY);
-        // only a 3D band has independent tiles (a 2D band's waves hold one tile each)
-        let pool = if options.threads == 1 || ctx.tiles_done.is_empty() {
-            None
-        } else {
-            let mut b = rayon::ThreadPoolBuilder::new();
-            if options.threads > 1 {
-                b = b.num_threads(options.threads);
-            }
-            // a pool of one thread (threads = 0 on one core, or RAYON_NUM_THREADS=1) runs the
-            // sequential sweep, which interleaves two tiles
-            b.build().ok().filter(|p| p.current_num_threads() > 1)
-        };
+        // only a 3D band has independent tiles (a 2D band's waves hold one tile each); one
+        // thread runs the sequential sweep, which interleaves two tiles
+        let parallel = !ctx.tiles_done.is_empty();
         let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
@@ -680,11 +693,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     d.store(1, Ordering::Relaxed);
                 }
             };
-            if let Some(p) = &pool {
+            if parallel {
                 // all 2^d sweeps of the iteration in one visit to the pool's threads, with a
                 // barrier between sweeps (waking the threads once per sweep costs more than a
                 // small sweep's work)
-                let acc = p.install(|| {
+                let acc = pool.install(|| {
                     let per_sweep = |s: usize, next_strip: &AtomicUsize, abandoned: &AtomicBool| {
                         let dir = s ^ (s >> 1); // Gray code
                         self.strip_worker(&ctx, dir, next_strip, abandoned, lim)
