@@ -63,13 +63,16 @@ impl<const D: usize> NarrowBand<D> {
         let mut row_keys = Vec::new();
         let mut row_start = Vec::new();
         let mut last = Vec::with_capacity(linear.len());
+        // one division per row, not per node: the nodes of a row are consecutive
+        let mut row_begin = 0u64; // the linear index of the current row's first grid node
         for (pos, &l) in linear.iter().enumerate() {
-            let key = l / n_last;
-            if row_keys.last() != Some(&key) {
+            if row_keys.is_empty() || l >= row_begin + n_last {
+                let key = l / n_last;
+                row_begin = key * n_last;
                 row_keys.push(key);
                 row_start.push(pos as u32);
             }
-            last.push((l % n_last) as u32);
+            last.push((l - row_begin) as u32);
         }
         row_start.push(linear.len() as u32);
         Ok(Self::assemble(shape, row_keys, row_start, last))

@@ -21,30 +21,21 @@ fn strides(shape: &[usize]) -> Vec<u64> {
     s
 }
 
-/// Grid indices (up to 3 axes; unused axes 0) of the nodes `linear[range]`: one division per
-/// node for the last axis, the leading ones recomputed only when the row changes (rows hold
-/// several consecutive band nodes).
+/// Grid indices (up to 3 axes; unused axes 0) of the nodes `linear[range]`, on all threads.
 fn node_coordinates(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>) -> Vec<[u32; 3]> {
     let d = shape.len();
-    let n_last = shape[d - 1] as u64;
-    let mut out = Vec::with_capacity(range.len());
-    let mut row = u64::MAX;
-    let mut lead = [0u32; 3];
-    for &l in &linear[range] {
-        let r = l / n_last;
-        if r != row {
-            row = r;
-            let mut key = r;
-            for k in (0..d - 1).rev() {
-                lead[k] = (key % shape[k] as u64) as u32;
+    linear[range]
+        .par_iter()
+        .map(|&l| {
+            let mut c = [0u32; 3];
+            let mut key = l;
+            for k in (0..d).rev() {
+                c[k] = (key % shape[k] as u64) as u32;
                 key /= shape[k] as u64;
             }
-        }
-        let mut c = lead;
-        c[d - 1] = (l - r * n_last) as u32;
-        out.push(c);
-    }
-    out
+            c
+        })
+        .collect()
 }
 
 fn check(shape: &[usize], linear: &[u64], range: &std::ops::Range<usize>) -> Result<()> {
@@ -59,6 +50,25 @@ fn check(shape: &[usize], linear: &[u64], range: &std::ops::Range<usize>) -> Res
         return Err(Error::invalid("linear", "band nodes must be strictly increasing linear indices inside the grid"));
     }
     Ok(())
+}
+
+/// Band nodes per parallel task of [`outward_directions_with`].
+const CHUNK: usize = 1 << 14;
+
+/// Calls `f(o, c)` for the nodes `o` of chunk `j` (of [`CHUNK`] nodes) of the `m` band nodes from
+/// `start` on, in order, with `c` the node's index along the last axis (of `n_last` nodes): one
+/// division per row, not per node.
+#[inline(always)]
+fn nodes_of_chunk(linear: &[u64], start: usize, j: usize, m: usize, n_last: u64, mut f: impl FnMut(usize, u32)) {
+    let (lo, hi) = (j * CHUNK, ((j + 1) * CHUNK).min(m));
+    let mut row_start = u64::MAX;
+    for o in lo..hi {
+        let l = linear[start + o];
+        if row_start == u64::MAX || l >= row_start + n_last {
+            row_start = l / n_last * n_last;
+        }
+        f(o, (l - row_start) as u32);
+    }
 }
 
 /// Entry of a [`neighbour_table`] where the neighbour is not a band node or lies outside the grid.
@@ -118,30 +128,6 @@ pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<u
     Ok(table)
 }
 
-/// The band position of the neighbour `x ± Δx e_k` of band node `i` (`o`-th of the range whose
-/// [`neighbour_table`] is `table`, `m` entries per group; `c` its grid index), if it is a band
-/// node inside the grid.
-#[inline]
-#[allow(clippy::too_many_arguments)]
-fn neighbour_at(
-    table: &[i32],
-    shape: &[usize],
-    linear: &[u64],
-    m: usize,
-    o: usize,
-    i: usize,
-    c: &[u32; 3],
-    k: usize,
-    sign: i64,
-) -> Option<usize> {
-    let d = shape.len();
-    if k + 1 < d {
-        let delta = table[(2 * k + usize::from(sign < 0)) * m + o];
-        return (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize);
-    }
-    last_axis_neighbour(linear, i, c[d - 1], shape[d - 1], sign)
-}
-
 /// The band position of the neighbour along the last axis (`n` nodes) on side `sign` of band node
 /// `i` (index `c` along that axis): the adjacent entry of the sorted band, if it is that node.
 #[inline]
@@ -169,21 +155,34 @@ pub fn rim_nodes_of(shape: &[usize], linear: &[u64], range: std::ops::Range<usiz
     if table.len() != 2 * (d - 1) * m {
         return Err(Error::invalid("neighbours", format!("expected shape ({}, {m})", 2 * (d - 1))));
     }
-    let coords = node_coordinates(shape, linear, range.clone());
-    let mut nodes = Vec::new();
-    let mut counts = Vec::with_capacity(2 * d);
-    for k in 0..d {
-        for sign in [1i64, -1] {
-            let before = nodes.len();
-            for (o, i) in range.clone().enumerate() {
-                if neighbour_at(table, shape, linear, m, o, i, &coords[o], k, sign).is_none() {
-                    nodes.push(i as u64);
-                }
-            }
-            counts.push(nodes.len() - before);
-        }
+    // along the leading axes, the table's entries without a neighbour; along the last axis, the
+    // nodes whose adjacent band entry is not their neighbour (chunk by chunk, in order)
+    let n_last = shape[d - 1] as u64;
+    let mut groups: Vec<Vec<u64>> = (0..2 * (d - 1))
+        .into_par_iter()
+        .map(|g| {
+            let row = &table[g * m..(g + 1) * m];
+            row.iter().zip(range.clone()).filter(|(&delta, _)| delta == NO_NEIGHBOUR).map(|(_, i)| i as u64).collect()
+        })
+        .collect();
+    for sign in [1i64, -1] {
+        let parts: Vec<Vec<u64>> = (0..m.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|j| {
+                let mut out = Vec::new();
+                nodes_of_chunk(linear, range.start, j, m, n_last, |o, c_last| {
+                    let i = range.start + o;
+                    if last_axis_neighbour(linear, i, c_last, shape[d - 1], sign).is_none() {
+                        out.push(i as u64);
+                    }
+                });
+                out
+            })
+            .collect();
+        groups.push(parts.concat());
     }
-    Ok((nodes, counts))
+    let counts = groups.iter().map(Vec::len).collect();
+    Ok((groups.concat(), counts))
 }
 
 /// Whether the neighbour along axis `k` on side `sign` of the node with grid index `c` lies
@@ -232,7 +231,7 @@ pub fn outward_directions_with(
     }
     let m = range.len();
     let leads_inside = |row: &[i32]| {
-        row.iter()
+        row.par_iter()
             .zip(range.clone())
             .all(|(&delta, i)| delta == NO_NEIGHBOUR || (0..linear.len() as i64).contains(&(i as i64 + delta as i64)))
     };
@@ -246,63 +245,89 @@ pub fn outward_directions_with(
     if direction.len() != m * d {
         return Err(Error::invalid("direction", format!("expected shape ({m}, {d})")));
     }
-    let coords = node_coordinates(shape, linear, range.clone());
-    // g holds φ(x + Δx e_k) until φ(x − Δx e_k) is known, then the central difference
-    let mut g = vec![0.0f64; m * d];
-    let mut next_rim = 0usize;
-    for k in 0..d {
-        for (side, sign) in [(0usize, 1i64), (1, -1)] {
-            let row = if k + 1 < d { &table[(2 * k + side) * m..][..m] } else { &[][..] };
-            for (o, i) in range.clone().enumerate() {
-                let neighbour = if k + 1 < d {
-                    let delta = row[o];
-                    (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize)
-                } else {
-                    last_axis_neighbour(linear, i, coords[o][k], shape[k], sign)
-                };
-                let v = match neighbour {
-                    Some(p) => phi[p],
-                    None => {
-                        let v = *rim_phi.get(next_rim).ok_or_else(|| {
-                            Error::invalid("rim_phi", format!("too few values: the rim has more than {} places", rim_phi.len()))
-                        })?;
-                        next_rim += 1;
-                        v
-                    }
-                };
-                let gk = &mut g[o * d + k];
-                if sign == 1 {
-                    *gk = v;
-                } else {
-                    *gk = (*gk - v) / (2.0 * spacing);
-                }
+    // The nodes go to the threads in chunks. Each node needs φ at its 2d neighbours; where one
+    // is off the band, the value comes from `rim_phi`, which holds group after group (axis k,
+    // side +1 then −1), each in node order. So the chunks first count their missing neighbours
+    // per group, and the prefix sums say where each chunk's values start in every group.
+    let n_last = shape[d - 1] as u64;
+    // the neighbour of node `o` of the range for group `g` (the node's index along the last axis
+    // is `c_last`), if it is a band node
+    let neighbour = |o: usize, c_last: u32, g: usize| -> Option<usize> {
+        let (k, sign) = (g / 2, if g % 2 == 0 { 1i64 } else { -1 });
+        let i = range.start + o;
+        if k + 1 < d {
+            let delta = table[g * m + o];
+            (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize)
+        } else {
+            last_axis_neighbour(linear, i, c_last, shape[d - 1], sign)
+        }
+    };
+    let chunks = m.div_ceil(CHUNK);
+    let groups = 2 * d;
+    let missing: Vec<[usize; 6]> = (0..chunks)
+        .into_par_iter()
+        .map(|j| {
+            let (lo, hi) = (j * CHUNK, ((j + 1) * CHUNK).min(m));
+            let mut count = [0usize; 6];
+            for (g, n) in count.iter_mut().enumerate().take(groups - 2) {
+                *n = table[g * m + lo..g * m + hi].iter().filter(|&&delta| delta == NO_NEIGHBOUR).count();
             }
+            nodes_of_chunk(linear, range.start, j, m, n_last, |o, c_last| {
+                count[groups - 2] += neighbour(o, c_last, groups - 2).is_none() as usize;
+                count[groups - 1] += neighbour(o, c_last, groups - 1).is_none() as usize;
+            });
+            count
+        })
+        .collect();
+    // where chunk j's values of group g start in `rim_phi`: all of the earlier groups, then
+    // group g's values of the earlier chunks
+    let mut start = vec![[0usize; 6]; chunks];
+    let mut next = 0usize;
+    for g in 0..groups {
+        for j in 0..chunks {
+            start[j][g] = next;
+            next += missing[j][g];
         }
     }
-    if next_rim != rim_phi.len() {
-        return Err(Error::invalid("rim_phi", format!("expected {next_rim} values (one per rim place), got {}", rim_phi.len())));
+    if next != rim_phi.len() {
+        return Err(Error::invalid("rim_phi", format!("expected {next} values (one per rim place), got {}", rim_phi.len())));
     }
     let mut norms = vec![0.0f64; m];
-    for (o, i) in range.enumerate() {
-        let gi = &g[o * d..(o + 1) * d];
-        let mut sq = 0.0f64;
-        for &c in gi {
-            sq += c * c;
-        }
-        let norm = sq.sqrt();
-        let safe = if norm > 1e-12 { norm } else { 1.0 };
-        let sgn = if phi[i] > 0.0 {
-            1.0
-        } else if phi[i] < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
-        for k in 0..d {
-            direction[o * d + k] = (sgn * (gi[k] / safe)) as f32;
-        }
-        norms[o] = norm;
-    }
+    direction.par_chunks_mut(CHUNK * d).zip(norms.par_chunks_mut(CHUNK)).enumerate().for_each(|(j, (dir, norms))| {
+        let mut rim = start[j];
+        let lo = j * CHUNK;
+        nodes_of_chunk(linear, range.start, j, m, n_last, |o, c_last| {
+            // g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)
+            let mut phi_at = |g: usize| match neighbour(o, c_last, g) {
+                Some(p) => phi[p],
+                None => {
+                    rim[g] += 1;
+                    rim_phi[rim[g] - 1]
+                }
+            };
+            let mut grad = [0.0f64; 3];
+            let mut sq = 0.0f64;
+            for (k, gk) in grad.iter_mut().enumerate().take(d) {
+                let plus = phi_at(2 * k);
+                *gk = (plus - phi_at(2 * k + 1)) / (2.0 * spacing);
+                sq += *gk * *gk;
+            }
+            let norm = sq.sqrt();
+            let safe = if norm > 1e-12 { norm } else { 1.0 };
+            let p = phi[range.start + o];
+            let sgn = if p > 0.0 {
+                1.0
+            } else if p < 0.0 {
+                -1.0
+            } else {
+                0.0
+            };
+            for k in 0..d {
+                dir[(o - lo) * d + k] = (sgn * (grad[k] / safe)) as f32;
+            }
+            norms[o - lo] = norm;
+        });
+    });
     Ok(norms)
 }
 

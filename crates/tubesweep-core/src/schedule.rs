@@ -22,6 +22,8 @@
 //! order and wait for the one tile of the previous strip they depend on (a pipelined
 //! wavefront): one synchronisation per tile instead of a barrier per wave, the same values.
 
+use rayon::prelude::*;
+
 /// Leading-axis rows per tile side.
 pub const TILE: usize = 8;
 
@@ -52,8 +54,8 @@ impl SweepSchedule {
     pub fn new<const D: usize>(leads: &[[usize; D]], shape: [usize; D]) -> Self {
         let lead_dims = D - 1;
         let n_orient = 1usize << lead_dims;
-        let mut sched = SweepSchedule::default();
-        for signs in 0..n_orient {
+        // the orientations are independent: one task each
+        let per_orientation: Vec<_> = (0..n_orient).into_par_iter().map(|signs| {
             // key: (wave, tile coords, row coords) in this orientation
             let mut keyed: Vec<(u64, u64, u64, u32)> = leads
                 .iter()
@@ -127,6 +129,10 @@ impl SweepSchedule {
                 }
                 strips.push(strip_tiles.len() as u32);
             }
+            (rows, tiles, waves, strip_tiles, strips, upstream)
+        }).collect();
+        let mut sched = SweepSchedule::default();
+        for (rows, tiles, waves, strip_tiles, strips, upstream) in per_orientation {
             sched.strip_tiles.push(strip_tiles);
             sched.strips.push(strips);
             sched.upstream.push(upstream);
