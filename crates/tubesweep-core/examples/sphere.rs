@@ -62,9 +62,10 @@ fn main() {
             Control::Continue
         })
         .unwrap();
+    let solve_s = t0.elapsed().as_secs_f64();
     let far = band.find([(3 * (n - 1) / 4) as i64, ((n - 1) / 2) as i64, ((n - 1) / 2) as i64]).unwrap();
     println!(
-        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5}",
+        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5} solve={solve_s:.3}s",
         band.len(),
         st.iterations,
         st.updates,
