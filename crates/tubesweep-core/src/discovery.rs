@@ -10,6 +10,7 @@
 //! does it straight into sorted C-order linear indices, without a K-sized temporary or a sort.
 
 use crate::error::{Error, Result};
+use rayon::prelude::*;
 
 /// Checks that every parent block origin is a multiple of `2 · block` inside the grid.
 fn check_parents<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block: u64) -> Result<()> {
@@ -143,26 +144,29 @@ pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f6
     if let Some(&bad) = linear.iter().find(|&&l| l >= total) {
         return Err(Error::invalid("linear", format!("linear index {bad} is outside the grid {shape:?}")));
     }
-    // one division per node for the last axis; the leading coordinates only when the row changes
-    // (the candidates come in C order, many to a row)
+    // in chunks on all threads; within a chunk one division per row, not per node (the
+    // candidates come in C order, many to a row)
+    const CHUNK: usize = 1 << 14;
     let n_last = shape[D - 1] as u64;
-    let mut out = Vec::with_capacity(linear.len() * D);
-    let mut row = u64::MAX;
-    let mut lead = [0.0f64; D];
-    for &l in linear {
-        let r = l / n_last;
-        if r != row {
-            row = r;
-            let mut key = r;
-            for k in (0..D - 1).rev() {
-                let n = shape[k] as u64;
-                lead[k] = lower[k] + spacing * (key % n) as f64;
-                key /= n;
+    let mut out = vec![0.0f64; linear.len() * D];
+    out.par_chunks_mut(CHUNK * D).zip(linear.par_chunks(CHUNK)).for_each(|(out, linear)| {
+        let mut row_begin = u64::MAX; // the linear index of the current row's first grid node
+        let mut lead = [0.0f64; D];
+        for (x, &l) in out.chunks_exact_mut(D).zip(linear) {
+            if row_begin == u64::MAX || l < row_begin || l >= row_begin + n_last {
+                let r = l / n_last;
+                row_begin = r * n_last;
+                let mut key = r;
+                for k in (0..D - 1).rev() {
+                    let n = shape[k] as u64;
+                    lead[k] = lower[k] + spacing * (key % n) as f64;
+                    key /= n;
+                }
             }
+            lead[D - 1] = lower[D - 1] + spacing * (l - row_begin) as f64;
+            x.copy_from_slice(&lead);
         }
-        lead[D - 1] = lower[D - 1] + spacing * (l - r * n_last) as f64;
-        out.extend_from_slice(&lead);
-    }
+    });
     Ok(out)
 }
 
