@@ -107,31 +107,44 @@ pub fn block_children<const D: usize>(
 /// sorted lexicographically: along each axis the pair `2i, 2i + 1` of a block never interleaves
 /// with another block's pair, so no sort of the output is needed.
 pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]) -> Result<Vec<u64>> {
-    for o in origins {
-        for k in 0..D {
-            if o[k] % 2 != 0 || o[k] >= shape[k] as u64 {
-                return Err(Error::invalid("origins", format!("block origin {o:?} is not an even grid index inside the grid {shape:?}")));
-            }
-        }
+    if let Some(o) = origins.par_iter().find_first(|o| (0..D).any(|k| o[k] % 2 != 0 || o[k] >= shape[k] as u64)) {
+        return Err(Error::invalid("origins", format!("block origin {o:?} is not an even grid index inside the grid {shape:?}")));
     }
     let mut sorted = origins.to_vec();
-    sorted.sort_unstable();
-    if sorted.windows(2).any(|w| w[0] == w[1]) {
+    sorted.par_sort_unstable();
+    if sorted.par_windows(2).any(|w| w[0] == w[1]) {
         return Err(Error::invalid("origins", "block origins repeat"));
     }
     let mut stride = [1u64; D];
     for k in (0..D.saturating_sub(1)).rev() {
         stride[k] = stride[k + 1] * shape[k + 1] as u64;
     }
-    // count first (a block has 2 nodes along an axis, 1 where the grid ends after its origin), so
-    // the output is allocated once at its final size
-    let count: usize = sorted
-        .iter()
-        .map(|o| (0..D).map(|k| if o[k] + 1 < shape[k] as u64 { 2 } else { 1 }).product::<usize>())
-        .sum();
-    let mut out = Vec::with_capacity(count);
-    emit(&shape, &stride, &sorted, 0, 0, &mut out);
-    debug_assert_eq!(out.len(), count);
+    // the origins by their first coordinate: their nodes come in C order group after group, so
+    // the groups are emitted on all threads, each into its own part of the output, whose size is
+    // counted first (a block has 2 nodes along an axis, 1 where the grid ends after its origin)
+    let nodes_of = |o: &[u64; D]| (0..D).map(|k| if o[k] + 1 < shape[k] as u64 { 2 } else { 1 }).product::<usize>();
+    let mut groups: Vec<&[[u64; D]]> = Vec::new();
+    let mut rest = &sorted[..];
+    while let Some(first) = rest.first() {
+        let len = rest.partition_point(|o| o[0] == first[0]);
+        let (group, tail) = rest.split_at(len);
+        groups.push(group);
+        rest = tail;
+    }
+    let counts: Vec<usize> = groups.par_iter().map(|g| g.iter().map(nodes_of).sum()).collect();
+    let mut out = vec![0u64; counts.iter().sum()];
+    let mut parts: Vec<&mut [u64]> = Vec::with_capacity(groups.len());
+    let mut tail = &mut out[..];
+    for &c in &counts {
+        let (part, t) = tail.split_at_mut(c);
+        parts.push(part);
+        tail = t;
+    }
+    groups.par_iter().zip(parts).for_each(|(group, part)| {
+        let mut nodes = Vec::with_capacity(part.len());
+        emit(&shape, &stride, group, 0, 0, &mut nodes);
+        part.copy_from_slice(&nodes);
+    });
     Ok(out)
 }
 
