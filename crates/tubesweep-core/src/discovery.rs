@@ -141,9 +141,9 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
         tail = t;
     }
     groups.par_iter().zip(parts).for_each(|(group, part)| {
-        let mut nodes = Vec::with_capacity(part.len());
-        emit(&shape, &stride, group, 0, 0, &mut nodes);
-        part.copy_from_slice(&nodes);
+        let mut written = 0;
+        emit(&shape, &stride, group, 0, 0, part, &mut written);
+        debug_assert_eq!(written, part.len());
     });
     Ok(out)
 }
@@ -184,14 +184,17 @@ pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f6
 }
 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along
-/// the axes before `axis`, whose contribution to the linear index is `base`).
-fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut Vec<u64>) {
+/// the axes before `axis`, whose contribution to the linear index is `base`) into `out` from
+/// position `written` on, which it advances.
+fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut [u64], written: &mut usize) {
     if axis + 1 == D {
         let n = shape[axis] as u64;
         for o in group {
-            out.push(base + o[axis]);
+            out[*written] = base + o[axis];
+            *written += 1;
             if o[axis] + 1 < n {
-                out.push(base + o[axis] + 1);
+                out[*written] = base + o[axis] + 1;
+                *written += 1;
             }
         }
         return;
@@ -206,7 +209,7 @@ fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]
         }
         for a in 0..2 {
             if c + a < n {
-                emit(shape, stride, &group[start..end], axis + 1, base + (c + a) * stride[axis], out);
+                emit(shape, stride, &group[start..end], axis + 1, base + (c + a) * stride[axis], out, written);
             }
         }
         start = end;
