@@ -163,8 +163,13 @@ def run_case(problem_name: str, n: int, method_name: str, repeats: int) -> Dict[
 
 def run_child(problem: str, n: int, method: str, repeats: int, timeout: float) -> Dict[str, Any]:
     cmd = [sys.executable, str(Path(__file__).resolve()), "--case", problem, str(n), method, str(repeats)]
+    # OpenBLAS's worker threads spin for about 0.1 s of CPU after every threaded call (the exact
+    # references' matrix products are one, just before the timed runs): on 2 cores that takes a
+    # core from whatever runs next. None of the timed methods uses NumPy's BLAS, so the children
+    # run it single-threaded, which spins nothing.
+    env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
     try:
-        cp = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=str(REPO))
+        cp = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=str(REPO), env=env)
     except subprocess.TimeoutExpired:
         return dict(problem=problem, n=n, method=method, status="timeout", note=f"over {timeout:.0f} s")
     for line in reversed(cp.stdout.splitlines()):

@@ -281,6 +281,11 @@ def test_native_node_points_and_neighbour_table(shape):
             found = inside & (at < len(lin)) & (lin[np.minimum(at, len(lin) - 1)] == nl)
             want[found] = at[found] - np.arange(lo, hi)[found]
             assert np.array_equal(table[2 * k + side], want)
+    # the same table read off the solver's band structure (what LevelSet.band uses)
+    band = _native.Band.from_linear(list(shape), lin)
+    assert np.array_equal(band.neighbour_table(lo, hi), table)
+    with pytest.raises(ValueError, match="range"):
+        band.neighbour_table(0, len(lin) + 1)
     pos, counts = _native.rim_nodes(list(shape), lin, lo, hi)
     pos2, counts2 = _native.rim_nodes(list(shape), lin, lo, hi, table)
     assert counts == counts2 and np.array_equal(pos, pos2)
@@ -306,3 +311,21 @@ def test_row_norms_are_numpys_bits():
             w = v.astype(np.float32)
             np.testing.assert_array_equal(row_norms(w), np.linalg.norm(w, axis=1))
     assert row_norms(np.zeros((3, 0))).shape == (3,)
+
+
+def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
+    """Circle, Sphere and Torus evaluate φ in Rust with the arithmetic of their NumPy formulas."""
+    from tubesweep._linalg import row_norms
+
+    rng = np.random.default_rng(7)
+    p3 = rng.uniform(-1, 1, (50_001, 3))
+    s = ts.surfaces.Sphere(radius=0.45, center=(0.1, -0.2, 0.05))
+    assert np.array_equal(s.signed_distance(p3), row_norms(p3 - s.center) - s.radius)
+    c = ts.surfaces.Circle(radius=0.3, center=(-0.1, 0.2))
+    p2 = p3[::3, :2]  # a strided view is accepted
+    assert np.array_equal(c.signed_distance(p2), row_norms(p2 - c.center) - c.radius)
+    t = ts.surfaces.Torus(R=0.6, r=0.25, center=(0.0, 0.1, -0.1))
+    q = p3 - t.center
+    assert np.array_equal(t.signed_distance(p3), np.hypot(np.hypot(q[:, 0], q[:, 1]) - t.R, q[:, 2]) - t.r)
+    with pytest.raises(ValueError, match=r"\(M, 3\)"):
+        s.signed_distance(p2)

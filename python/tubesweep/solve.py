@@ -339,6 +339,7 @@ def solve(
             )
         roles = _tube_roles(geom, inner_width, method)
         linear = geom.linear
+        band = geom.native_band  # built by the surface, or None
         if general is None:
             # The float64 φ (and |φ| where stored) only decide the roles: from here on the solver
             # keeps φ in single precision, and the band is built without them (memory is per band
@@ -346,7 +347,8 @@ def solve(
             phi = geom.signed.astype(np.float32)
             direction = geom.directions_for_solver()
             geom = None  # type: ignore[assignment]
-        band = _native.Band.from_linear(list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64))
+        if band is None or len(band) != len(linear):
+            band = _native.Band.from_linear(list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64))
         if method == "naive":
             break
         missing = band.nodes_missing_neighbours(roles == ROLE_INNER)

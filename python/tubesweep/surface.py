@@ -51,6 +51,10 @@ class BandGeometry:
         then overwrites ``direction`` with the extension weights instead of copying it (12 bytes
         per node in 3D). A user's :meth:`Surface.band` may leave it False (the default) and
         return cached arrays: they are copied, never modified.
+    native_band : tubesweep._native.Band or None
+        The band structure of ``linear`` when the surface already built it (level sets given by a
+        callable, whose outward directions read its neighbours): the solver uses it instead of
+        building it again. None (the default) otherwise.
     """
 
     linear: np.ndarray
@@ -58,6 +62,7 @@ class BandGeometry:
     signed: np.ndarray
     direction: np.ndarray
     consumable: bool = False
+    native_band: Any = None
 
     def directions_for_solver(self) -> np.ndarray:
         """``direction`` as the C-ordered float32 array the solver overwrites with the extension
@@ -291,17 +296,18 @@ class LevelSet(Surface):
         return g
 
     def _outward_directions(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int,
-                            direction: np.ndarray) -> np.ndarray:
+                            direction: np.ndarray, band: Any) -> np.ndarray:
         """For a callable φ: ``sgn(φ) ∇φ/|∇φ|`` at band nodes ``lo:hi`` into ``direction`` (float32)
         by central differences, in Rust (:func:`tubesweep._native.outward_directions`); returns
         ``|∇φ|``. φ at a neighbour that is itself a band node is already known; the callable is
-        evaluated only at the others (the band's outer rim), one batch per axis and side."""
+        evaluated only at the others (the band's outer rim), one batch per axis and side.
+        ``band`` is the native band of ``linear``, whose neighbours give the table."""
         from . import _native
 
         h = grid.spacing
         ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-        # one neighbour table (merge passes) for both calls
-        table = _native.neighbour_table(list(grid.shape), ulinear, lo, hi)
+        # one neighbour table for both calls, read off the band's own neighbours
+        table = band.neighbour_table(lo, hi)
         pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi, table)
         parts = []
         start = 0
@@ -328,6 +334,13 @@ class LevelSet(Surface):
             linear, values = discover_band(self._fn, grid, half_width, self.lipschitz)  # type: ignore[arg-type]
         if linear.size == 0:
             return BandGeometry(linear, values, values, np.zeros((0, grid.ndim), np.float32))
+        native_band = None
+        if self._array is None:
+            # the solver's band structure, built now: its neighbours give the outward directions
+            # (no separate neighbour search), and the solver takes it over
+            from . import _native
+
+            native_band = _native.Band.from_linear(list(grid.shape), linear.view(np.uint64))
         # the outward direction sgn(φ) ∇φ/|∇φ|, chunk by chunk (temporaries stay O(chunk))
         direction = np.empty((len(linear), grid.ndim), np.float32)
         near_lo, near_hi, all_lo, all_hi = np.inf, -np.inf, np.inf, -np.inf
@@ -337,7 +350,7 @@ class LevelSet(Surface):
                 n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
                 direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
             else:
-                norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi])
+                norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
             near = np.abs(values[lo:hi]) <= 0.5 * half_width
             all_lo, all_hi = min(all_lo, float(norm.min())), max(all_hi, float(norm.max()))
             if np.any(near):
@@ -346,7 +359,8 @@ class LevelSet(Surface):
             self._check_distance_like(near_lo, near_hi)
         else:
             self._check_distance_like(all_lo, all_hi)
-        return BandGeometry(linear, None, values, direction, consumable=True)  # distance = |φ|, not stored
+        # distance = |φ|, not stored
+        return BandGeometry(linear, None, values, direction, consumable=True, native_band=native_band)
 
     def _check_distance_like(self, lo: float, hi: float) -> None:
         """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface."""

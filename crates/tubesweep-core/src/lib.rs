@@ -12,6 +12,7 @@
 //! | the Lax–Friedrichs local solver | [`lax_friedrichs`] | Eq. (4), Sect. 5.1 |
 //! | built-in Hamiltonians (isotropic, moving medium, metric) | [`hamiltonians`] | Sect. 5.1, 6.3 |
 //! | the upwind extension update | [`extension`] | Eq. (5) applied to Eq. (8) |
+//! | exact signed distances of the analytic surfaces (sphere, torus) | [`analytic`] | Sect. 6 |
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the last split of the coarse-to-fine band search | [`discovery`] | — |
 //! | extension directions sgn(φ)∇φ/|∇φ| by central differences | [`normals`] | Eq. (8), Sect. 4 |
@@ -25,6 +26,7 @@
 //! `lower + h * (i, j[, k])`, and nodes are numbered in C order (the last axis varies fastest),
 //! like a NumPy array of the grid's shape.
 
+pub mod analytic;
 pub mod band;
 pub mod discovery;
 pub mod error;

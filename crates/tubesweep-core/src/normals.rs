@@ -9,6 +9,7 @@
 //! and [`outward_directions`] takes φ at them, in the same order. (φ is a user's function that
 //! the Python package evaluates, so the two halves are separate calls.)
 
+use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 
@@ -120,6 +121,47 @@ pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<u
                 }
             }
             true
+        })
+        .collect();
+    if fits.contains(&false) {
+        return Err(Error::invalid("linear", "a neighbour is 2^31 or more band nodes away: too large a band for a neighbour table"));
+    }
+    Ok(table)
+}
+
+/// The [`neighbour_table`] of band nodes `range`, read off a band already built from the same
+/// linear indices (its neighbours, [`NarrowBand::neighbours_of`]): the same entries without the
+/// merge passes, on all threads.
+pub fn neighbour_table_of_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::Range<usize>) -> Result<Vec<i32>> {
+    if range.start > range.end || range.end > band.len() {
+        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", band.len())));
+    }
+    let m = range.len();
+    let mut table = vec![NO_NEIGHBOUR; 2 * (D - 1) * m];
+    if m == 0 {
+        return Ok(table);
+    }
+    let sentinel = band.sentinel();
+    let fits: Vec<bool> = table
+        .par_chunks_mut(m)
+        .enumerate()
+        .map(|(group, out)| {
+            // group 2k: side +1 (the band's `plus`, entry 1); group 2k + 1: side −1 (entry 0)
+            let (k, side) = (group / 2, 1 - group % 2);
+            out.par_chunks_mut(CHUNK).enumerate().all(|(j, out)| {
+                for (o, e) in out.iter_mut().enumerate() {
+                    let i = range.start + j * CHUNK + o;
+                    // SAFETY: i < range.end ≤ band.len()
+                    let nb = unsafe { band.neighbours_of_unchecked(i) }[k][side];
+                    if nb != sentinel {
+                        match i32::try_from(nb as i64 - i as i64) {
+                            Ok(delta) if delta != NO_NEIGHBOUR => *e = delta,
+                            _ => return false,
+                        }
+                    }
+                }
+                true
+            })
         })
         .collect();
     if fits.contains(&false) {
@@ -375,5 +417,27 @@ mod tests {
         let (rim, counts) = rim_nodes(&shape, &linear, 6..9).unwrap();
         assert!(rim.is_empty() && counts == vec![0; 4]);
         assert!(rim_nodes(&shape, &linear, 6..30).is_err());
+    }
+
+    #[test]
+    fn the_table_of_a_built_band_is_the_merge_passes_table() {
+        // a spherical shell in 3D and an annulus in 2D, whole and in sub-ranges
+        let n = 23usize;
+        let c = (n - 1) as f64 / 2.0;
+        let lin3: Vec<u64> = (0..(n * n * n) as u64)
+            .filter(|&l| {
+                let (i, j, k) = ((l / (n * n) as u64) as f64, ((l / n as u64) % n as u64) as f64, (l % n as u64) as f64);
+                (((i - c).powi(2) + (j - c).powi(2) + (k - c).powi(2)).sqrt() - 8.0).abs() <= 2.5
+            })
+            .collect();
+        let band3 = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin3).unwrap();
+        for range in [0..lin3.len(), 17..lin3.len() / 2, 5..5] {
+            assert_eq!(neighbour_table_of_band(&band3, range.clone()).unwrap(), neighbour_table(&[n, n, n], &lin3, range).unwrap());
+        }
+        // the band touches the grid's faces: no neighbour may wrap around
+        let lin2: Vec<u64> = (0..(n * n) as u64).filter(|&l| l % n as u64 <= 2 || l / n as u64 >= (n - 2) as u64).collect();
+        let band2 = NarrowBand::<2>::from_sorted_linear([n, n], &lin2).unwrap();
+        assert_eq!(neighbour_table_of_band(&band2, 0..lin2.len()).unwrap(), neighbour_table(&[n, n], &lin2, 0..lin2.len()).unwrap());
+        assert!(neighbour_table_of_band(&band2, 0..lin2.len() + 1).is_err());
     }
 }

@@ -444,6 +444,22 @@ impl PyBand {
             .into_pyarray(py))
     }
 
+    /// The neighbour table of band nodes `start..stop` in the format of the module function
+    /// `neighbour_table` ((2·(d − 1), stop − start) int32: the neighbour's band position less the
+    /// node's, or −2^31), read off this band's own neighbours instead of merge passes over the
+    /// linear indices. See `tubesweep_core::normals::neighbour_table_of_band`.
+    fn neighbour_table<'py>(&self, py: Python<'py>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i32>>> {
+        if start > stop {
+            return Err(PyValueError::new_err(format!("start = {start} must not exceed stop = {stop}")));
+        }
+        let d = self.ndim();
+        let table = py
+            .detach(|| with_band!(self, b, tubesweep_core::normals::neighbour_table_of_band(b, start..stop)))
+            .map_err(to_pyerr)?;
+        let a = numpy::ndarray::Array2::from_shape_vec((2 * (d - 1), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py))
+    }
+
     /// Band positions of grid indices (M, d); -1 where the node is not in the band.
     fn find<'py>(&self, py: Python<'py>, indices: PyReadonlyArray2<'py, i64>) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let d = self.ndim();
@@ -815,6 +831,33 @@ fn neighbour_table<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyAr
     Ok(a.into_pyarray(py))
 }
 
+/// `|x − c| − r` at the points (M, d) with d = len(centre) (2 or 3): the exact signed distance
+/// to a circle or sphere. See `tubesweep_core::analytic::sphere_signed_distance`.
+#[pyfunction]
+fn sphere_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, radius: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if points.shape()[1] != centre.len() {
+        return Err(PyValueError::new_err(format!("points must have shape (M, {}) like the centre; got {:?}", centre.len(), points.shape())));
+    }
+    let p = c_slice(&points, "points")?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| tubesweep_core::analytic::sphere_signed_distance(p, &centre, radius, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
+/// `hypot(hypot(q_x, q_y) − R, q_z) − r` with `q = x − c` at the points (M, 3): the exact signed
+/// distance to a torus about the z axis. See `tubesweep_core::analytic::torus_signed_distance`.
+#[pyfunction]
+fn torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, major: f64, minor: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if points.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
+    }
+    let c = coords_array::<3>(&centre, "centre")?;
+    let p = c_slice(&points, "points")?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| tubesweep_core::analytic::torus_signed_distance(p, c, major, minor, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
 fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Option<&'a [i32]>> {
     table.as_ref().map(|t| c_slice(t, "neighbours")).transpose()
 }
@@ -888,6 +931,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
+    m.add_function(wrap_pyfunction!(sphere_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(torus_signed_distance, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
