@@ -281,14 +281,15 @@ def test_native_node_points_and_neighbour_table(shape):
             found = inside & (at < len(lin)) & (lin[np.minimum(at, len(lin) - 1)] == nl)
             want[found] = at[found] - np.arange(lo, hi)[found]
             assert np.array_equal(table[2 * k + side], want)
-    # the same table read off the solver's band structure (what LevelSet.band uses)
-    band = _native.Band.from_linear(list(shape), lin)
-    assert np.array_equal(band.neighbour_table(lo, hi), table)
-    with pytest.raises(ValueError, match="range"):
-        band.neighbour_table(0, len(lin) + 1)
     pos, counts = _native.rim_nodes(list(shape), lin, lo, hi)
     pos2, counts2 = _native.rim_nodes(list(shape), lin, lo, hi, table)
     assert counts == counts2 and np.array_equal(pos, pos2)
+    # the same places read off the solver's band structure (what LevelSet.band uses)
+    band = _native.Band.from_linear(list(shape), lin)
+    pos3, counts3 = band.rim_nodes(lo, hi)
+    assert counts3 == counts and np.array_equal(pos3, pos)
+    with pytest.raises(ValueError, match="range"):
+        band.rim_nodes(0, len(lin) + 1)
     with pytest.raises(ValueError):
         _native.rim_nodes(list(shape), lin, lo, hi, table[:, 1:].copy())
     bad = table.copy()

@@ -298,7 +298,7 @@ class LevelSet(Surface):
     def _outward_directions(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int,
                             direction: np.ndarray, band: Any) -> np.ndarray:
         """For a callable φ: ``sgn(φ) ∇φ/|∇φ|`` at band nodes ``lo:hi`` into ``direction`` (float32)
-        by central differences, in Rust (:func:`tubesweep._native.outward_directions`); returns
+        by central differences, in Rust (``tubesweep._native.Band.outward_directions``); returns
         ``|∇φ|``. φ at a neighbour that is itself a band node is already known; the callable is
         evaluated only at the others (the band's outer rim), one batch per axis and side.
         ``band`` is the native band of ``linear``, whose neighbours give the table."""
@@ -306,9 +306,8 @@ class LevelSet(Surface):
 
         h = grid.spacing
         ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-        # one neighbour table for both calls, read off the band's own neighbours
-        table = band.neighbour_table(lo, hi)
-        pos, counts = _native.rim_nodes(list(grid.shape), ulinear, lo, hi, table)
+        # the neighbours come from the band's own table (no search)
+        pos, counts = band.rim_nodes(lo, hi)
         parts = []
         start = 0
         for group, count in enumerate(counts):
@@ -318,7 +317,7 @@ class LevelSet(Surface):
                 parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
             start += count
         rim_phi = np.concatenate(parts) if parts else np.zeros(0)
-        return _native.outward_directions(list(grid.shape), h, ulinear, values, lo, hi, rim_phi, direction, table)
+        return band.outward_directions(h, values, lo, hi, rim_phi, direction)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)

@@ -129,47 +129,6 @@ pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<u
     Ok(table)
 }
 
-/// The [`neighbour_table`] of band nodes `range`, read off a band already built from the same
-/// linear indices (its neighbours, [`NarrowBand::neighbours_of`]): the same entries without the
-/// merge passes, on all threads.
-pub fn neighbour_table_of_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::Range<usize>) -> Result<Vec<i32>> {
-    if range.start > range.end || range.end > band.len() {
-        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", band.len())));
-    }
-    let m = range.len();
-    let mut table = vec![NO_NEIGHBOUR; 2 * (D - 1) * m];
-    if m == 0 {
-        return Ok(table);
-    }
-    let sentinel = band.sentinel();
-    let fits: Vec<bool> = table
-        .par_chunks_mut(m)
-        .enumerate()
-        .map(|(group, out)| {
-            // group 2k: side +1 (the band's `plus`, entry 1); group 2k + 1: side −1 (entry 0)
-            let (k, side) = (group / 2, 1 - group % 2);
-            out.par_chunks_mut(CHUNK).enumerate().all(|(j, out)| {
-                for (o, e) in out.iter_mut().enumerate() {
-                    let i = range.start + j * CHUNK + o;
-                    // SAFETY: i < range.end ≤ band.len()
-                    let nb = unsafe { band.neighbours_of_unchecked(i) }[k][side];
-                    if nb != sentinel {
-                        match i32::try_from(nb as i64 - i as i64) {
-                            Ok(delta) if delta != NO_NEIGHBOUR => *e = delta,
-                            _ => return false,
-                        }
-                    }
-                }
-                true
-            })
-        })
-        .collect();
-    if fits.contains(&false) {
-        return Err(Error::invalid("linear", "a neighbour is 2^31 or more band nodes away: too large a band for a neighbour table"));
-    }
-    Ok(table)
-}
-
 /// The band position of the neighbour along the last axis (`n` nodes) on side `sign` of band node
 /// `i` (index `c` along that axis): the adjacent entry of the sorted band, if it is that node.
 #[inline]
@@ -284,19 +243,13 @@ pub fn outward_directions_with(
     if phi.len() != linear.len() {
         return Err(Error::invalid("phi", format!("expected {} values (one per band node), got {}", linear.len(), phi.len())));
     }
-    if direction.len() != m * d {
-        return Err(Error::invalid("direction", format!("expected shape ({m}, {d})")));
-    }
-    // The nodes go to the threads in chunks. Each node needs φ at its 2d neighbours; where one
-    // is off the band, the value comes from `rim_phi`, which holds group after group (axis k,
-    // side +1 then −1), each in node order. So the chunks first count their missing neighbours
-    // per group, and the prefix sums say where each chunk's values start in every group.
     let n_last = shape[d - 1] as u64;
     // the neighbour of node `o` of the range for group `g` (the node's index along the last axis
     // is `c_last`), if it is a band node
+    let first = range.start;
     let neighbour = |o: usize, c_last: u32, g: usize| -> Option<usize> {
         let (k, sign) = (g / 2, if g % 2 == 0 { 1i64 } else { -1 });
-        let i = range.start + o;
+        let i = first + o;
         if k + 1 < d {
             let delta = table[g * m + o];
             (delta != NO_NEIGHBOUR).then(|| (i as i64 + delta as i64) as usize)
@@ -304,19 +257,103 @@ pub fn outward_directions_with(
             last_axis_neighbour(linear, i, c_last, shape[d - 1], sign)
         }
     };
+    directions_by_central_differences(d, spacing, phi, range, Some((linear, n_last)), rim_phi, direction, neighbour)
+}
+
+/// [`outward_directions`] with the neighbours read off a band already built from the same
+/// linear indices ([`NarrowBand::neighbours_of`]): no neighbour table, no merge passes. φ off
+/// the band comes from `rim_phi` in the order of [`rim_nodes_in_band`].
+pub fn outward_directions_in_band<const D: usize>(
+    band: &NarrowBand<D>,
+    spacing: f64,
+    phi: &[f64],
+    range: std::ops::Range<usize>,
+    rim_phi: &[f64],
+    direction: &mut [f32],
+) -> Result<Vec<f64>> {
+    if range.start > range.end || range.end > band.len() {
+        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", band.len())));
+    }
+    if phi.len() != band.len() {
+        return Err(Error::invalid("phi", format!("expected {} values (one per band node), got {}", band.len(), phi.len())));
+    }
+    let sentinel = band.sentinel();
+    let first = range.start;
+    let neighbour = |o: usize, _: u32, g: usize| -> Option<usize> {
+        // group 2k: side +1 (the band's `plus`, entry 1); group 2k + 1: side −1 (entry 0)
+        // SAFETY: o < m, so first + o < range.end ≤ band.len()
+        let nb = unsafe { band.neighbours_of_unchecked(first + o) }[g / 2][1 - g % 2];
+        (nb != sentinel).then_some(nb as usize)
+    };
+    directions_by_central_differences(D, spacing, phi, range, None, rim_phi, direction, neighbour)
+}
+
+/// [`rim_nodes`] read off a band already built from the same linear indices: for every group
+/// `(axis k, side)` in the order `k = 0, 1, …`, side `+1` then `−1`, the positions `i` in `range`
+/// whose neighbour there is not a band node, in increasing order.
+pub fn rim_nodes_in_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::Range<usize>) -> Result<(Vec<u64>, Vec<usize>)> {
+    if range.start > range.end || range.end > band.len() {
+        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", band.len())));
+    }
+    let sentinel = band.sentinel();
+    let groups: Vec<Vec<u64>> = (0..2 * D)
+        .into_par_iter()
+        .map(|g| {
+            let (k, side) = (g / 2, 1 - g % 2);
+            range
+                .clone()
+                // SAFETY: i < range.end ≤ band.len()
+                .filter(|&i| unsafe { band.neighbours_of_unchecked(i) }[k][side] == sentinel)
+                .map(|i| i as u64)
+                .collect()
+        })
+        .collect();
+    let counts = groups.iter().map(Vec::len).collect();
+    Ok((groups.concat(), counts))
+}
+
+/// The arithmetic of [`outward_directions`] for nodes `range` of a band of `phi.len()` nodes in
+/// `d` dimensions. `neighbour(o, c_last, g)` is the band position of the neighbour of node
+/// `range.start + o` in group `g` (axis `g / 2`, side `+1` for even `g`), or `None` where φ comes
+/// from `rim_phi`; `c_last` is the node's index along the last axis when `linear` (the sorted
+/// linear indices and the last axis's length) is given, 0 otherwise.
+#[allow(clippy::too_many_arguments)]
+fn directions_by_central_differences<N>(
+    d: usize,
+    spacing: f64,
+    phi: &[f64],
+    range: std::ops::Range<usize>,
+    linear: Option<(&[u64], u64)>,
+    rim_phi: &[f64],
+    direction: &mut [f32],
+    neighbour: N,
+) -> Result<Vec<f64>>
+where
+    N: Fn(usize, u32, usize) -> Option<usize> + Sync,
+{
+    let m = range.len();
+    // calls f(o, c_last) for the nodes o of chunk j, in order
+    let visit_chunk = |j: usize, f: &mut dyn FnMut(usize, u32)| match linear {
+        Some((linear, n_last)) => nodes_of_chunk(linear, range.start, j, m, n_last, f),
+        None => (j * CHUNK..((j + 1) * CHUNK).min(m)).for_each(|o| f(o, 0)),
+    };
+    if direction.len() != m * d {
+        return Err(Error::invalid("direction", format!("expected shape ({m}, {d})")));
+    }
+    // The nodes go to the threads in chunks. Each node needs φ at its 2d neighbours; where one
+    // is off the band, the value comes from `rim_phi`, which holds group after group (axis k,
+    // side +1 then −1), each in node order. So the chunks first count their missing neighbours
+    // per group, and the prefix sums say where each chunk's values start in every group.
     let chunks = m.div_ceil(CHUNK);
     let groups = 2 * d;
     let missing: Vec<[usize; 6]> = (0..chunks)
         .into_par_iter()
         .map(|j| {
-            let (lo, hi) = (j * CHUNK, ((j + 1) * CHUNK).min(m));
             let mut count = [0usize; 6];
-            for (g, n) in count.iter_mut().enumerate().take(groups - 2) {
-                *n = table[g * m + lo..g * m + hi].iter().filter(|&&delta| delta == NO_NEIGHBOUR).count();
-            }
-            nodes_of_chunk(linear, range.start, j, m, n_last, |o, c_last| {
-                count[groups - 2] += neighbour(o, c_last, groups - 2).is_none() as usize;
-                count[groups - 1] += neighbour(o, c_last, groups - 1).is_none() as usize;
+            visit_chunk(j, &mut |o, c_last| {
+                for (g, n) in count.iter_mut().enumerate().take(groups) {
+                    *n += neighbour(o, c_last, g).is_none() as usize;
+                }
             });
             count
         })
@@ -338,7 +375,7 @@ pub fn outward_directions_with(
     direction.par_chunks_mut(CHUNK * d).zip(norms.par_chunks_mut(CHUNK)).enumerate().for_each(|(j, (dir, norms))| {
         let mut rim = start[j];
         let lo = j * CHUNK;
-        nodes_of_chunk(linear, range.start, j, m, n_last, |o, c_last| {
+        visit_chunk(j, &mut |o, c_last| {
             // g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)
             let mut phi_at = |g: usize| match neighbour(o, c_last, g) {
                 Some(p) => phi[p],
@@ -420,24 +457,39 @@ mod tests {
     }
 
     #[test]
-    fn the_table_of_a_built_band_is_the_merge_passes_table() {
-        // a spherical shell in 3D and an annulus in 2D, whole and in sub-ranges
+    fn a_built_band_gives_the_rim_places_and_directions_of_the_merge_passes() {
+        // a spherical shell in 3D (φ = |x − c| − 8) and a band touching the grid's faces in 2D
+        // (where no neighbour may wrap around), whole and in sub-ranges
+        fn same<const D: usize>(shape: [usize; D], linear: &[u64], phi: &[f64], range: std::ops::Range<usize>) {
+            let band = NarrowBand::<D>::from_sorted_linear(shape, linear).unwrap();
+            let (rim, counts) = rim_nodes(&shape, linear, range.clone()).unwrap();
+            assert_eq!(rim_nodes_in_band(&band, range.clone()).unwrap(), (rim.clone(), counts.clone()));
+            // φ off the band: any values will do, as long as both read the same ones
+            let rim_phi: Vec<f64> = (0..rim.len()).map(|i| (i as f64 * 0.37).sin()).collect();
+            let mut a = vec![0.0f32; range.len() * D];
+            let mut b = a.clone();
+            let na = outward_directions(&shape, 0.5, linear, phi, range.clone(), &rim_phi, &mut a).unwrap();
+            let nb = outward_directions_in_band(&band, 0.5, phi, range.clone(), &rim_phi, &mut b).unwrap();
+            assert_eq!((&na, &a), (&nb, &b));
+            if !rim_phi.is_empty() {
+                assert!(outward_directions_in_band(&band, 0.5, phi, range.clone(), &rim_phi[1..], &mut b).is_err());
+            }
+        }
         let n = 23usize;
         let c = (n - 1) as f64 / 2.0;
-        let lin3: Vec<u64> = (0..(n * n * n) as u64)
-            .filter(|&l| {
-                let (i, j, k) = ((l / (n * n) as u64) as f64, ((l / n as u64) % n as u64) as f64, (l % n as u64) as f64);
-                (((i - c).powi(2) + (j - c).powi(2) + (k - c).powi(2)).sqrt() - 8.0).abs() <= 2.5
-            })
-            .collect();
-        let band3 = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin3).unwrap();
+        let r = |l: u64| {
+            let (i, j, k) = ((l / (n * n) as u64) as f64, ((l / n as u64) % n as u64) as f64, (l % n as u64) as f64);
+            ((i - c).powi(2) + (j - c).powi(2) + (k - c).powi(2)).sqrt() - 8.0
+        };
+        let lin3: Vec<u64> = (0..(n * n * n) as u64).filter(|&l| r(l).abs() <= 2.5).collect();
+        let phi3: Vec<f64> = lin3.iter().map(|&l| r(l)).collect();
         for range in [0..lin3.len(), 17..lin3.len() / 2, 5..5] {
-            assert_eq!(neighbour_table_of_band(&band3, range.clone()).unwrap(), neighbour_table(&[n, n, n], &lin3, range).unwrap());
+            same([n, n, n], &lin3, &phi3, range);
         }
-        // the band touches the grid's faces: no neighbour may wrap around
         let lin2: Vec<u64> = (0..(n * n) as u64).filter(|&l| l % n as u64 <= 2 || l / n as u64 >= (n - 2) as u64).collect();
+        let phi2: Vec<f64> = lin2.iter().map(|&l| (l % n as u64) as f64 - 1.3 + 0.01 * (l / n as u64) as f64).collect();
+        same([n, n], &lin2, &phi2, 0..lin2.len());
         let band2 = NarrowBand::<2>::from_sorted_linear([n, n], &lin2).unwrap();
-        assert_eq!(neighbour_table_of_band(&band2, 0..lin2.len()).unwrap(), neighbour_table(&[n, n], &lin2, 0..lin2.len()).unwrap());
-        assert!(neighbour_table_of_band(&band2, 0..lin2.len() + 1).is_err());
+        assert!(rim_nodes_in_band(&band2, 0..lin2.len() + 1).is_err());
     }
 }

@@ -444,20 +444,38 @@ impl PyBand {
             .into_pyarray(py))
     }
 
-    /// The neighbour table of band nodes `start..stop` in the format of the module function
-    /// `neighbour_table` ((2·(d − 1), stop − start) int32: the neighbour's band position less the
-    /// node's, or −2^31), read off this band's own neighbours instead of merge passes over the
-    /// linear indices. See `tubesweep_core::normals::neighbour_table_of_band`.
-    fn neighbour_table<'py>(&self, py: Python<'py>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i32>>> {
-        if start > stop {
-            return Err(PyValueError::new_err(format!("start = {start} must not exceed stop = {stop}")));
-        }
-        let d = self.ndim();
-        let table = py
-            .detach(|| with_band!(self, b, tubesweep_core::normals::neighbour_table_of_band(b, start..stop)))
+    /// The places where central differences of φ at band nodes `start..stop` need φ off the
+    /// band, as the module function `rim_nodes` gives them, read off this band's own neighbours
+    /// (it must be the band of those linear indices). See
+    /// `tubesweep_core::normals::rim_nodes_in_band`.
+    fn rim_nodes<'py>(&self, py: Python<'py>, start: usize, stop: usize) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
+        let (nodes, counts) = py
+            .detach(|| with_band!(self, b, tubesweep_core::normals::rim_nodes_in_band(b, start..stop)))
             .map_err(to_pyerr)?;
-        let a = numpy::ndarray::Array2::from_shape_vec((2 * (d - 1), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        Ok(a.into_pyarray(py))
+        let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
+        Ok((nodes.into_pyarray(py), counts))
+    }
+
+    /// The outward directions sgn(φ)∇φ/|∇φ| at band nodes `start..stop`, as the module function
+    /// `outward_directions` computes them (the same bits), with the neighbours read off this
+    /// band; `rim_phi` in the order of [`rim_nodes`](Self::rim_nodes). Returns |∇φ|. See
+    /// `tubesweep_core::normals::outward_directions_in_band`.
+    fn outward_directions<'py>(
+        &self,
+        py: Python<'py>,
+        spacing: f64,
+        phi: PyReadonlyArray1<'py, f64>,
+        start: usize,
+        stop: usize,
+        rim_phi: PyReadonlyArray1<'py, f64>,
+        mut direction: PyReadwriteArray2<'py, f32>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (ph, rim) = (phi.as_slice()?, rim_phi.as_slice()?);
+        let dir = c_slice_mut(&mut direction, "direction")?;
+        let norms = py
+            .detach(|| with_band!(self, b, tubesweep_core::normals::outward_directions_in_band(b, spacing, ph, start..stop, rim, dir)))
+            .map_err(to_pyerr)?;
+        Ok(norms.into_pyarray(py))
     }
 
     /// Band positions of grid indices (M, d); -1 where the node is not in the band.
