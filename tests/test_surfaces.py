@@ -330,3 +330,21 @@ def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
     assert np.array_equal(t.signed_distance(p3), np.hypot(np.hypot(q[:, 0], q[:, 1]) - t.R, q[:, 2]) - t.r)
     with pytest.raises(ValueError, match=r"\(M, 3\)"):
         s.signed_distance(p2)
+
+
+def test_native_ellipsoid_and_star_distances_match_their_numpy_formulations():
+    """Ellipsoid.signed_distance (Rust) gives the bits of its NumPy formulation, degenerate interior
+    points included; the Star's (Rust) agrees with its NumPy one to rounding (the sines and cosines
+    come from different libraries), on points near the curve and far from it."""
+    rng = np.random.default_rng(11)
+    p3 = rng.uniform(-1, 1, (30_000, 3))
+    # interior points on the plane of the shortest axis, where the closest point is a pole
+    p3[:500, 2] = 0.0
+    p3[:500, :2] *= 0.05
+    for e in (ts.surfaces.Ellipsoid(), ts.surfaces.Ellipsoid(0.5, 0.5, 0.4, center=(0.05, 0.0, -0.1))):
+        assert np.array_equal(e.signed_distance(p3), e._signed_distance_numpy(p3))
+    s = ts.surfaces.Star()
+    p2 = np.concatenate([rng.uniform(-1, 1, (5_000, 2)), s.curve(rng.uniform(0, 2 * np.pi, 5_000)) * rng.uniform(0.9, 1.1, (5_000, 1))])
+    a, b = s.signed_distance(p2), s._signed_distance_numpy(p2)
+    assert np.max(np.abs(a - b)) < 1e-14
+    assert np.array_equal(np.sign(a), np.sign(b))

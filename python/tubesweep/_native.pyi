@@ -40,6 +40,10 @@ def sphere_signed_distance(points: npt.NDArray[np.float64], centre: List[float],
 def torus_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], major: float, minor: float
 ) -> npt.NDArray[np.float64]: ...
+def ellipsoid_signed_distance(
+    points: npt.NDArray[np.float64], centre: List[float], axes: List[float]
+) -> npt.NDArray[np.float64]: ...
+def star_signed_distance(points: npt.NDArray[np.float64], r0: float, eps: float) -> npt.NDArray[np.float64]: ...
 __version__: str
 
 class Band:

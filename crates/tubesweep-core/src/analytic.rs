@@ -1,5 +1,5 @@
 //! Exact signed distances of the library's analytic surfaces, evaluated on all threads: the
-//! Python package's `Circle`, `Sphere` and `Torus` call these instead of NumPy expressions, with
+//! Python package's `Circle`, `Sphere`, `Torus`, `Ellipsoid` and `Star` call these instead of NumPy expressions, with
 //! the same arithmetic (so the same bits), because the band search evaluates φ at every
 //! candidate node and the outward directions at every rim place.
 
@@ -76,6 +76,151 @@ pub fn torus_signed_distance(
     Ok(())
 }
 
+/// The signed distance to the ellipsoid `Σ ((x_i − c_i)/a_i)² = 1` (semi-axes `axes`, centre
+/// `centre`) at the points (`M` rows of 3 coordinates) into `out`, with the arithmetic of the
+/// Python `Ellipsoid.signed_distance` (the same bits): the closest point is
+/// `y_i = a_i² x_i / (a_i² + t)` with `t` the root in `(−min a_i², ∞)` of the decreasing
+/// `Σ (a_i x_i / (a_i² + t))² − 1`, found by 100 bisections; interior points on the plane of the
+/// shortest axis far from the surface (where `a_min² + t` vanishes) have their closest point
+/// straight above or below them along that axis.
+pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3], out: &mut [f64]) -> Result<()> {
+    check_points(points, 3, out)?;
+    if !axes.iter().all(|&a| a > 0.0 && a.is_finite()) {
+        return Err(Error::invalid("axes", format!("semi-axes must be positive and finite, got {axes:?}")));
+    }
+    let a2 = [axes[0] * axes[0], axes[1] * axes[1], axes[2] * axes[2]];
+    // the first shortest axis, as np.argmin
+    let kmin = (0..3).fold(0, |m, k| if axes[k] < axes[m] { k } else { m });
+    let amax = axes.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
+        for (o, p) in out.iter_mut().zip(p.chunks_exact(3)) {
+            let x = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
+            let norm = ((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2]).sqrt();
+            let mut lo = -a2[kmin];
+            let mut hi = (amax * norm + 1e-300).max(0.0);
+            let ax_x = [axes[0] * x[0], axes[1] * x[1], axes[2] * x[2]];
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                let q = |k: usize| {
+                    let v = ax_x[k] / (a2[k] + mid);
+                    v * v
+                };
+                let g = (q(0) + q(1)) + q(2) - 1.0;
+                if g > 0.0 {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let t = 0.5 * (lo + hi);
+            let den = [a2[0] + t, a2[1] + t, a2[2] + t];
+            let mut y = [0.0f64; 3];
+            if den[kmin] <= 1e-12 * a2[kmin] {
+                let mut rest = 1.0;
+                let mut sum = 0.0;
+                for k in (0..3).filter(|&k| k != kmin) {
+                    y[k] = if a2[k] > a2[kmin] { a2[k] * x[k] / (a2[k] - a2[kmin]) } else { 0.0 };
+                    let v = y[k] / axes[k];
+                    sum += v * v;
+                }
+                rest -= sum;
+                let sign = if x[kmin] >= 0.0 { 1.0 } else { -1.0 };
+                y[kmin] = sign * axes[kmin] * rest.max(0.0).sqrt();
+            } else {
+                for k in 0..3 {
+                    y[k] = a2[k] * x[k] / den[k];
+                }
+            }
+            let d = [p[0] - (y[0] + centre[0]), p[1] - (y[1] + centre[1]), p[2] - (y[2] + centre[2])];
+            let dist = ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
+            let s = |k: usize| {
+                let v = x[k] / axes[k];
+                v * v
+            };
+            let inside = (s(0) + s(1)) + s(2) < 1.0;
+            *o = if inside { -dist } else { dist };
+        }
+    });
+    Ok(())
+}
+
+/// The signed distance to the six-fold star `r(θ) = r0 + ε sin²(3θ)` of the paper's Sect. 6.1 at
+/// the points (`M` rows of 2 coordinates) into `out`, by the algorithm of the Python
+/// `Star.signed_distance`: the closest point's polar angle is first searched on 129 angles
+/// within ±0.8 of the point's own (points with `| |x| − r(θ_x) | ≤ min(0.2, 0.9 r0)`) or on 4096
+/// angles round the whole curve (the others), then refined by 8 clipped Newton steps on
+/// `(γ(t) − x)·γ'(t) = 0`; inside (`|x| < r(θ_x)`) the distance is negative. Equal to the NumPy
+/// version to rounding (the sines and cosines come from a different library).
+pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) -> Result<()> {
+    check_points(points, 2, out)?;
+    if !(r0 > 0.0 && eps >= 0.0 && r0.is_finite() && eps.is_finite()) {
+        return Err(Error::invalid("r0", format!("need r0 > 0 and eps >= 0, got r0 = {r0}, eps = {eps}")));
+    }
+    let r = |t: f64| {
+        let s = (3.0 * t).sin();
+        r0 + eps * (s * s)
+    };
+    let curve = |t: f64| {
+        let rt = r(t);
+        [rt * t.cos(), rt * t.sin()]
+    };
+    const DENSE: usize = 4096;
+    let dense_step = 2.0 * std::f64::consts::PI / DENSE as f64;
+    let dense: Vec<[f64; 2]> = (0..DENSE).map(|j| curve(j as f64 * dense_step)).collect();
+    let near_limit = 0.2f64.min(0.9 * r0);
+    const WINDOW: usize = 129;
+    let window_step = 1.6 / (WINDOW - 1) as f64;
+    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 2)).for_each(|(out, p)| {
+        for (o, q) in out.iter_mut().zip(p.chunks_exact(2)) {
+            let (x, y) = (q[0], q[1]);
+            let polar = y.atan2(x);
+            let inside_radius = r(polar);
+            let d2 = |c: [f64; 2]| (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y);
+            let mut t;
+            if (x.hypot(y) - inside_radius).abs() <= near_limit {
+                t = polar - 0.8;
+                let mut best = f64::INFINITY;
+                for k in 0..WINDOW {
+                    let cand = if k + 1 == WINDOW { polar + 0.8 } else { polar + (-0.8 + k as f64 * window_step) };
+                    let dd = d2(curve(cand));
+                    if dd < best {
+                        best = dd;
+                        t = cand;
+                    }
+                }
+            } else {
+                let (mut best, mut jbest) = (f64::INFINITY, 0);
+                for (j, &c) in dense.iter().enumerate() {
+                    let dd = d2(c);
+                    if dd < best {
+                        best = dd;
+                        jbest = j;
+                    }
+                }
+                t = jbest as f64 * dense_step;
+            }
+            // Newton on g(t) = (γ(t) − q)·γ'(t) = 0, each step clipped to ±0.01
+            for _ in 0..8 {
+                let (s3, c, si) = ((3.0 * t).sin(), t.cos(), t.sin());
+                let rt = r0 + eps * (s3 * s3);
+                let dr = 3.0 * eps * (6.0 * t).sin();
+                let d2r = 18.0 * eps * (6.0 * t).cos();
+                let g1 = [dr * c - rt * si, dr * si + rt * c];
+                let g2 = [d2r * c - 2.0 * dr * si - rt * c, d2r * si + 2.0 * dr * c - rt * si];
+                let diff = [rt * c - x, rt * si - y];
+                let f = diff[0] * g1[0] + diff[1] * g1[1];
+                let fp = (g1[0] * g1[0] + g1[1] * g1[1]) + (diff[0] * g2[0] + diff[1] * g2[1]);
+                let step = if fp.abs() > 1e-14 { f / fp } else { 0.0 };
+                t -= step.clamp(-0.01, 0.01);
+            }
+            let c = curve(t);
+            let dist = ((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1])).sqrt();
+            *o = if x.hypot(y) < inside_radius { -dist } else { dist };
+        }
+    });
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,5 +247,45 @@ mod tests {
         for (v, e) in out.iter().zip([0.0, 0.0, 0.0, 0.3]) {
             assert!((v - e).abs() < 1e-15, "{v} vs {e}");
         }
+    }
+
+    #[test]
+    fn ellipsoid_distances() {
+        // on the axes: outside, on the surface, inside; and the degenerate interior case (the
+        // centre of an oblate spheroid: the closest points are the poles)
+        let axes = [0.5, 0.5, 0.4];
+        let p = [0.9, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.1, 0.0, 0.0, 0.0];
+        let mut out = [0.0; 4];
+        ellipsoid_signed_distance(&p, [0.0; 3], axes, &mut out).unwrap();
+        for (v, e) in out.iter().zip([0.4, 0.0, -0.3, -0.4]) {
+            assert!((v - e).abs() < 1e-12, "{v} vs {e}");
+        }
+        assert!(ellipsoid_signed_distance(&p, [0.0; 3], [0.5, 0.0, 0.4], &mut out).is_err());
+    }
+
+    #[test]
+    fn star_distances() {
+        // against a brute-force search over 400,000 points of r(θ) = 0.5 + 0.2 sin²(3θ), at points
+        // near the curve (Newton's case), far from it (the whole-curve search) and inside it
+        let (r0, eps) = (0.5, 0.2);
+        let p = [0.8, 0.0, 0.3, 0.0, 0.55, 0.33, -0.2, 0.61, 0.05, -0.02, -0.9, -0.7, 0.0, 0.0, 0.42, -0.1];
+        let mut out = [0.0; 8];
+        star_signed_distance(&p, r0, eps, &mut out).unwrap();
+        let m = 400_000;
+        let curve: Vec<(f64, f64)> = (0..m)
+            .map(|j| {
+                let t = 2.0 * std::f64::consts::PI * j as f64 / m as f64;
+                let r = r0 + eps * (3.0 * t).sin().powi(2);
+                (r * t.cos(), r * t.sin())
+            })
+            .collect();
+        for (q, &v) in p.chunks_exact(2).zip(&out) {
+            let d = curve.iter().map(|c| (c.0 - q[0]).hypot(c.1 - q[1])).fold(f64::INFINITY, f64::min);
+            let th = q[1].atan2(q[0]);
+            let inside = q[0].hypot(q[1]) < r0 + eps * (3.0 * th).sin().powi(2);
+            let want = if inside { -d } else { d };
+            assert!((v - want).abs() < 1e-6, "at {q:?}: {v} vs {want}");
+        }
+        assert!(star_signed_distance(&p, 0.0, eps, &mut out).is_err());
     }
 }

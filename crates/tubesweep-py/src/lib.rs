@@ -876,6 +876,33 @@ fn torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64
     Ok(out.into_pyarray(py))
 }
 
+/// The exact signed distance to the ellipsoid with semi-axes `axes` about `centre` at the points
+/// (M, 3). See `tubesweep_core::analytic::ellipsoid_signed_distance`.
+#[pyfunction]
+fn ellipsoid_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, axes: Vec<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if points.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
+    }
+    let (c, a) = (coords_array::<3>(&centre, "centre")?, coords_array::<3>(&axes, "axes")?);
+    let p = c_slice(&points, "points")?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| tubesweep_core::analytic::ellipsoid_signed_distance(p, c, a, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
+/// The exact signed distance to the six-fold star r(θ) = r0 + eps sin²(3θ) at the points (M, 2).
+/// See `tubesweep_core::analytic::star_signed_distance`.
+#[pyfunction]
+fn star_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, r0: f64, eps: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if points.shape()[1] != 2 {
+        return Err(PyValueError::new_err(format!("points must have shape (M, 2); got {:?}", points.shape())));
+    }
+    let p = c_slice(&points, "points")?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| tubesweep_core::analytic::star_signed_distance(p, r0, eps, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
 fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Option<&'a [i32]>> {
     table.as_ref().map(|t| c_slice(t, "neighbours")).transpose()
 }
@@ -951,6 +978,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
     m.add_function(wrap_pyfunction!(sphere_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(torus_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(ellipsoid_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(star_signed_distance, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
