@@ -150,7 +150,8 @@ pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3
 /// within ±0.8 of the point's own (points with `| |x| − r(θ_x) | ≤ min(0.2, 0.9 r0)`) or on 4096
 /// angles round the whole curve (the others), then refined by 8 clipped Newton steps on
 /// `(γ(t) − x)·γ'(t) = 0`; inside (`|x| < r(θ_x)`) the distance is negative. Equal to the NumPy
-/// version to rounding (the sines and cosines come from a different library).
+/// version to rounding (the sines and cosines come from a different library, and the window's
+/// candidates are evaluated by the angle-addition formulas).
 pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) -> Result<()> {
     check_points(points, 2, out)?;
     if !(r0 > 0.0 && eps >= 0.0 && r0.is_finite() && eps.is_finite()) {
@@ -170,6 +171,22 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
     let near_limit = 0.2f64.min(0.9 * r0);
     const WINDOW: usize = 129;
     let window_step = 1.6 / (WINDOW - 1) as f64;
+    // the window's angle offsets δ with cos δ, sin δ, cos 3δ and sin 3δ
+    struct Offset {
+        delta: f64,
+        c: f64,
+        s: f64,
+        c3: f64,
+        s3: f64,
+    }
+    let window: Vec<Offset> = (0..WINDOW)
+        .map(|k| {
+            let delta = if k + 1 == WINDOW { 0.8 } else { -0.8 + k as f64 * window_step };
+            let (s, c) = delta.sin_cos();
+            let (s3, c3) = (3.0 * delta).sin_cos();
+            Offset { delta, c, s, c3, s3 }
+        })
+        .collect();
     out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 2)).for_each(|(out, p)| {
         for (o, q) in out.iter_mut().zip(p.chunks_exact(2)) {
             let (x, y) = (q[0], q[1]);
@@ -178,26 +195,24 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
             let d2 = |c: [f64; 2]| (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y);
             let mut t;
             if (x.hypot(y) - inside_radius).abs() <= near_limit {
+                // γ(polar + δ) by the angle-addition formulas from the window's precomputed
+                // sines and cosines: no trigonometric call per candidate
+                let (sp, cp) = polar.sin_cos();
+                let (s3p, c3p) = (3.0 * polar).sin_cos();
                 t = polar - 0.8;
                 let mut best = f64::INFINITY;
-                for k in 0..WINDOW {
-                    let cand = if k + 1 == WINDOW { polar + 0.8 } else { polar + (-0.8 + k as f64 * window_step) };
-                    let dd = d2(curve(cand));
-                    if dd < best {
-                        best = dd;
-                        t = cand;
-                    }
-                }
-            } else {
-                let (mut best, mut jbest) = (f64::INFINITY, 0);
-                for (j, &c) in dense.iter().enumerate() {
+                for (k, w) in window.iter().enumerate() {
+                    let s3 = s3p * w.c3 + c3p * w.s3;
+                    let rt = r0 + eps * (s3 * s3);
+                    let c = [rt * (cp * w.c - sp * w.s), rt * (sp * w.c + cp * w.s)];
                     let dd = d2(c);
                     if dd < best {
                         best = dd;
-                        jbest = j;
+                        t = if k + 1 == WINDOW { polar + 0.8 } else { polar + w.delta };
                     }
                 }
-                t = jbest as f64 * dense_step;
+            } else {
+                t = nearest_sample(&dense, dense_step, x, y, polar, r0, r0 + eps) as f64 * dense_step;
             }
             // Newton on g(t) = (γ(t) − q)·γ'(t) = 0, each step clipped to ±0.01
             for _ in 0..8 {
@@ -219,6 +234,47 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
         }
     });
     Ok(())
+}
+
+/// The index of the sample of `dense` (the points `γ(j·step)` of a curve star-shaped about the
+/// origin with `r_min ≤ |γ| ≤ r_max`, `step = 2π / dense.len()`) nearest to `(x, y)`, whose polar
+/// angle is `polar`: the first nearest in index order, as a scan of all of them would give. The
+/// scan starts at the sample nearest in angle and walks outwards both ways, and stops once no
+/// sample further round can be nearer: a sample at angle `polar ± Δ` lies on that ray between
+/// radii `r_min` and `r_max`, and the distance from the point to that segment grows with `Δ`.
+fn nearest_sample(dense: &[[f64; 2]], step: f64, x: f64, y: f64, polar: f64, r_min: f64, r_max: f64) -> usize {
+    let m = dense.len();
+    let rho = x.hypot(y);
+    // the squared distance from the point to the segment of radii [r_min, r_max] at angle offset Δ
+    let bound = |delta: f64| {
+        let c = delta.cos();
+        let t = (rho * c).clamp(r_min, r_max);
+        rho * rho + t * t - 2.0 * rho * t * c
+    };
+    let d2 = |j: usize| {
+        let c = dense[j];
+        (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y)
+    };
+    let start = ((polar.rem_euclid(2.0 * std::f64::consts::PI) / step).round() as usize) % m;
+    let (mut best, mut jbest) = (d2(start), start);
+    let consider = |j: usize, best: &mut f64, jbest: &mut usize| {
+        let dd = d2(j);
+        if dd < *best || (dd == *best && j < *jbest) {
+            *best = dd;
+            *jbest = j;
+        }
+    };
+    for k in 1..=m / 2 {
+        // the samples k steps round either way are at least |Δ| ≥ (k − 1/2)·step off the point's
+        // angle (the start is within step/2 of it): none nearer once that bound exceeds the best
+        let delta = (k as f64 - 0.5) * step;
+        if delta > 0.0 && bound(delta.min(std::f64::consts::PI)) * (1.0 - 1e-12) > best {
+            break;
+        }
+        consider((start + k) % m, &mut best, &mut jbest);
+        consider((start + m - k) % m, &mut best, &mut jbest);
+    }
+    jbest
 }
 
 #[cfg(test)]
@@ -287,5 +343,36 @@ mod tests {
             assert!((v - want).abs() < 1e-6, "at {q:?}: {v} vs {want}");
         }
         assert!(star_signed_distance(&p, 0.0, eps, &mut out).is_err());
+    }
+
+    #[test]
+    fn the_pruned_search_finds_the_sample_a_full_scan_finds() {
+        let (r0, eps) = (0.5, 0.2);
+        let m = 4096;
+        let step = 2.0 * std::f64::consts::PI / m as f64;
+        let dense: Vec<[f64; 2]> = (0..m)
+            .map(|j| {
+                let t = j as f64 * step;
+                let r = r0 + eps * (3.0 * t).sin().powi(2);
+                [r * t.cos(), r * t.sin()]
+            })
+            .collect();
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..20_000 {
+            let (x, y) = (next() * 1.2, next() * 1.2);
+            let full = (0..m)
+                .min_by(|&a, &b| {
+                    let da = (dense[a][0] - x).powi(2) + (dense[a][1] - y).powi(2);
+                    let db = (dense[b][0] - x).powi(2) + (dense[b][1] - y).powi(2);
+                    da.partial_cmp(&db).unwrap().then(a.cmp(&b))
+                })
+                .unwrap();
+            let pruned = nearest_sample(&dense, step, x, y, y.atan2(x), r0, r0 + eps);
+            assert_eq!(pruned, full, "at ({x}, {y})");
+        }
     }
 }
