@@ -15,6 +15,13 @@ def block_children(
 def node_points(
     shape: List[int], linear: npt.NDArray[np.uint64], lower: List[float], spacing: float
 ) -> npt.NDArray[np.float64]: ...
+def keep_within(
+    linear: npt.NDArray[np.uint64],
+    values: npt.NDArray[np.float64],
+    half_width: float,
+    linear_out: npt.NDArray[np.uint64],  # written from the front
+    values_out: npt.NDArray[np.float64],  # written from the front
+) -> int: ...
 def neighbour_table(
     shape: List[int], linear: npt.NDArray[np.uint64], start: int, stop: int
 ) -> npt.NDArray[np.int32]: ...  # (2·(d − 1), stop − start)

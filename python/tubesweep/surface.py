@@ -188,11 +188,8 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
         lin = candidates[s0 : s0 + EVAL_CHUNK]
         # the node coordinates in Rust (the bits of Grid.points, without the (M, d) int64 indices)
         v = _evaluate(fn, _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing), name)
-        keep = np.abs(v) <= half_width
-        n = int(np.count_nonzero(keep))
-        np.compress(keep, lin, out=linear[kept : kept + n])
-        np.compress(keep, v, out=values[kept : kept + n])
-        kept += n
+        # the nodes with |φ| ≤ half_width, copied in order to the fronts of the outputs (in Rust)
+        kept += _native.keep_within(lin.view(np.uint64), v, half_width, linear[kept:].view(np.uint64), values[kept:])
     del candidates, lin  # (lin is a view of them)
     linear.resize(kept, refcheck=False)  # sorted, as the candidates are
     values.resize(kept, refcheck=False)

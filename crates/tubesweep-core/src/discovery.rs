@@ -110,15 +110,30 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
     if let Some(o) = origins.par_iter().find_first(|o| (0..D).any(|k| o[k] % 2 != 0 || o[k] >= shape[k] as u64)) {
         return Err(Error::invalid("origins", format!("block origin {o:?} is not an even grid index inside the grid {shape:?}")));
     }
-    let mut sorted = origins.to_vec();
-    sorted.par_sort_unstable();
-    if sorted.par_windows(2).any(|w| w[0] == w[1]) {
-        return Err(Error::invalid("origins", "block origins repeat"));
-    }
     let mut stride = [1u64; D];
     for k in (0..D.saturating_sub(1)).rev() {
         stride[k] = stride[k + 1] * shape[k + 1] as u64;
     }
+    // sorted lexicographically, which is the order of their linear indices (every coordinate is
+    // inside the grid): sorting those u64 keys is several times faster than comparing arrays
+    let mut keys: Vec<u64> = origins.par_iter().map(|o| (0..D).map(|k| o[k] * stride[k]).sum()).collect();
+    keys.par_sort_unstable();
+    if keys.par_windows(2).any(|w| w[0] == w[1]) {
+        return Err(Error::invalid("origins", "block origins repeat"));
+    }
+    let sorted: Vec<[u64; D]> = keys
+        .par_iter()
+        .map(|&l| {
+            let mut o = [0u64; D];
+            let mut key = l;
+            for k in (0..D).rev() {
+                o[k] = key % shape[k] as u64;
+                key /= shape[k] as u64;
+            }
+            o
+        })
+        .collect();
+    drop(keys);
     // the origins by their first coordinate: their nodes come in C order group after group, so
     // the groups are emitted on all threads, each into its own part of the output, whose size is
     // counted first (a block has 2 nodes along an axis, 1 where the grid ends after its origin)
@@ -181,6 +196,27 @@ pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f6
         }
     });
     Ok(out)
+}
+
+/// Copies the candidates with `|value| ≤ half_width` (the band's nodes) to the fronts of
+/// `linear_out` and `values_out`, in order, and returns how many there are: the filter of the
+/// band search after φ at the candidates is known. An error if the outputs are too short or the
+/// inputs differ in length.
+pub fn keep_within(linear: &[u64], values: &[f64], half_width: f64, linear_out: &mut [u64], values_out: &mut [f64]) -> Result<usize> {
+    if values.len() != linear.len() {
+        return Err(Error::invalid("values", format!("expected {} values (one per candidate), got {}", linear.len(), values.len())));
+    }
+    if linear_out.len() < linear.len() || values_out.len() < linear.len() {
+        return Err(Error::invalid("out", format!("the outputs must hold {} entries", linear.len())));
+    }
+    let mut n = 0;
+    for (&l, &v) in linear.iter().zip(values) {
+        // written unconditionally, kept by advancing: no branch to mispredict
+        linear_out[n] = l;
+        values_out[n] = v;
+        n += (v.abs() <= half_width) as usize;
+    }
+    Ok(n)
 }
 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along
@@ -309,5 +345,16 @@ mod tests {
         assert!(split_pair_blocks([6usize, 6], &[[1, 0]]).is_err());
         assert!(split_pair_blocks([6usize, 6], &[[6, 0]]).is_err());
         assert!(split_pair_blocks([6usize, 6], &[[2, 2], [2, 2]]).is_err());
+    }
+
+    #[test]
+    fn keep_within_keeps_the_band_in_order() {
+        let lin = [3u64, 5, 8, 9, 14];
+        let val = [0.5, -0.1, 0.2, -0.3, f64::NAN];
+        let (mut lo, mut vo) = ([0u64; 5], [0.0; 5]);
+        let n = keep_within(&lin, &val, 0.25, &mut lo, &mut vo).unwrap();
+        assert_eq!((n, &lo[..n], &vo[..n]), (2, &[5u64, 8][..], &[-0.1, 0.2][..]));
+        assert!(keep_within(&lin, &val, 0.25, &mut lo[..4], &mut vo).is_err());
+        assert!(keep_within(&lin, &val[..4], 0.25, &mut lo, &mut vo).is_err());
     }
 }

@@ -819,6 +819,23 @@ fn block_children<'py>(
     }
 }
 
+/// Copies the candidates with |values| ≤ half_width to the fronts of `linear_out` and
+/// `values_out` (C-contiguous, at least as long as the candidates) and returns their number. See
+/// `tubesweep_core::discovery::keep_within`.
+#[pyfunction]
+fn keep_within<'py>(
+    py: Python<'py>,
+    linear: PyReadonlyArray1<'py, u64>,
+    values: PyReadonlyArray1<'py, f64>,
+    half_width: f64,
+    mut linear_out: numpy::PyReadwriteArray1<'py, u64>,
+    mut values_out: numpy::PyReadwriteArray1<'py, f64>,
+) -> PyResult<usize> {
+    let (lin, val) = (c_slice(&linear, "linear")?, c_slice(&values, "values")?);
+    let (lo, vo) = (c_slice_mut(&mut linear_out, "linear_out")?, c_slice_mut(&mut values_out, "values_out")?);
+    py.detach(|| tubesweep_core::discovery::keep_within(lin, val, half_width, lo, vo)).map_err(to_pyerr)
+}
+
 /// World coordinates (M, d) of the nodes with C-order linear indices `linear` (the arithmetic of
 /// `Grid.points`). See `tubesweep_core::discovery::node_points`.
 #[pyfunction]
@@ -973,6 +990,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(children_radius_max, m)?)?;
     m.add_function(wrap_pyfunction!(block_children, m)?)?;
     m.add_function(wrap_pyfunction!(node_points, m)?)?;
+    m.add_function(wrap_pyfunction!(keep_within, m)?)?;
     m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
