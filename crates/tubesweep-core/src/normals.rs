@@ -375,25 +375,84 @@ where
     direction.par_chunks_mut(CHUNK * d).zip(norms.par_chunks_mut(CHUNK)).enumerate().for_each(|(j, (dir, norms))| {
         let mut rim = start[j];
         let lo = j * CHUNK;
+        // The neighbour values are gathered for a block of nodes at a time, and the block's
+        // differences, norms and directions are then computed axis by axis over plain arrays,
+        // which the compiler turns into vector divisions and square roots: the same operations
+        // in the same order per node, so the same bits.
+        let mut block = Block::new();
+        let two_h = 2.0 * spacing;
         visit_chunk(j, &mut |o, c_last| {
-            // g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)
-            let mut phi_at = |g: usize| match neighbour(o, c_last, g) {
-                Some(p) => phi[p],
-                None => {
-                    rim[g] += 1;
-                    rim_phi[rim[g] - 1]
+            let i = block.len;
+            for k in 0..d {
+                for side in 0..2 {
+                    let g = 2 * k + side;
+                    block.phi[g][i] = match neighbour(o, c_last, g) {
+                        Some(p) => phi[p],
+                        None => {
+                            rim[g] += 1;
+                            rim_phi[rim[g] - 1]
+                        }
+                    };
                 }
-            };
-            let mut grad = [0.0f64; 3];
-            let mut sq = 0.0f64;
-            for (k, gk) in grad.iter_mut().enumerate().take(d) {
-                let plus = phi_at(2 * k);
-                *gk = (plus - phi_at(2 * k + 1)) / (2.0 * spacing);
-                sq += *gk * *gk;
             }
-            let norm = sq.sqrt();
-            let safe = if norm > 1e-12 { norm } else { 1.0 };
-            let p = phi[range.start + o];
+            block.own[i] = phi[range.start + o];
+            if i == 0 {
+                block.first = o - lo;
+            }
+            block.len += 1;
+            if block.len == BLOCK {
+                block.finish(d, two_h, dir, norms);
+            }
+        });
+        block.finish(d, two_h, dir, norms);
+    });
+    Ok(norms)
+}
+
+/// Nodes per block of [`Block`].
+const BLOCK: usize = 256;
+
+/// φ at the neighbours of a block of up to [`BLOCK`] consecutive nodes of a chunk (group
+/// `2k + side`, side 0 the plus neighbour), φ at the nodes themselves, and where the block starts
+/// in the chunk.
+struct Block {
+    phi: [[f64; BLOCK]; 6],
+    own: [f64; BLOCK],
+    first: usize,
+    len: usize,
+}
+
+impl Block {
+    fn new() -> Box<Self> {
+        Box::new(Block { phi: [[0.0; BLOCK]; 6], own: [0.0; BLOCK], first: 0, len: 0 })
+    }
+
+    /// Writes the block's directions and |∇φ| to the chunk's `dir` and `norms` and empties it:
+    /// `g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)`, `|g|` summed in axis order,
+    /// `sgn(φ) g/|g|` (`g` itself where `|g| ≤ 1e-12`).
+    fn finish(&mut self, d: usize, two_h: f64, dir: &mut [f32], norms: &mut [f64]) {
+        let n = self.len;
+        if n == 0 {
+            return;
+        }
+        let mut grad = [[0.0f64; BLOCK]; 3];
+        let mut sq = [0.0f64; BLOCK];
+        for k in 0..d {
+            let (plus, minus, gk) = (&self.phi[2 * k][..n], &self.phi[2 * k + 1][..n], &mut grad[k][..n]);
+            for i in 0..n {
+                gk[i] = (plus[i] - minus[i]) / two_h;
+                sq[i] += gk[i] * gk[i];
+            }
+        }
+        let (dir, norms) = (&mut dir[self.first * d..(self.first + n) * d], &mut norms[self.first..self.first + n]);
+        let mut scale = [0.0f64; BLOCK];
+        for i in 0..n {
+            let norm = sq[i].sqrt();
+            norms[i] = norm;
+            scale[i] = if norm > 1e-12 { norm } else { 1.0 };
+        }
+        for i in 0..n {
+            let p = self.own[i];
             let sgn = if p > 0.0 {
                 1.0
             } else if p < 0.0 {
@@ -402,12 +461,11 @@ where
                 0.0
             };
             for k in 0..d {
-                dir[(o - lo) * d + k] = (sgn * (grad[k] / safe)) as f32;
+                dir[i * d + k] = (sgn * (grad[k][i] / scale[i])) as f32;
             }
-            norms[o - lo] = norm;
-        });
-    });
-    Ok(norms)
+        }
+        self.len = 0;
+    }
 }
 
 #[cfg(test)]
