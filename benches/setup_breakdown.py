@@ -52,25 +52,14 @@ def main() -> int:
     a = ap.parse_args()
     problem = PROBLEMS[a.surface](a.n)
     surf, grid = problem.surface, problem.grid
-    h, shape, lower = grid.spacing, list(grid.shape), [float(x) for x in grid.lower]
+    h, shape = grid.spacing, list(grid.shape)
     width = 4 * h  # the default outer tube
     fn = surf._fn
     linear, values = discover_band(fn, grid, width, surf.lipschitz)
     ul = linear.view(np.uint64)
     band = _native.Band.from_linear(shape, ul)
     pos, counts = band.rim_nodes(0, len(linear))
-
-    def rim_points() -> List[np.ndarray]:
-        parts, start = [], 0
-        for group, count in enumerate(counts):
-            x = _native.node_points(shape, ul[pos[start : start + count]], lower, h)
-            x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
-            parts.append(x)
-            start += count
-        return parts
-
-    points = rim_points()
-    rim_phi = np.concatenate([fn(x) for x in points])
+    rim_phi = surf._phi_at_rim_places(grid, linear, pos, counts)
     direction = np.empty((len(linear), grid.ndim), np.float32)
     r = a.repeats
     rows: Dict[str, float] = {
@@ -80,7 +69,7 @@ def main() -> int:
             lambda: discover_band(fn, grid, width, surf.lipschitz), r),
         "band structure (Band.from_linear)": median_ms(lambda: _native.Band.from_linear(shape, ul), r),
         "rim places (Band.rim_nodes)": median_ms(lambda: band.rim_nodes(0, len(linear)), r),
-        "rim coordinates and φ there": median_ms(lambda: [fn(x) for x in rim_points()], r),
+        "rim coordinates and φ there": median_ms(lambda: surf._phi_at_rim_places(grid, linear, pos, counts), r),
         "outward directions (Band.outward_directions)": median_ms(
             lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r),
         "LevelSet.band, all of the above": median_ms(lambda: surf.band(grid, width), r),

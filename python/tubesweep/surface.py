@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any, Callable, Iterator, Optional, Tuple, Union
+from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -298,13 +298,20 @@ class LevelSet(Surface):
         by central differences, in Rust (``tubesweep._native.Band.outward_directions``); returns
         ``|∇φ|``. φ at a neighbour that is itself a band node is already known; the callable is
         evaluated only at the others (the band's outer rim), one batch per axis and side.
-        ``band`` is the native band of ``linear``, whose neighbours give the table."""
+        ``band`` is the native band of ``linear``, whose neighbours give the rim places."""
+        # the neighbours come from the band's own table (no search)
+        pos, counts = band.rim_nodes(lo, hi)
+        rim_phi = self._phi_at_rim_places(grid, linear, pos, counts)
+        return band.outward_directions(grid.spacing, values, lo, hi, rim_phi, direction)
+
+    def _phi_at_rim_places(self, grid: Grid, linear: np.ndarray, pos: np.ndarray, counts: List[int]) -> np.ndarray:
+        """The callable φ at the places ``Band.rim_nodes`` lists (``pos``, ``counts``): for group
+        ``g`` (axis ``g // 2``, side +1 for even ``g``) at ``x ± Δx e_k`` of its band nodes, group
+        after group, one batch each."""
         from . import _native
 
         h = grid.spacing
         ulinear = linear.view(np.uint64)  # non-negative int64: the same bits
-        # the neighbours come from the band's own table (no search)
-        pos, counts = band.rim_nodes(lo, hi)
         parts = []
         start = 0
         for group, count in enumerate(counts):
@@ -313,8 +320,7 @@ class LevelSet(Surface):
                 x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
                 parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
             start += count
-        rim_phi = np.concatenate(parts) if parts else np.zeros(0)
-        return band.outward_directions(h, values, lo, hi, rim_phi, direction)
+        return np.concatenate(parts) if parts else np.zeros(0)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         self.check_grid(grid)

@@ -116,14 +116,13 @@ pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3
             let den = [a2[0] + t, a2[1] + t, a2[2] + t];
             let mut y = [0.0f64; 3];
             if den[kmin] <= 1e-12 * a2[kmin] {
-                let mut rest = 1.0;
                 let mut sum = 0.0;
                 for k in (0..3).filter(|&k| k != kmin) {
                     y[k] = if a2[k] > a2[kmin] { a2[k] * x[k] / (a2[k] - a2[kmin]) } else { 0.0 };
                     let v = y[k] / axes[k];
                     sum += v * v;
                 }
-                rest -= sum;
+                let rest = 1.0 - sum;
                 let sign = if x[kmin] >= 0.0 { 1.0 } else { -1.0 };
                 y[kmin] = sign * axes[kmin] * rest.max(0.0).sqrt();
             } else {
@@ -201,14 +200,14 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
                 let (s3p, c3p) = (3.0 * polar).sin_cos();
                 t = polar - 0.8;
                 let mut best = f64::INFINITY;
-                for (k, w) in window.iter().enumerate() {
+                for w in &window {
                     let s3 = s3p * w.c3 + c3p * w.s3;
                     let rt = r0 + eps * (s3 * s3);
                     let c = [rt * (cp * w.c - sp * w.s), rt * (sp * w.c + cp * w.s)];
                     let dd = d2(c);
                     if dd < best {
                         best = dd;
-                        t = if k + 1 == WINDOW { polar + 0.8 } else { polar + w.delta };
+                        t = polar + w.delta;
                     }
                 }
             } else {
@@ -268,7 +267,7 @@ fn nearest_sample(dense: &[[f64; 2]], step: f64, x: f64, y: f64, polar: f64, r_m
         // the samples k steps round either way are at least |Δ| ≥ (k − 1/2)·step off the point's
         // angle (the start is within step/2 of it): none nearer once that bound exceeds the best
         let delta = (k as f64 - 0.5) * step;
-        if delta > 0.0 && bound(delta.min(std::f64::consts::PI)) * (1.0 - 1e-12) > best {
+        if bound(delta.min(std::f64::consts::PI)) * (1.0 - 1e-12) > best {
             break;
         }
         consider((start + k) % m, &mut best, &mut jbest);
