@@ -246,6 +246,30 @@ pub enum Control {
     Stop,
 }
 
+/// Calls `$this.$method::<S, P, W, K>($args)` with the row loop specialised for the problem:
+/// the scheme `S`, a per-node slowness `P`, the front window `W` and the active flags `K`
+/// (see [`SweepContext::skip_inactive`]), so that nothing is dispatched inside the hot loop. The
+/// window runs only with the flags (see `SweepProblem::windowed`).
+macro_rules! specialised {
+    ($this:expr, $ctx:expr, $method:ident ( $($arg:expr),* )) => {{
+        let per_node = matches!($this.slowness, Slowness::PerNode(_));
+        match ($this.scheme, per_node, $ctx.windowed, $ctx.skip_inactive) {
+            (InnerScheme::Godunov, false, false, true) => $this.$method::<GODUNOV, false, false, true>($($arg),*),
+            (InnerScheme::Godunov, true, false, true) => $this.$method::<GODUNOV, true, false, true>($($arg),*),
+            (InnerScheme::Godunov, false, true, _) => $this.$method::<GODUNOV, false, true, true>($($arg),*),
+            (InnerScheme::Godunov, true, true, _) => $this.$method::<GODUNOV, true, true, true>($($arg),*),
+            (InnerScheme::Godunov, false, false, false) => $this.$method::<GODUNOV, false, false, false>($($arg),*),
+            (InnerScheme::Godunov, true, false, false) => $this.$method::<GODUNOV, true, false, false>($($arg),*),
+            (InnerScheme::LaxFriedrichs, false, _, true) => $this.$method::<LXF, false, false, true>($($arg),*),
+            (InnerScheme::LaxFriedrichs, true, _, true) => $this.$method::<LXF, true, false, true>($($arg),*),
+            (InnerScheme::LaxFriedrichs, false, _, false) => $this.$method::<LXF, false, false, false>($($arg),*),
+            (InnerScheme::LaxFriedrichs, true, _, false) => $this.$method::<LXF, true, false, false>($($arg),*),
+            (InnerScheme::General(_), _, _, true) => $this.$method::<GENERAL, false, false, true>($($arg),*),
+            (InnerScheme::General(_), _, _, false) => $this.$method::<GENERAL, false, false, false>($($arg),*),
+        }
+    }};
+}
+
 impl<'a, const D: usize> SweepProblem<'a, D> {
     fn check(&self, values: &[f64]) -> Result<()> {
         let n = self.band.len();
@@ -634,6 +658,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
         let shared = SharedValues { ptr: u.as_mut_ptr(), len: u.len() };
         let all_active = !options.skip_inactive;
+        // the plain sweeps update every node that starts active (all but the fixed nodes and the
+        // layer nodes without an upwind neighbour) in every sweep, and count them here
+        let updated_per_sweep = if all_active { active[..n].iter().filter(|a| a.load(Ordering::Relaxed) != 0).count() as u64 } else { 0 };
 
         // the largest slowness of a general Hamiltonian bounds the extrapolation of absent
         // neighbours (see `fill_missing`); computed once, it may scan every node
@@ -655,6 +682,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             row_dirty: &row_dirty,
             row_neighbours: &row_neighbours,
             windowed,
+            skip_inactive: !all_active,
             u: &shared,
             active: &active,
             weights,
@@ -683,16 +711,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let mut front = f64::INFINITY;
             let mut waiting = f64::INFINITY;
             let mut updates = 0u64;
-            let activate_all = || {
-                for (n, a) in active[..self.roles.len()].iter().enumerate() {
-                    if weights.get(n).map_or(true, |w| !w[0].is_nan()) {
-                        a.store(1, Ordering::Relaxed);
-                    }
-                }
-                for d in &row_dirty {
-                    d.store(1, Ordering::Relaxed);
-                }
-            };
             if parallel {
                 // all 2^d sweeps of the iteration in one visit to the pool's threads, with a
                 // barrier between sweeps (waking the threads once per sweep costs more than a
@@ -702,11 +720,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                         let dir = s ^ (s >> 1); // Gray code
                         self.strip_worker(&ctx, dir, next_strip, abandoned, lim)
                     };
-                    let between = |_s: usize| {
-                        if all_active {
-                            activate_all();
-                        }
-                    };
+                    let between = |_s: usize| {};
                     run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep, &between)
                 });
                 max_change = acc.max_change;
@@ -717,9 +731,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             } else {
                 for s in 0..n_orient {
                     let dir = s ^ (s >> 1); // Gray code
-                    if all_active {
-                        activate_all();
-                    }
                     let acc = self.sweep(&ctx, dir, lim);
                     max_change = max_change.max(acc.max_change);
                     front = front.min(acc.front);
@@ -727,6 +738,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     updates += acc.updates;
                     stats.sweeps += 1;
                 }
+            }
+            if all_active {
+                updates = updated_per_sweep * n_orient as u64;
             }
             stats.iterations += 1;
             stats.updates += updates;
@@ -769,23 +783,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let rows = sched.rows(lead);
         let tiles = sched.tiles(lead);
         let waves = sched.waves(lead);
-        // one specialised row loop per (scheme, speed) pair: no dispatch inside the hot loop
-        let per_node = matches!(self.slowness, Slowness::PerNode(_));
         // Two tiles of one wave are independent, so the sequential sweep interleaves them node by node:
         // the Gauss–Seidel chain along a row (each node reads the one just written) is latency
         // bound, and two independent chains keep the core busy while either waits.
         let run_pair = |t: usize, t_end: usize| -> Accumulator {
             let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
             let b: &[u32] = if t + 1 < t_end { &rows[tiles[t + 1] as usize..tiles[t + 2] as usize] } else { &[] };
-            match (self.scheme, per_node, ctx.windowed) {
-                (InnerScheme::Godunov, false, false) => self.run_rows_interleaved::<GODUNOV, false, false>(ctx, a, b, backwards, lim),
-                (InnerScheme::Godunov, true, false) => self.run_rows_interleaved::<GODUNOV, true, false>(ctx, a, b, backwards, lim),
-                (InnerScheme::Godunov, false, true) => self.run_rows_interleaved::<GODUNOV, false, true>(ctx, a, b, backwards, lim),
-                (InnerScheme::Godunov, true, true) => self.run_rows_interleaved::<GODUNOV, true, true>(ctx, a, b, backwards, lim),
-                (InnerScheme::LaxFriedrichs, false, _) => self.run_rows_interleaved::<LXF, false, false>(ctx, a, b, backwards, lim),
-                (InnerScheme::LaxFriedrichs, true, _) => self.run_rows_interleaved::<LXF, true, false>(ctx, a, b, backwards, lim),
-                (InnerScheme::General(_), _, _) => self.run_rows_interleaved::<GENERAL, false, false>(ctx, a, b, backwards, lim),
-            }
+            specialised!(self, ctx, run_rows_interleaved(ctx, a, b, backwards, lim))
         };
         // sequentially: the waves in order, two tiles of a wave interleaved at a time
         let mut total = Accumulator::default();
@@ -814,18 +818,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let backwards = dir >> (D - 1) & 1 == 1;
         let sched = self.band.schedule();
         let (rows, tiles) = (sched.rows(lead), sched.tiles(lead));
-        let per_node = matches!(self.slowness, Slowness::PerNode(_));
         let run_tile = |t: usize| -> Accumulator {
             let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
-            match (self.scheme, per_node, ctx.windowed) {
-                (InnerScheme::Godunov, false, false) => self.run_rows::<GODUNOV, false, false>(ctx, a, backwards, lim),
-                (InnerScheme::Godunov, true, false) => self.run_rows::<GODUNOV, true, false>(ctx, a, backwards, lim),
-                (InnerScheme::Godunov, false, true) => self.run_rows::<GODUNOV, false, true>(ctx, a, backwards, lim),
-                (InnerScheme::Godunov, true, true) => self.run_rows::<GODUNOV, true, true>(ctx, a, backwards, lim),
-                (InnerScheme::LaxFriedrichs, false, _) => self.run_rows::<LXF, false, false>(ctx, a, backwards, lim),
-                (InnerScheme::LaxFriedrichs, true, _) => self.run_rows::<LXF, true, false>(ctx, a, backwards, lim),
-                (InnerScheme::General(_), _, _) => self.run_rows::<GENERAL, false, false>(ctx, a, backwards, lim),
-            }
+            specialised!(self, ctx, run_rows(ctx, a, backwards, lim))
         };
         let id = ctx.sweep_id.load(Ordering::Relaxed);
         strip_worker(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), ctx.tiles_done, id, next_strip, abandoned, &run_tile)
@@ -834,7 +829,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// The rows of two independent tiles `a` and `b` (of one wave), each in order, with the
     /// nodes of the i-th rows of both interleaved: two independent Gauss–Seidel chains for the
     /// out-of-order core to overlap. The result is that of running `a`, then `b`.
-    fn run_rows_interleaved<const S: u8, const P: bool, const W: bool>(
+    fn run_rows_interleaved<const S: u8, const P: bool, const W: bool, const K: bool>(
         &self,
         ctx: &SweepContext<'_, D>,
         a: &[u32],
@@ -846,14 +841,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let common = a.len().min(b.len());
         for i in 0..common {
             let (ra, rb) = (a[i] as usize, b[i] as usize);
-            let (run_a, run_b) = (self.claim_row::<W>(ctx, ra, lim, &mut acc), self.claim_row::<W>(ctx, rb, lim, &mut acc));
+            let (run_a, run_b) = (self.claim_row::<W, K>(ctx, ra, lim, &mut acc), self.claim_row::<W, K>(ctx, rb, lim, &mut acc));
             if !(run_a && run_b) {
                 // a row with nothing to do is skipped whole: run the other alone
                 if run_a {
-                    self.run_claimed_row::<S, P, W>(ctx, ra, backwards, lim, &mut acc);
+                    self.run_claimed_row::<S, P, W, K>(ctx, ra, backwards, lim, &mut acc);
                 }
                 if run_b {
-                    self.run_claimed_row::<S, P, W>(ctx, rb, backwards, lim, &mut acc);
+                    self.run_claimed_row::<S, P, W, K>(ctx, rb, backwards, lim, &mut acc);
                 }
                 continue;
             }
@@ -864,37 +859,37 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let (mut marks_a, mut marks_b) = (0u8, 0u8);
             if backwards {
                 for j in 1..=m {
-                    self.visit::<S, P, W>(ctx, ea - j, lim, &mut acc, &mut low_a, &mut marks_a);
-                    self.visit::<S, P, W>(ctx, eb - j, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W, K>(ctx, ea - j, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W, K>(ctx, eb - j, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
                 for n in (sa..ea - m).rev() {
-                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
                 }
                 for n in (sb..eb - m).rev() {
-                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
             } else {
                 for j in 0..m {
-                    self.visit::<S, P, W>(ctx, sa + j, lim, &mut acc, &mut low_a, &mut marks_a);
-                    self.visit::<S, P, W>(ctx, sb + j, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W, K>(ctx, sa + j, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W, K>(ctx, sb + j, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
                 for n in sa + m..ea {
-                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
+                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
                 }
                 for n in sb + m..eb {
-                    self.visit::<S, P, W>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
+                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
                 }
             }
-            ctx.finish_row::<W>(ra, low_a, marks_a);
-            ctx.finish_row::<W>(rb, low_b, marks_b);
+            ctx.finish_row::<W, K>(ra, low_a, marks_a);
+            ctx.finish_row::<W, K>(rb, low_b, marks_b);
         }
-        acc.merge(self.run_rows::<S, P, W>(ctx, &a[common..], backwards, lim))
-            .merge(self.run_rows::<S, P, W>(ctx, &b[common..], backwards, lim))
+        acc.merge(self.run_rows::<S, P, W, K>(ctx, &a[common..], backwards, lim))
+            .merge(self.run_rows::<S, P, W, K>(ctx, &b[common..], backwards, lim))
     }
 
     /// The rows of one tile, in order, with the update specialised for scheme `S` and a
     /// constant (`P = false`) or per-node (`P = true`) slowness.
-    fn run_rows<const S: u8, const P: bool, const W: bool>(
+    fn run_rows<const S: u8, const P: bool, const W: bool, const K: bool>(
         &self,
         ctx: &SweepContext<'_, D>,
         rows: &[u32],
@@ -903,7 +898,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     ) -> Accumulator {
         let mut acc = Accumulator::default();
         for &r in rows {
-            self.run_row::<S, P, W>(ctx, r as usize, backwards, lim, &mut acc);
+            self.run_row::<S, P, W, K>(ctx, r as usize, backwards, lim, &mut acc);
         }
         acc
     }
@@ -927,16 +922,20 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// One row, in sweep order; skipped whole when none of its nodes is active (its dirty flag
     /// is clear) or all its values lie beyond the front window.
     #[inline(always)]
-    fn run_row<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
-        if self.claim_row::<W>(ctx, r, lim, acc) {
-            self.run_claimed_row::<S, P, W>(ctx, r, backwards, lim, acc);
+    fn run_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+        if self.claim_row::<W, K>(ctx, r, lim, acc) {
+            self.run_claimed_row::<S, P, W, K>(ctx, r, backwards, lim, acc);
         }
     }
 
     /// Whether row `r` has anything to do ([`SweepContext::take_row`], which clears its dirty
     /// flag when it has); in the unit tests, also checks the dirty-row invariant.
     #[inline(always)]
-    fn claim_row<const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
+    fn claim_row<const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
+        if !K {
+            // every row runs in every sweep
+            return true;
+        }
         #[cfg(test)]
         self.assert_clean_row_is_idle(ctx, r);
         ctx.take_row::<W>(r, lim, acc)
@@ -944,20 +943,20 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// The nodes of row `r`, which [`claim_row`](Self::claim_row) let through, in sweep order.
     #[inline(always)]
-    fn run_claimed_row<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+    fn run_claimed_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
         let (s, e) = self.band.row_range(r);
         let mut low = f64::INFINITY;
         let mut marks = 0u8;
         if backwards {
             for n in (s..e).rev() {
-                self.visit::<S, P, W>(ctx, n, lim, acc, &mut low, &mut marks);
+                self.visit::<S, P, W, K>(ctx, n, lim, acc, &mut low, &mut marks);
             }
         } else {
             for n in s..e {
-                self.visit::<S, P, W>(ctx, n, lim, acc, &mut low, &mut marks);
+                self.visit::<S, P, W, K>(ctx, n, lim, acc, &mut low, &mut marks);
             }
         }
-        ctx.finish_row::<W>(r, low, marks);
+        ctx.finish_row::<W, K>(r, low, marks);
     }
 
     #[inline(always)]
@@ -965,7 +964,24 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// neighbours when it changed by more than the threshold, and lowers `low` to its new value.
     /// `row` collects what the row's dirty flags need: [`KEEP_ROW`] when the node stays active,
     /// [`WAKE_ROWS`] when it activated its neighbours.
-    fn visit<const S: u8, const P: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
+    fn visit<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
+        if !K {
+            // plain sweeps: every node but the fixed ones, no flags (their updates are counted
+            // per sweep by the caller, see `SweepProblem::updated_per_sweep`)
+            if unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed {
+                return;
+            }
+            // SAFETY: n < band.len()
+            let nb = unsafe { self.band.neighbours_of_unchecked(n) };
+            if let Some(up) = self.local_update::<S, P>(ctx, n, &nb, lim.inf) {
+                let c = up.change();
+                if c > acc.max_change {
+                    acc.max_change = c;
+                }
+                ctx.u.set(n, up.new);
+            }
+            return;
+        }
         let active = ctx.active;
         // SAFETY: n < band.len(); active has that length plus the sentinel slot.
         let flag = unsafe { active.get_unchecked(n) };
@@ -1325,6 +1341,10 @@ struct SweepContext<'a, const D: usize> {
     /// The solve runs a front window: the sweeps track the row bounds, the front and the nodes
     /// waiting beyond the window; otherwise they skip that bookkeeping.
     windowed: bool,
+    /// Active flags are kept ([`SolveOptions::skip_inactive`]): a node is updated only when a
+    /// neighbour changed. Without them every node is updated in every sweep (the paper's plain
+    /// sweeps) and the sweeps touch neither the flags nor the rows' dirty flags.
+    skip_inactive: bool,
 }
 
 /// The smallest active-flag value that marks a node refused by the front window (0: inactive,
@@ -1364,7 +1384,10 @@ impl<const D: usize> SweepContext<'_, D> {
 
     /// After row `r` ran: lowers its bound to `low` and sets the dirty flags `marks` asks for.
     #[inline(always)]
-    fn finish_row<const W: bool>(&self, r: usize, low: f64, marks: u8) {
+    fn finish_row<const W: bool, const K: bool>(&self, r: usize, low: f64, marks: u8) {
+        if !K {
+            return;
+        }
         let key = order_key(low);
         if W {
             self.lower_row(r, key);
@@ -1654,7 +1677,7 @@ mod tests {
         for (scheme, coupled) in [(InnerScheme::Godunov, true), (InnerScheme::Godunov, false), (InnerScheme::LaxFriedrichs, false)] {
             let p = sphere_problem(&band, &roles, &dirs, h, scheme);
             let mut results = Vec::new();
-            for (threads, skip) in [(1, false), (1, true), (2, true), (4, true)] {
+            for (threads, skip) in [(1, false), (1, true), (2, true), (4, true), (2, false)] {
                 // the front window only runs with skipping: compared with plain sweeps without it
                 // (its own test is `the_front_window_reaches_the_same_fixed_point_with_fewer_updates`)
                 let opts = SolveOptions { threads, skip_inactive: skip, coupled, front_window: 0.0, ..Default::default() };
@@ -1664,9 +1687,13 @@ mod tests {
                 results.push((u, st));
             }
             let (u0, s0) = &results[0];
+            // plain sweeps on two threads: the sequential bits and the same count of updates
+            let (u_plain, s_plain) = &results[4];
+            assert_eq!((s_plain.iterations, s_plain.updates), (s0.iterations, s0.updates));
+            assert!(u_plain.iter().zip(u0).all(|(a, b)| a.to_bits() == b.to_bits()));
             // every thread count with skipping: bit-identical
             let (u1, s1) = &results[1];
-            for (u, s) in &results[2..] {
+            for (u, s) in &results[2..4] {
                 assert_eq!(s.iterations, s1.iterations);
                 assert!(u.iter().zip(u1).all(|(a, b)| a.to_bits() == b.to_bits()));
             }
