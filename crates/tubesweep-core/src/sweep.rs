@@ -694,7 +694,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let n_orient = 1usize << D;
         let inf = options.infinity.unwrap_or(crate::DEFAULT_INFINITY);
         // only a 3D band has independent tiles (a 2D band's waves hold one tile each); one
-        // thread runs the sequential sweep, which interleaves two tiles
+        // thread runs the sequential sweep
         let parallel = !ctx.tiles_done.is_empty();
         let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
@@ -773,33 +773,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 
     /// One sequential Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked
-    /// backwards): the waves in order, the tiles of a wave two at a time, the rows of a tile in
-    /// order. (In parallel, the threads run [`Self::strip_worker`].)
+    /// backwards): the waves in order, the tiles of a wave one after the other, the rows of a
+    /// tile in order. (In parallel, the threads run [`Self::strip_worker`].)
     fn sweep(&self, ctx: &SweepContext<'_, D>, dir: usize, lim: Limits) -> Accumulator {
-        let band = self.band;
         let lead = dir & ((1usize << (D - 1)) - 1);
         let backwards = dir >> (D - 1) & 1 == 1;
-        let sched = band.schedule();
-        let rows = sched.rows(lead);
-        let tiles = sched.tiles(lead);
-        let waves = sched.waves(lead);
-        // Two tiles of one wave are independent, so the sequential sweep interleaves them node by node:
-        // the Gauss–Seidel chain along a row (each node reads the one just written) is latency
-        // bound, and two independent chains keep the core busy while either waits.
-        let run_pair = |t: usize, t_end: usize| -> Accumulator {
-            let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
-            let b: &[u32] = if t + 1 < t_end { &rows[tiles[t + 1] as usize..tiles[t + 2] as usize] } else { &[] };
-            specialised!(self, ctx, run_rows_interleaved(ctx, a, b, backwards, lim))
-        };
-        // sequentially: the waves in order, two tiles of a wave interleaved at a time
-        let mut total = Accumulator::default();
-        for w in 0..waves.len() - 1 {
-            let (t0, t1) = (waves[w] as usize, waves[w + 1] as usize);
-            for t in (t0..t1).step_by(2) {
-                total = total.merge(run_pair(t, t1));
-            }
-        }
-        total
+        let rows = self.band.schedule().rows(lead);
+        // Sequentially, the rows in the schedule's order (the waves in order, the tiles of a wave
+        // one after the other): the order the parallel sweep's values are those of. (Interleaving
+        // two tiles of a wave node by node, two independent Gauss–Seidel chains, was 5–8% slower
+        // with the active flags and no faster without them: docs/architecture.md.)
+        specialised!(self, ctx, run_rows(ctx, rows, backwards, lim))
     }
 
     /// This thread's share of the parallel sweep in orientation `dir`, a pipelined wavefront over
@@ -824,67 +808,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         };
         let id = ctx.sweep_id.load(Ordering::Relaxed);
         strip_worker(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), ctx.tiles_done, id, next_strip, abandoned, &run_tile)
-    }
-
-    /// The rows of two independent tiles `a` and `b` (of one wave), each in order, with the
-    /// nodes of the i-th rows of both interleaved: two independent Gauss–Seidel chains for the
-    /// out-of-order core to overlap. The result is that of running `a`, then `b`.
-    fn run_rows_interleaved<const S: u8, const P: bool, const W: bool, const K: bool>(
-        &self,
-        ctx: &SweepContext<'_, D>,
-        a: &[u32],
-        b: &[u32],
-        backwards: bool,
-        lim: Limits,
-    ) -> Accumulator {
-        let mut acc = Accumulator::default();
-        let common = a.len().min(b.len());
-        for i in 0..common {
-            let (ra, rb) = (a[i] as usize, b[i] as usize);
-            let (run_a, run_b) = (self.claim_row::<W, K>(ctx, ra, lim, &mut acc), self.claim_row::<W, K>(ctx, rb, lim, &mut acc));
-            if !(run_a && run_b) {
-                // a row with nothing to do is skipped whole: run the other alone
-                if run_a {
-                    self.run_claimed_row::<S, P, W, K>(ctx, ra, backwards, lim, &mut acc);
-                }
-                if run_b {
-                    self.run_claimed_row::<S, P, W, K>(ctx, rb, backwards, lim, &mut acc);
-                }
-                continue;
-            }
-            let (sa, ea) = self.band.row_range(ra);
-            let (sb, eb) = self.band.row_range(rb);
-            let m = (ea - sa).min(eb - sb);
-            let (mut low_a, mut low_b) = (f64::INFINITY, f64::INFINITY);
-            let (mut marks_a, mut marks_b) = (0u8, 0u8);
-            if backwards {
-                for j in 1..=m {
-                    self.visit::<S, P, W, K>(ctx, ea - j, lim, &mut acc, &mut low_a, &mut marks_a);
-                    self.visit::<S, P, W, K>(ctx, eb - j, lim, &mut acc, &mut low_b, &mut marks_b);
-                }
-                for n in (sa..ea - m).rev() {
-                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
-                }
-                for n in (sb..eb - m).rev() {
-                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
-                }
-            } else {
-                for j in 0..m {
-                    self.visit::<S, P, W, K>(ctx, sa + j, lim, &mut acc, &mut low_a, &mut marks_a);
-                    self.visit::<S, P, W, K>(ctx, sb + j, lim, &mut acc, &mut low_b, &mut marks_b);
-                }
-                for n in sa + m..ea {
-                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_a, &mut marks_a);
-                }
-                for n in sb + m..eb {
-                    self.visit::<S, P, W, K>(ctx, n, lim, &mut acc, &mut low_b, &mut marks_b);
-                }
-            }
-            ctx.finish_row::<W, K>(ra, low_a, marks_a);
-            ctx.finish_row::<W, K>(rb, low_b, marks_b);
-        }
-        acc.merge(self.run_rows::<S, P, W, K>(ctx, &a[common..], backwards, lim))
-            .merge(self.run_rows::<S, P, W, K>(ctx, &b[common..], backwards, lim))
     }
 
     /// The rows of one tile, in order, with the update specialised for scheme `S` and a
