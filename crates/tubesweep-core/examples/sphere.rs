@@ -2,7 +2,8 @@
 //! Used for profiling the sweep kernel:
 //!   cargo run --release --example sphere -- 101 godunov 1 [coupled|pointwise]
 //!   (VERBOSE=1 prints every iteration; THR, TOL and WINDOW set the activation threshold, the
-//!   tolerance and the front window, `SolveOptions::front_window`)
+//!   tolerance and the front window, `SolveOptions::front_window`; PLAIN=1 runs the paper's plain
+//!   sweeps, as `paper_sweeps=True` does: no active flags, pointwise update, the rim in every sweep)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
 #[path = "common/shell.rs"]
 mod shell;
@@ -19,8 +20,9 @@ fn main() {
         _ => InnerScheme::Godunov,
     };
     let threads: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
-    let coupled = args.get(4).map_or(true, |s| s != "pointwise");
-    let defer_outer_rim = std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
+    let plain = std::env::var_os("PLAIN").is_some();
+    let coupled = !plain && args.get(4).map_or(true, |s| s != "pointwise");
+    let defer_outer_rim = !plain && std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
     let (lin, mut roles, mut dirs, h) = shell::sphere_shell(n);
     let t = Instant::now();
     let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
@@ -45,7 +47,18 @@ fn main() {
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
     let front_window: f64 =
         std::env::var("WINDOW").ok().and_then(|s| s.parse().ok()).unwrap_or(tubesweep_core::sweep::DEFAULT_FRONT_WINDOW);
-    let opts = SolveOptions { threads, activation_threshold: thr, tol, coupled, defer_outer_rim, front_window, ..Default::default() };
+    // the front window runs only with the active flags
+    let front_window = if plain { 0.0 } else { front_window };
+    let opts = SolveOptions {
+        threads,
+        activation_threshold: thr,
+        tol,
+        coupled,
+        defer_outer_rim,
+        front_window,
+        skip_inactive: !plain,
+        ..Default::default()
+    };
     let verbose = std::env::var_os("VERBOSE").is_some();
     let t0 = Instant::now();
     let st = p
