@@ -25,7 +25,9 @@ class SolveStats:
     last_change : float
         Largest change of any value during the last iteration.
     seconds : float
-        Wall-clock time of the sweeps (band construction excluded; see ``setup_seconds``).
+        Wall-clock time of the native solve: its preparation (the grid-path search behind the
+        numerical infinity and the front window, the outer rim, the active flags) and the sweeps
+        (band construction excluded; see ``setup_seconds``).
     band_points, inner_points, outer_points, fixed_points : int
         Nodes in the band, in the inner tube, in the extension layer, and held fixed (sources).
     setup_seconds : float

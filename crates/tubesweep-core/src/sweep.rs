@@ -219,7 +219,8 @@ pub struct SolveStats {
     pub converged: bool,
     /// Largest change during the last iteration.
     pub last_change: f64,
-    /// Wall-clock seconds in the sweeps.
+    /// Wall-clock seconds of [`SweepProblem::solve`]: the preparation (the grid-path search, the
+    /// outer rim, the flags) and the sweeps.
     pub seconds: f64,
     /// The numerical infinity used; nodes never reached hold exactly this value.
     pub infinity: f64,
@@ -359,9 +360,35 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         progress: &mut dyn FnMut(&IterationReport) -> Control,
     ) -> Result<SolveStats> {
         self.check(values)?;
-        // the grid-path search is shared by the infinity and the window's width, and run at most once
-        let hops = std::cell::OnceCell::new();
-        let hops = || *hops.get_or_init(|| self.grid_hops_from_sources());
+        let start = Instant::now();
+        // Every parallel step of the solve (the preparation, the sweeps and the rim) runs on a
+        // pool of `threads` threads of its own (rayon's default number for 0), never on the
+        // caller's: the sweeps hold all the pool's threads at their barriers, which a caller's
+        // pool busy with other work (or with another solve) could not give. The progress
+        // callback runs on the caller's thread.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(options.threads)
+            .build()
+            .map_err(|e| Error::invalid("threads", format!("could not start {} threads: {e}", options.threads)))?;
+        let pool = &pool;
+        // The grid-path search, shared by the infinity and the window's width, is sequential (see
+        // `grid_hops`): it runs beside the search for the outer rim when the rim is swept last.
+        let hops_needed = self.windowed(options)
+            || (options.infinity.is_none()
+                && match self.scheme {
+                    InnerScheme::General(ham) => ham.slowness_bound().is_some(),
+                    _ => true,
+                });
+        let weights = if options.defer_outer_rim { self.upwind_weights() } else { std::borrow::Cow::Borrowed(&[][..]) };
+        let weights: &[[f32; D]] = &weights;
+        let rim_last = !weights.is_empty();
+        let (hop_count, rim) = pool.install(|| {
+            rayon::join(
+                || hops_needed.then(|| self.grid_hops_from_sources()),
+                || if rim_last { crate::rim::outer_rim(self.band, self.roles, weights) } else { Vec::new() },
+            )
+        });
+        let hops = || hop_count.unwrap_or_else(|| self.grid_hops_from_sources());
         let inf = match options.infinity {
             Some(v) => {
                 if !(v.is_finite() && v > 0.0) {
@@ -384,26 +411,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if !(options.tol >= 0.0) {
             return Err(Error::invalid("tol", "must be non-negative"));
         }
-        let start = Instant::now();
         for (v, &r) in values.iter_mut().zip(self.roles) {
             if r != NodeRole::Fixed {
                 *v = inf;
             }
         }
         values.push(inf); // the sentinel slot read for absent neighbours
-        // Every parallel step of the solve (the preparation, the sweeps and the rim) runs on a
-        // pool of `threads` threads of its own (rayon's default number for 0), never on the
-        // caller's: the sweeps hold all the pool's threads at their barriers, which a caller's
-        // pool busy with other work (or with another solve) could not give. The progress
-        // callback runs on the caller's thread.
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads)
-            .build()
-            .map_err(|e| Error::invalid("threads", format!("could not start {} threads: {e}", options.threads)))?;
-        let pool = &pool;
         let mut stats = SolveStats { infinity: inf, ..Default::default() };
         let result = if options.defer_outer_rim {
-            self.iterate_rim_last(values, options, window_width, pool, progress, &mut stats)
+            self.iterate_rim_last(values, options, window_width, pool, progress, &mut stats, weights, &rim)
         } else {
             self.iterate(values, options, window_width, pool, progress, &mut stats)
         };
@@ -555,7 +571,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// [`iterate`](Self::iterate) in two phases: the band without its outer rim (held at the
     /// numerical infinity, read by nobody), then the rim's values in one pass in dependency order
-    /// ([`crate::rim`]).
+    /// ([`crate::rim`]). `weights` are [`Self::upwind_weights`], `rim` the
+    /// [`crate::rim::outer_rim`] of them (empty without a layer).
+    #[allow(clippy::too_many_arguments)]
     fn iterate_rim_last(
         &self,
         u: &mut [f64],
@@ -564,10 +582,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         pool: &rayon::ThreadPool,
         progress: &mut dyn FnMut(&IterationReport) -> Control,
         stats: &mut SolveStats,
+        weights: &[[f32; D]],
+        rim: &[bool],
     ) -> Result<()> {
-        let weights = self.upwind_weights();
-        let weights: &[[f32; D]] = &weights;
-        let rim = if weights.is_empty() { Vec::new() } else { pool.install(|| crate::rim::outer_rim(self.band, self.roles, weights)) };
         if !rim.iter().any(|&b| b) {
             return self.with_roles(self.roles, weights).iterate(u, options, window_width, pool, progress, stats);
         }
