@@ -1236,11 +1236,8 @@ struct LocalUpdate {
 impl LocalUpdate {
     #[inline(always)]
     fn change(&self) -> f64 {
-        if self.new > self.old {
-            self.new - self.old
-        } else {
-            self.old - self.new
-        }
+        // |new − old| without a branch (the same bits as either subtraction's magnitude)
+        (self.new - self.old).abs()
     }
 }
 
