@@ -739,8 +739,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                         let dir = s ^ (s >> 1); // Gray code
                         self.strip_worker(&ctx, dir, next_strip, abandoned, lim)
                     };
-                    let between = |_s: usize| {};
-                    run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep, &between)
+                    run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep)
                 });
                 max_change = acc.max_change;
                 front = acc.front;
@@ -1146,14 +1145,13 @@ fn spin_until(ready: impl Fn() -> bool, abandoned: &AtomicBool) -> bool {
 
 /// `n_sweeps` pipelined sweeps on every thread of the current rayon pool in one broadcast: sweep
 /// `s` is `per_sweep(s, next_strip, abandoned)` on every thread, with its own strip counter and
-/// sweep id (the ids `ids` hands out), and a barrier after it; `between(s)` runs on one thread
-/// before sweep `s` (with a barrier after it). A panic on one thread raises `abandoned`, which
-/// makes the others leave their waits, so the panic reaches the caller.
+/// sweep id (one thread takes the next id from `ids`, then all meet at a barrier), and a barrier
+/// after it. A panic on one thread raises `abandoned`, which makes the others leave their waits,
+/// so the panic reaches the caller.
 fn run_sweeps_in_one_broadcast(
     n_sweeps: usize,
     ids: &AtomicU32,
     per_sweep: &(dyn Fn(usize, &AtomicUsize, &AtomicBool) -> Accumulator + Sync),
-    between: &(dyn Fn(usize) + Sync),
 ) -> Accumulator {
     /// Raises `abandoned` when dropped by a panic.
     struct RaiseOnPanic<'a>(&'a AtomicBool);
@@ -1173,7 +1171,6 @@ fn run_sweeps_in_one_broadcast(
         let mut acc = Accumulator::default();
         for s in 0..n_sweeps {
             if b.index() == 0 {
-                between(s);
                 // the sweep's id: one past the last (ids start at 1, the done flags at 0)
                 ids.fetch_add(1, Ordering::Relaxed);
             }
@@ -2062,10 +2059,9 @@ mod tests {
         let strips = [0u32, 3, 6];
         let upstream = [NO_TILE, NO_TILE, NO_TILE, 0, 1, 2];
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-        let run = move |panic_in: Option<(usize, usize)>| -> (Accumulator, Vec<u32>, usize) {
+        let run = move |panic_in: Option<(usize, usize)>| -> (Accumulator, Vec<u32>) {
             let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
             let ids = AtomicU32::new(0);
-            let between_calls = AtomicUsize::new(0);
             let acc = pool.install(|| {
                 run_sweeps_in_one_broadcast(
                     3,
@@ -2079,16 +2075,13 @@ mod tests {
                             Accumulator { updates: 1, ..Accumulator::default() }
                         })
                     },
-                    &|_| {
-                        between_calls.fetch_add(1, Ordering::Relaxed);
-                    },
                 )
             });
-            (acc, done.iter().map(|d| d.load(Ordering::Relaxed)).collect(), between_calls.load(Ordering::Relaxed))
+            (acc, done.iter().map(|d| d.load(Ordering::Relaxed)).collect())
         };
         // a clean run visits every tile once per sweep, the last sweep's id is 3
-        let (acc, done, between) = run(None);
-        assert_eq!((acc.updates, between), (18, 3));
+        let (acc, done) = run(None);
+        assert_eq!(acc.updates, 18);
         assert!(done.iter().all(|&d| d == 3), "{done:?}");
         // a tile of the second sweep panics: the threads waiting for it (at the tile or the
         // barrier) must give up, and the panic come out
