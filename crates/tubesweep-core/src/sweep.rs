@@ -599,7 +599,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // (at least one pass, so that it gets values even when the first phase used it all).
         let base = stats.iterations;
         let budget = options.max_iterations.saturating_sub(base).max(1).saturating_mul(1 << D);
-        let passes = pool.install(|| crate::rim::extend_into_rim(self.band, &rim, weights, u, options.tol, budget));
+        let passes = pool.install(|| crate::rim::extend_into_rim(self.band, rim, weights, u, options.tol, budget));
         stats.iterations += 1;
         stats.sweeps += passes.passes;
         stats.updates += passes.updates;
