@@ -130,9 +130,9 @@ pub struct SolveOptions {
     /// Skip nodes none of whose neighbours changed since their last update (default true). The
     /// result is bit-identical either way for the pointwise updates, and identical to rounding
     /// (an ulp here and there) with the coupled Godunov update. Off, every node but the fixed
-    /// ones is updated in every sweep, in row loops that touch no flag: the paper's plain sweeps
-    /// (`paper_sweeps=True` in Python), kept as the baseline the accelerations are measured
-    /// against.
+    /// ones is updated in every sweep, in row loops that touch no flag: the paper's sweeps to the
+    /// letter, for measuring what the flags save. (Python's `paper_sweeps=True` keeps the flags:
+    /// the same bits from fewer updates.)
     pub skip_inactive: bool,
     /// A node whose value changes by at most this much does not re-activate its neighbours.
     /// 0 (the default) keeps the result bit-identical to plain sweeps; a value below `tol` trades
@@ -362,6 +362,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         progress: &mut dyn FnMut(&IterationReport) -> Control,
     ) -> Result<SolveStats> {
         self.check(values)?;
+        if let Some(v) = options.infinity {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::invalid("infinity", "must be positive and finite"));
+            }
+        }
+        if !(options.tol >= 0.0) {
+            return Err(Error::invalid("tol", "must be non-negative"));
+        }
         let start = Instant::now();
         // Every parallel step of the solve (the preparation, the sweeps and the rim) runs on a
         // pool of `threads` threads of its own (rayon's default number for 0), never on the
@@ -375,12 +383,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let pool = &pool;
         // The grid-path search, shared by the infinity and the window's width, is sequential (see
         // `grid_hops`): it runs beside the search for the outer rim when the rim is swept last.
-        let hops_needed = self.windowed(options)
-            || (options.infinity.is_none()
-                && match self.scheme {
-                    InnerScheme::General(ham) => ham.slowness_bound().is_some(),
-                    _ => true,
-                });
+        // (also run for a general Hamiltonian without a slowness bound, whose infinity does not
+        // use it: asking for the bound here would be a pass over every node of its own)
+        let hops_needed = self.windowed(options) || options.infinity.is_none();
         let weights = if options.defer_outer_rim { self.upwind_weights() } else { std::borrow::Cow::Borrowed(&[][..]) };
         let weights: &[[f32; D]] = &weights;
         let rim_last = !weights.is_empty();
@@ -392,12 +397,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         });
         let hops = || hop_count.unwrap_or_else(|| self.grid_hops_from_sources());
         let inf = match options.infinity {
-            Some(v) => {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(Error::invalid("infinity", "must be positive and finite"));
-                }
-                v
-            }
+            Some(v) => v,
             None => self.infinity_from_hops(&hops, values),
         };
         // the front window's width: `front_window · sqrt(range · h · s̄)` with the range of the
@@ -410,9 +410,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             0.0
         };
         let options = &SolveOptions { infinity: Some(inf), ..*options };
-        if !(options.tol >= 0.0) {
-            return Err(Error::invalid("tol", "must be non-negative"));
-        }
         for (v, &r) in values.iter_mut().zip(self.roles) {
             if r != NodeRole::Fixed {
                 *v = inf;
@@ -677,6 +674,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
         let shared = SharedValues { ptr: u.as_mut_ptr(), len: u.len() };
         let all_active = !options.skip_inactive;
+        debug_assert!(!(all_active && window_width > 0.0), "the front window runs only with the active flags");
         // the plain sweeps update every node that starts active (all but the fixed nodes and the
         // layer nodes without an upwind neighbour) in every sweep, and count them here
         let updated_per_sweep = if all_active { active[..n].iter().filter(|a| a.load(Ordering::Relaxed) != 0).count() as u64 } else { 0 };
@@ -799,8 +797,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let rows = self.band.schedule().rows(lead);
         // Sequentially, the rows in the schedule's order (the waves in order, the tiles of a wave
         // one after the other): the order the parallel sweep's values are those of. (Interleaving
-        // two tiles of a wave node by node, two independent Gauss–Seidel chains, was 5–8% slower
-        // with the active flags and no faster without them: docs/architecture.md.)
+        // two tiles of a wave node by node, two independent Gauss–Seidel chains, was slower with
+        // the active flags and no faster without them: docs/architecture.md.)
         specialised!(self, ctx, run_rows(ctx, rows, backwards, lim))
     }
 
@@ -860,8 +858,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         }
     }
 
-    /// One row, in sweep order; skipped whole when none of its nodes is active (its dirty flag
-    /// is clear) or all its values lie beyond the front window.
+    /// One row, in sweep order; with the flags (`K`), skipped whole when none of its nodes is
+    /// active (its dirty flag is clear) or all its values lie beyond the front window.
     #[inline(always)]
     fn run_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
         if self.claim_row::<W, K>(ctx, r, lim, acc) {
@@ -904,11 +902,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// Updates node `n` if it is active (and within the front window), re-activates its
     /// neighbours when it changed by more than the threshold, and lowers `low` to its new value.
     /// `row` collects what the row's dirty flags need: [`KEEP_ROW`] when the node stays active,
-    /// [`WAKE_ROWS`] when it activated its neighbours.
+    /// [`WAKE_ROWS`] when it activated its neighbours. Without the flags (`K = false`), updates
+    /// every node but the fixed ones and touches neither `low` nor `row`.
     fn visit<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
         if !K {
-            // plain sweeps: every node but the fixed ones, no flags (their updates are counted
-            // per sweep by the caller, see `SweepProblem::updated_per_sweep`)
+            // no flags: every node but the fixed ones (`iterate` counts these updates per sweep,
+            // `updated_per_sweep`)
+            // SAFETY: n < band.len(), the length of roles (checked in `check`)
             if unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed {
                 return;
             }
@@ -1627,6 +1627,15 @@ mod tests {
             let (u_plain, s_plain) = &results[4];
             assert_eq!((s_plain.iterations, s_plain.updates), (s0.iterations, s0.updates));
             assert!(u_plain.iter().zip(u0).all(|(a, b)| a.to_bits() == b.to_bits()));
+            // without the rim phase, every node but the fixed ones and the layer nodes without
+            // an upwind neighbour, in every one of the 2^3 sweeps of every iteration
+            let weights = p.upwind_weights();
+            let updated = (0..band.len()).filter(|&i| roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan())).count() as u64;
+            let opts = SolveOptions { threads: 2, skip_inactive: false, coupled, defer_outer_rim: false, front_window: 0.0, ..Default::default() };
+            let mut u = vec![0.0; band.len()];
+            let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged && st.iterations > 2);
+            assert_eq!(st.updates, updated * 8 * st.iterations as u64);
             // every thread count with skipping: bit-identical
             let (u1, s1) = &results[1];
             for (u, s) in &results[2..4] {
@@ -1999,9 +2008,8 @@ mod tests {
     }
 
     #[test]
-    fn the_strip_pipeline_gives_the_bits_of_the_paired_sequential_sweep() {
-        // large enough for many strips per orientation and waves of several tiles (the paired
-        // sequential sweep); 3 threads take strips out of step with the 2 leading axes
+    fn the_strip_pipeline_gives_the_bits_of_the_sequential_sweep() {
+        // large enough for many strips per orientation and waves of several tiles; 3 threads take strips out of step with the 2 leading axes
         let (band, roles, dirs, h) = sphere_band(121);
         let sched = band.schedule();
         for lead in 0..4 {
