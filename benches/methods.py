@@ -5,7 +5,7 @@ masks) and ``run(prepared)`` (the timed work, returning values at the evaluation
 statistics). What is timed:
 
 * ``tubesweep-*``: the whole public call ``ts.solve(...)`` (band discovery, source set-up and
-  sweeps); ``sweep_s`` is ``sol.stats.seconds`` (the sweeps only). ``tubesweep-godunov-tolh``
+  sweeps); ``sweep_s`` is ``sol.stats.seconds`` (the native solve: its preparation and the sweeps). ``tubesweep-godunov-tolh``
   stops at ``tol = 1e-3·Δx`` instead of the default ``1e-10``.
 * ``skfmm-tube``: finding the tube |φ| ≤ 2Δx (with tubesweep's coarse-to-fine band search, so
   that φ costs both the same), building the dense N^d arrays (distance-to-source level set,

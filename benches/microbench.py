@@ -4,7 +4,8 @@ parallel speed-up ≥ 1.7× on 2 cores).
 
 For each scheme and grid size it solves the sphere (radius 0.5, source (−0.5, 0, 0)) with
 ``ts.solve`` in child processes with ``RAYON_NUM_THREADS`` = 1 and = the number of cores, and
-reports ``stats.updates / stats.seconds`` (sweeps only, band construction excluded), that rate
+reports ``stats.updates / stats.seconds`` (the native solve: its preparation and the sweeps; band
+construction excluded), that rate
 divided by the thread count, and the speed-up of the sweeps. Every case runs once per round (the
 second of two solves in a fresh process), ``--repeats`` rounds; times are medians over the rounds
 and the ratios medians of the per-round ratios, so that this shared machine's drift, which moves
@@ -74,7 +75,7 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
     cores = os.cpu_count() or 1
     tlist = sorted(set(threads or (1, cores)))
     rows = []
-    print(f"sphere r=0.5, two-layer, sol.stats (sweeps only), {repeats} interleaved rounds (medians); {cores} cores")
+    print(f"sphere r=0.5, two-layer, sol.stats (native solve: preparation and sweeps), {repeats} interleaved rounds (medians); {cores} cores")
     print(f"{'scheme':8} {'N':>5} {'sweeps':>7} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} "
           f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8}")
     for h in schemes:

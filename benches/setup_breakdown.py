@@ -83,7 +83,7 @@ def main() -> int:
     for name, ms in rows.items():
         print(f"  {ms:8.2f}  {name}")
     print(f"  {setup:8.2f}  ts.solve set-up (sol.stats.setup_seconds: the above, roles, sources)")
-    print(f"  {sweeps:8.2f}  ts.solve sweeps (sol.stats.seconds)")
+    print(f"  {sweeps:8.2f}  ts.solve native solve: preparation and sweeps (sol.stats.seconds)")
     return 0
 
 

@@ -185,7 +185,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
                         lower=grid.lower, upper=grid.upper, shape=np.array(grid.shape), sources=sol.sources)
     s = sol.stats
     print(f"{name}: grid {grid.shape}, band {s.band_points} nodes ({s.inner_points} inner, {s.outer_points} outer), "
-          f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, sweeps {s.seconds:.3f} s, total {wall:.3f} s")
+          f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, solve {s.seconds:.3f} s, total {wall:.3f} s")
     print(f"wrote {out / 'solution.npz'}")
     if args.dense:
         np.save(out / "solution_dense.npy", sol.to_dense())

@@ -57,6 +57,7 @@ class SolveStats:
 
     @property
     def updates_per_second(self) -> float:
+        """Local updates per second of ``seconds`` (the native solve, its preparation included)."""
         return self.updates / self.seconds if self.seconds > 0 else float("nan")
 
     def as_dict(self) -> Dict[str, Any]:

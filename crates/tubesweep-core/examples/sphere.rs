@@ -2,8 +2,9 @@
 //! Used for profiling the sweep kernel:
 //!   cargo run --release --example sphere -- 101 godunov 1 [coupled|pointwise]
 //!   (VERBOSE=1 prints every iteration; THR, TOL and WINDOW set the activation threshold, the
-//!   tolerance and the front window, `SolveOptions::front_window`; PLAIN=1 runs the paper's plain
-//!   sweeps, as `paper_sweeps=True` does: no active flags, pointwise update, the rim in every sweep)
+//!   tolerance and the front window, `SolveOptions::front_window`; PLAIN=1 runs the paper's sweeps
+//!   to the letter: no active flags (`skip_inactive: false`), pointwise update, the rim in every
+//!   sweep; Python's `paper_sweeps=True` is the same but keeps the flags)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
 #[path = "common/shell.rs"]
 mod shell;

@@ -49,7 +49,7 @@ def local_orders(h: Sequence[float], err: Sequence[float]) -> List[float]:
 
 def run_record(sol: Any, wall_seconds: float) -> Dict[str, Any]:
     """The cost of one solve: band points, iterations (passes of 2^d sweeps), sweeps, local
-    updates, whether it converged, and seconds (sweeps only, set-up, and wall clock)."""
+    updates, whether it converged, and seconds (the native solve, the set-up, and wall clock)."""
     s = sol.stats
     return {
         "band_points": int(s.band_points),
