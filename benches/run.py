@@ -71,7 +71,8 @@ CAPS: Dict[str, Dict[str, int]] = {
 }
 #: dimension of each problem (the mesh peers apply to surfaces in 3D only)
 PROBLEM_DIMS = {"sphere": 3, "ellipsoid": 3, "star": 2, "torus": 3, "bunny": 3}
-METHOD_ORDER = ["tubesweep-godunov", "tubesweep-godunov-tolh", "tubesweep-lxf", "skfmm-tube", "heat", "mmp"]
+METHOD_ORDER = ["tubesweep-godunov", "tubesweep-godunov-tolh", "tubesweep-godunov-1t", "tubesweep-lxf", "skfmm-tube",
+                "heat", "mmp"]
 SCALE_SIZES = [1001, 2001]
 
 
@@ -292,6 +293,7 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
     if not problems:
         return None
     style = {"tubesweep-godunov": ("C0", "o", "-"), "tubesweep-godunov-tolh": ("C4", "o", ":"),
+             "tubesweep-godunov-1t": ("C7", "o", "-."),
              "tubesweep-lxf": ("C0", "s", "--"), "skfmm-tube": ("C1", "^", "-"),
              "heat": ("C2", "D", "-"), "mmp": ("C3", "v", "-")}
     ncol = min(3, len(problems))

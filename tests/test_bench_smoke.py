@@ -32,7 +32,8 @@ def result(tmp_path_factory):
     if HAVE["geographiclib"]:
         cases["ellipsoid"] = [21]
     out = tmp_path_factory.mktemp("bench")
-    methods = ["tubesweep-godunov", "tubesweep-godunov-tolh", "skfmm-tube", "heat", "mmp"]  # LxF: see tests/test_solve.py
+    methods = ["tubesweep-godunov", "tubesweep-godunov-tolh", "tubesweep-godunov-1t", "skfmm-tube", "heat",
+               "mmp"]  # LxF: see tests/test_solve.py
     res = bench.run_bench("quick", cases=cases, repeats=1, methods=methods, out=out, verbose=False)
     res["out"] = out
     res["cases"] = cases
@@ -90,6 +91,19 @@ def test_a_tolerance_tied_to_the_grid_stops_earlier_at_the_same_accuracy(result)
             h = 2.0 / (n - 1)  # every benchmark grid spans [-1, 1]^d
             assert loose["iterations"] <= full["iterations"] and loose["updates"] <= full["updates"]
             assert abs(loose["max_err"] - full["max_err"]) <= 3e-3 * h, (prob, n, loose["max_err"], full["max_err"])
+
+
+def test_one_thread_gives_the_same_answer_and_work_as_all_cores(result):
+    # the solve's result does not depend on the thread count (bit-identical sweeps), so the
+    # single-thread row differs from the default one only in its times
+    recs = result["records"]
+    for prob, ns in result["cases"].items():
+        for n in ns:
+            got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
+            one, every = got["tubesweep-godunov-1t"], got["tubesweep-godunov"]
+            assert one["status"] == "ok"
+            for key in ("max_err", "mean_err", "iterations", "updates", "band_points"):
+                assert one[key] == every[key], (prob, n, key, one[key], every[key])
 
 
 def test_peers_give_finite_errors(result):
