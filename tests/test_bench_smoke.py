@@ -40,20 +40,25 @@ def result(tmp_path_factory):
     return res
 
 
-def test_every_applicable_case_ran(result):
+def _cases(result):
+    """(problem, N, {method: record}) for every case of the run."""
     recs = result["records"]
     for prob, ns in result["cases"].items():
         for n in ns:
-            got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
-            assert got["tubesweep-godunov"]["status"] == "ok"
-            assert got["tubesweep-godunov-tolh"]["status"] == "ok"
-            assert "tubesweep-lxf" not in got
-            for m, mod in PEER_MODULE.items():
-                needs_mesh = m in ("heat", "mmp")
-                if HAVE[mod] and not (needs_mesh and (prob == "star" or not HAVE["skimage"])):
-                    assert got[m]["status"] == "ok", got[m]
-                else:
-                    assert m not in got
+            yield prob, n, {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
+
+
+def test_every_applicable_case_ran(result):
+    for prob, n, got in _cases(result):
+        assert got["tubesweep-godunov"]["status"] == "ok"
+        assert got["tubesweep-godunov-tolh"]["status"] == "ok"
+        assert "tubesweep-lxf" not in got
+        for m, mod in PEER_MODULE.items():
+            needs_mesh = m in ("heat", "mmp")
+            if HAVE[mod] and not (needs_mesh and (prob == "star" or not HAVE["skimage"])):
+                assert got[m]["status"] == "ok", got[m]
+            else:
+                assert m not in got
 
 
 def test_table_structure(result):
@@ -83,27 +88,21 @@ def test_tubesweep_errors_are_finite_and_small(result):
 def test_a_tolerance_tied_to_the_grid_stops_earlier_at_the_same_accuracy(result):
     # tol = 1e-3·Δx: fewer or as many iterations and updates, and errors against the exact answer
     # that differ from the converged solve's by about tol (far below the scheme's O(Δx) error)
-    recs = result["records"]
-    for prob, ns in result["cases"].items():
-        for n in ns:
-            got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
-            full, loose = got["tubesweep-godunov"], got["tubesweep-godunov-tolh"]
-            h = 2.0 / (n - 1)  # every benchmark grid spans [-1, 1]^d
-            assert loose["iterations"] <= full["iterations"] and loose["updates"] <= full["updates"]
-            assert abs(loose["max_err"] - full["max_err"]) <= 3e-3 * h, (prob, n, loose["max_err"], full["max_err"])
+    for prob, n, got in _cases(result):
+        full, loose = got["tubesweep-godunov"], got["tubesweep-godunov-tolh"]
+        h = 2.0 / (n - 1)  # every benchmark grid spans [-1, 1]^d
+        assert loose["iterations"] <= full["iterations"] and loose["updates"] <= full["updates"]
+        assert abs(loose["max_err"] - full["max_err"]) <= 3e-3 * h, (prob, n, loose["max_err"], full["max_err"])
 
 
 def test_one_thread_gives_the_same_answer_and_work_as_all_cores(result):
     # the solve's result does not depend on the thread count (bit-identical sweeps), so the
     # single-thread row differs from the default one only in its times
-    recs = result["records"]
-    for prob, ns in result["cases"].items():
-        for n in ns:
-            got = {r["method"]: r for r in recs if r["problem"] == prob and r["n"] == n}
-            one, every = got["tubesweep-godunov-1t"], got["tubesweep-godunov"]
-            assert one["status"] == "ok"
-            for key in ("max_err", "mean_err", "iterations", "updates", "band_points"):
-                assert one[key] == every[key], (prob, n, key, one[key], every[key])
+    for prob, n, got in _cases(result):
+        one, every = got["tubesweep-godunov-1t"], got["tubesweep-godunov"]
+        assert one["status"] == "ok"
+        for key in ("max_err", "mean_err", "iterations", "updates", "band_points"):
+            assert one[key] == every[key], (prob, n, key, one[key], every[key])
 
 
 def test_peers_give_finite_errors(result):
