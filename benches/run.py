@@ -236,6 +236,77 @@ def add_ratios(records: List[Dict[str, Any]]) -> None:
             r["ratio"] = r["wall_s"] / b
 
 
+def time_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Optional[float]:
+    """The time at which a method reaches the error ``err``, read off its (error, time) points
+    ordered by grid size: log–log linear interpolation on the first pair of consecutive points
+    whose errors bracket ``err`` (so the cheapest grid that reaches it); a point whose error
+    equals ``err`` gives its own time. ``None`` when no pair brackets it (no extrapolation)."""
+    pts = [(e, t) for e, t in curve if e > 0 and t > 0 and math.isfinite(e) and math.isfinite(t)]
+    if not (err > 0 and math.isfinite(err)):
+        return None
+    for (e0, t0), (e1, t1) in zip(pts, pts[1:]):
+        if min(e0, e1) <= err <= max(e0, e1):
+            if e0 == e1:
+                return min(t0, t1)
+            s = (math.log(err) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(t0) + s * (math.log(t1) - math.log(t0)))
+    for e, t in pts:
+        if e == err:
+            return t
+    return None
+
+
+#: the method the peers are compared with at equal error
+EQUAL_ERROR_BASE = "tubesweep-godunov"
+
+EQUAL_ERROR_NOTE = ("At equal accuracy: each case's wall time over the time tubesweep-godunov needs for the same max "
+                    "(mean) error, read off its sizes in this run by log–log interpolation (> 1: tubesweep is faster "
+                    "at equal accuracy; — where its sizes do not reach that error).")
+
+
+def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
+    """Every other method's case set beside tubesweep (Godunov) at the same accuracy: for each
+    (problem, method, N), the time tubesweep needs for that case's max error and for its mean
+    error (:func:`time_at_error` along tubesweep's sizes of the problem), and the case's time
+    over it (> 1: tubesweep is faster at equal accuracy). ``None`` where tubesweep's sizes in this
+    run do not bracket the error."""
+    ok = [r for r in records if r.get("status") == "ok"]
+    rows: List[Dict[str, Any]] = []
+    for prob in dict.fromkeys(r["problem"] for r in ok):
+        base = sorted((r for r in ok if r["problem"] == prob and r["method"] == EQUAL_ERROR_BASE), key=lambda r: r["n"])
+        if len(base) < 2:
+            continue
+        for m in METHOD_ORDER:
+            if m == EQUAL_ERROR_BASE:
+                continue
+            for r in sorted((r for r in ok if r["problem"] == prob and r["method"] == m), key=lambda r: r["n"]):
+                row: Dict[str, Any] = dict(problem=prob, method=m, n=r["n"], max_err=r["max_err"], mean_err=r["mean_err"],
+                                           wall_s=r["wall_s"])
+                for kind in ("max", "mean"):
+                    t = time_at_error([(b[f"{kind}_err"], b["wall_s"]) for b in base], r[f"{kind}_err"])
+                    row[f"ts_at_{kind}_s"] = t
+                    row[f"ratio_at_{kind}"] = None if t is None else r["wall_s"] / t
+                rows.append(row)
+    return rows
+
+
+EQUAL_ERROR_COLUMNS = [
+    ("problem", "problem", "str"), ("method", "method", "str"), ("N", "n", "str"), ("max err", "max_err", "err"),
+    ("wall ms", "wall_s", "ms"), ("ts ms at that max err", "ts_at_max_s", "ms"), ("× ts at equal max err", "ratio_at_max", "ratio"),
+    ("mean err", "mean_err", "err"), ("ts ms at that mean err", "ts_at_mean_s", "ms"),
+    ("× ts at equal mean err", "ratio_at_mean", "ratio"),
+]
+
+
+def equal_error_table(rows: List[Dict[str, Any]]) -> str:
+    """A Markdown table of :func:`equal_error`'s rows."""
+    out = ["| " + " | ".join(c[0] for c in EQUAL_ERROR_COLUMNS) + " |",
+           "|" + "|".join("---" if c[2] == "str" else "---:" for c in EQUAL_ERROR_COLUMNS) + "|"]
+    for r in rows:
+        out.append("| " + " | ".join(_fmt(r.get(key), kind) for _, key, kind in EQUAL_ERROR_COLUMNS) + " |")
+    return "\n".join(out)
+
+
 def _fmt(v: Any, kind: str) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
@@ -370,14 +441,18 @@ def run_bench(preset: str = "default", cases: Optional[Dict[str, List[int]]] = N
             print(f"[{i + 1}/{len(todo)}] {prob} N={n} {m}: {msg}  ({time.perf_counter() - t1:.1f} s)", flush=True)
     add_ratios(records)
     tab = table(records)
+    at_equal_error = equal_error(records)
+    eq_tab = equal_error_table(at_equal_error)
     elapsed = time.perf_counter() - t0
     out.mkdir(parents=True, exist_ok=True)
     png = plot(records, out / "time_vs_error.png") if make_plot else None
     case_notes = sorted({nt for r in records for nt in r.get("notes", [])})
     all_notes = notes + case_notes
     (out / "results.json").write_text(json.dumps(dict(machine=header, preset=preset, repeats=repeats, records=records,
-                                                       notes=all_notes, seconds=elapsed), indent=1, default=float))
-    md = [f"# tubesweep benchmark ({preset})", "", header, "", tab, ""] + [f"- {nt}" for nt in all_notes]
+                                                       equal_error=at_equal_error, notes=all_notes, seconds=elapsed),
+                                                  indent=1, default=float))
+    md = [f"# tubesweep benchmark ({preset})", "", header, "", tab, "", "## At equal accuracy", "", EQUAL_ERROR_NOTE, "",
+          eq_tab, ""] + [f"- {nt}" for nt in all_notes]
     (out / "results.md").write_text("\n".join(md) + "\n")
     if verbose:
         print()
@@ -386,9 +461,14 @@ def run_bench(preset: str = "default", cases: Optional[Dict[str, List[int]]] = N
         for nt in all_notes:
             print("note:", nt)
         print(f"× ts = median wall time / tubesweep-godunov's on the same problem and N (side by side in this run)")
+        print()
+        print(EQUAL_ERROR_NOTE)
+        print(eq_tab)
+        print()
         print(f"wrote {out / 'results.md'}, {out / 'results.json'}" + (f", {png}" if png else ""))
         print(f"total {elapsed:.0f} s")
-    return dict(records=records, notes=all_notes, table=tab, plot=png)
+    return dict(records=records, notes=all_notes, table=tab, plot=png, equal_error=at_equal_error,
+                equal_error_table=eq_tab)
 
 
 # --------------------------------------------------------------------------------------------

@@ -23,12 +23,12 @@ HAVE = {m: importlib.util.find_spec(m) is not None for m in ("skfmm", "potpourri
 PEER_MODULE = {"skfmm-tube": "skfmm", "heat": "potpourri3d", "mmp": "pygeodesic"}
 
 # Max error bounds for tubesweep (Godunov) at these sizes: about twice what is measured.
-GODUNOV_MAX = {("sphere", 21): 0.5, ("star", 101): 0.2, ("ellipsoid", 21): 0.5}
+GODUNOV_MAX = {("sphere", 21): 0.5, ("star", 101): 0.2, ("star", 201): 0.15, ("ellipsoid", 21): 0.5}
 
 
 @pytest.fixture(scope="module")
 def result(tmp_path_factory):
-    cases = {"sphere": [21], "star": [101]}
+    cases = {"sphere": [21], "star": [101, 201]}  # two sizes: a curve to compare at equal error
     if HAVE["geographiclib"]:
         cases["ellipsoid"] = [21]
     out = tmp_path_factory.mktemp("bench")
@@ -70,6 +70,54 @@ def test_table_structure(result):
     saved = json.loads((result["out"] / "results.json").read_text())
     assert len(saved["records"]) == len(result["records"])
     assert (result["out"] / "results.md").read_text().count("| tubesweep-godunov |") == sum(map(len, result["cases"].values()))
+
+
+def test_time_at_error_interpolates_log_log_on_the_cheapest_bracketing_sizes():
+    # (error, time) by grid size: error 1e-1 at 1 s, 1e-2 at 100 s, then a larger error again
+    curve = [(1e-1, 1.0), (1e-2, 100.0), (5e-2, 400.0)]
+    # halfway in log error between the first two points: halfway in log time, 10 s
+    assert bench.time_at_error(curve, math.sqrt(1e-1 * 1e-2)) == pytest.approx(10.0)
+    # 5e-2 is bracketed by the first pair and by the second: the first (cheaper) pair's time
+    assert bench.time_at_error(curve, 5e-2) == pytest.approx(10 ** (2 * math.log10(2)))
+    assert bench.time_at_error(curve, 1e-1) == pytest.approx(1.0)
+    assert bench.time_at_error(curve, 1e-2) == pytest.approx(100.0)
+    # outside the range: no extrapolation; one point: only its own error
+    assert bench.time_at_error(curve, 2e-1) is None and bench.time_at_error(curve, 1e-3) is None
+    assert bench.time_at_error([(1e-2, 3.0)], 1e-2) == 3.0 and bench.time_at_error([(1e-2, 3.0)], 2e-2) is None
+    assert bench.time_at_error(curve, float("nan")) is None
+
+
+def test_equal_error_rows_set_each_peer_case_beside_tubesweep_at_its_accuracy():
+    def rec(method, n, max_err, mean_err, wall):
+        return dict(status="ok", problem="p", method=method, n=n, max_err=max_err, mean_err=mean_err, wall_s=wall)
+
+    records = [rec("tubesweep-godunov", 41, 1e-1, 1e-2, 1.0), rec("tubesweep-godunov", 81, 1e-2, 1e-3, 100.0),
+               rec("skfmm-tube", 41, math.sqrt(1e-3), 1e-4, 30.0), rec("skfmm-tube", 81, 1e-2, 1e-2, 50.0),
+               dict(status="timeout", problem="p", method="heat", n=41)]
+    rows = bench.equal_error(records)
+    assert [(r["method"], r["n"]) for r in rows] == [("skfmm-tube", 41), ("skfmm-tube", 81)]
+    a, b = rows
+    assert a["ts_at_max_s"] == pytest.approx(10.0) and a["ratio_at_max"] == pytest.approx(3.0)
+    assert a["ts_at_mean_s"] is None and a["ratio_at_mean"] is None  # tubesweep's means do not reach 1e-4
+    assert b["ratio_at_max"] == pytest.approx(0.5) and b["ratio_at_mean"] == pytest.approx(50.0)
+    lines = bench.equal_error_table(rows).splitlines()
+    assert len(lines) == 4 and lines[2].count("|") == len(bench.EQUAL_ERROR_COLUMNS) + 1
+    assert "| 3.00 |" in lines[2] and "| — |" in lines[2]
+
+
+def test_the_run_reports_the_peers_at_equal_accuracy(result):
+    # the star ran at two sizes: every other method's star cases get a row
+    rows = [r for r in result["equal_error"] if r["problem"] == "star"]
+    others = [r for r in result["records"] if r["problem"] == "star" and r["status"] == "ok" and r["method"] != "tubesweep-godunov"]
+    assert sorted((r["method"], r["n"]) for r in rows) == sorted((r["method"], r["n"]) for r in others)
+    for r in rows:
+        if r["method"] == "tubesweep-godunov-1t":
+            # the same errors as the all-core solve at each size: its own size's time
+            same = [b for b in result["records"] if b["method"] == "tubesweep-godunov" and b["problem"] == "star" and b["n"] == r["n"]]
+            assert r["ts_at_max_s"] == pytest.approx(same[0]["wall_s"])
+    saved = json.loads((result["out"] / "results.json").read_text())
+    assert saved["equal_error"] == json.loads(json.dumps(result["equal_error"]))
+    assert "## At equal accuracy" in (result["out"] / "results.md").read_text()
 
 
 def test_tubesweep_errors_are_finite_and_small(result):
