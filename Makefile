@@ -39,6 +39,7 @@ test: build test-rust test-python
 
 test-rust:
 	cargo test --release -p tubesweep-core
+	cargo test --release -p tubesweep-core --features kernel-stats kernel_stats::
 
 test-python: build
 	$(PY) -m pytest -q

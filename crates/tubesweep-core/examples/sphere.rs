@@ -6,6 +6,9 @@
 //!   to the letter: no active flags (`skip_inactive: false`), pointwise update, the rim in every
 //!   sweep; Python's `paper_sweeps=True` is the same but keeps the flags)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
+//!   (built with `--features kernel-stats` it also prints the sweeps' counters: where the
+//!   parallel sweeps wait, the rows and nodes they visit, how far the updates move the values;
+//!   `tubesweep_core::kernel_stats`)
 #[path = "common/shell.rs"]
 mod shell;
 
@@ -96,4 +99,38 @@ fn main() {
         }
     }
     println!("  max |u - pi/4| on the inner nodes of x = 0: {err:.3e}");
+    if tubesweep_core::kernel_stats::ENABLED {
+        print_kernel_stats(threads.max(1), st.seconds);
+    }
+}
+
+/// The `kernel-stats` counters of the solve (see `tubesweep_core::kernel_stats`); `seconds` is
+/// the solve's time, `threads` its threads.
+fn print_kernel_stats(threads: usize, seconds: f64) {
+    use tubesweep_core::kernel_stats::{snapshot, CHANGE_BINS};
+    let s = snapshot();
+    // counting slows the sweeps (see kernel_stats), so the waits are given as a share of the
+    // threads' time in the solve as well
+    let thread_ms = threads as f64 * seconds * 1e3;
+    println!(
+        "  kernel stats: the {threads} threads waited {:.1} ms for upstream tiles ({} waits), {:.0}% of their {:.0} ms in the solve, and {:.1} ms at barriers ({:.0}%)",
+        s.tile_wait_ns as f64 * 1e-6,
+        s.tile_waits,
+        100.0 * s.tile_wait_ns as f64 * 1e-6 / thread_ms,
+        thread_ms,
+        s.barrier_wait_ns as f64 * 1e-6,
+        100.0 * s.barrier_wait_ns as f64 * 1e-6 / thread_ms,
+    );
+    println!("  rows reached {}, run {}; nodes visited in them {}", s.rows_seen, s.rows_run, s.node_visits);
+    for (role, name) in [(1, "inner"), (2, "layer")] {
+        let h = &s.change_histogram[role];
+        let total: u64 = h.iter().sum();
+        let bins: Vec<String> = (2..CHANGE_BINS).map(|b| format!("{}", h[b])).collect();
+        println!(
+            "  {name} updates {total}: unchanged {}, change ≥ 1 {}, per decade [1e-1, 1), [1e-2, 1e-1), …: {}",
+            h[0],
+            h[1],
+            bins.join(" ")
+        );
+    }
 }

@@ -36,6 +36,7 @@ pub mod grid_hops;
 pub mod hamiltonian;
 pub mod hamiltonians;
 pub mod interpolate;
+pub mod kernel_stats;
 pub mod lax_friedrichs;
 pub mod mesh;
 pub mod normals;

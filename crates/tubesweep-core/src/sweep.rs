@@ -748,6 +748,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 for s in 0..n_orient {
                     let dir = s ^ (s >> 1); // Gray code
                     let acc = self.sweep(&ctx, dir, lim);
+                    crate::kernel_stats::flush();
                     max_change = max_change.max(acc.max_change);
                     front = front.min(acc.front);
                     waiting = waiting.min(acc.waiting);
@@ -862,7 +863,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// active (its dirty flag is clear) or all its values lie beyond the front window.
     #[inline(always)]
     fn run_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
-        if self.claim_row::<W, K>(ctx, r, lim, acc) {
+        let run = self.claim_row::<W, K>(ctx, r, lim, acc);
+        if crate::kernel_stats::ENABLED {
+            let (s, e) = self.band.row_range(r);
+            crate::kernel_stats::row(run, e - s);
+        }
+        if run {
             self.run_claimed_row::<S, P, W, K>(ctx, r, backwards, lim, acc);
         }
     }
@@ -914,7 +920,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
             // SAFETY: n < band.len()
             let nb = unsafe { self.band.neighbours_of_unchecked(n) };
-            if let Some(up) = self.local_update::<S, P>(ctx, n, &nb, lim.inf) {
+            let result = self.local_update::<S, P>(ctx, n, &nb, lim.inf);
+            if crate::kernel_stats::ENABLED {
+                crate::kernel_stats::update(self.roles[n] as u8, result.map(|u| u.change()));
+            }
+            if let Some(up) = result {
                 let c = up.change();
                 if c > acc.max_change {
                     acc.max_change = c;
@@ -960,7 +970,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         acc.updates += 1;
         // SAFETY: n < band.len()
         let nb = unsafe { self.band.neighbours_of_unchecked(n) };
-        let Some(up) = self.local_update::<S, P>(ctx, n, &nb, lim.inf) else { return };
+        let result = self.local_update::<S, P>(ctx, n, &nb, lim.inf);
+        if crate::kernel_stats::ENABLED {
+            crate::kernel_stats::update(self.roles[n] as u8, result.map(|u| u.change()));
+        }
+        let Some(up) = result else { return };
         if W && unreached_beyond && up.new > lim.window {
             flag.store(lim.refused, Ordering::Relaxed);
             *row |= KEEP_ROW;
@@ -1113,7 +1127,15 @@ fn strip_worker(
             if up != NO_TILE {
                 // the previous strip was taken earlier by a running thread
                 let done = &tiles_done[up as usize];
-                if !spin_until(|| done.load(Ordering::Acquire) == id, abandoned) {
+                let ready = || done.load(Ordering::Acquire) == id;
+                if crate::kernel_stats::ENABLED && !ready() {
+                    let t = Instant::now();
+                    let ok = spin_until(ready, abandoned);
+                    crate::kernel_stats::tile_wait(t.elapsed().as_nanos() as u64);
+                    if !ok {
+                        return acc;
+                    }
+                } else if !spin_until(ready, abandoned) {
                     return acc;
                 }
             }
@@ -1178,6 +1200,7 @@ fn run_sweeps_in_one_broadcast(
                 return acc;
             }
             acc = acc.merge(per_sweep(s, &next_strip[s], &abandoned));
+            crate::kernel_stats::flush();
             // every tile of this sweep is done before any of the next starts
             if !barrier.wait(&abandoned) {
                 return acc;
@@ -1210,7 +1233,12 @@ impl SpinBarrier {
             self.generation.fetch_add(1, Ordering::AcqRel);
             return true;
         }
-        spin_until(|| self.generation.load(Ordering::Acquire) != generation, abandoned)
+        let t = crate::kernel_stats::ENABLED.then(Instant::now);
+        let ok = spin_until(|| self.generation.load(Ordering::Acquire) != generation, abandoned);
+        if let Some(t) = t {
+            crate::kernel_stats::barrier_wait(t.elapsed().as_nanos() as u64);
+        }
+        ok
     }
 }
 
