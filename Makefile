@@ -39,6 +39,7 @@ test: build test-rust test-python
 
 test-rust:
 	cargo test --release -p tubesweep-core
+	# the kernel-stats counters' test, on its own (its totals are process-wide)
 	cargo test --release -p tubesweep-core --features kernel-stats kernel_stats::
 
 test-python: build

@@ -236,23 +236,49 @@ def add_ratios(records: List[Dict[str, Any]]) -> None:
             r["ratio"] = r["wall_s"] / b
 
 
+#: errors within this relative difference count as equal (a case's error that equals tubesweep's
+#: finest or coarsest one in all printed digits is then read at that size, not left out)
+SAME_ERROR = 1e-9
+
+
 def time_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Optional[float]:
     """The time at which a method reaches the error ``err``, read off its (error, time) points
     ordered by grid size: log–log linear interpolation on the first pair of consecutive points
-    whose errors bracket ``err`` (so the cheapest grid that reaches it); a point whose error
-    equals ``err`` gives its own time. ``None`` when no pair brackets it (no extrapolation)."""
+    whose errors bracket ``err`` (so the cheapest grid that reaches it), errors within a relative
+    :data:`SAME_ERROR` of each other counting as equal; a point whose error equals ``err`` gives
+    its own time. ``None`` when no pair brackets it (no extrapolation: see
+    :func:`time_bound_at_error`)."""
     pts = [(e, t) for e, t in curve if e > 0 and t > 0 and math.isfinite(e) and math.isfinite(t)]
     if not (err > 0 and math.isfinite(err)):
         return None
+    lo_tol, hi_tol = 1 - SAME_ERROR, 1 + SAME_ERROR
     for (e0, t0), (e1, t1) in zip(pts, pts[1:]):
-        if min(e0, e1) <= err <= max(e0, e1):
-            if e0 == e1:
+        if min(e0, e1) * lo_tol <= err <= max(e0, e1) * hi_tol:
+            if abs(e0 - e1) <= SAME_ERROR * max(e0, e1):
                 return min(t0, t1)
             s = (math.log(err) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            s = min(1.0, max(0.0, s))
             return math.exp(math.log(t0) + s * (math.log(t1) - math.log(t0)))
     for e, t in pts:
-        if e == err:
+        if abs(e - err) <= SAME_ERROR * e:
             return t
+    return None
+
+
+def time_bound_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Optional[Tuple[str, float]]:
+    """Where :func:`time_at_error` finds nothing because ``err`` lies outside the errors of
+    ``curve``: ``(">", t)`` when every point is more accurate than ``err`` (the method would
+    reach it in at most ``t``, its cheapest point's time, taking a coarser grid to cost less), or
+    ``("<", t)`` when every point is less accurate (it would need a finer grid than its most
+    accurate point, which took ``t``: more than ``t``). The signs are those of the resulting
+    ratio of another time over it. ``None`` otherwise."""
+    pts = [(e, t) for e, t in curve if e > 0 and t > 0 and math.isfinite(e) and math.isfinite(t)]
+    if not pts or not (err > 0 and math.isfinite(err)) or time_at_error(pts, err) is not None:
+        return None
+    if all(e < err for e, _ in pts):
+        return (">", min(t for _, t in pts))
+    if all(e > err for e, _ in pts):
+        return ("<", min(pts)[1])
     return None
 
 
@@ -261,15 +287,18 @@ EQUAL_ERROR_BASE = "tubesweep-godunov"
 
 EQUAL_ERROR_NOTE = ("At equal accuracy: each case's wall time over the time tubesweep-godunov needs for the same max "
                     "(mean) error, read off its sizes in this run by log–log interpolation (> 1: tubesweep is faster "
-                    "at equal accuracy; — where its sizes do not reach that error).")
+                    "at equal accuracy). Outside the errors of its sizes, a bound: '>r' where even its coarsest size "
+                    "is more accurate (r: over its cheapest time), '<r' where it would need a finer size than the run "
+                    "has (r: over its most accurate size's time).")
 
 
 def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
     """Every other method's case set beside tubesweep (Godunov) at the same accuracy: for each
     (problem, method, N), the time tubesweep needs for that case's max error and for its mean
     error (:func:`time_at_error` along tubesweep's sizes of the problem), and the case's time
-    over it (> 1: tubesweep is faster at equal accuracy). ``None`` where tubesweep's sizes in this
-    run do not bracket the error."""
+    over it (> 1: tubesweep is faster at equal accuracy). Where tubesweep's sizes in this run do
+    not bracket the error, that time and ratio are ``None`` and ``ratio_bound_at_*`` holds the
+    bound (``">1.23"`` or ``"<0.45"``, :func:`time_bound_at_error`) when there is one."""
     ok = [r for r in records if r.get("status") == "ok"]
     rows: List[Dict[str, Any]] = []
     for prob in dict.fromkeys(r["problem"] for r in ok):
@@ -283,9 +312,12 @@ def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
                 row: Dict[str, Any] = dict(problem=prob, method=m, n=r["n"], max_err=r["max_err"], mean_err=r["mean_err"],
                                            wall_s=r["wall_s"])
                 for kind in ("max", "mean"):
-                    t = time_at_error([(b[f"{kind}_err"], b["wall_s"]) for b in base], r[f"{kind}_err"])
+                    curve = [(b[f"{kind}_err"], b["wall_s"]) for b in base]
+                    t = time_at_error(curve, r[f"{kind}_err"])
                     row[f"ts_at_{kind}_s"] = t
                     row[f"ratio_at_{kind}"] = None if t is None else r["wall_s"] / t
+                    bound = time_bound_at_error(curve, r[f"{kind}_err"])
+                    row[f"ratio_bound_at_{kind}"] = None if bound is None else f"{bound[0]}{r['wall_s'] / bound[1]:.2f}"
                 rows.append(row)
     return rows
 
@@ -299,11 +331,18 @@ EQUAL_ERROR_COLUMNS = [
 
 
 def equal_error_table(rows: List[Dict[str, Any]]) -> str:
-    """A Markdown table of :func:`equal_error`'s rows."""
+    """A Markdown table of :func:`equal_error`'s rows (a ratio's bound where it has none)."""
     out = ["| " + " | ".join(c[0] for c in EQUAL_ERROR_COLUMNS) + " |",
            "|" + "|".join("---" if c[2] == "str" else "---:" for c in EQUAL_ERROR_COLUMNS) + "|"]
     for r in rows:
-        out.append("| " + " | ".join(_fmt(r.get(key), kind) for _, key, kind in EQUAL_ERROR_COLUMNS) + " |")
+        cells = []
+        for _, key, kind in EQUAL_ERROR_COLUMNS:
+            v = r.get(key)
+            if v is None and key.startswith("ratio_at_") and r.get(key.replace("ratio_at_", "ratio_bound_at_")):
+                cells.append(r[key.replace("ratio_at_", "ratio_bound_at_")])
+            else:
+                cells.append(_fmt(v, kind))
+        out.append("| " + " | ".join(cells) + " |")
     return "\n".join(out)
 
 

@@ -85,6 +85,21 @@ def test_time_at_error_interpolates_log_log_on_the_cheapest_bracketing_sizes():
     assert bench.time_at_error(curve, 2e-1) is None and bench.time_at_error(curve, 1e-3) is None
     assert bench.time_at_error([(1e-2, 3.0)], 1e-2) == 3.0 and bench.time_at_error([(1e-2, 3.0)], 2e-2) is None
     assert bench.time_at_error(curve, float("nan")) is None
+    # an error equal to an end point's but for the last bits counts as that point's
+    assert bench.time_at_error(curve, 1e-2 * (1 - 1e-12)) == pytest.approx(100.0)
+    assert bench.time_at_error(curve, 1e-1 * (1 + 1e-12)) == pytest.approx(1.0)
+    assert bench.time_at_error(curve, 1e-2 * (1 - 1e-6)) is None
+
+
+def test_outside_the_curve_s_errors_the_time_is_bounded():
+    curve = [(1e-1, 2.0), (1e-2, 100.0), (5e-2, 400.0)]
+    # less accurate than every point: reached by the cheapest one at the latest
+    assert bench.time_bound_at_error(curve, 0.5) == (">", 2.0)
+    # more accurate than every point: needs more than the most accurate point's time
+    assert bench.time_bound_at_error(curve, 1e-3) == ("<", 100.0)
+    # inside the range, or no usable error: no bound
+    assert bench.time_bound_at_error(curve, 3e-2) is None and bench.time_bound_at_error(curve, 1e-2) is None
+    assert bench.time_bound_at_error(curve, float("inf")) is None and bench.time_bound_at_error([], 1.0) is None
 
 
 def test_equal_error_rows_set_each_peer_case_beside_tubesweep_at_its_accuracy():
@@ -98,11 +113,13 @@ def test_equal_error_rows_set_each_peer_case_beside_tubesweep_at_its_accuracy():
     assert [(r["method"], r["n"]) for r in rows] == [("skfmm-tube", 41), ("skfmm-tube", 81)]
     a, b = rows
     assert a["ts_at_max_s"] == pytest.approx(10.0) and a["ratio_at_max"] == pytest.approx(3.0)
-    assert a["ts_at_mean_s"] is None and a["ratio_at_mean"] is None  # tubesweep's means do not reach 1e-4
+    # tubesweep's means do not reach 1e-4: it would need more than its finest size's 100 s
+    assert a["ts_at_mean_s"] is None and a["ratio_at_mean"] is None and a["ratio_bound_at_mean"] == "<0.30"
+    assert a["ratio_bound_at_max"] is None
     assert b["ratio_at_max"] == pytest.approx(0.5) and b["ratio_at_mean"] == pytest.approx(50.0)
     lines = bench.equal_error_table(rows).splitlines()
     assert len(lines) == 4 and lines[2].count("|") == len(bench.EQUAL_ERROR_COLUMNS) + 1
-    assert "| 3.00 |" in lines[2] and "| — |" in lines[2]
+    assert "| 3.00 |" in lines[2] and "| — |" in lines[2] and lines[2].endswith("| <0.30 |")
 
 
 def test_the_run_reports_the_peers_at_equal_accuracy(result):

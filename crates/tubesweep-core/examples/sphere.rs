@@ -100,7 +100,9 @@ fn main() {
     }
     println!("  max |u - pi/4| on the inner nodes of x = 0: {err:.3e}");
     if tubesweep_core::kernel_stats::ENABLED {
-        print_kernel_stats(threads.max(1), st.seconds);
+        // 0 threads: rayon's default number (what the solve's own pool got)
+        let used = if threads == 0 { rayon::current_num_threads() } else { threads };
+        print_kernel_stats(used, st.seconds);
     }
 }
 
@@ -113,7 +115,8 @@ fn print_kernel_stats(threads: usize, seconds: f64) {
     // threads' time in the solve as well
     let thread_ms = threads as f64 * seconds * 1e3;
     println!(
-        "  kernel stats: the {threads} threads waited {:.1} ms for upstream tiles ({} waits), {:.0}% of their {:.0} ms in the solve, and {:.1} ms at barriers ({:.0}%)",
+        "  kernel stats: the {threads} thread{} waited {:.1} ms for upstream tiles ({} waits), {:.0}% of their {:.0} ms in the solve, and {:.1} ms at barriers ({:.0}%)",
+        if threads == 1 { "" } else { "s" },
         s.tile_wait_ns as f64 * 1e-6,
         s.tile_waits,
         100.0 * s.tile_wait_ns as f64 * 1e-6 / thread_ms,

@@ -7,6 +7,10 @@
 //! cargo run --release -p tubesweep-core --features kernel-stats --example sphere -- 201 godunov 2
 //! ```
 //!
+//! They count the sweeps only: the one pass that sets the outer rim's values at the end
+//! ([`crate::rim`], with `SolveOptions::defer_outer_rim`) is not in them, so the histogram's
+//! total is `SolveStats::updates` less the rim's updates.
+//!
 //! Each thread counts on its own and adds its counts to process-wide totals after every sweep
 //! ([`flush`]); [`snapshot`] reads the totals, [`reset`] clears them. They count every solve in
 //! the process. Counting costs time (a thread-local access per node visited), so with the feature
@@ -24,15 +28,16 @@ pub const CHANGE_BINS: usize = 20;
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct KernelStats {
     /// Waits of a parallel sweep's strip for the tile of the previous strip it depends on (only
-    /// those that found it not done yet), and their total time in nanoseconds, summed over the
-    /// threads.
+    /// those that found it not done yet).
     pub tile_waits: u64,
+    /// The time of those waits in nanoseconds, summed over the threads.
     pub tile_wait_ns: u64,
     /// Time the threads spent at the barriers between sweeps, in nanoseconds, summed over the
     /// threads.
     pub barrier_wait_ns: u64,
-    /// Rows the sweeps reached, and those they ran (dirty and not beyond the front window).
+    /// Rows the sweeps reached.
     pub rows_seen: u64,
+    /// Rows the sweeps ran (dirty and not beyond the front window).
     pub rows_run: u64,
     /// Nodes of the rows run (each visited, whether updated or not).
     pub node_visits: u64,
@@ -184,9 +189,10 @@ mod tests {
     use super::*;
 
     /// With the feature: the counters of a solve on the sphere agree with its statistics and do
-    /// not depend on the thread count (the sweeps are bit-identical). (`make test` runs it:
-    /// `cargo test -p tubesweep-core --features kernel-stats kernel_stats::`; it is the only
-    /// solve in that run, which the process-wide totals need.)
+    /// not depend on the thread count (the sweeps are bit-identical). The totals are
+    /// process-wide, so no other solve may run in the process meanwhile: run it on its own, as
+    /// `make test` does (`cargo test -p tubesweep-core --features kernel-stats kernel_stats::`);
+    /// in a run of every test with the feature, other tests' solves would add to its counts.
     #[cfg(feature = "kernel-stats")]
     #[test]
     fn the_counters_agree_with_the_solve_and_not_with_the_thread_count() {

@@ -1200,9 +1200,12 @@ fn run_sweeps_in_one_broadcast(
                 return acc;
             }
             acc = acc.merge(per_sweep(s, &next_strip[s], &abandoned));
-            crate::kernel_stats::flush();
             // every tile of this sweep is done before any of the next starts
-            if !barrier.wait(&abandoned) {
+            let passed = barrier.wait(&abandoned);
+            // this thread's counts, the wait at that barrier included (the pool ends with the
+            // solve)
+            crate::kernel_stats::flush();
+            if !passed {
                 return acc;
             }
         }
