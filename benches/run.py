@@ -241,6 +241,11 @@ def add_ratios(records: List[Dict[str, Any]]) -> None:
 SAME_ERROR = 1e-9
 
 
+def _usable_points(curve: Sequence[Tuple[float, float]]) -> List[Tuple[float, float]]:
+    """The (error, time) points of ``curve`` with both positive and finite, in order."""
+    return [(e, t) for e, t in curve if e > 0 and t > 0 and math.isfinite(e) and math.isfinite(t)]
+
+
 def time_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Optional[float]:
     """The time at which a method reaches the error ``err``, read off its (error, time) points
     ordered by grid size: log–log linear interpolation on the first pair of consecutive points
@@ -248,7 +253,7 @@ def time_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Optional[
     :data:`SAME_ERROR` of each other counting as equal; a point whose error equals ``err`` gives
     its own time. ``None`` when no pair brackets it (no extrapolation: see
     :func:`time_bound_at_error`)."""
-    pts = [(e, t) for e, t in curve if e > 0 and t > 0 and math.isfinite(e) and math.isfinite(t)]
+    pts = _usable_points(curve)
     if not (err > 0 and math.isfinite(err)):
         return None
     lo_tol, hi_tol = 1 - SAME_ERROR, 1 + SAME_ERROR
@@ -272,7 +277,7 @@ def time_bound_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Opt
     ``("<", t)`` when every point is less accurate (it would need a finer grid than its most
     accurate point, which took ``t``: more than ``t``). The signs are those of the resulting
     ratio of another time over it. ``None`` otherwise."""
-    pts = [(e, t) for e, t in curve if e > 0 and t > 0 and math.isfinite(e) and math.isfinite(t)]
+    pts = _usable_points(curve)
     if not pts or not (err > 0 and math.isfinite(err)) or time_at_error(pts, err) is not None:
         return None
     if all(e < err for e, _ in pts):

@@ -196,21 +196,11 @@ mod tests {
     #[cfg(feature = "kernel-stats")]
     #[test]
     fn the_counters_agree_with_the_solve_and_not_with_the_thread_count() {
-        use crate::sweep::{Extension, MissingNeighbour, NodeRole, Slowness, SolveOptions, SweepProblem};
+        use crate::sweep::SolveOptions;
+        use crate::test_bands::{sphere_band, sphere_problem};
         use crate::{Control, InnerScheme};
-        let n = 61;
-        let (band, mut roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
-        let src = band.find([(n / 4) as i64, (n / 2) as i64, (n / 2) as i64]).unwrap();
-        roles[src] = NodeRole::Fixed;
-        let p = SweepProblem {
-            band: &band,
-            roles: &roles,
-            spacing: h,
-            slowness: Slowness::Constant(1.0),
-            extension: Extension::Directions(&dirs),
-            scheme: InnerScheme::Godunov,
-            missing: MissingNeighbour::Extrapolate,
-        };
+        let (band, roles, dirs, h) = sphere_band(61);
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let mut runs = Vec::new();
         for threads in [1, 2] {
             reset();

@@ -1128,14 +1128,13 @@ fn strip_worker(
                 // the previous strip was taken earlier by a running thread
                 let done = &tiles_done[up as usize];
                 let ready = || done.load(Ordering::Acquire) == id;
-                if crate::kernel_stats::ENABLED && !ready() {
-                    let t = Instant::now();
-                    let ok = spin_until(ready, abandoned);
+                // counted (with the kernel-stats feature) only when the tile is not done yet
+                let waiting = (crate::kernel_stats::ENABLED && !ready()).then(Instant::now);
+                let ok = spin_until(ready, abandoned);
+                if let Some(t) = waiting {
                     crate::kernel_stats::tile_wait(t.elapsed().as_nanos() as u64);
-                    if !ok {
-                        return acc;
-                    }
-                } else if !spin_until(ready, abandoned) {
+                }
+                if !ok {
                     return acc;
                 }
             }
@@ -1539,7 +1538,7 @@ fn fill_missing<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_bands::shell_band;
+    use crate::test_bands::{shell_band, sphere_band, sphere_problem};
     use crate::hamiltonian::IsotropicEikonal;
 
     fn box_problem<'a>(band: &'a NarrowBand<2>, roles: &'a [NodeRole], scheme: InnerScheme<'a, 2>, h: f64) -> SweepProblem<'a, 2> {
@@ -1594,14 +1593,6 @@ mod tests {
         assert!(diff < 1e-9, "diff {diff}");
     }
 
-    /// A sphere of radius 0.5 in [−1,1]^3 (`shell_band`), source node nearest (−0.5, 0, 0).
-    fn sphere_band(n: usize) -> (NarrowBand<3>, Vec<NodeRole>, Vec<[f32; 3]>, f64) {
-        let (band, mut roles, dirs, h) = shell_band(n, 0.5, &[0.0]);
-        let src = band.find([(n / 4) as i64, (n / 2) as i64, (n / 2) as i64]).unwrap();
-        roles[src] = NodeRole::Fixed;
-        (band, roles, dirs, h)
-    }
-
     /// Solves `p` with 1 thread and with each of `threads`, asserting the same iterations, local
     /// updates and bits; returns the one-thread solution.
     fn assert_same_bits_for_threads(p: &SweepProblem<'_, 3>, threads: &[usize]) -> Vec<f64> {
@@ -1618,24 +1609,6 @@ mod tests {
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
         }
         a
-    }
-
-    fn sphere_problem<'a>(
-        band: &'a NarrowBand<3>,
-        roles: &'a [NodeRole],
-        dirs: &'a [[f32; 3]],
-        h: f64,
-        scheme: InnerScheme<'a, 3>,
-    ) -> SweepProblem<'a, 3> {
-        SweepProblem {
-            band,
-            roles,
-            spacing: h,
-            slowness: Slowness::Constant(1.0),
-            extension: Extension::Directions(dirs),
-            scheme,
-            missing: MissingNeighbour::Extrapolate,
-        }
     }
 
     #[test]

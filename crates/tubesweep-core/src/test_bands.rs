@@ -2,7 +2,8 @@
 //! the Rust examples use too (`examples/common/shell.rs`).
 
 use crate::band::NarrowBand;
-use crate::sweep::NodeRole;
+use crate::hamiltonian::InnerScheme;
+use crate::sweep::{Extension, MissingNeighbour, NodeRole, Slowness, SweepProblem};
 
 #[path = "../examples/common/shell.rs"]
 mod shell;
@@ -13,4 +14,32 @@ mod shell;
 pub(crate) fn shell_band(n: usize, r0: f64, centres: &[f64]) -> (NarrowBand<3>, Vec<NodeRole>, Vec<[f32; 3]>, f64) {
     let (lin, roles, dirs, h) = shell::shell_nodes(n, r0, centres);
     (NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap(), roles, dirs, h)
+}
+
+/// A sphere of radius 0.5 in [−1,1]^3 (`shell_band`), source node nearest (−0.5, 0, 0).
+pub(crate) fn sphere_band(n: usize) -> (NarrowBand<3>, Vec<NodeRole>, Vec<[f32; 3]>, f64) {
+    let (band, mut roles, dirs, h) = shell_band(n, 0.5, &[0.0]);
+    let src = band.find([(n / 4) as i64, (n / 2) as i64, (n / 2) as i64]).unwrap();
+    roles[src] = NodeRole::Fixed;
+    (band, roles, dirs, h)
+}
+
+/// The two-layer problem on such a band: unit speed, the outward directions, `scheme` in the
+/// inner tube, absent neighbours extrapolated.
+pub(crate) fn sphere_problem<'a>(
+    band: &'a NarrowBand<3>,
+    roles: &'a [NodeRole],
+    dirs: &'a [[f32; 3]],
+    h: f64,
+    scheme: InnerScheme<'a, 3>,
+) -> SweepProblem<'a, 3> {
+    SweepProblem {
+        band,
+        roles,
+        spacing: h,
+        slowness: Slowness::Constant(1.0),
+        extension: Extension::Directions(dirs),
+        scheme,
+        missing: MissingNeighbour::Extrapolate,
+    }
 }
