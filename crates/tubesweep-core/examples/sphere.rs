@@ -2,7 +2,8 @@
 //! Used for profiling the sweep kernel:
 //!   cargo run --release --example sphere -- 101 godunov 1 [coupled|pointwise]
 //!   (VERBOSE=1 prints every iteration; THR, TOL and WINDOW set the activation threshold, the
-//!   tolerance and the front window, `SolveOptions::front_window`; PLAIN=1 runs the paper's sweeps
+//!   tolerance and the front window, `SolveOptions::front_window`; SOURCE_AXIS=1 or 2 puts the
+//!   source on the y or z axis instead of x, z being the axis of the rows; PLAIN=1 runs the paper's sweeps
 //!   to the letter: no active flags (`skip_inactive: false`), pointwise update, the rim in every
 //!   sweep; Python's `paper_sweeps=True` is the same but keeps the flags)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
@@ -11,10 +12,12 @@
 //!   `tubesweep_core::kernel_stats`)
 #[path = "common/shell.rs"]
 mod shell;
+#[path = "common/sphere_source.rs"]
+mod sphere_source;
 
 use std::time::Instant;
 use tubesweep_core::sweep::{Extension, MissingNeighbour, Slowness};
-use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SweepProblem};
+use tubesweep_core::{Control, InnerScheme, NodeRole, SolveOptions, SweepProblem};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -27,15 +30,8 @@ fn main() {
     let plain = std::env::var_os("PLAIN").is_some();
     let coupled = !plain && args.get(4).map_or(true, |s| s != "pointwise");
     let defer_outer_rim = !plain && std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
-    let (lin, mut roles, mut dirs, h) = shell::sphere_shell(n);
-    let t = Instant::now();
-    let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
-    let build = t.elapsed().as_secs_f64();
-    let src = band.find([((n - 1) / 4) as i64, ((n - 1) / 2) as i64, ((n - 1) / 2) as i64]).unwrap();
-    roles[src] = NodeRole::Fixed;
-    // as the Python layer does: the upwind weights in place of the directions, and room for the
-    // solver's sentinel slot in the values (no copies of band-sized arrays)
-    tubesweep_core::sweep::extension_weights_in_place(&band, &roles, &mut dirs);
+    let source_axis: usize = std::env::var("SOURCE_AXIS").ok().and_then(|s| s.parse().ok()).unwrap_or(0);
+    let (band, roles, dirs, h, build) = sphere_source::sphere_with_source(n, source_axis);
     let p = SweepProblem {
         band: &band,
         roles: &roles,
@@ -45,6 +41,7 @@ fn main() {
         scheme,
         missing: MissingNeighbour::Extrapolate,
     };
+    // room for the solver's sentinel slot in the values (no copy of a band-sized array)
     let mut u = Vec::with_capacity(band.len() + 1);
     u.resize(band.len(), 0.0);
     let thr: f64 = std::env::var("THR").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-12);
@@ -80,7 +77,9 @@ fn main() {
         })
         .unwrap();
     let solve_s = t0.elapsed().as_secs_f64();
-    let far = band.find([(3 * (n - 1) / 4) as i64, ((n - 1) / 2) as i64, ((n - 1) / 2) as i64]).unwrap();
+    let mut antipode = [((n - 1) / 2) as i64; 3];
+    antipode[source_axis] = (3 * (n - 1) / 4) as i64;
+    let far = band.find(antipode).unwrap();
     println!(
         "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5} solve={solve_s:.3}s",
         band.len(),
@@ -93,12 +92,13 @@ fn main() {
     let exact = std::f64::consts::PI / 4.0;
     let mut err = 0.0f64;
     for (i, idx) in band.indices().iter().enumerate() {
-        // inner nodes on the plane x = 0: exact distance pi/4 at the closest point
-        if idx[0] == (n - 1) / 2 && roles[i] == NodeRole::Inner {
+        // inner nodes on the plane through the centre normal to the source's axis (x = 0 by
+        // default): exact distance pi/4 at the closest point
+        if idx[source_axis] == (n - 1) / 2 && roles[i] == NodeRole::Inner {
             err = err.max((u[i] - exact).abs());
         }
     }
-    println!("  max |u - pi/4| on the inner nodes of x = 0: {err:.3e}");
+    println!("  max |u - pi/4| on the inner nodes of {} = 0: {err:.3e}", ["x", "y", "z"][source_axis]);
     if tubesweep_core::kernel_stats::ENABLED {
         // 0 threads: rayon's default number (what the solve's own pool got)
         let used = if threads == 0 { rayon::current_num_threads() } else { threads };
