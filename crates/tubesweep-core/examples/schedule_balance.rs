@@ -5,10 +5,21 @@
 //! by event; and, for comparison, waves separated by barriers with the tiles of a wave spread
 //! greedily, largest first. Deterministic: no timing.
 //!   cargo run --release --example schedule_balance -- 101 201 401
+//!
+//! With `--windowed` (and the `kernel-stats` feature, whose row log it reads) the work is that
+//! of the default solve instead, the front window's: the sphere problem of the `sphere` example
+//! is solved on one thread, every row each sweep ran is logged with its nodes and updates, and
+//! the pipeline is simulated sweep by sweep with that work, for several tile shapes (rows of the
+//! strip axis × rows along the strip), under two cost models (see `WORK_MODELS`):
+//!   cargo run --release -p tubesweep-core --features kernel-stats --example schedule_balance -- --windowed 101 201
+//! (`SOURCE_AXIS=1` or `2` moves the source as in the `sphere` example.)
 #[path = "common/shell.rs"]
 mod shell;
+#[path = "common/sphere_source.rs"]
+mod sphere_source;
 
-use tubesweep_core::{NarrowBand, NodeRole};
+use tubesweep_core::kernel_stats::RowWork;
+use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SweepProblem};
 
 /// Largest-first assignment of `items` (work per task) to `threads`: the busiest thread's work.
 fn critical_path(items: &[usize], threads: usize) -> usize {
@@ -44,8 +55,19 @@ fn pipeline_time(strip_tiles: &[u32], strips: &[u32], upstream: &[u32], work: &d
 }
 
 fn main() {
+    let windowed = std::env::args().any(|a| a == "--windowed");
     let sizes: Vec<usize> = std::env::args().skip(1).filter_map(|s| s.parse().ok()).collect();
     let sizes = if sizes.is_empty() { vec![101, 201, 401] } else { sizes };
+    if windowed {
+        if !tubesweep_core::kernel_stats::ENABLED {
+            eprintln!("--windowed reads the sweeps' row log: build with `--features kernel-stats`");
+            std::process::exit(2);
+        }
+        for n in sizes {
+            windowed_bounds(n);
+        }
+        return;
+    }
     for n in sizes {
         let lin = shell::sphere_shell(n).0;
         let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
@@ -78,4 +100,128 @@ fn main() {
             );
         }
     }
+}
+
+/// Cost weights of the windowed work model: a row reached, a row run, a node visited, a local
+/// update, a tile (its synchronisation). "updates" counts the local updates only; "instructions"
+/// weighs each item by roughly the instructions it takes in the row loops (cachegrind, sphere
+/// N = 101, one thread: a local update about 150, a node visit about 12, a row about 5 to reach
+/// and 30 to run, a tile's wait and flag about 40).
+const WORK_MODELS: [(&str, [u64; 5]); 2] = [("updates", [0, 0, 0, 1, 0]), ("instructions", [5, 30, 12, 150, 40])];
+
+/// Tile shapes simulated: rows along the strip axis (the first leading axis) × rows along the
+/// strip (the second). The solver's is `TILE` × `TILE` = 8 × 8.
+const SHAPES: [(usize, usize); 8] = [(8, 8), (4, 8), (2, 8), (2, 16), (4, 4), (16, 16), (8, 4), (1, 16)];
+
+/// The load-balance bounds of the front window's sweeps on the sphere at `n`: the default solve's
+/// work per row and sweep, logged on one thread, put through the strip pipeline (2 and 4
+/// threads) for each tile shape and cost model.
+fn windowed_bounds(n: usize) {
+    let source_axis: usize = std::env::var("SOURCE_AXIS").ok().and_then(|s| s.parse().ok()).unwrap_or(0);
+    let (band, roles, weights, h, _) = sphere_source::sphere_with_source(n, source_axis);
+    let p = SweepProblem {
+        band: &band,
+        roles: &roles,
+        spacing: h,
+        slowness: tubesweep_core::sweep::Slowness::Constant(1.0),
+        extension: tubesweep_core::sweep::Extension::Weights(&weights),
+        scheme: InnerScheme::Godunov,
+        missing: tubesweep_core::sweep::MissingNeighbour::Extrapolate,
+    };
+    let mut u = Vec::with_capacity(band.len() + 1);
+    u.resize(band.len(), 0.0);
+    // the options of the `sphere` example, which are the Python layer's defaults
+    let opts = SolveOptions {
+        threads: 1,
+        activation_threshold: 1e-12,
+        tol: 1e-10,
+        front_window: tubesweep_core::sweep::DEFAULT_FRONT_WINDOW,
+        ..Default::default()
+    };
+    tubesweep_core::kernel_stats::log_rows(true);
+    let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+    let log = tubesweep_core::kernel_stats::take_row_log();
+    tubesweep_core::kernel_stats::log_rows(false);
+    // one entry per sweep, 8 per iteration (the pass that sets the outer rim at the end counts
+    // as an iteration and is not logged)
+    assert!(log.len() % 8 == 0 && log.len() >= 8 * (st.iterations - 1), "one log entry per sweep on one thread");
+    let logged: u64 = log.iter().flatten().map(|w| w.updates as u64).sum();
+    println!(
+        "sphere N={n}, source on axis {source_axis}: {} sweeps, {} updates in them ({} with the rim pass), {} rows",
+        log.len(),
+        logged,
+        st.updates,
+        band.n_rows()
+    );
+    // the rows' leading coordinates (of their first nodes)
+    let indices = band.indices();
+    let lead: Vec<[usize; 2]> = (0..band.n_rows())
+        .map(|r| {
+            let idx = indices[band.row_range(r).0];
+            [idx[0], idx[1]]
+        })
+        .collect();
+    println!("{:>8} {:>12} {:>10} {:>10}", "tile", "model", "2 threads", "4 threads");
+    for (ta, tb) in SHAPES {
+        for (name, cost) in WORK_MODELS {
+            let mut bounds = Vec::new();
+            for threads in [2usize, 4] {
+                let (mut total, mut time) = (0u64, 0u64);
+                for (k, rows_run) in log.iter().enumerate() {
+                    let s = k % 8;
+                    let dir = s ^ (s >> 1); // the solver's Gray code order of the orientations
+                    let (w, t) = sweep_pipeline(&lead, n, dir & 3, (ta, tb), rows_run, cost, threads);
+                    total += w;
+                    time += t;
+                }
+                bounds.push(total as f64 / time as f64);
+            }
+            println!("{:>8} {:>12} {:>9.2}x {:>9.2}x", format!("{ta}x{tb}"), name, bounds[0], bounds[1]);
+        }
+    }
+}
+
+/// One sweep in leading orientation `signs` through the strip pipeline with tiles of `shape`
+/// rows: (its total work, the time `threads` threads take), with `rows_run` the rows it ran and
+/// `cost` the model's weights. Every row is reached; every tile with a row costs the tile weight.
+fn sweep_pipeline(lead: &[[usize; 2]], n: usize, signs: usize, shape: (usize, usize), rows_run: &[RowWork], cost: [u64; 5], threads: usize) -> (u64, u64) {
+    let (na, nb) = ((n - 1) / shape.0 + 1, (n - 1) / shape.1 + 1);
+    let tile_of = |r: usize| -> usize {
+        let c0 = if signs & 1 != 0 { n - 1 - lead[r][0] } else { lead[r][0] };
+        let c1 = if signs & 2 != 0 { n - 1 - lead[r][1] } else { lead[r][1] };
+        (c0 / shape.0) * nb + c1 / shape.1
+    };
+    // work per tile; NONE marks a tile without rows
+    const NONE: u64 = u64::MAX;
+    let mut work = vec![NONE; na * nb];
+    for r in 0..lead.len() {
+        let t = tile_of(r);
+        work[t] = if work[t] == NONE { cost[4] + cost[0] } else { work[t] + cost[0] };
+    }
+    for w in rows_run {
+        work[tile_of(w.row as usize)] += cost[1] + cost[2] * w.nodes as u64 + cost[3] * w.updates as u64;
+    }
+    let total: u64 = work.iter().filter(|&&w| w != NONE).sum();
+    // the strips in order, each to the thread free first; a tile waits for the one before it in
+    // its strip (the same thread) and for the previous strip's tile with the same b
+    let mut finish = vec![0u64; na * nb];
+    let mut free = vec![0u64; threads];
+    for a in 0..na {
+        if (0..nb).all(|b| work[a * nb + b] == NONE) {
+            continue;
+        }
+        let i = (0..threads).min_by_key(|&i| free[i]).unwrap();
+        let mut now = free[i];
+        for b in 0..nb {
+            let t = a * nb + b;
+            if work[t] == NONE {
+                continue;
+            }
+            let ready = if a > 0 && work[t - nb] != NONE { finish[t - nb] } else { 0 };
+            now = now.max(ready) + work[t];
+            finish[t] = now;
+        }
+        free[i] = now;
+    }
+    (total, free.into_iter().max().unwrap_or(0))
 }

@@ -13,7 +13,9 @@
 //!
 //! Each thread counts on its own and adds its counts to process-wide totals after every sweep
 //! ([`flush`]); [`snapshot`] reads the totals, [`reset`] clears them. They count every solve in
-//! the process. Counting costs time (a thread-local access per node visited), so with the feature
+//! the process. On request ([`log_rows`]) the rows each sweep ran are also logged one by one, with
+//! their visits and updates ([`take_row_log`]): the work the load-balance model of
+//! `examples/schedule_balance.rs --windowed` puts through the parallel schedule. Counting costs time (a thread-local access per node visited), so with the feature
 //! the sweeps run slower than without it, and the waits measured include that.
 
 #[cfg(feature = "kernel-stats")]
@@ -113,19 +115,76 @@ pub fn barrier_wait(ns: u64) {
     let _ = ns;
 }
 
-/// A sweep reached a row; `run`: it ran its `nodes` nodes.
+/// A sweep reached row `r`; `run`: it ran its `nodes` nodes and made `updates` local updates
+/// there (counted with the flags only: without them the sweeps count updates per sweep).
 #[inline(always)]
-pub fn row(run: bool, nodes: usize) {
+pub fn row(r: usize, run: bool, nodes: usize, updates: u64) {
     #[cfg(feature = "kernel-stats")]
     {
         counters::add(counters::ROWS_SEEN, 1);
         if run {
             counters::add(counters::ROWS_RUN, 1);
             counters::add(counters::NODE_VISITS, nodes as u64);
+            if row_log::ON.load(Ordering::Relaxed) {
+                row_log::LOCAL.with(|l| l.borrow_mut().push(RowWork { row: r as u32, nodes: nodes as u32, updates: updates as u32 }));
+            }
         }
     }
     #[cfg(not(feature = "kernel-stats"))]
-    let _ = (run, nodes);
+    let _ = (r, run, nodes, updates);
+}
+
+/// A row a sweep ran, in the row log ([`log_rows`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RowWork {
+    /// The row (`NarrowBand::row_range`).
+    pub row: u32,
+    /// Its nodes, each visited.
+    pub nodes: u32,
+    /// The local updates made in it.
+    pub updates: u32,
+}
+
+#[cfg(feature = "kernel-stats")]
+mod row_log {
+    use super::RowWork;
+    use std::cell::RefCell;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Mutex;
+
+    /// Whether the rows run are logged.
+    pub static ON: AtomicBool = AtomicBool::new(false);
+    /// The flushed entries: each thread's rows of one sweep.
+    pub static ENTRIES: Mutex<Vec<Vec<RowWork>>> = Mutex::new(Vec::new());
+
+    thread_local! {
+        /// This thread's rows since its last flush.
+        pub static LOCAL: RefCell<Vec<RowWork>> = const { RefCell::new(Vec::new()) };
+    }
+}
+
+/// Starts (`true`) or stops logging every row the sweeps run, with its nodes and updates, and
+/// clears the log. For a work model of the sweeps (`examples/schedule_balance.rs`); the log
+/// grows by 12 bytes per row run.
+pub fn log_rows(on: bool) {
+    #[cfg(feature = "kernel-stats")]
+    {
+        row_log::ON.store(on, Ordering::Relaxed);
+        row_log::ENTRIES.lock().unwrap_or_else(|e| e.into_inner()).clear();
+    }
+    #[cfg(not(feature = "kernel-stats"))]
+    let _ = on;
+}
+
+/// The row log since [`log_rows`]: an entry per thread and sweep, added at every [`flush`] (with
+/// one thread, one entry per sweep, in the order of the sweeps). Empty without the feature.
+pub fn take_row_log() -> Vec<Vec<RowWork>> {
+    #[cfg(feature = "kernel-stats")]
+    {
+        std::mem::take(&mut *row_log::ENTRIES.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+    #[cfg(not(feature = "kernel-stats"))]
+    Vec::new()
 }
 
 /// A local update at a node of role `role` (1 inner, 2 layer) moved its value by `change`
@@ -143,14 +202,20 @@ pub fn update(role: u8, change: Option<f64>) {
 #[inline(always)]
 pub fn flush() {
     #[cfg(feature = "kernel-stats")]
-    counters::LOCAL.with(|l| {
-        for (total, v) in counters::TOTALS.iter().zip(l.iter()) {
-            let v = v.take();
-            if v != 0 {
-                total.fetch_add(v, Ordering::Relaxed);
+    {
+        counters::LOCAL.with(|l| {
+            for (total, v) in counters::TOTALS.iter().zip(l.iter()) {
+                let v = v.take();
+                if v != 0 {
+                    total.fetch_add(v, Ordering::Relaxed);
+                }
             }
+        });
+        if row_log::ON.load(Ordering::Relaxed) {
+            let rows = row_log::LOCAL.with(|l| std::mem::take(&mut *l.borrow_mut()));
+            row_log::ENTRIES.lock().unwrap_or_else(|e| e.into_inner()).push(rows);
         }
-    });
+    }
 }
 
 /// The totals now (all zero without the feature).
@@ -188,8 +253,9 @@ pub fn reset() {
 mod tests {
     use super::*;
 
-    /// With the feature: the counters of a solve on the sphere agree with its statistics and do
-    /// not depend on the thread count (the sweeps are bit-identical). The totals are
+    /// With the feature: the counters of a solve on the sphere, and its row log, agree with its
+    /// statistics, and the counters do not depend on the thread count (the sweeps are
+    /// bit-identical). The totals are
     /// process-wide, so no other solve may run in the process meanwhile: run it on its own, as
     /// `make test` does (`cargo test -p tubesweep-core --features kernel-stats kernel_stats::`);
     /// in a run of every test with the feature, other tests' solves would add to its counts.
@@ -204,11 +270,20 @@ mod tests {
         let mut runs = Vec::new();
         for threads in [1, 2] {
             reset();
+            log_rows(true);
             let mut u = vec![0.0; band.len()];
             // the rim in the sweeps, so that every update is a sweep's
             let opts = SolveOptions { threads, defer_outer_rim: false, ..Default::default() };
             let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
             let s = snapshot();
+            let log = take_row_log();
+            log_rows(false);
+            // an entry per thread and sweep, and together the rows run with their visits and
+            // updates
+            assert_eq!(log.len(), threads * st.sweeps);
+            assert_eq!(log.iter().map(|e| e.len() as u64).sum::<u64>(), s.rows_run);
+            assert_eq!(log.iter().flatten().map(|w| w.nodes as u64).sum::<u64>(), s.node_visits);
+            assert_eq!(log.iter().flatten().map(|w| w.updates as u64).sum::<u64>(), st.updates);
             let histogram: u64 = s.change_histogram.iter().flatten().sum();
             assert_eq!(histogram, st.updates, "every local update is binned once");
             assert_eq!(s.change_histogram[0].iter().sum::<u64>(), 0, "no fixed node is updated");

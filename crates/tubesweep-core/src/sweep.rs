@@ -864,12 +864,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     #[inline(always)]
     fn run_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
         let run = self.claim_row::<W, K>(ctx, r, lim, acc);
-        if crate::kernel_stats::ENABLED {
-            let (s, e) = self.band.row_range(r);
-            crate::kernel_stats::row(run, e - s);
-        }
+        let before = acc.updates;
         if run {
             self.run_claimed_row::<S, P, W, K>(ctx, r, backwards, lim, acc);
+        }
+        if crate::kernel_stats::ENABLED {
+            let (s, e) = self.band.row_range(r);
+            crate::kernel_stats::row(r, run, e - s, acc.updates - before);
         }
     }
 
