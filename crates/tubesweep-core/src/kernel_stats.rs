@@ -13,10 +13,12 @@
 //!
 //! Each thread counts on its own and adds its counts to process-wide totals after every sweep
 //! ([`flush`]); [`snapshot`] reads the totals, [`reset`] clears them. They count every solve in
-//! the process. On request ([`log_rows`]) the rows each sweep ran are also logged one by one, with
-//! their visits and updates ([`take_row_log`]): the work the load-balance model of
-//! `examples/schedule_balance.rs --windowed` puts through the parallel schedule. Counting costs time (a thread-local access per node visited), so with the feature
-//! the sweeps run slower than without it, and the waits measured include that.
+//! the process. On request ([`log_rows`]) the rows each sweep ran are also logged one by one,
+//! with their visits and updates ([`take_row_log`]): the work the load-balance model of
+//! `examples/schedule_balance.rs --windowed` puts through the parallel schedule.
+//!
+//! Counting costs time (a thread-local access per node visited), so with the feature the sweeps
+//! run slower than without it, and the waits measured include that.
 
 #[cfg(feature = "kernel-stats")]
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -116,7 +118,8 @@ pub fn barrier_wait(ns: u64) {
 }
 
 /// A sweep reached row `r`; `run`: it ran its `nodes` nodes and made `updates` local updates
-/// there (counted with the flags only: without them the sweeps count updates per sweep).
+/// there. `updates` is 0 in the sweeps without the active flags (`skip_inactive: false`, the
+/// `sphere` example's `PLAIN=1`), which count their updates per sweep instead.
 #[inline(always)]
 pub fn row(r: usize, run: bool, nodes: usize, updates: u64) {
     #[cfg(feature = "kernel-stats")]
@@ -141,7 +144,7 @@ pub struct RowWork {
     pub row: u32,
     /// Its nodes, each visited.
     pub nodes: u32,
-    /// The local updates made in it.
+    /// The local updates made in it (0 in the sweeps without the active flags: see [`row`]).
     pub updates: u32,
 }
 
@@ -176,8 +179,11 @@ pub fn log_rows(on: bool) {
     let _ = on;
 }
 
-/// The row log since [`log_rows`]: an entry per thread and sweep, added at every [`flush`] (with
-/// one thread, one entry per sweep, in the order of the sweeps). Empty without the feature.
+/// Takes the row log gathered since [`log_rows`] or the last call: an entry per [`flush`], that
+/// is one per sweep when the sweeps run sequentially (one thread, or a 2D band) and one per
+/// thread and sweep when they run in parallel, the threads' entries of a sweep together (each
+/// thread flushes after the barrier that ends the sweep, before any starts the next) and the
+/// sweeps in order. Empty without the feature.
 pub fn take_row_log() -> Vec<Vec<RowWork>> {
     #[cfg(feature = "kernel-stats")]
     {
@@ -211,8 +217,10 @@ pub fn flush() {
                 }
             }
         });
+        // drained on every flush, so that rows logged just before the log was switched off do
+        // not turn up in a later log
+        let rows = row_log::LOCAL.with(|l| std::mem::take(&mut *l.borrow_mut()));
         if row_log::ON.load(Ordering::Relaxed) {
-            let rows = row_log::LOCAL.with(|l| std::mem::take(&mut *l.borrow_mut()));
             row_log::ENTRIES.lock().unwrap_or_else(|e| e.into_inner()).push(rows);
         }
     }
@@ -254,10 +262,9 @@ mod tests {
     use super::*;
 
     /// With the feature: the counters of a solve on the sphere, and its row log, agree with its
-    /// statistics, and the counters do not depend on the thread count (the sweeps are
-    /// bit-identical). The totals are
-    /// process-wide, so no other solve may run in the process meanwhile: run it on its own, as
-    /// `make test` does (`cargo test -p tubesweep-core --features kernel-stats kernel_stats::`);
+    /// statistics, and neither depends on the thread count (the sweeps are bit-identical). The
+    /// totals are process-wide, so no other solve may run in the process meanwhile: run it on
+    /// its own, as `make test` does (`cargo test -p tubesweep-core --features kernel-stats kernel_stats::`);
     /// in a run of every test with the feature, other tests' solves would add to its counts.
     #[cfg(feature = "kernel-stats")]
     #[test]
@@ -268,6 +275,8 @@ mod tests {
         let (band, roles, dirs, h) = sphere_band(61);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let mut runs = Vec::new();
+        // per sweep, the rows run with their work, in row order
+        let mut logs: Vec<Vec<Vec<RowWork>>> = Vec::new();
         for threads in [1, 2] {
             reset();
             log_rows(true);
@@ -284,6 +293,15 @@ mod tests {
             assert_eq!(log.iter().map(|e| e.len() as u64).sum::<u64>(), s.rows_run);
             assert_eq!(log.iter().flatten().map(|w| w.nodes as u64).sum::<u64>(), s.node_visits);
             assert_eq!(log.iter().flatten().map(|w| w.updates as u64).sum::<u64>(), st.updates);
+            logs.push(
+                log.chunks(threads)
+                    .map(|sweep| {
+                        let mut rows: Vec<RowWork> = sweep.concat();
+                        rows.sort_unstable_by_key(|w| w.row);
+                        rows
+                    })
+                    .collect(),
+            );
             let histogram: u64 = s.change_histogram.iter().flatten().sum();
             assert_eq!(histogram, st.updates, "every local update is binned once");
             assert_eq!(s.change_histogram[0].iter().sum::<u64>(), 0, "no fixed node is updated");
@@ -298,6 +316,9 @@ mod tests {
             runs.push(KernelStats { tile_waits: 0, tile_wait_ns: 0, barrier_wait_ns: 0, ..s });
         }
         assert_eq!(runs[0], runs[1]);
+        // the threads' entries of a sweep together hold the rows the one thread ran, with the
+        // same work
+        assert_eq!(logs[0], logs[1]);
     }
 
     #[test]
