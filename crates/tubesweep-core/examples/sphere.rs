@@ -3,9 +3,9 @@
 //!   cargo run --release --example sphere -- 101 godunov 1 [coupled|pointwise]
 //!   (VERBOSE=1 prints every iteration; THR, TOL and WINDOW set the activation threshold, the
 //!   tolerance and the front window, `SolveOptions::front_window`; SOURCE_AXIS=1 or 2 puts the
-//!   source on the y or z axis instead of x, z being the axis of the rows; PLAIN=1 runs the paper's sweeps
-//!   to the letter: no active flags (`skip_inactive: false`), pointwise update, the rim in every
-//!   sweep; Python's `paper_sweeps=True` is the same but keeps the flags)
+//!   source on the y or z axis instead of x, z being the axis of the rows; PLAIN=1 runs the
+//!   paper's sweeps to the letter: no active flags (`skip_inactive: false`), pointwise update,
+//!   the rim in every sweep; Python's `paper_sweeps=True` is the same but keeps the flags)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
 //!   (built with `--features kernel-stats` it also prints the sweeps' counters: where the
 //!   parallel sweeps wait, the rows and nodes they visit, how far the updates move the values;
