@@ -19,7 +19,7 @@ mod shell;
 mod sphere_source;
 
 use tubesweep_core::kernel_stats::RowWork;
-use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SweepProblem};
+use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions};
 
 /// Largest-first assignment of `items` (work per task) to `threads`: the busiest thread's work.
 fn critical_path(items: &[usize], threads: usize) -> usize {
@@ -117,19 +117,10 @@ const SHAPES: [(usize, usize); 8] = [(8, 8), (4, 8), (2, 8), (2, 16), (4, 4), (1
 /// work per row and sweep, logged on one thread, put through the strip pipeline (2 and 4
 /// threads) for each tile shape and cost model.
 fn windowed_bounds(n: usize) {
-    let source_axis: usize = std::env::var("SOURCE_AXIS").ok().and_then(|s| s.parse().ok()).unwrap_or(0);
+    let source_axis = sphere_source::source_axis_from_env();
     let (band, roles, weights, h, _) = sphere_source::sphere_with_source(n, source_axis);
-    let p = SweepProblem {
-        band: &band,
-        roles: &roles,
-        spacing: h,
-        slowness: tubesweep_core::sweep::Slowness::Constant(1.0),
-        extension: tubesweep_core::sweep::Extension::Weights(&weights),
-        scheme: InnerScheme::Godunov,
-        missing: tubesweep_core::sweep::MissingNeighbour::Extrapolate,
-    };
-    let mut u = Vec::with_capacity(band.len() + 1);
-    u.resize(band.len(), 0.0);
+    let p = sphere_source::sphere_problem(&band, &roles, &weights, h, InnerScheme::Godunov);
+    let mut u = sphere_source::starting_values(&band);
     // the options of the `sphere` example, which are the Python layer's defaults
     let opts = SolveOptions {
         threads: 1,

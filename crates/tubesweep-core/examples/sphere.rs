@@ -16,8 +16,7 @@ mod shell;
 mod sphere_source;
 
 use std::time::Instant;
-use tubesweep_core::sweep::{Extension, MissingNeighbour, Slowness};
-use tubesweep_core::{Control, InnerScheme, NodeRole, SolveOptions, SweepProblem};
+use tubesweep_core::{Control, InnerScheme, NodeRole, SolveOptions};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -30,20 +29,10 @@ fn main() {
     let plain = std::env::var_os("PLAIN").is_some();
     let coupled = !plain && args.get(4).map_or(true, |s| s != "pointwise");
     let defer_outer_rim = !plain && std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
-    let source_axis: usize = std::env::var("SOURCE_AXIS").ok().and_then(|s| s.parse().ok()).unwrap_or(0);
+    let source_axis = sphere_source::source_axis_from_env();
     let (band, roles, dirs, h, build) = sphere_source::sphere_with_source(n, source_axis);
-    let p = SweepProblem {
-        band: &band,
-        roles: &roles,
-        spacing: h,
-        slowness: Slowness::Constant(1.0),
-        extension: Extension::Weights(&dirs),
-        scheme,
-        missing: MissingNeighbour::Extrapolate,
-    };
-    // room for the solver's sentinel slot in the values (no copy of a band-sized array)
-    let mut u = Vec::with_capacity(band.len() + 1);
-    u.resize(band.len(), 0.0);
+    let p = sphere_source::sphere_problem(&band, &roles, &dirs, h, scheme);
+    let mut u = sphere_source::starting_values(&band);
     let thr: f64 = std::env::var("THR").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-12);
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
     let front_window: f64 =
