@@ -10,7 +10,10 @@
 //! found by sorting `a_1 ≤ a_2 ≤ … ≤ a_d` and taking the first `m` values that are below the
 //! candidate: `ū = a_1 + f` if that does not exceed `a_2` (the first branch of Eq. (3)); else
 //! the two-term root `(a_1 + a_2 + sqrt(2 f^2 − (a_1 − a_2)^2)) / 2` (the second branch of
-//! Eq. (3)); in 3D, if that exceeds `a_3`, the three-term root.
+//! Eq. (3)); in 3D, if that exceeds `a_3`, the three-term root. Whether it does is decided by
+//! comparing `2 f^2 − (a_1 − a_2)^2` with `(2 a_3 − a_1 − a_2)^2`, so that the only square root
+//! taken is the returned root's: on the Gauss–Seidel chain of a row every update waits for the
+//! previous one.
 
 /// The Godunov update (Eq. (3)) for `D` axes. `mins[k]` is the smaller neighbour value along axis
 /// `k`, `f = h / F` at the node. Returns the new candidate value; the caller keeps the smaller of
@@ -25,10 +28,18 @@ pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
     }
     // two terms: (u − a0)^2 + (u − a1)^2 = f^2  (second branch of Eq. (3))
     let d = a[0] - a[1];
-    let u2 = 0.5 * (a[0] + a[1] + nonneg(2.0 * f * f - d * d).sqrt());
-    if D == 2 || u2 <= a[2] {
-        return u2;
+    let disc2 = nonneg(2.0 * f * f - d * d);
+    if D == 2 {
+        return 0.5 * (a[0] + a[1] + disc2.sqrt());
     }
+    // the two-term root stays at or below a2 iff sqrt(disc2) ≤ g = 2 a2 − a0 − a1 (≥ 0, as
+    // the a_k are sorted), i.e. iff disc2 ≤ g²: decided without the square root, which is then
+    // taken only for the root returned (it sits on the Gauss–Seidel chain of the sweep)
+    let g = 2.0 * a[2] - a[0] - a[1];
+    if disc2 <= g * g {
+        return 0.5 * (a[0] + a[1] + disc2.sqrt());
+    }
+    let u2 = 0.5 * (a[0] + a[1] + disc2.sqrt());
     if D == 3 {
         // three terms: 3u^2 − 2 s u + (q − f^2) = 0
         let s = a[0] + a[1] + a[2];
@@ -65,8 +76,8 @@ pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
 /// `c_k = 1 − w`; axes without such a neighbour have `c_k = 1` and `r_k` the neighbour's value.
 /// Solving the two equations together (block Gauss–Seidel) removes the slowly contracting node ↔
 /// layer cycle that plain Gauss–Seidel iterates by a factor `w` per pass; the fixed point is the
-/// same. The axes are ordered by `r_k / c_k` by cross-multiplying, so the only division is the
-/// root's (it sits on the Gauss–Seidel chain of the sweep).
+/// same. The axes are ordered by `r_k / c_k` by cross-multiplying, and the number of terms is
+/// decided by comparing squares, so the only square root and division are the returned root's.
 #[inline(always)]
 pub fn godunov_update_coupled<const D: usize>(r: [f64; D], c: [f64; D], f: f64) -> f64 {
     // order the axes by r_k / c_k (insertion sort of at most three pairs; c_k > 0)
@@ -83,19 +94,27 @@ pub fn godunov_update_coupled<const D: usize>(r: [f64; D], c: [f64; D], f: f64) 
     }
     // add axes while the root exceeds the next r_k / c_k: A ū² − 2 B ū + C = 0
     let (mut sa, mut sb, mut sc) = (0.0f64, 0.0f64, -f * f);
-    let mut u = p[0].0;
     for m in 0..D {
         let (rk, ck) = p[m];
         sa += ck * ck;
         sb += ck * rk;
         sc += rk * rk;
-        let disc = sb * sb - sa * sc;
-        u = (sb + nonneg(disc).sqrt()) / sa;
-        if m + 1 == D || p[m + 1].1 * u <= p[m + 1].0 {
-            return u;
+        let disc = nonneg(sb * sb - sa * sc);
+        if m + 1 == D {
+            return (sb + disc.sqrt()) / sa;
+        }
+        // the root (sb + sqrt(disc)) / sa stays at or below the next r / c iff
+        // c sqrt(disc) ≤ g = r sa − c sb (sa, c > 0), i.e. iff c² disc ≤ g², since
+        // g = Σ_{k ≤ m} c_k (r c_k − c r_k) ≥ 0 with the axes ordered by r_k / c_k: decided
+        // without the square root and the division, which are then taken only for the root
+        // returned (they sit on the Gauss–Seidel chain of the sweep)
+        let (rn, cn) = p[m + 1];
+        let g = rn * sa - cn * sb;
+        if cn * cn * disc <= g * g {
+            return (sb + disc.sqrt()) / sa;
         }
     }
-    u
+    unreachable!("the loop returns at m = D − 1")
 }
 
 /// One axis of [`godunov_update_coupled`]: the axis's smaller neighbour holds `a` and is an
@@ -240,6 +259,70 @@ mod tests {
         assert_eq!((a, c), (inf, 1.0));
         let u = godunov_update_coupled([0.3, a, 0.9], [1.0, c, 1.0], 0.1);
         assert!((u - 0.4).abs() < 1e-15, "{u}");
+    }
+
+    /// The largest root of Σ_k [(c_k u − r_k)^+]² = f² by the textbook route: for m = 1, 2, …
+    /// axes in increasing r_k / c_k, the root of the first m terms, accepted once it does not
+    /// exceed the next r_k / c_k (square root and division taken for every m).
+    fn reference_root(r: [f64; 3], c: [f64; 3], f: f64) -> f64 {
+        let mut k: Vec<(f64, f64)> = r.iter().copied().zip(c.iter().copied()).collect();
+        k.sort_by(|x, y| (x.0 / x.1).partial_cmp(&(y.0 / y.1)).unwrap());
+        let (mut sa, mut sb, mut sc) = (0.0, 0.0, -f * f);
+        for m in 0..3 {
+            sa += k[m].1 * k[m].1;
+            sb += k[m].1 * k[m].0;
+            sc += k[m].0 * k[m].0;
+            let u = (sb + (sb * sb - sa * sc).max(0.0).sqrt()) / sa;
+            if m == 2 || u <= k[m + 1].0 / k[m + 1].1 {
+                return u;
+            }
+        }
+        unreachable!()
+    }
+
+    #[test]
+    fn the_branch_tests_without_square_roots_pick_the_textbook_root() {
+        // the branch of Eq. (3) is decided by comparing squares (no square root or division):
+        // the same roots as the textbook route, on random neighbours, on exact ties between
+        // branches (a root landing exactly on the next neighbour) and with unreached neighbours
+        let inf = crate::DEFAULT_INFINITY;
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut one, mut two, mut three) = (0, 0, 0);
+        for i in 0..20_000 {
+            let f = 0.01 + 0.1 * next();
+            let mut a = [next() * 0.2, next() * 0.2, next() * 0.2];
+            match i % 4 {
+                // a tie: a2 exactly where the two-term root of a0, a1 lands
+                1 => a[2] = 0.5 * (a[0] + a[1] + (2.0 * f * f - (a[0] - a[1]).powi(2)).max(0.0).sqrt()),
+                2 => a[(i / 4) % 3] = inf,
+                _ => {}
+            }
+            let c = [1.0 - 0.9 * next(), 1.0, 1.0 - 0.9 * next()];
+            let plain = godunov_update(a, f);
+            let want = reference_root(a, [1.0; 3], f);
+            assert!((plain - want).abs() <= 1e-14 * want.abs().max(1.0), "{a:?} {f}: {plain} vs {want}");
+            let coupled = godunov_update_coupled(a, c, f);
+            let want = reference_root(a, c, f);
+            assert!((coupled - want).abs() <= 1e-14 * want.abs().max(1.0), "{a:?} {c:?} {f}: {coupled} vs {want}");
+            // and the root solves its own equation
+            let res: f64 = (0..3).map(|k| (c[k] * coupled - a[k]).max(0.0).powi(2)).sum();
+            assert!((res - f * f).abs() <= 1e-12 * f * f, "residual {}", res - f * f);
+            let mut s = a;
+            s.sort_by(|x, y| x.partial_cmp(y).unwrap());
+            match (plain <= s[1], plain <= s[2]) {
+                (true, _) => one += 1,
+                (false, true) => two += 1,
+                _ => three += 1,
+            }
+        }
+        // every branch of Eq. (3) was taken many times
+        assert!(one > 1000 && two > 1000 && three > 1000, "{one} {two} {three}");
     }
 
     #[test]
