@@ -6,9 +6,11 @@
 //! `(x − cp(x)) / |x − cp(x)|` of Eq. (8). [`TriangleTree`] answers these queries exactly:
 //! a binary tree of axis-aligned boxes over the triangles (split at the median centroid along
 //! the longest axis, a few triangles per leaf), searched depth-first, nearer child first, and
-//! pruned by the squared box distance against the best squared distance so far. The
-//! point–triangle projection is the Voronoi-region test (vertices, edges, face).
-//! Queries of many points run in parallel (rayon).
+//! pruned by the squared box distance against the best squared distance so far. An inner node
+//! holds its two children's boxes (in `f32`, rounded outwards: one cache line per step), and a
+//! leaf tests each triangle's own box before projecting onto it, which skips most projections
+//! (a leaf's box is looser than its triangles'). The point–triangle projection is the
+//! Voronoi-region test (vertices, edges, face). Queries of many points run in parallel (rayon).
 
 use rayon::prelude::*;
 
@@ -84,27 +86,58 @@ pub fn closest_point_on_triangle(p: V3, a: V3, b: V3, c: V3) -> (V3, Feature) {
     (axpy(axpy(a, v, ab), w, ac), Feature::Face)
 }
 
+/// An inner node of the tree: the boxes of its two children side by side (one cache line), so
+/// that a step of the search reads one node. The boxes are `f32`, rounded outwards, so they
+/// still contain their triangles and their distances stay lower bounds.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 struct Node {
-    lo: V3,
-    hi: V3,
-    /// leaf: first triangle in `order`; inner: index of the left child (right = left + 1)
+    lo: [[f32; 3]; 2],
+    hi: [[f32; 3]; 2],
+    /// Per child, a reference to it (see [`ChildRef`]).
+    child: [ChildRef; 2],
+}
+
+/// A subtree: an inner node's index in `nodes` (`count == 0`), or a leaf's first position in
+/// `order` and its number of triangles.
+#[derive(Clone, Copy, Debug)]
+struct ChildRef {
     start: u32,
-    /// leaf: number of triangles; inner: 0
     count: u32,
 }
 
+/// The largest `f32` at or below `x` (the box corners are rounded outwards).
+fn f32_down(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) <= x || y.is_nan() {
+        y
+    } else if y == 0.0 {
+        -f32::from_bits(1)
+    } else if y > 0.0 {
+        f32::from_bits(y.to_bits() - 1)
+    } else {
+        f32::from_bits(y.to_bits() + 1)
+    }
+}
+
+/// The smallest `f32` at or above `x`.
+fn f32_up(x: f64) -> f32 {
+    -f32_down(-x)
+}
+
+/// A box with `f32` corners that contains the `f64` box `[lo, hi]`.
+fn outward(lo: V3, hi: V3) -> ([f32; 3], [f32; 3]) {
+    ([f32_down(lo[0]), f32_down(lo[1]), f32_down(lo[2])], [f32_up(hi[0]), f32_up(hi[1]), f32_up(hi[2])])
+}
+
+/// Squared distance from `p` to the box `[lo, hi]` (0 inside); branch-free, since whether a
+/// coordinate lies below, inside or above the box is hard to predict.
 #[inline]
-fn box_dist2(p: V3, lo: V3, hi: V3) -> f64 {
+fn box_dist2(p: V3, lo: [f32; 3], hi: [f32; 3]) -> f64 {
     let mut s = 0.0;
     for k in 0..3 {
-        let d = if p[k] < lo[k] {
-            lo[k] - p[k]
-        } else if p[k] > hi[k] {
-            p[k] - hi[k]
-        } else {
-            0.0
-        };
+        // at most one of the two differences is positive
+        let d = (lo[k] as f64 - p[k]).max(p[k] - hi[k] as f64).max(0.0);
         s += d * d;
     }
     s
@@ -123,8 +156,15 @@ pub struct Closest {
 #[derive(Clone, Debug)]
 pub struct TriangleTree {
     tris: Vec<[V3; 3]>,
+    /// The triangles' indices, each leaf's contiguous.
     order: Vec<u32>,
+    /// Per position in `order`: that triangle's own box, which a leaf tests before the exact
+    /// projection (a leaf's box is looser than its triangles').
+    boxes: Vec<([f32; 3], [f32; 3])>,
     nodes: Vec<Node>,
+    /// The whole tree: its box and the reference to the root.
+    root_box: ([f32; 3], [f32; 3]),
+    root: ChildRef,
 }
 
 const LEAF_SIZE: usize = 4;
@@ -140,11 +180,14 @@ impl TriangleTree {
             .map(|t| [(t[0][0] + t[1][0] + t[2][0]) / 3.0, (t[0][1] + t[1][1] + t[2][1]) / 3.0, (t[0][2] + t[1][2] + t[2][2]) / 3.0])
             .collect();
         let mut order: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * n / LEAF_SIZE + 2);
-        nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], start: 0, count: 0 });
-        // iterative build: (node index, start, end)
-        let mut stack = vec![(0usize, 0usize, n)];
-        while let Some((ni, s, e)) = stack.pop() {
+        let mut nodes: Vec<Node> = Vec::with_capacity(n / LEAF_SIZE + 2);
+        let blank = Node { lo: [[0.0; 3]; 2], hi: [[0.0; 3]; 2], child: [ChildRef { start: 0, count: 0 }; 2] };
+        // iterative build: (the slot that refers to the subtree, start, end); a slot is a child
+        // of an inner node, or None for the root
+        let mut root = ChildRef { start: 0, count: 0 };
+        let mut root_box = ([0.0f32; 3], [0.0f32; 3]);
+        let mut stack: Vec<(Option<(usize, usize)>, usize, usize)> = vec![(None, 0, n)];
+        while let Some((slot, s, e)) = stack.pop() {
             let mut lo = [f64::INFINITY; 3];
             let mut hi = [f64::NEG_INFINITY; 3];
             let mut clo = [f64::INFINITY; 3];
@@ -162,26 +205,48 @@ impl TriangleTree {
                     chi[k] = chi[k].max(c[k]);
                 }
             }
-            nodes[ni].lo = lo;
-            nodes[ni].hi = hi;
-            if e - s <= LEAF_SIZE {
-                nodes[ni].start = s as u32;
-                nodes[ni].count = (e - s) as u32;
-                continue;
+            let reference = if e - s <= LEAF_SIZE {
+                ChildRef { start: s as u32, count: (e - s) as u32 }
+            } else {
+                let ext = sub(chi, clo);
+                let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] { 0 } else if ext[1] >= ext[2] { 1 } else { 2 };
+                let mid = (s + e) / 2;
+                order[s..e].select_nth_unstable_by(mid - s, |&x, &y| cent[x as usize][axis].total_cmp(&cent[y as usize][axis]));
+                let ni = nodes.len();
+                nodes.push(blank);
+                stack.push((Some((ni, 0)), s, mid));
+                stack.push((Some((ni, 1)), mid, e));
+                ChildRef { start: ni as u32, count: 0 }
+            };
+            let (blo, bhi) = outward(lo, hi);
+            match slot {
+                None => {
+                    root = reference;
+                    root_box = (blo, bhi);
+                }
+                Some((ni, side)) => {
+                    nodes[ni].child[side] = reference;
+                    nodes[ni].lo[side] = blo;
+                    nodes[ni].hi[side] = bhi;
+                }
             }
-            let ext = sub(chi, clo);
-            let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] { 0 } else if ext[1] >= ext[2] { 1 } else { 2 };
-            let mid = (s + e) / 2;
-            order[s..e].select_nth_unstable_by(mid - s, |&x, &y| cent[x as usize][axis].total_cmp(&cent[y as usize][axis]));
-            let left = nodes.len();
-            nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], start: 0, count: 0 });
-            nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], start: 0, count: 0 });
-            nodes[ni].start = left as u32;
-            nodes[ni].count = 0;
-            stack.push((left, s, mid));
-            stack.push((left + 1, mid, e));
         }
-        TriangleTree { tris: triangles, order, nodes }
+        let boxes = order
+            .iter()
+            .map(|&t| {
+                let tr = &triangles[t as usize];
+                let mut lo = tr[0];
+                let mut hi = tr[0];
+                for v in &tr[1..] {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(v[k]);
+                        hi[k] = hi[k].max(v[k]);
+                    }
+                }
+                outward(lo, hi)
+            })
+            .collect();
+        TriangleTree { tris: triangles, order, boxes, nodes, root_box, root }
     }
 
     pub fn len(&self) -> usize {
@@ -194,12 +259,15 @@ impl TriangleTree {
 
     /// Bytes held by the tree.
     pub fn heap_bytes(&self) -> usize {
-        self.tris.len() * std::mem::size_of::<[V3; 3]>() + self.order.len() * 4 + self.nodes.len() * std::mem::size_of::<Node>()
+        self.tris.len() * std::mem::size_of::<[V3; 3]>()
+            + self.order.len() * 4
+            + self.boxes.len() * std::mem::size_of::<([f32; 3], [f32; 3])>()
+            + self.nodes.len() * std::mem::size_of::<Node>()
     }
 
     /// Squared distance from `p` to the root box (a cheap lower bound).
     pub fn box_distance(&self, p: V3) -> f64 {
-        box_dist2(p, self.nodes[0].lo, self.nodes[0].hi).sqrt()
+        box_dist2(p, self.root_box.0, self.root_box.1).sqrt()
     }
 
     /// The exact closest point on the mesh to `p`, searching only within `max_distance`
@@ -213,7 +281,7 @@ impl TriangleTree {
     /// [`closest`](Self::closest), starting from triangle `hint` (typically the answer for a
     /// nearby point): its distance bounds the search from the start, which then only opens the
     /// boxes that can hold something closer. The answer is the same with or without a hint.
-    fn closest_from(&self, p: V3, max_distance: f64, hint: Option<usize>, stack: &mut Vec<(u32, f64)>) -> Option<Closest> {
+    fn closest_from(&self, p: V3, max_distance: f64, hint: Option<usize>, stack: &mut Vec<(ChildRef, f64)>) -> Option<Closest> {
         let mut best2 = if max_distance.is_finite() { max_distance * max_distance } else { f64::INFINITY };
         let mut best: Option<(V3, usize, Feature)> = None;
         if let Some(t) = hint {
@@ -227,17 +295,21 @@ impl TriangleTree {
             }
         }
         stack.clear();
-        let root_d = box_dist2(p, self.nodes[0].lo, self.nodes[0].hi);
+        let root_d = box_dist2(p, self.root_box.0, self.root_box.1);
         if root_d <= best2 {
-            stack.push((0, root_d));
+            stack.push((self.root, root_d));
         }
-        while let Some((ni, d2)) = stack.pop() {
+        while let Some((node, d2)) = stack.pop() {
             if d2 > best2 {
                 continue;
             }
-            let node = self.nodes[ni as usize];
             if node.count > 0 {
-                for &t in &self.order[node.start as usize..(node.start + node.count) as usize] {
+                let (a, b) = (node.start as usize, (node.start + node.count) as usize);
+                for (&t, bx) in self.order[a..b].iter().zip(&self.boxes[a..b]) {
+                    // the triangle's own box first: it bounds the distance from below
+                    if box_dist2(p, bx.0, bx.1) > best2 {
+                        continue;
+                    }
                     let tri = &self.tris[t as usize];
                     let (q, f) = closest_point_on_triangle(p, tri[0], tri[1], tri[2]);
                     let dd = sub(p, q);
@@ -252,25 +324,16 @@ impl TriangleTree {
                     }
                 }
             } else {
-                let l = node.start;
-                let r = l + 1;
-                let dl = box_dist2(p, self.nodes[l as usize].lo, self.nodes[l as usize].hi);
-                let dr = box_dist2(p, self.nodes[r as usize].lo, self.nodes[r as usize].hi);
+                let n = &self.nodes[node.start as usize];
+                let dl = box_dist2(p, n.lo[0], n.hi[0]);
+                let dr = box_dist2(p, n.lo[1], n.hi[1]);
                 // push the farther child first so that the nearer one is searched first
-                if dl <= dr {
-                    if dr <= best2 {
-                        stack.push((r, dr));
-                    }
-                    if dl <= best2 {
-                        stack.push((l, dl));
-                    }
-                } else {
-                    if dl <= best2 {
-                        stack.push((l, dl));
-                    }
-                    if dr <= best2 {
-                        stack.push((r, dr));
-                    }
+                let (near, far) = if dl <= dr { ((n.child[0], dl), (n.child[1], dr)) } else { ((n.child[1], dr), (n.child[0], dl)) };
+                if far.1 <= best2 {
+                    stack.push(far);
+                }
+                if near.1 <= best2 {
+                    stack.push(near);
                 }
             }
         }
@@ -363,6 +426,22 @@ mod tests {
             let batch = tree.closest_many(&pts, max_d);
             for (i, c) in pts.chunks_exact(3).enumerate() {
                 assert_eq!(batch[i], tree.closest([c[0], c[1], c[2]], max_d), "point {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn box_corners_round_outwards_to_f32() {
+        let mut s = 11u64;
+        let mut values = vec![0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1e-40, -1e-40, 3.4e38, -3.4e38, 1e300, -1e300, f64::MIN_POSITIVE];
+        values.extend((0..10_000).map(|i| (lcg(&mut s) - 0.5) * 10f64.powi(i % 9 - 4)));
+        for x in values {
+            let (d, u) = (f32_down(x), f32_up(x));
+            assert!((d as f64) <= x && (u as f64) >= x, "{x}: {d} {u}");
+            // and tightly: the next f32 above d lies above x
+            if d.is_finite() && d != 0.0 {
+                let next = f32::from_bits(if d > 0.0 { d.to_bits() + 1 } else { d.to_bits() - 1 });
+                assert!(next as f64 > x, "{x}: {d}, {next}");
             }
         }
     }

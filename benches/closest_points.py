@@ -1,0 +1,71 @@
+"""Closest points on a triangle mesh: the queries a mesh surface's band costs, timed alone.
+
+The band of a mesh surface (``MeshSurface.band``) is found coarse-to-fine with closest-point
+queries at block centres, then every candidate node is queried once more for its closest point
+(docs/meshes-and-output.md). This times both phases on the Stanford bunny's band (``make bench``'s
+grid, ``surface.grid(n)``), medians of warm runs, with the thread count of ``RAYON_NUM_THREADS``
+(all cores by default)::
+
+    .venv/bin/python benches/closest_points.py                  # N = 201, 5 runs
+    RAYON_NUM_THREADS=1 .venv/bin/python benches/closest_points.py --n 101
+
+To compare two commits, build each in its own checkout (``make build``) and run the script in
+both, alternately or at once on separate cores (``RAYON_NUM_THREADS=1 taskset -c 0 ...`` and
+``-c 1``): this shared machine's speed drifts by 10–40% between runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+from tubesweep.surface import coarse_to_fine_candidates  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from problems import PROBLEMS  # noqa: E402
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=201, help="grid nodes along the bunny's longest side")
+    ap.add_argument("--repeats", type=int, default=5)
+    a = ap.parse_args()
+    problem = PROBLEMS["bunny"](a.n)
+    surface, grid = problem.surface, problem.grid
+    half_width = 4 * grid.spacing  # the default outer tube
+    tree = surface.tree
+
+    def search() -> np.ndarray:
+        return coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: surface.closest(p, reach)[0])
+
+    candidates = search()
+    points = np.ascontiguousarray(grid.points(grid.unravel(candidates)))
+    reach = half_width * (1 + 1e-12)
+    tree.closest(points, reach)  # warm
+    coarse, final = [], []
+    for _ in range(a.repeats):
+        t = time.perf_counter()
+        search()
+        coarse.append(time.perf_counter() - t)
+        t = time.perf_counter()
+        d = tree.closest(points, reach)[0]
+        final.append(time.perf_counter() - t)
+    threads = os.environ.get("RAYON_NUM_THREADS", "all")
+    final_s = statistics.median(final)
+    print(f"bunny N={a.n}: {len(surface.faces)} triangles, {len(candidates):,} candidates, "
+          f"{int((d <= half_width).sum()):,} band nodes; threads {threads}, medians of {a.repeats}")
+    print(f"  coarse-to-fine search {1e3 * statistics.median(coarse):.0f} ms, closest points of the candidates "
+          f"{1e3 * final_s:.0f} ms ({1e9 * final_s / len(candidates):.0f} ns per query)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
