@@ -106,6 +106,10 @@ struct ChildRef {
     count: u32,
 }
 
+/// Where the tree's build puts a subtree's reference: the root (`None`), or child `side` of
+/// inner node `ni` (`Some((ni, side))`).
+type Slot = Option<(usize, usize)>;
+
 /// The largest `f32` at or below `x` (the box corners are rounded outwards).
 fn f32_down(x: f64) -> f32 {
     let y = x as f32;
@@ -186,7 +190,7 @@ impl TriangleTree {
         // of an inner node, or None for the root
         let mut root = ChildRef { start: 0, count: 0 };
         let mut root_box = ([0.0f32; 3], [0.0f32; 3]);
-        let mut stack: Vec<(Option<(usize, usize)>, usize, usize)> = vec![(None, 0, n)];
+        let mut stack: Vec<(Slot, usize, usize)> = vec![(None, 0, n)];
         while let Some((slot, s, e)) = stack.pop() {
             let mut lo = [f64::INFINITY; 3];
             let mut hi = [f64::NEG_INFINITY; 3];
