@@ -29,17 +29,17 @@ pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
     // two terms: (u − a0)^2 + (u − a1)^2 = f^2  (second branch of Eq. (3))
     let d = a[0] - a[1];
     let disc2 = nonneg(2.0 * f * f - d * d);
+    let two_term_root = || 0.5 * (a[0] + a[1] + disc2.sqrt());
     if D == 2 {
-        return 0.5 * (a[0] + a[1] + disc2.sqrt());
+        return two_term_root();
     }
     // the two-term root stays at or below a2 iff sqrt(disc2) ≤ g = 2 a2 − a0 − a1 (≥ 0, as
     // the a_k are sorted), i.e. iff disc2 ≤ g²: decided without the square root, which is then
     // taken only for the root returned (it sits on the Gauss–Seidel chain of the sweep)
     let g = 2.0 * a[2] - a[0] - a[1];
     if disc2 <= g * g {
-        return 0.5 * (a[0] + a[1] + disc2.sqrt());
+        return two_term_root();
     }
-    let u2 = 0.5 * (a[0] + a[1] + disc2.sqrt());
     if D == 3 {
         // three terms: 3u^2 − 2 s u + (q − f^2) = 0
         let s = a[0] + a[1] + a[2];
@@ -50,18 +50,17 @@ pub fn godunov_update<const D: usize>(mins: [f64; D], f: f64) -> f64 {
     // general D (not used by the solvers, kept for completeness)
     let mut sum = a[0] + a[1];
     let mut sum_sq = a[0] * a[0] + a[1] * a[1];
-    let mut u = u2;
     for m in 2..D {
         sum += a[m];
         sum_sq += a[m] * a[m];
         let mf = (m + 1) as f64;
         let disc = sum * sum - mf * (sum_sq - f * f);
-        u = (sum + disc.max(0.0).sqrt()) / mf;
+        let u = (sum + disc.max(0.0).sqrt()) / mf;
         if m + 1 == D || u <= a[m + 1] {
             return u;
         }
     }
-    u
+    unreachable!("the loop returns at m = D − 1")
 }
 
 /// The Godunov update for a node coupled to extension-layer neighbours: the largest root `ū` of
