@@ -3,12 +3,17 @@
 Usage::
 
     .venv/bin/python benches/warm_solves.py [N] [REPEATS]      # default N = 201, 7 solves
+    .venv/bin/python benches/warm_solves.py 201 7 --dense      # φ handed in as an array
 
 It uses only ``ts.solve`` and ``sol.stats``, so it runs unchanged on older checkouts: to compare
 two commits, build both (``make build`` in each checkout) and run it alternately in the two,
 several rounds, which is how docs/benchmarks.md compares set-up times across commits. One
-untimed solve first (the allocator's thresholds, the threads); OpenBLAS single-threaded as in
-``make bench``.
+untimed solve first (the allocator's thresholds, the threads), whose peak resident memory above
+the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
+``benches/run.py``); OpenBLAS single-threaded as in
+``make bench``. With ``--dense`` the surface is ``ts.LevelSet`` of φ sampled on the whole grid
+(the sphere's exact signed distance, an array of the grid's shape, as a user with a level set
+array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine.
 """
 
 from __future__ import annotations
@@ -27,22 +32,30 @@ import tubesweep as ts  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from problems import sphere  # noqa: E402
+from run import _peak_kb, _reset_peak, _status_kb  # noqa: E402
 
 
 def main() -> int:
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 201
-    repeats = int(sys.argv[2]) if len(sys.argv) > 2 else 7
+    dense = "--dense" in sys.argv
+    args = [a for a in sys.argv[1:] if a != "--dense"]
+    n = int(args[0]) if len(args) > 0 else 201
+    repeats = int(args[1]) if len(args) > 1 else 7
     p = sphere(n)
-    ts.solve(p.surface, p.grid, sources=[p.source])
+    surface = ts.LevelSet(p.dense_phi(p.grid)) if dense else p.surface
+    # the peak resident memory the first solve adds, as benches/run.py measures it ("ΔRSS")
+    reset_ok = _reset_peak()
+    before = _status_kb("VmRSS") or 0
+    ts.solve(surface, p.grid, sources=[p.source])
+    delta_rss_mb = round((_peak_kb(reset_ok) - before) / 1024, 1)
     wall, setup, sweeps = [], [], []
     for _ in range(repeats):
         t = time.perf_counter()
-        sol = ts.solve(p.surface, p.grid, sources=[p.source])
+        sol = ts.solve(surface, p.grid, sources=[p.source])
         wall.append(time.perf_counter() - t)
         setup.append(sol.stats.setup_seconds)
         sweeps.append(sol.stats.seconds)
     ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
-    print(json.dumps(dict(n=n, repeats=repeats, **ms)))
+    print(json.dumps(dict(n=n, repeats=repeats, dense=dense, **ms, first_solve_delta_rss_mb=delta_rss_mb)))
     return 0
 
 

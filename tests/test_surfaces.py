@@ -183,6 +183,59 @@ def test_rust_outward_directions_are_the_numpy_central_differences_bit_for_bit(s
     assert np.array_equal(geom.direction, want)
 
 
+def _numpy_band_of_samples(arr, grid, half_width):
+    """The NumPy code the Rust set-up of a sampled φ replaced: the band by a mask of the whole
+    array, central differences of the samples, one-sided at the grid's faces."""
+    flat = arr.reshape(-1)
+    linear = np.flatnonzero(np.abs(flat) <= half_width).astype(np.int64)
+    values = flat[linear]
+    h, d = grid.spacing, grid.ndim
+    g = np.empty((len(linear), d))
+    strides = [int(np.prod(grid.shape[k + 1 :])) for k in range(d)]
+    for k in range(d):
+        c = (linear // strides[k]) % grid.shape[k]
+        lo_ok, hi_ok = c > 0, c < grid.shape[k] - 1
+        up = np.where(hi_ok, flat[np.where(hi_ok, linear + strides[k], linear)], values)
+        dn = np.where(lo_ok, flat[np.where(lo_ok, linear - strides[k], linear)], values)
+        g[:, k] = (up - dn) / ((hi_ok.astype(float) + lo_ok.astype(float)) * h)
+    norm = np.linalg.norm(g, axis=1)
+    direction = (np.sign(values)[:, None] * (g / np.where(norm > 1e-12, norm, 1.0)[:, None])).astype(np.float32)
+    return linear, values, direction
+
+
+@pytest.mark.parametrize("shape", [(40, 57, 33), (61, 61, 61), (90, 70)])
+def test_sampled_phi_band_and_directions_are_the_numpy_formulas_bit_for_bit(shape):
+    # an off-centre sphere (circle) that the box cuts, so that band nodes lie on its faces, with
+    # noise so that nothing is symmetric
+    d = len(shape)
+    h = 2.0 / (max(shape) - 1)
+    grid = ts.Grid((-1.0,) * d, tuple(-1.0 + h * (n - 1) for n in shape), shape)
+    X = np.meshgrid(*[grid.lower[k] + h * np.arange(shape[k]) for k in range(d)], indexing="ij")
+    centre = [0.3, -0.2, 0.1][:d]
+    rng = np.random.default_rng(7)
+    phi = np.sqrt(sum((X[k] - centre[k]) ** 2 for k in range(d))) - 0.75 + 1e-3 * rng.standard_normal(shape)
+    geom = ts.LevelSet(phi).band(grid, 4 * h)
+    linear, values, direction = _numpy_band_of_samples(phi, grid, 4 * h)
+    assert np.array_equal(geom.linear, linear) and np.array_equal(geom.signed, values)
+    assert np.array_equal(geom.direction, direction)
+    on_face = np.zeros(len(linear), bool)
+    for k, c in enumerate(grid.unravel(linear).T):
+        on_face |= (c == 0) | (c == shape[k] - 1)
+    assert on_face.sum() > 50  # the one-sided differences were compared too
+    assert geom.native_band is not None and len(geom.native_band) == len(linear)
+    # a view in another memory order gives the same band
+    fortran = np.asfortranarray(phi)
+    assert np.array_equal(ts.LevelSet(fortran).band(grid, 4 * h).direction, direction)
+
+
+def test_sampled_phi_with_nan_or_inf_names_the_first_bad_index():
+    phi = np.linspace(-1, 1, 21 * 22 * 23).reshape(21, 22, 23)
+    phi[3, 4, 5] = np.inf
+    phi[7, 0, 1] = np.nan
+    with pytest.raises(ValueError, match=r"phi contains NaN or inf \(first at index \(3, 4, 5\)\)"):
+        ts.LevelSet(phi)
+
+
 def test_candidates_of_the_coarse_to_fine_search_are_sorted_and_cover_the_band():
     from tubesweep.surface import coarse_to_fine_candidates
 

@@ -22,6 +22,16 @@ def keep_within(
     linear_out: npt.NDArray[np.uint64],  # written from the front
     values_out: npt.NDArray[np.float64],  # written from the front
 ) -> int: ...
+def first_non_finite(phi: npt.NDArray[np.float64]) -> Optional[int]: ...  # C order, C-contiguous
+def band_of_samples(
+    phi: npt.NDArray[np.float64], half_width: float  # φ at every grid node, C-contiguous
+) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
+def outward_directions_of_samples(
+    phi: npt.NDArray[np.float64],
+    spacing: float,
+    linear: npt.NDArray[np.uint64],
+    direction: npt.NDArray[np.float32],  # (len(linear), d), written
+) -> npt.NDArray[np.float64]: ...
 def neighbour_table(
     shape: List[int], linear: npt.NDArray[np.uint64], start: int, stop: int
 ) -> npt.NDArray[np.int32]: ...  # (2·(d − 1), stop − start)

@@ -20,7 +20,6 @@ from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
-from ._linalg import row_norms
 from .grid import Grid
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
@@ -52,8 +51,8 @@ class BandGeometry:
         per node in 3D). A user's :meth:`Surface.band` may leave it False (the default) and
         return cached arrays: they are copied, never modified.
     native_band : tubesweep._native.Band or None
-        The band structure of ``linear`` when the surface already built it (level sets given by a
-        callable, whose outward directions read its neighbours): the solver uses it instead of
+        The band structure of ``linear`` when the surface already built it (level sets; for a
+        callable φ its neighbours give the outward directions): the solver uses it instead of
         building it again. None (the default) otherwise.
     """
 
@@ -196,12 +195,6 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
     return linear, values
 
 
-def _unit(g: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-    norm = row_norms(g)
-    safe = np.where(norm > 1e-12, norm, 1.0)
-    return g / safe[:, None], norm
-
-
 class LevelSet(Surface):
     """A curve or surface given as the zero level set of φ, close to a signed distance function.
 
@@ -232,11 +225,15 @@ class LevelSet(Surface):
             self._fn: Optional[Callable[[np.ndarray], np.ndarray]] = phi
             self._array: Optional[np.ndarray] = None
         else:
-            arr = np.asarray(phi, dtype=float)
+            from . import _native
+
+            # C order, as the core reads it (no copy for a C-ordered float64 array)
+            arr = np.ascontiguousarray(phi, dtype=float)
             if arr.ndim not in (2, 3):
                 raise ValueError(f"phi array must be 2D or 3D (the grid's shape); got {arr.ndim} dimensions")
-            if not np.all(np.isfinite(arr)):
-                i = np.unravel_index(int(np.flatnonzero(~np.isfinite(arr))[0]), arr.shape)
+            bad = _native.first_non_finite(arr)
+            if bad is not None:
+                i = np.unravel_index(bad, arr.shape)
                 raise ValueError(f"phi contains NaN or inf (first at index {tuple(int(x) for x in i)}); φ must be finite")
             self._fn = None
             self._array = arr
@@ -270,27 +267,6 @@ class LevelSet(Surface):
 
         assert self._array is not None
         return _interp_dense(self._array, grid, points)
-
-    def _gradient_at_nodes(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int) -> np.ndarray:
-        """Central differences of a sampled φ at band nodes ``lo:hi`` (one-sided at the box
-        boundary), (hi − lo, d)."""
-        h = grid.spacing
-        d = grid.ndim
-        lin = linear[lo:hi]
-        val = values[lo:hi]
-        g = np.empty((len(lin), d))
-        strides = np.array([int(np.prod(grid.shape[k + 1 :])) for k in range(d)], dtype=np.int64)
-        assert self._array is not None
-        flat = self._array.reshape(-1)
-        for k in range(d):
-            c = (lin // strides[k]) % grid.shape[k]  # index along axis k, without a (K, d) array
-            lo_ok = c > 0
-            hi_ok = c < grid.shape[k] - 1
-            up = np.where(hi_ok, flat[np.where(hi_ok, lin + strides[k], lin)], val)
-            dn = np.where(lo_ok, flat[np.where(lo_ok, lin - strides[k], lin)], val)
-            width = (hi_ok.astype(float) + lo_ok.astype(float)) * h
-            g[:, k] = (up - dn) / width
-        return g
 
     def _outward_directions(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int,
                             direction: np.ndarray, band: Any) -> np.ndarray:
@@ -328,29 +304,29 @@ class LevelSet(Surface):
             from .redistance import redistanced_band
 
             return redistanced_band(self, grid, half_width)
+        from . import _native
+
         if self._array is not None:
-            flat = self._array.reshape(-1)
-            linear = np.flatnonzero(np.abs(flat) <= half_width).astype(np.int64)
-            values = flat[linear]
+            # one pass over the samples in Rust, on all threads, with no temporary of the grid's
+            # size (tubesweep_core::sampled)
+            ulinear, values = _native.band_of_samples(self._array, half_width)
+            linear = ulinear.view(np.int64)  # below 2^63: the same bits
         else:
             linear, values = discover_band(self._fn, grid, half_width, self.lipschitz)  # type: ignore[arg-type]
         if linear.size == 0:
             return BandGeometry(linear, values, values, np.zeros((0, grid.ndim), np.float32))
-        native_band = None
-        if self._array is None:
-            # the solver's band structure, built now: its neighbours give the outward directions
-            # (no separate neighbour search), and the solver takes it over
-            from . import _native
-
-            native_band = _native.Band.from_linear(list(grid.shape), linear.view(np.uint64))
+        # the solver's band structure, built now: the solver takes it over (and for a callable φ
+        # its neighbours give the outward directions, no separate neighbour search)
+        native_band = _native.Band.from_linear(list(grid.shape), linear.view(np.uint64))
         # the outward direction sgn(φ) ∇φ/|∇φ|, chunk by chunk (temporaries stay O(chunk))
         direction = np.empty((len(linear), grid.ndim), np.float32)
         near_lo, near_hi, all_lo, all_hi = np.inf, -np.inf, np.inf, -np.inf
         for lo in range(0, len(linear), EVAL_CHUNK):
             hi = min(len(linear), lo + EVAL_CHUNK)
             if self._array is not None:
-                n, norm = _unit(self._gradient_at_nodes(grid, linear, values, lo, hi))
-                direction[lo:hi] = np.sign(values[lo:hi])[:, None] * n
+                # central differences of the samples, one-sided at the grid's faces
+                norm = _native.outward_directions_of_samples(self._array, grid.spacing, linear[lo:hi].view(np.uint64),
+                                                             direction[lo:hi])
             else:
                 norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
             near = np.abs(values[lo:hi]) <= 0.5 * half_width

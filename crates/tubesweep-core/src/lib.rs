@@ -15,6 +15,7 @@
 //! | exact signed distances of the analytic surfaces (sphere, torus) | [`analytic`] | Sect. 6 |
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the last split of the coarse-to-fine band search | [`discovery`] | — |
+//! | the band and directions of a φ sampled on the whole grid | [`sampled`] | Eq. (8), Sect. 4 |
 //! | extension directions sgn(φ)∇φ/|∇φ| by central differences | [`normals`] | Eq. (8), Sect. 4 |
 //! | the outer rim of the layer, extended into last in one pass | [`rim`] | Eq. (5) |
 //! | the longest grid path from the sources (numerical infinity, front window) | [`grid_hops`] | — |
@@ -41,6 +42,7 @@ pub mod lax_friedrichs;
 pub mod mesh;
 pub mod normals;
 pub mod rim;
+pub mod sampled;
 pub mod schedule;
 pub mod sweep;
 #[cfg(test)]

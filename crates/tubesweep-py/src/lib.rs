@@ -5,7 +5,7 @@
 mod errors;
 
 use errors::to_pyerr;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadwriteArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadonlyArrayDyn, PyReadwriteArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -982,6 +982,45 @@ fn outward_directions<'py>(
     Ok(norms.into_pyarray(py))
 }
 
+/// The position (in C order) of the first NaN or infinite sample of `phi`, or None. See
+/// `tubesweep_core::sampled::first_non_finite`.
+#[pyfunction]
+fn first_non_finite(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>) -> PyResult<Option<usize>> {
+    let s = c_slice(&phi, "phi")?;
+    Ok(py.detach(|| tubesweep_core::sampled::first_non_finite(s)))
+}
+
+/// Sorted linear node indices and a value at each, as NumPy arrays.
+type LinearAndValues<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>);
+
+/// The band `|φ| ≤ half_width` of a φ sampled on the whole grid (`phi` has the grid's shape):
+/// sorted C-order linear indices and φ there. See `tubesweep_core::sampled::band_of_samples`.
+#[pyfunction]
+fn band_of_samples<'py>(py: Python<'py>, phi: PyReadonlyArrayDyn<'py, f64>, half_width: f64) -> PyResult<LinearAndValues<'py>> {
+    let shape = phi.shape().to_vec();
+    let s = c_slice(&phi, "phi")?;
+    let (linear, values) = py.detach(|| tubesweep_core::sampled::band_of_samples(&shape, s, half_width)).map_err(to_pyerr)?;
+    Ok((linear.into_pyarray(py), values.into_pyarray(py)))
+}
+
+/// The outward directions sgn(φ)∇φ/|∇φ| of a φ sampled on the whole grid at the band nodes
+/// `linear`, written to `direction` ((len(linear), d) float32, C-contiguous); returns |∇φ|. See
+/// `tubesweep_core::sampled::outward_directions_of_samples`.
+#[pyfunction]
+fn outward_directions_of_samples<'py>(
+    py: Python<'py>,
+    phi: PyReadonlyArrayDyn<'py, f64>,
+    spacing: f64,
+    linear: PyReadonlyArray1<'py, u64>,
+    mut direction: PyReadwriteArray2<'py, f32>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let shape = phi.shape().to_vec();
+    let (s, lin) = (c_slice(&phi, "phi")?, c_slice(&linear, "linear")?);
+    let dir = c_slice_mut(&mut direction, "direction")?;
+    let norms = py.detach(|| tubesweep_core::sampled::outward_directions_of_samples(&shape, spacing, s, lin, dir)).map_err(to_pyerr)?;
+    Ok(norms.into_pyarray(py))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
@@ -991,6 +1030,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(block_children, m)?)?;
     m.add_function(wrap_pyfunction!(node_points, m)?)?;
     m.add_function(wrap_pyfunction!(keep_within, m)?)?;
+    m.add_function(wrap_pyfunction!(first_non_finite, m)?)?;
+    m.add_function(wrap_pyfunction!(band_of_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(outward_directions_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;

@@ -1,0 +1,206 @@
+//! A level set function φ *sampled on the whole grid* (the user hands in an array of the grid's
+//! shape): its band `|φ| ≤ half-width` and its extension directions `sgn(φ) ∇φ/|∇φ|` (paper
+//! Eq. (8), central differences as in Sect. 4), read straight from the samples.
+//!
+//! The array is read once to find the band, on all threads, with no temporary of the grid's size
+//! (the NumPy route, `np.flatnonzero(np.abs(phi) <= w)`, made two: |φ| and a mask); the
+//! directions then read φ at the band nodes' neighbours from the array itself, so nothing has to
+//! be looked up in the band. Along an axis where a node's neighbour lies outside the grid the
+//! difference is one-sided, `(φ(x) − φ(x − Δx e_k)) / Δx` (and likewise on the other side): the
+//! arithmetic of the NumPy code this replaced, so the directions are the same bits.
+
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+
+/// Grid nodes per parallel task when the array is scanned.
+const SCAN_CHUNK: usize = 1 << 16;
+
+/// Band nodes per parallel task when the directions are computed.
+const NODE_CHUNK: usize = 1 << 13;
+
+fn check_shape(shape: &[usize], samples: &[f64]) -> Result<()> {
+    if !(2..=3).contains(&shape.len()) || shape.contains(&0) {
+        return Err(Error::invalid("grid", format!("only 2D and 3D grids are supported, got shape {shape:?}")));
+    }
+    let total = shape.iter().try_fold(1usize, |p, &n| p.checked_mul(n));
+    if total != Some(samples.len()) {
+        return Err(Error::invalid("phi", format!("expected {} samples (the grid {shape:?}), got {}", total.unwrap_or(usize::MAX), samples.len())));
+    }
+    Ok(())
+}
+
+/// The position of the first sample that is NaN or infinite, if any (on all threads).
+pub fn first_non_finite(samples: &[f64]) -> Option<usize> {
+    samples
+        .par_chunks(SCAN_CHUNK)
+        .enumerate()
+        .find_map_first(|(j, chunk)| chunk.iter().position(|v| !v.is_finite()).map(|i| j * SCAN_CHUNK + i))
+}
+
+/// The band of a sampled φ: the sorted C-order linear indices of the nodes with
+/// `|φ| ≤ half_width`, and φ there. `samples` holds φ at every node of the grid of `shape`, in C
+/// order. NaN samples are never in the band (the caller checks for them first,
+/// [`first_non_finite`]).
+pub fn band_of_samples(shape: &[usize], samples: &[f64], half_width: f64) -> Result<(Vec<u64>, Vec<f64>)> {
+    check_shape(shape, samples)?;
+    if half_width.is_nan() || half_width < 0.0 {
+        return Err(Error::invalid("half_width", format!("must be a non-negative width, got {half_width}")));
+    }
+    let parts: Vec<(Vec<u64>, Vec<f64>)> = samples
+        .par_chunks(SCAN_CHUNK)
+        .enumerate()
+        .map(|(j, chunk)| {
+            let mut linear = Vec::new();
+            let mut values = Vec::new();
+            let base = (j * SCAN_CHUNK) as u64;
+            for (i, &v) in chunk.iter().enumerate() {
+                if v.abs() <= half_width {
+                    linear.push(base + i as u64);
+                    values.push(v);
+                }
+            }
+            (linear, values)
+        })
+        .collect();
+    let total: usize = parts.iter().map(|p| p.0.len()).sum();
+    let mut linear = Vec::with_capacity(total);
+    let mut values = Vec::with_capacity(total);
+    for (l, v) in parts {
+        linear.extend_from_slice(&l);
+        values.extend_from_slice(&v);
+    }
+    Ok((linear, values))
+}
+
+/// The outward directions `sgn(φ) g/|g|` (as f32, written to `direction`, one row of `d` per
+/// node) and `|g|` (returned) at the band nodes with linear indices `linear` (each inside the
+/// grid), where `g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)` with φ read from `samples`, one-sided
+/// where the neighbour lies outside the grid. `|g|` is summed in axis order; where it is at most
+/// 1e-12 the direction is `sgn(φ) g`.
+pub fn outward_directions_of_samples(shape: &[usize], spacing: f64, samples: &[f64], linear: &[u64], direction: &mut [f32]) -> Result<Vec<f64>> {
+    check_shape(shape, samples)?;
+    let d = shape.len();
+    if direction.len() != linear.len() * d {
+        return Err(Error::invalid("direction", format!("expected shape ({}, {d})", linear.len())));
+    }
+    if let Some(&l) = linear.iter().find(|&&l| l >= samples.len() as u64) {
+        return Err(Error::invalid("linear", format!("node {l} lies outside the grid of {} nodes", samples.len())));
+    }
+    let mut stride = [1usize; 3];
+    for k in (0..d - 1).rev() {
+        stride[k] = stride[k + 1] * shape[k + 1];
+    }
+    let mut norms = vec![0.0f64; linear.len()];
+    direction
+        .par_chunks_mut(NODE_CHUNK * d)
+        .zip(norms.par_chunks_mut(NODE_CHUNK))
+        .zip(linear.par_chunks(NODE_CHUNK))
+        .for_each(|((dir, norms), lin)| {
+            for (o, &l) in lin.iter().enumerate() {
+                let l = l as usize;
+                let own = samples[l];
+                let mut g = [0.0f64; 3];
+                let mut sq = 0.0f64;
+                for k in 0..d {
+                    let c = (l / stride[k]) % shape[k];
+                    let (up_in, down_in) = (c + 1 < shape[k], c > 0);
+                    let up = if up_in { samples[l + stride[k]] } else { own };
+                    let down = if down_in { samples[l - stride[k]] } else { own };
+                    // (1 + 1)·Δx = 2Δx exactly; one-sided: Δx
+                    let width = (up_in as u8 + down_in as u8) as f64 * spacing;
+                    g[k] = (up - down) / width;
+                    if k == 0 {
+                        sq = g[0] * g[0];
+                    } else {
+                        sq += g[k] * g[k];
+                    }
+                }
+                let norm = sq.sqrt();
+                norms[o] = norm;
+                let scale = if norm > 1e-12 { norm } else { 1.0 };
+                let sgn = if own > 0.0 {
+                    1.0
+                } else if own < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                };
+                for k in 0..d {
+                    dir[o * d + k] = (sgn * (g[k] / scale)) as f32;
+                }
+            }
+        });
+    Ok(norms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere_samples(n: usize, r: f64) -> Vec<f64> {
+        let c = (n - 1) as f64 / 2.0;
+        (0..n * n * n)
+            .map(|l| {
+                let (i, j, k) = ((l / (n * n)) as f64, ((l / n) % n) as f64, (l % n) as f64);
+                ((i - c).powi(2) + (j - c).powi(2) + (k - c).powi(2)).sqrt() - r
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_band_is_every_node_within_the_width_in_order() {
+        let n = 41;
+        let s = sphere_samples(n, 12.0);
+        let (linear, values) = band_of_samples(&[n, n, n], &s, 2.5).unwrap();
+        let expected: Vec<u64> = (0..s.len() as u64).filter(|&l| s[l as usize].abs() <= 2.5).collect();
+        assert_eq!(linear, expected);
+        assert!(linear.iter().zip(&values).all(|(&l, &v)| v == s[l as usize]));
+        assert!(band_of_samples(&[n, n], &s, 2.5).is_err());
+        assert!(band_of_samples(&[n, n, n], &s, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn non_finite_samples_are_found_first_to_last() {
+        let mut s = vec![0.5; 300_000];
+        assert_eq!(first_non_finite(&s), None);
+        s[250_000] = f64::INFINITY;
+        s[70_001] = f64::NAN;
+        assert_eq!(first_non_finite(&s), Some(70_001));
+    }
+
+    #[test]
+    fn directions_point_away_from_the_surface_and_are_one_sided_at_the_box() {
+        // φ = x − 2.5 along axis 0 of a 6×4 grid (Δx = 0.5: φ = 0.5 i − 1.25), every node
+        let shape = [6usize, 4];
+        let s: Vec<f64> = (0..24).map(|l| 0.5 * (l / 4) as f64 - 1.25).collect();
+        let linear: Vec<u64> = (0..24).collect();
+        let mut dir = vec![0.0f32; 48];
+        let norms = outward_directions_of_samples(&shape, 0.5, &s, &linear, &mut dir).unwrap();
+        for l in 0..24 {
+            // one-sided on the first and last row and column: still exactly 1 and 0
+            assert_eq!(norms[l], 1.0, "node {l}");
+            assert_eq!(dir[2 * l], if s[l] > 0.0 { 1.0 } else { -1.0 });
+            assert_eq!(dir[2 * l + 1], 0.0);
+        }
+        // a sphere: the direction is the unit radial vector to within O(Δx²)
+        let n = 31;
+        let s = sphere_samples(n, 10.7);
+        let (linear, _) = band_of_samples(&[n, n, n], &s, 2.0).unwrap();
+        let mut dir = vec![0.0f32; 3 * linear.len()];
+        let norms = outward_directions_of_samples(&[n, n, n], 1.0, &s, &linear, &mut dir).unwrap();
+        let c = (n - 1) as f64 / 2.0;
+        for (o, &l) in linear.iter().enumerate() {
+            let l = l as usize;
+            let x = [(l / (n * n)) as f64 - c, ((l / n) % n) as f64 - c, (l % n) as f64 - c];
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            let sgn = s[l].signum();
+            for k in 0..3 {
+                let e = (dir[3 * o + k] as f64 - sgn * x[k] / r).abs();
+                assert!(e < 0.01, "node {l}: {e}");
+            }
+            assert!((norms[o] - 1.0).abs() < 0.01);
+        }
+        assert!(outward_directions_of_samples(&[n, n, n], 1.0, &s, &[(n * n * n) as u64], &mut [0.0; 3]).is_err());
+        assert!(outward_directions_of_samples(&[n, n, n], 1.0, &s, &linear, &mut dir[1..]).is_err());
+    }
+}
