@@ -4,6 +4,7 @@ Usage::
 
     .venv/bin/python benches/warm_solves.py [N] [REPEATS]      # default N = 201, 7 solves
     .venv/bin/python benches/warm_solves.py 201 7 --dense      # φ handed in as an array
+    .venv/bin/python benches/warm_solves.py 101 3 --redistance # φ = |x|² − r² as an array
 
 It uses only ``ts.solve`` and ``sol.stats``, so it runs unchanged on older checkouts: to compare
 two commits, build both (``make build`` in each checkout) and run it alternately in the two,
@@ -13,7 +14,9 @@ the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
 ``benches/run.py``); OpenBLAS single-threaded as in
 ``make bench``. With ``--dense`` the surface is ``ts.LevelSet`` of φ sampled on the whole grid
 (the sphere's exact signed distance, an array of the grid's shape, as a user with a level set
-array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine.
+array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine. With
+``--redistance`` the array is ``|x|² − r²`` (the same sphere, not a distance function) and the
+surface ``ts.LevelSet(array, redistance=True)``.
 """
 
 from __future__ import annotations
@@ -36,12 +39,20 @@ from run import _peak_kb, _reset_peak, _status_kb  # noqa: E402
 
 
 def main() -> int:
-    dense = "--dense" in sys.argv
-    args = [a for a in sys.argv[1:] if a != "--dense"]
+    flags = {"--dense", "--redistance"}
+    redistance = "--redistance" in sys.argv
+    dense = "--dense" in sys.argv or redistance
+    args = [a for a in sys.argv[1:] if a not in flags]
     n = int(args[0]) if len(args) > 0 else 201
     repeats = int(args[1]) if len(args) > 1 else 7
     p = sphere(n)
-    surface = ts.LevelSet(p.dense_phi(p.grid)) if dense else p.surface
+    if redistance:
+        d = p.dense_phi(p.grid)  # |x − c| − r
+        surface = ts.LevelSet(d * (d + 2 * 0.5), redistance=True)  # |x − c|² − r², r = 0.5
+    elif dense:
+        surface = ts.LevelSet(p.dense_phi(p.grid))
+    else:
+        surface = p.surface
     # the peak resident memory the first solve adds, as benches/run.py measures it ("ΔRSS")
     reset_ok = _reset_peak()
     before = _status_kb("VmRSS") or 0
@@ -55,7 +66,7 @@ def main() -> int:
         setup.append(sol.stats.setup_seconds)
         sweeps.append(sol.stats.seconds)
     ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
-    print(json.dumps(dict(n=n, repeats=repeats, dense=dense, **ms, first_solve_delta_rss_mb=delta_rss_mb)))
+    print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, **ms, first_solve_delta_rss_mb=delta_rss_mb)))
     return 0
 
 

@@ -148,6 +148,45 @@ def test_redistance_reproduces_the_exact_distance_solution_2d_and_3d():
     assert np.max(np.abs(s3(V) - r3(V))) < 1e-3
 
 
+@pytest.mark.parametrize("d, n", [(2, 121), (3, 41)])
+def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
+    # Rust runs the projection of a sampled φ; it must be the NumPy iterations of
+    # tubesweep.redistance on the multilinear interpolant, bit for bit (flags included)
+    from tubesweep import _native
+    from tubesweep.euclidean import _interp_dense
+    from tubesweep.redistance import SAMPLED_GRADIENT_STEP, estimate_lipschitz, project_to_level_set
+
+    grid = ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
+    X = np.meshgrid(*[np.linspace(-1, 1, n)] * d, indexing="ij")
+    phi = (sum(x**2 for x in X) - 0.25) * (1 + 0.3 * X[0]) + 0.05 * np.sin(3 * X[1])
+    h = grid.spacing
+    surface = ts.LevelSet(phi, redistance=True)
+    want = 1.25 * float(np.max(np.sqrt(sum(g * g for g in np.gradient(phi, h)))))
+    assert estimate_lipschitz(surface, grid) == want
+    rng = np.random.default_rng(3)
+    x = rng.uniform(-1.1, 1.1, (3000, d))  # some beyond the box, where φ is clamped
+    cp0, s0, ok0 = project_to_level_set(lambda p: _interp_dense(phi, grid, p), x, SAMPLED_GRADIENT_STEP * h)
+    cp1, s1, ok1 = _native.project_to_sampled_level_set(phi, [-1.0] * d, h, x, SAMPLED_GRADIENT_STEP * h, 6, 30, 1e-12)
+    assert np.array_equal(cp0, cp1) and np.array_equal(s0, s1) and np.array_equal(ok0, ok1)
+    assert 0 < ok1.sum() < len(x)  # both outcomes were compared
+    # and the surface uses it: its distances are those of the projection at its band nodes
+    geom = surface.band(grid, 4 * h)
+    xb = grid.points(grid.unravel(geom.linear))
+    _, sb, okb = project_to_level_set(lambda p: _interp_dense(phi, grid, p), xb, SAMPLED_GRADIENT_STEP * h)
+    assert okb.all() and np.array_equal(geom.signed, sb)
+
+
+def test_sampled_redistance_in_3d_matches_the_sphere():
+    # the squashed quadric of the test above, sampled: its zero set is the sphere of radius 0.5
+    g3 = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    X = np.stack(np.meshgrid(*[np.linspace(-1, 1, 41)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    phi = (3 * (np.sum(X**2, axis=1) - 0.25) * (1 + 0.5 * X[:, 0])).reshape((41,) * 3)
+    s3 = ts.solve(ts.LevelSet(phi, redistance=True), g3, [(-0.5, 0, 0)])
+    r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)])
+    V, _ = Sphere().triangulation(12)
+    assert np.max(np.abs(s3(V) - r3(V))) < 1e-3  # 1.9e-4 (the interpolant's zero set is not the sphere's)
+
+
 # ------------------------------------------------------------------------------ band set-up in Rust
 def _numpy_outward_directions(fn, grid, linear, phi):
     """The NumPy central differences the Rust set-up replaced: φ at band neighbours looked up,

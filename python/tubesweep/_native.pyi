@@ -26,6 +26,17 @@ def first_non_finite(phi: npt.NDArray[np.float64]) -> Optional[int]: ...  # C or
 def band_of_samples(
     phi: npt.NDArray[np.float64], half_width: float  # φ at every grid node, C-contiguous
 ) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
+def max_gradient_norm_of_samples(phi: npt.NDArray[np.float64], spacing: float) -> float: ...
+def project_to_sampled_level_set(
+    phi: npt.NDArray[np.float64],  # φ at every grid node, C-contiguous
+    lower: List[float],
+    spacing: float,
+    points: npt.NDArray[np.float64],  # (M, d)
+    eps: float,
+    newton_steps: int,
+    orthogonality_steps: int,
+    tol: float,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
 def outward_directions_of_samples(
     phi: npt.NDArray[np.float64],
     spacing: float,

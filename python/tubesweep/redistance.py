@@ -12,6 +12,11 @@ The signed distance is ``sgn φ(x) · |x − cp(x)|`` and the extension directio
 ``sgn φ(x) (x − cp(x)) / |x − cp(x)|`` is the paper's ``sgn(φ) n`` of Eq. (8) (equivalently the
 closest-point direction of Sect. 5.2). Gradients are central differences of φ with step
 ``GRADIENT_STEP · Δx`` (a callable φ) or ``0.5 Δx`` (a sampled φ, multilinearly interpolated).
+
+For a sampled φ (an array) the same iterations, with the same arithmetic and bits, run in Rust on
+all threads (``tubesweep_core::redistance``), and the band's candidates and the bound on |∇φ|
+come from one pass over the samples each (``tubesweep_core::sampled``); this module's NumPy code
+runs them for a callable φ, which only Python can evaluate.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from typing import Callable, Tuple
 
 import numpy as np
 
-__all__ = ["project_to_level_set", "GRADIENT_STEP"]
+__all__ = ["project_to_level_set", "GRADIENT_STEP", "SAMPLED_GRADIENT_STEP"]
 
 #: Finite-difference step for ∇φ of a callable φ, in grid spacings.
 GRADIENT_STEP = 1e-3
@@ -82,23 +87,34 @@ def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
     return y, signed, ok
 
 
-def _phi_and_eps(surface, grid) -> Tuple[Callable[[np.ndarray], np.ndarray], float]:
+#: Finite-difference step for ∇φ of a sampled φ, in grid spacings.
+SAMPLED_GRADIENT_STEP = 0.5
+
+
+def _project(surface, grid, x: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`project_to_level_set` of the points ``x`` (M, d) for the surface's φ: in Rust for a
+    sampled φ (the same iterations and bits), in NumPy for a callable."""
     if surface.is_dense:
-        return (lambda p: surface.phi(p, grid)), 0.5 * grid.spacing
-    return (lambda p: surface.phi(p, grid)), GRADIENT_STEP * grid.spacing
+        from . import _native
+
+        return _native.project_to_sampled_level_set(
+            surface._array, [float(c) for c in grid.lower], grid.spacing, np.ascontiguousarray(x, dtype=float),
+            SAMPLED_GRADIENT_STEP * grid.spacing, 6, 30, 1e-12)
+    return project_to_level_set(lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing)
 
 
 def estimate_lipschitz(surface, grid, n: int = 17) -> float:
     """1.25 × the largest |∇φ| on an n^d lattice over the grid box (central differences), at
     least 1e-12: the bound on |∇φ| used to find the candidate band of a re-distanced level set."""
     if surface.is_dense:
-        g = np.gradient(surface._array, grid.spacing)
-        return max(1.25 * float(np.max(np.sqrt(sum(gk * gk for gk in g)))), 1e-12)
+        from . import _native
+
+        # the largest |∇φ| of numpy.gradient over every node, in one pass with nothing stored
+        return max(1.25 * _native.max_gradient_norm_of_samples(surface._array, grid.spacing), 1e-12)
     axes = [np.linspace(lo, hi, n) for lo, hi in zip(grid.lower, grid.upper)]
     pts = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, grid.ndim)
-    phi, _ = _phi_and_eps(surface, grid)
     step = (grid.upper[0] - grid.lower[0]) / (n - 1) * 0.25
-    g = _gradient(phi, pts, step)
+    g = _gradient(lambda p: surface.phi(p, grid), pts, step)
     return max(1.25 * float(np.max(np.linalg.norm(g, axis=1))), 1e-12)
 
 
@@ -112,15 +128,15 @@ def redistanced_band(surface, grid, half_width: float):
     L = surface.lipschitz if surface.lipschitz is not None else estimate_lipschitz(surface, grid)
     d = grid.ndim
     if surface.is_dense:
-        flat = surface._array.reshape(-1)
-        cand = np.flatnonzero(np.abs(flat) <= L * half_width).astype(np.int64)
+        from . import _native
+
+        cand = _native.band_of_samples(surface._array, L * half_width)[0].view(np.int64)
     else:
         cand, _ = discover_band(surface._fn, grid, L * half_width, L)
     if cand.size == 0:
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
     x = grid.points(grid.unravel(cand))
-    phi, eps = _phi_and_eps(surface, grid)
-    cp, signed, ok = project_to_level_set(phi, x, eps)
+    cp, signed, ok = _project(surface, grid, x)
     keep = ok & (np.abs(signed) <= half_width * (1 + 1e-9))  # ties on the band edge: rounding
     lin, x, cp, signed = cand[keep], x[keep], cp[keep], signed[keep]
     diff = x - cp
@@ -133,7 +149,5 @@ def redistanced_band(surface, grid, half_width: float):
 
 def redistanced_project(surface, points: np.ndarray, grid):
     """Unsigned distance and closest points of ``points`` on the zero level set of φ."""
-    phi, eps = _phi_and_eps(surface, grid)
-    p = np.asarray(points, dtype=float)
-    cp, signed, _ = project_to_level_set(phi, p, eps)
+    cp, signed, _ = _project(surface, grid, np.asarray(points, dtype=float))
     return np.abs(signed), cp

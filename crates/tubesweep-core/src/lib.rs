@@ -16,6 +16,7 @@
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
 //! | the last split of the coarse-to-fine band search | [`discovery`] | — |
 //! | the band and directions of a φ sampled on the whole grid | [`sampled`] | Eq. (8), Sect. 4 |
+//! | closest points on the zero level set of a sampled φ (re-distancing) | [`redistance`] | Eq. (8), Sect. 5.2 |
 //! | extension directions sgn(φ)∇φ/|∇φ| by central differences | [`normals`] | Eq. (8), Sect. 4 |
 //! | the outer rim of the layer, extended into last in one pass | [`rim`] | Eq. (5) |
 //! | the longest grid path from the sources (numerical infinity, front window) | [`grid_hops`] | — |
@@ -41,6 +42,7 @@ pub mod kernel_stats;
 pub mod lax_friedrichs;
 pub mod mesh;
 pub mod normals;
+pub mod redistance;
 pub mod rim;
 pub mod sampled;
 pub mod schedule;

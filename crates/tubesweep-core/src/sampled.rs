@@ -86,10 +86,7 @@ pub fn outward_directions_of_samples(shape: &[usize], spacing: f64, samples: &[f
     if let Some(&l) = linear.iter().find(|&&l| l >= samples.len() as u64) {
         return Err(Error::invalid("linear", format!("node {l} lies outside the grid of {} nodes", samples.len())));
     }
-    let mut stride = [1usize; 3];
-    for k in (0..d - 1).rev() {
-        stride[k] = stride[k + 1] * shape[k + 1];
-    }
+    let stride = strides(shape);
     let mut norms = vec![0.0f64; linear.len()];
     direction
         .par_chunks_mut(NODE_CHUNK * d)
@@ -99,22 +96,7 @@ pub fn outward_directions_of_samples(shape: &[usize], spacing: f64, samples: &[f
             for (o, &l) in lin.iter().enumerate() {
                 let l = l as usize;
                 let own = samples[l];
-                let mut g = [0.0f64; 3];
-                let mut sq = 0.0f64;
-                for k in 0..d {
-                    let c = (l / stride[k]) % shape[k];
-                    let (up_in, down_in) = (c + 1 < shape[k], c > 0);
-                    let up = if up_in { samples[l + stride[k]] } else { own };
-                    let down = if down_in { samples[l - stride[k]] } else { own };
-                    // (1 + 1)·Δx = 2Δx exactly; one-sided: Δx
-                    let width = (up_in as u8 + down_in as u8) as f64 * spacing;
-                    g[k] = (up - down) / width;
-                    if k == 0 {
-                        sq = g[0] * g[0];
-                    } else {
-                        sq += g[k] * g[k];
-                    }
-                }
+                let (g, sq) = gradient_at(shape, &stride, spacing, samples, l);
                 let norm = sq.sqrt();
                 norms[o] = norm;
                 let scale = if norm > 1e-12 { norm } else { 1.0 };
@@ -131,6 +113,56 @@ pub fn outward_directions_of_samples(shape: &[usize], spacing: f64, samples: &[f
             }
         });
     Ok(norms)
+}
+
+/// Strides of the axes of a C-order grid of `shape` (2 or 3 axes; the unused one 1).
+fn strides(shape: &[usize]) -> [usize; 3] {
+    let mut stride = [1usize; 3];
+    for k in (0..shape.len() - 1).rev() {
+        stride[k] = stride[k + 1] * shape[k + 1];
+    }
+    stride
+}
+
+/// `g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)` at node `l` (one-sided where the neighbour
+/// lies outside the grid: the differences of `numpy.gradient`) and `|g|²` summed in axis order.
+#[inline]
+fn gradient_at(shape: &[usize], stride: &[usize; 3], spacing: f64, samples: &[f64], l: usize) -> ([f64; 3], f64) {
+    let own = samples[l];
+    let mut g = [0.0f64; 3];
+    let mut sq = 0.0f64;
+    for k in 0..shape.len() {
+        let c = (l / stride[k]) % shape[k];
+        let (up_in, down_in) = (c + 1 < shape[k], c > 0);
+        let up = if up_in { samples[l + stride[k]] } else { own };
+        let down = if down_in { samples[l - stride[k]] } else { own };
+        // (1 + 1)·Δx = 2Δx exactly; one-sided: Δx
+        let width = (up_in as u8 + down_in as u8) as f64 * spacing;
+        g[k] = (up - down) / width;
+        if k == 0 {
+            sq = g[0] * g[0];
+        } else {
+            sq += g[k] * g[k];
+        }
+    }
+    (g, sq)
+}
+
+/// The largest `|∇φ|` over every node of the grid, by the differences of
+/// [`outward_directions_of_samples`] (those of `numpy.gradient`): a bound on |∇φ| for the band
+/// search of a φ that is not a distance function. One pass, on all threads, nothing stored.
+pub fn max_gradient_norm_of_samples(shape: &[usize], spacing: f64, samples: &[f64]) -> Result<f64> {
+    check_shape(shape, samples)?;
+    if shape.contains(&1) {
+        return Err(Error::invalid("grid", format!("needs at least 2 nodes per axis for differences, got shape {shape:?}")));
+    }
+    let stride = strides(shape);
+    let largest = (0..samples.len())
+        .into_par_iter()
+        .with_min_len(SCAN_CHUNK)
+        .map(|l| gradient_at(shape, &stride, spacing, samples, l).1)
+        .reduce(|| 0.0, f64::max);
+    Ok(largest.sqrt())
 }
 
 #[cfg(test)]
@@ -157,6 +189,15 @@ mod tests {
         assert!(linear.iter().zip(&values).all(|(&l, &v)| v == s[l as usize]));
         assert!(band_of_samples(&[n, n], &s, 2.5).is_err());
         assert!(band_of_samples(&[n, n, n], &s, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn the_largest_gradient_is_that_of_the_steepest_node() {
+        // φ = 3·x₀² on a 5×4 grid (Δx = 1): |∇φ| = 6·x₀ inside, one-sided 3·(16 − 9) = 21 at
+        // the last row, the largest
+        let s: Vec<f64> = (0..20).map(|l| 3.0 * ((l / 4) as f64).powi(2)).collect();
+        assert_eq!(max_gradient_norm_of_samples(&[5, 4], 1.0, &s).unwrap(), 21.0);
+        assert!(max_gradient_norm_of_samples(&[20, 1], 1.0, &s).is_err());
     }
 
     #[test]

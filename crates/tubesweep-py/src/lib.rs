@@ -1021,6 +1021,58 @@ fn outward_directions_of_samples<'py>(
     Ok(norms.into_pyarray(py))
 }
 
+/// The largest |∇φ| over the nodes of a φ sampled on the whole grid (the differences of
+/// `numpy.gradient`). See `tubesweep_core::sampled::max_gradient_norm_of_samples`.
+#[pyfunction]
+fn max_gradient_norm_of_samples(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>, spacing: f64) -> PyResult<f64> {
+    let shape = phi.shape().to_vec();
+    let s = c_slice(&phi, "phi")?;
+    py.detach(|| tubesweep_core::sampled::max_gradient_norm_of_samples(&shape, spacing, s)).map_err(to_pyerr)
+}
+
+/// Closest points, signed distances and convergence flags.
+type ProjectionArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// Closest points of `points` (M, d) on the zero level set of the multilinear interpolant of a
+/// φ sampled on the whole grid (`phi` has the grid's shape; `lower` and `spacing` place it):
+/// Newton projection and orthogonality iterations, the algorithm of `tubesweep.redistance`.
+/// Returns (closest points (M, d), signed distances (M,), converged (M,)). See
+/// `tubesweep_core::redistance::project_to_zero_level_set`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn project_to_sampled_level_set<'py>(
+    py: Python<'py>,
+    phi: PyReadonlyArrayDyn<'py, f64>,
+    lower: Vec<f64>,
+    spacing: f64,
+    points: PyReadonlyArray2<'py, f64>,
+    eps: f64,
+    newton_steps: usize,
+    orthogonality_steps: usize,
+    tol: f64,
+) -> PyResult<ProjectionArrays<'py>> {
+    use tubesweep_core::redistance::{project_to_zero_level_set, ProjectionOptions, SampledField};
+    let shape = phi.shape().to_vec();
+    let d = shape.len();
+    if points.shape()[1] != d {
+        return Err(PyValueError::new_err(format!("points must have shape (M, {d}) like the grid; got {:?}", points.shape())));
+    }
+    let (s, p) = (c_slice(&phi, "phi")?, c_slice(&points, "points")?);
+    let options = ProjectionOptions { eps, newton_steps, orthogonality_steps, tol };
+    fn run<const D: usize>(s: &[f64], shape: &[usize], lower: &[f64], spacing: f64, p: &[f64], options: ProjectionOptions) -> PyResult<tubesweep_core::redistance::Projection> {
+        let field = SampledField::<D>::new(s, shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?, spacing).map_err(to_pyerr)?;
+        project_to_zero_level_set(&field, p, options).map_err(to_pyerr)
+    }
+    let out = py.detach(|| match d {
+        2 => run::<2>(s, &shape, &lower, spacing, p, options),
+        3 => run::<3>(s, &shape, &lower, spacing, p, options),
+        _ => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+    })?;
+    let m = out.signed.len();
+    let closest = numpy::ndarray::Array2::from_shape_vec((m, d), out.closest).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((closest.into_pyarray(py), out.signed.into_pyarray(py), out.converged.into_pyarray(py)))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
@@ -1033,6 +1085,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(first_non_finite, m)?)?;
     m.add_function(wrap_pyfunction!(band_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions_of_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(max_gradient_norm_of_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(project_to_sampled_level_set, m)?)?;
     m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;
