@@ -41,9 +41,14 @@ def _gradient(phi: Callable[[np.ndarray], np.ndarray], y: np.ndarray, eps: float
     return g
 
 
+#: Newton steps before the orthogonality iterations, the most orthogonality iterations, and the
+#: move (relative to ``max(1, max |x|)``) below which a point has settled.
+NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 30, 1e-12
+
+
 def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray, eps: float,
-                         newton_steps: int = 6, orthogonality_steps: int = 30, tol: float = 1e-12
-                         ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+                         newton_steps: int = NEWTON_STEPS, orthogonality_steps: int = ORTHOGONALITY_STEPS,
+                         tol: float = SETTLED) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closest points of ``x`` (M, d) on ``{φ = 0}`` by Newton projection and orthogonality
     iterations (see the module docstring).
 
@@ -99,7 +104,7 @@ def _project(surface, grid, x: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.n
 
         return _native.project_to_sampled_level_set(
             surface._array, [float(c) for c in grid.lower], grid.spacing, np.ascontiguousarray(x, dtype=float),
-            SAMPLED_GRADIENT_STEP * grid.spacing, 6, 30, 1e-12)
+            SAMPLED_GRADIENT_STEP * grid.spacing, NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED)
     return project_to_level_set(lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing)
 
 
