@@ -275,6 +275,38 @@ def test_sampled_phi_with_nan_or_inf_names_the_first_bad_index():
         ts.LevelSet(phi)
 
 
+@pytest.mark.parametrize(
+    "surface, shape",
+    [(Sphere(), (101,) * 3), (Sphere(0.37, (0.1, -0.2, 0.05)), (57, 64, 49)), (Torus(), (61,) * 3),
+     (Ellipsoid(), (71,) * 3), (Circle(), (301, 301)), (REGISTRY["star"](), (301, 301))],
+)
+def test_library_surfaces_found_in_rust_are_the_callable_route_bit_for_bit(surface, shape):
+    # the library's analytic surfaces have their band found without calling back into Python;
+    # it must be the band, values and directions of the callable route, and the solver's band
+    d = len(shape)
+    h = 2.0 / (max(shape) - 1)
+    grid = ts.Grid((-1.0,) * d, tuple(-1.0 + h * (n - 1) for n in shape), shape)
+    assert surface._native_phi() is not None
+    fast = surface.band(grid, 4 * h)
+    surface._native_phi = lambda: None  # the instance now takes the callable route
+    slow = surface.band(grid, 4 * h)
+    assert np.array_equal(fast.linear, slow.linear) and np.array_equal(fast.signed, slow.signed)
+    assert np.array_equal(fast.direction, slow.direction) and fast.direction.dtype == np.float32
+    assert len(fast.native_band) == len(fast.linear)
+
+
+def test_a_subclass_that_changes_phi_takes_the_callable_route():
+    class Shifted(Sphere):
+        def signed_distance(self, p):
+            return super().signed_distance(p) - 0.1
+
+    assert Shifted()._native_phi() is None and Sphere()._native_phi() is not None
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    geom = Shifted().band(grid, 4 * grid.spacing)
+    r = np.linalg.norm(grid.points(grid.unravel(geom.linear)), axis=1)
+    np.testing.assert_allclose(geom.signed, r - 0.6, atol=1e-12)
+
+
 def test_candidates_of_the_coarse_to_fine_search_are_sorted_and_cover_the_band():
     from tubesweep.surface import coarse_to_fine_candidates
 

@@ -195,6 +195,15 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
     return linear, values
 
 
+def _norm_bounds(values: np.ndarray, norm: np.ndarray, half_width: float) -> Tuple[float, float, bool]:
+    """The range of |∇φ| (``norm``) over the band nodes within half the band of the surface
+    (``|φ| ≤ half_width/2``), and True; over all of them, and False, when there are none."""
+    near = np.abs(values) <= 0.5 * half_width
+    if np.any(near):
+        return float(norm[near].min()), float(norm[near].max()), True
+    return float(norm.min()), float(norm.max()), False
+
+
 class LevelSet(Surface):
     """A curve or surface given as the zero level set of φ, close to a signed distance function.
 
@@ -306,6 +315,20 @@ class LevelSet(Surface):
             return redistanced_band(self, grid, half_width)
         from . import _native
 
+        native_phi = self._native_phi() if self._fn is not None else None
+        if native_phi is not None:
+            # a library surface whose φ is evaluated in Rust: the search, the band structure, φ at
+            # its rim and the directions in one call, with no call back into Python (the same
+            # nodes and bits as the callable route below)
+            kind, parameters = native_phi
+            ulinear, values, native_band, direction, norm = _native.analytic_level_set_band(
+                kind, [float(p) for p in parameters], list(grid.shape), [float(x) for x in grid.lower], grid.spacing,
+                float(half_width), float(self.lipschitz))  # type: ignore[arg-type]
+            linear = ulinear.view(np.int64)
+            if linear.size == 0:
+                return BandGeometry(linear, values, values, direction)
+            self._check_distance_like(*_norm_bounds(values, norm, half_width)[:2])
+            return BandGeometry(linear, None, values, direction, consumable=True, native_band=native_band)
         if self._array is not None:
             # one pass over the samples in Rust, on all threads, with no temporary of the grid's
             # size (tubesweep_core::sampled)
@@ -320,7 +343,7 @@ class LevelSet(Surface):
         native_band = _native.Band.from_linear(list(grid.shape), linear.view(np.uint64))
         # the outward direction sgn(φ) ∇φ/|∇φ|, chunk by chunk (temporaries stay O(chunk))
         direction = np.empty((len(linear), grid.ndim), np.float32)
-        near_lo, near_hi, all_lo, all_hi = np.inf, -np.inf, np.inf, -np.inf
+        bounds: List[Tuple[float, float, bool]] = []
         for lo in range(0, len(linear), EVAL_CHUNK):
             hi = min(len(linear), lo + EVAL_CHUNK)
             if self._array is not None:
@@ -329,16 +352,18 @@ class LevelSet(Surface):
                                                              direction[lo:hi])
             else:
                 norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
-            near = np.abs(values[lo:hi]) <= 0.5 * half_width
-            all_lo, all_hi = min(all_lo, float(norm.min())), max(all_hi, float(norm.max()))
-            if np.any(near):
-                near_lo, near_hi = min(near_lo, float(norm[near].min())), max(near_hi, float(norm[near].max()))
-        if np.isfinite(near_lo):
-            self._check_distance_like(near_lo, near_hi)
-        else:
-            self._check_distance_like(all_lo, all_hi)
+            bounds.append(_norm_bounds(values[lo:hi], norm, half_width))
+        near = [b for b in bounds if b[2]]
+        lo_hi = (min(b[0] for b in near), max(b[1] for b in near)) if near else \
+            (min(b[0] for b in bounds), max(b[1] for b in bounds))
+        self._check_distance_like(*lo_hi)
         # distance = |φ|, not stored
         return BandGeometry(linear, None, values, direction, consumable=True, native_band=native_band)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        """For a library surface whose φ is evaluated in Rust (and not replaced by a subclass):
+        its kind and parameters for ``tubesweep._native.analytic_level_set_band``; else None."""
+        return None
 
     def _check_distance_like(self, lo: float, hi: float) -> None:
         """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface."""

@@ -276,8 +276,72 @@ fn nearest_sample(dense: &[[f64; 2]], step: f64, x: f64, y: f64, polar: f64, r_m
     jbest
 }
 
+/// One of the library's surfaces whose signed distance is evaluated here: what the Python package
+/// hands the core so that the band of such a surface is found without calling back into Python
+/// ([`crate::discovery::discover_band`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnalyticSurface {
+    /// [`sphere_signed_distance`]: a circle (2 centre coordinates) or a sphere (3).
+    Sphere { centre: Vec<f64>, radius: f64 },
+    /// [`torus_signed_distance`].
+    Torus { centre: [f64; 3], major: f64, minor: f64 },
+    /// [`ellipsoid_signed_distance`].
+    Ellipsoid { centre: [f64; 3], axes: [f64; 3] },
+    /// [`star_signed_distance`] (2D).
+    Star { r0: f64, eps: f64 },
+}
+
+impl AnalyticSurface {
+    /// The surface named `kind` ("sphere", "torus", "ellipsoid" or "star") with the parameters
+    /// in the order of the variant's fields (a sphere's centre has 2 or 3 coordinates).
+    pub fn from_parameters(kind: &str, p: &[f64]) -> Result<Self> {
+        let bad = || Error::invalid("parameters", format!("{p:?} are not the parameters of a {kind}"));
+        Ok(match (kind, p.len()) {
+            ("sphere", 3 | 4) => AnalyticSurface::Sphere { centre: p[..p.len() - 1].to_vec(), radius: p[p.len() - 1] },
+            ("torus", 5) => AnalyticSurface::Torus { centre: [p[0], p[1], p[2]], major: p[3], minor: p[4] },
+            ("ellipsoid", 6) => AnalyticSurface::Ellipsoid { centre: [p[0], p[1], p[2]], axes: [p[3], p[4], p[5]] },
+            ("star", 2) => AnalyticSurface::Star { r0: p[0], eps: p[1] },
+            ("sphere" | "torus" | "ellipsoid" | "star", _) => return Err(bad()),
+            _ => return Err(Error::invalid("kind", format!("unknown analytic surface {kind:?}; use sphere, torus, ellipsoid or star"))),
+        })
+    }
+
+    /// The dimension of the space the surface lies in.
+    pub fn ndim(&self) -> usize {
+        match self {
+            AnalyticSurface::Sphere { centre, .. } => centre.len(),
+            AnalyticSurface::Torus { .. } | AnalyticSurface::Ellipsoid { .. } => 3,
+            AnalyticSurface::Star { .. } => 2,
+        }
+    }
+
+    /// The signed distance at the points (`ndim` coordinates each) into `out`.
+    pub fn signed_distance(&self, points: &[f64], out: &mut [f64]) -> Result<()> {
+        match self {
+            AnalyticSurface::Sphere { centre, radius } => sphere_signed_distance(points, centre, *radius, out),
+            AnalyticSurface::Torus { centre, major, minor } => torus_signed_distance(points, *centre, *major, *minor, out),
+            AnalyticSurface::Ellipsoid { centre, axes } => ellipsoid_signed_distance(points, *centre, *axes, out),
+            AnalyticSurface::Star { r0, eps } => star_signed_distance(points, *r0, *eps, out),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn analytic_surfaces_from_their_parameters() {
+        let s = AnalyticSurface::from_parameters("sphere", &[0.0, 0.0, 1.0]).unwrap();
+        assert_eq!(s.ndim(), 2);
+        let mut out = [0.0; 2];
+        s.signed_distance(&[3.0, 0.0, 0.0, 0.5], &mut out).unwrap();
+        assert_eq!(out, [2.0, -0.5]);
+        assert_eq!(AnalyticSurface::from_parameters("torus", &[0.0, 0.0, 0.0, 0.5, 0.2]).unwrap().ndim(), 3);
+        assert_eq!(AnalyticSurface::from_parameters("ellipsoid", &[0.0, 0.0, 0.0, 0.6, 0.45, 0.3]).unwrap().ndim(), 3);
+        assert_eq!(AnalyticSurface::from_parameters("star", &[0.5, 0.2]).unwrap().ndim(), 2);
+        assert!(AnalyticSurface::from_parameters("torus", &[0.5, 0.2]).is_err());
+        assert!(AnalyticSurface::from_parameters("cube", &[1.0]).is_err());
+    }
     use super::*;
 
     #[test]

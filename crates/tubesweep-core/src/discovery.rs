@@ -2,8 +2,9 @@
 //! surface given by a distance-like function (`tubesweep.surface.coarse_to_fine_candidates`).
 //!
 //! The search keeps blocks of 2^L nodes per axis near the surface and splits them level by level;
-//! the level-set function itself is a Python callable, so the loop over levels stays in Python and
-//! only calls it. Here: the children of the kept blocks with their centres and radii
+//! the level-set function is usually a Python callable, so the loop over levels stays in Python and
+//! only calls it ([`discover_band`] runs the whole loop for a φ evaluated in Rust, the library's
+//! analytic surfaces). Here: the children of the kept blocks with their centres and radii
 //! ([`block_children`], [`children_radius_max`]), which the caller tests with φ at the centres,
 //! and the last split, of the kept 2 × … × 2 blocks into single nodes, which produces the
 //! candidate list, the largest array of the search (O(N^(d−1)) entries): [`split_pair_blocks`]
@@ -198,6 +199,97 @@ pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f6
     Ok(out)
 }
 
+/// A level-set function evaluated in Rust: `phi(points, out)` writes φ at the points (`D`
+/// coordinates each) to `out`.
+pub type PhiFn<'a> = dyn Fn(&[f64], &mut [f64]) -> Result<()> + Sync + 'a;
+
+/// Children (or candidates) per parallel task of [`discover_band`]: the Python search's
+/// `EVAL_CHUNK`, which bounds the temporaries.
+const EVAL_CHUNK: usize = 1 << 18;
+
+/// The band `|φ| ≤ half_width` of a level set whose φ is evaluated in Rust (`phi(points, out)`,
+/// `D` coordinates per point), found coarse-to-fine: the search of the Python package's
+/// `coarse_to_fine_candidates` and `discover_band` (see their documentation) with the same levels,
+/// tests and arithmetic, so the same nodes and values, but no call back into Python and no
+/// array of all the candidates' coordinates. `lipschitz` bounds |∇φ|. Returns sorted C-order
+/// linear indices and φ there.
+pub fn discover_band<const D: usize>(
+    shape: [usize; D],
+    lower: [f64; D],
+    spacing: f64,
+    half_width: f64,
+    lipschitz: f64,
+    phi: &PhiFn<'_>,
+) -> Result<(Vec<u64>, Vec<f64>)> {
+    if shape.contains(&0) || !(spacing > 0.0 && half_width >= 0.0 && lipschitz > 0.0) {
+        return Err(Error::invalid("grid", format!("need a non-empty grid, a positive spacing and Lipschitz bound, and a width ≥ 0; got shape {shape:?}, spacing {spacing}, half-width {half_width}, lipschitz {lipschitz}")));
+    }
+    let total: u64 = shape.iter().map(|&n| n as u64).product();
+    let longest = *shape.iter().max().expect("D ≥ 1") as f64;
+    // blocks of 2^L nodes per axis, L = ⌊log2(longest / 4)⌋ (at least 0)
+    let level = (longest / 4.0).log2().floor();
+    let mut block: u64 = if level >= 1.0 { 1 << level as u32 } else { 1 };
+    let candidates: Vec<u64> = if block == 1 {
+        (0..total).collect()
+    } else {
+        // the first level: the children of the lattice of twice the block's spacing, C order
+        let mut parents: Vec<[u64; D]> = vec![[0; D]];
+        for k in 0..D {
+            parents = parents
+                .iter()
+                .flat_map(|p| (0..shape[k] as u64).step_by(2 * block as usize).map(move |c| {
+                    let mut q = *p;
+                    q[k] = c;
+                    q
+                }))
+                .collect();
+        }
+        loop {
+            let kept: Vec<Vec<[u64; D]>> = parents
+                .par_chunks((EVAL_CHUNK >> D).max(1))
+                .map(|ps| {
+                    let (origins, centres, radii) = block_children(shape, ps, block, lower, spacing)?;
+                    let mut value = vec![0.0; origins.len()];
+                    phi(centres.as_flattened(), &mut value)?;
+                    Ok(origins
+                        .into_iter()
+                        .zip(value.iter().zip(&radii))
+                        .filter(|(_, (v, r))| v.abs() <= half_width + lipschitz * **r + 1e-12)
+                        .map(|(o, _)| o)
+                        .collect())
+                })
+                .collect::<Result<_>>()?;
+            parents = kept.concat();
+            block /= 2;
+            if block == 1 {
+                break;
+            }
+        }
+        split_pair_blocks(shape, &parents)?
+    };
+    // φ at the candidates and the filter, a slice at a time
+    let parts: Vec<(Vec<u64>, Vec<f64>)> = candidates
+        .par_chunks(EVAL_CHUNK / 8)
+        .map(|lin| {
+            let points = node_points(shape, lin, lower, spacing)?;
+            let mut value = vec![0.0; lin.len()];
+            phi(&points, &mut value)?;
+            let (mut l, mut v) = (vec![0; lin.len()], vec![0.0; lin.len()]);
+            let kept = keep_within(lin, &value, half_width, &mut l, &mut v)?;
+            l.truncate(kept);
+            v.truncate(kept);
+            Ok((l, v))
+        })
+        .collect::<Result<_>>()?;
+    let kept: usize = parts.iter().map(|p| p.0.len()).sum();
+    let (mut linear, mut values) = (Vec::with_capacity(kept), Vec::with_capacity(kept));
+    for (l, v) in parts {
+        linear.extend_from_slice(&l);
+        values.extend_from_slice(&v);
+    }
+    Ok((linear, values))
+}
+
 /// Copies the candidates with `|value| ≤ half_width` (the band's nodes) to the fronts of
 /// `linear_out` and `values_out`, in order, and returns how many there are: the filter of the
 /// band search after φ at the candidates is known. An error if the outputs are too short or the
@@ -254,6 +346,31 @@ fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn the_rust_search_finds_every_node_within_the_width() {
+        // a sphere off the centre of a non-cubic grid that cuts it, against a scan of every node
+        let (shape, lower, h) = ([37usize, 50, 29], [-1.0f64, -1.2, -0.8], 0.05);
+        let surface = crate::analytic::AnalyticSurface::from_parameters("sphere", &[0.1, -0.05, 0.2, 0.62]).unwrap();
+        let phi = |p: &[f64], out: &mut [f64]| surface.signed_distance(p, out);
+        for half_width in [0.0, 0.07, 0.2] {
+            let (linear, values) = discover_band(shape, lower, h, half_width, 1.0, &phi).unwrap();
+            let all: Vec<u64> = (0..(37 * 50 * 29) as u64).collect();
+            let points = node_points(shape, &all, lower, h).unwrap();
+            let mut v = vec![0.0; all.len()];
+            phi(&points, &mut v).unwrap();
+            let want: Vec<u64> = all.iter().copied().filter(|&l| v[l as usize].abs() <= half_width).collect();
+            assert_eq!(linear, want, "half-width {half_width}");
+            assert!(linear.iter().zip(&values).all(|(&l, &x)| x == v[l as usize]));
+        }
+        assert!(discover_band(shape, lower, -h, 0.1, 1.0, &phi).is_err());
+        // a tiny grid: every node is a candidate
+        let (linear, _) = discover_band([6, 7, 5], [-0.3, -0.3, -0.2], 0.1, 0.05, 1.0, &|p: &[f64], out: &mut [f64]| {
+            crate::analytic::sphere_signed_distance(p, &[0.0, 0.0, 0.0], 0.2, out)
+        })
+        .unwrap();
+        assert!(!linear.is_empty());
+    }
     use super::*;
 
     /// The straightforward answer: every node of every block, sorted.

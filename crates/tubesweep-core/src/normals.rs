@@ -312,6 +312,35 @@ pub fn rim_nodes_in_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::
     Ok((groups.concat(), counts))
 }
 
+/// φ at the places [`rim_nodes_in_band`] lists (`rim`, `counts`: group `g` is axis `g / 2`, side
+/// +1 for even `g`) for band nodes with linear indices `linear`: `phi` at `x ± Δx e_k`, with the
+/// node coordinates of [`crate::discovery::node_points`] (the arithmetic of the Python package's
+/// `_phi_at_rim_places`, so the same points), group after group. For a φ evaluated in Rust.
+pub fn rim_phi<const D: usize>(
+    shape: [usize; D],
+    linear: &[u64],
+    rim: &[u64],
+    counts: &[usize],
+    lower: [f64; D],
+    spacing: f64,
+    phi: &crate::discovery::PhiFn<'_>,
+) -> Result<Vec<f64>> {
+    if counts.len() != 2 * D || counts.iter().sum::<usize>() != rim.len() || rim.iter().any(|&i| i as usize >= linear.len()) {
+        return Err(Error::invalid("rim", "the rim places must be those of rim_nodes_in_band for this band"));
+    }
+    let mut out = vec![0.0; rim.len()];
+    let mut start = 0;
+    for (g, &count) in counts.iter().enumerate() {
+        let places: Vec<u64> = rim[start..start + count].iter().map(|&i| linear[i as usize]).collect();
+        let mut x = crate::discovery::node_points(shape, &places, lower, spacing)?;
+        let step = if g % 2 == 0 { spacing } else { -spacing };
+        x.par_chunks_mut(D).for_each(|p| p[g / 2] += step);
+        phi(&x, &mut out[start..start + count])?;
+        start += count;
+    }
+    Ok(out)
+}
+
 /// The arithmetic of [`outward_directions`] for nodes `range` of a band of `phi.len()` nodes in
 /// `d` dimensions. `neighbour(o, c_last, g)` is the band position of the neighbour of node
 /// `range.start + o` in group `g` (axis `g / 2`, side `+1` for even `g`), or `None` where φ comes

@@ -1073,6 +1073,60 @@ fn project_to_sampled_level_set<'py>(
     Ok((closest.into_pyarray(py), out.signed.into_pyarray(py), out.converged.into_pyarray(py)))
 }
 
+/// The band, its structure and its outward directions, of a library surface whose φ is evaluated
+/// in Rust.
+type AnalyticBand<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>, Option<PyBand>, Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f64>>);
+
+/// The band of a library surface with a Rust φ (`kind` "sphere", "torus", "ellipsoid" or
+/// "star", `parameters` as `tubesweep_core::analytic::AnalyticSurface::from_parameters` takes
+/// them), without calling back into Python: the coarse-to-fine search
+/// (`tubesweep_core::discovery::discover_band`), the band structure, φ at its rim and the
+/// outward directions, the same nodes and bits as the callable route. Returns (sorted linear
+/// indices, φ there, the band or None when empty, directions (K, d) float32, |∇φ| (K,)).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn analytic_level_set_band<'py>(
+    py: Python<'py>,
+    kind: &str,
+    parameters: Vec<f64>,
+    shape: Vec<usize>,
+    lower: Vec<f64>,
+    spacing: f64,
+    half_width: f64,
+    lipschitz: f64,
+) -> PyResult<AnalyticBand<'py>> {
+    use tubesweep_core::analytic::AnalyticSurface;
+    let surface = AnalyticSurface::from_parameters(kind, &parameters).map_err(to_pyerr)?;
+    if surface.ndim() != shape.len() {
+        return Err(PyValueError::new_err(format!("surface: a {kind} in {}D on a {}D grid", surface.ndim(), shape.len())));
+    }
+    type Found = (Vec<u64>, Vec<f64>, Option<AnyBand>, Vec<f32>, Vec<f64>);
+    #[allow(clippy::too_many_arguments)]
+    fn run<const D: usize>(surface: &AnalyticSurface, shape: &[usize], lower: &[f64], spacing: f64, half_width: f64, lipschitz: f64, wrap: fn(NarrowBand<D>) -> AnyBand) -> PyResult<Found> {
+        let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
+        let phi = |p: &[f64], out: &mut [f64]| surface.signed_distance(p, out);
+        let (linear, values) = tubesweep_core::discovery::discover_band::<D>(shape, lower, spacing, half_width, lipschitz, &phi).map_err(to_pyerr)?;
+        if linear.is_empty() {
+            return Ok((linear, values, None, Vec::new(), Vec::new()));
+        }
+        let band = NarrowBand::<D>::from_sorted_linear(shape, &linear).map_err(to_pyerr)?;
+        let all = 0..linear.len();
+        let (rim, counts) = tubesweep_core::normals::rim_nodes_in_band(&band, all.clone()).map_err(to_pyerr)?;
+        let rim_phi = tubesweep_core::normals::rim_phi(shape, &linear, &rim, &counts, lower, spacing, &phi).map_err(to_pyerr)?;
+        let mut direction = vec![0.0f32; linear.len() * D];
+        let norms = tubesweep_core::normals::outward_directions_in_band(&band, spacing, &values, all, &rim_phi, &mut direction).map_err(to_pyerr)?;
+        Ok((linear, values, Some(wrap(band)), direction, norms))
+    }
+    let (linear, values, band, direction, norms) = py.detach(|| match shape.len() {
+        2 => run::<2>(&surface, &shape, &lower, spacing, half_width, lipschitz, AnyBand::D2),
+        3 => run::<3>(&surface, &shape, &lower, spacing, half_width, lipschitz, AnyBand::D3),
+        d => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+    })?;
+    let d = shape.len();
+    let direction = numpy::ndarray::Array2::from_shape_vec((linear.len(), d), direction).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((linear.into_pyarray(py), values.into_pyarray(py), band.map(|band| PyBand { band }), direction.into_pyarray(py), norms.into_pyarray(py)))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
@@ -1087,6 +1141,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(outward_directions_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(max_gradient_norm_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(project_to_sampled_level_set, m)?)?;
+    m.add_function(wrap_pyfunction!(analytic_level_set_band, m)?)?;
     m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
     m.add_function(wrap_pyfunction!(rim_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions, m)?)?;

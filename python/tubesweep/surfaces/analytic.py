@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -12,6 +12,12 @@ from ..surface import LevelSet
 from ._triangulation import grid_mesh, polyline
 
 __all__ = ["Circle", "Sphere", "Star"]
+
+
+def own_phi(surface: Any, cls: type) -> bool:
+    """Whether ``surface``'s φ is ``cls.signed_distance`` itself (not replaced or overridden by a
+    subclass), so that the core may evaluate it without calling back into Python."""
+    return type(surface).signed_distance is cls.signed_distance and surface._fn == surface.signed_distance
 
 
 def _points(p: np.ndarray, d: int) -> np.ndarray:
@@ -38,6 +44,9 @@ class Circle(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, with the arithmetic of row_norms(p - center) - radius
         return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("sphere", [*map(float, self.center), self.radius]) if own_phi(self, Circle) else None
 
     @property
     def default_source(self) -> np.ndarray:
@@ -75,6 +84,9 @@ class Sphere(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, with the arithmetic of row_norms(p - center) - radius
         return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("sphere", [*map(float, self.center), self.radius]) if own_phi(self, Sphere) else None
 
     @property
     def default_source(self) -> np.ndarray:
@@ -187,6 +199,9 @@ class Star(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads: the algorithm of _signed_distance_numpy (equal to rounding)
         return _native.star_signed_distance(_points(p, 2), self.r0, self.eps)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("star", [self.r0, self.eps]) if own_phi(self, Star) else None
 
     def _signed_distance_numpy(self, p: np.ndarray) -> np.ndarray:
         """The NumPy formulation of :meth:`signed_distance` (the reference the tests compare with)."""

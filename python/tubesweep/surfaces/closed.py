@@ -4,7 +4,7 @@ distance function (exact, or 1-Lipschitz with |∇φ| = 1 almost everywhere for 
 
 from __future__ import annotations
 
-from typing import Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -12,7 +12,7 @@ from .. import _native
 from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import grid_mesh, marching_cubes
-from .analytic import _points
+from .analytic import _points, own_phi
 
 __all__ = ["Ellipsoid", "Torus", "RoundedCube", "DoubleTorus"]
 
@@ -91,6 +91,9 @@ class Ellipsoid(LevelSet):
         return _native.ellipsoid_signed_distance(_points(p, 3), [float(c) for c in self.center],
                                                  [float(a) for a in self.axes])
 
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("ellipsoid", [*map(float, self.center), *map(float, self.axes)]) if own_phi(self, Ellipsoid) else None
+
     def _signed_distance_numpy(self, p: np.ndarray) -> np.ndarray:
         """The NumPy formulation of :meth:`signed_distance` (the reference the tests compare with)."""
         p = np.asarray(p, dtype=float)
@@ -145,6 +148,9 @@ class Torus(LevelSet):
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads: hypot(hypot(q_x, q_y) − R, q_z) − r with q = p − center
         return _native.torus_signed_distance(_points(p, 3), [float(c) for c in self.center], self.R, self.r)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("torus", [*map(float, self.center), self.R, self.r]) if own_phi(self, Torus) else None
 
     @property
     def default_source(self) -> np.ndarray:
