@@ -9,7 +9,9 @@ Each piece runs ``--repeats`` times in a warm process (after one untimed run) an
 printed, with the whole solve's ``sol.stats.setup_seconds`` and ``sol.stats.seconds`` for scale.
 The pieces are those of ``LevelSet.band`` for a callable φ (docs/architecture.md): the
 coarse-to-fine band search (candidates, then φ at them and the filter), the band structure,
-the rim places, φ there, and the outward directions. Set ``OPENBLAS_NUM_THREADS=1`` as
+the rim places, φ there, and the outward directions; then the whole of it for the surface's φ
+as a plain callable, and for the library surface itself, whose band is found in Rust in one
+call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENBLAS_NUM_THREADS=1`` as
 ``make bench`` does (see README).
 """
 
@@ -72,7 +74,9 @@ def main() -> int:
         "rim coordinates and φ there": median_ms(lambda: surf._phi_at_rim_places(grid, linear, pos, counts), r),
         "outward directions (Band.outward_directions)": median_ms(
             lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r),
-        "LevelSet.band, all of the above": median_ms(lambda: surf.band(grid, width), r),
+        "LevelSet.band of the same φ as a callable, all of the above": median_ms(
+            lambda: ts.LevelSet(fn, lipschitz=surf.lipschitz).band(grid, width), r),
+        "LevelSet.band of the library surface (the same band found in Rust)": median_ms(lambda: surf.band(grid, width), r),
     }
     stats = []
     for _ in range(r + 1):
