@@ -37,6 +37,17 @@ def project_to_sampled_level_set(
     orthogonality_steps: int,
     tol: float,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+def analytic_level_set_band(
+    kind: str,  # "sphere", "torus", "ellipsoid" or "star"
+    parameters: List[float],
+    shape: List[int],
+    lower: List[float],
+    spacing: float,
+    half_width: float,
+    lipschitz: float,
+) -> Tuple[
+    npt.NDArray[np.uint64], npt.NDArray[np.float64], Optional["Band"], npt.NDArray[np.float32], npt.NDArray[np.float64]
+]: ...
 def outward_directions_of_samples(
     phi: npt.NDArray[np.float64],
     spacing: float,
