@@ -5,6 +5,8 @@ Usage::
     .venv/bin/python benches/warm_solves.py [N] [REPEATS]      # default N = 201, 7 solves
     .venv/bin/python benches/warm_solves.py 201 7 --dense      # φ handed in as an array
     .venv/bin/python benches/warm_solves.py 101 3 --redistance # φ = |x|² − r² as an array
+    .venv/bin/python benches/warm_solves.py 201 7 --tube       # ts.Tube built once, then tube.solve
+    .venv/bin/python benches/warm_solves.py 201 5 --bunny      # the bunny (surface.grid(n=N))
 
 It uses only ``ts.solve`` and ``sol.stats``, so it runs unchanged on older checkouts: to compare
 two commits, build both (``make build`` in each checkout) and run it alternately in the two,
@@ -16,7 +18,9 @@ the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
 (the sphere's exact signed distance, an array of the grid's shape, as a user with a level set
 array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine. With
 ``--redistance`` the array is ``|x|² − r²`` (the same sphere, not a distance function) and the
-surface ``ts.LevelSet(array, redistance=True)``.
+surface ``ts.LevelSet(array, redistance=True)``. With ``--tube`` the solves are ``tube.solve``
+on one ``ts.Tube`` built before them (its build time is printed as ``tube_build_ms``); with
+``--bunny`` the problem is the bench's bunny instead of the sphere.
 """
 
 from __future__ import annotations
@@ -34,18 +38,19 @@ import numpy as np  # noqa: E402
 import tubesweep as ts  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from problems import sphere  # noqa: E402
+from problems import bunny, sphere  # noqa: E402
 from run import _peak_kb, _reset_peak, _status_kb  # noqa: E402
 
 
 def main() -> int:
-    flags = {"--dense", "--redistance"}
+    flags = {"--dense", "--redistance", "--tube", "--bunny"}
     redistance = "--redistance" in sys.argv
     dense = "--dense" in sys.argv or redistance
+    use_tube = "--tube" in sys.argv
     args = [a for a in sys.argv[1:] if a not in flags]
     n = int(args[0]) if len(args) > 0 else 201
     repeats = int(args[1]) if len(args) > 1 else 7
-    p = sphere(n)
+    p = bunny(n) if "--bunny" in sys.argv else sphere(n)
     if redistance:
         d = p.dense_phi(p.grid)  # |x − c| − r
         surface = ts.LevelSet(d * (d + 2 * 0.5), redistance=True)  # |x − c|² − r², r = 0.5
@@ -53,20 +58,34 @@ def main() -> int:
         surface = ts.LevelSet(p.dense_phi(p.grid))
     else:
         surface = p.surface
+    extra = {}
+    if use_tube:
+        t = time.perf_counter()
+        tube = ts.Tube(surface, p.grid)
+        extra["tube_build_ms"] = round(1e3 * (time.perf_counter() - t), 1)
+
+        def run() -> ts.Solution:
+            return tube.solve([p.source])
+    else:
+
+        def run() -> ts.Solution:
+            return ts.solve(surface, p.grid, sources=[p.source])
+
     # the peak resident memory the first solve adds, as benches/run.py measures it ("ΔRSS")
     reset_ok = _reset_peak()
     before = _status_kb("VmRSS") or 0
-    ts.solve(surface, p.grid, sources=[p.source])
+    run()
     delta_rss_mb = round((_peak_kb(reset_ok) - before) / 1024, 1)
     wall, setup, sweeps = [], [], []
     for _ in range(repeats):
         t = time.perf_counter()
-        sol = ts.solve(surface, p.grid, sources=[p.source])
+        sol = run()
         wall.append(time.perf_counter() - t)
         setup.append(sol.stats.setup_seconds)
         sweeps.append(sol.stats.seconds)
     ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
-    print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, **ms, first_solve_delta_rss_mb=delta_rss_mb)))
+    print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, tube=use_tube, **ms,
+                          first_solve_delta_rss_mb=delta_rss_mb, **extra)))
     return 0
 
 

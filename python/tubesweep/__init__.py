@@ -24,6 +24,7 @@ from .euclidean import travel_time
 from .grid import Grid
 from .output import export, plot, triangulate
 from .solve import Solution, solve
+from .tube import Tube
 from .stats import SolveStats
 from .surface import LevelSet, Surface
 from . import surfaces
@@ -32,5 +33,5 @@ __version__ = "0.1.0"
 
 __all__ = [
     "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "export", "flows", "hamiltonians", "plot",
-    "solve", "surfaces", "travel_time", "triangulate", "__version__",
+    "solve", "surfaces", "travel_time", "triangulate", "Tube", "__version__",
 ]

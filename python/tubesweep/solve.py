@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from typing import Any, Callable, Optional, Tuple
@@ -303,16 +304,53 @@ def solve(
     surf = as_surface(surface)
     surf.check_grid(grid)
     src = as_sources(sources, grid)
+    general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
+    check_tolerance(tol, max_iterations)
+    cb = progress_callback(progress)
+    _check_source_init(source_init)
+    # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
+    # (unless a general Hamiltonian needs it) and the directions become the extension weights
+    tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
+    return _solve_on_tube(tube, src, general, scheme, speed, source_init, tol, max_iterations, cb, infinity, threads,
+                          paper_sweeps, t0, reuse=False)
+
+
+def _resolve_scheme(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Tuple[Any, str]:
     from . import hamiltonians as _hams
 
     general = _hams.resolve(hamiltonian, flow, allow_supersonic)
     scheme = check_hamiltonian(hamiltonian) if general is None else general.label
-    check_tolerance(tol, max_iterations)
-    cb = progress_callback(progress)
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}; got {method!r}")
+    return general, scheme
+
+
+def _check_source_init(source_init: str) -> None:
     if source_init not in SOURCE_INITS:
         raise ValueError(f"source_init must be one of {SOURCE_INITS}; got {source_init!r}")
+
+
+class _PreparedTube:
+    """The band of a surface on a grid with what every solve on it needs: the sorted linear
+    indices, the roles before the sources are fixed, the native band, φ in single precision, and
+    either the directions the solver may overwrite (``direction``; one solve) or the whole
+    geometry (``geom``, never modified; a general Hamiltonian reads it, and a :class:`Tube`
+    solves many times)."""
+
+    def __init__(self, grid: Grid, surface: Surface, inner: float, outer_eff: float, method: str, geom: Optional[BandGeometry],
+                 linear: np.ndarray, roles: np.ndarray, band: Any, phi: np.ndarray, direction: Optional[np.ndarray],
+                 seconds: float):
+        self.grid, self.surface, self.inner, self.outer_eff, self.method = grid, surface, inner, outer_eff, method
+        self.geom, self.linear, self.roles, self.band, self.phi, self.direction = geom, linear, roles, band, phi, direction
+        self.seconds = seconds
+
+
+def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool,
+                  reusable: bool = False) -> _PreparedTube:
+    """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
+    single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
+    keeps the geometry unmodified for many solves (:class:`Tube`)."""
+    t0 = time.perf_counter()
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}; got {method!r}")
     for name, val in (("inner", inner), ("outer", outer)):
         if not (isinstance(val, (int, float, np.floating, np.integer)) and np.isfinite(val)):
             raise ValueError(f"{name} must be a finite number of grid spacings; got {val!r}")
@@ -340,11 +378,15 @@ def solve(
         roles = _tube_roles(geom, inner_width, method)
         linear = geom.linear
         band = geom.native_band  # built by the surface, or None
-        if general is None:
-            # The float64 φ (and |φ| where stored) only decide the roles: from here on the solver
-            # keeps φ in single precision, and the band is built without them (memory is per band
-            # node: see docs/architecture.md).
-            phi = geom.signed.astype(np.float32)
+        # The float64 φ (and |φ| where stored) only decide the roles: from here on the solver
+        # keeps φ in single precision, and the band is built without them (memory is per band
+        # node: see docs/architecture.md).
+        phi = geom.signed.astype(np.float32)
+        direction: Optional[np.ndarray] = None
+        if reusable:
+            # kept for every solve: the solver gets copies of its directions
+            geom = dataclasses.replace(geom, consumable=False)
+        elif not keep_geometry:
             direction = geom.directions_for_solver()
             geom = None  # type: ignore[assignment]
         if band is None or len(band) != len(linear):
@@ -363,10 +405,26 @@ def solve(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
             f"close to a distance function there. Widening the extension layer to outer = {outer_eff + 1}",
             RuntimeWarning,
-            stacklevel=2,
+            stacklevel=3,
         )
         outer_eff += 1.0
+    return _PreparedTube(grid, surf, float(inner), outer_eff, method, geom, linear, roles, band, phi, direction,
+                         time.perf_counter() - t0)
 
+
+def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: str, speed: Any, source_init: str,
+                   tol: float, max_iterations: int, cb: Any, infinity: Any, threads: int, paper_sweeps: bool, t0: float,
+                   reuse: bool) -> "Solution":
+    """Fixes the sources on the prepared tube and sweeps. With ``reuse`` the tube is left as it
+    was (its roles and directions are copied); without, its arrays are consumed and dropped
+    before the sweeps."""
+    from . import hamiltonians as _hams
+
+    grid, surf, band = tube.grid, tube.surface, tube.band
+    h = grid.spacing
+    inner_width = tube.inner * h
+    roles = tube.roles.copy() if reuse else tube.roles
+    linear = tube.linear
     # node coordinates only for a speed given as a callable (an array is read at the nodes)
     x = grid.points(grid.unravel(linear)) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
@@ -384,14 +442,19 @@ def solve(
     positions, fixed_vals = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
     del x
+    method = tube.method
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
+    phi = tube.phi
     if general is None:
         # The linear indices are dropped before the sweeps and the fixed nodes go to the solver
         # sparsely; the directions are converted to the extension weights in place (no second
         # K×d buffer).
+        if reuse:
+            directions = tube.geom.directions_for_solver()  # a copy: the tube's stay as they are
+        else:
+            directions = tube.direction  # overwritten by the solver (a copy unless the geometry is consumable)
+            tube.direction = tube.linear = tube.roles = None  # type: ignore[assignment]
         del linear
-        directions = direction  # overwritten by the solver (a copy unless the geometry is consumable)
-        del direction
         setup = time.perf_counter() - t0
         values, st = band.solve(
             roles, positions, fixed_vals, h, slowness, directions, scheme, missing_policy,
@@ -400,9 +463,8 @@ def solve(
         )
         del directions
     else:
-        phi = geom.signed.astype(np.float32)
         setup = time.perf_counter() - t0
-        values, st = _hams.solve_band(general, surf, grid, geom, band, roles, positions, fixed_vals, src, speed_nodes,
+        values, st = _hams.solve_band(general, surf, grid, tube.geom, band, roles, positions, fixed_vals, src, speed_nodes,
                                       source_init == "exact", SOURCE_RADIUS, tol, max_iterations, _infinity(infinity), cb,
                                       _threads(threads), ACTIVATION_FRACTION * float(tol), not paper_sweeps)
     warn_unconverged(st, tol, max_iterations)
@@ -424,4 +486,4 @@ def solve(
         window_edge=st["window_edge"],
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
-                    float(inner), outer_eff)
+                    tube.inner, tube.outer_eff)
