@@ -11,7 +11,8 @@ Quick start::
     sol = ts.solve(sphere, grid, sources=[(-0.5, 0, 0)])
     sol([(0.5, 0, 0)])            # ≈ π/2 · 0.5
 
-Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :func:`travel_time` (the whole
+Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :class:`Tube` (the same band
+solved on many times: other sources, speeds, Hamiltonians), :func:`travel_time` (the whole
 box, Algorithm 1), :class:`Grid`, :class:`LevelSet`, :class:`ClosestPoint` (open and non-orientable surfaces,
 Sect. 5.2) and the library :mod:`tubesweep.surfaces`; meshes in, results out: :func:`surfaces.from_mesh`,
 :func:`triangulate`, :func:`export`, :func:`plot`.
