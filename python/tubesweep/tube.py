@@ -12,8 +12,10 @@ it once::
 
 Each :meth:`Tube.solve` gives the same values, bit for bit, as ``ts.solve`` with the same
 arguments, and leaves the tube as it was. The tube holds, per band node, its linear index
-(8 bytes), φ as float64 and float32 (12), the extension direction (4·d), the role (1) and the
-band's neighbour table (about 17 in 3D); a solve adds its own working arrays (docs/architecture.md).
+(8 bytes), φ as float64 and float32 (12; the unsigned distance too, 8 more, for closest-point
+and mesh surfaces), the extension direction (4·d), the role (1) and the band structure (about
+22 in 3D): 55 bytes per node for the sphere at N = 201 (:attr:`Tube.nbytes`). A solve adds its
+own working arrays (docs/architecture.md) and a copy of the directions.
 """
 
 from __future__ import annotations
