@@ -29,6 +29,14 @@ fn check_shape(shape: &[usize], samples: &[f64]) -> Result<()> {
     Ok(())
 }
 
+/// Differences along an axis need two nodes on it.
+fn check_differences(shape: &[usize]) -> Result<()> {
+    if shape.contains(&1) {
+        return Err(Error::invalid("grid", format!("needs at least 2 nodes per axis for differences, got shape {shape:?}")));
+    }
+    Ok(())
+}
+
 /// The position of the first sample that is NaN or infinite, if any (on all threads).
 pub fn first_non_finite(samples: &[f64]) -> Option<usize> {
     samples
@@ -79,6 +87,7 @@ pub fn band_of_samples(shape: &[usize], samples: &[f64], half_width: f64) -> Res
 /// 1e-12 the direction is `sgn(φ) g`.
 pub fn outward_directions_of_samples(shape: &[usize], spacing: f64, samples: &[f64], linear: &[u64], direction: &mut [f32]) -> Result<Vec<f64>> {
     check_shape(shape, samples)?;
+    check_differences(shape)?;
     let d = shape.len();
     if direction.len() != linear.len() * d {
         return Err(Error::invalid("direction", format!("expected shape ({}, {d})", linear.len())));
@@ -153,9 +162,7 @@ fn gradient_at(shape: &[usize], stride: &[usize; 3], spacing: f64, samples: &[f6
 /// search of a φ that is not a distance function. One pass, on all threads, nothing stored.
 pub fn max_gradient_norm_of_samples(shape: &[usize], spacing: f64, samples: &[f64]) -> Result<f64> {
     check_shape(shape, samples)?;
-    if shape.contains(&1) {
-        return Err(Error::invalid("grid", format!("needs at least 2 nodes per axis for differences, got shape {shape:?}")));
-    }
+    check_differences(shape)?;
     let stride = strides(shape);
     let largest = (0..samples.len())
         .into_par_iter()
@@ -243,5 +250,6 @@ mod tests {
         }
         assert!(outward_directions_of_samples(&[n, n, n], 1.0, &s, &[(n * n * n) as u64], &mut [0.0; 3]).is_err());
         assert!(outward_directions_of_samples(&[n, n, n], 1.0, &s, &linear, &mut dir[1..]).is_err());
+        assert!(outward_directions_of_samples(&[n * n * n, 1], 1.0, &s, &linear[..1], &mut dir[..2]).is_err());
     }
 }
