@@ -39,8 +39,9 @@ impl<'a, const D: usize> SampledField<'a, D> {
         if shape.iter().any(|&n| n < 2) {
             return Err(Error::invalid("grid", format!("needs at least 2 nodes per axis to interpolate, got shape {shape:?}")));
         }
-        if shape.iter().try_fold(1usize, |p, &n| p.checked_mul(n)) != Some(samples.len()) {
-            return Err(Error::invalid("phi", format!("expected {} samples (the grid {shape:?}), got {}", shape.iter().product::<usize>(), samples.len())));
+        let total = shape.iter().try_fold(1usize, |p, &n| p.checked_mul(n));
+        if total != Some(samples.len()) {
+            return Err(Error::invalid("phi", format!("expected {} samples (the grid {shape:?}), got {}", total.unwrap_or(usize::MAX), samples.len())));
         }
         if !(spacing > 0.0 && spacing.is_finite()) || lower.iter().any(|l| !l.is_finite()) {
             return Err(Error::invalid("grid", "the spacing must be positive and the lower corner finite"));
