@@ -312,33 +312,77 @@ pub fn rim_nodes_in_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::
     Ok((groups.concat(), counts))
 }
 
-/// φ at the places [`rim_nodes_in_band`] lists (`rim`, `counts`: group `g` is axis `g / 2`, side
-/// +1 for even `g`) for band nodes with linear indices `linear`: `phi` at `x ± Δx e_k`, with the
-/// node coordinates of [`crate::discovery::node_points`] (the arithmetic of the Python package's
-/// `_phi_at_rim_places`, so the same points), group after group. For a φ evaluated in Rust.
-pub fn rim_phi<const D: usize>(
-    shape: [usize; D],
+/// [`outward_directions_in_band`] for a φ evaluated in Rust (`phi`, the library's analytic
+/// surfaces), in one pass: chunk by chunk, φ at the chunk's off-band neighbours `x ± Δx e_k` is
+/// evaluated at once, with the node coordinates of [`crate::discovery::node_points`], and the
+/// differences follow. The same points and arithmetic as listing the rim places
+/// ([`rim_nodes_in_band`]), evaluating φ there and calling [`outward_directions_in_band`] (the
+/// callable route of the Python package), so the same bits, without the rim's lists, the
+/// prefix sums and a second pass over the band. `linear` are the band's sorted linear indices and
+/// `values` φ at its nodes; returns |∇φ| per node.
+pub fn outward_directions_of_function_in_band<const D: usize>(
+    band: &NarrowBand<D>,
     linear: &[u64],
-    rim: &[u64],
-    counts: &[usize],
+    values: &[f64],
     lower: [f64; D],
     spacing: f64,
     phi: &crate::discovery::PhiFn<'_>,
+    direction: &mut [f32],
 ) -> Result<Vec<f64>> {
-    if counts.len() != 2 * D || counts.iter().sum::<usize>() != rim.len() || rim.iter().any(|&i| i as usize >= linear.len()) {
-        return Err(Error::invalid("rim", "the rim places must be those of rim_nodes_in_band for this band"));
+    let m = band.len();
+    if linear.len() != m || values.len() != m || direction.len() != m * D {
+        return Err(Error::invalid("band", format!("expected {m} linear indices, values and directions (×{D}) for the band's nodes")));
     }
-    let mut out = vec![0.0; rim.len()];
-    let mut start = 0;
-    for (g, &count) in counts.iter().enumerate() {
-        let places: Vec<u64> = rim[start..start + count].iter().map(|&i| linear[i as usize]).collect();
-        let mut x = crate::discovery::node_points(shape, &places, lower, spacing)?;
-        let step = if g % 2 == 0 { spacing } else { -spacing };
-        x.par_chunks_mut(D).for_each(|p| p[g / 2] += step);
-        phi(&x, &mut out[start..start + count])?;
-        start += count;
-    }
-    Ok(out)
+    let (shape, sentinel) = (band.shape(), band.sentinel());
+    let mut norms = vec![0.0f64; m];
+    direction
+        .par_chunks_mut(CHUNK * D)
+        .zip(norms.par_chunks_mut(CHUNK))
+        .enumerate()
+        .try_for_each(|(j, (dir, norms))| -> Result<()> {
+            let lo = j * CHUNK;
+            let n = norms.len();
+            let coords = crate::discovery::node_points(shape, &linear[lo..lo + n], lower, spacing)?;
+            // the chunk's off-band neighbours, node by node and group by group (axis k, side +1
+            // then −1), and φ there
+            let mut places: Vec<f64> = Vec::new();
+            for o in 0..n {
+                // SAFETY: lo + o < m = band.len()
+                let nb = unsafe { band.neighbours_of_unchecked(lo + o) };
+                for g in 0..2 * D {
+                    if nb[g / 2][1 - g % 2] == sentinel {
+                        let at = places.len();
+                        places.extend_from_slice(&coords[o * D..(o + 1) * D]);
+                        places[at + g / 2] += if g % 2 == 0 { spacing } else { -spacing };
+                    }
+                }
+            }
+            let mut off_band = vec![0.0; places.len() / D];
+            phi(&places, &mut off_band)?;
+            let mut next = off_band.iter();
+            let mut block = Block::new();
+            let two_h = 2.0 * spacing;
+            for o in 0..n {
+                // SAFETY: as above
+                let nb = unsafe { band.neighbours_of_unchecked(lo + o) };
+                let i = block.len;
+                for g in 0..2 * D {
+                    let q = nb[g / 2][1 - g % 2];
+                    block.phi[g][i] = if q == sentinel { *next.next().expect("one value per off-band place") } else { values[q as usize] };
+                }
+                block.own[i] = values[lo + o];
+                if i == 0 {
+                    block.first = o;
+                }
+                block.len += 1;
+                if block.len == BLOCK {
+                    block.finish(D, two_h, dir, norms);
+                }
+            }
+            block.finish(D, two_h, dir, norms);
+            Ok(())
+        })?;
+    Ok(norms)
 }
 
 /// The arithmetic of [`outward_directions`] for nodes `range` of a band of `phi.len()` nodes in
@@ -541,6 +585,37 @@ mod tests {
         let (rim, counts) = rim_nodes(&shape, &linear, 6..9).unwrap();
         assert!(rim.is_empty() && counts == vec![0; 4]);
         assert!(rim_nodes(&shape, &linear, 6..30).is_err());
+    }
+
+    #[test]
+    fn a_function_gives_the_directions_of_its_values_at_the_rim_places() {
+        // a sphere's φ evaluated in Rust: the fused pass against the rim places, φ there by the
+        // node coordinates ± Δx, and the directions from them
+        let (shape, lower, h) = ([30usize, 26, 33], [-0.8f64, -0.7, -0.85], 0.05);
+        let phi = |p: &[f64], out: &mut [f64]| crate::analytic::sphere_signed_distance(p, &[0.02, -0.03, 0.0], 0.55, out);
+        let (linear, values) = crate::discovery::discover_band(shape, lower, h, 4.0 * h, 1.0, &phi).unwrap();
+        let band = NarrowBand::<3>::from_sorted_linear(shape, &linear).unwrap();
+        let (rim, counts) = rim_nodes_in_band(&band, 0..linear.len()).unwrap();
+        let mut rim_phi = Vec::new();
+        let mut start = 0;
+        for (g, &count) in counts.iter().enumerate() {
+            let places: Vec<u64> = rim[start..start + count].iter().map(|&i| linear[i as usize]).collect();
+            let mut x = crate::discovery::node_points(shape, &places, lower, h).unwrap();
+            for p in x.chunks_mut(3) {
+                p[g / 2] += if g % 2 == 0 { h } else { -h };
+            }
+            let mut v = vec![0.0; count];
+            phi(&x, &mut v).unwrap();
+            rim_phi.extend(v);
+            start += count;
+        }
+        let mut a = vec![0.0f32; 3 * linear.len()];
+        let mut b = a.clone();
+        let na = outward_directions_in_band(&band, h, &values, 0..linear.len(), &rim_phi, &mut a).unwrap();
+        let nb = outward_directions_of_function_in_band(&band, &linear, &values, lower, h, &phi, &mut b).unwrap();
+        assert!(!rim_phi.is_empty());
+        assert_eq!((&na, &a), (&nb, &b));
+        assert!(outward_directions_of_function_in_band(&band, &linear[1..], &values, lower, h, &phi, &mut b).is_err());
     }
 
     #[test]

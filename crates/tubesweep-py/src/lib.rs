@@ -1110,11 +1110,9 @@ fn analytic_level_set_band<'py>(
             return Ok((linear, values, None, Vec::new(), Vec::new()));
         }
         let band = NarrowBand::<D>::from_sorted_linear(shape, &linear).map_err(to_pyerr)?;
-        let all = 0..linear.len();
-        let (rim, counts) = tubesweep_core::normals::rim_nodes_in_band(&band, all.clone()).map_err(to_pyerr)?;
-        let rim_phi = tubesweep_core::normals::rim_phi(shape, &linear, &rim, &counts, lower, spacing, &phi).map_err(to_pyerr)?;
         let mut direction = vec![0.0f32; linear.len() * D];
-        let norms = tubesweep_core::normals::outward_directions_in_band(&band, spacing, &values, all, &rim_phi, &mut direction).map_err(to_pyerr)?;
+        let norms = tubesweep_core::normals::outward_directions_of_function_in_band(&band, &linear, &values, lower, spacing, &phi, &mut direction)
+            .map_err(to_pyerr)?;
         Ok((linear, values, Some(wrap(band)), direction, norms))
     }
     let (linear, values, band, direction, norms) = py.detach(|| match shape.len() {
