@@ -389,6 +389,9 @@ def test_native_node_points_and_neighbour_table(shape):
     lin = np.sort(rng.choice(grid.size, grid.size // 3, replace=False)).astype(np.uint64)
     lower = [float(x) for x in grid.lower]
     assert np.array_equal(_native.node_points(list(shape), lin, lower, grid.spacing), grid.points(grid.unravel(lin)))
+    assert np.array_equal(grid.node_points(lin.astype(np.int64)), grid.points(grid.unravel(lin)))
+    with pytest.raises(ValueError, match="outside the grid"):
+        grid.node_points(np.array([0, -1]))
     lo, hi = 5, len(lin) - 7
     table = _native.neighbour_table(list(shape), lin, lo, hi)
     d = len(shape)

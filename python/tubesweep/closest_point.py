@@ -120,7 +120,7 @@ class ClosestPoint(Surface):
         d = grid.ndim
         if linear.size == 0:
             return BandGeometry(linear, dist, dist, np.zeros((0, d), np.float32))
-        x = grid.points(grid.unravel(linear))
+        x = grid.node_points(linear)
         diff = x - self.closest_point(x)
         norm = row_norms(diff)
         ok = norm > DIRECTION_EPS * grid.spacing

@@ -124,6 +124,17 @@ class Grid:
         idx = np.asarray(indices)
         return self._lower + self._spacing * idx.astype(float)
 
+    def node_points(self, linear: np.ndarray) -> np.ndarray:
+        """Coordinates (M, d) of the nodes with C-order linear indices ``linear``: the bits of
+        ``points(unravel(linear))``, computed in Rust on all threads without the (M, d) index
+        array (for the band's nodes, in order, one division per grid row)."""
+        from . import _native
+
+        lin = np.ascontiguousarray(linear, dtype=np.int64)
+        # a negative index turns into one above every node: refused there like any outside one
+        return _native.node_points(list(self._shape), lin.view(np.uint64), [float(x) for x in self._lower],
+                                   self._spacing)
+
     def continuous_index(self, points: "np.ndarray | Sequence[Sequence[float]]") -> np.ndarray:
         """Fractional node index of points (M, d)."""
         p = np.asarray(points, dtype=float)

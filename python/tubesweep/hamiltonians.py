@@ -366,7 +366,7 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
                activation_threshold: float = 0.0, defer_outer_rim: bool = True) -> tuple:
     """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
     travel time (for ``exact_sources``), and runs the general Lax–Friedrichs sweeps (Sect. 5.1)."""
-    x = grid.points(grid.unravel(geom.linear))
+    x = grid.node_points(geom.linear)
     slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
     prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
     fixed = np.array(fixed_values, dtype=float)

@@ -140,7 +140,7 @@ def redistanced_band(surface, grid, half_width: float):
         cand, _ = discover_band(surface._fn, grid, L * half_width, L)
     if cand.size == 0:
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
-    x = grid.points(grid.unravel(cand))
+    x = grid.node_points(cand)
     cp, signed, ok = _project(surface, grid, x)
     keep = ok & (np.abs(signed) <= half_width * (1 + 1e-9))  # ties on the band edge: rounding
     lin, x, cp, signed = cand[keep], x[keep], cp[keep], signed[keep]

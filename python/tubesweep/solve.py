@@ -426,7 +426,7 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
     roles = tube.roles.copy() if reuse else tube.roles
     linear = tube.linear
     # node coordinates only for a speed given as a callable (an array is read at the nodes)
-    x = grid.points(grid.unravel(linear)) if callable(speed) else np.empty((len(linear), 0))
+    x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
     slowness: Any = 1.0 / speed_nodes
 

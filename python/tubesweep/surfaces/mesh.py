@@ -301,7 +301,7 @@ class MeshSurface(Surface):
         lin = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0])
         if lin.size == 0:
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
-        x = grid.points(grid.unravel(lin))
+        x = grid.node_points(lin)
         dist, cp, face, code = self.closest(x, half_width * (1 + 1e-12))
         keep = dist <= half_width
         lin, x, dist, cp, face, code = lin[keep], x[keep], dist[keep], cp[keep], face[keep], code[keep]
