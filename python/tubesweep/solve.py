@@ -328,19 +328,26 @@ def _check_source_init(source_init: str) -> None:
         raise ValueError(f"source_init must be one of {SOURCE_INITS}; got {source_init!r}")
 
 
+@dataclasses.dataclass
 class _PreparedTube:
     """The band of a surface on a grid with what every solve on it needs: the sorted linear
     indices, the roles before the sources are fixed, the native band, φ in single precision, and
     either the directions the solver may overwrite (``direction``; one solve) or the whole
     geometry (``geom``, never modified; a general Hamiltonian reads it, and a :class:`Tube`
-    solves many times)."""
+    solves many times). ``seconds``: the time the preparation took."""
 
-    def __init__(self, grid: Grid, surface: Surface, inner: float, outer_eff: float, method: str, geom: Optional[BandGeometry],
-                 linear: np.ndarray, roles: np.ndarray, band: Any, phi: np.ndarray, direction: Optional[np.ndarray],
-                 seconds: float):
-        self.grid, self.surface, self.inner, self.outer_eff, self.method = grid, surface, inner, outer_eff, method
-        self.geom, self.linear, self.roles, self.band, self.phi, self.direction = geom, linear, roles, band, phi, direction
-        self.seconds = seconds
+    grid: Grid
+    surface: Surface
+    inner: float
+    outer_eff: float
+    method: str
+    geom: Optional[BandGeometry]
+    linear: np.ndarray
+    roles: np.ndarray
+    band: Any
+    phi: np.ndarray
+    direction: Optional[np.ndarray]
+    seconds: float
 
 
 def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool,

@@ -59,11 +59,26 @@ class Tube:
         self.surface: Surface = as_surface(surface)
         self.surface.check_grid(self.grid)
         self._tube = _prepare_tube(self.surface, self.grid, inner, outer, method, keep_geometry=True, reusable=True)
-        self.method = method
-        self.inner = float(inner)
-        self.outer = self._tube.outer_eff
-        self.band_points = len(self._tube.linear)
-        self.setup_seconds = self._tube.seconds
+
+    @property
+    def method(self) -> str:
+        return self._tube.method
+
+    @property
+    def inner(self) -> float:
+        return self._tube.inner
+
+    @property
+    def outer(self) -> float:
+        return self._tube.outer_eff
+
+    @property
+    def band_points(self) -> int:
+        return len(self._tube.linear)
+
+    @property
+    def setup_seconds(self) -> float:
+        return self._tube.seconds
 
     def __repr__(self) -> str:
         return (f"Tube({type(self.surface).__name__}, grid shape {self.grid.shape}, {self.band_points:,} band points, "

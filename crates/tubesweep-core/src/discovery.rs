@@ -281,13 +281,19 @@ pub fn discover_band<const D: usize>(
             Ok((l, v))
         })
         .collect::<Result<_>>()?;
+    Ok(concat_band_parts(parts))
+}
+
+/// The band nodes' linear indices and values found in parts (slices of the grid or of the
+/// candidates, in order), joined in that order.
+pub(crate) fn concat_band_parts(parts: Vec<(Vec<u64>, Vec<f64>)>) -> (Vec<u64>, Vec<f64>) {
     let kept: usize = parts.iter().map(|p| p.0.len()).sum();
     let (mut linear, mut values) = (Vec::with_capacity(kept), Vec::with_capacity(kept));
     for (l, v) in parts {
         linear.extend_from_slice(&l);
         values.extend_from_slice(&v);
     }
-    Ok((linear, values))
+    (linear, values)
 }
 
 /// Copies the candidates with `|value| ≤ half_width` (the band's nodes) to the fronts of

@@ -365,19 +365,15 @@ pub fn outward_directions_of_function_in_band<const D: usize>(
             for o in 0..n {
                 // SAFETY: as above
                 let nb = unsafe { band.neighbours_of_unchecked(lo + o) };
-                let i = block.len;
-                for g in 0..2 * D {
+                let neighbour_phi = |g: usize| {
                     let q = nb[g / 2][1 - g % 2];
-                    block.phi[g][i] = if q == sentinel { *next.next().expect("one value per off-band place") } else { values[q as usize] };
-                }
-                block.own[i] = values[lo + o];
-                if i == 0 {
-                    block.first = o;
-                }
-                block.len += 1;
-                if block.len == BLOCK {
-                    block.finish(D, two_h, dir, norms);
-                }
+                    if q == sentinel {
+                        *next.next().expect("one value per off-band place")
+                    } else {
+                        values[q as usize]
+                    }
+                };
+                block.push(o, values[lo + o], D, neighbour_phi, two_h, dir, norms);
             }
             block.finish(D, two_h, dir, norms);
             Ok(())
@@ -455,27 +451,14 @@ where
         let mut block = Block::new();
         let two_h = 2.0 * spacing;
         visit_chunk(j, &mut |o, c_last| {
-            let i = block.len;
-            for k in 0..d {
-                for side in 0..2 {
-                    let g = 2 * k + side;
-                    block.phi[g][i] = match neighbour(o, c_last, g) {
-                        Some(p) => phi[p],
-                        None => {
-                            rim[g] += 1;
-                            rim_phi[rim[g] - 1]
-                        }
-                    };
+            let neighbour_phi = |g: usize| match neighbour(o, c_last, g) {
+                Some(p) => phi[p],
+                None => {
+                    rim[g] += 1;
+                    rim_phi[rim[g] - 1]
                 }
-            }
-            block.own[i] = phi[range.start + o];
-            if i == 0 {
-                block.first = o - lo;
-            }
-            block.len += 1;
-            if block.len == BLOCK {
-                block.finish(d, two_h, dir, norms);
-            }
+            };
+            block.push(o - lo, phi[range.start + o], d, neighbour_phi, two_h, dir, norms);
         });
         block.finish(d, two_h, dir, norms);
     });
@@ -498,6 +481,26 @@ struct Block {
 impl Block {
     fn new() -> Box<Self> {
         Box::new(Block { phi: [[0.0; BLOCK]; 6], own: [0.0; BLOCK], first: 0, len: 0 })
+    }
+
+    /// Appends node `o` of the chunk, with φ there `own` and at its neighbours `neighbour_phi(g)`
+    /// (group `g = 2k + side`, side 0 the plus neighbour, asked in that order), and finishes the
+    /// block into the chunk's `dir` and `norms` when it is full.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn push(&mut self, o: usize, own: f64, d: usize, mut neighbour_phi: impl FnMut(usize) -> f64, two_h: f64, dir: &mut [f32], norms: &mut [f64]) {
+        let i = self.len;
+        for g in 0..2 * d {
+            self.phi[g][i] = neighbour_phi(g);
+        }
+        self.own[i] = own;
+        if i == 0 {
+            self.first = o;
+        }
+        self.len += 1;
+        if self.len == BLOCK {
+            self.finish(d, two_h, dir, norms);
+        }
     }
 
     /// Writes the block's directions and |∇φ| to the chunk's `dir` and `norms` and empties it:

@@ -70,14 +70,7 @@ pub fn band_of_samples(shape: &[usize], samples: &[f64], half_width: f64) -> Res
             (linear, values)
         })
         .collect();
-    let total: usize = parts.iter().map(|p| p.0.len()).sum();
-    let mut linear = Vec::with_capacity(total);
-    let mut values = Vec::with_capacity(total);
-    for (l, v) in parts {
-        linear.extend_from_slice(&l);
-        values.extend_from_slice(&v);
-    }
-    Ok((linear, values))
+    Ok(crate::discovery::concat_band_parts(parts))
 }
 
 /// The outward directions `sgn(φ) g/|g|` (as f32, written to `direction`, one row of `d` per
