@@ -12,7 +12,11 @@
 //! the pipeline is simulated sweep by sweep with that work, for several tile shapes (rows in x,
 //! across the strips × rows in y, along a strip), under two cost models (see `WORK_MODELS`):
 //!   cargo run --release -p tubesweep-core --features kernel-stats --example schedule_balance -- --windowed 101 201
-//! (`SOURCE_AXIS=1` or `2` moves the source as in the `sphere` example.)
+//! (`SOURCE_AXIS=1` or `2` moves the source as in the `sphere` example.) Beside the pipeline it
+//! prints the bound of a list scheduler that hands any ready tile to the thread free first (a
+//! tile is ready once the tile before it in its strip and the one of the previous strip it reads
+//! are done; the ready tile of the earliest wave first): what a scheduler not tied to strips could
+//! reach on the same tiles.
 #[path = "common/shell.rs"]
 mod shell;
 #[path = "common/sphere_source.rs"]
@@ -153,67 +157,122 @@ fn windowed_bounds(n: usize) {
             [idx[0], idx[1]]
         })
         .collect();
-    println!("{:>8} {:>12} {:>10} {:>10}", "tile", "model", "2 threads", "4 threads");
+    println!("{:>8} {:>12} {:>10} {:>10} {:>10} {:>10}", "tile", "model", "2 threads", "4 threads", "2 greedy", "4 greedy");
     for (ta, tb) in SHAPES {
         for (name, cost) in WORK_MODELS {
             let mut bounds = Vec::new();
-            for threads in [2usize, 4] {
-                let (mut total, mut time) = (0u64, 0u64);
-                for (k, rows_run) in log.iter().enumerate() {
-                    let s = k % 8;
-                    let dir = s ^ (s >> 1); // the solver's Gray code order of the orientations
-                    let (w, t) = sweep_pipeline(&lead, n, dir & 3, (ta, tb), rows_run, cost, threads);
-                    total += w;
-                    time += t;
+            for greedy in [false, true] {
+                for threads in [2usize, 4] {
+                    let (mut total, mut time) = (0u64, 0u64);
+                    for (k, rows_run) in log.iter().enumerate() {
+                        let s = k % 8;
+                        let dir = s ^ (s >> 1); // the solver's Gray code order of the orientations
+                        let work = tile_work(&lead, n, dir & 3, (ta, tb), rows_run, cost);
+                        let nb = (n - 1) / tb + 1;
+                        let t = if greedy { greedy_time(&work, nb, threads) } else { pipeline_time_of_tiles(&work, nb, threads) };
+                        total += work.iter().filter(|&&w| w != NO_ROWS).sum::<u64>();
+                        time += t;
+                    }
+                    bounds.push(total as f64 / time as f64);
                 }
-                bounds.push(total as f64 / time as f64);
             }
-            println!("{:>8} {:>12} {:>9.2}x {:>9.2}x", format!("{ta}x{tb}"), name, bounds[0], bounds[1]);
+            println!(
+                "{:>8} {:>12} {:>9.2}x {:>9.2}x {:>9.2}x {:>9.2}x",
+                format!("{ta}x{tb}"),
+                name,
+                bounds[0],
+                bounds[1],
+                bounds[2],
+                bounds[3]
+            );
         }
     }
 }
 
-/// One sweep in leading orientation `signs` through the strip pipeline with tiles of `shape`
-/// rows: (its total work, the time `threads` threads take), with `rows_run` the rows it ran and
-/// `cost` the model's weights. Every row is reached; every tile with a row costs the tile weight.
-fn sweep_pipeline(lead: &[[usize; 2]], n: usize, signs: usize, shape: (usize, usize), rows_run: &[RowWork], cost: [u64; 5], threads: usize) -> (u64, u64) {
+/// Marks a tile without rows in [`tile_work`].
+const NO_ROWS: u64 = u64::MAX;
+
+/// The work of every tile of one sweep in leading orientation `signs` with tiles of `shape` rows,
+/// strip by strip (`a · nb + b`, `nb` tiles per strip), with `rows_run` the rows it ran and `cost`
+/// the model's weights: every row is reached, every tile with a row costs the tile weight;
+/// [`NO_ROWS`] for a tile without rows.
+fn tile_work(lead: &[[usize; 2]], n: usize, signs: usize, shape: (usize, usize), rows_run: &[RowWork], cost: [u64; 5]) -> Vec<u64> {
     let (na, nb) = ((n - 1) / shape.0 + 1, (n - 1) / shape.1 + 1);
     let tile_of = |r: usize| -> usize {
         let c0 = if signs & 1 != 0 { n - 1 - lead[r][0] } else { lead[r][0] };
         let c1 = if signs & 2 != 0 { n - 1 - lead[r][1] } else { lead[r][1] };
         (c0 / shape.0) * nb + c1 / shape.1
     };
-    // work per tile; NONE marks a tile without rows
-    const NONE: u64 = u64::MAX;
-    let mut work = vec![NONE; na * nb];
+    let mut work = vec![NO_ROWS; na * nb];
     for r in 0..lead.len() {
         let t = tile_of(r);
-        work[t] = if work[t] == NONE { cost[4] + cost[0] } else { work[t] + cost[0] };
+        work[t] = if work[t] == NO_ROWS { cost[4] + cost[0] } else { work[t] + cost[0] };
     }
     for w in rows_run {
         work[tile_of(w.row as usize)] += cost[1] + cost[2] * w.nodes as u64 + cost[3] * w.updates as u64;
     }
-    let total: u64 = work.iter().filter(|&&w| w != NONE).sum();
-    // the strips in order, each to the thread free first; a tile waits for the one before it in
-    // its strip (the same thread) and for the previous strip's tile with the same b
+    work
+}
+
+/// The strip pipeline's time for one sweep's tile `work` (`nb` tiles per strip): the strips in
+/// order, each to the thread free first; a tile waits for the one before it in its strip (the
+/// same thread) and for the previous strip's tile with the same `b`.
+fn pipeline_time_of_tiles(work: &[u64], nb: usize, threads: usize) -> u64 {
+    let na = work.len() / nb;
     let mut finish = vec![0u64; na * nb];
     let mut free = vec![0u64; threads];
     for a in 0..na {
-        if (0..nb).all(|b| work[a * nb + b] == NONE) {
+        if (0..nb).all(|b| work[a * nb + b] == NO_ROWS) {
             continue;
         }
         let i = (0..threads).min_by_key(|&i| free[i]).unwrap();
         let mut now = free[i];
         for b in 0..nb {
             let t = a * nb + b;
-            if work[t] == NONE {
+            if work[t] == NO_ROWS {
                 continue;
             }
-            let ready = if a > 0 && work[t - nb] != NONE { finish[t - nb] } else { 0 };
+            let ready = if a > 0 && work[t - nb] != NO_ROWS { finish[t - nb] } else { 0 };
             now = now.max(ready) + work[t];
             finish[t] = now;
         }
         free[i] = now;
     }
-    (total, free.into_iter().max().unwrap_or(0))
+    free.into_iter().max().unwrap_or(0)
+}
+
+/// A list scheduler on the same tiles and dependencies, not tied to strips: tile `(a, b)` is ready
+/// once `(a − 1, b)` and `(a, b − 1)` are done, and a thread that comes free takes the ready tile
+/// of the earliest wave `a + b` (then the lowest `a`). Returns the time the last tile finishes.
+fn greedy_time(work: &[u64], nb: usize, threads: usize) -> u64 {
+    let na = work.len() / nb;
+    let cost = |t: usize| if work[t] == NO_ROWS { 0 } else { work[t] };
+    let mut waiting_for: Vec<u8> = (0..na * nb).map(|t| (t >= nb) as u8 + (t % nb > 0) as u8).collect();
+    let mut ready = vec![0usize];
+    let mut running: Vec<(u64, usize)> = Vec::new(); // (finish time, tile)
+    let (mut idle, mut now, mut done) = (threads, 0u64, 0usize);
+    while done < na * nb {
+        while idle > 0 && !ready.is_empty() {
+            let i = (0..ready.len()).min_by_key(|&i| (ready[i] / nb + ready[i] % nb, ready[i] / nb)).unwrap();
+            let t = ready.swap_remove(i);
+            running.push((now + cost(t), t));
+            idle -= 1;
+        }
+        let k = (0..running.len()).min_by_key(|&k| running[k].0).unwrap();
+        let (finish, t) = running.swap_remove(k);
+        (now, done, idle) = (finish, done + 1, idle + 1);
+        if t / nb + 1 < na {
+            waiting_for[t + nb] -= 1;
+            if waiting_for[t + nb] == 0 {
+                ready.push(t + nb);
+            }
+        }
+        if t % nb + 1 < nb {
+            waiting_for[t + 1] -= 1;
+            if waiting_for[t + 1] == 0 {
+                ready.push(t + 1);
+            }
+        }
+    }
+    now
 }
