@@ -272,3 +272,34 @@ def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(cap
     assert [r.split()[0] for r in rows] == list(front_window_surfaces.NAMES)
     assert all(float(r.split()[-1]) < 1e-9 for r in rows)
     assert sys.modules["tubesweep.solve"].FRONT_WINDOW == default
+
+
+def test_oblique_planes_bench_axis_aligned_surfaces_settle_at_once_and_tilted_ones_do_not():
+    """benches/oblique_planes.py at small sizes: along an axis the paper's sweeps converge in one
+    iteration (and one to confirm it) at under 3.5 updates per node; a tilted line takes many;
+    the coupled update brings the 45° line down to a few iterations but not the 16.7° one."""
+    import oblique_planes
+
+    flat2, tilted2, diagonal2 = (oblique_planes.measure(v, 101) for v in ((0.0, 1.0), (0.3, 1.0), (1.0, 1.0)))
+    flat3 = oblique_planes.measure((0.0, 0.0, 1.0), 31)
+    for flat in (flat2, flat3):
+        assert flat["tilt"] == 0.0
+        assert flat["paper_iterations"] == 2 and flat["paper_updates_per_node"] < 3.5
+    assert tilted2["paper_iterations"] >= 10 and tilted2["default_iterations"] >= 8
+    assert diagonal2["paper_iterations"] >= 10 and diagonal2["default_iterations"] <= 5
+    assert tilted2["default_updates_per_node"] > 4 * flat2["default_updates_per_node"]
+
+
+def test_dependency_cycles_bench_finds_the_pairs_the_coupled_update_removes(capsys):
+    """benches/dependency_cycles.py: the gain around a hand-made 2-cycle and 4-cycle; on the
+    tilted line, the paper's update leaves inner–layer pairs that read each other, and with the
+    coupled update folded in no cycle is left."""
+    import dependency_cycles as dc
+
+    assert dc.cycles([{1: 0.5}, {0: 0.4}, {}]) == (1, 2, 2, pytest.approx(0.2))
+    assert dc.cycles([{1: 0.5}, {2: 0.5}, {3: 0.5}, {0: 0.4}]) == (1, 4, 4, pytest.approx(0.05))
+    assert dc.cycles([{1: 0.5}, {2: 0.5}, {}]) == (0, 0, 0, 0.0)
+    assert dc.main(["--case", "line2", "--n", "101"]) == 0
+    plain, coupled = (line.split() for line in capsys.readouterr().out.splitlines()[1:])
+    assert plain[4] == "plain" and int(plain[5]) > 0 and int(plain[7]) == 2 and float(plain[8]) > 0.05
+    assert coupled[4] == "coupled" and coupled[5:8] == ["0", "0", "0"]
