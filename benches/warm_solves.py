@@ -18,7 +18,8 @@ the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
 (the sphere's exact signed distance, an array of the grid's shape, as a user with a level set
 array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine. With
 ``--redistance`` the array is ``|x|² − r²`` (the same sphere, not a distance function) and the
-surface ``ts.LevelSet(array, redistance=True)``. With ``--tube`` the solves are ``tube.solve``
+surface ``ts.LevelSet(array, redistance=True)``; it also prints the band's candidates by a bound on
+|∇φ| over the whole box and, on checkouts that have it, by the bound near each node. With ``--tube`` the solves are ``tube.solve``
 on one ``ts.Tube`` built before them (its build time is printed as ``tube_build_ms``); with
 ``--bunny`` the problem is the bench's bunny instead of the sphere.
 """
@@ -42,6 +43,19 @@ from problems import bunny, sphere  # noqa: E402
 from run import _peak_kb, _reset_peak, _status_kb  # noqa: E402
 
 
+def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
+    """The candidates of the re-distanced band (outer = 4Δx) by a bound on |∇φ| over the whole
+    box and, where this checkout has it, by the bound near each node that it uses."""
+    from tubesweep import _native
+    from tubesweep.redistance import estimate_lipschitz
+
+    w = 4 * grid.spacing
+    out = {"whole_box_candidates": len(_native.band_of_samples(surface._array, estimate_lipschitz(surface, grid) * w)[0])}
+    if hasattr(_native, "redistance_candidates_of_samples"):
+        out["local_bound_candidates"] = len(_native.redistance_candidates_of_samples(surface._array, grid.spacing, w)[0])
+    return out
+
+
 def main() -> int:
     flags = {"--dense", "--redistance", "--tube", "--bunny"}
     redistance = "--redistance" in sys.argv
@@ -51,6 +65,7 @@ def main() -> int:
     n = int(args[0]) if len(args) > 0 else 201
     repeats = int(args[1]) if len(args) > 1 else 7
     p = bunny(n) if "--bunny" in sys.argv else sphere(n)
+    extra = {}
     if redistance:
         d = p.dense_phi(p.grid)  # |x − c| − r
         surface = ts.LevelSet(d * (d + 2 * 0.5), redistance=True)  # |x − c|² − r², r = 0.5
@@ -58,7 +73,6 @@ def main() -> int:
         surface = ts.LevelSet(p.dense_phi(p.grid))
     else:
         surface = p.surface
-    extra = {}
     if use_tube:
         t = time.perf_counter()
         tube = ts.Tube(surface, p.grid)
@@ -83,6 +97,8 @@ def main() -> int:
         wall.append(time.perf_counter() - t)
         setup.append(sol.stats.setup_seconds)
         sweeps.append(sol.stats.seconds)
+    if redistance:  # after the timed solves, whose memory it would otherwise change
+        extra.update(redistance_candidates(surface, p.grid))
     ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
     print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, tube=use_tube, **ms,
                           first_solve_delta_rss_mb=delta_rss_mb, **extra)))

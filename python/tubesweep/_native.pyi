@@ -27,6 +27,9 @@ def band_of_samples(
     phi: npt.NDArray[np.float64], half_width: float  # φ at every grid node, C-contiguous
 ) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
 def max_gradient_norm_of_samples(phi: npt.NDArray[np.float64], spacing: float) -> float: ...
+def redistance_candidates_of_samples(
+    phi: npt.NDArray[np.float64], spacing: float, half_width: float
+) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
 def project_to_sampled_level_set(
     phi: npt.NDArray[np.float64],  # φ at every grid node, C-contiguous
     lower: List[float],

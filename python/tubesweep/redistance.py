@@ -125,18 +125,26 @@ def estimate_lipschitz(surface, grid, n: int = 17) -> float:
 
 def redistanced_band(surface, grid, half_width: float):
     """The band of ``LevelSet(phi, redistance=True)``: candidates ``|φ| ≤ L·half_width`` (L a bound
-    on |∇φ|, so every node within ``half_width`` of the surface is a candidate), found
-    coarse-to-fine; then the exact signed distance by :func:`project_to_level_set`; keep
-    ``|d| ≤ half_width``."""
+    on |∇φ|, so every node within ``half_width`` of the surface is a candidate); then the exact
+    signed distance by :func:`project_to_level_set`; keep ``|d| ≤ half_width``.
+
+    For an array without a given ``lipschitz``, L is a bound on the gradient of φ's interpolant
+    near each node (per block of nodes, ``tubesweep_core::sampled::redistance_candidates_of_samples``):
+    a bound over the whole box would take φ's steepest part anywhere and make several times the
+    candidates. Otherwise L is the given bound or :func:`estimate_lipschitz`, and a callable's
+    candidates are found coarse-to-fine."""
     from .surface import BandGeometry, discover_band
 
-    L = surface.lipschitz if surface.lipschitz is not None else estimate_lipschitz(surface, grid)
     d = grid.ndim
     if surface.is_dense:
         from . import _native
 
-        cand = _native.band_of_samples(surface._array, L * half_width)[0].view(np.int64)
+        if surface.lipschitz is None:
+            cand = _native.redistance_candidates_of_samples(surface._array, grid.spacing, half_width)[0].view(np.int64)
+        else:
+            cand = _native.band_of_samples(surface._array, surface.lipschitz * half_width)[0].view(np.int64)
     else:
+        L = surface.lipschitz if surface.lipschitz is not None else estimate_lipschitz(surface, grid)
         cand, _ = discover_band(surface._fn, grid, L * half_width, L)
     if cand.size == 0:
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))

@@ -1030,6 +1030,18 @@ fn max_gradient_norm_of_samples(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>
     py.detach(|| tubesweep_core::sampled::max_gradient_norm_of_samples(&shape, spacing, s)).map_err(to_pyerr)
 }
 
+/// The candidates for the re-distanced band of a φ sampled on the whole grid: the nodes with
+/// `|φ| ≤ half_width · G`, `G` a bound on the gradient of φ's interpolant within reach of the
+/// node (sorted C-order linear indices and φ there). See
+/// `tubesweep_core::sampled::redistance_candidates_of_samples`.
+#[pyfunction]
+fn redistance_candidates_of_samples<'py>(py: Python<'py>, phi: PyReadonlyArrayDyn<'py, f64>, spacing: f64, half_width: f64) -> PyResult<LinearAndValues<'py>> {
+    let shape = phi.shape().to_vec();
+    let s = c_slice(&phi, "phi")?;
+    let (linear, values) = py.detach(|| tubesweep_core::sampled::redistance_candidates_of_samples(&shape, spacing, s, half_width)).map_err(to_pyerr)?;
+    Ok((linear.into_pyarray(py), values.into_pyarray(py)))
+}
+
 /// Closest points, signed distances and convergence flags.
 type ProjectionArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
 
@@ -1138,6 +1150,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(band_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(max_gradient_norm_of_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(redistance_candidates_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(project_to_sampled_level_set, m)?)?;
     m.add_function(wrap_pyfunction!(analytic_level_set_band, m)?)?;
     m.add_function(wrap_pyfunction!(neighbour_table, m)?)?;
