@@ -14,9 +14,9 @@ closest-point direction of Sect. 5.2). Gradients are central differences of φ w
 ``GRADIENT_STEP · Δx`` (a callable φ) or ``0.5 Δx`` (a sampled φ, multilinearly interpolated).
 
 For a sampled φ (an array) the same iterations, with the same arithmetic and bits, run in Rust on
-all threads (``tubesweep_core::redistance``), and the band's candidates and the bound on |∇φ|
-come from one pass over the samples each (``tubesweep_core::sampled``); this module's NumPy code
-runs them for a callable φ, which only Python can evaluate.
+all threads (``tubesweep_core::redistance``), and the band's candidates come from two passes over
+the samples with a bound on |∇φ| near each node (``tubesweep_core::sampled``); this module's NumPy
+code runs them for a callable φ, which only Python can evaluate.
 """
 
 from __future__ import annotations
@@ -109,8 +109,10 @@ def _project(surface, grid, x: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.n
 
 
 def estimate_lipschitz(surface, grid, n: int = 17) -> float:
-    """1.25 × the largest |∇φ| on an n^d lattice over the grid box (central differences), at
-    least 1e-12: the bound on |∇φ| used to find the candidate band of a re-distanced level set."""
+    """1.25 × the largest |∇φ| on an n^d lattice over the grid box (central differences; for an
+    array, over all its nodes), at least 1e-12: the bound on |∇φ| that finds the candidate band
+    of a re-distanced callable φ (an array's candidates use a bound near each node instead, see
+    :func:`redistanced_band`)."""
     if surface.is_dense:
         from . import _native
 

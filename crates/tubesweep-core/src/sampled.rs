@@ -180,11 +180,11 @@ const GRADIENT_BLOCK: usize = 8;
 /// `|∇φ| ≤ (Σ_k m_k²)^{1/2} / Δx` on the cell, with `m_k` the largest such difference
 /// ([`cell_gradient_bound_sq`]): `G` is the largest of these over the cells of blocks of
 /// [`GRADIENT_BLOCK`]^d nodes, the node's own block and the blocks next to it as far as
-/// `half_width` plus a cell's diagonal reaches. A single bound over the whole box, as for a callable φ,
-/// takes φ's steepest part anywhere (for `|x|² − r²`, the box's corners) and makes several times
-/// as many candidates, each of which the projection onto the zero level set then has to
-/// iterate. Two passes over the samples on all threads; the per-block bounds are the only
-/// storage (one value per block).
+/// `half_width` plus a cell's diagonal reaches. A single bound over the whole box, as for a
+/// callable φ, takes φ's steepest part anywhere (for `|x|² − r²`, the box's corners) and makes
+/// several times as many candidates, each of which the projection onto the zero level set then
+/// has to iterate. Two passes over the samples on all threads; the per-block bounds are the
+/// only storage (one value per block).
 pub fn redistance_candidates_of_samples(shape: &[usize], spacing: f64, samples: &[f64], half_width: f64) -> Result<(Vec<u64>, Vec<f64>)> {
     check_shape(shape, samples)?;
     check_differences(shape)?;
