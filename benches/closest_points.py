@@ -1,7 +1,8 @@
 """Closest points on a triangle mesh: the queries a mesh surface's band costs, timed alone.
 
-The band of a mesh surface (``MeshSurface.band``) is found coarse-to-fine with closest-point
-queries at block centres, then every candidate node is queried once more for its closest point
+The band of a mesh surface (``MeshSurface.band``) is found coarse-to-fine with queries at block
+centres (is any triangle within reach? ``MeshSurface.band_candidates``; on older checkouts the
+closest triangle's distance), then every candidate node is queried once more for its closest point
 (docs/meshes-and-output.md). This times both phases on the Stanford bunny's band (``make bench``'s
 grid, ``surface.grid(n)``), medians of warm runs, with the thread count of ``RAYON_NUM_THREADS``
 (all cores by default)::
@@ -44,6 +45,9 @@ def main() -> int:
     tree = surface.tree
 
     def search() -> np.ndarray:
+        if hasattr(surface, "band_candidates"):  # the band's own search (any triangle within reach)
+            return surface.band_candidates(grid, half_width)
+        # checkouts before it: the closest triangle's distance at every block centre
         return coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: surface.closest(p, reach)[0])
 
     candidates = search()

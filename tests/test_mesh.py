@@ -95,6 +95,26 @@ def test_band_matches_brute_force_and_directions_are_unit():
     assert np.allclose(geom.direction[off], (x - cp)[off] / d[off, None], atol=1e-6)
 
 
+def test_any_within_answers_as_the_closest_distance_and_the_search_keeps_the_same_nodes():
+    from tubesweep.surface import coarse_to_fine_candidates
+
+    v, f = icosphere(3)
+    m = MeshSurface(v, f)
+    rng = np.random.default_rng(4)
+    x = rng.uniform(-0.9, 0.9, size=(3000, 3))
+    d = m.closest(x)[0]
+    for limits in (d, np.nextafter(d, 0), 0.5 * d, d + 0.05, np.zeros(len(d))):
+        assert np.array_equal(m.tree.any_within(x, np.ascontiguousarray(limits)), d <= limits)
+    with pytest.raises(ValueError, match="thresholds"):
+        m.tree.any_within(x, d[:-1])
+    # the band's search (any triangle within reach) keeps the blocks that the closest distances keep
+    for n in (33, 61):
+        grid = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
+        hw = 4 * grid.spacing
+        by_distance = coarse_to_fine_candidates(grid, hw, 1.0, lambda p, reach: m.closest(p, reach)[0])
+        assert np.array_equal(m.band_candidates(grid, hw), by_distance)
+
+
 def test_signed_distance_of_closed_mesh_and_open_mesh_has_none():
     v, f = icosphere(3)
     m = MeshSurface(v, f)

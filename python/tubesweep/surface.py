@@ -118,7 +118,8 @@ def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, ou
 
 
 def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
-                              distance: Callable[[np.ndarray, float], np.ndarray]) -> np.ndarray:
+                              distance: Callable[[np.ndarray, float], np.ndarray],
+                              within: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None) -> np.ndarray:
     """Sorted C-order linear indices of the grid nodes that may lie within ``half_width`` of a
     surface, found without visiting the box.
 
@@ -126,7 +127,9 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     (exact when the distance is ``lipschitz``-Lipschitz, as a distance function is with constant
     1), then split in 2^d children, down to single nodes. ``distance(points, reach)`` returns the
     unsigned distance of the points; it may return anything larger than ``reach`` for points
-    farther than ``reach`` (a spatial index can stop its search there). Work and memory are
+    farther than ``reach`` (a spatial index can stop its search there). ``within(points,
+    thresholds)``, if given, is used instead and answers ``distance(points) <= thresholds`` itself
+    (a spatial index can stop at the first thing within the threshold). Work and memory are
     O(N^(d−1) log N); the single nodes of the last level are produced in C order as linear indices
     (8 bytes each, :func:`tubesweep._native.split_pair_blocks`), so the candidate list is the
     largest array this allocates.
@@ -154,8 +157,11 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
         kept = []
         for s0 in range(0, len(parents), step):
             o, centres, radius = _native.block_children(shape, parents[s0 : s0 + step], block, lower, h)
-            dist = distance(centres, reach)
-            kept.append(o[dist <= half_width + lipschitz * radius + 1e-12])
+            if within is not None:
+                kept.append(o[within(centres, half_width + lipschitz * radius + 1e-12)])
+            else:
+                dist = distance(centres, reach)
+                kept.append(o[dist <= half_width + lipschitz * radius + 1e-12])
         parents = kept[0] if len(kept) == 1 else np.concatenate(kept) if kept else parents[:0]
         block //= 2
         if block == 1:

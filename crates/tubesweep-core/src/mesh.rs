@@ -344,6 +344,84 @@ impl TriangleTree {
         best.map(|(q, t, f)| Closest { distance: best2.sqrt(), point: q, triangle: t, feature: f })
     }
 
+    /// Whether some triangle lies within `threshold` of `p`: the answer of
+    /// `closest(p, ∞).distance <= threshold` (the same distances, so the same answer) without
+    /// finding the closest triangle. The search starts from triangle `hint` and stops at the
+    /// first triangle within the threshold, which it returns. This is what the coarse-to-fine
+    /// band search asks of a block's centre, where the threshold (the band's half-width and the
+    /// block's radius) is wide and the closest triangle would take many projections to pin
+    /// down.
+    fn any_within(&self, p: V3, threshold: f64, hint: Option<usize>, stack: &mut Vec<(ChildRef, f64)>) -> Option<usize> {
+        if !(threshold >= 0.0) {
+            return None;
+        }
+        let within = |t: usize| {
+            let tri = &self.tris[t];
+            let dd = sub(p, closest_point_on_triangle(p, tri[0], tri[1], tri[2]).0);
+            dot(dd, dd).sqrt() <= threshold
+        };
+        if let Some(t) = hint {
+            if within(t) {
+                return Some(t);
+            }
+        }
+        // boxes are pruned against a hair more than threshold², so that rounding never prunes a
+        // box whose triangle passes the test above
+        let reach2 = threshold * threshold * (1.0 + 1e-9);
+        stack.clear();
+        let root_d = box_dist2(p, self.root_box.0, self.root_box.1);
+        if root_d <= reach2 {
+            stack.push((self.root, root_d));
+        }
+        while let Some((node, _)) = stack.pop() {
+            if node.count > 0 {
+                let (a, b) = (node.start as usize, (node.start + node.count) as usize);
+                for (&t, bx) in self.order[a..b].iter().zip(&self.boxes[a..b]) {
+                    if box_dist2(p, bx.0, bx.1) <= reach2 && within(t as usize) {
+                        return Some(t as usize);
+                    }
+                }
+            } else {
+                let n = &self.nodes[node.start as usize];
+                let dl = box_dist2(p, n.lo[0], n.hi[0]);
+                let dr = box_dist2(p, n.lo[1], n.hi[1]);
+                let (near, far) = if dl <= dr { ((n.child[0], dl), (n.child[1], dr)) } else { ((n.child[1], dr), (n.child[0], dl)) };
+                if far.1 <= reach2 {
+                    stack.push(far);
+                }
+                if near.1 <= reach2 {
+                    stack.push(near);
+                }
+            }
+        }
+        None
+    }
+
+    /// [`any_within`](Self::any_within) for many points `(M, 3)` (row-major) with a threshold
+    /// each, in parallel; each query starts from the triangle the previous point found.
+    pub fn any_within_many(&self, points: &[f64], thresholds: &[f64]) -> Vec<bool> {
+        const BLOCK: usize = 2048;
+        assert_eq!(points.len(), 3 * thresholds.len(), "one threshold per point");
+        let blocks: Vec<Vec<bool>> = points
+            .par_chunks(3 * BLOCK)
+            .zip(thresholds.par_chunks(BLOCK))
+            .map(|(block, limits)| {
+                let mut stack = Vec::with_capacity(64);
+                let mut hint = None;
+                block
+                    .chunks_exact(3)
+                    .zip(limits)
+                    .map(|(c, &t)| {
+                        let found = self.any_within([c[0], c[1], c[2]], t, hint, &mut stack);
+                        hint = found.or(hint);
+                        found.is_some()
+                    })
+                    .collect()
+            })
+            .collect();
+        blocks.concat()
+    }
+
     /// [`closest`](Self::closest) for many points `(M, 3)` (row-major), in parallel. Points are
     /// taken in blocks in their given order and each query starts from the previous point's
     /// triangle ([`closest_from`](Self::closest_from)): for grid nodes in C order, consecutive
@@ -432,6 +510,31 @@ mod tests {
                 assert_eq!(batch[i], tree.closest([c[0], c[1], c[2]], max_d), "point {i}");
             }
         }
+    }
+
+    #[test]
+    fn any_within_answers_as_the_closest_distance_does() {
+        // the octahedron again, points around it, thresholds around their distances (exact ties
+        // included: the threshold equal to the distance)
+        let v: [V3; 6] = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+        let f = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+        let tree = TriangleTree::new(f.iter().map(|t| [v[t[0]], v[t[1]], v[t[2]]]).collect());
+        let mut state = 5u64;
+        let (mut pts, mut limits) = (Vec::new(), Vec::new());
+        for _ in 0..4000 {
+            let p = [3.0 * lcg(&mut state) - 1.5, 3.0 * lcg(&mut state) - 1.5, 3.0 * lcg(&mut state) - 1.5];
+            let d = tree.closest(p, f64::INFINITY).unwrap().distance;
+            for t in [d, d * (1.0 - 1e-12), d * 0.5, d * 2.0 + 0.1, 0.0, -1.0] {
+                pts.extend_from_slice(&p);
+                limits.push(t);
+            }
+        }
+        let got = tree.any_within_many(&pts, &limits);
+        for (i, c) in pts.chunks_exact(3).enumerate() {
+            let d = tree.closest([c[0], c[1], c[2]], f64::INFINITY).unwrap().distance;
+            assert_eq!(got[i], d <= limits[i], "point {i}: distance {d}, threshold {}", limits[i]);
+        }
+        assert!(got.iter().any(|&b| b) && got.iter().any(|&b| !b));
     }
 
     #[test]

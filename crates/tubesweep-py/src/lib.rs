@@ -682,6 +682,18 @@ impl PyTriangleTree {
         self.tree.heap_bytes()
     }
 
+    /// Whether some triangle lies within `thresholds[i]` of `points[i]` ((M, 3) and (M,)): the
+    /// answer of `closest(points, inf)[0] <= thresholds` without finding the closest triangles.
+    /// See `tubesweep_core::mesh::TriangleTree::any_within_many`.
+    fn any_within<'py>(&self, py: Python<'py>, points: PyReadonlyArray2<'py, f64>, thresholds: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        if points.shape()[1] != 3 || points.shape()[0] != thresholds.len() {
+            return Err(PyValueError::new_err("points must have shape (M, 3) and thresholds shape (M,)"));
+        }
+        let (p, t) = (c_slice(&points, "points")?, c_slice(&thresholds, "thresholds")?);
+        let found = py.detach(|| self.tree.any_within_many(p, t));
+        Ok(found.into_pyarray(py))
+    }
+
     /// Closest points of `points` (M, 3) searched within `max_distance`: returns distance (M,)
     /// (inf where nothing is that close), closest point (M, 3), triangle (M,) (-1 where none) and
     /// feature code (M,) (0 face, 1-3 vertex a/b/c, 4 edge ab, 5 ac, 6 bc).

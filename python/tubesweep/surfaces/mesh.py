@@ -291,14 +291,15 @@ class MeshSurface(Surface):
         """Band nodes with ``|x − cp(x)| ≤ half_width``, found coarse-to-fine.
 
         Blocks of 2^L³ nodes are kept while the distance at their centre is within ``half_width`` +
-        the block's radius (the distance is 1-Lipschitz), then split; each query searches the AABB
-        tree only up to that radius, so blocks far from the mesh cost a few box tests. The extension
+        the block's radius (the distance is 1-Lipschitz), then split (:meth:`band_candidates`);
+        each query searches the AABB tree only up to that radius and stops at the first triangle
+        within it, so blocks far from the mesh cost a few box tests. The extension
         direction is ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2); at nodes on the surface, where it is
         undefined, the face normal.
         """
         self.check_grid(grid)
         h = grid.spacing
-        lin = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0])
+        lin = self.band_candidates(grid, half_width)
         if lin.size == 0:
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
         x = grid.node_points(lin)
@@ -316,6 +317,17 @@ class MeshSurface(Surface):
         else:
             signed = dist.copy()
         return BandGeometry(lin.astype(np.int64), dist, signed, direction.astype(np.float32), consumable=True)
+
+    def band_candidates(self, grid: Grid, half_width: float) -> np.ndarray:
+        """The nodes the coarse-to-fine search keeps (sorted linear indices), a superset of the
+        band's: a block is kept while some triangle lies within ``half_width`` + its radius of
+        its centre, which the AABB tree answers without finding the closest triangle (it stops
+        at the first one within reach)."""
+        tree = self.tree
+        return coarse_to_fine_candidates(
+            grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0],
+            within=lambda p, limits: tree.any_within(np.ascontiguousarray(p, dtype=float),
+                                                     np.ascontiguousarray(limits, dtype=float)))
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
         d, cp, _, _ = self.closest(points)
