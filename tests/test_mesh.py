@@ -113,6 +113,13 @@ def test_any_within_answers_as_the_closest_distance_and_the_search_keeps_the_sam
         hw = 4 * grid.spacing
         by_distance = coarse_to_fine_candidates(grid, hw, 1.0, lambda p, reach: m.closest(p, reach)[0])
         assert np.array_equal(m.band_candidates(grid, hw), by_distance)
+    # and on the bunny (an open, scanned mesh with triangles about a grid spacing wide)
+    bunny = from_mesh(BUNNY)
+    grid = bunny.grid(81)
+    hw = 4 * grid.spacing
+    by_distance = coarse_to_fine_candidates(grid, hw, 1.0, lambda p, reach: bunny.closest(p, reach)[0])
+    assert len(by_distance) > 10000
+    assert np.array_equal(bunny.band_candidates(grid, hw), by_distance)
 
 
 def test_signed_distance_of_closed_mesh_and_open_mesh_has_none():
