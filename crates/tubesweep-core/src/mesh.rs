@@ -328,20 +328,26 @@ impl TriangleTree {
                     }
                 }
             } else {
-                let n = &self.nodes[node.start as usize];
-                let dl = box_dist2(p, n.lo[0], n.hi[0]);
-                let dr = box_dist2(p, n.lo[1], n.hi[1]);
-                // push the farther child first so that the nearer one is searched first
-                let (near, far) = if dl <= dr { ((n.child[0], dl), (n.child[1], dr)) } else { ((n.child[1], dr), (n.child[0], dl)) };
-                if far.1 <= best2 {
-                    stack.push(far);
-                }
-                if near.1 <= best2 {
-                    stack.push(near);
-                }
+                self.push_children(p, node, best2, stack);
             }
         }
         best.map(|(q, t, f)| Closest { distance: best2.sqrt(), point: q, triangle: t, feature: f })
+    }
+
+    /// Pushes the children of inner node `node` whose boxes lie within `bound2` (squared) of
+    /// `p`, with their box distances: the farther first, so that the nearer one is searched first.
+    #[inline]
+    fn push_children(&self, p: V3, node: ChildRef, bound2: f64, stack: &mut Vec<(ChildRef, f64)>) {
+        let n = &self.nodes[node.start as usize];
+        let dl = box_dist2(p, n.lo[0], n.hi[0]);
+        let dr = box_dist2(p, n.lo[1], n.hi[1]);
+        let (near, far) = if dl <= dr { ((n.child[0], dl), (n.child[1], dr)) } else { ((n.child[1], dr), (n.child[0], dl)) };
+        if far.1 <= bound2 {
+            stack.push(far);
+        }
+        if near.1 <= bound2 {
+            stack.push(near);
+        }
     }
 
     /// Whether some triangle lies within `threshold` of `p`: the answer of
@@ -382,16 +388,7 @@ impl TriangleTree {
                     }
                 }
             } else {
-                let n = &self.nodes[node.start as usize];
-                let dl = box_dist2(p, n.lo[0], n.hi[0]);
-                let dr = box_dist2(p, n.lo[1], n.hi[1]);
-                let (near, far) = if dl <= dr { ((n.child[0], dl), (n.child[1], dr)) } else { ((n.child[1], dr), (n.child[0], dl)) };
-                if far.1 <= reach2 {
-                    stack.push(far);
-                }
-                if near.1 <= reach2 {
-                    stack.push(near);
-                }
+                self.push_children(p, node, reach2, stack);
             }
         }
         None
