@@ -19,9 +19,10 @@ the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
 array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine. With
 ``--redistance`` the array is ``|x|² − r²`` (the same sphere, not a distance function) and the
 surface ``ts.LevelSet(array, redistance=True)``; it also prints the band's candidates by a bound on
-|∇φ| over the whole box and, on checkouts that have it, by the bound near each node. With ``--tube`` the solves are ``tube.solve``
-on one ``ts.Tube`` built before them (its build time is printed as ``tube_build_ms``); with
-``--bunny`` the problem is the bench's bunny instead of the sphere.
+|∇φ| over the whole box and, on checkouts that have it, by the bound near each node. With
+``--tube`` the solves are ``tube.solve`` on one ``ts.Tube`` built before them (its build time is
+printed as ``tube_build_ms``); with ``--bunny`` the problem is the bench's bunny instead of the
+sphere.
 """
 
 from __future__ import annotations
