@@ -5,6 +5,7 @@ Usage::
     .venv/bin/python benches/warm_solves.py [N] [REPEATS]      # default N = 201, 7 solves
     .venv/bin/python benches/warm_solves.py 201 7 --dense      # φ handed in as an array
     .venv/bin/python benches/warm_solves.py 101 3 --redistance # φ = |x|² − r² as an array
+    .venv/bin/python benches/warm_solves.py 101 1 --redistance --callable  # … as a callable
     .venv/bin/python benches/warm_solves.py 201 7 --tube       # ts.Tube built once, then tube.solve
     .venv/bin/python benches/warm_solves.py 201 5 --bunny      # the bunny (surface.grid(n=N))
 
@@ -19,7 +20,8 @@ the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
 array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine. With
 ``--redistance`` the array is ``|x|² − r²`` (the same sphere, not a distance function) and the
 surface ``ts.LevelSet(array, redistance=True)``; it also prints the band's candidates by a bound on
-|∇φ| over the whole box and, on checkouts that have it, by the bound near each node. With
+|∇φ| over the whole box and, on checkouts that have it, by the bound near each node; with
+``--redistance --callable`` the same φ is a callable instead of an array. With
 ``--tube`` the solves are ``tube.solve`` on one ``ts.Tube`` built before them (its build time is
 printed as ``tube_build_ms``); with ``--bunny`` the problem is the bench's bunny instead of the
 sphere.
@@ -58,7 +60,7 @@ def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
 
 
 def main() -> int:
-    flags = {"--dense", "--redistance", "--tube", "--bunny"}
+    flags = {"--dense", "--redistance", "--callable", "--tube", "--bunny"}
     redistance = "--redistance" in sys.argv
     dense = "--dense" in sys.argv or redistance
     use_tube = "--tube" in sys.argv
@@ -67,7 +69,10 @@ def main() -> int:
     repeats = int(args[1]) if len(args) > 1 else 7
     p = bunny(n) if "--bunny" in sys.argv else sphere(n)
     extra = {}
-    if redistance:
+    if redistance and "--callable" in sys.argv:
+        centre = np.asarray(p.surface.center, dtype=float)
+        surface = ts.LevelSet(lambda x: np.sum((x - centre) ** 2, axis=1) - 0.25, redistance=True)  # r = 0.5
+    elif redistance:
         d = p.dense_phi(p.grid)  # |x − c| − r
         surface = ts.LevelSet(d * (d + 2 * 0.5), redistance=True)  # |x − c|² − r², r = 0.5
     elif dense:
@@ -98,7 +103,7 @@ def main() -> int:
         wall.append(time.perf_counter() - t)
         setup.append(sol.stats.setup_seconds)
         sweeps.append(sol.stats.seconds)
-    if redistance:  # after the timed solves, whose memory it would otherwise change
+    if redistance and surface.is_dense:  # after the timed solves, whose memory it would otherwise change
         extra.update(redistance_candidates(surface, p.grid))
     ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
     print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, tube=use_tube, **ms,

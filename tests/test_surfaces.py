@@ -199,6 +199,29 @@ def test_sampled_redistance_bounds_the_gradient_locally_and_finds_the_same_band(
     assert len(near) < 0.75 * len(everywhere)  # 0.58 in 3D at n = 41, 0.33 at N = 201 (docs/surfaces.md)
 
 
+@pytest.mark.parametrize("d, n", [(2, 121), (3, 41)])
+def test_callable_redistance_narrows_its_candidates_and_finds_the_same_band(d, n):
+    # a callable without a given bound: the whole box's bound finds the candidates, the gradient
+    # at the candidates then narrows them; the band, distances and directions are those of the
+    # whole box's bound alone (given as `lipschitz`), from fewer candidates
+    from tubesweep.redistance import _narrowed_by_candidate_gradients, estimate_lipschitz
+    from tubesweep.surface import discover_band
+
+    grid = ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
+    f = lambda p: (np.sum(p**2, axis=1) - 0.25) * (1 + 0.3 * p[:, 0]) + 0.05 * np.sin(3 * p[:, 1])  # noqa: E731
+    local = ts.LevelSet(f, redistance=True)
+    L = estimate_lipschitz(local, grid)
+    box = ts.LevelSet(f, redistance=True, lipschitz=L)
+    w = 4 * grid.spacing
+    a, b = local.band(grid, w), box.band(grid, w)
+    assert len(a.linear) > 0
+    assert np.array_equal(a.linear, b.linear) and np.array_equal(a.signed, b.signed)
+    assert np.array_equal(a.direction, b.direction)
+    everywhere, values = discover_band(f, grid, L * w, L)
+    narrowed = _narrowed_by_candidate_gradients(local, grid, w, L, everywhere, values)
+    assert np.all(np.isin(narrowed, everywhere)) and len(narrowed) < 0.75 * len(everywhere)
+
+
 def test_sampled_redistance_in_3d_matches_the_sphere():
     # the squashed quadric of the test above, sampled: its zero set is the sphere of radius 0.5
     g3 = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)

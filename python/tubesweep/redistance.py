@@ -125,6 +125,38 @@ def estimate_lipschitz(surface, grid, n: int = 17) -> float:
     return max(1.25 * float(np.max(np.linalg.norm(g, axis=1))), 1e-12)
 
 
+#: Passes of :func:`_narrowed_by_candidate_gradients`.
+CANDIDATE_BOUND_PASSES = 2
+
+
+def _narrowed_by_candidate_gradients(surface, grid, half_width: float, L: float, cand: np.ndarray,
+                                     values: np.ndarray) -> np.ndarray:
+    """The candidates of a re-distanced callable φ, narrowed: ``L`` (1.25 × the largest |∇φ| on a
+    lattice over the whole box) is replaced by 1.25 × the largest |∇φ| at the candidates
+    themselves, which hold every node within ``half_width`` of the surface and so the segments
+    from the band's nodes to their closest points; the candidates are kept where
+    ``|φ| ≤ L·half_width`` with that bound, and the step repeated with the fewer candidates
+    (:data:`CANDIDATE_BOUND_PASSES` in all, stopping when the bound does not fall). The same
+    estimate as the whole box's, taken where the band is: for ``|x|² − r²`` the whole box's
+    steepest part is its corners, several times the gradient at the surface."""
+    fn = lambda p: surface.phi(p, grid)  # noqa: E731
+    for _ in range(CANDIDATE_BOUND_PASSES):
+        if cand.size == 0:
+            break
+        steepest = 0.0
+        from .surface import EVAL_CHUNK
+
+        for lo in range(0, len(cand), EVAL_CHUNK):
+            g = _gradient(fn, grid.node_points(cand[lo : lo + EVAL_CHUNK]), GRADIENT_STEP * grid.spacing)
+            steepest = max(steepest, float(np.max(np.sum(g * g, axis=1))))
+        near = max(1.25 * np.sqrt(steepest), 1e-12)
+        if not near < L:
+            break
+        keep = np.abs(values) <= near * half_width
+        cand, values, L = cand[keep], values[keep], near
+    return cand
+
+
 def redistanced_band(surface, grid, half_width: float):
     """The band of ``LevelSet(phi, redistance=True)``: candidates ``|φ| ≤ L·half_width`` (L a bound
     on |∇φ|, so every node within ``half_width`` of the surface is a candidate); then the exact
@@ -134,7 +166,8 @@ def redistanced_band(surface, grid, half_width: float):
     near each node (per block of nodes, ``tubesweep_core::sampled::redistance_candidates_of_samples``):
     a bound over the whole box would take φ's steepest part anywhere and make several times the
     candidates. Otherwise L is the given bound or :func:`estimate_lipschitz`, and a callable's
-    candidates are found coarse-to-fine."""
+    candidates are found coarse-to-fine; without a given bound they are then narrowed by the
+    gradient at the candidates themselves (:func:`_narrowed_by_candidate_gradients`)."""
     from .surface import BandGeometry, discover_band
 
     d = grid.ndim
@@ -147,7 +180,9 @@ def redistanced_band(surface, grid, half_width: float):
             cand = _native.band_of_samples(surface._array, surface.lipschitz * half_width)[0].view(np.int64)
     else:
         L = surface.lipschitz if surface.lipschitz is not None else estimate_lipschitz(surface, grid)
-        cand, _ = discover_band(surface._fn, grid, L * half_width, L)
+        cand, values = discover_band(surface._fn, grid, L * half_width, L)
+        if surface.lipschitz is None:
+            cand = _narrowed_by_candidate_gradients(surface, grid, half_width, L, cand, values)
     if cand.size == 0:
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
     x = grid.node_points(cand)
