@@ -20,8 +20,9 @@ the process's before it is printed as ``first_solve_delta_rss_mb`` (the ΔRSS of
 array hands it in) instead of the library's ``Sphere``, whose φ is found coarse-to-fine. With
 ``--redistance`` the array is ``|x|² − r²`` (the same sphere, not a distance function) and the
 surface ``ts.LevelSet(array, redistance=True)``; it also prints the band's candidates by a bound on
-|∇φ| over the whole box and, on checkouts that have it, by the bound near each node; with
-``--redistance --callable`` the same φ is a callable instead of an array. With
+|∇φ| over the whole box and, on checkouts that have it, by the bound near each node (for a
+callable, by the gradient at the candidates); with ``--redistance --callable`` the same φ is a
+callable instead of an array. With
 ``--tube`` the solves are ``tube.solve`` on one ``ts.Tube`` built before them (its build time is
 printed as ``tube_build_ms``); with ``--bunny`` the problem is the bench's bunny instead of the
 sphere.
@@ -50,10 +51,19 @@ def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
     """The candidates of the re-distanced band (outer = 4Δx) by a bound on |∇φ| over the whole
     box and, where this checkout has it, by the bound near each node that it uses."""
     from tubesweep import _native
-    from tubesweep.redistance import estimate_lipschitz
+    from tubesweep import redistance as rd
 
     w = 4 * grid.spacing
-    out = {"whole_box_candidates": len(_native.band_of_samples(surface._array, estimate_lipschitz(surface, grid) * w)[0])}
+    L = rd.estimate_lipschitz(surface, grid)
+    if not surface.is_dense:  # a callable: found coarse-to-fine, then narrowed where that exists
+        from tubesweep.surface import discover_band
+
+        cand, values = discover_band(surface._fn, grid, L * w, L)
+        out = {"whole_box_candidates": len(cand)}
+        if hasattr(rd, "_narrowed_by_candidate_gradients"):
+            out["local_bound_candidates"] = len(rd._narrowed_by_candidate_gradients(surface, grid, w, L, cand, values))
+        return out
+    out = {"whole_box_candidates": len(_native.band_of_samples(surface._array, L * w)[0])}
     if hasattr(_native, "redistance_candidates_of_samples"):
         out["local_bound_candidates"] = len(_native.redistance_candidates_of_samples(surface._array, grid.spacing, w)[0])
     return out
@@ -62,7 +72,7 @@ def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
 def main() -> int:
     flags = {"--dense", "--redistance", "--callable", "--tube", "--bunny"}
     redistance = "--redistance" in sys.argv
-    dense = "--dense" in sys.argv or redistance
+    dense = ("--dense" in sys.argv or redistance) and "--callable" not in sys.argv
     use_tube = "--tube" in sys.argv
     args = [a for a in sys.argv[1:] if a not in flags]
     n = int(args[0]) if len(args) > 0 else 201
@@ -103,7 +113,7 @@ def main() -> int:
         wall.append(time.perf_counter() - t)
         setup.append(sol.stats.setup_seconds)
         sweeps.append(sol.stats.seconds)
-    if redistance and surface.is_dense:  # after the timed solves, whose memory it would otherwise change
+    if redistance:  # after the timed solves, whose memory it would otherwise change
         extra.update(redistance_candidates(surface, p.grid))
     ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
     print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, tube=use_tube, **ms,
