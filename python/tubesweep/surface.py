@@ -221,9 +221,9 @@ class LevelSet(Surface):
     lipschitz : float, optional
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
         default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
-        is estimated from |∇φ| on a coarse lattice of the grid box for a callable, and for an
-        array bounded near each node from the differences of the samples (a bound given here
-        applies to the whole box instead).
+        is estimated from |∇φ| on a coarse lattice of the grid box for a callable and then from
+        |∇φ| at the band's candidates, and for an array bounded near each node from the
+        differences of the samples (a bound given here applies to the whole box instead).
     redistance : bool
         For φ that is *not* a distance function (e.g. ``x² + y² − r²``): in the band only, replace
         φ by the signed distance to its zero level set — first ``φ/|∇φ|`` (a Newton step onto the
