@@ -139,13 +139,13 @@ def _narrowed_by_candidate_gradients(surface, grid, half_width: float, L: float,
     (:data:`CANDIDATE_BOUND_PASSES` in all, stopping when the bound does not fall). The same
     estimate as the whole box's, taken where the band is: for ``|x|² − r²`` the whole box's
     steepest part is its corners, several times the gradient at the surface."""
+    from .surface import EVAL_CHUNK
+
     fn = lambda p: surface.phi(p, grid)  # noqa: E731
     for _ in range(CANDIDATE_BOUND_PASSES):
         if cand.size == 0:
             break
         steepest = 0.0
-        from .surface import EVAL_CHUNK
-
         for lo in range(0, len(cand), EVAL_CHUNK):
             g = _gradient(fn, grid.node_points(cand[lo : lo + EVAL_CHUNK]), GRADIENT_STEP * grid.spacing)
             steepest = max(steepest, float(np.max(np.sum(g * g, axis=1))))
