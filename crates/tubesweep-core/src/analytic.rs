@@ -152,6 +152,12 @@ pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3
 /// version to rounding (the sines and cosines come from a different library, and the window's
 /// candidates are evaluated by the angle-addition formulas).
 pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) -> Result<()> {
+    star_signed_distance_with(points, r0, eps, out, false)
+}
+
+/// [`star_signed_distance`], with `whole_window` searching every candidate of the window (the
+/// tests compare the two).
+fn star_signed_distance_with(points: &[f64], r0: f64, eps: f64, out: &mut [f64], whole_window: bool) -> Result<()> {
     check_points(points, 2, out)?;
     if !(r0 > 0.0 && eps >= 0.0 && r0.is_finite() && eps.is_finite()) {
         return Err(Error::invalid("r0", format!("need r0 > 0 and eps >= 0, got r0 = {r0}, eps = {eps}")));
@@ -166,7 +172,10 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
     };
     const DENSE: usize = 4096;
     let dense_step = 2.0 * std::f64::consts::PI / DENSE as f64;
-    let dense: Vec<[f64; 2]> = (0..DENSE).map(|j| curve(j as f64 * dense_step)).collect();
+    // the whole curve's samples, made only if a point far from the curve needs them (a band's
+    // points are nearly all near it, and the 4096 samples' sines and cosines cost more than a
+    // few hundred points' distances)
+    let dense: std::sync::OnceLock<Vec<[f64; 2]>> = std::sync::OnceLock::new();
     let near_limit = 0.2f64.min(0.9 * r0);
     const WINDOW: usize = 129;
     let window_step = 1.6 / (WINDOW - 1) as f64;
@@ -186,6 +195,22 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
             Offset { delta, c, s, c3, s3 }
         })
         .collect();
+    // The window's candidates that can be nearest: the point of the curve at the point's own
+    // angle is |ρ − r(θ)| away, so the closest point is no farther and its angle lies within
+    // asin(|ρ − r(θ)| / ρ) of the point's. Every candidate beyond that, and WINDOW_MARGIN
+    // candidates more, is farther than one within it (a candidate's spacing along the curve is
+    // below that margin's sweep at radius ρ), so the first nearest of these is the first nearest
+    // of the whole window: the same start for Newton, the same bits.
+    const WINDOW_MARGIN: f64 = 3.0;
+    let window_span = |rho: f64, radial: f64| -> std::ops::Range<usize> {
+        if whole_window || !(rho > radial) {
+            return 0..WINDOW;
+        }
+        let half = (radial / rho).asin() + WINDOW_MARGIN * window_step;
+        let lo = ((0.8 - half) / window_step).floor().max(0.0) as usize;
+        let hi = (((0.8 + half) / window_step).ceil() as usize + 1).min(WINDOW);
+        lo..hi
+    };
     out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 2)).for_each(|(out, p)| {
         for (o, q) in out.iter_mut().zip(p.chunks_exact(2)) {
             let (x, y) = (q[0], q[1]);
@@ -200,7 +225,7 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
                 let (s3p, c3p) = (3.0 * polar).sin_cos();
                 t = polar - 0.8;
                 let mut best = f64::INFINITY;
-                for w in &window {
+                for w in &window[window_span(x.hypot(y), (x.hypot(y) - inside_radius).abs())] {
                     let s3 = s3p * w.c3 + c3p * w.s3;
                     let rt = r0 + eps * (s3 * s3);
                     let c = [rt * (cp * w.c - sp * w.s), rt * (sp * w.c + cp * w.s)];
@@ -211,7 +236,8 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
                     }
                 }
             } else {
-                t = nearest_sample(&dense, dense_step, x, y, polar, r0, r0 + eps) as f64 * dense_step;
+                let dense = dense.get_or_init(|| (0..DENSE).map(|j| curve(j as f64 * dense_step)).collect());
+                t = nearest_sample(dense, dense_step, x, y, polar, r0, r0 + eps) as f64 * dense_step;
             }
             // Newton on g(t) = (γ(t) − q)·γ'(t) = 0, each step clipped to ±0.01
             for _ in 0..8 {
@@ -406,6 +432,32 @@ mod tests {
             assert!((v - want).abs() < 1e-6, "at {q:?}: {v} vs {want}");
         }
         assert!(star_signed_distance(&p, 0.0, eps, &mut out).is_err());
+    }
+
+    #[test]
+    fn the_star_window_narrowed_to_reach_gives_the_whole_window_bits() {
+        // points up to the window's limit (0.2) from the curve, for the paper's star and a
+        // spikier one: the narrowed window starts Newton where the whole one does
+        let mut seed = 99u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for (r0, eps) in [(0.5, 0.2), (0.3, 0.5), (1.0, 0.05)] {
+            let mut p = Vec::new();
+            for _ in 0..100_000 {
+                let th = 2.0 * std::f64::consts::PI * next();
+                let off = 0.4 * next() - 0.2;
+                let r = r0 + eps * (3.0 * th).sin().powi(2) + off;
+                p.extend_from_slice(&[r * th.cos(), r * th.sin()]);
+            }
+            let (mut a, mut b) = (vec![0.0; p.len() / 2], vec![0.0; p.len() / 2]);
+            star_signed_distance_with(&p, r0, eps, &mut a, false).unwrap();
+            star_signed_distance_with(&p, r0, eps, &mut b, true).unwrap();
+            for i in 0..a.len() {
+                assert_eq!(a[i].to_bits(), b[i].to_bits(), "r0 {r0}, eps {eps}, point {:?}", &p[2 * i..2 * i + 2]);
+            }
+        }
     }
 
     #[test]
