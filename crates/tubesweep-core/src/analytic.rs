@@ -218,14 +218,16 @@ fn star_signed_distance_with(points: &[f64], r0: f64, eps: f64, out: &mut [f64],
             let inside_radius = r(polar);
             let d2 = |c: [f64; 2]| (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y);
             let mut t;
-            if (x.hypot(y) - inside_radius).abs() <= near_limit {
+            let rho = x.hypot(y);
+            let radial = (rho - inside_radius).abs();
+            if radial <= near_limit {
                 // γ(polar + δ) by the angle-addition formulas from the window's precomputed
                 // sines and cosines: no trigonometric call per candidate
                 let (sp, cp) = polar.sin_cos();
                 let (s3p, c3p) = (3.0 * polar).sin_cos();
                 t = polar - 0.8;
                 let mut best = f64::INFINITY;
-                for w in &window[window_span(x.hypot(y), (x.hypot(y) - inside_radius).abs())] {
+                for w in &window[window_span(rho, radial)] {
                     let s3 = s3p * w.c3 + c3p * w.s3;
                     let rt = r0 + eps * (s3 * s3);
                     let c = [rt * (cp * w.c - sp * w.s), rt * (sp * w.c + cp * w.s)];
@@ -255,7 +257,7 @@ fn star_signed_distance_with(points: &[f64], r0: f64, eps: f64, out: &mut [f64],
             }
             let c = curve(t);
             let dist = ((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1])).sqrt();
-            *o = if x.hypot(y) < inside_radius { -dist } else { dist };
+            *o = if rho < inside_radius { -dist } else { dist };
         }
     });
     Ok(())
