@@ -29,7 +29,8 @@ class Ellipsoid(LevelSet):
     center : (3,) float
 
     The closest point is ``y_i = a_i² x_i / (a_i² + t)`` with t the root in ``(−min a_i², ∞)`` of
-    ``Σ (a_i x_i / (a_i² + t))² = 1`` (a decreasing function of t: bisection to machine precision),
+    ``Σ (a_i x_i / (a_i² + t))² = 1`` (a convex decreasing function of t: Newton's method from the
+    left, which never passes the root, to the last bits),
     with the degenerate case of interior points on the plane of the shortest axis handled
     explicitly. There is no closed-form geodesic distance on a triaxial ellipsoid, so this class has
     no ``geodesic_distance``; tests compare against fine-grid solutions instead.
@@ -51,12 +52,8 @@ class Ellipsoid(LevelSet):
         ax = self.axes
         a2 = ax * ax
         kmin = int(np.argmin(ax))
-        lo = np.full(len(x), -a2[kmin])
-        hi = np.max(ax) * row_norms(x) + 1e-300
-        hi = np.maximum(hi, 0.0)
-        ax_x = ax * x
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = self._bisect(ax_x, a2, lo, hi)
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            t = self._newton_root(x, ax, a2, kmin)
         den = a2 + t[:, None]
         y = np.empty_like(x)
         degenerate = den[:, kmin] <= 1e-12 * a2[kmin]
@@ -76,15 +73,32 @@ class Ellipsoid(LevelSet):
         return y + self.center
 
     @staticmethod
-    def _bisect(ax_x: np.ndarray, a2: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        """Root of the decreasing ``Σ (a_i x_i / (a_i² + t))² − 1`` in [lo, hi], 100 bisections."""
+    def _newton_root(x: np.ndarray, ax: np.ndarray, a2: np.ndarray, kmin: int) -> np.ndarray:
+        """The root ``t`` of ``F(t) = Σ (a_i x_i / (a_i² + t))² − 1`` for each point of ``x``
+        (relative to the centre), or ``−a_kmin²`` where there is none above it: Newton's method
+        from ``t₀ = max_i (a_i |x_i| − a_i²)``, where ``F ≥ 0`` (``F`` is convex and decreasing, so
+        the steps move right and never pass the root), until ``F ≤ 0`` or a step no longer advances
+        ``t``, at most 100 steps; a term with ``x_i = 0`` is 0. The arithmetic of the core's
+        ``tubesweep_core::analytic::ellipsoid_root``, operation for operation (the same bits)."""
+        ax_x = ax * x
+        t = np.maximum(np.max(ax * np.abs(x) - a2, axis=1), -a2[kmin])
+        active = np.ones(len(x), dtype=bool)
         for _ in range(100):
-            mid = 0.5 * (lo + hi)
-            g = np.sum((ax_x / (a2 + mid[:, None])) ** 2, axis=1) - 1.0
-            pos = g > 0
-            lo = np.where(pos, mid, lo)
-            hi = np.where(pos, hi, mid)
-        return 0.5 * (lo + hi)
+            idx = np.flatnonzero(active)
+            if idx.size == 0:
+                break
+            ta = t[idx]
+            den = a2 + ta[:, None]
+            axa = ax_x[idx]
+            r = np.where(axa != 0.0, axa / den, 0.0)
+            q = r * r
+            slope = np.where(axa != 0.0, q / den, 0.0)
+            f = (q[:, 0] + q[:, 1]) + q[:, 2] - 1.0
+            nxt = ta + f / (2.0 * ((slope[:, 0] + slope[:, 1]) + slope[:, 2]))
+            advance = (f > 0.0) & (nxt > ta)
+            t[idx[advance]] = nxt[advance]
+            active[idx[~advance]] = False
+        return t
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
