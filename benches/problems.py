@@ -40,7 +40,6 @@ import numpy as np
 
 import tubesweep as ts
 import tubesweep.surfaces  # noqa: F401  (ts.surfaces)
-from tubesweep.surface import LevelSet
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
@@ -152,17 +151,17 @@ def ellipse_closest(y0: np.ndarray, y1: np.ndarray, a: float, c: float) -> Tuple
     return x0, x1
 
 
-class Spheroid(LevelSet):
-    """The oblate spheroid x²/a² + y²/a² + z²/c² = 1 (a ≥ c) with its exact signed distance."""
-
-    default_box = ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
+class Spheroid(ts.surfaces.Ellipsoid):
+    """The oblate spheroid x²/a² + y²/a² + z²/c² = 1 (a ≥ c): the library's ``Ellipsoid(a, a, c)``,
+    whose exact signed distance the core evaluates in Rust (what a user would solve on), with the
+    benchmark's own closest point (Newton on the meridian ellipse) and geographiclib's geodesics
+    for the exact answers."""
 
     def __init__(self, a: float = SPHEROID_A, c: float = SPHEROID_C):
         if not a >= c > 0:
             raise ValueError(f"need a >= c > 0 for an oblate spheroid; got a={a}, c={c}")
+        super().__init__(a, a, c)
         self.a, self.c = float(a), float(c)
-        super().__init__(self.signed_distance, lipschitz=1.0)
-        self.ndim = 3
 
     def closest(self, p: np.ndarray) -> np.ndarray:
         p = np.asarray(p, dtype=float)
@@ -172,14 +171,6 @@ class Spheroid(LevelSet):
         cx = np.where(rho > 0, p[:, 0] / safe, 1.0)
         cy = np.where(rho > 0, p[:, 1] / safe, 0.0)
         return np.stack([x0 * cx, x0 * cy, np.where(p[:, 2] >= 0, x1, -x1)], axis=1)
-
-    def signed_distance(self, p: np.ndarray) -> np.ndarray:
-        p = np.asarray(p, dtype=float)
-        rho = np.hypot(p[:, 0], p[:, 1])
-        x0, x1 = ellipse_closest(rho, np.abs(p[:, 2]), self.a, self.c)
-        d = np.hypot(rho - x0, np.abs(p[:, 2]) - x1)
-        inside = (rho / self.a) ** 2 + (p[:, 2] / self.c) ** 2 < 1.0
-        return np.where(inside, -d, d)
 
     def approx_phi(self, p: np.ndarray) -> np.ndarray:
         """g / |∇g| with g = ρ²/a² + z²/c² − 1: the same zero set, distance-like near it."""
@@ -260,21 +251,16 @@ TORUS_R, TORUS_r = 0.5, 0.25
 TORUS_MAX_ANGLE = 1.5  # rad, below the conjugate point π·sqrt(r/(R+r)) ≈ 1.814
 
 
-class Torus(LevelSet):
-    """The torus (sqrt(x² + y²) − R)² + z² = r² with its exact signed distance."""
-
-    default_box = ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
+class Torus(ts.surfaces.Torus):
+    """The torus (sqrt(x² + y²) − R)² + z² = r²: the library's ``Torus(R, r)``, whose exact signed
+    distance the core evaluates in Rust (what a user would solve on), with the benchmark's own
+    closest point and reference along the outer equator."""
 
     def __init__(self, R: float = TORUS_R, r: float = TORUS_r):
         if not R > r > 0:
             raise ValueError(f"need R > r > 0; got R={R}, r={r}")
+        super().__init__(R, r)
         self.R, self.r = float(R), float(r)
-        super().__init__(self.signed_distance, lipschitz=1.0)
-        self.ndim = 3
-
-    def signed_distance(self, p: np.ndarray) -> np.ndarray:
-        p = np.asarray(p, dtype=float)
-        return np.hypot(np.hypot(p[:, 0], p[:, 1]) - self.R, p[:, 2]) - self.r
 
     def closest(self, p: np.ndarray) -> np.ndarray:
         p = np.asarray(p, dtype=float)

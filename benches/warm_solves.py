@@ -8,6 +8,7 @@ Usage::
     .venv/bin/python benches/warm_solves.py 101 1 --redistance --callable  # … as a callable
     .venv/bin/python benches/warm_solves.py 201 7 --tube       # ts.Tube built once, then tube.solve
     .venv/bin/python benches/warm_solves.py 201 5 --bunny      # the bunny (surface.grid(n=N))
+    .venv/bin/python benches/warm_solves.py 201 7 --ellipsoid  # the bench's spheroid
 
 It uses only ``ts.solve`` and ``sol.stats``, so it runs unchanged on older checkouts: to compare
 two commits, build both (``make build`` in each checkout) and run it alternately in the two,
@@ -25,7 +26,8 @@ callable, by the gradient at the candidates); with ``--redistance --callable`` t
 callable instead of an array. With
 ``--tube`` the solves are ``tube.solve`` on one ``ts.Tube`` built before them (its build time is
 printed as ``tube_build_ms``); with ``--bunny`` the problem is the bench's bunny instead of the
-sphere.
+sphere, with ``--ellipsoid`` the bench's oblate spheroid (the library's ``Ellipsoid(0.5, 0.5, 0.4)``;
+it needs geographiclib for the exact answers, as ``make bench`` installs).
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ import numpy as np  # noqa: E402
 import tubesweep as ts  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from problems import bunny, sphere  # noqa: E402
+from problems import bunny, ellipsoid, sphere  # noqa: E402
 from run import _peak_kb, _reset_peak, _status_kb  # noqa: E402
 
 
@@ -70,14 +72,14 @@ def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
 
 
 def main() -> int:
-    flags = {"--dense", "--redistance", "--callable", "--tube", "--bunny"}
+    flags = {"--dense", "--redistance", "--callable", "--tube", "--bunny", "--ellipsoid"}
     redistance = "--redistance" in sys.argv
     dense = ("--dense" in sys.argv or redistance) and "--callable" not in sys.argv
     use_tube = "--tube" in sys.argv
     args = [a for a in sys.argv[1:] if a not in flags]
     n = int(args[0]) if len(args) > 0 else 201
     repeats = int(args[1]) if len(args) > 1 else 7
-    p = bunny(n) if "--bunny" in sys.argv else sphere(n)
+    p = bunny(n) if "--bunny" in sys.argv else ellipsoid(n) if "--ellipsoid" in sys.argv else sphere(n)
     extra = {}
     if redistance and "--callable" in sys.argv:
         centre = np.asarray(p.surface.center, dtype=float)
