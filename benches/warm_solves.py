@@ -9,6 +9,7 @@ Usage::
     .venv/bin/python benches/warm_solves.py 201 7 --tube       # ts.Tube built once, then tube.solve
     .venv/bin/python benches/warm_solves.py 201 5 --bunny      # the bunny (surface.grid(n=N))
     .venv/bin/python benches/warm_solves.py 201 7 --ellipsoid  # the bench's spheroid
+    .venv/bin/python benches/warm_solves.py 161 3 --library mobius  # a library surface
 
 It uses only ``ts.solve`` and ``sol.stats``, so it runs unchanged on older checkouts: to compare
 two commits, build both (``make build`` in each checkout) and run it alternately in the two,
@@ -27,7 +28,9 @@ callable instead of an array. With
 ``--tube`` the solves are ``tube.solve`` on one ``ts.Tube`` built before them (its build time is
 printed as ``tube_build_ms``); with ``--bunny`` the problem is the bench's bunny instead of the
 sphere, with ``--ellipsoid`` the bench's oblate spheroid (the library's ``Ellipsoid(0.5, 0.5, 0.4)``;
-it needs geographiclib for the exact answers, as ``make bench`` installs).
+it needs geographiclib for the exact answers, as ``make bench`` installs), and with ``--library
+NAME`` the library surface ``ts.surfaces.REGISTRY[NAME]()`` on its default box with N nodes per
+axis, from its default source.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ import os
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -76,11 +80,24 @@ def main() -> int:
     redistance = "--redistance" in sys.argv
     dense = ("--dense" in sys.argv or redistance) and "--callable" not in sys.argv
     use_tube = "--tube" in sys.argv
-    args = [a for a in sys.argv[1:] if a not in flags]
+    argv = sys.argv[1:]
+    library = None
+    if "--library" in argv:
+        i = argv.index("--library")
+        library = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
+    args = [a for a in argv if a not in flags]
     n = int(args[0]) if len(args) > 0 else 201
     repeats = int(args[1]) if len(args) > 1 else 7
-    p = bunny(n) if "--bunny" in sys.argv else ellipsoid(n) if "--ellipsoid" in sys.argv else sphere(n)
     extra = {}
+    if library is not None:
+        surf = ts.surfaces.REGISTRY[library]()
+        lower, upper = surf.default_box
+        p = SimpleNamespace(surface=surf, grid=ts.Grid(lower=lower, upper=upper, shape=(n,) * len(lower)),
+                            source=surf.default_source)
+        extra["library"] = library
+    else:
+        p = bunny(n) if "--bunny" in sys.argv else ellipsoid(n) if "--ellipsoid" in sys.argv else sphere(n)
     if redistance and "--callable" in sys.argv:
         centre = np.asarray(p.surface.center, dtype=float)
         surface = ts.LevelSet(lambda x: np.sum((x - centre) ** 2, axis=1) - 0.25, redistance=True)  # r = 0.5

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import tubesweep as ts
+from tubesweep._linalg import row_norms
 from tubesweep.surfaces import REGISTRY, Circle, DoubleTorus, Ellipse, Ellipsoid, Sphere, Torus
 
 
@@ -475,7 +476,6 @@ def test_native_node_points_and_neighbour_table(shape):
 def test_row_norms_are_numpys_bits():
     """The set-up's row norms (``tubesweep._linalg.row_norms``) give exactly the bits of
     ``np.linalg.norm(v, axis=1)`` (the surfaces' distances, and so the bands, are unchanged)."""
-    from tubesweep._linalg import row_norms
 
     rng = np.random.default_rng(7)
     for d in (1, 2, 3, 4, 6):
@@ -489,7 +489,6 @@ def test_row_norms_are_numpys_bits():
 
 def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
     """Circle, Sphere and Torus evaluate φ in Rust with the arithmetic of their NumPy formulas."""
-    from tubesweep._linalg import row_norms
 
     rng = np.random.default_rng(7)
     p3 = rng.uniform(-1, 1, (50_001, 3))
@@ -503,6 +502,23 @@ def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
     assert np.array_equal(t.signed_distance(p3), np.hypot(np.hypot(q[:, 0], q[:, 1]) - t.R, q[:, 2]) - t.r)
     with pytest.raises(ValueError, match=r"\(M, 3\)"):
         s.signed_distance(p2)
+
+
+def test_native_mobius_closest_points_match_the_numpy_formulation():
+    """MobiusBand.closest_parameters (Rust, point by point) finds the closest points of its NumPy
+    formulation: near the band, past its boundary and anywhere in the box, the distances agree to
+    1e-12 and the closest points to 1e-9; and a bad iteration count is refused."""
+    m = ts.surfaces.MobiusBand()
+    rng = np.random.default_rng(5)
+    th, s = rng.uniform(0, 2 * np.pi, 4000), rng.uniform(-1.3 * m.w, 1.3 * m.w, 4000)
+    p = np.concatenate([m.point(th, s) + rng.normal(scale=0.05, size=(4000, 3)), rng.uniform(-1, 1, (4000, 3))])
+    a, b = m.closest_parameters(p), m._closest_parameters_numpy(p)
+    assert np.all(np.abs(a[1]) <= m.w)
+    ca, cb = m.point(*a), m.point(*b)
+    assert np.max(np.abs(row_norms(ca - p) - row_norms(cb - p))) < 1e-12
+    assert np.max(row_norms(ca - cb)) < 1e-9
+    with pytest.raises(ValueError, match="newton_iterations"):
+        ts.surfaces.MobiusBand(newton_iterations=0)
 
 
 def test_native_ellipsoid_and_star_distances_match_their_numpy_formulations():

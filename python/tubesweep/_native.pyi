@@ -86,6 +86,9 @@ def ellipsoid_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], axes: List[float]
 ) -> npt.NDArray[np.float64]: ...
 def star_signed_distance(points: npt.NDArray[np.float64], r0: float, eps: float) -> npt.NDArray[np.float64]: ...
+def mobius_closest_parameters(
+    points: npt.NDArray[np.float64], r: float, w: float, iterations: int
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 __version__: str
 
 class Band:

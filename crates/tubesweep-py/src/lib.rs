@@ -919,6 +919,27 @@ fn ellipsoid_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py,
     Ok(out.into_pyarray(py))
 }
 
+/// The parameters (θ, s) of the closest point on the Möbius band (centre radius `r`, half-width
+/// `w`) of the points (M, 3), at most `iterations` Newton steps per candidate. See
+/// `tubesweep_core::mobius::mobius_closest_parameters`.
+#[pyfunction]
+fn mobius_closest_parameters<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    r: f64,
+    w: f64,
+    iterations: usize,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    if points.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
+    }
+    let p = c_slice(&points, "points")?;
+    let m = points.shape()[0];
+    let (mut theta, mut s) = (vec![0.0; m], vec![0.0; m]);
+    py.detach(|| tubesweep_core::mobius::mobius_closest_parameters(p, r, w, iterations, &mut theta, &mut s)).map_err(to_pyerr)?;
+    Ok((theta.into_pyarray(py), s.into_pyarray(py)))
+}
+
 /// The exact signed distance to the six-fold star r(θ) = r0 + eps sin²(3θ) at the points (M, 2).
 /// See `tubesweep_core::analytic::star_signed_distance`.
 #[pyfunction]
@@ -1171,6 +1192,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sphere_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(torus_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(ellipsoid_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(mobius_closest_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(star_signed_distance, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

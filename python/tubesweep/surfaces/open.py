@@ -9,6 +9,7 @@ from typing import Sequence, Tuple
 
 import numpy as np
 
+from .. import _native
 from ..closest_point import ClosestPoint
 from ._triangulation import grid_mesh
 
@@ -175,7 +176,8 @@ class MobiusBand(ClosestPoint):
         At most this many Newton steps per candidate (each point stops when its step falls below
         1e-13; near the band 4–6 steps suffice).
 
-    Closest point by numerical projection, vectorised: the interior critical point of
+    Closest point by numerical projection, point by point in Rust (the NumPy formulation stays as
+    ``_closest_parameters_numpy``): the interior critical point of
     ``½|X(θ, s) − x|²`` by Newton's method in (θ, s) from θ₀ = atan2(y, x) and s₀ the projection
     on the ruling, and the nearest point of the boundary curve by Newton's method in θ with
     s = ±w; the nearer admissible candidate wins (a minimum over a closed band is either an
@@ -190,6 +192,8 @@ class MobiusBand(ClosestPoint):
             raise ValueError(f"need 0 < w < R; got R={R}, w={w}")
         self.R = float(R)
         self.w = float(w)
+        if not int(newton_iterations) >= 1:
+            raise ValueError(f"newton_iterations must be at least 1; got {newton_iterations}")
         self.newton_iterations = int(newton_iterations)
         super().__init__(self._cp, ndim=3)
 
@@ -259,7 +263,14 @@ class MobiusBand(ClosestPoint):
         return th
 
     def closest_parameters(self, p: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-        """Parameters (θ, s) of the closest point of the band to each point of p (M, 3)."""
+        """Parameters (θ, s) of the closest point of the band to each point of p (M, 3): the
+        algorithm of :meth:`_closest_parameters_numpy`, point by point in Rust on all threads
+        (``tubesweep_core::mobius``; equal to the NumPy version to rounding)."""
+        x = np.ascontiguousarray(np.asarray(p, dtype=float).reshape(-1, 3))
+        return _native.mobius_closest_parameters(x, self.R, self.w, self.newton_iterations)
+
+    def _closest_parameters_numpy(self, p: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        """The vectorised NumPy formulation of :meth:`closest_parameters` (the tests' reference)."""
         x = np.asarray(p, dtype=float).reshape(-1, 3)
         th0 = np.arctan2(x[:, 1], x[:, 0])
         best_th = np.empty(len(x))
