@@ -176,3 +176,11 @@ class TriangleTree:
         self, points: npt.NDArray[np.float64], max_distance: float
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.uint8]]: ...
     def any_within(self, points: npt.NDArray[np.float64], thresholds: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]: ...
+    def band(
+        self,
+        points: npt.NDArray[np.float64],
+        half_width: float,
+        on_surface: float,
+        face_normals: npt.NDArray[np.float64],
+        pseudo_normals: Optional[npt.NDArray[np.float64]],
+    ) -> Tuple[npt.NDArray[np.uint32], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float32]]: ...

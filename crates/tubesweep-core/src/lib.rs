@@ -41,6 +41,7 @@ pub mod interpolate;
 pub mod kernel_stats;
 pub mod lax_friedrichs;
 pub mod mesh;
+pub mod mesh_band;
 pub mod mobius;
 pub mod normals;
 pub mod redistance;

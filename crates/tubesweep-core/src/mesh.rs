@@ -424,25 +424,42 @@ impl TriangleTree {
     /// triangle ([`closest_from`](Self::closest_from)): for grid nodes in C order, consecutive
     /// points are neighbours and the bound prunes most of the tree.
     pub fn closest_many(&self, points: &[f64], max_distance: f64) -> Vec<Option<Closest>> {
-        const BLOCK: usize = 2048;
         let blocks: Vec<Vec<Option<Closest>>> = points
-            .par_chunks(3 * BLOCK)
+            .par_chunks(3 * QUERY_BLOCK)
             .map(|block| {
-                let mut stack = Vec::with_capacity(64);
-                let mut hint = None;
-                block
-                    .chunks_exact(3)
-                    .map(|c| {
-                        let r = self.closest_from([c[0], c[1], c[2]], max_distance, hint, &mut stack);
-                        if let Some(ref a) = r {
-                            hint = Some(a.triangle);
-                        }
-                        r
-                    })
-                    .collect()
+                let mut search = ClosestSearch::new(self);
+                block.chunks_exact(3).map(|c| search.closest([c[0], c[1], c[2]], max_distance)).collect()
             })
             .collect();
         blocks.concat()
+    }
+}
+
+/// Points per parallel task of the batched queries.
+pub const QUERY_BLOCK: usize = 2048;
+
+/// A sequence of closest-point queries on one tree, each starting from the triangle the previous
+/// one found ([`TriangleTree::closest`] with that triangle's distance as the first bound): for
+/// points that follow each other in space, such as grid nodes in C order. The answers are those of
+/// single queries.
+pub struct ClosestSearch<'a> {
+    tree: &'a TriangleTree,
+    stack: Vec<(ChildRef, f64)>,
+    hint: Option<usize>,
+}
+
+impl<'a> ClosestSearch<'a> {
+    pub fn new(tree: &'a TriangleTree) -> Self {
+        ClosestSearch { tree, stack: Vec::with_capacity(64), hint: None }
+    }
+
+    /// The closest point on the mesh to `p` within `max_distance` (see [`TriangleTree::closest`]).
+    pub fn closest(&mut self, p: V3, max_distance: f64) -> Option<Closest> {
+        let r = self.tree.closest_from(p, max_distance, self.hint, &mut self.stack);
+        if let Some(ref a) = r {
+            self.hint = Some(a.triangle);
+        }
+        r
     }
 }
 

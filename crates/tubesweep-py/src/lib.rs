@@ -694,6 +694,56 @@ impl PyTriangleTree {
         Ok(found.into_pyarray(py))
     }
 
+    /// The band among the candidate nodes `points` (M, 3): the positions of those within
+    /// `half_width` of the mesh, their distances, signed distances (with `pseudo_normals`
+    /// (T, 7, 3), else the distances) and extension directions (K, 3) float32, `face_normals`
+    /// (T, 3) where a node lies within `on_surface` of the mesh. T is the tree's number of
+    /// triangles. See `tubesweep_core::mesh_band`.
+    #[allow(clippy::type_complexity)]
+    fn band<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+        half_width: f64,
+        on_surface: f64,
+        face_normals: PyReadonlyArray2<'py, f64>,
+        pseudo_normals: Option<PyReadonlyArray3<'py, f64>>,
+    ) -> PyResult<(Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f32>>)> {
+        let t = self.tree.len();
+        if points.shape()[1] != 3 {
+            return Err(PyValueError::new_err("points must have shape (M, 3)"));
+        }
+        if face_normals.shape() != [t, 3] {
+            return Err(PyValueError::new_err(format!("face_normals must have shape ({t}, 3), one per triangle of the tree")));
+        }
+        if let Some(pn) = &pseudo_normals {
+            if pn.shape() != [t, 7, 3] {
+                return Err(PyValueError::new_err(format!("pseudo_normals must have shape ({t}, 7, 3)")));
+            }
+        }
+        let p = c_slice(&points, "points")?;
+        let face: Vec<[f64; 3]> = c_slice(&face_normals, "face_normals")?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let pseudo: Option<Vec<[[f64; 3]; 7]>> = match &pseudo_normals {
+            Some(pn) => Some(
+                pn.as_slice()
+                    .map_err(|_| PyValueError::new_err("pseudo_normals must be C-contiguous"))?
+                    .chunks_exact(21)
+                    .map(|c| core::array::from_fn(|f| [c[3 * f], c[3 * f + 1], c[3 * f + 2]]))
+                    .collect(),
+            ),
+            None => None,
+        };
+        let band = py
+            .detach(|| {
+                let normals = tubesweep_core::mesh_band::MeshNormals { face: &face, pseudo: pseudo.as_deref() };
+                tubesweep_core::mesh_band::mesh_band(&self.tree, p, half_width, on_surface, &normals)
+            })
+            .map_err(to_pyerr)?;
+        let k = band.kept.len();
+        let direction = numpy::ndarray::Array2::from_shape_vec((k, 3), band.direction).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok((band.kept.into_pyarray(py), band.distance.into_pyarray(py), band.signed.into_pyarray(py), direction.into_pyarray(py)))
+    }
+
     /// Closest points of `points` (M, 3) searched within `max_distance`: returns distance (M,)
     /// (inf where nothing is that close), closest point (M, 3), triangle (M,) (-1 where none) and
     /// feature code (M,) (0 face, 1-3 vertex a/b/c, 4 edge ab, 5 ac, 6 bc).

@@ -200,6 +200,7 @@ class MeshSurface(Surface):
             raise ValueError("every triangle of the mesh is degenerate (zero area)")
         self._good = np.flatnonzero(good)  # tree triangles → mesh faces
         self._tree: Any = None
+        self._band_normals: Optional[Tuple[np.ndarray, Optional[np.ndarray]]] = None
         self.face_normals = np.zeros_like(cross)
         self.face_normals[good] = cross[good] / area2[good, None]
 
@@ -253,6 +254,26 @@ class MeshSurface(Surface):
             out[m] = self._edge_normals[self._edge_ids[face[m], e]]
         return out * self._flip
 
+    def _tree_normals(self) -> Tuple[np.ndarray, Optional[np.ndarray]]:
+        """Per triangle of the tree: its unit normal (T, 3) and, on a closed mesh, the outward
+        pseudo-normals of its seven features (T, 7, 3) in the order of the feature codes, which
+        the core's band reads (``tubesweep_core::mesh_band``). Built on first use."""
+        if self._band_normals is None:
+            g = self._good
+            face = np.ascontiguousarray(self.face_normals[g])
+            pseudo = None
+            if self.signed:
+                f = self.faces[g]
+                table = np.empty((len(g), 7, 3))
+                table[:, FACE] = face
+                for k, vert in ((VERT_A, 0), (VERT_B, 1), (VERT_C, 2)):
+                    table[:, k] = self._vertex_normals[f[:, vert]]
+                for k, e in ((EDGE_AB, 0), (EDGE_AC, 1), (EDGE_BC, 2)):
+                    table[:, k] = self._edge_normals[self._edge_ids[g, e]]
+                pseudo = np.ascontiguousarray(table * self._flip)
+            self._band_normals = (face, pseudo)
+        return self._band_normals
+
     @property
     def tree(self) -> Any:
         """The AABB tree over the non-degenerate triangles (built on first use)."""
@@ -303,20 +324,11 @@ class MeshSurface(Surface):
         if lin.size == 0:
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
         x = grid.node_points(lin)
-        dist, cp, face, code = self.closest(x, half_width * (1 + 1e-12))
-        keep = dist <= half_width
-        lin, x, dist, cp, face, code = lin[keep], x[keep], dist[keep], cp[keep], face[keep], code[keep]
-        diff = x - cp
-        safe = np.where(dist > 1e-12 * h, dist, 1.0)
-        direction = diff / safe[:, None]
-        on = dist <= 1e-12 * h
-        direction[on] = self.face_normals[face[on]]
-        if self.signed:
-            s = np.einsum("ij,ij->i", diff, self._pseudonormal(face, code))
-            signed = np.where(s < 0, -dist, dist)
-        else:
-            signed = dist.copy()
-        return BandGeometry(lin.astype(np.int64), dist, signed, direction.astype(np.float32), consumable=True)
+        # the closest points, the distances, signs and directions of the candidates within the
+        # half-width, in Rust on all threads (tubesweep_core::mesh_band)
+        face, pseudo = self._tree_normals()
+        kept, dist, signed, direction = self.tree.band(x, float(half_width), 1e-12 * h, face, pseudo)
+        return BandGeometry(lin[kept].astype(np.int64), dist, signed, direction, consumable=True)
 
     def band_candidates(self, grid: Grid, half_width: float) -> np.ndarray:
         """The nodes the coarse-to-fine search keeps (sorted linear indices), a superset of the
