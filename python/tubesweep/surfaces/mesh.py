@@ -257,7 +257,9 @@ class MeshSurface(Surface):
     def _tree_normals(self) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """Per triangle of the tree: its unit normal (T, 3) and, on a closed mesh, the outward
         pseudo-normals of its seven features (T, 7, 3) in the order of the feature codes, which
-        the core's band reads (``tubesweep_core::mesh_band``). Built on first use."""
+        the core's band reads (``tubesweep_core::mesh_band``). Built on first use and kept with
+        the surface: 24 bytes per triangle, 192 on a closed mesh (the bunny, open, 69,451
+        triangles: 1.7 MB)."""
         if self._band_normals is None:
             g = self._good
             face = np.ascontiguousarray(self.face_normals[g])
