@@ -325,7 +325,8 @@ def test_sampled_phi_with_nan_or_inf_names_the_first_bad_index():
 @pytest.mark.parametrize(
     "surface, shape",
     [(Sphere(), (101,) * 3), (Sphere(0.37, (0.1, -0.2, 0.05)), (57, 64, 49)), (Torus(), (61,) * 3),
-     (Ellipsoid(), (71,) * 3), (Circle(), (301, 301)), (REGISTRY["star"](), (301, 301))],
+     (Ellipsoid(), (71,) * 3), (Circle(), (301, 301)), (REGISTRY["star"](), (301, 301)),
+     (REGISTRY["rounded-cube"](), (81,) * 3), (DoubleTorus(), (81,) * 3)],
 )
 def test_library_surfaces_found_in_rust_are_the_callable_route_bit_for_bit(surface, shape):
     # the library's analytic surfaces have their band found without calling back into Python;
@@ -488,7 +489,8 @@ def test_row_norms_are_numpys_bits():
 
 
 def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
-    """Circle, Sphere and Torus evaluate φ in Rust with the arithmetic of their NumPy formulas."""
+    """Circle, Sphere, Torus, RoundedCube and DoubleTorus evaluate φ in Rust with the arithmetic of
+    their NumPy formulas."""
 
     rng = np.random.default_rng(7)
     p3 = rng.uniform(-1, 1, (50_001, 3))
@@ -500,6 +502,8 @@ def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
     t = ts.surfaces.Torus(R=0.6, r=0.25, center=(0.0, 0.1, -0.1))
     q = p3 - t.center
     assert np.array_equal(t.signed_distance(p3), np.hypot(np.hypot(q[:, 0], q[:, 1]) - t.R, q[:, 2]) - t.r)
+    for other in (ts.surfaces.RoundedCube(0.45, 0.12, center=(0.05, -0.1, 0.0)), DoubleTorus()):
+        assert np.array_equal(other.signed_distance(p3), other._signed_distance_numpy(p3))
     with pytest.raises(ValueError, match=r"\(M, 3\)"):
         s.signed_distance(p2)
 

@@ -76,6 +76,44 @@ pub fn torus_signed_distance(
     Ok(())
 }
 
+/// The signed distance to the cube of half-side `half_size` about `centre` with its edges and
+/// corners rounded to `radius`, `|max(q, 0)| + min(max_k q_k, 0) − radius` with
+/// `q = |x − c| − (half_size − radius)` componentwise (exact), at the points (`M` rows of 3
+/// coordinates) into `out`, with the arithmetic (and bits) of the Python
+/// `RoundedCube._signed_distance_numpy`.
+pub fn rounded_cube_signed_distance(points: &[f64], centre: [f64; 3], half_size: f64, radius: f64, out: &mut [f64]) -> Result<()> {
+    check_points(points, 3, out)?;
+    if !(radius > 0.0 && radius <= half_size && half_size.is_finite()) {
+        return Err(Error::invalid("radius", format!("need 0 < radius <= half_size, got radius = {radius}, half_size = {half_size}")));
+    }
+    let inner = half_size - radius;
+    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
+        for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
+            let q = [(x[0] - centre[0]).abs() - inner, (x[1] - centre[1]).abs() - inner, (x[2] - centre[2]).abs() - inner];
+            let m = [q[0].max(0.0), q[1].max(0.0), q[2].max(0.0)];
+            let outside = ((m[0] * m[0] + m[1] * m[1]) + m[2] * m[2]).sqrt();
+            let inside = q[0].max(q[1]).max(q[2]).min(0.0);
+            *o = outside + inside - radius;
+        }
+    });
+    Ok(())
+}
+
+/// `φ = min(φ₁, φ₂)` of the two ring tori (centre-circle radius `major`, tube radius `minor`)
+/// about the z axis through `(∓offset, 0, 0)`: the genus-2 surface of the Python `DoubleTorus`,
+/// with the arithmetic (and bits) of its `_signed_distance_numpy`, at the points (`M` rows of 3
+/// coordinates) into `out`.
+pub fn double_torus_signed_distance(points: &[f64], major: f64, minor: f64, offset: f64, out: &mut [f64]) -> Result<()> {
+    check_points(points, 3, out)?;
+    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
+        for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
+            let torus = |cx: f64| ((x[0] - cx).hypot(x[1]) - major).hypot(x[2]) - minor;
+            *o = torus(-offset).min(torus(offset));
+        }
+    });
+    Ok(())
+}
+
 /// The signed distance to the ellipsoid `Σ ((x_i − c_i)/a_i)² = 1` (semi-axes `axes`, centre
 /// `centre`) at the points (`M` rows of 3 coordinates) into `out`, with the arithmetic of the
 /// Python `Ellipsoid._signed_distance_numpy` (the same bits): the closest point is
@@ -344,6 +382,10 @@ pub enum AnalyticSurface {
     Ellipsoid { centre: [f64; 3], axes: [f64; 3] },
     /// [`star_signed_distance`] (2D).
     Star { r0: f64, eps: f64 },
+    /// [`rounded_cube_signed_distance`].
+    RoundedCube { centre: [f64; 3], half_size: f64, radius: f64 },
+    /// [`double_torus_signed_distance`].
+    DoubleTorus { major: f64, minor: f64, offset: f64 },
 }
 
 impl AnalyticSurface {
@@ -356,8 +398,15 @@ impl AnalyticSurface {
             ("torus", 5) => AnalyticSurface::Torus { centre: [p[0], p[1], p[2]], major: p[3], minor: p[4] },
             ("ellipsoid", 6) => AnalyticSurface::Ellipsoid { centre: [p[0], p[1], p[2]], axes: [p[3], p[4], p[5]] },
             ("star", 2) => AnalyticSurface::Star { r0: p[0], eps: p[1] },
-            ("sphere" | "torus" | "ellipsoid" | "star", _) => return Err(bad()),
-            _ => return Err(Error::invalid("kind", format!("unknown analytic surface {kind:?}; use sphere, torus, ellipsoid or star"))),
+            ("rounded-cube", 5) => AnalyticSurface::RoundedCube { centre: [p[0], p[1], p[2]], half_size: p[3], radius: p[4] },
+            ("double-torus", 3) => AnalyticSurface::DoubleTorus { major: p[0], minor: p[1], offset: p[2] },
+            ("sphere" | "torus" | "ellipsoid" | "star" | "rounded-cube" | "double-torus", _) => return Err(bad()),
+            _ => {
+                return Err(Error::invalid(
+                    "kind",
+                    format!("unknown analytic surface {kind:?}; use sphere, torus, ellipsoid, star, rounded-cube or double-torus"),
+                ))
+            }
         })
     }
 
@@ -366,6 +415,7 @@ impl AnalyticSurface {
         match self {
             AnalyticSurface::Sphere { centre, .. } => centre.len(),
             AnalyticSurface::Torus { .. } | AnalyticSurface::Ellipsoid { .. } => 3,
+            AnalyticSurface::RoundedCube { .. } | AnalyticSurface::DoubleTorus { .. } => 3,
             AnalyticSurface::Star { .. } => 2,
         }
     }
@@ -377,6 +427,8 @@ impl AnalyticSurface {
             AnalyticSurface::Torus { centre, major, minor } => torus_signed_distance(points, *centre, *major, *minor, out),
             AnalyticSurface::Ellipsoid { centre, axes } => ellipsoid_signed_distance(points, *centre, *axes, out),
             AnalyticSurface::Star { r0, eps } => star_signed_distance(points, *r0, *eps, out),
+            AnalyticSurface::RoundedCube { centre, half_size, radius } => rounded_cube_signed_distance(points, *centre, *half_size, *radius, out),
+            AnalyticSurface::DoubleTorus { major, minor, offset } => double_torus_signed_distance(points, *major, *minor, *offset, out),
         }
     }
 }
@@ -493,6 +545,29 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn rounded_cube_and_double_torus_distances() {
+        // the rounded cube: on a face, at a rounded edge and corner, inside
+        let mut out = [0.0; 4];
+        let p = [0.7, 0.0, 0.0, 0.6, 0.6, 0.0, 0.6, 0.6, 0.6, 0.1, 0.0, 0.0];
+        rounded_cube_signed_distance(&p, [0.0; 3], 0.5, 0.1, &mut out).unwrap();
+        let e = [0.2, 0.2 * 2f64.sqrt() - 0.1, 0.2 * 3f64.sqrt() - 0.1, -0.4];
+        for (v, e) in out.iter().zip(e) {
+            assert!((v - e).abs() < 1e-12, "{v} vs {e}");
+        }
+        assert!(rounded_cube_signed_distance(&p, [0.0; 3], 0.5, 0.6, &mut out).is_err());
+        // the double torus: on the outer equator of either torus, at the centre of a tube
+        let p = [-(0.36 + 0.35 + 0.12), 0.0, 0.0, 0.36 + 0.35, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let mut out = [0.0; 3];
+        double_torus_signed_distance(&p, 0.35, 0.12, 0.36, &mut out).unwrap();
+        let far = ((0.36f64.hypot(0.0) - 0.35).hypot(1.0)) - 0.12;
+        for (v, e) in out.iter().zip([0.0, -0.12, far]) {
+            assert!((v - e).abs() < 1e-12, "{v} vs {e}");
+        }
+        assert_eq!(AnalyticSurface::from_parameters("rounded-cube", &[0.0, 0.0, 0.0, 0.5, 0.1]).unwrap().ndim(), 3);
+        assert!(AnalyticSurface::from_parameters("double-torus", &[0.35, 0.12]).is_err());
     }
 
     #[test]

@@ -990,6 +990,34 @@ fn mobius_closest_parameters<'py>(
     Ok((theta.into_pyarray(py), s.into_pyarray(py)))
 }
 
+/// The exact signed distance to the rounded cube (half-side `half_size`, edges and corners rounded
+/// to `radius`) about `centre` at the points (M, 3). See
+/// `tubesweep_core::analytic::rounded_cube_signed_distance`.
+#[pyfunction]
+fn rounded_cube_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, half_size: f64, radius: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if points.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
+    }
+    let c = coords_array::<3>(&centre, "centre")?;
+    let p = c_slice(&points, "points")?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| tubesweep_core::analytic::rounded_cube_signed_distance(p, c, half_size, radius, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
+/// φ = min of the two torus distances of the double torus at the points (M, 3). See
+/// `tubesweep_core::analytic::double_torus_signed_distance`.
+#[pyfunction]
+fn double_torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, major: f64, minor: f64, offset: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if points.shape()[1] != 3 {
+        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
+    }
+    let p = c_slice(&points, "points")?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| tubesweep_core::analytic::double_torus_signed_distance(p, major, minor, offset, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
 /// The exact signed distance to the six-fold star r(θ) = r0 + eps sin²(3θ) at the points (M, 2).
 /// See `tubesweep_core::analytic::star_signed_distance`.
 #[pyfunction]
@@ -1242,6 +1270,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sphere_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(torus_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(ellipsoid_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(rounded_cube_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(double_torus_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(mobius_closest_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(star_signed_distance, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;

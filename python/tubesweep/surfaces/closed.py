@@ -224,6 +224,15 @@ class RoundedCube(LevelSet):
         self.ndim = 3
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
+        # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
+        return _native.rounded_cube_signed_distance(_points(p, 3), [float(c) for c in self.center],
+                                                    self.half_size, self.radius)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("rounded-cube", [*map(float, self.center), self.half_size, self.radius]) if own_phi(self, RoundedCube) else None
+
+    def _signed_distance_numpy(self, p: np.ndarray) -> np.ndarray:
+        """The NumPy formulation of :meth:`signed_distance` (the reference the tests compare with)."""
         q = np.abs(np.asarray(p, dtype=float) - self.center) - (self.half_size - self.radius)
         return row_norms(np.maximum(q, 0.0)) + np.minimum(np.max(q, axis=1), 0.0) - self.radius
 
@@ -265,6 +274,14 @@ class DoubleTorus(LevelSet):
         self.ndim = 3
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
+        # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
+        return _native.double_torus_signed_distance(_points(p, 3), self.R, self.r, self.offset)
+
+    def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
+        return ("double-torus", [self.R, self.r, self.offset]) if own_phi(self, DoubleTorus) else None
+
+    def _signed_distance_numpy(self, p: np.ndarray) -> np.ndarray:
+        """The NumPy formulation of :meth:`signed_distance` (the reference the tests compare with)."""
         p = np.asarray(p, dtype=float)
         out = None
         for cx in (-self.offset, self.offset):
