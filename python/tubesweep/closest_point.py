@@ -28,7 +28,7 @@ import numpy as np
 
 from ._linalg import row_norms
 from .grid import Grid
-from .surface import EVAL_CHUNK, BandGeometry, Surface, discover_band
+from .surface import EVAL_CHUNK, BandGeometry, Surface, coarse_to_fine_candidates
 
 __all__ = ["ClosestPoint", "DIRECTION_EPS"]
 
@@ -115,14 +115,30 @@ class ClosestPoint(Surface):
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """Band nodes with ``|x − cp(x)| ≤ half_width`` (found coarse-to-fine) and their outward
         directions ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2)."""
+        from . import _native
+
         self.check_grid(grid)
-        linear, dist = discover_band(self.distance, grid, half_width, self.lipschitz, name="cp")
         d = grid.ndim
-        if linear.size == 0:
-            return BandGeometry(linear, dist, dist, np.zeros((0, d), np.float32))
-        x = grid.node_points(linear)
-        diff = x - self.closest_point(x)
-        norm = row_norms(diff)
+        candidates = coarse_to_fine_candidates(grid, half_width, self.lipschitz, lambda p, reach: self.distance(p))
+        # cp once per candidate, chunk by chunk: the distances select the band, and the kept
+        # offsets x − cp(x) give its directions (no second cp evaluation at the band's nodes)
+        shape, lower = list(grid.shape), [float(x) for x in grid.lower]
+        parts_lin, parts_norm, parts_diff = [], [], []
+        for s0 in range(0, len(candidates), EVAL_CHUNK):
+            lin = candidates[s0 : s0 + EVAL_CHUNK]
+            x = _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing)
+            diff = x - self.closest_point(x)
+            norm = row_norms(diff)
+            keep = norm <= half_width
+            parts_lin.append(lin[keep])
+            parts_norm.append(norm[keep])
+            parts_diff.append(diff[keep])
+        if not parts_lin or sum(len(p) for p in parts_lin) == 0:
+            empty = np.zeros(0)
+            return BandGeometry(np.zeros(0, np.int64), empty, empty, np.zeros((0, d), np.float32))
+        linear = np.concatenate(parts_lin)
+        norm = np.concatenate(parts_norm)
+        diff = np.concatenate(parts_diff)
         ok = norm > DIRECTION_EPS * grid.spacing
         direction = np.zeros((len(linear), d))
         direction[ok] = diff[ok] / norm[ok, None]
