@@ -1,7 +1,8 @@
 //! Exact signed distances of the library's analytic surfaces, evaluated on all threads: the
-//! Python package's `Circle`, `Sphere`, `Torus`, `Ellipsoid` and `Star` call these instead of NumPy expressions, with
-//! the same arithmetic (so the same bits), because the band search evaluates φ at every
-//! candidate node and the outward directions at every rim place.
+//! Python package's `Circle`, `Sphere`, `Torus`, `Ellipsoid`, `Star`, `RoundedCube` and
+//! `DoubleTorus` call these instead of NumPy expressions, with the same arithmetic (so the same
+//! bits; the star's to rounding), because the band search evaluates φ at every candidate node and
+//! the outward directions at every rim place.
 
 use crate::error::{Error, Result};
 use rayon::prelude::*;
@@ -389,8 +390,9 @@ pub enum AnalyticSurface {
 }
 
 impl AnalyticSurface {
-    /// The surface named `kind` ("sphere", "torus", "ellipsoid" or "star") with the parameters
-    /// in the order of the variant's fields (a sphere's centre has 2 or 3 coordinates).
+    /// The surface named `kind` ("sphere", "torus", "ellipsoid", "star", "rounded-cube" or
+    /// "double-torus") with the parameters in the order of the variant's fields (a sphere's centre
+    /// has 2 or 3 coordinates).
     pub fn from_parameters(kind: &str, p: &[f64]) -> Result<Self> {
         let bad = || Error::invalid("parameters", format!("{p:?} are not the parameters of a {kind}"));
         Ok(match (kind, p.len()) {

@@ -1200,8 +1200,8 @@ fn project_to_sampled_level_set<'py>(
 /// in Rust.
 type AnalyticBand<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>, Option<PyBand>, Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f64>>);
 
-/// The band of a library surface with a Rust φ (`kind` "sphere", "torus", "ellipsoid" or
-/// "star", `parameters` as `tubesweep_core::analytic::AnalyticSurface::from_parameters` takes
+/// The band of a library surface with a Rust φ (`kind` "sphere", "torus", "ellipsoid", "star",
+/// "rounded-cube" or "double-torus", `parameters` as `tubesweep_core::analytic::AnalyticSurface::from_parameters` takes
 /// them), without calling back into Python: the coarse-to-fine search
 /// (`tubesweep_core::discovery::discover_band`), the band structure, φ at its rim and the
 /// outward directions, the same nodes and bits as the callable route. Returns (sorted linear
