@@ -502,8 +502,10 @@ def test_native_analytic_distances_are_the_numpy_expressions_bit_for_bit():
     t = ts.surfaces.Torus(R=0.6, r=0.25, center=(0.0, 0.1, -0.1))
     q = p3 - t.center
     assert np.array_equal(t.signed_distance(p3), np.hypot(np.hypot(q[:, 0], q[:, 1]) - t.R, q[:, 2]) - t.r)
+    p3[:3] = [[np.nan, 0.0, 0.0], [0.1, np.nan, 0.2], [0.3, 0.2, np.nan]]  # NaN stays NaN
     for other in (ts.surfaces.RoundedCube(0.45, 0.12, center=(0.05, -0.1, 0.0)), DoubleTorus()):
-        assert np.array_equal(other.signed_distance(p3), other._signed_distance_numpy(p3))
+        assert np.array_equal(other.signed_distance(p3), other._signed_distance_numpy(p3), equal_nan=True)
+        assert np.isnan(other.signed_distance(p3[:3])).all()
     with pytest.raises(ValueError, match=r"\(M, 3\)"):
         s.signed_distance(p2)
 
@@ -523,6 +525,51 @@ def test_native_mobius_closest_points_match_the_numpy_formulation():
     assert np.max(row_norms(ca - cb)) < 1e-9
     with pytest.raises(ValueError, match="newton_iterations"):
         ts.surfaces.MobiusBand(newton_iterations=0)
+    # a subclass that changes the projection takes the NumPy route, which follows the change
+    calls = []
+
+    class Counted(ts.surfaces.MobiusBand):
+        def _interior(self, x, th):
+            calls.append(len(x))
+            return super()._interior(x, th)
+
+    Counted().closest_parameters(p[:10])
+    assert calls == [10]
+
+
+def bisected_ellipsoid_distance(e, p):
+    """|x − y| by 100 bisections of the Lagrange multiplier (the algorithm before Newton's)."""
+    x = p - e.center
+    a, a2 = e.axes, e.axes**2
+    lo = np.full(len(x), -a2.min())
+    hi = a.max() * np.linalg.norm(x, axis=1) + 1e-300
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = np.sum((a * x / (a2 + mid[:, None])) ** 2, axis=1) - 1.0
+        lo, hi = np.where(g > 0, mid, lo), np.where(g > 0, hi, mid)
+    t = 0.5 * (lo + hi)
+    return np.linalg.norm(x - a2 * x / (a2 + t[:, None]), axis=1)
+
+
+def test_ellipsoid_distance_on_a_grid_plane_a_rounding_off_its_shortest_axis():
+    """An ellipsoid centred at z = 0.01 on the [−1, 1]³ grid of N = 201: the node plane nearest to
+    its equator lies 8.7e-18 off it, below rounding against c² in the Newton start. The distances
+    there are those of a bisection of the Lagrange multiplier (away from the pole region, where
+    the closest point leaves the plane), and the solve goes through."""
+    e = ts.surfaces.Ellipsoid(center=(0.0, 0.0, 0.01))
+    g = ts.Grid((-1,) * 3, (1,) * 3, (201,) * 3)
+    k = int(np.argmin(np.abs(g.lower[2] + g.spacing * np.arange(201) - 0.01)))
+    i, j = np.meshgrid(np.arange(201), np.arange(201), indexing="ij")
+    p = np.stack([g.lower[0] + g.spacing * i.ravel(), g.lower[1] + g.spacing * j.ravel(),
+                  np.full(i.size, g.lower[2] + g.spacing * k)], axis=1)
+    assert 0 < abs(p[0, 2] - 0.01) < 1e-16
+    q = p[:, :2] / e.axes[:2]
+    near_rim = np.sum(q**2, axis=1) > 0.85  # the degenerate region ends inside this
+    d = np.abs(e.signed_distance(p))
+    np.testing.assert_allclose(d[near_rim], bisected_ellipsoid_distance(e, p[near_rim]), rtol=0, atol=1e-12)
+    sol = ts.solve(e, g, sources=[e.default_source], outer=8)
+    assert sol.stats.converged
 
 
 def test_native_ellipsoid_and_star_distances_match_their_numpy_formulations():
@@ -530,11 +577,14 @@ def test_native_ellipsoid_and_star_distances_match_their_numpy_formulations():
     points included; the Star's (Rust) agrees with its NumPy one to rounding (the sines and cosines
     come from different libraries), on points near the curve and far from it."""
     rng = np.random.default_rng(11)
-    p3 = rng.uniform(-1, 1, (30_000, 3))
-    # interior points on the plane of the shortest axis, where the closest point is a pole
-    p3[:500, 2] = 0.0
-    p3[:500, :2] *= 0.05
+    base = rng.uniform(-1, 1, (30_000, 3))
     for e in (ts.surfaces.Ellipsoid(), ts.surfaces.Ellipsoid(0.5, 0.5, 0.4, center=(0.05, 0.0, -0.1))):
+        p3 = base.copy()
+        # interior points on the plane of the shortest axis, where the closest point is a pole,
+        # and points off that plane by less than rounding against the axis (t₀ on the pole)
+        p3[:500, 2] = e.center[2]
+        p3[:500, :2] = e.center[:2] + 0.05 * p3[:500, :2]
+        p3[500:1000, 2] = e.center[2] + 1e-20 * rng.uniform(-1, 1, 500)
         assert np.array_equal(e.signed_distance(p3), e._signed_distance_numpy(p3))
     s = ts.surfaces.Star()
     p2 = np.concatenate([rng.uniform(-1, 1, (5_000, 2)), s.curve(rng.uniform(0, 2 * np.pi, 5_000)) * rng.uniform(0.9, 1.1, (5_000, 1))])

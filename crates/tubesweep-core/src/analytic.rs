@@ -88,12 +88,15 @@ pub fn rounded_cube_signed_distance(points: &[f64], centre: [f64; 3], half_size:
         return Err(Error::invalid("radius", format!("need 0 < radius <= half_size, got radius = {radius}, half_size = {half_size}")));
     }
     let inner = half_size - radius;
+    // NumPy's maximum and minimum: NaN wins (f64::max and min would drop it)
+    let max = |a: f64, b: f64| if a.is_nan() || a > b { a } else { b };
+    let min = |a: f64, b: f64| if a.is_nan() || a < b { a } else { b };
     out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
         for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
             let q = [(x[0] - centre[0]).abs() - inner, (x[1] - centre[1]).abs() - inner, (x[2] - centre[2]).abs() - inner];
-            let m = [q[0].max(0.0), q[1].max(0.0), q[2].max(0.0)];
+            let m = [max(q[0], 0.0), max(q[1], 0.0), max(q[2], 0.0)];
             let outside = ((m[0] * m[0] + m[1] * m[1]) + m[2] * m[2]).sqrt();
-            let inside = q[0].max(q[1]).max(q[2]).min(0.0);
+            let inside = min(max(max(q[0], q[1]), q[2]), 0.0);
             *o = outside + inside - radius;
         }
     });
@@ -166,6 +169,7 @@ pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3
 
 /// Most Newton steps [`ellipsoid_root`] takes. It stops far earlier: after at most 11 steps on
 /// 200,000 random points of [−1, 1]³ for the default `Ellipsoid(0.6, 0.45, 0.3)` (one-off count).
+/// The Python `Ellipsoid._newton_root` takes as many (keep the two equal: the same bits).
 pub const ELLIPSOID_NEWTON_STEPS: usize = 100;
 
 /// The root `t` of the ellipsoid's `F(t) = Σ (a_i x_i / (a_i² + t))² − 1` for the point `x`
@@ -175,8 +179,12 @@ pub const ELLIPSOID_NEWTON_STEPS: usize = 100;
 /// `t₀ = max_i (a_i |x_i| − a_i²)` the largest term is 1, so `F(t₀) ≥ 0`: Newton's method from
 /// `t₀` moves right and never passes the root, and stops once `F ≤ 0` or a step no longer
 /// advances `t` (the root to the last bits), or after [`ELLIPSOID_NEWTON_STEPS`]. A term with
-/// `x_i = 0` is 0 (its limit), also where `a_i² + t` vanishes. The arithmetic is that of
-/// `Ellipsoid._newton_root` in Python, operation for operation.
+/// `x_i = 0` is 0 (its limit). So is a term whose `a_i² + t` is exactly 0: when `a_kmin |x_kmin|`
+/// is below rounding against `a_kmin²` (`|x_kmin|` about 1e-17 or less), `t₀` rounds onto the
+/// pole `−a_kmin²`, and the point is treated as lying on the plane `x_kmin = 0`, which it does to
+/// within rounding (without this the first step divides by 0 and the search stops at the pole,
+/// far from the root). The arithmetic is that of `Ellipsoid._newton_root` in Python, operation for
+/// operation.
 #[inline]
 pub fn ellipsoid_root(x: [f64; 3], axes: [f64; 3], a2: [f64; 3], kmin: usize) -> f64 {
     let ax_x = [axes[0] * x[0], axes[1] * x[1], axes[2] * x[2]];
@@ -189,7 +197,7 @@ pub fn ellipsoid_root(x: [f64; 3], axes: [f64; 3], a2: [f64; 3], kmin: usize) ->
         let mut q = [0.0f64; 3];
         let mut slope = [0.0f64; 3];
         for k in 0..3 {
-            if ax_x[k] != 0.0 {
+            if ax_x[k] != 0.0 && den[k] != 0.0 {
                 let r = ax_x[k] / den[k];
                 q[k] = r * r;
                 slope[k] = q[k] / den[k];
@@ -523,6 +531,8 @@ mod tests {
                     2 => x = [0.2 * x[0], 0.2 * x[1], 0.2 * x[2]],
                     3 => x[kmin] = 0.0,
                     4 => x[kmin] = 1e-12 * uniform(),
+                    // a hair off the plane, below rounding against a_kmin² (t₀ on the pole)
+                    6 => x[kmin] = 1e-20 * uniform(),
                     5 => x[(kmin + 1) % 3] = 0.0,
                     _ => {}
                 }

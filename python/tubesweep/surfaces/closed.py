@@ -78,7 +78,9 @@ class Ellipsoid(LevelSet):
         (relative to the centre), or ``−a_kmin²`` where there is none above it: Newton's method
         from ``t₀ = max_i (a_i |x_i| − a_i²)``, where ``F ≥ 0`` (``F`` is convex and decreasing, so
         the steps move right and never pass the root), until ``F ≤ 0`` or a step no longer advances
-        ``t``, at most 100 steps; a term with ``x_i = 0`` is 0. The arithmetic of the core's
+        ``t``, at most 100 steps (the core's ``ELLIPSOID_NEWTON_STEPS``: keep the two equal); a term
+        with ``x_i = 0``, or with ``a_i² + t`` exactly 0 (``t₀`` rounded onto the pole for
+        ``|x_kmin|`` below about 1e-17), is 0. The arithmetic of the core's
         ``tubesweep_core::analytic::ellipsoid_root``, operation for operation (the same bits)."""
         ax_x = ax * x
         t = np.maximum(np.max(ax * np.abs(x) - a2, axis=1), -a2[kmin])
@@ -90,9 +92,11 @@ class Ellipsoid(LevelSet):
             ta = t[idx]
             den = a2 + ta[:, None]
             axa = ax_x[idx]
-            r = np.where(axa != 0.0, axa / den, 0.0)
+            # a term is 0 where x_i = 0 and where a_i² + t is exactly 0 (t₀ rounded onto the pole)
+            live = (axa != 0.0) & (den != 0.0)
+            r = np.where(live, axa / den, 0.0)
             q = r * r
-            slope = np.where(axa != 0.0, q / den, 0.0)
+            slope = np.where(live, q / den, 0.0)
             f = (q[:, 0] + q[:, 1]) + q[:, 2] - 1.0
             nxt = ta + f / (2.0 * ((slope[:, 0] + slope[:, 1]) + slope[:, 2]))
             advance = (f > 0.0) & (nxt > ta)
