@@ -84,6 +84,10 @@ def main() -> int:
     library = None
     if "--library" in argv:
         i = argv.index("--library")
+        if i + 1 >= len(argv) or argv[i + 1] not in ts.surfaces.REGISTRY:
+            raise SystemExit(f"--library takes a surface name: one of {', '.join(ts.surfaces.REGISTRY)}")
+        if dense or "--callable" in argv:
+            raise SystemExit("--library solves on the library surface itself: not with --dense, --redistance or --callable")
         library = argv[i + 1]
         argv = argv[:i] + argv[i + 2:]
     args = [a for a in argv if a not in flags]

@@ -145,6 +145,23 @@ def test_signed_distance_of_closed_mesh_and_open_mesh_has_none():
     assert np.array_equal(geom.signed, geom.distance)
 
 
+def test_band_of_a_closed_mesh_carries_the_signed_distance():
+    """The band of a closed mesh (worked out in the core with the closest points) holds the signed
+    distance of ``signed_distance`` bit for bit, with the sign of the sphere it approximates away
+    from the mesh, for either orientation of the faces."""
+    v, f = icosphere(3)
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    for faces in (f, f[:, ::-1]):
+        m = MeshSurface(v, faces)
+        geom = m.band(grid, 4 * grid.spacing)
+        x = grid.points(grid.unravel(geom.linear))
+        assert np.array_equal(geom.signed, m.signed_distance(x))
+        assert np.array_equal(np.abs(geom.signed), geom.distance)
+        r = np.linalg.norm(x, axis=1)
+        clear = np.abs(r - 0.5) > 0.02
+        assert clear.sum() > 1000 and np.all(np.sign(geom.signed[clear]) == np.sign(r[clear] - 0.5))
+
+
 def test_solution_on_icosphere_mesh_matches_great_circles():
     v, f = icosphere(4)  # 2562 vertices, within 1.2e-3 of the sphere r = 0.5
     m = from_mesh((v, f))

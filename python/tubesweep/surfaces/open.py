@@ -160,6 +160,11 @@ class PlanePatch(ClosestPoint):
         return grid_mesh(np.stack([x, y, np.zeros_like(x)], -1) + self.center)
 
 
+#: The methods of :class:`MobiusBand` whose arithmetic the core's closest point repeats: a
+#: subclass that overrides one of them takes the NumPy route.
+_MOBIUS_NUMPY_METHODS = ("point", "_derivs", "_interior", "_boundary", "_closest_parameters_numpy")
+
+
 class MobiusBand(ClosestPoint):
     """The Möbius band ``X(θ, s) = ((R + s cos(θ/2)) cos θ, (R + s cos(θ/2)) sin θ, s sin(θ/2))``,
     ``θ ∈ [0, 2π)``, ``|s| ≤ w`` — open (its boundary is one closed curve, ``s = ±w``) and
@@ -267,6 +272,9 @@ class MobiusBand(ClosestPoint):
         algorithm of :meth:`_closest_parameters_numpy`, point by point in Rust on all threads
         (``tubesweep_core::mobius``; equal to the NumPy version to rounding)."""
         x = np.ascontiguousarray(np.asarray(p, dtype=float).reshape(-1, 3))
+        if not all(getattr(type(self), m) is getattr(MobiusBand, m) for m in _MOBIUS_NUMPY_METHODS):
+            # a subclass changed the band or its projection: the NumPy route follows the change
+            return self._closest_parameters_numpy(x)
         return _native.mobius_closest_parameters(x, self.R, self.w, self.newton_iterations)
 
     def _closest_parameters_numpy(self, p: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
