@@ -29,12 +29,14 @@ pub enum Feature {
 
 type V3 = [f64; 3];
 
+/// `a − b` componentwise.
 #[inline]
-fn sub(a: V3, b: V3) -> V3 {
+pub(crate) fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
+/// `a · b`, summed in axis order.
 #[inline]
-fn dot(a: V3, b: V3) -> f64 {
+pub(crate) fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 #[inline]

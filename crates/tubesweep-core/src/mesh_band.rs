@@ -10,7 +10,7 @@
 //! took it over, so the band, its distances and its directions are the same bits.
 
 use crate::error::{Error, Result};
-use crate::mesh::{ClosestSearch, TriangleTree, QUERY_BLOCK};
+use crate::mesh::{dot, sub, ClosestSearch, TriangleTree, QUERY_BLOCK};
 use rayon::prelude::*;
 
 /// The normals the band needs, per triangle of the tree (in the tree's triangle order).
@@ -68,7 +68,7 @@ pub fn mesh_band(tree: &TriangleTree, points: &[f64], half_width: f64, on_surfac
                 if !(dist <= half_width) {
                     continue;
                 }
-                let diff = [x[0] - found.point[0], x[1] - found.point[1], x[2] - found.point[2]];
+                let diff = sub(x, found.point);
                 let direction = if dist <= on_surface {
                     normals.face[found.triangle]
                 } else {
@@ -77,7 +77,7 @@ pub fn mesh_band(tree: &TriangleTree, points: &[f64], half_width: f64, on_surfac
                 let signed = match normals.pseudo {
                     Some(pseudo) => {
                         let n = pseudo[found.triangle][found.feature as usize];
-                        if (diff[0] * n[0] + diff[1] * n[1]) + diff[2] * n[2] < 0.0 {
+                        if dot(diff, n) < 0.0 {
                             -dist
                         } else {
                             dist

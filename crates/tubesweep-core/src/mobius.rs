@@ -14,6 +14,7 @@
 //! and at the few points equidistant from two candidates either may win.
 
 use crate::error::{Error, Result};
+use crate::mesh::{dot, sub};
 use rayon::prelude::*;
 
 /// Points per parallel task.
@@ -41,16 +42,6 @@ fn derivatives(r: f64, th: f64, s: f64) -> [[f64; 3]; 5] {
     ]
 }
 
-#[inline]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]
-}
-
-#[inline]
-fn minus(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 /// The band's point `X(θ, s)`.
 #[inline]
 pub fn mobius_point(r: f64, th: f64, s: f64) -> [f64; 3] {
@@ -66,10 +57,10 @@ pub fn mobius_point(r: f64, th: f64, s: f64) -> [f64; 3] {
 fn interior(r: f64, x: [f64; 3], th0: f64, iterations: usize) -> (f64, f64) {
     let d0 = derivatives(r, th0, 0.0);
     let mut th = th0;
-    let mut s = dot(minus(x, d0[0]), d0[2]);
+    let mut s = dot(sub(x, d0[0]), d0[2]);
     for _ in 0..iterations {
         let [p, pt, ps, ptt, pts] = derivatives(r, th, s);
-        let d = minus(p, x);
+        let d = sub(p, x);
         let (g1, g2) = (dot(d, pt), dot(d, ps));
         let tt = dot(pt, pt);
         let h11 = tt + dot(d, ptt);
@@ -97,7 +88,7 @@ fn boundary(r: f64, x: [f64; 3], th0: f64, sb: f64, iterations: usize) -> f64 {
     let mut th = th0;
     for _ in 0..iterations {
         let [p, pt, _, ptt, _] = derivatives(r, th, sb);
-        let d = minus(p, x);
+        let d = sub(p, x);
         let g = dot(d, pt);
         let tt = dot(pt, pt);
         let h = tt + dot(d, ptt);
@@ -134,7 +125,7 @@ pub fn mobius_closest_parameters(points: &[f64], r: f64, w: f64, iterations: usi
             // the interior candidate counts only inside the band; then the boundaries, in order
             let candidates = [(ti, si, si.abs() <= w), (boundary(r, x, th0, -w, iterations), -w, true), (boundary(r, x, th0, w, iterations), w, true)];
             for (th, sv, ok) in candidates {
-                let q = minus(mobius_point(r, th, sv), x);
+                let q = sub(mobius_point(r, th, sv), x);
                 let d = dot(q, q).sqrt();
                 if ok && d < best.0 {
                     best = (d, th, sv);
@@ -160,7 +151,7 @@ mod tests {
             let th = 2.0 * std::f64::consts::PI * i as f64 / nt as f64;
             for j in 0..=ns {
                 let s = -w + 2.0 * w * j as f64 / ns as f64;
-                let q = minus(mobius_point(r, th, s), x);
+                let q = sub(mobius_point(r, th, s), x);
                 let d = dot(q, q);
                 if d < best.0 {
                     best = (d, th, s);
@@ -174,7 +165,7 @@ mod tests {
             for a in -2..=2 {
                 for c in -2..=2 {
                     let (th, s) = (t0 + 0.5 * a as f64 * dt, (s0 + 0.5 * c as f64 * ds).clamp(-w, w));
-                    let q = minus(mobius_point(r, th, s), x);
+                    let q = sub(mobius_point(r, th, s), x);
                     let d = dot(q, q);
                     if d < b.0 {
                         b = (d, th, s);
@@ -214,7 +205,7 @@ mod tests {
         for i in 0..m {
             let x = [points[3 * i], points[3 * i + 1], points[3 * i + 2]];
             assert!(s[i].abs() <= w, "point {x:?}: s = {} outside the band", s[i]);
-            let q = minus(mobius_point(r, th[i], s[i]), x);
+            let q = sub(mobius_point(r, th[i], s[i]), x);
             let d = dot(q, q).sqrt();
             let exact = brute_force_distance(r, w, x);
             assert!((d - exact).abs() < 1e-9, "point {x:?}: distance {d} against {exact} by brute force");

@@ -76,6 +76,28 @@ fn c_slice_mut<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(a: &'a mut n
     Ok(a.as_slice_mut()?)
 }
 
+/// The points (M, `d`) of a query as a C-ordered slice; a wrong shape names the one it needs.
+fn points_slice<'a>(points: &'a PyReadonlyArray2<'_, f64>, d: usize) -> PyResult<&'a [f64]> {
+    if points.shape()[1] != d {
+        return Err(PyValueError::new_err(format!("points must have shape (M, {d}); got {:?}", points.shape())));
+    }
+    c_slice(points, "points")
+}
+
+/// φ of a library surface at the points (M, `d`): one value per point, computed by `phi` (a
+/// function of `tubesweep_core::analytic`) without the GIL.
+fn phi_at_points<'py>(
+    py: Python<'py>,
+    points: &PyReadonlyArray2<'py, f64>,
+    d: usize,
+    phi: impl FnOnce(&[f64], &mut [f64]) -> tubesweep_core::Result<()> + Send,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let p = points_slice(points, d)?;
+    let mut out = vec![0.0; points.shape()[0]];
+    py.detach(|| phi(p, &mut out)).map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
 /// Node roles as the core's enum, without copying: validates that every byte is a role.
 fn node_roles(roles: &[u8]) -> PyResult<&[NodeRole]> {
     if let Some(&bad) = roles.iter().find(|&&r| NodeRole::from_u8(r).is_none()) {
@@ -935,38 +957,23 @@ fn sphere_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f6
     if points.shape()[1] != centre.len() {
         return Err(PyValueError::new_err(format!("points must have shape (M, {}) like the centre; got {:?}", centre.len(), points.shape())));
     }
-    let p = c_slice(&points, "points")?;
-    let mut out = vec![0.0; points.shape()[0]];
-    py.detach(|| tubesweep_core::analytic::sphere_signed_distance(p, &centre, radius, &mut out)).map_err(to_pyerr)?;
-    Ok(out.into_pyarray(py))
+    phi_at_points(py, &points, centre.len(), |p, out| tubesweep_core::analytic::sphere_signed_distance(p, &centre, radius, out))
 }
 
 /// `hypot(hypot(q_x, q_y) − R, q_z) − r` with `q = x − c` at the points (M, 3): the exact signed
 /// distance to a torus about the z axis. See `tubesweep_core::analytic::torus_signed_distance`.
 #[pyfunction]
 fn torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, major: f64, minor: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if points.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
-    }
     let c = coords_array::<3>(&centre, "centre")?;
-    let p = c_slice(&points, "points")?;
-    let mut out = vec![0.0; points.shape()[0]];
-    py.detach(|| tubesweep_core::analytic::torus_signed_distance(p, c, major, minor, &mut out)).map_err(to_pyerr)?;
-    Ok(out.into_pyarray(py))
+    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::torus_signed_distance(p, c, major, minor, out))
 }
 
 /// The exact signed distance to the ellipsoid with semi-axes `axes` about `centre` at the points
 /// (M, 3). See `tubesweep_core::analytic::ellipsoid_signed_distance`.
 #[pyfunction]
 fn ellipsoid_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, axes: Vec<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if points.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
-    }
     let (c, a) = (coords_array::<3>(&centre, "centre")?, coords_array::<3>(&axes, "axes")?);
-    let p = c_slice(&points, "points")?;
-    let mut out = vec![0.0; points.shape()[0]];
-    py.detach(|| tubesweep_core::analytic::ellipsoid_signed_distance(p, c, a, &mut out)).map_err(to_pyerr)?;
-    Ok(out.into_pyarray(py))
+    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::ellipsoid_signed_distance(p, c, a, out))
 }
 
 /// The parameters (θ, s) of the closest point on the Möbius band (centre radius `r`, half-width
@@ -980,10 +987,7 @@ fn mobius_closest_parameters<'py>(
     w: f64,
     iterations: usize,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
-    if points.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
-    }
-    let p = c_slice(&points, "points")?;
+    let p = points_slice(&points, 3)?;
     let m = points.shape()[0];
     let (mut theta, mut s) = (vec![0.0; m], vec![0.0; m]);
     py.detach(|| tubesweep_core::mobius::mobius_closest_parameters(p, r, w, iterations, &mut theta, &mut s)).map_err(to_pyerr)?;
@@ -995,40 +999,22 @@ fn mobius_closest_parameters<'py>(
 /// `tubesweep_core::analytic::rounded_cube_signed_distance`.
 #[pyfunction]
 fn rounded_cube_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, half_size: f64, radius: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if points.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
-    }
     let c = coords_array::<3>(&centre, "centre")?;
-    let p = c_slice(&points, "points")?;
-    let mut out = vec![0.0; points.shape()[0]];
-    py.detach(|| tubesweep_core::analytic::rounded_cube_signed_distance(p, c, half_size, radius, &mut out)).map_err(to_pyerr)?;
-    Ok(out.into_pyarray(py))
+    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::rounded_cube_signed_distance(p, c, half_size, radius, out))
 }
 
 /// φ = min of the two torus distances of the double torus at the points (M, 3). See
 /// `tubesweep_core::analytic::double_torus_signed_distance`.
 #[pyfunction]
 fn double_torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, major: f64, minor: f64, offset: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if points.shape()[1] != 3 {
-        return Err(PyValueError::new_err(format!("points must have shape (M, 3); got {:?}", points.shape())));
-    }
-    let p = c_slice(&points, "points")?;
-    let mut out = vec![0.0; points.shape()[0]];
-    py.detach(|| tubesweep_core::analytic::double_torus_signed_distance(p, major, minor, offset, &mut out)).map_err(to_pyerr)?;
-    Ok(out.into_pyarray(py))
+    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::double_torus_signed_distance(p, major, minor, offset, out))
 }
 
 /// The exact signed distance to the six-fold star r(θ) = r0 + eps sin²(3θ) at the points (M, 2).
 /// See `tubesweep_core::analytic::star_signed_distance`.
 #[pyfunction]
 fn star_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, r0: f64, eps: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if points.shape()[1] != 2 {
-        return Err(PyValueError::new_err(format!("points must have shape (M, 2); got {:?}", points.shape())));
-    }
-    let p = c_slice(&points, "points")?;
-    let mut out = vec![0.0; points.shape()[0]];
-    py.detach(|| tubesweep_core::analytic::star_signed_distance(p, r0, eps, &mut out)).map_err(to_pyerr)?;
-    Ok(out.into_pyarray(py))
+    phi_at_points(py, &points, 2, |p, out| tubesweep_core::analytic::star_signed_distance(p, r0, eps, out))
 }
 
 fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Option<&'a [i32]>> {

@@ -265,14 +265,9 @@ class MeshSurface(Surface):
             face = np.ascontiguousarray(self.face_normals[g])
             pseudo = None
             if self.signed:
-                f = self.faces[g]
-                table = np.empty((len(g), 7, 3))
-                table[:, FACE] = face
-                for k, vert in ((VERT_A, 0), (VERT_B, 1), (VERT_C, 2)):
-                    table[:, k] = self._vertex_normals[f[:, vert]]
-                for k, e in ((EDGE_AB, 0), (EDGE_AC, 1), (EDGE_BC, 2)):
-                    table[:, k] = self._edge_normals[self._edge_ids[g, e]]
-                pseudo = np.ascontiguousarray(table * self._flip)
+                # feature code k of every tree triangle, k = FACE … EDGE_BC
+                pseudo = np.ascontiguousarray(np.stack(
+                    [self._pseudonormal(g, np.full(len(g), k)) for k in range(EDGE_BC + 1)], axis=1))
             self._band_normals = (face, pseudo)
         return self._band_normals
 
