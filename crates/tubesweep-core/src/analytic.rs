@@ -167,8 +167,8 @@ pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3
     Ok(())
 }
 
-/// Most Newton steps [`ellipsoid_root`] takes. It stops far earlier: after at most 11 steps on
-/// 200,000 random points of [−1, 1]³ for the default `Ellipsoid(0.6, 0.45, 0.3)` (one-off count).
+/// Most Newton steps [`ellipsoid_root`] takes; it stops far earlier, the convergence being
+/// quadratic once near the root.
 /// The Python `Ellipsoid._newton_root` takes as many (keep the two equal: the same bits).
 pub const ELLIPSOID_NEWTON_STEPS: usize = 100;
 
