@@ -127,6 +127,12 @@ class Band:
     def interpolate(
         self, values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
     ) -> npt.NDArray[np.float64]: ...
+    def nearest_source_labels(
+        self,
+        values: npt.NDArray[np.float64],
+        fixed_positions: npt.NDArray[np.int64],
+        fixed_labels: npt.NDArray[np.int64],
+    ) -> npt.NDArray[np.int64]: ...
     def solve(
         self,
         roles: npt.NDArray[np.uint8],

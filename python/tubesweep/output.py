@@ -187,6 +187,8 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
         Further per-vertex arrays to write beside ``u``.
 
     ``u`` is :meth:`Solution.on_mesh` at the vertices (``inf`` where never reached becomes NaN).
+    With several sources, ``nearest_source`` (:meth:`Solution.nearest_source` at the vertices,
+    -1 where no front arrives) is written too.
     2D curves are written as line cells with z = 0.
     """
     path = Path(path)
@@ -197,6 +199,8 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
     u = sol.on_mesh(v)
     u = np.where(np.isfinite(u), u, np.nan)
     data: Dict[str, np.ndarray] = {"u": u}
+    if len(sol.sources) > 1:
+        data["nearest_source"] = sol.nearest_source(v).astype(float)
     for name, a in (point_data or {}).items():
         a = np.asarray(a, dtype=float)
         if a.shape[0] != len(v):
@@ -250,9 +254,21 @@ def _orientation(f: np.ndarray, v: np.ndarray) -> float:
     return 1.0 if vol >= 0 else -1.0
 
 
+def _nearest_face(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
+    """Index of the face whose centroid is nearest to each point (in chunks of points, so that
+    the distance table stays a few million entries)."""
+    chunk = max(1, 4_000_000 // max(len(centroids), 1))
+    out = np.empty(len(points), dtype=np.int64)
+    for lo in range(0, len(points), chunk):
+        p = points[lo : lo + chunk]
+        out[lo : lo + chunk] = np.argmin(((p[:, None, :] - centroids[None, :, :]) ** 2).sum(-1), axis=1)
+    return out
+
+
 def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, levels: Union[int, Sequence[float]] = 12,
          cmap: str = "viridis", views: Sequence[Tuple[float, float]] = ((20.0, -60.0), (20.0, 120.0)),
-         title: Optional[str] = None, sources: bool = True, colorbar: bool = True, up: str = "z") -> Any:
+         title: Optional[str] = None, sources: bool = True, colorbar: bool = True, up: str = "z",
+         paths: Optional[Sequence[Any]] = None) -> Any:
     """A picture of a solution: a matplotlib :class:`~matplotlib.figure.Figure`.
 
     2D: the band coloured by ``u``, iso-distance lines, the curve φ = 0 (white) and the sources
@@ -270,6 +286,9 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     cmap, title, sources, colorbar : as usual
     up : {"x", "y", "z"}
         The axis drawn vertically in 3D (many mesh files, the bunny and spot among them, are "y").
+    paths : sequence of (P, d) arrays, optional
+        Polylines drawn in red over the surface, e.g. :meth:`Solution.geodesic_paths` (in 3D a
+        segment on the far side of an oriented surface is drawn faint).
 
     Returns the Figure (``fig.savefig("u.png")`` to save; it displays inline in notebooks).
     """
@@ -279,6 +298,10 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     from matplotlib.ticker import MaxNLocator
 
     grid = sol.grid
+    lines = [np.asarray(q, dtype=float) for q in (paths or [])]
+    for i, q in enumerate(lines):
+        if q.ndim != 2 or q.shape[1] != grid.ndim or len(q) < 1:
+            raise ValueError(f"paths[{i}] must be an array of shape (P, {grid.ndim}); got shape {q.shape}")
     finite = sol.values[np.isfinite(sol.values)]
     umax = float(finite.max()) if finite.size else 1.0
     lv = np.asarray(MaxNLocator(int(levels) + 1).tick_values(0.0, umax) if np.ndim(levels) == 0 else levels, dtype=float)
@@ -302,6 +325,8 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
             ax.contour(X, Y, phi.reshape(grid.shape), levels=[0.0], colors="w", linewidths=1.0)
         if lv.size:
             ax.contour(X, Y, dense, levels=lv, colors="k", linewidths=0.5)
+        for q in lines:
+            ax.plot(q[:, 0], q[:, 1], "r-", lw=1.5)
         if sources:
             ax.plot(sol.sources[:, 0], sol.sources[:, 1], "r*", ms=13, mec="k", mew=0.5)
         ax.set_aspect("equal")
@@ -336,6 +361,7 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     seg_all = np.concatenate([s for s, _ in iso]) if iso else np.zeros((0, 2, 3))
     seg_face = np.concatenate([t for _, t in iso]) if iso else np.zeros(0, np.int64)
     orient = _orientation(f, v)
+    centroids = tri.mean(1)
     if ax is not None:
         axes = [ax]
         fig = ax.figure
@@ -357,9 +383,18 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
         seen = (n[seg_face] @ eye) * orient > 0 if orient != 0 else np.ones(len(seg_face), bool)
         if np.any(seen):
             a.add_collection3d(Line3DCollection(seg_all[seen], colors="k", linewidths=0.6, zorder=2))
+        for q in lines:
+            if len(q) < 2:
+                continue
+            seg = np.stack([q[:-1], q[1:]], axis=1)[:, :, perm]
+            near = _nearest_face(seg.mean(1), centroids)
+            front = (n[near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(near), bool)
+            for sel, alpha in ((front, 1.0), (~front, 0.3)):
+                if np.any(sel):
+                    a.add_collection3d(Line3DCollection(seg[sel], colors="r", linewidths=1.6, alpha=alpha, zorder=3))
         if sources:
             # a source on the far side of an oriented mesh is drawn faint
-            near = np.argmin(((src[:, None, :] - tri.mean(1)[None, :, :]) ** 2).sum(-1), axis=1)
+            near = _nearest_face(src, centroids)
             front = (n[near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(near), bool)
             for sel, alpha in ((front, 1.0), (~front, 0.3)):
                 if np.any(sel):

@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 import time
 import warnings
-from typing import Any, Callable, Optional, Tuple
+from typing import Any, Callable, List, Optional, Tuple
 
 import numpy as np
 
@@ -66,7 +66,8 @@ class Solution:
 
     def __init__(self, grid: Grid, band: Any, values: np.ndarray, roles: np.ndarray,
                  phi: np.ndarray, stats: SolveStats, sources: np.ndarray, surface: Surface,
-                 hamiltonian: str, method: str, inner: float, outer: float):
+                 hamiltonian: str, method: str, inner: float, outer: float,
+                 fixed: Tuple[np.ndarray, np.ndarray], isotropic: bool):
         self.grid = grid
         self._band = band
         self.values = values
@@ -79,6 +80,10 @@ class Solution:
         self.method = method
         self.inner = inner
         self.outer = outer
+        # the nodes fixed by the sources (band positions) and the source of each
+        self._fixed = fixed
+        self._isotropic = isotropic
+        self._labels: Optional[np.ndarray] = None
 
     def __repr__(self) -> str:
         s = self.stats
@@ -123,27 +128,76 @@ class Solution:
         out = self(p)
         bad = np.flatnonzero(~np.isfinite(out))
         if bad.size:
-            d = self.grid.ndim
-            r = int(np.ceil(self.outer)) + 1
-            offs = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
-            offs = offs[np.argsort((offs * offs).sum(1), kind="stable")]
-            ci = self.grid.continuous_index(p[bad])
-            base = np.rint(ci).astype(np.int64)
-            best = np.full(bad.size, np.nan)
-            best_d = np.full(bad.size, np.inf)
-            for o in offs:
-                idx = base + o
-                pos = self._band.find(np.ascontiguousarray(idx))
-                ok = pos >= 0
-                if not np.any(ok):
-                    continue
-                vals = np.where(ok, self.values[np.maximum(pos, 0)], np.inf)
-                dist = np.linalg.norm(idx - ci, axis=1)
-                take = ok & np.isfinite(vals) & (dist < best_d) & (dist <= self.outer + 1)
-                best[take] = vals[take]
-                best_d[take] = dist[take]
-            out[bad] = best
+            pos = self._nearest_reached(p[bad])
+            out[bad] = np.where(pos >= 0, self.values[np.maximum(pos, 0)], np.nan)
         return out
+
+    def _nearest_reached(self, p: np.ndarray) -> np.ndarray:
+        """Band position (M,) of the reached band node nearest to each point within ``outer + 1``
+        grid spacings of it, -1 where there is none."""
+        d = self.grid.ndim
+        r = int(np.ceil(self.outer)) + 1
+        offs = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+        offs = offs[np.argsort((offs * offs).sum(1), kind="stable")]
+        ci = self.grid.continuous_index(p)
+        base = np.rint(ci).astype(np.int64)
+        best = np.full(len(p), -1, dtype=np.int64)
+        best_d = np.full(len(p), np.inf)
+        for o in offs:
+            idx = base + o
+            pos = self._band.find(np.ascontiguousarray(idx))
+            ok = pos >= 0
+            if not np.any(ok):
+                continue
+            vals = np.where(ok, self.values[np.maximum(pos, 0)], np.inf)
+            dist = np.linalg.norm(idx - ci, axis=1)
+            take = ok & np.isfinite(vals) & (dist < best_d) & (dist <= self.outer + 1)
+            best[take] = pos[take]
+            best_d[take] = dist[take]
+        return best
+
+    def nearest_source(self, points: Any = None) -> np.ndarray:
+        """Which source reaches each place first: indices into :attr:`sources`, -1 where no front
+        arrives (another component of the surface).
+
+        Without ``points``, one label per band node (aligned with :attr:`values`); with
+        ``points`` (M, d), e.g. the vertices of a mesh of the surface, the label of the nearest
+        reached band node within ``outer`` grid spacings of each point (-1 where there is none).
+        For speed 1 the labels partition the surface into the geodesic Voronoi cells of the
+        sources. They are recovered from the solved values (``tubesweep_core::nearest_source``:
+        each node takes the label of its smallest, earlier-reached neighbour) and are first-order
+        accurate like the values: nodes within about a grid spacing of a cell boundary may take the
+        neighbouring cell's label.
+        """
+        if self._labels is None:
+            positions, sources = self._fixed
+            self._labels = self._band.nearest_source_labels(
+                np.ascontiguousarray(self.values, dtype=float), np.ascontiguousarray(positions, dtype=np.int64),
+                np.ascontiguousarray(sources, dtype=np.int64))
+        labels: np.ndarray = self._labels
+        if points is None:
+            return labels.copy()
+        p = as_points(points, self.grid.ndim, "points")
+        pos = self._nearest_reached(p)
+        return np.where(pos >= 0, labels[np.maximum(pos, 0)], -1)
+
+    def geodesic_path(self, start: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> np.ndarray:
+        """The shortest path on the surface from ``start`` (a point on it) to the source whose front
+        reaches it first, as a polyline (P, d) from the start to that source.
+
+        Traced backwards along the characteristics: steps of ``step`` grid spacings against the
+        gradient of the solution, each projected back onto the surface (see
+        :mod:`tubesweep.geodesic_paths`). For speed F(x) it is the path of least travel time.
+        Only for isotropic Hamiltonians (``"godunov"``, ``"lxf"``, ``Isotropic()``): under a
+        moving medium or a metric the fastest path does not run against ∇u.
+        """
+        return self.geodesic_paths(np.atleast_2d(np.asarray(start, dtype=float)), step=step, max_steps=max_steps)[0]
+
+    def geodesic_paths(self, starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
+        """:meth:`geodesic_path` from each of the points ``starts`` (M, d), traced together."""
+        from .geodesic_paths import trace_paths
+
+        return trace_paths(self, starts, step=step, max_steps=max_steps)
 
     def to_dense(self, fill: float = np.nan) -> np.ndarray:
         """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
@@ -166,8 +220,9 @@ def _tube_roles(geom: BandGeometry, inner_width: float, method: str) -> np.ndarr
 
 def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, sources: np.ndarray,
                  slowness_at: Callable[[np.ndarray], np.ndarray], source_init: str, inner_width: float
-                 ) -> Tuple[np.ndarray, np.ndarray]:
-    """Positions in the band and values of the nodes fixed by the point sources."""
+                 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions in the band and values of the nodes fixed by the point sources, and the index of
+    the source each node's value comes from (the nearest, where several sources fix one node)."""
     h = grid.spacing
     d = grid.ndim
     dist, proj = surface.project(sources, grid)
@@ -189,7 +244,8 @@ def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, ro
                     f"sources[{i}]: the grid node nearest to the source is not in the inner tube; "
                     "move the source onto the surface, refine the grid or increase `inner`"
                 )
-            best[pos] = 0.0
+            if pos not in best or best[pos][0] > 0.0:
+                best[pos] = (0.0, i)
             continue
         idx = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64) + offsets
         pos = band.find(np.ascontiguousarray(idx))
@@ -206,11 +262,12 @@ def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, ro
             near = geo <= geo.min()
         slow = 0.5 * (slowness_at(cp[near]) + slowness_at(sp[None])[0])
         for p, v in zip(pos[near], geo[near] * slow):
-            if p not in best or v < best[p]:
-                best[p] = v
+            if p not in best or v < best[p][0]:
+                best[p] = (v, i)
     positions = np.fromiter(best.keys(), dtype=np.int64, count=len(best))
-    values = np.fromiter(best.values(), dtype=float, count=len(best))
-    return positions, values
+    values = np.fromiter((v for v, _ in best.values()), dtype=float, count=len(best))
+    labels = np.fromiter((k for _, k in best.values()), dtype=np.int64, count=len(best))
+    return positions, values, labels
 
 
 def solve(
@@ -446,7 +503,7 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
 
         return 1.0 / _interp_dense(np.asarray(speed, dtype=float), grid, p)
 
-    positions, fixed_vals = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
+    positions, fixed_vals, fixed_sources = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
     del x
     method = tube.method
@@ -493,4 +550,4 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         window_edge=st["window_edge"],
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
-                    tube.inner, tube.outer_eff)
+                    tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic")

@@ -22,6 +22,7 @@
 //! | the longest grid path from the sources (numerical infinity, front window) | [`grid_hops`] | — |
 //! | the Gauss–Seidel sweeping driver | [`sweep`] | Algorithms 1, 2 and 3 |
 //! | multilinear interpolation in the band | [`interpolate`] | — |
+//! | which source reaches each node first (nearest-source labels) | [`nearest_source`] | — |
 //! | exact closest points on triangle meshes (AABB tree) | [`mesh`] | Sect. 5.2 |
 //!
 //! Grids are uniform with spacing `h` in every axis; node `(i, j[, k])` sits at
@@ -43,6 +44,7 @@ pub mod lax_friedrichs;
 pub mod mesh;
 pub mod mesh_band;
 pub mod mobius;
+pub mod nearest_source;
 pub mod normals;
 pub mod redistance;
 pub mod rim;

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
 use tubesweep_core::interpolate::interpolate;
+use tubesweep_core::nearest_source::nearest_source_labels;
 use tubesweep_core::sweep::{extension_weights_in_place, Extension, MissingNeighbour, Slowness};
 use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
 use tubesweep_core::{Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
@@ -551,6 +552,33 @@ impl PyBand {
             AnyBand::D2(b) => interpolate(b, vals, [lower[0], lower[1]], spacing, pts),
             AnyBand::D3(b) => interpolate(b, vals, [lower[0], lower[1], lower[2]], spacing, pts),
         });
+        Ok(out.into_pyarray(py))
+    }
+
+    /// The label of the source whose front reaches each band node first (see
+    /// `tubesweep_core::nearest_source`): `values` one per band node, the fixed nodes' band
+    /// positions and the source each was fixed from; -1 where no front arrives.
+    fn nearest_source_labels<'py>(
+        &self,
+        py: Python<'py>,
+        values: PyReadonlyArray1<'py, f64>,
+        fixed_positions: PyReadonlyArray1<'py, i64>,
+        fixed_labels: PyReadonlyArray1<'py, i64>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let vals = c_slice(&values, "values")?;
+        let to_u32 = |a: &PyReadonlyArray1<'py, i64>, name: &str| -> PyResult<Vec<u32>> {
+            c_slice(a, name)?
+                .iter()
+                .map(|&v| u32::try_from(v).map_err(|_| PyValueError::new_err(format!("{name}: {v} is not a valid index"))))
+                .collect()
+        };
+        let fixed = to_u32(&fixed_positions, "fixed_positions")?;
+        let labels = to_u32(&fixed_labels, "fixed_labels")?;
+        let out = py.detach(|| match &self.band {
+            AnyBand::D2(b) => nearest_source_labels(b, vals, &fixed, &labels),
+            AnyBand::D3(b) => nearest_source_labels(b, vals, &fixed, &labels),
+        })
+        .map_err(to_pyerr)?;
         Ok(out.into_pyarray(py))
     }
 

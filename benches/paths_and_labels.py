@@ -1,0 +1,82 @@
+"""Geodesic paths and nearest-source labels, measured on the sphere against great circles.
+
+For the sphere of radius 0.5 in [−1, 1]³ (N nodes per side) with one source at (−0.5, 0, 0),
+40 random starts at least 0.3 from the antipode (the cut locus): the error of the paths'
+lengths against the great-circle distance, their largest distance from the great circle's
+plane, and the time of tracing all 40 together. Then four sources: the share of band nodes
+whose label differs from the nearest source along great circles, among the nodes more than two
+grid spacings from a cell boundary and among the rest, and the time of the labels.
+These are the figures of docs/paths-and-labels.md::
+
+    .venv/bin/python benches/paths_and_labels.py            # N = 41, 81, 161, 321
+    .venv/bin/python benches/paths_and_labels.py 41 81
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+import tubesweep as ts
+
+R = 0.5
+
+
+def starts(m: int, src: np.ndarray, seed: int = 1) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < m:
+        p = rng.normal(size=3)
+        p *= R / np.linalg.norm(p)
+        if R * np.arccos(np.clip(p @ src / R**2, -1, 1)) < np.pi * R - 0.3:
+            out.append(p)
+    return np.array(out)
+
+
+def main(sizes: list) -> int:
+    src = np.array([-R, 0.0, 0.0])
+    print("paths: sphere r = 0.5, source (-0.5, 0, 0), 40 starts at least 0.3 from the antipode")
+    print("| N | h | length error max | max / h | off the great circle: median | max | trace 40 paths |")
+    print("|---|---|---|---|---|---|---|")
+    for n in sizes:
+        g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
+        h = g.spacing
+        sol = ts.solve(ts.surfaces.Sphere(R), g, [src])
+        st = starts(40, src)
+        t = time.perf_counter()
+        paths = sol.geodesic_paths(st)
+        took = time.perf_counter() - t
+        err, off = [], []
+        for s0, p in zip(st, paths):
+            exact = R * np.arccos(np.clip(src @ s0 / R**2, -1, 1))
+            err.append(abs(np.linalg.norm(np.diff(p, axis=0), axis=1).sum() - exact))
+            nrm = np.cross(s0, src)
+            off.append(np.max(np.abs(p @ (nrm / np.linalg.norm(nrm)))))
+        print(f"| {n} | {h:.4g} | {max(err):.2e} | {max(err) / h:.2f} | {np.median(off):.2e} | {max(off):.2e} | "
+              f"{1e3 * took:.0f} ms |")
+    sources = np.array([[R, 0, 0], [-R, 0, 0], [0, 0, R], [0, -R * 0.6, -R * 0.8]])
+    print()
+    print("labels: the same sphere, four sources; label differs from the nearest source along great circles")
+    print("| N | band nodes | > 2h from a cell boundary | within 2h | labels |")
+    print("|---|---|---|---|---|")
+    for n in sizes:
+        g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
+        sol = ts.solve(ts.surfaces.Sphere(R), g, sources)
+        t = time.perf_counter()
+        lab = sol.nearest_source()
+        took = time.perf_counter() - t
+        x = sol.points
+        cp = R * x / np.linalg.norm(x, axis=1)[:, None]
+        geo = R * np.arccos(np.clip(cp @ sources.T / R**2, -1, 1))
+        srt = np.sort(geo, axis=1)
+        away = srt[:, 1] - srt[:, 0] > 2 * g.spacing
+        wrong = lab != np.argmin(geo, axis=1)
+        print(f"| {n} | {len(lab):,} | {wrong[away].sum()} of {away.sum():,} | {wrong[~away].sum():,} of "
+              f"{(~away).sum():,} ({100 * wrong[~away].mean():.0f}%) | {1e3 * took:.1f} ms |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main([int(a) for a in sys.argv[1:]] or [41, 81, 161, 321]))

@@ -1,0 +1,79 @@
+"""Nearest-source labels (Solution.nearest_source; tubesweep_core::nearest_source)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.output import read_vtp
+
+R = 0.5
+
+
+def _exact_sphere_labels(points, sources):
+    """The nearest source along great circles, and the margin to the second nearest."""
+    cp = R * points / np.linalg.norm(points, axis=1)[:, None]
+    geo = R * np.arccos(np.clip(cp @ sources.T / R**2, -1, 1))
+    order = np.sort(geo, axis=1)
+    return np.argmin(geo, axis=1), order[:, 1] - order[:, 0]
+
+
+@pytest.mark.parametrize("hamiltonian", ["godunov", "lxf"])
+def test_labels_on_a_sphere_are_the_geodesic_voronoi_cells(hamiltonian):
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61))
+    sources = np.array([[R, 0, 0], [-R, 0, 0], [0, 0, R], [0, -R * 0.6, -R * 0.8]])
+    sol = ts.solve(ts.surfaces.Sphere(R), g, sources, hamiltonian=hamiltonian)
+    labels = sol.nearest_source()
+    assert labels.shape == sol.values.shape and labels.dtype == np.int64
+    assert np.all(labels >= 0)  # one component, every node reached
+    exact, margin = _exact_sphere_labels(sol.points, sources)
+    away = margin > 2 * g.spacing
+    assert away.mean() > 0.8
+    assert np.array_equal(labels[away], exact[away])
+    # near the cells' boundaries, about one spacing either side, either label
+    assert np.mean(labels[~away] == exact[~away]) > 0.7
+    # every source's own nodes carry its label
+    for k, s in enumerate(sources):
+        near = np.linalg.norm(sol.points - s, axis=1) < 1.5 * g.spacing
+        assert np.all(labels[near] == k)
+    # the labels are computed once and handed out as copies
+    labels[:] = -5
+    assert np.all(sol.nearest_source() >= 0)
+
+
+def test_labels_at_points_and_on_a_component_no_source_reaches():
+    g = ts.Grid((-1, -1), (1, 1), (161, 161))
+    two = ts.LevelSet(lambda p: np.minimum(np.linalg.norm(p - (0.45, 0), axis=1), np.linalg.norm(p + (0.45, 0), axis=1)) - 0.3)
+    sol = ts.solve(two, g, [(0.75, 0.0), (0.15, 0.0)])
+    t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    right = np.column_stack([0.45 + 0.3 * np.cos(t), 0.3 * np.sin(t)])
+    left = right - (0.9, 0.0)
+    lab = sol.nearest_source(right)
+    # the cells meet where the angle from the centre is ±π/2
+    clear = np.abs(np.abs(np.cos(t))) > 0.1
+    assert np.array_equal(lab[clear], np.where(np.cos(t[clear]) > 0, 0, 1))
+    assert np.all(sol.nearest_source(left) == -1)
+    band = sol.nearest_source()
+    assert np.all(band[~np.isfinite(sol.values)] == -1) and np.all(band[np.isfinite(sol.values)] >= 0)
+    # far from the band: no label
+    assert sol.nearest_source([(0.0, 0.95)])[0] == -1
+    with pytest.raises(ValueError, match="points must have shape"):
+        sol.nearest_source([(0.0, 0.0, 0.0)])
+
+
+def test_labels_follow_the_sources_order_on_a_tube_and_reach_the_export(tmp_path):
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    tube = ts.Tube(ts.surfaces.Sphere(R), g)
+    a = tube.solve([(R, 0, 0), (-R, 0, 0)])
+    b = tube.solve([(-R, 0, 0), (R, 0, 0)])
+    la, lb = a.nearest_source(), b.nearest_source()
+    x = a.points[:, 0]
+    clear = np.abs(x) > 2 * g.spacing
+    assert np.array_equal(la[clear], np.where(x[clear] > 0, 0, 1))
+    assert np.array_equal(lb[clear], 1 - la[clear])
+    path = ts.export(a, tmp_path / "two.vtp")
+    pts, _, data = read_vtp(path)
+    assert np.array_equal(data["nearest_source"], a.nearest_source(pts).astype(float))
+    one = ts.export(tube.solve([(R, 0, 0)]), tmp_path / "one.vtp")
+    assert "nearest_source" not in read_vtp(one)[2]
