@@ -2,11 +2,14 @@
 
 For the sphere of radius 0.5 in [−1, 1]³ (N nodes per side) with one source at (−0.5, 0, 0),
 40 random starts at least 0.3 from the antipode (the cut locus): the error of the paths'
-lengths against the great-circle distance, their largest distance from the great circle's
+lengths against the great-circle distance (and that of ``u`` at the starts), their largest distance from the great circle's
 plane, and the time of tracing all 40 together. Then four sources: the share of band nodes
 whose label differs from the nearest source along great circles, among the nodes more than two
-grid spacings from a cell boundary and among the rest, and the time of the labels.
-These are the figures of docs/paths-and-labels.md::
+grid spacings from a cell boundary and among the rest, and the time of the labels. Last, on
+the Stanford bunny (``../shared/data``, grid ``surface.grid(n)``) from vertex 0 to 8 random
+vertices: the paths' lengths and ``u`` against the exact polyhedral geodesic distances
+(pygeodesic, MMP; skipped without it or the data). These are the figures of
+docs/paths-and-labels.md::
 
     .venv/bin/python benches/paths_and_labels.py            # N = 41, 81, 161, 321
     .venv/bin/python benches/paths_and_labels.py 41 81
@@ -38,8 +41,9 @@ def starts(m: int, src: np.ndarray, seed: int = 1) -> np.ndarray:
 def main(sizes: list) -> int:
     src = np.array([-R, 0.0, 0.0])
     print("paths: sphere r = 0.5, source (-0.5, 0, 0), 40 starts at least 0.3 from the antipode")
-    print("| N | h | length error max | max / h | off the great circle: median | max | trace 40 paths |")
-    print("|---|---|---|---|---|---|---|")
+    print("| N | h | length error max | max / h | u error at the starts, max / h | off the great circle: median | max "
+          "| trace 40 paths |")
+    print("|---|---|---|---|---|---|---|---|")
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
         h = g.spacing
@@ -48,13 +52,15 @@ def main(sizes: list) -> int:
         t = time.perf_counter()
         paths = sol.geodesic_paths(st)
         took = time.perf_counter() - t
-        err, off = [], []
+        err, off, uerr = [], [], []
         for s0, p in zip(st, paths):
             exact = R * np.arccos(np.clip(src @ s0 / R**2, -1, 1))
             err.append(abs(np.linalg.norm(np.diff(p, axis=0), axis=1).sum() - exact))
+            uerr.append(abs(sol(s0[None])[0] - exact))
             nrm = np.cross(s0, src)
             off.append(np.max(np.abs(p @ (nrm / np.linalg.norm(nrm)))))
-        print(f"| {n} | {h:.4g} | {max(err):.2e} | {max(err) / h:.2f} | {np.median(off):.2e} | {max(off):.2e} | "
+        print(f"| {n} | {h:.4g} | {max(err):.2e} | {max(err) / h:.2f} | {max(uerr) / h:.2f} | {np.median(off):.2e} | "
+              f"{max(off):.2e} | "
               f"{1e3 * took:.0f} ms |")
     sources = np.array([[R, 0, 0], [-R, 0, 0], [0, 0, R], [0, -R * 0.6, -R * 0.8]])
     print()
@@ -75,7 +81,39 @@ def main(sizes: list) -> int:
         wrong = lab != np.argmin(geo, axis=1)
         print(f"| {n} | {len(lab):,} | {wrong[away].sum()} of {away.sum():,} | {wrong[~away].sum():,} of "
               f"{(~away).sum():,} ({100 * wrong[~away].mean():.0f}%) | {1e3 * took:.1f} ms |")
+    bunny_rows(sizes)
     return 0
+
+
+def bunny_rows(sizes: list) -> None:
+    from pathlib import Path
+
+    mesh_file = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "stanford-bunny.obj"
+    try:
+        import pygeodesic.geodesic as geodesic
+    except ImportError:
+        print("\nbunny: skipped (pip install pygeodesic)")
+        return
+    if not mesh_file.exists():
+        print(f"\nbunny: skipped ({mesh_file} not found)")
+        return
+    bunny = ts.surfaces.from_mesh(mesh_file)
+    v = bunny.vertices
+    targets = np.random.default_rng(0).choice(len(v), 8, replace=False)
+    exact = np.array([geodesic.PyGeodesicAlgorithmExact(v, bunny.faces).geodesicDistance(0, int(t))[0] for t in targets])
+    print()
+    print("bunny: from vertex 0 to 8 random vertices, against exact polyhedral geodesics (MMP); errors in h")
+    print("| N | h | path length error: mean | max | u error: mean | max |")
+    print("|---|---|---|---|---|---|")
+    for n in sizes:
+        if n > 201:
+            continue
+        g = bunny.grid(n)
+        sol = ts.solve(bunny, g, [v[0]])
+        lengths = np.array([np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in sol.geodesic_paths(v[targets])])
+        u = sol.on_mesh(v[targets])
+        el, eu = np.abs(lengths - exact) / g.spacing, np.abs(u - exact) / g.spacing
+        print(f"| {n} | {g.spacing:.3g} | {el.mean():.2f} | {el.max():.2f} | {eu.mean():.2f} | {eu.max():.2f} |")
 
 
 if __name__ == "__main__":

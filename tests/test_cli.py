@@ -74,3 +74,24 @@ def test_demo_quick(tmp_path, capsys):
     assert "sphere" in out and "star" in out
     for name in ("sphere.png", "star.png", "layered.png"):
         assert (tmp_path / name).stat().st_size > 10_000
+
+
+def test_solve_traces_paths_and_labels_cells(tmp_path, capsys):
+    args = ["solve", "--surface", "sphere", "--n", "61", "--source", "0.5", "0", "0", "--source", "-0.5", "0", "0",
+            "--path-from", "0", "0.5", "0", "--path-from", "0.3", "0", "0.4", "--out", str(tmp_path), "--quiet"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "path 1 from (0.3, 0.0, 0.4): length" in out and "to source 0" in out
+    paths = np.load(tmp_path / "paths.npz")
+    assert sorted(paths.keys()) == ["path_0", "path_1"]
+    assert np.array_equal(paths["path_1"][-1], [0.5, 0.0, 0.0])
+    # the quarter circle from (0, 0.5, 0): π/4 to either source
+    assert np.linalg.norm(np.diff(paths["path_0"], axis=0), axis=1).sum() == pytest.approx(np.pi / 4, abs=0.01)
+    data = np.load(tmp_path / "solution.npz")
+    x = -1 + (2 / 60) * data["indices"][:, 0]
+    clear = np.abs(x) > 0.1
+    assert np.array_equal(data["nearest_source"][clear], np.where(x[clear] > 0, 0, 1))
+    with pytest.raises(SystemExit, match="needs --mesh"):
+        main(["solve", "--surface", "sphere", "--n", "41", "--path-from-vertex", "3", "--out", str(tmp_path), "--quiet"])
+    with pytest.raises(SystemExit, match="3 coordinates"):
+        main(["solve", "--surface", "sphere", "--n", "41", "--path-from", "0", "0.5", "--out", str(tmp_path), "--quiet"])

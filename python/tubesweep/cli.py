@@ -10,7 +10,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
-from typing import List, Optional, Sequence
+from typing import Any, List, Optional, Sequence
 
 import numpy as np
 
@@ -89,6 +89,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "as in most mesh files, z otherwise)")
     p.add_argument("--export", type=Path, action="append", metavar="FILE",
                    help="write the surface mesh with u as point data for ParaView: .vtu .vtp .vtk .ply (repeatable)")
+    p.add_argument("--path-from", type=float, nargs="+", action="append", metavar="X",
+                   help="trace the geodesic path from this point of the surface to its nearest source (repeatable); "
+                   "writes paths.npz, prints each length and draws the paths in --png")
+    p.add_argument("--path-from-vertex", type=int, action="append", metavar="I",
+                   help="--mesh: trace the geodesic path from vertex I (repeatable)")
     _add_solver_options(p)
 
     t = sub.add_parser("travel-time", help="first-arrival time in the whole box (Algorithm 1)",
@@ -132,6 +137,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
     if args.source_vertex and not args.mesh:
         raise SystemExit("--source-vertex needs --mesh")
+    if args.path_from_vertex and not args.mesh:
+        raise SystemExit("--path-from-vertex needs --mesh")
     if args.mesh:
         from .surfaces.mesh import from_mesh
 
@@ -181,8 +188,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
+    labels = {"nearest_source": sol.nearest_source()} if len(sol.sources) > 1 else {}
     np.savez_compressed(out / "solution.npz", indices=sol.indices, values=sol.values, roles=sol.roles, phi=sol.phi,
-                        lower=grid.lower, upper=grid.upper, shape=np.array(grid.shape), sources=sol.sources)
+                        lower=grid.lower, upper=grid.upper, shape=np.array(grid.shape), sources=sol.sources, **labels)
     s = sol.stats
     print(f"{name}: grid {grid.shape}, band {s.band_points} nodes ({s.inner_points} inner, {s.outer_points} outer), "
           f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, solve {s.seconds:.3f} s, total {wall:.3f} s")
@@ -195,14 +203,43 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
         t1 = time.perf_counter()
         print(f"wrote {export(sol, path)} ({time.perf_counter() - t1:.2f} s)")
+    paths = _trace_paths(args, surface, sol, out)
     if args.png:
         from .output import plot
 
         up = args.up or ("y" if args.mesh else "z")
-        fig = plot(sol, up=up, title=f"{name}, {args.hamiltonian}, grid {'x'.join(map(str, grid.shape))}")
+        fig = plot(sol, up=up, title=f"{name}, {args.hamiltonian}, grid {'x'.join(map(str, grid.shape))}", paths=paths)
         fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
         print(f"wrote {out / 'solution.png'}")
     return 0
+
+
+def _trace_paths(args: argparse.Namespace, surface: Any, sol: Any, out: Path) -> list:
+    """The geodesic paths of --path-from / --path-from-vertex: printed, written to paths.npz."""
+    starts = [np.array(p, dtype=float) for p in args.path_from or []]
+    for i in args.path_from_vertex or []:
+        nv = len(surface.vertices)
+        if not 0 <= i < nv:
+            raise SystemExit(f"--path-from-vertex {i}: the mesh has vertices 0..{nv - 1}")
+        starts.append(surface.vertices[i])
+    if not starts:
+        return []
+    d = sol.grid.ndim
+    bad = [len(p) for p in starts if len(p) != d]
+    if bad:
+        raise SystemExit(f"--path-from needs {d} coordinates on a {d}D grid; got {bad[0]}")
+    from .geodesic_paths import _onto_surface
+
+    paths = sol.geodesic_paths(np.array(starts))
+    ends = _onto_surface(sol, np.asarray(sol.sources, dtype=float))  # where a finished path ends
+    for k, (p0, path) in enumerate(zip(starts, paths)):
+        length = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+        hit = np.flatnonzero(np.all(ends == path[-1], axis=1))
+        where = f"to source {int(hit[0])}" if hit.size else "stopped short of the sources (see the warning)"
+        print(f"path {k} from {tuple(round(float(v), 6) for v in p0)}: length {length:.6g} {where}, {len(path)} points")
+    np.savez_compressed(out / "paths.npz", **{f"path_{k}": p for k, p in enumerate(paths)})
+    print(f"wrote {out / 'paths.npz'}")
+    return paths
 
 
 def cmd_travel_time(args: argparse.Namespace) -> int:
