@@ -5,7 +5,8 @@ For the sphere of radius 0.5 in [−1, 1]³ (N nodes per side) with one source a
 lengths against the great-circle distance (and that of ``u`` at the starts), their largest distance from the great circle's
 plane, and the time of tracing all 40 together. Then four sources: the share of band nodes
 whose label differs from the nearest source along great circles, among the nodes more than two
-grid spacings from a cell boundary and among the rest, and the time of the labels. Last, on
+grid spacings from a cell boundary and among the rest, and the time of the labels. Then paths from points on the boundaries of
+two and of three of three sources' regions. Last, on
 the Stanford bunny (``../shared/data``, grid ``surface.grid(n)``) from vertex 0 to 8 random
 vertices: the paths' lengths and ``u`` against the exact polyhedral geodesic distances
 (pygeodesic, MMP; skipped without it or the data). These are the figures of
@@ -81,6 +82,17 @@ def main(sizes: list) -> int:
         wrong = lab != np.argmin(geo, axis=1)
         print(f"| {n} | {len(lab):,} | {wrong[away].sum()} of {away.sum():,} | {wrong[~away].sum():,} of "
               f"{(~away).sum():,} ({100 * wrong[~away].mean():.0f}%) | {1e3 * took:.1f} ms |")
+    print()
+    print("paths from where regions meet: sources (±0.5, 0, 0), (0, 0, 0.5); length error against π/4, in h")
+    print("| N | from (0, -0.3, -0.4): two regions | from (0, 0.5, 0): three regions |")
+    print("|---|---|---|")
+    for n in sizes:
+        g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
+        sol = ts.solve(ts.surfaces.Sphere(R), g, sources[:3])
+        two = np.array([0.0, -0.3, -0.4])
+        lengths = [np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in sol.geodesic_paths([two, (0.0, R, 0.0)])]
+        e = [abs(v - np.pi / 4) / g.spacing for v in lengths]
+        print(f"| {n} | {e[0]:.2f} | {e[1]:.2f} |")
     bunny_rows(sizes)
     return 0
 

@@ -72,7 +72,10 @@ def test_demo_quick(tmp_path, capsys):
     assert main(["demo", "--quick", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "sphere" in out and "star" in out
-    for name in ("sphere.png", "star.png", "layered.png"):
+    # the paths' lengths against great circles at N = 61 (h = 1/30)
+    err = float(out.split("length error max ")[1].split()[0])
+    assert err < 0.5 / 30
+    for name in ("sphere.png", "sphere_paths.png", "star.png", "layered.png"):
         assert (tmp_path / name).stat().st_size > 10_000
 
 

@@ -79,6 +79,22 @@ def test_paths_end_at_the_source_that_reaches_the_start_first():
             assert end == np.argmin(geo) == k
 
 
+@pytest.mark.parametrize("n", [61, 121])
+def test_paths_from_where_regions_meet_leave_the_boundary(n):
+    sources = np.array([[R, 0, 0], [-R, 0, 0], [0, 0, R]])
+    sol = _sphere(n, sources)
+    h = sol.grid.spacing
+    two = np.array([0.0, -0.3, -0.4])  # as far from sources 0 and 1, on the boundary of their regions
+    three = np.array([0.0, R, 0.0])  # as far from all three
+    p2, p3 = sol.geodesic_paths([two, three])
+    # measured: 0.07 h and 0.72 h at N = 61, 0.02 h and 0.30 h at N = 121 (benches/paths_and_labels.py
+    # prints other N); with central differences alone the first ran along the boundary, 1.8 h too long
+    assert abs(_length(p2) - np.pi / 4 * 2 * R) < 0.2 * h
+    assert abs(_length(p3) - np.pi / 4 * 2 * R) < 1.0 * h
+    for p in (p2, p3):
+        assert any(np.array_equal(p[-1], s) for s in sources)
+
+
 def test_paths_on_a_mesh_and_an_open_surface_reach_the_source():
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61))
     hemi = ts.solve(ts.surfaces.Hemisphere(), g, [(0.0, 0.0, 0.5)])

@@ -13,13 +13,13 @@ with ``s`` a fraction of the grid spacing and ``P_Σ`` the surface's closest-poi
 ``∇u`` is the multilinear interpolant of the central differences of ``u`` at the band nodes
 (the difference of the interpolated ``u`` one grid spacing either side of the point), which is
 continuous from cell to cell; the extension equation (8) makes ``u`` constant along the normals
-in the extension layer, so ``∇u`` is tangent to the surface up to the scheme's error. Like ``u``
-the paths are first-order accurate: their distance from the true geodesic and the error of
-their length are O(Δx) (tested on the sphere against great circles).
+in the extension layer, so ``∇u`` is tangent to the surface up to the scheme's error. Where two
+fronts meet ``u`` has a kink, and there one-sided differences are taken (see :func:`_gradient`)
+so that a path leaves the kink instead of running along it. The paths' lengths are first-order
+accurate (measured against great circles and exact polyhedral geodesics: docs/paths-and-labels.md).
 
-A path stops early, with a :class:`RuntimeWarning`, where ``∇u`` vanishes or ``u`` stops
-decreasing (a cut locus, such as the point opposite a single source on a sphere, has no unique
-descent direction, but the path leaves it after its first step), and after ``max_steps`` steps.
+A path stops early, with a :class:`RuntimeWarning`, where ``∇u`` vanishes, leaves the band, or
+``u`` stops decreasing for :data:`STALL_STEPS` steps, and after ``max_steps`` steps.
 """
 
 from __future__ import annotations
@@ -84,9 +84,34 @@ class _SourceFinder:
         return best
 
 
-def _gradient(sol: "Solution", x: np.ndarray) -> np.ndarray:
-    """∇u at points (M, d): the interpolated u one grid spacing either side, per axis (the
-    multilinear interpolant of the nodes' central differences); NaN where a stencil leaves the band."""
+class _CellLabels:
+    """Whether the interpolation stencil of a point (the 2^d corners of its cell) lies wholly in
+    one source's region: with several sources u = min_k u_k has a kink where two regions meet,
+    and a difference across it mixes the two fronts' gradients."""
+
+    def __init__(self, sol: "Solution"):
+        self.sol = sol
+        self.labels = sol.nearest_source()
+        d = sol.grid.ndim
+        self.corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+
+    def clean(self, x: np.ndarray, target: np.ndarray) -> np.ndarray:
+        """(M,) True where every corner of the cell of x is a band node labelled ``target``."""
+        base = self.sol.grid.cell_index(x)
+        corners = (base[None, :, :] + self.corners[:, None, :]).reshape(-1, x.shape[1])
+        pos = self.sol._band.find(np.ascontiguousarray(corners)).reshape(len(self.corners), len(x))
+        return np.all((pos >= 0) & (self.labels[np.maximum(pos, 0)] == target[None, :]), axis=0)
+
+
+def _gradient(sol: "Solution", x: np.ndarray, u0: np.ndarray, cells: Optional[_CellLabels] = None,
+              target: Optional[np.ndarray] = None) -> np.ndarray:
+    """∇u at points (M, d) where u is ``u0``: per axis the central difference of the interpolated
+    u one grid spacing either side (the multilinear interpolant of the nodes' central
+    differences). Two cases take a one-sided difference instead, so that the path leaves a kink
+    of u for one side rather than running along it: with several sources, where one side's
+    stencil reaches into another source's region (``cells``, ``target``: the region the path
+    descends in), the other side's; and across a ridge of u (u larger at the point than on
+    both sides: two fronts meet there), the steeper side's. NaN where a stencil leaves the band."""
     h = sol.grid.spacing
     m, d = x.shape
     shifted = np.empty((2 * d, m, d))
@@ -96,7 +121,27 @@ def _gradient(sol: "Solution", x: np.ndarray) -> np.ndarray:
         shifted[2 * k + 1] = x
         shifted[2 * k + 1, :, k] -= h
     u = sol(shifted.reshape(-1, d)).reshape(2 * d, m)
-    return np.stack([(u[2 * k] - u[2 * k + 1]) / (2 * h) for k in range(d)], axis=1)
+    g = np.empty((m, d))
+    sided = np.empty((m, d))
+    foreign = np.zeros((m, d), dtype=bool)
+    if cells is not None and target is not None:
+        clean = cells.clean(shifted.reshape(-1, d), np.tile(target, 2 * d)).reshape(2 * d, m)
+    for k in range(d):
+        ahead, behind = u[2 * k] - u0, u0 - u[2 * k + 1]
+        ridge = (ahead < 0) & (behind > 0)
+        g[:, k] = np.where(ridge, np.where(-ahead > behind, ahead, behind) / h, (ahead + behind) / (2 * h))
+        sided[:, k] = g[:, k]
+        if cells is not None and target is not None:
+            fwd, bwd = clean[2 * k], clean[2 * k + 1]
+            sided[:, k] = np.where(fwd & ~bwd, ahead / h, np.where(bwd & ~fwd, behind / h, g[:, k]))
+            foreign[:, k] = ~fwd & ~bwd
+    if cells is None:
+        return g
+    # an axis along which both sides reach into other regions (next to where three regions
+    # meet) says nothing of the target front's gradient: left out while another axis does
+    some = ~np.all(foreign, axis=1)
+    sided[foreign & some[:, None]] = 0.0
+    return np.where(some[:, None], sided, g)
 
 
 def _onto_surface(sol: "Solution", x: np.ndarray) -> np.ndarray:
@@ -154,7 +199,10 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
     finder = _SourceFinder(grid, np.ascontiguousarray(src, dtype=float), s)
     paths: List[List[np.ndarray]] = [[x[i].copy()] for i in range(len(x))]
     active = np.arange(len(x))
-    cur = x.copy()
+    cur, ucur = x.copy(), u.copy()
+    # with several sources each path descends in the region of the source that reaches its start first
+    cells = _CellLabels(sol) if len(sol.sources) > 1 else None
+    target = sol.nearest_source(x) if cells is not None else None
     best_u = u.copy()
     no_progress = np.zeros(len(x), dtype=np.int64)
     stalled: List[int] = []
@@ -169,7 +217,7 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         active = active[~done]
         if active.size == 0:
             break
-        g = _gradient(sol, cur[active])
+        g = _gradient(sol, cur[active], ucur[active], cells, None if cells is None else target[active])
         gn = np.linalg.norm(g, axis=1)
         bad = ~(gn > 0) | ~np.all(np.isfinite(g), axis=1)
         stalled.extend(int(i) for i in active[bad])
@@ -185,7 +233,7 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         active, nxt, un = active[keep], nxt[keep], un[keep]
         for i, q in zip(active, nxt):
             paths[i].append(q.copy())
-        cur[active] = nxt
+        cur[active], ucur[active] = nxt, un
         better = un < best_u[active]
         best_u[active] = np.where(better, un, best_u[active])
         no_progress[active] = np.where(better, 0, no_progress[active] + 1)
