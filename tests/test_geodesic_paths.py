@@ -183,3 +183,18 @@ def test_path_lengths_on_the_bunny_match_exact_polyhedral_geodesics():
     assert np.mean(np.abs(lengths - exact)) < 0.25 * g.spacing
     for p in paths:
         assert np.array_equal(p[-1], v[0])
+
+
+def test_the_source_finder_agrees_with_brute_force():
+    from tubesweep.geodesic_paths import _SourceFinder
+
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    rng = np.random.default_rng(0)
+    src = rng.uniform(-0.9, 0.9, size=(5000, 3))
+    src[100:200] = src[100]  # a hundred sources at one point: the lowest index wins
+    pts = rng.uniform(-0.9, 0.9, size=(3000, 3))
+    pts[:50] = src[100] + 0.001
+    got = _SourceFinder(g, src, 0.05).within(pts)
+    d = np.linalg.norm(pts[:, None] - src[None], axis=2)
+    want = np.where(d.min(1) <= 0.05, d.argmin(1), -1)
+    assert np.array_equal(got, want) and np.count_nonzero(got >= 0) > 500

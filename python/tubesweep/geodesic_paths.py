@@ -65,22 +65,30 @@ class _SourceFinder:
 
     def within(self, points: np.ndarray) -> np.ndarray:
         """Index of the nearest source within ``radius`` of each point (M,), -1 where none."""
-        best = np.full(len(points), -1, dtype=np.int64)
-        best_d = np.full(len(points), np.inf)
+        m, d = points.shape
         base = np.floor(self.grid.continuous_index(points)).astype(np.int64)
-        for o in self.offsets:
-            key = self._keys(base + o)
-            lo = np.searchsorted(self.keys, key, "left")
-            hi = np.searchsorted(self.keys, key, "right")
-            for j in range(int((hi - lo).max(initial=0))):
-                has = lo + j < hi
-                if not np.any(has):
-                    break
-                cand = self.order[np.minimum(lo + j, len(self.order) - 1)]
-                dist = np.linalg.norm(points - self.sources[cand], axis=1)
-                take = has & (dist <= self.radius) & (dist < best_d)
-                best[take] = cand[take]
-                best_d[take] = dist[take]
+        keys = self._keys((base[:, None, :] + self.offsets[None, :, :]).reshape(-1, d))
+        lo = np.searchsorted(self.keys, keys, "left")
+        count = np.searchsorted(self.keys, keys, "right") - lo
+        owner = np.repeat(np.arange(m), len(self.offsets))
+        best = np.full(m, -1, dtype=np.int64)
+        best_d = np.full(m, np.inf)
+        for j in range(int(count.max(initial=0))):
+            has = np.flatnonzero(count > j)
+            cand = self.order[lo[has] + j]
+            who = owner[has]
+            dist = np.linalg.norm(points[who] - self.sources[cand], axis=1)
+            near = dist <= self.radius
+            who, cand, dist = who[near], cand[near], dist[near]
+            if who.size == 0:
+                continue
+            # per point the nearest candidate (then the lowest index), against the best so far
+            first = np.lexsort((cand, dist, who))
+            who, cand, dist = who[first], cand[first], dist[first]
+            lead = np.r_[True, who[1:] != who[:-1]]
+            who, cand, dist = who[lead], cand[lead], dist[lead]
+            better = (dist < best_d[who]) | ((dist == best_d[who]) & (cand < best[who]))
+            best[who[better]], best_d[who[better]] = cand[better], dist[better]
         return best
 
 
