@@ -95,6 +95,9 @@ def double_torus_signed_distance(
 def mobius_closest_parameters(
     points: npt.NDArray[np.float64], r: float, w: float, iterations: int
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def open_surface_closest_points(
+    kind: str, points: npt.NDArray[np.float64], centre: List[float], size: float
+) -> npt.NDArray[np.float64]: ...
 __version__: str
 
 class Band:

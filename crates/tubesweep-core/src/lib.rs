@@ -24,6 +24,8 @@
 //! | multilinear interpolation in the band | [`interpolate`] | — |
 //! | which source reaches each node first (nearest-source labels) | [`nearest_source`] | — |
 //! | exact closest points on triangle meshes (AABB tree) | [`mesh`] | Sect. 5.2 |
+//! | closest points on the hemisphere, disc and plane patch | [`open_surfaces`] | Sect. 5.2, Fig. 9 |
+//! | closest points on the Möbius band | [`mobius`] | Sect. 5.2, Fig. 9 |
 //!
 //! Grids are uniform with spacing `h` in every axis; node `(i, j[, k])` sits at
 //! `lower + h * (i, j[, k])`, and nodes are numbered in C order (the last axis varies fastest),
@@ -45,6 +47,7 @@ pub mod mesh;
 pub mod mesh_band;
 pub mod mobius;
 pub mod nearest_source;
+pub mod open_surfaces;
 pub mod normals;
 pub mod redistance;
 pub mod rim;

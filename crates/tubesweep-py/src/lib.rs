@@ -1022,6 +1022,33 @@ fn mobius_closest_parameters<'py>(
     Ok((theta.into_pyarray(py), s.into_pyarray(py)))
 }
 
+/// The closest points (M, 3) on one of the library's open surfaces (`kind`: "hemisphere" or
+/// "disc" of radius `size`, "plane-patch" of half-side `size`) about `centre` of the points
+/// (M, 3). See `tubesweep_core::open_surfaces`.
+#[pyfunction]
+fn open_surface_closest_points<'py>(
+    py: Python<'py>,
+    kind: &str,
+    points: PyReadonlyArray2<'py, f64>,
+    centre: Vec<f64>,
+    size: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    use tubesweep_core::open_surfaces::{disc_closest_points, hemisphere_closest_points, plane_patch_closest_points};
+    let cp = match kind {
+        "hemisphere" => hemisphere_closest_points,
+        "disc" => disc_closest_points,
+        "plane-patch" => plane_patch_closest_points,
+        _ => return Err(PyValueError::new_err(format!("kind must be 'hemisphere', 'disc' or 'plane-patch'; got {kind:?}"))),
+    };
+    let c = coords_array::<3>(&centre, "centre")?;
+    let p = points_slice(&points, 3)?;
+    let m = points.shape()[0];
+    let mut out = vec![0.0; 3 * m];
+    py.detach(|| cp(p, c, size, &mut out)).map_err(to_pyerr)?;
+    use numpy::PyArrayMethods;
+    numpy::PyArray1::from_vec(py, out).reshape([m, 3])
+}
+
 /// The exact signed distance to the rounded cube (half-side `half_size`, edges and corners rounded
 /// to `radius`) about `centre` at the points (M, 3). See
 /// `tubesweep_core::analytic::rounded_cube_signed_distance`.
@@ -1287,6 +1314,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rounded_cube_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(double_torus_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(mobius_closest_parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(open_surface_closest_points, m)?)?;
     m.add_function(wrap_pyfunction!(star_signed_distance, m)?)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -23,6 +23,12 @@ def _safe_unit(v: np.ndarray, fallback: np.ndarray) -> np.ndarray:
     return np.where(n > 1e-300, v / np.where(n > 1e-300, n, 1.0), fallback)
 
 
+def _native_cp(kind: str, p: np.ndarray, center: np.ndarray, size: float) -> np.ndarray:
+    """The closest points of an open library surface, computed in the Rust core."""
+    x = np.ascontiguousarray(np.asarray(p, dtype=float).reshape(-1, 3))
+    return _native.open_surface_closest_points(kind, x, [float(c) for c in center], size)
+
+
 class Hemisphere(ClosestPoint):
     """The upper hemisphere ``{|x − c| = radius, z ≥ c_z}`` — an open surface bounded by the
     equator circle (the "rim").
@@ -49,6 +55,10 @@ class Hemisphere(ClosestPoint):
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
+        return _native_cp("hemisphere", p, self.center, self.radius)
+
+    def _cp_numpy(self, p: np.ndarray) -> np.ndarray:
+        """The closest point in NumPy (the core's ``hemisphere_closest_points`` gives the same bits)."""
         q = np.asarray(p, dtype=float) - self.center
         up = _safe_unit(q, np.array([0.0, 0.0, 1.0])) * self.radius
         h = np.c_[q[:, :2], np.zeros(len(q))]
@@ -97,6 +107,10 @@ class Disc(ClosestPoint):
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
+        return _native_cp("disc", p, self.center, self.radius)
+
+    def _cp_numpy(self, p: np.ndarray) -> np.ndarray:
+        """The closest point in NumPy (the core's ``disc_closest_points`` gives the same bits)."""
         q = np.asarray(p, dtype=float) - self.center
         r = np.hypot(q[:, 0], q[:, 1])
         f = np.where(r > self.radius, self.radius / np.where(r > 0, r, 1.0), 1.0)
@@ -140,6 +154,10 @@ class PlanePatch(ClosestPoint):
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
+        return _native_cp("plane-patch", p, self.center, self.half_size)
+
+    def _cp_numpy(self, p: np.ndarray) -> np.ndarray:
+        """The closest point in NumPy (the core's ``plane_patch_closest_points`` gives the same bits)."""
         q = np.asarray(p, dtype=float) - self.center
         s = self.half_size
         return np.c_[np.clip(q[:, 0], -s, s), np.clip(q[:, 1], -s, s), np.zeros(len(q))] + self.center
