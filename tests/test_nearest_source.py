@@ -74,6 +74,31 @@ def test_labels_follow_the_sources_order_on_a_tube_and_reach_the_export(tmp_path
     assert np.array_equal(lb[clear], 1 - la[clear])
     path = ts.export(a, tmp_path / "two.vtp")
     pts, _, data = read_vtp(path)
-    assert np.array_equal(data["nearest_source"], a.nearest_source(pts).astype(float))
+    labels = data["nearest_source"]
+    assert set(np.unique(labels)) == {0.0, 1.0}
+    clear = np.abs(pts[:, 0]) > 2 * g.spacing
+    assert np.array_equal(labels[clear], np.where(pts[clear, 0] > 0, 0.0, 1.0))
     one = ts.export(tube.solve([(R, 0, 0)]), tmp_path / "one.vtp")
     assert "nearest_source" not in read_vtp(one)[2]
+
+
+def test_labels_with_node_sources_duplicates_and_anisotropic_hamiltonians(tmp_path):
+    from tubesweep.flows import solid_body_rotation
+
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    sources = np.array([[R, 0, 0], [-R, 0, 0], [R, 0, 0]])  # the third repeats the first
+    for init in ("exact", "node"):
+        sol = ts.solve(ts.surfaces.Sphere(R), g, sources, source_init=init)
+        labels = sol.nearest_source()
+        x = sol.points[:, 0]
+        clear = np.abs(x) > 2 * g.spacing
+        # a node as near to two sources takes the first of them
+        assert np.array_equal(labels[clear], np.where(x[clear] > 0, 0, 1)), init
+    c = ts.surfaces.Circle(0.6)
+    g2 = ts.Grid((-1, -1), (1, 1), (81, 81))
+    moving = ts.solve(c, g2, [(0.6, 0.0), (-0.6, 0.0)], flow=solid_body_rotation(0.5))
+    with pytest.raises(ValueError, match="isotropic"):
+        moving.nearest_source()
+    # the export leaves the labels out rather than failing
+    _, _, data = read_vtp(ts.export(moving, tmp_path / "moving.vtp"))
+    assert "nearest_source" not in data and "u" in data

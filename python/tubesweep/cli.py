@@ -188,7 +188,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
-    labels = {"nearest_source": sol.nearest_source()} if len(sol.sources) > 1 else {}
+    labels = {"nearest_source": sol.nearest_source()} if len(sol.sources) > 1 and sol._isotropic else {}
     np.savez_compressed(out / "solution.npz", indices=sol.indices, values=sol.values, roles=sol.roles, phi=sol.phi,
                         lower=grid.lower, upper=grid.upper, shape=np.array(grid.shape), sources=sol.sources, **labels)
     s = sol.stats

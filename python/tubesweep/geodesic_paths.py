@@ -8,7 +8,8 @@ reaches it first is therefore traced by steps against the gradient,
     x_{k+1} = P_Σ( x_k − s ∇u(x_k) / |∇u(x_k)| ),
 
 with ``s`` a fraction of the grid spacing and ``P_Σ`` the surface's closest-point projection
-(``Surface.project``), until ``x_k`` lies within ``s`` of a source, which ends the path.
+(``Surface.project``), until ``x_k`` lies within :data:`FINISH_RADIUS` grid spacings of a source,
+whose position ends the path.
 
 ``∇u`` is the multilinear interpolant of the central differences of ``u`` at the band nodes
 (the difference of the interpolated ``u`` one grid spacing either side of the point), which is
@@ -38,6 +39,11 @@ __all__ = ["trace_paths"]
 
 #: Steps in a row without a decrease of ``u`` after which a path is declared stalled.
 STALL_STEPS = 8
+
+#: A path ends with a straight segment to a source once it is this many grid spacings from it
+#: (the radius of the nodes a source fixes, ``solve.SOURCE_RADIUS``: there u is the exact
+#: distance, and a gradient stencil that straddles the source's cone points poorly).
+FINISH_RADIUS = 2.0
 
 
 class _SourceFinder:
@@ -116,10 +122,11 @@ def _gradient(sol: "Solution", x: np.ndarray, u0: np.ndarray, cells: Optional[_C
     """∇u at points (M, d) where u is ``u0``: per axis the central difference of the interpolated
     u one grid spacing either side (the multilinear interpolant of the nodes' central
     differences). Two cases take a one-sided difference instead, so that the path leaves a kink
-    of u for one side rather than running along it: with several sources, where one side's
-    stencil reaches into another source's region (``cells``, ``target``: the region the path
-    descends in), the other side's; and across a ridge of u (u larger at the point than on
-    both sides: two fronts meet there), the steeper side's. NaN where a stencil leaves the band."""
+    of u for one side rather than running along it: with several sources, where the stencil
+    reaches into another source's region on one side only (``cells``, ``target``: the region the
+    path descends in), the other side's; and across a ridge of u (u larger at the point than on
+    both sides: two fronts meet there), the steeper side's. Where one side of the stencil
+    leaves the band or the grid, the other side's difference; NaN where both do."""
     h = sol.grid.spacing
     m, d = x.shape
     shifted = np.empty((2 * d, m, d))
@@ -130,26 +137,20 @@ def _gradient(sol: "Solution", x: np.ndarray, u0: np.ndarray, cells: Optional[_C
         shifted[2 * k + 1, :, k] -= h
     u = sol(shifted.reshape(-1, d)).reshape(2 * d, m)
     g = np.empty((m, d))
-    sided = np.empty((m, d))
-    foreign = np.zeros((m, d), dtype=bool)
+    clean = None
     if cells is not None and target is not None:
         clean = cells.clean(shifted.reshape(-1, d), np.tile(target, 2 * d)).reshape(2 * d, m)
     for k in range(d):
         ahead, behind = u[2 * k] - u0, u0 - u[2 * k + 1]
         ridge = (ahead < 0) & (behind > 0)
         g[:, k] = np.where(ridge, np.where(-ahead > behind, ahead, behind) / h, (ahead + behind) / (2 * h))
-        sided[:, k] = g[:, k]
-        if cells is not None and target is not None:
+        # one side of the stencil outside the band or the grid: the other side's difference
+        g[:, k] = np.where(np.isnan(ahead) & ~np.isnan(behind), behind / h,
+                           np.where(np.isnan(behind) & ~np.isnan(ahead), ahead / h, g[:, k]))
+        if clean is not None:
             fwd, bwd = clean[2 * k], clean[2 * k + 1]
-            sided[:, k] = np.where(fwd & ~bwd, ahead / h, np.where(bwd & ~fwd, behind / h, g[:, k]))
-            foreign[:, k] = ~fwd & ~bwd
-    if cells is None:
-        return g
-    # an axis along which both sides reach into other regions (next to where three regions
-    # meet) says nothing of the target front's gradient: left out while another axis does
-    some = ~np.all(foreign, axis=1)
-    sided[foreign & some[:, None]] = 0.0
-    return np.where(some[:, None], sided, g)
+            g[:, k] = np.where(fwd & ~bwd, ahead / h, np.where(bwd & ~fwd, behind / h, g[:, k]))
+    return g
 
 
 def _onto_surface(sol: "Solution", x: np.ndarray) -> np.ndarray:
@@ -175,7 +176,8 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
             f"geodesic paths need an isotropic Hamiltonian (godunov, lxf or Isotropic()); this solution is "
             f"{sol.hamiltonian!r}, whose fastest paths do not run against ∇u"
         )
-    if not (isinstance(step, (int, float, np.floating, np.integer)) and 0.0 < float(step) <= 1.0):
+    if isinstance(step, (bool, np.bool_)) or not (
+            isinstance(step, (int, float, np.floating, np.integer)) and 0.0 < float(step) <= 1.0):
         raise ValueError(f"step must be a number of grid spacings in (0, 1]; got {step!r}")
     grid = sol.grid
     h = grid.spacing
@@ -184,7 +186,7 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
     if max_steps is None:
         # far longer than any path that stays in the grid: each step goes s·(1 − O(Δx)) along it
         max_steps = int(np.ceil(8 * sum(grid.shape) / float(step)))
-    elif not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
+    elif isinstance(max_steps, (bool, np.bool_)) or not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
         raise ValueError(f"max_steps must be a positive integer; got {max_steps!r}")
     dist, _ = sol.surface.project(p, grid)
     x = _onto_surface(sol, p)
@@ -204,7 +206,9 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         )
     src = _onto_surface(sol, np.asarray(sol.sources, dtype=float))
     s = float(step) * h
-    finder = _SourceFinder(grid, np.ascontiguousarray(src, dtype=float), s)
+    # a path ends once it is within FINISH_RADIUS grid spacings of a source, with a straight last
+    # segment: closer in, the stencil of the gradient straddles the source's cone
+    finder = _SourceFinder(grid, np.ascontiguousarray(src, dtype=float), FINISH_RADIUS * h)
     paths: List[List[np.ndarray]] = [[x[i].copy()] for i in range(len(x))]
     active = np.arange(len(x))
     cur, ucur = x.copy(), u.copy()
@@ -214,7 +218,7 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
     best_u = u.copy()
     no_progress = np.zeros(len(x), dtype=np.int64)
     stalled: List[int] = []
-    for _ in range(max_steps):
+    for taken in range(max_steps + 1):
         if active.size == 0:
             break
         arrived = finder.within(cur[active])
@@ -223,7 +227,7 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
             if np.linalg.norm(paths[i][-1] - src[k]) > 0:
                 paths[i].append(src[k].copy())
         active = active[~done]
-        if active.size == 0:
+        if active.size == 0 or taken == max_steps:
             break
         g = _gradient(sol, cur[active], ucur[active], cells, None if cells is None else target[active])
         gn = np.linalg.norm(g, axis=1)

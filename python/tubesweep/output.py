@@ -187,8 +187,8 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
         Further per-vertex arrays to write beside ``u``.
 
     ``u`` is :meth:`Solution.on_mesh` at the vertices (``inf`` where never reached becomes NaN).
-    With several sources, ``nearest_source`` (:meth:`Solution.nearest_source` at the vertices,
-    -1 where no front arrives) is written too.
+    With several sources and an isotropic Hamiltonian, ``nearest_source``
+    (:meth:`Solution.nearest_source` at the vertices, -1 where no front arrives) is written too.
     2D curves are written as line cells with z = 0.
     """
     path = Path(path)
@@ -199,7 +199,7 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
     u = sol.on_mesh(v)
     u = np.where(np.isfinite(u), u, np.nan)
     data: Dict[str, np.ndarray] = {"u": u}
-    if len(sol.sources) > 1:
+    if len(sol.sources) > 1 and sol._isotropic:
         data["nearest_source"] = sol.nearest_source(v).astype(float)
     for name, a in (point_data or {}).items():
         a = np.asarray(a, dtype=float)
@@ -255,14 +255,21 @@ def _orientation(f: np.ndarray, v: np.ndarray) -> float:
 
 
 def _nearest_face(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
-    """Index of the face whose centroid is nearest to each point (in chunks of points, so that
-    the distance table stays a few million entries)."""
-    chunk = max(1, 4_000_000 // max(len(centroids), 1))
-    out = np.empty(len(points), dtype=np.int64)
-    for lo in range(0, len(points), chunk):
-        p = points[lo : lo + chunk]
-        out[lo : lo + chunk] = np.argmin(((p[:, None, :] - centroids[None, :, :]) ** 2).sum(-1), axis=1)
-    return out
+    """Index of the face whose centroid is nearest to each point: a k-d tree where SciPy is
+    installed, else in chunks of points small enough that the table of differences stays near a
+    million entries."""
+    if len(points) == 0:
+        return np.zeros(0, dtype=np.int64)
+    try:
+        from scipy.spatial import cKDTree
+    except ImportError:
+        chunk = max(1, 1_000_000 // (3 * max(len(centroids), 1)))
+        out = np.empty(len(points), dtype=np.int64)
+        for lo in range(0, len(points), chunk):
+            p = points[lo : lo + chunk]
+            out[lo : lo + chunk] = np.argmin(((p[:, None, :] - centroids[None, :, :]) ** 2).sum(-1), axis=1)
+        return out
+    return np.asarray(cKDTree(centroids).query(points)[1], dtype=np.int64)
 
 
 def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, levels: Union[int, Sequence[float]] = 12,
@@ -362,6 +369,11 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     seg_face = np.concatenate([t for _, t in iso]) if iso else np.zeros(0, np.int64)
     orient = _orientation(f, v)
     centroids = tri.mean(1)
+    # the paths' segments, and the face next to each (to draw those on the far side faint)
+    segs = [np.stack([q[:-1], q[1:]], axis=1)[:, :, perm] for q in lines if len(q) >= 2]
+    seg = np.concatenate(segs) if segs else np.zeros((0, 2, 3))
+    seg_near = _nearest_face(seg.mean(1), centroids)
+    src_near = _nearest_face(src, centroids)
     if ax is not None:
         axes = [ax]
         fig = ax.figure
@@ -383,19 +395,14 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
         seen = (n[seg_face] @ eye) * orient > 0 if orient != 0 else np.ones(len(seg_face), bool)
         if np.any(seen):
             a.add_collection3d(Line3DCollection(seg_all[seen], colors="k", linewidths=0.6, zorder=2))
-        for q in lines:
-            if len(q) < 2:
-                continue
-            seg = np.stack([q[:-1], q[1:]], axis=1)[:, :, perm]
-            near = _nearest_face(seg.mean(1), centroids)
-            front = (n[near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(near), bool)
+        if len(seg):
+            front = (n[seg_near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(seg), bool)
             for sel, alpha in ((front, 1.0), (~front, 0.3)):
                 if np.any(sel):
                     a.add_collection3d(Line3DCollection(seg[sel], colors="r", linewidths=1.6, alpha=alpha, zorder=3))
         if sources:
             # a source on the far side of an oriented mesh is drawn faint
-            near = _nearest_face(src, centroids)
-            front = (n[near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(near), bool)
+            front = (n[src_near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(src_near), bool)
             for sel, alpha in ((front, 1.0), (~front, 0.3)):
                 if np.any(sel):
                     a.scatter(*src[sel].T, c="r", marker="*", s=160, edgecolors="k", linewidths=0.5,

@@ -120,7 +120,7 @@ class Solution:
         """The solution at the vertices (M, d) of a mesh of the surface (e.g. for display or export).
 
         Multilinear interpolation (:meth:`__call__`); where its stencil leaves the band or meets an
-        unreached node, the value of the nearest reached band node within ``outer`` grid spacings
+        unreached node, the value of the nearest reached band node within ``outer + 1`` grid spacings
         (the band values are constant along the normals, Eq. (8), so this is first-order
         accurate). NaN only for vertices farther than that from every reached band node.
         """
@@ -134,26 +134,43 @@ class Solution:
 
     def _nearest_reached(self, p: np.ndarray) -> np.ndarray:
         """Band position (M,) of the reached band node nearest to each point within ``outer + 1``
-        grid spacings of it, -1 where there is none."""
+        grid spacings of it, -1 where there is none. The offsets from the point's nearest node
+        are tried in increasing length, and a point is settled once no longer offset can hold a
+        nearer node."""
         d = self.grid.ndim
         r = int(np.ceil(self.outer)) + 1
-        offs = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
-        offs = offs[np.argsort((offs * offs).sum(1), kind="stable")]
-        ci = self.grid.continuous_index(p)
-        base = np.rint(ci).astype(np.int64)
         best = np.full(len(p), -1, dtype=np.int64)
         best_d = np.full(len(p), np.inf)
-        for o in offs:
-            idx = base + o
+        ci = self.grid.continuous_index(p)
+        # points beyond reach of the grid's nodes are left at -1 (and never cast to indices)
+        near = np.flatnonzero(np.all((ci > -(r + 1)) & (ci < np.asarray(self.grid.shape) + r), axis=1))
+        if near.size == 0:
+            return best
+        ci = ci[near]
+        base = np.rint(ci).astype(np.int64)
+        offs = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+        lengths = np.sqrt((offs * offs).sum(1))
+        order = np.argsort(lengths, kind="stable")
+        # |ci − base| ≤ √d/2, so a node at offset o lies at least |o| − √d/2 from the point
+        slack = 0.5 * np.sqrt(d)
+        open_ = np.arange(len(near))
+        bd = np.full(len(near), np.inf)
+        bp = np.full(len(near), -1, dtype=np.int64)
+        for o, length in zip(offs[order], lengths[order]):
+            open_ = open_[bd[open_] > length - slack]
+            if open_.size == 0:
+                break
+            idx = base[open_] + o
             pos = self._band.find(np.ascontiguousarray(idx))
             ok = pos >= 0
             if not np.any(ok):
                 continue
             vals = np.where(ok, self.values[np.maximum(pos, 0)], np.inf)
-            dist = np.linalg.norm(idx - ci, axis=1)
-            take = ok & np.isfinite(vals) & (dist < best_d) & (dist <= self.outer + 1)
-            best[take] = pos[take]
-            best_d[take] = dist[take]
+            dist = np.linalg.norm(idx - ci[open_], axis=1)
+            take = ok & np.isfinite(vals) & (dist < bd[open_]) & (dist <= self.outer + 1)
+            bp[open_[take]] = pos[take]
+            bd[open_[take]] = dist[take]
+        best[near], best_d[near] = bp, bd
         return best
 
     def nearest_source(self, points: Any = None) -> np.ndarray:
@@ -162,13 +179,20 @@ class Solution:
 
         Without ``points``, one label per band node (aligned with :attr:`values`); with
         ``points`` (M, d), e.g. the vertices of a mesh of the surface, the label of the nearest
-        reached band node within ``outer`` grid spacings of each point (-1 where there is none).
+        reached band node within ``outer + 1`` grid spacings of each point (-1 where there is none).
         For speed 1 the labels partition the surface into the geodesic Voronoi cells of the
         sources. They are recovered from the solved values (``tubesweep_core::nearest_source``:
         each node takes the label of its smallest, earlier-reached neighbour) and are first-order
         accurate like the values: nodes within about a grid spacing of a cell boundary may take the
-        neighbouring cell's label.
+        neighbouring cell's label. Only for isotropic Hamiltonians (``"godunov"``, ``"lxf"``,
+        ``Isotropic()``): under a moving medium or a metric the smallest neighbour is not the one
+        the front came from, and a ``ValueError`` says so.
         """
+        if not self._isotropic:
+            raise ValueError(
+                f"nearest_source needs an isotropic Hamiltonian (godunov, lxf or Isotropic()); this solution is "
+                f"{self.hamiltonian!r}. Solve each source on one ts.Tube and take the argmin of the values instead"
+            )
         if self._labels is None:
             positions, sources = self._fixed
             self._labels = self._band.nearest_source_labels(
@@ -191,7 +215,11 @@ class Solution:
         Only for isotropic Hamiltonians (``"godunov"``, ``"lxf"``, ``Isotropic()``): under a
         moving medium or a metric the fastest path does not run against ∇u.
         """
-        return self.geodesic_paths(np.atleast_2d(np.asarray(start, dtype=float)), step=step, max_steps=max_steps)[0]
+        p = as_points(start, self.grid.ndim, "start")
+        if len(p) != 1:
+            raise ValueError(f"start must be one point of shape ({self.grid.ndim},); got {len(p)} points "
+                             "(use geodesic_paths for several)")
+        return self.geodesic_paths(p, step=step, max_steps=max_steps)[0]
 
     def geodesic_paths(self, starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
         """:meth:`geodesic_path` from each of the points ``starts`` (M, d), traced together."""

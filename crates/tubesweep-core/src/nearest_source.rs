@@ -9,9 +9,11 @@
 //! Going from a node to its smallest neighbour therefore leads back, through ever earlier nodes,
 //! to a node fixed by a source. The labels are assigned in that order: the nodes in increasing
 //! `u` (ties by band position), each taking the label of its smallest already-labelled neighbour
-//! whose value is at most its own. A node left without one (which a converged solution of the
-//! paper's schemes does not produce, but a Lax–Friedrichs or unconverged solution may) takes the
-//! label of its smallest labelled neighbour in later passes. Unreached nodes (`u = ∞`) keep `-1`.
+//! whose value is at most its own. A few nodes are left without one: extension-layer nodes tied
+//! in value with a neighbour later in that order (the sphere with four sources at N = 61 has 3),
+//! and more in a Lax–Friedrichs or unconverged solution. They take the label of their smallest
+//! labelled neighbour afterwards, breadth first from the labelled nodes (each node once, so the
+//! whole stays linear in the band after the sort). Unreached nodes (`u = ∞`) keep `-1`.
 //!
 //! The labels are first-order like `u`: a node within about one grid spacing of the boundary
 //! between two cells may take the other source's label.
@@ -76,21 +78,36 @@ pub fn nearest_source_labels<const D: usize>(
         let i = i as usize;
         label[i] = pick(i, &label, true);
     }
-    loop {
-        let mut changed = false;
-        for &i in &order {
-            let i = i as usize;
-            if label[i] < 0 {
-                let l = pick(i, &label, false);
-                if l >= 0 {
-                    label[i] = l;
-                    changed = true;
+    // the rest, breadth first: each round labels the unlabelled reached nodes next to labelled
+    // ones (from the labels of the rounds before), in band order
+    let reached_unlabelled = |m: usize, label: &[i64]| label[m] < 0 && values[m].is_finite();
+    let mut queued = vec![false; n];
+    let mut round: Vec<u32> = Vec::new();
+    for &i in &order {
+        let i = i as usize;
+        if label[i] < 0 && band.neighbours_of(i).iter().flatten().any(|&m| m != sentinel && label[m as usize] >= 0) {
+            queued[i] = true;
+            round.push(i as u32);
+        }
+    }
+    while !round.is_empty() {
+        round.sort_unstable();
+        let found: Vec<i64> = round.iter().map(|&i| pick(i as usize, &label, false)).collect();
+        for (&i, &l) in round.iter().zip(&found) {
+            label[i as usize] = l;
+        }
+        let mut next = Vec::new();
+        for &i in &round {
+            for pair in band.neighbours_of(i as usize) {
+                for m in pair {
+                    if m != sentinel && !queued[m as usize] && reached_unlabelled(m as usize, &label) {
+                        queued[m as usize] = true;
+                        next.push(m);
+                    }
                 }
             }
         }
-        if !changed {
-            break;
-        }
+        round = next;
     }
     Ok(label)
 }
@@ -139,6 +156,24 @@ mod tests {
             }
         }
         assert!(checked > band.len() * 9 / 10);
+    }
+
+    /// Values that decrease away from the only source (no converged solution looks like this):
+    /// every reached node still gets the source's label, breadth first.
+    #[test]
+    fn nodes_without_an_earlier_neighbour_are_labelled_breadth_first() {
+        let band = NarrowBand::<2>::full_box([301, 301]).unwrap();
+        let source = band.find([150, 150]).unwrap();
+        let mut values = vec![0.0; band.len()];
+        for n in 0..band.len() {
+            let [i, j] = band.index_of(n);
+            values[n] = 1000.0 - ((i as f64 - 150.0).powi(2) + (j as f64 - 150.0).powi(2)).sqrt();
+        }
+        values[band.find([0, 0]).unwrap()] = f64::INFINITY;
+        let labels = nearest_source_labels(&band, &values, &[source as u32], &[7]).unwrap();
+        for n in 0..band.len() {
+            assert_eq!(labels[n], if values[n].is_finite() { 7 } else { -1 });
+        }
     }
 
     #[test]
