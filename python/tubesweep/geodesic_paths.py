@@ -47,32 +47,36 @@ FINISH_RADIUS = 2.0
 
 
 class _SourceFinder:
-    """Which source, if any, lies within ``radius`` of each point: the sources bucketed by grid
-    cell, and each point checks the 3^d cells around its own (``radius`` ≤ one grid spacing)."""
+    """Which source, if any, lies within ``radius`` of each point: the sources bucketed in cubes
+    of side ``radius`` over the grid's box, and each point checks the 3^d cubes around its own."""
 
     def __init__(self, grid: Any, sources: np.ndarray, radius: float):
-        self.grid = grid
+        self.lower = np.asarray(grid.lower, dtype=float)
+        self.cell = float(radius)
+        # cubes over the box, two more on every side (points and sources may lie a little outside)
+        self.dims = np.ceil((np.asarray(grid.upper, dtype=float) - self.lower) / self.cell).astype(np.int64) + 5
         self.sources = sources
         self.radius = radius
-        keys = self._keys(np.floor(grid.continuous_index(sources)).astype(np.int64))
+        keys = self._keys(self._cubes(sources))
         self.order = np.argsort(keys, kind="stable")
         self.keys = keys[self.order]
         d = grid.ndim
         self.offsets = np.stack(np.meshgrid(*([np.arange(-1, 2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
 
-    def _keys(self, cells: np.ndarray) -> np.ndarray:
-        # a linear key over a box two cells larger than the grid on every side
-        dims = np.asarray(self.grid.shape, dtype=np.int64) + 4
-        c = np.clip(cells + 2, 0, dims - 1)
+    def _cubes(self, points: np.ndarray) -> np.ndarray:
+        return np.floor((points - self.lower) / self.cell).astype(np.int64)
+
+    def _keys(self, cubes: np.ndarray) -> np.ndarray:
+        c = np.clip(cubes + 2, 0, self.dims - 1)
         key = np.zeros(len(c), dtype=np.int64)
         for k in range(c.shape[1]):
-            key = key * dims[k] + c[:, k]
+            key = key * self.dims[k] + c[:, k]
         return key
 
     def within(self, points: np.ndarray) -> np.ndarray:
         """Index of the nearest source within ``radius`` of each point (M,), -1 where none."""
         m, d = points.shape
-        base = np.floor(self.grid.continuous_index(points)).astype(np.int64)
+        base = self._cubes(points)
         keys = self._keys((base[:, None, :] + self.offsets[None, :, :]).reshape(-1, d))
         lo = np.searchsorted(self.keys, keys, "left")
         count = np.searchsorted(self.keys, keys, "right") - lo
