@@ -9,7 +9,8 @@ grid spacings from a cell boundary and among the rest, and the time of the label
 two and of three of three sources' regions. Last, on
 the Stanford bunny (``../shared/data``, grid ``surface.grid(n)``) from vertex 0 to 8 random
 vertices: the paths' lengths and ``u`` against the exact polyhedral geodesic distances
-(pygeodesic, MMP; skipped without it or the data). These are the figures of
+(pygeodesic, MMP; skipped without it or the data), and the time of the labels at all its vertices
+with two sources. These are the figures of
 docs/paths-and-labels.md::
 
     .venv/bin/python benches/paths_and_labels.py            # N = 41, 81, 161, 321
@@ -126,6 +127,11 @@ def bunny_rows(sizes: list) -> None:
         u = sol.on_mesh(v[targets])
         el, eu = np.abs(lengths - exact) / g.spacing, np.abs(u - exact) / g.spacing
         print(f"| {n} | {g.spacing:.3g} | {el.mean():.2f} | {el.max():.2f} | {eu.mean():.2f} | {eu.max():.2f} |")
+    nb = max((n for n in sizes if n <= 201), default=161)
+    two = ts.solve(bunny, bunny.grid(nb), v[[0, 20000]])
+    t = time.perf_counter()
+    two.nearest_source(v)
+    print(f"\nbunny, two sources, N = {nb}: labels at its {len(v):,} vertices in {1e3 * (time.perf_counter() - t):.0f} ms")
 
 
 if __name__ == "__main__":
