@@ -119,6 +119,8 @@ def test_bad_requests_are_refused_with_the_argument_named():
         sol.geodesic_path((0.0, 0.6), step=0.0)
     with pytest.raises(ValueError, match="step"):
         sol.geodesic_path((0.0, 0.6), step=True)
+    with pytest.raises(ValueError, match="step"):
+        sol.geodesic_path((0.0, 0.6), step=1e-6)
     with pytest.raises(ValueError, match="max_steps"):
         sol.geodesic_path((0.0, 0.6), max_steps=True)
     with pytest.raises(ValueError, match="start must be one point"):
@@ -190,12 +192,23 @@ def test_paths_to_many_sources_off_the_nodes_end_at_a_source():
 
 def test_a_path_starting_at_the_edge_of_the_grid_uses_one_sided_differences():
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
-    sol = ts.solve(ts.surfaces.PlanePatch(1.5), g, [(0.0, 0.0, 0.0)])
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        path = sol.geodesic_path((0.98, 0.98, 0.0))
-    assert np.array_equal(path[-1], [0.0, 0.0, 0.0])
-    assert abs(_length(path) - 0.98 * np.sqrt(2)) < 0.5 * g.spacing
+    for sources in ([(0.0, 0.0, 0.0)], [(0.0, 0.0, 0.0), (-0.8, 0.8, 0.0)]):
+        sol = ts.solve(ts.surfaces.PlanePatch(1.5), g, sources)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            path = sol.geodesic_path((0.98, 0.98, 0.0))
+        assert np.array_equal(path[-1], [0.0, 0.0, 0.0])
+        assert abs(_length(path) - 0.98 * np.sqrt(2)) < 0.5 * g.spacing
+    # a sphere cut by the grid, two sources: a start next to the cut, whose stencil leaves the
+    # grid, takes steps (it stopped where it started: found in review). Its geodesic dips below
+    # the cut, so the path ends at the grid's edge, with a warning.
+    cut = ts.Grid((-1, -1, -0.2), (1, 1, 1), (41, 41, 25))
+    sources = np.array([[0.3, 0, 0.4], [-0.4743, 0, -0.1581]])
+    sol = ts.solve(ts.surfaces.Sphere(R), cut, sources)
+    with pytest.warns(RuntimeWarning, match="stopped before reaching a source"):
+        path = sol.geodesic_path((0.0934, 0.4672, -0.1516))
+    u = sol(path)
+    assert len(path) >= 5 and np.all(np.diff(u) < 0)
 
 
 def test_plot_draws_paths(tmp_path):

@@ -99,6 +99,9 @@ def test_labels_with_node_sources_duplicates_and_anisotropic_hamiltonians(tmp_pa
     moving = ts.solve(c, g2, [(0.6, 0.0), (-0.6, 0.0)], flow=solid_body_rotation(0.5))
     with pytest.raises(ValueError, match="isotropic"):
         moving.nearest_source()
+    # one source: its label wherever a front arrives, for any Hamiltonian
+    single = ts.solve(c, g2, [(0.6, 0.0)], flow=solid_body_rotation(0.5))
+    assert np.array_equal(single.nearest_source(), np.where(np.isfinite(single.values), 0, -1))
     # the export leaves the labels out rather than failing
     _, _, data = read_vtp(ts.export(moving, tmp_path / "moving.vtp"))
     assert "nearest_source" not in data and "u" in data

@@ -561,6 +561,19 @@ def test_native_open_surface_closest_points_are_the_numpy_formulas_bit_for_bit()
     numpy_route = ts.ClosestPoint(hemi._cp_numpy)
     a, b = ts.solve(hemi, g, [hemi.default_source]), ts.solve(numpy_route, g, [hemi.default_source])
     assert np.array_equal(a.linear, b.linear) and np.array_equal(a.values, b.values)
+    # a subclass with its own NumPy formula gets it (here: the lower hemisphere)
+    class Lower(ts.surfaces.Hemisphere):
+        def _cp_numpy(self, q):
+            return super()._cp_numpy(q * [1, 1, -1]) * [1, 1, -1]
+
+    assert np.all(Lower()._cp(p[:100])[:, 2] <= 0) and np.all(hemi._cp(p[:100])[:, 2] >= 0)
+    for bad in (np.inf, -1.0, (0.5, 0.5), "x"):
+        with pytest.raises(ValueError, match="radius must be"):
+            ts.surfaces.Disc(bad)
+    with pytest.raises(ValueError, match="center"):
+        ts.surfaces.PlanePatch(0.5, center=(np.nan, 0, 0))
+    with pytest.raises(ValueError, match=r"\(M, 3\)"):
+        hemi._cp(p[:3, :2])
     with pytest.raises(ValueError, match="kind must be"):
         _native.open_surface_closest_points("cone", p[:2], [0.0, 0.0, 0.0], 0.5)
     with pytest.raises(ValueError, match=r"\(M, 3\)"):

@@ -31,11 +31,16 @@ from typing import TYPE_CHECKING, Any, List, Optional
 import numpy as np
 
 from ._validate import as_points
+from .solve import SOURCE_RADIUS
 
 if TYPE_CHECKING:  # pragma: no cover
     from .solve import Solution
 
 __all__ = ["trace_paths"]
+
+#: The smallest step, in grid spacings (a path takes about length / (step·Δx) steps, each a few
+#: NumPy calls and two projections).
+MIN_STEP = 0.01
 
 #: Steps in a row without a decrease of ``u`` after which a path is declared stalled.
 STALL_STEPS = 8
@@ -43,7 +48,7 @@ STALL_STEPS = 8
 #: A path ends with a straight segment to a source once it is this many grid spacings from it
 #: (the radius of the nodes a source fixes, ``solve.SOURCE_RADIUS``: there u is the exact
 #: distance, and a gradient stencil that straddles the source's cone points poorly).
-FINISH_RADIUS = 2.0
+FINISH_RADIUS = SOURCE_RADIUS
 
 
 class _SourceFinder:
@@ -114,11 +119,14 @@ class _CellLabels:
         self.corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
 
     def clean(self, x: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """(M,) True where every corner of the cell of x is a band node labelled ``target``."""
-        base = self.sol.grid.cell_index(x)
+        """(M,) True where x lies in the grid and every corner of its cell is a band node labelled
+        ``target`` (a point outside the grid is never clean: its difference is NaN)."""
+        grid = self.sol.grid
+        base = grid.cell_index(x)
         corners = (base[None, :, :] + self.corners[:, None, :]).reshape(-1, x.shape[1])
         pos = self.sol._band.find(np.ascontiguousarray(corners)).reshape(len(self.corners), len(x))
-        return np.all((pos >= 0) & (self.labels[np.maximum(pos, 0)] == target[None, :]), axis=0)
+        inside = grid.contains(x, tol=0.0)
+        return inside & np.all((pos >= 0) & (self.labels[np.maximum(pos, 0)] == target[None, :]), axis=0)
 
 
 def _gradient(sol: "Solution", x: np.ndarray, u0: np.ndarray, cells: Optional[_CellLabels] = None,
@@ -172,7 +180,7 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
     it first, by steps of ``step`` grid spacings against ∇u (see the module's docstring).
 
     Raises ``ValueError`` for a solution of an anisotropic Hamiltonian, a ``step`` outside
-    (0, 1], a start farther from the surface than the inner tube, outside the band, or not
+    [MIN_STEP, 1], a start farther from the surface than the inner tube, outside the band, or not
     reached by any source.
     """
     if not sol._isotropic:
@@ -181,8 +189,8 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
             f"{sol.hamiltonian!r}, whose fastest paths do not run against ∇u"
         )
     if isinstance(step, (bool, np.bool_)) or not (
-            isinstance(step, (int, float, np.floating, np.integer)) and 0.0 < float(step) <= 1.0):
-        raise ValueError(f"step must be a number of grid spacings in (0, 1]; got {step!r}")
+            isinstance(step, (int, float, np.floating, np.integer)) and MIN_STEP <= float(step) <= 1.0):
+        raise ValueError(f"step must be a number of grid spacings in [{MIN_STEP}, 1]; got {step!r}")
     grid = sol.grid
     h = grid.spacing
     d = grid.ndim

@@ -186,9 +186,10 @@ class Solution:
         accurate like the values: nodes within about a grid spacing of a cell boundary may take the
         neighbouring cell's label. Only for isotropic Hamiltonians (``"godunov"``, ``"lxf"``,
         ``Isotropic()``): under a moving medium or a metric the smallest neighbour is not the one
-        the front came from, and a ``ValueError`` says so.
+        the front came from, and a ``ValueError`` says so (with one source the labels are 0
+        wherever a front arrives, for any Hamiltonian).
         """
-        if not self._isotropic:
+        if not self._isotropic and len(self.sources) > 1:
             raise ValueError(
                 f"nearest_source needs an isotropic Hamiltonian (godunov, lxf or Isotropic()); this solution is "
                 f"{self.hamiltonian!r}. Solve each source on one ts.Tube and take the argmin of the values instead"
@@ -207,7 +208,9 @@ class Solution:
 
     def geodesic_path(self, start: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> np.ndarray:
         """The shortest path on the surface from ``start`` (a point on it) to the source whose front
-        reaches it first, as a polyline (P, d) from the start to that source.
+        reaches it first, as a polyline (P, d) from the start to that source (where two sources lie
+        within a few grid spacings of each other, the one the path comes within two spacings of
+        first).
 
         Traced backwards along the characteristics: steps of ``step`` grid spacings against the
         gradient of the solution, each projected back onto the surface (see

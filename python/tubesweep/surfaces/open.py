@@ -5,7 +5,7 @@ orientable), so φ is not defined — the tube is ``{|x − cp(x)| ≤ h}``."""
 
 from __future__ import annotations
 
-from typing import Sequence, Tuple
+from typing import Any, Sequence, Tuple
 
 import numpy as np
 
@@ -23,10 +23,32 @@ def _safe_unit(v: np.ndarray, fallback: np.ndarray) -> np.ndarray:
     return np.where(n > 1e-300, v / np.where(n > 1e-300, n, 1.0), fallback)
 
 
-def _native_cp(kind: str, p: np.ndarray, center: np.ndarray, size: float) -> np.ndarray:
-    """The closest points of an open library surface, computed in the Rust core."""
-    x = np.ascontiguousarray(np.asarray(p, dtype=float).reshape(-1, 3))
-    return _native.open_surface_closest_points(kind, x, [float(c) for c in center], size)
+def _native_cp(surface: Any, base: type, kind: str, p: np.ndarray, size: float) -> np.ndarray:
+    """The closest points of an open library surface, computed in the Rust core; a subclass that
+    overrides ``_cp_numpy`` gets its own NumPy formula instead."""
+    if type(surface)._cp_numpy is not base._cp_numpy:  # type: ignore[attr-defined]
+        return surface._cp_numpy(p)
+    x = np.asarray(p, dtype=float)
+    if x.ndim != 2 or x.shape[1] != 3:
+        raise ValueError(f"points must have shape (M, 3); got {x.shape}")
+    return _native.open_surface_closest_points(kind, np.ascontiguousarray(x), [float(c) for c in surface.center], size)
+
+
+def _check_size(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a positive finite number; got {value!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise ValueError(f"{name} must be positive and finite; got {value!r}")
+    return v
+
+
+def _check_center(center: Any) -> np.ndarray:
+    c = np.asarray(center, dtype=float).reshape(3)
+    if not np.all(np.isfinite(c)):
+        raise ValueError(f"center must be three finite coordinates; got {center!r}")
+    return c
 
 
 class Hemisphere(ClosestPoint):
@@ -48,14 +70,12 @@ class Hemisphere(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        if not radius > 0:
-            raise ValueError(f"radius must be positive; got {radius}")
-        self.radius = float(radius)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.radius = _check_size("radius", radius)
+        self.center = _check_center(center)
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
-        return _native_cp("hemisphere", p, self.center, self.radius)
+        return _native_cp(self, Hemisphere, "hemisphere", p, self.radius)
 
     def _cp_numpy(self, p: np.ndarray) -> np.ndarray:
         """The closest point in NumPy (the core's ``hemisphere_closest_points`` gives the same bits)."""
@@ -100,14 +120,12 @@ class Disc(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, radius: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        if not radius > 0:
-            raise ValueError(f"radius must be positive; got {radius}")
-        self.radius = float(radius)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.radius = _check_size("radius", radius)
+        self.center = _check_center(center)
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
-        return _native_cp("disc", p, self.center, self.radius)
+        return _native_cp(self, Disc, "disc", p, self.radius)
 
     def _cp_numpy(self, p: np.ndarray) -> np.ndarray:
         """The closest point in NumPy (the core's ``disc_closest_points`` gives the same bits)."""
@@ -147,14 +165,12 @@ class PlanePatch(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, half_size: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        if not half_size > 0:
-            raise ValueError(f"half_size must be positive; got {half_size}")
-        self.half_size = float(half_size)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.half_size = _check_size("half_size", half_size)
+        self.center = _check_center(center)
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
-        return _native_cp("plane-patch", p, self.center, self.half_size)
+        return _native_cp(self, PlanePatch, "plane-patch", p, self.half_size)
 
     def _cp_numpy(self, p: np.ndarray) -> np.ndarray:
         """The closest point in NumPy (the core's ``plane_patch_closest_points`` gives the same bits)."""
