@@ -41,7 +41,7 @@ def project_to_sampled_level_set(
     tol: float,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
 def analytic_level_set_band(
-    kind: str,  # "sphere", "torus", "ellipsoid" or "star"
+    kind: str,  # "sphere", "torus", "ellipsoid", "star", "rounded-cube" or "double-torus"
     parameters: List[float],
     shape: List[int],
     lower: List[float],

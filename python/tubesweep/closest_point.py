@@ -82,10 +82,12 @@ class ClosestPoint(Surface):
     Examples
     --------
     >>> import numpy as np, tubesweep as ts
-    >>> def cp(x):  # the upper hemisphere of radius 0.5
-    ...     y = x / np.linalg.norm(x, axis=1, keepdims=True) * 0.5
-    ...     rim = np.c_[x[:, :2] / np.linalg.norm(x[:, :2], axis=1, keepdims=True) * 0.5, 0 * x[:, 2]]
-    ...     return np.where(x[:, 2:] >= 0, y, rim)
+    >>> def cp(x):  # the upper hemisphere of radius 0.5 (at the centre and on the axis, any point)
+    ...     r = np.linalg.norm(x, axis=1, keepdims=True)
+    ...     rho = np.linalg.norm(x[:, :2], axis=1, keepdims=True)
+    ...     up = np.where(r > 0, 0.5 * x / np.where(r > 0, r, 1), [0, 0, 0.5])
+    ...     rim_xy = np.where(rho > 0, 0.5 * x[:, :2] / np.where(rho > 0, rho, 1), [0.5, 0])
+    ...     return np.where(x[:, 2:] >= 0, up, np.c_[rim_xy, 0 * x[:, 2]])
     >>> surf = ts.ClosestPoint(cp)
     """
 
