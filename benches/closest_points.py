@@ -9,6 +9,7 @@ grid, ``surface.grid(n)``), medians of warm runs, with the thread count of ``RAY
 
     .venv/bin/python benches/closest_points.py                  # N = 201, 5 runs
     RAYON_NUM_THREADS=1 .venv/bin/python benches/closest_points.py --n 101
+    .venv/bin/python benches/closest_points.py --split          # also by where the candidates lie
 
 To compare two commits, build each in its own checkout (``make build``) and run the script in
 both, alternately or at once on separate cores (``RAYON_NUM_THREADS=1 taskset -c 0 ...`` and
@@ -38,6 +39,8 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=201, help="grid nodes along the bunny's longest side")
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--split", action="store_true",
+                    help="also time the queries of the candidates outside the band, of the band, and of its inner tube")
     a = ap.parse_args()
     problem = PROBLEMS["bunny"](a.n)
     surface, grid = problem.surface, problem.grid
@@ -68,6 +71,23 @@ def main() -> int:
           f"{int((d <= half_width).sum()):,} band nodes; threads {threads}, medians of {a.repeats}")
     print(f"  coarse-to-fine search {1e3 * statistics.median(coarse):.0f} ms, closest points of the candidates "
           f"{1e3 * final_s:.0f} ms ({1e9 * final_s / len(candidates):.0f} ns per query)")
+    if a.split:
+        inner_width = 2 * grid.spacing  # the default inner tube
+
+        def timed(selected: np.ndarray) -> float:
+            pts = np.ascontiguousarray(points[selected])
+            runs = []
+            for _ in range(a.repeats):
+                t = time.perf_counter()
+                tree.closest(pts, reach)
+                runs.append(time.perf_counter() - t)
+            return statistics.median(runs)
+
+        for label, selected in [("outside the band", d > half_width), ("the band", d <= half_width),
+                                ("the inner tube", d <= inner_width)]:
+            s = timed(selected)
+            k = int(selected.sum())
+            print(f"  {label}: {k:,} queries, {1e3 * s:.0f} ms ({1e9 * s / max(k, 1):.0f} ns per query)")
     return 0
 
 
