@@ -94,3 +94,78 @@ def test_bad_speed_array_error_names_the_node():
                  lambda: ts.solve(circle, G2, [(0.5, 0)], speed=speed)):
         with pytest.raises(ValueError, match=r"at \(0\.5, 0\.0\)"):
             call()
+
+
+G3 = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+SPHERE = ts.surfaces.Sphere(0.5)
+
+
+def test_tol_must_be_positive_and_max_iterations_bounded():
+    # tol = 0 used to run all max_iterations (a change of exactly 0 never passed `< tol`)
+    for bad in (0, 0.0, True):
+        with pytest.raises(ValueError, match="tol must be a positive"):
+            ts.solve(SPHERE, G3, [(-0.5, 0, 0)], tol=bad)
+    with pytest.raises(ValueError, match="max_iterations"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], max_iterations=2**70)
+
+
+@pytest.mark.parametrize("speed", [1e15, 1e9])
+def test_a_tol_not_small_against_a_cell_s_travel_time_is_refused(speed):
+    # at speed 1e15 the default tol 1e-10 exceeds every travel time: the sweeps stopped at once,
+    # half the band at the numerical infinity, reported converged
+    with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel time across one grid cell"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed)
+    with pytest.raises(ValueError, match="travel time across one grid cell"):
+        ts.travel_time(G2, [(0, 0)], speed=speed)
+    # the fix the message names works, and gives the speed-1 answer scaled
+    cell = G3.spacing / speed
+    u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, tol=1e-10 * cell)([(0.5, 0, 0)])[0]
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)])([(0.5, 0, 0)])[0]
+    assert abs(u * speed - u1) < 1e-6 * u1
+
+
+def test_a_small_grid_in_small_units_needs_a_tol_in_those_units():
+    s = 1e-12
+    grid = ts.Grid((-s,) * 3, (s,) * 3, (31,) * 3)
+    with pytest.raises(ValueError, match="tol"):
+        ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)])
+    u = ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], tol=1e-10 * grid.spacing)([(0.5 * s, 0, 0)])[0]
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)])([(0.5, 0, 0)])[0]
+    assert abs(u / s - u1) < 1e-6
+
+
+@pytest.mark.parametrize("value, match", [(np.nan, "speed is nan"), (-1.0, "speed is -1.0"), (0.0, "speed is 0.0")])
+def test_a_speed_callable_is_checked_at_the_source_too(value, match):
+    # the callable is also evaluated at the source and at closest points, which used to go unchecked
+    def speed(p):
+        return np.where(np.linalg.norm(p - [-0.5, 0, 0], axis=1) < 1e-12, value, 1.0)
+
+    with pytest.raises(ValueError, match=match):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed)
+
+    def speed2(p):
+        return np.where(np.linalg.norm(p - [0.013, 0.011], axis=1) < 1e-12, value, 1.0)
+
+    with pytest.raises(ValueError, match=match):
+        ts.travel_time(G2, [(0.013, 0.011)], speed=speed2)
+
+
+def test_a_grid_too_coarse_for_the_surface_is_refused():
+    # at N = 4 every band node lay within two spacings of the source and was fixed to the chord:
+    # u(0.5, 0, 0) = 0.876 against pi/2, reported converged
+    with pytest.raises(ValueError, match="too coarse"):
+        ts.solve(SPHERE, ts.Grid((-1,) * 3, (1,) * 3, (4,) * 3), [(-0.5, 0, 0)])
+
+
+def test_threads_beyond_the_cores_are_refused():
+    import os
+
+    with pytest.raises(ValueError, match="threads"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], threads=4 * (os.cpu_count() or 1) + 1)
+    with pytest.raises(ValueError, match="threads"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], threads=True)
+
+
+def test_mobius_newton_iterations_are_bounded():
+    with pytest.raises(ValueError, match="newton_iterations"):
+        ts.surfaces.MobiusBand(newton_iterations=10**12)

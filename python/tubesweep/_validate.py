@@ -66,11 +66,45 @@ def check_hamiltonian(hamiltonian: str) -> str:
     return hamiltonian.lower()
 
 
+MAX_ITERATIONS_LIMIT = 10**9
+
+
 def check_tolerance(tol: float, max_iterations: int) -> None:
-    if not (isinstance(tol, (int, float, np.floating)) and np.isfinite(tol) and tol >= 0):
-        raise ValueError(f"tol must be a non-negative finite number; got {tol!r}")
-    if not (isinstance(max_iterations, (int, np.integer)) and max_iterations >= 1):
-        raise ValueError(f"max_iterations must be a positive integer; got {max_iterations!r}")
+    if not (isinstance(tol, (int, float, np.floating)) and not isinstance(tol, bool) and np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be a positive finite number (the sweeps stop once no value changes by more in an "
+                         f"iteration); got {tol!r}")
+    if not (isinstance(max_iterations, (int, np.integer)) and not isinstance(max_iterations, bool)
+            and 1 <= max_iterations <= MAX_ITERATIONS_LIMIT):
+        raise ValueError(f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}")
+
+
+def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float) -> None:
+    """Refuses a ``tol`` that is not small against the travel time across one grid cell: the stopping
+    test compares absolute changes with it, so a ``tol`` of that size (short travel times: a large
+    speed, or a grid in small units) stops the sweeps before the front has crossed the band, with
+    nodes still at the numerical infinity."""
+    cell = spacing * mean_slowness
+    if tol >= 0.1 * cell:
+        raise ValueError(
+            f"tol={tol:g} is not small against the travel time across one grid cell (spacing × mean slowness = "
+            f"{cell:.3g}): the sweeps would stop before the front crosses the band. Pass a tol relative to it, "
+            f"e.g. tol=1e-10 * {cell:.3g} (or rescale the units of the grid or the speed)")
+
+
+def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
+    """A speed callable's values at ``points`` (source points, their closest points), checked as
+    the values at the nodes are: one per point, finite and positive."""
+    vals = np.asarray(speed(points), dtype=float)
+    if vals.shape != (points.shape[0],):
+        raise ValueError(f"speed callable must map points of shape (M, {points.shape[1]}) to values of shape (M,); "
+                         f"returned shape {vals.shape} for M = {points.shape[0]} ({what})")
+    bad = ~(np.isfinite(vals) & (vals > 0))
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        p = tuple(float(x) for x in points[i])
+        raise ValueError(f"speed is {vals[i]} at {p} ({what}); it must be positive and finite everywhere the "
+                         f"solution reaches")
+    return vals
 
 
 def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np.ndarray]) -> "float | np.ndarray":
@@ -181,6 +215,10 @@ def check_infinity(infinity: Optional[float]) -> Optional[float]:
 
 
 def check_threads(threads: int) -> int:
-    if not (isinstance(threads, (int, np.integer)) and threads >= 0):
+    if not (isinstance(threads, (int, np.integer)) and not isinstance(threads, bool) and threads >= 0):
         raise ValueError(f"threads must be a non-negative integer (0 = all cores); got {threads!r}")
+    cores = os.cpu_count() or 1
+    if threads > 4 * cores:
+        raise ValueError(f"threads={threads} is more than 4 × the {cores} cores of this machine; the sweeps gain "
+                         f"nothing from more threads than cores (0 = all cores)")
     return int(threads)

@@ -18,6 +18,8 @@ from ._validate import (
     check_hamiltonian,
     check_memory,
     check_tolerance,
+    check_tolerance_scale,
+    speed_at_points,
     progress_callback,
     speed_values,
     warn_unconverged,
@@ -145,9 +147,11 @@ def travel_time(
     else:
         slowness = 1.0 / speed_values(speed, grid, np.empty((0, grid.ndim)), None)
 
+    check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)))
+
     def slowness_at(x: np.ndarray) -> np.ndarray:
         if callable(speed):
-            return 1.0 / np.asarray(speed(x), dtype=float)
+            return 1.0 / speed_at_points(speed, x, "a source")
         if np.ndim(slowness) == 0:
             return np.full(len(x), float(slowness))
         # multilinear interpolation of the slowness array

@@ -21,6 +21,8 @@ from ._validate import (
     as_sources,
     check_hamiltonian,
     check_tolerance,
+    check_tolerance_scale,
+    speed_at_points,
     progress_callback,
     speed_values,
     warn_unconverged,
@@ -527,15 +529,22 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
 
     def slowness_at(p: np.ndarray) -> np.ndarray:
         if callable(speed):
-            return 1.0 / np.asarray(speed(p), dtype=float)
+            return 1.0 / speed_at_points(speed, p, "a source or the closest point of a node near it")
         if np.ndim(speed) == 0:
             return np.full(len(p), 1.0 / float(speed))
         from .euclidean import _interp_dense
 
         return 1.0 / _interp_dense(np.asarray(speed, dtype=float), grid, p)
 
+    if general is None:
+        check_tolerance_scale(tol, h, float(np.mean(slowness)))
     positions, fixed_vals, fixed_sources = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
+    if tube.method != "naive" and not np.any(roles == ROLE_INNER):
+        raise ValueError(
+            f"the grid is too coarse for this surface: every node of the inner tube lies within {SOURCE_RADIUS:g} grid "
+            f"spacings (h = {h:.4g}) of a source, so its value is the source's initialisation and nothing is solved; "
+            f"refine the grid")
     del x
     method = tube.method
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"

@@ -231,8 +231,10 @@ class MobiusBand(ClosestPoint):
             raise ValueError(f"need 0 < w < R; got R={R}, w={w}")
         self.R = float(R)
         self.w = float(w)
-        if not int(newton_iterations) >= 1:
-            raise ValueError(f"newton_iterations must be at least 1; got {newton_iterations}")
+        if not (isinstance(newton_iterations, (int, np.integer)) and not isinstance(newton_iterations, bool)
+                and 1 <= newton_iterations <= 10_000):
+            raise ValueError(f"newton_iterations must be an integer from 1 to 10,000 (60 is plenty: Newton's method "
+                             f"converges in a few steps); got {newton_iterations!r}")
         self.newton_iterations = int(newton_iterations)
         super().__init__(self._cp, ndim=3)
 
