@@ -230,3 +230,22 @@ def test_point_vortex_flow_is_tangent_with_the_known_speed():
     np.testing.assert_allclose(cored(far), v(far), rtol=2e-4)
     with pytest.raises(ValueError, match="centers"):
         point_vortices([(0.0, 1.0)], 1.0)
+
+
+def test_a_sigma_below_the_hamiltonian_s_bound_is_refused_with_the_bound():
+    # sigma = 0.5 for the isotropic H (|dH/dp_k| up to 1) gave NaN and -inf, reported converged
+    c = Circle(R)
+    g = _grid2(101)
+    with pytest.raises(ValueError, match=r"sigma\[0\] = 0.5 is below max \|∂H/∂p_0\| = 1"):
+        ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(sigma=0.5))
+    # solid-body rotation with omega = 1: |v_k| up to max|x| on the band, so sigma_k >= 1 + max|v_k|
+    with pytest.raises(ValueError, match=r"sigma\[0\] = 0.01 is below"):
+        ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.MovingMedium(solid_body_rotation(1.0), sigma=0.01))
+    with pytest.raises(ValueError, match=r"sigma\[1\] = 1.2 is below"):
+        ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.MovingMedium(solid_body_rotation(1.0), sigma=(2.0, 1.2)))
+    metric = np.array([[2.0, 0.6], [0.6, 0.5]])
+    with pytest.raises(ValueError, match="sigma"):
+        ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(metric, sigma=1.0))
+    # exactly the bound is admissible, and gives the per-node default's answer up to viscosity
+    ok = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(sigma=1.0))
+    assert ok.stats.converged and np.all(np.isfinite(ok(c.sample(200))))

@@ -291,6 +291,27 @@ struct GeneralInputs<'s> {
     sigma: Option<&'s [f64]>,
 }
 
+/// Per axis, the largest over the band's nodes of the Hamiltonian's own viscosity `σ_k` (the exact
+/// bound of `|∂H/∂p_k|` it uses without a user's `sigma`): the smallest constant `sigma` that keeps
+/// the Lax–Friedrichs update monotone everywhere.
+fn required_sigma<const D: usize>(inputs: &GeneralInputs<'_>, flow: &[[f64; D]], metric: &[[[f64; D]; D]], n: usize) -> [f64; D] {
+    let ham: Box<dyn Hamiltonian<D> + '_> = match inputs.kind.as_str() {
+        // a flow or metric missing or of the wrong length is refused after this, by the caller
+        "moving_medium" if flow.len() == n => Box::new(MovingMedium { slowness: inputs.slowness, flow, sigma: None }),
+        "metric" if metric.len() == n => Box::new(Metric { slowness: inputs.slowness, metric, sigma: None }),
+        "moving_medium" | "metric" => return [0.0; D],
+        _ => Box::new(Isotropic { slowness: inputs.slowness, sigma: None }),
+    };
+    let mut needed = [0.0f64; D];
+    for node in 0..n {
+        let v = ham.viscosity(node);
+        for k in 0..D {
+            needed[k] = needed[k].max(v[k]);
+        }
+    }
+    needed
+}
+
 /// Sweeps with the general Lax–Friedrichs update of Sect. 5.1 and a built-in Hamiltonian.
 #[allow(clippy::too_many_arguments)]
 fn solve_general_generic<'py, const D: usize>(
@@ -331,6 +352,18 @@ fn solve_general_generic<'py, const D: usize>(
         Some(_) => return Err(PyValueError::new_err(format!("metric must have shape ({n}, {D}, {D})"))),
         None => Vec::new(),
     };
+    // the smallest admissible constant viscosities: the default (exact) σ of every node, per axis
+    if let Some(sig) = inputs.sigma {
+        let needed = required_sigma::<D>(&inputs, flow, &metric, n);
+        if let Some(k) = (0..D).find(|&k| sig[k] < needed[k]) {
+            return Err(PyValueError::new_err(format!(
+                "sigma[{k}] = {} is below max |∂H/∂p_{k}| = {} over the band (Sect. 5.1): the Lax–Friedrichs update would \
+                 not be monotone and the values would blow up; pass sigma of at least {:?}, or leave sigma out for the \
+                 exact per-node bound",
+                sig[k], needed[k], needed
+            )));
+        }
+    }
     let iso;
     let mm;
     let met;
