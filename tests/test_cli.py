@@ -99,3 +99,28 @@ def test_solve_traces_paths_and_labels_cells(tmp_path, capsys):
         main(["solve", "--surface", "sphere", "--n", "41", "--path-from-vertex", "3", "--out", str(tmp_path), "--quiet"])
     with pytest.raises(SystemExit, match="3 coordinates"):
         main(["solve", "--surface", "sphere", "--n", "41", "--path-from", "0", "0.5", "--out", str(tmp_path), "--quiet"])
+
+
+def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
+    # φ in an .npz (it was read as an NpzFile and failed on .shape)
+    g = np.linspace(-1, 1, 41)
+    x, y = np.meshgrid(g, g, indexing="ij")
+    np.savez(tmp_path / "phi.npz", phi=np.hypot(x, y) - 0.5)
+    rc = main(["solve", "--phi", str(tmp_path / "phi.npz"), "--lower", "-1", "-1", "--upper", "1", "1",
+               "--source", "0.5", "0", "--out", str(tmp_path / "o"), "--quiet"])
+    assert rc == 0 and (tmp_path / "o" / "solution.npz").exists()
+    (tmp_path / "notnumpy.txt").write_text("hello")
+    with pytest.raises(SystemExit, match="not a NumPy .npy or .npz file"):
+        main(["solve", "--phi", str(tmp_path / "notnumpy.txt"), "--lower", "-1", "-1", "--upper", "1", "1",
+              "--source", "0.5", "0", "--out", str(tmp_path / "o2")])
+    # --out an existing file, an unknown export format: refused before solving (no traceback)
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(SystemExit, match="exists and is not a directory"):
+        main(["solve", "--surface", "circle", "--n", "41", "--out", str(tmp_path / "afile")])
+    with pytest.raises(SystemExit, match="unknown format '.xyz'"):
+        main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "x.xyz"), "--out", str(tmp_path / "o3")])
+    assert not (tmp_path / "o3").exists()
+    # a mesh file nothing can read: an error line and exit code 2
+    (tmp_path / "m.unknownext").write_text("1 2 3")
+    assert main(["solve", "--mesh", str(tmp_path / "m.unknownext"), "--out", str(tmp_path / "o4"), "--quiet"]) == 2
+    assert "error:" in capsys.readouterr().err

@@ -130,6 +130,25 @@ def _grid_for(surface, n: int, lower: Optional[Sequence[float]], upper: Optional
     return Grid(lower, upper, (n,) * len(lower))
 
 
+def _load_phi(path: Path) -> np.ndarray:
+    """φ sampled on the grid from a ``.npy`` file, or from a ``.npz`` holding one array (or one named
+    ``phi``)."""
+    try:
+        data = np.load(path, allow_pickle=False)
+    except ValueError:
+        raise SystemExit(f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
+                         f"φ with numpy.save or numpy.savez") from None
+    if isinstance(data, np.lib.npyio.NpzFile):
+        with data:
+            names = list(data.files)
+            if "phi" in names:
+                return np.asarray(data["phi"])
+            if len(names) == 1:
+                return np.asarray(data[names[0]])
+        raise SystemExit(f"--phi {path}: an .npz file must hold one array or one named 'phi'; it holds {names}")
+    return np.asarray(data)
+
+
 def cmd_solve(args: argparse.Namespace) -> int:
     from .grid import Grid
     from .solve import solve
@@ -139,6 +158,14 @@ def cmd_solve(args: argparse.Namespace) -> int:
         raise SystemExit("--source-vertex needs --mesh")
     if args.path_from_vertex and not args.mesh:
         raise SystemExit("--path-from-vertex needs --mesh")
+    # what can be checked before the solve is checked before it
+    from .output import EXPORT_FORMATS
+
+    for path in args.export or []:
+        if Path(path).suffix.lower() not in EXPORT_FORMATS:
+            raise SystemExit(f"--export {path}: unknown format {Path(path).suffix!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    if args.out.exists() and not args.out.is_dir():
+        raise SystemExit(f"--out {args.out}: exists and is not a directory")
     if args.mesh:
         from .surfaces.mesh import from_mesh
 
@@ -156,12 +183,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
         grid = _grid_for(surface, 101 if args.n is None else args.n, args.lower, args.upper)
         name = args.surface
     else:
-        phi = np.load(args.phi)
+        phi = _load_phi(args.phi)
         if args.lower is None or args.upper is None:
             raise SystemExit("--phi needs --lower and --upper (the grid's corners)")
         grid = Grid(args.lower, args.upper, phi.shape)
         surface = LevelSet(phi)
         name = args.phi.stem
+    bad_arity = [len(p) for p in args.path_from or [] if len(p) != grid.ndim]
+    if bad_arity:
+        raise SystemExit(f"--path-from needs {grid.ndim} coordinates on a {grid.ndim}D grid; got {bad_arity[0]}")
     if args.source_vertex:
         nv = len(surface.vertices)
         bad = [i for i in args.source_vertex if not 0 <= i < nv]
@@ -305,7 +335,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     except KeyboardInterrupt:
         print("\ninterrupted", file=sys.stderr)
         return 130
-    except (ValueError, TypeError, MemoryError, ImportError, FileNotFoundError) as e:
+    except (ValueError, TypeError, MemoryError, ImportError, OSError, NotImplementedError) as e:
+        # OSError: files (missing, a directory, no permission); NotImplementedError: a mesh format
+        # that trimesh/meshio cannot read
         print(f"error: {e}", file=sys.stderr)
         return 2
     parser.print_help()
