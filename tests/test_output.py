@@ -161,3 +161,21 @@ def test_fig8_is_registered():
     from tubesweep import reproduce
 
     assert "fig8" in reproduce.experiments()
+
+
+def test_export_checks_a_user_mesh_and_writes_vectors_and_odd_names(sphere_sol, tmp_path):
+    v, f = ts.triangulate(sphere_sol)
+    # faces pointing past the vertices, negative or fractional: refused, no file written
+    for faces, match in [(np.array([[0, 1, len(v)]]), f"index vertex {len(v)}"), (np.array([[0, -1, 2]]), "index vertex -1"),
+                         (np.array([[0, 1, 2.7]]), "whole-number"), (np.array([0, 1, 2]), "shape")]:
+        with pytest.raises(ValueError, match=match):
+            ts.export(sphere_sol, tmp_path / "bad.vtp", mesh=(v, faces))
+    with pytest.raises(ValueError, match="NaN or inf"):
+        ts.export(sphere_sol, tmp_path / "bad.vtp", mesh=(np.where(np.arange(len(v))[:, None] == 3, np.nan, v), f))
+    assert not (tmp_path / "bad.vtp").exists()
+    with pytest.raises(ValueError, match=r"point_data\['t'\] must have shape"):
+        ts.export(sphere_sol, tmp_path / "s.vtp", point_data={"t": np.zeros((len(v), 5, 2))})
+    # a vector per vertex and a name with XML's special characters: a well-formed file, read back
+    name = 'a "b" <c> & d'
+    p, cells, data = read_vtp(ts.export(sphere_sol, tmp_path / "s.vtp", point_data={name: v, "x": v[:, 0]}))
+    assert np.array_equal(data[name], v) and np.array_equal(data["x"], v[:, 0]) and np.array_equal(cells, f)

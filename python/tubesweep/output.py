@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -53,6 +54,29 @@ def _band_box(sol: Any) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     return lo, shape, arr
 
 
+def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
+    """A user's ``mesh=(vertices, faces)``: finite vertices ``(n, 2 or 3)`` and faces ``(m, 2 or 3)``
+    of whole numbers indexing them, so that no written file points at a vertex that is not there."""
+    try:
+        v_in, f_in = mesh
+    except (TypeError, ValueError):
+        raise ValueError("mesh must be a pair (vertices (n, 3), faces (m, 3))") from None
+    v = np.asarray(v_in, dtype=float)
+    if v.ndim != 2 or v.shape[1] not in (2, 3) or not np.all(np.isfinite(v)):
+        raise ValueError(f"mesh vertices must be finite coordinates of shape (n, 2) or (n, 3); got shape {v.shape}"
+                         + ("" if v.ndim != 2 or np.all(np.isfinite(v)) else " with NaN or inf"))
+    f = np.asarray(f_in)
+    if f.ndim != 2 or f.shape[1] not in (2, 3) or (f.size and not np.issubdtype(f.dtype, np.number)):
+        raise ValueError(f"mesh faces must be an integer array of shape (m, 3) (or (m, 2) segments); got shape {f.shape}")
+    if f.size and (not np.all(np.isfinite(f)) or np.any(f != np.round(f))):
+        raise ValueError("mesh faces must hold whole-number vertex indices")
+    f = f.astype(np.int64)
+    if f.size and (f.min() < 0 or f.max() >= len(v)):
+        bad = int(f.min()) if f.min() < 0 else int(f.max())
+        raise ValueError(f"mesh faces index vertex {bad}, but there are vertices 0..{len(v) - 1}")
+    return v, f
+
+
 def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np.ndarray, np.ndarray]:
     """A mesh of the surface of a solution: ``(vertices (n, d), cells)``.
 
@@ -71,8 +95,7 @@ def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np
     in 2D (off-band nodes are NaN there). A surface with neither (a bare closest-point function) needs ``mesh=``.
     """
     if mesh is not None:
-        v, f = mesh
-        return np.asarray(v, dtype=float), np.asarray(f, dtype=np.int64)
+        return _checked_mesh(mesh)
     surf = sol.surface
     tri = getattr(surf, "triangulation", None)
     if callable(tri):
@@ -135,9 +158,11 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
         fh.write(f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{m if kind == "Lines" else 0}" '
                  f'NumberOfStrips="0" NumberOfPolys="{m if kind == "Polys" else 0}">\n')
         names = list(point_data)
-        fh.write(f'<PointData Scalars="{names[0]}">\n' if names else "<PointData>\n")
+        fh.write(f'<PointData Scalars={quoteattr(str(names[0]))}>\n' if names else "<PointData>\n")
         for name, a in point_data.items():
-            fh.write(f'<DataArray type="Float64" Name="{name}" format="ascii">\n{arr(a, "%.17g")}\n</DataArray>\n')
+            comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""
+            fh.write(f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="ascii">\n'
+                     f'{arr(a, "%.17g")}\n</DataArray>\n')
         fh.write("</PointData>\n<Points>\n")
         fh.write(f'<DataArray type="Float64" NumberOfComponents="3" format="ascii">\n{arr(points, "%.17g")}\n</DataArray>\n')
         fh.write(f"</Points>\n<{kind}>\n")
@@ -167,7 +192,10 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
     if conn is None or offs is None:
         raise ValueError(f"{path}: no {kind} connectivity")
     k = int(offs[0]) if len(offs) else 3
-    data = {el.get("Name"): values(el, float) for el in piece.findall("PointData/DataArray")}
+    data = {}
+    for el in piece.findall("PointData/DataArray"):
+        a = values(el, float)
+        data[el.get("Name")] = a.reshape(-1, int(el.get("NumberOfComponents"))) if el.get("NumberOfComponents") else a
     return points, conn.reshape(-1, k), data
 
 
@@ -203,6 +231,9 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
         data["nearest_source"] = sol.nearest_source(v).astype(float)
     for name, a in (point_data or {}).items():
         a = np.asarray(a, dtype=float)
+        if a.ndim not in (1, 2) or (a.ndim == 2 and not 1 <= a.shape[1] <= 9):
+            raise ValueError(f"point_data[{name!r}] must have shape (n,) or (n, k) with k at most 9 (one value or "
+                             f"vector per vertex); got {a.shape}")
         if a.shape[0] != len(v):
             raise ValueError(f"point_data[{name!r}] has {a.shape[0]} entries but the mesh has {len(v)} vertices")
         data[name] = a
