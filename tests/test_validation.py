@@ -169,3 +169,25 @@ def test_threads_beyond_the_cores_are_refused():
 def test_mobius_newton_iterations_are_bounded():
     with pytest.raises(ValueError, match="newton_iterations"):
         ts.surfaces.MobiusBand(newton_iterations=10**12)
+
+
+def test_a_surface_smaller_than_the_tube_says_to_refine_the_grid():
+    # the library's exact distance was refused as "not close to a signed distance function" with
+    # redistancing as the only advice, which then failed the same way
+    with pytest.raises(ValueError, match="refine the grid"):
+        ts.solve(ts.surfaces.Sphere(0.05), G3, [(-0.05, 0, 0)])
+
+
+@pytest.mark.parametrize("make", [
+    lambda: ts.surfaces.Sphere(0.5, center=(np.nan, 0, 0)),
+    lambda: ts.surfaces.Circle(center=(np.nan, 0)),
+    lambda: ts.surfaces.Sphere(0.5, center=(0, 0)),
+    lambda: ts.surfaces.Torus(center=(0, 0, np.inf)),
+    lambda: ts.surfaces.Ellipsoid(center=(0, 0, np.nan)),
+    lambda: ts.surfaces.RoundedCube(center=(np.nan, 0, 0)),
+    lambda: ts.surfaces.Ellipse(center="ab"),
+])
+def test_surface_centres_must_be_finite_coordinates(make):
+    # a NaN centre gave "the band is empty ... check that the surface passes through the grid"
+    with pytest.raises(ValueError, match="center must be [23] finite coordinates"):
+        make()

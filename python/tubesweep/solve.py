@@ -496,7 +496,9 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
         if attempt == _MAX_WIDENINGS:
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
-                "inner nodes lack a neighbour. φ is far from a distance function; use ts.LevelSet(phi, redistance=True)"
+                "inner nodes lack a neighbour. φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), "
+                "or the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
+                "than the tube: refine the grid)"
             )
         warnings.warn(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "

@@ -20,6 +20,17 @@ def own_phi(surface: Any, cls: type) -> bool:
     return type(surface).signed_distance is cls.signed_distance and surface._fn == surface.signed_distance
 
 
+def finite_center(center: Any, d: int) -> np.ndarray:
+    """A surface's ``center``: ``d`` finite coordinates, or a ValueError that says so."""
+    try:
+        c = np.asarray(center, dtype=float)
+    except (TypeError, ValueError):
+        c = np.array([np.nan])
+    if c.shape != (d,) or not np.all(np.isfinite(c)):
+        raise ValueError(f"center must be {d} finite coordinates; got {center!r}")
+    return c
+
+
 def _points(p: np.ndarray, d: int) -> np.ndarray:
     """``p`` as the C-ordered (M, d) float64 array the native distances read."""
     p = np.ascontiguousarray(p, dtype=float)
@@ -37,7 +48,7 @@ class Circle(LevelSet):
         if not radius > 0:
             raise ValueError(f"radius must be positive; got {radius}")
         self.radius = float(radius)
-        self.center = np.asarray(center, dtype=float).reshape(2)
+        self.center = finite_center(center, 2)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 2
 
@@ -77,7 +88,7 @@ class Sphere(LevelSet):
         if not radius > 0:
             raise ValueError(f"radius must be positive; got {radius}")
         self.radius = float(radius)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.center = finite_center(center, 3)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 3
 

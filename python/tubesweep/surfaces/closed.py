@@ -12,7 +12,7 @@ from .. import _native
 from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import grid_mesh, marching_cubes
-from .analytic import _points, own_phi
+from .analytic import _points, finite_center, own_phi
 
 __all__ = ["Ellipsoid", "Torus", "RoundedCube", "DoubleTorus"]
 
@@ -42,7 +42,7 @@ class Ellipsoid(LevelSet):
         if not (a > 0 and b > 0 and c > 0):
             raise ValueError(f"semi-axes must be positive; got a={a}, b={b}, c={c}")
         self.axes = np.array([a, b, c], dtype=float)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.center = finite_center(center, 3)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 3
 
@@ -159,7 +159,7 @@ class Torus(LevelSet):
             raise ValueError(f"need R > r > 0 (a ring torus); got R={R}, r={r}")
         self.R = float(R)
         self.r = float(r)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.center = finite_center(center, 3)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 3
 
@@ -223,7 +223,7 @@ class RoundedCube(LevelSet):
             raise ValueError(f"need 0 < radius <= half_size; got radius={radius}, half_size={half_size}")
         self.half_size = float(half_size)
         self.radius = float(radius)
-        self.center = np.asarray(center, dtype=float).reshape(3)
+        self.center = finite_center(center, 3)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 3
 

@@ -9,6 +9,7 @@ import numpy as np
 from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import polyline
+from .analytic import finite_center
 
 __all__ = ["Ellipse"]
 
@@ -37,7 +38,7 @@ class Ellipse(LevelSet):
             raise ValueError(f"semi-axes a, b must be positive; got a={a}, b={b}")
         self.a = float(a)
         self.b = float(b)
-        self.center = np.asarray(center, dtype=float).reshape(2)
+        self.center = finite_center(center, 2)
         self._t0 = np.linspace(0.0, 2 * np.pi, 64, endpoint=False)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 2
