@@ -191,3 +191,30 @@ def test_surface_centres_must_be_finite_coordinates(make):
     # a NaN centre gave "the band is empty ... check that the surface passes through the grid"
     with pytest.raises(ValueError, match="center must be [23] finite coordinates"):
         make()
+
+
+def test_a_band_too_large_for_the_memory_is_refused_before_the_search():
+    # at N = 100000 the sphere's band (6e10 nodes) was searched until the Rust allocator aborted
+    # the process (or, for the hemisphere, NumPy raised from deep inside the search)
+    huge3 = ts.Grid((-1,) * 3, (1,) * 3, (100_000,) * 3)
+    for surface in (SPHERE, ts.surfaces.Hemisphere(0.5), ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5)):
+        with pytest.raises(MemoryError, match="the band .* needs about .* GiB"):
+            ts.solve(surface, huge3, [(-0.5, 0, 0)])
+    with pytest.raises(MemoryError, match="coarser grid"):
+        ts.Tube(SPHERE, huge3)
+    with pytest.raises(MemoryError, match="the band"):
+        ts.solve(ts.surfaces.Circle(0.5), ts.Grid((-1, -1), (1, 1), (10**9, 10**9)), [(-0.5, 0)])
+
+
+@pytest.mark.parametrize("surface, grid", [
+    (SPHERE, ts.Grid((-1,) * 3, (1,) * 3, (161,) * 3)),
+    (ts.surfaces.Torus(0.5, 0.25), ts.Grid((-1,) * 3, (1,) * 3, (121,) * 3)),
+    (ts.surfaces.Hemisphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (121,) * 3)),
+    (ts.surfaces.Circle(0.5), ts.Grid((-1, -1), (1, 1), (401, 401))),
+])
+def test_the_memory_check_s_band_estimate_is_close_to_the_band(surface, grid):
+    from tubesweep.solve import _estimated_band_nodes
+
+    sol = ts.solve(surface, grid, [surface.default_source])
+    estimate = _estimated_band_nodes(surface, grid, 4 * grid.spacing)
+    assert 0.7 < estimate / sol.stats.band_points < 1.3, (estimate, sol.stats.band_points)

@@ -12,6 +12,8 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    available_memory_bytes,
+    check_memory,
     ACTIVATION_FRACTION,
     FRONT_WINDOW,
     check_threads as _threads,
@@ -440,6 +442,39 @@ class _PreparedTube:
     seconds: float
 
 
+# The memory a solve adds per band node at its peak (`benches/run.py --scale`: 57–58 B at N = 1001
+# and 2001), for the check below.
+_BAND_BYTES_PER_NODE = 60
+# Points per axis (along the box's longest side) of the coarse sample that estimates the band.
+_BAND_ESTIMATE_POINTS = 17
+
+
+def _check_band_memory(surf: Surface, grid: Grid, half_width: float) -> None:
+    """Raises MemoryError before the band search when the band would not fit in memory. Skipped
+    when even a band filling the whole box would fit (every grid up to a few hundred nodes per
+    axis); otherwise the surface's area is estimated from its distance at a coarse sample of the
+    box (the nodes within one coarse spacing H of it fill a shell of volume ≈ 2·H·area), and the
+    band of half-width w holds about 2·w·area / h^d nodes."""
+    avail = available_memory_bytes()
+    if avail is None or grid.size * _BAND_BYTES_PER_NODE <= 0.9 * avail or getattr(surf, "redistance", False):
+        return
+    nodes = _estimated_band_nodes(surf, grid, half_width)
+    check_memory(nodes * _BAND_BYTES_PER_NODE, f"the band (about {nodes:.3g} nodes at grid spacing {grid.spacing:.3g})",
+                 "use a coarser grid (fewer nodes per axis) or a thinner tube")
+
+
+def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float:
+    """About how many nodes of ``grid`` lie within ``half_width`` of ``surf`` (see
+    :func:`_check_band_memory`), from the surface's distance at a coarse sample of the box."""
+    lower, upper = np.asarray(grid.lower, dtype=float), np.asarray(grid.upper, dtype=float)
+    big_h = float(np.max(upper - lower)) / (_BAND_ESTIMATE_POINTS - 1)
+    axes = [np.arange(lo, hi + 0.5 * big_h, big_h) for lo, hi in zip(lower, upper)]
+    points = np.stack([c.reshape(-1) for c in np.meshgrid(*axes, indexing="ij")], axis=1)
+    dist = np.asarray(surf.project(points, grid)[0], dtype=float)
+    area = np.count_nonzero(dist <= big_h) * big_h ** grid.ndim / (2 * big_h)
+    return 2 * half_width * area / grid.spacing ** grid.ndim
+
+
 def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool,
                   reusable: bool = False) -> _PreparedTube:
     """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
@@ -465,6 +500,7 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
     inner_width = inner * h
     outer_eff = float(outer) if method == "two-layer" else float(inner)
 
+    _check_band_memory(surf, grid, outer_eff * h)
     for attempt in range(_MAX_WIDENINGS + 1):
         geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
