@@ -218,3 +218,14 @@ def test_the_memory_check_s_band_estimate_is_close_to_the_band(surface, grid):
     sol = ts.solve(surface, grid, [surface.default_source])
     estimate = _estimated_band_nodes(surface, grid, 4 * grid.spacing)
     assert 0.7 < estimate / sol.stats.band_points < 1.3, (estimate, sol.stats.band_points)
+
+
+def test_grid_shapes_are_whole_numbers_and_flags_are_booleans():
+    for shape in ["abc", (31.7, 31), (True, 31)]:
+        with pytest.raises(TypeError, match="shape must be a sequence of whole numbers"):
+            ts.Grid((-1, -1), (1, 1), shape)
+    assert ts.Grid((-1, -1), (1, 1), (31.0, np.int64(31))).shape == (31, 31)
+    with pytest.raises(TypeError, match="lower and upper"):
+        ts.Grid((-1 + 1j, -1), (1, 1), (31, 31))
+    with pytest.raises(TypeError, match="paper_sweeps must be True or False"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], paper_sweeps="no")

@@ -33,12 +33,17 @@ class Grid:
     """
 
     def __init__(self, lower: Sequence[float], upper: Sequence[float], shape: Sequence[int]):
-        lo = np.asarray(lower, dtype=float).reshape(-1)
-        hi = np.asarray(upper, dtype=float).reshape(-1)
         try:
+            lo = np.asarray(lower, dtype=float).reshape(-1)
+            hi = np.asarray(upper, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise TypeError(f"lower and upper must be sequences of real numbers; got {lower!r} and {upper!r}") from None
+        try:
+            if isinstance(shape, (str, bytes)) or any(isinstance(n, bool) or float(n) != int(n) for n in shape):
+                raise ValueError
             shp = tuple(int(n) for n in shape)
-        except TypeError:
-            raise TypeError(f"shape must be a sequence of integers, got {shape!r}") from None
+        except (TypeError, ValueError, OverflowError):
+            raise TypeError(f"shape must be a sequence of whole numbers of nodes per axis, got {shape!r}") from None
         if not (lo.size == hi.size == len(shp)):
             raise ValueError(
                 f"lower, upper and shape must have the same length (2 or 3); got {lo.size}, {hi.size}, {len(shp)}"

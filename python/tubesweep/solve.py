@@ -555,6 +555,8 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
     before the sweeps."""
     from . import hamiltonians as _hams
 
+    if not isinstance(paper_sweeps, (bool, np.bool_)):
+        raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band
     h = grid.spacing
     inner_width = tube.inner * h
