@@ -109,6 +109,10 @@ def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
     rc = main(["solve", "--phi", str(tmp_path / "phi.npz"), "--lower", "-1", "-1", "--upper", "1", "1",
                "--source", "0.5", "0", "--out", str(tmp_path / "o"), "--quiet"])
     assert rc == 0 and (tmp_path / "o" / "solution.npz").exists()
+    (tmp_path / "empty.npy").write_bytes(b"")
+    with pytest.raises(SystemExit, match="not a NumPy .npy or .npz file"):
+        main(["solve", "--phi", str(tmp_path / "empty.npy"), "--lower", "-1", "-1", "--upper", "1", "1",
+              "--source", "0.5", "0", "--out", str(tmp_path / "o1")])
     (tmp_path / "notnumpy.txt").write_text("hello")
     with pytest.raises(SystemExit, match="not a NumPy .npy or .npz file"):
         main(["solve", "--phi", str(tmp_path / "notnumpy.txt"), "--lower", "-1", "-1", "--upper", "1", "1",

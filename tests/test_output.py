@@ -173,6 +173,8 @@ def test_export_checks_a_user_mesh_and_writes_vectors_and_odd_names(sphere_sol, 
     with pytest.raises(ValueError, match="NaN or inf"):
         ts.export(sphere_sol, tmp_path / "bad.vtp", mesh=(np.where(np.arange(len(v))[:, None] == 3, np.nan, v), f))
     assert not (tmp_path / "bad.vtp").exists()
+    with pytest.raises(ValueError, match="control characters"):
+        ts.export(sphere_sol, tmp_path / "s.vtp", point_data={"a\x01b": v[:, 0]})
     with pytest.raises(ValueError, match=r"point_data\['t'\] must have shape"):
         ts.export(sphere_sol, tmp_path / "s.vtp", point_data={"t": np.zeros((len(v), 5, 2))})
     # a vector per vertex and a name with XML's special characters: a well-formed file, read back

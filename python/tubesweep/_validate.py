@@ -78,17 +78,19 @@ def check_tolerance(tol: float, max_iterations: int) -> None:
         raise ValueError(f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}")
 
 
-def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float) -> None:
+def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cells: int) -> None:
     """Refuses a ``tol`` that is not small against the travel time across one grid cell: the stopping
     test compares absolute changes with it, so a ``tol`` of that size (short travel times: a large
     speed, or a grid in small units) stops the sweeps before the front has crossed the band, with
     nodes still at the numerical infinity."""
     cell = spacing * mean_slowness
-    if tol >= 0.1 * cell:
+    scale = cell * cells  # about the travel time across the grid's longest side
+    if tol >= 1e-2 * scale:
         raise ValueError(
-            f"tol={tol:g} is not small against the travel time across one grid cell (spacing × mean slowness = "
-            f"{cell:.3g}): the sweeps would stop before the front crosses the band. Pass a tol relative to it, "
-            f"e.g. tol=1e-10 * {cell:.3g} (or rescale the units of the grid or the speed)")
+            f"tol={tol:g} is not small against the travel times of this problem (about {scale:.3g} across the grid, "
+            f"{cell:.3g} across one grid cell: spacing × mean slowness): the sweeps would stop before the front "
+            f"crosses the band. Pass a tol relative to them, e.g. tol=1e-10 * {cell:.3g} or tol=1e-3 * {cell:.3g} "
+            f"(or rescale the units of the grid or the speed)")
 
 
 def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
@@ -217,8 +219,6 @@ def check_infinity(infinity: Optional[float]) -> Optional[float]:
 def check_threads(threads: int) -> int:
     if not (isinstance(threads, (int, np.integer)) and not isinstance(threads, bool) and threads >= 0):
         raise ValueError(f"threads must be a non-negative integer (0 = all cores); got {threads!r}")
-    cores = os.cpu_count() or 1
-    if threads > 4 * cores:
-        raise ValueError(f"threads={threads} is more than 4 × the {cores} cores of this machine; the sweeps gain "
-                         f"nothing from more threads than cores (0 = all cores)")
-    return int(threads)
+    # more threads than cores gain nothing (and thousands take minutes to start); the result is the
+    # same bits for any count, so a larger request runs on all cores
+    return min(int(threads), os.cpu_count() or 1)

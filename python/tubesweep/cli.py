@@ -133,9 +133,11 @@ def _grid_for(surface, n: int, lower: Optional[Sequence[float]], upper: Optional
 def _load_phi(path: Path) -> np.ndarray:
     """φ sampled on the grid from a ``.npy`` file, or from a ``.npz`` holding one array (or one named
     ``phi``)."""
+    import zipfile
+
     try:
         data = np.load(path, allow_pickle=False)
-    except ValueError:
+    except (ValueError, EOFError, zipfile.BadZipFile):
         raise SystemExit(f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
                          f"φ with numpy.save or numpy.savez") from None
     if isinstance(data, np.lib.npyio.NpzFile):

@@ -147,7 +147,7 @@ def travel_time(
     else:
         slowness = 1.0 / speed_values(speed, grid, np.empty((0, grid.ndim)), None)
 
-    check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)))
+    check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))
 
     def slowness_at(x: np.ndarray) -> np.ndarray:
         if callable(speed):

@@ -39,11 +39,14 @@ class Grid:
         except (TypeError, ValueError):
             raise TypeError(f"lower and upper must be sequences of real numbers; got {lower!r} and {upper!r}") from None
         try:
-            if isinstance(shape, (str, bytes)) or any(isinstance(n, bool) or float(n) != int(n) for n in shape):
-                raise ValueError
+            if isinstance(shape, (str, bytes)):
+                raise TypeError
+            whole = all(not isinstance(n, bool) and float(n) == int(n) for n in shape)
             shp = tuple(int(n) for n in shape)
         except (TypeError, ValueError, OverflowError):
             raise TypeError(f"shape must be a sequence of whole numbers of nodes per axis, got {shape!r}") from None
+        if not whole:
+            raise ValueError(f"shape must hold whole numbers of nodes per axis, got {shape!r}")
         if not (lo.size == hi.size == len(shp)):
             raise ValueError(
                 f"lower, upper and shape must have the same length (2 or 3); got {lo.size}, {hi.size}, {len(shp)}"

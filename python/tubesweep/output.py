@@ -66,8 +66,9 @@ def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"mesh vertices must be finite coordinates of shape (n, 2) or (n, 3); got shape {v.shape}"
                          + ("" if v.ndim != 2 or np.all(np.isfinite(v)) else " with NaN or inf"))
     f = np.asarray(f_in)
-    if f.ndim != 2 or f.shape[1] not in (2, 3) or (f.size and not np.issubdtype(f.dtype, np.number)):
-        raise ValueError(f"mesh faces must be an integer array of shape (m, 3) (or (m, 2) segments); got shape {f.shape}")
+    if f.ndim != 2 or f.shape[1] not in (2, 3, 4) or (f.size and not np.issubdtype(f.dtype, np.number)):
+        raise ValueError(f"mesh faces must be an integer array of shape (m, 3) (or (m, 4) quads, (m, 2) segments); "
+                         f"got shape {f.shape}")
     if f.size and (not np.all(np.isfinite(f)) or np.any(f != np.round(f))):
         raise ValueError("mesh faces must hold whole-number vertex indices")
     f = f.astype(np.int64)
@@ -230,6 +231,8 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
     if len(sol.sources) > 1 and sol._isotropic:
         data["nearest_source"] = sol.nearest_source(v).astype(float)
     for name, a in (point_data or {}).items():
+        if not isinstance(name, str) or not name or any(ord(ch) < 32 for ch in name):
+            raise ValueError(f"point_data names must be non-empty strings without control characters; got {name!r}")
         a = np.asarray(a, dtype=float)
         if a.ndim not in (1, 2) or (a.ndim == 2 and not 1 <= a.shape[1] <= 9):
             raise ValueError(f"point_data[{name!r}] must have shape (n,) or (n, k) with k at most 9 (one value or "

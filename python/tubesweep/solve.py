@@ -442,9 +442,10 @@ class _PreparedTube:
     seconds: float
 
 
-# The memory a solve adds per band node at its peak (`benches/run.py --scale`: 57–58 B at N = 1001
-# and 2001), for the check below.
-_BAND_BYTES_PER_NODE = 60
+# The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
+# N = 1001 and 2001 (`benches/run.py --scale`), more through `ts.Tube` and the general Hamiltonians
+# (up to about 110 B at N = 301).
+_BAND_BYTES_PER_NODE = 110
 # Points per axis (along the box's longest side) of the coarse sample that estimates the band.
 _BAND_ESTIMATE_POINTS = 17
 
@@ -468,10 +469,13 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
     :func:`_check_band_memory`), from the surface's distance at a coarse sample of the box."""
     lower, upper = np.asarray(grid.lower, dtype=float), np.asarray(grid.upper, dtype=float)
     big_h = float(np.max(upper - lower)) / (_BAND_ESTIMATE_POINTS - 1)
-    axes = [np.arange(lo, hi + 0.5 * big_h, big_h) for lo, hi in zip(lower, upper)]
+    axes = [np.minimum(np.arange(lo, hi + 0.5 * big_h, big_h), hi) for lo, hi in zip(lower, upper)]
     points = np.stack([c.reshape(-1) for c in np.meshgrid(*axes, indexing="ij")], axis=1)
-    dist = np.asarray(surf.project(points, grid)[0], dtype=float)
-    area = np.count_nonzero(dist <= big_h) * big_h ** grid.ndim / (2 * big_h)
+    try:
+        dist = np.asarray(surf.project(points, grid)[0], dtype=float)
+    except Exception:  # a surface undefined at some sample far from it: no estimate, the search decides
+        return 0.0
+    area = np.count_nonzero(np.isfinite(dist) & (dist <= big_h)) * big_h ** grid.ndim / (2 * big_h)
     return 2 * half_width * area / grid.spacing ** grid.ndim
 
 
@@ -574,13 +578,16 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
             return np.full(len(p), 1.0 / float(speed))
         from .euclidean import _interp_dense
 
-        return 1.0 / _interp_dense(np.asarray(speed, dtype=float), grid, p)
+        f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
+        if not np.all(np.isfinite(f) & (f > 0)):
+            raise ValueError("speed array is NaN, inf or not positive next to a source (interpolated there for the "
+                             "source's initialisation); it must be positive and finite around every source")
+        return 1.0 / f
 
-    if general is None:
-        check_tolerance_scale(tol, h, float(np.mean(slowness)))
+    check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     positions, fixed_vals, fixed_sources = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
     roles[positions] = ROLE_FIXED
-    if tube.method != "naive" and not np.any(roles == ROLE_INNER):
+    if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER):
         raise ValueError(
             f"the grid is too coarse for this surface: every node of the inner tube lies within {SOURCE_RADIUS:g} grid "
             f"spacings (h = {h:.4g}) of a source, so its value is the source's initialisation and nothing is solved; "

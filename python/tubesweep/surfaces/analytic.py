@@ -23,7 +23,7 @@ def own_phi(surface: Any, cls: type) -> bool:
 def finite_center(center: Any, d: int) -> np.ndarray:
     """A surface's ``center``: ``d`` finite coordinates, or a ValueError that says so."""
     try:
-        c = np.asarray(center, dtype=float)
+        c = np.asarray(center, dtype=float).reshape(-1)
     except (TypeError, ValueError):
         c = np.array([np.nan])
     if c.shape != (d,) or not np.all(np.isfinite(c)):
