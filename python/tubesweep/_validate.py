@@ -100,6 +100,11 @@ def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
     if vals.shape != (points.shape[0],):
         raise ValueError(f"speed callable must map points of shape (M, {points.shape[1]}) to values of shape (M,); "
                          f"returned shape {vals.shape} for M = {points.shape[0]} ({what})")
+    return checked_point_speeds(vals, points, what)
+
+
+def checked_point_speeds(vals: np.ndarray, points: np.ndarray, what: str) -> np.ndarray:
+    """Speeds at ``points`` (one each), refused where they are not finite and positive."""
     bad = ~(np.isfinite(vals) & (vals > 0))
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])

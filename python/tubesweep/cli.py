@@ -161,11 +161,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.path_from_vertex and not args.mesh:
         raise SystemExit("--path-from-vertex needs --mesh")
     # what can be checked before the solve is checked before it
-    from .output import EXPORT_FORMATS
+    from .output import export_format
 
     for path in args.export or []:
-        if Path(path).suffix.lower() not in EXPORT_FORMATS:
-            raise SystemExit(f"--export {path}: unknown format {Path(path).suffix!r}; use one of {', '.join(EXPORT_FORMATS)}")
+        try:
+            export_format(path)
+        except ValueError as e:
+            raise SystemExit(f"--export {path}: {e}") from None
     if args.out.exists() and not args.out.is_dir():
         raise SystemExit(f"--out {args.out}: exists and is not a directory")
     if args.mesh:

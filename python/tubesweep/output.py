@@ -200,6 +200,15 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
     return points, conn.reshape(-1, k), data
 
 
+def export_format(path: Union[str, Path]) -> str:
+    """The format of an export path (its suffix, lower case), or a ValueError naming the ones known."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in EXPORT_FORMATS:
+        raise ValueError(f"export: unknown format {path.suffix!r} of {str(path)!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    return suffix
+
+
 def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] = None,
            point_data: Optional[Dict[str, Any]] = None) -> Path:
     """Writes the surface of ``sol`` with the solution ``u`` at its vertices, for ParaView.
@@ -221,9 +230,7 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
     2D curves are written as line cells with z = 0.
     """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in EXPORT_FORMATS:
-        raise ValueError(f"export: unknown format {path.suffix!r} of {str(path)!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    suffix = export_format(path)
     v, cells = triangulate(sol, mesh=mesh)
     u = sol.on_mesh(v)
     u = np.where(np.isfinite(u), u, np.nan)

@@ -24,6 +24,7 @@ from ._validate import (
     check_hamiltonian,
     check_tolerance,
     check_tolerance_scale,
+    checked_point_speeds,
     speed_at_points,
     progress_callback,
     speed_values,
@@ -579,10 +580,7 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         from .euclidean import _interp_dense
 
         f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
-        if not np.all(np.isfinite(f) & (f > 0)):
-            raise ValueError("speed array is NaN, inf or not positive next to a source (interpolated there for the "
-                             "source's initialisation); it must be positive and finite around every source")
-        return 1.0 / f
+        return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
 
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     positions, fixed_vals, fixed_sources = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)

@@ -12,6 +12,7 @@ import numpy as np
 from .. import _native
 from ..closest_point import ClosestPoint
 from ._triangulation import grid_mesh
+from .analytic import finite_center
 
 __all__ = ["Hemisphere", "Disc", "PlanePatch", "MobiusBand"]
 
@@ -44,12 +45,6 @@ def _check_size(name: str, value: Any) -> float:
     return v
 
 
-def _check_center(center: Any) -> np.ndarray:
-    c = np.asarray(center, dtype=float).reshape(3)
-    if not np.all(np.isfinite(c)):
-        raise ValueError(f"center must be three finite coordinates; got {center!r}")
-    return c
-
 
 class Hemisphere(ClosestPoint):
     """The upper hemisphere ``{|x − c| = radius, z ≥ c_z}`` — an open surface bounded by the
@@ -71,7 +66,7 @@ class Hemisphere(ClosestPoint):
 
     def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0, 0.0)):
         self.radius = _check_size("radius", radius)
-        self.center = _check_center(center)
+        self.center = finite_center(center, 3)
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
@@ -121,7 +116,7 @@ class Disc(ClosestPoint):
 
     def __init__(self, radius: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
         self.radius = _check_size("radius", radius)
-        self.center = _check_center(center)
+        self.center = finite_center(center, 3)
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
@@ -166,7 +161,7 @@ class PlanePatch(ClosestPoint):
 
     def __init__(self, half_size: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
         self.half_size = _check_size("half_size", half_size)
-        self.center = _check_center(center)
+        self.center = finite_center(center, 3)
         super().__init__(self._cp, ndim=3)
 
     def _cp(self, p: np.ndarray) -> np.ndarray:
