@@ -126,6 +126,22 @@ def test_a_tol_not_small_against_a_cell_s_travel_time_is_refused(speed):
     assert abs(u * speed - u1) < 1e-6 * u1
 
 
+def test_a_metric_that_shrinks_the_travel_times_needs_a_tol_on_their_scale():
+    # M = 1e30·I makes every travel time 1e-15 of the isotropic one: the default tol stopped the
+    # sweeps after two iterations with 87% of the band at infinity, reported converged
+    big = ts.hamiltonians.Metric(1e30 * np.eye(3))
+    with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel times.*Hamiltonian"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=big)
+    # the tol it names works, and gives the identity metric's answer scaled by 1e-15
+    cell = 1e-15 * G3.spacing
+    u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=big, tol=1e-10 * cell)([(0.5, 0, 0)])[0]
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(3)))([(0.5, 0, 0)])[0]
+    assert abs(u * 1e15 - u1) < 1e-6 * u1
+    # a metric that lengthens the travel times is no reason to refuse the default tol
+    slow = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(1e-30 * np.eye(3)))([(0.5, 0, 0)])[0]
+    assert abs(slow * 1e-15 - u1) < 1e-6 * u1
+
+
 def test_a_small_grid_in_small_units_needs_a_tol_in_those_units():
     s = 1e-12
     grid = ts.Grid((-s,) * 3, (s,) * 3, (31,) * 3)

@@ -78,19 +78,21 @@ def check_tolerance(tol: float, max_iterations: int) -> None:
         raise ValueError(f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}")
 
 
-def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cells: int) -> None:
+def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cells: int,
+                          cell_time: str = "spacing × mean slowness", rescale: str = "the speed") -> None:
     """Refuses a ``tol`` that is not small against the travel time across one grid cell: the stopping
     test compares absolute changes with it, so a ``tol`` of that size (short travel times: a large
     speed, or a grid in small units) stops the sweeps before the front has crossed the band, with
-    nodes still at the numerical infinity."""
+    nodes still at the numerical infinity. ``cell_time`` says in the message how the travel time
+    across a cell was found, ``rescale`` what else the user may rescale besides the grid."""
     cell = spacing * mean_slowness
     scale = cell * cells  # about the travel time across the grid's longest side
     if tol >= 1e-2 * scale:
         raise ValueError(
             f"tol={tol:g} is not small against the travel times of this problem (about {scale:.3g} across the grid, "
-            f"{cell:.3g} across one grid cell: spacing × mean slowness): the sweeps would stop before the front "
+            f"{cell:.3g} across one grid cell: {cell_time}): the sweeps would stop before the front "
             f"crosses the band. Pass a tol relative to them, e.g. tol=1e-10 * {cell:.3g} or tol=1e-3 * {cell:.3g} "
-            f"(or rescale the units of the grid or the speed)")
+            f"(or rescale the units of the grid or {rescale})")
 
 
 def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:

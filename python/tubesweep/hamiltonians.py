@@ -26,6 +26,7 @@ from typing import Any, Callable, Dict, Optional, Sequence
 import numpy as np
 
 from .grid import Grid
+from ._validate import check_tolerance_scale
 
 __all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
 
@@ -359,6 +360,18 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
     return None
 
 
+def _mean_cell_time(ham: Hamiltonian, prep: _Prepared, n_nodes: int, grid: Grid) -> float:
+    """The mean travel time of one grid step along ±each axis under ``ham``'s local (constant)
+    Hamiltonian, over up to 4,096 nodes spread through the band: the scale of the values that
+    ``tol`` is compared with. A metric or a flow changes it from spacing × slowness (a metric
+    ``M = 1e30·I`` makes it 1e-15 times smaller)."""
+    nodes = np.unique(np.linspace(0, n_nodes - 1, min(n_nodes, 4096)).astype(np.int64))
+    d, h = grid.ndim, grid.spacing
+    times = [ham.local_time(prep, nodes, np.broadcast_to(sign * h * np.eye(d)[k], (len(nodes), d)))
+             for k in range(d) for sign in (1.0, -1.0)]
+    return float(np.mean(times))
+
+
 def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any, roles: np.ndarray,
                positions: np.ndarray, fixed_values: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
                source_radius: float, tol: float, max_iterations: int, infinity: Optional[float],
@@ -369,6 +382,9 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
     x = grid.node_points(geom.linear)
     slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
     prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
+    check_tolerance_scale(tol, grid.spacing, _mean_cell_time(ham, prep, len(roles), grid) / grid.spacing,
+                          max(grid.shape), "the Hamiltonian's travel time along the axes, averaged over the band",
+                          "the Hamiltonian's coefficients")
     fixed = np.array(fixed_values, dtype=float)
     if exact_sources and positions.size:
         _, cp = surface.project(x[positions], grid)
