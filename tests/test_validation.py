@@ -175,6 +175,21 @@ def test_a_grid_too_coarse_for_the_surface_is_refused():
         ts.solve(SPHERE, ts.Grid((-1,) * 3, (1,) * 3, (4,) * 3), [(-0.5, 0, 0)])
 
 
+@pytest.mark.parametrize("surface", [ts.surfaces.Disc(radius=1e-3), ts.surfaces.PlanePatch(half_size=1e-3),
+                                     ts.surfaces.Disc(radius=0.04)])
+def test_an_open_surface_smaller_than_two_cells_is_refused(surface):
+    # a disc of radius 0.02 h with sources at its rim gave distances 29% short (0.5 h: 15%),
+    # with no warning; from a radius of one spacing on it is within the coarse grid's error
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    with pytest.raises(ValueError, match="too coarse for this surface: the surface spans only"):
+        ts.solve(surface, grid, [(1e-3, 0, 0), (-1e-3, 0, 0)])
+    with pytest.raises(ValueError, match="spans only"):
+        ts.Tube(surface, grid)
+    r = grid.spacing
+    sol = ts.solve(ts.surfaces.Disc(radius=r), grid, [(r, 0, 0), (-r, 0, 0)])
+    assert abs(sol([(0, r, 0)])[0] - np.sqrt(2) * r) < 0.02 * r
+
+
 def test_threads_beyond_the_cores_run_on_all_cores():
     # threads=100000 used to start OS threads for minutes; the bits are those of any thread count
     a = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], threads=100_000).values
