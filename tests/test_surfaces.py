@@ -155,7 +155,8 @@ def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
     # tubesweep.redistance on the multilinear interpolant, bit for bit (flags included)
     from tubesweep import _native
     from tubesweep.euclidean import _interp_dense
-    from tubesweep.redistance import SAMPLED_GRADIENT_STEP, estimate_lipschitz, project_to_level_set
+    from tubesweep.redistance import (NEWTON_STEPS, ORTHOGONALITY_STEPS, SAMPLED_GRADIENT_STEP, SETTLED,
+                                      estimate_lipschitz, project_to_level_set)
 
     grid = ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
     X = np.meshgrid(*[np.linspace(-1, 1, n)] * d, indexing="ij")
@@ -166,15 +167,42 @@ def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
     assert estimate_lipschitz(surface, grid) == want
     rng = np.random.default_rng(3)
     x = rng.uniform(-1.1, 1.1, (3000, d))  # some beyond the box, where φ is clamped
-    cp0, s0, ok0 = project_to_level_set(lambda p: _interp_dense(phi, grid, p), x, SAMPLED_GRADIENT_STEP * h)
-    cp1, s1, ok1 = _native.project_to_sampled_level_set(phi, [-1.0] * d, h, x, SAMPLED_GRADIENT_STEP * h, 6, 30, 1e-12)
+    box = (np.full(d, -1.0), -1.0 + (n - 1) * h)  # the Rust projection's box, the same arithmetic
+    cp0, s0, ok0 = project_to_level_set(lambda p: _interp_dense(phi, grid, p), x, SAMPLED_GRADIENT_STEP * h, box=box)
+    cp1, s1, ok1 = _native.project_to_sampled_level_set(phi, [-1.0] * d, h, x, SAMPLED_GRADIENT_STEP * h, NEWTON_STEPS,
+                                                         ORTHOGONALITY_STEPS, SETTLED)
     assert np.array_equal(cp0, cp1) and np.array_equal(s0, s1) and np.array_equal(ok0, ok1)
     assert 0 < ok1.sum() < len(x)  # both outcomes were compared
     # and the surface uses it: its distances are those of the projection at its band nodes
     geom = surface.band(grid, 4 * h)
     xb = grid.points(grid.unravel(geom.linear))
-    _, sb, okb = project_to_level_set(lambda p: _interp_dense(phi, grid, p), xb, SAMPLED_GRADIENT_STEP * h)
+    _, sb, okb = project_to_level_set(lambda p: _interp_dense(phi, grid, p), xb, SAMPLED_GRADIENT_STEP * h, box=box)
     assert okb.all() and np.array_equal(geom.signed, sb)
+
+
+def test_redistancing_next_to_the_box_s_side_finds_the_whole_band():
+    # a circle 0.05 from the box's sides (Δx = 0.079): the first Newton step from nodes inside
+    # jumped beyond the side, where the interpolant is flat, and the orthogonality iterations of
+    # nodes at a distance half the radius needed more than 30 steps; 20 of the 204 band nodes were
+    # dropped and the box's corners stayed at inf, reported converged
+    L, n = 0.55, 15
+    grid = ts.Grid((-L, -L), (L, L), (n, n))
+    X, Y = grid.meshgrid()
+    exact = ts.solve(ts.surfaces.Circle(0.5), grid, [(-0.5, 0.0)])
+    for phi in (X**2 + Y**2 - 0.25, lambda p: np.sum(p * p, axis=1) - 0.25):
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.5, 0.0)])
+        assert np.array_equal(sol.linear, exact.linear)
+        assert np.all(np.isfinite(sol.values))
+        assert np.max(np.abs(sol.values - exact.values)) < 0.05
+
+
+def test_redistancing_warns_where_band_nodes_cannot_be_projected():
+    # a tube (4Δx = 0.6) wider than the sphere's radius: nodes on the box's edges within the tube
+    # do not settle; they are left out, and the warning says so instead of a silent inf
+    grid = ts.Grid((-0.6,) * 3, (0.6,) * 3, (9,) * 3)
+    X, Y, Z = grid.meshgrid()
+    with pytest.warns(RuntimeWarning, match="could not be projected onto it.*refine the grid"):
+        ts.solve(ts.LevelSet(X**2 + Y**2 + Z**2 - 0.25, redistance=True), grid, [(-0.5, 0, 0)])
 
 
 @pytest.mark.parametrize("d, n", [(2, 121), (3, 41)])

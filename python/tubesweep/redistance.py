@@ -14,14 +14,15 @@ closest-point direction of Sect. 5.2). Gradients are central differences of φ w
 ``GRADIENT_STEP · Δx`` (a callable φ) or ``0.5 Δx`` (a sampled φ, multilinearly interpolated).
 
 For a sampled φ (an array) the same iterations, with the same arithmetic and bits, run in Rust on
-all threads (``tubesweep_core::redistance``), and the band's candidates come from two passes over
+all threads (``tubesweep_core::redistance``), with the points kept in the grid's box, where φ is
+known (``box`` of :func:`project_to_level_set`), and the band's candidates come from two passes over
 the samples with a bound on |∇φ| near each node (``tubesweep_core::sampled``); this module's NumPy
 code runs them for a callable φ, which only Python can evaluate.
 """
 
 from __future__ import annotations
 
-from typing import Callable, Tuple
+from typing import Callable, Optional, Tuple
 
 import numpy as np
 
@@ -43,14 +44,20 @@ def _gradient(phi: Callable[[np.ndarray], np.ndarray], y: np.ndarray, eps: float
 
 #: Newton steps before the orthogonality iterations, the most orthogonality iterations, and the
 #: move (relative to ``max(1, max |x|)``) below which a point has settled.
-NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 30, 1e-12
+NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 200, 1e-12
 
 
 def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray, eps: float,
                          newton_steps: int = NEWTON_STEPS, orthogonality_steps: int = ORTHOGONALITY_STEPS,
-                         tol: float = SETTLED) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+                         tol: float = SETTLED,
+                         box: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closest points of ``x`` (M, d) on ``{φ = 0}`` by Newton projection and orthogonality
     iterations (see the module docstring).
+
+    ``box`` (lower, upper corners): where φ is known, for a φ sampled on a grid; the Newton steps
+    then keep the points in it (clamped before the first step and after each), as the Rust
+    projection of a sampled φ does (``tubesweep_core::redistance``). A callable φ, known
+    everywhere, is projected without one.
 
     Returns ``(cp (M, d), signed distance (M,), converged (M,) bool)``. ``converged`` is False
     where ∇φ vanished or the iterations did not settle (such nodes are far from the surface
@@ -61,13 +68,17 @@ def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
     y = x.copy()
     ok = np.ones(len(x), bool)
 
+    def into_box(y: np.ndarray) -> np.ndarray:
+        return y if box is None else np.minimum(np.maximum(y, box[0]), box[1])
+
     def newton(y: np.ndarray, steps: int) -> Tuple[np.ndarray, np.ndarray]:
         good = np.ones(len(y), bool)
+        y = into_box(y)
         for _ in range(steps):
             g = _gradient(phi, y, eps)
             n2 = np.sum(g * g, axis=1)
             good &= n2 > 1e-24
-            y = y - np.where(good, phi(y) / np.where(good, n2, 1.0), 0.0)[:, None] * g
+            y = into_box(y - np.where(good, phi(y) / np.where(good, n2, 1.0), 0.0)[:, None] * g)
         return y, good
 
     y, good = newton(y, newton_steps)
@@ -157,6 +168,32 @@ def _narrowed_by_candidate_gradients(surface, grid, half_width: float, L: float,
     return cand
 
 
+def _warn_if_band_nodes_unprojected(surface, grid, x: np.ndarray, cp: np.ndarray, ok: np.ndarray,
+                                    half_width: float) -> None:
+    """Warns where candidates whose projection failed lie within the band for certain: their last
+    iterate is on the zero level set (|φ| there below 1e-6 of |φ| at the node), so the node's
+    distance is at most its distance to that point, and that is within ``half_width``. Such nodes
+    are left out of the band (their closest point is not known), and band nodes that extend from
+    them may stay unreached: that happens where the tube is as wide as the surface's radius of
+    curvature, on grids far too coarse for the surface."""
+    failed = np.flatnonzero(~ok)
+    if failed.size == 0:
+        return
+    xf, yf = x[failed], cp[failed]
+    with np.errstate(invalid="ignore"):
+        on_surface = np.abs(surface.phi(yf, grid)) <= 1e-6 * np.abs(surface.phi(xf, grid))
+    within = on_surface & (np.linalg.norm(xf - yf, axis=1) <= half_width)
+    if np.any(within):
+        import warnings
+
+        warnings.warn(
+            f"{int(np.count_nonzero(within))} nodes within the tube (at most {half_width:.3g} from the zero level set) "
+            "could not be projected onto it (the closest-point iterations did not settle): they are left out of the "
+            "band, and nodes beyond them may stay unreached (inf). The tube is about as wide as the surface's radius "
+            f"of curvature there, e.g. near {tuple(round(float(c), 6) for c in xf[np.argmax(within)])}; refine the grid",
+            RuntimeWarning, stacklevel=6)
+
+
 def redistanced_band(surface, grid, half_width: float):
     """The band of ``LevelSet(phi, redistance=True)``: candidates ``|φ| ≤ L·half_width`` (L a bound
     on |∇φ|, so every node within ``half_width`` of the surface is a candidate); then the exact
@@ -187,6 +224,7 @@ def redistanced_band(surface, grid, half_width: float):
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
     x = grid.node_points(cand)
     cp, signed, ok = _project(surface, grid, x)
+    _warn_if_band_nodes_unprojected(surface, grid, x, cp, ok, half_width)
     keep = ok & (np.abs(signed) <= half_width * (1 + 1e-9))  # ties on the band edge: rounding
     lin, x, cp, signed = cand[keep], x[keep], cp[keep], signed[keep]
     diff = x - cp
