@@ -181,3 +181,21 @@ def test_export_checks_a_user_mesh_and_writes_vectors_and_odd_names(sphere_sol, 
     name = 'a "b" <c> & d'
     p, cells, data = read_vtp(ts.export(sphere_sol, tmp_path / "s.vtp", point_data={name: v, "x": v[:, 0]}))
     assert np.array_equal(data[name], v) and np.array_equal(data["x"], v[:, 0]) and np.array_equal(cells, f)
+
+
+def test_plot_levels_and_dense_fill_are_checked(circle_sol):
+    # levels=-3 raised from matplotlib's locator, 2.5 was cut to 2, fill='x' from NumPy
+    pytest.importorskip("matplotlib")
+    for bad in (-3, 2.5, True):
+        with pytest.raises(ValueError, match="levels must be a number of iso-lines"):
+            ts.plot(circle_sol, levels=bad)
+    with pytest.raises(ValueError, match="levels must be finite"):
+        ts.plot(circle_sol, levels=[0.5, np.nan])
+    with pytest.raises(TypeError, match="levels must hold real numbers"):
+        ts.plot(circle_sol, levels=[0.5 + 1j])
+    ts.plot(circle_sol, levels=4.0)
+    for bad in ("x", 1j, True, [1, 2]):
+        with pytest.raises(TypeError, match="fill must be a real number"):
+            circle_sol.to_dense(fill=bad)
+    dense = circle_sol.to_dense(fill=-1)
+    assert np.count_nonzero(dense == -1) == circle_sol.grid.size - len(circle_sol.values)

@@ -290,3 +290,39 @@ def test_the_band_estimate_survives_a_closest_point_map_undefined_far_from_the_s
     est = _estimated_band_nodes(ts.ClosestPoint(cp), g, 4 * g.spacing)
     exact = _estimated_band_nodes(ts.surfaces.Hemisphere(0.5), g, 4 * g.spacing)
     assert est == 0.0 or 0.5 < est / exact < 2.0
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: ts.solve(ts.LevelSet(np.zeros((31,) * 3) + 0j), G3, [(-0.5, 0, 0)]), "phi array"),
+    (lambda: ts.solve(ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5 + 0j), G3, [(-0.5, 0, 0)]),
+     "phi callable"),
+    (lambda: ts.solve(SPHERE, G3, np.array([(-0.5 + 0j, 0, 0)])), "sources"),
+    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.ones(G3.shape) + 0j), "speed array"),
+    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=lambda p: np.ones(len(p)) + 0j), "speed callable"),
+    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(3) + 0j)), "M"),
+    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)])(np.array([(0.5 + 0j, 0, 0)])), "points"),
+])
+def test_complex_input_is_refused_not_cut_to_its_real_part(call, name):
+    # NumPy dropped the imaginary parts with only a ComplexWarning
+    with pytest.raises(TypeError, match=f"{name}.* must hold real numbers"):
+        call()
+
+
+def test_surface_lengths_and_tube_widths_are_real_numbers():
+    # Sphere('0.5') raised "'>' not supported between str and int"; True was a radius of 1 and
+    # inner=True a tube of one spacing
+    for bad in ("0.5", 0.5j, True, [0.5]):
+        with pytest.raises(TypeError, match="radius must be a positive real number"):
+            ts.surfaces.Sphere(bad)
+    for bad in (-1, 0, np.inf, np.nan):
+        with pytest.raises(ValueError, match="radius must be positive and finite"):
+            ts.surfaces.Sphere(bad)
+    with pytest.raises(ValueError, match="R must be positive and finite"):
+        ts.surfaces.Torus(R=np.inf, r=0.2)
+    with pytest.raises(TypeError, match="half_size must be a positive real number"):
+        ts.surfaces.PlanePatch(half_size="big")
+    with pytest.raises(TypeError, match="b must be a positive real number"):
+        ts.surfaces.Ellipsoid(0.5, None, 0.3)
+    assert ts.surfaces.Sphere(np.float32(0.5)).radius == 0.5
+    with pytest.raises(ValueError, match="inner must be a finite number"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], inner=True)

@@ -30,11 +30,21 @@ def as_grid(grid: Any) -> Grid:
     return grid
 
 
+def real_array(value: Any, name: str) -> np.ndarray:
+    """``value`` as a float64 array; complex values are refused (NumPy would drop the imaginary
+    part with only a ``ComplexWarning``) with a ``TypeError`` that names the argument."""
+    a = np.asarray(value)
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must hold real numbers; got complex values (dtype {a.dtype}). Pass the real part "
+                        f"(x.real) if the imaginary part is zero")
+    return a.astype(float, copy=False)
+
+
 def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
-    """Converts to a float (M, ndim) array; rejects NaN/inf and wrong shapes."""
+    """Converts to a float (M, ndim) array; rejects complex values, NaN/inf and wrong shapes."""
     try:
-        p = np.asarray(points, dtype=float)
-    except (TypeError, ValueError):
+        p = real_array(points, name)
+    except ValueError:
         raise TypeError(f"{name} must be an array-like of shape (M, {ndim}) of numbers") from None
     if p.ndim == 1 and p.size == ndim:
         p = p.reshape(1, ndim)
@@ -98,7 +108,7 @@ def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cell
 def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
     """A speed callable's values at ``points`` (source points, their closest points), checked as
     the values at the nodes are: one per point, finite and positive."""
-    vals = np.asarray(speed(points), dtype=float)
+    vals = real_array(speed(points), "speed callable's values")
     if vals.shape != (points.shape[0],):
         raise ValueError(f"speed callable must map points of shape (M, {points.shape[1]}) to values of shape (M,); "
                          f"returned shape {vals.shape} for M = {points.shape[0]} ({what})")
@@ -123,7 +133,7 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
     callable ``f(points (M, d)) -> (M,)``.
     """
     if callable(speed):
-        vals = np.asarray(speed(points), dtype=float)
+        vals = real_array(speed(points), "speed callable's values")
         if vals.shape != (points.shape[0],):
             raise ValueError(
                 f"speed callable must map points of shape (M, {grid.ndim}) to values of shape (M,); "
@@ -138,7 +148,7 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
             raise ValueError(f"speed must be positive and finite; got {f}. The speed F(x) > 0 is the wave speed in |∇u| = 1/F")
         return f
     else:
-        arr = np.asarray(speed, dtype=float)
+        arr = real_array(speed, "speed array")
         if arr.shape != grid.shape:
             raise ValueError(f"speed array must have the grid's shape {grid.shape}; got {arr.shape}")
         vals = arr.reshape(-1)[linear] if linear is not None else arr.reshape(-1)

@@ -27,6 +27,7 @@ from typing import Callable, Optional, Tuple
 import numpy as np
 
 from ._linalg import row_norms
+from ._validate import real_array
 from .grid import Grid
 from .surface import EVAL_CHUNK, BandGeometry, Surface, coarse_to_fine_candidates
 
@@ -42,7 +43,7 @@ def _evaluate_cp(cp: Callable[[np.ndarray], np.ndarray], points: np.ndarray) -> 
     out = np.empty((m, d))
     for s in range(0, m, EVAL_CHUNK):
         chunk = points[s : s + EVAL_CHUNK]
-        v = np.asarray(cp(chunk), dtype=float)
+        v = real_array(cp(chunk), "cp's values")
         if v.shape != chunk.shape:
             raise ValueError(
                 f"cp must map points of shape (M, {d}) to closest points of shape (M, {d}); it returned shape {v.shape} "

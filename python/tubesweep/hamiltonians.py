@@ -26,7 +26,7 @@ from typing import Any, Callable, Dict, Optional, Sequence
 import numpy as np
 
 from .grid import Grid
-from ._validate import check_tolerance_scale
+from ._validate import check_tolerance_scale, real_array
 
 __all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
 
@@ -82,12 +82,12 @@ def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail:
     """A per-node field from a constant, an array of ``grid.shape + tail``, or a callable on points."""
     want = (len(linear),) + tail
     if callable(value):
-        out = np.asarray(value(points), dtype=float)
+        out = real_array(value(points), f"{name} callable's values")
         if out.shape != want:
             raise ValueError(f"{name} callable must map points (M, {grid.ndim}) to an array of shape (M,)+{tail}; "
                              f"returned {out.shape} for M = {len(linear)}")
     else:
-        arr = np.asarray(value, dtype=float)
+        arr = real_array(value, name)
         if arr.shape == tail:
             out = np.broadcast_to(arr, want).copy()
         elif arr.shape == tuple(grid.shape) + tail:

@@ -23,6 +23,7 @@ from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from ._validate import real_array
 from .surface import LevelSet
 
 __all__ = ["triangulate", "export", "plot", "read_vtp", "EXPORT_FORMATS"]
@@ -352,7 +353,16 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
             raise ValueError(f"paths[{i}] must be an array of shape (P, {grid.ndim}); got shape {q.shape}")
     finite = sol.values[np.isfinite(sol.values)]
     umax = float(finite.max()) if finite.size else 1.0
-    lv = np.asarray(MaxNLocator(int(levels) + 1).tick_values(0.0, umax) if np.ndim(levels) == 0 else levels, dtype=float)
+    if np.ndim(levels) == 0:
+        if (isinstance(levels, (bool, np.bool_)) or not isinstance(levels, (int, float, np.integer, np.floating))
+                or not (float(levels).is_integer() and levels >= 0)):
+            raise ValueError(f"levels must be a number of iso-lines (an integer ≥ 0) or a sequence of their values; "
+                             f"got {levels!r}")
+        lv = MaxNLocator(int(levels) + 1).tick_values(0.0, umax) if levels > 0 else np.zeros(0)
+    else:
+        lv = real_array(levels, "levels").reshape(-1)
+        if not np.all(np.isfinite(lv)):
+            raise ValueError(f"levels must be finite values of the solution; got {levels!r}")
     lv = lv[(lv > 0) & (lv < umax)]
     import matplotlib
 

@@ -237,7 +237,9 @@ class Solution:
 
     def to_dense(self, fill: float = np.nan) -> np.ndarray:
         """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
-        out = np.full(self.grid.size, fill, dtype=float)
+        if isinstance(fill, (bool, np.bool_, str, bytes)) or np.ndim(fill) != 0 or np.iscomplexobj(fill):
+            raise TypeError(f"fill must be a real number (the value outside the band, NaN by default); got {fill!r}")
+        out = np.full(self.grid.size, float(fill), dtype=float)
         out[self.linear] = self.values
         return out.reshape(self.grid.shape)
 
@@ -513,7 +515,8 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
     for name, val in (("inner", inner), ("outer", outer)):
-        if not (isinstance(val, (int, float, np.floating, np.integer)) and np.isfinite(val)):
+        if not (isinstance(val, (int, float, np.floating, np.integer)) and not isinstance(val, (bool, np.bool_))
+                and np.isfinite(val)):
             raise ValueError(f"{name} must be a finite number of grid spacings; got {val!r}")
     if inner < 1.0:
         raise ValueError(

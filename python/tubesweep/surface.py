@@ -21,6 +21,7 @@ from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 import numpy as np
 
 from .grid import Grid
+from ._validate import real_array
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
 
@@ -104,7 +105,7 @@ def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, ou
     out = np.empty((m,) + out_shape)
     for s in range(0, m, EVAL_CHUNK):
         chunk = points[s : s + EVAL_CHUNK]
-        v = np.asarray(fn(chunk), dtype=float)
+        v = real_array(fn(chunk), f"the values of the {name}")
         if v.shape != (chunk.shape[0],) + out_shape:
             raise ValueError(
                 f"{name} must map points of shape (M, {points.shape[1]}) to an array of shape (M{''.join(', ' + str(n) for n in out_shape)}); "
@@ -174,7 +175,7 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
 
 
 def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
-                  name: str = "surface") -> Tuple[np.ndarray, np.ndarray]:
+                  name: str = "phi callable") -> Tuple[np.ndarray, np.ndarray]:
     """Grid nodes with ``|fn| ≤ half_width`` for a level set function ``fn``, found coarse-to-fine
     (:func:`coarse_to_fine_candidates`). Returns sorted linear indices and the values of ``fn``
     there."""
@@ -245,7 +246,7 @@ class LevelSet(Surface):
             from . import _native
 
             # C order, as the core reads it (no copy for a C-ordered float64 array)
-            arr = np.ascontiguousarray(phi, dtype=float)
+            arr = np.ascontiguousarray(real_array(phi, "phi array"))
             if arr.ndim not in (2, 3):
                 raise ValueError(f"phi array must be 2D or 3D (the grid's shape); got {arr.ndim} dimensions")
             bad = _native.first_non_finite(arr)
@@ -279,7 +280,7 @@ class LevelSet(Surface):
     def phi(self, points: np.ndarray, grid: Grid) -> np.ndarray:
         """φ at arbitrary points (multilinear interpolation for a sampled φ)."""
         if self._fn is not None:
-            return _evaluate(self._fn, points, "surface")
+            return _evaluate(self._fn, points, "phi callable")
         from .euclidean import _interp_dense
 
         assert self._array is not None
@@ -311,7 +312,7 @@ class LevelSet(Surface):
             if count:
                 x = _native.node_points(list(grid.shape), ulinear[pos[start : start + count]], [float(c) for c in grid.lower], h)
                 x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
-                parts.append(_evaluate(self._fn, x, "surface"))  # type: ignore[arg-type]
+                parts.append(_evaluate(self._fn, x, "phi callable"))  # type: ignore[arg-type]
             start += count
         return np.concatenate(parts) if parts else np.zeros(0)
 

@@ -20,6 +20,21 @@ def own_phi(surface: Any, cls: type) -> bool:
     return type(surface).signed_distance is cls.signed_distance and surface._fn == surface.signed_distance
 
 
+def size_parameter(name: str, value: Any) -> float:
+    """A surface's length (radius, semi-axis, half-size): a positive finite real number. A bool,
+    a string or a complex number is a TypeError, a non-positive or non-finite one a ValueError,
+    each naming the parameter."""
+    if (isinstance(value, (bool, np.bool_, str, bytes)) or np.ndim(value) != 0 or np.iscomplexobj(value)):
+        raise TypeError(f"{name} must be a positive real number (a length in the grid's units); got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a positive real number (a length in the grid's units); got {value!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise ValueError(f"{name} must be positive and finite; got {value!r}")
+    return v
+
+
 def finite_center(center: Any, d: int) -> np.ndarray:
     """A surface's ``center``: ``d`` finite coordinates, or a ValueError that says so."""
     try:
@@ -45,9 +60,7 @@ class Circle(LevelSet):
     default_box = ((-1.0, -1.0), (1.0, 1.0))
 
     def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0)):
-        if not radius > 0:
-            raise ValueError(f"radius must be positive; got {radius}")
-        self.radius = float(radius)
+        self.radius = size_parameter("radius", radius)
         self.center = finite_center(center, 2)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 2
@@ -85,9 +98,7 @@ class Sphere(LevelSet):
     default_box = ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
 
     def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        if not radius > 0:
-            raise ValueError(f"radius must be positive; got {radius}")
-        self.radius = float(radius)
+        self.radius = size_parameter("radius", radius)
         self.center = finite_center(center, 3)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 3

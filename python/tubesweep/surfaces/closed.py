@@ -12,7 +12,7 @@ from .. import _native
 from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import grid_mesh, marching_cubes
-from .analytic import _points, finite_center, own_phi
+from .analytic import _points, finite_center, own_phi, size_parameter
 
 __all__ = ["Ellipsoid", "Torus", "RoundedCube", "DoubleTorus"]
 
@@ -39,9 +39,7 @@ class Ellipsoid(LevelSet):
     default_box = _CUBE
 
     def __init__(self, a: float = 0.6, b: float = 0.45, c: float = 0.3, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        if not (a > 0 and b > 0 and c > 0):
-            raise ValueError(f"semi-axes must be positive; got a={a}, b={b}, c={c}")
-        self.axes = np.array([a, b, c], dtype=float)
+        self.axes = np.array([size_parameter("a", a), size_parameter("b", b), size_parameter("c", c)])
         self.center = finite_center(center, 3)
         super().__init__(self.signed_distance, lipschitz=1.0)
         self.ndim = 3
@@ -155,6 +153,7 @@ class Torus(LevelSet):
     default_box = _CUBE
 
     def __init__(self, R: float = 0.5, r: float = 0.2, center: Sequence[float] = (0.0, 0.0, 0.0)):
+        R, r = size_parameter("R", R), size_parameter("r", r)
         if not (R > r > 0):
             raise ValueError(f"need R > r > 0 (a ring torus); got R={R}, r={r}")
         self.R = float(R)
@@ -219,6 +218,7 @@ class RoundedCube(LevelSet):
     default_box = _CUBE
 
     def __init__(self, half_size: float = 0.5, radius: float = 0.1, center: Sequence[float] = (0.0, 0.0, 0.0)):
+        half_size, radius = size_parameter("half_size", half_size), size_parameter("radius", radius)
         if not (0 < radius <= half_size):
             raise ValueError(f"need 0 < radius <= half_size; got radius={radius}, half_size={half_size}")
         self.half_size = float(half_size)
@@ -269,6 +269,7 @@ class DoubleTorus(LevelSet):
     default_box = _CUBE
 
     def __init__(self, R: float = 0.35, r: float = 0.12, offset: float = 0.36):
+        R, r, offset = size_parameter("R", R), size_parameter("r", r), size_parameter("offset", offset)
         if not (R > r > 0):
             raise ValueError(f"need R > r > 0; got R={R}, r={r}")
         if not (offset > 0 and 2 * offset < 2 * (R + r) and offset > R - r):

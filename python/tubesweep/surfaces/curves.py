@@ -9,7 +9,7 @@ import numpy as np
 from .._linalg import row_norms
 from ..surface import LevelSet
 from ._triangulation import polyline
-from .analytic import finite_center
+from .analytic import finite_center, size_parameter
 
 __all__ = ["Ellipse"]
 
@@ -34,8 +34,7 @@ class Ellipse(LevelSet):
     default_box = ((-1.0, -1.0), (1.0, 1.0))
 
     def __init__(self, a: float = 0.6, b: float = 0.35, center: Sequence[float] = (0.0, 0.0)):
-        if not (a > 0 and b > 0):
-            raise ValueError(f"semi-axes a, b must be positive; got a={a}, b={b}")
+        a, b = size_parameter("a", a), size_parameter("b", b)
         self.a = float(a)
         self.b = float(b)
         self.center = finite_center(center, 2)

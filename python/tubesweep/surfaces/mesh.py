@@ -30,6 +30,7 @@ import numpy as np
 
 from ..grid import Grid
 from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
+from .analytic import size_parameter
 
 __all__ = ["from_mesh", "MeshSurface", "read_mesh", "closest_points_on_triangles"]
 
@@ -449,8 +450,7 @@ def from_mesh(mesh: Union[str, Path, Tuple[Any, Any]], *, normalize: bool = Fals
     offset = np.zeros(3)
     scale = 1.0
     if normalize:
-        if not size > 0:
-            raise ValueError(f"size must be positive; got {size}")
+        size = size_parameter("size", size)
         used = v[np.unique(np.asarray(f, dtype=np.int64))]
         lo, hi = used.min(0), used.max(0)
         scale = float(size) / float((hi - lo).max())

@@ -12,7 +12,7 @@ import numpy as np
 from .. import _native
 from ..closest_point import ClosestPoint
 from ._triangulation import grid_mesh
-from .analytic import finite_center
+from .analytic import finite_center, size_parameter
 
 __all__ = ["Hemisphere", "Disc", "PlanePatch", "MobiusBand"]
 
@@ -35,14 +35,6 @@ def _native_cp(surface: Any, base: type, kind: str, p: np.ndarray, size: float) 
     return _native.open_surface_closest_points(kind, np.ascontiguousarray(x), [float(c) for c in surface.center], size)
 
 
-def _check_size(name: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a positive finite number; got {value!r}") from None
-    if not (np.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be positive and finite; got {value!r}")
-    return v
 
 
 
@@ -65,7 +57,7 @@ class Hemisphere(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        self.radius = _check_size("radius", radius)
+        self.radius = size_parameter("radius", radius)
         self.center = finite_center(center, 3)
         super().__init__(self._cp, ndim=3)
 
@@ -115,7 +107,7 @@ class Disc(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, radius: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        self.radius = _check_size("radius", radius)
+        self.radius = size_parameter("radius", radius)
         self.center = finite_center(center, 3)
         super().__init__(self._cp, ndim=3)
 
@@ -160,7 +152,7 @@ class PlanePatch(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, half_size: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
-        self.half_size = _check_size("half_size", half_size)
+        self.half_size = size_parameter("half_size", half_size)
         self.center = finite_center(center, 3)
         super().__init__(self._cp, ndim=3)
 
@@ -222,6 +214,7 @@ class MobiusBand(ClosestPoint):
     default_box = _CUBE
 
     def __init__(self, R: float = 0.6, w: float = 0.3, newton_iterations: int = 60):
+        R, w = size_parameter("R", R), size_parameter("w", w)
         if not (0 < w < R):
             raise ValueError(f"need 0 < w < R; got R={R}, w={w}")
         self.R = float(R)
