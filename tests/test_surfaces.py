@@ -595,8 +595,8 @@ def test_native_open_surface_closest_points_are_the_numpy_formulas_bit_for_bit()
             return super()._cp_numpy(q * [1, 1, -1]) * [1, 1, -1]
 
     assert np.all(Lower()._cp(p[:100])[:, 2] <= 0) and np.all(hemi._cp(p[:100])[:, 2] >= 0)
-    for bad in (np.inf, -1.0, (0.5, 0.5), "x"):
-        with pytest.raises(ValueError, match="radius must be"):
+    for bad, error in ((np.inf, ValueError), (-1.0, ValueError), ((0.5, 0.5), TypeError), ("x", TypeError)):
+        with pytest.raises(error, match="radius must be"):
             ts.surfaces.Disc(bad)
     with pytest.raises(ValueError, match="center"):
         ts.surfaces.PlanePatch(0.5, center=(np.nan, 0, 0))
