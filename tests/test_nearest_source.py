@@ -105,3 +105,18 @@ def test_labels_with_node_sources_duplicates_and_anisotropic_hamiltonians(tmp_pa
     # the export leaves the labels out rather than failing
     _, _, data = read_vtp(ts.export(moving, tmp_path / "moving.vtp"))
     assert "nearest_source" not in data and "u" in data
+
+
+def test_a_point_on_a_component_no_source_reaches_gets_no_value_and_no_label():
+    # two spheres 8 spacings apart, sources on one: the nearest *reached* node of a point on the
+    # other lay on the first's band, and the point read u = 0.0 and label 0
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+
+    def phi(p):
+        return np.minimum(np.linalg.norm(p - [0.5, 0, 0], axis=1) - 0.3, np.linalg.norm(p + [0.5, 0, 0], axis=1) - 0.3)
+
+    sol = ts.solve(phi, g, [(0.2, 0, 0), (0.8, 0, 0)])
+    far = [(-0.2, 0, 0)]
+    assert np.isinf(sol(far)[0]) and np.isnan(sol.on_mesh(far)[0]) and sol.nearest_source(far)[0] == -1
+    near = [(0.5, 0.3, 0)]
+    assert abs(sol.on_mesh(near)[0] - 0.3 * np.pi / 2) < 0.1 * 0.3 * np.pi / 2 and sol.nearest_source(near)[0] in (0, 1)

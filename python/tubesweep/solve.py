@@ -138,14 +138,15 @@ class Solution:
         return out
 
     def _nearest_reached(self, p: np.ndarray) -> np.ndarray:
-        """Band position (M,) of the reached band node nearest to each point within ``outer + 1``
-        grid spacings of it, -1 where there is none. The offsets from the point's nearest node
-        are tried in increasing length, and a point is settled once no longer offset can hold a
-        nearer node."""
+        """Band position (M,) of the band node nearest to each point within ``outer + 1`` grid
+        spacings of it, -1 where there is none or where that node was not reached (a component
+        of the surface no source reaches: the nearest *reached* node would lie on another
+        component's band, whose value and source the point does not have). The offsets from the
+        point's nearest node are tried in increasing length, and a point is settled once no
+        longer offset can hold a nearer node."""
         d = self.grid.ndim
         r = int(np.ceil(self.outer)) + 1
         best = np.full(len(p), -1, dtype=np.int64)
-        best_d = np.full(len(p), np.inf)
         ci = self.grid.continuous_index(p)
         # points beyond reach of the grid's nodes are left at -1 (and never cast to indices)
         near = np.flatnonzero(np.all((ci > -(r + 1)) & (ci < np.asarray(self.grid.shape) + r), axis=1))
@@ -170,12 +171,13 @@ class Solution:
             ok = pos >= 0
             if not np.any(ok):
                 continue
-            vals = np.where(ok, self.values[np.maximum(pos, 0)], np.inf)
             dist = np.linalg.norm(idx - ci[open_], axis=1)
-            take = ok & np.isfinite(vals) & (dist < bd[open_]) & (dist <= self.outer + 1)
+            take = ok & (dist < bd[open_]) & (dist <= self.outer + 1)
             bp[open_[take]] = pos[take]
             bd[open_[take]] = dist[take]
-        best[near], best_d[near] = bp, bd
+        found = bp >= 0
+        bp[found & ~np.isfinite(self.values[np.maximum(bp, 0)])] = -1
+        best[near] = bp
         return best
 
     def nearest_source(self, points: Any = None) -> np.ndarray:
