@@ -44,7 +44,15 @@ def _gradient(phi: Callable[[np.ndarray], np.ndarray], y: np.ndarray, eps: float
 
 #: Newton steps before the orthogonality iterations, the most orthogonality iterations, and the
 #: move (relative to ``max(1, max |x|)``) below which a point has settled.
-NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 200, 1e-12
+NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 30, 1e-12
+
+#: The most orthogonality iterations of a second projection of the band's candidates that did not
+#: settle in :data:`ORTHOGONALITY_STEPS` but lie within 1.5 × the band's half-width of a point on
+#: the zero level set (:func:`redistanced_band`). The iterations converge linearly, by about the
+#: ratio of the distance to the radius of curvature per step: nodes half a radius away needed more
+#: than 30. Only those candidates get the extra steps; the many far ones that never settle (the
+#: tube of a torus quartic at N = 81: 237k of 327k candidates) stop at 30.
+ORTHOGONALITY_RETRY_STEPS = 300
 
 
 def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray, eps: float,
@@ -107,7 +115,8 @@ def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
 SAMPLED_GRADIENT_STEP = 0.5
 
 
-def _project(surface, grid, x: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _project(surface, grid, x: np.ndarray,
+             orthogonality_steps: int = ORTHOGONALITY_STEPS) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`project_to_level_set` of the points ``x`` (M, d) for the surface's φ: in Rust for a
     sampled φ (the same iterations and bits), in NumPy for a callable."""
     if surface.is_dense:
@@ -115,8 +124,9 @@ def _project(surface, grid, x: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.n
 
         return _native.project_to_sampled_level_set(
             surface._array, [float(c) for c in grid.lower], grid.spacing, np.ascontiguousarray(x, dtype=float),
-            SAMPLED_GRADIENT_STEP * grid.spacing, NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED)
-    return project_to_level_set(lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing)
+            SAMPLED_GRADIENT_STEP * grid.spacing, NEWTON_STEPS, orthogonality_steps, SETTLED)
+    return project_to_level_set(lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing,
+                                orthogonality_steps=orthogonality_steps)
 
 
 def estimate_lipschitz(surface, grid, n: int = 17) -> float:
@@ -174,24 +184,36 @@ def _warn_if_band_nodes_unprojected(surface, grid, x: np.ndarray, cp: np.ndarray
     iterate is on the zero level set (|φ| there below 1e-6 of |φ| at the node), so the node's
     distance is at most its distance to that point, and that is within ``half_width``. Such nodes
     are left out of the band (their closest point is not known), and band nodes that extend from
-    them may stay unreached: that happens where the tube is as wide as the surface's radius of
-    curvature, on grids far too coarse for the surface."""
+    them may stay unreached: that happens where the tube is about as wide as the surface's radius
+    of curvature (a grid too coarse for the surface) or where the zero level set has a sharp edge
+    or corner (the box's |x|_∞ − r), whose nodes never settle on one closest point."""
     failed = np.flatnonzero(~ok)
     if failed.size == 0:
         return
-    xf, yf = x[failed], cp[failed]
-    with np.errstate(invalid="ignore"):
-        on_surface = np.abs(surface.phi(yf, grid)) <= 1e-6 * np.abs(surface.phi(xf, grid))
-    within = on_surface & (np.linalg.norm(xf - yf, axis=1) <= half_width)
+    within = _on_zero_set_within(surface, grid, x[failed], cp[failed], half_width)
     if np.any(within):
         import warnings
 
         warnings.warn(
             f"{int(np.count_nonzero(within))} nodes within the tube (at most {half_width:.3g} from the zero level set) "
             "could not be projected onto it (the closest-point iterations did not settle): they are left out of the "
-            "band, and nodes beyond them may stay unreached (inf). The tube is about as wide as the surface's radius "
-            f"of curvature there, e.g. near {tuple(round(float(c), 6) for c in xf[np.argmax(within)])}; refine the grid",
+            "band, and nodes beyond them may stay unreached (inf). Either the tube is about as wide as the surface's "
+            "radius of curvature there (refine the grid), or φ's zero level set has a sharp edge or corner there "
+            f"(smooth φ: refining does not help), e.g. near {tuple(round(float(c), 6) for c in x[failed][np.argmax(within)])}",
             RuntimeWarning, stacklevel=6)
+
+
+def _on_zero_set_within(surface, grid, x: np.ndarray, y: np.ndarray, reach: float) -> np.ndarray:
+    """Where a point of the zero level set lies within ``reach`` of ``x``, found from the last
+    iterate ``y`` of an unsettled projection by Newton steps alone (no orthogonality iterations):
+    where the point they reach is on the zero level set (|φ| below 1e-6 of |φ(x)|) and within
+    ``reach``, the distance of ``x`` from the surface is at most ``reach``."""
+    if len(x) == 0:
+        return np.zeros(0, bool)
+    on, _, _ = _project(surface, grid, y, orthogonality_steps=0)
+    with np.errstate(invalid="ignore"):
+        on_surface = np.abs(surface.phi(on, grid)) <= 1e-6 * np.abs(surface.phi(x, grid))
+    return on_surface & (np.linalg.norm(x - on, axis=1) <= reach)
 
 
 def redistanced_band(surface, grid, half_width: float):
@@ -224,6 +246,11 @@ def redistanced_band(surface, grid, half_width: float):
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
     x = grid.node_points(cand)
     cp, signed, ok = _project(surface, grid, x)
+    # candidates that did not settle but lie near the band (their last iterate on the zero level
+    # set within 1.5 half-widths): projected again with more steps (ORTHOGONALITY_RETRY_STEPS)
+    retry = np.flatnonzero(~ok & _on_zero_set_within(surface, grid, x, cp, 1.5 * half_width))
+    if retry.size:
+        cp[retry], signed[retry], ok[retry] = _project(surface, grid, x[retry], ORTHOGONALITY_RETRY_STEPS)
     _warn_if_band_nodes_unprojected(surface, grid, x, cp, ok, half_width)
     keep = ok & (np.abs(signed) <= half_width * (1 + 1e-9))  # ties on the band edge: rounding
     lin, x, cp, signed = cand[keep], x[keep], cp[keep], signed[keep]

@@ -536,7 +536,10 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
 
     _check_band_memory(surf, grid, outer_eff * h)
     for attempt in range(_MAX_WIDENINGS + 1):
-        geom = surf.band(grid, outer_eff * h)
+        with warnings.catch_warnings():
+            if attempt > 0:  # a warning about the band's nodes was given at the first attempt
+                warnings.filterwarnings("ignore", message=".*could not be projected onto it", category=RuntimeWarning)
+            geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
             raise ValueError(
                 "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
