@@ -258,3 +258,26 @@ def test_cli_solve_mesh(tmp_path, capsys):
         main(["solve", "--mesh", str(p), "--n", "41", "--source-vertex", "99999", "--quiet", "--out", str(out)])
     assert main(["solve", "--mesh", str(tmp_path / "nope.obj"), "--quiet", "--out", str(out)]) == 2
     assert "does not exist" in capsys.readouterr().err
+
+
+def test_degenerate_and_corrupt_mesh_input_is_refused_clearly(tmp_path):
+    v, f = ts.surfaces.Sphere(0.5).triangulation(10)
+    bad = tmp_path / "oob.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 5\n")  # trimesh's IndexError, and a CLI traceback
+    with pytest.raises(ValueError, match="oob.obj: not a readable triangle mesh"):
+        from_mesh(bad)
+    assert main(["solve", "--mesh", str(bad), "--out", str(tmp_path / "o")]) != 0
+    with pytest.raises(ValueError, match="vertices all coincide"):  # was a ZeroDivisionError
+        from_mesh((np.zeros((3, 3)), [[0, 1, 2]]), normalize=True)
+    with pytest.raises(ValueError, match="center must be 3 finite"):
+        from_mesh((v, f), normalize=True, center=(1, 2))
+    with pytest.raises(ValueError, match="whole-number vertex indices"):  # was truncated
+        from_mesh((v, f.astype(float) + 0.7))
+    with pytest.raises(TypeError, match="whole-number vertex indices"):
+        from_mesh((v, f.astype(bool)))
+    m = from_mesh((v, f))
+    for n in (50.5, "50", np.nan):
+        with pytest.raises(TypeError, match="n must be a whole number"):
+            m.grid(n)
+    with pytest.raises(ValueError, match="padding must be a finite number"):
+        m.grid(50, padding=np.nan)

@@ -199,3 +199,22 @@ def test_plot_levels_and_dense_fill_are_checked(circle_sol):
             circle_sol.to_dense(fill=bad)
     dense = circle_sol.to_dense(fill=-1)
     assert np.count_nonzero(dense == -1) == circle_sol.grid.size - len(circle_sol.values)
+
+
+def test_export_quads_point_data_and_bad_files(sphere_sol, tmp_path):
+    pytest.importorskip("meshio")
+    v, f = ts.surfaces.Sphere(0.5).triangulation(10)
+    ts.export(sphere_sol, tmp_path / "q.vtu", mesh=(v, [[0, 1, 2, 3]]))  # quads: meshio's WriteError before
+    with pytest.raises(ValueError, match="mesh must have vertices and faces"):
+        ts.export(sphere_sol, tmp_path / "e.vtp", mesh=(v, np.zeros((0, 3), int)))
+    assert not list(tmp_path.glob("e.vtp*"))  # no truncated file left behind
+    with pytest.raises(ValueError, match="the solution's own field"):  # silently replaced u
+        ts.export(sphere_sol, tmp_path / "p.vtp", mesh=(v, f), point_data={"u": np.zeros(len(v))})
+    with pytest.raises(TypeError, match="point_data must be a dict"):
+        ts.export(sphere_sol, tmp_path / "p.vtp", point_data=[1, 2])
+    with pytest.raises(TypeError, match="must hold real numbers"):
+        ts.export(sphere_sol, tmp_path / "p.vtp", mesh=(v, f), point_data={"c": np.zeros(len(v)) + 1j})
+    junk = tmp_path / "junk.vtp"
+    junk.write_text("hello")
+    with pytest.raises(ValueError, match="junk.vtp: not an XML VTK file"):
+        ts.output.read_vtp(junk)

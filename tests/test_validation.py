@@ -326,3 +326,47 @@ def test_surface_lengths_and_tube_widths_are_real_numbers():
     assert ts.surfaces.Sphere(np.float32(0.5)).radius == 0.5
     with pytest.raises(ValueError, match="inner must be a finite number"):
         ts.solve(SPHERE, G3, [(-0.5, 0, 0)], inner=True)
+
+
+def test_travel_times_too_large_to_square_are_refused():
+    # at speed 1e-200 the squared travel times overflowed: travel_time returned 1/20 of the answer,
+    # reported converged, and solve ran 10,001 iterations
+    with pytest.raises(ValueError, match="too large to compute"):
+        ts.travel_time(G2, [(0, 0)], speed=1e-200)
+    with pytest.raises(ValueError, match="too large to compute"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=1e-200)
+
+
+def test_the_solution_keeps_its_own_copy_of_the_sources():
+    src = np.array([[-0.5, 0, 0.0], [0.5, 0, 0]])
+    sol = ts.solve(SPHERE, G3, src)
+    src[:] = 0.0
+    assert np.array_equal(sol.sources, [[-0.5, 0, 0], [0.5, 0, 0]])
+
+
+def test_a_tube_refuses_to_solve_after_its_phi_array_changed():
+    x = np.stack(G3.meshgrid(), -1)
+    phi = np.linalg.norm(x, axis=-1) - 0.5
+    tube = ts.Tube(phi, G3)
+    tube.solve([(-0.5, 0, 0)])
+    phi -= 0.2  # a source at the new surface was accepted on the old band
+    with pytest.raises(ValueError, match="was changed after the Tube was built"):
+        tube.solve([(-0.7, 0, 0)])
+
+
+@pytest.mark.parametrize("call, error, match", [
+    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.complex128(2 + 1j)), TypeError, "speed must be a real"),
+    (lambda: ts.hamiltonians.Isotropic(sigma=np.array([1.5 + 1j] * 3)), TypeError, "sigma must hold real"),
+    (lambda: ts.flows.point_vortices(np.array([[0.5, 0, 0]]), np.array([0.1 + 1j])), TypeError, "strengths must hold"),
+    (lambda: ts.surfaces.Star("0.5"), TypeError, "r0 must be a positive real"),
+    (lambda: ts.surfaces.Star(np.inf), ValueError, "r0 must be positive and finite"),
+    (lambda: ts.surfaces.Star(0.5, eps=-1), ValueError, "eps must be"),
+    (lambda: ts.LevelSet(lambda p: p[:, 0], lipschitz=np.complex128(1 + 1j)), TypeError, "lipschitz must be a real"),
+    (lambda: ts.solve(SPHERE, G3, {"a": 1}), TypeError, r"sources must be an array-like of shape \(M, 3\)"),
+    (lambda: ts.surfaces.Sphere(10**400), ValueError, "radius must be positive and finite"),
+    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.diag([1e30, 1, 1]))),
+     ValueError, "numerically singular"),
+])
+def test_more_bad_arguments_name_themselves(call, error, match):
+    with pytest.raises(error, match=match):
+        call()

@@ -33,18 +33,39 @@ def as_grid(grid: Any) -> Grid:
 def real_array(value: Any, name: str) -> np.ndarray:
     """``value`` as a float64 array; complex values are refused (NumPy would drop the imaginary
     part with only a ``ComplexWarning``) with a ``TypeError`` that names the argument."""
-    a = np.asarray(value)
-    if np.iscomplexobj(a):
+    try:
+        a = np.asarray(value)
+    except ValueError:  # ragged nesting
+        raise TypeError(f"{name} must be an array of real numbers; got {type(value).__name__}") from None
+    complex_values = np.iscomplexobj(a) or (
+        a.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in a.reshape(-1)))
+    if complex_values:
         raise TypeError(f"{name} must hold real numbers; got complex values (dtype {a.dtype}). Pass the real part "
                         f"(x.real) if the imaginary part is zero")
-    return a.astype(float, copy=False)
+    try:
+        return a.astype(float, copy=False)
+    except (TypeError, ValueError, OverflowError):
+        raise TypeError(f"{name} must be an array of real numbers; got {type(value).__name__}") from None
+
+
+def whole_indices(value: Any, name: str) -> np.ndarray:
+    """Indices (faces of a mesh): an int64 array of whole numbers. Floats with a fraction, NaN,
+    bools and anything not numeric are refused (they were truncated or read as 0/1)."""
+    f = np.asarray(value)
+    if f.size and (f.dtype == bool or not np.issubdtype(f.dtype, np.number) or np.iscomplexobj(f)):
+        raise TypeError(f"{name} must hold whole-number vertex indices; got dtype {f.dtype}")
+    if f.size and (not np.all(np.isfinite(f)) or np.any(f != np.round(f))):
+        raise ValueError(f"{name} must hold whole-number vertex indices")
+    return f.astype(np.int64)
 
 
 def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
     """Converts to a float (M, ndim) array; rejects complex values, NaN/inf and wrong shapes."""
     try:
         p = real_array(points, name)
-    except ValueError:
+    except TypeError as e:
+        if "complex" in str(e):
+            raise
         raise TypeError(f"{name} must be an array-like of shape (M, {ndim}) of numbers") from None
     if p.ndim == 1 and p.size == ndim:
         p = p.reshape(1, ndim)
@@ -57,7 +78,7 @@ def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
 
 
 def as_sources(sources: Any, grid: Grid) -> np.ndarray:
-    s = as_points(sources, grid.ndim, "sources")
+    s = as_points(sources, grid.ndim, "sources").copy()  # kept by the solution: not the caller's array
     if s.shape[0] == 0:
         raise ValueError("sources is empty; give at least one source point")
     inside = grid.contains(s)
@@ -97,6 +118,12 @@ def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cell
     across a cell was found, ``rescale`` what else the user may rescale besides the grid."""
     cell = spacing * mean_slowness
     scale = cell * cells  # about the travel time across the grid's longest side
+    if not scale < 1e100:
+        # the local updates square travel times across a cell: beyond about 1e154 they overflow
+        raise ValueError(
+            f"the travel times of this problem are too large to compute (about {scale:.3g} across the grid, "
+            f"{cell:.3g} across one grid cell: {cell_time}); rescale the units of the grid or {rescale} so that "
+            f"they are below about 1e100")
     if tol >= 1e-2 * scale:
         raise ValueError(
             f"tol={tol:g} is not small against the travel times of this problem (about {scale:.3g} across the grid, "
@@ -140,6 +167,8 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
                 f"returned shape {vals.shape} for M = {points.shape[0]}"
             )
     elif np.ndim(speed) == 0:
+        if np.iscomplexobj(speed):
+            raise TypeError(f"speed must be a real number; got {speed!r}")
         try:
             f = float(speed)
         except (TypeError, ValueError):

@@ -9,6 +9,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from ._validate import real_array
+
 __all__ = ["point_vortices", "solid_body_rotation", "rotation_travel_time_circle", "rotation_travel_time_sphere", "Flow"]
 
 Flow = Callable[[np.ndarray], np.ndarray]
@@ -39,12 +41,12 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
 
     At ``x = x_j`` the term is taken as 0 (its principal value for δ = 0, its limit for δ > 0).
     """
-    c = np.asarray(centers, dtype=float)
+    c = real_array(centers, "centers")
     if c.ndim == 1:
         c = c.reshape(1, -1)
     if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] == 0:
         raise ValueError(f"centers must have shape (N, 3) (point vortices live on a sphere in 3D); got {np.shape(centers)}")
-    s = np.broadcast_to(np.asarray(strengths, dtype=float), (c.shape[0],)).copy() if np.ndim(strengths) <= 1 else None
+    s = np.broadcast_to(real_array(strengths, "strengths"), (c.shape[0],)).copy() if np.ndim(strengths) <= 1 else None
     if s is None or not np.all(np.isfinite(s)):
         raise ValueError(f"strengths must be a number or one finite number per vortex ({c.shape[0]}); got {strengths!r}")
     if not (np.isfinite(core) and core >= 0):

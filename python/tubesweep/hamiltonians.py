@@ -49,7 +49,7 @@ class _Prepared:
 def _check_sigma(sigma: Any, d: Optional[int] = None) -> Optional[np.ndarray]:
     if sigma is None:
         return None
-    s = np.atleast_1d(np.asarray(sigma, dtype=float))
+    s = np.atleast_1d(real_array(sigma, "sigma"))
     if d is not None and s.size == 1:
         s = np.full(d, float(s[0]))
     if not np.all(np.isfinite(s)) or np.any(s <= 0):
@@ -330,7 +330,12 @@ class Metric(Hamiltonian):
             mt = P @ m @ P + mnn[:, None, None] * n[:, :, None] * n[:, None, :]
             m = np.where(has[:, None, None], mt, m)
         m = np.ascontiguousarray(m)
-        return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), extra={"inverse": np.linalg.inv(m)})
+        try:
+            inverse = np.linalg.inv(m)
+        except np.linalg.LinAlgError:
+            raise ValueError("M is numerically singular at some band node (after its tangential part was taken): "
+                             "its eigenvalues span too many orders of magnitude; rescale M or use tangential=False") from None
+        return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), extra={"inverse": inverse})
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
         """``s · sqrt(dᵀ M⁻¹ d)`` with the node's (tangential) metric."""

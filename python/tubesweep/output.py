@@ -23,7 +23,7 @@ from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from ._validate import real_array
+from ._validate import real_array, whole_indices
 from .surface import LevelSet
 
 __all__ = ["triangulate", "export", "plot", "read_vtp", "EXPORT_FORMATS"]
@@ -62,7 +62,7 @@ def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
         v_in, f_in = mesh
     except (TypeError, ValueError):
         raise ValueError("mesh must be a pair (vertices (n, 3), faces (m, 3))") from None
-    v = np.asarray(v_in, dtype=float)
+    v = real_array(v_in, "mesh vertices")
     if v.ndim != 2 or v.shape[1] not in (2, 3) or not np.all(np.isfinite(v)):
         raise ValueError(f"mesh vertices must be finite coordinates of shape (n, 2) or (n, 3); got shape {v.shape}"
                          + ("" if v.ndim != 2 or np.all(np.isfinite(v)) else " with NaN or inf"))
@@ -70,9 +70,12 @@ def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
     if f.ndim != 2 or f.shape[1] not in (2, 3, 4) or (f.size and not np.issubdtype(f.dtype, np.number)):
         raise ValueError(f"mesh faces must be an integer array of shape (m, 3) (or (m, 4) quads, (m, 2) segments); "
                          f"got shape {f.shape}")
-    if f.size and (not np.all(np.isfinite(f)) or np.any(f != np.round(f))):
-        raise ValueError("mesh faces must hold whole-number vertex indices")
-    f = f.astype(np.int64)
+    if len(v) == 0 or f.size == 0:
+        raise ValueError(f"mesh must have vertices and faces; got {len(v)} vertices and {len(f)} faces")
+    try:
+        f = whole_indices(f, "mesh faces")
+    except TypeError as e:
+        raise ValueError(str(e)) from None
     if f.size and (f.min() < 0 or f.max() >= len(v)):
         bad = int(f.min()) if f.min() < 0 else int(f.max())
         raise ValueError(f"mesh faces index vertex {bad}, but there are vertices 0..{len(v) - 1}")
@@ -155,27 +158,37 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
     def arr(a: np.ndarray, fmt: str) -> str:
         return "\n".join(" ".join(fmt % x for x in row) for row in np.atleast_2d(a).reshape(len(a), -1))
 
-    with open(path, "w") as fh:
-        fh.write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n')
-        fh.write(f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{m if kind == "Lines" else 0}" '
-                 f'NumberOfStrips="0" NumberOfPolys="{m if kind == "Polys" else 0}">\n')
-        names = list(point_data)
-        fh.write(f'<PointData Scalars={quoteattr(str(names[0]))}>\n' if names else "<PointData>\n")
-        for name, a in point_data.items():
-            comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""
-            fh.write(f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="ascii">\n'
-                     f'{arr(a, "%.17g")}\n</DataArray>\n')
-        fh.write("</PointData>\n<Points>\n")
-        fh.write(f'<DataArray type="Float64" NumberOfComponents="3" format="ascii">\n{arr(points, "%.17g")}\n</DataArray>\n')
-        fh.write(f"</Points>\n<{kind}>\n")
-        fh.write(f'<DataArray type="Int64" Name="connectivity" format="ascii">\n{arr(cells, "%d")}\n</DataArray>\n')
-        fh.write(f'<DataArray type="Int64" Name="offsets" format="ascii">\n{arr(np.arange(1, m + 1) * k, "%d")}\n</DataArray>\n')
-        fh.write(f"</{kind}>\n</Piece>\n</PolyData>\n</VTKFile>\n")
+    # written next to the target and renamed when complete: an error half-way leaves no
+    # truncated file behind
+    part = path.with_name(path.name + ".part")
+    try:
+        with open(part, "w") as fh:
+            fh.write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n')
+            fh.write(f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{m if kind == "Lines" else 0}" '
+                     f'NumberOfStrips="0" NumberOfPolys="{m if kind == "Polys" else 0}">\n')
+            names = list(point_data)
+            fh.write(f'<PointData Scalars={quoteattr(str(names[0]))}>\n' if names else "<PointData>\n")
+            for name, a in point_data.items():
+                comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""
+                fh.write(f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="ascii">\n'
+                         f'{arr(a, "%.17g")}\n</DataArray>\n')
+            fh.write("</PointData>\n<Points>\n")
+            fh.write(f'<DataArray type="Float64" NumberOfComponents="3" format="ascii">\n{arr(points, "%.17g")}\n</DataArray>\n')
+            fh.write(f"</Points>\n<{kind}>\n")
+            fh.write(f'<DataArray type="Int64" Name="connectivity" format="ascii">\n{arr(cells, "%d")}\n</DataArray>\n')
+            fh.write(f'<DataArray type="Int64" Name="offsets" format="ascii">\n{arr(np.arange(1, m + 1) * k, "%d")}\n</DataArray>\n')
+            fh.write(f"</{kind}>\n</Piece>\n</PolyData>\n</VTKFile>\n")
+        part.replace(path)
+    finally:
+        part.unlink(missing_ok=True)
 
 
 def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, np.ndarray]]:
     """Reads an ASCII ``.vtp`` written by :func:`export`: points (n, 3), cells, point data."""
-    root = ET.parse(str(path)).getroot()
+    try:
+        root = ET.parse(str(path)).getroot()
+    except ET.ParseError as e:
+        raise ValueError(f"{path}: not an XML VTK file ({e})") from None
     piece = root.find("PolyData/Piece")
     if piece is None:
         raise ValueError(f"{path}: not a VTK PolyData file")
@@ -238,10 +251,14 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
     data: Dict[str, np.ndarray] = {"u": u}
     if len(sol.sources) > 1 and sol._isotropic:
         data["nearest_source"] = sol.nearest_source(v).astype(float)
+    if point_data is not None and not isinstance(point_data, dict):
+        raise TypeError(f"point_data must be a dict of name -> values per vertex; got {type(point_data).__name__}")
     for name, a in (point_data or {}).items():
         if not isinstance(name, str) or not name or any(ord(ch) < 32 for ch in name):
             raise ValueError(f"point_data names must be non-empty strings without control characters; got {name!r}")
-        a = np.asarray(a, dtype=float)
+        if name in data:
+            raise ValueError(f"point_data[{name!r}]: the name {name!r} is the solution's own field; choose another name")
+        a = real_array(a, f"point_data[{name!r}]")
         if a.ndim not in (1, 2) or (a.ndim == 2 and not 1 <= a.shape[1] <= 9):
             raise ValueError(f"point_data[{name!r}] must have shape (n,) or (n, k) with k at most 9 (one value or "
                              f"vector per vertex); got {a.shape}")
@@ -254,7 +271,7 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
         _write_vtp(path, pts, cells, data)
         return path
     meshio = _need("meshio", "mesh", f"writing {suffix} files")
-    kind = "triangle" if cells.shape[1] == 3 else "line"
+    kind = {2: "line", 3: "triangle", 4: "quad"}[cells.shape[1]]
     if suffix == ".ply" and kind == "line":
         raise ValueError("export: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
     if suffix == ".ply" and len(pts) < 2**31:
@@ -347,16 +364,18 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     from matplotlib.ticker import MaxNLocator
 
     grid = sol.grid
-    lines = [np.asarray(q, dtype=float) for q in (paths or [])]
+    lines = [real_array(q, f"paths[{i}]") for i, q in enumerate(paths or [])]
     for i, q in enumerate(lines):
         if q.ndim != 2 or q.shape[1] != grid.ndim or len(q) < 1:
             raise ValueError(f"paths[{i}] must be an array of shape (P, {grid.ndim}); got shape {q.shape}")
     finite = sol.values[np.isfinite(sol.values)]
     umax = float(finite.max()) if finite.size else 1.0
     if np.ndim(levels) == 0:
+        if isinstance(levels, np.ndarray):
+            levels = levels.item()
         if (isinstance(levels, (bool, np.bool_)) or not isinstance(levels, (int, float, np.integer, np.floating))
-                or not (float(levels).is_integer() and levels >= 0)):
-            raise ValueError(f"levels must be a number of iso-lines (an integer ≥ 0) or a sequence of their values; "
+                or not (float(levels).is_integer() and 0 <= levels <= 1000)):
+            raise ValueError(f"levels must be a number of iso-lines (an integer from 0 to 1000) or a sequence of their values; "
                              f"got {levels!r}")
         lv = MaxNLocator(int(levels) + 1).tick_values(0.0, umax) if levels > 0 else np.zeros(0)
     else:
@@ -410,7 +429,9 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     v = v[:, perm]
     src = sol.sources[:, perm]
     tri = v[f]
-    uface = np.nanmean(np.where(np.isfinite(u[f]), u[f], np.nan), axis=1)
+    finite = np.isfinite(u[f])
+    # the mean of the reached corners (NaN for a face none of whose corners was reached)
+    uface = np.where(finite, u[f], 0.0).sum(axis=1) / np.where(finite.any(axis=1), finite.sum(axis=1), np.nan)
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
     base = cmap_obj(norm(np.nan_to_num(uface, nan=umax)))

@@ -239,7 +239,8 @@ class Solution:
 
     def to_dense(self, fill: float = np.nan) -> np.ndarray:
         """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
-        if isinstance(fill, (bool, np.bool_, str, bytes)) or np.ndim(fill) != 0 or np.iscomplexobj(fill):
+        if (fill is None or isinstance(fill, (bool, np.bool_, str, bytes)) or np.ndim(fill) != 0
+                or np.iscomplexobj(fill)):
             raise TypeError(f"fill must be a real number (the value outside the band, NaN by default); got {fill!r}")
         out = np.full(self.grid.size, float(fill), dtype=float)
         out[self.linear] = self.values
@@ -487,10 +488,10 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
 def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray, roles: np.ndarray,
                                    inner: float) -> None:
     """Refuses a surface that the grid cannot resolve: one whose closest points from the inner
-    tube span less than two grid spacings along every axis (a disc or plane patch smaller than a
-    cell; on a disc of radius 0.02Δx the distances came out 29% short, with no warning). Closed
-    surfaces that small are refused earlier, by the distance check (their tube reaches the
-    centre). The inner tube of a surface that small has at most ``(2·inner + 3)^d`` nodes, so the
+    tube span less than two grid spacings along every axis of their bounding box (a disc or plane
+    patch smaller than a cell; on a disc of radius 0.02Δx the distances came out 29% short, with
+    no warning; a closed mesh or closest-point curve that small too, while a level set that small
+    is refused earlier, by the distance check, its tube reaching the centre). The inner tube of a surface that small has at most ``(2·inner + 3)^d`` nodes, so the
     closest points are computed only for a band that small: nothing is added to other solves."""
     h = grid.spacing
     inner_nodes = np.flatnonzero(roles == ROLE_INNER)
@@ -503,8 +504,8 @@ def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray
     extent = float(np.max(np.ptp(closest, axis=0)))
     if extent < 2.0 * h:
         raise ValueError(
-            f"the grid is too coarse for this surface: the surface spans only {extent:.3g} along its longest axis "
-            f"(measured from the inner tube's closest points), less than two grid spacings (h = {h:.4g}), so the "
+            f"the grid is too coarse for this surface: the surface spans only {extent:.3g} along the longest side of "
+            f"its bounding box (from the inner tube's closest points), less than two grid spacings (h = {h:.4g}), so the "
             f"grid cannot resolve it; refine the grid to a spacing below {extent / 2:.3g}, or shrink the box")
 
 

@@ -218,7 +218,10 @@ class LevelSet(Surface):
     ----------
     phi : ndarray of ``grid.shape`` or callable ``phi(points (M, d)) -> (M,)``
         The level set function sampled on the grid, or a vectorised function. Only the band is
-        evaluated for a callable (found coarse-to-fine, never the whole box).
+        evaluated for a callable (found coarse-to-fine, never the whole box). A C-ordered float64
+        array is used in place, not copied (no second array of the grid's size): do not change it
+        while a solution or a :class:`~tubesweep.Tube` built from it is in use (a Tube refuses to
+        solve after a change); pass ``phi.copy()`` to keep it free.
     lipschitz : float, optional
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
         default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
@@ -257,6 +260,9 @@ class LevelSet(Surface):
             self._array = arr
             self.ndim = arr.ndim
         self.redistance = bool(redistance)
+        if lipschitz is not None and (isinstance(lipschitz, (bool, np.bool_, str, bytes)) or np.ndim(lipschitz) != 0
+                                      or np.iscomplexobj(lipschitz)):
+            raise TypeError(f"lipschitz must be a real number (a bound on |∇φ|); got {lipschitz!r}")
         if lipschitz is None:
             self.lipschitz: Optional[float] = None if self.redistance else 1.5
         elif self.redistance:

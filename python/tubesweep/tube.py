@@ -59,6 +59,10 @@ class Tube:
         self.surface: Surface = as_surface(surface)
         self.surface.check_grid(self.grid)
         self._tube = _prepare_tube(self.surface, self.grid, inner, outer, method, keep_geometry=True, reusable=True)
+        # a φ array is used in place, not copied: its values at the band's nodes, kept to notice
+        # a change before a later solve projects sources on the changed array (O(band) per solve)
+        array = getattr(self.surface, "_array", None)
+        self._phi_at_band = None if array is None else array.reshape(-1)[self._tube.linear].copy()
 
     @property
     def method(self) -> str:
@@ -104,6 +108,11 @@ class Tube:
         :func:`tubesweep.solve` (which see), without building the band again.
         ``sol.stats.setup_seconds`` is then the time spent on the sources and the speed."""
         t0 = time.perf_counter()
+        if self._phi_at_band is not None and not np.array_equal(
+                self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band):  # type: ignore[attr-defined]
+            raise ValueError("the φ array of this Tube's surface was changed after the Tube was built: its band no "
+                             "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
+                             "the array free to change)")
         src = as_sources(sources, self.grid)
         general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
         check_tolerance(tol, max_iterations)

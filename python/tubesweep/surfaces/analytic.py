@@ -28,6 +28,8 @@ def size_parameter(name: str, value: Any) -> float:
         raise TypeError(f"{name} must be a positive real number (a length in the grid's units); got {value!r}")
     try:
         v = float(value)
+    except OverflowError:
+        v = float("inf")
     except (TypeError, ValueError):
         raise TypeError(f"{name} must be a positive real number (a length in the grid's units); got {value!r}") from None
     if not (np.isfinite(v) and v > 0):
@@ -147,7 +149,10 @@ class Star(LevelSet):
     default_box = ((-1.0, -1.0), (1.0, 1.0))
 
     def __init__(self, r0: float = 0.5, eps: float = 0.2, *, exact: bool = True):
-        self.r0 = float(r0)
+        self.r0 = size_parameter("r0", r0)
+        if (isinstance(eps, (bool, np.bool_, str, bytes)) or np.ndim(eps) != 0 or np.iscomplexobj(eps)
+                or not np.isfinite(float(eps)) or float(eps) < 0):
+            raise ValueError(f"eps must be a finite real number >= 0 (the star's amplitude); got {eps!r}")
         self.eps = float(eps)
         self.exact = bool(exact)
         if not (self.r0 > self.eps >= 0 or (self.r0 > 0 and self.eps >= 0)):

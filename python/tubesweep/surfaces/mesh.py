@@ -30,7 +30,8 @@ import numpy as np
 
 from ..grid import Grid
 from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
-from .analytic import size_parameter
+from .._validate import real_array, whole_indices
+from .analytic import finite_center, size_parameter
 
 __all__ = ["from_mesh", "MeshSurface", "read_mesh", "closest_points_on_triangles"]
 
@@ -54,7 +55,11 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
     except ImportError:
         trimesh = None
     if trimesh is not None:
-        m = trimesh.load(str(path), force="mesh", process=False, maintain_order=True)
+        try:
+            m = trimesh.load(str(path), force="mesh", process=False, maintain_order=True)
+        except (ValueError, IndexError, KeyError, TypeError, AttributeError) as e:
+            raise ValueError(f"{path}: not a readable triangle mesh ({type(e).__name__}: {e}); tubesweep reads OBJ, "
+                             "PLY, STL and OFF files") from None
         v = np.asarray(m.vertices, dtype=float)
         f = np.asarray(m.faces, dtype=np.int64)
         if f.size == 0:
@@ -174,8 +179,8 @@ class MeshSurface(Surface):
 
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, *, signed: Optional[bool] = None,
                  name: str = "mesh", scale: float = 1.0, offset: Optional[np.ndarray] = None):
-        v = np.ascontiguousarray(vertices, dtype=float)
-        f = np.ascontiguousarray(faces, dtype=np.int64)
+        v = np.ascontiguousarray(real_array(vertices, "vertices"))
+        f = np.ascontiguousarray(whole_indices(faces, "faces"))
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices must have shape (n, 3); got {v.shape}")
         if f.ndim != 2 or f.shape[1] != 3:
@@ -381,8 +386,11 @@ class MeshSurface(Surface):
             Empty grid spacings between the bounding box and the grid's faces on every side; it must
             hold the outer tube (``outer`` = 4 by default, 5 for the paper's bunny) plus one node.
         """
-        if padding < 0:
-            raise ValueError(f"padding must be >= 0 grid spacings; got {padding}")
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
+            raise TypeError(f"n must be a whole number of nodes along the longest axis; got {n!r}")
+        if (isinstance(padding, (bool, np.bool_, str)) or np.ndim(padding) != 0 or np.iscomplexobj(padding)
+                or not np.isfinite(float(padding)) or padding < 0):
+            raise ValueError(f"padding must be a finite number >= 0 of grid spacings; got {padding!r}")
         if n < 2 * padding + 3:
             raise ValueError(f"n = {n} nodes cannot hold {padding} spacings of padding on both sides; use n >= {int(2 * padding + 3)}")
         lo, hi = self.bounds
@@ -444,16 +452,22 @@ def from_mesh(mesh: Union[str, Path, Tuple[Any, Any]], *, normalize: bool = Fals
             v, f = mesh
         except (TypeError, ValueError):
             raise TypeError("mesh must be a file path or a pair (vertices, faces)") from None
-        v = np.asarray(v, dtype=float)
-        f = np.asarray(f)
+        v = real_array(v, "vertices")
+        f = whole_indices(f, "faces")
         name = "mesh"
     offset = np.zeros(3)
     scale = 1.0
     if normalize:
         size = size_parameter("size", size)
-        used = v[np.unique(np.asarray(f, dtype=np.int64))]
+        target = finite_center(center, 3)
+        if f.size == 0 or f.min() < 0 or f.max() >= len(v) or v.ndim != 2 or v.shape[1] != 3:
+            return MeshSurface(v, f, signed=signed, name=name)  # raises with the mesh's own message
+        used = v[np.unique(f)]
         lo, hi = used.min(0), used.max(0)
+        if not float((hi - lo).max()) > 0:
+            raise ValueError("the mesh's vertices all coincide: it has no extent to normalize (every triangle is "
+                             "degenerate)")
         scale = float(size) / float((hi - lo).max())
-        offset = 0.5 * (lo + hi) - np.asarray(center, dtype=float) / scale
+        offset = 0.5 * (lo + hi) - target / scale
         v = (v - offset) * scale
     return MeshSurface(v, f, signed=signed, name=name, scale=scale, offset=offset)
