@@ -95,10 +95,10 @@ def test_solve_traces_paths_and_labels_cells(tmp_path, capsys):
     x = -1 + (2 / 60) * data["indices"][:, 0]
     clear = np.abs(x) > 0.1
     assert np.array_equal(data["nearest_source"][clear], np.where(x[clear] > 0, 0, 1))
-    with pytest.raises(SystemExit, match="needs --mesh"):
-        main(["solve", "--surface", "sphere", "--n", "41", "--path-from-vertex", "3", "--out", str(tmp_path), "--quiet"])
-    with pytest.raises(SystemExit, match="3 coordinates"):
-        main(["solve", "--surface", "sphere", "--n", "41", "--path-from", "0", "0.5", "--out", str(tmp_path), "--quiet"])
+    assert main(["solve", "--surface", "sphere", "--n", "41", "--path-from-vertex", "3", "--out", str(tmp_path), "--quiet"]) == 2
+    assert "needs --mesh" in capsys.readouterr().err
+    assert main(["solve", "--surface", "sphere", "--n", "41", "--path-from", "0", "0.5", "--out", str(tmp_path), "--quiet"]) == 2
+    assert "3 coordinates" in capsys.readouterr().err
 
 
 def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
@@ -110,21 +110,44 @@ def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
                "--source", "0.5", "0", "--out", str(tmp_path / "o"), "--quiet"])
     assert rc == 0 and (tmp_path / "o" / "solution.npz").exists()
     (tmp_path / "empty.npy").write_bytes(b"")
-    with pytest.raises(SystemExit, match="not a NumPy .npy or .npz file"):
-        main(["solve", "--phi", str(tmp_path / "empty.npy"), "--lower", "-1", "-1", "--upper", "1", "1",
-              "--source", "0.5", "0", "--out", str(tmp_path / "o1")])
+    assert main(["solve", "--phi", str(tmp_path / "empty.npy"), "--lower", "-1", "-1", "--upper", "1", "1",
+              "--source", "0.5", "0", "--out", str(tmp_path / "o1")]) == 2
+    assert "not a NumPy .npy or .npz file" in capsys.readouterr().err
     (tmp_path / "notnumpy.txt").write_text("hello")
-    with pytest.raises(SystemExit, match="not a NumPy .npy or .npz file"):
-        main(["solve", "--phi", str(tmp_path / "notnumpy.txt"), "--lower", "-1", "-1", "--upper", "1", "1",
-              "--source", "0.5", "0", "--out", str(tmp_path / "o2")])
+    assert main(["solve", "--phi", str(tmp_path / "notnumpy.txt"), "--lower", "-1", "-1", "--upper", "1", "1",
+              "--source", "0.5", "0", "--out", str(tmp_path / "o2")]) == 2
+    assert "not a NumPy .npy or .npz file" in capsys.readouterr().err
     # --out an existing file, an unknown export format: refused before solving (no traceback)
     (tmp_path / "afile").write_text("")
-    with pytest.raises(SystemExit, match="exists and is not a directory"):
-        main(["solve", "--surface", "circle", "--n", "41", "--out", str(tmp_path / "afile")])
-    with pytest.raises(SystemExit, match="unknown format '.xyz'"):
-        main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "x.xyz"), "--out", str(tmp_path / "o3")])
+    assert main(["solve", "--surface", "circle", "--n", "41", "--out", str(tmp_path / "afile")]) == 2
+    assert "exists and is not a directory" in capsys.readouterr().err
+    assert main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "x.xyz"), "--out", str(tmp_path / "o3")]) == 2
+    assert "unknown format '.xyz'" in capsys.readouterr().err
     assert not (tmp_path / "o3").exists()
     # a mesh file nothing can read: an error line and exit code 2
     (tmp_path / "m.unknownext").write_text("1 2 3")
     assert main(["solve", "--mesh", str(tmp_path / "m.unknownext"), "--out", str(tmp_path / "o4"), "--quiet"]) == 2
     assert "error:" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--source", "-0.5", "0", "0", "--source", "1", "1"], "--source needs 3 coordinates"),
+    (["--lower", "-1", "-1", "-1"], "give both --lower and --upper"),
+    (["--padding", "3"], "--padding applies to --mesh only"),
+    (["--path-from", "0", "0", "0"], "farther than the inner tube"),
+])
+def test_contradictory_or_incomplete_arguments_are_refused_before_the_solve(tmp_path, capsys, argv, message):
+    # NumPy's "inhomogeneous shape", silently ignored --lower/--padding, a path start off the
+    # surface found only after the solve had written its files
+    out = tmp_path / "o"
+    assert main(["solve", "--surface", "sphere", "--n", "41", "--out", str(out), "--quiet", *argv]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_curve_cannot_be_exported_to_ply_and_a_directory_is_not_a_mesh(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "c.ply"), "--out", str(out)]) == 2
+    assert ".ply holds surfaces only" in capsys.readouterr().err and not out.exists()
+    assert main(["solve", "--mesh", str(tmp_path), "--out", str(out)]) == 2
+    assert "is a directory" in capsys.readouterr().err

@@ -67,7 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--n", type=int, default=None,
                    help="nodes per axis for --surface (default: 101); for --mesh, nodes along the longest side of the "
                    "mesh's bounding box, padding included (default: 200)")
-    p.add_argument("--padding", type=float, default=8.0, help="--mesh: empty grid spacings around the mesh (default 8)")
+    p.add_argument("--padding", type=float, default=None, help="--mesh: empty grid spacings around the mesh (default 8)")
     p.add_argument("--normalize", action="store_true",
                    help="--mesh: centre the mesh at the origin and scale its longest side to 1 (sources are then in "
                    "the new coordinates)")
@@ -119,13 +119,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class UsageError(ValueError):
+    """A command line that cannot run (an argument missing, out of range or contradicting another):
+    printed as an ``error:`` line, exit status 2, like every other refused input."""
+
+
 def _grid_for(surface, n: int, lower: Optional[Sequence[float]], upper: Optional[Sequence[float]]):
     from .grid import Grid
 
     if lower is None or upper is None:
         box = getattr(surface, "default_box", None)
         if box is None:
-            raise SystemExit("give --lower and --upper for this surface")
+            raise UsageError("give --lower and --upper for this surface")
         lower, upper = box
     return Grid(lower, upper, (n,) * len(lower))
 
@@ -138,7 +143,7 @@ def _load_phi(path: Path) -> np.ndarray:
     try:
         data = np.load(path, allow_pickle=False)
     except (ValueError, EOFError, zipfile.BadZipFile):
-        raise SystemExit(f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
+        raise UsageError(f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
                          f"φ with numpy.save or numpy.savez") from None
     if isinstance(data, np.lib.npyio.NpzFile):
         with data:
@@ -147,7 +152,7 @@ def _load_phi(path: Path) -> np.ndarray:
                 return np.asarray(data["phi"])
             if len(names) == 1:
                 return np.asarray(data[names[0]])
-        raise SystemExit(f"--phi {path}: an .npz file must hold one array or one named 'phi'; it holds {names}")
+        raise UsageError(f"--phi {path}: an .npz file must hold one array or one named 'phi'; it holds {names}")
     return np.asarray(data)
 
 
@@ -157,9 +162,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
     from .surface import LevelSet
 
     if args.source_vertex and not args.mesh:
-        raise SystemExit("--source-vertex needs --mesh")
+        raise UsageError("--source-vertex needs --mesh")
     if args.path_from_vertex and not args.mesh:
-        raise SystemExit("--path-from-vertex needs --mesh")
+        raise UsageError("--path-from-vertex needs --mesh")
     # what can be checked before the solve is checked before it
     from .output import export_format
 
@@ -167,21 +172,24 @@ def cmd_solve(args: argparse.Namespace) -> int:
         try:
             export_format(path)
         except ValueError as e:
-            raise SystemExit(f"--export {path}: {e}") from None
+            raise UsageError(f"--export {path}: {e}") from None
     if args.out.exists() and not args.out.is_dir():
-        raise SystemExit(f"--out {args.out}: exists and is not a directory")
+        raise UsageError(f"--out {args.out}: exists and is not a directory")
     if args.mesh:
         from .surfaces.mesh import from_mesh
 
         surface = from_mesh(args.mesh, normalize=args.normalize)
         n = 200 if args.n is None else args.n
         if args.lower is not None or args.upper is not None:
-            raise SystemExit("--mesh picks its grid from --n and --padding; do not give --lower/--upper")
-        grid = surface.grid(n, padding=args.padding)
+            raise UsageError("--mesh picks its grid from --n and --padding; do not give --lower/--upper")
+        grid = surface.grid(n, padding=8.0 if args.padding is None else args.padding)
         name = args.mesh.stem
         print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
     elif args.surface:
         from .surfaces import REGISTRY
+
+        if (args.lower is None) != (args.upper is None):
+            raise UsageError("give both --lower and --upper (the grid's corners), or neither for the surface's own box")
 
         surface = REGISTRY[args.surface]()
         grid = _grid_for(surface, 101 if args.n is None else args.n, args.lower, args.upper)
@@ -189,18 +197,37 @@ def cmd_solve(args: argparse.Namespace) -> int:
     else:
         phi = _load_phi(args.phi)
         if args.lower is None or args.upper is None:
-            raise SystemExit("--phi needs --lower and --upper (the grid's corners)")
+            raise UsageError("--phi needs --lower and --upper (the grid's corners)")
         grid = Grid(args.lower, args.upper, phi.shape)
         surface = LevelSet(phi)
         name = args.phi.stem
+    if args.padding is not None and not args.mesh:
+        raise UsageError("--padding applies to --mesh only (a --surface or --phi grid is given by its box)")
     bad_arity = [len(p) for p in args.path_from or [] if len(p) != grid.ndim]
     if bad_arity:
-        raise SystemExit(f"--path-from needs {grid.ndim} coordinates on a {grid.ndim}D grid; got {bad_arity[0]}")
+        raise UsageError(f"--path-from needs {grid.ndim} coordinates on a {grid.ndim}D grid; got {bad_arity[0]}")
+    bad_arity = [len(p) for p in args.source or [] if len(p) != grid.ndim]
+    if bad_arity:
+        raise UsageError(f"--source needs {grid.ndim} coordinates on a {grid.ndim}D grid; got {bad_arity[0]}")
+    for i in args.path_from_vertex or []:
+        if not 0 <= i < len(surface.vertices):
+            raise UsageError(f"--path-from-vertex {i}: the mesh has vertices 0..{len(surface.vertices) - 1}")
+    if args.path_from:
+        # a start off the surface is refused by the paths; refused here before the solve instead
+        dist, _ = surface.project(np.array(args.path_from, dtype=float), grid)
+        far = np.flatnonzero(~(dist <= args.inner * grid.spacing * (1 + 1e-6)))
+        if far.size:
+            raise UsageError(f"--path-from {' '.join(map(str, args.path_from[far[0]]))}: {float(dist[far[0]]):.4g} from "
+                             f"the surface, farther than the inner tube ({args.inner:g} grid spacings); start on the surface")
+    if grid.ndim == 2:
+        for path in args.export or []:
+            if Path(path).suffix.lower() == ".ply":
+                raise UsageError(f"--export {path}: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
     if args.source_vertex:
         nv = len(surface.vertices)
         bad = [i for i in args.source_vertex if not 0 <= i < nv]
         if bad:
-            raise SystemExit(f"--source-vertex {bad[0]}: the mesh has vertices 0..{nv - 1}")
+            raise UsageError(f"--source-vertex {bad[0]}: the mesh has vertices 0..{nv - 1}")
         sources = surface.vertices[np.array(args.source_vertex)]
         if args.source:
             sources = np.vstack([sources, np.array(args.source, dtype=float)])
@@ -209,7 +236,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     elif hasattr(surface, "default_source"):
         sources = np.atleast_2d(surface.default_source)
     else:
-        raise SystemExit("give --source")
+        raise UsageError("give --source")
     progress = make_progress(f"solve {name}", args.quiet)
     t0 = time.perf_counter()
     try:
@@ -254,14 +281,14 @@ def _trace_paths(args: argparse.Namespace, surface: Any, sol: Any, out: Path) ->
     for i in args.path_from_vertex or []:
         nv = len(surface.vertices)
         if not 0 <= i < nv:
-            raise SystemExit(f"--path-from-vertex {i}: the mesh has vertices 0..{nv - 1}")
+            raise UsageError(f"--path-from-vertex {i}: the mesh has vertices 0..{nv - 1}")
         starts.append(surface.vertices[i])
     if not starts:
         return []
     d = sol.grid.ndim
     bad = [len(p) for p in starts if len(p) != d]
     if bad:
-        raise SystemExit(f"--path-from needs {d} coordinates on a {d}D grid; got {bad[0]}")
+        raise UsageError(f"--path-from needs {d} coordinates on a {d}D grid; got {bad[0]}")
     from .geodesic_paths import _onto_surface
 
     paths = sol.geodesic_paths(np.array(starts))

@@ -48,6 +48,8 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
     those of the file), otherwise meshio; polygons are fan-triangulated.
     """
     path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"mesh file {str(path)!r} is a directory, not a mesh file")
     if not path.is_file():
         raise FileNotFoundError(f"mesh file {str(path)!r} does not exist")
     try:
