@@ -268,3 +268,18 @@ def test_the_source_finder_agrees_with_brute_force():
         got = _SourceFinder(g, src, radius).within(pts)
         want = np.where(d.min(1) <= radius, d.argmin(1), -1)
         assert np.array_equal(got, want) and np.count_nonzero(got >= 0) > 50
+
+
+def test_a_path_caught_where_u_barely_decreases_stalls_instead_of_running_in_place():
+    # on Spot at grid(81) with three sources the path from vertex 2000 reached a point where u
+    # fell only at the rounding level: rounding-level decreases reset the stall count, and it ran
+    # on in place, 136 of its 299 points repeating the last one
+    spot_file = Path(__file__).resolve().parents[2] / "shared" / "data" / "spot.obj"
+    if not spot_file.is_file():
+        pytest.skip("needs ../shared/data/spot.obj")
+    spot = ts.surfaces.from_mesh(spot_file)
+    sol = ts.solve(spot, spot.grid(81), spot.vertices[[285, 0, 1000]])
+    with pytest.warns(RuntimeWarning, match="stopped before reaching a source"):
+        path = sol.geodesic_path(spot.vertices[2000])
+    steps = np.linalg.norm(np.diff(path, axis=0), axis=1)
+    assert np.count_nonzero(steps < 1e-9) == 0 and len(path) < 150

@@ -45,6 +45,10 @@ MIN_STEP = 0.01
 #: Steps in a row without a decrease of ``u`` after which a path is declared stalled.
 STALL_STEPS = 8
 
+#: A step makes progress when it lowers u by more than this fraction of ``step·Δx·|∇u|``, the
+#: decrease expected of it (see :data:`STALL_STEPS`).
+PROGRESS_FRACTION = 1e-3
+
 #: A path ends with a straight segment to a source once it is this many grid spacings from it
 #: (the radius of the nodes a source fixes, ``solve.SOURCE_RADIUS``: there u is the exact
 #: distance, and a gradient stencil that straddles the source's cone points poorly).
@@ -254,11 +258,14 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         lost = ~np.isfinite(un)
         stalled.extend(int(i) for i in active[lost])
         keep = ~lost
-        active, nxt, un = active[keep], nxt[keep], un[keep]
+        active, nxt, un, gn = active[keep], nxt[keep], un[keep], gn[keep]
         for i, q in zip(active, nxt):
             paths[i].append(q.copy())
         cur[active], ucur[active] = nxt, un
-        better = un < best_u[active]
+        # progress is a decrease of at least PROGRESS_FRACTION of the step's expected s·|∇u|: a
+        # path caught where u barely varies (decreases at the rounding level) stalls instead of
+        # running on in place until max_steps
+        better = un < best_u[active] - PROGRESS_FRACTION * s * gn
         best_u[active] = np.where(better, un, best_u[active])
         no_progress[active] = np.where(better, 0, no_progress[active] + 1)
         stuck = no_progress[active] >= STALL_STEPS
