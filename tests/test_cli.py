@@ -151,3 +151,8 @@ def test_a_curve_cannot_be_exported_to_ply_and_a_directory_is_not_a_mesh(tmp_pat
     assert ".ply holds surfaces only" in capsys.readouterr().err and not out.exists()
     assert main(["solve", "--mesh", str(tmp_path), "--out", str(out)]) == 2
     assert "is a directory" in capsys.readouterr().err
+
+
+def test_an_unknown_experiment_is_an_error_line_with_exit_status_2(capsys):
+    assert main(["reproduce", "nosuch"]) == 2
+    assert "unknown experiment" in capsys.readouterr().err

@@ -281,3 +281,4 @@ def test_degenerate_and_corrupt_mesh_input_is_refused_clearly(tmp_path):
             m.grid(n)
     with pytest.raises(ValueError, match="padding must be a finite number"):
         m.grid(50, padding=np.nan)
+    assert m.grid(50.0).shape == m.grid(np.int64(50)).shape == m.grid(50).shape

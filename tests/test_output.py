@@ -218,3 +218,21 @@ def test_export_quads_point_data_and_bad_files(sphere_sol, tmp_path):
     junk.write_text("hello")
     with pytest.raises(ValueError, match="junk.vtp: not an XML VTK file"):
         ts.output.read_vtp(junk)
+
+
+def test_vtp_export_keeps_the_target_s_mode_and_writes_through_symlinks(circle_sol, tmp_path):
+    import os
+
+    target = tmp_path / "a.vtp"
+    ts.export(circle_sol, target)
+    os.chmod(target, 0o600)  # a private file stays private (the rename made it 0644)
+    ts.export(circle_sol, target)
+    assert os.stat(target).st_mode & 0o777 == 0o600
+    link = tmp_path / "l.vtp"
+    link.symlink_to(target)
+    ts.export(circle_sol, link)
+    assert link.is_symlink() and len(ts.output.read_vtp(target)[0]) > 0
+    (tmp_path / "d.vtp").mkdir()
+    with pytest.raises(IsADirectoryError):
+        ts.export(circle_sol, tmp_path / "d.vtp")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.vtp", "d.vtp", "l.vtp"]

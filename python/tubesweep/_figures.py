@@ -16,7 +16,7 @@ def _plt() -> Any:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise SystemExit("pictures need matplotlib: pip install 'tubesweep[plot]'") from None
+        raise ImportError("pictures need matplotlib: pip install 'tubesweep[plot]'") from None
     return plt
 
 

@@ -214,7 +214,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
             raise UsageError(f"--path-from-vertex {i}: the mesh has vertices 0..{len(surface.vertices) - 1}")
     if args.path_from:
         # a start off the surface is refused by the paths; refused here before the solve instead
-        dist, _ = surface.project(np.array(args.path_from, dtype=float), grid)
+        starts = np.array(args.path_from, dtype=float)
+        outside = np.flatnonzero(~grid.contains(starts))
+        if outside.size:
+            raise UsageError(f"--path-from {' '.join(map(str, args.path_from[outside[0]]))}: outside the grid")
+        dist, _ = surface.project(starts, grid)
         far = np.flatnonzero(~(dist <= args.inner * grid.spacing * (1 + 1e-6)))
         if far.size:
             raise UsageError(f"--path-from {' '.join(map(str, args.path_from[far[0]]))}: {float(dist[far[0]]):.4g} from "

@@ -158,9 +158,26 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
     def arr(a: np.ndarray, fmt: str) -> str:
         return "\n".join(" ".join(fmt % x for x in row) for row in np.atleast_2d(a).reshape(len(a), -1))
 
-    # written next to the target and renamed when complete: an error half-way leaves no
-    # truncated file behind
-    part = path.with_name(path.name + ".part")
+    # written to a temporary file next to the target (through symlinks) and renamed over it when
+    # complete, with the target's mode: an error half-way leaves no truncated file behind. A
+    # read-only target is refused as open() would; where no file can be created next to it (a
+    # read-only directory holding a writable file), the file is written in place.
+    import os
+    import shutil
+    import tempfile
+
+    target = Path(os.path.realpath(path))
+    if target.is_dir():
+        raise IsADirectoryError(f"{path} is a directory")
+    if target.exists() and not os.access(target, os.W_OK):
+        raise PermissionError(f"{path} is not writable")
+    try:
+        fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+    except PermissionError:
+        fd, name = -1, ""
+    part = Path(name) if name else target
+    if fd >= 0:
+        os.close(fd)
     try:
         with open(part, "w") as fh:
             fh.write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n')
@@ -178,9 +195,25 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
             fh.write(f'<DataArray type="Int64" Name="connectivity" format="ascii">\n{arr(cells, "%d")}\n</DataArray>\n')
             fh.write(f'<DataArray type="Int64" Name="offsets" format="ascii">\n{arr(np.arange(1, m + 1) * k, "%d")}\n</DataArray>\n')
             fh.write(f"</{kind}>\n</Piece>\n</PolyData>\n</VTKFile>\n")
-        part.replace(path)
+        if part != target:
+            if target.exists():
+                shutil.copymode(target, part)
+            else:
+                os.chmod(part, 0o666 & ~_umask())
+            os.replace(part, target)
     finally:
-        part.unlink(missing_ok=True)
+        if part != target:
+            part.unlink(missing_ok=True)
+
+
+def _umask() -> int:
+    """The process's file-creation mask (mkstemp creates files 0600; a new export gets the mode
+    open() would give it)."""
+    import os
+
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, np.ndarray]]:
@@ -423,6 +456,8 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     if up not in ("x", "y", "z"):
         raise ValueError(f"up must be 'x', 'y' or 'z'; got {up!r}")
     v, f = triangulate(sol, mesh=mesh)
+    if f.shape[1] == 4:  # quads as two triangles each: the shading and the iso-lines walk triangles
+        f = np.vstack([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
     u = sol.on_mesh(v)
     # a cyclic permutation of the axes (keeps orientation) puts `up` last, mplot3d's vertical
     perm = {"x": [1, 2, 0], "y": [2, 0, 1], "z": [0, 1, 2]}[up]

@@ -248,7 +248,8 @@ def redistanced_band(surface, grid, half_width: float):
     cp, signed, ok = _project(surface, grid, x)
     # candidates that did not settle but lie near the band (their last iterate on the zero level
     # set within 1.5 half-widths): projected again with more steps (ORTHOGONALITY_RETRY_STEPS)
-    retry = np.flatnonzero(~ok & _on_zero_set_within(surface, grid, x, cp, 1.5 * half_width))
+    unsettled = np.flatnonzero(~ok)
+    retry = unsettled[_on_zero_set_within(surface, grid, x[unsettled], cp[unsettled], 1.5 * half_width)]
     if retry.size:
         cp[retry], signed[retry], ok[retry] = _project(surface, grid, x[retry], ORTHOGONALITY_RETRY_STEPS)
     _warn_if_band_nodes_unprojected(surface, grid, x, cp, ok, half_width)

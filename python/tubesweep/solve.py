@@ -125,9 +125,10 @@ class Solution:
         """The solution at the vertices (M, d) of a mesh of the surface (e.g. for display or export).
 
         Multilinear interpolation (:meth:`__call__`); where its stencil leaves the band or meets an
-        unreached node, the value of the nearest reached band node within ``outer + 1`` grid spacings
-        (the band values are constant along the normals, Eq. (8), so this is first-order
-        accurate). NaN only for vertices farther than that from every reached band node.
+        unreached node, the value of the nearest band node within ``outer + 1`` grid spacings (the
+        band values are constant along the normals, Eq. (8), so this is first-order accurate). NaN
+        where there is none, or where that node was not reached (a component of the surface no
+        source reaches, or, in a solve stopped early, a part the front had not reached).
         """
         p = as_points(vertices, self.grid.ndim, "vertices")
         out = self(p)
@@ -186,7 +187,8 @@ class Solution:
 
         Without ``points``, one label per band node (aligned with :attr:`values`); with
         ``points`` (M, d), e.g. the vertices of a mesh of the surface, the label of the nearest
-        reached band node within ``outer + 1`` grid spacings of each point (-1 where there is none).
+        band node within ``outer + 1`` grid spacings of each point (-1 where there is none or it
+        was not reached).
         For speed 1 the labels partition the surface into the geodesic Voronoi cells of the
         sources. They are recovered from the solved values (``tubesweep_core::nearest_source``:
         each node takes the label of its smallest, earlier-reached neighbour) and are first-order

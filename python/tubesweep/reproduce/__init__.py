@@ -37,7 +37,7 @@ def run(names, out_dir: Path, quick: bool = False) -> Dict[str, dict]:
         names = list(table)
     unknown = [n for n in names if n not in table]
     if unknown:
-        raise SystemExit(f"unknown experiment(s) {unknown}; choose from {sorted(table)} or 'all'")
+        raise ValueError(f"unknown experiment(s) {unknown}; choose from {sorted(table)} or 'all'")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     results = {}

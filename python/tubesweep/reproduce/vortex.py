@@ -63,7 +63,7 @@ def _plt() -> Any:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise SystemExit("figures need matplotlib: pip install 'tubesweep[plot]'") from None
+        raise ImportError("figures need matplotlib: pip install 'tubesweep[plot]'") from None
     return plt
 
 

@@ -388,8 +388,10 @@ class MeshSurface(Surface):
             Empty grid spacings between the bounding box and the grid's faces on every side; it must
             hold the outer tube (``outer`` = 4 by default, 5 for the paper's bunny) plus one node.
         """
-        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
+        if (isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, float, np.integer, np.floating))
+                or not float(n).is_integer()):
             raise TypeError(f"n must be a whole number of nodes along the longest axis; got {n!r}")
+        n = int(n)
         if (isinstance(padding, (bool, np.bool_, str)) or np.ndim(padding) != 0 or np.iscomplexobj(padding)
                 or not np.isfinite(float(padding)) or padding < 0):
             raise ValueError(f"padding must be a finite number >= 0 of grid spacings; got {padding!r}")
