@@ -48,6 +48,21 @@ def real_array(value: Any, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be an array of real numbers; got {type(value).__name__}") from None
 
 
+def real_scalar(value: Any, name: str, what: str = "a real number") -> float:
+    """``value`` as a float: one real number (a NumPy scalar or 0-d array too; beyond the float
+    range, ±inf). None, a bool, a string, a sequence or a complex number is a ``TypeError`` that
+    says ``name`` must be ``what``."""
+    if (value is None or isinstance(value, (bool, np.bool_, str, bytes)) or np.ndim(value) != 0
+            or np.iscomplexobj(value)):
+        raise TypeError(f"{name} must be {what}; got {value!r}")
+    try:
+        return float(value)
+    except OverflowError:
+        return float("inf") if value > 0 else float("-inf")
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be {what}; got {value!r}") from None
+
+
 def whole_indices(value: Any, name: str) -> np.ndarray:
     """Indices (faces of a mesh): an int64 array of whole numbers. Floats with a fraction, NaN,
     bools and anything not numeric are refused (they were truncated or read as 0/1)."""

@@ -166,13 +166,9 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.path_from_vertex and not args.mesh:
         raise UsageError("--path-from-vertex needs --mesh")
     # what can be checked before the solve is checked before it
+    from .geodesic_paths import starts_beyond_inner_tube
     from .output import export_format
 
-    for path in args.export or []:
-        try:
-            export_format(path)
-        except ValueError as e:
-            raise UsageError(f"--export {path}: {e}") from None
     if args.out.exists() and not args.out.is_dir():
         raise UsageError(f"--out {args.out}: exists and is not a directory")
     if args.mesh:
@@ -218,15 +214,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
         outside = np.flatnonzero(~grid.contains(starts))
         if outside.size:
             raise UsageError(f"--path-from {' '.join(map(str, args.path_from[outside[0]]))}: outside the grid")
-        dist, _ = surface.project(starts, grid)
-        far = np.flatnonzero(~(dist <= args.inner * grid.spacing * (1 + 1e-6)))
+        far, dist = starts_beyond_inner_tube(surface, grid, starts, args.inner)
         if far.size:
             raise UsageError(f"--path-from {' '.join(map(str, args.path_from[far[0]]))}: {float(dist[far[0]]):.4g} from "
                              f"the surface, farther than the inner tube ({args.inner:g} grid spacings); start on the surface")
-    if grid.ndim == 2:
-        for path in args.export or []:
-            if Path(path).suffix.lower() == ".ply":
-                raise UsageError(f"--export {path}: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
+    for path in args.export or []:
+        try:
+            export_format(path, curve=grid.ndim == 2)
+        except ValueError as e:
+            raise UsageError(f"--export {path}: {e}") from None
     if args.source_vertex:
         nv = len(surface.vertices)
         bad = [i for i in args.source_vertex if not 0 <= i < nv]

@@ -26,7 +26,7 @@ A path stops early, with a :class:`RuntimeWarning`, where ``∇u`` vanishes, lea
 from __future__ import annotations
 
 import warnings
-from typing import TYPE_CHECKING, Any, List, Optional
+from typing import TYPE_CHECKING, Any, List, Optional, Tuple
 
 import numpy as np
 
@@ -179,6 +179,13 @@ def _onto_surface(sol: "Solution", x: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(y, dtype=float)
 
 
+def starts_beyond_inner_tube(surface: Any, grid: Any, points: np.ndarray, inner: float) -> Tuple[np.ndarray, np.ndarray]:
+    """The indices of the ``points`` (M, d) farther from the surface than the inner tube
+    (``inner`` grid spacings), where a path cannot start, and every point's distance."""
+    dist, _ = surface.project(points, grid)
+    return np.flatnonzero(~(dist <= inner * grid.spacing * (1 + 1e-6))), dist
+
+
 def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
     """Polylines (P_i, d) from each start (projected onto the surface) to the source that reaches
     it first, by steps of ``step`` grid spacings against ∇u (see the module's docstring).
@@ -204,9 +211,8 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         max_steps = int(np.ceil(8 * sum(grid.shape) / float(step)))
     elif isinstance(max_steps, (bool, np.bool_)) or not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
         raise ValueError(f"max_steps must be a positive integer; got {max_steps!r}")
-    dist, _ = sol.surface.project(p, grid)
+    far, dist = starts_beyond_inner_tube(sol.surface, grid, p, sol.inner)
     x = _onto_surface(sol, p)
-    far = np.flatnonzero(~(dist <= sol.inner * h * (1 + 1e-6)))
     if far.size:
         i = int(far[0])
         raise ValueError(

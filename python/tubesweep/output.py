@@ -247,12 +247,15 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
     return points, conn.reshape(-1, k), data
 
 
-def export_format(path: Union[str, Path]) -> str:
-    """The format of an export path (its suffix, lower case), or a ValueError naming the ones known."""
+def export_format(path: Union[str, Path], curve: bool = False) -> str:
+    """The format of an export path (its suffix, lower case), or a ValueError naming the ones known;
+    ``curve``: the mesh is of line cells (a 2D curve), which ``.ply`` cannot hold."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in EXPORT_FORMATS:
         raise ValueError(f"export: unknown format {path.suffix!r} of {str(path)!r}; use one of {', '.join(EXPORT_FORMATS)}")
+    if curve and suffix == ".ply":
+        raise ValueError("export: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
     return suffix
 
 
@@ -305,8 +308,7 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
         return path
     meshio = _need("meshio", "mesh", f"writing {suffix} files")
     kind = {2: "line", 3: "triangle", 4: "quad"}[cells.shape[1]]
-    if suffix == ".ply" and kind == "line":
-        raise ValueError("export: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
+    export_format(path, curve=kind == "line")
     if suffix == ".ply" and len(pts) < 2**31:
         cells = cells.astype(np.int32)  # PLY has no 64-bit integers
     m = meshio.Mesh(pts, [(kind, cells)], point_data={} if suffix == ".obj" else data)

@@ -27,6 +27,7 @@ from ._validate import (
     checked_point_speeds,
     speed_at_points,
     progress_callback,
+    real_scalar,
     speed_values,
     warn_unconverged,
 )
@@ -241,10 +242,8 @@ class Solution:
 
     def to_dense(self, fill: float = np.nan) -> np.ndarray:
         """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
-        if (fill is None or isinstance(fill, (bool, np.bool_, str, bytes)) or np.ndim(fill) != 0
-                or np.iscomplexobj(fill)):
-            raise TypeError(f"fill must be a real number (the value outside the band, NaN by default); got {fill!r}")
-        out = np.full(self.grid.size, float(fill), dtype=float)
+        value = real_scalar(fill, "fill", "a real number (the value outside the band, NaN by default)")
+        out = np.full(self.grid.size, value, dtype=float)
         out[self.linear] = self.values
         return out.reshape(self.grid.shape)
 

@@ -21,7 +21,7 @@ from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 import numpy as np
 
 from .grid import Grid
-from ._validate import real_array
+from ._validate import real_array, real_scalar
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
 
@@ -260,9 +260,8 @@ class LevelSet(Surface):
             self._array = arr
             self.ndim = arr.ndim
         self.redistance = bool(redistance)
-        if lipschitz is not None and (isinstance(lipschitz, (bool, np.bool_, str, bytes)) or np.ndim(lipschitz) != 0
-                                      or np.iscomplexobj(lipschitz)):
-            raise TypeError(f"lipschitz must be a real number (a bound on |∇φ|); got {lipschitz!r}")
+        if lipschitz is not None:
+            lipschitz = real_scalar(lipschitz, "lipschitz", "a real number (a bound on |∇φ|)")
         if lipschitz is None:
             self.lipschitz: Optional[float] = None if self.redistance else 1.5
         elif self.redistance:

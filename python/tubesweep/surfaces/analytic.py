@@ -9,6 +9,7 @@ import numpy as np
 from .. import _native
 from .._linalg import row_norms
 from ..surface import LevelSet
+from .._validate import real_scalar
 from ._triangulation import grid_mesh, polyline
 
 __all__ = ["Circle", "Sphere", "Star"]
@@ -24,14 +25,7 @@ def size_parameter(name: str, value: Any) -> float:
     """A surface's length (radius, semi-axis, half-size): a positive finite real number. A bool,
     a string or a complex number is a TypeError, a non-positive or non-finite one a ValueError,
     each naming the parameter."""
-    if (isinstance(value, (bool, np.bool_, str, bytes)) or np.ndim(value) != 0 or np.iscomplexobj(value)):
-        raise TypeError(f"{name} must be a positive real number (a length in the grid's units); got {value!r}")
-    try:
-        v = float(value)
-    except OverflowError:
-        v = float("inf")
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a positive real number (a length in the grid's units); got {value!r}") from None
+    v = real_scalar(value, name, "a positive real number (a length in the grid's units)")
     if not (np.isfinite(v) and v > 0):
         raise ValueError(f"{name} must be positive and finite; got {value!r}")
     return v
@@ -150,10 +144,12 @@ class Star(LevelSet):
 
     def __init__(self, r0: float = 0.5, eps: float = 0.2, *, exact: bool = True):
         self.r0 = size_parameter("r0", r0)
-        if (isinstance(eps, (bool, np.bool_, str, bytes)) or np.ndim(eps) != 0 or np.iscomplexobj(eps)
-                or not np.isfinite(float(eps)) or float(eps) < 0):
+        try:
+            self.eps = real_scalar(eps, "eps")
+        except TypeError:
+            self.eps = float("nan")  # refused below, as a ValueError like a negative amplitude
+        if not (np.isfinite(self.eps) and self.eps >= 0):
             raise ValueError(f"eps must be a finite real number >= 0 (the star's amplitude); got {eps!r}")
-        self.eps = float(eps)
         self.exact = bool(exact)
         if not (self.r0 > self.eps >= 0 or (self.r0 > 0 and self.eps >= 0)):
             raise ValueError("need r0 > 0 and eps >= 0")

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..grid import Grid
 from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
-from .._validate import real_array, whole_indices
+from .._validate import real_array, real_scalar, whole_indices
 from .analytic import finite_center, size_parameter
 
 __all__ = ["from_mesh", "MeshSurface", "read_mesh", "closest_points_on_triangles"]
@@ -392,8 +392,11 @@ class MeshSurface(Surface):
                 or not float(n).is_integer()):
             raise TypeError(f"n must be a whole number of nodes along the longest axis; got {n!r}")
         n = int(n)
-        if (isinstance(padding, (bool, np.bool_, str)) or np.ndim(padding) != 0 or np.iscomplexobj(padding)
-                or not np.isfinite(float(padding)) or padding < 0):
+        try:
+            pad = real_scalar(padding, "padding")
+        except TypeError:
+            pad = float("nan")  # refused below, as a ValueError like a negative padding
+        if not (np.isfinite(pad) and pad >= 0):
             raise ValueError(f"padding must be a finite number >= 0 of grid spacings; got {padding!r}")
         if n < 2 * padding + 3:
             raise ValueError(f"n = {n} nodes cannot hold {padding} spacings of padding on both sides; use n >= {int(2 * padding + 3)}")
