@@ -447,6 +447,8 @@ class _PreparedTube:
     phi: np.ndarray
     direction: Optional[np.ndarray]
     seconds: float
+    #: pairs of neighbouring nodes across a gap narrower than the tubes, and the narrowest gap
+    facing: Tuple[int, float] = (0, float("inf"))
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -484,6 +486,35 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
         return 0.0
     area = np.count_nonzero(np.isfinite(dist) & (dist <= big_h)) * big_h ** grid.ndim / (2 * big_h)
     return 2 * half_width * area / grid.spacing ** grid.ndim
+
+
+def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
+                         direction: np.ndarray, inner: float) -> Tuple[int, float]:
+    """Warns where two parts of the surface face each other across a gap so narrow that the inner
+    tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
+    ``tubesweep_core::facing_sheets``): the eikonal equation crosses the gap there and the travel
+    times beyond it come out too short, a shortcut the surface does not have. Returns the number
+    of such pairs and the narrowest gap (``inf`` where there is none)."""
+    h = grid.spacing
+    node, _, gap = band.facing_sheet_pairs(
+        roles == ROLE_INNER, np.ascontiguousarray(phi, dtype=np.float32),
+        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim), h)
+    if node.size == 0:
+        return 0, float("inf")
+    narrowest = int(np.argmin(gap))
+    where = tuple(round(float(v), 6) for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
+    needed = float(gap[narrowest]) / (2 * inner + 2)
+    warnings.warn(
+        f"the surface faces itself across gaps narrower than its tubes at {node.size} pair(s) of neighbouring band "
+        f"nodes (the narrowest, {float(gap[narrowest]):.4g} wide, near {where}): there the inner tube of one side "
+        "touches the band of the other, and where the other side is reached first the front crosses the gap, so "
+        "travel times beyond it can come out too short (stats.facing_pairs; docs/surfaces.md). Refine the grid to a "
+        f"spacing below about {needed:.4g} (now {h:.4g}), gap / (2·inner + 2); a gap that narrows as the grid is "
+        "refined is a sharp concave edge or parts of the surface that touch",
+        RuntimeWarning,
+        stacklevel=4,
+    )
+    return int(node.size), float(gap[narrowest])
 
 
 def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray, roles: np.ndarray,
@@ -584,8 +615,10 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
             stacklevel=3,
         )
         outer_eff += 1.0
+    facing = _warn_if_tubes_touch(grid, band, linear, roles, phi,
+                                  direction if direction is not None else geom.direction, inner)
     return _PreparedTube(grid, surf, float(inner), outer_eff, method, geom, linear, roles, band, phi, direction,
-                         time.perf_counter() - t0)
+                         time.perf_counter() - t0, facing)
 
 
 def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: str, speed: Any, source_init: str,
@@ -668,7 +701,7 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
         inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
         setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
-        window_edge=st["window_edge"],
+        window_edge=st["window_edge"], facing_pairs=tube.facing[0], narrowest_gap=tube.facing[1],
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
                     tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic")

@@ -39,6 +39,14 @@ class SolveStats:
         docs/architecture.md): ``inf`` when it had opened, always so for a converged solve. After
         a solve stopped by ``max_iterations``, the nodes above it are not reached yet (``inf``)
         and the values just below it are not converged.
+    facing_pairs : int
+        Pairs of neighbouring band nodes that lie across a gap between two parts of the surface
+        facing each other, narrower than the tubes (a thin part, a narrow slot or fold, parts that
+        nearly touch): the eikonal equation can cross the gap there, and the solve warned that
+        travel times beyond it can be too short (docs/surfaces.md, "Parts of the surface that
+        face each other"). 0 when the grid resolves every gap.
+    narrowest_gap : float
+        The narrowest such gap, ``|cp(a) − cp(b)|`` over those pairs (``inf`` when there is none).
     """
 
     iterations: int
@@ -54,6 +62,8 @@ class SolveStats:
     setup_seconds: float = 0.0
     band_bytes: int = 0
     window_edge: float = float("inf")
+    facing_pairs: int = 0
+    narrowest_gap: float = float("inf")
 
     @property
     def updates_per_second(self) -> float:

@@ -14,6 +14,7 @@
 //! | the upwind extension update | [`extension`] | Eq. (5) applied to Eq. (8) |
 //! | exact signed distances of the analytic surfaces (sphere, torus) | [`analytic`] | Sect. 6 |
 //! | the narrow band (inner tube + extension layer) | [`band`] | Fig. 4 |
+//! | where the tubes of two facing parts of the surface touch (shortcuts) | [`facing_sheets`] | Sect. 3–4 |
 //! | the last split of the coarse-to-fine band search | [`discovery`] | — |
 //! | the band and directions of a φ sampled on the whole grid | [`sampled`] | Eq. (8), Sect. 4 |
 //! | closest points on the zero level set of a sampled φ (re-distancing) | [`redistance`] | Eq. (8), Sect. 5.2 |
@@ -36,6 +37,7 @@ pub mod band;
 pub mod discovery;
 pub mod error;
 pub mod extension;
+pub mod facing_sheets;
 pub mod godunov;
 pub mod grid_hops;
 pub mod hamiltonian;

@@ -562,6 +562,36 @@ impl PyBand {
         Ok(out.into_pyarray(py))
     }
 
+    /// The pairs of neighbouring band nodes that straddle a gap between two parts of the surface
+    /// facing each other (see `tubesweep_core::facing_sheets`): `inner` per node, `phi` its
+    /// signed or unsigned distance, `direction` (K, d) its outward direction. Returns the pairs'
+    /// band positions and their gaps `|cp(a) − cp(b)|`.
+    #[allow(clippy::type_complexity)]
+    fn facing_sheet_pairs<'py>(
+        &self,
+        py: Python<'py>,
+        inner: PyReadonlyArray1<'py, bool>,
+        phi: PyReadonlyArray1<'py, f32>,
+        direction: PyReadonlyArray2<'py, f32>,
+        spacing: f64,
+    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
+        let d = self.ndim();
+        if direction.shape()[1] != d {
+            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
+        }
+        let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
+        let pairs = py
+            .detach(|| match &self.band {
+                AnyBand::D2(b) => tubesweep_core::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
+                AnyBand::D3(b) => tubesweep_core::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
+            })
+            .map_err(to_pyerr)?;
+        let node: Vec<i64> = pairs.iter().map(|p| p.node as i64).collect();
+        let neighbour: Vec<i64> = pairs.iter().map(|p| p.neighbour as i64).collect();
+        let gap: Vec<f64> = pairs.iter().map(|p| p.gap).collect();
+        Ok((node.into_pyarray(py), neighbour.into_pyarray(py), gap.into_pyarray(py)))
+    }
+
     /// Multilinear interpolation of `values` at `points` (M, d); NaN where the stencil leaves
     /// the band.
     fn interpolate<'py>(

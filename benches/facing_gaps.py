@@ -1,0 +1,131 @@
+"""Parts of a surface that face each other across a gap narrower than the tubes: where the solve
+warns (``solve._warn_if_tubes_touch``, ``tubesweep_core::facing_sheets``) and what the answer is
+there, against exact distances.
+
+Usage::
+
+    .venv/bin/python benches/facing_gaps.py            # about 40 s
+    .venv/bin/python benches/facing_gaps.py --skip-meshes
+
+Sections:
+
+* ``plate``: a closed box 1 × 1 × t (a triangle mesh, 12 triangles) with t = 0.08, source at the
+  centre of its top face; the travel time to the centre of the bottom face, exactly 1 + t (over an
+  edge and back), at grids ``surface.grid(N)``. Where the two faces' tubes touch, the front
+  crosses the plate. The same for t = 1 (the cube: convex edges only, no warning; its first-order
+  error at the edges for comparison).
+* ``library``: the facing pairs of every library surface on its default box at N = 41 and 81
+  (121 and 241 for the curves): none but the double torus's body at N = 41, 4.8 spacings thick.
+* ``meshes``: Spot (``../shared/data/spot.obj``, source vertex 285) at grids 81 and 201, with the
+  error at every vertex against exact polyhedral geodesics (pygeodesic, MMP; skipped without it),
+  and the bunny's facing pairs at grids 101 and 201.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+import tubesweep as ts  # noqa: E402
+
+DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+
+
+def box_mesh(t: float):
+    """The closed box [−½, ½]² × [−t/2, t/2] as 8 vertices and 12 outward triangles."""
+    v = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-t / 2, t / 2)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    f = np.array([tri for a, b, c, d in quads for tri in ((a, b, c), (a, c, d))])
+    return v, f
+
+
+def solve_quietly(surface, grid, sources):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = ts.solve(surface, grid, sources)
+    warned = any("faces itself" in str(w.message) for w in caught)
+    return sol, warned
+
+
+def plate() -> None:
+    print("plate: box 1 x 1 x t, source at the top face's centre, u at the bottom face's centre (exact 1 + t)")
+    print(f"  {'t':>5} {'N':>4} {'h':>8} {'warned':>6} {'pairs':>6} {'gap':>8} {'advised h':>9} {'u':>8} {'error/h':>8}")
+    for t, sizes in ((0.08, (41, 81, 121, 161)), (1.0, (41, 81))):
+        surface = ts.surfaces.from_mesh(box_mesh(t))
+        for n in sizes:
+            grid = surface.grid(n)
+            h = grid.spacing
+            sol, warned = solve_quietly(surface, grid, np.array([[0.0, 0.0, t / 2]]))
+            u = float(sol(np.array([[0.0, 0.0, -t / 2]]))[0])
+            st = sol.stats
+            advised = st.narrowest_gap / (2 * sol.inner + 2)
+            print(f"  {t:5.2f} {n:4d} {h:8.4f} {str(warned):>6} {st.facing_pairs:6d} {st.narrowest_gap:8.4f} "
+                  f"{advised:9.4f} {u:8.4f} {(u - (1 + t)) / h:8.2f}")
+
+
+def library() -> None:
+    print("library surfaces on their default boxes: facing pairs (narrowest gap)")
+    for name, cls in ts.surfaces.REGISTRY.items():
+        surface = cls()
+        lower, upper = surface.default_box
+        row = []
+        for n in ((121, 241) if len(lower) == 2 else (41, 81)):
+            grid = ts.Grid(lower, upper, (n,) * len(lower))
+            start = np.array([[0.9, 0.1, 0.1][: len(lower)]])
+            src = np.asarray(surface.project(start, grid)[1])
+            sol, _ = solve_quietly(surface, grid, src)
+            st = sol.stats
+            row.append(f"N={n}: {st.facing_pairs}" + (f" ({st.narrowest_gap:.3g})" if st.facing_pairs else ""))
+        print(f"  {name:13} " + ", ".join(row))
+
+
+def meshes() -> None:
+    spot_file, bunny_file = DATA / "spot.obj", DATA / "stanford-bunny.obj"
+    if not spot_file.is_file():
+        print(f"meshes: skipped ({spot_file} not found)")
+        return
+    try:
+        import pygeodesic.geodesic as geodesic
+    except ImportError:
+        geodesic = None
+    spot = ts.surfaces.from_mesh(spot_file)
+    v = spot.vertices
+    exact = None
+    if geodesic is not None:
+        exact, _ = geodesic.PyGeodesicAlgorithmExact(v, spot.faces).geodesicDistances(np.array([285]), None)
+    print("Spot, source vertex 285: facing pairs, narrowest gap, error at the vertices / h (against MMP)")
+    for n in (81, 201):
+        grid = spot.grid(n)
+        sol, warned = solve_quietly(spot, grid, v[[285]])
+        st = sol.stats
+        line = f"  N={n:3d} h={grid.spacing:.4f} warned={warned} pairs={st.facing_pairs} gap={st.narrowest_gap:.4f}"
+        if exact is not None:
+            err = (sol(v) - exact) / grid.spacing
+            line += f"  error/h: min {np.min(err):.2f}, median {np.median(err):.2f}, max {np.max(err):.2f}"
+        print(line)
+    if bunny_file.is_file():
+        bunny = ts.surfaces.from_mesh(bunny_file)
+        for n in (101, 201):
+            sol, warned = solve_quietly(bunny, bunny.grid(n), bunny.vertices[[0]])
+            st = sol.stats
+            print(f"  bunny N={n}: warned={warned} pairs={st.facing_pairs} gap={st.narrowest_gap:.5f}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--skip-meshes", action="store_true")
+    args = ap.parse_args()
+    plate()
+    library()
+    if not args.skip_meshes:
+        meshes()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,132 @@
+"""Parts of a surface that face each other across a gap narrower than the tubes
+(``solve._warn_if_tubes_touch``, ``tubesweep_core::facing_sheets``): the solve warns, says where
+and how narrow, and records it in ``SolveStats``; surfaces the grid resolves give no pair."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+
+PLATE = 0.08  # the thickness of the box 1 × 1 × PLATE
+
+
+def box_mesh(t: float):
+    """The closed box [−½, ½]² × [−t/2, t/2]: 8 vertices, 12 outward triangles."""
+    v = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-t / 2, t / 2)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return v, np.array([tri for a, b, c, d in quads for tri in ((a, b, c), (a, c, d))])
+
+
+@pytest.fixture(scope="module")
+def plate():
+    return ts.surfaces.from_mesh(box_mesh(PLATE))
+
+
+def facing_warnings(caught):
+    return [w for w in caught if issubclass(w.category, RuntimeWarning) and "faces itself" in str(w.message)]
+
+
+@pytest.mark.parametrize("n", [41, 81])
+def test_a_plate_thinner_than_the_tubes_warns_and_the_front_crosses_it(plate, n):
+    grid = plate.grid(n)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = ts.solve(plate, grid, [[0.0, 0.0, PLATE / 2]])
+    found = facing_warnings(caught)
+    assert len(found) == 1
+    message = str(found[0].message)
+    advised = PLATE / (2 * 2.0 + 2)
+    assert f"{advised:.4g}" in message and "0.08 wide" in message
+    assert sol.stats.facing_pairs > 0
+    assert sol.stats.narrowest_gap == pytest.approx(PLATE, abs=1e-6)
+    u = sol(np.array([[0.0, 0.0, -PLATE / 2]]))[0]
+    if n == 41:
+        # what the warning is about: the bottom face's centre, 1 + t away over an edge, is
+        # reached through the plate, whose inner tubes touch (1.9 spacings thick)
+        assert u < 0.5 * (1 + PLATE)
+    else:
+        # 5.1 spacings thick: only the inner tube of one face touches the extension layer of the
+        # other, which passes on the other face's values, later ones here: no shortcut
+        assert 1 + PLATE - 10 * grid.spacing < u < 1 + PLATE
+
+
+def test_the_plate_on_the_advised_grid_gives_no_warning_and_first_order_distances(plate):
+    grid = plate.grid(121)
+    assert grid.spacing < PLATE / 6
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = ts.solve(plate, grid, [[0.0, 0.0, PLATE / 2]])
+    assert facing_warnings(caught) == []
+    assert sol.stats.facing_pairs == 0 and sol.stats.narrowest_gap == np.inf
+    u = sol(np.array([[0.0, 0.0, -PLATE / 2]]))[0]
+    # two convex edges on the way, each about 4.5 spacings short (benches/facing_gaps.py)
+    assert 1 + PLATE - 10 * grid.spacing < u < 1 + PLATE
+
+
+def test_a_tube_on_the_plate_warns_at_construction_and_its_solves_record_it(plate):
+    with pytest.warns(RuntimeWarning, match="faces itself"):
+        tube = ts.Tube(plate, plate.grid(41))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = tube.solve([[0.0, 0.0, PLATE / 2]])
+    assert sol.stats.facing_pairs > 0
+
+
+def test_the_double_torus_body_is_too_thin_for_41_nodes_but_not_for_61():
+    surf = ts.surfaces.DoubleTorus()
+    lower, upper = surf.default_box
+    src = None
+    stats = {}
+    for n in (41, 61):
+        grid = ts.Grid(lower, upper, (n,) * 3)
+        if src is None:
+            src = np.asarray(surf.project(np.array([[0.9, 0.1, 0.1]]), grid)[1])
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            stats[n] = ts.solve(surf, grid, src).stats
+        assert (len(facing_warnings(caught)) == 1) == (n == 41)
+    # the body is 2r = 0.24 thick, 4.8 spacings at N = 41
+    assert stats[41].facing_pairs > 0 and 0.15 < stats[41].narrowest_gap < 0.25
+    assert stats[61].facing_pairs == 0
+
+
+@pytest.mark.parametrize("name,n", [("sphere", 41), ("torus", 41), ("ellipsoid", 41), ("rounded-cube", 41),
+                                    ("hemisphere", 41), ("mobius", 41), ("plane", 41), ("star", 121),
+                                    ("ellipse", 121)])
+def test_resolved_library_surfaces_give_no_pair(name, n):
+    surf = ts.surfaces.REGISTRY[name]()
+    lower, upper = surf.default_box
+    grid = ts.Grid(lower, upper, (n,) * len(lower))
+    src = np.asarray(surf.project(np.array([[0.9, 0.1, 0.1][: len(lower)]]), grid)[1])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = ts.solve(surf, grid, src)
+    assert facing_warnings(caught) == []
+    assert sol.stats.facing_pairs == 0
+
+
+@pytest.mark.parametrize("scale", [0.7, 1.7])
+def test_a_level_set_that_is_only_roughly_a_distance_gives_no_pair(scale):
+    # closest points x − |φ| n miss the sphere along n when |∇φ| ≠ 1; one sheet all the same
+    grid = ts.Grid([-1] * 3, [1] * 3, (61,) * 3)
+    surf = ts.LevelSet(lambda p: scale * (np.linalg.norm(p, axis=1) - 0.5))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = ts.solve(surf, grid, [[0.5, 0.0, 0.0]])
+    assert facing_warnings(caught) == []
+    assert sol.stats.facing_pairs == 0
+
+
+def test_facing_pairs_are_checked_against_the_band():
+    band = ts._native.Band.from_linear([4, 4], np.arange(16, dtype=np.uint64))
+    ok = (np.ones(16, bool), np.zeros(16, np.float32), np.zeros((16, 2), np.float32))
+    with pytest.raises(ValueError, match="one per band node"):
+        band.facing_sheet_pairs(ok[0][1:], ok[1], ok[2], 0.1)
+    with pytest.raises(ValueError, match="spacing"):
+        band.facing_sheet_pairs(*ok, 0.0)
+    with pytest.raises(ValueError, match="shape"):
+        band.facing_sheet_pairs(ok[0], ok[1], np.zeros((16, 3), np.float32), 0.1)
