@@ -9,7 +9,8 @@ Each piece runs ``--repeats`` times in a warm process (after one untimed run) an
 printed, with the whole solve's ``sol.stats.setup_seconds`` and ``sol.stats.seconds`` for scale.
 The pieces are those of ``LevelSet.band`` for a callable φ (docs/architecture.md): the
 coarse-to-fine band search (candidates, then φ at them and the filter), the band structure,
-the rim places, φ there, and the outward directions; then the whole of it for the surface's φ
+the rim places, φ there, the outward directions and the check for gaps narrower than the tubes
+(``solve._warn_if_tubes_touch``); then the whole of it for the surface's φ
 as a plain callable, and for the library surface itself, whose band is found in Rust in one
 call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENBLAS_NUM_THREADS=1`` as
 ``make bench`` does (see README).
@@ -63,6 +64,9 @@ def main() -> int:
     pos, counts = band.rim_nodes(0, len(linear))
     rim_phi = surf._phi_at_rim_places(grid, linear, pos, counts)
     direction = np.empty((len(linear), grid.ndim), np.float32)
+    band.outward_directions(h, values, 0, len(linear), rim_phi, direction)
+    phi32 = values.astype(np.float32)
+    inner = np.abs(values) <= 2 * h  # the default inner tube
     r = a.repeats
     rows: Dict[str, float] = {
         "band search: candidates (coarse-to-fine levels, last split)": median_ms(
@@ -74,6 +78,8 @@ def main() -> int:
         "rim coordinates and φ there": median_ms(lambda: surf._phi_at_rim_places(grid, linear, pos, counts), r),
         "outward directions (Band.outward_directions)": median_ms(
             lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r),
+        "facing pairs (Band.facing_sheet_pairs: gaps narrower than the tubes)": median_ms(
+            lambda: band.facing_sheet_pairs(inner, phi32, direction, h), r),
         "LevelSet.band of the same φ as a callable, all of the above": median_ms(
             lambda: ts.LevelSet(fn, lipschitz=surf.lipschitz).band(grid, width), r),
         "LevelSet.band of the library surface (the same band found in Rust)": median_ms(lambda: surf.band(grid, width), r),
