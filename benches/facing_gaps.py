@@ -4,7 +4,7 @@ there, against exact distances.
 
 Usage::
 
-    .venv/bin/python benches/facing_gaps.py            # about 6 s
+    .venv/bin/python benches/facing_gaps.py            # about 8 s
     .venv/bin/python benches/facing_gaps.py --skip-meshes
 
 Sections:
@@ -18,7 +18,9 @@ Sections:
   (121 and 241 for the curves): none but the double torus's body at N = 41, 4.8 spacings thick.
 * ``meshes``: Spot (``../shared/data/spot.obj``, source vertex 285) at grids 81 and 201, with the
   error at every vertex against exact polyhedral geodesics (pygeodesic, MMP; skipped without it),
-  and the bunny's facing pairs at grids 101 and 201.
+  and the bunny's facing pairs at grids 101 and 201; then the geodesic paths from 300 random
+  vertices that stop short (Spot at grid 81 with three sources, the bunny at 101 and 201) and how
+  many of them end next to a pair across a narrow gap.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 import tubesweep as ts  # noqa: E402
+from tubesweep import geodesic_paths  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
@@ -123,6 +126,22 @@ def meshes() -> None:
             sol, warned, _ = solve_quietly(bunny, bunny.grid(n), bunny.vertices[[0]])
             st = sol.stats
             print(f"  bunny N={n}: warned={warned} pairs={st.facing_pairs} gap={st.narrowest_gap:.5f}")
+    print("geodesic paths from 300 random vertices (seed 1) that stop short, and how many of them end within "
+          f"{geodesic_paths.GAP_REACH:g} spacings of a pair across a narrow gap")
+    cases = [("spot", spot, 81, [285, 0, 1000])]
+    if bunny_file.is_file():
+        cases += [("bunny", bunny, 101, [0]), ("bunny", bunny, 201, [0])]
+    for name, mesh, n, sources in cases:
+        sol, _, _ = solve_quietly(mesh, mesh.grid(n), mesh.vertices[sources])
+        starts = np.random.default_rng(1).choice(len(mesh.vertices), 300, replace=False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            paths = sol.geodesic_paths(mesh.vertices[starts])
+        ends = np.array([p[-1] for p in paths])
+        src = mesh.vertices[sources]
+        short = np.min(np.linalg.norm(ends[:, None, :] - src[None], axis=2), axis=1) > 1e-9
+        at_gaps = geodesic_paths._near_narrow_gaps(sol, ends[short])
+        print(f"  {name} N={n}, sources {sources}: {int(short.sum())} stop short, {at_gaps} of them at a narrow gap")
 
 
 def main() -> None:

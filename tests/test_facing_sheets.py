@@ -54,6 +54,21 @@ def test_a_plate_thinner_than_the_tubes_warns_and_the_front_crosses_it(plate, n)
         assert 1 + PLATE - 10 * grid.spacing < u < 1 + PLATE
 
 
+def test_narrow_gaps_gives_the_pairs_midpoints_inside_the_plate_and_their_gaps(plate):
+    grid = plate.grid(41)
+    with pytest.warns(RuntimeWarning, match="faces itself"):
+        sol = ts.solve(plate, grid, [[0.0, 0.0, PLATE / 2]])
+    mid, gap = sol.narrow_gaps()
+    assert mid.shape == (sol.stats.facing_pairs, 3) and gap.shape == (sol.stats.facing_pairs,)
+    # each midpoint half a spacing from its nodes, the nodes within a spacing of the plate
+    assert np.all(np.abs(mid[:, 2]) <= PLATE / 2 + grid.spacing)
+    assert np.all(np.abs(mid[:, :2]) <= 0.5 + grid.spacing)
+    assert gap.min() == pytest.approx(PLATE, abs=1e-6) and gap.min() == sol.stats.narrowest_gap
+    # the copy is the caller's
+    gap[:] = 0
+    assert sol.narrow_gaps()[1].min() == pytest.approx(PLATE, abs=1e-6)
+
+
 def test_the_plate_on_the_advised_grid_gives_no_warning_and_first_order_distances(plate):
     grid = plate.grid(121)
     assert grid.spacing < PLATE / 6
@@ -62,6 +77,7 @@ def test_the_plate_on_the_advised_grid_gives_no_warning_and_first_order_distance
         sol = ts.solve(plate, grid, [[0.0, 0.0, PLATE / 2]])
     assert facing_warnings(caught) == []
     assert sol.stats.facing_pairs == 0 and sol.stats.narrowest_gap == np.inf
+    assert sol.narrow_gaps()[0].shape == (0, 3)
     u = sol(np.array([[0.0, 0.0, -PLATE / 2]]))[0]
     # two convex edges on the way, each about 4.5 spacings short (benches/facing_gaps.py)
     assert 1 + PLATE - 10 * grid.spacing < u < 1 + PLATE

@@ -279,7 +279,24 @@ def test_a_path_caught_where_u_barely_decreases_stalls_instead_of_running_in_pla
         pytest.skip("needs ../shared/data/spot.obj")
     spot = ts.surfaces.from_mesh(spot_file)
     sol = ts.solve(spot, spot.grid(81), spot.vertices[[285, 0, 1000]])
-    with pytest.warns(RuntimeWarning, match="stopped before reaching a source"):
+    with pytest.warns(RuntimeWarning, match="stopped before reaching a source") as caught:
         path = sol.geodesic_path(spot.vertices[2000])
     steps = np.linalg.norm(np.diff(path, axis=0), axis=1)
     assert np.count_nonzero(steps < 1e-9) == 0 and len(path) < 150
+    # it stopped next to a place where Spot faces itself across a gap narrower than the tubes
+    # (sol.narrow_gaps()), and the warning says so
+    stalled = [str(w.message) for w in caught if "stopped before reaching a source" in str(w.message)]
+    assert "1 of them stopped within 3 grid spacings of a gap narrower than the tubes" in stalled[0]
+    mid, _ = sol.narrow_gaps()
+    assert np.min(np.linalg.norm(mid - path[-1], axis=1)) <= 3 * sol.grid.spacing
+
+
+def test_a_stall_away_from_any_narrow_gap_does_not_mention_one():
+    # a sphere cut by the grid (as above): the path leaves the grid, with no narrow gap anywhere
+    cut = ts.Grid((-1, -1, -0.2), (1, 1, 1), (41, 41, 25))
+    sources = np.array([[0.3, 0, 0.4], [-0.4743, 0, -0.1581]])
+    sol = ts.solve(ts.surfaces.Sphere(0.5), cut, sources)
+    assert sol.narrow_gaps()[0].shape == (0, 3)
+    with pytest.warns(RuntimeWarning, match="stopped before reaching a source") as caught:
+        sol.geodesic_path((0.0934, 0.4672, -0.1516))
+    assert not any("gap narrower" in str(w.message) for w in caught)

@@ -54,6 +54,11 @@ PROGRESS_FRACTION = 1e-3
 #: distance, and a gradient stencil that straddles the source's cone points poorly).
 FINISH_RADIUS = SOURCE_RADIUS
 
+#: A stalled path whose end lies within this many grid spacings of a pair of band nodes across a
+#: gap narrower than the tubes (``Solution.narrow_gaps``) is reported as stopped at such a gap: the
+#: paths that stalled on Spot and the bunny all ended about 2 spacings from one.
+GAP_REACH = 3.0
+
 
 class _SourceFinder:
     """Which source, if any, lies within ``radius`` of each point: the sources bucketed in cubes
@@ -179,6 +184,21 @@ def _onto_surface(sol: "Solution", x: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(y, dtype=float)
 
 
+def _near_narrow_gaps(sol: "Solution", ends: np.ndarray) -> int:
+    """How many of the points ``ends`` (M, d) lie within :data:`GAP_REACH` grid spacings of a pair
+    of band nodes across a gap narrower than the tubes (``Solution.narrow_gaps``)."""
+    mid, _ = sol.narrow_gaps()
+    if mid.size == 0 or ends.size == 0:
+        return 0
+    reach2 = (GAP_REACH * sol.grid.spacing) ** 2
+    near = 0
+    for lo in range(0, len(ends), 256):
+        e = ends[lo : lo + 256]
+        d2 = np.min(np.sum((e[:, None, :] - mid[None, :, :]) ** 2, axis=2), axis=1)
+        near += int(np.count_nonzero(d2 <= reach2))
+    return near
+
+
 def starts_beyond_inner_tube(surface: Any, grid: Any, points: np.ndarray, inner: float) -> Tuple[np.ndarray, np.ndarray]:
     """The indices of the ``points`` (M, d) farther from the surface than the inner tube
     (``inner`` grid spacings), where a path cannot start, and every point's distance."""
@@ -278,10 +298,16 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         stalled.extend(int(i) for i in active[stuck])
         active = active[~stuck]
     if stalled:
+        at_gaps = _near_narrow_gaps(sol, np.array([paths[i][-1] for i in stalled]))
+        gaps_note = ""
+        if at_gaps:
+            gaps_note = (f"; {at_gaps} of them stopped within {GAP_REACH:g} grid spacings of a gap narrower than the tubes, "
+                         "where the front can cross from another part of the surface (sol.narrow_gaps(), "
+                         "sol.stats.facing_pairs): refine the grid there")
         warnings.warn(
             f"{len(stalled)} geodesic path(s) stopped before reaching a source (first: starts[{min(stalled)}]): "
             "the gradient of u vanished, left the band, or u stopped decreasing (a cut locus or a region the "
-            "scheme resolves poorly); refine the grid or start elsewhere",
+            f"scheme resolves poorly); refine the grid or start elsewhere{gaps_note}",
             RuntimeWarning,
             stacklevel=3,
         )

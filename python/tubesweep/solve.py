@@ -73,7 +73,8 @@ class Solution:
     def __init__(self, grid: Grid, band: Any, values: np.ndarray, roles: np.ndarray,
                  phi: np.ndarray, stats: SolveStats, sources: np.ndarray, surface: Surface,
                  hamiltonian: str, method: str, inner: float, outer: float,
-                 fixed: Tuple[np.ndarray, np.ndarray], isotropic: bool):
+                 fixed: Tuple[np.ndarray, np.ndarray], isotropic: bool,
+                 facing: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None):
         self.grid = grid
         self._band = band
         self.values = values
@@ -90,6 +91,20 @@ class Solution:
         self._fixed = fixed
         self._isotropic = isotropic
         self._labels: Optional[np.ndarray] = None
+        # the pairs of band nodes across gaps narrower than the tubes (positions, positions, gaps)
+        empty = np.empty(0, np.int64)
+        self._facing = facing if facing is not None else (empty, empty, np.empty(0))
+
+    def narrow_gaps(self) -> Tuple[np.ndarray, np.ndarray]:
+        """Where the surface faces itself across a gap narrower than the tubes (see
+        ``stats.facing_pairs`` and docs/surfaces.md): the midpoints ``(M, d)`` of the pairs of
+        neighbouring band nodes that lie across such a gap, and each gap ``|cp(a) − cp(b)|``
+        ``(M,)``. Travel times beyond these places can be too short; empty where the grid resolves
+        every gap."""
+        node, neighbour, gap = self._facing
+        lin = self.linear
+        mid = 0.5 * (self.grid.node_points(lin[node]) + self.grid.node_points(lin[neighbour]))
+        return mid.reshape(-1, self.grid.ndim), gap.copy()
 
     def __repr__(self) -> str:
         s = self.stats
@@ -447,8 +462,9 @@ class _PreparedTube:
     phi: np.ndarray
     direction: Optional[np.ndarray]
     seconds: float
-    #: pairs of neighbouring nodes across a gap narrower than the tubes, and the narrowest gap
-    facing: Tuple[int, float] = (0, float("inf"))
+    #: the pairs of neighbouring nodes across a gap narrower than the tubes: their band positions
+    #: and their gaps (``_warn_if_tubes_touch``)
+    facing: Tuple[np.ndarray, np.ndarray, np.ndarray] = (np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0))
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -489,18 +505,18 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
 
 
 def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
-                         direction: np.ndarray, inner: float) -> Tuple[int, float]:
+                         direction: np.ndarray, inner: float) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
     ``tubesweep_core::facing_sheets``): the eikonal equation crosses the gap there and the travel
-    times beyond it come out too short, a shortcut the surface does not have. Returns the number
-    of such pairs and the narrowest gap (``inf`` where there is none)."""
+    times beyond it come out too short, a shortcut the surface does not have. Returns the pairs'
+    band positions and their gaps."""
     h = grid.spacing
-    node, _, gap = band.facing_sheet_pairs(
+    node, neighbour, gap = band.facing_sheet_pairs(
         roles == ROLE_INNER, np.ascontiguousarray(phi, dtype=np.float32),
         np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim), h)
     if node.size == 0:
-        return 0, float("inf")
+        return node, neighbour, gap
     narrowest = int(np.argmin(gap))
     where = tuple(round(float(v), 6) for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
     needed = float(gap[narrowest]) / (2 * inner + 2)
@@ -514,7 +530,7 @@ def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.nd
         RuntimeWarning,
         stacklevel=4,
     )
-    return int(node.size), float(gap[narrowest])
+    return node, neighbour, gap
 
 
 def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray, roles: np.ndarray,
@@ -701,7 +717,9 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
         inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
         setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
-        window_edge=st["window_edge"], facing_pairs=tube.facing[0], narrowest_gap=tube.facing[1],
+        window_edge=st["window_edge"], facing_pairs=int(tube.facing[0].size),
+        narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
-                    tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic")
+                    tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",
+                    tube.facing)

@@ -44,7 +44,8 @@ class SolveStats:
         facing each other, narrower than the tubes (a thin part, a narrow slot or fold, parts that
         nearly touch): the eikonal equation can cross the gap there, and the solve warned that
         travel times beyond it can be too short (docs/surfaces.md, "Parts of the surface that
-        face each other"). 0 when the grid resolves every gap.
+        face each other"; the places: ``Solution.narrow_gaps()``). 0 when the grid resolves every
+        gap.
     narrowest_gap : float
         The narrowest such gap, ``|cp(a) − cp(b)|`` over those pairs (``inf`` when there is none).
     """
