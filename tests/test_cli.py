@@ -156,3 +156,19 @@ def test_a_curve_cannot_be_exported_to_ply_and_a_directory_is_not_a_mesh(tmp_pat
 def test_an_unknown_experiment_is_an_error_line_with_exit_status_2(capsys):
     assert main(["reproduce", "nosuch"]) == 2
     assert "unknown experiment" in capsys.readouterr().err
+
+
+def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, capsys):
+    # a plate 0.08 thick meshed as 12 triangles, on a grid too coarse for it: the solve warns that
+    # the surface faces itself across a narrow gap
+    v = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.04, 0.04)])
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    faces = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+    mesh = tmp_path / "plate.obj"
+    mesh.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces))
+    rc = main(["solve", "--mesh", str(mesh), "--n", "41", "--source", "0", "0", "0.04", "--out", str(tmp_path), "--quiet"])
+    assert rc == 0
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if "faces itself" in ln]
+    assert len(lines) == 1 and lines[0].startswith("warning: the surface faces itself")
+    assert "RuntimeWarning" not in err and "sol = solve(" not in err

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Any, List, Optional, Sequence
 
@@ -344,12 +345,25 @@ def cmd_info(_: argparse.Namespace) -> int:
     return 0
 
 
+def _warning_line(message: Any, category: Any, filename: str, lineno: int, file: Any = None,
+                  line: Optional[str] = None) -> None:
+    """Shows a warning as one ``warning: …`` line on stderr, without the library's source line
+    (what the command-line user can act on is the message)."""
+    print(f"warning: {message}", file=sys.stderr if file is None else file)
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
         parser.print_help()
         return 0
+    with warnings.catch_warnings():
+        warnings.showwarning = _warning_line
+        return _run(parser, args)
+
+
+def _run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     try:
         if args.command == "solve":
             return cmd_solve(args)
