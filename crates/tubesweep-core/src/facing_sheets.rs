@@ -14,22 +14,28 @@
 //! directions of Eq. (8) (`(x − cp(x))/|x − cp(x)|`, pointing away from each node's own closest
 //! point; the normal for nodes on the surface) and `cp(x) = x − |φ| n`:
 //!
-//! 1. *Facing.* Both lie off the surface, `t_a, t_b > ` [`MIN_OFF_SURFACE`]; their directions
-//!    point against each other, `n_a · n_b < ` [`FACING_COSINE`]; and each lies on its own side
-//!    of the other's closest point, `n_a · (b − cp(a)) > 0` and `n_b · (a − cp(b)) > 0`, i.e.
-//!    `t_a + n_a[k] > 0` and `t_b − n_b[k] > 0`. Two nodes on either side of one sheet fail the
-//!    last condition (each lies behind the other's tangent plane), whatever the scale of φ.
-//! 2. *Across.* The chord `cp(a) − cp(b)` is longer than [`MIN_ACROSS`] spacings and runs along
-//!    both directions, within 30° of each ([`ACROSS_COSINE`]). On one smooth sheet the chord
-//!    between the closest points of two neighbours is nearly tangent. This catches gaps of one
-//!    to two spacings, where the node between the sheets and the node beyond one of them point
-//!    the same way (a plate 1.9 spacings thick, crossed by one node).
+//! 1. *Facing.* Both lie off the surface, `t_a, t_b > ` [`MIN_OFF_SURFACE`], on the same side of
+//!    it (φ's signs agree; always so for an unsigned φ); their directions point against each
+//!    other, `n_a · n_b < ` [`FACING_COSINE`]; and each lies on its own side of the other's
+//!    closest point, `n_a · (b − cp(a)) > 0` and `n_b · (a − cp(b)) > 0`, i.e. `t_a + n_a[k] > 0`
+//!    and `t_b − n_b[k] > 0`. Two nodes on either side of one sheet fail the signs (a signed φ,
+//!    which may be only roughly a distance: with `|∇φ| > 2` the last condition alone would let
+//!    them through) or the last condition (an unsigned φ, an exact distance: each lies behind the
+//!    other's tangent plane).
+//! 2. *Across.* The two lie on opposite sides of the surface (φ's signs differ) yet their
+//!    directions point the same way, `n_a · n_b > 0`, and the chord `cp(a) − cp(b)` is longer
+//!    than [`MIN_ACROSS`] spacings and runs along both directions, within 30° of each
+//!    ([`ACROSS_COSINE`]). On one sheet two nodes on opposite sides point opposite ways, and two
+//!    on one side have the same sign. This catches gaps of one to two spacings, where the node
+//!    between the sheets and the node beyond one of them point the same way (a plate 1.9 spacings
+//!    thick, crossed by one node). It needs a signed φ: on open or unsigned surfaces (closest
+//!    points, open meshes) only the first test runs.
 //!
 //! Smooth surfaces, open surfaces' rims and the Möbius band give no pair; neither do convex
 //! edges (the cube's: `n_a · n_b ≈ 0`, and the chord cannot lie within 30° of two perpendicular
 //! directions), where the method's error is first order. A gap narrower than about one spacing
-//! can look like a single sheet to both tests and is not always found. The pair's gap is
-//! `|cp(a) − cp(b)|`.
+//! (two on an unsigned surface) can look like a single sheet to both tests and is not always
+//! found. The pair's gap is `|cp(a) − cp(b)|`.
 
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
@@ -43,8 +49,8 @@ pub const MIN_OFF_SURFACE: f64 = 0.25;
 pub const FACING_COSINE: f64 = -0.5;
 
 /// The shortest chord `|cp(a) − cp(b)|`, in grid spacings, that the second test takes for a
-/// gap: one spacing, more than a single sheet gives where φ is only roughly a distance (its
-/// closest points `x − |φ| n` then miss the sheet along `n` by up to `|1 − |∇φ||·|φ|`).
+/// gap (the closest points `x − |φ| n` of a φ that is only roughly a distance miss the sheet
+/// along `n` by up to `|1 − |∇φ||·|φ|`; the test's other conditions exclude those pairs).
 pub const MIN_ACROSS: f64 = 1.0;
 
 /// The smallest cosine between the chord and each node's direction for the chord to run across
@@ -103,10 +109,14 @@ pub fn facing_sheet_pairs<const D: usize>(
             let chord2 = dot(&chord, &chord);
             let facing = ta > MIN_OFF_SURFACE
                 && tb > MIN_OFF_SURFACE
+                && (phi[a] as f64) * (phi[b] as f64) > 0.0
                 && dot(&na, &nb) < FACING_COSINE
                 && ta + na[k] > 0.0
                 && tb - nb[k] > 0.0;
-            let across = chord2 > MIN_ACROSS * MIN_ACROSS && {
+            // on opposite sides of the surface (φ's signs) yet pointing the same way: the inside
+            // node's closest point and the outside node's lie on different sheets
+            let opposite_sides_same_way = (phi[a] as f64) * (phi[b] as f64) < 0.0 && dot(&na, &nb) > 0.0;
+            let across = opposite_sides_same_way && chord2 > MIN_ACROSS * MIN_ACROSS && {
                 let (ca, cb) = (dot(&chord, &na), dot(&chord, &nb));
                 let min2 = ACROSS_COSINE * ACROSS_COSINE * chord2;
                 ca * ca >= min2 && cb * cb >= min2
@@ -145,7 +155,9 @@ mod tests {
             let y = idx[0] as f64 * h;
             let (d0, d1) = ((y - y0).abs(), (y - y1).abs());
             let (d, s) = if d0 <= d1 { (d0, (y - y0).signum()) } else { (d1, (y - y1).signum()) };
-            phi.push(d as f32);
+            // inside (negative) between the lines
+            let inside = y > y0.min(y1) && y < y0.max(y1);
+            phi.push(if inside { -d } else { d } as f32);
             dir.extend([if d > 0.0 { s as f32 } else { 0.0 }, 0.0]);
         }
         (band, phi, dir)
@@ -156,7 +168,7 @@ mod tests {
         let h = 0.1;
         // lines 0.5 apart (5 spacings): inner tubes of 2 spacings touch across the middle
         let (band, phi, dir) = two_lines(12, h, 0.3, 0.8);
-        let inner: Vec<bool> = phi.iter().map(|&p| p as f64 <= 2.0 * h + 1e-6).collect();
+        let inner: Vec<bool> = phi.iter().map(|&p| (p as f64).abs() <= 2.0 * h + 1e-6).collect();
         let pairs = facing_sheet_pairs(&band, &inner, &phi, &dir, h).unwrap();
         // one pair per column, across the middle (nodes at y = 0.5 and 0.6)
         assert_eq!(pairs.len(), 12);
@@ -173,13 +185,28 @@ mod tests {
         // pointing up), the node at y = 0.6 just beyond the upper one (pointing up too)
         let h = 0.1;
         let (band, phi, dir) = two_lines(10, h, 0.415, 0.59);
-        let inner: Vec<bool> = phi.iter().map(|&p| p as f64 <= 2.0 * h + 1e-6).collect();
+        let inner: Vec<bool> = phi.iter().map(|&p| (p as f64).abs() <= 2.0 * h + 1e-6).collect();
         let pairs = facing_sheet_pairs(&band, &inner, &phi, &dir, h).unwrap();
         assert!(!pairs.is_empty());
         for p in &pairs {
             let (ia, ib) = (band.index_of(p.node), band.index_of(p.neighbour));
             assert_eq!((ia[0], ib[0]), (5, 6));
             assert!((p.gap - 0.175).abs() < 1e-6, "gap {}", p.gap);
+        }
+    }
+
+    #[test]
+    fn a_level_set_that_is_a_multiple_of_a_distance_gives_no_pair() {
+        // φ = g·(signed distance) to one line: the closest points x − |φ| n of two nodes on one
+        // side lie (g − 1) spacings apart along n, a chord like the strip's, but both nodes are
+        // outside; two nodes on either side of the line each lie on its own side of the other's
+        // closest point once g > 2, but their signs differ
+        let h = 0.1;
+        for g in [1.5f32, 2.0, 2.5, 3.0] {
+            let (band, phi, dir) = two_lines(12, h, 0.55, 10.0);
+            let phi: Vec<f32> = phi.iter().map(|&p| g * p).collect();
+            let all = vec![true; band.len()];
+            assert!(facing_sheet_pairs(&band, &all, &phi, &dir, h).unwrap().is_empty(), "g = {g}");
         }
     }
 
@@ -192,7 +219,7 @@ mod tests {
         assert!(facing_sheet_pairs(&band, &all, &phi, &dir, h).unwrap().is_empty());
         // two lines 0.9 apart: the nodes between them that meet are in no inner tube
         let (band, phi, dir) = two_lines(14, h, 0.2, 1.1);
-        let inner: Vec<bool> = phi.iter().map(|&p| p as f64 <= 2.0 * h + 1e-6).collect();
+        let inner: Vec<bool> = phi.iter().map(|&p| (p as f64).abs() <= 2.0 * h + 1e-6).collect();
         assert!(facing_sheet_pairs(&band, &inner, &phi, &dir, h).unwrap().is_empty());
     }
 
