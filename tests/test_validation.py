@@ -354,6 +354,21 @@ def test_a_tube_refuses_to_solve_after_its_phi_array_changed():
         tube.solve([(-0.7, 0, 0)])
 
 
+def test_a_solution_refuses_paths_after_its_phi_array_changed():
+    x = np.stack(G3.meshgrid(), -1)
+    phi = np.linalg.norm(x, axis=-1) - 0.5
+    sol = ts.solve(phi, G3, [(-0.5, 0, 0)])
+    assert len(sol.geodesic_path((0.5, 0, 0))) > 2
+    phi -= 0.2  # the paths would be projected onto the new surface, r = 0.7, far from the band's
+    with pytest.raises(ValueError, match="was changed after the solve"):
+        sol.geodesic_path((0.5, 0, 0))
+    # a copy leaves the solution free of the caller's array
+    phi2 = np.linalg.norm(x, axis=-1) - 0.5
+    sol2 = ts.solve(ts.LevelSet(phi2.copy()), G3, [(-0.5, 0, 0)])
+    phi2 -= 0.2
+    assert len(sol2.geodesic_path((0.5, 0, 0))) > 2
+
+
 @pytest.mark.parametrize("call, error, match", [
     (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.complex128(2 + 1j)), TypeError, "speed must be a real"),
     (lambda: ts.hamiltonians.Isotropic(sigma=np.array([1.5 + 1j] * 3)), TypeError, "sigma must hold real"),

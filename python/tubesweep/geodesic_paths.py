@@ -212,8 +212,9 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
 
     Raises ``ValueError`` for a solution of an anisotropic Hamiltonian, a ``step`` outside
     [MIN_STEP, 1], a start farther from the surface than the inner tube, outside the band, or not
-    reached by any source.
+    reached by any source, and when the surface's φ array was changed after the solve.
     """
+    sol._check_surface_unchanged()
     if not sol._isotropic:
         raise ValueError(
             f"geodesic paths need an isotropic Hamiltonian (godunov, lxf or Isotropic()); this solution is "

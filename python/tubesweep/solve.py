@@ -53,6 +53,8 @@ SOURCE_RADIUS = 2.0
 ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
 
 _MAX_WIDENINGS = 4
+# band nodes at which a solution samples its surface's φ array, to notice a later change
+_PHI_SAMPLE = 4096
 _ROLE_CHUNK = 1 << 18
 
 
@@ -94,6 +96,21 @@ class Solution:
         # the pairs of band nodes across gaps narrower than the tubes (positions, positions, gaps)
         empty = np.empty(0, np.int64)
         self._facing = facing if facing is not None else (empty, empty, np.empty(0))
+        # for a φ array: its values at a sample of the band's nodes (linear indices, values)
+        self._phi_sample: Optional[Tuple[np.ndarray, np.ndarray]] = None
+
+    def _check_surface_unchanged(self) -> None:
+        """Refuses to go on when the surface's φ array, which the solution uses in place for its
+        projections, was changed after the solve (checked at a sample of the band's nodes)."""
+        if self._phi_sample is None:
+            return
+        pick, values = self._phi_sample
+        if not np.array_equal(self.surface._array.reshape(-1)[pick], values):  # type: ignore[attr-defined]
+            raise ValueError(
+                "the φ array of this solution's surface was changed after the solve: its projections onto the surface "
+                "no longer match the solution. Solve again for the new φ (pass phi.copy() to LevelSet to keep the "
+                "array free to change)"
+            )
 
     def narrow_gaps(self) -> Tuple[np.ndarray, np.ndarray]:
         """Where the surface faces itself across a gap narrower than the tubes (see
@@ -701,6 +718,13 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
     method = tube.method
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
     phi = tube.phi
+    array = getattr(surf, "_array", None)
+    phi_sample = None
+    if array is not None:
+        # a φ array is used in place: a sample of it at the band's nodes, for the solution to
+        # notice a change before it projects points with it (geodesic paths)
+        pick = linear[:: max(1, len(linear) // _PHI_SAMPLE)]
+        phi_sample = (pick, array.reshape(-1)[pick].copy())
     if general is None:
         # The linear indices are dropped before the sweeps and the fixed nodes go to the solver
         # sparsely; the directions are converted to the extension weights in place (no second
@@ -742,6 +766,8 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         window_edge=st["window_edge"], facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
     )
-    return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
-                    tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",
-                    tube.facing)
+    sol = Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
+                   tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",
+                   tube.facing)
+    sol._phi_sample = phi_sample
+    return sol

@@ -221,7 +221,8 @@ class LevelSet(Surface):
         evaluated for a callable (found coarse-to-fine, never the whole box). A C-ordered float64
         array is used in place, not copied (no second array of the grid's size): do not change it
         while a solution or a :class:`~tubesweep.Tube` built from it is in use (a Tube refuses to
-        solve after a change); pass ``phi.copy()`` to keep it free.
+        solve after a change, and a solution to trace geodesic paths, whose projections use it);
+        pass ``phi.copy()`` to keep it free.
     lipschitz : float, optional
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
         default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
