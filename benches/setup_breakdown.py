@@ -10,7 +10,7 @@ printed, with the whole solve's ``sol.stats.setup_seconds`` and ``sol.stats.seco
 The pieces are those of ``LevelSet.band`` for a callable φ (docs/architecture.md): the
 coarse-to-fine band search (candidates, then φ at them and the filter), the band structure,
 the rim places, φ there, the outward directions and the check for gaps narrower than the tubes
-(``solve._warn_if_tubes_touch``); then the whole of it for the surface's φ
+(the kinks of φ, then ``solve._warn_if_tubes_touch``); then the whole of it for the surface's φ
 as a plain callable, and for the library surface itself, whose band is found in Rust in one
 call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENBLAS_NUM_THREADS=1`` as
 ``make bench`` does (see README).
@@ -19,6 +19,7 @@ call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENB
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import time
@@ -31,7 +32,9 @@ import numpy as np  # noqa: E402
 
 import tubesweep as ts  # noqa: E402
 from tubesweep import _native  # noqa: E402
-from tubesweep.surface import coarse_to_fine_candidates, discover_band  # noqa: E402
+from tubesweep.surface import _kinks, coarse_to_fine_candidates, discover_band  # noqa: E402
+
+solve_module = importlib.import_module("tubesweep.solve")  # (``tubesweep.solve`` the attribute is the function)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from problems import PROBLEMS  # noqa: E402
@@ -64,9 +67,10 @@ def main() -> int:
     pos, counts = band.rim_nodes(0, len(linear))
     rim_phi = surf._phi_at_rim_places(grid, linear, pos, counts)
     direction = np.empty((len(linear), grid.ndim), np.float32)
-    band.outward_directions(h, values, 0, len(linear), rim_phi, direction)
+    norm = band.outward_directions(h, values, 0, len(linear), rim_phi, direction)
     phi32 = values.astype(np.float32)
-    inner = np.abs(values) <= 2 * h  # the default inner tube
+    roles = np.where(np.abs(values) <= 2 * h, solve_module.ROLE_INNER, solve_module.ROLE_OUTER).astype(np.uint8)
+    kink = _kinks(norm)
     r = a.repeats
     rows: Dict[str, float] = {
         "band search: candidates (coarse-to-fine levels, last split)": median_ms(
@@ -78,8 +82,9 @@ def main() -> int:
         "rim coordinates and φ there": median_ms(lambda: surf._phi_at_rim_places(grid, linear, pos, counts), r),
         "outward directions (Band.outward_directions)": median_ms(
             lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r),
-        "facing pairs (Band.facing_sheet_pairs: gaps narrower than the tubes)": median_ms(
-            lambda: band.facing_sheet_pairs(inner, phi32, direction, h), r),
+        "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(lambda: _kinks(norm), r),
+        "gaps narrower than the tubes: the pairs (solve._warn_if_tubes_touch)": median_ms(
+            lambda: solve_module._warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r),
         "LevelSet.band of the same φ as a callable, all of the above": median_ms(
             lambda: ts.LevelSet(fn, lipschitz=surf.lipschitz).band(grid, width), r),
         "LevelSet.band of the library surface (the same band found in Rust)": median_ms(lambda: surf.band(grid, width), r),

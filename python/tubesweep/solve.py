@@ -528,8 +528,38 @@ def _widening_can_help(surf: Surface) -> bool:
     return not getattr(surf, "redistance", False)
 
 
+def _ridge_pairs(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
+                 kink: Optional[np.ndarray]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pairs of neighbouring band nodes of which one straddles a kink of a level set's φ (a
+    ridge between facing parts, ``BandGeometry.kink``) and one lies in the inner tube, with the
+    gap ``2|φ|`` at the kink's node. There the central differences give no reliable direction,
+    so the directions' tests of ``Band.facing_sheet_pairs`` can miss the pair (two spheres
+    ``min(d₁, d₂)`` 5 spacings apart were crossed without a word)."""
+    empty = np.empty(0, np.int64)
+    if kink is None or not np.any(kink):
+        return empty, empty, np.empty(0)
+    at = np.flatnonzero(kink)
+    idx = grid.unravel(linear[at])
+    nodes, neighbours = [], []
+    for k in range(grid.ndim):
+        for side in (1, -1):
+            moved = idx.copy()
+            moved[:, k] += side
+            pos = band.find(np.ascontiguousarray(moved, dtype=np.int64))
+            ok = pos >= 0
+            a, b = at[ok], pos[ok]
+            ok = (roles[a] == ROLE_INNER) | (roles[b] == ROLE_INNER)
+            a, b = a[ok], b[ok]
+            nodes.append(np.minimum(a, b))
+            neighbours.append(np.maximum(a, b))
+    node, neighbour = np.concatenate(nodes), np.concatenate(neighbours)
+    gap = 2.0 * np.abs(phi[np.where(kink[node], node, neighbour)]).astype(float)
+    return node, neighbour, gap
+
+
 def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
-                         direction: np.ndarray, inner: float) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+                         direction: np.ndarray, inner: float,
+                         kink: Optional[np.ndarray] = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
     ``tubesweep_core::facing_sheets``): the eikonal equation crosses the gap there and the travel
@@ -539,6 +569,15 @@ def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.nd
     node, neighbour, gap = band.facing_sheet_pairs(
         roles == ROLE_INNER, np.ascontiguousarray(phi, dtype=np.float32),
         np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim), h)
+    ridge = _ridge_pairs(grid, band, linear, roles, phi, kink)
+    if ridge[0].size:
+        node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip((node, neighbour, gap), ridge))
+        # a pair found both ways counts once (the smaller gap)
+        order = np.lexsort((gap, neighbour, node))
+        node, neighbour, gap = node[order], neighbour[order], gap[order]
+        first = np.ones(node.size, bool)
+        first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
+        node, neighbour, gap = node[first], neighbour[first], gap[first]
     if node.size == 0:
         return node, neighbour, gap
     narrowest = int(np.argmin(gap))
@@ -546,7 +585,7 @@ def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.nd
     needed = float(gap[narrowest]) / (2 * inner + 2)
     warnings.warn(
         f"the surface faces itself across gaps narrower than its tubes at {node.size} pair(s) of neighbouring band "
-        f"nodes (the narrowest, {float(gap[narrowest]):.4g} wide, near {where}): there the inner tube of one side "
+        f"nodes (the narrowest found, {float(gap[narrowest]):.4g} wide, near {where}): there the inner tube of one side "
         "touches the band of the other, and where the other side is reached first the front crosses the gap, so "
         "travel times beyond it can come out too short (stats.facing_pairs; docs/surfaces.md). Refine the grid to a "
         f"spacing below about {needed:.4g} (now {h:.4g}), gap / (2·inner + 2); a gap that narrows as the grid is "
@@ -627,6 +666,7 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
         # keeps φ in single precision, and the band is built without them (memory is per band
         # node: see docs/architecture.md).
         phi = geom.signed.astype(np.float32)
+        kink = geom.kink
         direction: Optional[np.ndarray] = None
         if reusable:
             # kept for every solve: the solver gets copies of its directions
@@ -671,7 +711,7 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
         )
         outer_eff += 1.0
     facing = _warn_if_tubes_touch(grid, band, linear, roles, phi,
-                                  direction if direction is not None else geom.direction, inner)
+                                  direction if direction is not None else geom.direction, inner, kink)
     return _PreparedTube(grid, surf, float(inner), outer_eff, method, geom, linear, roles, band, phi, direction,
                          time.perf_counter() - t0, facing)
 

@@ -47,7 +47,8 @@ class SolveStats:
         face each other"; the places: ``Solution.narrow_gaps()``). 0 when the grid resolves every
         gap.
     narrowest_gap : float
-        The narrowest such gap, ``|cp(a) − cp(b)|`` over those pairs (``inf`` when there is none).
+        The narrowest such gap found, ``|cp(a) − cp(b)|`` over those pairs (``inf`` when there is
+        none); the true gap can be narrower. Gaps under about one grid spacing are not found.
     """
 
     iterations: int

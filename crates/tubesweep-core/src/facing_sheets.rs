@@ -31,19 +31,24 @@
 //!    thick, crossed by one node). It needs a signed φ: on open or unsigned surfaces (closest
 //!    points, open meshes) only the first test runs.
 //!
+//! For a level set the Python side adds a third case (`solve._ridge_pairs`): a node whose central
+//! differences straddle a kink of φ, where the directions are not reliable.
+//!
 //! Smooth surfaces, open surfaces' rims and the Möbius band give no pair; neither do convex
 //! edges (the cube's: `n_a · n_b ≈ 0`, and the chord cannot lie within 30° of two perpendicular
 //! directions), where the method's error is first order. A gap narrower than about one spacing
-//! (two on an unsigned surface) can look like a single sheet to both tests and is not always
+//! (two on an unsigned surface) looks like a single sheet to both tests and is in practice not
 //! found. The pair's gap is `|cp(a) − cp(b)|`.
 
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 
-/// Nodes closer to the surface than this many grid spacings carry a normal, not a direction
-/// away from their closest point, and are not tested.
-pub const MIN_OFF_SURFACE: f64 = 0.25;
+/// Nodes closer to the surface than this many grid spacings are not tested by the facing test:
+/// on it (a mesh's nodes within 1e-12 spacings) a node carries a face normal, not a direction
+/// away from its closest point. At a quarter spacing, plates 1.5–1.9 spacings thick were missed
+/// wherever a face passed within a quarter spacing of a node (about 40% of placements).
+pub const MIN_OFF_SURFACE: f64 = 0.02;
 
 /// The largest cosine between two nodes' directions for them to face each other (120°).
 pub const FACING_COSINE: f64 = -0.5;
@@ -92,8 +97,10 @@ pub fn facing_sheet_pairs<const D: usize>(
     }
     let sentinel = band.sentinel();
     let dir = |n: usize| -> [f64; D] { std::array::from_fn(|k| direction[D * n + k] as f64) };
+    let dot = |u: &[f64; D], v: &[f64; D]| -> f64 { (0..D).map(|j| u[j] * v[j]).sum() };
     let pairs_from = |a: usize, out: &mut Vec<FacingPair>| {
-        let ta = (phi[a] as f64).abs() / spacing;
+        let pa = phi[a] as f64;
+        let ta = pa.abs() / spacing;
         let na = dir(a);
         for (k, pair) in band.neighbours_of(a).iter().enumerate() {
             let b = pair[1];
@@ -101,22 +108,26 @@ pub fn facing_sheet_pairs<const D: usize>(
                 continue;
             }
             let b = b as usize;
+            let pb = phi[b] as f64;
             let nb = dir(b);
-            let tb = (phi[b] as f64).abs() / spacing;
+            let cosine = dot(&na, &nb);
+            // the signs and the directions first: most pairs lie on one side of one sheet and
+            // point the same way, and neither test can take them
+            let same_side = pa * pb > 0.0;
+            let opposite_sides = pa * pb < 0.0;
+            if !((same_side && cosine < FACING_COSINE) || (opposite_sides && cosine > 0.0)) {
+                continue;
+            }
+            let tb = pb.abs() / spacing;
             // the chord cp(a) − cp(b) in grid spacings: (a − b) − t_a n_a + t_b n_b, a − b = −e_k
             let chord: [f64; D] = std::array::from_fn(|j| if j == k { -1.0 } else { 0.0 } - ta * na[j] + tb * nb[j]);
-            let dot = |u: &[f64; D], v: &[f64; D]| -> f64 { (0..D).map(|j| u[j] * v[j]).sum() };
             let chord2 = dot(&chord, &chord);
-            let facing = ta > MIN_OFF_SURFACE
-                && tb > MIN_OFF_SURFACE
-                && (phi[a] as f64) * (phi[b] as f64) > 0.0
-                && dot(&na, &nb) < FACING_COSINE
-                && ta + na[k] > 0.0
-                && tb - nb[k] > 0.0;
-            // on opposite sides of the surface (φ's signs) yet pointing the same way: the inside
-            // node's closest point and the outside node's lie on different sheets
-            let opposite_sides_same_way = (phi[a] as f64) * (phi[b] as f64) < 0.0 && dot(&na, &nb) > 0.0;
-            let across = opposite_sides_same_way && chord2 > MIN_ACROSS * MIN_ACROSS && {
+            // facing: on one side, pointing against each other, each on its own side of the
+            // other's closest point
+            let facing = same_side && ta > MIN_OFF_SURFACE && tb > MIN_OFF_SURFACE && ta + na[k] > 0.0 && tb - nb[k] > 0.0;
+            // across: on opposite sides of the surface yet pointing the same way, so that the
+            // inside node's closest point and the outside node's lie on different sheets
+            let across = opposite_sides && chord2 > MIN_ACROSS * MIN_ACROSS && {
                 let (ca, cb) = (dot(&chord, &na), dot(&chord, &nb));
                 let min2 = ACROSS_COSINE * ACROSS_COSINE * chord2;
                 ca * ca >= min2 && cb * cb >= min2
