@@ -414,8 +414,9 @@ class LevelSet(Surface):
                 "surface (it should be ≈ 1). Use ts.LevelSet(phi, redistance=True), which re-distances φ in the band, "
                 "or pass a signed distance function; the tube widths are measured in units of φ. If φ is a distance "
                 "function, the grid is too coarse for the surface: the tube (outer × grid spacing on each side) "
-                "reaches a point where ∇φ vanishes, such as the centre of a sphere not much larger than the tube "
-                "or the core of a thin tube; refine the grid"
+                "reaches a point where ∇φ vanishes, such as the centre of a sphere not much larger than the tube, "
+                "the core of a thin tube, or the middle of a gap between two parts of the surface that face each "
+                "other; refine the grid"
             )
         if lo < GRAD_WARN_LOW or hi > GRAD_WARN_HIGH:
             warnings.warn(
