@@ -157,7 +157,7 @@ def meshes() -> None:
             st = sol.stats
             print(f"  bunny N={n}: warned={warned} pairs={st.facing_pairs} gap={st.narrowest_gap:.5f}")
     print("geodesic paths from 300 random vertices (seed 1) that stop short, and how many of them end within "
-          f"{geodesic_paths.GAP_REACH:g} spacings of a pair across a narrow gap")
+          f"{geodesic_paths.GAP_REACH:g} spacings (plus half the gap) of a pair across a narrow gap")
     cases = [("spot", spot, 81, [285, 0, 1000])]
     if bunny_file.is_file():
         cases += [("bunny", bunny, 101, [0]), ("bunny", bunny, 201, [0])]

@@ -70,7 +70,7 @@ def main() -> int:
     norm = band.outward_directions(h, values, 0, len(linear), rim_phi, direction)
     phi32 = values.astype(np.float32)
     roles = np.where(np.abs(values) <= 2 * h, solve_module.ROLE_INNER, solve_module.ROLE_OUTER).astype(np.uint8)
-    kink = _kinks(norm)
+    kink = _kinks(norm, grid, linear, band)
     r = a.repeats
     rows: Dict[str, float] = {
         "band search: candidates (coarse-to-fine levels, last split)": median_ms(
@@ -82,7 +82,7 @@ def main() -> int:
         "rim coordinates and φ there": median_ms(lambda: surf._phi_at_rim_places(grid, linear, pos, counts), r),
         "outward directions (Band.outward_directions)": median_ms(
             lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r),
-        "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(lambda: _kinks(norm), r),
+        "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(lambda: _kinks(norm, grid, linear, band), r),
         "gaps narrower than the tubes: the pairs (solve._warn_if_tubes_touch)": median_ms(
             lambda: solve_module._warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r),
         "LevelSet.band of the same φ as a callable, all of the above": median_ms(

@@ -380,9 +380,9 @@ def _run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print("\ninterrupted", file=sys.stderr)
         return 130
-    except (ValueError, TypeError, MemoryError, ImportError, OSError, NotImplementedError) as e:
+    except (ValueError, TypeError, MemoryError, ImportError, OSError, NotImplementedError, Warning) as e:
         # OSError: files (missing, a directory, no permission); NotImplementedError: a mesh format
-        # that trimesh/meshio cannot read
+        # that trimesh/meshio cannot read; Warning: a warning turned into an error (-W error)
         print(f"error: {e}", file=sys.stderr)
         return 2
     parser.print_help()

@@ -521,11 +521,20 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
     return 2 * half_width * area / grid.spacing ** grid.ndim
 
 
-def _widening_can_help(surf: Surface) -> bool:
-    """Whether a wider extension layer can give inner nodes the neighbours they lack: not for a
-    re-distanced band, which holds every node within the layer that could be projected onto the
-    zero level set (see ``_prepare_tube``)."""
-    return not getattr(surf, "redistance", False)
+def _lacking_neighbours(grid: Grid, band: Any, linear: np.ndarray, missing: np.ndarray) -> np.ndarray:
+    """The linear indices (sorted, unique) of the in-grid neighbours that the band nodes
+    ``missing`` (band positions) lack in the band."""
+    idx = grid.unravel(linear[missing])
+    shape = np.asarray(grid.shape)
+    lacking = [np.empty(0, np.int64)]
+    for k in range(grid.ndim):
+        for side in (1, -1):
+            moved = idx.copy()
+            moved[:, k] += side
+            moved = moved[(moved[:, k] >= 0) & (moved[:, k] < shape[k])]
+            absent = band.find(np.ascontiguousarray(moved, dtype=np.int64)) < 0
+            lacking.append(np.ravel_multi_index(tuple(moved[absent].T), grid.shape).astype(np.int64))
+    return np.unique(np.concatenate(lacking))
 
 
 def _ridge_pairs(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
@@ -647,6 +656,7 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
     outer_eff = float(outer) if method == "two-layer" else float(inner)
 
     _check_band_memory(surf, grid, outer_eff * h)
+    previously_lacking: Optional[np.ndarray] = None
     for attempt in range(_MAX_WIDENINGS + 1):
         with warnings.catch_warnings():
             if attempt > 0:  # a warning about the band's nodes was given at the first attempt
@@ -681,21 +691,25 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
         missing = band.nodes_missing_neighbours(roles == ROLE_INNER)
         if missing.size == 0:
             break
-        if not _widening_can_help(surf):
-            # A re-distanced band holds every node within `outer` of the zero level set that could
-            # be projected onto it, and an inner node's neighbours lie within inner + 1 < outer:
-            # the missing ones could not be projected (a sharp edge or corner of the zero level
-            # set), and a wider layer would not add them (the box's |x|_∞ − r at N = 41 widened
-            # four times in 12 s and ended in the error below). Go on without them: the inner
-            # nodes next to them take one-sided updates.
-            warnings.warn(
-                f"{missing.size} inner-tube nodes lack a neighbour that the re-distancing could not project onto the "
-                "zero level set (see the warning before): their updates go on from the neighbours they have, and "
-                "values near those places are less accurate or unreached (inf); smooth φ there or refine the grid",
-                RuntimeWarning,
-                stacklevel=3,
+        lacking = _lacking_neighbours(grid, band, linear, missing)
+        if getattr(surf, "redistance", False) and previously_lacking is not None and np.all(
+                np.isin(lacking, previously_lacking)):
+            # A re-distanced band holds the nodes within the layer that could be projected onto
+            # the zero level set; the layer was widened and none of the missing neighbours came
+            # in, so they are nodes the projection cannot place (the box's |x|_∞ − r at N = 41
+            # widened four times in 13 s before ending in the error below). Going on without
+            # them gave wrong answers elsewhere (a circle 3 spacings in radius came out far short
+            # at its antipode), so the solve stops here.
+            bound = getattr(surf, "lipschitz", None)
+            raise ValueError(
+                f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
+                "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
+                "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
+                "there (round the edges over a few grid spacings), pass a signed distance function, or refine the grid"
+                + ("" if bound is None else f"; or the lipschitz bound given, {bound:g}, is below |∇φ| near the surface, "
+                   "which keeps those nodes from the candidates (leave it out to have it estimated)")
             )
-            break
+        previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
@@ -763,7 +777,7 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
     if array is not None:
         # a φ array is used in place: a sample of it at the band's nodes, for the solution to
         # notice a change before it projects points with it (geodesic paths)
-        pick = linear[:: max(1, len(linear) // _PHI_SAMPLE)]
+        pick = linear[:: max(1, len(linear) // _PHI_SAMPLE)].copy()  # not a view: `linear` is dropped
         phi_sample = (pick, array.reshape(-1)[pick].copy())
     if general is None:
         # The linear indices are dropped before the sweeps and the fixed nodes go to the solver
