@@ -692,30 +692,34 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
         if missing.size == 0:
             break
         lacking = _lacking_neighbours(grid, band, linear, missing)
-        if getattr(surf, "redistance", False) and previously_lacking is not None and np.all(
-                np.isin(lacking, previously_lacking)):
-            # A re-distanced band holds the nodes within the layer that could be projected onto
-            # the zero level set; the layer was widened and none of the missing neighbours came
-            # in, so they are nodes the projection cannot place (the box's |x|_∞ − r at N = 41
-            # widened four times in 13 s before ending in the error below). Going on without
-            # them gave wrong answers elsewhere (a circle 3 spacings in radius came out far short
-            # at its antipode), so the solve stops here.
-            bound = getattr(surf, "lipschitz", None)
+        estimated_bound = getattr(surf, "redistance", False) and getattr(surf, "lipschitz", None) is None
+        if estimated_bound and previously_lacking is not None and np.all(np.isin(previously_lacking, lacking)):
+            # A re-distanced band, its candidates found with an estimated bound on |∇φ|, holds the
+            # nodes within the layer that could be projected onto the zero level set; the layer
+            # was widened and none of the missing neighbours came in, so they are nodes the
+            # projection cannot place (the box's |x|_∞ − r at N = 41 widened four times in 13 s
+            # before ending in the error below). Going on without them gave wrong answers
+            # elsewhere (a circle 3 spacings in radius came out far short at its antipode), so the
+            # solve stops here. With a given bound below |∇φ| the candidates depend on the
+            # layer's width and a later widening can still bring them in: widened as for any φ.
             raise ValueError(
                 f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
                 "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
                 "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
                 "there (round the edges over a few grid spacings), pass a signed distance function, or refine the grid"
-                + ("" if bound is None else f"; or the lipschitz bound given, {bound:g}, is below |∇φ| near the surface, "
-                   "which keeps those nodes from the candidates (leave it out to have it estimated)")
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
+            given = getattr(surf, "lipschitz", None) if getattr(surf, "redistance", False) else None
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
-                "inner nodes lack a neighbour. φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), "
-                "or the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
+                "inner nodes lack a neighbour. "
+                + ("φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or " if given is None and
+                   not getattr(surf, "redistance", False) else "")
+                + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
                 "than the tube: refine the grid)"
+                + ("" if given is None else f", or the lipschitz bound given, {given:g}, is below |∇φ| near the surface "
+                   "and keeps nodes from the band's candidates (leave it out to have it estimated)")
             )
         warnings.warn(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
