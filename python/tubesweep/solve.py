@@ -33,7 +33,7 @@ from ._validate import (
 )
 from .grid import Grid
 from .stats import SolveStats
-from .surface import BandGeometry, Surface, as_surface
+from .surface import BandGeometry, Surface, as_surface, band_neighbours
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
 
@@ -76,7 +76,8 @@ class Solution:
                  phi: np.ndarray, stats: SolveStats, sources: np.ndarray, surface: Surface,
                  hamiltonian: str, method: str, inner: float, outer: float,
                  fixed: Tuple[np.ndarray, np.ndarray], isotropic: bool,
-                 facing: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None):
+                 facing: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None,
+                 phi_sample: Optional[Tuple[np.ndarray, np.ndarray]] = None):
         self.grid = grid
         self._band = band
         self.values = values
@@ -97,7 +98,7 @@ class Solution:
         empty = np.empty(0, np.int64)
         self._facing = facing if facing is not None else (empty, empty, np.empty(0))
         # for a φ array: its values at a sample of the band's nodes (linear indices, values)
-        self._phi_sample: Optional[Tuple[np.ndarray, np.ndarray]] = None
+        self._phi_sample = phi_sample
 
     def _check_surface_unchanged(self) -> None:
         """Refuses to go on when the surface's φ array, which the solution uses in place for its
@@ -524,16 +525,10 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
 def _lacking_neighbours(grid: Grid, band: Any, linear: np.ndarray, missing: np.ndarray) -> np.ndarray:
     """The linear indices (sorted, unique) of the in-grid neighbours that the band nodes
     ``missing`` (band positions) lack in the band."""
-    idx = grid.unravel(linear[missing])
-    shape = np.asarray(grid.shape)
     lacking = [np.empty(0, np.int64)]
-    for k in range(grid.ndim):
-        for side in (1, -1):
-            moved = idx.copy()
-            moved[:, k] += side
-            moved = moved[(moved[:, k] >= 0) & (moved[:, k] < shape[k])]
-            absent = band.find(np.ascontiguousarray(moved, dtype=np.int64)) < 0
-            lacking.append(np.ravel_multi_index(tuple(moved[absent].T), grid.shape).astype(np.int64))
+    for moved, inside, pos in band_neighbours(grid, band, linear, missing):
+        absent = moved[inside & (pos < 0)]
+        lacking.append(np.ravel_multi_index(tuple(absent.T), grid.shape).astype(np.int64))
     return np.unique(np.concatenate(lacking))
 
 
@@ -548,19 +543,14 @@ def _ridge_pairs(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, p
     if kink is None or not np.any(kink):
         return empty, empty, np.empty(0)
     at = np.flatnonzero(kink)
-    idx = grid.unravel(linear[at])
     nodes, neighbours = [], []
-    for k in range(grid.ndim):
-        for side in (1, -1):
-            moved = idx.copy()
-            moved[:, k] += side
-            pos = band.find(np.ascontiguousarray(moved, dtype=np.int64))
-            ok = pos >= 0
-            a, b = at[ok], pos[ok]
-            ok = (roles[a] == ROLE_INNER) | (roles[b] == ROLE_INNER)
-            a, b = a[ok], b[ok]
-            nodes.append(np.minimum(a, b))
-            neighbours.append(np.maximum(a, b))
+    for _, _, pos in band_neighbours(grid, band, linear, at):
+        ok = pos >= 0
+        a, b = at[ok], pos[ok]
+        ok = (roles[a] == ROLE_INNER) | (roles[b] == ROLE_INNER)
+        a, b = a[ok], b[ok]
+        nodes.append(np.minimum(a, b))
+        neighbours.append(np.maximum(a, b))
     node, neighbour = np.concatenate(nodes), np.concatenate(neighbours)
     gap = 2.0 * np.abs(phi[np.where(kink[node], node, neighbour)]).astype(float)
     return node, neighbour, gap
@@ -656,6 +646,9 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
     outer_eff = float(outer) if method == "two-layer" else float(inner)
 
     _check_band_memory(surf, grid, outer_eff * h)
+    # a re-distanced band, and the bound on |∇φ| its candidates were found with when the user gave it
+    redistanced = bool(getattr(surf, "redistance", False))
+    given_bound = getattr(surf, "lipschitz", None) if redistanced else None
     previously_lacking: Optional[np.ndarray] = None
     for attempt in range(_MAX_WIDENINGS + 1):
         with warnings.catch_warnings():
@@ -692,8 +685,7 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
         if missing.size == 0:
             break
         lacking = _lacking_neighbours(grid, band, linear, missing)
-        estimated_bound = getattr(surf, "redistance", False) and getattr(surf, "lipschitz", None) is None
-        if estimated_bound and previously_lacking is not None and np.all(np.isin(previously_lacking, lacking)):
+        if redistanced and given_bound is None and previously_lacking is not None and np.all(np.isin(previously_lacking, lacking)):
             # A re-distanced band, its candidates found with an estimated bound on |∇φ|, holds the
             # nodes within the layer that could be projected onto the zero level set; the layer
             # was widened and none of the missing neighbours came in, so they are nodes the
@@ -710,16 +702,14 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
-            given = getattr(surf, "lipschitz", None) if getattr(surf, "redistance", False) else None
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
                 "inner nodes lack a neighbour. "
-                + ("φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or " if given is None and
-                   not getattr(surf, "redistance", False) else "")
+                + ("" if redistanced else "φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or ")
                 + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
                 "than the tube: refine the grid)"
-                + ("" if given is None else f", or the lipschitz bound given, {given:g}, is below |∇φ| near the surface "
-                   "and keeps nodes from the band's candidates (leave it out to have it estimated)")
+                + ("" if given_bound is None else f", or the lipschitz bound given, {given_bound:g}, is below |∇φ| near "
+                   "the surface and keeps nodes from the band's candidates (leave it out to have it estimated)")
             )
         warnings.warn(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
@@ -824,8 +814,6 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         window_edge=st["window_edge"], facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
     )
-    sol = Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
-                   tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",
-                   tube.facing)
-    sol._phi_sample = phi_sample
-    return sol
+    return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
+                    tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",
+                    tube.facing, phi_sample)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from typing import Any, Callable, List, Optional, Tuple, Union
+from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -33,13 +33,29 @@ EVAL_CHUNK = 1 << 18
 GRAD_ERROR_LOW, GRAD_ERROR_HIGH = 1.0 / 3.0, 3.0
 GRAD_WARN_LOW, GRAD_WARN_HIGH = 0.6, 1.8
 
-#: A band node whose central-difference |∇φ| is below this fraction of the median over its chunk
-#: of the band (sampled) straddles a kink of φ where the gradient turns by more than about 140°
+#: A band node whose central-difference |∇φ| is below this fraction of the median over the band
+#: (sampled) and of the largest among its neighbours straddles a kink of φ where the gradient turns by more than about 140°
 #: (|n₁ + n₂|/2 < 0.35 for unit gradients): the ridge between two parts of the surface that face
 #: each other. A convex edge of 90° gives 0.71, and the double torus's creases stay above it from
 #: N = 61 on (at 0.5 they counted as gaps up to N = 81); two spheres min(d₁, d₂) 4.5–5.5 spacings
 #: apart were all found with it, one in 8 missed at 0.25.
 KINK_FRACTION = 0.35
+
+
+def band_neighbours(grid: Grid, band: Any, linear: np.ndarray, nodes: np.ndarray
+                    ) -> Iterator[Tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """For each axis and side in turn, the neighbours of the band nodes ``nodes`` (band positions;
+    ``linear`` the band's linear indices): their grid indices ``(M, d)``, whether each lies in the
+    grid, and its band position (-1 off the grid or off the band)."""
+    idx = grid.unravel(linear[nodes])
+    for k in range(grid.ndim):
+        for side in (1, -1):
+            moved = idx.copy()
+            moved[:, k] += side
+            inside = (moved[:, k] >= 0) & (moved[:, k] < grid.shape[k])
+            pos = np.full(len(moved), -1, np.int64)
+            pos[inside] = band.find(np.ascontiguousarray(moved[inside], dtype=np.int64))
+            yield moved, inside, pos
 
 
 def _kinks(norm: np.ndarray, grid: Grid, linear: np.ndarray, band: Any) -> np.ndarray:
@@ -55,18 +71,10 @@ def _kinks(norm: np.ndarray, grid: Grid, linear: np.ndarray, band: Any) -> np.nd
     cand = np.flatnonzero(norm < KINK_FRACTION * typical)
     if cand.size == 0:
         return kink
-    idx = grid.unravel(linear[cand])
-    shape = np.asarray(grid.shape)
     largest = np.zeros(cand.size)
-    for k in range(grid.ndim):
-        for side in (1, -1):
-            moved = idx.copy()
-            moved[:, k] += side
-            inside = (moved[:, k] >= 0) & (moved[:, k] < shape[k])
-            pos = np.full(cand.size, -1, np.int64)
-            pos[inside] = band.find(np.ascontiguousarray(moved[inside], dtype=np.int64))
-            found = pos >= 0
-            largest[found] = np.maximum(largest[found], norm[pos[found]])
+    for _, _, pos in band_neighbours(grid, band, linear, cand):
+        found = pos >= 0
+        largest[found] = np.maximum(largest[found], norm[pos[found]])
     kink[cand[norm[cand] < KINK_FRACTION * largest]] = True
     return kink
 
