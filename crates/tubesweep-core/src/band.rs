@@ -19,7 +19,7 @@
 //! (17 in 3D).
 
 use crate::error::{Error, Result};
-use crate::schedule::SweepSchedule;
+use crate::schedule::{SweepSchedule, LONG_SIDE, THIN_SIDE};
 use rayon::prelude::*;
 
 /// The band nodes and their neighbour table. `D` is the dimension (2 or 3).
@@ -35,6 +35,9 @@ pub struct NarrowBand<const D: usize> {
     /// axis, bit 1 when the next node is its plus neighbour.
     along_row: Vec<u8>,
     schedule: SweepSchedule,
+    /// 3D only: the parallel sweeps' schedules of rectangular tiles, strips thin along the first
+    /// leading axis (`[0]`) and along the second (`[1]`) (see [`crate::schedule`]).
+    strip_schedules: Vec<SweepSchedule>,
 }
 
 impl<const D: usize> NarrowBand<D> {
@@ -103,10 +106,17 @@ impl<const D: usize> NarrowBand<D> {
             lead: vec![len as u32; len * 2 * (D - 1)],
             along_row: vec![0; len],
             schedule: SweepSchedule::default(),
+            strip_schedules: Vec::new(),
         };
         band.build_neighbours();
         let leads: Vec<[usize; D]> = (0..band.n_rows()).map(|r| band.row_lead(r)).collect();
         band.schedule = SweepSchedule::new(&leads, band.shape);
+        if D == 3 {
+            band.strip_schedules = [([THIN_SIDE, LONG_SIDE], 0), ([LONG_SIDE, THIN_SIDE], 1)]
+                .iter()
+                .map(|&(sides, strip_axis)| SweepSchedule::with_tile_sides(&leads, band.shape, sides, strip_axis))
+                .collect();
+        }
         band
     }
 
@@ -202,10 +212,25 @@ impl<const D: usize> NarrowBand<D> {
         self.schedule.rows(signs)
     }
 
-    /// The parallel sweep schedule.
+    /// The sequential sweep's schedule (square tiles).
     #[inline]
     pub fn schedule(&self) -> &SweepSchedule {
         &self.schedule
+    }
+
+    /// 3D: the parallel sweeps' schedule with strips thin along leading axis `axis` (0 or 1).
+    /// Panics on a 2D band, whose sweeps run sequentially.
+    #[inline]
+    pub fn strip_schedule(&self, axis: usize) -> &SweepSchedule {
+        &self.strip_schedules[axis]
+    }
+
+    /// The first two grid indices of row `r`'s nodes (3D: the row's place in the plane of the
+    /// leading axes).
+    #[inline]
+    pub fn row_leading_indices(&self, r: usize) -> [usize; 2] {
+        let lead = self.row_lead(r);
+        [lead[0], if D > 2 { lead[1] } else { 0 }]
     }
 
     /// The grid index of band node `n`.
@@ -409,6 +434,7 @@ impl<const D: usize> NarrowBand<D> {
             + self.lead.len() * 4
             + self.along_row.len()
             + self.schedule.heap_bytes()
+            + self.strip_schedules.iter().map(|s| s.heap_bytes()).sum::<usize>()
     }
 }
 
@@ -541,8 +567,7 @@ mod tests {
     fn an_empty_band_has_an_empty_schedule() {
         let band = NarrowBand::<3>::from_sorted_linear([5, 5, 5], &[]).unwrap();
         assert_eq!(band.len(), 0);
-        for signs in 0..4 {
-            let sched = band.schedule();
+        for (signs, sched) in (0..4).flat_map(|signs| [(signs, band.schedule()), (signs, band.strip_schedule(0)), (signs, band.strip_schedule(1))]) {
             assert!(sched.rows(signs).is_empty());
             let (strips, strip_tiles) = (sched.strips(signs), sched.strip_tiles(signs));
             assert_eq!(strips.first(), Some(&0));
@@ -584,8 +609,8 @@ mod tests {
     fn strip_pipeline_orders_every_pair_of_neighbour_rows() {
         let n = 61usize;
         let band = crate::test_bands::shell_band(n, 0.6, &[0.0]).0;
-        let sched = band.schedule();
-        for signs in 0..4 {
+        // the square tiles and the rectangular ones, strips along either leading axis
+        for (signs, sched) in (0..4).flat_map(|signs| [(signs, band.schedule()), (signs, band.strip_schedule(0)), (signs, band.strip_schedule(1))]) {
             let (rows, tiles) = (sched.rows(signs), sched.tiles(signs));
             let (strip_tiles, strips, upstream) = (sched.strip_tiles(signs), sched.strips(signs), sched.upstream(signs));
             assert!(strips.len() > 4, "{} strips", strips.len() - 1);

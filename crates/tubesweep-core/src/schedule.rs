@@ -21,11 +21,24 @@
 //! Two tiles that run at the same time are never face neighbours. Threads take whole strips in
 //! order and wait for the one tile of the previous strip they depend on (a pipelined
 //! wavefront): one synchronisation per tile instead of a barrier per wave, the same values.
+//!
+//! Nothing in that argument needs square tiles. The parallel sweeps use two schedules of
+//! rectangular tiles, [`THIN_SIDE`] rows along one leading axis and [`LONG_SIDE`] along the
+//! other, and pick one per iteration: the strips thin along the axis in which the iteration's
+//! work is concentrated (a front crossing that axis), so that more strips share it
+//! (docs/architecture.md, "Strips thin across the front"). The values stay those of the
+//! sequential sweep whichever is picked.
 
 use rayon::prelude::*;
 
-/// Leading-axis rows per tile side.
+/// Leading-axis rows per tile side of the square tiles (the sequential sweep and 2D bands).
 pub const TILE: usize = 8;
+
+/// Rows along the thin side of the parallel sweeps' rectangular tiles (the thickness of a strip).
+pub const THIN_SIDE: usize = 2;
+
+/// Rows along the long side of the parallel sweeps' rectangular tiles.
+pub const LONG_SIDE: usize = 16;
 
 /// The wave/tile/row order for each orientation of the leading axes.
 #[derive(Debug, Clone, Default)]
@@ -49,9 +62,18 @@ pub struct SweepSchedule {
 pub const NO_TILE: u32 = u32::MAX;
 
 impl SweepSchedule {
-    /// Builds the schedule from the leading indices of the rows (`lead[r][k]` for `k < lead_dims`)
-    /// and the grid shape.
+    /// Builds the schedule of square [`TILE`] × [`TILE`] tiles from the leading indices of the
+    /// rows (`lead[r][k]` for `k < lead_dims`) and the grid shape.
     pub fn new<const D: usize>(leads: &[[usize; D]], shape: [usize; D]) -> Self {
+        Self::with_tile_sides(leads, shape, [TILE, TILE], 0)
+    }
+
+    /// The same with tiles of `sides[k]` rows along leading axis `k`, and strips made of the
+    /// tiles with the same tile coordinate along `strip_axis` (0 or 1), ordered along the other
+    /// (3D; a 2D band's single leading axis ignores both).
+    pub fn with_tile_sides<const D: usize>(leads: &[[usize; D]], shape: [usize; D], sides: [usize; 2], strip_axis: usize) -> Self {
+        assert!(strip_axis < 2, "the strip axis is one of the two leading axes");
+        assert!(sides.iter().all(|&s| s > 0), "tile sides must be positive");
         let lead_dims = D - 1;
         let n_orient = 1usize << lead_dims;
         // the orientations are independent: one task each
@@ -66,9 +88,10 @@ impl SweepSchedule {
                     let mut row = 0u64;
                     for k in 0..lead_dims {
                         let c = if signs & (1 << k) != 0 { shape[k] - 1 - lead[k] } else { lead[k] };
-                        let t = (c / TILE) as u64;
+                        let side = sides[k.min(1)];
+                        let t = (c / side) as u64;
                         wave += t;
-                        tile = tile * (shape[k] / TILE + 1) as u64 + t;
+                        tile = tile * (shape[k] / side + 1) as u64 + t;
                         row = row * shape[k] as u64 + c as u64;
                     }
                     if lead_dims == 1 {
@@ -106,11 +129,16 @@ impl SweepSchedule {
                 strip_tiles = (0..tiles.len() as u32 - 1).collect();
                 strips[1] = strip_tiles.len() as u32;
             } else if lead_dims == 2 {
-                let stride = (shape[1] / TILE + 1) as u64;
+                let stride = (shape[1] / sides[1] + 1) as u64;
                 let mut by_coords: Vec<(u64, u64, u32)> = (0..tiles.len() - 1)
                     .map(|t| {
                         let key = keyed[tiles[t] as usize].1;
-                        (key / stride, key % stride, t as u32)
+                        let (a, b) = (key / stride, key % stride);
+                        if strip_axis == 0 {
+                            (a, b, t as u32)
+                        } else {
+                            (b, a, t as u32)
+                        }
                     })
                     .collect();
                 by_coords.sort_unstable();

@@ -17,6 +17,7 @@ use crate::error::{Error, Result};
 use crate::extension::{extension_apply_upwind, extension_weights};
 use crate::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
 use crate::hamiltonian::InnerScheme;
+use crate::schedule::{SweepSchedule, TILE};
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize, Ordering};
@@ -210,6 +211,11 @@ impl Default for SolveOptions {
 /// iterations, wider ones more updates.
 pub const DEFAULT_FRONT_WINDOW: f64 = 2.0;
 
+/// How many times more of an iteration's work the fullest slab along one leading axis must hold
+/// than the fullest along the other before the parallel sweeps run strips thin across that axis
+/// (`SweepProblem::thin_strip_axis`); below it they keep the square tiles.
+const THIN_STRIP_RATIO: f64 = 2.0;
+
 /// What a solve did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveStats {
@@ -236,6 +242,10 @@ pub struct SolveStats {
     /// unreached (they hold the numerical infinity), and the values just below it are not
     /// converged yet.
     pub window_edge: f64,
+    /// Parallel iterations (3D, more than one thread) whose sweeps ran strips thin across the
+    /// first and the second leading axis (`SweepProblem::thin_strip_axis`); the others ran
+    /// square tiles. The values are the same bits either way.
+    pub thin_strip_iterations: [usize; 2],
 }
 
 /// Reported to the progress callback after every iteration.
@@ -691,8 +701,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let tiles_done: Vec<AtomicU32> = if threads == 1 || D < 3 {
             Vec::new()
         } else {
-            let sched = self.band.schedule();
-            let most = (0..1usize << (D - 1)).map(|o| sched.tiles(o).len()).max().unwrap_or(0);
+            let most = [self.band.schedule(), self.band.strip_schedule(0), self.band.strip_schedule(1)]
+                .into_iter()
+                .flat_map(|sched| (0..1usize << (D - 1)).map(move |o| sched.tiles(o).len()))
+                .max()
+                .unwrap_or(0);
             (0..most).map(|_| AtomicU32::new(0)).collect()
         };
         let windowed = window_width > 0.0 && window_width.is_finite() && first_front < f64::INFINITY;
@@ -737,12 +750,20 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 // barrier between sweeps (waking the threads once per sweep costs more than a
                 // small sweep's work)
                 let acc = pool.install(|| {
+                    // strips thin across the front of this iteration's work, or square tiles
+                    // (decided here, on the pool's threads, which then stay awake for the sweeps)
+                    let thin = self.thin_strip_axis(&ctx, lim);
+                    let sched = thin.map_or(self.band.schedule(), |axis| self.band.strip_schedule(axis));
                     let per_sweep = |s: usize, next_strip: &AtomicUsize, abandoned: &AtomicBool| {
                         let dir = s ^ (s >> 1); // Gray code
-                        self.strip_worker(&ctx, dir, next_strip, abandoned, lim)
+                        self.strip_worker(&ctx, sched, dir, next_strip, abandoned, lim)
                     };
-                    run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep)
+                    (run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep), thin)
                 });
+                let (acc, thin) = acc;
+                if let Some(axis) = thin {
+                    stats.thin_strip_iterations[axis] += 1;
+                }
                 max_change = acc.max_change;
                 front = acc.front;
                 waiting = acc.waiting;
@@ -793,6 +814,49 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         Ok(())
     }
 
+    /// The leading axis (0 or 1) across which the parallel sweeps' strips should be thin in the
+    /// coming iteration, or `None` for square tiles. The work is predicted from the rows that
+    /// will run (dirty, with a lower bound inside the window), each weighted by its nodes and
+    /// binned in slabs of [`TILE`] rows along each axis. When the fullest slab along one axis
+    /// holds more than [`THIN_STRIP_RATIO`] times the work of the fullest along the other, a
+    /// front crosses that axis (a ring about a source on it), and strips thin across it spread
+    /// the front's rows over more strips, which the threads run side by side; with square tiles
+    /// they would fall in one or two strips. Otherwise (a front across the rows' own axis, or
+    /// none in particular) the square tiles' fewer waits pay more. Any choice gives the values
+    /// of the sequential sweep; this one only decides how well the threads share the work.
+    fn thin_strip_axis(&self, ctx: &SweepContext<'_, D>, lim: Limits) -> Option<usize> {
+        let shape = self.band.shape();
+        let empty = || [vec![0u64; shape[0] / TILE + 1], vec![0u64; shape[1] / TILE + 1]];
+        let slabs = (0..self.band.n_rows())
+            .into_par_iter()
+            .with_min_len(1024)
+            .fold(empty, |mut slabs, r| {
+                if ctx.row_dirty[r].load(Ordering::Relaxed) != 0 && ctx.row_low[r].load(Ordering::Relaxed) <= lim.window_key {
+                    let (s, e) = self.band.row_range(r);
+                    let ab = self.band.row_leading_indices(r);
+                    for k in 0..2 {
+                        slabs[k][ab[k] / TILE] += (e - s) as u64;
+                    }
+                }
+                slabs
+            })
+            .reduce(empty, |mut a, b| {
+                for k in 0..2 {
+                    a[k].iter_mut().zip(&b[k]).for_each(|(x, y)| *x += y);
+                }
+                a
+            });
+        let fullest = |k: usize| slabs[k].iter().copied().max().unwrap_or(0);
+        let (f0, f1) = (fullest(0) as f64, fullest(1) as f64);
+        if f0 > THIN_STRIP_RATIO * f1 {
+            Some(0)
+        } else if f1 > THIN_STRIP_RATIO * f0 {
+            Some(1)
+        } else {
+            None
+        }
+    }
+
     /// One sequential Gauss–Seidel sweep in orientation `dir` (bit `k` set = axis `k` walked
     /// backwards): the waves in order, the tiles of a wave one after the other, the rows of a
     /// tile in order. (In parallel, the threads run [`Self::strip_worker`].)
@@ -811,9 +875,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// strips of tiles (see [`crate::schedule`]): it takes the next strip (`next_strip`) and runs
     /// its tiles in order, each once the tile of the previous strip it depends on is done in this
     /// sweep (id `ctx.sweep_id`). The values are those of the sequential sweep.
+    #[allow(clippy::too_many_arguments)]
     fn strip_worker(
         &self,
         ctx: &SweepContext<'_, D>,
+        sched: &SweepSchedule,
         dir: usize,
         next_strip: &AtomicUsize,
         abandoned: &AtomicBool,
@@ -821,7 +887,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     ) -> Accumulator {
         let lead = dir & ((1usize << (D - 1)) - 1);
         let backwards = dir >> (D - 1) & 1 == 1;
-        let sched = self.band.schedule();
         let (rows, tiles) = (sched.rows(lead), sched.tiles(lead));
         let run_tile = |t: usize| -> Accumulator {
             let a = &rows[tiles[t] as usize..tiles[t + 1] as usize];
@@ -1672,6 +1737,37 @@ mod tests {
         }
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         assert_same_bits_for_threads(&p, &[2, 3]);
+    }
+
+    /// A source on the sphere at (−0.5, 0, 0) sends its front across the first axis, one at
+    /// (0, −0.5, 0) across the second, and one at (0, 0, −0.5) across the rows' own axis: the
+    /// parallel sweeps pick strips thin across the first, thin across the second, and square
+    /// tiles, and the values are the sequential sweep's bits every time.
+    #[test]
+    fn strips_thin_across_the_front_are_picked_per_iteration_and_keep_the_sequential_bits() {
+        let n = 81usize;
+        for axis in 0..3 {
+            let (band, mut roles, dirs, h) = shell_band(n, 0.5, &[0.0]);
+            let mut at = [(n / 2) as i64; 3];
+            at[axis] = (n / 4) as i64;
+            roles[band.find(at).unwrap()] = NodeRole::Fixed;
+            let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+            let (u1, s1) = converged(&p, SolveOptions { threads: 1, ..Default::default() });
+            assert_eq!(s1.thin_strip_iterations, [0, 0], "one thread runs the sequential sweep");
+            for threads in [2, 3] {
+                let (u, s) = converged(&p, SolveOptions { threads, ..Default::default() });
+                assert!(u.iter().zip(&u1).all(|(a, b)| a.to_bits() == b.to_bits()), "source on axis {axis}, {threads} threads");
+                assert_eq!((s.iterations, s.updates), (s1.iterations, s1.updates));
+                let thin = s.thin_strip_iterations;
+                match axis {
+                    2 => assert_eq!(thin, [0, 0]),
+                    _ => {
+                        assert!(2 * thin[axis] > s.iterations, "axis {axis}: {thin:?} of {}", s.iterations);
+                        assert_eq!(thin[1 - axis], 0, "axis {axis}: {thin:?}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
