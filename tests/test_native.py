@@ -73,3 +73,26 @@ def test_a_failing_solve_leaves_the_directions_as_they_were_and_fortran_order_is
         band.solve(roles, *fixed, directions=np.asfortranarray(directions), **ok)
     with pytest.raises(ValueError, match="points must be a C-ordered"):
         band.interpolate(np.zeros(25), [0.0, 0.0], 0.25, np.asfortranarray(np.zeros((4, 2))))
+
+
+def test_the_analytic_band_s_gradient_norms_are_single_precision_and_bound_like_the_whole_band():
+    """|∇φ| comes back in float32 (4 bytes per node at the set-up's peak, not 8), and
+    ``surface._norm_bounds``, which works chunk by chunk, gives the range of the whole band: over
+    the nodes within half the band of the surface when there are any, over all of them when not."""
+    from tubesweep.surface import EVAL_CHUNK, _norm_bounds
+
+    n = 61
+    h = 2.0 / (n - 1)
+    linear, values, band, direction, norm = _native.analytic_level_set_band(
+        "sphere", [0.0, 0.0, 0.0, 0.5], [n, n, n], [-1.0, -1.0, -1.0], h, 4 * h, 1.0)
+    assert norm.dtype == np.float32 and direction.dtype == np.float32
+    assert len(norm) == len(linear) == len(values) == len(band) > 0
+    assert np.all(np.abs(norm - 1.0) < 0.05)
+    rng = np.random.default_rng(3)
+    k = 2 * EVAL_CHUNK + 123  # three chunks, the last one short
+    values = rng.uniform(-1.0, 1.0, k)
+    norm = rng.uniform(0.5, 1.5, k).astype(np.float32)
+    near = np.abs(values) <= 0.25
+    assert _norm_bounds(values, norm, 0.5) == (float(norm[near].min()), float(norm[near].max()), True)
+    far = np.where(np.abs(values) < 0.3, 0.3, values)  # no node within 0.25
+    assert _norm_bounds(far, norm, 0.5) == (float(norm.min()), float(norm.max()), False)

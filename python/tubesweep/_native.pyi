@@ -49,7 +49,7 @@ def analytic_level_set_band(
     half_width: float,
     lipschitz: float,
 ) -> Tuple[
-    npt.NDArray[np.uint64], npt.NDArray[np.float64], Optional["Band"], npt.NDArray[np.float32], npt.NDArray[np.float64]
+    npt.NDArray[np.uint64], npt.NDArray[np.float64], Optional["Band"], npt.NDArray[np.float32], npt.NDArray[np.float32]
 ]: ...
 def outward_directions_of_samples(
     phi: npt.NDArray[np.float64],

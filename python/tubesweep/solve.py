@@ -604,9 +604,12 @@ def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray
     is refused earlier, by the distance check, its tube reaching the centre). The inner tube of a surface that small has at most ``(2·inner + 3)^d`` nodes, so the
     closest points are computed only for a band that small: nothing is added to other solves."""
     h = grid.spacing
-    inner_nodes = np.flatnonzero(roles == ROLE_INNER)
-    if inner_nodes.size == 0 or inner_nodes.size > (2 * int(np.ceil(inner)) + 3) ** grid.ndim:
+    # counted before they are listed: the list of a large band's inner nodes (8 bytes per inner
+    # node) would raise the set-up's peak memory
+    n_inner = int(np.count_nonzero(roles == ROLE_INNER))
+    if n_inner == 0 or n_inner > (2 * int(np.ceil(inner)) + 3) ** grid.ndim:
         return
+    inner_nodes = np.flatnonzero(roles == ROLE_INNER)
     _, closest = surf.project(grid.node_points(linear[inner_nodes]), grid)
     closest = closest[np.all(np.isfinite(closest), axis=1)]
     if closest.size == 0:

@@ -255,11 +255,19 @@ def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width
 
 def _norm_bounds(values: np.ndarray, norm: np.ndarray, half_width: float) -> Tuple[float, float, bool]:
     """The range of |∇φ| (``norm``) over the band nodes within half the band of the surface
-    (``|φ| ≤ half_width/2``), and True; over all of them, and False, when there are none."""
-    near = np.abs(values) <= 0.5 * half_width
-    if np.any(near):
-        return float(norm[near].min()), float(norm[near].max()), True
-    return float(norm.min()), float(norm.max()), False
+    (``|φ| ≤ half_width/2``), and True; over all of them, and False, when there are none.
+    Chunk by chunk: a temporary of the band's size (8 bytes per node for ``|φ|``) would raise
+    the set-up's peak memory."""
+    lo, hi, lo_all, hi_all = np.inf, -np.inf, np.inf, -np.inf
+    for start in range(0, len(values), EVAL_CHUNK):
+        v, g = values[start : start + EVAL_CHUNK], norm[start : start + EVAL_CHUNK]
+        lo_all, hi_all = min(lo_all, float(g.min())), max(hi_all, float(g.max()))
+        near = g[np.abs(v) <= 0.5 * half_width]
+        if near.size:
+            lo, hi = min(lo, float(near.min())), max(hi, float(near.max()))
+    if lo <= hi:
+        return lo, hi, True
+    return lo_all, hi_all, False
 
 
 class LevelSet(Surface):

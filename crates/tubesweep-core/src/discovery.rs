@@ -267,21 +267,36 @@ pub fn discover_band<const D: usize>(
         }
         split_pair_blocks(shape, &parents)?
     };
-    // φ at the candidates and the filter, a slice at a time
-    let parts: Vec<(Vec<u64>, Vec<f64>)> = candidates
-        .par_chunks(EVAL_CHUNK / 8)
-        .map(|lin| {
+    // φ at the candidates and the filter, a slice at a time. Each slice's band nodes are kept at
+    // the start of its place in one pair of buffers of the candidates' size, then moved together:
+    // the buffers' pages past a slice's kept nodes are never touched (zeroed allocations), and
+    // each buffer is one allocation, returned whole. (A pair of vectors per slice, joined at the
+    // end, left the allocator holding their freed memory: about 15 bytes per band node at the
+    // set-up's peak at N = 2001; docs/architecture.md, "The narrow band".)
+    let slice = EVAL_CHUNK / 8;
+    let (mut linear, mut values) = (vec![0u64; candidates.len()], vec![0.0f64; candidates.len()]);
+    let kept: Vec<usize> = candidates
+        .par_chunks(slice)
+        .zip(linear.par_chunks_mut(slice).zip(values.par_chunks_mut(slice)))
+        .map(|(lin, (l, v))| {
             let points = node_points(shape, lin, lower, spacing)?;
             let mut value = vec![0.0; lin.len()];
             phi(&points, &mut value)?;
-            let (mut l, mut v) = (vec![0; lin.len()], vec![0.0; lin.len()]);
-            let kept = keep_within(lin, &value, half_width, &mut l, &mut v)?;
-            l.truncate(kept);
-            v.truncate(kept);
-            Ok((l, v))
+            keep_within(lin, &value, half_width, l, v)
         })
         .collect::<Result<_>>()?;
-    Ok(concat_band_parts(parts))
+    drop(candidates);
+    let mut end = 0;
+    for (i, &k) in kept.iter().enumerate() {
+        linear.copy_within(i * slice..i * slice + k, end);
+        values.copy_within(i * slice..i * slice + k, end);
+        end += k;
+    }
+    linear.truncate(end);
+    values.truncate(end);
+    linear.shrink_to_fit();
+    values.shrink_to_fit();
+    Ok((linear, values))
 }
 
 /// The band nodes' linear indices and values found in parts (slices of the grid or of the

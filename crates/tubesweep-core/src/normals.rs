@@ -319,7 +319,8 @@ pub fn rim_nodes_in_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::
 /// ([`rim_nodes_in_band`]), evaluating φ there and calling [`outward_directions_in_band`] (the
 /// callable route of the Python package), so the same bits, without the rim's lists, the
 /// prefix sums and a second pass over the band. `linear` are the band's sorted linear indices and
-/// `values` φ at its nodes; returns |∇φ| per node.
+/// `values` φ at its nodes; returns |∇φ| per node, in single precision (what the checks on it
+/// need, and 4 bytes per node less at the set-up's peak: docs/architecture.md, "The narrow band").
 pub fn outward_directions_of_function_in_band<const D: usize>(
     band: &NarrowBand<D>,
     linear: &[u64],
@@ -328,20 +329,22 @@ pub fn outward_directions_of_function_in_band<const D: usize>(
     spacing: f64,
     phi: &crate::discovery::PhiFn<'_>,
     direction: &mut [f32],
-) -> Result<Vec<f64>> {
+) -> Result<Vec<f32>> {
     let m = band.len();
     if linear.len() != m || values.len() != m || direction.len() != m * D {
         return Err(Error::invalid("band", format!("expected {m} linear indices, values and directions (×{D}) for the band's nodes")));
     }
     let (shape, sentinel) = (band.shape(), band.sentinel());
-    let mut norms = vec![0.0f64; m];
+    let mut norms_out = vec![0.0f32; m];
     direction
         .par_chunks_mut(CHUNK * D)
-        .zip(norms.par_chunks_mut(CHUNK))
+        .zip(norms_out.par_chunks_mut(CHUNK))
         .enumerate()
-        .try_for_each(|(j, (dir, norms))| -> Result<()> {
+        .try_for_each(|(j, (dir, norms_out))| -> Result<()> {
             let lo = j * CHUNK;
-            let n = norms.len();
+            let n = norms_out.len();
+            let mut norms = vec![0.0f64; n];
+            let norms = &mut norms[..];
             let coords = crate::discovery::node_points(shape, &linear[lo..lo + n], lower, spacing)?;
             // the chunk's off-band neighbours, node by node and group by group (axis k, side +1
             // then −1), and φ there
@@ -376,9 +379,10 @@ pub fn outward_directions_of_function_in_band<const D: usize>(
                 block.push(o, values[lo + o], D, neighbour_phi, two_h, dir, norms);
             }
             block.finish(D, two_h, dir, norms);
+            norms_out.iter_mut().zip(norms.iter()).for_each(|(o, &v)| *o = v as f32);
             Ok(())
         })?;
-    Ok(norms)
+    Ok(norms_out)
 }
 
 /// The arithmetic of [`outward_directions`] for nodes `range` of a band of `phi.len()` nodes in
@@ -617,6 +621,7 @@ mod tests {
         let na = outward_directions_in_band(&band, h, &values, 0..linear.len(), &rim_phi, &mut a).unwrap();
         let nb = outward_directions_of_function_in_band(&band, &linear, &values, lower, h, &phi, &mut b).unwrap();
         assert!(!rim_phi.is_empty());
+        let na: Vec<f32> = na.iter().map(|&v| v as f32).collect();
         assert_eq!((&na, &a), (&nb, &b));
         assert!(outward_directions_of_function_in_band(&band, &linear[1..], &values, lower, h, &phi, &mut b).is_err());
     }

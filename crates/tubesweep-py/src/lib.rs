@@ -1302,14 +1302,14 @@ fn project_to_sampled_level_set<'py>(
 
 /// The band, its structure and its outward directions, of a library surface whose φ is evaluated
 /// in Rust.
-type AnalyticBand<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>, Option<PyBand>, Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f64>>);
+type AnalyticBand<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>, Option<PyBand>, Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>);
 
 /// The band of a library surface with a Rust φ (`kind` "sphere", "torus", "ellipsoid", "star",
 /// "rounded-cube" or "double-torus", `parameters` as `tubesweep_core::analytic::AnalyticSurface::from_parameters` takes
 /// them), without calling back into Python: the coarse-to-fine search
 /// (`tubesweep_core::discovery::discover_band`), the band structure, φ at its rim and the
 /// outward directions, the same nodes and bits as the callable route. Returns (sorted linear
-/// indices, φ there, the band or None when empty, directions (K, d) float32, |∇φ| (K,)).
+/// indices, φ there, the band or None when empty, directions (K, d) float32, |∇φ| (K,) float32).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 fn analytic_level_set_band<'py>(
@@ -1327,7 +1327,7 @@ fn analytic_level_set_band<'py>(
     if surface.ndim() != shape.len() {
         return Err(PyValueError::new_err(format!("surface: a {kind} in {}D on a {}D grid", surface.ndim(), shape.len())));
     }
-    type Found = (Vec<u64>, Vec<f64>, Option<AnyBand>, Vec<f32>, Vec<f64>);
+    type Found = (Vec<u64>, Vec<f64>, Option<AnyBand>, Vec<f32>, Vec<f32>);
     #[allow(clippy::too_many_arguments)]
     fn run<const D: usize>(surface: &AnalyticSurface, shape: &[usize], lower: &[f64], spacing: f64, half_width: f64, lipschitz: f64, wrap: fn(NarrowBand<D>) -> AnyBand) -> PyResult<Found> {
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
