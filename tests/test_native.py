@@ -96,3 +96,7 @@ def test_the_analytic_band_s_gradient_norms_are_single_precision_and_bound_like_
     assert _norm_bounds(values, norm, 0.5) == (float(norm[near].min()), float(norm[near].max()), True)
     far = np.where(np.abs(values) < 0.3, 0.3, values)  # no node within 0.25
     assert _norm_bounds(far, norm, 0.5) == (float(norm.min()), float(norm.max()), False)
+    # a NaN is passed on, as the whole band's minimum would, and does not hide the near nodes
+    norm[k // 2] = np.nan
+    lo, hi, found = _norm_bounds(np.zeros(k), norm, 0.5)
+    assert np.isnan(lo) and np.isnan(hi) and found

@@ -258,14 +258,16 @@ def _norm_bounds(values: np.ndarray, norm: np.ndarray, half_width: float) -> Tup
     (``|φ| ≤ half_width/2``), and True; over all of them, and False, when there are none.
     Chunk by chunk: a temporary of the band's size (8 bytes per node for ``|φ|``) would raise
     the set-up's peak memory."""
-    lo, hi, lo_all, hi_all = np.inf, -np.inf, np.inf, -np.inf
+    lo, hi, lo_all, hi_all, any_near = np.inf, -np.inf, np.inf, -np.inf, False
     for start in range(0, len(values), EVAL_CHUNK):
         v, g = values[start : start + EVAL_CHUNK], norm[start : start + EVAL_CHUNK]
-        lo_all, hi_all = min(lo_all, float(g.min())), max(hi_all, float(g.max()))
+        # np.minimum and np.maximum pass a NaN on, as the minimum over the whole band would
+        lo_all, hi_all = float(np.minimum(lo_all, g.min())), float(np.maximum(hi_all, g.max()))
         near = g[np.abs(v) <= 0.5 * half_width]
         if near.size:
-            lo, hi = min(lo, float(near.min())), max(hi, float(near.max()))
-    if lo <= hi:
+            any_near = True
+            lo, hi = float(np.minimum(lo, near.min())), float(np.maximum(hi, near.max()))
+    if any_near:
         return lo, hi, True
     return lo_all, hi_all, False
 
@@ -428,8 +430,9 @@ class LevelSet(Surface):
                                                              direction[lo:hi])
             else:
                 norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
-            bounds.append(_norm_bounds(values[lo:hi], norm, half_width))
             norms[lo:hi] = norm
+            # bounded in single precision, as the library surfaces' band call returns |∇φ|
+            bounds.append(_norm_bounds(values[lo:hi], norms[lo:hi], half_width))
         near = [b for b in bounds if b[2]]
         lo_hi = (min(b[0] for b in near), max(b[1] for b in near)) if near else \
             (min(b[0] for b in bounds), max(b[1] for b in bounds))

@@ -1,9 +1,12 @@
 //! The load-balance bound of the parallel sweep on the sphere band: the total work of a sweep
 //! (band nodes) over the time the schedule needs with `threads` threads when a node costs one
-//! unit and synchronisation is free. Two schedules: the strip pipeline the solver runs (threads
-//! take strips in order, a tile waits for its upstream tile, see `schedule.rs`), simulated event
-//! by event; and, for comparison, waves separated by barriers with the tiles of a wave spread
-//! greedily, largest first. Deterministic: no timing.
+//! unit and synchronisation is free. Two schedules: the strip pipeline of the square tiles
+//! (`NarrowBand::schedule`; threads take strips in order, a tile waits for its upstream tile, see
+//! `schedule.rs`), simulated event by event; and, for comparison, waves separated by barriers
+//! with the tiles of a wave spread greedily, largest first. Deterministic: no timing. (The solver
+//! now also runs strips thin across the front, `NarrowBand::strip_schedule`, picked per
+//! iteration; the windowed mode below models tile shapes with strips along the first axis, which
+//! is what it picks for the `sphere` example's source on x.)
 //!   cargo run --release --example schedule_balance -- 101 201 401
 //!
 //! With `--windowed` (and the `kernel-stats` feature, whose row log it reads) the work is that

@@ -21,6 +21,7 @@
 use crate::error::{Error, Result};
 use crate::schedule::{SweepSchedule, LONG_SIDE, THIN_SIDE};
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// The band nodes and their neighbour table. `D` is the dimension (2 or 3).
 #[derive(Debug, Clone)]
@@ -36,8 +37,9 @@ pub struct NarrowBand<const D: usize> {
     along_row: Vec<u8>,
     schedule: SweepSchedule,
     /// 3D only: the parallel sweeps' schedules of rectangular tiles, strips thin along the first
-    /// leading axis (`[0]`) and along the second (`[1]`) (see [`crate::schedule`]).
-    strip_schedules: Vec<SweepSchedule>,
+    /// leading axis (`[0]`) and along the second (`[1]`) (see [`crate::schedule`]); built at the
+    /// first parallel solve, so that a band only ever swept on one thread does not hold them.
+    strip_schedules: OnceLock<[SweepSchedule; 2]>,
 }
 
 impl<const D: usize> NarrowBand<D> {
@@ -106,17 +108,10 @@ impl<const D: usize> NarrowBand<D> {
             lead: vec![len as u32; len * 2 * (D - 1)],
             along_row: vec![0; len],
             schedule: SweepSchedule::default(),
-            strip_schedules: Vec::new(),
+            strip_schedules: OnceLock::new(),
         };
         band.build_neighbours();
-        let leads: Vec<[usize; D]> = (0..band.n_rows()).map(|r| band.row_lead(r)).collect();
-        band.schedule = SweepSchedule::new(&leads, band.shape);
-        if D == 3 {
-            band.strip_schedules = [([THIN_SIDE, LONG_SIDE], 0), ([LONG_SIDE, THIN_SIDE], 1)]
-                .iter()
-                .map(|&(sides, strip_axis)| SweepSchedule::with_tile_sides(&leads, band.shape, sides, strip_axis))
-                .collect();
-        }
+        band.schedule = SweepSchedule::new(&band.row_leads(), band.shape);
         band
     }
 
@@ -218,11 +213,20 @@ impl<const D: usize> NarrowBand<D> {
         &self.schedule
     }
 
-    /// 3D: the parallel sweeps' schedule with strips thin along leading axis `axis` (0 or 1).
-    /// Panics on a 2D band, whose sweeps run sequentially.
-    #[inline]
+    /// 3D: the parallel sweeps' schedule with strips thin along leading axis `axis` (0 or 1),
+    /// built at the first call. Panics on a 2D band, whose sweeps run sequentially.
     pub fn strip_schedule(&self, axis: usize) -> &SweepSchedule {
-        &self.strip_schedules[axis]
+        assert!(D == 3, "only a 3D band has strips of tiles");
+        &self.strip_schedules.get_or_init(|| {
+            let leads = self.row_leads();
+            let build = |sides, strip_axis| SweepSchedule::with_tile_sides(&leads, self.shape, sides, strip_axis);
+            [build([THIN_SIDE, LONG_SIDE], 0), build([LONG_SIDE, THIN_SIDE], 1)]
+        })[axis]
+    }
+
+    /// The leading indices of every row.
+    fn row_leads(&self) -> Vec<[usize; D]> {
+        (0..self.n_rows()).map(|r| self.row_lead(r)).collect()
     }
 
     /// The first two grid indices of row `r`'s nodes (3D: the row's place in the plane of the
@@ -434,7 +438,7 @@ impl<const D: usize> NarrowBand<D> {
             + self.lead.len() * 4
             + self.along_row.len()
             + self.schedule.heap_bytes()
-            + self.strip_schedules.iter().map(|s| s.heap_bytes()).sum::<usize>()
+            + self.strip_schedules.get().map_or(0, |s| s.iter().map(SweepSchedule::heap_bytes).sum())
     }
 }
 
