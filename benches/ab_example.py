@@ -11,7 +11,8 @@ changes are worth. Two ways to pair the runs so that a drift of the machine hits
   threads each (the way to compare multi-threaded runs).
 
 Prints the medians and the median of the per-round ratios B/A (< 1: B faster) with its
-quartiles, and in how many rounds B was faster. Usage, with two builds of the example copied
+quartiles, and in how many rounds B was faster; then each side's mean, 90th percentile and the
+rounds above 1.3 times its median (the slow runs a median hides). Usage, with two builds of the example copied
 aside (``cargo build --release -p tubesweep-core --example sphere`` at each commit)::
 
     .venv/bin/python benches/ab_example.py /tmp/sphere_a /tmp/sphere_b --n 201 --rounds 30
@@ -102,6 +103,16 @@ def main() -> int:
           f"A median {1e3 * statistics.median(ta):.1f} ms, B median {1e3 * statistics.median(tb):.1f} ms")
     print(f"  B/A per round: median {statistics.median(ratios):.3f} (quartiles {ratios[q]:.3f}–{ratios[-1 - q]:.3f}), "
           f"B faster in {sum(r < 1 for r in ratios)} of {a.rounds}")
+
+    def tail(t: List[float]) -> str:
+        s = sorted(t)
+        slow = sum(x > 1.3 * statistics.median(s) for x in s)
+        return (f"mean {1e3 * statistics.mean(s):.1f} ms, 90th percentile {1e3 * s[int(0.9 * len(s))]:.1f} ms, "
+                f"{slow} of {len(s)} above 1.3 × its median")
+
+    # the slow runs a median hides (threads that start on one core, a slow spell)
+    print(f"  A: {tail(ta)}")
+    print(f"  B: {tail(tb)}")
     return 0
 
 

@@ -5,7 +5,9 @@
 //!   tolerance and the front window, `SolveOptions::front_window`; SOURCE_AXIS=1 or 2 puts the
 //!   source on the y or z axis instead of x, z being the axis of the rows; PLAIN=1 runs the
 //!   paper's sweeps to the letter: no active flags (`skip_inactive: false`), pointwise update,
-//!   the rim in every sweep; Python's `paper_sweeps=True` is the same but keeps the flags)
+//!   the rim in every sweep; Python's `paper_sweeps=True` is the same but keeps the flags;
+//!   SPREAD=0 leaves the pool's threads where the system starts them,
+//!   `SolveOptions::spread_threads`)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
 //!   (built with `--features kernel-stats` it also prints the sweeps' counters: where the
 //!   parallel sweeps wait, the rows and nodes they visit, how far the updates move the values;
@@ -47,6 +49,8 @@ fn main() {
         defer_outer_rim,
         front_window,
         skip_inactive: !plain,
+        // `SPREAD=0`: the pool's threads start where the system puts them
+        spread_threads: std::env::var("SPREAD").map_or(true, |v| v != "0"),
         ..Default::default()
     };
     let verbose = std::env::var_os("VERBOSE").is_some();

@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
 
+mod spread_threads;
 mod strip_pipeline;
 mod sweep_state;
 use strip_pipeline::{run_sweeps_in_one_broadcast, strip_worker};
@@ -186,6 +187,10 @@ pub struct SolveOptions {
     /// window there multiplied the iterations); on curves (2D bands, a few ms) it saved little on a
     /// circle and cost 1–3× the time on the six-fold star, whose front stalls at the arms.
     pub front_window: f64,
+    /// On Linux, with more than one thread: before the sweeps, move each of the pool's threads
+    /// once to a CPU of its own, then let it run anywhere again (`sweep/spread_threads.rs`):
+    /// fresh threads often start on one core. The same values either way.
+    pub spread_threads: bool,
 }
 
 impl Default for SolveOptions {
@@ -200,6 +205,7 @@ impl Default for SolveOptions {
             coupled: true,
             defer_outer_rim: true,
             front_window: DEFAULT_FRONT_WINDOW,
+            spread_threads: true,
         }
     }
 }
@@ -730,6 +736,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // only a 3D band has independent tiles (a 2D band's waves hold one tile each); one
         // thread runs the sequential sweep
         let parallel = !ctx.tiles_done.is_empty();
+        if parallel && options.spread_threads {
+            spread_threads::over_cpus(pool);
+        }
+
         let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
@@ -1844,3 +1854,4 @@ mod tests {
         assert_eq!(u.len(), band.len());
     }
 }
+
