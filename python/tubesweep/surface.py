@@ -421,7 +421,6 @@ class LevelSet(Surface):
         # the outward direction sgn(φ) ∇φ/|∇φ|, chunk by chunk (temporaries stay O(chunk))
         direction = np.empty((len(linear), grid.ndim), np.float32)
         norms = np.empty(len(linear), np.float32)
-        bounds: List[Tuple[float, float, bool]] = []
         for lo in range(0, len(linear), EVAL_CHUNK):
             hi = min(len(linear), lo + EVAL_CHUNK)
             if self._array is not None:
@@ -431,12 +430,8 @@ class LevelSet(Surface):
             else:
                 norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
             norms[lo:hi] = norm
-            # bounded in single precision, as the library surfaces' band call returns |∇φ|
-            bounds.append(_norm_bounds(values[lo:hi], norms[lo:hi], half_width))
-        near = [b for b in bounds if b[2]]
-        lo_hi = (min(b[0] for b in near), max(b[1] for b in near)) if near else \
-            (min(b[0] for b in bounds), max(b[1] for b in bounds))
-        self._check_distance_like(*lo_hi)
+        # bounded in single precision, as the library surfaces' band call returns |∇φ|
+        self._check_distance_like(*_norm_bounds(values, norms, half_width)[:2])
         # distance = |φ|, not stored
         kink = _kinks(norms, grid, linear, native_band)
         del norms

@@ -17,8 +17,8 @@ use crate::error::{Error, Result};
 use crate::extension::{extension_apply_upwind, extension_weights};
 use crate::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
 use crate::hamiltonian::InnerScheme;
-use crate::schedule::{SweepSchedule, TILE};
 use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
+use crate::schedule::{SweepSchedule, TILE};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -739,7 +739,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if parallel && options.spread_threads {
             spread_threads::over_cpus(pool);
         }
-
         let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
@@ -759,7 +758,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 // all 2^d sweeps of the iteration in one visit to the pool's threads, with a
                 // barrier between sweeps (waking the threads once per sweep costs more than a
                 // small sweep's work)
-                let acc = pool.install(|| {
+                let (acc, thin) = pool.install(|| {
                     // strips thin across the front of this iteration's work, or square tiles
                     // (decided here, on the pool's threads, which then stay awake for the sweeps)
                     let thin = self.thin_strip_axis(&ctx, lim);
@@ -770,7 +769,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     };
                     (run_sweeps_in_one_broadcast(n_orient, &ctx.sweep_id, &per_sweep), thin)
                 });
-                let (acc, thin) = acc;
                 if let Some(axis) = thin {
                     stats.thin_strip_iterations[axis] += 1;
                 }
@@ -841,6 +839,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .into_par_iter()
             .with_min_len(1024)
             .fold(empty, |mut slabs, r| {
+                // the rows `SweepContext::take_row` will let through
                 if ctx.row_dirty[r].load(Ordering::Relaxed) != 0 && ctx.row_low[r].load(Ordering::Relaxed) <= lim.window_key {
                     let (s, e) = self.band.row_range(r);
                     let ab = self.band.row_leading_indices(r);
