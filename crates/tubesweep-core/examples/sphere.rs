@@ -7,7 +7,8 @@
 //!   paper's sweeps to the letter: no active flags (`skip_inactive: false`), pointwise update,
 //!   the rim in every sweep; Python's `paper_sweeps=True` is the same but keeps the flags;
 //!   SPREAD=0 leaves the pool's threads where the system starts them,
-//!   `SolveOptions::spread_threads`)
+//!   `SolveOptions::spread_threads`; PREFETCH_ABOVE=bytes sets `SolveOptions::row_prefetch_above`,
+//!   0 prefetches the rows ahead in every iteration and "never" in none)
 //!   valgrind --tool=callgrind target/release/examples/sphere 61 godunov 1
 //!   (built with `--features kernel-stats` it also prints the sweeps' counters: where the
 //!   parallel sweeps wait, the rows and nodes they visit, how far the updates move the values;
@@ -51,6 +52,12 @@ fn main() {
         skip_inactive: !plain,
         // `SPREAD=0`: the pool's threads start where the system puts them
         spread_threads: std::env::var("SPREAD").map_or(true, |v| v != "0"),
+        // `PREFETCH_ABOVE=bytes`: `SolveOptions::row_prefetch_above` (0 always, "never" never)
+        row_prefetch_above: match std::env::var("PREFETCH_ABOVE") {
+            Ok(v) if v == "never" => usize::MAX,
+            Ok(v) if !v.is_empty() => v.parse().expect("PREFETCH_ABOVE: a number of bytes or \"never\""),
+            _ => tubesweep_core::sweep::default_row_prefetch_above(),
+        },
         ..Default::default()
     };
     let verbose = std::env::var_os("VERBOSE").is_some();
@@ -74,12 +81,13 @@ fn main() {
     antipode[source_axis] = (3 * (n - 1) / 4) as i64;
     let far = band.find(antipode).unwrap();
     println!(
-        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s u(antipode)={:.5} solve={solve_s:.3}s",
+        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s prefetched={} u(antipode)={:.5} solve={solve_s:.3}s",
         band.len(),
         st.iterations,
         st.updates,
         st.seconds,
         st.updates as f64 / st.seconds / 1e6,
+        st.prefetch_iterations,
         u[far]
     );
     let exact = std::f64::consts::PI / 4.0;

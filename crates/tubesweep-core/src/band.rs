@@ -179,19 +179,18 @@ impl<const D: usize> NarrowBand<D> {
     /// as in a breadth-first search.
     #[inline(always)]
     pub fn prefetch_neighbours(&self, n: usize) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            if let (Some(lead), Some(row)) = (self.lead.get(n * 2 * (D - 1)), self.along_row.get(n)) {
-                // SAFETY: prefetching is a hint with no effect on memory; both pointers are valid
-                unsafe {
-                    _mm_prefetch::<_MM_HINT_T0>((lead as *const u32).cast());
-                    _mm_prefetch::<_MM_HINT_T0>((row as *const u8).cast());
-                }
-            }
+        if let (Some(lead), Some(row)) = (self.lead.get(n * 2 * (D - 1)), self.along_row.get(n)) {
+            crate::prefetch::prefetch(lead);
+            crate::prefetch::prefetch(row);
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = n;
+    }
+
+    /// The same hint for the neighbour-table entries of the nodes `start..end` (a row's, in the
+    /// sweeps: [`crate::sweep`]'s row prefetch).
+    #[inline(always)]
+    pub fn prefetch_neighbour_range(&self, start: usize, end: usize) {
+        crate::prefetch::prefetch_range(&self.lead, start * 2 * (D - 1), end * 2 * (D - 1));
+        crate::prefetch::prefetch_range(&self.along_row, start, end);
     }
 
     /// Node range `[start, end)` of row `r`.

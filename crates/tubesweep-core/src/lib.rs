@@ -50,6 +50,7 @@ pub mod mesh_band;
 pub mod mobius;
 pub mod nearest_source;
 pub mod open_surfaces;
+mod prefetch;
 pub mod normals;
 pub mod redistance;
 pub mod rim;

@@ -135,18 +135,6 @@ unsafe impl Sync for SharedValues {}
 /// How many root nodes ahead their weights and neighbour entries are prefetched.
 const PREFETCH_AHEAD: usize = 16;
 
-/// Asks the processor to fetch `x` into cache (a hint; nothing on other architectures).
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: prefetching is a hint with no effect on memory; the pointer is valid
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((x as *const T).cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
-
 /// Sets the rim's values (`rim` from [`outer_rim`]) from the rest of the band, which must hold
 /// its converged values; `u` has the band's length plus the sentinel slot (the numerical
 /// infinity), and the rim nodes hold the numerical infinity on entry.
@@ -222,7 +210,7 @@ pub fn extend_into_rim<const D: usize>(
             let (mut updates, mut first_change) = (0u64, 0.0f64);
             for (j, &root) in chunk.iter().enumerate() {
                 if let Some(&ahead) = chunk.get(j + PREFETCH_AHEAD) {
-                    prefetch(&weights[ahead as usize]);
+                    crate::prefetch::prefetch(&weights[ahead as usize]);
                     band.prefetch_neighbours(ahead as usize);
                 }
                 stack.push(root);

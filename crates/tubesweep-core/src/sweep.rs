@@ -23,10 +23,12 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
 
+mod row_prefetch;
 mod spread_threads;
 mod strip_pipeline;
 mod sweep_state;
 use strip_pipeline::{run_sweeps_in_one_broadcast, strip_worker};
+pub use row_prefetch::{default_row_prefetch_above, last_level_cache_bytes, DEFAULT_CACHE_SHARE};
 use sweep_state::{order_key, Accumulator, Limits, SharedValues, SweepContext, KEEP_ROW, REFUSED, WAKE_ROWS};
 
 /// What the sweep does at a node.
@@ -191,6 +193,14 @@ pub struct SolveOptions {
     /// once to a CPU of its own, then let it run anywhere again (`sweep/spread_threads.rs`):
     /// fresh threads often start on one core. The same values either way.
     pub spread_threads: bool,
+    /// The sweeps prefetch the data of the rows a few places ahead in their order when the rows
+    /// the previous iteration visited held more than this many bytes of the arrays the kernel
+    /// reads (the first iteration counts every row, or none with the front window): with the
+    /// band's data beyond the last-level cache the tiles' short runs through memory would wait
+    /// on it; within, the hints only cost instructions (`sweep/row_prefetch.rs`). Default
+    /// [`default_row_prefetch_above`], a share of the last-level cache; 0 prefetches always,
+    /// `usize::MAX` never. The same values either way.
+    pub row_prefetch_above: usize,
 }
 
 impl Default for SolveOptions {
@@ -206,6 +216,7 @@ impl Default for SolveOptions {
             defer_outer_rim: true,
             front_window: DEFAULT_FRONT_WINDOW,
             spread_threads: true,
+            row_prefetch_above: default_row_prefetch_above(),
         }
     }
 }
@@ -252,6 +263,9 @@ pub struct SolveStats {
     /// first and the second leading axis (`SweepProblem::thin_strip_axis`); the others ran
     /// square tiles. The values are the same bits either way.
     pub thin_strip_iterations: [usize; 2],
+    /// Iterations whose sweeps prefetched the rows ahead ([`SolveOptions::row_prefetch_above`]).
+    /// The values are the same bits either way.
+    pub prefetch_iterations: usize,
 }
 
 /// Reported to the progress callback after every iteration.
@@ -739,6 +753,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if parallel && options.spread_threads {
             spread_threads::over_cpus(pool);
         }
+        // the rows the first iteration visits: every row, or with the window the few near the
+        // sources (then the next iterations decide from what the sweeps visited)
+        let mut visited_per_sweep = if windowed { 0 } else { n as u64 };
         let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
@@ -749,11 +766,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 window_key: order_key(window),
                 settled: options.tol,
                 refused: REFUSED + (stats.iterations % 250) as u8,
+                prefetch_ahead: self.row_prefetch_ahead(&ctx, visited_per_sweep, options.row_prefetch_above),
             };
             let mut max_change = 0.0f64;
             let mut front = f64::INFINITY;
             let mut waiting = f64::INFINITY;
             let mut updates = 0u64;
+            let mut visited = 0u64;
             if parallel {
                 // all 2^d sweeps of the iteration in one visit to the pool's threads, with a
                 // barrier between sweeps (waking the threads once per sweep costs more than a
@@ -776,6 +795,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 front = acc.front;
                 waiting = acc.waiting;
                 updates = acc.updates;
+                visited = acc.visited;
                 stats.sweeps += n_orient;
             } else {
                 for s in 0..n_orient {
@@ -786,11 +806,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     front = front.min(acc.front);
                     waiting = waiting.min(acc.waiting);
                     updates += acc.updates;
+                    visited += acc.visited;
                     stats.sweeps += 1;
                 }
             }
             if all_active {
                 updates = updated_per_sweep * n_orient as u64;
+            }
+            visited_per_sweep = visited / n_orient as u64;
+            if lim.prefetch_ahead > 0 {
+                stats.prefetch_iterations += 1;
             }
             stats.iterations += 1;
             stats.updates += updates;
@@ -915,7 +940,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         lim: Limits,
     ) -> Accumulator {
         let mut acc = Accumulator::default();
-        for &r in rows {
+        for (t, &r) in rows.iter().enumerate() {
+            if lim.prefetch_ahead > 0 {
+                if let Some(&ahead) = rows.get(t + lim.prefetch_ahead) {
+                    self.prefetch_row::<K, W>(ctx, ahead as usize, lim);
+                }
+            }
             self.run_row::<S, P, W, K>(ctx, r as usize, backwards, lim, &mut acc);
         }
         acc
@@ -969,6 +999,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     #[inline(always)]
     fn run_claimed_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
         let (s, e) = self.band.row_range(r);
+        acc.visited += (e - s) as u64;
         let mut low = f64::INFINITY;
         let mut marks = 0u8;
         if backwards {
@@ -1333,6 +1364,51 @@ mod tests {
             assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
         }
         a
+    }
+
+    #[test]
+    fn prefetching_the_rows_ahead_gives_the_same_bits_and_follows_the_visited_bytes() {
+        let (band, roles, dirs, h) = sphere_band(41);
+        let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
+        // plain sweeps, the flags without and with the front window, Lax–Friedrichs; 1 and 2
+        // threads; the rows fetched ahead in every iteration or in none
+        let cases = [
+            (InnerScheme::Godunov, false, 0.0),
+            (InnerScheme::Godunov, true, 0.0),
+            (InnerScheme::Godunov, true, DEFAULT_FRONT_WINDOW),
+            (InnerScheme::LaxFriedrichs, true, 0.0),
+        ];
+        for (scheme, skip_inactive, front_window) in cases {
+            let p = sphere_problem(&band, &roles, &dirs, h, scheme);
+            for threads in [1, 2] {
+                let run = |above: usize| {
+                    let opts = SolveOptions { threads, skip_inactive, front_window, row_prefetch_above: above, ..Default::default() };
+                    let mut u = vec![0.0; band.len()];
+                    let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+                    assert!(st.converged);
+                    (u, st)
+                };
+                let (a, sa) = run(usize::MAX);
+                let (b, sb) = run(0);
+                assert_eq!(sa.prefetch_iterations, 0);
+                // every iteration of sweeps but the rim's pass (counted as one more) and, with
+                // the window, the first (which counts no visited rows before it)
+                assert!(sb.prefetch_iterations + 2 >= sb.iterations && sb.prefetch_iterations < sb.iterations, "{sb:?}");
+                assert_eq!((sa.iterations, sa.updates), (sb.iterations, sb.updates));
+                assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{skip_inactive} {front_window} {threads}");
+            }
+        }
+        // the plain sweeps visit every row in every sweep: they prefetch in every iteration when
+        // the band's swept bytes exceed the bound, in none when they do not
+        let probe = SolveOptions { threads: 1, skip_inactive: false, coupled: false, front_window: 0.0, ..Default::default() };
+        // per node: value, role, neighbour table (two u32 per leading axis and a byte), weights
+        let swept = band.len() * (8 + 1 + (8 * 2 + 1) + 4 * 3);
+        for (above, expect_all) in [(swept - 1, true), (swept, false)] {
+            let mut u = vec![0.0; band.len()];
+            let st = p.solve(&mut u, &SolveOptions { row_prefetch_above: above, ..probe }, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged && st.iterations > 2);
+            assert_eq!(st.prefetch_iterations, if expect_all { st.iterations - 1 } else { 0 }, "bound {above} of {swept}: {st:?}");
+        }
     }
 
     #[test]

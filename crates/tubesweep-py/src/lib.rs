@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
 use tubesweep_core::interpolate::interpolate;
 use tubesweep_core::nearest_source::nearest_source_labels;
-use tubesweep_core::sweep::{extension_weights_in_place, Extension, MissingNeighbour, Slowness};
+use tubesweep_core::sweep::{default_row_prefetch_above, extension_weights_in_place, Extension, MissingNeighbour, Slowness};
 use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
 use tubesweep_core::{Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
 
@@ -680,7 +680,7 @@ impl PyBand {
         if !(front_window >= 0.0 && front_window.is_finite()) {
             return Err(PyValueError::new_err("front_window must be a non-negative finite number (0 switches the window off)"));
         }
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim, front_window, spread_threads: true };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim, front_window, spread_threads: true, row_prefetch_above: default_row_prefetch_above() };
         let roles = roles.as_slice()?;
         let fixed = FixedNodes { positions: fixed_positions.as_slice()?, values: fixed_values.as_slice()? };
         match &self.band {
@@ -724,7 +724,7 @@ impl PyBand {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
         // the coupled update is Godunov's; the general Hamiltonians use Lax–Friedrichs
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false, defer_outer_rim, front_window: 0.0, spread_threads: true };
+        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false, defer_outer_rim, front_window: 0.0, spread_threads: true, row_prefetch_above: default_row_prefetch_above() };
         let inputs = GeneralInputs {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,

@@ -154,11 +154,14 @@ pub(super) struct Accumulator {
     /// A lower bound of the values of the active nodes left beyond the front window (infinite
     /// when none were): where the window goes next when nothing in it moved.
     pub(super) waiting: f64,
+    /// The nodes of the rows that ran (all nodes of every row without the flags): what the
+    /// sweep read, for the next iteration's [`Limits::prefetch_ahead`].
+    pub(super) visited: u64,
 }
 
 impl Default for Accumulator {
     fn default() -> Self {
-        Accumulator { max_change: 0.0, updates: 0, front: f64::INFINITY, waiting: f64::INFINITY }
+        Accumulator { max_change: 0.0, updates: 0, front: f64::INFINITY, waiting: f64::INFINITY, visited: 0 }
     }
 }
 
@@ -169,6 +172,7 @@ impl Accumulator {
             updates: self.updates + o.updates,
             front: self.front.min(o.front),
             waiting: self.waiting.min(o.waiting),
+            visited: self.visited + o.visited,
         }
     }
 }
@@ -192,6 +196,9 @@ pub(super) struct Limits {
     pub(super) refused: u8,
     /// A change larger than this (the tolerance) counts towards [`Accumulator::front`].
     pub(super) settled: f64,
+    /// How many rows ahead in the visiting order the sweeps prefetch the rows' data; 0 for none
+    /// (see `row_prefetch.rs`).
+    pub(super) prefetch_ahead: usize,
 }
 
 /// The node values, shared by the threads of a parallel sweep. The schedule guarantees that the
@@ -210,6 +217,11 @@ impl SharedValues {
     pub(super) fn get(&self, i: usize) -> f64 {
         debug_assert!(i < self.len);
         unsafe { *self.ptr.add(i) }
+    }
+    /// Prefetch hint for the values `start..end` ([`crate::prefetch`]).
+    #[inline(always)]
+    pub(super) fn prefetch(&self, start: usize, end: usize) {
+        crate::prefetch::prefetch_raw_range(self.ptr as *const f64, self.len, start, end);
     }
     #[inline(always)]
     pub(super) fn set(&self, i: usize, v: f64) {
