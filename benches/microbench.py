@@ -18,7 +18,15 @@ fewer local updates; "× paper" is the paper sweeps' time over the default's at 
 count (> 1: the default is faster). The default's updates are fewer and dearer (the cheap ones are
 the ones it skips), so its updates per second are lower while its time is shorter: compare times.
 
-    .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3]
+Then a second table times the kernel alone: the Rust ``sphere`` example (built here with cargo)
+with ``PLAIN=1``, the paper's sweeps to the letter without the active flags (every node but the
+fixed ones updated in every sweep), Godunov, at ``--kernel-sizes`` on 1 thread and on all cores,
+interleaved the same way. Its rate counts no skipped node, so it is the kernel's rate per update;
+the "prefetched" column says in how many iterations the sweeps fetched the rows ahead
+(``SolveOptions::row_prefetch_above``: when the visited rows' data exceed a share of the
+last-level cache).
+
+    .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3] [--kernel-sizes 101,201,401]
 """
 
 from __future__ import annotations
@@ -26,6 +34,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -101,12 +110,69 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
     return rows
 
 
+SPHERE_EXAMPLE = REPO / "target" / "release" / "examples" / "sphere"
+_EXAMPLE_LINE = re.compile(r"band=(\d+) .*iterations=(\d+) updates=(\d+) sweeps=([0-9.]+)s .*prefetched=(\d+)")
+
+
+def build_sphere_example() -> Path:
+    """Builds the Rust ``sphere`` example (cargo's incremental build: seconds when up to date)."""
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "sphere"], cwd=str(REPO), check=True)
+    return SPHERE_EXAMPLE
+
+
+def kernel_once(example: Path, n: int, threads: int) -> Dict[str, Any]:
+    """One run of the example's flag-free sweeps (``PLAIN=1``: every node but the fixed ones
+    updated in every sweep, pointwise, the rim in every sweep): the kernel's own rate."""
+    env = dict(os.environ, PLAIN="1")
+    cp = subprocess.run([str(example), str(n), "godunov", str(threads)], capture_output=True, text=True, env=env, check=True)
+    m = _EXAMPLE_LINE.search(cp.stdout)
+    if m is None:
+        raise RuntimeError(f"unexpected output of {example}: {cp.stdout[-500:]}")
+    band, iters, updates, secs, prefetched = m.groups()
+    return dict(n=n, threads=threads, band_points=int(band), iterations=int(iters), updates=int(updates),
+                seconds=float(secs), prefetch_iterations=int(prefetched))
+
+
+def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads: Optional[Sequence[int]] = None,
+               example: Optional[Path] = None) -> List[Dict[str, Any]]:
+    """The 3D Godunov kernel alone: the Rust ``sphere`` example's flag-free sweeps, one run of
+    every (size, thread count) per round, ``repeats`` rounds; time = the native solve (no Python,
+    no band construction), the speed-up a median of per-round ratios."""
+    cores = os.cpu_count() or 1
+    tlist = sorted(set(threads or (1, cores)))
+    example = example or build_sphere_example()
+    print(f"the kernel alone: Rust sphere example, PLAIN=1 (every node in every sweep), Godunov, "
+          f"{repeats} interleaved rounds (medians); {cores} cores")
+    print(f"{'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} {'Mupd/s':>8} "
+          f"{'Mupd/s/core':>11} {'speed-up':>8} {'prefetched':>10}")
+    rows = []
+    for n in sizes:
+        runs: Dict[int, List[Dict[str, Any]]] = {t: [] for t in tlist}
+        for _ in range(repeats):
+            for t in tlist:
+                runs[t].append(kernel_once(example, n, t))
+        secs = {t: [r["seconds"] for r in runs[t]] for t in tlist}
+        for t in tlist:
+            r = dict(runs[t][0])
+            r["sweep_s"] = statistics.median(secs[t])
+            r["updates_per_s"] = r["updates"] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
+            r["per_core"] = r["updates_per_s"] / t
+            r["speedup"] = statistics.median(a / b for a, b in zip(secs[tlist[0]], secs[t]))
+            rows.append(r)
+            print(f"{n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
+                  f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
+                  f"{r['speedup']:8.2f} {r['prefetch_iterations']:>4d} of {r['iterations']:<3d}", flush=True)
+    return rows
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(description="updates per second per core of the sweep kernel, via ts.solve")
     ap.add_argument("--sizes", default="101,201", help="grid sizes N, comma-separated (default 101,201)")
     ap.add_argument("--schemes", default="godunov,lxf")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", help="thread counts to compare (default: 1 and all cores)")
+    ap.add_argument("--kernel-sizes", default="101,201,401",
+                    help="grid sizes of the kernel-alone table (the Rust example's flag-free sweeps); '' skips it")
     ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.child:
@@ -114,6 +180,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 0
     th = [int(x) for x in a.threads.split(",")] if a.threads else None
     run([int(x) for x in a.sizes.split(",")], a.schemes.split(","), a.repeats, th)
+    if a.kernel_sizes.strip():
+        print()
+        run_kernel([int(x) for x in a.kernel_sizes.split(",")], a.repeats, th)
     return 0
 
 

@@ -261,6 +261,23 @@ def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_th
     assert by[("default", 2)]["vs_paper"] > 0
 
 
+def test_microbench_times_the_flag_free_kernel_with_the_same_work_on_every_thread_count():
+    import microbench
+
+    rows = microbench.run_kernel(sizes=(31,), repeats=2, threads=(1, 2))
+    assert [(r["n"], r["threads"]) for r in rows] == [(31, 1), (31, 2)]
+    r1, r2 = rows
+    assert (r1["iterations"], r1["updates"], r1["band_points"]) == (r2["iterations"], r2["updates"], r2["band_points"])
+    # every node but the fixed ones (and layer nodes without an upwind neighbour) in every one of
+    # the 8 sweeps of every iteration (the example's plain sweeps keep the rim in every sweep)
+    per_sweep, rest = divmod(r1["updates"], 8 * r1["iterations"])
+    assert rest == 0 and 0.9 * r1["band_points"] < per_sweep < r1["band_points"]
+    for r in rows:
+        assert r["per_core"] == pytest.approx(r["updates"] / r["sweep_s"] / r["threads"])
+        assert 0 <= r["prefetch_iterations"] <= r["iterations"]
+    assert r2["speedup"] > 0 and math.isfinite(r2["speedup"])
+
+
 def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):
     """benches/front_window_surfaces.py at a small size: every surface prints a row, the two
     solutions agree to far below the tolerance's scale, and the window is left at its default."""

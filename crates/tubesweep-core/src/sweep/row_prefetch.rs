@@ -25,7 +25,7 @@ use std::sync::OnceLock;
 pub(super) const ROW_PREFETCH_AHEAD: usize = 2;
 
 /// The share of the last-level cache above which the sweeps prefetch (see the module doc).
-pub const DEFAULT_CACHE_SHARE: f64 = 0.4;
+pub const DEFAULT_CACHE_SHARE: f64 = 0.5;
 
 /// The last-level cache assumed where the system does not say (Linux's sysfs): 32 MiB.
 const ASSUMED_LAST_LEVEL_CACHE: usize = 32 << 20;
