@@ -175,6 +175,8 @@ def travel_time(
         iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
         last_change=st["last_change"], seconds=st["seconds"], band_points=grid.size, inner_points=grid.size - len(lin),
         outer_points=0, fixed_points=len(lin), setup_seconds=setup, band_bytes=band.nbytes + grid.size * 10 + 8 * band.n_rows,  # values, role, active flag; per row a lower bound
+        thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
+        prefetch_iterations=int(st["prefetch_iterations"]),
     )
     return u, stats
 

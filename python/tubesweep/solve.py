@@ -816,6 +816,8 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
         window_edge=st["window_edge"], facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
+        thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
+        prefetch_iterations=int(st["prefetch_iterations"]),
     )
     return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
                     tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, asdict
-from typing import Any, Dict
+from typing import Any, Dict, Tuple
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,15 @@ class SolveStats:
     narrowest_gap : float
         The narrowest such gap found, ``|cp(a) − cp(b)|`` over those pairs (``inf`` when there is
         none); the true gap can be narrower. Gaps under about one grid spacing are not found.
+    thin_strip_iterations : tuple of two ints
+        Parallel iterations (3D, more than one thread) whose sweeps ran strips thin across the
+        first and across the second leading axis of the grid, where the iteration's work crossed
+        that axis; the others ran square tiles (docs/architecture.md, "Strips thin across the
+        front"). ``(0, 0)`` on one thread and in 2D. The values do not depend on it.
+    prefetch_iterations : int
+        Iterations whose sweeps fetched the rows' data ahead into the cache, because the rows the
+        previous iteration visited held more data than half the last-level cache
+        (docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
     """
 
     iterations: int
@@ -66,6 +75,8 @@ class SolveStats:
     window_edge: float = float("inf")
     facing_pairs: int = 0
     narrowest_gap: float = float("inf")
+    thin_strip_iterations: Tuple[int, int] = (0, 0)
+    prefetch_iterations: int = 0
 
     @property
     def updates_per_second(self) -> float:

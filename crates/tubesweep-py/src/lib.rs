@@ -57,6 +57,8 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     d.set_item("seconds", s.seconds)?;
     d.set_item("infinity", s.infinity)?;
     d.set_item("window_edge", s.window_edge)?;
+    d.set_item("thin_strip_iterations", (s.thin_strip_iterations[0], s.thin_strip_iterations[1]))?;
+    d.set_item("prefetch_iterations", s.prefetch_iterations)?;
     Ok(d)
 }
 
