@@ -397,11 +397,17 @@ def test_stats_say_how_the_sweeps_ran_without_changing_the_values():
     assert two.stats.thin_strip_iterations[0] > 0 and two.stats.thin_strip_iterations[1] == 0
     assert sum(two.stats.thin_strip_iterations) < two.stats.iterations
     assert np.array_equal(one.values, two.values, equal_nan=True)
+    # the rows are fetched ahead only where the iterations' rows outgrow half the last-level
+    # cache: not the 41 k nodes here (about 40 bytes each of the arrays the sweeps read) on
+    # caches of 4 MB and more
+    from tubesweep import _native
+
+    small = one.stats.band_points * 48 < _native.last_level_cache_bytes() / 2
     for s in (one.stats, two.stats):
-        # a band of 41 k nodes (1.6 MB of the arrays the sweeps read) stays below half of any
-        # last-level cache this runs on
-        assert s.prefetch_iterations == 0
-        assert s.as_dict()["prefetch_iterations"] == 0
+        assert 0 <= s.prefetch_iterations <= s.iterations
+        if small:
+            assert s.prefetch_iterations == 0
+        assert s.as_dict()["prefetch_iterations"] == s.prefetch_iterations
     # 2D: no tiles to share
     disc = ts.solve(Circle(0.5), ts.Grid((-1, -1), (1, 1), (101, 101)), [(-0.5, 0)], threads=2)
     assert disc.stats.thin_strip_iterations == (0, 0) and disc.stats.prefetch_iterations == 0

@@ -55,9 +55,10 @@ class SolveStats:
         that axis; the others ran square tiles (docs/architecture.md, "Strips thin across the
         front"). ``(0, 0)`` on one thread and in 2D. The values do not depend on it.
     prefetch_iterations : int
-        Iterations whose sweeps fetched the rows' data ahead into the cache, because the rows the
-        previous iteration visited held more data than half the last-level cache
-        (docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
+        Iterations whose sweeps fetched the rows' data ahead into the cache (x86-64): those after
+        an iteration whose visited rows held more data than half the last-level cache (before
+        the first, every row counts as visited, or none with the front window;
+        docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
     """
 
     iterations: int

@@ -5,7 +5,8 @@
 //!   tolerance and the front window, `SolveOptions::front_window`; SOURCE_AXIS=1 or 2 puts the
 //!   source on the y or z axis instead of x, z being the axis of the rows; PLAIN=1 runs the
 //!   paper's sweeps to the letter: no active flags (`skip_inactive: false`), pointwise update,
-//!   the rim in every sweep; Python's `paper_sweeps=True` is the same but keeps the flags;
+//!   the rim in every sweep; Python's `paper_sweeps=True` is the same but keeps the flags, and
+//!   PAPER=1 runs that (pointwise, the rim in every sweep, no window, the flags kept);
 //!   SPREAD=0 leaves the pool's threads where the system starts them,
 //!   `SolveOptions::spread_threads`; PREFETCH_ABOVE=bytes sets `SolveOptions::row_prefetch_above`,
 //!   0 prefetches the rows ahead in every iteration and "never" in none)
@@ -30,8 +31,10 @@ fn main() {
     };
     let threads: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
     let plain = std::env::var_os("PLAIN").is_some();
-    let coupled = !plain && args.get(4).map_or(true, |s| s != "pointwise");
-    let defer_outer_rim = !plain && std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
+    // Python's `paper_sweeps=True`: the paper's sweeps with the active flags kept
+    let paper = std::env::var_os("PAPER").is_some();
+    let coupled = !plain && !paper && args.get(4).map_or(true, |s| s != "pointwise");
+    let defer_outer_rim = !plain && !paper && std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
     let source_axis = sphere_source::source_axis_from_env();
     let (band, roles, dirs, h, build) = sphere_source::sphere_with_source(n, source_axis);
     let p = sphere_source::sphere_problem(&band, &roles, &dirs, h, scheme);
@@ -41,7 +44,7 @@ fn main() {
     let front_window: f64 =
         std::env::var("WINDOW").ok().and_then(|s| s.parse().ok()).unwrap_or(tubesweep_core::sweep::DEFAULT_FRONT_WINDOW);
     // the front window runs only with the active flags
-    let front_window = if plain { 0.0 } else { front_window };
+    let front_window = if plain || paper { 0.0 } else { front_window };
     let opts = SolveOptions {
         threads,
         activation_threshold: thr,

@@ -185,6 +185,12 @@ impl<const D: usize> NarrowBand<D> {
         }
     }
 
+    /// The bytes of the neighbour table per node: two `u32` per leading axis and a byte of
+    /// presence bits along the rows.
+    pub const fn neighbour_table_bytes_per_node(&self) -> usize {
+        2 * (D - 1) * std::mem::size_of::<u32>() + std::mem::size_of::<u8>()
+    }
+
     /// The same hint for the neighbour-table entries of the nodes `start..end` (a row's, in the
     /// sweeps: [`crate::sweep`]'s row prefetch).
     #[inline(always)]

@@ -34,6 +34,7 @@
 
 pub mod analytic;
 pub mod band;
+pub mod cache_size;
 pub mod discovery;
 pub mod error;
 pub mod extension;

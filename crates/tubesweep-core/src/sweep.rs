@@ -28,7 +28,7 @@ mod spread_threads;
 mod strip_pipeline;
 mod sweep_state;
 use strip_pipeline::{run_sweeps_in_one_broadcast, strip_worker};
-pub use row_prefetch::{default_row_prefetch_above, last_level_cache_bytes, DEFAULT_CACHE_SHARE};
+pub use row_prefetch::{default_row_prefetch_above, DEFAULT_CACHE_SHARE};
 use sweep_state::{order_key, Accumulator, Limits, SharedValues, SweepContext, KEEP_ROW, REFUSED, WAKE_ROWS};
 
 /// What the sweep does at a node.
@@ -195,11 +195,13 @@ pub struct SolveOptions {
     pub spread_threads: bool,
     /// The sweeps prefetch the data of the rows a few places ahead in their order when the rows
     /// the previous iteration visited held more than this many bytes of the arrays the kernel
-    /// reads (the first iteration counts every row, or none with the front window): with the
-    /// band's data beyond the last-level cache the tiles' short runs through memory would wait
-    /// on it; within, the hints only cost instructions (`sweep/row_prefetch.rs`). Default
-    /// [`default_row_prefetch_above`], a share of the last-level cache; 0 prefetches always,
-    /// `usize::MAX` never. The same values either way.
+    /// reads (before the first iteration every row counts as visited, or none with the front
+    /// window): with the band's data beyond the last-level cache the tiles' short runs through
+    /// memory would wait on it; within, the hints only cost instructions
+    /// (`sweep/row_prefetch.rs`). Default [`default_row_prefetch_above`], a share of the
+    /// last-level cache; 0 prefetches in every iteration that follows one that visited a row
+    /// (and in the first unless the window is on), `usize::MAX` never; x86-64 only. The same
+    /// values either way.
     pub row_prefetch_above: usize,
 }
 
@@ -1398,17 +1400,52 @@ mod tests {
                 assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{skip_inactive} {front_window} {threads}");
             }
         }
-        // the plain sweeps visit every row in every sweep: they prefetch in every iteration when
-        // the band's swept bytes exceed the bound, in none when they do not
-        let probe = SolveOptions { threads: 1, skip_inactive: false, coupled: false, front_window: 0.0, ..Default::default() };
-        // per node: value, role, neighbour table (two u32 per leading axis and a byte), weights
-        let swept = band.len() * (8 + 1 + (8 * 2 + 1) + 4 * 3);
-        for (above, expect_all) in [(swept - 1, true), (swept, false)] {
-            let mut u = vec![0.0; band.len()];
-            let st = p.solve(&mut u, &SolveOptions { row_prefetch_above: above, ..probe }, &mut |_| Control::Continue).unwrap();
-            assert!(st.converged && st.iterations > 2);
-            assert_eq!(st.prefetch_iterations, if expect_all { st.iterations - 1 } else { 0 }, "bound {above} of {swept}: {st:?}");
+        // The bound against the rows visited: per node the value, role and neighbour table, the
+        // upwind weights, and where the solve has them the active flag, the coupling mask and a
+        // per-node slowness.
+        use std::mem::size_of;
+        let bytes = |flags: bool, coupled: bool, per_node: bool| {
+            size_of::<f64>()
+                + size_of::<NodeRole>()
+                + 2 * 2 * size_of::<u32>()
+                + size_of::<u8>()
+                + size_of::<[f32; 3]>()
+                + usize::from(flags) * size_of::<AtomicU8>()
+                + usize::from(coupled) * size_of::<u8>()
+                + usize::from(per_node) * size_of::<f64>()
+        };
+        assert_eq!(bytes(false, false, false), 38);
+        let ones = vec![1.0; band.len()];
+        let per_node = SweepProblem { slowness: Slowness::PerNode(&ones), ..sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov) };
+        let n = band.len();
+        let count = |p: &SweepProblem<'_, 3>, opts: SolveOptions| {
+            let mut u = vec![0.0; n];
+            let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+            assert!(st.converged && st.iterations > 3);
+            (st.prefetch_iterations, st.iterations)
+        };
+        let base = SolveOptions { threads: 1, front_window: 0.0, ..Default::default() };
+        // The plain sweeps visit every row in every sweep: every iteration of sweeps (all but
+        // the rim's pass, counted as one more) prefetches when the band's bytes exceed the bound,
+        // none when they do not.
+        for (p, coupled, slow) in [(&p, false, false), (&per_node, true, true)] {
+            let swept = n * bytes(false, coupled, slow);
+            let opts = SolveOptions { skip_inactive: false, coupled, ..base };
+            let (k, it) = count(p, SolveOptions { row_prefetch_above: swept - 1, ..opts });
+            assert_eq!(k, it - 1, "coupled {coupled}, per-node slowness {slow}");
+            assert_eq!(count(p, SolveOptions { row_prefetch_above: swept, ..opts }).0, 0);
         }
+        // With the flags the first iteration is taken to visit every row, and the later ones
+        // count the rows that ran, fewer: just below the band's bytes only the first prefetches.
+        let swept = n * bytes(true, true, true);
+        let opts = SolveOptions { skip_inactive: true, coupled: true, ..base };
+        assert_eq!(count(&per_node, SolveOptions { row_prefetch_above: swept - 1, ..opts }).0, 1);
+        assert_eq!(count(&per_node, SolveOptions { row_prefetch_above: swept, ..opts }).0, 0);
+        // With the front window the first iteration counts no row, so even a bound of 0 lets
+        // it and the rim's pass go without; every other iteration visits rows and prefetches.
+        let opts = SolveOptions { front_window: DEFAULT_FRONT_WINDOW, row_prefetch_above: 0, ..base };
+        let (k, it) = count(&p, opts);
+        assert_eq!(k, it - 2);
     }
 
     #[test]

@@ -1354,6 +1354,14 @@ fn analytic_level_set_band<'py>(
     Ok((linear.into_pyarray(py), values.into_pyarray(py), band.map(|band| PyBand { band }), direction.into_pyarray(py), norms.into_pyarray(py)))
 }
 
+/// The bytes of the processor's last-level cache as the sweeps see it
+/// (`tubesweep_core::cache_size::last_level_cache_bytes`: Linux's sysfs, else 32 MiB); they
+/// prefetch their rows when an iteration's rows hold more than half of it.
+#[pyfunction]
+fn last_level_cache_bytes() -> usize {
+    tubesweep_core::cache_size::last_level_cache_bytes()
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
@@ -1363,6 +1371,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(block_children, m)?)?;
     m.add_function(wrap_pyfunction!(node_points, m)?)?;
     m.add_function(wrap_pyfunction!(keep_within, m)?)?;
+    m.add_function(wrap_pyfunction!(last_level_cache_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(first_non_finite, m)?)?;
     m.add_function(wrap_pyfunction!(band_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions_of_samples, m)?)?;
