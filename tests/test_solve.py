@@ -397,12 +397,12 @@ def test_stats_say_how_the_sweeps_ran_without_changing_the_values():
     assert two.stats.thin_strip_iterations[0] > 0 and two.stats.thin_strip_iterations[1] == 0
     assert sum(two.stats.thin_strip_iterations) < two.stats.iterations
     assert np.array_equal(one.values, two.values, equal_nan=True)
-    # the rows are fetched ahead only where the iterations' rows outgrow half the last-level
-    # cache: not the 41 k nodes here (about 40 bytes each of the arrays the sweeps read) on
-    # caches of 4 MB and more
+    # the rows are fetched ahead only where the iterations' rows outgrow a share of the
+    # last-level cache: not the 41 k nodes here (about 40 bytes each of the arrays the sweeps
+    # read) on caches of 8 MB and more
     from tubesweep import _native
 
-    small = one.stats.band_points * 48 < _native.last_level_cache_bytes() / 2
+    small = one.stats.band_points * 48 < _native.row_prefetch_above()
     for s in (one.stats, two.stats):
         assert 0 <= s.prefetch_iterations <= s.iterations
         if small:

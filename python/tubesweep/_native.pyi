@@ -78,7 +78,7 @@ def outward_directions(
     direction: npt.NDArray[np.float32],  # (stop − start, d) C-contiguous, written
     neighbours: Optional[npt.NDArray[np.int32]] = None,  # neighbour_table(shape, linear, start, stop)
 ) -> npt.NDArray[np.float64]: ...
-def last_level_cache_bytes() -> int: ...  # the sweeps prefetch their rows above half of it (Linux sysfs, else 32 MiB)
+def row_prefetch_above() -> int: ...  # bytes of an iteration's rows above which the next prefetches its rows (a share of the last-level cache)
 def sphere_signed_distance(points: npt.NDArray[np.float64], centre: List[float], radius: float) -> npt.NDArray[np.float64]: ...
 def torus_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], major: float, minor: float

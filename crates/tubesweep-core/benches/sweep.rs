@@ -11,6 +11,13 @@
 //!   the front window off (with it, the first iteration covers only the window round the source);
 //! * `to-convergence` (N = 101 only, to keep `cargo bench` short): the whole solve, tol 1e-10.
 //!
+//! And the kernel alone, Godunov: `plain-to-convergence` at N = 101, 201 and 401 (about 30 s of
+//! the run's time at N = 401), the paper's sweeps to the letter
+//! (`skip_inactive: false`: every node but the fixed ones updated in every sweep, pointwise, the
+//! rim in every sweep), whose rate counts no skipped node, on one thread and on all cores; at
+//! N = 401 the band's arrays outgrow a 32 MB last-level cache and the sweeps fetch their rows
+//! ahead (`row_prefetch_above`).
+//!
 //! Throughput is reported in elements = local updates (`SolveStats::updates` of one calibration
 //! run), so criterion prints local updates per second. Run with
 //! `cargo bench -p tubesweep-core --bench sweep`.
@@ -81,6 +88,30 @@ fn run(p: &SweepProblem<'_, 3>, values: &mut Vec<f64>, opts: &SolveOptions) -> u
     stats.updates
 }
 
+/// The paper's sweeps to the letter (see the module doc).
+fn plain() -> SolveOptions {
+    SolveOptions { skip_inactive: false, coupled: false, defer_outer_rim: false, front_window: 0.0, ..Default::default() }
+}
+
+fn bench_plain_kernel(c: &mut Criterion) {
+    for n in [101usize, 201, 401] {
+        let b = sphere_band(n);
+        let mut values = vec![0.0; b.band.len()];
+        let mut group = c.benchmark_group(format!("sphere-N{n}"));
+        group.sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3));
+        group.sampling_mode(SamplingMode::Flat);
+        let p = problem(&b, InnerScheme::Godunov);
+        for threads in [1, 0] {
+            let opts = SolveOptions { threads, ..plain() };
+            let updates = run(&p, &mut values, &opts);
+            group.throughput(Throughput::Elements(updates));
+            let id = BenchmarkId::new("plain-to-convergence", if threads == 1 { "godunov-1-thread" } else { "godunov-all-cores" });
+            group.bench_function(id, |bch| bch.iter(|| run(&p, &mut values, &opts)));
+        }
+        group.finish();
+    }
+}
+
 fn bench_kernel(c: &mut Criterion) {
     let schemes: [(&str, InnerScheme<'static, 3>); 2] =
         [("godunov", InnerScheme::Godunov), ("lxf", InnerScheme::LaxFriedrichs)];
@@ -112,5 +143,5 @@ fn bench_kernel(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench_kernel);
+criterion_group!(benches, bench_kernel, bench_plain_kernel);
 criterion_main!(benches);

@@ -1354,12 +1354,12 @@ fn analytic_level_set_band<'py>(
     Ok((linear.into_pyarray(py), values.into_pyarray(py), band.map(|band| PyBand { band }), direction.into_pyarray(py), norms.into_pyarray(py)))
 }
 
-/// The bytes of the processor's last-level cache as the sweeps see it
-/// (`tubesweep_core::cache_size::last_level_cache_bytes`: Linux's sysfs, else 32 MiB); they
-/// prefetch their rows when an iteration's rows hold more than half of it.
+/// The bytes of the sweeps' arrays that the rows of an iteration must hold for the next
+/// iteration to prefetch its rows: `SolveOptions::row_prefetch_above`'s default, a share of the
+/// last-level cache (`tubesweep_core::sweep::default_row_prefetch_above`).
 #[pyfunction]
-fn last_level_cache_bytes() -> usize {
-    tubesweep_core::cache_size::last_level_cache_bytes()
+fn row_prefetch_above() -> usize {
+    default_row_prefetch_above()
 }
 
 #[pymodule]
@@ -1371,7 +1371,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(block_children, m)?)?;
     m.add_function(wrap_pyfunction!(node_points, m)?)?;
     m.add_function(wrap_pyfunction!(keep_within, m)?)?;
-    m.add_function(wrap_pyfunction!(last_level_cache_bytes, m)?)?;
+    m.add_function(wrap_pyfunction!(row_prefetch_above, m)?)?;
     m.add_function(wrap_pyfunction!(first_non_finite, m)?)?;
     m.add_function(wrap_pyfunction!(band_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(outward_directions_of_samples, m)?)?;

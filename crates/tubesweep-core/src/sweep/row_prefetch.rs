@@ -14,8 +14,8 @@
 //! only cost instructions; docs/architecture.md ("Rows fetched ahead") has the measurements.
 //!
 //! A row is fetched only if it looks as if it will run when the hint is issued: its dirty flag
-//! set (with the active flags) and its lower bound inside the front window. A row that the two
-//! rows before it wake is then missed; fetching the clean rows too made the default sweeps at
+//! set (with the active flags) and its lower bound inside the front window. A row that the rows
+//! just before it wake is then missed; fetching the clean rows too made the default sweeps at
 //! N = 1001 on two threads 1.47× slower (6 alternating rounds) and Python's paper sweeps at
 //! N = 401 no faster (1.009×). A general Hamiltonian's own per-node data (a metric, a flow) are
 //! neither counted nor fetched. On other architectures than x86-64 the sweeps never prefetch.
@@ -28,12 +28,14 @@ use crate::cache_size::last_level_cache_bytes;
 use crate::prefetch::prefetch_range;
 use std::sync::atomic::Ordering;
 
-/// How many rows ahead in the visiting order the sweeps prefetch (1, 2, 4 and 8 measured within
-/// a few percent of each other on the sphere at N = 401).
-pub(super) const ROW_PREFETCH_AHEAD: usize = 2;
+/// How many rows ahead in the visiting order the sweeps prefetch. Against 2, with the `sphere`
+/// example's paper sweeps alternately (docs/architecture.md, "Rows fetched ahead"): 8 took 0.924
+/// of the time at N = 401 on one thread, 0.939 on two and 0.893 at N = 301; 12 and 16 gained
+/// 1–4% more than 8 on one thread but lost 5% on two (a tile's first rows go unfetched).
+pub(super) const ROW_PREFETCH_AHEAD: usize = 8;
 
 /// The share of the last-level cache above which the sweeps prefetch (see the module doc).
-pub const DEFAULT_CACHE_SHARE: f64 = 0.5;
+pub const DEFAULT_CACHE_SHARE: f64 = 0.25;
 
 /// The default [`SolveOptions::row_prefetch_above`](super::SolveOptions::row_prefetch_above):
 /// [`DEFAULT_CACHE_SHARE`] of [`last_level_cache_bytes`].
