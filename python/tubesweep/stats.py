@@ -56,8 +56,8 @@ class SolveStats:
         front"). ``(0, 0)`` on one thread and in 2D. The values do not depend on it.
     prefetch_iterations : int
         Iterations whose sweeps fetched the rows' data ahead into the cache (x86-64): those after
-        an iteration whose visited rows held more data than a quarter of the last-level cache (before
-        the first, every row counts as visited, or none with the front window;
+        an iteration whose visited rows held more data than a quarter of the last-level cache
+        (before the first, every row counts as visited, or none with the front window;
         docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
     """
 
