@@ -41,6 +41,7 @@ pub(crate) fn prefetch_raw_range<T>(base: *const T, len: usize, start: usize, en
 /// `len` elements of `size` bytes at address `base`: the first line's address and how many.
 /// `None` when the range is empty or the elements have no size.
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 fn cache_lines(base: usize, size: usize, len: usize, start: usize, end: usize) -> Option<(usize, usize)> {
     let end = end.min(len);
     if start >= end || size == 0 {
