@@ -1446,6 +1446,24 @@ mod tests {
         let opts = SolveOptions { front_window: DEFAULT_FRONT_WINDOW, row_prefetch_above: 0, ..base };
         let (k, it) = count(&p, opts);
         assert_eq!(k, it - 2);
+        // a 2D box (no extension layer, so no weights; Lax–Friedrichs, which reads its own
+        // value next to the box's sides): the same bits, every iteration prefetching
+        let n2 = 61;
+        let box2 = NarrowBand::<2>::full_box([n2, n2]).unwrap();
+        let mut roles2 = vec![NodeRole::Inner; box2.len()];
+        roles2[box2.find([30, 20]).unwrap()] = NodeRole::Fixed;
+        for scheme in [InnerScheme::Godunov, InnerScheme::LaxFriedrichs] {
+            let p2 = box_problem(&box2, &roles2, scheme, 1.0 / (n2 - 1) as f64);
+            let run = |above: usize| {
+                let mut u = vec![0.0; box2.len()];
+                let st = p2.solve(&mut u, &SolveOptions { row_prefetch_above: above, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+                assert!(st.converged);
+                (u, st)
+            };
+            let ((a, sa), (b, sb)) = (run(usize::MAX), run(0));
+            assert_eq!((sa.prefetch_iterations, sb.prefetch_iterations), (0, sb.iterations));
+            assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
     }
 
     #[test]
