@@ -69,7 +69,7 @@ fn main() {
         .solve(&mut u, &opts, &mut |r| {
             if verbose {
                 println!(
-                    "  iteration {:3} at {:7.3} s  largest change {:.3e}  updates {}",
+                    "  iteration {:3} at {:9.6} s  largest change {:.3e}  updates {}",
                     r.iteration,
                     t0.elapsed().as_secs_f64(),
                     r.max_change,
