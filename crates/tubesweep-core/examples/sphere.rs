@@ -84,7 +84,7 @@ fn main() {
     antipode[source_axis] = (3 * (n - 1) / 4) as i64;
     let far = band.find(antipode).unwrap();
     println!(
-        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.3}s {:.1} M updates/s prefetched={} u(antipode)={:.5} solve={solve_s:.3}s",
+        "N={n} coupled={coupled} rim_last={defer_outer_rim} window={front_window} band={} build={build:.3}s iterations={} updates={} sweeps={:.6}s {:.1} M updates/s prefetched={} u(antipode)={:.5} solve={solve_s:.3}s",
         band.len(),
         st.iterations,
         st.updates,
