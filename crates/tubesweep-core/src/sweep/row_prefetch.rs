@@ -15,8 +15,8 @@
 //!
 //! A row is fetched only if it looks as if it will run when the hint is issued: its dirty flag
 //! set (with the active flags) and its lower bound inside the front window. A row that the rows
-//! just before it wake is then missed; fetching the clean rows too made the default sweeps at
-//! N = 1001 on two threads 1.47× slower (6 alternating rounds) and Python's paper sweeps at
+//! just before it wake is then missed; fetching the clean rows too (two rows ahead) made the default
+//! sweeps at N = 1001 on two threads 1.47× slower (6 alternating rounds) and Python's paper sweeps at
 //! N = 401 no faster (1.009×). A general Hamiltonian's own per-node data (a metric, a flow) are
 //! neither counted nor fetched. On other architectures than x86-64 the sweeps never prefetch.
 //!
