@@ -399,7 +399,7 @@ def test_stats_say_how_the_sweeps_ran_without_changing_the_values():
     assert np.array_equal(one.values, two.values, equal_nan=True)
     # the rows are fetched ahead only where the iterations' rows outgrow a share of the
     # last-level cache: not the 41 k nodes here (about 40 bytes each of the arrays the sweeps
-    # read) on caches of 8 MB and more
+    # read) on caches of 8 MB and more (on smaller ones only the bounds below are checked)
     from tubesweep import _native
 
     small = one.stats.band_points * 48 < _native.row_prefetch_above()

@@ -11,12 +11,12 @@
 //!   the front window off (with it, the first iteration covers only the window round the source);
 //! * `to-convergence` (N = 101 only, to keep `cargo bench` short): the whole solve, tol 1e-10.
 //!
-//! And the kernel alone, Godunov: `plain-to-convergence` at N = 101, 201 and 401 (about 30 s of
+//! And the kernel alone, Godunov: `plain-to-convergence` at N = 101, 201 and 401 (about 45 s of
 //! the run's time at N = 401), the paper's sweeps to the letter
 //! (`skip_inactive: false`: every node but the fixed ones updated in every sweep, pointwise, the
 //! rim in every sweep), whose rate counts no skipped node, on one thread and on all cores; at
-//! N = 401 the band's arrays outgrow a 32 MB last-level cache and the sweeps fetch their rows
-//! ahead (`row_prefetch_above`).
+//! N = 201 and 401 the iterations' rows exceed a quarter of a 32 MB last-level cache and the
+//! sweeps fetch their rows ahead (`row_prefetch_above`).
 //!
 //! Throughput is reported in elements = local updates (`SolveStats::updates` of one calibration
 //! run), so criterion prints local updates per second. Run with

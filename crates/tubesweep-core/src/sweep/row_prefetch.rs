@@ -31,7 +31,7 @@ use std::sync::atomic::Ordering;
 /// How many rows ahead in the visiting order the sweeps prefetch. Against 2, with the `sphere`
 /// example's paper sweeps alternately (docs/architecture.md, "Rows fetched ahead"): 8 took 0.924
 /// of the time at N = 401 on one thread, 0.939 on two and 0.893 at N = 301; 12 and 16 gained
-/// 1–4% more than 8 on one thread but lost 5% on two (a tile's first rows go unfetched).
+/// 1–4% more than 8 on one thread, and 16 lost 5% on two (a tile's first rows go unfetched).
 pub(super) const ROW_PREFETCH_AHEAD: usize = 8;
 
 /// The share of the last-level cache above which the sweeps prefetch (see the module doc).
