@@ -179,10 +179,7 @@ impl<const D: usize> NarrowBand<D> {
     /// as in a breadth-first search.
     #[inline(always)]
     pub fn prefetch_neighbours(&self, n: usize) {
-        if let (Some(lead), Some(row)) = (self.lead.get(n * 2 * (D - 1)), self.along_row.get(n)) {
-            crate::prefetch::prefetch(lead);
-            crate::prefetch::prefetch(row);
-        }
+        self.prefetch_neighbour_range(n, n + 1);
     }
 
     /// The bytes of the neighbour table per node: two `u32` per leading axis and a byte of

@@ -866,8 +866,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .into_par_iter()
             .with_min_len(1024)
             .fold(empty, |mut slabs, r| {
-                // the rows `SweepContext::take_row` will let through
-                if ctx.row_dirty[r].load(Ordering::Relaxed) != 0 && ctx.row_low[r].load(Ordering::Relaxed) <= lim.window_key {
+                if ctx.row_may_run::<true>(r, lim) {
                     let (s, e) = self.band.row_range(r);
                     let ab = self.band.row_leading_indices(r);
                     for k in 0..2 {

@@ -26,7 +26,6 @@ use super::sweep_state::{Limits, SweepContext};
 use super::{Slowness, SweepProblem};
 use crate::cache_size::last_level_cache_bytes;
 use crate::prefetch::prefetch_range;
-use std::sync::atomic::Ordering;
 
 /// How many rows ahead in the visiting order the sweeps prefetch. Against 2, with the `sphere`
 /// example's paper sweeps alternately (docs/architecture.md, "Rows fetched ahead"): 8 took 0.924
@@ -77,17 +76,12 @@ impl<const D: usize> SweepProblem<'_, D> {
         }
     }
 
-    /// Asks for the cache lines that the sweep will read at the nodes of row `r`, unless the row
-    /// looks as if it will not run (with the flags `K`, its dirty flag is clear now; with the
-    /// window `W`, its lower bound lies beyond it: [`SweepContext::take_row`]'s tests, which this
-    /// one only reads, ahead of time).
+    /// Asks for the cache lines that the sweep will read at the nodes of row `r`, unless, with
+    /// the flags (`K`), the row looks as if it will not run ([`SweepContext::row_may_run`], the
+    /// window's test with `W`; without the flags every row runs).
     #[inline(always)]
     pub(super) fn prefetch_row<const K: bool, const W: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, lim: Limits) {
-        // SAFETY: r < n_rows; row_dirty and row_low have n_rows + 1 entries
-        if K && unsafe { ctx.row_dirty.get_unchecked(r) }.load(Ordering::Relaxed) == 0 {
-            return;
-        }
-        if W && unsafe { ctx.row_low.get_unchecked(r) }.load(Ordering::Relaxed) > lim.window_key {
+        if K && !ctx.row_may_run::<W>(r, lim) {
             return;
         }
         let (s, e) = self.band.row_range(r);

@@ -14,7 +14,7 @@
 //! --env-a SPREAD=0` (one build S of the `sphere` example, the threads left where they start
 //! against spread; 2-core machine of docs/benchmarks.md): at N = 201 mean 51.1 → 49.6 ms, 90th
 //! percentile 61 → 51 ms, runs above 1.3 times the median 5 → 1 of 60, medians 49 and 49; at
-//! N = 101 mean 17.9 → 17.2 ms, medians 15 and 16 ms (the example prints whole milliseconds).
+//! N = 101 mean 17.9 → 17.2 ms, medians 15 and 16 ms (the example then printed whole milliseconds).
 //! In an earlier set of 40 alternating runs of a prototype (the same spreading, switched by an
 //! environment variable the solver no longer reads), in a spell where the threads often started
 //! together, 12 of 40 runs at N = 101 took more than 1.3 times the median without (mean 21.1 ms,

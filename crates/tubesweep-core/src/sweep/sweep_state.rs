@@ -59,6 +59,19 @@ pub(super) const KEEP_ROW: u8 = 1;
 pub(super) const WAKE_ROWS: u8 = 2;
 
 impl<const D: usize> SweepContext<'_, D> {
+    /// Whether row `r` would run now: its dirty flag is set and, with the window (`W`), its
+    /// lower bound lies within it ([`take_row`](Self::take_row)'s tests, read without acting on
+    /// them; with the window off its key is that of infinity, so `W = true` is right there too,
+    /// only slower). For predicting the work ahead.
+    #[inline(always)]
+    pub(super) fn row_may_run<const W: bool>(&self, r: usize, lim: Limits) -> bool {
+        // SAFETY: r < n_rows; row_dirty and row_low have n_rows + 1 entries
+        unsafe {
+            self.row_dirty.get_unchecked(r).load(Ordering::Relaxed) != 0
+                && (!W || self.row_low.get_unchecked(r).load(Ordering::Relaxed) <= lim.window_key)
+        }
+    }
+
     /// Whether row `r` has anything to do: a node may be active and not all its values lie
     /// beyond the front window (a dirty row that does lie beyond it lowers `acc.waiting` to its
     /// bound). Clears the row's dirty flag when it has.
