@@ -42,6 +42,49 @@ pub struct NarrowBand<const D: usize> {
     strip_schedules: OnceLock<[SweepSchedule; 2]>,
 }
 
+/// A borrowed view of a band's neighbour table: the arrays' addresses and the sentinel. The sweep
+/// kernel writes the values through a raw pointer, which the compiler must assume may change
+/// anything reachable through a reference, so it would load the table's addresses again from the
+/// band at every node; held in a local copy (registers), they are loaded once per row.
+#[derive(Debug, Clone, Copy)]
+pub struct NeighbourTable<'a, const D: usize> {
+    lead: &'a [u32],
+    along_row: &'a [u8],
+    sentinel: u32,
+}
+
+impl<const D: usize> NeighbourTable<'_, D> {
+    /// [`NarrowBand::sentinel`].
+    #[inline(always)]
+    pub fn sentinel(&self) -> u32 {
+        self.sentinel
+    }
+
+    /// The neighbours of node `n` ([`NarrowBand::neighbours_of`]), without the bounds check.
+    ///
+    /// # Safety
+    /// `n` is a node of the band.
+    #[inline(always)]
+    pub unsafe fn neighbours_of_unchecked(&self, n: usize) -> [[u32; 2]; D] {
+        debug_assert!((n as u32) < self.sentinel);
+        let sentinel = self.sentinel;
+        let mut nb = [[sentinel; 2]; D];
+        let base = n * 2 * (D - 1);
+        for k in 0..D - 1 {
+            nb[k][0] = *self.lead.get_unchecked(base + 2 * k);
+            nb[k][1] = *self.lead.get_unchecked(base + 2 * k + 1);
+        }
+        let bits = *self.along_row.get_unchecked(n);
+        if bits & 1 != 0 {
+            nb[D - 1][0] = n as u32 - 1;
+        }
+        if bits & 2 != 0 {
+            nb[D - 1][1] = n as u32 + 1;
+        }
+        nb
+    }
+}
+
 impl<const D: usize> NarrowBand<D> {
     /// Builds the band from the C-order linear indices of its nodes, which must be strictly
     /// increasing (sorted, no duplicates) and inside the grid of shape `shape`.
@@ -149,28 +192,20 @@ impl<const D: usize> NarrowBand<D> {
         unsafe { self.neighbours_of_unchecked(n) }
     }
 
-    /// [`neighbours_of`](Self::neighbours_of) without the bounds check, for the sweep kernel.
+    /// [`neighbours_of`](Self::neighbours_of) without the bounds check.
     ///
     /// # Safety
     /// `n < self.len()`.
     #[inline(always)]
     pub unsafe fn neighbours_of_unchecked(&self, n: usize) -> [[u32; 2]; D] {
-        debug_assert!(n < self.len());
-        let sentinel = self.last.len() as u32;
-        let mut nb = [[sentinel; 2]; D];
-        let base = n * 2 * (D - 1);
-        for k in 0..D - 1 {
-            nb[k][0] = *self.lead.get_unchecked(base + 2 * k);
-            nb[k][1] = *self.lead.get_unchecked(base + 2 * k + 1);
-        }
-        let bits = *self.along_row.get_unchecked(n);
-        if bits & 1 != 0 {
-            nb[D - 1][0] = n as u32 - 1;
-        }
-        if bits & 2 != 0 {
-            nb[D - 1][1] = n as u32 + 1;
-        }
-        nb
+        self.neighbour_table().neighbours_of_unchecked(n)
+    }
+
+    /// The neighbour table as a small copyable view, which the sweep kernel copies once per row
+    /// into locals (see [`NeighbourTable`]).
+    #[inline(always)]
+    pub fn neighbour_table(&self) -> NeighbourTable<'_, D> {
+        NeighbourTable { lead: &self.lead, along_row: &self.along_row, sentinel: self.last.len() as u32 }
     }
 
     /// Asks the processor to fetch the neighbour-table entries of node `n` into cache ahead of

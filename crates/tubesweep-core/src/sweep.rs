@@ -12,7 +12,7 @@
 //! only ever replaced by smaller ones (this is automatic for Godunov and is the paper's explicit
 //! acceptance rule for Lax–Friedrichs, proof of Corollary 1).
 
-use crate::band::NarrowBand;
+use crate::band::{NarrowBand, NeighbourTable};
 use crate::error::{Error, Result};
 use crate::extension::{extension_apply_upwind, extension_weights};
 use crate::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
@@ -1003,16 +1003,33 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         acc.visited += (e - s) as u64;
         let mut low = f64::INFINITY;
         let mut marks = 0u8;
+        let arrays = self.node_arrays(ctx);
         if backwards {
             for n in (s..e).rev() {
-                self.visit::<S, P, W, K>(ctx, n, lim, acc, &mut low, &mut marks);
+                self.visit::<S, P, W, K>(ctx, &arrays, n, lim, acc, &mut low, &mut marks);
             }
         } else {
             for n in s..e {
-                self.visit::<S, P, W, K>(ctx, n, lim, acc, &mut low, &mut marks);
+                self.visit::<S, P, W, K>(ctx, &arrays, n, lim, acc, &mut low, &mut marks);
             }
         }
         ctx.finish_row::<W, K>(r, low, marks);
+    }
+
+    /// The arrays the kernel reads at a node, copied into locals for a row ([`NodeArrays`]).
+    #[inline(always)]
+    fn node_arrays<'k>(&'k self, ctx: &SweepContext<'k, D>) -> NodeArrays<'k, D> {
+        NodeArrays {
+            u: *ctx.u,
+            roles: self.roles,
+            table: self.band.neighbour_table(),
+            weights: ctx.weights,
+            coupling: ctx.coupling,
+            active: ctx.active,
+            cyclic: ctx.cyclic,
+            slowness: self.slowness,
+            spacing: self.spacing,
+        }
     }
 
     #[inline(always)]
@@ -1021,34 +1038,34 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// `row` collects what the row's dirty flags need: [`KEEP_ROW`] when the node stays active,
     /// [`WAKE_ROWS`] when it activated its neighbours. Without the flags (`K = false`), updates
     /// every node but the fixed ones and touches neither `low` nor `row`.
-    fn visit<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
+    fn visit<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, arr: &NodeArrays<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
         if !K {
             // no flags: every node but the fixed ones (`iterate` counts these updates per sweep,
             // `updated_per_sweep`)
             // SAFETY: n < band.len(), the length of roles (checked in `check`)
-            if unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed {
+            if unsafe { *arr.roles.get_unchecked(n) } == NodeRole::Fixed {
                 return;
             }
             // SAFETY: n < band.len()
-            let nb = unsafe { self.band.neighbours_of_unchecked(n) };
-            let result = self.local_update::<S, P>(ctx, n, &nb, lim.inf);
+            let nb = unsafe { arr.table.neighbours_of_unchecked(n) };
+            let result = self.local_update::<S, P>(ctx, arr, n, &nb, lim.inf);
             if crate::kernel_stats::ENABLED {
-                crate::kernel_stats::update(self.roles[n] as u8, result.map(|u| u.change()));
+                crate::kernel_stats::update(arr.roles[n] as u8, result.map(|u| u.change()));
             }
             if let Some(up) = result {
                 let c = up.change();
                 if c > acc.max_change {
                     acc.max_change = c;
                 }
-                ctx.u.set(n, up.new);
+                arr.u.set(n, up.new);
             }
             return;
         }
-        let active = ctx.active;
+        let active = arr.active;
         // SAFETY: n < band.len(); active has that length plus the sentinel slot.
         let flag = unsafe { active.get_unchecked(n) };
         // fixed nodes get activated by their neighbours too: one test for both (no short circuit)
-        let fixed = unsafe { *self.roles.get_unchecked(n) } == NodeRole::Fixed;
+        let fixed = unsafe { *arr.roles.get_unchecked(n) } == NodeRole::Fixed;
         let state = flag.load(Ordering::Relaxed);
         if (state == 0) | fixed {
             return;
@@ -1058,8 +1075,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // if it lies within the window
         let mut unreached_beyond = false;
         if W {
-            let value = ctx.u.get(n);
-            if value > lim.window && (ctx.cyclic.is_empty() || unsafe { *ctx.cyclic.get_unchecked(n) } == 0) {
+            let value = arr.u.get(n);
+            if value > lim.window && (arr.cyclic.is_empty() || unsafe { *arr.cyclic.get_unchecked(n) } == 0) {
                 if !unreached(value, lim.inf) {
                     *row |= KEEP_ROW;
                     if value < acc.waiting {
@@ -1080,10 +1097,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         flag.store(0, Ordering::Relaxed);
         acc.updates += 1;
         // SAFETY: n < band.len()
-        let nb = unsafe { self.band.neighbours_of_unchecked(n) };
-        let result = self.local_update::<S, P>(ctx, n, &nb, lim.inf);
+        let nb = unsafe { arr.table.neighbours_of_unchecked(n) };
+        let result = self.local_update::<S, P>(ctx, arr, n, &nb, lim.inf);
         if crate::kernel_stats::ENABLED {
-            crate::kernel_stats::update(self.roles[n] as u8, result.map(|u| u.change()));
+            crate::kernel_stats::update(arr.roles[n] as u8, result.map(|u| u.change()));
         }
         let Some(up) = result else { return };
         if W && unreached_beyond && up.new > lim.window {
@@ -1102,7 +1119,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if c > acc.max_change {
             acc.max_change = c;
         }
-        ctx.u.set(n, up.new);
+        arr.u.set(n, up.new);
         if W {
             if up.new < *low {
                 *low = up.new;
@@ -1127,11 +1144,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// update (5) in the layer, the scheme's local solver with monotone acceptance in the inner
     /// tube. `None` when the value would not change. Nothing is written.
     #[inline(always)]
-    fn local_update<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, n: usize, nb: &[[u32; 2]; D], inf: f64) -> Option<LocalUpdate> {
-        let u = ctx.u;
+    fn local_update<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, arr: &NodeArrays<'_, D>, n: usize, nb: &[[u32; 2]; D], inf: f64) -> Option<LocalUpdate> {
+        let u = arr.u;
         // SAFETY: n < band.len(); roles, weights and the neighbour table have at least that
         // length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`.
-        let role = unsafe { *self.roles.get_unchecked(n) };
+        let role = unsafe { *arr.roles.get_unchecked(n) };
         let old = u.get(n);
         if role == NodeRole::Outer {
             // Eq. (5) with the precomputed upwind weights, reading only the upwind neighbours.
@@ -1139,7 +1156,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             // the paper: the extended value then approaches the solution from above like the
             // inner values do. Dropping them would let a too-small value into the layer, which
             // the monotone Godunov update could never undo.
-            let w = unsafe { *ctx.weights.get_unchecked(n) };
+            let w = unsafe { *arr.weights.get_unchecked(n) };
             if w[0].is_nan() {
                 // no upwind neighbour (or a vanishing normal, e.g. on a medial axis): the node
                 // keeps its value even when a neighbour re-activates it
@@ -1154,8 +1171,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             minus[k] = u.get(nb[k][0] as usize);
             plus[k] = u.get(nb[k][1] as usize);
         }
-        let h = self.spacing;
-        let slow = match (P, self.slowness) {
+        let h = arr.spacing;
+        let slow = match (P, arr.slowness) {
             (true, Slowness::PerNode(s)) => unsafe { *s.get_unchecked(n) },
             (_, Slowness::Constant(s)) => s,
             (false, Slowness::PerNode(s)) => unsafe { *s.get_unchecked(n) },
@@ -1163,7 +1180,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let mut self_dependent = false;
         let candidate = if S == GODUNOV {
             let mut mins = [0.0; D];
-            let mask = if ctx.coupling.is_empty() { 0 } else { unsafe { *ctx.coupling.get_unchecked(n) } };
+            let mask = if arr.coupling.is_empty() { 0 } else { unsafe { *arr.coupling.get_unchecked(n) } };
             if mask == 0 {
                 for k in 0..D {
                     mins[k] = fmin(minus[k], plus[k]);
@@ -1182,7 +1199,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                     if mask >> (2 * k + side) & 1 == 1 {
                         // SAFETY: the mask only marks neighbours in the band
                         let q = nb[k][side] as usize;
-                        let w = unsafe { ctx.weights.get_unchecked(q)[k] }.abs() as f64;
+                        let w = unsafe { arr.weights.get_unchecked(q)[k] }.abs() as f64;
                         (mins[k], coef[k]) = coupled_axis(a, w, old, inf);
                     }
                 }
@@ -1190,14 +1207,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
         } else if S == LXF {
             if self.missing == MissingNeighbour::Extrapolate {
-                self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, h * slow, &mut minus, &mut plus);
+                self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, h * slow, &mut minus, &mut plus);
             }
             lxf_eikonal_update(minus, plus, h * slow)
         } else {
             let InnerScheme::General(ham) = self.scheme else { return None };
             if self.missing == MissingNeighbour::Extrapolate {
                 let f = h * ctx.general_slowness;
-                self_dependent = fill_missing(nb, self.band.sentinel(), old, inf, f, &mut minus, &mut plus);
+                self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, f, &mut minus, &mut plus);
             }
             let p = central_gradient(minus, plus, h);
             lxf_general_update(minus, plus, ham.viscosity(n), ham.value(n, p), h)
@@ -1209,6 +1226,24 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             None
         }
     }
+}
+
+/// What the kernel reads at a node, copied from the problem and the sweep context once per row.
+/// The values are written through a raw pointer ([`SharedValues`]), so the compiler must assume
+/// that a write may change anything reachable through a reference, and would load these
+/// addresses again from the problem and the context at every node; held in locals, they stay in
+/// registers.
+#[derive(Clone, Copy)]
+struct NodeArrays<'k, const D: usize> {
+    u: SharedValues,
+    roles: &'k [NodeRole],
+    table: NeighbourTable<'k, D>,
+    weights: &'k [[f32; D]],
+    coupling: &'k [u8],
+    active: &'k [AtomicU8],
+    cyclic: &'k [u8],
+    slowness: Slowness<'k>,
+    spacing: f64,
 }
 
 /// Whether `v` is the numerical infinity `inf`, up to the rounding of an extension update whose

@@ -217,6 +217,7 @@ pub(super) struct Limits {
 /// The node values, shared by the threads of a parallel sweep. The schedule guarantees that the
 /// tiles processed at the same time write disjoint nodes and read no node another tile writes
 /// (see [`crate::schedule`]), so unsynchronised access is race-free.
+#[derive(Clone, Copy)]
 pub(super) struct SharedValues {
     pub(super) ptr: *mut f64,
     pub(super) len: usize,
