@@ -1027,7 +1027,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             coupling: ctx.coupling,
             active: ctx.active,
             cyclic: ctx.cyclic,
-            slowness: self.slowness,
+            slowness_per_node: match self.slowness {
+                Slowness::PerNode(s) => s,
+                Slowness::Constant(_) => &[],
+            },
+            h_times_constant_slowness: match self.slowness {
+                Slowness::Constant(s) => self.spacing * s,
+                Slowness::PerNode(_) => f64::NAN,
+            },
             spacing: self.spacing,
         }
     }
@@ -1172,11 +1179,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             plus[k] = u.get(nb[k][1] as usize);
         }
         let h = arr.spacing;
-        let slow = match (P, arr.slowness) {
-            (true, Slowness::PerNode(s)) => unsafe { *s.get_unchecked(n) },
-            (_, Slowness::Constant(s)) => s,
-            (false, Slowness::PerNode(s)) => unsafe { *s.get_unchecked(n) },
-        };
+        // SAFETY: n < band.len()
+        let f = unsafe { arr.h_times_slowness::<P>(n) };
         let mut self_dependent = false;
         let candidate = if S == GODUNOV {
             let mut mins = [0.0; D];
@@ -1185,7 +1189,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 for k in 0..D {
                     mins[k] = fmin(minus[k], plus[k]);
                 }
-                godunov_update(mins, h * slow)
+                godunov_update(mins, f)
             } else {
                 // An extension-layer neighbour O that reads this node with weight w holds
                 // u_O = w u + r. Its stored value was computed from this node's value then, which
@@ -1203,13 +1207,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                         (mins[k], coef[k]) = coupled_axis(a, w, old, inf);
                     }
                 }
-                godunov_update_coupled(mins, coef, h * slow)
+                godunov_update_coupled(mins, coef, f)
             }
         } else if S == LXF {
             if self.missing == MissingNeighbour::Extrapolate {
-                self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, h * slow, &mut minus, &mut plus);
+                self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, f, &mut minus, &mut plus);
             }
-            lxf_eikonal_update(minus, plus, h * slow)
+            lxf_eikonal_update(minus, plus, f)
         } else {
             let InnerScheme::General(ham) = self.scheme else { return None };
             if self.missing == MissingNeighbour::Extrapolate {
@@ -1242,8 +1246,27 @@ struct NodeArrays<'k, const D: usize> {
     coupling: &'k [u8],
     active: &'k [AtomicU8],
     cyclic: &'k [u8],
-    slowness: Slowness<'k>,
+    /// The per-node slowness; empty when it is constant.
+    slowness_per_node: &'k [f64],
+    /// `h / F`, the right-hand side of the local solvers, when the slowness is constant.
+    h_times_constant_slowness: f64,
     spacing: f64,
+}
+
+impl<const D: usize> NodeArrays<'_, D> {
+    /// `h / F(x_n)` at node `n` (`P`: the slowness is given per node).
+    ///
+    /// # Safety
+    /// `n` is a node of the band (the per-node slowness has the band's length, checked in
+    /// `SweepProblem::check`).
+    #[inline(always)]
+    unsafe fn h_times_slowness<const P: bool>(&self, n: usize) -> f64 {
+        if P {
+            self.spacing * *self.slowness_per_node.get_unchecked(n)
+        } else {
+            self.h_times_constant_slowness
+        }
+    }
 }
 
 /// Whether `v` is the numerical infinity `inf`, up to the rounding of an extension update whose
