@@ -24,7 +24,11 @@ fixed ones updated in every sweep), Godunov, at ``--kernel-sizes`` on 1 thread a
 interleaved the same way. Its rate counts no skipped node, so it is the kernel's rate per update;
 the "prefetched" column says in how many iterations the sweeps fetched the rows ahead
 (``SolveOptions::row_prefetch_above``: when the visited rows' data exceed a share of the
-last-level cache).
+last-level cache). With more than one thread count it also prints, before and after the table,
+the round trip of a cache line between the first two CPUs (the Rust ``core_to_core`` example):
+the parallel sweeps pass values and flags between the cores at every tile, so the speed-up
+falls as that latency grows, and on a virtual machine the latency is the host's placement of
+the virtual CPUs, which can change from one day to the next.
 
     .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3] [--kernel-sizes 101,201,401]
 """
@@ -111,6 +115,7 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
 
 
 SPHERE_EXAMPLE = REPO / "target" / "release" / "examples" / "sphere"
+CORE_TO_CORE_EXAMPLE = REPO / "target" / "release" / "examples" / "core_to_core"
 _EXAMPLE_LINE = re.compile(r"band=(\d+) .*iterations=(\d+) updates=(\d+) sweeps=([0-9.]+)s .*prefetched=(\d+)")
 
 
@@ -118,6 +123,25 @@ def build_sphere_example() -> Path:
     """Builds the Rust ``sphere`` example (cargo's incremental build: seconds when up to date)."""
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "sphere"], cwd=str(REPO), check=True)
     return SPHERE_EXAMPLE
+
+
+def core_round_trip_ns() -> Optional[float]:
+    """The Rust ``core_to_core`` example's median round trip of a cache line between the first two
+    CPUs (ns), or None where it cannot pin threads. The parallel sweeps hand values and flags from
+    core to core at every tile, so their speed-up falls as this grows; on a virtual machine it is
+    the host's placement of the virtual CPUs, and it can change between runs."""
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "core_to_core"],
+                   cwd=str(REPO), check=True)
+    cp = subprocess.run([str(CORE_TO_CORE_EXAMPLE)], capture_output=True, text=True, check=True)
+    m = re.search(r"round_trip_ns=([0-9.]+)", cp.stdout)
+    return float(m.group(1)) if m else None
+
+
+def _print_round_trip(when: str, ns: Optional[float]) -> None:
+    if ns is None:
+        print(f"core-to-core round trip ({when}): not measured (needs Linux and two CPUs)")
+    else:
+        print(f"core-to-core round trip ({when}): {ns:.0f} ns (examples/core_to_core.rs)")
 
 
 def kernel_once(example: Path, n: int, threads: int) -> Dict[str, Any]:
@@ -143,6 +167,9 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
     example = example or build_sphere_example()
     print(f"the kernel alone: Rust sphere example, PLAIN=1 (every node in every sweep), Godunov, "
           f"{repeats} interleaved rounds (medians); {cores} cores")
+    round_trip = core_round_trip_ns() if len(tlist) > 1 else None
+    if len(tlist) > 1:
+        _print_round_trip("before", round_trip)
     print(f"{'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} {'Mupd/s':>8} "
           f"{'Mupd/s/core':>11} {'speed-up':>8} {'prefetched':>10}")
     rows = []
@@ -158,10 +185,13 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
             r["updates_per_s"] = r["updates"] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
             r["per_core"] = r["updates_per_s"] / t
             r["speedup"] = statistics.median(a / b for a, b in zip(secs[tlist[0]], secs[t]))
+            r["core_round_trip_ns"] = round_trip
             rows.append(r)
             print(f"{n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
                   f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
                   f"{r['speedup']:8.2f} {r['prefetch_iterations']:>4d} of {r['iterations']:<3d}", flush=True)
+    if len(tlist) > 1:
+        _print_round_trip("after", core_round_trip_ns())
     return rows
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -276,6 +277,12 @@ def test_microbench_times_the_flag_free_kernel_with_the_same_work_on_every_threa
         assert r["per_core"] == pytest.approx(r["updates"] / r["sweep_s"] / r["threads"])
         assert 0 <= r["prefetch_iterations"] <= r["iterations"]
     assert r2["speedup"] > 0 and math.isfinite(r2["speedup"])
+    # the round trip between the first two CPUs, where threads can be pinned (Linux, two CPUs)
+    trip = r1["core_round_trip_ns"]
+    if sys.platform.startswith("linux") and len(os.sched_getaffinity(0)) >= 2:
+        assert trip is not None and 0 < trip < 1e6
+    else:
+        assert trip is None
 
 
 def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):
