@@ -24,11 +24,13 @@ fixed ones updated in every sweep), Godunov, at ``--kernel-sizes`` on 1 thread a
 interleaved the same way. Its rate counts no skipped node, so it is the kernel's rate per update;
 the "prefetched" column says in how many iterations the sweeps fetched the rows ahead
 (``SolveOptions::row_prefetch_above``: when the visited rows' data exceed a share of the
-last-level cache). With more than one thread count it also prints, before and after the table,
-the round trip of a cache line between the first two CPUs (the Rust ``core_to_core`` example):
-the parallel sweeps pass values and flags between the cores at every tile, so the speed-up
-falls as that latency grows, and on a virtual machine the latency is the host's placement of
-the virtual CPUs, which can change from one day to the next.
+last-level cache). With more than one thread count it also measures, before every round, the
+round trip of a cache line between the first two CPUs (the Rust ``core_to_core`` example) and
+prints the rounds' range: the parallel sweeps pass values and flags between the cores at every
+tile, so the speed-up falls as that latency grows, and on a virtual machine the latency is the
+host's placement of the virtual CPUs, which can change within minutes (this machine has shown
+about 45 and about 370 ns). When a size's rounds ran at both, it also prints the median
+speed-up of each group.
 
     .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3] [--kernel-sizes 101,201,401]
 """
@@ -125,23 +127,41 @@ def build_sphere_example() -> Path:
     return SPHERE_EXAMPLE
 
 
-def core_round_trip_ns() -> Optional[float]:
+def core_round_trip_ns(trips: int = 50_000) -> Optional[float]:
     """The Rust ``core_to_core`` example's median round trip of a cache line between the first two
     CPUs (ns), or None where it cannot pin threads. The parallel sweeps hand values and flags from
     core to core at every tile, so their speed-up falls as this grows; on a virtual machine it is
-    the host's placement of the virtual CPUs, and it can change between runs."""
+    the host's placement of the virtual CPUs, and it can change between runs, even within one."""
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "core_to_core"],
                    cwd=str(REPO), check=True)
-    cp = subprocess.run([str(CORE_TO_CORE_EXAMPLE)], capture_output=True, text=True, check=True)
+    cp = subprocess.run([str(CORE_TO_CORE_EXAMPLE), str(trips)], capture_output=True, text=True, check=True)
     m = re.search(r"round_trip_ns=([0-9.]+)", cp.stdout)
     return float(m.group(1)) if m else None
 
 
-def _print_round_trip(when: str, ns: Optional[float]) -> None:
-    if ns is None:
-        print(f"core-to-core round trip ({when}): not measured (needs Linux and two CPUs)")
-    else:
-        print(f"core-to-core round trip ({when}): {ns:.0f} ns (examples/core_to_core.rs)")
+def _latency_column(trips: List[Optional[float]]) -> str:
+    """The rounds' core-to-core round trips as ``median`` or ``min–max`` (ns)."""
+    got = [t for t in trips if t is not None]
+    if not got:
+        return "n/a"
+    lo, hi = min(got), max(got)
+    return f"{lo:.0f}" if hi < 1.5 * lo else f"{lo:.0f}–{hi:.0f}"
+
+
+def _split_speedups(trips: List[Optional[float]], speedups: List[float]) -> Optional[str]:
+    """When the rounds ran at two latencies (the host moved the virtual CPUs), the median
+    speed-up of the rounds on either side of the geometric midpoint."""
+    pairs = [(t, s) for t, s in zip(trips, speedups) if t is not None]
+    if len(pairs) < 2:
+        return None
+    lo, hi = min(t for t, _ in pairs), max(t for t, _ in pairs)
+    if hi < 2 * lo:
+        return None
+    mid = (lo * hi) ** 0.5
+    near = [s for t, s in pairs if t < mid]
+    far = [s for t, s in pairs if t >= mid]
+    return (f"speed-up {statistics.median(near):.2f} in {len(near)} rounds at {lo:.0f}–{max(t for t, _ in pairs if t < mid):.0f} ns, "
+            f"{statistics.median(far):.2f} in {len(far)} rounds at {min(t for t, _ in pairs if t >= mid):.0f}–{hi:.0f} ns")
 
 
 def kernel_once(example: Path, n: int, threads: int) -> Dict[str, Any]:
@@ -167,15 +187,17 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
     example = example or build_sphere_example()
     print(f"the kernel alone: Rust sphere example, PLAIN=1 (every node in every sweep), Godunov, "
           f"{repeats} interleaved rounds (medians); {cores} cores")
-    round_trip = core_round_trip_ns() if len(tlist) > 1 else None
-    if len(tlist) > 1:
-        _print_round_trip("before", round_trip)
+    multi = len(tlist) > 1
     print(f"{'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} {'Mupd/s':>8} "
-          f"{'Mupd/s/core':>11} {'speed-up':>8} {'prefetched':>10}")
+          f"{'Mupd/s/core':>11} {'speed-up':>8} {'prefetched':>10} {'core-to-core ns':>15}")
     rows = []
+    notes = []
     for n in sizes:
         runs: Dict[int, List[Dict[str, Any]]] = {t: [] for t in tlist}
+        trips: List[Optional[float]] = []
         for _ in range(repeats):
+            # the latency between the two cores right before the round's runs
+            trips.append(core_round_trip_ns() if multi else None)
             for t in tlist:
                 runs[t].append(kernel_once(example, n, t))
         secs = {t: [r["seconds"] for r in runs[t]] for t in tlist}
@@ -184,14 +206,20 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
             r["sweep_s"] = statistics.median(secs[t])
             r["updates_per_s"] = r["updates"] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
             r["per_core"] = r["updates_per_s"] / t
-            r["speedup"] = statistics.median(a / b for a, b in zip(secs[tlist[0]], secs[t]))
-            r["core_round_trip_ns"] = round_trip
+            ratios = [a / b for a, b in zip(secs[tlist[0]], secs[t])]
+            r["speedup"] = statistics.median(ratios)
+            r["core_round_trip_ns"] = trips
             rows.append(r)
             print(f"{n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
                   f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
-                  f"{r['speedup']:8.2f} {r['prefetch_iterations']:>4d} of {r['iterations']:<3d}", flush=True)
-    if len(tlist) > 1:
-        _print_round_trip("after", core_round_trip_ns())
+                  f"{r['speedup']:8.2f} {r['prefetch_iterations']:>4d} of {r['iterations']:<3d} "
+                  f"{_latency_column(trips) if multi else '':>15}", flush=True)
+            split = _split_speedups(trips, ratios) if t != tlist[0] else None
+            if split:
+                notes.append(f"  N = {n}, {t} threads: {split}")
+    if notes:
+        print("rounds at two core-to-core latencies (examples/core_to_core.rs, measured before each round):")
+        print("\n".join(notes))
     return rows
 
 

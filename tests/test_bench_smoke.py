@@ -277,12 +277,28 @@ def test_microbench_times_the_flag_free_kernel_with_the_same_work_on_every_threa
         assert r["per_core"] == pytest.approx(r["updates"] / r["sweep_s"] / r["threads"])
         assert 0 <= r["prefetch_iterations"] <= r["iterations"]
     assert r2["speedup"] > 0 and math.isfinite(r2["speedup"])
-    # the round trip between the first two CPUs, where threads can be pinned (Linux, two CPUs)
-    trip = r1["core_round_trip_ns"]
+    # the round trip between the first two CPUs before every round, where threads can be pinned
+    # (Linux, two CPUs)
+    trips = r1["core_round_trip_ns"]
+    assert len(trips) == 2
     if sys.platform.startswith("linux") and len(os.sched_getaffinity(0)) >= 2:
-        assert trip is not None and 0 < trip < 1e6
+        assert all(t is not None and 0 < t < 1e6 for t in trips)
     else:
-        assert trip is None
+        assert trips == [None, None]
+
+
+def test_microbench_splits_the_speed_ups_of_rounds_at_two_core_to_core_latencies():
+    import microbench
+
+    assert microbench._latency_column([44.0, 50.0, 46.0]) == "44"
+    assert microbench._latency_column([44.0, 370.0]) == "44–370"
+    assert microbench._latency_column([None, None]) == "n/a"
+    # one latency: nothing to split
+    assert microbench._split_speedups([44.0, 47.0, 45.0], [1.8, 1.7, 1.9]) is None
+    assert microbench._split_speedups([None, None], [1.8, 1.7]) is None
+    # two: the medians of each side of the geometric midpoint (about 127 ns here)
+    split = microbench._split_speedups([44.0, 370.0, 46.0, 360.0, 45.0], [1.80, 1.50, 1.82, 1.55, 1.78])
+    assert split == "speed-up 1.80 in 3 rounds at 44–46 ns, 1.52 in 2 rounds at 360–370 ns"
 
 
 def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):
