@@ -92,12 +92,17 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
     rows = []
     print(f"sphere r=0.5, two-layer, sol.stats (native solve: preparation and sweeps), {repeats} interleaved rounds (medians); {cores} cores")
     print(f"{'scheme':8} {'N':>5} {'sweeps':>7} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} "
-          f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8}")
+          f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8} {'core-to-core ns':>15}")
+    multi = len(tlist) > 1
+    notes = []
     for h in schemes:
         for n in sizes:
             cases = [(paper, t) for paper in (True, False) for t in tlist]
             runs: Dict[Any, List[Dict[str, Any]]] = {c: [] for c in cases}
+            trips: List[Optional[float]] = []
             for _ in range(repeats):
+                # the latency between the two cores right before the round's runs
+                trips.append(core_round_trip_ns() if multi else None)
                 for paper, t in cases:
                     runs[(paper, t)].append(measure(n, h, t, 2, paper))
             secs = {c: [r["seconds"][-1] for r in runs[c]] for c in cases}  # the warm (second) solve
@@ -107,12 +112,19 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
                 r["sweep_s"] = med
                 r["updates_per_s"] = r["updates"] / med if med > 0 else float("nan")
                 r["per_core"] = r["updates_per_s"] / t
-                r["speedup"] = statistics.median(a / b for a, b in zip(secs[(paper, tlist[0])], secs[(paper, t)]))
+                ratios = [a / b for a, b in zip(secs[(paper, tlist[0])], secs[(paper, t)])]
+                r["speedup"] = statistics.median(ratios)
                 r["vs_paper"] = statistics.median(a / b for a, b in zip(secs[(True, t)], secs[(paper, t)]))
+                r["core_round_trip_ns"] = trips
                 rows.append(r)
                 print(f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
                       f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
-                      f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f}", flush=True)
+                      f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f} "
+                      f"{_latency_column(trips) if multi else '':>15}", flush=True)
+                split = _split_speedups(trips, ratios) if t != tlist[0] else None
+                if split:
+                    notes.append(f"  {h}, N = {n}, {r['sweeps']} sweeps, {t} threads: {split}")
+    _print_split_notes(notes)
     return rows
 
 
@@ -162,6 +174,12 @@ def _split_speedups(trips: List[Optional[float]], speedups: List[float]) -> Opti
     far = [s for t, s in pairs if t >= mid]
     return (f"speed-up {statistics.median(near):.2f} in {len(near)} rounds at {lo:.0f}–{max(t for t, _ in pairs if t < mid):.0f} ns, "
             f"{statistics.median(far):.2f} in {len(far)} rounds at {min(t for t, _ in pairs if t >= mid):.0f}–{hi:.0f} ns")
+
+
+def _print_split_notes(notes: List[str]) -> None:
+    if notes:
+        print("rounds at two core-to-core latencies (examples/core_to_core.rs, measured before each round):")
+        print("\n".join(notes))
 
 
 def kernel_once(example: Path, n: int, threads: int) -> Dict[str, Any]:
@@ -217,9 +235,7 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
             split = _split_speedups(trips, ratios) if t != tlist[0] else None
             if split:
                 notes.append(f"  N = {n}, {t} threads: {split}")
-    if notes:
-        print("rounds at two core-to-core latencies (examples/core_to_core.rs, measured before each round):")
-        print("\n".join(notes))
+    _print_split_notes(notes)
     return rows
 
 

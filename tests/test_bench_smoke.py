@@ -260,6 +260,11 @@ def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_th
     # the default sweeps solve the same equations with fewer local updates
     assert by[("default", 1)]["updates"] < by[("paper", 1)]["updates"]
     assert by[("default", 2)]["vs_paper"] > 0
+    # one core-to-core round trip per round, where threads can be pinned
+    trips = rows[0]["core_round_trip_ns"]
+    assert len(trips) == 2 and all(r["core_round_trip_ns"] == trips for r in rows)
+    if sys.platform.startswith("linux") and len(os.sched_getaffinity(0)) >= 2:
+        assert all(t is not None and 0 < t < 1e6 for t in trips)
 
 
 def test_microbench_times_the_flag_free_kernel_with_the_same_work_on_every_thread_count():
