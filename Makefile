@@ -48,6 +48,10 @@ test-python: build
 bench: build
 	$(PIP) install -q potpourri3d pygeodesic scikit-fmm geographiclib
 	$(PY) benches/run.py
+	# issue 7's other targets: the sphere at N = 1001 and 2001, and the kernel's updates per
+	# second per core and 2-core speed-up
+	$(PY) benches/run.py --scale
+	$(PY) benches/microbench.py --sizes 101,201,401 --schemes godunov --repeats 5
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce
