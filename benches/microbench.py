@@ -29,7 +29,7 @@ round trip of a cache line between the first two CPUs (the Rust ``core_to_core``
 prints the rounds' range: the parallel sweeps pass values and flags between the cores at every
 tile, so the speed-up falls as that latency grows, and on a virtual machine the latency is the
 host's placement of the virtual CPUs, which can change within minutes (this machine has shown
-about 45 and about 370 ns). When a size's rounds ran at both, it also prints the median
+about 42 ns and 360–400 ns). When a size's rounds ran at both, it also prints the median
 speed-up of each group.
 
     .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3] [--kernel-sizes 101,201,401]
@@ -139,41 +139,70 @@ def build_sphere_example() -> Path:
     return SPHERE_EXAMPLE
 
 
+_CORE_TO_CORE_BUILT = False
+
+
 def core_round_trip_ns(trips: int = 50_000) -> Optional[float]:
     """The Rust ``core_to_core`` example's median round trip of a cache line between the first two
-    CPUs (ns), or None where it cannot pin threads. The parallel sweeps hand values and flags from
-    core to core at every tile, so their speed-up falls as this grows; on a virtual machine it is
-    the host's placement of the virtual CPUs, and it can change between runs, even within one."""
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "core_to_core"],
-                   cwd=str(REPO), check=True)
-    cp = subprocess.run([str(CORE_TO_CORE_EXAMPLE), str(trips)], capture_output=True, text=True, check=True)
+    CPUs (ns), or None where it cannot be measured (no Rust toolchain, not Linux, fewer than two
+    CPUs, pinning refused, or no answer within a minute). The parallel sweeps hand values and flags
+    from core to core at every tile, so their speed-up falls as this grows; on a virtual machine it
+    is the host's placement of the virtual CPUs, and it can change between runs, even within one.
+    The example is built at the first call."""
+    global _CORE_TO_CORE_BUILT
+    try:
+        if not _CORE_TO_CORE_BUILT:
+            subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "core_to_core"],
+                           cwd=str(REPO), check=True)
+            _CORE_TO_CORE_BUILT = True
+        cp = subprocess.run([str(CORE_TO_CORE_EXAMPLE), str(trips)], capture_output=True, text=True, check=True,
+                            timeout=60)
+    except (OSError, subprocess.SubprocessError):
+        return None
     m = re.search(r"round_trip_ns=([0-9.]+)", cp.stdout)
     return float(m.group(1)) if m else None
 
 
+# rounds whose core-to-core round trips differ by more than this factor are shown as a range and
+# their speed-ups split into the nearer and the farther rounds
+_LATENCY_SPREAD = 1.5
+
+
 def _latency_column(trips: List[Optional[float]]) -> str:
-    """The rounds' core-to-core round trips as ``median`` or ``min–max`` (ns)."""
+    """The rounds' core-to-core round trips (ns): the smallest when they agree to within
+    ``_LATENCY_SPREAD``, else ``min–max``; ``n/a`` when none was measured."""
     got = [t for t in trips if t is not None]
     if not got:
         return "n/a"
     lo, hi = min(got), max(got)
-    return f"{lo:.0f}" if hi < 1.5 * lo else f"{lo:.0f}–{hi:.0f}"
+    return f"{lo:.0f}" if hi < _LATENCY_SPREAD * lo else f"{lo:.0f}–{hi:.0f}"
+
+
+def _ns_range(values: List[float]) -> str:
+    lo, hi = min(values), max(values)
+    return f"{lo:.0f} ns" if round(lo) == round(hi) else f"{lo:.0f}–{hi:.0f} ns"
 
 
 def _split_speedups(trips: List[Optional[float]], speedups: List[float]) -> Optional[str]:
-    """When the rounds ran at two latencies (the host moved the virtual CPUs), the median
-    speed-up of the rounds on either side of the geometric midpoint."""
-    pairs = [(t, s) for t, s in zip(trips, speedups) if t is not None]
+    """When the rounds ran at two latencies (the host moved the virtual CPUs: the largest round
+    trip at least ``_LATENCY_SPREAD`` times the smallest), the median speed-up of the rounds on
+    either side of the geometric midpoint; None otherwise, or without two measured rounds."""
+    pairs = [(t, s) for t, s in zip(trips, speedups) if t is not None and t > 0]
     if len(pairs) < 2:
         return None
     lo, hi = min(t for t, _ in pairs), max(t for t, _ in pairs)
-    if hi < 2 * lo:
+    if hi < _LATENCY_SPREAD * lo:
         return None
     mid = (lo * hi) ** 0.5
-    near = [s for t, s in pairs if t < mid]
-    far = [s for t, s in pairs if t >= mid]
-    return (f"speed-up {statistics.median(near):.2f} in {len(near)} rounds at {lo:.0f}–{max(t for t, _ in pairs if t < mid):.0f} ns, "
-            f"{statistics.median(far):.2f} in {len(far)} rounds at {min(t for t, _ in pairs if t >= mid):.0f}–{hi:.0f} ns")
+    near = [(t, s) for t, s in pairs if t < mid]
+    far = [(t, s) for t, s in pairs if t >= mid]
+
+    def group(g: List[Any]) -> str:
+        n = len(g)
+        return (f"{statistics.median(s for _, s in g):.2f} in {n} round{'s' if n > 1 else ''} at "
+                f"{_ns_range([t for t, _ in g])}")
+
+    return f"speed-up {group(near)}, {group(far)}"
 
 
 def _print_split_notes(notes: List[str]) -> None:

@@ -260,11 +260,12 @@ def test_microbench_interleaves_the_cases_and_reports_the_same_work_for_every_th
     # the default sweeps solve the same equations with fewer local updates
     assert by[("default", 1)]["updates"] < by[("paper", 1)]["updates"]
     assert by[("default", 2)]["vs_paper"] > 0
-    # one core-to-core round trip per round, where threads can be pinned
+    # one core-to-core round trip per round, where threads can be pinned (a measured figure:
+    # only its presence is checked)
     trips = rows[0]["core_round_trip_ns"]
-    assert len(trips) == 2 and all(r["core_round_trip_ns"] == trips for r in rows)
+    assert len(trips) == 2
     if sys.platform.startswith("linux") and len(os.sched_getaffinity(0)) >= 2:
-        assert all(t is not None and 0 < t < 1e6 for t in trips)
+        assert all(t is not None and math.isfinite(t) for t in trips)
 
 
 def test_microbench_times_the_flag_free_kernel_with_the_same_work_on_every_thread_count():
@@ -283,11 +284,11 @@ def test_microbench_times_the_flag_free_kernel_with_the_same_work_on_every_threa
         assert 0 <= r["prefetch_iterations"] <= r["iterations"]
     assert r2["speedup"] > 0 and math.isfinite(r2["speedup"])
     # the round trip between the first two CPUs before every round, where threads can be pinned
-    # (Linux, two CPUs)
+    # (Linux, two CPUs; a measured figure: only its presence is checked)
     trips = r1["core_round_trip_ns"]
     assert len(trips) == 2
     if sys.platform.startswith("linux") and len(os.sched_getaffinity(0)) >= 2:
-        assert all(t is not None and 0 < t < 1e6 for t in trips)
+        assert all(t is not None and math.isfinite(t) for t in trips)
     else:
         assert trips == [None, None]
 
@@ -297,13 +298,22 @@ def test_microbench_splits_the_speed_ups_of_rounds_at_two_core_to_core_latencies
 
     assert microbench._latency_column([44.0, 50.0, 46.0]) == "44"
     assert microbench._latency_column([44.0, 370.0]) == "44–370"
+    assert microbench._latency_column([44.0, None, 70.0]) == "44–70"
     assert microbench._latency_column([None, None]) == "n/a"
-    # one latency: nothing to split
+    # one latency (within the spread of 1.5): nothing to split
     assert microbench._split_speedups([44.0, 47.0, 45.0], [1.8, 1.7, 1.9]) is None
     assert microbench._split_speedups([None, None], [1.8, 1.7]) is None
-    # two: the medians of each side of the geometric midpoint (about 127 ns here)
-    split = microbench._split_speedups([44.0, 370.0, 46.0, 360.0, 45.0], [1.80, 1.50, 1.82, 1.55, 1.78])
-    assert split == "speed-up 1.80 in 3 rounds at 44–46 ns, 1.52 in 2 rounds at 360–370 ns"
+    assert microbench._split_speedups([44.0, None], [1.8, 1.7]) is None
+    # a zero (a broken measurement) is left out rather than dividing the rounds at 0
+    assert microbench._split_speedups([0.0, 44.0, 45.0], [1.0, 1.8, 1.7]) is None
+    # two: the medians of each side of the geometric midpoint (about 127 ns here); unmeasured
+    # rounds are left out
+    split = microbench._split_speedups([44.0, 370.0, 46.0, 360.0, 45.0, None], [1.80, 1.40, 1.82, 1.60, 1.78, 1.0])
+    assert split == "speed-up 1.80 in 3 rounds at 44–46 ns, 1.50 in 2 rounds at 360–370 ns"
+    # a spread between 1.5 and 2 shows as a range and splits too; one round prints one figure
+    assert microbench._latency_column([40.0, 70.0]) == "40–70"
+    assert microbench._split_speedups([40.0, 70.0, 41.0], [1.8, 1.6, 1.7]) == (
+        "speed-up 1.75 in 2 rounds at 40–41 ns, 1.60 in 1 round at 70 ns")
 
 
 def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):

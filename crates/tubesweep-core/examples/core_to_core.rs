@@ -21,8 +21,18 @@ use std::time::Instant;
 #[repr(align(128))]
 struct Line(AtomicU64);
 
+/// The counter's value that tells the echo thread to stop (a round ended by its time budget).
+const STOP: u64 = u64::MAX;
+
+/// A round ends after this long even if its trips are not done (two threads that cannot run at
+/// once, e.g. under a CPU quota below two, take a scheduler slice per trip).
+const ROUND_BUDGET_S: f64 = 0.25;
+
+/// Spins before a waiting thread yields its CPU once.
+const SPINS_BEFORE_YIELD: u32 = 1 << 16;
+
 fn main() {
-    let trips: u64 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(200_000);
+    let trips: u64 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(200_000).max(2);
     let cpus = match allowed_cpus() {
         Ok(c) if c.len() >= 2 => c,
         Ok(_) => {
@@ -35,40 +45,85 @@ fn main() {
         }
     };
     let (a, b) = (cpus[0], cpus[1]);
-    let mut rounds: Vec<f64> = (0..7).map(|_| round_trip_ns(a, b, trips)).collect();
+    let mut rounds = Vec::new();
+    for _ in 0..7 {
+        match round_trip_ns(a, b, trips) {
+            Ok(ns) => rounds.push(ns),
+            Err(why) => {
+                println!("core_to_core unavailable: {why}");
+                return;
+            }
+        }
+    }
     rounds.sort_by(f64::total_cmp);
     println!("core_to_core cpus={a},{b} round_trip_ns={:.1}", rounds[rounds.len() / 2]);
 }
 
-/// Mean round trip in nanoseconds over `trips` exchanges between CPUs `a` and `b`.
-fn round_trip_ns(a: usize, b: usize, trips: u64) -> f64 {
+/// Waits until `line` holds `want` (or [`STOP`]); false on `STOP`.
+fn wait_for(line: &AtomicU64, want: u64) -> bool {
+    let mut spins = 0u32;
+    loop {
+        let v = line.load(Ordering::Acquire);
+        if v == want {
+            return true;
+        }
+        if v == STOP {
+            return false;
+        }
+        spins += 1;
+        if spins == SPINS_BEFORE_YIELD {
+            spins = 0;
+            std::thread::yield_now();
+        }
+        std::hint::spin_loop();
+    }
+}
+
+/// Mean round trip in nanoseconds over up to `trips` exchanges between CPUs `a` and `b` (fewer
+/// when [`ROUND_BUDGET_S`] runs out); an error when a thread cannot be pinned.
+fn round_trip_ns(a: usize, b: usize, trips: u64) -> Result<f64, String> {
     let line = Arc::new(Line(AtomicU64::new(0)));
     let other = Arc::clone(&line);
-    let echo = std::thread::spawn(move || {
-        pin(b);
+    let echo = std::thread::spawn(move || -> Result<(), String> {
+        let pinned = pin(b);
+        if pinned.is_err() {
+            other.0.store(STOP, Ordering::Release);
+            return pinned;
+        }
         for i in 0..trips {
-            while other.0.load(Ordering::Acquire) != 2 * i + 1 {
-                std::hint::spin_loop();
+            if !wait_for(&other.0, 2 * i + 1) {
+                return Ok(());
             }
             other.0.store(2 * i + 2, Ordering::Release);
         }
+        Ok(())
     });
-    pin(a);
-    // let the other thread reach its CPU and its loop before the clock starts
-    line.0.store(1, Ordering::Release);
-    while line.0.load(Ordering::Acquire) != 2 {
-        std::hint::spin_loop();
-    }
-    let t0 = Instant::now();
-    for i in 1..trips {
-        line.0.store(2 * i + 1, Ordering::Release);
-        while line.0.load(Ordering::Acquire) != 2 * i + 2 {
-            std::hint::spin_loop();
+    let result = (|| {
+        pin(a)?;
+        // let the other thread reach its CPU and its loop before the clock starts
+        line.0.store(1, Ordering::Release);
+        if !wait_for(&line.0, 2) {
+            return Err("the echo thread stopped".to_string());
         }
-    }
-    let secs = t0.elapsed().as_secs_f64();
-    echo.join().expect("the echo thread does not panic");
-    secs * 1e9 / (trips - 1).max(1) as f64
+        let t0 = Instant::now();
+        let mut done = 0u64;
+        for i in 1..trips {
+            line.0.store(2 * i + 1, Ordering::Release);
+            if !wait_for(&line.0, 2 * i + 2) {
+                return Err("the echo thread stopped".to_string());
+            }
+            done += 1;
+            if done % 1024 == 0 && t0.elapsed().as_secs_f64() > ROUND_BUDGET_S {
+                break;
+            }
+        }
+        Ok(t0.elapsed().as_secs_f64() * 1e9 / done as f64)
+    })();
+    // release the echo thread if the round ended early or failed
+    line.0.store(STOP, Ordering::Release);
+    let echoed = echo.join().map_err(|_| "the echo thread panicked".to_string())?;
+    echoed?;
+    result
 }
 
 #[cfg(target_os = "linux")]
@@ -91,14 +146,19 @@ fn allowed_cpus() -> Result<Vec<usize>, String> {
 
 /// Pins the calling thread to CPU `cpu`.
 #[cfg(target_os = "linux")]
-fn pin(cpu: usize) {
+fn pin(cpu: usize) -> Result<(), String> {
     // SAFETY: as in `allowed_cpus`
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
         libc::CPU_SET(cpu, &mut set);
-        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
+        if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
+            return Err(format!("sched_setaffinity to CPU {cpu} failed: {}", std::io::Error::last_os_error()));
+        }
     }
+    Ok(())
 }
 
 #[cfg(not(target_os = "linux"))]
-fn pin(_cpu: usize) {}
+fn pin(_cpu: usize) -> Result<(), String> {
+    Err("pinning threads to CPUs is implemented for Linux only".into())
+}

@@ -43,10 +43,10 @@ pub struct NarrowBand<const D: usize> {
 }
 
 /// A borrowed view of a band's neighbour table: the arrays' addresses and the sentinel. The sweep
-/// kernel writes the values through a raw pointer, which the compiler must assume may change
-/// anything reachable through a reference, so it would load the table's addresses again from the
-/// band at every node; held in a local copy (registers), they are loaded once per row.
-#[derive(Debug, Clone, Copy)]
+/// kernel copies it once per row, so that the table's addresses stay in registers instead of
+/// being loaded from the band again at every node after each write of a value
+/// (docs/architecture.md, "The kernel's arrays in registers").
+#[derive(Clone, Copy)]
 pub struct NeighbourTable<'a, const D: usize> {
     lead: &'a [u32],
     along_row: &'a [u8],
@@ -66,7 +66,7 @@ impl<const D: usize> NeighbourTable<'_, D> {
     /// `n` is a node of the band.
     #[inline(always)]
     pub unsafe fn neighbours_of_unchecked(&self, n: usize) -> [[u32; 2]; D] {
-        debug_assert!((n as u32) < self.sentinel);
+        debug_assert!(n < self.sentinel as usize);
         let sentinel = self.sentinel;
         let mut nb = [[sentinel; 2]; D];
         let base = n * 2 * (D - 1);

@@ -708,7 +708,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         }
         // per row: may a node be active (all at the start; the last slot stands for "no row")
         let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
-        let shared = SharedValues { ptr: u.as_mut_ptr(), len: u.len() };
+        let shared = SharedValues::new(u);
         let all_active = !options.skip_inactive;
         debug_assert!(!(all_active && window_width > 0.0), "the front window runs only with the active flags");
         // the plain sweeps update every node that starts active (all but the fixed nodes and the
@@ -1183,6 +1183,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let f = unsafe { arr.h_times_slowness::<P>(n) };
         let mut self_dependent = false;
         let candidate = if S == GODUNOV {
+            debug_assert!(!f.is_nan(), "a constant slowness dispatched as per-node (P = false with Slowness::PerNode)");
             let mut mins = [0.0; D];
             let mask = if arr.coupling.is_empty() { 0 } else { unsafe { *arr.coupling.get_unchecked(n) } };
             if mask == 0 {
@@ -1210,6 +1211,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 godunov_update_coupled(mins, coef, f)
             }
         } else if S == LXF {
+            debug_assert!(!f.is_nan(), "a constant slowness dispatched as per-node (P = false with Slowness::PerNode)");
             if self.missing == MissingNeighbour::Extrapolate {
                 self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, f, &mut minus, &mut plus);
             }
@@ -1233,13 +1235,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 }
 
 /// What the kernel reads at a node, copied from the problem and the sweep context once per row.
-/// The values are written through a raw pointer ([`SharedValues`]), so the compiler must assume
-/// that a write may change anything reachable through a reference, and would load these
-/// addresses again from the problem and the context at every node; held in locals, they stay in
-/// registers.
+/// The values are written through a raw pointer ([`SharedValues`]); read through the problem and
+/// the context, these addresses were loaded again from memory at every node after such a write
+/// (seen in the generated row loop), while held in locals they stay in registers: the same bits,
+/// 0.97–0.99 of the sweep time (docs/architecture.md, "The kernel's arrays in registers").
 #[derive(Clone, Copy)]
 struct NodeArrays<'k, const D: usize> {
-    u: SharedValues,
+    u: SharedValues<'k>,
     roles: &'k [NodeRole],
     table: NeighbourTable<'k, D>,
     weights: &'k [[f32; D]],
@@ -1248,7 +1250,9 @@ struct NodeArrays<'k, const D: usize> {
     cyclic: &'k [u8],
     /// The per-node slowness; empty when it is constant.
     slowness_per_node: &'k [f64],
-    /// `h / F`, the right-hand side of the local solvers, when the slowness is constant.
+    /// `h / F`, the right-hand side of the local solvers, when the slowness is constant; NaN
+    /// when it is given per node (then only [`Self::h_times_slowness`] with `P = true` is used,
+    /// and a general Hamiltonian, which takes its slowness from the Hamiltonian, reads neither).
     h_times_constant_slowness: f64,
     spacing: f64,
 }
@@ -1257,10 +1261,12 @@ impl<const D: usize> NodeArrays<'_, D> {
     /// `h / F(x_n)` at node `n` (`P`: the slowness is given per node).
     ///
     /// # Safety
-    /// `n` is a node of the band (the per-node slowness has the band's length, checked in
-    /// `SweepProblem::check`).
+    /// `n` is a node of the band, and `P` is set exactly when the slowness is given per node (as
+    /// the `specialised!` dispatch sets it; the per-node slowness has the band's length, checked
+    /// in `SweepProblem::check`).
     #[inline(always)]
     unsafe fn h_times_slowness<const P: bool>(&self, n: usize) -> f64 {
+        debug_assert!(!P || n < self.slowness_per_node.len(), "P = true without a per-node slowness");
         if P {
             self.spacing * *self.slowness_per_node.get_unchecked(n)
         } else {
@@ -1427,6 +1433,39 @@ mod tests {
 
     // elsewhere the sweeps never prefetch (`row_prefetch_ahead`), so there is nothing to count
     #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn a_constant_slowness_gives_the_bits_of_the_same_slowness_given_per_node() {
+        // The kernel takes h/F once per row for a constant slowness and h·s[n] at every node for
+        // a per-node one (`NodeArrays::h_times_slowness`): the same product, so the same bits.
+        let (band, roles, dirs, h) = sphere_band(41);
+        let c = 0.7;
+        let per_node = vec![c; band.len()];
+        for (scheme, coupled, skip_inactive, front_window) in [
+            (InnerScheme::Godunov, true, true, DEFAULT_FRONT_WINDOW),
+            (InnerScheme::Godunov, false, true, 0.0),
+            (InnerScheme::Godunov, false, false, 0.0),
+            (InnerScheme::LaxFriedrichs, false, true, 0.0),
+        ] {
+            for threads in [1, 2] {
+                let opts = SolveOptions { threads, coupled, skip_inactive, front_window, ..Default::default() };
+                let solve = |slowness| {
+                    let p = SweepProblem { slowness, ..sphere_problem(&band, &roles, &dirs, h, scheme) };
+                    let mut u = vec![0.0; band.len()];
+                    let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+                    assert!(st.converged);
+                    (u, st.updates)
+                };
+                let (a, ua) = solve(Slowness::Constant(c));
+                let (b, ub) = solve(Slowness::PerNode(&per_node));
+                assert_eq!(ua, ub);
+                assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{coupled} {skip_inactive} {threads}");
+                // and the slowness counts: unit speed gives other values
+                let (one, _) = solve(Slowness::Constant(1.0));
+                assert!(a.iter().zip(&one).any(|(x, y)| x != y));
+            }
+        }
+    }
+
     #[test]
     fn prefetching_the_rows_ahead_gives_the_same_bits_and_follows_the_visited_bytes() {
         let (band, roles, dirs, h) = sphere_band(41);

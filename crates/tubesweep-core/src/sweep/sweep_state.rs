@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, AtomicU8, Ordering};
 
 /// What the threads of a sweep share.
 pub(super) struct SweepContext<'a, const D: usize> {
-    pub(super) u: &'a SharedValues,
+    pub(super) u: &'a SharedValues<'a>,
     pub(super) active: &'a [AtomicU8],
     pub(super) weights: &'a [[f32; D]],
     /// Per inner node, bit `2k + side` set when the neighbour `nb[k][side]` is an extension-layer
@@ -217,16 +217,24 @@ pub(super) struct Limits {
 /// The node values, shared by the threads of a parallel sweep. The schedule guarantees that the
 /// tiles processed at the same time write disjoint nodes and read no node another tile writes
 /// (see [`crate::schedule`]), so unsynchronised access is race-free.
+/// Copies (held in registers by the row loop) borrow the values for `'a`, like the slice they
+/// were made from.
 #[derive(Clone, Copy)]
-pub(super) struct SharedValues {
-    pub(super) ptr: *mut f64,
-    pub(super) len: usize,
+pub(super) struct SharedValues<'a> {
+    ptr: *mut f64,
+    len: usize,
+    borrowed: std::marker::PhantomData<&'a [std::cell::Cell<f64>]>,
 }
 
-unsafe impl Sync for SharedValues {}
-unsafe impl Send for SharedValues {}
+unsafe impl Sync for SharedValues<'_> {}
+unsafe impl Send for SharedValues<'_> {}
 
-impl SharedValues {
+impl<'a> SharedValues<'a> {
+    /// The values of `u`, borrowed mutably for as long as any copy lives.
+    pub(super) fn new(u: &'a mut [f64]) -> Self {
+        SharedValues { ptr: u.as_mut_ptr(), len: u.len(), borrowed: std::marker::PhantomData }
+    }
+
     #[inline(always)]
     pub(super) fn get(&self, i: usize) -> f64 {
         debug_assert!(i < self.len);
