@@ -29,7 +29,7 @@ round trip of a cache line between the first two CPUs (the Rust ``core_to_core``
 prints the rounds' range: the parallel sweeps pass values and flags between the cores at every
 tile, so the speed-up falls as that latency grows, and on a virtual machine the latency is the
 host's placement of the virtual CPUs, which can change within minutes (this machine has shown
-about 42 ns and 360–400 ns). When a size's rounds ran at both, it also prints the median
+about 42 ns and 360–440 ns). When a size's rounds ran at both, it also prints the median
 speed-up of each group.
 
     .venv/bin/python benches/microbench.py [--sizes 101,201] [--repeats 3] [--kernel-sizes 101,201,401]

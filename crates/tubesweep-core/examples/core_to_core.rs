@@ -7,11 +7,18 @@
 //! The parallel sweeps hand values and "tile done" flags from one core to the next at every
 //! tile (`sweep/strip_pipeline.rs`), so their speed-up on two cores falls as this latency grows.
 //! It is the host's doing, not the program's: on a virtual machine the two virtual CPUs may sit
-//! on one core complex (tens of nanoseconds) or on two (hundreds), and that can change from day
-//! to day. `benches/microbench.py` prints it beside the speed-ups it measures.
+//! on one core complex (tens of nanoseconds) or on two (hundreds); the 2-core machine of
+//! docs/benchmarks.md showed about 42 ns and 360–440 ns, switching within minutes.
+//! `benches/microbench.py` prints it beside the speed-ups it measures. On a machine with more
+//! CPUs, the first two allowed may be one core's two hardware threads, or not the pair a
+//! solve's threads run on.
+//!
+//! A round stops after a quarter of a second even if its trips are not done, and a waiting
+//! thread yields its CPU now and then, so that two threads that cannot run at once (a CPU quota
+//! below two) slow the measurement down instead of hanging it.
 //!
 //! Output: `core_to_core cpus=A,B round_trip_ns=T`, or `core_to_core unavailable: why` (not Linux,
-//! or fewer than two CPUs allowed).
+//! fewer than two CPUs allowed, or a thread that could not be pinned).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
