@@ -108,14 +108,8 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
             secs = {c: [r["seconds"][-1] for r in runs[c]] for c in cases}  # the warm (second) solve
             for paper, t in cases:
                 r = dict(runs[(paper, t)][0])
-                med = statistics.median(secs[(paper, t)])
-                r["sweep_s"] = med
-                r["updates_per_s"] = r["updates"] / med if med > 0 else float("nan")
-                r["per_core"] = r["updates_per_s"] / t
-                ratios = [a / b for a, b in zip(secs[(paper, tlist[0])], secs[(paper, t)])]
-                r["speedup"] = statistics.median(ratios)
+                ratios = _fill_rates(r, secs[(paper, t)], secs[(paper, tlist[0])], t, trips)
                 r["vs_paper"] = statistics.median(a / b for a, b in zip(secs[(True, t)], secs[(paper, t)]))
-                r["core_round_trip_ns"] = trips
                 rows.append(r)
                 print(f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
                       f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
@@ -205,6 +199,20 @@ def _split_speedups(trips: List[Optional[float]], speedups: List[float]) -> Opti
     return f"speed-up {group(near)}, {group(far)}"
 
 
+def _fill_rates(r: Dict[str, Any], secs: List[float], base_secs: List[float], threads: int,
+                trips: List[Optional[float]]) -> List[float]:
+    """Sets a case's median sweep time, its updates per second (in all and per core), its
+    speed-up over the first thread count (the median of the per-round ratios) and the rounds'
+    core-to-core round trips; returns the per-round speed-ups."""
+    r["sweep_s"] = statistics.median(secs)
+    r["updates_per_s"] = r["updates"] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
+    r["per_core"] = r["updates_per_s"] / threads
+    ratios = [a / b for a, b in zip(base_secs, secs)]
+    r["speedup"] = statistics.median(ratios)
+    r["core_round_trip_ns"] = trips
+    return ratios
+
+
 def _print_split_notes(notes: List[str]) -> None:
     if notes:
         print("rounds at two core-to-core latencies (examples/core_to_core.rs, measured before each round):")
@@ -250,12 +258,7 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
         secs = {t: [r["seconds"] for r in runs[t]] for t in tlist}
         for t in tlist:
             r = dict(runs[t][0])
-            r["sweep_s"] = statistics.median(secs[t])
-            r["updates_per_s"] = r["updates"] / r["sweep_s"] if r["sweep_s"] > 0 else float("nan")
-            r["per_core"] = r["updates_per_s"] / t
-            ratios = [a / b for a, b in zip(secs[tlist[0]], secs[t])]
-            r["speedup"] = statistics.median(ratios)
-            r["core_round_trip_ns"] = trips
+            ratios = _fill_rates(r, secs[t], secs[tlist[0]], t, trips)
             rows.append(r)
             print(f"{n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
                   f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "

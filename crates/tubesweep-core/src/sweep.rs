@@ -1181,9 +1181,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let h = arr.spacing;
         // SAFETY: n < band.len()
         let f = unsafe { arr.h_times_slowness::<P>(n) };
+        // NaN only for a per-node slowness dispatched with P = false, which the general
+        // Hamiltonian (taking its slowness from the Hamiltonian) alone may be
+        debug_assert!(S == GENERAL || !f.is_nan(), "a per-node slowness dispatched with P = false");
         let mut self_dependent = false;
         let candidate = if S == GODUNOV {
-            debug_assert!(!f.is_nan(), "a constant slowness dispatched as per-node (P = false with Slowness::PerNode)");
             let mut mins = [0.0; D];
             let mask = if arr.coupling.is_empty() { 0 } else { unsafe { *arr.coupling.get_unchecked(n) } };
             if mask == 0 {
@@ -1211,7 +1213,6 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 godunov_update_coupled(mins, coef, f)
             }
         } else if S == LXF {
-            debug_assert!(!f.is_nan(), "a constant slowness dispatched as per-node (P = false with Slowness::PerNode)");
             if self.missing == MissingNeighbour::Extrapolate {
                 self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, f, &mut minus, &mut plus);
             }
