@@ -18,7 +18,7 @@ Sections:
   (121 and 241 for the curves): none but the double torus's body at N = 41, 4.8 spacings thick.
 * ``spheres``: two spheres as ``min(d₁, d₂)``, 4.5–5.5 spacings apart in 8 random placements
   each: how often the front reaches the second sphere, and how often without a warning.
-* ``meshes``: Spot (``../shared/data/spot.obj``, source vertex 285) at grids 81 and 201, with the
+* ``meshes``: Spot (``ts.data.spot()``, source vertex 285) at grids 81 and 201, with the
   error at every vertex against exact polyhedral geodesics (pygeodesic, MMP; skipped without it),
   and the bunny's facing pairs at grids 101 and 201; then the geodesic paths from 300 random
   vertices that stop short (Spot at grid 81 with three sources, the bunny at 101 and 201) and how
@@ -31,7 +31,6 @@ import argparse
 import os
 import re
 import warnings
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -40,7 +39,6 @@ import numpy as np  # noqa: E402
 import tubesweep as ts  # noqa: E402
 from tubesweep import geodesic_paths  # noqa: E402
 
-DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
 
 def box_mesh(t: float):
@@ -124,7 +122,7 @@ def spheres() -> None:
 
 
 def meshes() -> None:
-    spot_file, bunny_file = DATA / "spot.obj", DATA / "stanford-bunny.obj"
+    spot_file, bunny_file = ts.data.spot(), ts.data.bunny()
     if not spot_file.is_file():
         print(f"meshes: skipped ({spot_file} not found)")
         return

@@ -36,7 +36,6 @@ import os
 import statistics
 import time
 import warnings
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -47,7 +46,7 @@ import tubesweep as ts  # noqa: E402
 euclidean, geodesic_paths, hamiltonians, redistance, solve = (
     importlib.import_module(f"tubesweep.{m}") for m in ("euclidean", "geodesic_paths", "hamiltonians", "redistance", "solve"))
 
-SPOT = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "spot.obj"
+SPOT = ts.data.spot()
 
 
 class patched:
@@ -161,7 +160,7 @@ def sharp_box(sizes: tuple, rounds: int) -> None:
 
 def spot() -> None:
     if not SPOT.is_file():
-        print("spot: skipped (needs ../shared/data/spot.obj)")
+        print("spot: skipped (the bundled spot mesh is missing)")
         return
     mesh = ts.surfaces.from_mesh(SPOT)
     sol = ts.solve(mesh, mesh.grid(81), mesh.vertices[[285, 0, 1000]])

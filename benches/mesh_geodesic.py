@@ -6,7 +6,7 @@ Sect. 5.2) on a mesh from one source vertex, interpolates the solution onto ever
 (MMP algorithm, pygeodesic — a benchmark-only dependency: ``pip install pygeodesic``).
 Errors are reported in units of the grid spacing Δx.
 
-    .venv/bin/python benches/mesh_geodesic.py --mesh ../shared/data/stanford-bunny.obj --n 200 --outer 5
+    .venv/bin/python benches/mesh_geodesic.py --mesh bunny --n 200 --outer 5
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def exact_geodesics(v: np.ndarray, f: np.ndarray, source: int) -> np.ndarray:
 
 def compare(mesh: str, n: int, outer: float, source: int | None = None, hamiltonian: str = "godunov") -> dict:
     t0 = time.perf_counter()
-    surf = ts.surfaces.from_mesh(mesh)
+    surf = ts.surfaces.from_mesh(ts.data.path(mesh) if mesh in ts.data.NAMES else mesh)
     t_load = time.perf_counter() - t0
     grid = surf.grid(n)
     src = surf.default_source_vertex if source is None else int(source)
@@ -66,7 +66,7 @@ def compare(mesh: str, n: int, outer: float, source: int | None = None, hamilton
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--mesh", default=str(Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "stanford-bunny.obj"))
+    p.add_argument("--mesh", default="bunny", help="a mesh file, or bunny / spot for the bundled meshes (default: bunny)")
     p.add_argument("--n", type=int, nargs="+", default=[200])
     p.add_argument("--outer", type=float, default=5.0)
     p.add_argument("--source-vertex", type=int)

@@ -7,7 +7,7 @@ plane, and the time of tracing all 40 together. Then four sources: the share of 
 whose label differs from the nearest source along great circles, among the nodes more than two
 grid spacings from a cell boundary and among the rest, and the time of the labels. Then paths from points on the boundaries of
 two and of three of three sources' regions. Last, on
-the Stanford bunny (``../shared/data``, grid ``surface.grid(n)``) from vertex 0 to 8 random
+the Stanford bunny (``ts.data.bunny()``, grid ``surface.grid(n)``) from vertex 0 to 8 random
 vertices: the paths' lengths and ``u`` against the exact polyhedral geodesic distances
 (pygeodesic, MMP; skipped without it or the data), and the time of the labels at all its vertices
 with two sources. These are the figures of
@@ -99,9 +99,7 @@ def main(sizes: list) -> int:
 
 
 def bunny_rows(sizes: list) -> None:
-    from pathlib import Path
-
-    mesh_file = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "stanford-bunny.obj"
+    mesh_file = ts.data.bunny()
     try:
         import pygeodesic.geodesic as geodesic
     except ImportError:

@@ -42,8 +42,7 @@ import tubesweep as ts
 import tubesweep.surfaces  # noqa: F401  (ts.surfaces)
 
 REPO = Path(__file__).resolve().parents[1]
-DATA = REPO.parent / "shared" / "data"
-BUNNY = DATA / "stanford-bunny.obj"
+BUNNY = ts.data.bunny()
 
 #: Points on the surface where errors are measured (fixed, the same for every method and N).
 N_EVAL = 2000
@@ -300,20 +299,7 @@ def torus(n: int) -> Problem:
 # --------------------------------------------------------------------------------------------
 # Stanford bunny
 # --------------------------------------------------------------------------------------------
-def read_obj(path: Path) -> Tuple[np.ndarray, np.ndarray]:
-    """Vertices (V, 3) and triangles (F, 3) of a Wavefront OBJ file (polygons fanned)."""
-    verts: List[List[float]] = []
-    faces: List[List[int]] = []
-    with open(path) as fh:
-        for line in fh:
-            if line.startswith("v "):
-                verts.append([float(x) for x in line.split()[1:4]])
-            elif line.startswith("f "):
-                idx = [int(tok.split("/")[0]) for tok in line.split()[1:]]
-                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
-                for k in range(1, len(idx) - 1):
-                    faces.append([idx[0], idx[k], idx[k + 1]])
-    return np.asarray(verts, dtype=float), np.asarray(faces, dtype=np.int64)
+read_obj = ts.data.read_obj  # plain or gzip-compressed OBJ, file order kept
 
 
 def compact_mesh(v: np.ndarray, f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:

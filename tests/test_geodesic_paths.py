@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -233,10 +232,9 @@ def test_plot_draws_paths(tmp_path):
         assert sorted(c.get_alpha() for c in red) == [0.3, 1.0]
 
 
-BUNNY = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "stanford-bunny.obj"
+BUNNY = ts.data.bunny()
 
 
-@pytest.mark.skipif(not BUNNY.is_file(), reason="shared bunny mesh not found")
 def test_path_lengths_on_the_bunny_match_exact_polyhedral_geodesics():
     geodesic = pytest.importorskip("pygeodesic.geodesic")
     bunny = ts.surfaces.from_mesh(BUNNY)
@@ -274,10 +272,7 @@ def test_a_path_caught_where_u_barely_decreases_stalls_instead_of_running_in_pla
     # on Spot at grid(81) with three sources the path from vertex 2000 reached a point where u
     # fell only at the rounding level: rounding-level decreases reset the stall count, and it ran
     # on in place, 136 of its 299 points repeating the last one
-    spot_file = Path(__file__).resolve().parents[2] / "shared" / "data" / "spot.obj"
-    if not spot_file.is_file():
-        pytest.skip("needs ../shared/data/spot.obj")
-    spot = ts.surfaces.from_mesh(spot_file)
+    spot = ts.surfaces.from_mesh(ts.data.spot())
     sol = ts.solve(spot, spot.grid(81), spot.vertices[[285, 0, 1000]])
     with pytest.warns(RuntimeWarning, match="stopped before reaching a source") as caught:
         path = sol.geodesic_path(spot.vertices[2000])

@@ -2,7 +2,6 @@
 the band, signed distance of closed meshes, file reading, grids, and solutions against exact
 geodesics (great circles on a sphere mesh, exact polyhedral geodesics on the Stanford bunny)."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,8 +10,7 @@ import tubesweep as ts
 from tubesweep.cli import main
 from tubesweep.surfaces.mesh import FACE, VERT_A, EDGE_BC, MeshSurface, closest_points_on_triangles, from_mesh
 
-DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
-BUNNY = DATA / "stanford-bunny.obj"
+BUNNY = ts.data.bunny()
 
 
 def icosphere(level: int = 3, radius: float = 0.5):
@@ -212,7 +210,6 @@ def test_grid_helper():
         m.grid(n=10, padding=6)
 
 
-@pytest.mark.skipif(not BUNNY.is_file(), reason="shared bunny mesh not found")
 def test_bunny_coarse_against_exact_geodesics():
     bunny = from_mesh(BUNNY)
     assert not bunny.closed  # scanned, holes at the base

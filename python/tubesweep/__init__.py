@@ -28,11 +28,11 @@ from .solve import Solution, solve
 from .tube import Tube
 from .stats import SolveStats
 from .surface import LevelSet, Surface
-from . import surfaces
+from . import data, surfaces
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "export", "flows", "hamiltonians", "plot",
+    "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "data", "export", "flows", "hamiltonians", "plot",
     "solve", "surfaces", "travel_time", "triangulate", "Tube", "__version__",
 ]

@@ -20,7 +20,7 @@ from ._progress import make_progress
 
 EPILOG = """examples:
   tubesweep solve --surface sphere --n 101 --png
-  tubesweep solve --mesh ../shared/data/stanford-bunny.obj --n 200 --outer 5 --export out/bunny.vtu --png
+  tubesweep solve --mesh bunny --n 200 --outer 5 --export out/bunny.vtu --png
   tubesweep solve --mesh spot.obj --source-vertex 0 --export out/spot.ply
   tubesweep solve --surface star --n 401 --hamiltonian lxf --source 0.5 0 --out out/star
   tubesweep solve --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0
@@ -63,8 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=_surface_names(), help="a built-in curve or surface")
     src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
-    src.add_argument("--mesh", type=Path, help="a triangle mesh (.obj .ply .stl .off), used in the closest-point "
-                     "representation (Sect. 5.2): open and scanned meshes with holes are fine")
+    src.add_argument("--mesh", type=Path, help="a triangle mesh file (.obj .ply .stl .off .obj.gz), or 'bunny' / 'spot' "
+                     "for the bundled example meshes; used in the closest-point representation (Sect. 5.2): open and "
+                     "scanned meshes with holes are fine")
     p.add_argument("--n", type=int, default=None,
                    help="nodes per axis for --surface (default: 101); for --mesh, nodes along the longest side of the "
                    "mesh's bounding box, padding included (default: 200)")
@@ -175,12 +176,17 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.mesh:
         from .surfaces.mesh import from_mesh
 
-        surface = from_mesh(args.mesh, normalize=args.normalize)
+        from . import data
+
+        mesh_file = args.mesh
+        if not mesh_file.exists() and str(mesh_file).lower() in data.NAMES:
+            mesh_file = data.path(str(mesh_file))  # a bundled example mesh
+        surface = from_mesh(mesh_file, normalize=args.normalize)
         n = 200 if args.n is None else args.n
         if args.lower is not None or args.upper is not None:
             raise UsageError("--mesh picks its grid from --n and --padding; do not give --lower/--upper")
         grid = surface.grid(n, padding=8.0 if args.padding is None else args.padding)
-        name = args.mesh.stem
+        name = surface.name
         print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
     elif args.surface:
         from .surfaces import REGISTRY

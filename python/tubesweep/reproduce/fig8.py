@@ -21,11 +21,10 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from .. import data
 from ..grid import Grid
 from ..solve import solve
 from ..surface import LevelSet
-
-SHARED_DATA = Path(__file__).resolve().parents[3] / ".." / "shared" / "data"
 
 
 def _torus(p: np.ndarray, big: float = 0.5, small: float = 0.2) -> np.ndarray:
@@ -74,14 +73,10 @@ def _cases(quick: bool) -> List[Dict[str, Any]]:
         lo, hi = getattr(s, "default_box", cube)
         cases.append(dict(name=name, surface=s, grid=Grid(lo, hi, (n_a,) * 3), source=np.asarray(s.default_source),
                           outer=4.0, up="z", exact=None))
-    for fname, n_full, outer in (("stanford-bunny.obj", 200, 5.0), ("spot.obj", 150, 4.0)):
-        path = SHARED_DATA / fname
-        if not path.is_file():
-            print(f"  skipping {fname}: not found at {path}")
-            continue
-        m = from_mesh(path)
+    for key, n_full, outer in (("bunny", 200, 5.0), ("spot", 150, 4.0)):
+        m = from_mesh(data.path(key))
         src = m.default_source_vertex
-        cases.append(dict(name=path.stem, surface=m, grid=m.grid(60 if quick else n_full, padding=outer + 3),
+        cases.append(dict(name=m.name, surface=m, grid=m.grid(60 if quick else n_full, padding=outer + 3),
                           source=m.vertices[src], outer=outer, up="y",
                           exact=lambda v, m=m, src=src: _exact_mesh_geodesics(m.vertices, m.faces, src)))
     return cases

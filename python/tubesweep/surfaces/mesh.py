@@ -52,6 +52,10 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
         raise IsADirectoryError(f"mesh file {str(path)!r} is a directory, not a mesh file")
     if not path.is_file():
         raise FileNotFoundError(f"mesh file {str(path)!r} does not exist")
+    if path.name.lower().endswith(".obj.gz"):  # the bundled example meshes (tubesweep.data)
+        from ..data import read_obj
+
+        return read_obj(path)
     try:
         import trimesh  # noqa: F401
     except ImportError:
@@ -435,7 +439,8 @@ def from_mesh(mesh: Union[str, Path, Tuple[Any, Any]], *, normalize: bool = Fals
 
     Parameters
     ----------
-    mesh : path to an OBJ / PLY / STL / OFF file, or a pair ``(vertices (n, 3), faces (m, 3))``
+    mesh : path to an OBJ / PLY / STL / OFF file (or ``.obj.gz``, e.g. :func:`tubesweep.data.bunny`), or a
+        pair ``(vertices (n, 3), faces (m, 3))``
     normalize : bool
         Move the centre of the bounding box to ``center`` and scale the longest side to ``size``.
         The applied map is kept as ``surface.offset`` / ``surface.scale``.
@@ -446,14 +451,14 @@ def from_mesh(mesh: Union[str, Path, Tuple[Any, Any]], *, normalize: bool = Fals
 
     Examples
     --------
-    >>> bunny = ts.surfaces.from_mesh("../shared/data/stanford-bunny.obj")
+    >>> bunny = ts.surfaces.from_mesh(ts.data.bunny())
     >>> grid = bunny.grid(n=200)
     >>> sol = ts.solve(bunny, grid, sources=[bunny.default_source], outer=5)
     >>> u = sol.on_mesh(bunny.vertices)
     """
     if isinstance(mesh, (str, Path)):
         v, f = read_mesh(mesh)
-        name = Path(mesh).stem
+        name = Path(str(mesh)[:-3] if str(mesh).lower().endswith(".gz") else mesh).stem
     else:
         try:
             v, f = mesh
