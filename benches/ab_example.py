@@ -80,10 +80,18 @@ def main() -> int:
     for i in range(a.rounds):
         if a.mode == "simultaneous":
             core_a, core_b = (0, 1) if i % 2 == 0 else (1, 0)
-            pa = subprocess.Popen(["taskset", "-c", str(core_a)] + command(a.a, a.n, a.scheme, 1), env=env_a,
-                                  stdout=subprocess.PIPE, text=True)
-            pb = subprocess.Popen(["taskset", "-c", str(core_b)] + command(a.b, a.n, a.scheme, 1), env=env_b,
-                                  stdout=subprocess.PIPE, text=True)
+            pa = subprocess.Popen(
+                ["taskset", "-c", str(core_a)] + command(a.a, a.n, a.scheme, 1),
+                env=env_a,
+                stdout=subprocess.PIPE,
+                text=True,
+            )
+            pb = subprocess.Popen(
+                ["taskset", "-c", str(core_b)] + command(a.b, a.n, a.scheme, 1),
+                env=env_b,
+                stdout=subprocess.PIPE,
+                text=True,
+            )
             out_a, out_b = pa.communicate()[0], pb.communicate()[0]
             if pa.returncode or pb.returncode:
                 raise SystemExit(f"a run failed (exit codes {pa.returncode}, {pb.returncode})")
@@ -91,24 +99,31 @@ def main() -> int:
             runs = {}
             for side in ("a", "b") if i % 2 == 0 else ("b", "a"):
                 binary, env = (a.a, env_a) if side == "a" else (a.b, env_b)
-                runs[side] = subprocess.run(command(binary, a.n, a.scheme, a.threads), env=env, check=True,
-                                            stdout=subprocess.PIPE, text=True).stdout
+                runs[side] = subprocess.run(
+                    command(binary, a.n, a.scheme, a.threads), env=env, check=True, stdout=subprocess.PIPE, text=True
+                ).stdout
             out_a, out_b = runs["a"], runs["b"]
         ta.append(sweep_seconds(out_a, a.a))
         tb.append(sweep_seconds(out_b, a.b))
     ratios = sorted(y / x for x, y in zip(ta, tb))
     q = len(ratios) // 4
     threads = 1 if a.mode == "simultaneous" else a.threads
-    print(f"{a.scheme} N={a.n} {a.mode}, {threads} thread(s) each, {a.rounds} rounds: "
-          f"A median {1e3 * statistics.median(ta):.1f} ms, B median {1e3 * statistics.median(tb):.1f} ms")
-    print(f"  B/A per round: median {statistics.median(ratios):.3f} (quartiles {ratios[q]:.3f}–{ratios[-1 - q]:.3f}), "
-          f"B faster in {sum(r < 1 for r in ratios)} of {a.rounds}")
+    print(
+        f"{a.scheme} N={a.n} {a.mode}, {threads} thread(s) each, {a.rounds} rounds: "
+        f"A median {1e3 * statistics.median(ta):.1f} ms, B median {1e3 * statistics.median(tb):.1f} ms"
+    )
+    print(
+        f"  B/A per round: median {statistics.median(ratios):.3f} (quartiles {ratios[q]:.3f}–{ratios[-1 - q]:.3f}), "
+        f"B faster in {sum(r < 1 for r in ratios)} of {a.rounds}"
+    )
 
     def tail(t: List[float]) -> str:
         s = sorted(t)
         slow = sum(x > 1.3 * statistics.median(s) for x in s)
-        return (f"mean {1e3 * statistics.mean(s):.1f} ms, 90th percentile {1e3 * s[int(0.9 * len(s))]:.1f} ms, "
-                f"{slow} of {len(s)} above 1.3 × its median")
+        return (
+            f"mean {1e3 * statistics.mean(s):.1f} ms, 90th percentile {1e3 * s[int(0.9 * len(s))]:.1f} ms, "
+            f"{slow} of {len(s)} above 1.3 × its median"
+        )
 
     # the slow runs a median hides (threads that start on one core, a slow spell)
     print(f"  A: {tail(ta)}")

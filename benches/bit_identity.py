@@ -83,8 +83,9 @@ def cases():
     g101 = _cube(101)
     for threads in (1, 2):  # big enough for the parallel strips, the front window and the row prefetch
         yield f"sphere N=101 {threads}t", _solution(ts.solve(sphere, g101, [(-0.5, 0, 0)], threads=threads))
-        yield f"sphere N=101 lxf {threads}t", _solution(
-            ts.solve(sphere, g101, [(-0.5, 0, 0)], hamiltonian="lxf", threads=threads)
+        yield (
+            f"sphere N=101 lxf {threads}t",
+            _solution(ts.solve(sphere, g101, [(-0.5, 0, 0)], hamiltonian="lxf", threads=threads)),
         )
     yield "sphere speed", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], speed=lambda p: 1.0 + 0.5 * p[:, 2]))
 
@@ -94,7 +95,10 @@ def cases():
     yield "geodesic paths", [m.geodesic_path((0.5, 0.0, 0.0))] + m.geodesic_paths([(0.1, -0.48, 0.1), (0.3, 0.3, 0.3)])
 
     tube = ts.Tube(sphere, g)
-    yield "tube re-solve", _solution(tube.solve([(0, 0, 0.5)])) + _solution(tube.solve([(0, 0, 0.5)], hamiltonian="lxf"))
+    yield (
+        "tube re-solve",
+        _solution(tube.solve([(0, 0, 0.5)])) + _solution(tube.solve([(0, 0, 0.5)], hamiltonian="lxf")),
+    )
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -108,9 +112,20 @@ def cases():
     g2 = _cube(161, 2)
     st = ts.solve(star, g2, [star.default_source])
     yield "star curve", _solution(st) + [st.geodesic_path(-np.asarray(star.default_source))]
-    yield "circle moving medium", _solution(ts.solve(ts.surfaces.Circle(0.5), g2, [(-0.5, 0)], flow=solid_body_rotation(0.5)))
-    yield "circle metric", _solution(
-        ts.solve(ts.surfaces.Circle(0.5), g2, [(-0.5, 0)], hamiltonian=ts.hamiltonians.Metric(np.array([[2.0, 0.3], [0.3, 1.0]])))
+    yield (
+        "circle moving medium",
+        _solution(ts.solve(ts.surfaces.Circle(0.5), g2, [(-0.5, 0)], flow=solid_body_rotation(0.5))),
+    )
+    yield (
+        "circle metric",
+        _solution(
+            ts.solve(
+                ts.surfaces.Circle(0.5),
+                g2,
+                [(-0.5, 0)],
+                hamiltonian=ts.hamiltonians.Metric(np.array([[2.0, 0.3], [0.3, 1.0]])),
+            )
+        ),
     )
     vort = point_vortices([(0.3, 0.2, 0.0), (-0.2, -0.3, 0.0)], [0.1, -0.1], core=0.05)
     yield "sphere vortices", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], flow=vort))
@@ -127,8 +142,14 @@ def cases():
     gb = _cube(81, 2)
     for ham in ("godunov", "lxf"):
         for threads in (1, 2):
-            u, st_ = ts.travel_time(gb, [(0.1, 0.2), (-0.5, -0.5)], speed=lambda p: 1.0 + 0.3 * p[:, 0],
-                                    hamiltonian=ham, threads=threads, return_stats=True)
+            u, st_ = ts.travel_time(
+                gb,
+                [(0.1, 0.2), (-0.5, -0.5)],
+                speed=lambda p: 1.0 + 0.3 * p[:, 0],
+                hamiltonian=ham,
+                threads=threads,
+                return_stats=True,
+            )
             yield f"travel_time 2D {ham} {threads}t", [u, np.array([st_.iterations])]
     yield "travel_time 3D", [ts.travel_time(_cube(31), [(0.1, 0.2, -0.3)], speed=2.0)]
 

@@ -39,8 +39,11 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=201, help="grid nodes along the bunny's longest side")
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--split", action="store_true",
-                    help="also time the queries of the candidates outside the band, of the band, and of its inner tube")
+    ap.add_argument(
+        "--split",
+        action="store_true",
+        help="also time the queries of the candidates outside the band, of the band, and of its inner tube",
+    )
     a = ap.parse_args()
     problem = PROBLEMS["bunny"](a.n)
     surface, grid = problem.surface, problem.grid
@@ -67,10 +70,14 @@ def main() -> int:
         final.append(time.perf_counter() - t)
     threads = os.environ.get("RAYON_NUM_THREADS", "all")
     final_s = statistics.median(final)
-    print(f"bunny N={a.n}: {len(surface.faces)} triangles, {len(candidates):,} candidates, "
-          f"{int((d <= half_width).sum()):,} band nodes; threads {threads}, medians of {a.repeats}")
-    print(f"  coarse-to-fine search {1e3 * statistics.median(coarse):.0f} ms, closest points of the candidates "
-          f"{1e3 * final_s:.0f} ms ({1e9 * final_s / len(candidates):.0f} ns per query)")
+    print(
+        f"bunny N={a.n}: {len(surface.faces)} triangles, {len(candidates):,} candidates, "
+        f"{int((d <= half_width).sum()):,} band nodes; threads {threads}, medians of {a.repeats}"
+    )
+    print(
+        f"  coarse-to-fine search {1e3 * statistics.median(coarse):.0f} ms, closest points of the candidates "
+        f"{1e3 * final_s:.0f} ms ({1e9 * final_s / len(candidates):.0f} ns per query)"
+    )
     if a.split:
         inner_width = 2 * grid.spacing  # the default inner tube
 
@@ -83,8 +90,11 @@ def main() -> int:
                 runs.append(time.perf_counter() - t)
             return statistics.median(runs)
 
-        for label, selected in [("outside the band", d > half_width), ("the band", d <= half_width),
-                                ("the inner tube", d <= inner_width)]:
+        for label, selected in [
+            ("outside the band", d > half_width),
+            ("the band", d <= half_width),
+            ("the inner tube", d <= inner_width),
+        ]:
             s = timed(selected)
             k = int(selected.sum())
             print(f"  {label}: {k:,} queries, {1e3 * s:.0f} ms ({1e9 * s / max(k, 1):.0f} ns per query)")

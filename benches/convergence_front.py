@@ -49,8 +49,10 @@ def tilted_plane(sizes: Sequence[int]) -> None:
     print(f"{'N':>5} {'two-layer':>10} {'naive':>6} {'paper sweeps':>13}")
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
-        its = [ts.solve(lambda p: p @ normal, g, [(0, 0, 0)], **kw).stats.iterations
-               for kw in ({}, {"method": "naive"}, {"paper_sweeps": True})]
+        its = [
+            ts.solve(lambda p: p @ normal, g, [(0, 0, 0)], **kw).stats.iterations
+            for kw in ({}, {"method": "naive"}, {"paper_sweeps": True})
+        ]
         print(f"{n:5d} {its[0]:10d} {its[1]:6d} {its[2]:13d}")
 
 

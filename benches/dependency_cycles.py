@@ -148,7 +148,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--n", type=int, help="grid size (default: 201 for the line, 41 in 3D)")
     args = ap.parse_args(argv)
     warnings.simplefilter("ignore")
-    print(f"{'case':>7s} {'N':>4s} {'band':>7s} {'iters':>5s} {'update':>8s} {'cycles':>6s} {'nodes':>6s} {'largest':>7s} {'gain':>8s}")
+    print(
+        f"{'case':>7s} {'N':>4s} {'band':>7s} {'iters':>5s} {'update':>8s} {'cycles':>6s} {'nodes':>6s} {'largest':>7s} {'gain':>8s}"
+    )
     for name in [args.case] if args.case else ["line2", "plane3", "sphere"]:
         n = args.n or (201 if name == "line2" else 41)
         surface, grid, source = case(name, n)
@@ -159,8 +161,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         graph = reads(sol, geometry.direction)
         for label, g in (("plain", graph), ("coupled", couple(graph, sol.roles))):
             k, nodes, largest, gain = cycles(g)
-            print(f"{name:>7s} {n:>4d} {len(sol.values):>7,d} {sol.stats.iterations:>5d} {label:>8s} {k:>6d} {nodes:>6d} "
-                  f"{largest:>7d} {gain:>8.1e}")
+            print(
+                f"{name:>7s} {n:>4d} {len(sol.values):>7,d} {sol.stats.iterations:>5d} {label:>8s} {k:>6d} {nodes:>6d} "
+                f"{largest:>7d} {gain:>8.1e}"
+            )
     return 0
 
 

@@ -40,7 +40,6 @@ import tubesweep as ts  # noqa: E402
 from tubesweep import geodesic_paths  # noqa: E402
 
 
-
 def box_mesh(t: float):
     """The closed box [−½, ½]² × [−t/2, t/2] as 8 vertices and 12 outward triangles."""
     v = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-t / 2, t / 2)])
@@ -63,7 +62,9 @@ def solve_quietly(surface, grid, sources):
 
 def plate() -> None:
     print("plate: box 1 x 1 x t, source at the top face's centre, u at the bottom face's centre (exact 1 + t)")
-    print(f"  {'t':>5} {'N':>4} {'h':>8} {'warned':>6} {'pairs':>6} {'gap':>8} {'advised h':>9} {'u':>8} {'error/h':>8}")
+    print(
+        f"  {'t':>5} {'N':>4} {'h':>8} {'warned':>6} {'pairs':>6} {'gap':>8} {'advised h':>9} {'u':>8} {'error/h':>8}"
+    )
     for t, sizes in ((0.08, (41, 81, 121, 161)), (1.0, (41, 81))):
         surface = ts.surfaces.from_mesh(box_mesh(t))
         for n in sizes:
@@ -73,8 +74,10 @@ def plate() -> None:
             u = float(sol(np.array([[0.0, 0.0, -t / 2]]))[0])
             st = sol.stats
             advised = st.narrowest_gap / (2 * sol.inner + 2)
-            print(f"  {t:5.2f} {n:4d} {h:8.4f} {str(warned):>6} {st.facing_pairs:6d} {st.narrowest_gap:8.4f} "
-                  f"{advised:9.4f} {u:8.4f} {(u - (1 + t)) / h:8.2f}")
+            print(
+                f"  {t:5.2f} {n:4d} {h:8.4f} {str(warned):>6} {st.facing_pairs:6d} {st.narrowest_gap:8.4f} "
+                f"{advised:9.4f} {u:8.4f} {(u - (1 + t)) / h:8.2f}"
+            )
 
 
 def library() -> None:
@@ -83,7 +86,7 @@ def library() -> None:
         surface = cls()
         lower, upper = surface.default_box
         row = []
-        for n in ((121, 241) if len(lower) == 2 else (41, 81)):
+        for n in (121, 241) if len(lower) == 2 else (41, 81):
             grid = ts.Grid(lower, upper, (n,) * len(lower))
             start = np.array([[0.9, 0.1, 0.1][: len(lower)]])
             src = np.asarray(surface.project(start, grid)[1])
@@ -154,8 +157,10 @@ def meshes() -> None:
             sol, warned, _ = solve_quietly(bunny, bunny.grid(n), bunny.vertices[[0]])
             st = sol.stats
             print(f"  bunny N={n}: warned={warned} pairs={st.facing_pairs} gap={st.narrowest_gap:.5f}")
-    print("geodesic paths from 300 random vertices (seed 1) that stop short, and how many of them end within "
-          f"{geodesic_paths.GAP_REACH:g} spacings (plus half the gap) of a pair across a narrow gap")
+    print(
+        "geodesic paths from 300 random vertices (seed 1) that stop short, and how many of them end within "
+        f"{geodesic_paths.GAP_REACH:g} spacings (plus half the gap) of a pair across a narrow gap"
+    )
     cases = [("spot", spot, 81, [285, 0, 1000])]
     if bunny_file.is_file():
         cases += [("bunny", bunny, 101, [0]), ("bunny", bunny, 201, [0])]

@@ -24,8 +24,19 @@ import numpy as np
 import tubesweep as ts
 import tubesweep.surfaces as tss
 
-NAMES = ("Sphere", "Ellipsoid", "Torus", "DoubleTorus", "RoundedCube", "Hemisphere", "MobiusBand", "PlanePatch",
-         "Disc", "Circle", "Star")
+NAMES = (
+    "Sphere",
+    "Ellipsoid",
+    "Torus",
+    "DoubleTorus",
+    "RoundedCube",
+    "Hemisphere",
+    "MobiusBand",
+    "PlanePatch",
+    "Disc",
+    "Circle",
+    "Star",
+)
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -38,9 +49,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     solve_module = sys.modules["tubesweep.solve"]
     default = solve_module.FRONT_WINDOW
     windows = [float(w) for w in a.windows.split(",")] if a.windows else [default]
-    print(f"N={a.n}, Godunov two-layer, default sweeps; window off → on (FRONT_WINDOW = "
-          f"{', '.join(f'{w:g}' for w in windows)}; default {default:g}), best of {a.repeats}")
-    print(f"{'surface':12s} {'window':>6s} {'iters':>9s} {'updates':>21s} {'ratio':>6s} {'sweep ms':>13s} {'max |Δu|':>9s}")
+    print(
+        f"N={a.n}, Godunov two-layer, default sweeps; window off → on (FRONT_WINDOW = "
+        f"{', '.join(f'{w:g}' for w in windows)}; default {default:g}), best of {a.repeats}"
+    )
+    print(
+        f"{'surface':12s} {'window':>6s} {'iters':>9s} {'updates':>21s} {'ratio':>6s} {'sweep ms':>13s} {'max |Δu|':>9s}"
+    )
     try:
         for name in NAMES:
             surf = getattr(tss, name)()
@@ -59,9 +74,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             fin = np.isfinite(s0.values)
             for w, (s1, t1) in zip(windows, runs[1:]):
                 diff = float(np.max(np.abs(s0.values[fin] - s1.values[fin]))) if fin.any() else 0.0
-                print(f"{name:12s} {w:6g} {s0.stats.iterations:4d}→{s1.stats.iterations:<4d} "
-                      f"{s0.stats.updates:10,d}→{s1.stats.updates:<10,d} "
-                      f"{s1.stats.updates / max(s0.stats.updates, 1):6.2f} {t0 * 1e3:6.0f}→{t1 * 1e3:<6.0f} {diff:9.1e}", flush=True)
+                print(
+                    f"{name:12s} {w:6g} {s0.stats.iterations:4d}→{s1.stats.iterations:<4d} "
+                    f"{s0.stats.updates:10,d}→{s1.stats.updates:<10,d} "
+                    f"{s1.stats.updates / max(s0.stats.updates, 1):6.2f} {t0 * 1e3:6.0f}→{t1 * 1e3:<6.0f} {diff:9.1e}",
+                    flush=True,
+                )
     finally:
         solve_module.FRONT_WINDOW = default
     return 0

@@ -42,9 +42,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 import tubesweep as ts  # noqa: E402
+
 # the modules themselves (``tubesweep.solve`` the attribute is the function)
 euclidean, geodesic_paths, hamiltonians, redistance, solve = (
-    importlib.import_module(f"tubesweep.{m}") for m in ("euclidean", "geodesic_paths", "hamiltonians", "redistance", "solve"))
+    importlib.import_module(f"tubesweep.{m}")
+    for m in ("euclidean", "geodesic_paths", "hamiltonians", "redistance", "solve")
+)
 
 SPOT = ts.data.spot()
 
@@ -77,17 +80,23 @@ def disc() -> None:
 def metric() -> None:
     grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
     with patched(hamiltonians, "check_tolerance_scale", lambda *a, **k: None):
-        sol = ts.solve(ts.surfaces.Sphere(0.5), grid, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(1e30 * np.eye(3)))
-    print(f"metric 1e30·I (check off): {sol.stats.iterations} iterations, {np.isinf(sol.values).mean():.1%} of the band "
-          f"unreached, converged={sol.stats.converged}")
+        sol = ts.solve(
+            ts.surfaces.Sphere(0.5), grid, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(1e30 * np.eye(3))
+        )
+    print(
+        f"metric 1e30·I (check off): {sol.stats.iterations} iterations, {np.isinf(sol.values).mean():.1%} of the band "
+        f"unreached, converged={sol.stats.converged}"
+    )
 
 
 def tiny_speed() -> None:
     grid = ts.Grid((-1, -1), (1, 1), (41, 41))
     with patched(euclidean, "check_tolerance_scale", lambda *a, **k: None):
         u, st = ts.travel_time(grid, [(0, 0)], speed=1e-200, return_stats=True)
-    print(f"travel_time at speed 1e-200 (check off): u(corner)·F = {u[0, 0] * 1e-200:.4g} against √2 = {np.sqrt(2):.4g}, "
-          f"converged={st.converged}")
+    print(
+        f"travel_time at speed 1e-200 (check off): u(corner)·F = {u[0, 0] * 1e-200:.4g} against √2 = {np.sqrt(2):.4g}, "
+        f"converged={st.converged}"
+    )
 
 
 def box_side() -> None:
@@ -96,8 +105,10 @@ def box_side() -> None:
     X, Y = grid.meshgrid()
     exact = ts.solve(ts.surfaces.Circle(0.5), grid, [(-0.5, 0.0)])
     sol = ts.solve(ts.LevelSet(X**2 + Y**2 - 0.25, redistance=True), grid, [(-0.5, 0.0)])
-    print(f"box side: re-distanced band {len(sol.linear)} nodes against the circle's {len(exact.linear)}, "
-          f"{int(np.count_nonzero(~np.isfinite(sol.values)))} at inf, converged={sol.stats.converged}")
+    print(
+        f"box side: re-distanced band {len(sol.linear)} nodes against the circle's {len(exact.linear)}, "
+        f"{int(np.count_nonzero(~np.isfinite(sol.values)))} at inf, converged={sol.stats.converged}"
+    )
 
 
 def retry(rounds: int) -> None:
@@ -118,8 +129,10 @@ def retry(rounds: int) -> None:
             nodes[label] = len(band.linear)
     for label in ("off", "on"):
         ts_ = times[label]
-        print(f"retry {label:3}: band {nodes[label]:,} nodes, band search median {statistics.median(ts_):.2f} s "
-              f"(range {min(ts_):.2f}–{max(ts_):.2f}, {rounds} alternating rounds)")
+        print(
+            f"retry {label:3}: band {nodes[label]:,} nodes, band search median {statistics.median(ts_):.2f} s "
+            f"(range {min(ts_):.2f}–{max(ts_):.2f}, {rounds} alternating rounds)"
+        )
     print(f"  ratio of medians on/off: {statistics.median(times['on']) / statistics.median(times['off']):.2f}")
 
 
@@ -130,6 +143,7 @@ def sharp_box(sizes: tuple, rounds: int) -> None:
     widening, as before the stop) the solve widens the layer four times before its error; now it
     stops at the first widening that brings none of them in. The two alternate, ``rounds`` times;
     the medians of the time to the error and their ratio are printed."""
+
     def box(n):
         grid = ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3)
         X, Y, Z = grid.meshgrid()
@@ -153,9 +167,13 @@ def sharp_box(sizes: tuple, rounds: int) -> None:
                         outcome[label] = f"ValueError: {str(e)[:60]}..."
                     times[label].append(time.perf_counter() - t)
         for label, ts_ in times.items():
-            print(f"sharp box N={n}, {label}: {outcome[label]} median {statistics.median(ts_):.1f} s "
-                  f"(range {min(ts_):.1f}–{max(ts_):.1f}, {rounds} alternating rounds)")
-        print(f"  ratio of medians now/before: {statistics.median(times['now']) / statistics.median(times['widening to the end']):.2f}")
+            print(
+                f"sharp box N={n}, {label}: {outcome[label]} median {statistics.median(ts_):.1f} s "
+                f"(range {min(ts_):.1f}–{max(ts_):.1f}, {rounds} alternating rounds)"
+            )
+        print(
+            f"  ratio of medians now/before: {statistics.median(times['now']) / statistics.median(times['widening to the end']):.2f}"
+        )
 
 
 def spot() -> None:

@@ -50,23 +50,38 @@ def compare(mesh: str, n: int, outer: float, source: int | None = None, hamilton
     err = np.abs(u[ok] - exact[ok]) / grid.spacing
     rel = np.abs(u[ok] - exact[ok]) / np.max(exact[ok])
     return {
-        "mesh": Path(mesh).name, "n": n, "grid": list(grid.shape), "dx": grid.spacing, "outer": outer,
-        "hamiltonian": hamiltonian, "source_vertex": src, "vertices_compared": int(ok.sum()),
+        "mesh": Path(mesh).name,
+        "n": n,
+        "grid": list(grid.shape),
+        "dx": grid.spacing,
+        "outer": outer,
+        "hamiltonian": hamiltonian,
+        "source_vertex": src,
+        "vertices_compared": int(ok.sum()),
         "nan_vertices": int(np.count_nonzero(~np.isfinite(u[ok]))),
-        "band_points": sol.stats.band_points, "iterations": sol.stats.iterations,
-        "seconds_load": round(t_load, 2), "seconds_setup": round(sol.stats.setup_seconds, 2),
-        "seconds_sweeps": round(sol.stats.seconds, 2), "seconds_solve_total": round(t_solve, 2),
-        "seconds_exact_geodesic": round(t_exact, 2), "max_geodesic": float(np.max(exact[ok])),
-        "err_dx_max": float(np.nanmax(err)), "err_dx_mean": float(np.nanmean(err)),
-        "err_dx_median": float(np.nanmedian(err)), "err_dx_p95": float(np.nanpercentile(err, 95)),
-        "err_dx_p99": float(np.nanpercentile(err, 99)), "err_rel_max": float(np.nanmax(rel)),
+        "band_points": sol.stats.band_points,
+        "iterations": sol.stats.iterations,
+        "seconds_load": round(t_load, 2),
+        "seconds_setup": round(sol.stats.setup_seconds, 2),
+        "seconds_sweeps": round(sol.stats.seconds, 2),
+        "seconds_solve_total": round(t_solve, 2),
+        "seconds_exact_geodesic": round(t_exact, 2),
+        "max_geodesic": float(np.max(exact[ok])),
+        "err_dx_max": float(np.nanmax(err)),
+        "err_dx_mean": float(np.nanmean(err)),
+        "err_dx_median": float(np.nanmedian(err)),
+        "err_dx_p95": float(np.nanpercentile(err, 95)),
+        "err_dx_p99": float(np.nanpercentile(err, 99)),
+        "err_rel_max": float(np.nanmax(rel)),
         "err_rel_mean": float(np.nanmean(rel)),
     }
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--mesh", default="bunny", help="a mesh file, or bunny / spot for the bundled meshes (default: bunny)")
+    p.add_argument(
+        "--mesh", default="bunny", help="a mesh file, or bunny / spot for the bundled meshes (default: bunny)"
+    )
     p.add_argument("--n", type=int, nargs="+", default=[200])
     p.add_argument("--outer", type=float, default=5.0)
     p.add_argument("--source-vertex", type=int)

@@ -73,7 +73,9 @@ def marching_cubes_mesh(problem: Problem) -> Tuple[np.ndarray, np.ndarray]:
     return clean_mesh(v, f.astype(np.int64), 1e-7 * h)
 
 
-def interpolate_on_mesh(v: np.ndarray, f: np.ndarray, values: np.ndarray, points: np.ndarray, k: int = 12) -> np.ndarray:
+def interpolate_on_mesh(
+    v: np.ndarray, f: np.ndarray, values: np.ndarray, points: np.ndarray, k: int = 12
+) -> np.ndarray:
     """Linear (barycentric) interpolation of vertex ``values`` at the closest point of the mesh
     to each of ``points`` (closest among the ``k`` triangles with the nearest centroids)."""
     from scipy.spatial import cKDTree
@@ -104,7 +106,7 @@ def interpolate_on_mesh(v: np.ndarray, f: np.ndarray, values: np.ndarray, points
     best_d = np.where(sel, dist, best_d)
     best_u = np.where(sel, la * ua + lb * ub + lc * uc, best_u)
     # edges
-    for (x, y, ux, uy) in ((a, b, ua, ub), (b, c, ub, uc), (c, a, uc, ua)):
+    for x, y, ux, uy in ((a, b, ua, ub), (b, c, ub, uc), (c, a, uc, ua)):
         e = y - x
         ee = np.maximum((e * e).sum(-1), 1e-300)
         t = np.clip(((p - x) * e).sum(-1) / ee, 0.0, 1.0)
@@ -180,11 +182,15 @@ class Tubesweep(Method):
         self.hamiltonian = hamiltonian
         self.tol_h = tol_h
         self.threads = threads
-        self.name = (f"tubesweep-{hamiltonian}" + ("" if tol_h is None else "-tolh")
-                     + ("" if threads == 0 else f"-{threads}t"))
-        self.label = (f"tubesweep ({'Godunov' if hamiltonian == 'godunov' else 'Lax–Friedrichs'}, two-layer"
-                      + ("" if tol_h is None else f", tol = {tol_h:g}·Δx")
-                      + ("" if threads == 0 else f", {threads} thread" + ("s" if threads > 1 else "")) + ")")
+        self.name = (
+            f"tubesweep-{hamiltonian}" + ("" if tol_h is None else "-tolh") + ("" if threads == 0 else f"-{threads}t")
+        )
+        self.label = (
+            f"tubesweep ({'Godunov' if hamiltonian == 'godunov' else 'Lax–Friedrichs'}, two-layer"
+            + ("" if tol_h is None else f", tol = {tol_h:g}·Δx")
+            + ("" if threads == 0 else f", {threads} thread" + ("s" if threads > 1 else ""))
+            + ")"
+        )
 
     def run(self, problem: Problem) -> Outcome:
         kw: Dict[str, Any] = {} if self.tol_h is None else {"tol": self.tol_h * problem.grid.spacing}
@@ -195,9 +201,18 @@ class Tubesweep(Method):
         wall = time.perf_counter() - t0
         st = sol.stats
         return Outcome(
-            sol(problem.eval_points), problem.exact,
-            dict(wall=wall, sweep_s=st.seconds, setup_s=st.setup_seconds, band_points=st.band_points,
-                 iterations=st.iterations, updates=st.updates, converged=st.converged, band_bytes=st.band_bytes),
+            sol(problem.eval_points),
+            problem.exact,
+            dict(
+                wall=wall,
+                sweep_s=st.seconds,
+                setup_s=st.setup_seconds,
+                band_points=st.band_points,
+                iterations=st.iterations,
+                updates=st.updates,
+                converged=st.converged,
+                band_bytes=st.band_bytes,
+            ),
         )
 
 
@@ -234,7 +249,9 @@ class SkfmmTube(Method):
         u = np.ma.MaskedArray(np.where(np.ma.getdata(psi) < 0, r, np.ma.getdata(d) + radius), np.ma.getmaskarray(d))
         wall = time.perf_counter() - t0
         vals = interpolate_dense(u, grid, problem.eval_points)
-        return Outcome(vals, problem.exact, dict(wall=wall, setup_s=t_tube, band_points=int(len(tube)), dense_nodes=int(grid.size)))
+        return Outcome(
+            vals, problem.exact, dict(wall=wall, setup_s=t_tube, band_points=int(len(tube)), dense_nodes=int(grid.size))
+        )
 
 
 class MeshMethod(Method):
@@ -304,11 +321,22 @@ class MMP(MeshMethod):
         algo = geodesic.PyGeodesicAlgorithmExact(v, f.astype(np.int32))
         dist, _ = algo.geodesicDistances(np.array([src], dtype=np.int32), None)
         wall = time.perf_counter() - t0
-        return Outcome(self.values_at_eval(prepared, np.asarray(dist, dtype=float)), exact, dict(wall=wall, band_points=int(len(v))))
+        return Outcome(
+            self.values_at_eval(prepared, np.asarray(dist, dtype=float)),
+            exact,
+            dict(wall=wall, band_points=int(len(v))),
+        )
 
 
 METHODS: Dict[str, Method] = {
     m.name: m
-    for m in (Tubesweep("godunov"), Tubesweep("godunov", tol_h=1e-3), Tubesweep("godunov", threads=1), Tubesweep("lxf"),
-              SkfmmTube(), Heat(), MMP())
+    for m in (
+        Tubesweep("godunov"),
+        Tubesweep("godunov", tol_h=1e-3),
+        Tubesweep("godunov", threads=1),
+        Tubesweep("lxf"),
+        SkfmmTube(),
+        Heat(),
+        MMP(),
+    )
 }

@@ -64,9 +64,17 @@ def _child(n: int, hamiltonian: str, repeats: int, paper: bool) -> Dict[str, Any
         secs.append(st.seconds)
     assert st is not None
     med = statistics.median(secs)
-    return dict(n=n, hamiltonian=hamiltonian, band_points=st.band_points, iterations=st.iterations,
-                updates=st.updates, sweep_s=med, updates_per_s=st.updates / med if med > 0 else float("nan"),
-                converged=bool(st.converged), seconds=[float(s) for s in secs])
+    return dict(
+        n=n,
+        hamiltonian=hamiltonian,
+        band_points=st.band_points,
+        iterations=st.iterations,
+        updates=st.updates,
+        sweep_s=med,
+        updates_per_s=st.updates / med if med > 0 else float("nan"),
+        converged=bool(st.converged),
+        seconds=[float(s) for s in secs],
+    )
 
 
 def measure(n: int, hamiltonian: str, threads: int, repeats: int, paper: bool = False) -> Dict[str, Any]:
@@ -82,17 +90,25 @@ def measure(n: int, hamiltonian: str, threads: int, repeats: int, paper: bool = 
     raise RuntimeError(f"child failed: {cp.stderr.strip()[-500:]}")
 
 
-def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", "lxf"), repeats: int = 3,
-        threads: Optional[Sequence[int]] = None) -> List[Dict[str, Any]]:
+def run(
+    sizes: Sequence[int] = (101, 201),
+    schemes: Sequence[str] = ("godunov", "lxf"),
+    repeats: int = 3,
+    threads: Optional[Sequence[int]] = None,
+) -> List[Dict[str, Any]]:
     """Runs every (sweeps, threads) case of a scheme and size once per round, ``repeats`` rounds,
     so that the machine's drift affects all cases alike; the speed-up and "× paper" are medians
     of the per-round ratios (the two times of a ratio come from the same round)."""
     cores = os.cpu_count() or 1
     tlist = sorted(set(threads or (1, cores)))
     rows = []
-    print(f"sphere r=0.5, two-layer, sol.stats (native solve: preparation and sweeps), {repeats} interleaved rounds (medians); {cores} cores")
-    print(f"{'scheme':8} {'N':>5} {'sweeps':>7} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} "
-          f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8} {'core-to-core ns':>15}")
+    print(
+        f"sphere r=0.5, two-layer, sol.stats (native solve: preparation and sweeps), {repeats} interleaved rounds (medians); {cores} cores"
+    )
+    print(
+        f"{'scheme':8} {'N':>5} {'sweeps':>7} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} "
+        f"{'sweep ms':>9} {'Mupd/s':>8} {'Mupd/s/core':>11} {'speed-up':>8} {'× paper':>8} {'core-to-core ns':>15}"
+    )
     multi = len(tlist) > 1
     notes = []
     for h in schemes:
@@ -111,10 +127,13 @@ def run(sizes: Sequence[int] = (101, 201), schemes: Sequence[str] = ("godunov", 
                 ratios = _fill_rates(r, secs[(paper, t)], secs[(paper, tlist[0])], t, trips)
                 r["vs_paper"] = statistics.median(a / b for a, b in zip(secs[(True, t)], secs[(paper, t)]))
                 rows.append(r)
-                print(f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
-                      f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
-                      f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f} "
-                      f"{_latency_column(trips) if multi else '':>15}", flush=True)
+                print(
+                    f"{h:8} {n:5d} {r['sweeps']:>7} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} "
+                    f"{r['updates']:13,d} {1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} "
+                    f"{r['per_core'] / 1e6:11.1f} {r['speedup']:8.2f} {r['vs_paper']:8.2f} "
+                    f"{_latency_column(trips) if multi else '':>15}",
+                    flush=True,
+                )
                 split = _split_speedups(trips, ratios) if t != tlist[0] else None
                 if split:
                     notes.append(f"  {h}, N = {n}, {r['sweeps']} sweeps, {t} threads: {split}")
@@ -129,7 +148,9 @@ _EXAMPLE_LINE = re.compile(r"band=(\d+) .*iterations=(\d+) updates=(\d+) sweeps=
 
 def build_sphere_example() -> Path:
     """Builds the Rust ``sphere`` example (cargo's incremental build: seconds when up to date)."""
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "sphere"], cwd=str(REPO), check=True)
+    subprocess.run(
+        ["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "sphere"], cwd=str(REPO), check=True
+    )
     return SPHERE_EXAMPLE
 
 
@@ -146,11 +167,15 @@ def core_round_trip_ns(trips: int = 50_000) -> Optional[float]:
     global _CORE_TO_CORE_BUILT
     try:
         if not _CORE_TO_CORE_BUILT:
-            subprocess.run(["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "core_to_core"],
-                           cwd=str(REPO), check=True)
+            subprocess.run(
+                ["cargo", "build", "--release", "-q", "-p", "tubesweep-core", "--example", "core_to_core"],
+                cwd=str(REPO),
+                check=True,
+            )
             _CORE_TO_CORE_BUILT = True
-        cp = subprocess.run([str(CORE_TO_CORE_EXAMPLE), str(trips)], capture_output=True, text=True, check=True,
-                            timeout=60)
+        cp = subprocess.run(
+            [str(CORE_TO_CORE_EXAMPLE), str(trips)], capture_output=True, text=True, check=True, timeout=60
+        )
     except (OSError, subprocess.SubprocessError):
         return None
     m = re.search(r"round_trip_ns=([0-9.]+)", cp.stdout)
@@ -193,14 +218,17 @@ def _split_speedups(trips: List[Optional[float]], speedups: List[float]) -> Opti
 
     def group(g: List[Any]) -> str:
         n = len(g)
-        return (f"{statistics.median(s for _, s in g):.2f} in {n} round{'s' if n > 1 else ''} at "
-                f"{_ns_range([t for t, _ in g])}")
+        return (
+            f"{statistics.median(s for _, s in g):.2f} in {n} round{'s' if n > 1 else ''} at "
+            f"{_ns_range([t for t, _ in g])}"
+        )
 
     return f"speed-up {group(near)}, {group(far)}"
 
 
-def _fill_rates(r: Dict[str, Any], secs: List[float], base_secs: List[float], threads: int,
-                trips: List[Optional[float]]) -> List[float]:
+def _fill_rates(
+    r: Dict[str, Any], secs: List[float], base_secs: List[float], threads: int, trips: List[Optional[float]]
+) -> List[float]:
     """Sets a case's median sweep time, its updates per second (in all and per core), its
     speed-up over the first thread count (the median of the per-round ratios) and the rounds'
     core-to-core round trips; returns the per-round speed-ups."""
@@ -223,28 +251,45 @@ def kernel_once(example: Path, n: int, threads: int) -> Dict[str, Any]:
     """One run of the example's flag-free sweeps (``PLAIN=1``: every node but the fixed ones
     updated in every sweep, pointwise, the rim in every sweep): the kernel's own rate."""
     env = dict(os.environ, PLAIN="1")
-    cp = subprocess.run([str(example), str(n), "godunov", str(threads)], capture_output=True, text=True, env=env, check=True)
+    cp = subprocess.run(
+        [str(example), str(n), "godunov", str(threads)], capture_output=True, text=True, env=env, check=True
+    )
     m = _EXAMPLE_LINE.search(cp.stdout)
     if m is None:
         raise RuntimeError(f"unexpected output of {example}: {cp.stdout[-500:]}")
     band, iters, updates, secs, prefetched = m.groups()
-    return dict(n=n, threads=threads, band_points=int(band), iterations=int(iters), updates=int(updates),
-                seconds=float(secs), prefetch_iterations=int(prefetched))
+    return dict(
+        n=n,
+        threads=threads,
+        band_points=int(band),
+        iterations=int(iters),
+        updates=int(updates),
+        seconds=float(secs),
+        prefetch_iterations=int(prefetched),
+    )
 
 
-def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads: Optional[Sequence[int]] = None,
-               example: Optional[Path] = None) -> List[Dict[str, Any]]:
+def run_kernel(
+    sizes: Sequence[int] = (101, 201, 401),
+    repeats: int = 3,
+    threads: Optional[Sequence[int]] = None,
+    example: Optional[Path] = None,
+) -> List[Dict[str, Any]]:
     """The 3D Godunov kernel alone: the Rust ``sphere`` example's flag-free sweeps, one run of
     every (size, thread count) per round, ``repeats`` rounds; time = the native solve (no Python,
     no band construction), the speed-up a median of per-round ratios."""
     cores = os.cpu_count() or 1
     tlist = sorted(set(threads or (1, cores)))
     example = example or build_sphere_example()
-    print(f"the kernel alone: Rust sphere example, PLAIN=1 (every node in every sweep), Godunov, "
-          f"{repeats} interleaved rounds (medians); {cores} cores")
+    print(
+        f"the kernel alone: Rust sphere example, PLAIN=1 (every node in every sweep), Godunov, "
+        f"{repeats} interleaved rounds (medians); {cores} cores"
+    )
     multi = len(tlist) > 1
-    print(f"{'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} {'Mupd/s':>8} "
-          f"{'Mupd/s/core':>11} {'speed-up':>8} {'prefetched':>10} {'core-to-core ns':>15}")
+    print(
+        f"{'N':>5} {'threads':>7} {'band pts':>10} {'iters':>5} {'updates':>13} {'sweep ms':>9} {'Mupd/s':>8} "
+        f"{'Mupd/s/core':>11} {'speed-up':>8} {'prefetched':>10} {'core-to-core ns':>15}"
+    )
     rows = []
     notes = []
     for n in sizes:
@@ -260,10 +305,13 @@ def run_kernel(sizes: Sequence[int] = (101, 201, 401), repeats: int = 3, threads
             r = dict(runs[t][0])
             ratios = _fill_rates(r, secs[t], secs[tlist[0]], t, trips)
             rows.append(r)
-            print(f"{n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
-                  f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
-                  f"{r['speedup']:8.2f} {r['prefetch_iterations']:>4d} of {r['iterations']:<3d} "
-                  f"{_latency_column(trips) if multi else '':>15}", flush=True)
+            print(
+                f"{n:5d} {t:7d} {r['band_points']:10,d} {r['iterations']:5d} {r['updates']:13,d} "
+                f"{1e3 * r['sweep_s']:9.1f} {r['updates_per_s'] / 1e6:8.1f} {r['per_core'] / 1e6:11.1f} "
+                f"{r['speedup']:8.2f} {r['prefetch_iterations']:>4d} of {r['iterations']:<3d} "
+                f"{_latency_column(trips) if multi else '':>15}",
+                flush=True,
+            )
             split = _split_speedups(trips, ratios) if t != tlist[0] else None
             if split:
                 notes.append(f"  N = {n}, {t} threads: {split}")
@@ -277,8 +325,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--schemes", default="godunov,lxf")
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", help="thread counts to compare (default: 1 and all cores)")
-    ap.add_argument("--kernel-sizes", default="101,201,401",
-                    help="grid sizes of the kernel-alone table (the Rust example's flag-free sweeps); '' skips it")
+    ap.add_argument(
+        "--kernel-sizes",
+        default="101,201,401",
+        help="grid sizes of the kernel-alone table (the Rust example's flag-free sweeps); '' skips it",
+    )
     ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.child:

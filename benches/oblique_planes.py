@@ -54,7 +54,9 @@ def measure(normal: Sequence[float], n: int) -> Dict[str, float]:
 
 def row(normal: Sequence[float], n: int) -> str:
     m = measure(normal, n)
-    cells = " ".join(f"{int(m[f'{k}_iterations']):>6d} {m[f'{k}_updates_per_node']:>9.2f}" for k in ("paper", "default"))
+    cells = " ".join(
+        f"{int(m[f'{k}_iterations']):>6d} {m[f'{k}_updates_per_node']:>9.2f}" for k in ("paper", "default")
+    )
     return f"{len(normal)}D {n:>5d} {str(tuple(normal)):>16s} {m['tilt']:>6.1f} {int(m['band_points']):>9,d} {cells}"
 
 
@@ -66,7 +68,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     warnings.simplefilter("ignore")  # the planes' φ is exact; nothing to warn about
     print("straight lines and planes with a source on them, two-layer Godunov, inner 2, outer 4")
     print(f"{'':2s} {'':>5s} {'':>16s} {'':>6s} {'':>9s} {'paper sweeps':>16s} {'default sweeps':>16s}")
-    print(f"{'':2s} {'N':>5s} {'normal':>16s} {'tilt°':>6s} {'band pts':>9s} " + " ".join([f"{'iters':>6s} {'upd/node':>9s}"] * 2))
+    print(
+        f"{'':2s} {'N':>5s} {'normal':>16s} {'tilt°':>6s} {'band pts':>9s} "
+        + " ".join([f"{'iters':>6s} {'upd/node':>9s}"] * 2)
+    )
     for normal in NORMALS_2D:
         print(row(normal, args.n2))
     for normal in NORMALS_3D:

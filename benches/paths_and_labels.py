@@ -43,8 +43,10 @@ def starts(m: int, src: np.ndarray, seed: int = 1) -> np.ndarray:
 def main(sizes: list) -> int:
     src = np.array([-R, 0.0, 0.0])
     print("paths: sphere r = 0.5, source (-0.5, 0, 0), 40 starts at least 0.3 from the antipode")
-    print("| N | h | length error max | max / h | u error at the starts, max / h | off the great circle: median | max "
-          "| trace 40 paths |")
+    print(
+        "| N | h | length error max | max / h | u error at the starts, max / h | off the great circle: median | max "
+        "| trace 40 paths |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
@@ -61,9 +63,11 @@ def main(sizes: list) -> int:
             uerr.append(abs(sol(s0[None])[0] - exact))
             nrm = np.cross(s0, src)
             off.append(np.max(np.abs(p @ (nrm / np.linalg.norm(nrm)))))
-        print(f"| {n} | {h:.4g} | {max(err):.2e} | {max(err) / h:.2f} | {max(uerr) / h:.2f} | {np.median(off):.2e} | "
-              f"{max(off):.2e} | "
-              f"{1e3 * took:.0f} ms |")
+        print(
+            f"| {n} | {h:.4g} | {max(err):.2e} | {max(err) / h:.2f} | {max(uerr) / h:.2f} | {np.median(off):.2e} | "
+            f"{max(off):.2e} | "
+            f"{1e3 * took:.0f} ms |"
+        )
     sources = np.array([[R, 0, 0], [-R, 0, 0], [0, 0, R], [0, -R * 0.6, -R * 0.8]])
     print()
     print("labels: the same sphere, four sources; label differs from the nearest source along great circles")
@@ -81,8 +85,10 @@ def main(sizes: list) -> int:
         srt = np.sort(geo, axis=1)
         away = srt[:, 1] - srt[:, 0] > 2 * g.spacing
         wrong = lab != np.argmin(geo, axis=1)
-        print(f"| {n} | {len(lab):,} | {wrong[away].sum()} of {away.sum():,} | {wrong[~away].sum():,} of "
-              f"{(~away).sum():,} ({100 * wrong[~away].mean():.0f}%) | {1e3 * took:.1f} ms |")
+        print(
+            f"| {n} | {len(lab):,} | {wrong[away].sum()} of {away.sum():,} | {wrong[~away].sum():,} of "
+            f"{(~away).sum():,} ({100 * wrong[~away].mean():.0f}%) | {1e3 * took:.1f} ms |"
+        )
     print()
     print("paths from where regions meet: sources (±0.5, 0, 0), (0, 0, 0.5); length error against π/4, in h")
     print("| N | from (0, -0.3, -0.4): two regions | from (0, 0.5, 0): three regions |")
@@ -111,7 +117,9 @@ def bunny_rows(sizes: list) -> None:
     bunny = ts.surfaces.from_mesh(mesh_file)
     v = bunny.vertices
     targets = np.random.default_rng(0).choice(len(v), 8, replace=False)
-    exact = np.array([geodesic.PyGeodesicAlgorithmExact(v, bunny.faces).geodesicDistance(0, int(t))[0] for t in targets])
+    exact = np.array(
+        [geodesic.PyGeodesicAlgorithmExact(v, bunny.faces).geodesicDistance(0, int(t))[0] for t in targets]
+    )
     print()
     print("bunny: from vertex 0 to 8 random vertices, against exact polyhedral geodesics (MMP); errors in h")
     print("| N | h | path length error: mean | max | u error: mean | max |")
@@ -132,8 +140,10 @@ def bunny_rows(sizes: list) -> None:
     t1 = time.perf_counter()
     two.nearest_source(v)
     t2 = time.perf_counter()
-    print(f"\nbunny, two sources, N = {nb}: labels of the {len(two.values):,} band nodes in {1e3 * (t1 - t):.0f} ms, "
-          f"then at its {len(v):,} vertices in {1e3 * (t2 - t1):.0f} ms")
+    print(
+        f"\nbunny, two sources, N = {nb}: labels of the {len(two.values):,} band nodes in {1e3 * (t1 - t):.0f} ms, "
+        f"then at its {len(v):,} vertices in {1e3 * (t2 - t1):.0f} ms"
+    )
 
 
 if __name__ == "__main__":

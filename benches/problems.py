@@ -199,7 +199,9 @@ class Spheroid(ts.surfaces.Ellipsoid):
         slat, slon = self.geodetic(s)
         out = np.empty(len(q))
         for i in range(len(q)):
-            out[i] = geod.Inverse(float(slat[0]), float(slon[0]), float(lat[i]), float(lon[i]), Geodesic.DISTANCE)["s12"]
+            out[i] = geod.Inverse(float(slat[0]), float(slon[0]), float(lat[i]), float(lon[i]), Geodesic.DISTANCE)[
+                "s12"
+            ]
         return out
 
 
@@ -217,9 +219,21 @@ def ellipsoid(n: int) -> Problem:
         phi[near] = surf.signed_distance(x[near])
         return phi.reshape(grid.shape)
 
-    p = Problem("ellipsoid", n, 3, surf, box_grid(n, 3), src, pts, surf.geodesic_distance(pts, src),
-                surf.geodesic_distance, dense)
-    p.notes.append(f"oblate spheroid a={SPHEROID_A}, c={SPHEROID_C} (f={1 - SPHEROID_C / SPHEROID_A:.2f}); exact: geographiclib")
+    p = Problem(
+        "ellipsoid",
+        n,
+        3,
+        surf,
+        box_grid(n, 3),
+        src,
+        pts,
+        surf.geodesic_distance(pts, src),
+        surf.geodesic_distance,
+        dense,
+    )
+    p.notes.append(
+        f"oblate spheroid a={SPHEROID_A}, c={SPHEROID_C} (f={1 - SPHEROID_C / SPHEROID_A:.2f}); exact: geographiclib"
+    )
     return p
 
 
@@ -291,7 +305,9 @@ def torus(n: int) -> Problem:
     def dense(grid: ts.Grid) -> np.ndarray:
         return surf.signed_distance(dense_points(grid)).reshape(grid.shape)
 
-    p = Problem("torus", n, 3, surf, box_grid(n, 3), src, pts, surf.equator_distance(pts, src), surf.equator_distance, dense)
+    p = Problem(
+        "torus", n, 3, surf, box_grid(n, 3), src, pts, surf.equator_distance(pts, src), surf.equator_distance, dense
+    )
     p.notes.append(f"torus R={TORUS_R}, r={TORUS_r}; errors on the outer equator, |Δθ| ≤ {TORUS_MAX_ANGLE} rad")
     return p
 

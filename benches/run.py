@@ -71,8 +71,15 @@ CAPS: Dict[str, Dict[str, int]] = {
 }
 #: dimension of each problem (the mesh peers apply to surfaces in 3D only)
 PROBLEM_DIMS = {"sphere": 3, "ellipsoid": 3, "star": 2, "torus": 3, "bunny": 3}
-METHOD_ORDER = ["tubesweep-godunov", "tubesweep-godunov-tolh", "tubesweep-godunov-1t", "tubesweep-lxf", "skfmm-tube",
-                "heat", "mmp"]
+METHOD_ORDER = [
+    "tubesweep-godunov",
+    "tubesweep-godunov-tolh",
+    "tubesweep-godunov-1t",
+    "tubesweep-lxf",
+    "skfmm-tube",
+    "heat",
+    "mmp",
+]
 SCALE_SIZES = [1001, 2001]
 
 
@@ -183,8 +190,9 @@ def run_child(problem: str, n: int, method: str, repeats: int, timeout: float) -
 # --------------------------------------------------------------------------------------------
 # the run (parent side)
 # --------------------------------------------------------------------------------------------
-def plan(preset: str, cases: Optional[Dict[str, List[int]]] = None, methods: Optional[Sequence[str]] = None
-         ) -> Tuple[List[Tuple[str, int, str]], List[str]]:
+def plan(
+    preset: str, cases: Optional[Dict[str, List[int]]] = None, methods: Optional[Sequence[str]] = None
+) -> Tuple[List[Tuple[str, int, str]], List[str]]:
     """The (problem, N, method) cases to run and notes on what is skipped and why."""
     from methods import METHODS
     from problems import bunny_available
@@ -228,8 +236,11 @@ def plan(preset: str, cases: Optional[Dict[str, List[int]]] = None, methods: Opt
 
 
 def add_ratios(records: List[Dict[str, Any]]) -> None:
-    base = {(r["problem"], r["n"]): r["wall_s"] for r in records
-            if r.get("status") == "ok" and r["method"] == "tubesweep-godunov"}
+    base = {
+        (r["problem"], r["n"]): r["wall_s"]
+        for r in records
+        if r.get("status") == "ok" and r["method"] == "tubesweep-godunov"
+    }
     for r in records:
         b = base.get((r["problem"], r["n"]))
         if r.get("status") == "ok" and b:
@@ -290,11 +301,13 @@ def time_bound_at_error(curve: Sequence[Tuple[float, float]], err: float) -> Opt
 #: the method the peers are compared with at equal error
 EQUAL_ERROR_BASE = "tubesweep-godunov"
 
-EQUAL_ERROR_NOTE = ("At equal accuracy: each case's wall time over the time tubesweep-godunov needs for the same max "
-                    "(mean) error, read off its sizes in this run by log–log interpolation (> 1: tubesweep is faster "
-                    "at equal accuracy). Outside the errors of its sizes, a bound: '>r' where even its coarsest size "
-                    "is more accurate (r: over its cheapest time), '<r' where it would need a finer size than the run "
-                    "has (r: over its most accurate size's time).")
+EQUAL_ERROR_NOTE = (
+    "At equal accuracy: each case's wall time over the time tubesweep-godunov needs for the same max "
+    "(mean) error, read off its sizes in this run by log–log interpolation (> 1: tubesweep is faster "
+    "at equal accuracy). Outside the errors of its sizes, a bound: '>r' where even its coarsest size "
+    "is more accurate (r: over its cheapest time), '<r' where it would need a finer size than the run "
+    "has (r: over its most accurate size's time)."
+)
 
 
 def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
@@ -314,8 +327,9 @@ def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
             if m == EQUAL_ERROR_BASE:
                 continue
             for r in sorted((r for r in ok if r["problem"] == prob and r["method"] == m), key=lambda r: r["n"]):
-                row: Dict[str, Any] = dict(problem=prob, method=m, n=r["n"], max_err=r["max_err"], mean_err=r["mean_err"],
-                                           wall_s=r["wall_s"])
+                row: Dict[str, Any] = dict(
+                    problem=prob, method=m, n=r["n"], max_err=r["max_err"], mean_err=r["mean_err"], wall_s=r["wall_s"]
+                )
                 for kind in ("max", "mean"):
                     curve = [(b[f"{kind}_err"], b["wall_s"]) for b in base]
                     t = time_at_error(curve, r[f"{kind}_err"])
@@ -328,17 +342,25 @@ def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
 
 
 EQUAL_ERROR_COLUMNS = [
-    ("problem", "problem", "str"), ("method", "method", "str"), ("N", "n", "str"), ("max err", "max_err", "err"),
-    ("wall ms", "wall_s", "ms"), ("ts ms at that max err", "ts_at_max_s", "ms"), ("× ts at equal max err", "ratio_at_max", "ratio"),
-    ("mean err", "mean_err", "err"), ("ts ms at that mean err", "ts_at_mean_s", "ms"),
+    ("problem", "problem", "str"),
+    ("method", "method", "str"),
+    ("N", "n", "str"),
+    ("max err", "max_err", "err"),
+    ("wall ms", "wall_s", "ms"),
+    ("ts ms at that max err", "ts_at_max_s", "ms"),
+    ("× ts at equal max err", "ratio_at_max", "ratio"),
+    ("mean err", "mean_err", "err"),
+    ("ts ms at that mean err", "ts_at_mean_s", "ms"),
     ("× ts at equal mean err", "ratio_at_mean", "ratio"),
 ]
 
 
 def equal_error_table(rows: List[Dict[str, Any]]) -> str:
     """A Markdown table of :func:`equal_error`'s rows (a ratio's bound where it has none)."""
-    out = ["| " + " | ".join(c[0] for c in EQUAL_ERROR_COLUMNS) + " |",
-           "|" + "|".join("---" if c[2] == "str" else "---:" for c in EQUAL_ERROR_COLUMNS) + "|"]
+    out = [
+        "| " + " | ".join(c[0] for c in EQUAL_ERROR_COLUMNS) + " |",
+        "|" + "|".join("---" if c[2] == "str" else "---:" for c in EQUAL_ERROR_COLUMNS) + "|",
+    ]
     for r in rows:
         cells = []
         for _, key, kind in EQUAL_ERROR_COLUMNS:
@@ -370,11 +392,20 @@ def _fmt(v: Any, kind: str) -> str:
 
 
 COLUMNS = [
-    ("problem", "problem", "str"), ("N", "n", "str"), ("method", "method", "str"),
-    ("max err", "max_err", "err"), ("mean err", "mean_err", "err"), ("wall ms", "wall_s", "ms"),
-    ("× ts", "ratio", "ratio"), ("sweep ms", "sweep_s", "ms"), ("ΔRSS MB", "delta_rss_mb", "mb"),
-    ("RSS MB", "peak_rss_mb", "mb"), ("band pts", "band_points", "int"), ("iters", "iterations", "int"),
-    ("updates", "updates", "int"), ("Mupd/s", "updates_per_s", "rate"),
+    ("problem", "problem", "str"),
+    ("N", "n", "str"),
+    ("method", "method", "str"),
+    ("max err", "max_err", "err"),
+    ("mean err", "mean_err", "err"),
+    ("wall ms", "wall_s", "ms"),
+    ("× ts", "ratio", "ratio"),
+    ("sweep ms", "sweep_s", "ms"),
+    ("ΔRSS MB", "delta_rss_mb", "mb"),
+    ("RSS MB", "peak_rss_mb", "mb"),
+    ("band pts", "band_points", "int"),
+    ("iters", "iterations", "int"),
+    ("updates", "updates", "int"),
+    ("Mupd/s", "updates_per_s", "rate"),
 ]
 
 
@@ -407,10 +438,15 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
     problems = [p for p in PRESETS["full"] if any(r["problem"] == p for r in ok)]
     if not problems:
         return None
-    style = {"tubesweep-godunov": ("C0", "o", "-"), "tubesweep-godunov-tolh": ("C4", "o", ":"),
-             "tubesweep-godunov-1t": ("C7", "o", "-."),
-             "tubesweep-lxf": ("C0", "s", "--"), "skfmm-tube": ("C1", "^", "-"),
-             "heat": ("C2", "D", "-"), "mmp": ("C3", "v", "-")}
+    style = {
+        "tubesweep-godunov": ("C0", "o", "-"),
+        "tubesweep-godunov-tolh": ("C4", "o", ":"),
+        "tubesweep-godunov-1t": ("C7", "o", "-."),
+        "tubesweep-lxf": ("C0", "s", "--"),
+        "skfmm-tube": ("C1", "^", "-"),
+        "heat": ("C2", "D", "-"),
+        "mmp": ("C3", "v", "-"),
+    }
     ncol = min(3, len(problems))
     nrow = math.ceil(len(problems) / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(4.6 * ncol, 3.9 * nrow), squeeze=False)
@@ -422,7 +458,9 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
             c, mk, ls = style[m]
             ax.loglog([r["wall_s"] for r in rs], [r["max_err"] for r in rs], color=c, marker=mk, ls=ls, label=m)
             for r in (rs[0], rs[-1]):
-                ax.annotate(f"N={r['n']}", (r["wall_s"], r["max_err"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+                ax.annotate(
+                    f"N={r['n']}", (r["wall_s"], r["max_err"]), fontsize=7, xytext=(3, 3), textcoords="offset points"
+                )
         from matplotlib.ticker import NullFormatter
 
         ax.xaxis.set_minor_formatter(NullFormatter())
@@ -432,7 +470,7 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
         ax.set_ylabel("max error on the surface")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    for ax in list(axes.flat)[len(problems):]:
+    for ax in list(axes.flat)[len(problems) :]:
         ax.set_visible(False)
     fig.suptitle("Time vs error (log–log); each line: one method over grid sizes N", fontsize=10)
     fig.tight_layout()
@@ -455,13 +493,22 @@ def machine() -> str:
     except OSError:
         pass
     load = os.getloadavg() if hasattr(os, "getloadavg") else (math.nan,) * 3
-    return (f"{platform.node()} · {cpu} · {os.cpu_count()} logical cores · Python {platform.python_version()} · "
-            f"load average at start {load[0]:.1f}")
+    return (
+        f"{platform.node()} · {cpu} · {os.cpu_count()} logical cores · Python {platform.python_version()} · "
+        f"load average at start {load[0]:.1f}"
+    )
 
 
-def run_bench(preset: str = "default", cases: Optional[Dict[str, List[int]]] = None, repeats: int = 3,
-              methods: Optional[Sequence[str]] = None, out: Path = OUT, timeout: float = 900.0,
-              verbose: bool = True, make_plot: bool = True) -> Dict[str, Any]:
+def run_bench(
+    preset: str = "default",
+    cases: Optional[Dict[str, List[int]]] = None,
+    repeats: int = 3,
+    methods: Optional[Sequence[str]] = None,
+    out: Path = OUT,
+    timeout: float = 900.0,
+    verbose: bool = True,
+    make_plot: bool = True,
+) -> Dict[str, Any]:
     """Runs the benchmark and writes ``results.json``, ``results.md`` and the plot to ``out``.
     Returns ``{"records", "notes", "table", "plot"}``."""
     todo, notes = plan(preset, cases, methods)
@@ -492,11 +539,35 @@ def run_bench(preset: str = "default", cases: Optional[Dict[str, List[int]]] = N
     png = plot(records, out / "time_vs_error.png") if make_plot else None
     case_notes = sorted({nt for r in records for nt in r.get("notes", [])})
     all_notes = notes + case_notes
-    (out / "results.json").write_text(json.dumps(dict(machine=header, preset=preset, repeats=repeats, records=records,
-                                                       equal_error=at_equal_error, notes=all_notes, seconds=elapsed),
-                                                  indent=1, default=float))
-    md = [f"# tubesweep benchmark ({preset})", "", header, "", tab, "", "## At equal accuracy", "", EQUAL_ERROR_NOTE, "",
-          eq_tab, ""] + [f"- {nt}" for nt in all_notes]
+    (out / "results.json").write_text(
+        json.dumps(
+            dict(
+                machine=header,
+                preset=preset,
+                repeats=repeats,
+                records=records,
+                equal_error=at_equal_error,
+                notes=all_notes,
+                seconds=elapsed,
+            ),
+            indent=1,
+            default=float,
+        )
+    )
+    md = [
+        f"# tubesweep benchmark ({preset})",
+        "",
+        header,
+        "",
+        tab,
+        "",
+        "## At equal accuracy",
+        "",
+        EQUAL_ERROR_NOTE,
+        "",
+        eq_tab,
+        "",
+    ] + [f"- {nt}" for nt in all_notes]
     (out / "results.md").write_text("\n".join(md) + "\n")
     if verbose:
         print()
@@ -511,15 +582,20 @@ def run_bench(preset: str = "default", cases: Optional[Dict[str, List[int]]] = N
         print()
         print(f"wrote {out / 'results.md'}, {out / 'results.json'}" + (f", {png}" if png else ""))
         print(f"total {elapsed:.0f} s")
-    return dict(records=records, notes=all_notes, table=tab, plot=png, equal_error=at_equal_error,
-                equal_error_table=eq_tab)
+    return dict(
+        records=records, notes=all_notes, table=tab, plot=png, equal_error=at_equal_error, equal_error_table=eq_tab
+    )
 
 
 # --------------------------------------------------------------------------------------------
 # scale runs
 # --------------------------------------------------------------------------------------------
-def run_scale(sizes: Sequence[int] = SCALE_SIZES, out: Path = OUT, timeout: float = 3600.0,
-              methods: Sequence[str] = ("tubesweep-godunov",)) -> List[Dict[str, Any]]:
+def run_scale(
+    sizes: Sequence[int] = SCALE_SIZES,
+    out: Path = OUT,
+    timeout: float = 3600.0,
+    methods: Sequence[str] = ("tubesweep-godunov",),
+) -> List[Dict[str, Any]]:
     """Sphere at large N with tubesweep (Godunov; ``methods`` may add ``tubesweep-godunov-tolh``),
     one run each in a child process: time, peak memory, band points and bytes per band point."""
     # (both methods allowed here are Godunov)
@@ -533,11 +609,14 @@ def run_scale(sizes: Sequence[int] = SCALE_SIZES, out: Path = OUT, timeout: floa
         if r.get("status") == "ok":
             r["bytes_per_band_point"] = r["delta_rss_mb"] * 1024 * 1024 / r["band_points"]
             r["band_bytes_per_point"] = r["band_bytes"] / r["band_points"]
-            print(f"N={label}: wall {r['wall_s']:.2f} s (sweeps {r['sweep_s']:.2f} s, set-up {r['setup_s']:.2f} s), "
-                  f"{r['band_points']:,} band points, {r['iterations']} iterations, {r['updates']:,} updates "
-                  f"({r['updates_per_s'] / 1e6:.1f} M/s), peak ΔRSS {r['delta_rss_mb']:.0f} MB "
-                  f"= {r['bytes_per_band_point']:.0f} B/point (solver-held arrays {r['band_bytes_per_point']:.0f} B/point), "
-                  f"max err {r['max_err']:.2e}  ({time.perf_counter() - t1:.0f} s)", flush=True)
+            print(
+                f"N={label}: wall {r['wall_s']:.2f} s (sweeps {r['sweep_s']:.2f} s, set-up {r['setup_s']:.2f} s), "
+                f"{r['band_points']:,} band points, {r['iterations']} iterations, {r['updates']:,} updates "
+                f"({r['updates_per_s'] / 1e6:.1f} M/s), peak ΔRSS {r['delta_rss_mb']:.0f} MB "
+                f"= {r['bytes_per_band_point']:.0f} B/point (solver-held arrays {r['band_bytes_per_point']:.0f} B/point), "
+                f"max err {r['max_err']:.2e}  ({time.perf_counter() - t1:.0f} s)",
+                flush=True,
+            )
         else:
             print(f"N={label}: {r.get('status')}: {r.get('note')}", flush=True)
         recs.append(r)
@@ -562,7 +641,9 @@ def parse_cases(text: str) -> Dict[str, List[int]]:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     g = ap.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="smallest sizes only (~1 min)")
     g.add_argument("--full", action="store_true", help="every size, no caps on the slow peers (long)")

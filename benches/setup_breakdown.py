@@ -74,20 +74,29 @@ def main() -> int:
     r = a.repeats
     rows: Dict[str, float] = {
         "band search: candidates (coarse-to-fine levels, last split)": median_ms(
-            lambda: coarse_to_fine_candidates(grid, width, surf.lipschitz, lambda p, reach: np.abs(fn(p))), r),
+            lambda: coarse_to_fine_candidates(grid, width, surf.lipschitz, lambda p, reach: np.abs(fn(p))), r
+        ),
         "band search: whole (candidates, their coordinates, φ, the filter)": median_ms(
-            lambda: discover_band(fn, grid, width, surf.lipschitz), r),
+            lambda: discover_band(fn, grid, width, surf.lipschitz), r
+        ),
         "band structure (Band.from_linear)": median_ms(lambda: _native.Band.from_linear(shape, ul), r),
         "rim places (Band.rim_nodes)": median_ms(lambda: band.rim_nodes(0, len(linear)), r),
         "rim coordinates and φ there": median_ms(lambda: surf._phi_at_rim_places(grid, linear, pos, counts), r),
         "outward directions (Band.outward_directions)": median_ms(
-            lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r),
-        "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(lambda: _kinks(norm, grid, linear, band), r),
+            lambda: band.outward_directions(h, values, 0, len(linear), rim_phi, direction), r
+        ),
+        "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(
+            lambda: _kinks(norm, grid, linear, band), r
+        ),
         "gaps narrower than the tubes: the pairs (solve._warn_if_tubes_touch)": median_ms(
-            lambda: solve_module._warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r),
+            lambda: solve_module._warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r
+        ),
         "LevelSet.band of the same φ as a callable, all of the above": median_ms(
-            lambda: ts.LevelSet(fn, lipschitz=surf.lipschitz).band(grid, width), r),
-        "LevelSet.band of the library surface (the same band found in Rust)": median_ms(lambda: surf.band(grid, width), r),
+            lambda: ts.LevelSet(fn, lipschitz=surf.lipschitz).band(grid, width), r
+        ),
+        "LevelSet.band of the library surface (the same band found in Rust)": median_ms(
+            lambda: surf.band(grid, width), r
+        ),
     }
     stats = []
     for _ in range(r + 1):

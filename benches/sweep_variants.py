@@ -63,10 +63,16 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--repeats", type=int, default=5)
     a = ap.parse_args(argv)
-    subprocess.run(["cargo", "build", "--release", "--example", "sphere", "-p", "tubesweep-core"], cwd=REPO,
-                   check=True, capture_output=True)
+    subprocess.run(
+        ["cargo", "build", "--release", "--example", "sphere", "-p", "tubesweep-core"],
+        cwd=REPO,
+        check=True,
+        capture_output=True,
+    )
     print(f"sphere r=0.5, Godunov, Rust example; {a.repeats} interleaved rounds; sweep seconds (median, min)")
-    print(f"{'N':>5} {'threads':>7} {'variant':>9} {'iters':>5} {'updates':>13} {'median s':>9} {'min s':>8} {'× paper':>8}")
+    print(
+        f"{'N':>5} {'threads':>7} {'variant':>9} {'iters':>5} {'updates':>13} {'median s':>9} {'min s':>8} {'× paper':>8}"
+    )
     for n in (int(x) for x in a.sizes.split(",")):
         for t in (int(x) for x in a.threads.split(",")):
             times: Dict[str, List[float]] = {v: [] for v in VARIANTS}
@@ -80,8 +86,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             for name in VARIANTS:
                 med = statistics.median(times[name])
                 it, up = work[name]
-                print(f"{n:5d} {t:7d} {name:>9} {it:5d} {up:13,d} {med:9.3f} {min(times[name]):8.3f} {paper / med:8.2f}",
-                      flush=True)
+                print(
+                    f"{n:5d} {t:7d} {name:>9} {it:5d} {up:13,d} {med:9.3f} {min(times[name]):8.3f} {paper / med:8.2f}",
+                    flush=True,
+                )
     return 0
 
 

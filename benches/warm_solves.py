@@ -71,7 +71,9 @@ def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
         return out
     out = {"whole_box_candidates": len(_native.band_of_samples(surface._array, L * w)[0])}
     if hasattr(_native, "redistance_candidates_of_samples"):
-        out["local_bound_candidates"] = len(_native.redistance_candidates_of_samples(surface._array, grid.spacing, w)[0])
+        out["local_bound_candidates"] = len(
+            _native.redistance_candidates_of_samples(surface._array, grid.spacing, w)[0]
+        )
     return out
 
 
@@ -87,9 +89,11 @@ def main() -> int:
         if i + 1 >= len(argv) or argv[i + 1] not in ts.surfaces.REGISTRY:
             raise SystemExit(f"--library takes a surface name: one of {', '.join(ts.surfaces.REGISTRY)}")
         if dense or "--callable" in argv:
-            raise SystemExit("--library solves on the library surface itself: not with --dense, --redistance or --callable")
+            raise SystemExit(
+                "--library solves on the library surface itself: not with --dense, --redistance or --callable"
+            )
         library = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
+        argv = argv[:i] + argv[i + 2 :]
     args = [a for a in argv if a not in flags]
     n = int(args[0]) if len(args) > 0 else 201
     repeats = int(args[1]) if len(args) > 1 else 7
@@ -97,8 +101,9 @@ def main() -> int:
     if library is not None:
         surf = ts.surfaces.REGISTRY[library]()
         lower, upper = surf.default_box
-        p = SimpleNamespace(surface=surf, grid=ts.Grid(lower=lower, upper=upper, shape=(n,) * len(lower)),
-                            source=surf.default_source)
+        p = SimpleNamespace(
+            surface=surf, grid=ts.Grid(lower=lower, upper=upper, shape=(n,) * len(lower)), source=surf.default_source
+        )
         extra["library"] = library
     else:
         p = bunny(n) if "--bunny" in sys.argv else ellipsoid(n) if "--ellipsoid" in sys.argv else sphere(n)
@@ -138,9 +143,24 @@ def main() -> int:
         sweeps.append(sol.stats.seconds)
     if redistance:  # after the timed solves, whose memory it would otherwise change
         extra.update(redistance_candidates(surface, p.grid))
-    ms = {k: round(1e3 * float(np.median(v)), 1) for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))}
-    print(json.dumps(dict(n=n, repeats=repeats, dense=dense, redistance=redistance, tube=use_tube, **ms,
-                          first_solve_delta_rss_mb=delta_rss_mb, **extra)))
+    ms = {
+        k: round(1e3 * float(np.median(v)), 1)
+        for k, v in (("wall_ms", wall), ("setup_ms", setup), ("sweeps_ms", sweeps))
+    }
+    print(
+        json.dumps(
+            dict(
+                n=n,
+                repeats=repeats,
+                dense=dense,
+                redistance=redistance,
+                tube=use_tube,
+                **ms,
+                first_solve_delta_rss_mb=delta_rss_mb,
+                **extra,
+            )
+        )
+    )
     return 0
 
 

@@ -20,7 +20,10 @@ sys.path.insert(0, str(BENCHES))
 import run as bench  # noqa: E402
 from problems import Spheroid, Torus, ellipse_closest  # noqa: E402
 
-HAVE = {m: importlib.util.find_spec(m) is not None for m in ("skfmm", "potpourri3d", "pygeodesic", "geographiclib", "skimage")}
+HAVE = {
+    m: importlib.util.find_spec(m) is not None
+    for m in ("skfmm", "potpourri3d", "pygeodesic", "geographiclib", "skimage")
+}
 PEER_MODULE = {"skfmm-tube": "skfmm", "heat": "potpourri3d", "mmp": "pygeodesic"}
 
 # Max error bounds for tubesweep (Godunov) at these sizes: about twice what is measured.
@@ -33,8 +36,14 @@ def result(tmp_path_factory):
     if HAVE["geographiclib"]:
         cases["ellipsoid"] = [21]
     out = tmp_path_factory.mktemp("bench")
-    methods = ["tubesweep-godunov", "tubesweep-godunov-tolh", "tubesweep-godunov-1t", "skfmm-tube", "heat",
-               "mmp"]  # LxF: see tests/test_solve.py
+    methods = [
+        "tubesweep-godunov",
+        "tubesweep-godunov-tolh",
+        "tubesweep-godunov-1t",
+        "skfmm-tube",
+        "heat",
+        "mmp",
+    ]  # LxF: see tests/test_solve.py
     res = bench.run_bench("quick", cases=cases, repeats=1, methods=methods, out=out, verbose=False)
     res["out"] = out
     res["cases"] = cases
@@ -70,7 +79,9 @@ def test_table_structure(result):
     assert len(lines) == 2 + len(result["records"])
     saved = json.loads((result["out"] / "results.json").read_text())
     assert len(saved["records"]) == len(result["records"])
-    assert (result["out"] / "results.md").read_text().count("| tubesweep-godunov |") == sum(map(len, result["cases"].values()))
+    assert (result["out"] / "results.md").read_text().count("| tubesweep-godunov |") == sum(
+        map(len, result["cases"].values())
+    )
 
 
 def test_time_at_error_interpolates_log_log_on_the_cheapest_bracketing_sizes():
@@ -107,9 +118,13 @@ def test_equal_error_rows_set_each_peer_case_beside_tubesweep_at_its_accuracy():
     def rec(method, n, max_err, mean_err, wall):
         return dict(status="ok", problem="p", method=method, n=n, max_err=max_err, mean_err=mean_err, wall_s=wall)
 
-    records = [rec("tubesweep-godunov", 41, 1e-1, 1e-2, 1.0), rec("tubesweep-godunov", 81, 1e-2, 1e-3, 100.0),
-               rec("skfmm-tube", 41, math.sqrt(1e-3), 1e-4, 30.0), rec("skfmm-tube", 81, 1e-2, 1e-2, 50.0),
-               dict(status="timeout", problem="p", method="heat", n=41)]
+    records = [
+        rec("tubesweep-godunov", 41, 1e-1, 1e-2, 1.0),
+        rec("tubesweep-godunov", 81, 1e-2, 1e-3, 100.0),
+        rec("skfmm-tube", 41, math.sqrt(1e-3), 1e-4, 30.0),
+        rec("skfmm-tube", 81, 1e-2, 1e-2, 50.0),
+        dict(status="timeout", problem="p", method="heat", n=41),
+    ]
     rows = bench.equal_error(records)
     assert [(r["method"], r["n"]) for r in rows] == [("skfmm-tube", 41), ("skfmm-tube", 81)]
     a, b = rows
@@ -126,12 +141,20 @@ def test_equal_error_rows_set_each_peer_case_beside_tubesweep_at_its_accuracy():
 def test_the_run_reports_the_peers_at_equal_accuracy(result):
     # the star ran at two sizes: every other method's star cases get a row
     rows = [r for r in result["equal_error"] if r["problem"] == "star"]
-    others = [r for r in result["records"] if r["problem"] == "star" and r["status"] == "ok" and r["method"] != "tubesweep-godunov"]
+    others = [
+        r
+        for r in result["records"]
+        if r["problem"] == "star" and r["status"] == "ok" and r["method"] != "tubesweep-godunov"
+    ]
     assert sorted((r["method"], r["n"]) for r in rows) == sorted((r["method"], r["n"]) for r in others)
     for r in rows:
         if r["method"] == "tubesweep-godunov-1t":
             # the same errors as the all-core solve at each size: its own size's time
-            same = [b for b in result["records"] if b["method"] == "tubesweep-godunov" and b["problem"] == "star" and b["n"] == r["n"]]
+            same = [
+                b
+                for b in result["records"]
+                if b["method"] == "tubesweep-godunov" and b["problem"] == "star" and b["n"] == r["n"]
+            ]
             assert r["ts_at_max_s"] == pytest.approx(same[0]["wall_s"])
     saved = json.loads((result["out"] / "results.json").read_text())
     assert saved["equal_error"] == json.loads(json.dumps(result["equal_error"]))
@@ -198,13 +221,17 @@ def test_geographiclib_matches_integrated_geodesics_on_the_spheroid():
     def on_surface(lat_deg, lon_deg):
         lat, lon = np.radians(lat_deg), np.radians(lon_deg)
         k = 1 / np.hypot(a * np.cos(lat), c * np.sin(lat))
-        return np.array([a * a * np.cos(lat) * k * np.cos(lon), a * a * np.cos(lat) * k * np.sin(lon), c * c * np.sin(lat) * k])
+        return np.array(
+            [a * a * np.cos(lat) * k * np.cos(lon), a * a * np.cos(lat) * k * np.sin(lon), c * c * np.sin(lat) * k]
+        )
 
     for lat0, az, dist in [(0.0, 30.0, 1.2), (20.0, 10.0, 2.0), (-40.0, 120.0, 1.0)]:
         lat = np.radians(lat0)
         azr = np.radians(az)
         v0 = np.sin(azr) * np.array([0, 1, 0]) + np.cos(azr) * np.array([-np.sin(lat), 0, np.cos(lat)])
-        sol = solve_ivp(rhs, (0, dist), np.concatenate([on_surface(lat0, 0.0), v0]), rtol=1e-12, atol=1e-14, method="DOP853")
+        sol = solve_ivp(
+            rhs, (0, dist), np.concatenate([on_surface(lat0, 0.0), v0]), rtol=1e-12, atol=1e-14, method="DOP853"
+        )
         r = geod.Direct(lat0, 0.0, az, dist)
         assert np.linalg.norm(sol.y[:3, -1] - on_surface(r["lat2"], r["lon2"])) < 1e-7
 
@@ -313,7 +340,8 @@ def test_microbench_splits_the_speed_ups_of_rounds_at_two_core_to_core_latencies
     # a spread between 1.5 and 2 shows as a range and splits too; one round prints one figure
     assert microbench._latency_column([40.0, 70.0]) == "40–70"
     assert microbench._split_speedups([40.0, 70.0, 41.0], [1.8, 1.6, 1.7]) == (
-        "speed-up 1.75 in 2 rounds at 40–41 ns, 1.60 in 1 round at 70 ns")
+        "speed-up 1.75 in 2 rounds at 40–41 ns, 1.60 in 1 round at 70 ns"
+    )
 
 
 def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):

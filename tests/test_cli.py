@@ -20,7 +20,9 @@ def test_help_explains_itself(capsys):
 
 def test_solve_builtin_circle_writes_band_and_picture(tmp_path, capsys):
     pytest.importorskip("matplotlib")
-    assert main(["solve", "--surface", "circle", "--n", "101", "--out", str(tmp_path), "--png", "--dense", "--quiet"]) == 0
+    assert (
+        main(["solve", "--surface", "circle", "--n", "101", "--out", str(tmp_path), "--png", "--dense", "--quiet"]) == 0
+    )
     data = np.load(tmp_path / "solution.npz")
     idx, vals = data["indices"], data["values"]
     assert idx.shape[1] == 2 and len(vals) == len(idx)
@@ -39,8 +41,27 @@ def test_solve_phi_file(tmp_path):
     x = np.linspace(-1, 1, 61)
     X, Y = np.meshgrid(x, x, indexing="ij")
     np.save(tmp_path / "phi.npy", np.hypot(X, Y) - 0.5)
-    rc = main(["solve", "--phi", str(tmp_path / "phi.npy"), "--lower", "-1", "-1", "--upper", "1", "1",
-               "--source", "0.5", "0", "--hamiltonian", "lxf", "--out", str(tmp_path / "o"), "--quiet"])
+    rc = main(
+        [
+            "solve",
+            "--phi",
+            str(tmp_path / "phi.npy"),
+            "--lower",
+            "-1",
+            "-1",
+            "--upper",
+            "1",
+            "1",
+            "--source",
+            "0.5",
+            "0",
+            "--hamiltonian",
+            "lxf",
+            "--out",
+            str(tmp_path / "o"),
+            "--quiet",
+        ]
+    )
     assert rc == 0
     assert (tmp_path / "o" / "solution.npz").exists()
 
@@ -52,7 +73,9 @@ def test_bad_input_is_a_clear_error_with_exit_code_2(tmp_path, capsys):
 
 
 def test_travel_time(tmp_path):
-    assert main(["travel-time", "--n", "41", "--dim", "2", "--source", "0.1", "0", "--out", str(tmp_path), "--quiet"]) == 0
+    assert (
+        main(["travel-time", "--n", "41", "--dim", "2", "--source", "0.1", "0", "--out", str(tmp_path), "--quiet"]) == 0
+    )
     u = np.load(tmp_path / "travel_time.npy")
     assert u[20, 20] == pytest.approx(0.1, abs=1e-12)
 
@@ -80,8 +103,32 @@ def test_demo_quick(tmp_path, capsys):
 
 
 def test_solve_traces_paths_and_labels_cells(tmp_path, capsys):
-    args = ["solve", "--surface", "sphere", "--n", "61", "--source", "0.5", "0", "0", "--source", "-0.5", "0", "0",
-            "--path-from", "0", "0.5", "0", "--path-from", "0.3", "0", "0.4", "--out", str(tmp_path), "--quiet"]
+    args = [
+        "solve",
+        "--surface",
+        "sphere",
+        "--n",
+        "61",
+        "--source",
+        "0.5",
+        "0",
+        "0",
+        "--source",
+        "-0.5",
+        "0",
+        "0",
+        "--path-from",
+        "0",
+        "0.5",
+        "0",
+        "--path-from",
+        "0.3",
+        "0",
+        "0.4",
+        "--out",
+        str(tmp_path),
+        "--quiet",
+    ]
     assert main(args) == 0
     out = capsys.readouterr().out.splitlines()
     line = next(ln for ln in out if ln.startswith("path 1 from (0.3, 0.0, 0.4): length"))
@@ -95,9 +142,19 @@ def test_solve_traces_paths_and_labels_cells(tmp_path, capsys):
     x = -1 + (2 / 60) * data["indices"][:, 0]
     clear = np.abs(x) > 0.1
     assert np.array_equal(data["nearest_source"][clear], np.where(x[clear] > 0, 0, 1))
-    assert main(["solve", "--surface", "sphere", "--n", "41", "--path-from-vertex", "3", "--out", str(tmp_path), "--quiet"]) == 2
+    assert (
+        main(
+            ["solve", "--surface", "sphere", "--n", "41", "--path-from-vertex", "3", "--out", str(tmp_path), "--quiet"]
+        )
+        == 2
+    )
     assert "needs --mesh" in capsys.readouterr().err
-    assert main(["solve", "--surface", "sphere", "--n", "41", "--path-from", "0", "0.5", "--out", str(tmp_path), "--quiet"]) == 2
+    assert (
+        main(
+            ["solve", "--surface", "sphere", "--n", "41", "--path-from", "0", "0.5", "--out", str(tmp_path), "--quiet"]
+        )
+        == 2
+    )
     assert "3 coordinates" in capsys.readouterr().err
 
 
@@ -106,22 +163,92 @@ def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
     g = np.linspace(-1, 1, 41)
     x, y = np.meshgrid(g, g, indexing="ij")
     np.savez(tmp_path / "phi.npz", phi=np.hypot(x, y) - 0.5)
-    rc = main(["solve", "--phi", str(tmp_path / "phi.npz"), "--lower", "-1", "-1", "--upper", "1", "1",
-               "--source", "0.5", "0", "--out", str(tmp_path / "o"), "--quiet"])
+    rc = main(
+        [
+            "solve",
+            "--phi",
+            str(tmp_path / "phi.npz"),
+            "--lower",
+            "-1",
+            "-1",
+            "--upper",
+            "1",
+            "1",
+            "--source",
+            "0.5",
+            "0",
+            "--out",
+            str(tmp_path / "o"),
+            "--quiet",
+        ]
+    )
     assert rc == 0 and (tmp_path / "o" / "solution.npz").exists()
     (tmp_path / "empty.npy").write_bytes(b"")
-    assert main(["solve", "--phi", str(tmp_path / "empty.npy"), "--lower", "-1", "-1", "--upper", "1", "1",
-              "--source", "0.5", "0", "--out", str(tmp_path / "o1")]) == 2
+    assert (
+        main(
+            [
+                "solve",
+                "--phi",
+                str(tmp_path / "empty.npy"),
+                "--lower",
+                "-1",
+                "-1",
+                "--upper",
+                "1",
+                "1",
+                "--source",
+                "0.5",
+                "0",
+                "--out",
+                str(tmp_path / "o1"),
+            ]
+        )
+        == 2
+    )
     assert "not a NumPy .npy or .npz file" in capsys.readouterr().err
     (tmp_path / "notnumpy.txt").write_text("hello")
-    assert main(["solve", "--phi", str(tmp_path / "notnumpy.txt"), "--lower", "-1", "-1", "--upper", "1", "1",
-              "--source", "0.5", "0", "--out", str(tmp_path / "o2")]) == 2
+    assert (
+        main(
+            [
+                "solve",
+                "--phi",
+                str(tmp_path / "notnumpy.txt"),
+                "--lower",
+                "-1",
+                "-1",
+                "--upper",
+                "1",
+                "1",
+                "--source",
+                "0.5",
+                "0",
+                "--out",
+                str(tmp_path / "o2"),
+            ]
+        )
+        == 2
+    )
     assert "not a NumPy .npy or .npz file" in capsys.readouterr().err
     # --out an existing file, an unknown export format: refused before solving (no traceback)
     (tmp_path / "afile").write_text("")
     assert main(["solve", "--surface", "circle", "--n", "41", "--out", str(tmp_path / "afile")]) == 2
     assert "exists and is not a directory" in capsys.readouterr().err
-    assert main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "x.xyz"), "--out", str(tmp_path / "o3")]) == 2
+    assert (
+        main(
+            [
+                "solve",
+                "--surface",
+                "circle",
+                "--n",
+                "41",
+                "--export",
+                str(tmp_path / "x.xyz"),
+                "--out",
+                str(tmp_path / "o3"),
+            ]
+        )
+        == 2
+    )
     assert "unknown format '.xyz'" in capsys.readouterr().err
     assert not (tmp_path / "o3").exists()
     # a mesh file nothing can read: an error line and exit code 2
@@ -130,12 +257,15 @@ def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
     assert "error:" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--source", "-0.5", "0", "0", "--source", "1", "1"], "--source needs 3 coordinates"),
-    (["--lower", "-1", "-1", "-1"], "give both --lower and --upper"),
-    (["--padding", "3"], "--padding applies to --mesh only"),
-    (["--path-from", "0", "0", "0"], "farther than the inner tube"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--source", "-0.5", "0", "0", "--source", "1", "1"], "--source needs 3 coordinates"),
+        (["--lower", "-1", "-1", "-1"], "give both --lower and --upper"),
+        (["--padding", "3"], "--padding applies to --mesh only"),
+        (["--path-from", "0", "0", "0"], "farther than the inner tube"),
+    ],
+)
 def test_contradictory_or_incomplete_arguments_are_refused_before_the_solve(tmp_path, capsys, argv, message):
     # NumPy's "inhomogeneous shape", silently ignored --lower/--padding, a path start off the
     # surface found only after the solve had written its files
@@ -147,7 +277,9 @@ def test_contradictory_or_incomplete_arguments_are_refused_before_the_solve(tmp_
 
 def test_a_curve_cannot_be_exported_to_ply_and_a_directory_is_not_a_mesh(tmp_path, capsys):
     out = tmp_path / "o"
-    assert main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "c.ply"), "--out", str(out)]) == 2
+    assert (
+        main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "c.ply"), "--out", str(out)]) == 2
+    )
     assert ".ply holds surfaces only" in capsys.readouterr().err and not out.exists()
     assert main(["solve", "--mesh", str(tmp_path), "--out", str(out)]) == 2
     assert "is a directory" in capsys.readouterr().err
@@ -165,8 +297,12 @@ def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, ca
     quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     faces = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
     mesh = tmp_path / "plate.obj"
-    mesh.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces))
-    rc = main(["solve", "--mesh", str(mesh), "--n", "41", "--source", "0", "0", "0.04", "--out", str(tmp_path), "--quiet"])
+    mesh.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces)
+    )
+    rc = main(
+        ["solve", "--mesh", str(mesh), "--n", "41", "--source", "0", "0", "0.04", "--out", str(tmp_path), "--quiet"]
+    )
     assert rc == 0
     err = capsys.readouterr().err
     lines = [ln for ln in err.splitlines() if "faces itself" in ln]

@@ -30,8 +30,10 @@ def hemisphere_errors():
                 assert sol.stats.converged
                 u = sol(V)
                 assert not np.any(np.isnan(u))
-                out[ham, n, name] = (float(np.max(np.abs(u - hemi.geodesic_distance(V, src)))),
-                                     float(np.max(np.abs(sol(rim) - hemi.geodesic_distance(rim, src)))))
+                out[ham, n, name] = (
+                    float(np.max(np.abs(u - hemi.geodesic_distance(V, src)))),
+                    float(np.max(np.abs(sol(rim) - hemi.geodesic_distance(rim, src)))),
+                )
     return out
 
 
@@ -143,8 +145,8 @@ def test_mobius_closest_point_is_exact_and_band_is_complete():
     Q = m.point(T, S).reshape(-1, 3)
     brute = np.array([np.min(np.linalg.norm(Q - p, axis=1)) for p in P])
     d = m.distance(P)
-    assert np.all(d <= brute + 1e-12)        # never worse than a dense search
-    assert np.max(brute - d) < 5e-3           # and that search's resolution bounds the gap
+    assert np.all(d <= brute + 1e-12)  # never worse than a dense search
+    assert np.max(brute - d) < 5e-3  # and that search's resolution bounds the gap
     grid = ts.Grid(*m.default_box, (41,) * 3)
     lin, _ = discover_band(m.distance, grid, 4 * grid.spacing, 1.0)
     every = m.distance(grid.points(grid.unravel(np.arange(grid.size))))
@@ -258,7 +260,9 @@ def test_without_extrapolation_lax_friedrichs_leaks_at_a_cut_end(monkeypatch):
     monkeypatch.setattr(mod, "_native", fake)
     # the level set builds the band itself (for its directions): drop it, so the solver builds its own
     real_band = ts.LevelSet.band
-    monkeypatch.setattr(ts.LevelSet, "band", lambda self, g, w: dataclasses.replace(real_band(self, g, w), native_band=None))
+    monkeypatch.setattr(
+        ts.LevelSet, "band", lambda self, g, w: dataclasses.replace(real_band(self, g, w), native_band=None)
+    )
     bad = ts.solve(_cut_line(), grid, [_A], hamiltonian="lxf", infinity=1e6)([_B])[0]
     assert good == pytest.approx(np.sqrt(2), abs=1e-6)
     assert bad > 10

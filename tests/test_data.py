@@ -87,6 +87,10 @@ def test_nothing_a_user_runs_refers_to_a_folder_beside_the_repository():
 
 def test_the_pattern_catches_the_ways_the_path_was_written():
     s = "sha" + "red"
-    for line in (f"--mesh ../{s}/data/spot.obj", f'parents[1] / ".." / "{s}" / "data"', f'REPO.parent / "{s}" / "data"'):
+    for line in (
+        f"--mesh ../{s}/data/spot.obj",
+        f'parents[1] / ".." / "{s}" / "data"',
+        f'REPO.parent / "{s}" / "data"',
+    ):
         assert _SIBLING.search(line), line
     assert not _SIBLING.search("a shared machine; shared by two faces")

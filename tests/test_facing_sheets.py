@@ -85,8 +85,9 @@ def test_two_spheres_as_min_of_distances_five_spacings_apart_warn(as_array):
     def phi(p):
         return np.minimum(np.linalg.norm(p - c1, axis=1) - r, np.linalg.norm(p - c2, axis=1) - r)
 
-    surface = ts.LevelSet(phi(np.stack(grid.meshgrid(), -1).reshape(-1, 3)).reshape(grid.shape) if as_array else phi,
-                          lipschitz=1.0)
+    surface = ts.LevelSet(
+        phi(np.stack(grid.meshgrid(), -1).reshape(-1, 3)).reshape(grid.shape) if as_array else phi, lipschitz=1.0
+    )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         sol = ts.solve(surface, grid, [c1 - r * axis])
@@ -163,9 +164,20 @@ def test_the_double_torus_body_is_too_thin_for_41_nodes_but_not_for_61():
     assert stats[61].facing_pairs == 0
 
 
-@pytest.mark.parametrize("name,n", [("sphere", 41), ("torus", 41), ("ellipsoid", 41), ("rounded-cube", 41),
-                                    ("hemisphere", 41), ("mobius", 41), ("plane", 41), ("star", 121),
-                                    ("ellipse", 121)])
+@pytest.mark.parametrize(
+    "name,n",
+    [
+        ("sphere", 41),
+        ("torus", 41),
+        ("ellipsoid", 41),
+        ("rounded-cube", 41),
+        ("hemisphere", 41),
+        ("mobius", 41),
+        ("plane", 41),
+        ("star", 121),
+        ("ellipse", 121),
+    ],
+)
 def test_resolved_library_surfaces_give_no_pair(name, n):
     surf = ts.surfaces.REGISTRY[name]()
     lower, upper = surf.default_box

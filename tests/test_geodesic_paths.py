@@ -136,7 +136,9 @@ def test_bad_requests_are_refused_with_the_argument_named():
     with pytest.raises(ValueError, match="isotropic"):
         moving.geodesic_path((0.0, 0.6))
     # a component no source reaches: two circles, the source on one
-    two = ts.LevelSet(lambda p: np.minimum(np.linalg.norm(p - (0.4, 0), axis=1), np.linalg.norm(p + (0.4, 0), axis=1)) - 0.3)
+    two = ts.LevelSet(
+        lambda p: np.minimum(np.linalg.norm(p - (0.4, 0), axis=1), np.linalg.norm(p + (0.4, 0), axis=1)) - 0.3
+    )
     sol2 = ts.solve(two, g, [(0.7, 0.0)])
     with pytest.raises(ValueError, match="not reached by any source"):
         sol2.geodesic_path((-0.7, 0.0))
@@ -227,7 +229,11 @@ def test_plot_draws_paths(tmp_path):
     fig3 = ts.plot(sol3, paths=paths3)
     fig3.savefig(tmp_path / "paths.png")
     for ax in fig3.axes[:2]:  # both views: every segment drawn, in red, those behind the sphere faint
-        red = [c for c in ax.collections if isinstance(c, Line3DCollection) and np.allclose(c.get_color()[0][:3], (1, 0, 0))]
+        red = [
+            c
+            for c in ax.collections
+            if isinstance(c, Line3DCollection) and np.allclose(c.get_color()[0][:3], (1, 0, 0))
+        ]
         assert sum(len(c.get_segments()) for c in red) == sum(len(p) - 1 for p in paths3)
         assert sorted(c.get_alpha() for c in red) == [0.3, 1.0]
 
@@ -240,7 +246,9 @@ def test_path_lengths_on_the_bunny_match_exact_polyhedral_geodesics():
     bunny = ts.surfaces.from_mesh(BUNNY)
     v = bunny.vertices
     targets = np.random.default_rng(0).choice(len(v), 8, replace=False)
-    exact = np.array([geodesic.PyGeodesicAlgorithmExact(v, bunny.faces).geodesicDistance(0, int(t))[0] for t in targets])
+    exact = np.array(
+        [geodesic.PyGeodesicAlgorithmExact(v, bunny.faces).geodesicDistance(0, int(t))[0] for t in targets]
+    )
     g = bunny.grid(81)
     sol = ts.solve(bunny, g, [v[0]])
     paths = sol.geodesic_paths(v[targets])

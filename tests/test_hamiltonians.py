@@ -30,6 +30,7 @@ def _orders(errors):
 
 # ---------------------------------------------------------------- v = 0 and the isotropic Hamiltonian
 
+
 def test_isotropic_general_update_equals_eq4_on_a_circle():
     c = Circle(R)
     g = _grid2(161)
@@ -50,6 +51,7 @@ def test_zero_flow_reproduces_the_isotropic_solution_on_a_sphere():
 
 
 # ---------------------------------------------------------------- moving medium: solid-body rotation
+
 
 def test_solid_body_rotation_on_a_circle_converges_at_first_order():
     """Exact: u(α) = min(Rα/(F+ωR), R(2π−α)/(F−ωR)) (flows.rotation_travel_time_circle)."""
@@ -93,6 +95,7 @@ def test_solid_body_rotation_on_a_sphere_matches_the_rotating_frame_solution():
 
 
 # ---------------------------------------------------------------- Riemannian metric
+
 
 def _metric_circle_exact(p: np.ndarray, M: np.ndarray) -> np.ndarray:
     """u(θ) = min over both ways of ∫ R dθ / sqrt(tᵀ M t) (trapezoid rule, 2e5 panels)."""
@@ -150,6 +153,7 @@ def test_metric_must_be_symmetric_positive_definite():
 
 # ---------------------------------------------------------------- validation, options
 
+
 def test_supersonic_flow_raises_with_location_and_ratio_and_can_be_allowed():
     c = Circle(R)
     g = _grid2(81)
@@ -158,7 +162,10 @@ def test_supersonic_flow_raises_with_location_and_ratio_and_can_be_allowed():
     def gust(p):  # |v| = 0.5 except near (R, 0), where it reaches 2 > F = 1
         return rot(p) * (1 + 3 * np.exp(-np.sum((p - np.array([R, 0.0])) ** 2, axis=1) / 0.01))[:, None]
 
-    with pytest.raises(ValueError, match=r"\|v\| ≥ F at \d+ of \d+ inner-tube nodes.*Worst at \(0\.475, 0\).*\|v\|/F = 2\).*1 supersonic region.*allow_supersonic=True"):
+    with pytest.raises(
+        ValueError,
+        match=r"\|v\| ≥ F at \d+ of \d+ inner-tube nodes.*Worst at \(0\.475, 0\).*\|v\|/F = 2\).*1 supersonic region.*allow_supersonic=True",
+    ):
         ts.solve(c, g, [(-R, 0)], speed=1.0, flow=gust)
     with pytest.warns(RuntimeWarning, match="computing the Lax–Friedrichs solution anyway"):
         sol = ts.solve(c, g, [(-R, 0)], speed=1.0, flow=gust, allow_supersonic=True)
@@ -211,6 +218,7 @@ def test_sigma_override_larger_viscosity_still_converges_and_wrong_size_raises()
 
 
 # ---------------------------------------------------------------- flows
+
 
 def test_point_vortex_flow_is_tangent_with_the_known_speed():
     xj = np.array([0.0, 0.0, R])

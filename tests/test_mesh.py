@@ -2,7 +2,6 @@
 the band, signed distance of closed meshes, file reading, grids, and solutions against exact
 geodesics (great circles on a sphere mesh, exact polyhedral geodesics on the Stanford bunny)."""
 
-
 import numpy as np
 import pytest
 
@@ -15,12 +14,43 @@ BUNNY = ts.data.bunny()
 
 def icosphere(level: int = 3, radius: float = 0.5):
     """A sphere mesh: the icosahedron, subdivided ``level`` times, projected onto the sphere."""
-    t = (1 + 5 ** 0.5) / 2
-    v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
-         (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
-    f = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6),
-         (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10),
-         (8, 6, 7), (9, 8, 1)]
+    t = (1 + 5**0.5) / 2
+    v = [
+        (-1, t, 0),
+        (1, t, 0),
+        (-1, -t, 0),
+        (1, -t, 0),
+        (0, -1, t),
+        (0, 1, t),
+        (0, -1, -t),
+        (0, 1, -t),
+        (t, 0, -1),
+        (t, 0, 1),
+        (-t, 0, -1),
+        (-t, 0, 1),
+    ]
+    f = [
+        (0, 11, 5),
+        (0, 5, 1),
+        (0, 1, 7),
+        (0, 7, 10),
+        (0, 10, 11),
+        (1, 5, 9),
+        (5, 11, 4),
+        (11, 10, 2),
+        (10, 7, 6),
+        (7, 1, 8),
+        (3, 9, 4),
+        (3, 4, 2),
+        (3, 2, 6),
+        (3, 6, 8),
+        (3, 8, 9),
+        (4, 9, 5),
+        (2, 4, 11),
+        (6, 2, 10),
+        (8, 6, 7),
+        (9, 8, 1),
+    ]
     verts = [np.array(p, float) / np.linalg.norm(p) for p in v]
     faces = f
     for _ in range(level):
@@ -134,7 +164,7 @@ def test_signed_distance_of_closed_mesh_and_open_mesh_has_none():
     flipped = MeshSurface(v, f[:, ::-1])
     assert np.all(np.sign(flipped.signed_distance(x[clear])) == np.sign(r[clear] - 0.5))
     # an open mesh (upper half): no inside/outside, but closest points work
-    keep = (v[f].mean(1)[:, 2] > 0)
+    keep = v[f].mean(1)[:, 2] > 0
     half = MeshSurface(v, f[keep])
     assert not half.closed and not half.signed and half.boundary_edges > 0
     with pytest.raises(ValueError, match="signed=True needs a closed"):
@@ -245,8 +275,22 @@ def test_cli_solve_mesh(tmp_path, capsys):
     p = tmp_path / "ball.ply"
     meshio.write(str(p), meshio.Mesh(v, [("triangle", f)]))
     out = tmp_path / "out"
-    rc = main(["solve", "--mesh", str(p), "--n", "41", "--source-vertex", "0", "--export", str(out / "ball.vtu"),
-               "--quiet", "--out", str(out)])
+    rc = main(
+        [
+            "solve",
+            "--mesh",
+            str(p),
+            "--n",
+            "41",
+            "--source-vertex",
+            "0",
+            "--export",
+            str(out / "ball.vtu"),
+            "--quiet",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     m = meshio.read(str(out / "ball.vtu"))
     assert m.points.shape == (len(v), 3) and 0 <= m.point_data["u"][0] < 0.5 / 24

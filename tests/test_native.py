@@ -22,8 +22,16 @@ def test_solve_argument_errors():
     band = _native.Band.full_box([5, 5])
     roles = np.ones(25, np.uint8)
     fixed = (np.zeros(0, np.int64), np.zeros(0))
-    ok = dict(spacing=0.25, slowness=1.0, directions=None, scheme="godunov", missing="infinity", tol=1e-9,
-              max_iterations=10, infinity=None)
+    ok = dict(
+        spacing=0.25,
+        slowness=1.0,
+        directions=None,
+        scheme="godunov",
+        missing="infinity",
+        tol=1e-9,
+        max_iterations=10,
+        infinity=None,
+    )
     with pytest.raises(ValueError, match="one entry per band node"):
         band.solve(roles[:-1], *fixed, **ok)
     with pytest.raises(ValueError, match="role"):
@@ -57,8 +65,9 @@ def test_a_failing_solve_leaves_the_directions_as_they_were_and_fortran_order_is
     roles = np.ones(25, np.uint8)
     roles[3] = 2  # one extension-layer node
     fixed = (np.zeros(0, np.int64), np.zeros(0))
-    ok = dict(spacing=0.25, slowness=1.0, scheme="godunov", missing="infinity", tol=1e-9, max_iterations=10,
-              infinity=None)
+    ok = dict(
+        spacing=0.25, slowness=1.0, scheme="godunov", missing="infinity", tol=1e-9, max_iterations=10, infinity=None
+    )
     directions = np.tile(np.float32([0.6, 0.8]), (25, 1))
     before = directions.copy()
     for bad in ({"spacing": -1.0}, {"infinity": -1.0}, {"tol": -1.0}, {"slowness": np.ones(3)}):
@@ -84,7 +93,8 @@ def test_the_analytic_band_s_gradient_norms_are_single_precision_and_bound_like_
     n = 61
     h = 2.0 / (n - 1)
     linear, values, band, direction, norm = _native.analytic_level_set_band(
-        "sphere", [0.0, 0.0, 0.0, 0.5], [n, n, n], [-1.0, -1.0, -1.0], h, 4 * h, 1.0)
+        "sphere", [0.0, 0.0, 0.0, 0.5], [n, n, n], [-1.0, -1.0, -1.0], h, 4 * h, 1.0
+    )
     assert norm.dtype == np.float32 and direction.dtype == np.float32
     assert len(norm) == len(linear) == len(values) == len(band) > 0
     assert np.all(np.abs(norm - 1.0) < 0.05)

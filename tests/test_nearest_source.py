@@ -44,7 +44,9 @@ def test_labels_on_a_sphere_are_the_geodesic_voronoi_cells(hamiltonian):
 
 def test_labels_at_points_and_on_a_component_no_source_reaches():
     g = ts.Grid((-1, -1), (1, 1), (161, 161))
-    two = ts.LevelSet(lambda p: np.minimum(np.linalg.norm(p - (0.45, 0), axis=1), np.linalg.norm(p + (0.45, 0), axis=1)) - 0.3)
+    two = ts.LevelSet(
+        lambda p: np.minimum(np.linalg.norm(p - (0.45, 0), axis=1), np.linalg.norm(p + (0.45, 0), axis=1)) - 0.3
+    )
     sol = ts.solve(two, g, [(0.75, 0.0), (0.15, 0.0)])
     t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
     right = np.column_stack([0.45 + 0.3 * np.cos(t), 0.3 * np.sin(t)])

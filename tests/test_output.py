@@ -166,8 +166,12 @@ def test_fig8_is_registered():
 def test_export_checks_a_user_mesh_and_writes_vectors_and_odd_names(sphere_sol, tmp_path):
     v, f = ts.triangulate(sphere_sol)
     # faces pointing past the vertices, negative or fractional: refused, no file written
-    for faces, match in [(np.array([[0, 1, len(v)]]), f"index vertex {len(v)}"), (np.array([[0, -1, 2]]), "index vertex -1"),
-                         (np.array([[0, 1, 2.7]]), "whole-number"), (np.array([0, 1, 2]), "shape")]:
+    for faces, match in [
+        (np.array([[0, 1, len(v)]]), f"index vertex {len(v)}"),
+        (np.array([[0, -1, 2]]), "index vertex -1"),
+        (np.array([[0, 1, 2.7]]), "whole-number"),
+        (np.array([0, 1, 2]), "shape"),
+    ]:
         with pytest.raises(ValueError, match=match):
             ts.export(sphere_sol, tmp_path / "bad.vtp", mesh=(v, faces))
     with pytest.raises(ValueError, match="NaN or inf"):

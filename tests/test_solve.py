@@ -18,7 +18,9 @@ def circle_error(n, ham, init="exact"):
     return np.max(np.abs(sol(pts) - c.geodesic_distance(pts, c.default_source))), g.spacing, sol
 
 
-RING = np.stack([np.zeros(720), 0.5 * np.cos(np.linspace(0, 2 * np.pi, 720)), 0.5 * np.sin(np.linspace(0, 2 * np.pi, 720))], 1)
+RING = np.stack(
+    [np.zeros(720), 0.5 * np.cos(np.linspace(0, 2 * np.pi, 720)), 0.5 * np.sin(np.linspace(0, 2 * np.pi, 720))], 1
+)
 
 
 def sphere_error(n, ham, init="exact"):
@@ -186,7 +188,9 @@ def test_variable_speed_on_the_circle(order):
         sol = ts.solve(c, g, [(0.5, 0.0)], speed=lambda p: 1 + 0.5 * p[:, 0])
         pts = 0.5 * np.stack([np.cos(th), np.sin(th)], 1)
         tt = np.linspace(0, 1, 2001)
-        exact = np.array([np.sum(np.diff(tt) * 0.5 * ((f := 0.5 * abs(t) / (1 + 0.25 * np.cos(tt * t)))[1:] + f[:-1])) for t in th])
+        exact = np.array(
+            [np.sum(np.diff(tt) * 0.5 * ((f := 0.5 * abs(t) / (1 + 0.25 * np.cos(tt * t)))[1:] + f[:-1])) for t in th]
+        )
         errs.append(np.max(np.abs(sol(pts) - exact)))
         hs.append(g.spacing)
     assert order(hs, errs) > 0.8, errs

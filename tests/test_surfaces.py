@@ -157,8 +157,15 @@ def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
     # tubesweep.redistance on the multilinear interpolant, bit for bit (flags included)
     from tubesweep import _native
     from tubesweep.euclidean import _interp_dense
-    from tubesweep.redistance import (NEWTON_STEPS, ORTHOGONALITY_RETRY_STEPS, ORTHOGONALITY_STEPS,
-                                      SAMPLED_GRADIENT_STEP, SETTLED, estimate_lipschitz, project_to_level_set)
+    from tubesweep.redistance import (
+        NEWTON_STEPS,
+        ORTHOGONALITY_RETRY_STEPS,
+        ORTHOGONALITY_STEPS,
+        SAMPLED_GRADIENT_STEP,
+        SETTLED,
+        estimate_lipschitz,
+        project_to_level_set,
+    )
 
     grid = ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
     X = np.meshgrid(*[np.linspace(-1, 1, n)] * d, indexing="ij")
@@ -171,8 +178,9 @@ def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
     x = rng.uniform(-1.1, 1.1, (3000, d))  # some beyond the box, where φ is clamped
     box = (np.full(d, -1.0), -1.0 + (n - 1) * h)  # the Rust projection's box, the same arithmetic
     cp0, s0, ok0 = project_to_level_set(lambda p: _interp_dense(phi, grid, p), x, SAMPLED_GRADIENT_STEP * h, box=box)
-    cp1, s1, ok1 = _native.project_to_sampled_level_set(phi, [-1.0] * d, h, x, SAMPLED_GRADIENT_STEP * h, NEWTON_STEPS,
-                                                         ORTHOGONALITY_STEPS, SETTLED)
+    cp1, s1, ok1 = _native.project_to_sampled_level_set(
+        phi, [-1.0] * d, h, x, SAMPLED_GRADIENT_STEP * h, NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED
+    )
     assert np.array_equal(cp0, cp1) and np.array_equal(s0, s1) and np.array_equal(ok0, ok1)
     assert 0 < ok1.sum() < len(x)  # both outcomes were compared
     # and the surface uses it: its distances are those of the projection at its band nodes
@@ -181,9 +189,13 @@ def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
     _, sb, okb = project_to_level_set(lambda p: _interp_dense(phi, grid, p), xb, SAMPLED_GRADIENT_STEP * h, box=box)
     # band nodes that did not settle in ORTHOGONALITY_STEPS were projected again with more steps
     again = ~okb
-    _, sb[again], okb[again] = project_to_level_set(lambda p: _interp_dense(phi, grid, p), xb[again],
-                                                    SAMPLED_GRADIENT_STEP * h, box=box,
-                                                    orthogonality_steps=ORTHOGONALITY_RETRY_STEPS)
+    _, sb[again], okb[again] = project_to_level_set(
+        lambda p: _interp_dense(phi, grid, p),
+        xb[again],
+        SAMPLED_GRADIENT_STEP * h,
+        box=box,
+        orthogonality_steps=ORTHOGONALITY_RETRY_STEPS,
+    )
     assert okb.all() and np.array_equal(geom.signed, sb)
 
 
@@ -388,9 +400,16 @@ def test_sampled_phi_with_nan_or_inf_names_the_first_bad_index():
 
 @pytest.mark.parametrize(
     "surface, shape",
-    [(Sphere(), (101,) * 3), (Sphere(0.37, (0.1, -0.2, 0.05)), (57, 64, 49)), (Torus(), (61,) * 3),
-     (Ellipsoid(), (71,) * 3), (Circle(), (301, 301)), (REGISTRY["star"](), (301, 301)),
-     (REGISTRY["rounded-cube"](), (81,) * 3), (DoubleTorus(), (81,) * 3)],
+    [
+        (Sphere(), (101,) * 3),
+        (Sphere(0.37, (0.1, -0.2, 0.05)), (57, 64, 49)),
+        (Torus(), (61,) * 3),
+        (Ellipsoid(), (71,) * 3),
+        (Circle(), (301, 301)),
+        (REGISTRY["star"](), (301, 301)),
+        (REGISTRY["rounded-cube"](), (81,) * 3),
+        (DoubleTorus(), (81,) * 3),
+    ],
 )
 def test_library_surfaces_found_in_rust_are_the_callable_route_bit_for_bit(surface, shape):
     # the library's analytic surfaces have their band found without calling back into Python;
@@ -439,7 +458,9 @@ def _reference_candidates(grid, half_width, lipschitz, distance):
     d = grid.ndim
     h = grid.spacing
     block = 1 << max(0, int(np.floor(np.log2(max(grid.shape) / 4))))
-    origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(-1, d)
+    origins = np.stack(np.meshgrid(*[np.arange(0, n, block) for n in grid.shape], indexing="ij"), axis=-1).reshape(
+        -1, d
+    )
     if block == 1:
         return np.sort(grid.linear_index(origins))
     corners = np.stack(np.meshgrid(*([np.arange(2)] * d), indexing="ij"), axis=-1).reshape(-1, d)
@@ -480,6 +501,7 @@ def test_coarse_to_fine_candidates_match_the_straightforward_search(shape):
             def distance(p, reach):
                 calls[key].append((np.array(p), reach))
                 return np.abs(phi(p))
+
             return distance
 
         got = coarse_to_fine_candidates(grid, hw, lip, recorder("new"))
@@ -534,8 +556,17 @@ def test_native_node_points_and_neighbour_table(shape):
     bad = table.copy()
     bad[0, 0] = len(lin)  # leads outside the band
     with pytest.raises(ValueError):
-        _native.outward_directions(list(shape), grid.spacing, lin, np.zeros(len(lin)), lo, hi, np.zeros(sum(counts)),
-                                   np.zeros((hi - lo, d), np.float32), bad)
+        _native.outward_directions(
+            list(shape),
+            grid.spacing,
+            lin,
+            np.zeros(len(lin)),
+            lo,
+            hi,
+            np.zeros(sum(counts)),
+            np.zeros((hi - lo, d), np.float32),
+            bad,
+        )
 
 
 def test_row_norms_are_numpys_bits():
@@ -613,8 +644,14 @@ def test_native_open_surface_closest_points_are_the_numpy_formulas_bit_for_bit()
     p[1000:2000, 2] = 0.0  # in the equator's plane
     p[2000] = 0.0
     p[3000:3100] *= 1e-310
-    surfaces = (ts.surfaces.Hemisphere(), ts.surfaces.Hemisphere(0.3, (0.1, -0.2, 0.05)), ts.surfaces.Disc(),
-                ts.surfaces.Disc(0.4, (0.1, 0.2, -0.3)), ts.surfaces.PlanePatch(), ts.surfaces.PlanePatch(0.3, (0.2, 0.1, 0.0)))
+    surfaces = (
+        ts.surfaces.Hemisphere(),
+        ts.surfaces.Hemisphere(0.3, (0.1, -0.2, 0.05)),
+        ts.surfaces.Disc(),
+        ts.surfaces.Disc(0.4, (0.1, 0.2, -0.3)),
+        ts.surfaces.PlanePatch(),
+        ts.surfaces.PlanePatch(0.3, (0.2, 0.1, 0.0)),
+    )
     with np.errstate(all="ignore"):
         for surf in surfaces:
             for q in (p, p + np.asarray(surf.center)):  # about the origin and about the centre
@@ -625,6 +662,7 @@ def test_native_open_surface_closest_points_are_the_numpy_formulas_bit_for_bit()
     numpy_route = ts.ClosestPoint(hemi._cp_numpy)
     a, b = ts.solve(hemi, g, [hemi.default_source]), ts.solve(numpy_route, g, [hemi.default_source])
     assert np.array_equal(a.linear, b.linear) and np.array_equal(a.values, b.values)
+
     # a subclass with its own NumPy formula gets it (here: the lower hemisphere)
     class Lower(ts.surfaces.Hemisphere):
         def _cp_numpy(self, q):
@@ -668,8 +706,14 @@ def test_ellipsoid_distance_on_a_grid_plane_a_rounding_off_its_shortest_axis():
     g = ts.Grid((-1,) * 3, (1,) * 3, (201,) * 3)
     k = int(np.argmin(np.abs(g.lower[2] + g.spacing * np.arange(201) - 0.01)))
     i, j = np.meshgrid(np.arange(201), np.arange(201), indexing="ij")
-    p = np.stack([g.lower[0] + g.spacing * i.ravel(), g.lower[1] + g.spacing * j.ravel(),
-                  np.full(i.size, g.lower[2] + g.spacing * k)], axis=1)
+    p = np.stack(
+        [
+            g.lower[0] + g.spacing * i.ravel(),
+            g.lower[1] + g.spacing * j.ravel(),
+            np.full(i.size, g.lower[2] + g.spacing * k),
+        ],
+        axis=1,
+    )
     assert 0 < abs(p[0, 2] - 0.01) < 1e-16
     q = p[:, :2] / e.axes[:2]
     near_rim = np.sum(q**2, axis=1) > 0.85  # the degenerate region ends inside this
@@ -694,7 +738,9 @@ def test_native_ellipsoid_and_star_distances_match_their_numpy_formulations():
         p3[500:1000, 2] = e.center[2] + 1e-20 * rng.uniform(-1, 1, 500)
         assert np.array_equal(e.signed_distance(p3), e._signed_distance_numpy(p3))
     s = ts.surfaces.Star()
-    p2 = np.concatenate([rng.uniform(-1, 1, (5_000, 2)), s.curve(rng.uniform(0, 2 * np.pi, 5_000)) * rng.uniform(0.9, 1.1, (5_000, 1))])
+    p2 = np.concatenate(
+        [rng.uniform(-1, 1, (5_000, 2)), s.curve(rng.uniform(0, 2 * np.pi, 5_000)) * rng.uniform(0.9, 1.1, (5_000, 1))]
+    )
     a, b = s.signed_distance(p2), s._signed_distance_numpy(p2)
     assert np.max(np.abs(a - b)) < 1e-14
     assert np.array_equal(np.sign(a), np.sign(b))

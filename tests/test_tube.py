@@ -14,7 +14,11 @@ G2 = ts.Grid((-1,) * 2, (1,) * 2, (121,) * 2)
 def _same(a: ts.Solution, b: ts.Solution) -> None:
     assert np.array_equal(a.values, b.values)
     assert np.array_equal(a.roles, b.roles) and np.array_equal(a.indices, b.indices)
-    assert (a.stats.iterations, a.stats.updates, a.stats.band_points) == (b.stats.iterations, b.stats.updates, b.stats.band_points)
+    assert (a.stats.iterations, a.stats.updates, a.stats.band_points) == (
+        b.stats.iterations,
+        b.stats.updates,
+        b.stats.band_points,
+    )
 
 
 def test_repeated_solves_are_those_of_ts_solve_and_leave_the_tube_as_it_was():
@@ -59,7 +63,10 @@ def test_curves_the_naive_method_and_other_widths():
     for src in ([(-0.5, 0)], [(0, 0.5)]):
         _same(tube.solve(src), ts.solve(Circle(), G2, src, inner=3.0, outer=6.0))
     naive = ts.Tube(Circle(), G2, method="naive")
-    _same(naive.solve([(0.5, 0)], max_iterations=20), ts.solve(Circle(), G2, [(0.5, 0)], method="naive", max_iterations=20))
+    _same(
+        naive.solve([(0.5, 0)], max_iterations=20),
+        ts.solve(Circle(), G2, [(0.5, 0)], method="naive", max_iterations=20),
+    )
     assert "121, 121" in repr(tube) and tube.nbytes > 20 * tube.band_points
 
 

@@ -90,8 +90,10 @@ def test_memory_guard():
 def test_bad_speed_array_error_names_the_node():
     speed = np.ones((21, 21))
     speed[15, 10] = -1.0
-    for call in (lambda: ts.travel_time(G2, [(0, 0)], speed=speed),
-                 lambda: ts.solve(circle, G2, [(0.5, 0)], speed=speed)):
+    for call in (
+        lambda: ts.travel_time(G2, [(0, 0)], speed=speed),
+        lambda: ts.solve(circle, G2, [(0.5, 0)], speed=speed),
+    ):
         with pytest.raises(ValueError, match=r"at \(0\.5, 0\.0\)"):
             call()
 
@@ -175,8 +177,9 @@ def test_a_grid_too_coarse_for_the_surface_is_refused():
         ts.solve(SPHERE, ts.Grid((-1,) * 3, (1,) * 3, (4,) * 3), [(-0.5, 0, 0)])
 
 
-@pytest.mark.parametrize("surface", [ts.surfaces.Disc(radius=1e-3), ts.surfaces.PlanePatch(half_size=1e-3),
-                                     ts.surfaces.Disc(radius=0.04)])
+@pytest.mark.parametrize(
+    "surface", [ts.surfaces.Disc(radius=1e-3), ts.surfaces.PlanePatch(half_size=1e-3), ts.surfaces.Disc(radius=0.04)]
+)
 def test_an_open_surface_smaller_than_two_cells_is_refused(surface):
     # a disc of radius 0.02 h with sources at its rim gave distances 29% short (0.5 h: 15%),
     # with no warning; from a radius of one spacing on it is within the coarse grid's error
@@ -222,15 +225,18 @@ def test_a_surface_smaller_than_the_tube_says_to_refine_the_grid():
         ts.solve(ts.surfaces.Sphere(0.05), G3, [(-0.05, 0, 0)])
 
 
-@pytest.mark.parametrize("make", [
-    lambda: ts.surfaces.Sphere(0.5, center=(np.nan, 0, 0)),
-    lambda: ts.surfaces.Circle(center=(np.nan, 0)),
-    lambda: ts.surfaces.Sphere(0.5, center=(0, 0)),
-    lambda: ts.surfaces.Torus(center=(0, 0, np.inf)),
-    lambda: ts.surfaces.Ellipsoid(center=(0, 0, np.nan)),
-    lambda: ts.surfaces.RoundedCube(center=(np.nan, 0, 0)),
-    lambda: ts.surfaces.Ellipse(center="ab"),
-])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: ts.surfaces.Sphere(0.5, center=(np.nan, 0, 0)),
+        lambda: ts.surfaces.Circle(center=(np.nan, 0)),
+        lambda: ts.surfaces.Sphere(0.5, center=(0, 0)),
+        lambda: ts.surfaces.Torus(center=(0, 0, np.inf)),
+        lambda: ts.surfaces.Ellipsoid(center=(0, 0, np.nan)),
+        lambda: ts.surfaces.RoundedCube(center=(np.nan, 0, 0)),
+        lambda: ts.surfaces.Ellipse(center="ab"),
+    ],
+)
 def test_surface_centres_must_be_finite_coordinates(make):
     # a NaN centre gave "the band is empty ... check that the surface passes through the grid"
     with pytest.raises(ValueError, match="center must be [23] finite coordinates"):
@@ -250,12 +256,15 @@ def test_a_band_too_large_for_the_memory_is_refused_before_the_search():
         ts.solve(ts.surfaces.Circle(0.5), ts.Grid((-1, -1), (1, 1), (10**9, 10**9)), [(-0.5, 0)])
 
 
-@pytest.mark.parametrize("surface, grid", [
-    (SPHERE, ts.Grid((-1,) * 3, (1,) * 3, (161,) * 3)),
-    (ts.surfaces.Torus(0.5, 0.25), ts.Grid((-1,) * 3, (1,) * 3, (121,) * 3)),
-    (ts.surfaces.Hemisphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (121,) * 3)),
-    (ts.surfaces.Circle(0.5), ts.Grid((-1, -1), (1, 1), (401, 401))),
-])
+@pytest.mark.parametrize(
+    "surface, grid",
+    [
+        (SPHERE, ts.Grid((-1,) * 3, (1,) * 3, (161,) * 3)),
+        (ts.surfaces.Torus(0.5, 0.25), ts.Grid((-1,) * 3, (1,) * 3, (121,) * 3)),
+        (ts.surfaces.Hemisphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (121,) * 3)),
+        (ts.surfaces.Circle(0.5), ts.Grid((-1, -1), (1, 1), (401, 401))),
+    ],
+)
 def test_the_memory_check_s_band_estimate_is_close_to_the_band(surface, grid):
     from tubesweep.solve import _estimated_band_nodes
 
@@ -292,16 +301,21 @@ def test_the_band_estimate_survives_a_closest_point_map_undefined_far_from_the_s
     assert est == 0.0 or 0.5 < est / exact < 2.0
 
 
-@pytest.mark.parametrize("call, name", [
-    (lambda: ts.solve(ts.LevelSet(np.zeros((31,) * 3) + 0j), G3, [(-0.5, 0, 0)]), "phi array"),
-    (lambda: ts.solve(ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5 + 0j), G3, [(-0.5, 0, 0)]),
-     "phi callable"),
-    (lambda: ts.solve(SPHERE, G3, np.array([(-0.5 + 0j, 0, 0)])), "sources"),
-    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.ones(G3.shape) + 0j), "speed array"),
-    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=lambda p: np.ones(len(p)) + 0j), "speed callable"),
-    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(3) + 0j)), "M"),
-    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)])(np.array([(0.5 + 0j, 0, 0)])), "points"),
-])
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda: ts.solve(ts.LevelSet(np.zeros((31,) * 3) + 0j), G3, [(-0.5, 0, 0)]), "phi array"),
+        (
+            lambda: ts.solve(ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5 + 0j), G3, [(-0.5, 0, 0)]),
+            "phi callable",
+        ),
+        (lambda: ts.solve(SPHERE, G3, np.array([(-0.5 + 0j, 0, 0)])), "sources"),
+        (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.ones(G3.shape) + 0j), "speed array"),
+        (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=lambda p: np.ones(len(p)) + 0j), "speed callable"),
+        (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(3) + 0j)), "M"),
+        (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)])(np.array([(0.5 + 0j, 0, 0)])), "points"),
+    ],
+)
 def test_complex_input_is_refused_not_cut_to_its_real_part(call, name):
     # NumPy dropped the imaginary parts with only a ComplexWarning
     with pytest.raises(TypeError, match=f"{name}.* must hold real numbers"):
@@ -369,19 +383,33 @@ def test_a_solution_refuses_paths_after_its_phi_array_changed():
     assert len(sol2.geodesic_path((0.5, 0, 0))) > 2
 
 
-@pytest.mark.parametrize("call, error, match", [
-    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.complex128(2 + 1j)), TypeError, "speed must be a real"),
-    (lambda: ts.hamiltonians.Isotropic(sigma=np.array([1.5 + 1j] * 3)), TypeError, "sigma must hold real"),
-    (lambda: ts.flows.point_vortices(np.array([[0.5, 0, 0]]), np.array([0.1 + 1j])), TypeError, "strengths must hold"),
-    (lambda: ts.surfaces.Star("0.5"), TypeError, "r0 must be a positive real"),
-    (lambda: ts.surfaces.Star(np.inf), ValueError, "r0 must be positive and finite"),
-    (lambda: ts.surfaces.Star(0.5, eps=-1), ValueError, "eps must be"),
-    (lambda: ts.LevelSet(lambda p: p[:, 0], lipschitz=np.complex128(1 + 1j)), TypeError, "lipschitz must be a real"),
-    (lambda: ts.solve(SPHERE, G3, {"a": 1}), TypeError, r"sources must be an array-like of shape \(M, 3\)"),
-    (lambda: ts.surfaces.Sphere(10**400), ValueError, "radius must be positive and finite"),
-    (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.diag([1e30, 1, 1]))),
-     ValueError, "numerically singular"),
-])
+@pytest.mark.parametrize(
+    "call, error, match",
+    [
+        (lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=np.complex128(2 + 1j)), TypeError, "speed must be a real"),
+        (lambda: ts.hamiltonians.Isotropic(sigma=np.array([1.5 + 1j] * 3)), TypeError, "sigma must hold real"),
+        (
+            lambda: ts.flows.point_vortices(np.array([[0.5, 0, 0]]), np.array([0.1 + 1j])),
+            TypeError,
+            "strengths must hold",
+        ),
+        (lambda: ts.surfaces.Star("0.5"), TypeError, "r0 must be a positive real"),
+        (lambda: ts.surfaces.Star(np.inf), ValueError, "r0 must be positive and finite"),
+        (lambda: ts.surfaces.Star(0.5, eps=-1), ValueError, "eps must be"),
+        (
+            lambda: ts.LevelSet(lambda p: p[:, 0], lipschitz=np.complex128(1 + 1j)),
+            TypeError,
+            "lipschitz must be a real",
+        ),
+        (lambda: ts.solve(SPHERE, G3, {"a": 1}), TypeError, r"sources must be an array-like of shape \(M, 3\)"),
+        (lambda: ts.surfaces.Sphere(10**400), ValueError, "radius must be positive and finite"),
+        (
+            lambda: ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.diag([1e30, 1, 1]))),
+            ValueError,
+            "numerically singular",
+        ),
+    ],
+)
 def test_more_bad_arguments_name_themselves(call, error, match):
     with pytest.raises(error, match=match):
         call()

@@ -33,6 +33,21 @@ from . import data, surfaces
 __version__ = "0.1.0"
 
 __all__ = [
-    "ClosestPoint", "Grid", "LevelSet", "Solution", "SolveStats", "Surface", "data", "export", "flows", "hamiltonians", "plot",
-    "solve", "surfaces", "travel_time", "triangulate", "Tube", "__version__",
+    "ClosestPoint",
+    "Grid",
+    "LevelSet",
+    "Solution",
+    "SolveStats",
+    "Surface",
+    "data",
+    "export",
+    "flows",
+    "hamiltonians",
+    "plot",
+    "solve",
+    "surfaces",
+    "travel_time",
+    "triangulate",
+    "Tube",
+    "__version__",
 ]

@@ -65,8 +65,9 @@ def solution_png(sol: Any, path: Path, title: str = "", levels: int = 16) -> Pat
     return path
 
 
-def field_png(grid: Any, u: np.ndarray, path: Path, sources: np.ndarray, title: str = "",
-              speed: Optional[np.ndarray] = None) -> Path:
+def field_png(
+    grid: Any, u: np.ndarray, path: Path, sources: np.ndarray, title: str = "", speed: Optional[np.ndarray] = None
+) -> Path:
     """A 2D travel-time field (or the middle slice of a 3D one) with iso-lines."""
     plt = _plt()
     if grid.ndim == 3:

@@ -24,7 +24,8 @@ def keep_within(
 ) -> int: ...
 def first_non_finite(phi: npt.NDArray[np.float64]) -> Optional[int]: ...  # C order, C-contiguous
 def band_of_samples(
-    phi: npt.NDArray[np.float64], half_width: float  # φ at every grid node, C-contiguous
+    phi: npt.NDArray[np.float64],
+    half_width: float,  # φ at every grid node, C-contiguous
 ) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64]]: ...
 def max_gradient_norm_of_samples(phi: npt.NDArray[np.float64], spacing: float) -> float: ...
 def redistance_candidates_of_samples(
@@ -78,8 +79,12 @@ def outward_directions(
     direction: npt.NDArray[np.float32],  # (stop − start, d) C-contiguous, written
     neighbours: Optional[npt.NDArray[np.int32]] = None,  # neighbour_table(shape, linear, start, stop)
 ) -> npt.NDArray[np.float64]: ...
-def row_prefetch_above() -> int: ...  # bytes of an iteration's rows above which the next prefetches its rows (a share of the last-level cache)
-def sphere_signed_distance(points: npt.NDArray[np.float64], centre: List[float], radius: float) -> npt.NDArray[np.float64]: ...
+def row_prefetch_above() -> (
+    int
+): ...  # bytes of an iteration's rows above which the next prefetches its rows (a share of the last-level cache)
+def sphere_signed_distance(
+    points: npt.NDArray[np.float64], centre: List[float], radius: float
+) -> npt.NDArray[np.float64]: ...
 def torus_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], major: float, minor: float
 ) -> npt.NDArray[np.float64]: ...
@@ -99,6 +104,7 @@ def mobius_closest_parameters(
 def open_surface_closest_points(
     kind: str, points: npt.NDArray[np.float64], centre: List[float], size: float
 ) -> npt.NDArray[np.float64]: ...
+
 __version__: str
 
 class Band:
@@ -198,7 +204,9 @@ class TriangleTree:
     def closest(
         self, points: npt.NDArray[np.float64], max_distance: float
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.uint8]]: ...
-    def any_within(self, points: npt.NDArray[np.float64], thresholds: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]: ...
+    def any_within(
+        self, points: npt.NDArray[np.float64], thresholds: npt.NDArray[np.float64]
+    ) -> npt.NDArray[np.bool_]: ...
     def band(
         self,
         points: npt.NDArray[np.float64],

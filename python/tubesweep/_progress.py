@@ -29,7 +29,12 @@ class SweepProgress:
             self._bar.update(1)
             self._bar.set_postfix(change=f"{max_change:.2e}", refresh=False)
         else:
-            print(f"\r{self._desc}: iteration {iteration}, largest change {max_change:.2e}", end="", file=sys.stderr, flush=True)
+            print(
+                f"\r{self._desc}: iteration {iteration}, largest change {max_change:.2e}",
+                end="",
+                file=sys.stderr,
+                flush=True,
+            )
 
     def close(self) -> None:
         if self._bar is not None:

@@ -26,7 +26,9 @@ FRONT_WINDOW = 2.0
 
 def as_grid(grid: Any) -> Grid:
     if not isinstance(grid, Grid):
-        raise TypeError(f"grid must be a tubesweep.Grid, got {type(grid).__name__}; build one with ts.Grid(lower, upper, shape)")
+        raise TypeError(
+            f"grid must be a tubesweep.Grid, got {type(grid).__name__}; build one with ts.Grid(lower, upper, shape)"
+        )
     return grid
 
 
@@ -38,10 +40,13 @@ def real_array(value: Any, name: str) -> np.ndarray:
     except ValueError:  # ragged nesting
         raise TypeError(f"{name} must be an array of real numbers; got {type(value).__name__}") from None
     complex_values = np.iscomplexobj(a) or (
-        a.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in a.reshape(-1)))
+        a.dtype == object and any(isinstance(x, (complex, np.complexfloating)) for x in a.reshape(-1))
+    )
     if complex_values:
-        raise TypeError(f"{name} must hold real numbers; got complex values (dtype {a.dtype}). Pass the real part "
-                        f"(x.real) if the imaginary part is zero")
+        raise TypeError(
+            f"{name} must hold real numbers; got complex values (dtype {a.dtype}). Pass the real part "
+            f"(x.real) if the imaginary part is zero"
+        )
     try:
         return a.astype(float, copy=False)
     except (TypeError, ValueError, OverflowError):
@@ -52,8 +57,12 @@ def real_scalar(value: Any, name: str, what: str = "a real number") -> float:
     """``value`` as a float: one real number (a NumPy scalar or 0-d array too; beyond the float
     range, ±inf). None, a bool, a string, a sequence or a complex number is a ``TypeError`` that
     says ``name`` must be ``what``."""
-    if (value is None or isinstance(value, (bool, np.bool_, str, bytes)) or np.ndim(value) != 0
-            or np.iscomplexobj(value)):
+    if (
+        value is None
+        or isinstance(value, (bool, np.bool_, str, bytes))
+        or np.ndim(value) != 0
+        or np.iscomplexobj(value)
+    ):
         raise TypeError(f"{name} must be {what}; got {value!r}")
     try:
         return float(value)
@@ -117,15 +126,28 @@ MAX_ITERATIONS_LIMIT = 10**9
 
 def check_tolerance(tol: float, max_iterations: int) -> None:
     if not (isinstance(tol, (int, float, np.floating)) and not isinstance(tol, bool) and np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be a positive finite number (the sweeps stop once no value changes by more in an "
-                         f"iteration); got {tol!r}")
-    if not (isinstance(max_iterations, (int, np.integer)) and not isinstance(max_iterations, bool)
-            and 1 <= max_iterations <= MAX_ITERATIONS_LIMIT):
-        raise ValueError(f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}")
+        raise ValueError(
+            f"tol must be a positive finite number (the sweeps stop once no value changes by more in an "
+            f"iteration); got {tol!r}"
+        )
+    if not (
+        isinstance(max_iterations, (int, np.integer))
+        and not isinstance(max_iterations, bool)
+        and 1 <= max_iterations <= MAX_ITERATIONS_LIMIT
+    ):
+        raise ValueError(
+            f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}"
+        )
 
 
-def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cells: int,
-                          cell_time: str = "spacing × mean slowness", rescale: str = "the speed") -> None:
+def check_tolerance_scale(
+    tol: float,
+    spacing: float,
+    mean_slowness: float,
+    cells: int,
+    cell_time: str = "spacing × mean slowness",
+    rescale: str = "the speed",
+) -> None:
     """Refuses a ``tol`` that is not small against the travel time across one grid cell: the stopping
     test compares absolute changes with it, so a ``tol`` of that size (short travel times: a large
     speed, or a grid in small units) stops the sweeps before the front has crossed the band, with
@@ -138,13 +160,15 @@ def check_tolerance_scale(tol: float, spacing: float, mean_slowness: float, cell
         raise ValueError(
             f"the travel times of this problem are too large to compute (about {scale:.3g} across the grid, "
             f"{cell:.3g} across one grid cell: {cell_time}); rescale the units of the grid or {rescale} so that "
-            f"they are below about 1e100")
+            f"they are below about 1e100"
+        )
     if tol >= 1e-2 * scale:
         raise ValueError(
             f"tol={tol:g} is not small against the travel times of this problem (about {scale:.3g} across the grid, "
             f"{cell:.3g} across one grid cell: {cell_time}): the sweeps would stop before the front "
             f"crosses the band. Pass a tol relative to them, e.g. tol=1e-10 * {cell:.3g} or tol=1e-3 * {cell:.3g} "
-            f"(or rescale the units of the grid or {rescale})")
+            f"(or rescale the units of the grid or {rescale})"
+        )
 
 
 def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
@@ -152,8 +176,10 @@ def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
     the values at the nodes are: one per point, finite and positive."""
     vals = real_array(speed(points), "speed callable's values")
     if vals.shape != (points.shape[0],):
-        raise ValueError(f"speed callable must map points of shape (M, {points.shape[1]}) to values of shape (M,); "
-                         f"returned shape {vals.shape} for M = {points.shape[0]} ({what})")
+        raise ValueError(
+            f"speed callable must map points of shape (M, {points.shape[1]}) to values of shape (M,); "
+            f"returned shape {vals.shape} for M = {points.shape[0]} ({what})"
+        )
     return checked_point_speeds(vals, points, what)
 
 
@@ -163,8 +189,9 @@ def checked_point_speeds(vals: np.ndarray, points: np.ndarray, what: str) -> np.
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         p = tuple(float(x) for x in points[i])
-        raise ValueError(f"speed is {vals[i]} at {p} ({what}); it must be positive and finite everywhere the "
-                         f"solution reaches")
+        raise ValueError(
+            f"speed is {vals[i]} at {p} ({what}); it must be positive and finite everywhere the solution reaches"
+        )
     return vals
 
 
@@ -187,15 +214,20 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
         try:
             f = float(speed)
         except (TypeError, ValueError):
-            raise TypeError(f"speed must be a number, an array of grid.shape or a callable; got {type(speed).__name__}") from None
+            raise TypeError(
+                f"speed must be a number, an array of grid.shape or a callable; got {type(speed).__name__}"
+            ) from None
         if not np.isfinite(f) or f <= 0:
-            raise ValueError(f"speed must be positive and finite; got {f}. The speed F(x) > 0 is the wave speed in |∇u| = 1/F")
+            raise ValueError(
+                f"speed must be positive and finite; got {f}. The speed F(x) > 0 is the wave speed in |∇u| = 1/F"
+            )
         return f
     else:
         arr = real_array(speed, "speed array")
         if arr.shape != grid.shape:
             raise ValueError(f"speed array must have the grid's shape {grid.shape}; got {arr.shape}")
         vals = arr.reshape(-1)[linear] if linear is not None else arr.reshape(-1)
+
     def where(i: int) -> tuple:
         if points.shape[1] == grid.ndim and len(points) > i:
             p = points[i]
@@ -248,7 +280,8 @@ def warn_unconverged(stats: dict, tol: float, max_iterations: int) -> None:
         behind = (
             f"; the sweeps' front window had reached u = {edge:.4g}: the nodes above it are not reached "
             "yet (inf), and the values just below it are not converged"
-            if edge < float("inf") else ""
+            if edge < float("inf")
+            else ""
         )
         warnings.warn(
             f"the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "

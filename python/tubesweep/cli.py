@@ -36,9 +36,15 @@ def _surface_names() -> List[str]:
 
 
 def _add_solver_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--hamiltonian", choices=["godunov", "lxf"], default="godunov",
-                   help="numerical Hamiltonian: Godunov (Eq. 3) or Lax-Friedrichs (Eq. 4) (default: godunov)")
-    p.add_argument("--tol", type=float, default=1e-10, help="stop when the largest change in an iteration is below this")
+    p.add_argument(
+        "--hamiltonian",
+        choices=["godunov", "lxf"],
+        default="godunov",
+        help="numerical Hamiltonian: Godunov (Eq. 3) or Lax-Friedrichs (Eq. 4) (default: godunov)",
+    )
+    p.add_argument(
+        "--tol", type=float, default=1e-10, help="stop when the largest change in an iteration is below this"
+    )
     p.add_argument("--max-iterations", type=int, default=10000)
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: ./out)")
     p.add_argument("--png", action="store_true", help="also write a picture (needs matplotlib)")
@@ -57,52 +63,112 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"tubesweep {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser("solve", help="first-arrival time on a curve/surface (two-layer tube, Algorithm 3)",
-                       description="Solve |grad_S u| = 1/F on an implicit curve or surface and write the band values "
-                       "(solution.npz: indices, values, roles, phi, grid) and optionally a PNG.")
+    p = sub.add_parser(
+        "solve",
+        help="first-arrival time on a curve/surface (two-layer tube, Algorithm 3)",
+        description="Solve |grad_S u| = 1/F on an implicit curve or surface and write the band values "
+        "(solution.npz: indices, values, roles, phi, grid) and optionally a PNG.",
+    )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=_surface_names(), help="a built-in curve or surface")
     src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
-    src.add_argument("--mesh", type=Path, help="a triangle mesh file (.obj .ply .stl .off .obj.gz), or 'bunny' / 'spot' "
-                     "for the bundled example meshes; used in the closest-point representation (Sect. 5.2): open and "
-                     "scanned meshes with holes are fine")
-    p.add_argument("--n", type=int, default=None,
-                   help="nodes per axis for --surface (default: 101); for --mesh, nodes along the longest side of the "
-                   "mesh's bounding box, padding included (default: 200)")
-    p.add_argument("--padding", type=float, default=None, help="--mesh: empty grid spacings around the mesh (default 8)")
-    p.add_argument("--normalize", action="store_true",
-                   help="--mesh: centre the mesh at the origin and scale its longest side to 1 (sources are then in "
-                   "the new coordinates)")
-    p.add_argument("--source-vertex", type=int, action="append",
-                   help="--mesh: a source at this vertex (0-based; repeat for several; default: the vertex farthest "
-                   "from the centroid)")
-    p.add_argument("--lower", type=float, nargs="+", help="grid lower corner (with --phi; default for --surface: the surface's box)")
+    src.add_argument(
+        "--mesh",
+        type=Path,
+        help="a triangle mesh file (.obj .ply .stl .off .obj.gz), or 'bunny' / 'spot' "
+        "for the bundled example meshes; used in the closest-point representation (Sect. 5.2): open and "
+        "scanned meshes with holes are fine",
+    )
+    p.add_argument(
+        "--n",
+        type=int,
+        default=None,
+        help="nodes per axis for --surface (default: 101); for --mesh, nodes along the longest side of the "
+        "mesh's bounding box, padding included (default: 200)",
+    )
+    p.add_argument(
+        "--padding", type=float, default=None, help="--mesh: empty grid spacings around the mesh (default 8)"
+    )
+    p.add_argument(
+        "--normalize",
+        action="store_true",
+        help="--mesh: centre the mesh at the origin and scale its longest side to 1 (sources are then in "
+        "the new coordinates)",
+    )
+    p.add_argument(
+        "--source-vertex",
+        type=int,
+        action="append",
+        help="--mesh: a source at this vertex (0-based; repeat for several; default: the vertex farthest "
+        "from the centroid)",
+    )
+    p.add_argument(
+        "--lower",
+        type=float,
+        nargs="+",
+        help="grid lower corner (with --phi; default for --surface: the surface's box)",
+    )
     p.add_argument("--upper", type=float, nargs="+", help="grid upper corner")
-    p.add_argument("--source", type=float, nargs="+", action="append",
-                   help="a source point on the surface (repeat for several; default: the surface's own)")
+    p.add_argument(
+        "--source",
+        type=float,
+        nargs="+",
+        action="append",
+        help="a source point on the surface (repeat for several; default: the surface's own)",
+    )
     p.add_argument("--speed", type=float, default=1.0, help="constant speed F (default 1)")
-    p.add_argument("--method", choices=["two-layer", "naive"], default="two-layer",
-                   help="two-layer = Algorithm 3 (default); naive = Algorithm 2, the baseline that does not converge")
+    p.add_argument(
+        "--method",
+        choices=["two-layer", "naive"],
+        default="two-layer",
+        help="two-layer = Algorithm 3 (default); naive = Algorithm 2, the baseline that does not converge",
+    )
     p.add_argument("--inner", type=float, default=2.0, help="inner tube half-width in grid spacings (default 2)")
     p.add_argument("--outer", type=float, default=4.0, help="outer tube half-width in grid spacings (default 4)")
     p.add_argument("--source-init", choices=["exact", "node"], default="exact")
-    p.add_argument("--dense", action="store_true", help="also write the dense array solution_dense.npy (NaN off the band)")
-    p.add_argument("--up", choices=["x", "y", "z"], help="the vertical axis of 3D pictures (default: y for --mesh, "
-                   "as in most mesh files, z otherwise)")
-    p.add_argument("--export", type=Path, action="append", metavar="FILE",
-                   help="write the surface mesh with u as point data for ParaView: .vtu .vtp .vtk .ply (repeatable)")
-    p.add_argument("--path-from", type=float, nargs="+", action="append", metavar="X",
-                   help="trace the geodesic path from this point of the surface to its nearest source (repeatable); "
-                   "writes paths.npz, prints each length and draws the paths in --png")
-    p.add_argument("--path-from-vertex", type=int, action="append", metavar="I",
-                   help="--mesh: trace the geodesic path from vertex I (repeatable)")
+    p.add_argument(
+        "--dense", action="store_true", help="also write the dense array solution_dense.npy (NaN off the band)"
+    )
+    p.add_argument(
+        "--up",
+        choices=["x", "y", "z"],
+        help="the vertical axis of 3D pictures (default: y for --mesh, as in most mesh files, z otherwise)",
+    )
+    p.add_argument(
+        "--export",
+        type=Path,
+        action="append",
+        metavar="FILE",
+        help="write the surface mesh with u as point data for ParaView: .vtu .vtp .vtk .ply (repeatable)",
+    )
+    p.add_argument(
+        "--path-from",
+        type=float,
+        nargs="+",
+        action="append",
+        metavar="X",
+        help="trace the geodesic path from this point of the surface to its nearest source (repeatable); "
+        "writes paths.npz, prints each length and draws the paths in --png",
+    )
+    p.add_argument(
+        "--path-from-vertex",
+        type=int,
+        action="append",
+        metavar="I",
+        help="--mesh: trace the geodesic path from vertex I (repeatable)",
+    )
     _add_solver_options(p)
 
-    t = sub.add_parser("travel-time", help="first-arrival time in the whole box (Algorithm 1)",
-                       description="Travel times from point sources in [-1,1]^d with constant speed; writes travel_time.npy.")
+    t = sub.add_parser(
+        "travel-time",
+        help="first-arrival time in the whole box (Algorithm 1)",
+        description="Travel times from point sources in [-1,1]^d with constant speed; writes travel_time.npy.",
+    )
     t.add_argument("--n", type=int, default=201)
     t.add_argument("--dim", type=int, choices=[2, 3], default=2)
-    t.add_argument("--source", type=float, nargs="+", action="append", help="a source point (repeatable; default: origin)")
+    t.add_argument(
+        "--source", type=float, nargs="+", action="append", help="a source point (repeatable; default: origin)"
+    )
     t.add_argument("--speed", type=float, default=1.0)
     _add_solver_options(t)
 
@@ -110,9 +176,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", type=Path, default=Path("out/demo"))
     d.add_argument("--quick", action="store_true", help="smaller grids")
 
-    r = sub.add_parser("reproduce", help="reproduce the paper's tables and figures",
-                       description="Reproduce the numerical experiments of Wong & Leung (2016). Writes CSV, Markdown "
-                       "and PNG files per experiment.")
+    r = sub.add_parser(
+        "reproduce",
+        help="reproduce the paper's tables and figures",
+        description="Reproduce the numerical experiments of Wong & Leung (2016). Writes CSV, Markdown "
+        "and PNG files per experiment.",
+    )
     r.add_argument("names", nargs="+", help="experiment names or 'all' (see 'tubesweep reproduce list')")
     r.add_argument("--quick", action="store_true", help="small grids only (under two minutes in all)")
     r.add_argument("--out", type=Path, default=Path("out/reproduce"))
@@ -145,8 +214,10 @@ def _load_phi(path: Path) -> np.ndarray:
     try:
         data = np.load(path, allow_pickle=False)
     except (ValueError, EOFError, zipfile.BadZipFile):
-        raise UsageError(f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
-                         f"φ with numpy.save or numpy.savez") from None
+        raise UsageError(
+            f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
+            f"φ with numpy.save or numpy.savez"
+        ) from None
     if isinstance(data, np.lib.npyio.NpzFile):
         with data:
             names = list(data.files)
@@ -223,8 +294,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
             raise UsageError(f"--path-from {' '.join(map(str, args.path_from[outside[0]]))}: outside the grid")
         far, dist = starts_beyond_inner_tube(surface, grid, starts, args.inner)
         if far.size:
-            raise UsageError(f"--path-from {' '.join(map(str, args.path_from[far[0]]))}: {float(dist[far[0]]):.4g} from "
-                             f"the surface, farther than the inner tube ({args.inner:g} grid spacings); start on the surface")
+            raise UsageError(
+                f"--path-from {' '.join(map(str, args.path_from[far[0]]))}: {float(dist[far[0]]):.4g} from "
+                f"the surface, farther than the inner tube ({args.inner:g} grid spacings); start on the surface"
+            )
     for path in args.export or []:
         try:
             export_format(path, curve=grid.ndim == 2)
@@ -247,9 +320,20 @@ def cmd_solve(args: argparse.Namespace) -> int:
     progress = make_progress(f"solve {name}", args.quiet)
     t0 = time.perf_counter()
     try:
-        sol = solve(surface, grid, sources, hamiltonian=args.hamiltonian, speed=args.speed, inner=args.inner,
-                    outer=args.outer, method=args.method, source_init=args.source_init, tol=args.tol,
-                    max_iterations=args.max_iterations, progress=progress)
+        sol = solve(
+            surface,
+            grid,
+            sources,
+            hamiltonian=args.hamiltonian,
+            speed=args.speed,
+            inner=args.inner,
+            outer=args.outer,
+            method=args.method,
+            source_init=args.source_init,
+            tol=args.tol,
+            max_iterations=args.max_iterations,
+            progress=progress,
+        )
     finally:
         if progress is not None:
             progress.close()  # type: ignore[attr-defined]
@@ -257,11 +341,23 @@ def cmd_solve(args: argparse.Namespace) -> int:
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     labels = {"nearest_source": sol.nearest_source()} if len(sol.sources) > 1 and sol._isotropic else {}
-    np.savez_compressed(out / "solution.npz", indices=sol.indices, values=sol.values, roles=sol.roles, phi=sol.phi,
-                        lower=grid.lower, upper=grid.upper, shape=np.array(grid.shape), sources=sol.sources, **labels)
+    np.savez_compressed(
+        out / "solution.npz",
+        indices=sol.indices,
+        values=sol.values,
+        roles=sol.roles,
+        phi=sol.phi,
+        lower=grid.lower,
+        upper=grid.upper,
+        shape=np.array(grid.shape),
+        sources=sol.sources,
+        **labels,
+    )
     s = sol.stats
-    print(f"{name}: grid {grid.shape}, band {s.band_points} nodes ({s.inner_points} inner, {s.outer_points} outer), "
-          f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, solve {s.seconds:.3f} s, total {wall:.3f} s")
+    print(
+        f"{name}: grid {grid.shape}, band {s.band_points} nodes ({s.inner_points} inner, {s.outer_points} outer), "
+        f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, solve {s.seconds:.3f} s, total {wall:.3f} s"
+    )
     print(f"wrote {out / 'solution.npz'}")
     if args.dense:
         np.save(out / "solution_dense.npy", sol.to_dense())
@@ -318,14 +414,24 @@ def cmd_travel_time(args: argparse.Namespace) -> int:
     sources = np.array(args.source, dtype=float) if args.source else np.zeros((1, args.dim))
     progress = make_progress("travel-time", args.quiet)
     try:
-        u, s = travel_time(grid, sources, speed=args.speed, hamiltonian=args.hamiltonian, tol=args.tol,
-                           max_iterations=args.max_iterations, return_stats=True, progress=progress)
+        u, s = travel_time(
+            grid,
+            sources,
+            speed=args.speed,
+            hamiltonian=args.hamiltonian,
+            tol=args.tol,
+            max_iterations=args.max_iterations,
+            return_stats=True,
+            progress=progress,
+        )
     finally:
         if progress is not None:
             progress.close()  # type: ignore[attr-defined]
     args.out.mkdir(parents=True, exist_ok=True)
     np.save(args.out / "travel_time.npy", u)
-    print(f"grid {grid.shape}: {s.iterations} iterations, {s.updates} updates, {s.seconds:.3f} s; wrote {args.out / 'travel_time.npy'}")
+    print(
+        f"grid {grid.shape}: {s.iterations} iterations, {s.updates} updates, {s.seconds:.3f} s; wrote {args.out / 'travel_time.npy'}"
+    )
     if args.png:
         from ._figures import field_png
 
@@ -347,12 +453,15 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 def cmd_info(_: argparse.Namespace) -> int:
     from . import _native
 
-    print(f"tubesweep {__version__} (core {_native.__version__}), numpy {np.__version__}, python {sys.version.split()[0]}")
+    print(
+        f"tubesweep {__version__} (core {_native.__version__}), numpy {np.__version__}, python {sys.version.split()[0]}"
+    )
     return 0
 
 
-def _warning_line(message: Any, category: Any, filename: str, lineno: int, file: Any = None,
-                  line: Optional[str] = None) -> None:
+def _warning_line(
+    message: Any, category: Any, filename: str, lineno: int, file: Any = None, line: Optional[str] = None
+) -> None:
     """Shows a warning as one ``warning: …`` line on stderr, without the library's source line
     (what the command-line user can act on is the message)."""
     print(f"warning: {message}", file=sys.stderr if file is None else file)

@@ -70,14 +70,26 @@ def run_demo(out: Path, quick: bool = False) -> int:
     speed = lambda p: 1.5 + 0.5 * np.tanh(8 * p[:, 1])  # noqa: E731
     u, st = travel_time(gridb, [(0.0, -0.6)], speed=speed, return_stats=True)
     X, Y = gridb.meshgrid()
-    field_png(gridb, u, out / "layered.png", np.array([[0.0, -0.6]]), title="travel time, layered medium",
-              speed=1.5 + 0.5 * np.tanh(8 * Y))
+    field_png(
+        gridb,
+        u,
+        out / "layered.png",
+        np.array([[0.0, -0.6]]),
+        title="travel time, layered medium",
+        speed=1.5 + 0.5 * np.tanh(8 * Y),
+    )
 
-    print(f"{'problem':<16} {'H':<8} {'N':>5} {'max error':>10} {'iters':>6} {'band pts':>9} {'sweeps s':>9} {'total s':>8}")
+    print(
+        f"{'problem':<16} {'H':<8} {'N':>5} {'max error':>10} {'iters':>6} {'band pts':>9} {'sweeps s':>9} {'total s':>8}"
+    )
     for name, ham, n, err, s, wall in rows:
-        print(f"{name:<16} {ham:<8} {n:>5} {err:>10.2e} {s.iterations:>6} {s.band_points:>9} {s.seconds:>9.3f} {wall:>8.3f}")
-    print(f"geodesic paths on the sphere (5 starts, 3 sources, N={n3}): length error max {path_err:.2e} "
-          f"(u at the starts: {u_err:.2e})")
+        print(
+            f"{name:<16} {ham:<8} {n:>5} {err:>10.2e} {s.iterations:>6} {s.band_points:>9} {s.seconds:>9.3f} {wall:>8.3f}"
+        )
+    print(
+        f"geodesic paths on the sphere (5 starts, 3 sources, N={n3}): length error max {path_err:.2e} "
+        f"(u at the starts: {u_err:.2e})"
+    )
     print(f"layered medium (box 301^2, Godunov): {st.iterations} iterations, {st.seconds:.3f} s")
     print(f"pictures: {out / 'sphere.png'}, {out / 'sphere_paths.png'}, {out / 'star.png'}, {out / 'layered.png'}")
     return 0

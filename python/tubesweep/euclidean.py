@@ -42,11 +42,15 @@ def _box_band(shape: Tuple[int, ...]) -> Any:
     return _native.Band.full_box(list(shape))
 
 
-def _source_nodes(grid: Grid, sources: np.ndarray, slowness_at: Callable[[np.ndarray], np.ndarray]) -> Tuple[np.ndarray, np.ndarray]:
+def _source_nodes(
+    grid: Grid, sources: np.ndarray, slowness_at: Callable[[np.ndarray], np.ndarray]
+) -> Tuple[np.ndarray, np.ndarray]:
     """Linear indices and exact local travel times of the nodes near the sources."""
     h = grid.spacing
     r = int(np.ceil(SOURCE_RADIUS))
-    offsets = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * grid.ndim), indexing="ij"), axis=-1).reshape(-1, grid.ndim)
+    offsets = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * grid.ndim), indexing="ij"), axis=-1).reshape(
+        -1, grid.ndim
+    )
     best: dict = {}
     for s in sources:
         base = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64)
@@ -68,11 +72,29 @@ def _source_nodes(grid: Grid, sources: np.ndarray, slowness_at: Callable[[np.nda
 
 
 @overload
-def travel_time(grid: Grid, sources: Any, *, speed: Any = ..., hamiltonian: str = ..., tol: float = ...,
-                max_iterations: int = ..., return_stats: Literal[False] = ..., progress: Any = ...) -> np.ndarray: ...
+def travel_time(
+    grid: Grid,
+    sources: Any,
+    *,
+    speed: Any = ...,
+    hamiltonian: str = ...,
+    tol: float = ...,
+    max_iterations: int = ...,
+    return_stats: Literal[False] = ...,
+    progress: Any = ...,
+) -> np.ndarray: ...
 @overload
-def travel_time(grid: Grid, sources: Any, *, speed: Any = ..., hamiltonian: str = ..., tol: float = ...,
-                max_iterations: int = ..., return_stats: Literal[True], progress: Any = ...) -> Tuple[np.ndarray, SolveStats]: ...
+def travel_time(
+    grid: Grid,
+    sources: Any,
+    *,
+    speed: Any = ...,
+    hamiltonian: str = ...,
+    tol: float = ...,
+    max_iterations: int = ...,
+    return_stats: Literal[True],
+    progress: Any = ...,
+) -> Tuple[np.ndarray, SolveStats]: ...
 
 
 def travel_time(
@@ -137,10 +159,14 @@ def travel_time(
     scheme = check_hamiltonian(hamiltonian)
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
-    check_memory(grid.size * _BYTES_PER_BOX_NODE, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver")
+    check_memory(
+        grid.size * _BYTES_PER_BOX_NODE, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver"
+    )
 
     if callable(speed) or np.ndim(speed) > 0:
-        pts = np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1) if callable(speed) else np.empty((0, grid.ndim))
+        pts = (
+            np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1) if callable(speed) else np.empty((0, grid.ndim))
+        )
         f = speed_values(speed, grid, pts, None)
         slowness: Any = 1.0 / f
         del pts
@@ -163,8 +189,21 @@ def travel_time(
     roles[lin] = 0
     setup = time.perf_counter() - t0
     values, st = band.solve(
-        roles, np.ascontiguousarray(lin, dtype=np.int64), np.ascontiguousarray(val, dtype=float), grid.spacing, slowness, None, scheme, "extrapolate", float(tol), int(max_iterations),
-        _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
+        roles,
+        np.ascontiguousarray(lin, dtype=np.int64),
+        np.ascontiguousarray(val, dtype=float),
+        grid.spacing,
+        slowness,
+        None,
+        scheme,
+        "extrapolate",
+        float(tol),
+        int(max_iterations),
+        _infinity(infinity),
+        cb,
+        _threads(threads),
+        True,
+        ACTIVATION_FRACTION * float(tol),
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf
@@ -172,9 +211,18 @@ def travel_time(
     if not return_stats:
         return u
     stats = SolveStats(
-        iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
-        last_change=st["last_change"], seconds=st["seconds"], band_points=grid.size, inner_points=grid.size - len(lin),
-        outer_points=0, fixed_points=len(lin), setup_seconds=setup, band_bytes=band.nbytes + grid.size * 10 + 8 * band.n_rows,  # values, role, active flag; per row a lower bound
+        iterations=st["iterations"],
+        sweeps=st["sweeps"],
+        updates=st["updates"],
+        converged=st["converged"],
+        last_change=st["last_change"],
+        seconds=st["seconds"],
+        band_points=grid.size,
+        inner_points=grid.size - len(lin),
+        outer_points=0,
+        fixed_points=len(lin),
+        setup_seconds=setup,
+        band_bytes=band.nbytes + grid.size * 10 + 8 * band.n_rows,  # values, role, active flag; per row a lower bound
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
     )

@@ -11,7 +11,13 @@ import numpy as np
 
 from ._validate import real_array
 
-__all__ = ["point_vortices", "solid_body_rotation", "rotation_travel_time_circle", "rotation_travel_time_sphere", "Flow"]
+__all__ = [
+    "point_vortices",
+    "solid_body_rotation",
+    "rotation_travel_time_circle",
+    "rotation_travel_time_sphere",
+    "Flow",
+]
 
 Flow = Callable[[np.ndarray], np.ndarray]
 
@@ -45,10 +51,14 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
     if c.ndim == 1:
         c = c.reshape(1, -1)
     if c.ndim != 2 or c.shape[1] != 3 or c.shape[0] == 0:
-        raise ValueError(f"centers must have shape (N, 3) (point vortices live on a sphere in 3D); got {np.shape(centers)}")
+        raise ValueError(
+            f"centers must have shape (N, 3) (point vortices live on a sphere in 3D); got {np.shape(centers)}"
+        )
     s = np.broadcast_to(real_array(strengths, "strengths"), (c.shape[0],)).copy() if np.ndim(strengths) <= 1 else None
     if s is None or not np.all(np.isfinite(s)):
-        raise ValueError(f"strengths must be a number or one finite number per vortex ({c.shape[0]}); got {strengths!r}")
+        raise ValueError(
+            f"strengths must be a number or one finite number per vortex ({c.shape[0]}); got {strengths!r}"
+        )
     if not (np.isfinite(core) and core >= 0):
         raise ValueError(f"core must be a non-negative vortex core radius; got {core!r}")
     delta2 = float(core) ** 2
@@ -73,7 +83,9 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
     return flow
 
 
-def solid_body_rotation(omega: float, axis: Sequence[float] = (0.0, 0.0, 1.0), center: Sequence[float] | None = None) -> Flow:
+def solid_body_rotation(
+    omega: float, axis: Sequence[float] = (0.0, 0.0, 1.0), center: Sequence[float] | None = None
+) -> Flow:
     """Rigid rotation of the medium with angular speed ``omega`` about ``axis`` through ``center``:
     ``v(x) = ω â × (x − c)`` in 3D and ``v(x) = ω (−(y − c_y), x − c_x)`` in 2D (``axis`` ignored).
 
@@ -105,7 +117,9 @@ def solid_body_rotation(omega: float, axis: Sequence[float] = (0.0, 0.0, 1.0), c
     return flow
 
 
-def rotation_travel_time_circle(points: np.ndarray, radius: float, source_angle: float, speed: float, omega: float) -> np.ndarray:
+def rotation_travel_time_circle(
+    points: np.ndarray, radius: float, source_angle: float, speed: float, omega: float
+) -> np.ndarray:
     """Exact first-arrival time on the circle ``|x| = radius`` in the medium rotating rigidly
     with angular speed ``omega`` (counter-clockwise), from a source at angle ``source_angle``::
 
@@ -121,8 +135,9 @@ def rotation_travel_time_circle(points: np.ndarray, radius: float, source_angle:
     return np.minimum(radius * a / (speed + vr), radius * (2 * np.pi - a) / (speed - vr))
 
 
-def rotation_travel_time_sphere(points: np.ndarray, radius: float, source: Sequence[float], speed: float,
-                                omega: float, iterations: int = 80) -> np.ndarray:
+def rotation_travel_time_sphere(
+    points: np.ndarray, radius: float, source: Sequence[float], speed: float, omega: float, iterations: int = 80
+) -> np.ndarray:
     """Exact first-arrival time on the sphere ``|x| = radius`` in the medium rotating rigidly about
     the z axis with angular speed ``omega``, from ``source`` (on the sphere).
 

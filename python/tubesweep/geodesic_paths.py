@@ -139,8 +139,13 @@ class _CellLabels:
         return inside & np.all((pos >= 0) & (self.labels[np.maximum(pos, 0)] == target[None, :]), axis=0)
 
 
-def _gradient(sol: "Solution", x: np.ndarray, u0: np.ndarray, cells: Optional[_CellLabels] = None,
-              target: Optional[np.ndarray] = None) -> np.ndarray:
+def _gradient(
+    sol: "Solution",
+    x: np.ndarray,
+    u0: np.ndarray,
+    cells: Optional[_CellLabels] = None,
+    target: Optional[np.ndarray] = None,
+) -> np.ndarray:
     """∇u at points (M, d) where u is ``u0``: per axis the central difference of the interpolated
     u one grid spacing either side (the multilinear interpolant of the nodes' central
     differences). Two cases take a one-sided difference instead, so that the path leaves a kink
@@ -167,8 +172,11 @@ def _gradient(sol: "Solution", x: np.ndarray, u0: np.ndarray, cells: Optional[_C
         ridge = (ahead < 0) & (behind > 0)
         g[:, k] = np.where(ridge, np.where(-ahead > behind, ahead, behind) / h, (ahead + behind) / (2 * h))
         # one side of the stencil outside the band or the grid: the other side's difference
-        g[:, k] = np.where(np.isnan(ahead) & ~np.isnan(behind), behind / h,
-                           np.where(np.isnan(behind) & ~np.isnan(ahead), ahead / h, g[:, k]))
+        g[:, k] = np.where(
+            np.isnan(ahead) & ~np.isnan(behind),
+            behind / h,
+            np.where(np.isnan(behind) & ~np.isnan(ahead), ahead / h, g[:, k]),
+        )
         if clean is not None:
             fwd, bwd = clean[2 * k], clean[2 * k + 1]
             g[:, k] = np.where(fwd & ~bwd, ahead / h, np.where(bwd & ~fwd, behind / h, g[:, k]))
@@ -209,14 +217,18 @@ def _near_narrow_gaps(sol: "Solution", ends: np.ndarray) -> int:
     return near
 
 
-def starts_beyond_inner_tube(surface: Any, grid: Any, points: np.ndarray, inner: float) -> Tuple[np.ndarray, np.ndarray]:
+def starts_beyond_inner_tube(
+    surface: Any, grid: Any, points: np.ndarray, inner: float
+) -> Tuple[np.ndarray, np.ndarray]:
     """The indices of the ``points`` (M, d) farther from the surface than the inner tube
     (``inner`` grid spacings), where a path cannot start, and every point's distance."""
     dist, _ = surface.project(points, grid)
     return np.flatnonzero(~(dist <= inner * grid.spacing * (1 + 1e-6))), dist
 
 
-def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
+def trace_paths(
+    sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None
+) -> List[np.ndarray]:
     """Polylines (P_i, d) from each start (projected onto the surface) to the source that reaches
     it first, by steps of ``step`` grid spacings against ∇u (see the module's docstring).
 
@@ -231,7 +243,8 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
             f"{sol.hamiltonian!r}, whose fastest paths do not run against ∇u"
         )
     if isinstance(step, (bool, np.bool_)) or not (
-            isinstance(step, (int, float, np.floating, np.integer)) and MIN_STEP <= float(step) <= 1.0):
+        isinstance(step, (int, float, np.floating, np.integer)) and MIN_STEP <= float(step) <= 1.0
+    ):
         raise ValueError(f"step must be a number of grid spacings in [{MIN_STEP}, 1]; got {step!r}")
     grid = sol.grid
     h = grid.spacing
@@ -254,8 +267,11 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
     for i in np.flatnonzero(~np.isfinite(u)):
         raise ValueError(
             f"starts[{int(i)}] = {tuple(float(v) for v in p[i])} "
-            + ("is not reached by any source (another component of the surface)" if u[i] == np.inf
-               else "lies where the solution is not defined (outside the band or the grid)")
+            + (
+                "is not reached by any source (another component of the surface)"
+                if u[i] == np.inf
+                else "lies where the solution is not defined (outside the band or the grid)"
+            )
         )
     src = _onto_surface(sol, np.asarray(sol.sources, dtype=float))
     s = float(step) * h
@@ -312,9 +328,11 @@ def trace_paths(sol: "Solution", starts: Any, *, step: float = 0.5, max_steps: O
         at_gaps = _near_narrow_gaps(sol, np.array([paths[i][-1] for i in stalled]))
         gaps_note = ""
         if at_gaps:
-            gaps_note = (f"; {at_gaps} of them stopped within {GAP_REACH:g} grid spacings of a gap narrower than the tubes, "
-                         "where the front can cross from another part of the surface (sol.narrow_gaps(), "
-                         "sol.stats.facing_pairs): refine the grid there")
+            gaps_note = (
+                f"; {at_gaps} of them stopped within {GAP_REACH:g} grid spacings of a gap narrower than the tubes, "
+                "where the front can cross from another part of the surface (sol.narrow_gaps(), "
+                "sol.stats.facing_pairs): refine the grid there"
+            )
         warnings.warn(
             f"{len(stalled)} geodesic path(s) stopped before reaching a source (first: starts[{min(stalled)}]): "
             "the gradient of u vanished, left the band, or u stopped decreasing (a cut locus or a region the "

@@ -140,8 +140,9 @@ class Grid:
 
         lin = np.ascontiguousarray(linear, dtype=np.int64)
         # a negative index turns into one above every node: refused there like any outside one
-        return _native.node_points(list(self._shape), lin.view(np.uint64), [float(x) for x in self._lower],
-                                   self._spacing)
+        return _native.node_points(
+            list(self._shape), lin.view(np.uint64), [float(x) for x in self._lower], self._spacing
+        )
 
     def continuous_index(self, points: "np.ndarray | Sequence[Sequence[float]]") -> np.ndarray:
         """Fractional node index of points (M, d)."""

@@ -84,8 +84,10 @@ def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail:
     if callable(value):
         out = real_array(value(points), f"{name} callable's values")
         if out.shape != want:
-            raise ValueError(f"{name} callable must map points (M, {grid.ndim}) to an array of shape (M,)+{tail}; "
-                             f"returned {out.shape} for M = {len(linear)}")
+            raise ValueError(
+                f"{name} callable must map points (M, {grid.ndim}) to an array of shape (M,)+{tail}; "
+                f"returned {out.shape} for M = {len(linear)}"
+            )
     else:
         arr = real_array(value, name)
         if arr.shape == tail:
@@ -93,8 +95,10 @@ def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail:
         elif arr.shape == tuple(grid.shape) + tail:
             out = arr.reshape((-1,) + tail)[linear]
         else:
-            raise ValueError(f"{name} must be a constant of shape {tail}, an array of shape grid.shape + {tail} = "
-                             f"{tuple(grid.shape) + tail}, or a callable; got shape {arr.shape}")
+            raise ValueError(
+                f"{name} must be a constant of shape {tail}, an array of shape grid.shape + {tail} = "
+                f"{tuple(grid.shape) + tail}, or a callable; got shape {arr.shape}"
+            )
     if not np.all(np.isfinite(out)):
         i = int(np.flatnonzero(~np.all(np.isfinite(out.reshape(len(out), -1)), axis=1))[0])
         raise ValueError(f"{name} is NaN or inf at {tuple(float(c) for c in points[i])}; it must be finite on the band")
@@ -110,7 +114,7 @@ def _regions(linear: np.ndarray, grid: Grid, select: np.ndarray) -> list:
     positions."""
     pos = np.flatnonzero(select)
     lookup = {int(l): int(i) for i, l in zip(pos, linear[pos])}
-    strides = [int(np.prod(grid.shape[k + 1:])) for k in range(grid.ndim)]
+    strides = [int(np.prod(grid.shape[k + 1 :])) for k in range(grid.ndim)]
     idx = grid.unravel(linear[pos])
     index_of = {int(l): j for j, l in enumerate(linear[pos])}
     seen = np.zeros(len(pos), dtype=bool)
@@ -145,8 +149,16 @@ class Hamiltonian:
     def __init__(self, sigma: Any = None):
         self.sigma = _check_sigma(sigma)
 
-    def prepare(self, surface: Any, grid: Grid, linear: np.ndarray, x: np.ndarray, direction: np.ndarray,
-                slowness: np.ndarray, roles: np.ndarray) -> _Prepared:  # pragma: no cover - interface
+    def prepare(
+        self,
+        surface: Any,
+        grid: Grid,
+        linear: np.ndarray,
+        x: np.ndarray,
+        direction: np.ndarray,
+        slowness: np.ndarray,
+        roles: np.ndarray,
+    ) -> _Prepared:  # pragma: no cover - interface
         raise NotImplementedError
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
@@ -206,7 +218,9 @@ class MovingMedium(Hamiltonian):
     def __init__(self, flow: Any, *, allow_supersonic: bool = False, sigma: Any = None):
         super().__init__(sigma)
         if flow is None:
-            raise ValueError("MovingMedium needs a flow: a callable v(points) -> (M, d), an array of grid.shape + (d,) or a vector")
+            raise ValueError(
+                "MovingMedium needs a flow: a callable v(points) -> (M, d), an array of grid.shape + (d,) or a vector"
+            )
         self.flow = flow
         self.allow_supersonic = bool(allow_supersonic)
 
@@ -244,7 +258,8 @@ class MovingMedium(Hamiltonian):
             nb = int(np.count_nonzero(bad))
             regions = sorted(_regions(linear, grid, bad), key=lambda r: -float(ratio[r].max()))
             where = "; ".join(
-                f"around {_fmt(x[r].mean(axis=0))} ({len(r)} nodes, up to {float(ratio[r].max()):.3g})" for r in regions[:5]
+                f"around {_fmt(x[r].mean(axis=0))} ({len(r)} nodes, up to {float(ratio[r].max()):.3g})"
+                for r in regions[:5]
             ) + ("; …" if len(regions) > 5 else "")
             msg = (
                 f"flow: |v| ≥ F at {nb} of {int(np.count_nonzero(active))} inner-tube nodes — the medium outruns the wave "
@@ -254,13 +269,25 @@ class MovingMedium(Hamiltonian):
             )
             if not self.allow_supersonic:
                 raise ValueError(
-                    msg + " Pass allow_supersonic=True to compute the Lax–Friedrichs solution of the equation as written "
+                    msg
+                    + " Pass allow_supersonic=True to compute the Lax–Friedrichs solution of the equation as written "
                     "anyway, or make the flow subsonic (e.g. a vortex core: ts.flows.point_vortices(..., core=δ))"
                 )
-            warnings.warn(msg + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway", RuntimeWarning, stacklevel=4)
-        return _Prepared(self.kind, slowness, flow=v, sigma=self._sigma(d),
-                         extra={"max_mach": float(ratio[active].max()) if np.any(active) else 0.0,
-                                "supersonic_nodes": int(np.count_nonzero(bad))})
+            warnings.warn(
+                msg + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+        return _Prepared(
+            self.kind,
+            slowness,
+            flow=v,
+            sigma=self._sigma(d),
+            extra={
+                "max_mach": float(ratio[active].max()) if np.any(active) else 0.0,
+                "supersonic_nodes": int(np.count_nonzero(bad)),
+            },
+        )
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
         """Arrival time at displacement ``d`` from a point source in a uniform flow ``v``: the front
@@ -333,8 +360,10 @@ class Metric(Hamiltonian):
         try:
             inverse = np.linalg.inv(m)
         except np.linalg.LinAlgError:
-            raise ValueError("M is numerically singular at some band node (after its tangential part was taken): "
-                             "its eigenvalues span too many orders of magnitude; rescale M or use tangential=False") from None
+            raise ValueError(
+                "M is numerically singular at some band node (after its tangential part was taken): "
+                "its eigenvalues span too many orders of magnitude; rescale M or use tangential=False"
+            ) from None
         return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), extra={"inverse": inverse})
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
@@ -348,8 +377,10 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
     (``"godunov"``, ``"lxf"``). ``flow`` selects :class:`MovingMedium`."""
     if isinstance(hamiltonian, Hamiltonian):
         if flow is not None:
-            raise ValueError("pass either flow= or a Hamiltonian object as hamiltonian=, not both "
-                             "(use hamiltonian=ts.hamiltonians.MovingMedium(flow) for full control)")
+            raise ValueError(
+                "pass either flow= or a Hamiltonian object as hamiltonian=, not both "
+                "(use hamiltonian=ts.hamiltonians.MovingMedium(flow) for full control)"
+            )
         if allow_supersonic:
             if not isinstance(hamiltonian, MovingMedium):
                 raise ValueError("allow_supersonic only applies to the moving-medium equation (flow=...)")
@@ -372,24 +403,48 @@ def _mean_cell_time(ham: Hamiltonian, prep: _Prepared, n_nodes: int, grid: Grid)
     ``M = 1e30·I`` makes it 1e-15 times smaller)."""
     nodes = np.unique(np.linspace(0, n_nodes - 1, min(n_nodes, 4096)).astype(np.int64))
     d, h = grid.ndim, grid.spacing
-    times = [ham.local_time(prep, nodes, np.broadcast_to(sign * h * np.eye(d)[k], (len(nodes), d)))
-             for k in range(d) for sign in (1.0, -1.0)]
+    times = [
+        ham.local_time(prep, nodes, np.broadcast_to(sign * h * np.eye(d)[k], (len(nodes), d)))
+        for k in range(d)
+        for sign in (1.0, -1.0)
+    ]
     return float(np.mean(times))
 
 
-def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any, roles: np.ndarray,
-               positions: np.ndarray, fixed_values: np.ndarray, sources: np.ndarray, speed_nodes: Any, exact_sources: bool,
-               source_radius: float, tol: float, max_iterations: int, infinity: Optional[float],
-               progress: Optional[Callable[[int, float, int], None]], threads: int = 0,
-               activation_threshold: float = 0.0, defer_outer_rim: bool = True) -> tuple:
+def solve_band(
+    ham: Hamiltonian,
+    surface: Any,
+    grid: Grid,
+    geom: Any,
+    band: Any,
+    roles: np.ndarray,
+    positions: np.ndarray,
+    fixed_values: np.ndarray,
+    sources: np.ndarray,
+    speed_nodes: Any,
+    exact_sources: bool,
+    source_radius: float,
+    tol: float,
+    max_iterations: int,
+    infinity: Optional[float],
+    progress: Optional[Callable[[int, float, int], None]],
+    threads: int = 0,
+    activation_threshold: float = 0.0,
+    defer_outer_rim: bool = True,
+) -> tuple:
     """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
     travel time (for ``exact_sources``), and runs the general Lax–Friedrichs sweeps (Sect. 5.1)."""
     x = grid.node_points(geom.linear)
     slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
     prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
-    check_tolerance_scale(tol, grid.spacing, _mean_cell_time(ham, prep, len(roles), grid) / grid.spacing,
-                          max(grid.shape), "the Hamiltonian's travel time along the axes, averaged over the band",
-                          "the Hamiltonian's coefficients")
+    check_tolerance_scale(
+        tol,
+        grid.spacing,
+        _mean_cell_time(ham, prep, len(roles), grid) / grid.spacing,
+        max(grid.shape),
+        "the Hamiltonian's travel time along the axes, averaged over the band",
+        "the Hamiltonian's coefficients",
+    )
     fixed = np.array(fixed_values, dtype=float)
     if exact_sources and positions.size:
         _, cp = surface.project(x[positions], grid)
@@ -403,10 +458,25 @@ def solve_band(ham: Hamiltonian, surface: Any, grid: Grid, geom: Any, band: Any,
             best = np.where(near, np.minimum(best, t), best)
         fixed = np.where(np.isfinite(best), best, fixed)
     values, st = band.solve_general(
-        roles, positions, fixed, grid.spacing, prep.kind, prep.slowness, geom.directions_for_solver(),
-        "extrapolate", float(tol), int(max_iterations), None if infinity is None else float(infinity),
-        flow=prep.flow, metric=prep.metric, sigma=prep.sigma, progress=progress, threads=int(threads),
-        skip_inactive=True, activation_threshold=float(activation_threshold), defer_outer_rim=bool(defer_outer_rim),
+        roles,
+        positions,
+        fixed,
+        grid.spacing,
+        prep.kind,
+        prep.slowness,
+        geom.directions_for_solver(),
+        "extrapolate",
+        float(tol),
+        int(max_iterations),
+        None if infinity is None else float(infinity),
+        flow=prep.flow,
+        metric=prep.metric,
+        sigma=prep.sigma,
+        progress=progress,
+        threads=int(threads),
+        skip_inactive=True,
+        activation_threshold=float(activation_threshold),
+        defer_outer_rim=bool(defer_outer_rim),
     )
     st = dict(st)
     st.update(prep.extra if "inverse" not in prep.extra else {})

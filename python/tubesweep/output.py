@@ -32,14 +32,15 @@ __all__ = ["triangulate", "export", "plot", "read_vtp", "EXPORT_FORMATS"]
 EXPORT_FORMATS = (".vtu", ".vtp", ".vtk", ".ply", ".obj")
 
 
-
 def _need(module: str, extra: str, what: str) -> Any:
     import importlib
 
     try:
         return importlib.import_module(module)
     except ImportError:
-        raise ImportError(f"{what} needs the optional package {module.split('.')[0]!r}: pip install 'tubesweep[{extra}]'") from None
+        raise ImportError(
+            f"{what} needs the optional package {module.split('.')[0]!r}: pip install 'tubesweep[{extra}]'"
+        ) from None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -64,12 +65,16 @@ def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
         raise ValueError("mesh must be a pair (vertices (n, 3), faces (m, 3))") from None
     v = real_array(v_in, "mesh vertices")
     if v.ndim != 2 or v.shape[1] not in (2, 3) or not np.all(np.isfinite(v)):
-        raise ValueError(f"mesh vertices must be finite coordinates of shape (n, 2) or (n, 3); got shape {v.shape}"
-                         + ("" if v.ndim != 2 or np.all(np.isfinite(v)) else " with NaN or inf"))
+        raise ValueError(
+            f"mesh vertices must be finite coordinates of shape (n, 2) or (n, 3); got shape {v.shape}"
+            + ("" if v.ndim != 2 or np.all(np.isfinite(v)) else " with NaN or inf")
+        )
     f = np.asarray(f_in)
     if f.ndim != 2 or f.shape[1] not in (2, 3, 4) or (f.size and not np.issubdtype(f.dtype, np.number)):
-        raise ValueError(f"mesh faces must be an integer array of shape (m, 3) (or (m, 4) quads, (m, 2) segments); "
-                         f"got shape {f.shape}")
+        raise ValueError(
+            f"mesh faces must be an integer array of shape (m, 3) (or (m, 4) quads, (m, 2) segments); "
+            f"got shape {f.shape}"
+        )
     if len(v) == 0 or f.size == 0:
         raise ValueError(f"mesh must have vertices and faces; got {len(v)} vertices and {len(f)} faces")
     try:
@@ -138,7 +143,11 @@ def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np
         closed = np.allclose(c[0], c[-1])
         pts = c[:-1] if closed else c
         m = len(pts)
-        e = np.stack([np.arange(m), np.arange(1, m + 1) % m], axis=1) if closed else np.stack([np.arange(m - 1), np.arange(1, m)], axis=1)
+        e = (
+            np.stack([np.arange(m), np.arange(1, m + 1) % m], axis=1)
+            if closed
+            else np.stack([np.arange(m - 1), np.arange(1, m)], axis=1)
+        )
         verts.append(pts * h + origin)
         segs.append(e + n0)
         n0 += m
@@ -180,20 +189,30 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
         os.close(fd)
     try:
         with open(part, "w") as fh:
-            fh.write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n')
-            fh.write(f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{m if kind == "Lines" else 0}" '
-                     f'NumberOfStrips="0" NumberOfPolys="{m if kind == "Polys" else 0}">\n')
+            fh.write(
+                '<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n'
+            )
+            fh.write(
+                f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{m if kind == "Lines" else 0}" '
+                f'NumberOfStrips="0" NumberOfPolys="{m if kind == "Polys" else 0}">\n'
+            )
             names = list(point_data)
-            fh.write(f'<PointData Scalars={quoteattr(str(names[0]))}>\n' if names else "<PointData>\n")
+            fh.write(f"<PointData Scalars={quoteattr(str(names[0]))}>\n" if names else "<PointData>\n")
             for name, a in point_data.items():
                 comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""
-                fh.write(f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="ascii">\n'
-                         f'{arr(a, "%.17g")}\n</DataArray>\n')
+                fh.write(
+                    f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="ascii">\n'
+                    f"{arr(a, '%.17g')}\n</DataArray>\n"
+                )
             fh.write("</PointData>\n<Points>\n")
-            fh.write(f'<DataArray type="Float64" NumberOfComponents="3" format="ascii">\n{arr(points, "%.17g")}\n</DataArray>\n')
+            fh.write(
+                f'<DataArray type="Float64" NumberOfComponents="3" format="ascii">\n{arr(points, "%.17g")}\n</DataArray>\n'
+            )
             fh.write(f"</Points>\n<{kind}>\n")
             fh.write(f'<DataArray type="Int64" Name="connectivity" format="ascii">\n{arr(cells, "%d")}\n</DataArray>\n')
-            fh.write(f'<DataArray type="Int64" Name="offsets" format="ascii">\n{arr(np.arange(1, m + 1) * k, "%d")}\n</DataArray>\n')
+            fh.write(
+                f'<DataArray type="Int64" Name="offsets" format="ascii">\n{arr(np.arange(1, m + 1) * k, "%d")}\n</DataArray>\n'
+            )
             fh.write(f"</{kind}>\n</Piece>\n</PolyData>\n</VTKFile>\n")
         if part != target:
             if target.exists():
@@ -253,14 +272,21 @@ def export_format(path: Union[str, Path], curve: bool = False) -> str:
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in EXPORT_FORMATS:
-        raise ValueError(f"export: unknown format {path.suffix!r} of {str(path)!r}; use one of {', '.join(EXPORT_FORMATS)}")
+        raise ValueError(
+            f"export: unknown format {path.suffix!r} of {str(path)!r}; use one of {', '.join(EXPORT_FORMATS)}"
+        )
     if curve and suffix == ".ply":
         raise ValueError("export: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
     return suffix
 
 
-def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] = None,
-           point_data: Optional[Dict[str, Any]] = None) -> Path:
+def export(
+    sol: Any,
+    path: Union[str, Path],
+    *,
+    mesh: Optional[Tuple[Any, Any]] = None,
+    point_data: Optional[Dict[str, Any]] = None,
+) -> Path:
     """Writes the surface of ``sol`` with the solution ``u`` at its vertices, for ParaView.
 
     Parameters
@@ -293,11 +319,15 @@ def export(sol: Any, path: Union[str, Path], *, mesh: Optional[Tuple[Any, Any]] 
         if not isinstance(name, str) or not name or any(ord(ch) < 32 for ch in name):
             raise ValueError(f"point_data names must be non-empty strings without control characters; got {name!r}")
         if name in data:
-            raise ValueError(f"point_data[{name!r}]: the name {name!r} is the solution's own field; choose another name")
+            raise ValueError(
+                f"point_data[{name!r}]: the name {name!r} is the solution's own field; choose another name"
+            )
         a = real_array(a, f"point_data[{name!r}]")
         if a.ndim not in (1, 2) or (a.ndim == 2 and not 1 <= a.shape[1] <= 9):
-            raise ValueError(f"point_data[{name!r}] must have shape (n,) or (n, k) with k at most 9 (one value or "
-                             f"vector per vertex); got {a.shape}")
+            raise ValueError(
+                f"point_data[{name!r}] must have shape (n,) or (n, k) with k at most 9 (one value or "
+                f"vector per vertex); got {a.shape}"
+            )
         if a.shape[0] != len(v):
             raise ValueError(f"point_data[{name!r}] has {a.shape[0]} entries but the mesh has {len(v)} vertices")
         data[name] = a
@@ -366,10 +396,20 @@ def _nearest_face(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
     return np.asarray(cKDTree(centroids).query(points)[1], dtype=np.int64)
 
 
-def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, levels: Union[int, Sequence[float]] = 12,
-         cmap: str = "viridis", views: Sequence[Tuple[float, float]] = ((20.0, -60.0), (20.0, 120.0)),
-         title: Optional[str] = None, sources: bool = True, colorbar: bool = True, up: str = "z",
-         paths: Optional[Sequence[Any]] = None) -> Any:
+def plot(
+    sol: Any,
+    *,
+    ax: Any = None,
+    mesh: Optional[Tuple[Any, Any]] = None,
+    levels: Union[int, Sequence[float]] = 12,
+    cmap: str = "viridis",
+    views: Sequence[Tuple[float, float]] = ((20.0, -60.0), (20.0, 120.0)),
+    title: Optional[str] = None,
+    sources: bool = True,
+    colorbar: bool = True,
+    up: str = "z",
+    paths: Optional[Sequence[Any]] = None,
+) -> Any:
     """A picture of a solution: a matplotlib :class:`~matplotlib.figure.Figure`.
 
     2D: the band coloured by ``u``, iso-distance lines, the curve φ = 0 (white) and the sources
@@ -408,10 +448,15 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
     if np.ndim(levels) == 0:
         if isinstance(levels, np.ndarray):
             levels = levels.item()
-        if (isinstance(levels, (bool, np.bool_)) or not isinstance(levels, (int, float, np.integer, np.floating))
-                or not (float(levels).is_integer() and 0 <= levels <= 1000)):
-            raise ValueError(f"levels must be a number of iso-lines (an integer from 0 to 1000) or a sequence of their values; "
-                             f"got {levels!r}")
+        if (
+            isinstance(levels, (bool, np.bool_))
+            or not isinstance(levels, (int, float, np.integer, np.floating))
+            or not (float(levels).is_integer() and 0 <= levels <= 1000)
+        ):
+            raise ValueError(
+                f"levels must be a number of iso-lines (an integer from 0 to 1000) or a sequence of their values; "
+                f"got {levels!r}"
+            )
         lv = MaxNLocator(int(levels) + 1).tick_values(0.0, umax) if levels > 0 else np.zeros(0)
     else:
         lv = real_array(levels, "levels").reshape(-1)
@@ -489,7 +534,9 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
         views = views[:1]
     else:
         fig = Figure(figsize=(5.2 * len(views) + 1.0, 5.0))
-        axes = [fig.add_subplot(1, len(views), i + 1, projection="3d", computed_zorder=False) for i in range(len(views))]
+        axes = [
+            fig.add_subplot(1, len(views), i + 1, projection="3d", computed_zorder=False) for i in range(len(views))
+        ]
     ext = np.ptp(v, axis=0)
     for a, (elev, azim) in zip(axes, views):
         e, z = np.radians(elev), np.radians(azim)
@@ -514,8 +561,17 @@ def plot(sol: Any, *, ax: Any = None, mesh: Optional[Tuple[Any, Any]] = None, le
             front = (n[src_near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(src_near), bool)
             for sel, alpha in ((front, 1.0), (~front, 0.3)):
                 if np.any(sel):
-                    a.scatter(*src[sel].T, c="r", marker="*", s=160, edgecolors="k", linewidths=0.5,
-                              depthshade=False, zorder=3, alpha=alpha)
+                    a.scatter(
+                        *src[sel].T,
+                        c="r",
+                        marker="*",
+                        s=160,
+                        edgecolors="k",
+                        linewidths=0.5,
+                        depthshade=False,
+                        zorder=3,
+                        alpha=alpha,
+                    )
         lo, hi = v.min(0), v.max(0)
         a.set_xlim(lo[0], hi[0])
         a.set_ylim(lo[1], hi[1])

@@ -55,10 +55,15 @@ NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 30, 1e-12
 ORTHOGONALITY_RETRY_STEPS = 300
 
 
-def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray, eps: float,
-                         newton_steps: int = NEWTON_STEPS, orthogonality_steps: int = ORTHOGONALITY_STEPS,
-                         tol: float = SETTLED,
-                         box: Optional[Tuple[np.ndarray, np.ndarray]] = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def project_to_level_set(
+    phi: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    eps: float,
+    newton_steps: int = NEWTON_STEPS,
+    orthogonality_steps: int = ORTHOGONALITY_STEPS,
+    tol: float = SETTLED,
+    box: Optional[Tuple[np.ndarray, np.ndarray]] = None,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closest points of ``x`` (M, d) on ``{φ = 0}`` by Newton projection and orthogonality
     iterations (see the module docstring).
 
@@ -115,18 +120,27 @@ def project_to_level_set(phi: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
 SAMPLED_GRADIENT_STEP = 0.5
 
 
-def _project(surface, grid, x: np.ndarray,
-             orthogonality_steps: int = ORTHOGONALITY_STEPS) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _project(
+    surface, grid, x: np.ndarray, orthogonality_steps: int = ORTHOGONALITY_STEPS
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`project_to_level_set` of the points ``x`` (M, d) for the surface's φ: in Rust for a
     sampled φ (the same iterations and bits), in NumPy for a callable."""
     if surface.is_dense:
         from . import _native
 
         return _native.project_to_sampled_level_set(
-            surface._array, [float(c) for c in grid.lower], grid.spacing, np.ascontiguousarray(x, dtype=float),
-            SAMPLED_GRADIENT_STEP * grid.spacing, NEWTON_STEPS, orthogonality_steps, SETTLED)
-    return project_to_level_set(lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing,
-                                orthogonality_steps=orthogonality_steps)
+            surface._array,
+            [float(c) for c in grid.lower],
+            grid.spacing,
+            np.ascontiguousarray(x, dtype=float),
+            SAMPLED_GRADIENT_STEP * grid.spacing,
+            NEWTON_STEPS,
+            orthogonality_steps,
+            SETTLED,
+        )
+    return project_to_level_set(
+        lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing, orthogonality_steps=orthogonality_steps
+    )
 
 
 def estimate_lipschitz(surface, grid, n: int = 17) -> float:
@@ -150,8 +164,9 @@ def estimate_lipschitz(surface, grid, n: int = 17) -> float:
 CANDIDATE_BOUND_PASSES = 2
 
 
-def _narrowed_by_candidate_gradients(surface, grid, half_width: float, L: float, cand: np.ndarray,
-                                     values: np.ndarray) -> np.ndarray:
+def _narrowed_by_candidate_gradients(
+    surface, grid, half_width: float, L: float, cand: np.ndarray, values: np.ndarray
+) -> np.ndarray:
     """The candidates of a re-distanced callable φ, narrowed: ``L`` (1.25 × the largest |∇φ| on a
     lattice over the whole box) is replaced by 1.25 × the largest |∇φ| at the candidates
     themselves, which hold every node within ``half_width`` of the surface and so the segments
@@ -178,8 +193,9 @@ def _narrowed_by_candidate_gradients(surface, grid, half_width: float, L: float,
     return cand
 
 
-def _warn_if_band_nodes_unprojected(surface, grid, x: np.ndarray, cp: np.ndarray, ok: np.ndarray,
-                                    half_width: float) -> None:
+def _warn_if_band_nodes_unprojected(
+    surface, grid, x: np.ndarray, cp: np.ndarray, ok: np.ndarray, half_width: float
+) -> None:
     """Warns where candidates whose projection failed lie within the band for certain: their last
     iterate is on the zero level set (|φ| there below 1e-6 of |φ| at the node), so the node's
     distance is at most its distance to that point, and that is within ``half_width``. Such nodes
@@ -200,7 +216,9 @@ def _warn_if_band_nodes_unprojected(surface, grid, x: np.ndarray, cp: np.ndarray
             "band, and nodes beyond them may stay unreached (inf). Either the tube is about as wide as the surface's "
             "radius of curvature there (refine the grid), or φ's zero level set has a sharp edge or corner there "
             f"(smooth φ: refining does not help), e.g. near {tuple(round(float(c), 6) for c in x[failed][np.argmax(within)])}",
-            RuntimeWarning, stacklevel=6)
+            RuntimeWarning,
+            stacklevel=6,
+        )
 
 
 def _on_zero_set_within(surface, grid, x: np.ndarray, y: np.ndarray, reach: float) -> np.ndarray:

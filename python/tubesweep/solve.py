@@ -72,12 +72,25 @@ class Solution:
     sources : (S, d) float
     """
 
-    def __init__(self, grid: Grid, band: Any, values: np.ndarray, roles: np.ndarray,
-                 phi: np.ndarray, stats: SolveStats, sources: np.ndarray, surface: Surface,
-                 hamiltonian: str, method: str, inner: float, outer: float,
-                 fixed: Tuple[np.ndarray, np.ndarray], isotropic: bool,
-                 facing: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None,
-                 phi_sample: Optional[Tuple[np.ndarray, np.ndarray]] = None):
+    def __init__(
+        self,
+        grid: Grid,
+        band: Any,
+        values: np.ndarray,
+        roles: np.ndarray,
+        phi: np.ndarray,
+        stats: SolveStats,
+        sources: np.ndarray,
+        surface: Surface,
+        hamiltonian: str,
+        method: str,
+        inner: float,
+        outer: float,
+        fixed: Tuple[np.ndarray, np.ndarray],
+        isotropic: bool,
+        facing: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None,
+        phi_sample: Optional[Tuple[np.ndarray, np.ndarray]] = None,
+    ):
         self.grid = grid
         self._band = band
         self.values = values
@@ -240,8 +253,10 @@ class Solution:
         if self._labels is None:
             positions, sources = self._fixed
             self._labels = self._band.nearest_source_labels(
-                np.ascontiguousarray(self.values, dtype=float), np.ascontiguousarray(positions, dtype=np.int64),
-                np.ascontiguousarray(sources, dtype=np.int64))
+                np.ascontiguousarray(self.values, dtype=float),
+                np.ascontiguousarray(positions, dtype=np.int64),
+                np.ascontiguousarray(sources, dtype=np.int64),
+            )
         labels: np.ndarray = self._labels
         if points is None:
             return labels.copy()
@@ -263,8 +278,10 @@ class Solution:
         """
         p = as_points(start, self.grid.ndim, "start")
         if len(p) != 1:
-            raise ValueError(f"start must be one point of shape ({self.grid.ndim},); got {len(p)} points "
-                             "(use geodesic_paths for several)")
+            raise ValueError(
+                f"start must be one point of shape ({self.grid.ndim},); got {len(p)} points "
+                "(use geodesic_paths for several)"
+            )
         return self.geodesic_paths(p, step=step, max_steps=max_steps)[0]
 
     def geodesic_paths(self, starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
@@ -293,9 +310,17 @@ def _tube_roles(geom: BandGeometry, inner_width: float, method: str) -> np.ndarr
     return roles
 
 
-def _fix_sources(surface: Surface, grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, sources: np.ndarray,
-                 slowness_at: Callable[[np.ndarray], np.ndarray], source_init: str, inner_width: float
-                 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _fix_sources(
+    surface: Surface,
+    grid: Grid,
+    band: Any,
+    linear: np.ndarray,
+    roles: np.ndarray,
+    sources: np.ndarray,
+    slowness_at: Callable[[np.ndarray], np.ndarray],
+    source_init: str,
+    inner_width: float,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions in the band and values of the nodes fixed by the point sources, and the index of
     the source each node's value comes from (the nearest, where several sources fix one node)."""
     h = grid.spacing
@@ -443,8 +468,22 @@ def solve(
     # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
     # (unless a general Hamiltonian needs it) and the directions become the extension weights
     tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
-    return _solve_on_tube(tube, src, general, scheme, speed, source_init, tol, max_iterations, cb, infinity, threads,
-                          paper_sweeps, t0, reuse=False)
+    return _solve_on_tube(
+        tube,
+        src,
+        general,
+        scheme,
+        speed,
+        source_init,
+        tol,
+        max_iterations,
+        cb,
+        infinity,
+        threads,
+        paper_sweeps,
+        t0,
+        reuse=False,
+    )
 
 
 def _resolve_scheme(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Tuple[Any, str]:
@@ -503,8 +542,11 @@ def _check_band_memory(surf: Surface, grid: Grid, half_width: float) -> None:
     if avail is None or grid.size * _BAND_BYTES_PER_NODE <= 0.9 * avail or getattr(surf, "redistance", False):
         return
     nodes = _estimated_band_nodes(surf, grid, half_width)
-    check_memory(nodes * _BAND_BYTES_PER_NODE, f"the band (about {nodes:.3g} nodes at grid spacing {grid.spacing:.3g})",
-                 "use a coarser grid (fewer nodes per axis) or a thinner tube")
+    check_memory(
+        nodes * _BAND_BYTES_PER_NODE,
+        f"the band (about {nodes:.3g} nodes at grid spacing {grid.spacing:.3g})",
+        "use a coarser grid (fewer nodes per axis) or a thinner tube",
+    )
 
 
 def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float:
@@ -518,8 +560,8 @@ def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float
         dist = np.asarray(surf.project(points, grid)[0], dtype=float)
     except Exception:  # a surface undefined at some sample far from it: no estimate, the search decides
         return 0.0
-    area = np.count_nonzero(np.isfinite(dist) & (dist <= big_h)) * big_h ** grid.ndim / (2 * big_h)
-    return 2 * half_width * area / grid.spacing ** grid.ndim
+    area = np.count_nonzero(np.isfinite(dist) & (dist <= big_h)) * big_h**grid.ndim / (2 * big_h)
+    return 2 * half_width * area / grid.spacing**grid.ndim
 
 
 def _lacking_neighbours(grid: Grid, band: Any, linear: np.ndarray, missing: np.ndarray) -> np.ndarray:
@@ -532,8 +574,9 @@ def _lacking_neighbours(grid: Grid, band: Any, linear: np.ndarray, missing: np.n
     return np.unique(np.concatenate(lacking))
 
 
-def _ridge_pairs(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
-                 kink: Optional[np.ndarray]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _ridge_pairs(
+    grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray, kink: Optional[np.ndarray]
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pairs of neighbouring band nodes of which one straddles a kink of a level set's φ (a
     ridge between facing parts, ``BandGeometry.kink``) and one lies in the inner tube, with the
     gap ``2|φ|`` at the kink's node. There the central differences give no reliable direction,
@@ -556,9 +599,16 @@ def _ridge_pairs(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, p
     return node, neighbour, gap
 
 
-def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray,
-                         direction: np.ndarray, inner: float,
-                         kink: Optional[np.ndarray] = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _warn_if_tubes_touch(
+    grid: Grid,
+    band: Any,
+    linear: np.ndarray,
+    roles: np.ndarray,
+    phi: np.ndarray,
+    direction: np.ndarray,
+    inner: float,
+    kink: Optional[np.ndarray] = None,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
     ``tubesweep_core::facing_sheets``): the eikonal equation crosses the gap there and the travel
@@ -566,8 +616,11 @@ def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.nd
     band positions and their gaps."""
     h = grid.spacing
     node, neighbour, gap = band.facing_sheet_pairs(
-        roles == ROLE_INNER, np.ascontiguousarray(phi, dtype=np.float32),
-        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim), h)
+        roles == ROLE_INNER,
+        np.ascontiguousarray(phi, dtype=np.float32),
+        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim),
+        h,
+    )
     ridge = _ridge_pairs(grid, band, linear, roles, phi, kink)
     if ridge[0].size:
         node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip((node, neighbour, gap), ridge))
@@ -595,8 +648,9 @@ def _warn_if_tubes_touch(grid: Grid, band: Any, linear: np.ndarray, roles: np.nd
     return node, neighbour, gap
 
 
-def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray, roles: np.ndarray,
-                                   inner: float) -> None:
+def _check_surface_spans_two_cells(
+    surf: Surface, grid: Grid, linear: np.ndarray, roles: np.ndarray, inner: float
+) -> None:
     """Refuses a surface that the grid cannot resolve: one whose closest points from the inner
     tube span less than two grid spacings along every axis of their bounding box (a disc or plane
     patch smaller than a cell; on a disc of radius 0.02Δx the distances came out 29% short, with
@@ -619,11 +673,13 @@ def _check_surface_spans_two_cells(surf: Surface, grid: Grid, linear: np.ndarray
         raise ValueError(
             f"the grid is too coarse for this surface: the surface spans only {extent:.3g} along the longest side of "
             f"its bounding box (from the inner tube's closest points), less than two grid spacings (h = {h:.4g}), so the "
-            f"grid cannot resolve it; refine the grid to a spacing below {extent / 2:.3g}, or shrink the box")
+            f"grid cannot resolve it; refine the grid to a spacing below {extent / 2:.3g}, or shrink the box"
+        )
 
 
-def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool,
-                  reusable: bool = False) -> _PreparedTube:
+def _prepare_tube(
+    surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool, reusable: bool = False
+) -> _PreparedTube:
     """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
     single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
     keeps the geometry unmodified for many solves (:class:`Tube`)."""
@@ -631,8 +687,11 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
     for name, val in (("inner", inner), ("outer", outer)):
-        if not (isinstance(val, (int, float, np.floating, np.integer)) and not isinstance(val, (bool, np.bool_))
-                and np.isfinite(val)):
+        if not (
+            isinstance(val, (int, float, np.floating, np.integer))
+            and not isinstance(val, (bool, np.bool_))
+            and np.isfinite(val)
+        ):
             raise ValueError(f"{name} must be a finite number of grid spacings; got {val!r}")
     if inner < 1.0:
         raise ValueError(
@@ -681,14 +740,21 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
             direction = geom.directions_for_solver()
             geom = None  # type: ignore[assignment]
         if band is None or len(band) != len(linear):
-            band = _native.Band.from_linear(list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64))
+            band = _native.Band.from_linear(
+                list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64)
+            )
         if method == "naive":
             break
         missing = band.nodes_missing_neighbours(roles == ROLE_INNER)
         if missing.size == 0:
             break
         lacking = _lacking_neighbours(grid, band, linear, missing)
-        if redistanced and given_bound is None and previously_lacking is not None and np.all(np.isin(previously_lacking, lacking)):
+        if (
+            redistanced
+            and given_bound is None
+            and previously_lacking is not None
+            and np.all(np.isin(previously_lacking, lacking))
+        ):
             # A re-distanced band, its candidates found with an estimated bound on |∇φ|, holds the
             # nodes within the layer that could be projected onto the zero level set; the layer
             # was widened and none of the missing neighbours came in, so they are nodes the
@@ -708,11 +774,19 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
                 "inner nodes lack a neighbour. "
-                + ("" if redistanced else "φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or ")
+                + (
+                    ""
+                    if redistanced
+                    else "φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or "
+                )
                 + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
                 "than the tube: refine the grid)"
-                + ("" if given_bound is None else f", or the lipschitz bound given, {given_bound:g}, is below |∇φ| near "
-                   "the surface and keeps nodes from the band's candidates (leave it out to have it estimated)")
+                + (
+                    ""
+                    if given_bound is None
+                    else f", or the lipschitz bound given, {given_bound:g}, is below |∇φ| near "
+                    "the surface and keeps nodes from the band's candidates (leave it out to have it estimated)"
+                )
             )
         warnings.warn(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
@@ -721,15 +795,42 @@ def _prepare_tube(surf: Surface, grid: Grid, inner: float, outer: float, method:
             stacklevel=3,
         )
         outer_eff += 1.0
-    facing = _warn_if_tubes_touch(grid, band, linear, roles, phi,
-                                  direction if direction is not None else geom.direction, inner, kink)
-    return _PreparedTube(grid, surf, float(inner), outer_eff, method, geom, linear, roles, band, phi, direction,
-                         time.perf_counter() - t0, facing)
+    facing = _warn_if_tubes_touch(
+        grid, band, linear, roles, phi, direction if direction is not None else geom.direction, inner, kink
+    )
+    return _PreparedTube(
+        grid,
+        surf,
+        float(inner),
+        outer_eff,
+        method,
+        geom,
+        linear,
+        roles,
+        band,
+        phi,
+        direction,
+        time.perf_counter() - t0,
+        facing,
+    )
 
 
-def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: str, speed: Any, source_init: str,
-                   tol: float, max_iterations: int, cb: Any, infinity: Any, threads: int, paper_sweeps: bool, t0: float,
-                   reuse: bool) -> "Solution":
+def _solve_on_tube(
+    tube: _PreparedTube,
+    src: np.ndarray,
+    general: Any,
+    scheme: str,
+    speed: Any,
+    source_init: str,
+    tol: float,
+    max_iterations: int,
+    cb: Any,
+    infinity: Any,
+    threads: int,
+    paper_sweeps: bool,
+    t0: float,
+    reuse: bool,
+) -> "Solution":
     """Fixes the sources on the prepared tube and sweeps. With ``reuse`` the tube is left as it
     was (its roles and directions are copied); without, its arrays are consumed and dropped
     before the sweeps."""
@@ -758,13 +859,16 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
 
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
-    positions, fixed_vals, fixed_sources = _fix_sources(surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width)
+    positions, fixed_vals, fixed_sources = _fix_sources(
+        surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width
+    )
     roles[positions] = ROLE_FIXED
     if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER):
         raise ValueError(
             f"the grid is too coarse for this surface: every node of the inner tube lies within {SOURCE_RADIUS:g} grid "
             f"spacings (h = {h:.4g}) of a source, so its value is the source's initialisation and nothing is solved; "
-            f"refine the grid")
+            f"refine the grid"
+        )
     del x
     method = tube.method
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
@@ -788,16 +892,49 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
         del linear
         setup = time.perf_counter() - t0
         values, st = band.solve(
-            roles, positions, fixed_vals, h, slowness, directions, scheme, missing_policy,
-            float(tol), int(max_iterations), _infinity(infinity), cb, _threads(threads), True, ACTIVATION_FRACTION * float(tol),
-            not paper_sweeps, not paper_sweeps, 0.0 if paper_sweeps else FRONT_WINDOW,
+            roles,
+            positions,
+            fixed_vals,
+            h,
+            slowness,
+            directions,
+            scheme,
+            missing_policy,
+            float(tol),
+            int(max_iterations),
+            _infinity(infinity),
+            cb,
+            _threads(threads),
+            True,
+            ACTIVATION_FRACTION * float(tol),
+            not paper_sweeps,
+            not paper_sweeps,
+            0.0 if paper_sweeps else FRONT_WINDOW,
         )
         del directions
     else:
         setup = time.perf_counter() - t0
-        values, st = _hams.solve_band(general, surf, grid, tube.geom, band, roles, positions, fixed_vals, src, speed_nodes,
-                                      source_init == "exact", SOURCE_RADIUS, tol, max_iterations, _infinity(infinity), cb,
-                                      _threads(threads), ACTIVATION_FRACTION * float(tol), not paper_sweeps)
+        values, st = _hams.solve_band(
+            general,
+            surf,
+            grid,
+            tube.geom,
+            band,
+            roles,
+            positions,
+            fixed_vals,
+            src,
+            speed_nodes,
+            source_init == "exact",
+            SOURCE_RADIUS,
+            tol,
+            max_iterations,
+            _infinity(infinity),
+            cb,
+            _threads(threads),
+            ACTIVATION_FRACTION * float(tol),
+            not paper_sweeps,
+        )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
@@ -810,15 +947,39 @@ def _solve_on_tube(tube: _PreparedTube, src: np.ndarray, general: Any, scheme: s
     windowed = grid.ndim == 3 and scheme == "godunov" and not paper_sweeps and FRONT_WINDOW > 0
     per_node = 8 + 1 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0) + (1 if windowed else 0)
     stats = SolveStats(
-        iterations=st["iterations"], sweeps=st["sweeps"], updates=st["updates"], converged=st["converged"],
-        last_change=st["last_change"], seconds=st["seconds"], band_points=len(roles),
-        inner_points=len(roles) - n_outer, outer_points=n_outer, fixed_points=len(positions),
-        setup_seconds=setup, band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
-        window_edge=st["window_edge"], facing_pairs=int(tube.facing[0].size),
+        iterations=st["iterations"],
+        sweeps=st["sweeps"],
+        updates=st["updates"],
+        converged=st["converged"],
+        last_change=st["last_change"],
+        seconds=st["seconds"],
+        band_points=len(roles),
+        inner_points=len(roles) - n_outer,
+        outer_points=n_outer,
+        fixed_points=len(positions),
+        setup_seconds=setup,
+        band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
+        window_edge=st["window_edge"],
+        facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
     )
-    return Solution(grid, band, values, roles, phi, stats, src, surf, scheme, method,
-                    tube.inner, tube.outer_eff, (positions, fixed_sources), general is None or general.label == "isotropic",
-                    tube.facing, phi_sample)
+    return Solution(
+        grid,
+        band,
+        values,
+        roles,
+        phi,
+        stats,
+        src,
+        surf,
+        scheme,
+        method,
+        tube.inner,
+        tube.outer_eff,
+        (positions, fixed_sources),
+        general is None or general.label == "isotropic",
+        tube.facing,
+        phi_sample,
+    )

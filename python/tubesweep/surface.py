@@ -42,8 +42,9 @@ GRAD_WARN_LOW, GRAD_WARN_HIGH = 0.6, 1.8
 KINK_FRACTION = 0.35
 
 
-def band_neighbours(grid: Grid, band: Any, linear: np.ndarray, nodes: np.ndarray
-                    ) -> Iterator[Tuple[np.ndarray, np.ndarray, np.ndarray]]:
+def band_neighbours(
+    grid: Grid, band: Any, linear: np.ndarray, nodes: np.ndarray
+) -> Iterator[Tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """For each axis and side in turn, the neighbours of the band nodes ``nodes`` (band positions;
     ``linear`` the band's linear indices): their grid indices ``(M, d)``, whether each lies in the
     grid, and its band position (-1 off the grid or off the band)."""
@@ -150,7 +151,9 @@ class Surface:
             raise ValueError(f"surface is {self.ndim}D but the grid is {grid.ndim}D")
 
 
-def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, out_shape: Tuple[int, ...] = ()) -> np.ndarray:
+def _evaluate(
+    fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, out_shape: Tuple[int, ...] = ()
+) -> np.ndarray:
     """Calls a user's vectorised function in chunks and checks what comes back."""
     m = points.shape[0]
     out = np.empty((m,) + out_shape)
@@ -165,13 +168,19 @@ def _evaluate(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, ou
         out[s : s + EVAL_CHUNK] = v
     if not np.all(np.isfinite(out)):
         bad = np.flatnonzero(~np.isfinite(out.reshape(m, -1)).all(axis=1))[0]
-        raise ValueError(f"{name} returned NaN or inf at {tuple(float(x) for x in points[bad])}; it must be finite near the surface")
+        raise ValueError(
+            f"{name} returned NaN or inf at {tuple(float(x) for x in points[bad])}; it must be finite near the surface"
+        )
     return out
 
 
-def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
-                              distance: Callable[[np.ndarray, float], np.ndarray],
-                              within: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None) -> np.ndarray:
+def coarse_to_fine_candidates(
+    grid: Grid,
+    half_width: float,
+    lipschitz: float,
+    distance: Callable[[np.ndarray, float], np.ndarray],
+    within: Optional[Callable[[np.ndarray, np.ndarray], np.ndarray]] = None,
+) -> np.ndarray:
     """Sorted C-order linear indices of the grid nodes that may lie within ``half_width`` of a
     surface, found without visiting the box.
 
@@ -200,8 +209,11 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     # the previous one kept. The children, their centres and radii come from Rust
     # (:func:`tubesweep._native.block_children`), a slice of parents at a time so that the
     # temporaries (and the callable's own) stay O(EVAL_CHUNK); only the kept blocks are stored.
-    parents = np.stack(np.meshgrid(*[np.arange(0, n, 2 * block) for n in grid.shape], indexing="ij"),
-                       axis=-1).reshape(-1, d).astype(np.int64)
+    parents = (
+        np.stack(np.meshgrid(*[np.arange(0, n, 2 * block) for n in grid.shape], indexing="ij"), axis=-1)
+        .reshape(-1, d)
+        .astype(np.int64)
+    )
     step = max(1, EVAL_CHUNK >> d)  # parents per slice: at most EVAL_CHUNK children
     while True:
         radius_max = 0.5 * h * _native.children_radius_max(shape, parents, block)
@@ -225,13 +237,13 @@ def coarse_to_fine_candidates(grid: Grid, half_width: float, lipschitz: float,
     return linear.view(np.int64)  # below 2^63: the same bits
 
 
-def discover_band(fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float,
-                  name: str = "phi callable") -> Tuple[np.ndarray, np.ndarray]:
+def discover_band(
+    fn: Callable[[np.ndarray], np.ndarray], grid: Grid, half_width: float, lipschitz: float, name: str = "phi callable"
+) -> Tuple[np.ndarray, np.ndarray]:
     """Grid nodes with ``|fn| ≤ half_width`` for a level set function ``fn``, found coarse-to-fine
     (:func:`coarse_to_fine_candidates`). Returns sorted linear indices and the values of ``fn``
     there."""
-    candidates = coarse_to_fine_candidates(grid, half_width, lipschitz,
-                                           lambda p, reach: np.abs(_evaluate(fn, p, name)))
+    candidates = coarse_to_fine_candidates(grid, half_width, lipschitz, lambda p, reach: np.abs(_evaluate(fn, p, name)))
     from . import _native
 
     shape, lower = list(grid.shape), [float(x) for x in grid.lower]
@@ -302,8 +314,13 @@ class LevelSet(Surface):
     near the surface); far from it the solver raises an error that says so.
     """
 
-    def __init__(self, phi: Union[np.ndarray, Callable[[np.ndarray], np.ndarray]], *, lipschitz: Optional[float] = None,
-                 redistance: bool = False):
+    def __init__(
+        self,
+        phi: Union[np.ndarray, Callable[[np.ndarray], np.ndarray]],
+        *,
+        lipschitz: Optional[float] = None,
+        redistance: bool = False,
+    ):
         if callable(phi):
             self._fn: Optional[Callable[[np.ndarray], np.ndarray]] = phi
             self._array: Optional[np.ndarray] = None
@@ -317,7 +334,9 @@ class LevelSet(Surface):
             bad = _native.first_non_finite(arr)
             if bad is not None:
                 i = np.unravel_index(bad, arr.shape)
-                raise ValueError(f"phi contains NaN or inf (first at index {tuple(int(x) for x in i)}); φ must be finite")
+                raise ValueError(
+                    f"phi contains NaN or inf (first at index {tuple(int(x) for x in i)}); φ must be finite"
+                )
             self._fn = None
             self._array = arr
             self.ndim = arr.ndim
@@ -342,7 +361,9 @@ class LevelSet(Surface):
     def check_grid(self, grid: Grid) -> None:
         super().check_grid(grid)
         if self._array is not None and self._array.shape != grid.shape:
-            raise ValueError(f"phi has shape {self._array.shape} but the grid has shape {grid.shape}; sample φ on the grid's nodes")
+            raise ValueError(
+                f"phi has shape {self._array.shape} but the grid has shape {grid.shape}; sample φ on the grid's nodes"
+            )
 
     def phi(self, points: np.ndarray, grid: Grid) -> np.ndarray:
         """φ at arbitrary points (multilinear interpolation for a sampled φ)."""
@@ -353,8 +374,9 @@ class LevelSet(Surface):
         assert self._array is not None
         return _interp_dense(self._array, grid, points)
 
-    def _outward_directions(self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int,
-                            direction: np.ndarray, band: Any) -> np.ndarray:
+    def _outward_directions(
+        self, grid: Grid, linear: np.ndarray, values: np.ndarray, lo: int, hi: int, direction: np.ndarray, band: Any
+    ) -> np.ndarray:
         """For a callable φ: ``sgn(φ) ∇φ/|∇φ|`` at band nodes ``lo:hi`` into ``direction`` (float32)
         by central differences, in Rust (``tubesweep._native.Band.outward_directions``); returns
         ``|∇φ|``. φ at a neighbour that is itself a band node is already known; the callable is
@@ -377,7 +399,9 @@ class LevelSet(Surface):
         start = 0
         for group, count in enumerate(counts):
             if count:
-                x = _native.node_points(list(grid.shape), ulinear[pos[start : start + count]], [float(c) for c in grid.lower], h)
+                x = _native.node_points(
+                    list(grid.shape), ulinear[pos[start : start + count]], [float(c) for c in grid.lower], h
+                )
                 x[:, group // 2] += (1 if group % 2 == 0 else -1) * h
                 parts.append(_evaluate(self._fn, x, "phi callable"))  # type: ignore[arg-type]
             start += count
@@ -398,14 +422,27 @@ class LevelSet(Surface):
             # nodes and bits as the callable route below)
             kind, parameters = native_phi
             ulinear, values, native_band, direction, norm = _native.analytic_level_set_band(
-                kind, [float(p) for p in parameters], list(grid.shape), [float(x) for x in grid.lower], grid.spacing,
-                float(half_width), float(self.lipschitz))  # type: ignore[arg-type]
+                kind,
+                [float(p) for p in parameters],
+                list(grid.shape),
+                [float(x) for x in grid.lower],
+                grid.spacing,
+                float(half_width),
+                float(self.lipschitz),
+            )  # type: ignore[arg-type]
             linear = ulinear.view(np.int64)
             if linear.size == 0:
                 return BandGeometry(linear, values, values, direction)
             self._check_distance_like(*_norm_bounds(values, norm, half_width)[:2])
-            return BandGeometry(linear, None, values, direction, consumable=True, native_band=native_band,
-                                kink=_kinks(norm, grid, linear, native_band))
+            return BandGeometry(
+                linear,
+                None,
+                values,
+                direction,
+                consumable=True,
+                native_band=native_band,
+                kink=_kinks(norm, grid, linear, native_band),
+            )
         if self._array is not None:
             # one pass over the samples in Rust, on all threads, with no temporary of the grid's
             # size (tubesweep_core::sampled)
@@ -425,8 +462,9 @@ class LevelSet(Surface):
             hi = min(len(linear), lo + EVAL_CHUNK)
             if self._array is not None:
                 # central differences of the samples, one-sided at the grid's faces
-                norm = _native.outward_directions_of_samples(self._array, grid.spacing, linear[lo:hi].view(np.uint64),
-                                                             direction[lo:hi])
+                norm = _native.outward_directions_of_samples(
+                    self._array, grid.spacing, linear[lo:hi].view(np.uint64), direction[lo:hi]
+                )
             else:
                 norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
             norms[lo:hi] = norm

@@ -85,8 +85,10 @@ class Tube:
         return self._tube.seconds
 
     def __repr__(self) -> str:
-        return (f"Tube({type(self.surface).__name__}, grid shape {self.grid.shape}, {self.band_points:,} band points, "
-                f"inner {self.inner:g}, outer {self.outer:g}, {self.method})")
+        return (
+            f"Tube({type(self.surface).__name__}, grid shape {self.grid.shape}, {self.band_points:,} band points, "
+            f"inner {self.inner:g}, outer {self.outer:g}, {self.method})"
+        )
 
     def solve(
         self,
@@ -109,17 +111,34 @@ class Tube:
         ``sol.stats.setup_seconds`` is then the time spent on the sources and the speed."""
         t0 = time.perf_counter()
         if self._phi_at_band is not None and not np.array_equal(
-                self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band):  # type: ignore[attr-defined]
-            raise ValueError("the φ array of this Tube's surface was changed after the Tube was built: its band no "
-                             "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
-                             "the array free to change)")
+            self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band
+        ):  # type: ignore[attr-defined]
+            raise ValueError(
+                "the φ array of this Tube's surface was changed after the Tube was built: its band no "
+                "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
+                "the array free to change)"
+            )
         src = as_sources(sources, self.grid)
         general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
         check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
-        return _solve_on_tube(self._tube, src, general, scheme, speed, source_init, tol, max_iterations, cb, infinity,
-                              threads, paper_sweeps, t0, reuse=True)
+        return _solve_on_tube(
+            self._tube,
+            src,
+            general,
+            scheme,
+            speed,
+            source_init,
+            tol,
+            max_iterations,
+            cb,
+            infinity,
+            threads,
+            paper_sweeps,
+            t0,
+            reuse=True,
+        )
 
     @property
     def nbytes(self) -> int:

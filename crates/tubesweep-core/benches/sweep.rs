@@ -59,7 +59,11 @@ fn sphere_band(n: usize) -> SphereBand {
                     best = (d2, roles.len());
                 }
                 linear.push(((i * n + j) * n + k) as u64);
-                roles.push(if phi.abs() <= inner * (1.0 + 1e-9) { NodeRole::Inner } else { NodeRole::Outer });
+                roles.push(if phi.abs() <= inner * (1.0 + 1e-9) {
+                    NodeRole::Inner
+                } else {
+                    NodeRole::Outer
+                });
                 let s = phi.signum() / r.max(1e-300);
                 directions.push([(s * x) as f32, (s * y) as f32, (s * z) as f32]);
             }
@@ -67,7 +71,12 @@ fn sphere_band(n: usize) -> SphereBand {
     }
     roles[best.1] = NodeRole::Fixed;
     let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &linear).expect("valid band");
-    SphereBand { band, roles, directions, h }
+    SphereBand {
+        band,
+        roles,
+        directions,
+        h,
+    }
 }
 
 fn problem<'a>(b: &'a SphereBand, scheme: InnerScheme<'a, 3>) -> SweepProblem<'a, 3> {
@@ -90,7 +99,13 @@ fn run(p: &SweepProblem<'_, 3>, values: &mut Vec<f64>, opts: &SolveOptions) -> u
 
 /// The paper's sweeps to the letter (see the module doc).
 fn plain() -> SolveOptions {
-    SolveOptions { skip_inactive: false, coupled: false, defer_outer_rim: false, front_window: 0.0, ..Default::default() }
+    SolveOptions {
+        skip_inactive: false,
+        coupled: false,
+        defer_outer_rim: false,
+        front_window: 0.0,
+        ..Default::default()
+    }
 }
 
 fn bench_plain_kernel(c: &mut Criterion) {
@@ -98,14 +113,24 @@ fn bench_plain_kernel(c: &mut Criterion) {
         let b = sphere_band(n);
         let mut values = vec![0.0; b.band.len()];
         let mut group = c.benchmark_group(format!("sphere-N{n}"));
-        group.sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3));
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_secs(1))
+            .measurement_time(Duration::from_secs(3));
         group.sampling_mode(SamplingMode::Flat);
         let p = problem(&b, InnerScheme::Godunov);
         for threads in [1, 0] {
             let opts = SolveOptions { threads, ..plain() };
             let updates = run(&p, &mut values, &opts);
             group.throughput(Throughput::Elements(updates));
-            let id = BenchmarkId::new("plain-to-convergence", if threads == 1 { "godunov-1-thread" } else { "godunov-all-cores" });
+            let id = BenchmarkId::new(
+                "plain-to-convergence",
+                if threads == 1 {
+                    "godunov-1-thread"
+                } else {
+                    "godunov-all-cores"
+                },
+            );
             group.bench_function(id, |bch| bch.iter(|| run(&p, &mut values, &opts)));
         }
         group.finish();
@@ -119,11 +144,18 @@ fn bench_kernel(c: &mut Criterion) {
         let b = sphere_band(n);
         let mut values = vec![0.0; b.band.len()];
         let mut group = c.benchmark_group(format!("sphere-N{n}"));
-        group.sample_size(10).warm_up_time(Duration::from_secs(1)).measurement_time(Duration::from_secs(3));
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_secs(1))
+            .measurement_time(Duration::from_secs(3));
         group.sampling_mode(SamplingMode::Flat);
         for (name, scheme) in schemes.iter() {
             let p = problem(&b, *scheme);
-            let one = SolveOptions { max_iterations: 1, front_window: 0.0, ..Default::default() };
+            let one = SolveOptions {
+                max_iterations: 1,
+                front_window: 0.0,
+                ..Default::default()
+            };
             let updates = run(&p, &mut values, &one);
             group.throughput(Throughput::Elements(updates));
             group.bench_function(BenchmarkId::new("first-iteration", name), |bch| {

@@ -39,7 +39,11 @@ const ROUND_BUDGET_S: f64 = 0.25;
 const SPINS_BEFORE_YIELD: u32 = 1 << 16;
 
 fn main() {
-    let trips: u64 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(200_000).max(2);
+    let trips: u64 = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(200_000)
+        .max(2);
     let cpus = match allowed_cpus() {
         Ok(c) if c.len() >= 2 => c,
         Ok(_) => {
@@ -63,7 +67,10 @@ fn main() {
         }
     }
     rounds.sort_by(f64::total_cmp);
-    println!("core_to_core cpus={a},{b} round_trip_ns={:.1}", rounds[rounds.len() / 2]);
+    println!(
+        "core_to_core cpus={a},{b} round_trip_ns={:.1}",
+        rounds[rounds.len() / 2]
+    );
 }
 
 /// Waits until `line` holds `want` (or [`STOP`]); false on `STOP`.
@@ -142,7 +149,9 @@ fn allowed_cpus() -> Result<Vec<usize>, String> {
         if libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) != 0 {
             return Err("sched_getaffinity failed".into());
         }
-        Ok((0..libc::CPU_SETSIZE as usize).filter(|&c| libc::CPU_ISSET(c, &set)).collect())
+        Ok((0..libc::CPU_SETSIZE as usize)
+            .filter(|&c| libc::CPU_ISSET(c, &set))
+            .collect())
     }
 }
 
@@ -159,7 +168,10 @@ fn pin(cpu: usize) -> Result<(), String> {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
         libc::CPU_SET(cpu, &mut set);
         if libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set) != 0 {
-            return Err(format!("sched_setaffinity to CPU {cpu} failed: {}", std::io::Error::last_os_error()));
+            return Err(format!(
+                "sched_setaffinity to CPU {cpu} failed: {}",
+                std::io::Error::last_os_error()
+            ));
         }
     }
     Ok(())

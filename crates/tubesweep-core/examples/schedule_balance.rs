@@ -43,7 +43,13 @@ fn critical_path(items: &[usize], threads: usize) -> usize {
 /// The strip pipeline of `sweep_strips`: every thread takes the next strip when it is free and
 /// runs its tiles in order, each starting when the thread is free and its upstream tile is done.
 /// Returns the time the last thread finishes.
-fn pipeline_time(strip_tiles: &[u32], strips: &[u32], upstream: &[u32], work: &dyn Fn(usize) -> usize, threads: usize) -> usize {
+fn pipeline_time(
+    strip_tiles: &[u32],
+    strips: &[u32],
+    upstream: &[u32],
+    work: &dyn Fn(usize) -> usize,
+    threads: usize,
+) -> usize {
     let mut finish = vec![0usize; upstream.len()];
     let mut free = vec![0usize; threads];
     for s in 0..strips.len() - 1 {
@@ -52,7 +58,11 @@ fn pipeline_time(strip_tiles: &[u32], strips: &[u32], upstream: &[u32], work: &d
         let mut t_now = free[i];
         for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
             let up = upstream[t as usize];
-            let ready = if up == tubesweep_core::schedule::NO_TILE { 0 } else { finish[up as usize] };
+            let ready = if up == tubesweep_core::schedule::NO_TILE {
+                0
+            } else {
+                finish[up as usize]
+            };
             t_now = t_now.max(ready) + work(t as usize);
             finish[t as usize] = t_now;
         }
@@ -98,7 +108,13 @@ fn main() {
                     total += per_tile.iter().sum::<usize>();
                     waves_time += critical_path(&per_tile, threads);
                 }
-                pipeline += pipeline_time(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), &work, threads);
+                pipeline += pipeline_time(
+                    sched.strip_tiles(lead),
+                    sched.strips(lead),
+                    sched.upstream(lead),
+                    &work,
+                    threads,
+                );
             }
             println!(
                 "N={n} threads={threads}: load-balance bound {:.2}x for the strip pipeline, {:.2}x for waves with barriers",
@@ -143,7 +159,10 @@ fn windowed_bounds(n: usize) {
     // one entry per sweep, 8 per iteration (the pass that sets the outer rim at the end, when
     // there is one, counts as an iteration and is not logged)
     let swept = log.len() / 8;
-    assert!(log.len() == 8 * swept && (swept == st.iterations || swept + 1 == st.iterations), "one log entry per sweep on one thread");
+    assert!(
+        log.len() == 8 * swept && (swept == st.iterations || swept + 1 == st.iterations),
+        "one log entry per sweep on one thread"
+    );
     let logged: u64 = log.iter().flatten().map(|w| w.updates as u64).sum();
     println!(
         "sphere N={n}, source on axis {source_axis}: {} sweeps, {} updates in them ({} with the rim pass), {} rows",
@@ -160,7 +179,10 @@ fn windowed_bounds(n: usize) {
             [idx[0], idx[1]]
         })
         .collect();
-    println!("{:>8} {:>12} {:>10} {:>10} {:>10} {:>10}", "tile", "model", "2 threads", "4 threads", "2 greedy", "4 greedy");
+    println!(
+        "{:>8} {:>12} {:>10} {:>10} {:>10} {:>10}",
+        "tile", "model", "2 threads", "4 threads", "2 greedy", "4 greedy"
+    );
     for (ta, tb) in SHAPES {
         for (name, cost) in WORK_MODELS {
             let mut bounds = Vec::new();
@@ -172,7 +194,11 @@ fn windowed_bounds(n: usize) {
                         let dir = s ^ (s >> 1); // the solver's Gray code order of the orientations
                         let work = tile_work(&lead, n, dir & 3, (ta, tb), rows_run, cost);
                         let nb = (n - 1) / tb + 1;
-                        let t = if greedy { greedy_time(&work, nb, threads) } else { pipeline_time_of_tiles(&work, nb, threads) };
+                        let t = if greedy {
+                            greedy_time(&work, nb, threads)
+                        } else {
+                            pipeline_time_of_tiles(&work, nb, threads)
+                        };
                         total += work.iter().filter(|&&w| w != NO_ROWS).sum::<u64>();
                         time += t;
                     }
@@ -199,7 +225,14 @@ const NO_ROWS: u64 = u64::MAX;
 /// strip by strip (`a · nb + b`, `nb` tiles per strip), with `rows_run` the rows it ran and `cost`
 /// the model's weights: every row is reached, every tile with a row costs the tile weight;
 /// [`NO_ROWS`] for a tile without rows.
-fn tile_work(lead: &[[usize; 2]], n: usize, signs: usize, shape: (usize, usize), rows_run: &[RowWork], cost: [u64; 5]) -> Vec<u64> {
+fn tile_work(
+    lead: &[[usize; 2]],
+    n: usize,
+    signs: usize,
+    shape: (usize, usize),
+    rows_run: &[RowWork],
+    cost: [u64; 5],
+) -> Vec<u64> {
     let (na, nb) = ((n - 1) / shape.0 + 1, (n - 1) / shape.1 + 1);
     let tile_of = |r: usize| -> usize {
         let c0 = if signs & 1 != 0 { n - 1 - lead[r][0] } else { lead[r][0] };
@@ -209,7 +242,11 @@ fn tile_work(lead: &[[usize; 2]], n: usize, signs: usize, shape: (usize, usize),
     let mut work = vec![NO_ROWS; na * nb];
     for r in 0..lead.len() {
         let t = tile_of(r);
-        work[t] = if work[t] == NO_ROWS { cost[4] + cost[0] } else { work[t] + cost[0] };
+        work[t] = if work[t] == NO_ROWS {
+            cost[4] + cost[0]
+        } else {
+            work[t] + cost[0]
+        };
     }
     for w in rows_run {
         work[tile_of(w.row as usize)] += cost[1] + cost[2] * w.nodes as u64 + cost[3] * w.updates as u64;
@@ -235,7 +272,11 @@ fn pipeline_time_of_tiles(work: &[u64], nb: usize, threads: usize) -> u64 {
             if work[t] == NO_ROWS {
                 continue;
             }
-            let ready = if a > 0 && work[t - nb] != NO_ROWS { finish[t - nb] } else { 0 };
+            let ready = if a > 0 && work[t - nb] != NO_ROWS {
+                finish[t - nb]
+            } else {
+                0
+            };
             now = now.max(ready) + work[t];
             finish[t] = now;
         }
@@ -256,7 +297,9 @@ fn greedy_time(work: &[u64], nb: usize, threads: usize) -> u64 {
     let (mut idle, mut now, mut done) = (threads, 0u64, 0usize);
     while done < na * nb {
         while idle > 0 && !ready.is_empty() {
-            let i = (0..ready.len()).min_by_key(|&i| (ready[i] / nb + ready[i] % nb, ready[i] / nb)).unwrap();
+            let i = (0..ready.len())
+                .min_by_key(|&i| (ready[i] / nb + ready[i] % nb, ready[i] / nb))
+                .unwrap();
             let t = ready.swap_remove(i);
             running.push((now + cost(t), t));
             idle -= 1;

@@ -41,8 +41,10 @@ fn main() {
     let mut u = sphere_source::starting_values(&band);
     let thr: f64 = std::env::var("THR").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-12);
     let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-10);
-    let front_window: f64 =
-        std::env::var("WINDOW").ok().and_then(|s| s.parse().ok()).unwrap_or(tubesweep_core::sweep::DEFAULT_FRONT_WINDOW);
+    let front_window: f64 = std::env::var("WINDOW")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(tubesweep_core::sweep::DEFAULT_FRONT_WINDOW);
     // the front window runs only with the active flags
     let front_window = if plain || paper { 0.0 } else { front_window };
     let opts = SolveOptions {
@@ -102,10 +104,17 @@ fn main() {
             err = err.max((u[i] - exact).abs());
         }
     }
-    println!("  max |u - pi/4| on the inner nodes of {} = 0: {err:.3e}", ["x", "y", "z"][source_axis]);
+    println!(
+        "  max |u - pi/4| on the inner nodes of {} = 0: {err:.3e}",
+        ["x", "y", "z"][source_axis]
+    );
     if tubesweep_core::kernel_stats::ENABLED {
         // 0 threads: rayon's default number (what the solve's own pool got)
-        let used = if threads == 0 { rayon::current_num_threads() } else { threads };
+        let used = if threads == 0 {
+            rayon::current_num_threads()
+        } else {
+            threads
+        };
         print_kernel_stats(used, st.seconds);
     }
 }
@@ -128,7 +137,10 @@ fn print_kernel_stats(threads: usize, seconds: f64) {
         s.barrier_wait_ns as f64 * 1e-6,
         100.0 * s.barrier_wait_ns as f64 * 1e-6 / thread_ms,
     );
-    println!("  rows reached {}, run {}; nodes visited in them {}", s.rows_seen, s.rows_run, s.node_visits);
+    println!(
+        "  rows reached {}, run {}; nodes visited in them {}",
+        s.rows_seen, s.rows_run, s.node_visits
+    );
     for (role, name) in [(1, "inner"), (2, "layer")] {
         let h = &s.change_histogram[role];
         let total: u64 = h.iter().sum();

@@ -12,10 +12,7 @@ const CHUNK: usize = 1 << 13;
 
 fn check_points(points: &[f64], d: usize, out: &[f64]) -> Result<()> {
     if d == 0 || points.len() % d != 0 {
-        return Err(Error::invalid(
-            "points",
-            format!("expected an (M, {d}) array"),
-        ));
+        return Err(Error::invalid("points", format!("expected an (M, {d}) array")));
     }
     if out.len() != points.len() / d {
         return Err(Error::invalid(
@@ -33,12 +30,7 @@ fn check_points(points: &[f64], d: usize, out: &[f64]) -> Result<()> {
 /// `φ(x) = |x − c| − r`, the signed distance to the circle (d = 2) or sphere (d = 3) of radius
 /// `r` about `c`, at the points (`M` rows of `d = centre.len()` coordinates) into `out`. `|x − c|`
 /// is `sqrt(Σ_k (x_k − c_k)²)` summed in axis order.
-pub fn sphere_signed_distance(
-    points: &[f64],
-    centre: &[f64],
-    radius: f64,
-    out: &mut [f64],
-) -> Result<()> {
+pub fn sphere_signed_distance(points: &[f64], centre: &[f64], radius: f64, out: &mut [f64]) -> Result<()> {
     let d = centre.len();
     check_points(points, d, out)?;
     out.par_chunks_mut(CHUNK)
@@ -58,13 +50,7 @@ pub fn sphere_signed_distance(
 /// `φ(x) = hypot(hypot(q_x, q_y) − R, q_z) − r` with `q = x − c`: the signed distance to the
 /// torus about the z axis through `c` with centre-circle radius `R` and tube radius `r`, at the
 /// points (`M` rows of 3 coordinates) into `out`.
-pub fn torus_signed_distance(
-    points: &[f64],
-    centre: [f64; 3],
-    major: f64,
-    minor: f64,
-    out: &mut [f64],
-) -> Result<()> {
+pub fn torus_signed_distance(points: &[f64], centre: [f64; 3], major: f64, minor: f64, out: &mut [f64]) -> Result<()> {
     check_points(points, 3, out)?;
     out.par_chunks_mut(CHUNK)
         .zip(points.par_chunks(CHUNK * 3))
@@ -82,24 +68,39 @@ pub fn torus_signed_distance(
 /// `q = |x − c| − (half_size − radius)` componentwise (exact), at the points (`M` rows of 3
 /// coordinates) into `out`, with the arithmetic (and bits) of the Python
 /// `RoundedCube._signed_distance_numpy`.
-pub fn rounded_cube_signed_distance(points: &[f64], centre: [f64; 3], half_size: f64, radius: f64, out: &mut [f64]) -> Result<()> {
+pub fn rounded_cube_signed_distance(
+    points: &[f64],
+    centre: [f64; 3],
+    half_size: f64,
+    radius: f64,
+    out: &mut [f64],
+) -> Result<()> {
     check_points(points, 3, out)?;
     if !(radius > 0.0 && radius <= half_size && half_size.is_finite()) {
-        return Err(Error::invalid("radius", format!("need 0 < radius <= half_size, got radius = {radius}, half_size = {half_size}")));
+        return Err(Error::invalid(
+            "radius",
+            format!("need 0 < radius <= half_size, got radius = {radius}, half_size = {half_size}"),
+        ));
     }
     let inner = half_size - radius;
     // NumPy's maximum and minimum: NaN wins (f64::max and min would drop it)
     let max = |a: f64, b: f64| if a.is_nan() || a > b { a } else { b };
     let min = |a: f64, b: f64| if a.is_nan() || a < b { a } else { b };
-    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
-        for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
-            let q = [(x[0] - centre[0]).abs() - inner, (x[1] - centre[1]).abs() - inner, (x[2] - centre[2]).abs() - inner];
-            let m = [max(q[0], 0.0), max(q[1], 0.0), max(q[2], 0.0)];
-            let outside = ((m[0] * m[0] + m[1] * m[1]) + m[2] * m[2]).sqrt();
-            let inside = min(max(max(q[0], q[1]), q[2]), 0.0);
-            *o = outside + inside - radius;
-        }
-    });
+    out.par_chunks_mut(CHUNK)
+        .zip(points.par_chunks(CHUNK * 3))
+        .for_each(|(out, p)| {
+            for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
+                let q = [
+                    (x[0] - centre[0]).abs() - inner,
+                    (x[1] - centre[1]).abs() - inner,
+                    (x[2] - centre[2]).abs() - inner,
+                ];
+                let m = [max(q[0], 0.0), max(q[1], 0.0), max(q[2], 0.0)];
+                let outside = ((m[0] * m[0] + m[1] * m[1]) + m[2] * m[2]).sqrt();
+                let inside = min(max(max(q[0], q[1]), q[2]), 0.0);
+                *o = outside + inside - radius;
+            }
+        });
     Ok(())
 }
 
@@ -107,14 +108,22 @@ pub fn rounded_cube_signed_distance(points: &[f64], centre: [f64; 3], half_size:
 /// about the z axis through `(∓offset, 0, 0)`: the genus-2 surface of the Python `DoubleTorus`,
 /// with the arithmetic (and bits) of its `_signed_distance_numpy`, at the points (`M` rows of 3
 /// coordinates) into `out`.
-pub fn double_torus_signed_distance(points: &[f64], major: f64, minor: f64, offset: f64, out: &mut [f64]) -> Result<()> {
+pub fn double_torus_signed_distance(
+    points: &[f64],
+    major: f64,
+    minor: f64,
+    offset: f64,
+    out: &mut [f64],
+) -> Result<()> {
     check_points(points, 3, out)?;
-    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
-        for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
-            let torus = |cx: f64| ((x[0] - cx).hypot(x[1]) - major).hypot(x[2]) - minor;
-            *o = torus(-offset).min(torus(offset));
-        }
-    });
+    out.par_chunks_mut(CHUNK)
+        .zip(points.par_chunks(CHUNK * 3))
+        .for_each(|(out, p)| {
+            for (o, x) in out.iter_mut().zip(p.chunks_exact(3)) {
+                let torus = |cx: f64| ((x[0] - cx).hypot(x[1]) - major).hypot(x[2]) - minor;
+                *o = torus(-offset).min(torus(offset));
+            }
+        });
     Ok(())
 }
 
@@ -128,42 +137,55 @@ pub fn double_torus_signed_distance(points: &[f64], major: f64, minor: f64, offs
 pub fn ellipsoid_signed_distance(points: &[f64], centre: [f64; 3], axes: [f64; 3], out: &mut [f64]) -> Result<()> {
     check_points(points, 3, out)?;
     if !axes.iter().all(|&a| a > 0.0 && a.is_finite()) {
-        return Err(Error::invalid("axes", format!("semi-axes must be positive and finite, got {axes:?}")));
+        return Err(Error::invalid(
+            "axes",
+            format!("semi-axes must be positive and finite, got {axes:?}"),
+        ));
     }
     let a2 = [axes[0] * axes[0], axes[1] * axes[1], axes[2] * axes[2]];
     // the first shortest axis, as np.argmin
     let kmin = (0..3).fold(0, |m, k| if axes[k] < axes[m] { k } else { m });
-    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 3)).for_each(|(out, p)| {
-        for (o, p) in out.iter_mut().zip(p.chunks_exact(3)) {
-            let x = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
-            let t = ellipsoid_root(x, axes, a2, kmin);
-            let den = [a2[0] + t, a2[1] + t, a2[2] + t];
-            let mut y = [0.0f64; 3];
-            if den[kmin] <= 1e-12 * a2[kmin] {
-                let mut sum = 0.0;
-                for k in (0..3).filter(|&k| k != kmin) {
-                    y[k] = if a2[k] > a2[kmin] { a2[k] * x[k] / (a2[k] - a2[kmin]) } else { 0.0 };
-                    let v = y[k] / axes[k];
-                    sum += v * v;
+    out.par_chunks_mut(CHUNK)
+        .zip(points.par_chunks(CHUNK * 3))
+        .for_each(|(out, p)| {
+            for (o, p) in out.iter_mut().zip(p.chunks_exact(3)) {
+                let x = [p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]];
+                let t = ellipsoid_root(x, axes, a2, kmin);
+                let den = [a2[0] + t, a2[1] + t, a2[2] + t];
+                let mut y = [0.0f64; 3];
+                if den[kmin] <= 1e-12 * a2[kmin] {
+                    let mut sum = 0.0;
+                    for k in (0..3).filter(|&k| k != kmin) {
+                        y[k] = if a2[k] > a2[kmin] {
+                            a2[k] * x[k] / (a2[k] - a2[kmin])
+                        } else {
+                            0.0
+                        };
+                        let v = y[k] / axes[k];
+                        sum += v * v;
+                    }
+                    let rest = 1.0 - sum;
+                    let sign = if x[kmin] >= 0.0 { 1.0 } else { -1.0 };
+                    y[kmin] = sign * axes[kmin] * rest.max(0.0).sqrt();
+                } else {
+                    for k in 0..3 {
+                        y[k] = a2[k] * x[k] / den[k];
+                    }
                 }
-                let rest = 1.0 - sum;
-                let sign = if x[kmin] >= 0.0 { 1.0 } else { -1.0 };
-                y[kmin] = sign * axes[kmin] * rest.max(0.0).sqrt();
-            } else {
-                for k in 0..3 {
-                    y[k] = a2[k] * x[k] / den[k];
-                }
+                let d = [
+                    p[0] - (y[0] + centre[0]),
+                    p[1] - (y[1] + centre[1]),
+                    p[2] - (y[2] + centre[2]),
+                ];
+                let dist = ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
+                let s = |k: usize| {
+                    let v = x[k] / axes[k];
+                    v * v
+                };
+                let inside = (s(0) + s(1)) + s(2) < 1.0;
+                *o = if inside { -dist } else { dist };
             }
-            let d = [p[0] - (y[0] + centre[0]), p[1] - (y[1] + centre[1]), p[2] - (y[2] + centre[2])];
-            let dist = ((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]).sqrt();
-            let s = |k: usize| {
-                let v = x[k] / axes[k];
-                v * v
-            };
-            let inside = (s(0) + s(1)) + s(2) < 1.0;
-            *o = if inside { -dist } else { dist };
-        }
-    });
+        });
     Ok(())
 }
 
@@ -234,7 +256,10 @@ pub fn star_signed_distance(points: &[f64], r0: f64, eps: f64, out: &mut [f64]) 
 fn star_signed_distance_with(points: &[f64], r0: f64, eps: f64, out: &mut [f64], whole_window: bool) -> Result<()> {
     check_points(points, 2, out)?;
     if !(r0 > 0.0 && eps >= 0.0 && r0.is_finite() && eps.is_finite()) {
-        return Err(Error::invalid("r0", format!("need r0 > 0 and eps >= 0, got r0 = {r0}, eps = {eps}")));
+        return Err(Error::invalid(
+            "r0",
+            format!("need r0 > 0 and eps >= 0, got r0 = {r0}, eps = {eps}"),
+        ));
     }
     let r = |t: f64| {
         let s = (3.0 * t).sin();
@@ -263,7 +288,11 @@ fn star_signed_distance_with(points: &[f64], r0: f64, eps: f64, out: &mut [f64],
     }
     let window: Vec<Offset> = (0..WINDOW)
         .map(|k| {
-            let delta = if k + 1 == WINDOW { 0.8 } else { -0.8 + k as f64 * window_step };
+            let delta = if k + 1 == WINDOW {
+                0.8
+            } else {
+                -0.8 + k as f64 * window_step
+            };
             let (s, c) = delta.sin_cos();
             let (s3, c3) = (3.0 * delta).sin_cos();
             Offset { delta, c, s, c3, s3 }
@@ -285,55 +314,57 @@ fn star_signed_distance_with(points: &[f64], r0: f64, eps: f64, out: &mut [f64],
         let hi = (((0.8 + half) / window_step).ceil() as usize + 1).min(WINDOW);
         lo..hi
     };
-    out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK * 2)).for_each(|(out, p)| {
-        for (o, q) in out.iter_mut().zip(p.chunks_exact(2)) {
-            let (x, y) = (q[0], q[1]);
-            let polar = y.atan2(x);
-            let inside_radius = r(polar);
-            let d2 = |c: [f64; 2]| (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y);
-            let mut t;
-            let rho = x.hypot(y);
-            let radial = (rho - inside_radius).abs();
-            if radial <= near_limit {
-                // γ(polar + δ) by the angle-addition formulas from the window's precomputed
-                // sines and cosines: no trigonometric call per candidate
-                let (sp, cp) = polar.sin_cos();
-                let (s3p, c3p) = (3.0 * polar).sin_cos();
-                t = polar - 0.8;
-                let mut best = f64::INFINITY;
-                for w in &window[window_span(rho, radial)] {
-                    let s3 = s3p * w.c3 + c3p * w.s3;
-                    let rt = r0 + eps * (s3 * s3);
-                    let c = [rt * (cp * w.c - sp * w.s), rt * (sp * w.c + cp * w.s)];
-                    let dd = d2(c);
-                    if dd < best {
-                        best = dd;
-                        t = polar + w.delta;
+    out.par_chunks_mut(CHUNK)
+        .zip(points.par_chunks(CHUNK * 2))
+        .for_each(|(out, p)| {
+            for (o, q) in out.iter_mut().zip(p.chunks_exact(2)) {
+                let (x, y) = (q[0], q[1]);
+                let polar = y.atan2(x);
+                let inside_radius = r(polar);
+                let d2 = |c: [f64; 2]| (c[0] - x) * (c[0] - x) + (c[1] - y) * (c[1] - y);
+                let mut t;
+                let rho = x.hypot(y);
+                let radial = (rho - inside_radius).abs();
+                if radial <= near_limit {
+                    // γ(polar + δ) by the angle-addition formulas from the window's precomputed
+                    // sines and cosines: no trigonometric call per candidate
+                    let (sp, cp) = polar.sin_cos();
+                    let (s3p, c3p) = (3.0 * polar).sin_cos();
+                    t = polar - 0.8;
+                    let mut best = f64::INFINITY;
+                    for w in &window[window_span(rho, radial)] {
+                        let s3 = s3p * w.c3 + c3p * w.s3;
+                        let rt = r0 + eps * (s3 * s3);
+                        let c = [rt * (cp * w.c - sp * w.s), rt * (sp * w.c + cp * w.s)];
+                        let dd = d2(c);
+                        if dd < best {
+                            best = dd;
+                            t = polar + w.delta;
+                        }
                     }
+                } else {
+                    let dense = dense.get_or_init(|| (0..DENSE).map(|j| curve(j as f64 * dense_step)).collect());
+                    t = nearest_sample(dense, dense_step, x, y, polar, r0, r0 + eps) as f64 * dense_step;
                 }
-            } else {
-                let dense = dense.get_or_init(|| (0..DENSE).map(|j| curve(j as f64 * dense_step)).collect());
-                t = nearest_sample(dense, dense_step, x, y, polar, r0, r0 + eps) as f64 * dense_step;
+                // Newton on g(t) = (γ(t) − q)·γ'(t) = 0, each step clipped to ±0.01
+                for _ in 0..8 {
+                    let (s3, c, si) = ((3.0 * t).sin(), t.cos(), t.sin());
+                    let rt = r0 + eps * (s3 * s3);
+                    let dr = 3.0 * eps * (6.0 * t).sin();
+                    let d2r = 18.0 * eps * (6.0 * t).cos();
+                    let g1 = [dr * c - rt * si, dr * si + rt * c];
+                    let g2 = [d2r * c - 2.0 * dr * si - rt * c, d2r * si + 2.0 * dr * c - rt * si];
+                    let diff = [rt * c - x, rt * si - y];
+                    let f = diff[0] * g1[0] + diff[1] * g1[1];
+                    let fp = (g1[0] * g1[0] + g1[1] * g1[1]) + (diff[0] * g2[0] + diff[1] * g2[1]);
+                    let step = if fp.abs() > 1e-14 { f / fp } else { 0.0 };
+                    t -= step.clamp(-0.01, 0.01);
+                }
+                let c = curve(t);
+                let dist = ((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1])).sqrt();
+                *o = if rho < inside_radius { -dist } else { dist };
             }
-            // Newton on g(t) = (γ(t) − q)·γ'(t) = 0, each step clipped to ±0.01
-            for _ in 0..8 {
-                let (s3, c, si) = ((3.0 * t).sin(), t.cos(), t.sin());
-                let rt = r0 + eps * (s3 * s3);
-                let dr = 3.0 * eps * (6.0 * t).sin();
-                let d2r = 18.0 * eps * (6.0 * t).cos();
-                let g1 = [dr * c - rt * si, dr * si + rt * c];
-                let g2 = [d2r * c - 2.0 * dr * si - rt * c, d2r * si + 2.0 * dr * c - rt * si];
-                let diff = [rt * c - x, rt * si - y];
-                let f = diff[0] * g1[0] + diff[1] * g1[1];
-                let fp = (g1[0] * g1[0] + g1[1] * g1[1]) + (diff[0] * g2[0] + diff[1] * g2[1]);
-                let step = if fp.abs() > 1e-14 { f / fp } else { 0.0 };
-                t -= step.clamp(-0.01, 0.01);
-            }
-            let c = curve(t);
-            let dist = ((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1])).sqrt();
-            *o = if rho < inside_radius { -dist } else { dist };
-        }
-    });
+        });
     Ok(())
 }
 
@@ -392,7 +423,11 @@ pub enum AnalyticSurface {
     /// [`star_signed_distance`] (2D).
     Star { r0: f64, eps: f64 },
     /// [`rounded_cube_signed_distance`].
-    RoundedCube { centre: [f64; 3], half_size: f64, radius: f64 },
+    RoundedCube {
+        centre: [f64; 3],
+        half_size: f64,
+        radius: f64,
+    },
     /// [`double_torus_signed_distance`].
     DoubleTorus { major: f64, minor: f64, offset: f64 },
 }
@@ -434,11 +469,19 @@ impl AnalyticSurface {
     pub fn signed_distance(&self, points: &[f64], out: &mut [f64]) -> Result<()> {
         match self {
             AnalyticSurface::Sphere { centre, radius } => sphere_signed_distance(points, centre, *radius, out),
-            AnalyticSurface::Torus { centre, major, minor } => torus_signed_distance(points, *centre, *major, *minor, out),
+            AnalyticSurface::Torus { centre, major, minor } => {
+                torus_signed_distance(points, *centre, *major, *minor, out)
+            }
             AnalyticSurface::Ellipsoid { centre, axes } => ellipsoid_signed_distance(points, *centre, *axes, out),
             AnalyticSurface::Star { r0, eps } => star_signed_distance(points, *r0, *eps, out),
-            AnalyticSurface::RoundedCube { centre, half_size, radius } => rounded_cube_signed_distance(points, *centre, *half_size, *radius, out),
-            AnalyticSurface::DoubleTorus { major, minor, offset } => double_torus_signed_distance(points, *major, *minor, *offset, out),
+            AnalyticSurface::RoundedCube {
+                centre,
+                half_size,
+                radius,
+            } => rounded_cube_signed_distance(points, *centre, *half_size, *radius, out),
+            AnalyticSurface::DoubleTorus { major, minor, offset } => {
+                double_torus_signed_distance(points, *major, *minor, *offset, out)
+            }
         }
     }
 }
@@ -453,8 +496,18 @@ mod tests {
         let mut out = [0.0; 2];
         s.signed_distance(&[3.0, 0.0, 0.0, 0.5], &mut out).unwrap();
         assert_eq!(out, [2.0, -0.5]);
-        assert_eq!(AnalyticSurface::from_parameters("torus", &[0.0, 0.0, 0.0, 0.5, 0.2]).unwrap().ndim(), 3);
-        assert_eq!(AnalyticSurface::from_parameters("ellipsoid", &[0.0, 0.0, 0.0, 0.6, 0.45, 0.3]).unwrap().ndim(), 3);
+        assert_eq!(
+            AnalyticSurface::from_parameters("torus", &[0.0, 0.0, 0.0, 0.5, 0.2])
+                .unwrap()
+                .ndim(),
+            3
+        );
+        assert_eq!(
+            AnalyticSurface::from_parameters("ellipsoid", &[0.0, 0.0, 0.0, 0.6, 0.45, 0.3])
+                .unwrap()
+                .ndim(),
+            3
+        );
         assert_eq!(AnalyticSurface::from_parameters("star", &[0.5, 0.2]).unwrap().ndim(), 2);
         assert!(AnalyticSurface::from_parameters("torus", &[0.5, 0.2]).is_err());
         assert!(AnalyticSurface::from_parameters("cube", &[1.0]).is_err());
@@ -548,7 +601,10 @@ mod tests {
                 let t = ellipsoid_root(x, axes, a2, kmin);
                 let b = bisected_root(x, axes, a2, kmin);
                 let scale = 1.0f64.max(b.abs());
-                assert!((t - b).abs() <= 1e-14 * scale, "axes {axes:?}, x {x:?}: Newton {t}, bisection {b}");
+                assert!(
+                    (t - b).abs() <= 1e-14 * scale,
+                    "axes {axes:?}, x {x:?}: Newton {t}, bisection {b}"
+                );
                 // never right of the root: F(t) ≥ 0 up to rounding, where the root is well
                 // conditioned (next to t = −a_kmin² one ulp of t moves F by far more)
                 if a2[kmin] + t > 1e-6 {
@@ -578,7 +634,12 @@ mod tests {
         for (v, e) in out.iter().zip([0.0, -0.12, far]) {
             assert!((v - e).abs() < 1e-12, "{v} vs {e}");
         }
-        assert_eq!(AnalyticSurface::from_parameters("rounded-cube", &[0.0, 0.0, 0.0, 0.5, 0.1]).unwrap().ndim(), 3);
+        assert_eq!(
+            AnalyticSurface::from_parameters("rounded-cube", &[0.0, 0.0, 0.0, 0.5, 0.1])
+                .unwrap()
+                .ndim(),
+            3
+        );
         assert!(AnalyticSurface::from_parameters("double-torus", &[0.35, 0.12]).is_err());
     }
 
@@ -601,7 +662,9 @@ mod tests {
         // against a brute-force search over 400,000 points of r(θ) = 0.5 + 0.2 sin²(3θ), at points
         // near the curve (Newton's case), far from it (the whole-curve search) and inside it
         let (r0, eps) = (0.5, 0.2);
-        let p = [0.8, 0.0, 0.3, 0.0, 0.55, 0.33, -0.2, 0.61, 0.05, -0.02, -0.9, -0.7, 0.0, 0.0, 0.42, -0.1];
+        let p = [
+            0.8, 0.0, 0.3, 0.0, 0.55, 0.33, -0.2, 0.61, 0.05, -0.02, -0.9, -0.7, 0.0, 0.0, 0.42, -0.1,
+        ];
         let mut out = [0.0; 8];
         star_signed_distance(&p, r0, eps, &mut out).unwrap();
         let m = 400_000;
@@ -613,7 +676,10 @@ mod tests {
             })
             .collect();
         for (q, &v) in p.chunks_exact(2).zip(&out) {
-            let d = curve.iter().map(|c| (c.0 - q[0]).hypot(c.1 - q[1])).fold(f64::INFINITY, f64::min);
+            let d = curve
+                .iter()
+                .map(|c| (c.0 - q[0]).hypot(c.1 - q[1]))
+                .fold(f64::INFINITY, f64::min);
             let th = q[1].atan2(q[0]);
             let inside = q[0].hypot(q[1]) < r0 + eps * (3.0 * th).sin().powi(2);
             let want = if inside { -d } else { d };
@@ -643,7 +709,12 @@ mod tests {
             star_signed_distance_with(&p, r0, eps, &mut a, false).unwrap();
             star_signed_distance_with(&p, r0, eps, &mut b, true).unwrap();
             for i in 0..a.len() {
-                assert_eq!(a[i].to_bits(), b[i].to_bits(), "r0 {r0}, eps {eps}, point {:?}", &p[2 * i..2 * i + 2]);
+                assert_eq!(
+                    a[i].to_bits(),
+                    b[i].to_bits(),
+                    "r0 {r0}, eps {eps}, point {:?}",
+                    &p[2 * i..2 * i + 2]
+                );
             }
         }
     }

@@ -94,12 +94,19 @@ impl<const D: usize> NarrowBand<D> {
         if linear.len() >= u32::MAX as usize {
             return Err(Error::invalid(
                 "indices",
-                format!("the band has {} nodes; at most {} are supported", linear.len(), u32::MAX - 1),
+                format!(
+                    "the band has {} nodes; at most {} are supported",
+                    linear.len(),
+                    u32::MAX - 1
+                ),
             ));
         }
         for w in linear.windows(2) {
             if w[0] >= w[1] {
-                return Err(Error::invalid("indices", "band nodes must be sorted in C order without duplicates"));
+                return Err(Error::invalid(
+                    "indices",
+                    "band nodes must be sorted in C order without duplicates",
+                ));
             }
         }
         if let Some(&l) = linear.last() {
@@ -133,7 +140,10 @@ impl<const D: usize> NarrowBand<D> {
         let n_rows: usize = shape[..D - 1].iter().product();
         let total = n_rows * n_last;
         if total >= u32::MAX as usize {
-            return Err(Error::invalid("grid", format!("the grid has {total} nodes; at most {} are supported", u32::MAX - 1)));
+            return Err(Error::invalid(
+                "grid",
+                format!("the grid has {total} nodes; at most {} are supported", u32::MAX - 1),
+            ));
         }
         let row_keys: Vec<u64> = (0..n_rows as u64).collect();
         let row_start: Vec<u32> = (0..=n_rows).map(|r| (r * n_last) as u32).collect();
@@ -205,7 +215,11 @@ impl<const D: usize> NarrowBand<D> {
     /// into locals (see [`NeighbourTable`]).
     #[inline(always)]
     pub fn neighbour_table(&self) -> NeighbourTable<'_, D> {
-        NeighbourTable { lead: &self.lead, along_row: &self.along_row, sentinel: self.last.len() as u32 }
+        NeighbourTable {
+            lead: &self.lead,
+            along_row: &self.along_row,
+            sentinel: self.last.len() as u32,
+        }
     }
 
     /// Asks the processor to fetch the neighbour-table entries of node `n` into cache ahead of
@@ -450,7 +464,9 @@ impl<const D: usize> NarrowBand<D> {
                         }
                         row_keys[r] + stride[k]
                     };
-                    let Ok(rr) = row_keys.binary_search(&target) else { continue };
+                    let Ok(rr) = row_keys.binary_search(&target) else {
+                        continue;
+                    };
                     let (ts, te) = (row_start[rr] as usize, row_start[rr + 1] as usize);
                     let mut t = ts;
                     for n in s..e {
@@ -475,17 +491,26 @@ impl<const D: usize> NarrowBand<D> {
             + self.lead.len() * 4
             + self.along_row.len()
             + self.schedule.heap_bytes()
-            + self.strip_schedules.get().map_or(0, |s| s.iter().map(SweepSchedule::heap_bytes).sum())
+            + self
+                .strip_schedules
+                .get()
+                .map_or(0, |s| s.iter().map(SweepSchedule::heap_bytes).sum())
     }
 }
 
 fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
     if !(2..=3).contains(&D) {
-        return Err(Error::invalid("grid", format!("only 2D and 3D grids are supported, got {D}D")));
+        return Err(Error::invalid(
+            "grid",
+            format!("only 2D and 3D grids are supported, got {D}D"),
+        ));
     }
     for (k, &n) in shape.iter().enumerate() {
         if n < 3 {
-            return Err(Error::invalid("shape", format!("axis {k} has {n} nodes; at least 3 are needed")));
+            return Err(Error::invalid(
+                "shape",
+                format!("axis {k} has {n} nodes; at least 3 are needed"),
+            ));
         }
     }
     Ok(())
@@ -519,7 +544,10 @@ mod tests {
                     let expect = band.find(j).map(|p| p as u32).unwrap_or(band.sentinel());
                     assert_eq!(band.neighbours_of(n)[k][side], expect);
                     if let Some(p) = band.find(j) {
-                        assert_eq!(linear(shape, band.index_of(p)), linear(shape, [j[0] as usize, j[1] as usize, j[2] as usize]));
+                        assert_eq!(
+                            linear(shape, band.index_of(p)),
+                            linear(shape, [j[0] as usize, j[1] as usize, j[2] as usize])
+                        );
                     }
                 }
             }
@@ -547,7 +575,8 @@ mod tests {
                         want[j] = lead[j] as i64;
                     }
                     want[k] += if side == 0 { -1 } else { 1 };
-                    let exists = (0..band.n_rows()).find(|&p| (0..D - 1).all(|j| band.row_lead(p)[j] as i64 == want[j]));
+                    let exists =
+                        (0..band.n_rows()).find(|&p| (0..D - 1).all(|j| band.row_lead(p)[j] as i64 == want[j]));
                     assert_eq!(exists.unwrap_or(band.n_rows()), q, "row {r} axis {k} side {side}");
                 }
             }
@@ -595,7 +624,9 @@ mod tests {
                     let mut j = [idx[0] as i64, idx[1] as i64];
                     j[k] += if side == 0 { -1 } else { 1 };
                     let inset = j.iter().all(|&c| c >= 0 && c < 20)
-                        && lin.binary_search(&linear(shape, [j[0] as usize, j[1] as usize])).is_ok();
+                        && lin
+                            .binary_search(&linear(shape, [j[0] as usize, j[1] as usize]))
+                            .is_ok();
                     let nb = band.neighbours_of(n)[k][side];
                     assert_eq!(nb != band.sentinel(), inset, "node {idx:?} axis {k} side {side}");
                 }
@@ -608,7 +639,13 @@ mod tests {
     fn an_empty_band_has_an_empty_schedule() {
         let band = NarrowBand::<3>::from_sorted_linear([5, 5, 5], &[]).unwrap();
         assert_eq!(band.len(), 0);
-        for (signs, sched) in (0..4).flat_map(|signs| [(signs, band.schedule()), (signs, band.strip_schedule(0)), (signs, band.strip_schedule(1))]) {
+        for (signs, sched) in (0..4).flat_map(|signs| {
+            [
+                (signs, band.schedule()),
+                (signs, band.strip_schedule(0)),
+                (signs, band.strip_schedule(1)),
+            ]
+        }) {
             assert!(sched.rows(signs).is_empty());
             let (strips, strip_tiles) = (sched.strips(signs), sched.strip_tiles(signs));
             assert_eq!(strips.first(), Some(&0));
@@ -651,9 +688,16 @@ mod tests {
         let n = 61usize;
         let band = crate::test_bands::shell_band(n, 0.6, &[0.0]).0;
         // the square tiles and the rectangular ones, strips along either leading axis
-        for (signs, sched) in (0..4).flat_map(|signs| [(signs, band.schedule()), (signs, band.strip_schedule(0)), (signs, band.strip_schedule(1))]) {
+        for (signs, sched) in (0..4).flat_map(|signs| {
+            [
+                (signs, band.schedule()),
+                (signs, band.strip_schedule(0)),
+                (signs, band.strip_schedule(1)),
+            ]
+        }) {
             let (rows, tiles) = (sched.rows(signs), sched.tiles(signs));
-            let (strip_tiles, strips, upstream) = (sched.strip_tiles(signs), sched.strips(signs), sched.upstream(signs));
+            let (strip_tiles, strips, upstream) =
+                (sched.strip_tiles(signs), sched.strips(signs), sched.upstream(signs));
             assert!(strips.len() > 4, "{} strips", strips.len() - 1);
             let mut sorted = strip_tiles.to_vec();
             sorted.sort();
@@ -670,7 +714,10 @@ mod tests {
             let mut strip_of = vec![0usize; tiles.len() - 1];
             let mut in_strip = vec![0usize; tiles.len() - 1];
             for s in 0..strips.len() - 1 {
-                for (i, &t) in strip_tiles[strips[s] as usize..strips[s + 1] as usize].iter().enumerate() {
+                for (i, &t) in strip_tiles[strips[s] as usize..strips[s + 1] as usize]
+                    .iter()
+                    .enumerate()
+                {
                     strip_of[t as usize] = s;
                     in_strip[t as usize] = i;
                 }
@@ -687,7 +734,10 @@ mod tests {
                     // walk back along the strip to a tile with an upstream link
                     let s = strip_of[t];
                     let mut found = None;
-                    for &c in strip_tiles[strips[s] as usize..strips[s] as usize + in_strip[t] + 1].iter().rev() {
+                    for &c in strip_tiles[strips[s] as usize..strips[s] as usize + in_strip[t] + 1]
+                        .iter()
+                        .rev()
+                    {
                         if upstream[c as usize] != NO_TILE {
                             found = Some(upstream[c as usize] as usize);
                             break;

@@ -45,8 +45,12 @@ fn cache_dir_last_level(dir: &Path) -> Option<usize> {
         if read("type").as_deref() == Some("Instruction") {
             continue;
         }
-        let Some(level) = read("level").and_then(|l| l.parse::<u32>().ok()) else { continue };
-        let Some(size) = read("size").and_then(|s| parse_cache_size(&s)).filter(|&s| s > 0) else { continue };
+        let Some(level) = read("level").and_then(|l| l.parse::<u32>().ok()) else {
+            continue;
+        };
+        let Some(size) = read("size").and_then(|s| parse_cache_size(&s)).filter(|&s| s > 0) else {
+            continue;
+        };
         if best.is_none_or(|(l, _)| level > l) {
             best = Some((level, size));
         }
@@ -123,7 +127,15 @@ mod tests {
             ],
         );
         assert_eq!(last_level_cache_in(&root.join("a")), Some(32 << 20));
-        fake_cpu(&root.join("b"), 0, &[(Some("2"), Some("Unified"), Some("2048K")), (Some("3"), Some("Unified"), Some("0K")), (Some("3"), Some("Unified"), None)]);
+        fake_cpu(
+            &root.join("b"),
+            0,
+            &[
+                (Some("2"), Some("Unified"), Some("2048K")),
+                (Some("3"), Some("Unified"), Some("0K")),
+                (Some("3"), Some("Unified"), None),
+            ],
+        );
         assert_eq!(last_level_cache_in(&root.join("b")), Some(2 << 20));
         // no cpu0 (a container's view): the first CPU that has one, in order of its number
         fs::create_dir_all(root.join("c")).unwrap();
@@ -132,7 +144,14 @@ mod tests {
         fake_cpu(&root.join("c"), 3, &[(Some("3"), Some("Unified"), Some("16M"))]);
         assert_eq!(last_level_cache_in(&root.join("c")), Some(16 << 20));
         // nothing readable
-        fake_cpu(&root.join("d"), 0, &[(None, Some("Unified"), Some("4M")), (Some("x"), Some("Data"), Some("1M"))]);
+        fake_cpu(
+            &root.join("d"),
+            0,
+            &[
+                (None, Some("Unified"), Some("4M")),
+                (Some("x"), Some("Data"), Some("1M")),
+            ],
+        );
         assert_eq!(last_level_cache_in(&root.join("d")), None);
         assert_eq!(last_level_cache_in(&root.join("missing")), None);
         fs::remove_dir_all(&root).unwrap();

@@ -23,7 +23,10 @@ fn check_parents<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block
             if o[k] % (2 * block) != 0 || o[k] >= shape[k] as u64 {
                 return Err(Error::invalid(
                     "parents",
-                    format!("block origin {o:?} is not a multiple of {} inside the grid {shape:?}", 2 * block),
+                    format!(
+                        "block origin {o:?} is not a multiple of {} inside the grid {shape:?}",
+                        2 * block
+                    ),
                 ));
             }
         }
@@ -36,7 +39,12 @@ fn check_parents<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block
 /// the grid, parent by parent, the corners in C order (axis 0 slowest). A block at the upper edge
 /// of the grid is cut to it (its last node is the grid's last along that axis).
 #[inline]
-fn for_children<const D: usize>(shape: &[usize; D], parents: &[[u64; D]], block: u64, mut f: impl FnMut(&[u64; D], &[u64; D])) {
+fn for_children<const D: usize>(
+    shape: &[usize; D],
+    parents: &[[u64; D]],
+    block: u64,
+    mut f: impl FnMut(&[u64; D], &[u64; D]),
+) {
     for p in parents {
         'corner: for corner in 0..(1usize << D) {
             let mut o = [0u64; D];
@@ -89,10 +97,16 @@ pub fn block_children<const D: usize>(
 ) -> Result<(Vec<[u64; D]>, Vec<[f64; D]>, Vec<f64>)> {
     check_parents(&shape, parents, block)?;
     let cap = parents.len() << D;
-    let (mut origins, mut centres, mut radii) = (Vec::with_capacity(cap), Vec::with_capacity(cap), Vec::with_capacity(cap));
+    let (mut origins, mut centres, mut radii) = (
+        Vec::with_capacity(cap),
+        Vec::with_capacity(cap),
+        Vec::with_capacity(cap),
+    );
     for_children(&shape, parents, block, |o, last| {
         origins.push(*o);
-        centres.push(core::array::from_fn(|k| lower[k] + spacing * (0.5 * (o[k] + last[k]) as f64)));
+        centres.push(core::array::from_fn(|k| {
+            lower[k] + spacing * (0.5 * (o[k] + last[k]) as f64)
+        }));
         radii.push(0.5 * spacing * diagonal(o, last));
     });
     Ok((origins, centres, radii))
@@ -108,8 +122,14 @@ pub fn block_children<const D: usize>(
 /// sorted lexicographically: along each axis the pair `2i, 2i + 1` of a block never interleaves
 /// with another block's pair, so no sort of the output is needed.
 pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]) -> Result<Vec<u64>> {
-    if let Some(o) = origins.par_iter().find_first(|o| (0..D).any(|k| o[k] % 2 != 0 || o[k] >= shape[k] as u64)) {
-        return Err(Error::invalid("origins", format!("block origin {o:?} is not an even grid index inside the grid {shape:?}")));
+    if let Some(o) = origins
+        .par_iter()
+        .find_first(|o| (0..D).any(|k| o[k] % 2 != 0 || o[k] >= shape[k] as u64))
+    {
+        return Err(Error::invalid(
+            "origins",
+            format!("block origin {o:?} is not an even grid index inside the grid {shape:?}"),
+        ));
     }
     let mut stride = [1u64; D];
     for k in (0..D.saturating_sub(1)).rev() {
@@ -117,7 +137,10 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
     }
     // sorted lexicographically, which is the order of their linear indices (every coordinate is
     // inside the grid): sorting those u64 keys is several times faster than comparing arrays
-    let mut keys: Vec<u64> = origins.par_iter().map(|o| (0..D).map(|k| o[k] * stride[k]).sum()).collect();
+    let mut keys: Vec<u64> = origins
+        .par_iter()
+        .map(|o| (0..D).map(|k| o[k] * stride[k]).sum())
+        .collect();
     keys.par_sort_unstable();
     if keys.par_windows(2).any(|w| w[0] == w[1]) {
         return Err(Error::invalid("origins", "block origins repeat"));
@@ -138,7 +161,11 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
     // the origins by their first coordinate: their nodes come in C order group after group, so
     // the groups are emitted on all threads, each into its own part of the output, whose size is
     // counted first (a block has 2 nodes along an axis, 1 where the grid ends after its origin)
-    let nodes_of = |o: &[u64; D]| (0..D).map(|k| if o[k] + 1 < shape[k] as u64 { 2 } else { 1 }).product::<usize>();
+    let nodes_of = |o: &[u64; D]| {
+        (0..D)
+            .map(|k| if o[k] + 1 < shape[k] as u64 { 2 } else { 1 })
+            .product::<usize>()
+    };
     let mut groups: Vec<&[[u64; D]]> = Vec::new();
     let mut rest = &sorted[..];
     while let Some(first) = rest.first() {
@@ -168,34 +195,44 @@ pub fn split_pair_blocks<const D: usize>(shape: [usize; D], origins: &[[u64; D]]
 /// `linear` (each inside the grid of `shape`), with the arithmetic of `Grid.points`, so the same
 /// bits: the points at which the caller evaluates φ for the candidates of the band, as `D`
 /// coordinates per node, one node after another.
-pub fn node_points<const D: usize>(shape: [usize; D], linear: &[u64], lower: [f64; D], spacing: f64) -> Result<Vec<f64>> {
+pub fn node_points<const D: usize>(
+    shape: [usize; D],
+    linear: &[u64],
+    lower: [f64; D],
+    spacing: f64,
+) -> Result<Vec<f64>> {
     let total: u64 = shape.iter().map(|&n| n as u64).product();
     if let Some(&bad) = linear.iter().find(|&&l| l >= total) {
-        return Err(Error::invalid("linear", format!("linear index {bad} is outside the grid {shape:?}")));
+        return Err(Error::invalid(
+            "linear",
+            format!("linear index {bad} is outside the grid {shape:?}"),
+        ));
     }
     // in chunks on all threads; within a chunk one division per row, not per node (the
     // candidates come in C order, many to a row)
     const CHUNK: usize = 1 << 14;
     let n_last = shape[D - 1] as u64;
     let mut out = vec![0.0f64; linear.len() * D];
-    out.par_chunks_mut(CHUNK * D).zip(linear.par_chunks(CHUNK)).for_each(|(out, linear)| {
-        let mut row_begin = u64::MAX; // the linear index of the current row's first grid node
-        let mut lead = [0.0f64; D];
-        for (x, &l) in out.chunks_exact_mut(D).zip(linear) {
-            if row_begin == u64::MAX || l < row_begin || l >= row_begin + n_last {
-                let r = l / n_last;
-                row_begin = r * n_last;
-                let mut key = r;
-                for k in (0..D - 1).rev() {
-                    let n = shape[k] as u64;
-                    lead[k] = lower[k] + spacing * (key % n) as f64;
-                    key /= n;
+    out.par_chunks_mut(CHUNK * D)
+        .zip(linear.par_chunks(CHUNK))
+        .for_each(|(out, linear)| {
+            let mut row_begin = u64::MAX; // the linear index of the current row's first grid node
+            let mut lead = [0.0f64; D];
+            for (x, &l) in out.chunks_exact_mut(D).zip(linear) {
+                if row_begin == u64::MAX || l < row_begin || l >= row_begin + n_last {
+                    let r = l / n_last;
+                    row_begin = r * n_last;
+                    let mut key = r;
+                    for k in (0..D - 1).rev() {
+                        let n = shape[k] as u64;
+                        lead[k] = lower[k] + spacing * (key % n) as f64;
+                        key /= n;
+                    }
                 }
+                lead[D - 1] = lower[D - 1] + spacing * (l - row_begin) as f64;
+                x.copy_from_slice(&lead);
             }
-            lead[D - 1] = lower[D - 1] + spacing * (l - row_begin) as f64;
-            x.copy_from_slice(&lead);
-        }
-    });
+        });
     Ok(out)
 }
 
@@ -237,11 +274,13 @@ pub fn discover_band<const D: usize>(
         for k in 0..D {
             parents = parents
                 .iter()
-                .flat_map(|p| (0..shape[k] as u64).step_by(2 * block as usize).map(move |c| {
-                    let mut q = *p;
-                    q[k] = c;
-                    q
-                }))
+                .flat_map(|p| {
+                    (0..shape[k] as u64).step_by(2 * block as usize).map(move |c| {
+                        let mut q = *p;
+                        q[k] = c;
+                        q
+                    })
+                })
                 .collect();
         }
         loop {
@@ -315,12 +354,28 @@ pub(crate) fn concat_band_parts(parts: Vec<(Vec<u64>, Vec<f64>)>) -> (Vec<u64>, 
 /// `linear_out` and `values_out`, in order, and returns how many there are: the filter of the
 /// band search after φ at the candidates is known. An error if the outputs are too short or the
 /// inputs differ in length.
-pub fn keep_within(linear: &[u64], values: &[f64], half_width: f64, linear_out: &mut [u64], values_out: &mut [f64]) -> Result<usize> {
+pub fn keep_within(
+    linear: &[u64],
+    values: &[f64],
+    half_width: f64,
+    linear_out: &mut [u64],
+    values_out: &mut [f64],
+) -> Result<usize> {
     if values.len() != linear.len() {
-        return Err(Error::invalid("values", format!("expected {} values (one per candidate), got {}", linear.len(), values.len())));
+        return Err(Error::invalid(
+            "values",
+            format!(
+                "expected {} values (one per candidate), got {}",
+                linear.len(),
+                values.len()
+            ),
+        ));
     }
     if linear_out.len() < linear.len() || values_out.len() < linear.len() {
-        return Err(Error::invalid("out", format!("the outputs must hold {} entries", linear.len())));
+        return Err(Error::invalid(
+            "out",
+            format!("the outputs must hold {} entries", linear.len()),
+        ));
     }
     let mut n = 0;
     for (&l, &v) in linear.iter().zip(values) {
@@ -335,7 +390,15 @@ pub fn keep_within(linear: &[u64], values: &[f64], half_width: f64, linear_out: 
 /// Emits, in C order, the nodes of the blocks `group` (sorted; all share their coordinates along
 /// the axes before `axis`, whose contribution to the linear index is `base`) into `out` from
 /// position `written` on, which it advances.
-fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]], axis: usize, base: u64, out: &mut [u64], written: &mut usize) {
+fn emit<const D: usize>(
+    shape: &[usize; D],
+    stride: &[u64; D],
+    group: &[[u64; D]],
+    axis: usize,
+    base: u64,
+    out: &mut [u64],
+    written: &mut usize,
+) {
     if axis + 1 == D {
         let n = shape[axis] as u64;
         for o in group {
@@ -358,7 +421,15 @@ fn emit<const D: usize>(shape: &[usize; D], stride: &[u64; D], group: &[[u64; D]
         }
         for a in 0..2 {
             if c + a < n {
-                emit(shape, stride, &group[start..end], axis + 1, base + (c + a) * stride[axis], out, written);
+                emit(
+                    shape,
+                    stride,
+                    &group[start..end],
+                    axis + 1,
+                    base + (c + a) * stride[axis],
+                    out,
+                    written,
+                );
             }
         }
         start = end;
@@ -380,15 +451,24 @@ mod tests {
             let points = node_points(shape, &all, lower, h).unwrap();
             let mut v = vec![0.0; all.len()];
             phi(&points, &mut v).unwrap();
-            let want: Vec<u64> = all.iter().copied().filter(|&l| v[l as usize].abs() <= half_width).collect();
+            let want: Vec<u64> = all
+                .iter()
+                .copied()
+                .filter(|&l| v[l as usize].abs() <= half_width)
+                .collect();
             assert_eq!(linear, want, "half-width {half_width}");
             assert!(linear.iter().zip(&values).all(|(&l, &x)| x == v[l as usize]));
         }
         assert!(discover_band(shape, lower, -h, 0.1, 1.0, &phi).is_err());
         // a tiny grid: every node is a candidate
-        let (linear, _) = discover_band([6, 7, 5], [-0.3, -0.3, -0.2], 0.1, 0.05, 1.0, &|p: &[f64], out: &mut [f64]| {
-            crate::analytic::sphere_signed_distance(p, &[0.0, 0.0, 0.0], 0.2, out)
-        })
+        let (linear, _) = discover_band(
+            [6, 7, 5],
+            [-0.3, -0.3, -0.2],
+            0.1,
+            0.05,
+            1.0,
+            &|p: &[f64], out: &mut [f64]| crate::analytic::sphere_signed_distance(p, &[0.0, 0.0, 0.0], 0.2, out),
+        )
         .unwrap();
         assert!(!linear.is_empty());
     }
@@ -436,7 +516,10 @@ mod tests {
 
         let shape2 = [6usize, 11];
         let origins2: Vec<[u64; 2]> = vec![[4, 10], [0, 0], [2, 4], [0, 8], [4, 0], [2, 2]];
-        assert_eq!(split_pair_blocks(shape2, &origins2).unwrap(), reference(shape2, &origins2));
+        assert_eq!(
+            split_pair_blocks(shape2, &origins2).unwrap(),
+            reference(shape2, &origins2)
+        );
         assert!(split_pair_blocks(shape2, &[]).unwrap().is_empty());
     }
 
@@ -447,7 +530,18 @@ mod tests {
         let parents = [[4u64, 8], [0, 0], [4, 4]];
         let (o, c, r) = block_children(shape, &parents, 2, [-1.0, 0.5], 0.25).unwrap();
         // parent by parent, corners in C order, only those starting inside the grid
-        let want: Vec<[u64; 2]> = vec![[4, 8], [6, 8], [0, 0], [0, 2], [2, 0], [2, 2], [4, 4], [4, 6], [6, 4], [6, 6]];
+        let want: Vec<[u64; 2]> = vec![
+            [4, 8],
+            [6, 8],
+            [0, 0],
+            [0, 2],
+            [2, 0],
+            [2, 2],
+            [4, 4],
+            [4, 6],
+            [6, 4],
+            [6, 6],
+        ];
         assert_eq!(o, want);
         for ((o, c), r) in o.iter().zip(&c).zip(&r) {
             let last = [(o[0] + 2).min(7) - 1, (o[1] + 2).min(10) - 1];

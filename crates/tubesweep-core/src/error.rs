@@ -17,7 +17,10 @@ pub enum Error {
 
 impl Error {
     pub fn invalid(argument: &'static str, message: impl Into<String>) -> Self {
-        Error::InvalidArgument { argument, message: message.into() }
+        Error::InvalidArgument {
+            argument,
+            message: message.into(),
+        }
     }
 }
 

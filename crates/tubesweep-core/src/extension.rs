@@ -51,7 +51,11 @@ pub fn extension_update<const D: usize>(
 /// exists or `v` vanishes. The band structure does not change during a solve, so the solver
 /// computes these once and the update becomes [`extension_apply`].
 #[inline]
-pub fn extension_weights<const D: usize>(v: [f32; D], present_minus: [bool; D], present_plus: [bool; D]) -> Option<[f32; D]> {
+pub fn extension_weights<const D: usize>(
+    v: [f32; D],
+    present_minus: [bool; D],
+    present_plus: [bool; D],
+) -> Option<[f32; D]> {
     let mut w = [0.0f64; D];
     let mut den = 0.0;
     for k in 0..D {
@@ -93,7 +97,11 @@ pub fn extension_apply<const D: usize>(weights: [f32; D], minus: [f64; D], plus:
 /// neighbour along each axis: `neighbours[k] = [minus, plus]`, `value(i)` the value of node `i`.
 /// Bit-identical to [`extension_apply`] (the terms it adds for the downwind side are exact zeros).
 #[inline(always)]
-pub fn extension_apply_upwind<const D: usize>(weights: [f32; D], neighbours: &[[u32; 2]; D], value: impl Fn(u32) -> f64) -> f64 {
+pub fn extension_apply_upwind<const D: usize>(
+    weights: [f32; D],
+    neighbours: &[[u32; 2]; D],
+    value: impl Fn(u32) -> f64,
+) -> f64 {
     let mut acc = 0.0;
     for k in 0..D {
         let w = weights[k] as f64;
@@ -138,6 +146,9 @@ mod tests {
         let s = std::f32::consts::FRAC_1_SQRT_2;
         let got = extension_update([s, s], [1.0, 5.0], [0.0, 0.0], [false, true], [true; 2]);
         assert_eq!(got, Some(5.0));
-        assert_eq!(extension_update([0.0f32, 0.0], [1.0, 1.0], [1.0, 1.0], [true; 2], [true; 2]), None);
+        assert_eq!(
+            extension_update([0.0f32, 0.0], [1.0, 1.0], [1.0, 1.0], [true; 2], [true; 2]),
+            None
+        );
     }
 }

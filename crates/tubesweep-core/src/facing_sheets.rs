@@ -89,7 +89,10 @@ pub fn facing_sheet_pairs<const D: usize>(
     if inner.len() != k_nodes || phi.len() != k_nodes || direction.len() != D * k_nodes {
         return Err(Error::invalid(
             "inner, phi, direction",
-            format!("expected {k_nodes} entries each ({} directions), one per band node", D * k_nodes),
+            format!(
+                "expected {k_nodes} entries each ({} directions), one per band node",
+                D * k_nodes
+            ),
         ));
     }
     if !(spacing > 0.0 && spacing.is_finite()) {
@@ -124,7 +127,8 @@ pub fn facing_sheet_pairs<const D: usize>(
             let chord2 = dot(&chord, &chord);
             // facing: on one side, pointing against each other, each on its own side of the
             // other's closest point
-            let facing = same_side && ta > MIN_OFF_SURFACE && tb > MIN_OFF_SURFACE && ta + na[k] > 0.0 && tb - nb[k] > 0.0;
+            let facing =
+                same_side && ta > MIN_OFF_SURFACE && tb > MIN_OFF_SURFACE && ta + na[k] > 0.0 && tb - nb[k] > 0.0;
             // across: on opposite sides of the surface yet pointing the same way, so that the
             // inside node's closest point and the outside node's lie on different sheets
             let across = opposite_sides && chord2 > MIN_ACROSS * MIN_ACROSS && {
@@ -133,7 +137,11 @@ pub fn facing_sheet_pairs<const D: usize>(
                 ca * ca >= min2 && cb * cb >= min2
             };
             if facing || across {
-                out.push(FacingPair { node: a, neighbour: b, gap: spacing * chord2.sqrt() });
+                out.push(FacingPair {
+                    node: a,
+                    neighbour: b,
+                    gap: spacing * chord2.sqrt(),
+                });
             }
         }
     };
@@ -165,7 +173,11 @@ mod tests {
             // axis 0 across the lines, axis 1 along them
             let y = idx[0] as f64 * h;
             let (d0, d1) = ((y - y0).abs(), (y - y1).abs());
-            let (d, s) = if d0 <= d1 { (d0, (y - y0).signum()) } else { (d1, (y - y1).signum()) };
+            let (d, s) = if d0 <= d1 {
+                (d0, (y - y0).signum())
+            } else {
+                (d1, (y - y1).signum())
+            };
             // inside (negative) between the lines
             let inside = y > y0.min(y1) && y < y0.max(y1);
             phi.push(if inside { -d } else { d } as f32);
@@ -217,7 +229,10 @@ mod tests {
             let (band, phi, dir) = two_lines(12, h, 0.55, 10.0);
             let phi: Vec<f32> = phi.iter().map(|&p| g * p).collect();
             let all = vec![true; band.len()];
-            assert!(facing_sheet_pairs(&band, &all, &phi, &dir, h).unwrap().is_empty(), "g = {g}");
+            assert!(
+                facing_sheet_pairs(&band, &all, &phi, &dir, h).unwrap().is_empty(),
+                "g = {g}"
+            );
         }
     }
 

@@ -305,10 +305,16 @@ mod tests {
             let c = [1.0 - 0.9 * next(), 1.0, 1.0 - 0.9 * next()];
             let plain = godunov_update(a, f);
             let want = reference_root(a, [1.0; 3], f);
-            assert!((plain - want).abs() <= 1e-14 * want.abs().max(1.0), "{a:?} {f}: {plain} vs {want}");
+            assert!(
+                (plain - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "{a:?} {f}: {plain} vs {want}"
+            );
             let coupled = godunov_update_coupled(a, c, f);
             let want = reference_root(a, c, f);
-            assert!((coupled - want).abs() <= 1e-14 * want.abs().max(1.0), "{a:?} {c:?} {f}: {coupled} vs {want}");
+            assert!(
+                (coupled - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "{a:?} {c:?} {f}: {coupled} vs {want}"
+            );
             // and the root solves its own equation
             let res: f64 = (0..3).map(|k| (c[k] * coupled - a[k]).max(0.0).powi(2)).sum();
             assert!((res - f * f).abs() <= 1e-12 * f * f, "residual {}", res - f * f);

@@ -113,11 +113,21 @@ mod tests {
             }
         }
         let band = NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap();
-        let pole = band.find([(n / 2) as i64, (n / 2) as i64, (n / 2 + (0.4 * n as f64) as usize) as i64]).unwrap();
+        let pole = band
+            .find([
+                (n / 2) as i64,
+                (n / 2) as i64,
+                (n / 2 + (0.4 * n as f64) as usize) as i64,
+            ])
+            .unwrap();
         for sources in [vec![pole], vec![pole, 17, band.len() - 1]] {
             let expected = reference(&band, &sources);
             assert!(expected > 50, "a shell this size is {expected} steps across");
-            assert_eq!(max_grid_hops(&band, sources.iter().copied()), expected, "sources {sources:?}");
+            assert_eq!(
+                max_grid_hops(&band, sources.iter().copied()),
+                expected,
+                "sources {sources:?}"
+            );
         }
     }
 }

@@ -68,7 +68,11 @@ mod tests {
     fn reproduces_linear_functions_and_flags_missing_corners() {
         let band = NarrowBand::<2>::full_box([5, 5]).unwrap();
         let h = 0.25;
-        let vals: Vec<f64> = band.indices().iter().map(|i| 2.0 * i[0] as f64 * h - i[1] as f64 * h).collect();
+        let vals: Vec<f64> = band
+            .indices()
+            .iter()
+            .map(|i| 2.0 * i[0] as f64 * h - i[1] as f64 * h)
+            .collect();
         let pts = [0.3, 0.6, 1.0, 1.0, 2.0, 0.0];
         let out = interpolate(&band, &vals, [0.0, 0.0], h, &pts);
         assert!((out[0] - (0.6 - 0.6)).abs() < 1e-12);

@@ -93,8 +93,9 @@ pub fn change_bin(change: Option<f64>) -> usize {
 }
 
 /// The lower ends of the decade bins: 1e-1, 1e-2, …, 1e-17 (the last bin takes the rest).
-const DECADES: [f64; CHANGE_BINS - 3] =
-    [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15, 1e-16, 1e-17];
+const DECADES: [f64; CHANGE_BINS - 3] = [
+    1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15, 1e-16, 1e-17,
+];
 
 /// A strip waited `ns` nanoseconds for its upstream tile.
 #[inline(always)]
@@ -129,7 +130,13 @@ pub fn row(r: usize, run: bool, nodes: usize, updates: u64) {
             counters::add(counters::ROWS_RUN, 1);
             counters::add(counters::NODE_VISITS, nodes as u64);
             if row_log::ON.load(Ordering::Relaxed) {
-                row_log::LOCAL.with(|l| l.borrow_mut().push(RowWork { row: r as u32, nodes: nodes as u32, updates: updates as u32 }));
+                row_log::LOCAL.with(|l| {
+                    l.borrow_mut().push(RowWork {
+                        row: r as u32,
+                        nodes: nodes as u32,
+                        updates: updates as u32,
+                    })
+                });
             }
         }
     }
@@ -198,7 +205,10 @@ pub fn take_row_log() -> Vec<Vec<RowWork>> {
 #[inline(always)]
 pub fn update(role: u8, change: Option<f64>) {
     #[cfg(feature = "kernel-stats")]
-    counters::add(counters::CHANGES + (role as usize).min(2) * CHANGE_BINS + change_bin(change), 1);
+    counters::add(
+        counters::CHANGES + (role as usize).min(2) * CHANGE_BINS + change_bin(change),
+        1,
+    );
     #[cfg(not(feature = "kernel-stats"))]
     let _ = (role, change);
 }
@@ -282,7 +292,11 @@ mod tests {
             log_rows(true);
             let mut u = vec![0.0; band.len()];
             // the rim in the sweeps, so that every update is a sweep's
-            let opts = SolveOptions { threads, defer_outer_rim: false, ..Default::default() };
+            let opts = SolveOptions {
+                threads,
+                defer_outer_rim: false,
+                ..Default::default()
+            };
             let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
             let s = snapshot();
             let log = take_row_log();
@@ -305,7 +319,10 @@ mod tests {
             let histogram: u64 = s.change_histogram.iter().flatten().sum();
             assert_eq!(histogram, st.updates, "every local update is binned once");
             assert_eq!(s.change_histogram[0].iter().sum::<u64>(), 0, "no fixed node is updated");
-            assert!(s.node_visits >= st.updates && s.rows_run <= s.rows_seen && s.rows_run > 0, "{s:?}");
+            assert!(
+                s.node_visits >= st.updates && s.rows_run <= s.rows_seen && s.rows_run > 0,
+                "{s:?}"
+            );
             // every row is reached in every sweep
             assert_eq!(s.rows_seen, (band.n_rows() * st.sweeps) as u64);
             // the first updates take nodes from the numerical infinity: changes of at least 1
@@ -313,7 +330,12 @@ mod tests {
             if threads == 1 {
                 assert_eq!((s.tile_waits, s.barrier_wait_ns), (0, 0));
             }
-            runs.push(KernelStats { tile_waits: 0, tile_wait_ns: 0, barrier_wait_ns: 0, ..s });
+            runs.push(KernelStats {
+                tile_waits: 0,
+                tile_wait_ns: 0,
+                barrier_wait_ns: 0,
+                ..s
+            });
         }
         assert_eq!(runs[0], runs[1]);
         // the threads' entries of a sweep together hold the rows the one thread ran, with the

@@ -50,9 +50,9 @@ pub mod mesh;
 pub mod mesh_band;
 pub mod mobius;
 pub mod nearest_source;
+pub mod normals;
 pub mod open_surfaces;
 mod prefetch;
-pub mod normals;
 pub mod redistance;
 pub mod rim;
 pub mod sampled;
@@ -64,7 +64,7 @@ mod test_bands;
 pub use band::NarrowBand;
 pub use error::{Error, Result};
 pub use hamiltonian::{Hamiltonian, InnerScheme};
-pub use sweep::{NodeRole, SolveOptions, SolveStats, SweepProblem, Control, IterationReport};
+pub use sweep::{Control, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
 
 /// The default "numerical infinity": large enough to dominate any travel time a user will meet
 /// in a unit-sized box, small enough that the Lax–Friedrichs update (which averages neighbours)

@@ -133,7 +133,10 @@ fn f32_up(x: f64) -> f32 {
 
 /// A box with `f32` corners that contains the `f64` box `[lo, hi]`.
 fn outward(lo: V3, hi: V3) -> ([f32; 3], [f32; 3]) {
-    ([f32_down(lo[0]), f32_down(lo[1]), f32_down(lo[2])], [f32_up(hi[0]), f32_up(hi[1]), f32_up(hi[2])])
+    (
+        [f32_down(lo[0]), f32_down(lo[1]), f32_down(lo[2])],
+        [f32_up(hi[0]), f32_up(hi[1]), f32_up(hi[2])],
+    )
 }
 
 /// Squared distance from `p` to the box `[lo, hi]` (0 inside); branch-free, since whether a
@@ -183,11 +186,21 @@ impl TriangleTree {
         let n = triangles.len();
         let cent: Vec<V3> = triangles
             .iter()
-            .map(|t| [(t[0][0] + t[1][0] + t[2][0]) / 3.0, (t[0][1] + t[1][1] + t[2][1]) / 3.0, (t[0][2] + t[1][2] + t[2][2]) / 3.0])
+            .map(|t| {
+                [
+                    (t[0][0] + t[1][0] + t[2][0]) / 3.0,
+                    (t[0][1] + t[1][1] + t[2][1]) / 3.0,
+                    (t[0][2] + t[1][2] + t[2][2]) / 3.0,
+                ]
+            })
             .collect();
         let mut order: Vec<u32> = (0..n as u32).collect();
         let mut nodes: Vec<Node> = Vec::with_capacity(n / LEAF_SIZE + 2);
-        let blank = Node { lo: [[0.0; 3]; 2], hi: [[0.0; 3]; 2], child: [ChildRef { start: 0, count: 0 }; 2] };
+        let blank = Node {
+            lo: [[0.0; 3]; 2],
+            hi: [[0.0; 3]; 2],
+            child: [ChildRef { start: 0, count: 0 }; 2],
+        };
         // iterative build: (the slot that refers to the subtree, start, end); a slot is a child
         // of an inner node, or None for the root
         let mut root = ChildRef { start: 0, count: 0 };
@@ -212,17 +225,31 @@ impl TriangleTree {
                 }
             }
             let reference = if e - s <= LEAF_SIZE {
-                ChildRef { start: s as u32, count: (e - s) as u32 }
+                ChildRef {
+                    start: s as u32,
+                    count: (e - s) as u32,
+                }
             } else {
                 let ext = sub(chi, clo);
-                let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] { 0 } else if ext[1] >= ext[2] { 1 } else { 2 };
+                let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
+                    0
+                } else if ext[1] >= ext[2] {
+                    1
+                } else {
+                    2
+                };
                 let mid = (s + e) / 2;
-                order[s..e].select_nth_unstable_by(mid - s, |&x, &y| cent[x as usize][axis].total_cmp(&cent[y as usize][axis]));
+                order[s..e].select_nth_unstable_by(mid - s, |&x, &y| {
+                    cent[x as usize][axis].total_cmp(&cent[y as usize][axis])
+                });
                 let ni = nodes.len();
                 nodes.push(blank);
                 stack.push((Some((ni, 0)), s, mid));
                 stack.push((Some((ni, 1)), mid, e));
-                ChildRef { start: ni as u32, count: 0 }
+                ChildRef {
+                    start: ni as u32,
+                    count: 0,
+                }
             };
             let (blo, bhi) = outward(lo, hi);
             match slot {
@@ -252,7 +279,14 @@ impl TriangleTree {
                 outward(lo, hi)
             })
             .collect();
-        TriangleTree { tris: triangles, order, boxes, nodes, root_box, root }
+        TriangleTree {
+            tris: triangles,
+            order,
+            boxes,
+            nodes,
+            root_box,
+            root,
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -287,8 +321,18 @@ impl TriangleTree {
     /// [`closest`](Self::closest), starting from triangle `hint` (typically the answer for a
     /// nearby point): its distance bounds the search from the start, which then only opens the
     /// boxes that can hold something closer. The answer is the same with or without a hint.
-    fn closest_from(&self, p: V3, max_distance: f64, hint: Option<usize>, stack: &mut Vec<(ChildRef, f64)>) -> Option<Closest> {
-        let mut best2 = if max_distance.is_finite() { max_distance * max_distance } else { f64::INFINITY };
+    fn closest_from(
+        &self,
+        p: V3,
+        max_distance: f64,
+        hint: Option<usize>,
+        stack: &mut Vec<(ChildRef, f64)>,
+    ) -> Option<Closest> {
+        let mut best2 = if max_distance.is_finite() {
+            max_distance * max_distance
+        } else {
+            f64::INFINITY
+        };
         let mut best: Option<(V3, usize, Feature)> = None;
         if let Some(t) = hint {
             let tri = &self.tris[t];
@@ -333,7 +377,12 @@ impl TriangleTree {
                 self.push_children(p, node, best2, stack);
             }
         }
-        best.map(|(q, t, f)| Closest { distance: best2.sqrt(), point: q, triangle: t, feature: f })
+        best.map(|(q, t, f)| Closest {
+            distance: best2.sqrt(),
+            point: q,
+            triangle: t,
+            feature: f,
+        })
     }
 
     /// Pushes the children of inner node `node` whose boxes lie within `bound2` (squared) of
@@ -343,7 +392,11 @@ impl TriangleTree {
         let n = &self.nodes[node.start as usize];
         let dl = box_dist2(p, n.lo[0], n.hi[0]);
         let dr = box_dist2(p, n.lo[1], n.hi[1]);
-        let (near, far) = if dl <= dr { ((n.child[0], dl), (n.child[1], dr)) } else { ((n.child[1], dr), (n.child[0], dl)) };
+        let (near, far) = if dl <= dr {
+            ((n.child[0], dl), (n.child[1], dr))
+        } else {
+            ((n.child[1], dr), (n.child[0], dl))
+        };
         if far.1 <= bound2 {
             stack.push(far);
         }
@@ -359,7 +412,13 @@ impl TriangleTree {
     /// band search asks of a block's centre, where the threshold (the band's half-width and the
     /// block's radius) is wide and the closest triangle would take many projections to pin
     /// down.
-    fn any_within(&self, p: V3, threshold: f64, hint: Option<usize>, stack: &mut Vec<(ChildRef, f64)>) -> Option<usize> {
+    fn any_within(
+        &self,
+        p: V3,
+        threshold: f64,
+        hint: Option<usize>,
+        stack: &mut Vec<(ChildRef, f64)>,
+    ) -> Option<usize> {
         if !(threshold >= 0.0) {
             return None;
         }
@@ -430,7 +489,10 @@ impl TriangleTree {
             .par_chunks(3 * QUERY_BLOCK)
             .map(|block| {
                 let mut search = ClosestSearch::new(self);
-                block.chunks_exact(3).map(|c| search.closest([c[0], c[1], c[2]], max_distance)).collect()
+                block
+                    .chunks_exact(3)
+                    .map(|c| search.closest([c[0], c[1], c[2]], max_distance))
+                    .collect()
             })
             .collect();
         blocks.concat()
@@ -452,7 +514,11 @@ pub struct ClosestSearch<'a> {
 
 impl<'a> ClosestSearch<'a> {
     pub fn new(tree: &'a TriangleTree) -> Self {
-        ClosestSearch { tree, stack: Vec::with_capacity(64), hint: None }
+        ClosestSearch {
+            tree,
+            stack: Vec::with_capacity(64),
+            hint: None,
+        }
     }
 
     /// The closest point on the mesh to `p` within `max_distance` (see [`TriangleTree::closest`]).
@@ -480,7 +546,9 @@ mod tests {
     }
 
     fn lcg(state: &mut u64) -> f64 {
-        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((*state >> 11) as f64) / ((1u64 << 53) as f64)
     }
 
@@ -493,11 +561,20 @@ mod tests {
         let (a, b, c) = ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
         let (q, f) = closest_point_on_triangle([0.2, 0.2, 1.0], a, b, c);
         assert!(close(q, [0.2, 0.2, 0.0]) && f == Feature::Face);
-        assert_eq!(closest_point_on_triangle([-1.0, -1.0, 0.5], a, b, c).1, Feature::VertexA);
+        assert_eq!(
+            closest_point_on_triangle([-1.0, -1.0, 0.5], a, b, c).1,
+            Feature::VertexA
+        );
         assert_eq!(closest_point_on_triangle([2.0, -0.1, 0.0], a, b, c).1, Feature::VertexB);
         assert_eq!(closest_point_on_triangle([-0.1, 3.0, 0.0], a, b, c).1, Feature::VertexC);
-        assert_eq!(closest_point_on_triangle([0.5, -1.0, 0.0], a, b, c), ([0.5, 0.0, 0.0], Feature::EdgeAB));
-        assert_eq!(closest_point_on_triangle([-1.0, 0.5, 0.0], a, b, c), ([0.0, 0.5, 0.0], Feature::EdgeAC));
+        assert_eq!(
+            closest_point_on_triangle([0.5, -1.0, 0.0], a, b, c),
+            ([0.5, 0.0, 0.0], Feature::EdgeAB)
+        );
+        assert_eq!(
+            closest_point_on_triangle([-1.0, 0.5, 0.0], a, b, c),
+            ([0.0, 0.5, 0.0], Feature::EdgeAC)
+        );
         let (q, f) = closest_point_on_triangle([1.0, 1.0, 0.0], a, b, c);
         assert_eq!(f, Feature::EdgeBC);
         assert!(close(q, [0.5, 0.5, 0.0]));
@@ -506,15 +583,35 @@ mod tests {
     #[test]
     fn warm_started_batches_give_the_answers_of_single_queries() {
         // a small closed mesh (octahedron) and a line of nearby points, as grid nodes come
-        let v: [V3; 6] = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-        let f = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+        let v: [V3; 6] = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let f = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
         let tris: Vec<[V3; 3]> = f.iter().map(|t| [v[t[0]], v[t[1]], v[t[2]]]).collect();
         let tree = TriangleTree::new(tris);
         let mut state = 7u64;
         let mut pts = Vec::new();
         for i in 0..5000 {
             let t = i as f64 / 5000.0;
-            pts.extend_from_slice(&[1.5 * (6.0 * t).cos(), 1.5 * (6.0 * t).sin(), 2.0 * t - 1.0 + 0.01 * lcg(&mut state)]);
+            pts.extend_from_slice(&[
+                1.5 * (6.0 * t).cos(),
+                1.5 * (6.0 * t).sin(),
+                2.0 * t - 1.0 + 0.01 * lcg(&mut state),
+            ]);
             // exact ties too: points on the axes are equidistant from several faces
             if i % 97 == 0 {
                 pts.extend_from_slice(&[0.0, 0.0, 3.0 * lcg(&mut state) - 1.5]);
@@ -532,13 +629,33 @@ mod tests {
     fn any_within_answers_as_the_closest_distance_does() {
         // the octahedron again, points around it, thresholds around their distances (exact ties
         // included: the threshold equal to the distance)
-        let v: [V3; 6] = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
-        let f = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+        let v: [V3; 6] = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let f = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
         let tree = TriangleTree::new(f.iter().map(|t| [v[t[0]], v[t[1]], v[t[2]]]).collect());
         let mut state = 5u64;
         let (mut pts, mut limits) = (Vec::new(), Vec::new());
         for _ in 0..4000 {
-            let p = [3.0 * lcg(&mut state) - 1.5, 3.0 * lcg(&mut state) - 1.5, 3.0 * lcg(&mut state) - 1.5];
+            let p = [
+                3.0 * lcg(&mut state) - 1.5,
+                3.0 * lcg(&mut state) - 1.5,
+                3.0 * lcg(&mut state) - 1.5,
+            ];
             let d = tree.closest(p, f64::INFINITY).unwrap().distance;
             for t in [d, d * (1.0 - 1e-12), d * 0.5, d * 2.0 + 0.1, 0.0, -1.0] {
                 pts.extend_from_slice(&p);
@@ -548,7 +665,12 @@ mod tests {
         let got = tree.any_within_many(&pts, &limits);
         for (i, c) in pts.chunks_exact(3).enumerate() {
             let d = tree.closest([c[0], c[1], c[2]], f64::INFINITY).unwrap().distance;
-            assert_eq!(got[i], d <= limits[i], "point {i}: distance {d}, threshold {}", limits[i]);
+            assert_eq!(
+                got[i],
+                d <= limits[i],
+                "point {i}: distance {d}, threshold {}",
+                limits[i]
+            );
         }
         assert!(got.iter().any(|&b| b) && got.iter().any(|&b| !b));
     }
@@ -556,7 +678,21 @@ mod tests {
     #[test]
     fn box_corners_round_outwards_to_f32() {
         let mut s = 11u64;
-        let mut values = vec![0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1e-40, -1e-40, 3.4e38, -3.4e38, 1e300, -1e300, f64::MIN_POSITIVE];
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            -0.1,
+            1e-40,
+            -1e-40,
+            3.4e38,
+            -3.4e38,
+            1e300,
+            -1e300,
+            f64::MIN_POSITIVE,
+        ];
         values.extend((0..10_000).map(|i| (lcg(&mut s) - 0.5) * 10f64.powi(i % 9 - 4)));
         for x in values {
             let (d, u) = (f32_down(x), f32_up(x));

@@ -40,15 +40,27 @@ pub struct MeshBand {
 /// C order of the grid, so that each query starts near the previous one's answer): the points
 /// within `half_width` of the mesh, with their distances, signs and directions. Points within
 /// `on_surface` of the mesh take their triangle's normal as the direction.
-pub fn mesh_band(tree: &TriangleTree, points: &[f64], half_width: f64, on_surface: f64, normals: &MeshNormals<'_>) -> Result<MeshBand> {
+pub fn mesh_band(
+    tree: &TriangleTree,
+    points: &[f64],
+    half_width: f64,
+    on_surface: f64,
+    normals: &MeshNormals<'_>,
+) -> Result<MeshBand> {
     if points.len() % 3 != 0 {
         return Err(Error::invalid("points", "expected an (M, 3) array"));
     }
     if points.len() / 3 > u32::MAX as usize {
-        return Err(Error::invalid("points", format!("at most {} candidates are supported", u32::MAX)));
+        return Err(Error::invalid(
+            "points",
+            format!("at most {} candidates are supported", u32::MAX),
+        ));
     }
     if normals.face.len() != tree.len() || normals.pseudo.is_some_and(|p| p.len() != tree.len()) {
-        return Err(Error::invalid("normals", format!("expected one per triangle of the tree ({})", tree.len())));
+        return Err(Error::invalid(
+            "normals",
+            format!("expected one per triangle of the tree ({})", tree.len()),
+        ));
     }
     if !(half_width >= 0.0) {
         return Err(Error::invalid("half_width", "must be non-negative"));
@@ -63,7 +75,9 @@ pub fn mesh_band(tree: &TriangleTree, points: &[f64], half_width: f64, on_surfac
             let mut part = MeshBand::default();
             for (i, c) in block.chunks_exact(3).enumerate() {
                 let x = [c[0], c[1], c[2]];
-                let Some(found) = search.closest(x, reach) else { continue };
+                let Some(found) = search.closest(x, reach) else {
+                    continue;
+                };
                 let dist = found.distance;
                 if !(dist <= half_width) {
                     continue;
@@ -150,7 +164,10 @@ mod tests {
         points.extend_from_slice(&[1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0]);
         let half_width = 0.3;
         for signed in [true, false] {
-            let normals = MeshNormals { face: &face, pseudo: if signed { Some(&pseudo) } else { None } };
+            let normals = MeshNormals {
+                face: &face,
+                pseudo: if signed { Some(&pseudo) } else { None },
+            };
             let band = mesh_band(&tree, &points, half_width, 1e-12, &normals).unwrap();
             let mut expected = Vec::new();
             for (m, c) in points.chunks_exact(3).enumerate() {
@@ -189,9 +206,15 @@ mod tests {
     #[test]
     fn rejects_mismatched_normals() {
         let (tree, face, _) = octahedron();
-        let normals = MeshNormals { face: &face[..3], pseudo: None };
+        let normals = MeshNormals {
+            face: &face[..3],
+            pseudo: None,
+        };
         assert!(mesh_band(&tree, &[0.0, 0.0, 0.0], 0.1, 0.0, &normals).is_err());
-        let normals = MeshNormals { face: &face, pseudo: None };
+        let normals = MeshNormals {
+            face: &face,
+            pseudo: None,
+        };
         assert!(mesh_band(&tree, &[0.0, 0.0], 0.1, 0.0, &normals).is_err());
         assert!(mesh_band(&tree, &[0.0, 0.0, 0.0], f64::NAN, 0.0, &normals).is_err());
     }

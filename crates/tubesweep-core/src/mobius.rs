@@ -37,7 +37,11 @@ fn derivatives(r: f64, th: f64, s: f64) -> [[f64; 3]; 5] {
         [rho * c, rho * si, s * s2],
         [-0.5 * s * s2 * c - rho * si, -0.5 * s * s2 * si + rho * c, 0.5 * s * c2],
         [c2 * c, c2 * si, s2],
-        [-0.25 * s * c2 * c + s * s2 * si - rho * c, -0.25 * s * c2 * si - s * s2 * c - rho * si, -0.25 * s * s2],
+        [
+            -0.25 * s * c2 * c + s * s2 * si - rho * c,
+            -0.25 * s * c2 * si - s * s2 * c - rho * si,
+            -0.25 * s * s2,
+        ],
         [-0.5 * s2 * c - c2 * si, -0.5 * s2 * si + c2 * c, 0.5 * c2],
     ]
 }
@@ -105,7 +109,14 @@ fn boundary(r: f64, x: [f64; 3], th0: f64, sb: f64, iterations: usize) -> f64 {
 /// The parameters `(θ, s)` of the closest point on the Möbius band (centre radius `r`,
 /// half-width `w`) of each point (`M` rows of 3 coordinates), into `theta` and `s`, with at most
 /// `iterations` Newton steps per candidate (module notes).
-pub fn mobius_closest_parameters(points: &[f64], r: f64, w: f64, iterations: usize, theta: &mut [f64], s: &mut [f64]) -> Result<()> {
+pub fn mobius_closest_parameters(
+    points: &[f64],
+    r: f64,
+    w: f64,
+    iterations: usize,
+    theta: &mut [f64],
+    s: &mut [f64],
+) -> Result<()> {
     if points.len() % 3 != 0 {
         return Err(Error::invalid("points", "expected an (M, 3) array"));
     }
@@ -116,25 +127,33 @@ pub fn mobius_closest_parameters(points: &[f64], r: f64, w: f64, iterations: usi
     if !(w > 0.0 && w < r && r.is_finite()) {
         return Err(Error::invalid("w", format!("need 0 < w < R, got R = {r}, w = {w}")));
     }
-    theta.par_chunks_mut(CHUNK).zip(s.par_chunks_mut(CHUNK)).zip(points.par_chunks(3 * CHUNK)).for_each(|((theta, s), p)| {
-        for ((t_out, s_out), x) in theta.iter_mut().zip(s.iter_mut()).zip(p.chunks_exact(3)) {
-            let x = [x[0], x[1], x[2]];
-            let th0 = x[1].atan2(x[0]);
-            let (ti, si) = interior(r, x, th0, iterations);
-            let mut best = (f64::INFINITY, th0, 0.0);
-            // the interior candidate counts only inside the band; then the boundaries, in order
-            let candidates = [(ti, si, si.abs() <= w), (boundary(r, x, th0, -w, iterations), -w, true), (boundary(r, x, th0, w, iterations), w, true)];
-            for (th, sv, ok) in candidates {
-                let q = sub(mobius_point(r, th, sv), x);
-                let d = dot(q, q).sqrt();
-                if ok && d < best.0 {
-                    best = (d, th, sv);
+    theta
+        .par_chunks_mut(CHUNK)
+        .zip(s.par_chunks_mut(CHUNK))
+        .zip(points.par_chunks(3 * CHUNK))
+        .for_each(|((theta, s), p)| {
+            for ((t_out, s_out), x) in theta.iter_mut().zip(s.iter_mut()).zip(p.chunks_exact(3)) {
+                let x = [x[0], x[1], x[2]];
+                let th0 = x[1].atan2(x[0]);
+                let (ti, si) = interior(r, x, th0, iterations);
+                let mut best = (f64::INFINITY, th0, 0.0);
+                // the interior candidate counts only inside the band; then the boundaries, in order
+                let candidates = [
+                    (ti, si, si.abs() <= w),
+                    (boundary(r, x, th0, -w, iterations), -w, true),
+                    (boundary(r, x, th0, w, iterations), w, true),
+                ];
+                for (th, sv, ok) in candidates {
+                    let q = sub(mobius_point(r, th, sv), x);
+                    let d = dot(q, q).sqrt();
+                    if ok && d < best.0 {
+                        best = (d, th, sv);
+                    }
                 }
+                *t_out = best.1;
+                *s_out = best.2;
             }
-            *t_out = best.1;
-            *s_out = best.2;
-        }
-    });
+        });
     Ok(())
 }
 
@@ -208,7 +227,10 @@ mod tests {
             let q = sub(mobius_point(r, th[i], s[i]), x);
             let d = dot(q, q).sqrt();
             let exact = brute_force_distance(r, w, x);
-            assert!((d - exact).abs() < 1e-9, "point {x:?}: distance {d} against {exact} by brute force");
+            assert!(
+                (d - exact).abs() < 1e-9,
+                "point {x:?}: distance {d} against {exact} by brute force"
+            );
         }
     }
 

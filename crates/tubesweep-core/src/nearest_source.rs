@@ -34,23 +34,34 @@ pub fn nearest_source_labels<const D: usize>(
 ) -> Result<Vec<i64>> {
     let n = band.len();
     if values.len() != n {
-        return Err(Error::invalid("values", format!("expected one per band node ({n}), got {}", values.len())));
+        return Err(Error::invalid(
+            "values",
+            format!("expected one per band node ({n}), got {}", values.len()),
+        ));
     }
     if fixed.len() != fixed_labels.len() {
         return Err(Error::invalid("fixed_labels", "expected one label per fixed node"));
     }
     if let Some(i) = values.iter().position(|v| v.is_nan()) {
-        return Err(Error::invalid("values", format!("NaN at band position {i}; labels need a solved field")));
+        return Err(Error::invalid(
+            "values",
+            format!("NaN at band position {i}; labels need a solved field"),
+        ));
     }
     let mut label = vec![-1i64; n];
     for (&p, &l) in fixed.iter().zip(fixed_labels) {
         let p = p as usize;
         if p >= n {
-            return Err(Error::invalid("fixed", format!("band position {p} is out of range (band of {n} nodes)")));
+            return Err(Error::invalid(
+                "fixed",
+                format!("band position {p} is out of range (band of {n} nodes)"),
+            ));
         }
         label[p] = l as i64;
     }
-    let mut order: Vec<u32> = (0..n as u32).filter(|&i| label[i as usize] < 0 && values[i as usize].is_finite()).collect();
+    let mut order: Vec<u32> = (0..n as u32)
+        .filter(|&i| label[i as usize] < 0 && values[i as usize].is_finite())
+        .collect();
     order.par_sort_unstable_by(|&a, &b| values[a as usize].total_cmp(&values[b as usize]).then(a.cmp(&b)));
     let sentinel = band.sentinel();
     // the label of the smallest labelled neighbour of `i` (ties: the smaller band position),
@@ -85,7 +96,13 @@ pub fn nearest_source_labels<const D: usize>(
     let mut round: Vec<u32> = Vec::new();
     for &i in &order {
         let i = i as usize;
-        if label[i] < 0 && band.neighbours_of(i).iter().flatten().any(|&m| m != sentinel && label[m as usize] >= 0) {
+        if label[i] < 0
+            && band
+                .neighbours_of(i)
+                .iter()
+                .flatten()
+                .any(|&m| m != sentinel && label[m as usize] >= 0)
+        {
             queued[i] = true;
             round.push(i as u32);
         }
@@ -128,7 +145,10 @@ mod tests {
         let mut fixed_labels = Vec::new();
         for n in 0..band.len() {
             let [i, j] = band.index_of(n);
-            let d: Vec<f64> = sources.iter().map(|s| ((i as f64 - s.0).powi(2) + (j as f64 - s.1).powi(2)).sqrt()).collect();
+            let d: Vec<f64> = sources
+                .iter()
+                .map(|s| ((i as f64 - s.0).powi(2) + (j as f64 - s.1).powi(2)).sqrt())
+                .collect();
             values[n] = d[0].min(d[1]);
             if d[0] == 0.0 || d[1] == 0.0 {
                 fixed.push(n as u32);

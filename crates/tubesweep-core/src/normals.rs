@@ -41,14 +41,25 @@ fn node_coordinates(shape: &[usize], linear: &[u64], range: std::ops::Range<usiz
 
 fn check(shape: &[usize], linear: &[u64], range: &std::ops::Range<usize>) -> Result<()> {
     if !(2..=3).contains(&shape.len()) || shape.iter().any(|&n| n == 0 || n > u32::MAX as usize) {
-        return Err(Error::invalid("grid", format!("only 2D and 3D grids are supported, got shape {shape:?}")));
+        return Err(Error::invalid(
+            "grid",
+            format!("only 2D and 3D grids are supported, got shape {shape:?}"),
+        ));
     }
     if range.start > range.end || range.end > linear.len() {
-        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", linear.len())));
+        return Err(Error::invalid(
+            "range",
+            format!("{range:?} is not a range of the {} band nodes", linear.len()),
+        ));
     }
     let total: u64 = shape.iter().map(|&n| n as u64).product();
-    if linear[range.clone()].windows(2).any(|w| w[0] >= w[1]) || linear[range.clone()].last().is_some_and(|&l| l >= total) {
-        return Err(Error::invalid("linear", "band nodes must be strictly increasing linear indices inside the grid"));
+    if linear[range.clone()].windows(2).any(|w| w[0] >= w[1])
+        || linear[range.clone()].last().is_some_and(|&l| l >= total)
+    {
+        return Err(Error::invalid(
+            "linear",
+            "band nodes must be strictly increasing linear indices inside the grid",
+        ));
     }
     Ok(())
 }
@@ -124,7 +135,10 @@ pub fn neighbour_table(shape: &[usize], linear: &[u64], range: std::ops::Range<u
         })
         .collect();
     if fits.contains(&false) {
-        return Err(Error::invalid("linear", "a neighbour is 2^31 or more band nodes away: too large a band for a neighbour table"));
+        return Err(Error::invalid(
+            "linear",
+            "a neighbour is 2^31 or more band nodes away: too large a band for a neighbour table",
+        ));
     }
     Ok(table)
 }
@@ -150,11 +164,19 @@ pub fn rim_nodes(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>)
 }
 
 /// [`rim_nodes`] from the [`neighbour_table`] of band nodes `range`.
-pub fn rim_nodes_of(shape: &[usize], linear: &[u64], range: std::ops::Range<usize>, table: &[i32]) -> Result<(Vec<u64>, Vec<usize>)> {
+pub fn rim_nodes_of(
+    shape: &[usize],
+    linear: &[u64],
+    range: std::ops::Range<usize>,
+    table: &[i32],
+) -> Result<(Vec<u64>, Vec<usize>)> {
     check(shape, linear, &range)?;
     let (d, m) = (shape.len(), range.len());
     if table.len() != 2 * (d - 1) * m {
-        return Err(Error::invalid("neighbours", format!("expected shape ({}, {m})", 2 * (d - 1))));
+        return Err(Error::invalid(
+            "neighbours",
+            format!("expected shape ({}, {m})", 2 * (d - 1)),
+        ));
     }
     // along the leading axes, the table's entries without a neighbour; along the last axis, the
     // nodes whose adjacent band entry is not their neighbour (chunk by chunk, in order)
@@ -163,7 +185,11 @@ pub fn rim_nodes_of(shape: &[usize], linear: &[u64], range: std::ops::Range<usiz
         .into_par_iter()
         .map(|g| {
             let row = &table[g * m..(g + 1) * m];
-            row.iter().zip(range.clone()).filter(|(&delta, _)| delta == NO_NEIGHBOUR).map(|(_, i)| i as u64).collect()
+            row.iter()
+                .zip(range.clone())
+                .filter(|(&delta, _)| delta == NO_NEIGHBOUR)
+                .map(|(_, i)| i as u64)
+                .collect()
         })
         .collect();
     for sign in [1i64, -1] {
@@ -228,7 +254,10 @@ pub fn outward_directions_with(
 ) -> Result<Vec<f64>> {
     check(shape, linear, &range)?;
     if table.len() != 2 * (shape.len() - 1) * range.len() {
-        return Err(Error::invalid("neighbours", format!("expected shape ({}, {})", 2 * (shape.len() - 1), range.len())));
+        return Err(Error::invalid(
+            "neighbours",
+            format!("expected shape ({}, {})", 2 * (shape.len() - 1), range.len()),
+        ));
     }
     let m = range.len();
     let leads_inside = |row: &[i32]| {
@@ -241,7 +270,14 @@ pub fn outward_directions_with(
     }
     let d = shape.len();
     if phi.len() != linear.len() {
-        return Err(Error::invalid("phi", format!("expected {} values (one per band node), got {}", linear.len(), phi.len())));
+        return Err(Error::invalid(
+            "phi",
+            format!(
+                "expected {} values (one per band node), got {}",
+                linear.len(),
+                phi.len()
+            ),
+        ));
     }
     let n_last = shape[d - 1] as u64;
     // the neighbour of node `o` of the range for group `g` (the node's index along the last axis
@@ -257,7 +293,16 @@ pub fn outward_directions_with(
             last_axis_neighbour(linear, i, c_last, shape[d - 1], sign)
         }
     };
-    directions_by_central_differences(d, spacing, phi, range, Some((linear, n_last)), rim_phi, direction, neighbour)
+    directions_by_central_differences(
+        d,
+        spacing,
+        phi,
+        range,
+        Some((linear, n_last)),
+        rim_phi,
+        direction,
+        neighbour,
+    )
 }
 
 /// [`outward_directions`] with the neighbours read off a band already built from the same
@@ -272,10 +317,16 @@ pub fn outward_directions_in_band<const D: usize>(
     direction: &mut [f32],
 ) -> Result<Vec<f64>> {
     if range.start > range.end || range.end > band.len() {
-        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", band.len())));
+        return Err(Error::invalid(
+            "range",
+            format!("{range:?} is not a range of the {} band nodes", band.len()),
+        ));
     }
     if phi.len() != band.len() {
-        return Err(Error::invalid("phi", format!("expected {} values (one per band node), got {}", band.len(), phi.len())));
+        return Err(Error::invalid(
+            "phi",
+            format!("expected {} values (one per band node), got {}", band.len(), phi.len()),
+        ));
     }
     let sentinel = band.sentinel();
     let first = range.start;
@@ -291,9 +342,15 @@ pub fn outward_directions_in_band<const D: usize>(
 /// [`rim_nodes`] read off a band already built from the same linear indices: for every group
 /// `(axis k, side)` in the order `k = 0, 1, …`, side `+1` then `−1`, the positions `i` in `range`
 /// whose neighbour there is not a band node, in increasing order.
-pub fn rim_nodes_in_band<const D: usize>(band: &NarrowBand<D>, range: std::ops::Range<usize>) -> Result<(Vec<u64>, Vec<usize>)> {
+pub fn rim_nodes_in_band<const D: usize>(
+    band: &NarrowBand<D>,
+    range: std::ops::Range<usize>,
+) -> Result<(Vec<u64>, Vec<usize>)> {
     if range.start > range.end || range.end > band.len() {
-        return Err(Error::invalid("range", format!("{range:?} is not a range of the {} band nodes", band.len())));
+        return Err(Error::invalid(
+            "range",
+            format!("{range:?} is not a range of the {} band nodes", band.len()),
+        ));
     }
     let sentinel = band.sentinel();
     let groups: Vec<Vec<u64>> = (0..2 * D)
@@ -332,7 +389,10 @@ pub fn outward_directions_of_function_in_band<const D: usize>(
 ) -> Result<Vec<f32>> {
     let m = band.len();
     if linear.len() != m || values.len() != m || direction.len() != m * D {
-        return Err(Error::invalid("band", format!("expected {m} linear indices, values and directions (×{D}) for the band's nodes")));
+        return Err(Error::invalid(
+            "band",
+            format!("expected {m} linear indices, values and directions (×{D}) for the band's nodes"),
+        ));
     }
     let (shape, sentinel) = (band.shape(), band.sentinel());
     let mut norms_out = vec![0.0f32; m];
@@ -442,30 +502,37 @@ where
         }
     }
     if next != rim_phi.len() {
-        return Err(Error::invalid("rim_phi", format!("expected {next} values (one per rim place), got {}", rim_phi.len())));
+        return Err(Error::invalid(
+            "rim_phi",
+            format!("expected {next} values (one per rim place), got {}", rim_phi.len()),
+        ));
     }
     let mut norms = vec![0.0f64; m];
-    direction.par_chunks_mut(CHUNK * d).zip(norms.par_chunks_mut(CHUNK)).enumerate().for_each(|(j, (dir, norms))| {
-        let mut rim = start[j];
-        let lo = j * CHUNK;
-        // The neighbour values are gathered for a block of nodes at a time, and the block's
-        // differences, norms and directions are then computed axis by axis over plain arrays,
-        // which the compiler turns into vector divisions and square roots: the same operations
-        // in the same order per node, so the same bits.
-        let mut block = Block::new();
-        let two_h = 2.0 * spacing;
-        visit_chunk(j, &mut |o, c_last| {
-            let neighbour_phi = |g: usize| match neighbour(o, c_last, g) {
-                Some(p) => phi[p],
-                None => {
-                    rim[g] += 1;
-                    rim_phi[rim[g] - 1]
-                }
-            };
-            block.push(o - lo, phi[range.start + o], d, neighbour_phi, two_h, dir, norms);
+    direction
+        .par_chunks_mut(CHUNK * d)
+        .zip(norms.par_chunks_mut(CHUNK))
+        .enumerate()
+        .for_each(|(j, (dir, norms))| {
+            let mut rim = start[j];
+            let lo = j * CHUNK;
+            // The neighbour values are gathered for a block of nodes at a time, and the block's
+            // differences, norms and directions are then computed axis by axis over plain arrays,
+            // which the compiler turns into vector divisions and square roots: the same operations
+            // in the same order per node, so the same bits.
+            let mut block = Block::new();
+            let two_h = 2.0 * spacing;
+            visit_chunk(j, &mut |o, c_last| {
+                let neighbour_phi = |g: usize| match neighbour(o, c_last, g) {
+                    Some(p) => phi[p],
+                    None => {
+                        rim[g] += 1;
+                        rim_phi[rim[g] - 1]
+                    }
+                };
+                block.push(o - lo, phi[range.start + o], d, neighbour_phi, two_h, dir, norms);
+            });
+            block.finish(d, two_h, dir, norms);
         });
-        block.finish(d, two_h, dir, norms);
-    });
     Ok(norms)
 }
 
@@ -484,7 +551,12 @@ struct Block {
 
 impl Block {
     fn new() -> Box<Self> {
-        Box::new(Block { phi: [[0.0; BLOCK]; 6], own: [0.0; BLOCK], first: 0, len: 0 })
+        Box::new(Block {
+            phi: [[0.0; BLOCK]; 6],
+            own: [0.0; BLOCK],
+            first: 0,
+            len: 0,
+        })
     }
 
     /// Appends node `o` of the chunk, with φ there `own` and at its neighbours `neighbour_phi(g)`
@@ -492,7 +564,16 @@ impl Block {
     /// block into the chunk's `dir` and `norms` when it is full.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn push(&mut self, o: usize, own: f64, d: usize, mut neighbour_phi: impl FnMut(usize) -> f64, two_h: f64, dir: &mut [f32], norms: &mut [f64]) {
+    fn push(
+        &mut self,
+        o: usize,
+        own: f64,
+        d: usize,
+        mut neighbour_phi: impl FnMut(usize) -> f64,
+        two_h: f64,
+        dir: &mut [f32],
+        norms: &mut [f64],
+    ) {
         let i = self.len;
         for g in 0..2 * d {
             self.phi[g][i] = neighbour_phi(g);
@@ -524,7 +605,10 @@ impl Block {
                 sq[i] += gk[i] * gk[i];
             }
         }
-        let (dir, norms) = (&mut dir[self.first * d..(self.first + n) * d], &mut norms[self.first..self.first + n]);
+        let (dir, norms) = (
+            &mut dir[self.first * d..(self.first + n) * d],
+            &mut norms[self.first..self.first + n],
+        );
         let mut scale = [0.0f64; BLOCK];
         for i in 0..n {
             let norm = sq[i].sqrt();
@@ -599,7 +683,8 @@ mod tests {
         // a sphere's φ evaluated in Rust: the fused pass against the rim places, φ there by the
         // node coordinates ± Δx, and the directions from them
         let (shape, lower, h) = ([30usize, 26, 33], [-0.8f64, -0.7, -0.85], 0.05);
-        let phi = |p: &[f64], out: &mut [f64]| crate::analytic::sphere_signed_distance(p, &[0.02, -0.03, 0.0], 0.55, out);
+        let phi =
+            |p: &[f64], out: &mut [f64]| crate::analytic::sphere_signed_distance(p, &[0.02, -0.03, 0.0], 0.55, out);
         let (linear, values) = crate::discovery::discover_band(shape, lower, h, 4.0 * h, 1.0, &phi).unwrap();
         let band = NarrowBand::<3>::from_sorted_linear(shape, &linear).unwrap();
         let (rim, counts) = rim_nodes_in_band(&band, 0..linear.len()).unwrap();
@@ -633,7 +718,10 @@ mod tests {
         fn same<const D: usize>(shape: [usize; D], linear: &[u64], phi: &[f64], range: std::ops::Range<usize>) {
             let band = NarrowBand::<D>::from_sorted_linear(shape, linear).unwrap();
             let (rim, counts) = rim_nodes(&shape, linear, range.clone()).unwrap();
-            assert_eq!(rim_nodes_in_band(&band, range.clone()).unwrap(), (rim.clone(), counts.clone()));
+            assert_eq!(
+                rim_nodes_in_band(&band, range.clone()).unwrap(),
+                (rim.clone(), counts.clone())
+            );
             // φ off the band: any values will do, as long as both read the same ones
             let rim_phi: Vec<f64> = (0..rim.len()).map(|i| (i as f64 * 0.37).sin()).collect();
             let mut a = vec![0.0f32; range.len() * D];
@@ -648,7 +736,11 @@ mod tests {
         let n = 23usize;
         let c = (n - 1) as f64 / 2.0;
         let r = |l: u64| {
-            let (i, j, k) = ((l / (n * n) as u64) as f64, ((l / n as u64) % n as u64) as f64, (l % n as u64) as f64);
+            let (i, j, k) = (
+                (l / (n * n) as u64) as f64,
+                ((l / n as u64) % n as u64) as f64,
+                (l % n as u64) as f64,
+            );
             ((i - c).powi(2) + (j - c).powi(2) + (k - c).powi(2)).sqrt() - 8.0
         };
         let lin3: Vec<u64> = (0..(n * n * n) as u64).filter(|&l| r(l).abs() <= 2.5).collect();
@@ -656,8 +748,13 @@ mod tests {
         for range in [0..lin3.len(), 17..lin3.len() / 2, 5..5] {
             same([n, n, n], &lin3, &phi3, range);
         }
-        let lin2: Vec<u64> = (0..(n * n) as u64).filter(|&l| l % n as u64 <= 2 || l / n as u64 >= (n - 2) as u64).collect();
-        let phi2: Vec<f64> = lin2.iter().map(|&l| (l % n as u64) as f64 - 1.3 + 0.01 * (l / n as u64) as f64).collect();
+        let lin2: Vec<u64> = (0..(n * n) as u64)
+            .filter(|&l| l % n as u64 <= 2 || l / n as u64 >= (n - 2) as u64)
+            .collect();
+        let phi2: Vec<f64> = lin2
+            .iter()
+            .map(|&l| (l % n as u64) as f64 - 1.3 + 0.01 * (l / n as u64) as f64)
+            .collect();
         same([n, n], &lin2, &phi2, 0..lin2.len());
         let band2 = NarrowBand::<2>::from_sorted_linear([n, n], &lin2).unwrap();
         assert!(rim_nodes_in_band(&band2, 0..lin2.len() + 1).is_err());

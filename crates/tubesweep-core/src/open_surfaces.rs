@@ -32,13 +32,18 @@ fn map_points(points: &[f64], out: &mut [f64], cp: impl Fn(V3) -> V3 + Sync) -> 
         return Err(Error::invalid("points", "expected an (M, 3) array"));
     }
     if out.len() != points.len() {
-        return Err(Error::invalid("out", format!("expected {} values (three per point)", points.len())));
+        return Err(Error::invalid(
+            "out",
+            format!("expected {} values (three per point)", points.len()),
+        ));
     }
-    out.par_chunks_mut(3 * CHUNK).zip(points.par_chunks(3 * CHUNK)).for_each(|(o, p)| {
-        for (o, x) in o.chunks_exact_mut(3).zip(p.chunks_exact(3)) {
-            o.copy_from_slice(&cp([x[0], x[1], x[2]]));
-        }
-    });
+    out.par_chunks_mut(3 * CHUNK)
+        .zip(points.par_chunks(3 * CHUNK))
+        .for_each(|(o, p)| {
+            for (o, x) in o.chunks_exact_mut(3).zip(p.chunks_exact(3)) {
+                o.copy_from_slice(&cp([x[0], x[1], x[2]]));
+            }
+        });
     Ok(())
 }
 
@@ -58,8 +63,16 @@ pub fn hemisphere_closest_points(points: &[f64], centre: V3, radius: f64, out: &
     check_centre_and_size(centre, radius, "radius")?;
     map_points(points, out, |x| {
         let q = [x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]];
-        let u = if q[2] >= 0.0 { safe_unit(q, [0.0, 0.0, 1.0]) } else { safe_unit([q[0], q[1], 0.0], [1.0, 0.0, 0.0]) };
-        [u[0] * radius + centre[0], u[1] * radius + centre[1], u[2] * radius + centre[2]]
+        let u = if q[2] >= 0.0 {
+            safe_unit(q, [0.0, 0.0, 1.0])
+        } else {
+            safe_unit([q[0], q[1], 0.0], [1.0, 0.0, 0.0])
+        };
+        [
+            u[0] * radius + centre[0],
+            u[1] * radius + centre[1],
+            u[2] * radius + centre[2],
+        ]
     })
 }
 
@@ -70,7 +83,11 @@ pub fn disc_closest_points(points: &[f64], centre: V3, radius: f64, out: &mut [f
     map_points(points, out, |x| {
         let q = [x[0] - centre[0], x[1] - centre[1], x[2] - centre[2]];
         let r = q[0].hypot(q[1]);
-        let f = if r > radius { radius / if r > 0.0 { r } else { 1.0 } } else { 1.0 };
+        let f = if r > radius {
+            radius / if r > 0.0 { r } else { 1.0 }
+        } else {
+            1.0
+        };
         [q[0] * f + centre[0], q[1] * f + centre[1], 0.0 + centre[2]]
     })
 }

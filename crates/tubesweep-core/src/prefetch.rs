@@ -30,7 +30,11 @@ pub(crate) fn prefetch_raw_range<T>(base: *const T, len: usize, start: usize, en
         for k in 0..lines {
             // SAFETY: prefetching is a hint with no effect on memory; the lines overlap the
             // elements `start..end`, and even an invalid address would not fault
-            unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>((first + k * CACHE_LINE) as *const i8) };
+            unsafe {
+                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                    (first + k * CACHE_LINE) as *const i8,
+                )
+            };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
@@ -69,7 +73,10 @@ mod tests {
         assert_eq!(cache_lines(base, 8, 100, 7, 9), Some((0x1040, 1)));
         assert_eq!(cache_lines(base, 8, 100, 3, 40), Some((0x1000, 6)));
         // the end is clamped to the array
-        assert_eq!(cache_lines(base, 8, 100, 90, 10_000), cache_lines(base, 8, 100, 90, 100));
+        assert_eq!(
+            cache_lines(base, 8, 100, 90, 10_000),
+            cache_lines(base, 8, 100, 90, 100)
+        );
         assert_eq!(cache_lines(base, 8, 100, 90, 100), Some((0x1000 + 11 * 64, 2)));
         // empty, reversed, past the end, zero-sized
         for (s, e) in [(0, 0), (5, 5), (7, 3), (100, 200)] {

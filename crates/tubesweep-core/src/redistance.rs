@@ -38,20 +38,39 @@ impl<'a, const D: usize> SampledField<'a, D> {
     /// lower corner `lower` and spacing `spacing`, in C order.
     pub fn new(samples: &'a [f64], shape: [usize; D], lower: [f64; D], spacing: f64) -> Result<Self> {
         if shape.iter().any(|&n| n < 2) {
-            return Err(Error::invalid("grid", format!("needs at least 2 nodes per axis to interpolate, got shape {shape:?}")));
+            return Err(Error::invalid(
+                "grid",
+                format!("needs at least 2 nodes per axis to interpolate, got shape {shape:?}"),
+            ));
         }
         let total = shape.iter().try_fold(1usize, |p, &n| p.checked_mul(n));
         if total != Some(samples.len()) {
-            return Err(Error::invalid("phi", format!("expected {} samples (the grid {shape:?}), got {}", total.unwrap_or(usize::MAX), samples.len())));
+            return Err(Error::invalid(
+                "phi",
+                format!(
+                    "expected {} samples (the grid {shape:?}), got {}",
+                    total.unwrap_or(usize::MAX),
+                    samples.len()
+                ),
+            ));
         }
         if !(spacing > 0.0 && spacing.is_finite()) || lower.iter().any(|l| !l.is_finite()) {
-            return Err(Error::invalid("grid", "the spacing must be positive and the lower corner finite"));
+            return Err(Error::invalid(
+                "grid",
+                "the spacing must be positive and the lower corner finite",
+            ));
         }
         let mut stride = [1usize; D];
         for k in (0..D - 1).rev() {
             stride[k] = stride[k + 1] * shape[k + 1];
         }
-        Ok(SampledField { samples, shape, stride, lower, spacing })
+        Ok(SampledField {
+            samples,
+            shape,
+            stride,
+            lower,
+            spacing,
+        })
     }
 
     /// φ at `p`: the multilinear interpolant of the cell that holds `p`, the cell and the
@@ -175,17 +194,31 @@ pub struct Projection {
 
 /// The closest points on `{φ = 0}` of `points` (`D` coordinates each) for the sampled `field`
 /// (see the module documentation), on all threads.
-pub fn project_to_zero_level_set<const D: usize>(field: &SampledField<'_, D>, points: &[f64], options: ProjectionOptions) -> Result<Projection> {
+pub fn project_to_zero_level_set<const D: usize>(
+    field: &SampledField<'_, D>,
+    points: &[f64],
+    options: ProjectionOptions,
+) -> Result<Projection> {
     if !points.len().is_multiple_of(D) || points.iter().any(|x| !x.is_finite()) {
-        return Err(Error::invalid("points", format!("must be finite, {D} coordinates each")));
+        return Err(Error::invalid(
+            "points",
+            format!("must be finite, {D} coordinates each"),
+        ));
     }
     if !(options.eps > 0.0 && options.eps.is_finite()) {
-        return Err(Error::invalid("eps", format!("the step of the differences must be positive, got {}", options.eps)));
+        return Err(Error::invalid(
+            "eps",
+            format!("the step of the differences must be positive, got {}", options.eps),
+        ));
     }
     let scale = points.par_iter().map(|x| x.abs()).reduce(|| 0.0, f64::max).max(1.0);
     let settled = options.tol * scale;
     let m = points.len() / D;
-    let mut out = Projection { closest: vec![0.0; m * D], signed: vec![0.0; m], converged: vec![false; m] };
+    let mut out = Projection {
+        closest: vec![0.0; m * D],
+        signed: vec![0.0; m],
+        converged: vec![false; m],
+    };
     points
         .par_chunks(D)
         .zip(out.closest.par_chunks_mut(D))
@@ -269,7 +302,9 @@ mod tests {
         let h = 0.25;
         // φ = 1 + 2x − y + 0.5 x y: multilinear, so reproduced everywhere in the box
         let f = |x: f64, y: f64| 1.0 + 2.0 * x - y + 0.5 * x * y;
-        let samples: Vec<f64> = (0..n * n).map(|l| f(-1.0 + h * (l / n) as f64, -1.0 + h * (l % n) as f64)).collect();
+        let samples: Vec<f64> = (0..n * n)
+            .map(|l| f(-1.0 + h * (l / n) as f64, -1.0 + h * (l % n) as f64))
+            .collect();
         let field = SampledField::new(&samples, [n, n], [-1.0, -1.0], h).unwrap();
         for p in [[-1.0, -1.0], [0.3, -0.7], [0.99, 1.0], [1.0, 1.0], [-0.125, 0.625]] {
             assert!((field.value(&p) - f(p[0], p[1])).abs() < 1e-14, "{p:?}");
@@ -295,12 +330,22 @@ mod tests {
                 [rho * c * a, rho * c * t.sin(), rho * b]
             })
             .collect();
-        let opts = ProjectionOptions { eps: 0.5 * h, newton_steps: 6, orthogonality_steps: 30, tol: 1e-12 };
+        let opts = ProjectionOptions {
+            eps: 0.5 * h,
+            newton_steps: 6,
+            orthogonality_steps: 30,
+            tol: 1e-12,
+        };
         let p = project_to_zero_level_set(&field, &pts, opts).unwrap();
         for (i, x) in pts.chunks(3).enumerate() {
             let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
             assert!(p.converged[i]);
-            assert!((p.signed[i] - (r - 0.5)).abs() < 2e-3, "point {i}: {} against {}", p.signed[i], r - 0.5);
+            assert!(
+                (p.signed[i] - (r - 0.5)).abs() < 2e-3,
+                "point {i}: {} against {}",
+                p.signed[i],
+                r - 0.5
+            );
             let c = &p.closest[3 * i..3 * i + 3];
             assert!(field.value(&[c[0], c[1], c[2]]).abs() < 1e-10);
         }

@@ -50,7 +50,11 @@ pub fn outer_rim<const D: usize>(band: &NarrowBand<D>, roles: &[NodeRole], weigh
         .into_par_iter()
         .map(|q| {
             roles[q] == NodeRole::Outer
-                && band.neighbours_of(q).iter().flatten().any(|&m| m != sentinel && roles[m as usize] == NodeRole::Inner)
+                && band
+                    .neighbours_of(q)
+                    .iter()
+                    .flatten()
+                    .any(|&m| m != sentinel && roles[m as usize] == NodeRole::Inner)
         })
         .collect();
     // the layer nodes that those read and that are not next to an inner node themselves (few:
@@ -65,13 +69,20 @@ pub fn outer_rim<const D: usize>(band: &NarrowBand<D>, roles: &[NodeRole], weigh
         if std::mem::replace(&mut needed[q as usize], true) {
             continue;
         }
-        for m in upwind_reads(weights[q as usize], &band.neighbours_of(q as usize)).into_iter().flatten() {
+        for m in upwind_reads(weights[q as usize], &band.neighbours_of(q as usize))
+            .into_iter()
+            .flatten()
+        {
             if is_outer(m) && !needed[m as usize] {
                 stack.push(m);
             }
         }
     }
-    roles.par_iter().zip(needed.par_iter()).map(|(&r, &nd)| r == NodeRole::Outer && !nd).collect()
+    roles
+        .par_iter()
+        .zip(needed.par_iter())
+        .map(|(&r, &nd)| r == NodeRole::Outer && !nd)
+        .collect()
 }
 
 /// The `cyclic` rim nodes (sorted) in an order that puts every node after the nodes it reads,
@@ -167,7 +178,11 @@ pub fn extend_into_rim<const D: usize>(
                 return AtomicU8::new(0);
             }
             let nb = band.neighbours_of(q);
-            let reads = upwind_reads(weights[q], &nb).into_iter().flatten().filter(|&m| is_rim(m)).count() as u8;
+            let reads = upwind_reads(weights[q], &nb)
+                .into_iter()
+                .flatten()
+                .filter(|&m| is_rim(m))
+                .count() as u8;
             let mut read_by = 0u8;
             for k in 0..D {
                 for (side, &p) in nb[k].iter().enumerate() {
@@ -184,8 +199,10 @@ pub fn extend_into_rim<const D: usize>(
         .collect();
     // the rim nodes that read no rim node, in band order; each is followed at once by the rim
     // nodes it completes (depth first: they are its neighbours, so their data is still in cache)
-    let roots: Vec<u32> =
-        (0..n as u32).into_par_iter().filter(|&q| rim[q as usize] && pending[q as usize].load(Ordering::Relaxed) & 3 == 0).collect();
+    let roots: Vec<u32> = (0..n as u32)
+        .into_par_iter()
+        .filter(|&q| rim[q as usize] && pending[q as usize].load(Ordering::Relaxed) & 3 == 0)
+        .collect();
     // Eq. (5) at rim node q from the current values (a node without upwind neighbour keeps its
     // value)
     let candidate = |q: usize, value: &dyn Fn(usize) -> f64| -> f64 {
@@ -238,10 +255,18 @@ pub fn extend_into_rim<const D: usize>(
             (updates, first_change)
         })
         .reduce(|| (0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
-    let mut stats = RimPasses { passes: 1, converged: true, updates, first_change, ..Default::default() };
+    let mut stats = RimPasses {
+        passes: 1,
+        converged: true,
+        updates,
+        first_change,
+        ..Default::default()
+    };
     // the cycles and what lies downwind of them: still waiting for a rim node they read
-    let cyclic: Vec<u32> =
-        (0..n as u32).into_par_iter().filter(|&q| rim[q as usize] && pending[q as usize].load(Ordering::Relaxed) & 3 != 0).collect();
+    let cyclic: Vec<u32> = (0..n as u32)
+        .into_par_iter()
+        .filter(|&q| rim[q as usize] && pending[q as usize].load(Ordering::Relaxed) & 3 != 0)
+        .collect();
     if cyclic.is_empty() {
         return stats;
     }
@@ -273,7 +298,10 @@ pub fn extend_into_rim<const D: usize>(
             u[q as usize] = candidate(q as usize, &|i| u[i]);
         }
         // how far another pass would move the nodes where cycles close (evaluated, not written)
-        let residual = closing.iter().map(|&q| (candidate(q as usize, &|i| u[i]) - u[q as usize]).abs()).fold(0.0f64, f64::max);
+        let residual = closing
+            .iter()
+            .map(|&q| (candidate(q as usize, &|i| u[i]) - u[q as usize]).abs())
+            .fold(0.0f64, f64::max);
         stats.passes += 1;
         stats.updates += (order.len() + closing.len()) as u64;
         stats.last_change = residual;
@@ -308,7 +336,10 @@ mod tests {
         let mut u = vec![1.5, inf, inf, inf, inf, inf, inf]; // and the sentinel slot
         let st = extend_into_rim(&band, &rim, &weights, &mut u, 0.0, 10);
         assert_eq!(u[..6], [1.5; 6]);
-        assert_eq!((st.passes, st.updates, st.first_change, st.last_change, st.converged), (1, 5, inf - 1.5, 0.0, true));
+        assert_eq!(
+            (st.passes, st.updates, st.first_change, st.last_change, st.converged),
+            (1, 5, inf - 1.5, 0.0, true)
+        );
         // the other way: node 5 fixed, every layer node reading its plus neighbour
         let mut roles = vec![NodeRole::Outer; 6];
         roles[5] = NodeRole::Fixed;
@@ -342,7 +373,10 @@ mod tests {
         let mut u = start.clone();
         let st = extend_into_rim(&band, &rim, &weights, &mut u, tol, 1000);
         assert!(st.converged && st.passes > 10 && st.last_change <= tol, "{st:?}");
-        assert!((u[1] - (2.0 * a + b) / 3.0).abs() < 1e-10 && (u[2] - (a + 2.0 * b) / 3.0).abs() < 1e-10, "{u:?}");
+        assert!(
+            (u[1] - (2.0 * a + b) / 3.0).abs() < 1e-10 && (u[2] - (a + 2.0 * b) / 3.0).abs() < 1e-10,
+            "{u:?}"
+        );
         assert_eq!(u[3], u[2]);
         // the first pass finds no node in order; each later pass evaluates the three nodes in the
         // order [2, 1, 3] (node 2 reads node 1, evaluated after it: the cycle closes at node 2)
@@ -363,13 +397,22 @@ mod tests {
         roles[0] = NodeRole::Inner;
         let mut weights = vec![[0.0f32, 1.0]; 6];
         weights[0] = [0.0, 0.0];
-        assert_eq!(outer_rim(&band, &roles, &weights), vec![false, false, true, true, true, true]);
+        assert_eq!(
+            outer_rim(&band, &roles, &weights),
+            vec![false, false, true, true, true, true]
+        );
         // node 1 reading its plus neighbour makes node 2 needed
         weights[1] = [0.0, -1.0];
-        assert_eq!(outer_rim(&band, &roles, &weights), vec![false, false, false, true, true, true]);
+        assert_eq!(
+            outer_rim(&band, &roles, &weights),
+            vec![false, false, false, true, true, true]
+        );
         // and a chain: node 2 reads node 3, which reads node 4
         weights[2] = [0.0, -1.0];
         weights[3] = [0.0, -1.0];
-        assert_eq!(outer_rim(&band, &roles, &weights), vec![false, false, false, false, false, true]);
+        assert_eq!(
+            outer_rim(&band, &roles, &weights),
+            vec![false, false, false, false, false, true]
+        );
     }
 }

@@ -20,11 +20,21 @@ const NODE_CHUNK: usize = 1 << 13;
 
 fn check_shape(shape: &[usize], samples: &[f64]) -> Result<()> {
     if !(2..=3).contains(&shape.len()) || shape.contains(&0) {
-        return Err(Error::invalid("grid", format!("only 2D and 3D grids are supported, got shape {shape:?}")));
+        return Err(Error::invalid(
+            "grid",
+            format!("only 2D and 3D grids are supported, got shape {shape:?}"),
+        ));
     }
     let total = shape.iter().try_fold(1usize, |p, &n| p.checked_mul(n));
     if total != Some(samples.len()) {
-        return Err(Error::invalid("phi", format!("expected {} samples (the grid {shape:?}), got {}", total.unwrap_or(usize::MAX), samples.len())));
+        return Err(Error::invalid(
+            "phi",
+            format!(
+                "expected {} samples (the grid {shape:?}), got {}",
+                total.unwrap_or(usize::MAX),
+                samples.len()
+            ),
+        ));
     }
     Ok(())
 }
@@ -32,7 +42,10 @@ fn check_shape(shape: &[usize], samples: &[f64]) -> Result<()> {
 /// Differences along an axis need two nodes on it.
 fn check_differences(shape: &[usize]) -> Result<()> {
     if shape.contains(&1) {
-        return Err(Error::invalid("grid", format!("needs at least 2 nodes per axis for differences, got shape {shape:?}")));
+        return Err(Error::invalid(
+            "grid",
+            format!("needs at least 2 nodes per axis for differences, got shape {shape:?}"),
+        ));
     }
     Ok(())
 }
@@ -52,7 +65,10 @@ pub fn first_non_finite(samples: &[f64]) -> Option<usize> {
 pub fn band_of_samples(shape: &[usize], samples: &[f64], half_width: f64) -> Result<(Vec<u64>, Vec<f64>)> {
     check_shape(shape, samples)?;
     if half_width.is_nan() || half_width < 0.0 {
-        return Err(Error::invalid("half_width", format!("must be a non-negative width, got {half_width}")));
+        return Err(Error::invalid(
+            "half_width",
+            format!("must be a non-negative width, got {half_width}"),
+        ));
     }
     let parts: Vec<(Vec<u64>, Vec<f64>)> = samples
         .par_chunks(SCAN_CHUNK)
@@ -78,15 +94,27 @@ pub fn band_of_samples(shape: &[usize], samples: &[f64], half_width: f64) -> Res
 /// grid), where `g_k = (φ(x + Δx e_k) − φ(x − Δx e_k)) / (2Δx)` with φ read from `samples`, one-sided
 /// where the neighbour lies outside the grid. `|g|` is summed in axis order; where it is at most
 /// 1e-12 the direction is `sgn(φ) g`.
-pub fn outward_directions_of_samples(shape: &[usize], spacing: f64, samples: &[f64], linear: &[u64], direction: &mut [f32]) -> Result<Vec<f64>> {
+pub fn outward_directions_of_samples(
+    shape: &[usize],
+    spacing: f64,
+    samples: &[f64],
+    linear: &[u64],
+    direction: &mut [f32],
+) -> Result<Vec<f64>> {
     check_shape(shape, samples)?;
     check_differences(shape)?;
     let d = shape.len();
     if direction.len() != linear.len() * d {
-        return Err(Error::invalid("direction", format!("expected shape ({}, {d})", linear.len())));
+        return Err(Error::invalid(
+            "direction",
+            format!("expected shape ({}, {d})", linear.len()),
+        ));
     }
     if let Some(&l) = linear.iter().find(|&&l| l >= samples.len() as u64) {
-        return Err(Error::invalid("linear", format!("node {l} lies outside the grid of {} nodes", samples.len())));
+        return Err(Error::invalid(
+            "linear",
+            format!("node {l} lies outside the grid of {} nodes", samples.len()),
+        ));
     }
     let stride = strides(shape);
     let mut norms = vec![0.0f64; linear.len()];
@@ -185,19 +213,36 @@ const GRADIENT_BLOCK: usize = 8;
 /// several times as many candidates, each of which the projection onto the zero level set then
 /// has to iterate. Two passes over the samples on all threads; the per-block bounds are the
 /// only storage (one value per block).
-pub fn redistance_candidates_of_samples(shape: &[usize], spacing: f64, samples: &[f64], half_width: f64) -> Result<(Vec<u64>, Vec<f64>)> {
+pub fn redistance_candidates_of_samples(
+    shape: &[usize],
+    spacing: f64,
+    samples: &[f64],
+    half_width: f64,
+) -> Result<(Vec<u64>, Vec<f64>)> {
     check_shape(shape, samples)?;
     check_differences(shape)?;
     if half_width.is_nan() || half_width < 0.0 {
-        return Err(Error::invalid("half_width", format!("must be a non-negative width, got {half_width}")));
+        return Err(Error::invalid(
+            "half_width",
+            format!("must be a non-negative width, got {half_width}"),
+        ));
     }
     if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(Error::invalid("spacing", format!("must be positive and finite, got {spacing}")));
+        return Err(Error::invalid(
+            "spacing",
+            format!("must be positive and finite, got {spacing}"),
+        ));
     }
     // a 2D grid as one slab of a 3D one: (1, n0, n1)
-    let dims: [usize; 3] = if shape.len() == 2 { [1, shape[0], shape[1]] } else { [shape[0], shape[1], shape[2]] };
+    let dims: [usize; 3] = if shape.len() == 2 {
+        [1, shape[0], shape[1]]
+    } else {
+        [shape[0], shape[1], shape[2]]
+    };
     let blocks: [usize; 3] = std::array::from_fn(|k| dims[k].div_ceil(GRADIENT_BLOCK));
-    let block_of = |i: usize, j: usize, k: usize| ((i / GRADIENT_BLOCK) * blocks[1] + j / GRADIENT_BLOCK) * blocks[2] + k / GRADIENT_BLOCK;
+    let block_of = |i: usize, j: usize, k: usize| {
+        ((i / GRADIENT_BLOCK) * blocks[1] + j / GRADIENT_BLOCK) * blocks[2] + k / GRADIENT_BLOCK
+    };
     // per block, the largest |Σ_a m_a²| over the cells whose lowest corner is one of its nodes,
     // m_a the largest |Δφ| along the cell's edges in direction a (a 2D grid's cells span no
     // first axis)
@@ -226,7 +271,9 @@ pub fn redistance_candidates_of_samples(shape: &[usize], spacing: f64, samples: 
     let cells: Vec<f64> = per_slab.into_iter().flatten().collect();
     // the blocks within reach of a node: `half_width` and a cell's diagonal from anywhere in its
     // own block
-    let reach = ((half_width / spacing + (shape.len() as f64).sqrt()) / GRADIENT_BLOCK as f64).ceil().max(1.0) as usize;
+    let reach = ((half_width / spacing + (shape.len() as f64).sqrt()) / GRADIENT_BLOCK as f64)
+        .ceil()
+        .max(1.0) as usize;
     let bound: Vec<f64> = (0..cells.len())
         .into_par_iter()
         .map(|b| {
@@ -274,7 +321,12 @@ pub fn redistance_candidates_of_samples(shape: &[usize], spacing: f64, samples: 
 #[inline]
 fn cell_gradient_bound_sq(samples: &[f64], l: usize, plane: usize, row: usize, flat: bool) -> f64 {
     let edges_2d = |base: usize| -> (f64, f64, [f64; 4]) {
-        let c = [samples[base], samples[base + 1], samples[base + row], samples[base + row + 1]];
+        let c = [
+            samples[base],
+            samples[base + 1],
+            samples[base + row],
+            samples[base + row + 1],
+        ];
         let along_k = (c[1] - c[0]).abs().max((c[3] - c[2]).abs());
         let along_j = (c[2] - c[0]).abs().max((c[3] - c[1]).abs());
         (along_j, along_k, c)
@@ -387,13 +439,29 @@ mod tests {
             let x = [(l / (n * n)) as f64 - c, ((l / n) % n) as f64 - c, (l % n) as f64 - c];
             (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
         };
-        let near: Vec<u64> = (0..s.len()).filter(|&l| ((radius(l) - r) * spacing).abs() <= half_width - 0.1).map(|l| l as u64).collect();
-        assert!(near.iter().all(|l| linear.binary_search(l).is_ok()), "a node near the surface is missing");
+        let near: Vec<u64> = (0..s.len())
+            .filter(|&l| ((radius(l) - r) * spacing).abs() <= half_width - 0.1)
+            .map(|l| l as u64)
+            .collect();
+        assert!(
+            near.iter().all(|l| linear.binary_search(l).is_ok()),
+            "a node near the surface is missing"
+        );
         // the whole-box bound (1.25 × the steepest node) takes several times the candidates
         let global = 1.25 * max_gradient_norm_of_samples(&[n, n, n], spacing, &s).unwrap();
         let (everywhere, _) = band_of_samples(&[n, n, n], &s, global * half_width).unwrap();
-        assert!(linear.len() * 2 < everywhere.len(), "{} candidates against {}", linear.len(), everywhere.len());
-        assert!(linear.len() * 2 < near.len() * 5, "{} candidates for {} nodes near the surface", linear.len(), near.len());
+        assert!(
+            linear.len() * 2 < everywhere.len(),
+            "{} candidates against {}",
+            linear.len(),
+            everywhere.len()
+        );
+        assert!(
+            linear.len() * 2 < near.len() * 5,
+            "{} candidates for {} nodes near the surface",
+            linear.len(),
+            near.len()
+        );
         // a 2D grid: a circle, the same rule
         let m = 61;
         let cm = (m - 1) as f64 / 2.0;

@@ -71,70 +71,78 @@ impl SweepSchedule {
     /// The same with tiles of `sides[k]` rows along leading axis `k`, and strips made of the
     /// tiles with the same tile coordinate along `strip_axis` (0 or 1), ordered along the other
     /// (3D; a 2D band's single leading axis ignores both).
-    pub fn with_tile_sides<const D: usize>(leads: &[[usize; D]], shape: [usize; D], sides: [usize; 2], strip_axis: usize) -> Self {
+    pub fn with_tile_sides<const D: usize>(
+        leads: &[[usize; D]],
+        shape: [usize; D],
+        sides: [usize; 2],
+        strip_axis: usize,
+    ) -> Self {
         assert!(strip_axis < 2, "the strip axis is one of the two leading axes");
         assert!(sides.iter().all(|&s| s > 0), "tile sides must be positive");
         let lead_dims = D - 1;
         let n_orient = 1usize << lead_dims;
         // the orientations are independent: one task each
-        let per_orientation: Vec<_> = (0..n_orient).into_par_iter().map(|signs| {
-            let keyed = rows_in_order(leads, shape, sides, signs);
-            let mut rows = Vec::with_capacity(keyed.len());
-            let mut tiles = vec![0u32];
-            let mut waves = vec![0u32];
-            for (i, &(wave, tile, _, r)) in keyed.iter().enumerate() {
-                if i > 0 {
-                    let (pw, pt, _, _) = keyed[i - 1];
-                    if pt != tile || pw != wave {
-                        tiles.push(i as u32);
-                    }
-                    if pw != wave {
-                        waves.push((tiles.len() - 1) as u32);
-                    }
-                }
-                rows.push(r);
-            }
-            tiles.push(keyed.len() as u32);
-            waves.push((tiles.len() - 1) as u32);
-            // strips: the tiles by (a, b), with a tile's key `a·stride + b` (two leading axes)
-            let (mut strip_tiles, mut strips, mut upstream) = (Vec::new(), Vec::new(), Vec::new());
-            if lead_dims == 2 && keyed.is_empty() {
-                // no rows: one empty strip over the one empty tile
-                strips = vec![0u32, 0];
-                upstream = vec![NO_TILE; tiles.len() - 1];
-                strip_tiles = (0..tiles.len() as u32 - 1).collect();
-                strips[1] = strip_tiles.len() as u32;
-            } else if lead_dims == 2 {
-                let stride = (shape[1] / sides[1] + 1) as u64;
-                let mut by_coords: Vec<(u64, u64, u32)> = (0..tiles.len() - 1)
-                    .map(|t| {
-                        let key = keyed[tiles[t] as usize].1;
-                        let (a, b) = (key / stride, key % stride);
-                        if strip_axis == 0 {
-                            (a, b, t as u32)
-                        } else {
-                            (b, a, t as u32)
+        let per_orientation: Vec<_> = (0..n_orient)
+            .into_par_iter()
+            .map(|signs| {
+                let keyed = rows_in_order(leads, shape, sides, signs);
+                let mut rows = Vec::with_capacity(keyed.len());
+                let mut tiles = vec![0u32];
+                let mut waves = vec![0u32];
+                for (i, &(wave, tile, _, r)) in keyed.iter().enumerate() {
+                    if i > 0 {
+                        let (pw, pt, _, _) = keyed[i - 1];
+                        if pt != tile || pw != wave {
+                            tiles.push(i as u32);
                         }
-                    })
-                    .collect();
-                by_coords.sort_unstable();
-                upstream = vec![NO_TILE; tiles.len() - 1];
-                strips.push(0u32);
-                for (i, &(a, b, t)) in by_coords.iter().enumerate() {
-                    if i > 0 && by_coords[i - 1].0 != a {
-                        strips.push(i as u32);
-                    }
-                    strip_tiles.push(t);
-                    if a > 0 {
-                        if let Ok(j) = by_coords.binary_search_by(|&(x, y, _)| (x, y).cmp(&(a - 1, b))) {
-                            upstream[t as usize] = by_coords[j].2;
+                        if pw != wave {
+                            waves.push((tiles.len() - 1) as u32);
                         }
                     }
+                    rows.push(r);
                 }
-                strips.push(strip_tiles.len() as u32);
-            }
-            (rows, tiles, waves, strip_tiles, strips, upstream)
-        }).collect();
+                tiles.push(keyed.len() as u32);
+                waves.push((tiles.len() - 1) as u32);
+                // strips: the tiles by (a, b), with a tile's key `a·stride + b` (two leading axes)
+                let (mut strip_tiles, mut strips, mut upstream) = (Vec::new(), Vec::new(), Vec::new());
+                if lead_dims == 2 && keyed.is_empty() {
+                    // no rows: one empty strip over the one empty tile
+                    strips = vec![0u32, 0];
+                    upstream = vec![NO_TILE; tiles.len() - 1];
+                    strip_tiles = (0..tiles.len() as u32 - 1).collect();
+                    strips[1] = strip_tiles.len() as u32;
+                } else if lead_dims == 2 {
+                    let stride = (shape[1] / sides[1] + 1) as u64;
+                    let mut by_coords: Vec<(u64, u64, u32)> = (0..tiles.len() - 1)
+                        .map(|t| {
+                            let key = keyed[tiles[t] as usize].1;
+                            let (a, b) = (key / stride, key % stride);
+                            if strip_axis == 0 {
+                                (a, b, t as u32)
+                            } else {
+                                (b, a, t as u32)
+                            }
+                        })
+                        .collect();
+                    by_coords.sort_unstable();
+                    upstream = vec![NO_TILE; tiles.len() - 1];
+                    strips.push(0u32);
+                    for (i, &(a, b, t)) in by_coords.iter().enumerate() {
+                        if i > 0 && by_coords[i - 1].0 != a {
+                            strips.push(i as u32);
+                        }
+                        strip_tiles.push(t);
+                        if a > 0 {
+                            if let Ok(j) = by_coords.binary_search_by(|&(x, y, _)| (x, y).cmp(&(a - 1, b))) {
+                                upstream[t as usize] = by_coords[j].2;
+                            }
+                        }
+                    }
+                    strips.push(strip_tiles.len() as u32);
+                }
+                (rows, tiles, waves, strip_tiles, strips, upstream)
+            })
+            .collect();
         let mut sched = SweepSchedule::default();
         for (rows, tiles, waves, strip_tiles, strips, upstream) in per_orientation {
             sched.strip_tiles.push(strip_tiles);
@@ -204,14 +212,23 @@ impl SweepSchedule {
 /// sorted by `(wave, tile)` and each tile's few rows by their key: linear in the rows, where one
 /// sort of all rows by the whole key cost about 2–3 ms per band at N = 201 (both strip
 /// schedules, 4 orientations each, at a band's first parallel solve).
-fn rows_in_order<const D: usize>(leads: &[[usize; D]], shape: [usize; D], sides: [usize; 2], signs: usize) -> Vec<(u64, u64, u64, u32)> {
+fn rows_in_order<const D: usize>(
+    leads: &[[usize; D]],
+    shape: [usize; D],
+    sides: [usize; 2],
+    signs: usize,
+) -> Vec<(u64, u64, u64, u32)> {
     let lead_dims = D - 1;
     let key = |lead: &[usize; D]| {
         let mut wave = 0u64;
         let mut tile = 0u64;
         let mut row = 0u64;
         for k in 0..lead_dims {
-            let c = if signs & (1 << k) != 0 { shape[k] - 1 - lead[k] } else { lead[k] };
+            let c = if signs & (1 << k) != 0 {
+                shape[k] - 1 - lead[k]
+            } else {
+                lead[k]
+            };
             let side = sides[k.min(1)];
             let t = (c / side) as u64;
             wave += t;
@@ -294,10 +311,13 @@ mod tests {
     #[test]
     fn the_bucketed_order_is_the_order_of_one_sort_by_the_whole_key() {
         // rings, and two far corners of a large plane (more tiles than rows: one sort)
-        let cases = [1usize, 2, 9, 37, 64].into_iter().map(|n| (ring_leads(n), [n, n + 3, 5])).chain(std::iter::once((
-            vec![[0, 3, 0], [999, 998, 0], [0, 2, 0]],
-            [1000, 1000, 5],
-        )));
+        let cases = [1usize, 2, 9, 37, 64]
+            .into_iter()
+            .map(|n| (ring_leads(n), [n, n + 3, 5]))
+            .chain(std::iter::once((
+                vec![[0, 3, 0], [999, 998, 0], [0, 2, 0]],
+                [1000, 1000, 5],
+            )));
         for (leads, shape) in cases {
             let n = shape[0];
             for sides in [[8, 8], [2, 16], [16, 2], [1, 1], [3, 5]] {
@@ -309,7 +329,11 @@ mod tests {
                         .map(|(r, lead)| {
                             let (mut wave, mut tile, mut row) = (0u64, 0u64, 0u64);
                             for k in 0..2 {
-                                let c = if signs & (1 << k) != 0 { shape[k] - 1 - lead[k] } else { lead[k] };
+                                let c = if signs & (1 << k) != 0 {
+                                    shape[k] - 1 - lead[k]
+                                } else {
+                                    lead[k]
+                                };
                                 let t = (c / sides[k]) as u64;
                                 wave += t;
                                 tile = tile * (shape[k] / sides[k] + 1) as u64 + t;

@@ -27,8 +27,8 @@ mod row_prefetch;
 mod spread_threads;
 mod strip_pipeline;
 mod sweep_state;
-use strip_pipeline::{run_sweeps_in_one_broadcast, strip_worker};
 pub use row_prefetch::{default_row_prefetch_above, DEFAULT_CACHE_SHARE};
+use strip_pipeline::{run_sweeps_in_one_broadcast, strip_worker};
 use sweep_state::{order_key, Accumulator, Limits, SharedValues, SweepContext, KEEP_ROW, REFUSED, WAKE_ROWS};
 
 /// What the sweep does at a node.
@@ -90,22 +90,30 @@ pub enum Extension<'a, const D: usize> {
 /// and an outer node without an upwind neighbour gets NaN (it keeps its value). The band does not
 /// change during a solve, so the weights are computed once; doing it in place saves `4 D` bytes
 /// per band node.
-pub fn extension_weights_in_place<const D: usize>(band: &NarrowBand<D>, roles: &[NodeRole], directions: &mut [[f32; D]]) {
+pub fn extension_weights_in_place<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    directions: &mut [[f32; D]],
+) {
     let sentinel = band.sentinel();
-    directions.par_iter_mut().zip(roles.par_iter()).enumerate().for_each(|(n, (v, &r))| {
-        if r != NodeRole::Outer {
-            *v = [0.0; D];
-            return;
-        }
-        let nb = band.neighbours_of(n);
-        let mut pm = [true; D];
-        let mut pp = [true; D];
-        for k in 0..D {
-            pm[k] = nb[k][0] != sentinel;
-            pp[k] = nb[k][1] != sentinel;
-        }
-        *v = extension_weights(*v, pm, pp).unwrap_or([f32::NAN; D]);
-    });
+    directions
+        .par_iter_mut()
+        .zip(roles.par_iter())
+        .enumerate()
+        .for_each(|(n, (v, &r))| {
+            if r != NodeRole::Outer {
+                *v = [0.0; D];
+                return;
+            }
+            let nb = band.neighbours_of(n);
+            let mut pm = [true; D];
+            let mut pp = [true; D];
+            for k in 0..D {
+                pm[k] = nb[k][0] != sentinel;
+                pp[k] = nb[k][1] != sentinel;
+            }
+            *v = extension_weights(*v, pm, pp).unwrap_or([f32::NAN; D]);
+        });
 }
 
 /// Everything the driver needs about one problem.
@@ -313,10 +321,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     fn check(&self, values: &[f64]) -> Result<()> {
         let n = self.band.len();
         if self.roles.len() != n {
-            return Err(Error::invalid("roles", format!("expected {n} roles, got {}", self.roles.len())));
+            return Err(Error::invalid(
+                "roles",
+                format!("expected {n} roles, got {}", self.roles.len()),
+            ));
         }
         if values.len() != n {
-            return Err(Error::invalid("values", format!("expected {n} values, got {}", values.len())));
+            return Err(Error::invalid(
+                "values",
+                format!("expected {n} values, got {}", values.len()),
+            ));
         }
         if let Slowness::PerNode(s) = self.slowness {
             if s.len() != n {
@@ -326,10 +340,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         if self.roles.iter().any(|&r| r == NodeRole::Outer) {
             match self.extension {
                 Extension::None => {
-                    return Err(Error::invalid("directions", "the band has extension-layer nodes but no directions"));
+                    return Err(Error::invalid(
+                        "directions",
+                        "the band has extension-layer nodes but no directions",
+                    ));
                 }
                 Extension::Directions(d) | Extension::Weights(d) if d.len() != n => {
-                    return Err(Error::invalid("directions", format!("expected {n} directions, got {}", d.len())));
+                    return Err(Error::invalid(
+                        "directions",
+                        format!("expected {n} directions, got {}", d.len()),
+                    ));
                 }
                 _ => {}
             }
@@ -378,7 +398,12 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// The largest number of grid steps from a fixed node to any band node it reaches
     /// (breadth-first search over the neighbour table; 0 without fixed nodes).
     pub fn grid_hops_from_sources(&self) -> u32 {
-        let sources = self.roles.iter().enumerate().filter(|(_, &r)| r == NodeRole::Fixed).map(|(i, _)| i);
+        let sources = self
+            .roles
+            .iter()
+            .enumerate()
+            .filter(|(_, &r)| r == NodeRole::Fixed)
+            .map(|(i, _)| i);
         crate::grid_hops::max_grid_hops(self.band, sources)
     }
 
@@ -422,13 +447,23 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // (also run for a general Hamiltonian without a slowness bound, whose infinity does not
         // use it: asking for the bound here would be a pass over every node of its own)
         let hops_needed = self.windowed(options) || options.infinity.is_none();
-        let weights = if options.defer_outer_rim { self.upwind_weights() } else { std::borrow::Cow::Borrowed(&[][..]) };
+        let weights = if options.defer_outer_rim {
+            self.upwind_weights()
+        } else {
+            std::borrow::Cow::Borrowed(&[][..])
+        };
         let weights: &[[f32; D]] = &weights;
         let rim_last = !weights.is_empty();
         let (hop_count, rim) = pool.install(|| {
             rayon::join(
                 || hops_needed.then(|| self.grid_hops_from_sources()),
-                || if rim_last { crate::rim::outer_rim(self.band, self.roles, weights) } else { Vec::new() },
+                || {
+                    if rim_last {
+                        crate::rim::outer_rim(self.band, self.roles, weights)
+                    } else {
+                        Vec::new()
+                    }
+                },
             )
         });
         let hops = || hop_count.unwrap_or_else(|| self.grid_hops_from_sources());
@@ -445,14 +480,20 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         } else {
             0.0
         };
-        let options = &SolveOptions { infinity: Some(inf), ..*options };
+        let options = &SolveOptions {
+            infinity: Some(inf),
+            ..*options
+        };
         for (v, &r) in values.iter_mut().zip(self.roles) {
             if r != NodeRole::Fixed {
                 *v = inf;
             }
         }
         values.push(inf); // the sentinel slot read for absent neighbours
-        let mut stats = SolveStats { infinity: inf, ..Default::default() };
+        let mut stats = SolveStats {
+            infinity: inf,
+            ..Default::default()
+        };
         let result = if options.defer_outer_rim {
             self.iterate_rim_last(values, options, window_width, pool, progress, &mut stats, weights, &rim)
         } else {
@@ -575,7 +616,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 let reads_back = |b: u32, k: usize, b_reads_minus: bool| {
                     b != sentinel
                         && roles[b as usize] == NodeRole::Outer
-                        && if b_reads_minus { weights[b as usize][k] > 0.0 } else { weights[b as usize][k] < 0.0 }
+                        && if b_reads_minus {
+                            weights[b as usize][k] > 0.0
+                        } else {
+                            weights[b as usize][k] < 0.0
+                        }
                 };
                 // a reads its plus neighbour when w_a[k] < 0, its minus neighbour when w_a[k] > 0;
                 // the plus neighbour reads a (its minus neighbour) when its w[k] > 0, and so on
@@ -598,7 +643,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             roles,
             spacing: self.spacing,
             slowness: self.slowness,
-            extension: if weights.is_empty() { Extension::None } else { Extension::Weights(weights) },
+            extension: if weights.is_empty() {
+                Extension::None
+            } else {
+                Extension::Weights(weights)
+            },
             scheme: self.scheme,
             missing: self.missing,
         }
@@ -621,26 +670,44 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         rim: &[bool],
     ) -> Result<()> {
         if !rim.iter().any(|&b| b) {
-            return self.with_roles(self.roles, weights).iterate(u, options, window_width, pool, progress, stats);
+            return self
+                .with_roles(self.roles, weights)
+                .iterate(u, options, window_width, pool, progress, stats);
         }
-        let without_rim: Vec<NodeRole> =
-            pool.install(|| self.roles.par_iter().zip(rim.par_iter()).map(|(&r, &b)| if b { NodeRole::Fixed } else { r }).collect());
-        self.with_roles(&without_rim, weights).iterate(u, options, window_width, pool, progress, stats)?;
+        let without_rim: Vec<NodeRole> = pool.install(|| {
+            self.roles
+                .par_iter()
+                .zip(rim.par_iter())
+                .map(|(&r, &b)| if b { NodeRole::Fixed } else { r })
+                .collect()
+        });
+        self.with_roles(&without_rim, weights)
+            .iterate(u, options, window_width, pool, progress, stats)?;
         drop(without_rim);
         // The rim counts as one iteration, reported after the first phase's; its passes (one,
         // and those over its cyclic part) count as sweeps and share the budget of sweeps left
         // (at least one pass, so that it gets values even when the first phase used it all).
         let base = stats.iterations;
-        let budget = options.max_iterations.saturating_sub(base).max(1).saturating_mul(1 << D);
+        let budget = options
+            .max_iterations
+            .saturating_sub(base)
+            .max(1)
+            .saturating_mul(1 << D);
         let passes = pool.install(|| crate::rim::extend_into_rim(self.band, rim, weights, u, options.tol, budget));
         stats.iterations += 1;
         stats.sweeps += passes.passes;
         stats.updates += passes.updates;
         stats.converged &= passes.converged;
         stats.last_change = stats.last_change.max(passes.last_change);
-        let report = IterationReport { iteration: stats.iterations, max_change: passes.first_change, updates: passes.updates };
+        let report = IterationReport {
+            iteration: stats.iterations,
+            max_change: passes.first_change,
+            updates: passes.updates,
+        };
         if progress(&report) == Control::Stop {
-            return Err(Error::Interrupted { iterations: stats.iterations });
+            return Err(Error::Interrupted {
+                iterations: stats.iterations,
+            });
         }
         Ok(())
     }
@@ -672,7 +739,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let active: Vec<AtomicU8> = (0..=n)
                 .into_par_iter()
                 .map(|i| {
-                    let updated = i < n && self.roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan());
+                    let updated =
+                        i < n && self.roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan());
                     AtomicU8::new(updated as u8)
                 })
                 .collect();
@@ -695,8 +763,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 .reduce(|| f64::INFINITY, f64::min);
             (active, start_low, coupling, first_front)
         });
-        let row_low: Vec<AtomicU64> =
-            start_low.iter().chain(std::iter::once(&f64::INFINITY)).map(|&v| AtomicU64::new(order_key(v))).collect();
+        let row_low: Vec<AtomicU64> = start_low
+            .iter()
+            .chain(std::iter::once(&f64::INFINITY))
+            .map(|&v| AtomicU64::new(order_key(v)))
+            .collect();
         let row_neighbours = self.band.row_neighbours();
         // the rows next to a row with fixed nodes read them, like the rows a row wakes (see
         // `finish_row`): their bound is at most the smallest value that row starts with
@@ -710,10 +781,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let row_dirty: Vec<AtomicU8> = (0..=self.band.n_rows()).map(|_| AtomicU8::new(1)).collect();
         let shared = SharedValues::new(u);
         let all_active = !options.skip_inactive;
-        debug_assert!(!(all_active && window_width > 0.0), "the front window runs only with the active flags");
+        debug_assert!(
+            !(all_active && window_width > 0.0),
+            "the front window runs only with the active flags"
+        );
         // the plain sweeps update every node that starts active (all but the fixed nodes and the
         // layer nodes without an upwind neighbour) in every sweep, and count them here
-        let updated_per_sweep = if all_active { active[..n].iter().filter(|a| a.load(Ordering::Relaxed) != 0).count() as u64 } else { 0 };
+        let updated_per_sweep = if all_active {
+            active[..n].iter().filter(|a| a.load(Ordering::Relaxed) != 0).count() as u64
+        } else {
+            0
+        };
 
         // the largest slowness of a general Hamiltonian bounds the extrapolation of absent
         // neighbours (see `fill_missing`); computed once, it may scan every node
@@ -723,15 +801,23 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let tiles_done: Vec<AtomicU32> = if threads == 1 || D < 3 {
             Vec::new()
         } else {
-            let most = [self.band.schedule(), self.band.strip_schedule(0), self.band.strip_schedule(1)]
-                .into_iter()
-                .flat_map(|sched| (0..1usize << (D - 1)).map(move |o| sched.tiles(o).len()))
-                .max()
-                .unwrap_or(0);
+            let most = [
+                self.band.schedule(),
+                self.band.strip_schedule(0),
+                self.band.strip_schedule(1),
+            ]
+            .into_iter()
+            .flat_map(|sched| (0..1usize << (D - 1)).map(move |o| sched.tiles(o).len()))
+            .max()
+            .unwrap_or(0);
             (0..most).map(|_| AtomicU32::new(0)).collect()
         };
         let windowed = window_width > 0.0 && window_width.is_finite() && first_front < f64::INFINITY;
-        let cyclic = if windowed { pool.install(|| self.upwind_two_cycles(weights)) } else { Vec::new() };
+        let cyclic = if windowed {
+            pool.install(|| self.upwind_two_cycles(weights))
+        } else {
+            Vec::new()
+        };
         let ctx = SweepContext {
             cyclic: &cyclic,
             row_low: &row_low,
@@ -758,7 +844,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // the rows the first iteration visits: every row, or with the window the few near the
         // sources (then the next iterations decide from what the sweeps visited)
         let mut visited_per_sweep = if windowed { 0 } else { n as u64 };
-        let mut window = if windowed { first_front + window_width } else { f64::INFINITY };
+        let mut window = if windowed {
+            first_front + window_width
+        } else {
+            f64::INFINITY
+        };
         stats.window_edge = f64::INFINITY;
         while stats.iterations < options.max_iterations {
             let lim = Limits {
@@ -824,8 +914,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             stats.last_change = max_change;
             // the window this iteration ran with (what a solve stopped here leaves behind)
             stats.window_edge = lim.window;
-            if progress(&IterationReport { iteration: stats.iterations, max_change, updates }) == Control::Stop {
-                return Err(Error::Interrupted { iterations: stats.iterations });
+            if progress(&IterationReport {
+                iteration: stats.iterations,
+                max_change,
+                updates,
+            }) == Control::Stop
+            {
+                return Err(Error::Interrupted {
+                    iterations: stats.iterations,
+                });
             }
             // converged only when no node was left out by the window (then `front` is infinite
             // and the window opens fully for the next iteration)
@@ -928,7 +1025,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             specialised!(self, ctx, run_rows(ctx, a, backwards, lim))
         };
         let id = ctx.sweep_id.load(Ordering::Relaxed);
-        strip_worker(sched.strip_tiles(lead), sched.strips(lead), sched.upstream(lead), ctx.tiles_done, id, next_strip, abandoned, &run_tile)
+        strip_worker(
+            sched.strip_tiles(lead),
+            sched.strips(lead),
+            sched.upstream(lead),
+            ctx.tiles_done,
+            id,
+            next_strip,
+            abandoned,
+            &run_tile,
+        )
     }
 
     /// The rows of one tile, in order, with the update specialised for scheme `S` and a
@@ -971,7 +1077,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// One row, in sweep order; with the flags (`K`), skipped whole when none of its nodes is
     /// active (its dirty flag is clear) or all its values lie beyond the front window.
     #[inline(always)]
-    fn run_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+    fn run_row<const S: u8, const P: bool, const W: bool, const K: bool>(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        r: usize,
+        backwards: bool,
+        lim: Limits,
+        acc: &mut Accumulator,
+    ) {
         let run = self.claim_row::<W, K>(ctx, r, lim, acc);
         let before = acc.updates;
         if run {
@@ -986,7 +1099,13 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// Whether row `r` has anything to do ([`SweepContext::take_row`], which clears its dirty
     /// flag when it has); in the unit tests, also checks the dirty-row invariant.
     #[inline(always)]
-    fn claim_row<const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, lim: Limits, acc: &mut Accumulator) -> bool {
+    fn claim_row<const W: bool, const K: bool>(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        r: usize,
+        lim: Limits,
+        acc: &mut Accumulator,
+    ) -> bool {
         if !K {
             // every row runs in every sweep
             return true;
@@ -998,7 +1117,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// The nodes of row `r`, which [`claim_row`](Self::claim_row) let through, in sweep order.
     #[inline(always)]
-    fn run_claimed_row<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, r: usize, backwards: bool, lim: Limits, acc: &mut Accumulator) {
+    fn run_claimed_row<const S: u8, const P: bool, const W: bool, const K: bool>(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        r: usize,
+        backwards: bool,
+        lim: Limits,
+        acc: &mut Accumulator,
+    ) {
         let (s, e) = self.band.row_range(r);
         acc.visited += (e - s) as u64;
         let mut low = f64::INFINITY;
@@ -1045,7 +1171,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// `row` collects what the row's dirty flags need: [`KEEP_ROW`] when the node stays active,
     /// [`WAKE_ROWS`] when it activated its neighbours. Without the flags (`K = false`), updates
     /// every node but the fixed ones and touches neither `low` nor `row`.
-    fn visit<const S: u8, const P: bool, const W: bool, const K: bool>(&self, ctx: &SweepContext<'_, D>, arr: &NodeArrays<'_, D>, n: usize, lim: Limits, acc: &mut Accumulator, low: &mut f64, row: &mut u8) {
+    fn visit<const S: u8, const P: bool, const W: bool, const K: bool>(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        arr: &NodeArrays<'_, D>,
+        n: usize,
+        lim: Limits,
+        acc: &mut Accumulator,
+        low: &mut f64,
+        row: &mut u8,
+    ) {
         if !K {
             // no flags: every node but the fixed ones (`iterate` counts these updates per sweep,
             // `updated_per_sweep`)
@@ -1151,7 +1286,14 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     /// update (5) in the layer, the scheme's local solver with monotone acceptance in the inner
     /// tube. `None` when the value would not change. Nothing is written.
     #[inline(always)]
-    fn local_update<const S: u8, const P: bool>(&self, ctx: &SweepContext<'_, D>, arr: &NodeArrays<'_, D>, n: usize, nb: &[[u32; 2]; D], inf: f64) -> Option<LocalUpdate> {
+    fn local_update<const S: u8, const P: bool>(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        arr: &NodeArrays<'_, D>,
+        n: usize,
+        nb: &[[u32; 2]; D],
+        inf: f64,
+    ) -> Option<LocalUpdate> {
         let u = arr.u;
         // SAFETY: n < band.len(); roles, weights and the neighbour table have at least that
         // length (checked in `check`); neighbour entries are ≤ len, the sentinel slot of `u`.
@@ -1170,7 +1312,15 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 return None;
             }
             let v = extension_apply_upwind(w, nb, |i| u.get(i as usize));
-            return if v == old { None } else { Some(LocalUpdate { old, new: v, self_dependent: false }) };
+            return if v == old {
+                None
+            } else {
+                Some(LocalUpdate {
+                    old,
+                    new: v,
+                    self_dependent: false,
+                })
+            };
         }
         let mut minus = [0.0; D];
         let mut plus = [0.0; D];
@@ -1183,11 +1333,18 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         let f = unsafe { arr.h_times_slowness::<P>(n) };
         // NaN only for a per-node slowness dispatched with P = false, which the general
         // Hamiltonian (taking its slowness from the Hamiltonian) alone may be
-        debug_assert!(S == GENERAL || !f.is_nan(), "a per-node slowness dispatched with P = false");
+        debug_assert!(
+            S == GENERAL || !f.is_nan(),
+            "a per-node slowness dispatched with P = false"
+        );
         let mut self_dependent = false;
         let candidate = if S == GODUNOV {
             let mut mins = [0.0; D];
-            let mask = if arr.coupling.is_empty() { 0 } else { unsafe { *arr.coupling.get_unchecked(n) } };
+            let mask = if arr.coupling.is_empty() {
+                0
+            } else {
+                unsafe { *arr.coupling.get_unchecked(n) }
+            };
             if mask == 0 {
                 for k in 0..D {
                     mins[k] = fmin(minus[k], plus[k]);
@@ -1218,7 +1375,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
             lxf_eikonal_update(minus, plus, f)
         } else {
-            let InnerScheme::General(ham) = self.scheme else { return None };
+            let InnerScheme::General(ham) = self.scheme else {
+                return None;
+            };
             if self.missing == MissingNeighbour::Extrapolate {
                 let f = h * ctx.general_slowness;
                 self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, f, &mut minus, &mut plus);
@@ -1228,7 +1387,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         };
         // monotone acceptance: keep the smaller value (Sect. 4, proof of Corollary 1)
         if candidate < old {
-            Some(LocalUpdate { old, new: candidate, self_dependent })
+            Some(LocalUpdate {
+                old,
+                new: candidate,
+                self_dependent,
+            })
         } else {
             None
         }
@@ -1267,7 +1430,10 @@ impl<const D: usize> NodeArrays<'_, D> {
     /// in `SweepProblem::check`).
     #[inline(always)]
     unsafe fn h_times_slowness<const P: bool>(&self, n: usize) -> f64 {
-        debug_assert!(!P || n < self.slowness_per_node.len(), "P = true without a per-node slowness");
+        debug_assert!(
+            !P || n < self.slowness_per_node.len(),
+            "P = true without a per-node slowness"
+        );
         if P {
             self.spacing * *self.slowness_per_node.get_unchecked(n)
         } else {
@@ -1305,7 +1471,6 @@ impl LocalUpdate {
 const GODUNOV: u8 = 0;
 const LXF: u8 = 1;
 const GENERAL: u8 = 2;
-
 
 /// Replaces the values of absent neighbours by a linear extrapolation through the node,
 /// `2 u − u_opposite`, limited to `[u − f, u + f]` with `f = h · s` the largest change a solution
@@ -1358,11 +1523,16 @@ fn fill_missing<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_bands::{shell_band, sphere_band, sphere_problem};
     use crate::hamiltonian::IsotropicEikonal;
     use crate::schedule::NO_TILE;
+    use crate::test_bands::{shell_band, sphere_band, sphere_problem};
 
-    fn box_problem<'a>(band: &'a NarrowBand<2>, roles: &'a [NodeRole], scheme: InnerScheme<'a, 2>, h: f64) -> SweepProblem<'a, 2> {
+    fn box_problem<'a>(
+        band: &'a NarrowBand<2>,
+        roles: &'a [NodeRole],
+        scheme: InnerScheme<'a, 2>,
+        h: f64,
+    ) -> SweepProblem<'a, 2> {
         SweepProblem {
             band,
             roles,
@@ -1383,7 +1553,9 @@ mod tests {
         roles[0] = NodeRole::Fixed;
         let mut u = vec![0.0; band.len()];
         let p = box_problem(&band, &roles, InnerScheme::Godunov, h);
-        let stats = p.solve(&mut u, &SolveOptions::default(), &mut |_| Control::Continue).unwrap();
+        let stats = p
+            .solve(&mut u, &SolveOptions::default(), &mut |_| Control::Continue)
+            .unwrap();
         assert!(stats.converged);
         assert_eq!(stats.iterations, 2);
         // along the axes the Godunov solution is exact
@@ -1404,11 +1576,18 @@ mod tests {
         roles[centre] = NodeRole::Fixed;
         let slowness = vec![1.0; band.len()];
         let ham = IsotropicEikonal { slowness: &slowness };
-        let opts = SolveOptions { tol: 1e-12, ..Default::default() };
+        let opts = SolveOptions {
+            tol: 1e-12,
+            ..Default::default()
+        };
         let mut a = vec![0.0; band.len()];
         let mut b = vec![0.0; band.len()];
-        let sa = box_problem(&band, &roles, InnerScheme::LaxFriedrichs, h).solve(&mut a, &opts, &mut |_| Control::Continue).unwrap();
-        let sb = box_problem(&band, &roles, InnerScheme::General(&ham), h).solve(&mut b, &opts, &mut |_| Control::Continue).unwrap();
+        let sa = box_problem(&band, &roles, InnerScheme::LaxFriedrichs, h)
+            .solve(&mut a, &opts, &mut |_| Control::Continue)
+            .unwrap();
+        let sb = box_problem(&band, &roles, InnerScheme::General(&ham), h)
+            .solve(&mut b, &opts, &mut |_| Control::Continue)
+            .unwrap();
         assert!(sa.converged && sb.converged);
         let diff = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
         assert!(diff < 1e-9, "diff {diff}");
@@ -1419,7 +1598,16 @@ mod tests {
     fn assert_same_bits_for_threads(p: &SweepProblem<'_, 3>, threads: &[usize]) -> Vec<f64> {
         let run = |threads: usize| {
             let mut u = vec![0.0; p.band.len()];
-            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            let st = p
+                .solve(
+                    &mut u,
+                    &SolveOptions {
+                        threads,
+                        ..Default::default()
+                    },
+                    &mut |_| Control::Continue,
+                )
+                .unwrap();
             assert!(st.converged);
             (u, st.iterations, st.updates)
         };
@@ -1448,9 +1636,18 @@ mod tests {
             (InnerScheme::LaxFriedrichs, false, true, 0.0),
         ] {
             for threads in [1, 2] {
-                let opts = SolveOptions { threads, coupled, skip_inactive, front_window, ..Default::default() };
+                let opts = SolveOptions {
+                    threads,
+                    coupled,
+                    skip_inactive,
+                    front_window,
+                    ..Default::default()
+                };
                 let solve = |slowness| {
-                    let p = SweepProblem { slowness, ..sphere_problem(&band, &roles, &dirs, h, scheme) };
+                    let p = SweepProblem {
+                        slowness,
+                        ..sphere_problem(&band, &roles, &dirs, h, scheme)
+                    };
                     let mut u = vec![0.0; band.len()];
                     let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
                     assert!(st.converged);
@@ -1459,7 +1656,10 @@ mod tests {
                 let (a, ua) = solve(Slowness::Constant(c));
                 let (b, ub) = solve(Slowness::PerNode(&per_node));
                 assert_eq!(ua, ub);
-                assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{coupled} {skip_inactive} {threads}");
+                assert!(
+                    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "{coupled} {skip_inactive} {threads}"
+                );
                 // and the slowness counts: unit speed gives other values
                 let (one, _) = solve(Slowness::Constant(1.0));
                 assert!(a.iter().zip(&one).any(|(x, y)| x != y));
@@ -1483,7 +1683,13 @@ mod tests {
             let p = sphere_problem(&band, &roles, &dirs, h, scheme);
             for threads in [1, 2] {
                 let run = |above: usize| {
-                    let opts = SolveOptions { threads, skip_inactive, front_window, row_prefetch_above: above, ..Default::default() };
+                    let opts = SolveOptions {
+                        threads,
+                        skip_inactive,
+                        front_window,
+                        row_prefetch_above: above,
+                        ..Default::default()
+                    };
                     let mut u = vec![0.0; band.len()];
                     let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
                     assert!(st.converged);
@@ -1494,9 +1700,15 @@ mod tests {
                 assert_eq!(sa.prefetch_iterations, 0);
                 // every iteration of sweeps but the rim's pass (counted as one more) and, with
                 // the window, the first (which counts no visited rows before it)
-                assert!(sb.prefetch_iterations + 2 >= sb.iterations && sb.prefetch_iterations < sb.iterations, "{sb:?}");
+                assert!(
+                    sb.prefetch_iterations + 2 >= sb.iterations && sb.prefetch_iterations < sb.iterations,
+                    "{sb:?}"
+                );
                 assert_eq!((sa.iterations, sa.updates), (sb.iterations, sb.updates));
-                assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()), "{skip_inactive} {front_window} {threads}");
+                assert!(
+                    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "{skip_inactive} {front_window} {threads}"
+                );
             }
         }
         // The bound against the rows visited: per node the value, role and neighbour table, the
@@ -1515,7 +1727,10 @@ mod tests {
         };
         assert_eq!(bytes(false, false, false), 38);
         let ones = vec![1.0; band.len()];
-        let per_node = SweepProblem { slowness: Slowness::PerNode(&ones), ..sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov) };
+        let per_node = SweepProblem {
+            slowness: Slowness::PerNode(&ones),
+            ..sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov)
+        };
         let n = band.len();
         let count = |p: &SweepProblem<'_, 3>, opts: SolveOptions| {
             let mut u = vec![0.0; n];
@@ -1523,26 +1738,78 @@ mod tests {
             assert!(st.converged && st.iterations > 3);
             (st.prefetch_iterations, st.iterations)
         };
-        let base = SolveOptions { threads: 1, front_window: 0.0, ..Default::default() };
+        let base = SolveOptions {
+            threads: 1,
+            front_window: 0.0,
+            ..Default::default()
+        };
         // The plain sweeps visit every row in every sweep: every iteration of sweeps (all but
         // the rim's pass, counted as one more) prefetches when the band's bytes exceed the bound,
         // none when they do not.
         for (p, coupled, slow) in [(&p, false, false), (&per_node, true, true)] {
             let swept = n * bytes(false, coupled, slow);
-            let opts = SolveOptions { skip_inactive: false, coupled, ..base };
-            let (k, it) = count(p, SolveOptions { row_prefetch_above: swept - 1, ..opts });
+            let opts = SolveOptions {
+                skip_inactive: false,
+                coupled,
+                ..base
+            };
+            let (k, it) = count(
+                p,
+                SolveOptions {
+                    row_prefetch_above: swept - 1,
+                    ..opts
+                },
+            );
             assert_eq!(k, it - 1, "coupled {coupled}, per-node slowness {slow}");
-            assert_eq!(count(p, SolveOptions { row_prefetch_above: swept, ..opts }).0, 0);
+            assert_eq!(
+                count(
+                    p,
+                    SolveOptions {
+                        row_prefetch_above: swept,
+                        ..opts
+                    }
+                )
+                .0,
+                0
+            );
         }
         // With the flags the first iteration is taken to visit every row, and the later ones
         // count the rows that ran, fewer: just below the band's bytes only the first prefetches.
         let swept = n * bytes(true, true, true);
-        let opts = SolveOptions { skip_inactive: true, coupled: true, ..base };
-        assert_eq!(count(&per_node, SolveOptions { row_prefetch_above: swept - 1, ..opts }).0, 1);
-        assert_eq!(count(&per_node, SolveOptions { row_prefetch_above: swept, ..opts }).0, 0);
+        let opts = SolveOptions {
+            skip_inactive: true,
+            coupled: true,
+            ..base
+        };
+        assert_eq!(
+            count(
+                &per_node,
+                SolveOptions {
+                    row_prefetch_above: swept - 1,
+                    ..opts
+                }
+            )
+            .0,
+            1
+        );
+        assert_eq!(
+            count(
+                &per_node,
+                SolveOptions {
+                    row_prefetch_above: swept,
+                    ..opts
+                }
+            )
+            .0,
+            0
+        );
         // With the front window the first iteration counts no row, so even a bound of 0 lets
         // it and the rim's pass go without; every other iteration visits rows and prefetches.
-        let opts = SolveOptions { front_window: DEFAULT_FRONT_WINDOW, row_prefetch_above: 0, ..base };
+        let opts = SolveOptions {
+            front_window: DEFAULT_FRONT_WINDOW,
+            row_prefetch_above: 0,
+            ..base
+        };
         let (k, it) = count(&p, opts);
         assert_eq!(k, it - 2);
         // a 2D box (no extension layer, so no weights; Lax–Friedrichs, which reads its own
@@ -1555,7 +1822,16 @@ mod tests {
             let p2 = box_problem(&box2, &roles2, scheme, 1.0 / (n2 - 1) as f64);
             let run = |above: usize| {
                 let mut u = vec![0.0; box2.len()];
-                let st = p2.solve(&mut u, &SolveOptions { row_prefetch_above: above, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+                let st = p2
+                    .solve(
+                        &mut u,
+                        &SolveOptions {
+                            row_prefetch_above: above,
+                            ..Default::default()
+                        },
+                        &mut |_| Control::Continue,
+                    )
+                    .unwrap();
                 assert!(st.converged);
                 (u, st)
             };
@@ -1568,13 +1844,23 @@ mod tests {
     #[test]
     fn parallel_and_skipping_sweeps_are_bit_identical_to_the_plain_sequential_sweep() {
         let (band, roles, dirs, h) = sphere_band(41);
-        for (scheme, coupled) in [(InnerScheme::Godunov, true), (InnerScheme::Godunov, false), (InnerScheme::LaxFriedrichs, false)] {
+        for (scheme, coupled) in [
+            (InnerScheme::Godunov, true),
+            (InnerScheme::Godunov, false),
+            (InnerScheme::LaxFriedrichs, false),
+        ] {
             let p = sphere_problem(&band, &roles, &dirs, h, scheme);
             let mut results = Vec::new();
             for (threads, skip) in [(1, false), (1, true), (2, true), (4, true), (2, false)] {
                 // the front window only runs with skipping: compared with plain sweeps without it
                 // (its own test is `the_front_window_reaches_the_same_fixed_point_with_fewer_updates`)
-                let opts = SolveOptions { threads, skip_inactive: skip, coupled, front_window: 0.0, ..Default::default() };
+                let opts = SolveOptions {
+                    threads,
+                    skip_inactive: skip,
+                    coupled,
+                    front_window: 0.0,
+                    ..Default::default()
+                };
                 let mut u = vec![0.0; band.len()];
                 let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
                 assert!(st.converged);
@@ -1588,8 +1874,17 @@ mod tests {
             // without the rim phase, every node but the fixed ones and the layer nodes without
             // an upwind neighbour, in every one of the 2^3 sweeps of every iteration
             let weights = p.upwind_weights();
-            let updated = (0..band.len()).filter(|&i| roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan())).count() as u64;
-            let opts = SolveOptions { threads: 2, skip_inactive: false, coupled, defer_outer_rim: false, front_window: 0.0, ..Default::default() };
+            let updated = (0..band.len())
+                .filter(|&i| roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan()))
+                .count() as u64;
+            let opts = SolveOptions {
+                threads: 2,
+                skip_inactive: false,
+                coupled,
+                defer_outer_rim: false,
+                front_window: 0.0,
+                ..Default::default()
+            };
             let mut u = vec![0.0; band.len()];
             let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
             assert!(st.converged && st.iterations > 2);
@@ -1610,7 +1905,12 @@ mod tests {
                 assert!(u1.iter().zip(u0).all(|(a, b)| a.to_bits() == b.to_bits()));
             }
             // skipping saves work
-            assert!(results[1].1.updates < s0.updates, "{} vs {}", results[1].1.updates, s0.updates);
+            assert!(
+                results[1].1.updates < s0.updates,
+                "{} vs {}",
+                results[1].1.updates,
+                s0.updates
+            );
             // on the sphere the solution is close to the great-circle distance
             let far = band.find([30, 20, 20]).unwrap();
             eprintln!("far {}", u0[far]);
@@ -1621,7 +1921,9 @@ mod tests {
     /// Solves `p` to convergence with `opts` (tol 1e-13).
     fn converged(p: &SweepProblem<'_, 3>, opts: SolveOptions) -> (Vec<f64>, SolveStats) {
         let mut u = vec![0.0; p.band.len()];
-        let st = p.solve(&mut u, &SolveOptions { tol: 1e-13, ..opts }, &mut |_| Control::Continue).unwrap();
+        let st = p
+            .solve(&mut u, &SolveOptions { tol: 1e-13, ..opts }, &mut |_| Control::Continue)
+            .unwrap();
         assert!(st.converged);
         (u, st)
     }
@@ -1633,7 +1935,15 @@ mod tests {
     /// Solves `p` to convergence with the front window off and at its default, asserts the same
     /// fixed point (to 1e-11) and returns both runs' stats.
     fn window_off_and_on(p: &SweepProblem<'_, 3>) -> (SolveStats, SolveStats) {
-        let run = |front_window: f64| converged(p, SolveOptions { front_window, ..Default::default() });
+        let run = |front_window: f64| {
+            converged(
+                p,
+                SolveOptions {
+                    front_window,
+                    ..Default::default()
+                },
+            )
+        };
         let (a, sa) = run(0.0);
         let (b, sb) = run(DEFAULT_FRONT_WINDOW);
         assert!(max_difference(&a, &b) < 1e-11);
@@ -1671,7 +1981,12 @@ mod tests {
         // the window reaches the same fixed point with fewer updates
         let (sa, sb) = window_off_and_on(&p);
         // measured: 0.62 of the updates; 1.34 when the window held the 2-cycles back
-        assert!((sb.updates as f64) < 0.8 * sa.updates as f64, "{} vs {}", sb.updates, sa.updates);
+        assert!(
+            (sb.updates as f64) < 0.8 * sa.updates as f64,
+            "{} vs {}",
+            sb.updates,
+            sa.updates
+        );
     }
 
     #[test]
@@ -1681,7 +1996,9 @@ mod tests {
         let n = 81;
         let (band, mut roles, dirs, h) = shell_band(n, 0.5, &[0.0]);
         let src = band.find([(n / 4) as i64, (n / 2) as i64, (n / 2) as i64]).unwrap();
-        let row = (0..band.n_rows()).find(|&r| (band.row_range(r).0..band.row_range(r).1).contains(&src)).unwrap();
+        let row = (0..band.n_rows())
+            .find(|&r| (band.row_range(r).0..band.row_range(r).1).contains(&src))
+            .unwrap();
         let (s, e) = band.row_range(row);
         for r in &mut roles[s..e] {
             *r = NodeRole::Fixed;
@@ -1690,19 +2007,38 @@ mod tests {
         let (sa, sb) = window_off_and_on(&p);
         // measured: 0.56 of the updates; 1.0 when the rows next to the fixed ones started beyond
         // the window (nothing woke them, and the window jumped past the infinity)
-        assert!((sb.updates as f64) < 0.7 * sa.updates as f64, "{} vs {}", sb.updates, sa.updates);
+        assert!(
+            (sb.updates as f64) < 0.7 * sa.updates as f64,
+            "{} vs {}",
+            sb.updates,
+            sa.updates
+        );
     }
 
     #[test]
     fn the_front_window_reaches_the_same_fixed_point_with_fewer_updates() {
         let (band, roles, dirs, h) = sphere_band(81);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let run = |front_window: f64, threads: usize| converged(&p, SolveOptions { front_window, threads, ..Default::default() });
+        let run = |front_window: f64, threads: usize| {
+            converged(
+                &p,
+                SolveOptions {
+                    front_window,
+                    threads,
+                    ..Default::default()
+                },
+            )
+        };
         let (a, sa) = run(0.0, 1);
         let (b, sb) = run(DEFAULT_FRONT_WINDOW, 1);
         let diff = max_difference(&a, &b);
         assert!(diff < 1e-11, "windowed and whole-band sweeps differ by {diff}");
-        assert!((sb.updates as f64) < 0.8 * sa.updates as f64, "{} vs {}", sb.updates, sa.updates);
+        assert!(
+            (sb.updates as f64) < 0.8 * sa.updates as f64,
+            "{} vs {}",
+            sb.updates,
+            sa.updates
+        );
         // a narrow window takes more iterations; the stopping test waits until it has opened
         let (c, sc) = run(0.3, 1);
         assert!(max_difference(&a, &c) < 1e-11);
@@ -1725,7 +2061,13 @@ mod tests {
         let src = band.find([10, (n / 2) as i64, (n / 2) as i64]).unwrap();
         roles[src] = NodeRole::Fixed;
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let second: Vec<usize> = band.indices().iter().enumerate().filter(|(_, idx)| idx[0] > n / 2).map(|(i, _)| i).collect();
+        let second: Vec<usize> = band
+            .indices()
+            .iter()
+            .enumerate()
+            .filter(|(_, idx)| idx[0] > n / 2)
+            .map(|(i, _)| i)
+            .collect();
         assert!(!second.is_empty());
         let (band1, mut roles1, dirs1, _) = shell_band(n, 0.25, &[-0.5]);
         roles1[band1.find([10, (n / 2) as i64, (n / 2) as i64]).unwrap()] = NodeRole::Fixed;
@@ -1736,9 +2078,22 @@ mod tests {
         for infinity in [None, Some(1e3), Some(1e5)] {
             let run = |front_window: f64| {
                 let mut u = vec![0.0; band.len()];
-                let st = p.solve(&mut u, &SolveOptions { front_window, infinity, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+                let st = p
+                    .solve(
+                        &mut u,
+                        &SolveOptions {
+                            front_window,
+                            infinity,
+                            ..Default::default()
+                        },
+                        &mut |_| Control::Continue,
+                    )
+                    .unwrap();
                 assert!(st.converged && st.window_edge == f64::INFINITY);
-                assert!(second.iter().all(|&i| u[i] == st.infinity), "an unreached node is not at the infinity");
+                assert!(
+                    second.iter().all(|&i| u[i] == st.infinity),
+                    "an unreached node is not at the infinity"
+                );
                 (u, st)
             };
             let (a, sa) = run(0.0);
@@ -1746,8 +2101,18 @@ mod tests {
             assert!(max_difference(&a, &b) < 1e-11);
             // the window runs as on the first sphere alone; then one pass finds the second
             // component's nodes unreached (measured: 15 iterations for every infinity, 14 alone)
-            assert!(sb.iterations <= alone.iterations + 2, "{infinity:?}: {} iterations against {}", sb.iterations, alone.iterations);
-            assert!(sb.updates <= sa.updates, "{infinity:?}: {} updates against {}", sb.updates, sa.updates);
+            assert!(
+                sb.iterations <= alone.iterations + 2,
+                "{infinity:?}: {} iterations against {}",
+                sb.iterations,
+                alone.iterations
+            );
+            assert!(
+                sb.updates <= sa.updates,
+                "{infinity:?}: {} updates against {}",
+                sb.updates,
+                sa.updates
+            );
         }
     }
 
@@ -1756,12 +2121,25 @@ mod tests {
         let (band, roles, dirs, h) = sphere_band(81);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let mut u = vec![0.0; band.len()];
-        let st = p.solve(&mut u, &SolveOptions { max_iterations: 4, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+        let st = p
+            .solve(
+                &mut u,
+                &SolveOptions {
+                    max_iterations: 4,
+                    ..Default::default()
+                },
+                &mut |_| Control::Continue,
+            )
+            .unwrap();
         assert!(!st.converged);
         assert!(st.window_edge.is_finite() && st.window_edge > 0.0, "{}", st.window_edge);
         // every value set lies within the window; the nodes beyond it are not reached yet
         let reached = (0..band.len()).filter(|&i| u[i] < st.infinity).count();
-        assert!(reached > 0 && reached < band.len() / 2, "{reached} of {} reached", band.len());
+        assert!(
+            reached > 0 && reached < band.len() / 2,
+            "{reached} of {} reached",
+            band.len()
+        );
         assert!(u.iter().all(|&v| v <= st.window_edge || v == st.infinity));
         // and it did only the work of the window: the first iteration updates a small part of
         // the band (measured: 31 k of the whole band's 188 k updates). (Whether values beyond the
@@ -1770,7 +2148,11 @@ mod tests {
         let first_updates = |front_window: f64| {
             let mut w = vec![0.0; band.len()];
             let mut first = 0;
-            let opts = SolveOptions { max_iterations: 1, front_window, ..Default::default() };
+            let opts = SolveOptions {
+                max_iterations: 1,
+                front_window,
+                ..Default::default()
+            };
             p.solve(&mut w, &opts, &mut |r| {
                 if r.iteration == 1 {
                     first = r.updates; // (the rim's pass is reported as the second)
@@ -1783,7 +2165,17 @@ mod tests {
         let (windowed, whole) = (first_updates(DEFAULT_FRONT_WINDOW), first_updates(0.0));
         assert!(windowed * 4 < whole, "{windowed} against {whole}");
         // with the window off, the same budget leaves no edge
-        let st = p.solve(&mut u, &SolveOptions { max_iterations: 4, front_window: 0.0, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+        let st = p
+            .solve(
+                &mut u,
+                &SolveOptions {
+                    max_iterations: 4,
+                    front_window: 0.0,
+                    ..Default::default()
+                },
+                &mut |_| Control::Continue,
+            )
+            .unwrap();
         assert_eq!(st.window_edge, f64::INFINITY);
     }
 
@@ -1800,7 +2192,11 @@ mod tests {
                 let phi = r - 0.5;
                 if phi.abs() <= 4.0 * h {
                     lin.push((i * n + j) as u64);
-                    roles.push(if phi.abs() <= 2.0 * h { NodeRole::Inner } else { NodeRole::Outer });
+                    roles.push(if phi.abs() <= 2.0 * h {
+                        NodeRole::Inner
+                    } else {
+                        NodeRole::Outer
+                    });
                     dirs.push([(x[0] * phi.signum() / r) as f32, (x[1] * phi.signum() / r) as f32]);
                 }
             }
@@ -1820,7 +2216,16 @@ mod tests {
         let mut work = Vec::new();
         for front_window in [0.0, DEFAULT_FRONT_WINDOW] {
             let mut v = vec![0.0; band.len()];
-            let st = p.solve(&mut v, &SolveOptions { front_window, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            let st = p
+                .solve(
+                    &mut v,
+                    &SolveOptions {
+                        front_window,
+                        ..Default::default()
+                    },
+                    &mut |_| Control::Continue,
+                )
+                .unwrap();
             assert!(st.converged);
             work.push((st.iterations, st.updates));
             u.push(v);
@@ -1836,7 +2241,10 @@ mod tests {
         // wake the neighbours must still keep the node's row dirty (the clean-row check in
         // `run_row` asserts it), and the result must not depend on the threads
         let (band, roles, _, h) = sphere_band(41);
-        let roles: Vec<NodeRole> = roles.iter().map(|&r| if r == NodeRole::Outer { NodeRole::Inner } else { r }).collect();
+        let roles: Vec<NodeRole> = roles
+            .iter()
+            .map(|&r| if r == NodeRole::Outer { NodeRole::Inner } else { r })
+            .collect();
         let p = SweepProblem {
             band: &band,
             roles: &roles,
@@ -1850,7 +2258,12 @@ mod tests {
         for threads in [1, 2, 3] {
             let mut u = vec![0.0; band.len()];
             // (a tube without its layer need not converge, Sect. 3: a fixed budget)
-            let opts = SolveOptions { threads, activation_threshold: 1e-3, max_iterations: 40, ..Default::default() };
+            let opts = SolveOptions {
+                threads,
+                activation_threshold: 1e-3,
+                max_iterations: 40,
+                ..Default::default()
+            };
             let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
             assert_eq!(st.iterations, 40);
             match &first {
@@ -1868,7 +2281,17 @@ mod tests {
         let mut stats = Vec::new();
         for front_window in [0.0, DEFAULT_FRONT_WINDOW] {
             let mut v = vec![0.0; band.len()];
-            stats.push(p.solve(&mut v, &SolveOptions { front_window, ..Default::default() }, &mut |_| Control::Continue).unwrap());
+            stats.push(
+                p.solve(
+                    &mut v,
+                    &SolveOptions {
+                        front_window,
+                        ..Default::default()
+                    },
+                    &mut |_| Control::Continue,
+                )
+                .unwrap(),
+            );
             u.push(v);
         }
         let work = |s: &SolveStats| (s.iterations, s.sweeps, s.updates, s.converged, s.last_change.to_bits());
@@ -1880,7 +2303,16 @@ mod tests {
     fn coupled_update_reaches_the_pointwise_fixed_point_with_fewer_updates() {
         let (band, roles, dirs, h) = sphere_band(41);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-        let run = |coupled: bool, threads: usize| converged(&p, SolveOptions { coupled, threads, ..Default::default() });
+        let run = |coupled: bool, threads: usize| {
+            converged(
+                &p,
+                SolveOptions {
+                    coupled,
+                    threads,
+                    ..Default::default()
+                },
+            )
+        };
         let (a, sa) = run(true, 1);
         let (b, sb) = run(false, 1);
         let diff = max_difference(&a, &b);
@@ -1898,12 +2330,26 @@ mod tests {
         let (band, roles, dirs, h) = sphere_band(41);
         for scheme in [InnerScheme::Godunov, InnerScheme::LaxFriedrichs] {
             let p = sphere_problem(&band, &roles, &dirs, h, scheme);
-            let run = |defer_outer_rim: bool, threads: usize| converged(&p, SolveOptions { defer_outer_rim, threads, ..Default::default() });
+            let run = |defer_outer_rim: bool, threads: usize| {
+                converged(
+                    &p,
+                    SolveOptions {
+                        defer_outer_rim,
+                        threads,
+                        ..Default::default()
+                    },
+                )
+            };
             let (a, sa) = run(true, 1);
             let (b, sb) = run(false, 1);
             let diff = max_difference(&a, &b);
             assert!(diff < 1e-10, "rim last and rim in every sweep differ by {diff}");
-            assert!((sa.updates as f64) < 0.85 * sb.updates as f64, "{} vs {}", sa.updates, sb.updates);
+            assert!(
+                (sa.updates as f64) < 0.85 * sb.updates as f64,
+                "{} vs {}",
+                sa.updates,
+                sb.updates
+            );
             let (c, _) = run(true, 3);
             assert!(a.iter().zip(&c).all(|(x, y)| x.to_bits() == y.to_bits()));
         }
@@ -1922,7 +2368,11 @@ mod tests {
         let mut checked = 0;
         for q in (0..band.len()).filter(|&q| rim[q] && !w[q][0].is_nan()) {
             let again = crate::extension::extension_apply_upwind(w[q], &band.neighbours_of(q), |i| {
-                if i == band.sentinel() { st.infinity } else { u[i as usize] }
+                if i == band.sentinel() {
+                    st.infinity
+                } else {
+                    u[i as usize]
+                }
             });
             assert_eq!(again.to_bits(), u[q].to_bits(), "rim node {q}");
             checked += 1;
@@ -1957,7 +2407,13 @@ mod tests {
             // no needed layer node reads a rim node in its update (5)
             if roles[i] == NodeRole::Outer && !rim[i] && !w[i][0].is_nan() {
                 for k in 0..3 {
-                    let side = if w[i][k] > 0.0 { 0 } else if w[i][k] < 0.0 { 1 } else { continue };
+                    let side = if w[i][k] > 0.0 {
+                        0
+                    } else if w[i][k] < 0.0 {
+                        1
+                    } else {
+                        continue;
+                    };
                     let q = band.neighbours_of(i)[k][side];
                     assert!(q == band.sentinel() || !rim[q as usize]);
                 }
@@ -1991,17 +2447,36 @@ mod tests {
             at[axis] = (n / 4) as i64;
             roles[band.find(at).unwrap()] = NodeRole::Fixed;
             let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
-            let (u1, s1) = converged(&p, SolveOptions { threads: 1, ..Default::default() });
+            let (u1, s1) = converged(
+                &p,
+                SolveOptions {
+                    threads: 1,
+                    ..Default::default()
+                },
+            );
             assert_eq!(s1.thin_strip_iterations, [0, 0], "one thread runs the sequential sweep");
             for threads in [2, 3] {
-                let (u, s) = converged(&p, SolveOptions { threads, ..Default::default() });
-                assert!(u.iter().zip(&u1).all(|(a, b)| a.to_bits() == b.to_bits()), "source on axis {axis}, {threads} threads");
+                let (u, s) = converged(
+                    &p,
+                    SolveOptions {
+                        threads,
+                        ..Default::default()
+                    },
+                );
+                assert!(
+                    u.iter().zip(&u1).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "source on axis {axis}, {threads} threads"
+                );
                 assert_eq!((s.iterations, s.updates), (s1.iterations, s1.updates));
                 let thin = s.thin_strip_iterations;
                 match axis {
                     2 => assert_eq!(thin, [0, 0]),
                     _ => {
-                        assert!(2 * thin[axis] > s.iterations, "axis {axis}: {thin:?} of {}", s.iterations);
+                        assert!(
+                            2 * thin[axis] > s.iterations,
+                            "axis {axis}: {thin:?} of {}",
+                            s.iterations
+                        );
                         assert_eq!(thin[1 - axis], 0, "axis {axis}: {thin:?}");
                     }
                 }
@@ -2024,8 +2499,13 @@ mod tests {
         // the gap: some strip follows a strip that is not its neighbour along the first axis
         let sched = band.schedule();
         let (strip_tiles, strips, upstream) = (sched.strip_tiles(0), sched.strips(0), sched.upstream(0));
-        let strips_without_upstream =
-            (0..strips.len() - 1).filter(|&s| strip_tiles[strips[s] as usize..strips[s + 1] as usize].iter().all(|&t| upstream[t as usize] == NO_TILE)).count();
+        let strips_without_upstream = (0..strips.len() - 1)
+            .filter(|&s| {
+                strip_tiles[strips[s] as usize..strips[s + 1] as usize]
+                    .iter()
+                    .all(|&t| upstream[t as usize] == NO_TILE)
+            })
+            .count();
         assert!(strips_without_upstream >= 2, "{strips_without_upstream}");
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let a = assert_same_bits_for_threads(&p, &[2, 3]);
@@ -2043,7 +2523,16 @@ mod tests {
         };
         for threads in [1, 2] {
             let mut u = Vec::new();
-            let st = p.solve(&mut u, &SolveOptions { threads, ..Default::default() }, &mut |_| Control::Continue).unwrap();
+            let st = p
+                .solve(
+                    &mut u,
+                    &SolveOptions {
+                        threads,
+                        ..Default::default()
+                    },
+                    &mut |_| Control::Continue,
+                )
+                .unwrap();
             assert!(st.converged && u.is_empty());
         }
     }
@@ -2066,9 +2555,20 @@ mod tests {
         // stopping in the rim's last pass ends the solve there
         let mut u = vec![0.0; band.len()];
         let err = p
-            .solve(&mut u, &opts, &mut |r| if r.iteration == st.iterations { Control::Stop } else { Control::Continue })
+            .solve(&mut u, &opts, &mut |r| {
+                if r.iteration == st.iterations {
+                    Control::Stop
+                } else {
+                    Control::Continue
+                }
+            })
             .unwrap_err();
-        assert_eq!(err, Error::Interrupted { iterations: st.iterations });
+        assert_eq!(
+            err,
+            Error::Interrupted {
+                iterations: st.iterations
+            }
+        );
     }
 
     #[test]
@@ -2078,9 +2578,10 @@ mod tests {
         roles[0] = NodeRole::Fixed;
         let mut u = vec![0.0; band.len()];
         let p = box_problem(&band, &roles, InnerScheme::LaxFriedrichs, 0.1);
-        let err = p.solve(&mut u, &SolveOptions::default(), &mut |_| Control::Stop).unwrap_err();
+        let err = p
+            .solve(&mut u, &SolveOptions::default(), &mut |_| Control::Stop)
+            .unwrap_err();
         assert_eq!(err, Error::Interrupted { iterations: 1 });
         assert_eq!(u.len(), band.len());
     }
 }
-

@@ -13,7 +13,12 @@ mod shell;
 /// directions. No sources. Returns the band, the roles, the directions and h.
 pub(crate) fn shell_band(n: usize, r0: f64, centres: &[f64]) -> (NarrowBand<3>, Vec<NodeRole>, Vec<[f32; 3]>, f64) {
     let (lin, roles, dirs, h) = shell::shell_nodes(n, r0, centres);
-    (NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap(), roles, dirs, h)
+    (
+        NarrowBand::<3>::from_sorted_linear([n, n, n], &lin).unwrap(),
+        roles,
+        dirs,
+        h,
+    )
 }
 
 /// A sphere of radius 0.5 in [−1,1]^3 (`shell_band`), source node nearest (−0.5, 0, 0).

@@ -5,16 +5,23 @@
 mod errors;
 
 use errors::to_pyerr;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadonlyArrayDyn, PyReadwriteArray2, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyReadonlyArrayDyn,
+    PyReadwriteArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
+use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
 use tubesweep_core::interpolate::interpolate;
 use tubesweep_core::nearest_source::nearest_source_labels;
-use tubesweep_core::sweep::{default_row_prefetch_above, extension_weights_in_place, Extension, MissingNeighbour, Slowness};
-use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
-use tubesweep_core::{Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
+use tubesweep_core::sweep::{
+    default_row_prefetch_above, extension_weights_in_place, Extension, MissingNeighbour, Slowness,
+};
+use tubesweep_core::{
+    Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem,
+};
 
 enum AnyBand {
     D2(NarrowBand<2>),
@@ -28,14 +35,18 @@ struct PyBand {
 }
 
 fn shape_array<const D: usize>(shape: &[usize]) -> PyResult<[usize; D]> {
-    shape.try_into().map_err(|_| PyValueError::new_err(format!("shape must have {D} entries")))
+    shape
+        .try_into()
+        .map_err(|_| PyValueError::new_err(format!("shape must have {D} entries")))
 }
 
 fn parse_scheme(name: &str) -> PyResult<u8> {
     match name {
         "godunov" => Ok(0),
         "lxf" => Ok(1),
-        _ => Err(PyValueError::new_err(format!("hamiltonian: unknown scheme {name:?}; use 'godunov' or 'lxf'"))),
+        _ => Err(PyValueError::new_err(format!(
+            "hamiltonian: unknown scheme {name:?}; use 'godunov' or 'lxf'"
+        ))),
     }
 }
 
@@ -57,24 +68,37 @@ fn stats_dict<'py>(py: Python<'py>, s: &SolveStats) -> PyResult<Bound<'py, PyDic
     d.set_item("seconds", s.seconds)?;
     d.set_item("infinity", s.infinity)?;
     d.set_item("window_edge", s.window_edge)?;
-    d.set_item("thin_strip_iterations", (s.thin_strip_iterations[0], s.thin_strip_iterations[1]))?;
+    d.set_item(
+        "thin_strip_iterations",
+        (s.thin_strip_iterations[0], s.thin_strip_iterations[1]),
+    )?;
     d.set_item("prefetch_iterations", s.prefetch_iterations)?;
     Ok(d)
 }
 
 /// The data of a C-ordered (row-major) NumPy array. `as_slice` also accepts Fortran order, whose
 /// data would then be read with the axes swapped: that is an error here, naming the argument.
-fn c_slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(a: &'a numpy::PyReadonlyArray<'_, T, D>, name: &str) -> PyResult<&'a [T]> {
+fn c_slice<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    a: &'a numpy::PyReadonlyArray<'_, T, D>,
+    name: &str,
+) -> PyResult<&'a [T]> {
     if !a.is_c_contiguous() {
-        return Err(PyValueError::new_err(format!("{name} must be a C-ordered array; pass np.ascontiguousarray({name})")));
+        return Err(PyValueError::new_err(format!(
+            "{name} must be a C-ordered array; pass np.ascontiguousarray({name})"
+        )));
     }
     Ok(a.as_slice()?)
 }
 
 /// [`c_slice`] for an array the solver writes.
-fn c_slice_mut<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(a: &'a mut numpy::PyReadwriteArray<'_, T, D>, name: &str) -> PyResult<&'a mut [T]> {
+fn c_slice_mut<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(
+    a: &'a mut numpy::PyReadwriteArray<'_, T, D>,
+    name: &str,
+) -> PyResult<&'a mut [T]> {
     if !a.is_c_contiguous() {
-        return Err(PyValueError::new_err(format!("{name} must be a C-ordered array; pass np.ascontiguousarray({name})")));
+        return Err(PyValueError::new_err(format!(
+            "{name} must be a C-ordered array; pass np.ascontiguousarray({name})"
+        )));
     }
     Ok(a.as_slice_mut()?)
 }
@@ -82,7 +106,10 @@ fn c_slice_mut<'a, T: numpy::Element, D: numpy::ndarray::Dimension>(a: &'a mut n
 /// The points (M, `d`) of a query as a C-ordered slice; a wrong shape names the one it needs.
 fn points_slice<'a>(points: &'a PyReadonlyArray2<'_, f64>, d: usize) -> PyResult<&'a [f64]> {
     if points.shape()[1] != d {
-        return Err(PyValueError::new_err(format!("points must have shape (M, {d}); got {:?}", points.shape())));
+        return Err(PyValueError::new_err(format!(
+            "points must have shape (M, {d}); got {:?}",
+            points.shape()
+        )));
     }
     c_slice(points, "points")
 }
@@ -165,28 +192,45 @@ fn check_fixed(n: usize, fixed: &FixedNodes<'_>) -> PyResult<()> {
         )));
     }
     if let Some(&p) = fixed.positions.iter().find(|&&p| p < 0 || p as usize >= n) {
-        return Err(PyValueError::new_err(format!("fixed_positions: {p} is not a position in the band of {n} nodes")));
+        return Err(PyValueError::new_err(format!(
+            "fixed_positions: {p} is not a position in the band of {n} nodes"
+        )));
     }
     Ok(())
 }
 
 /// Everything the solve would reject, checked before `directions` is overwritten with the
 /// extension weights: a call that fails leaves the caller's array as it was.
-fn check_before_consuming(n: usize, spacing: f64, options: &SolveOptions, slowness_len: Option<usize>, fixed: &FixedNodes<'_>) -> PyResult<()> {
+fn check_before_consuming(
+    n: usize,
+    spacing: f64,
+    options: &SolveOptions,
+    slowness_len: Option<usize>,
+    fixed: &FixedNodes<'_>,
+) -> PyResult<()> {
     if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(PyValueError::new_err(format!("spacing must be positive and finite, got {spacing}")));
+        return Err(PyValueError::new_err(format!(
+            "spacing must be positive and finite, got {spacing}"
+        )));
     }
     if !(options.tol >= 0.0) {
-        return Err(PyValueError::new_err(format!("tol must be non-negative, got {}", options.tol)));
+        return Err(PyValueError::new_err(format!(
+            "tol must be non-negative, got {}",
+            options.tol
+        )));
     }
     if let Some(v) = options.infinity {
         if !(v.is_finite() && v > 0.0) {
-            return Err(PyValueError::new_err(format!("infinity must be positive and finite, got {v}")));
+            return Err(PyValueError::new_err(format!(
+                "infinity must be positive and finite, got {v}"
+            )));
         }
     }
     if let Some(len) = slowness_len {
         if len != n {
-            return Err(PyValueError::new_err(format!("speed: the slowness must have one entry per band node ({n}), got {len}")));
+            return Err(PyValueError::new_err(format!(
+                "speed: the slowness must have one entry per band node ({n}), got {len}"
+            )));
         }
     }
     check_fixed(n, fixed)
@@ -251,7 +295,9 @@ fn solve_generic<'py, const D: usize>(
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
     let n = band.len();
     if roles.len() != n {
-        return Err(PyValueError::new_err(format!("roles must have one entry per band node ({n})")));
+        return Err(PyValueError::new_err(format!(
+            "roles must have one entry per band node ({n})"
+        )));
     }
     let roles = node_roles(roles)?;
     let slowness_arr: Option<PyReadonlyArray1<'py, f64>>;
@@ -278,7 +324,11 @@ fn solve_generic<'py, const D: usize>(
             (None, None) => Slowness::Constant(1.0),
         },
         extension: extension_in_place::<D>(band, roles, &mut directions, n)?,
-        scheme: if scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
+        scheme: if scheme == 0 {
+            InnerScheme::Godunov
+        } else {
+            InnerScheme::LaxFriedrichs
+        },
         missing,
     };
     run_sweeps(py, &problem, fixed, &options, progress)
@@ -296,13 +346,29 @@ struct GeneralInputs<'s> {
 /// Per axis, the largest over the band's nodes of the Hamiltonian's own viscosity `σ_k` (the exact
 /// bound of `|∂H/∂p_k|` it uses without a user's `sigma`): the smallest constant `sigma` that keeps
 /// the Lax–Friedrichs update monotone everywhere.
-fn required_sigma<const D: usize>(inputs: &GeneralInputs<'_>, flow: &[[f64; D]], metric: &[[[f64; D]; D]], n: usize) -> [f64; D] {
+fn required_sigma<const D: usize>(
+    inputs: &GeneralInputs<'_>,
+    flow: &[[f64; D]],
+    metric: &[[[f64; D]; D]],
+    n: usize,
+) -> [f64; D] {
     let ham: Box<dyn Hamiltonian<D> + '_> = match inputs.kind.as_str() {
         // a flow or metric missing or of the wrong length is refused after this, by the caller
-        "moving_medium" if flow.len() == n => Box::new(MovingMedium { slowness: inputs.slowness, flow, sigma: None }),
-        "metric" if metric.len() == n => Box::new(Metric { slowness: inputs.slowness, metric, sigma: None }),
+        "moving_medium" if flow.len() == n => Box::new(MovingMedium {
+            slowness: inputs.slowness,
+            flow,
+            sigma: None,
+        }),
+        "metric" if metric.len() == n => Box::new(Metric {
+            slowness: inputs.slowness,
+            metric,
+            sigma: None,
+        }),
         "moving_medium" | "metric" => return [0.0; D],
-        _ => Box::new(Isotropic { slowness: inputs.slowness, sigma: None }),
+        _ => Box::new(Isotropic {
+            slowness: inputs.slowness,
+            sigma: None,
+        }),
     };
     let mut needed = [0.0f64; D];
     for node in 0..n {
@@ -330,14 +396,21 @@ fn solve_general_generic<'py, const D: usize>(
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
     let n = band.len();
     if roles.len() != n {
-        return Err(PyValueError::new_err(format!("roles must have one entry per band node ({n})")));
+        return Err(PyValueError::new_err(format!(
+            "roles must have one entry per band node ({n})"
+        )));
     }
     if inputs.slowness.len() != n && inputs.slowness.len() != 1 {
-        return Err(PyValueError::new_err(format!("slowness must have 1 or {n} entries, got {}", inputs.slowness.len())));
+        return Err(PyValueError::new_err(format!(
+            "slowness must have 1 or {n} entries, got {}",
+            inputs.slowness.len()
+        )));
     }
     if let Some(s) = inputs.sigma {
         if s.len() != D || !s.iter().all(|x| x.is_finite() && *x > 0.0) {
-            return Err(PyValueError::new_err(format!("sigma must hold {D} positive finite numbers")));
+            return Err(PyValueError::new_err(format!(
+                "sigma must hold {D} positive finite numbers"
+            )));
         }
     }
     let roles = node_roles(roles)?;
@@ -371,21 +444,32 @@ fn solve_general_generic<'py, const D: usize>(
     let met;
     let ham: &dyn Hamiltonian<D> = match inputs.kind.as_str() {
         "isotropic" => {
-            iso = Isotropic { slowness: inputs.slowness, sigma: inputs.sigma };
+            iso = Isotropic {
+                slowness: inputs.slowness,
+                sigma: inputs.sigma,
+            };
             &iso
         }
         "moving_medium" => {
             if flow.is_empty() && n > 0 {
                 return Err(PyValueError::new_err("hamiltonian 'moving_medium' needs flow (K, d)"));
             }
-            mm = MovingMedium { slowness: inputs.slowness, flow, sigma: inputs.sigma };
+            mm = MovingMedium {
+                slowness: inputs.slowness,
+                flow,
+                sigma: inputs.sigma,
+            };
             &mm
         }
         "metric" => {
             if metric.is_empty() && n > 0 {
                 return Err(PyValueError::new_err("hamiltonian 'metric' needs metric (K, d, d)"));
             }
-            met = Metric { slowness: inputs.slowness, metric: &metric, sigma: inputs.sigma };
+            met = Metric {
+                slowness: inputs.slowness,
+                metric: &metric,
+                sigma: inputs.sigma,
+            };
             &met
         }
         other => {
@@ -427,7 +511,10 @@ impl PyBand {
             .detach(|| match shape.len() {
                 2 => NarrowBand::<2>::from_sorted_linear(shape[..].try_into().unwrap(), lin).map(AnyBand::D2),
                 3 => NarrowBand::<3>::from_sorted_linear(shape[..].try_into().unwrap(), lin).map(AnyBand::D3),
-                d => Err(tubesweep_core::Error::invalid("grid", format!("only 2D and 3D grids are supported, got {d}D"))),
+                d => Err(tubesweep_core::Error::invalid(
+                    "grid",
+                    format!("only 2D and 3D grids are supported, got {d}D"),
+                )),
             })
             .map_err(to_pyerr)?;
         Ok(PyBand { band })
@@ -438,8 +525,12 @@ impl PyBand {
     fn full_box(py: Python<'_>, shape: Vec<usize>) -> PyResult<Self> {
         let band = py
             .detach(|| match shape.len() {
-                2 => shape_array::<2>(&shape).ok().map(|s| NarrowBand::<2>::full_box(s).map(AnyBand::D2)),
-                3 => shape_array::<3>(&shape).ok().map(|s| NarrowBand::<3>::full_box(s).map(AnyBand::D3)),
+                2 => shape_array::<2>(&shape)
+                    .ok()
+                    .map(|s| NarrowBand::<2>::full_box(s).map(AnyBand::D2)),
+                3 => shape_array::<3>(&shape)
+                    .ok()
+                    .map(|s| NarrowBand::<3>::full_box(s).map(AnyBand::D3)),
                 _ => None,
             })
             .ok_or_else(|| PyValueError::new_err("grid: only 2D and 3D grids are supported"))?
@@ -494,7 +585,9 @@ impl PyBand {
     fn neighbours<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<i64>>> {
         let (flat, k, d): (Vec<i64>, usize, usize) = with_band!(self, b, {
             let d = self.ndim();
-            let flat = (0..b.len()).flat_map(|n| b.neighbours_of(n).into_iter().flat_map(|p| [p[0] as i64, p[1] as i64])).collect();
+            let flat = (0..b.len())
+                .flat_map(|n| b.neighbours_of(n).into_iter().flat_map(|p| [p[0] as i64, p[1] as i64]))
+                .collect();
             (flat, b.len(), d)
         });
         Ok(numpy::ndarray::Array3::from_shape_vec((k, d, 2), flat)
@@ -506,7 +599,12 @@ impl PyBand {
     /// band, as the module function `rim_nodes` gives them, read off this band's own neighbours
     /// (it must be the band of those linear indices). See
     /// `tubesweep_core::normals::rim_nodes_in_band`.
-    fn rim_nodes<'py>(&self, py: Python<'py>, start: usize, stop: usize) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
+    fn rim_nodes<'py>(
+        &self,
+        py: Python<'py>,
+        start: usize,
+        stop: usize,
+    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
         let (nodes, counts) = py
             .detach(|| with_band!(self, b, tubesweep_core::normals::rim_nodes_in_band(b, start..stop)))
             .map_err(to_pyerr)?;
@@ -531,7 +629,13 @@ impl PyBand {
         let (ph, rim) = (phi.as_slice()?, rim_phi.as_slice()?);
         let dir = c_slice_mut(&mut direction, "direction")?;
         let norms = py
-            .detach(|| with_band!(self, b, tubesweep_core::normals::outward_directions_in_band(b, spacing, ph, start..stop, rim, dir)))
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::normals::outward_directions_in_band(b, spacing, ph, start..stop, rim, dir)
+                )
+            })
             .map_err(to_pyerr)?;
         Ok(norms.into_pyarray(py))
     }
@@ -555,12 +659,20 @@ impl PyBand {
     }
 
     /// Band positions of the selected nodes that lack an in-grid neighbour in the band.
-    fn nodes_missing_neighbours<'py>(&self, py: Python<'py>, select: PyReadonlyArray1<'py, bool>) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    fn nodes_missing_neighbours<'py>(
+        &self,
+        py: Python<'py>,
+        select: PyReadonlyArray1<'py, bool>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let sel = select.as_slice()?;
         if sel.len() != self.__len__() {
             return Err(PyValueError::new_err("select must have one entry per band node"));
         }
-        let out: Vec<i64> = with_band!(self, b, b.nodes_missing_neighbours(sel).into_iter().map(|n| n as i64).collect());
+        let out: Vec<i64> = with_band!(
+            self,
+            b,
+            b.nodes_missing_neighbours(sel).into_iter().map(|n| n as i64).collect()
+        );
         Ok(out.into_pyarray(py))
     }
 
@@ -576,7 +688,11 @@ impl PyBand {
         phi: PyReadonlyArray1<'py, f32>,
         direction: PyReadonlyArray2<'py, f32>,
         spacing: f64,
-    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
+    ) -> PyResult<(
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<f64>>,
+    )> {
         let d = self.ndim();
         if direction.shape()[1] != d {
             return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
@@ -634,16 +750,19 @@ impl PyBand {
         let to_u32 = |a: &PyReadonlyArray1<'py, i64>, name: &str| -> PyResult<Vec<u32>> {
             c_slice(a, name)?
                 .iter()
-                .map(|&v| u32::try_from(v).map_err(|_| PyValueError::new_err(format!("{name}: {v} is not a valid index"))))
+                .map(|&v| {
+                    u32::try_from(v).map_err(|_| PyValueError::new_err(format!("{name}: {v} is not a valid index")))
+                })
                 .collect()
         };
         let fixed = to_u32(&fixed_positions, "fixed_positions")?;
         let labels = to_u32(&fixed_labels, "fixed_labels")?;
-        let out = py.detach(|| match &self.band {
-            AnyBand::D2(b) => nearest_source_labels(b, vals, &fixed, &labels),
-            AnyBand::D3(b) => nearest_source_labels(b, vals, &fixed, &labels),
-        })
-        .map_err(to_pyerr)?;
+        let out = py
+            .detach(|| match &self.band {
+                AnyBand::D2(b) => nearest_source_labels(b, vals, &fixed, &labels),
+                AnyBand::D3(b) => nearest_source_labels(b, vals, &fixed, &labels),
+            })
+            .map_err(to_pyerr)?;
         Ok(out.into_pyarray(py))
     }
 
@@ -680,14 +799,35 @@ impl PyBand {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
         if !(front_window >= 0.0 && front_window.is_finite()) {
-            return Err(PyValueError::new_err("front_window must be a non-negative finite number (0 switches the window off)"));
+            return Err(PyValueError::new_err(
+                "front_window must be a non-negative finite number (0 switches the window off)",
+            ));
         }
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled, defer_outer_rim, front_window, spread_threads: true, row_prefetch_above: default_row_prefetch_above() };
+        let options = SolveOptions {
+            tol,
+            max_iterations,
+            infinity,
+            threads,
+            skip_inactive,
+            activation_threshold,
+            coupled,
+            defer_outer_rim,
+            front_window,
+            spread_threads: true,
+            row_prefetch_above: default_row_prefetch_above(),
+        };
         let roles = roles.as_slice()?;
-        let fixed = FixedNodes { positions: fixed_positions.as_slice()?, values: fixed_values.as_slice()? };
+        let fixed = FixedNodes {
+            positions: fixed_positions.as_slice()?,
+            values: fixed_values.as_slice()?,
+        };
         match &self.band {
-            AnyBand::D2(b) => solve_generic(py, b, roles, &fixed, spacing, &slowness, directions, scheme, missing, options, progress),
-            AnyBand::D3(b) => solve_generic(py, b, roles, &fixed, spacing, &slowness, directions, scheme, missing, options, progress),
+            AnyBand::D2(b) => solve_generic(
+                py, b, roles, &fixed, spacing, &slowness, directions, scheme, missing, options, progress,
+            ),
+            AnyBand::D3(b) => solve_generic(
+                py, b, roles, &fixed, spacing, &slowness, directions, scheme, missing, options, progress,
+            ),
         }
     }
 
@@ -726,7 +866,19 @@ impl PyBand {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
         // the coupled update is Godunov's; the general Hamiltonians use Lax–Friedrichs
-        let options = SolveOptions { tol, max_iterations, infinity, threads, skip_inactive, activation_threshold, coupled: false, defer_outer_rim, front_window: 0.0, spread_threads: true, row_prefetch_above: default_row_prefetch_above() };
+        let options = SolveOptions {
+            tol,
+            max_iterations,
+            infinity,
+            threads,
+            skip_inactive,
+            activation_threshold,
+            coupled: false,
+            defer_outer_rim,
+            front_window: 0.0,
+            spread_threads: true,
+            row_prefetch_above: default_row_prefetch_above(),
+        };
         let inputs = GeneralInputs {
             kind: hamiltonian.to_string(),
             slowness: slowness.as_slice()?,
@@ -744,10 +896,17 @@ impl PyBand {
             },
         };
         let roles = roles.as_slice()?;
-        let fixed = FixedNodes { positions: fixed_positions.as_slice()?, values: fixed_values.as_slice()? };
+        let fixed = FixedNodes {
+            positions: fixed_positions.as_slice()?,
+            values: fixed_values.as_slice()?,
+        };
         match &self.band {
-            AnyBand::D2(b) => solve_general_generic(py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress),
-            AnyBand::D3(b) => solve_general_generic(py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress),
+            AnyBand::D2(b) => solve_general_generic(
+                py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress,
+            ),
+            AnyBand::D3(b) => solve_general_generic(
+                py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress,
+            ),
         }
     }
 }
@@ -765,7 +924,9 @@ impl PyTriangleTree {
     #[new]
     fn new(vertices: PyReadonlyArray2<'_, f64>, faces: PyReadonlyArray2<'_, i64>) -> PyResult<Self> {
         if vertices.shape()[1] != 3 || faces.shape()[1] != 3 {
-            return Err(PyValueError::new_err("vertices and faces must have shape (n, 3) and (m, 3)"));
+            return Err(PyValueError::new_err(
+                "vertices and faces must have shape (n, 3) and (m, 3)",
+            ));
         }
         let v = c_slice(&vertices, "vertices")?;
         let f = c_slice(&faces, "faces")?;
@@ -778,14 +939,18 @@ impl PyTriangleTree {
             let mut tri = [[0.0; 3]; 3];
             for (k, &i) in t.iter().enumerate() {
                 if i < 0 || i as usize >= n {
-                    return Err(PyValueError::new_err(format!("faces: vertex index {i} out of range 0..{n}")));
+                    return Err(PyValueError::new_err(format!(
+                        "faces: vertex index {i} out of range 0..{n}"
+                    )));
                 }
                 let i = i as usize;
                 tri[k] = [v[3 * i], v[3 * i + 1], v[3 * i + 2]];
             }
             tris.push(tri);
         }
-        Ok(PyTriangleTree { tree: tubesweep_core::mesh::TriangleTree::new(tris) })
+        Ok(PyTriangleTree {
+            tree: tubesweep_core::mesh::TriangleTree::new(tris),
+        })
     }
 
     fn __len__(&self) -> usize {
@@ -800,9 +965,16 @@ impl PyTriangleTree {
     /// Whether some triangle lies within `thresholds[i]` of `points[i]` ((M, 3) and (M,)): the
     /// answer of `closest(points, inf)[0] <= thresholds` without finding the closest triangles.
     /// See `tubesweep_core::mesh::TriangleTree::any_within_many`.
-    fn any_within<'py>(&self, py: Python<'py>, points: PyReadonlyArray2<'py, f64>, thresholds: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    fn any_within<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+        thresholds: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
         if points.shape()[1] != 3 || points.shape()[0] != thresholds.len() {
-            return Err(PyValueError::new_err("points must have shape (M, 3) and thresholds shape (M,)"));
+            return Err(PyValueError::new_err(
+                "points must have shape (M, 3) and thresholds shape (M,)",
+            ));
         }
         let (p, t) = (c_slice(&points, "points")?, c_slice(&thresholds, "thresholds")?);
         let found = py.detach(|| self.tree.any_within_many(p, t));
@@ -823,21 +995,33 @@ impl PyTriangleTree {
         on_surface: f64,
         face_normals: PyReadonlyArray2<'py, f64>,
         pseudo_normals: Option<PyReadonlyArray3<'py, f64>>,
-    ) -> PyResult<(Bound<'py, PyArray1<u32>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f32>>)> {
+    ) -> PyResult<(
+        Bound<'py, PyArray1<u32>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray2<f32>>,
+    )> {
         let t = self.tree.len();
         if points.shape()[1] != 3 {
             return Err(PyValueError::new_err("points must have shape (M, 3)"));
         }
         if face_normals.shape() != [t, 3] {
-            return Err(PyValueError::new_err(format!("face_normals must have shape ({t}, 3), one per triangle of the tree")));
+            return Err(PyValueError::new_err(format!(
+                "face_normals must have shape ({t}, 3), one per triangle of the tree"
+            )));
         }
         if let Some(pn) = &pseudo_normals {
             if pn.shape() != [t, 7, 3] {
-                return Err(PyValueError::new_err(format!("pseudo_normals must have shape ({t}, 7, 3)")));
+                return Err(PyValueError::new_err(format!(
+                    "pseudo_normals must have shape ({t}, 7, 3)"
+                )));
             }
         }
         let p = c_slice(&points, "points")?;
-        let face: Vec<[f64; 3]> = c_slice(&face_normals, "face_normals")?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let face: Vec<[f64; 3]> = c_slice(&face_normals, "face_normals")?
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
         let pseudo: Option<Vec<[[f64; 3]; 7]>> = match &pseudo_normals {
             Some(pn) => Some(
                 pn.as_slice()
@@ -850,13 +1034,22 @@ impl PyTriangleTree {
         };
         let band = py
             .detach(|| {
-                let normals = tubesweep_core::mesh_band::MeshNormals { face: &face, pseudo: pseudo.as_deref() };
+                let normals = tubesweep_core::mesh_band::MeshNormals {
+                    face: &face,
+                    pseudo: pseudo.as_deref(),
+                };
                 tubesweep_core::mesh_band::mesh_band(&self.tree, p, half_width, on_surface, &normals)
             })
             .map_err(to_pyerr)?;
         let k = band.kept.len();
-        let direction = numpy::ndarray::Array2::from_shape_vec((k, 3), band.direction).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        Ok((band.kept.into_pyarray(py), band.distance.into_pyarray(py), band.signed.into_pyarray(py), direction.into_pyarray(py)))
+        let direction = numpy::ndarray::Array2::from_shape_vec((k, 3), band.direction)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok((
+            band.kept.into_pyarray(py),
+            band.distance.into_pyarray(py),
+            band.signed.into_pyarray(py),
+            direction.into_pyarray(py),
+        ))
     }
 
     /// Closest points of `points` (M, 3) searched within `max_distance`: returns distance (M,)
@@ -868,7 +1061,12 @@ impl PyTriangleTree {
         py: Python<'py>,
         points: PyReadonlyArray2<'py, f64>,
         max_distance: f64,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<u8>>)> {
+    ) -> PyResult<(
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<u8>>,
+    )> {
         if points.shape()[1] != 3 {
             return Err(PyValueError::new_err("points must have shape (M, 3)"));
         }
@@ -895,8 +1093,14 @@ impl PyTriangleTree {
                 }
             }
         }
-        let cp = numpy::ndarray::Array2::from_shape_vec((m, 3), cp).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        Ok((dist.into_pyarray(py), cp.into_pyarray(py), tri.into_pyarray(py), feat.into_pyarray(py)))
+        let cp =
+            numpy::ndarray::Array2::from_shape_vec((m, 3), cp).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok((
+            dist.into_pyarray(py),
+            cp.into_pyarray(py),
+            tri.into_pyarray(py),
+            feat.into_pyarray(py),
+        ))
     }
 }
 
@@ -904,7 +1108,11 @@ impl PyTriangleTree {
 /// nodes of the 2 × … × 2 blocks with lowest corners `origins` (M, d) (even grid indices, no
 /// repeats, any order), cut to the grid of `shape`. See `tubesweep_core::discovery`.
 #[pyfunction]
-fn split_pair_blocks<'py>(py: Python<'py>, shape: Vec<usize>, origins: PyReadonlyArray2<'py, i64>) -> PyResult<Bound<'py, PyArray1<u64>>> {
+fn split_pair_blocks<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    origins: PyReadonlyArray2<'py, i64>,
+) -> PyResult<Bound<'py, PyArray1<u64>>> {
     let d = shape.len();
     if origins.shape()[1] != d {
         return Err(PyValueError::new_err(format!("origins must have shape (M, {d})")));
@@ -914,20 +1122,27 @@ fn split_pair_blocks<'py>(py: Python<'py>, shape: Vec<usize>, origins: PyReadonl
         return Err(PyValueError::new_err(format!("origins: negative grid index {bad}")));
     }
     fn blocks<const D: usize>(flat: &[i64]) -> Vec<[u64; D]> {
-        flat.chunks_exact(D).map(|c| core::array::from_fn(|k| c[k] as u64)).collect()
+        flat.chunks_exact(D)
+            .map(|c| core::array::from_fn(|k| c[k] as u64))
+            .collect()
     }
     let out = py
         .detach(|| match d {
             2 => tubesweep_core::discovery::split_pair_blocks::<2>(shape_array(&shape).unwrap(), &blocks::<2>(flat)),
             3 => tubesweep_core::discovery::split_pair_blocks::<3>(shape_array(&shape).unwrap(), &blocks::<3>(flat)),
-            _ => Err(tubesweep_core::Error::invalid("grid", format!("only 2D and 3D grids are supported, got {d}D"))),
+            _ => Err(tubesweep_core::Error::invalid(
+                "grid",
+                format!("only 2D and 3D grids are supported, got {d}D"),
+            )),
         })
         .map_err(to_pyerr)?;
     Ok(out.into_pyarray(py))
 }
 
 fn blocks_of<const D: usize>(flat: &[i64]) -> Vec<[u64; D]> {
-    flat.chunks_exact(D).map(|c| core::array::from_fn(|k| c[k] as u64)).collect()
+    flat.chunks_exact(D)
+        .map(|c| core::array::from_fn(|k| c[k] as u64))
+        .collect()
 }
 
 /// Block origins (M, d) as a C-ordered int64 array with no negative entry.
@@ -942,7 +1157,10 @@ fn block_origins<'a>(origins: &'a PyReadonlyArray2<'_, i64>, d: usize, name: &st
     Ok(flat)
 }
 
-fn flat_2d<'py, T: numpy::Element, const D: usize>(py: Python<'py>, rows: Vec<[T; D]>) -> PyResult<Bound<'py, PyArray2<T>>> {
+fn flat_2d<'py, T: numpy::Element, const D: usize>(
+    py: Python<'py>,
+    rows: Vec<[T; D]>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
     let m = rows.len();
     let flat: Vec<T> = rows.into_iter().flatten().collect();
     let a = numpy::ndarray::Array2::from_shape_vec((m, D), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -950,23 +1168,44 @@ fn flat_2d<'py, T: numpy::Element, const D: usize>(py: Python<'py>, rows: Vec<[T
 }
 
 fn coords_array<const D: usize>(v: &[f64], name: &str) -> PyResult<[f64; D]> {
-    v.try_into().map_err(|_| PyValueError::new_err(format!("{name} must have {D} entries")))
+    v.try_into()
+        .map_err(|_| PyValueError::new_err(format!("{name} must have {D} entries")))
 }
 
 /// The largest `|last − o|` (grid spacings) over the children of blocks of `2·block` nodes per
 /// axis with lowest corners `parents` (M, d). See `tubesweep_core::discovery::children_radius_max`.
 #[pyfunction]
-fn children_radius_max(py: Python<'_>, shape: Vec<usize>, parents: PyReadonlyArray2<'_, i64>, block: u64) -> PyResult<f64> {
+fn children_radius_max(
+    py: Python<'_>,
+    shape: Vec<usize>,
+    parents: PyReadonlyArray2<'_, i64>,
+    block: u64,
+) -> PyResult<f64> {
     let flat = block_origins(&parents, shape.len(), "parents")?;
     py.detach(|| match shape.len() {
-        2 => tubesweep_core::discovery::children_radius_max::<2>(shape_array(&shape).unwrap(), &blocks_of::<2>(flat), block),
-        3 => tubesweep_core::discovery::children_radius_max::<3>(shape_array(&shape).unwrap(), &blocks_of::<3>(flat), block),
-        d => Err(tubesweep_core::Error::invalid("grid", format!("only 2D and 3D grids are supported, got {d}D"))),
+        2 => tubesweep_core::discovery::children_radius_max::<2>(
+            shape_array(&shape).unwrap(),
+            &blocks_of::<2>(flat),
+            block,
+        ),
+        3 => tubesweep_core::discovery::children_radius_max::<3>(
+            shape_array(&shape).unwrap(),
+            &blocks_of::<3>(flat),
+            block,
+        ),
+        d => Err(tubesweep_core::Error::invalid(
+            "grid",
+            format!("only 2D and 3D grids are supported, got {d}D"),
+        )),
     })
     .map_err(to_pyerr)
 }
 
-type Children<'py> = (Bound<'py, PyArray2<i64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+type Children<'py> = (
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
 
 /// The children (blocks of `block` nodes per axis) of the blocks of `2·block` with lowest corners
 /// `parents` (M, d): `(origins (C, d) int64, centres (C, d), radii (C,))`, centres in world
@@ -981,10 +1220,19 @@ fn block_children<'py>(
     spacing: f64,
 ) -> PyResult<Children<'py>> {
     let flat = block_origins(&parents, shape.len(), "parents")?;
-    fn run<'py, const D: usize>(py: Python<'py>, shape: &[usize], flat: &[i64], block: u64, lower: &[f64], spacing: f64) -> PyResult<Children<'py>> {
+    fn run<'py, const D: usize>(
+        py: Python<'py>,
+        shape: &[usize],
+        flat: &[i64],
+        block: u64,
+        lower: &[f64],
+        spacing: f64,
+    ) -> PyResult<Children<'py>> {
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
         let (o, c, r) = py
-            .detach(|| tubesweep_core::discovery::block_children::<D>(shape, &blocks_of::<D>(flat), block, lower, spacing))
+            .detach(|| {
+                tubesweep_core::discovery::block_children::<D>(shape, &blocks_of::<D>(flat), block, lower, spacing)
+            })
             .map_err(to_pyerr)?;
         let o: Vec<[i64; D]> = o.into_iter().map(|b| b.map(|x| x as i64)).collect();
         Ok((flat_2d(py, o)?, flat_2d(py, c)?, r.into_pyarray(py)))
@@ -992,7 +1240,9 @@ fn block_children<'py>(
     match shape.len() {
         2 => run::<2>(py, &shape, flat, block, &lower, spacing),
         3 => run::<3>(py, &shape, flat, block, &lower, spacing),
-        d => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+        d => Err(PyValueError::new_err(format!(
+            "only 2D and 3D grids are supported, got {d}D"
+        ))),
     }
 }
 
@@ -1009,25 +1259,46 @@ fn keep_within<'py>(
     mut values_out: numpy::PyReadwriteArray1<'py, f64>,
 ) -> PyResult<usize> {
     let (lin, val) = (c_slice(&linear, "linear")?, c_slice(&values, "values")?);
-    let (lo, vo) = (c_slice_mut(&mut linear_out, "linear_out")?, c_slice_mut(&mut values_out, "values_out")?);
-    py.detach(|| tubesweep_core::discovery::keep_within(lin, val, half_width, lo, vo)).map_err(to_pyerr)
+    let (lo, vo) = (
+        c_slice_mut(&mut linear_out, "linear_out")?,
+        c_slice_mut(&mut values_out, "values_out")?,
+    );
+    py.detach(|| tubesweep_core::discovery::keep_within(lin, val, half_width, lo, vo))
+        .map_err(to_pyerr)
 }
 
 /// World coordinates (M, d) of the nodes with C-order linear indices `linear` (the arithmetic of
 /// `Grid.points`). See `tubesweep_core::discovery::node_points`.
 #[pyfunction]
-fn node_points<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, lower: Vec<f64>, spacing: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn node_points<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    linear: PyReadonlyArray1<'py, u64>,
+    lower: Vec<f64>,
+    spacing: f64,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let lin = c_slice(&linear, "linear")?;
-    fn run<'py, const D: usize>(py: Python<'py>, shape: &[usize], lin: &[u64], lower: &[f64], spacing: f64) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn run<'py, const D: usize>(
+        py: Python<'py>,
+        shape: &[usize],
+        lin: &[u64],
+        lower: &[f64],
+        spacing: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
-        let p = py.detach(|| tubesweep_core::discovery::node_points::<D>(shape, lin, lower, spacing)).map_err(to_pyerr)?;
-        let a = numpy::ndarray::Array2::from_shape_vec((lin.len(), D), p).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let p = py
+            .detach(|| tubesweep_core::discovery::node_points::<D>(shape, lin, lower, spacing))
+            .map_err(to_pyerr)?;
+        let a = numpy::ndarray::Array2::from_shape_vec((lin.len(), D), p)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
         Ok(a.into_pyarray(py))
     }
     match shape.len() {
         2 => run::<2>(py, &shape, lin, &lower, spacing),
         3 => run::<3>(py, &shape, lin, &lower, spacing),
-        d => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+        d => Err(PyValueError::new_err(format!(
+            "only 2D and 3D grids are supported, got {d}D"
+        ))),
     }
 }
 
@@ -1036,37 +1307,72 @@ fn node_points<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1
 /// the node's, or −2^31 where φ there must be supplied (off the band or outside the grid). See
 /// `tubesweep_core::normals::neighbour_table`.
 #[pyfunction]
-fn neighbour_table<'py>(py: Python<'py>, shape: Vec<usize>, linear: PyReadonlyArray1<'py, u64>, start: usize, stop: usize) -> PyResult<Bound<'py, PyArray2<i32>>> {
+fn neighbour_table<'py>(
+    py: Python<'py>,
+    shape: Vec<usize>,
+    linear: PyReadonlyArray1<'py, u64>,
+    start: usize,
+    stop: usize,
+) -> PyResult<Bound<'py, PyArray2<i32>>> {
     let lin = linear.as_slice()?;
-    let table = py.detach(|| tubesweep_core::normals::neighbour_table(&shape, lin, start..stop)).map_err(to_pyerr)?;
-    let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len().saturating_sub(1), stop - start), table).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let table = py
+        .detach(|| tubesweep_core::normals::neighbour_table(&shape, lin, start..stop))
+        .map_err(to_pyerr)?;
+    let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len().saturating_sub(1), stop - start), table)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(a.into_pyarray(py))
 }
 
 /// `|x − c| − r` at the points (M, d) with d = len(centre) (2 or 3): the exact signed distance
 /// to a circle or sphere. See `tubesweep_core::analytic::sphere_signed_distance`.
 #[pyfunction]
-fn sphere_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, radius: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn sphere_signed_distance<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    centre: Vec<f64>,
+    radius: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     if points.shape()[1] != centre.len() {
-        return Err(PyValueError::new_err(format!("points must have shape (M, {}) like the centre; got {:?}", centre.len(), points.shape())));
+        return Err(PyValueError::new_err(format!(
+            "points must have shape (M, {}) like the centre; got {:?}",
+            centre.len(),
+            points.shape()
+        )));
     }
-    phi_at_points(py, &points, centre.len(), |p, out| tubesweep_core::analytic::sphere_signed_distance(p, &centre, radius, out))
+    phi_at_points(py, &points, centre.len(), |p, out| {
+        tubesweep_core::analytic::sphere_signed_distance(p, &centre, radius, out)
+    })
 }
 
 /// `hypot(hypot(q_x, q_y) − R, q_z) − r` with `q = x − c` at the points (M, 3): the exact signed
 /// distance to a torus about the z axis. See `tubesweep_core::analytic::torus_signed_distance`.
 #[pyfunction]
-fn torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, major: f64, minor: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn torus_signed_distance<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    centre: Vec<f64>,
+    major: f64,
+    minor: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let c = coords_array::<3>(&centre, "centre")?;
-    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::torus_signed_distance(p, c, major, minor, out))
+    phi_at_points(py, &points, 3, |p, out| {
+        tubesweep_core::analytic::torus_signed_distance(p, c, major, minor, out)
+    })
 }
 
 /// The exact signed distance to the ellipsoid with semi-axes `axes` about `centre` at the points
 /// (M, 3). See `tubesweep_core::analytic::ellipsoid_signed_distance`.
 #[pyfunction]
-fn ellipsoid_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, axes: Vec<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn ellipsoid_signed_distance<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    centre: Vec<f64>,
+    axes: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (c, a) = (coords_array::<3>(&centre, "centre")?, coords_array::<3>(&axes, "axes")?);
-    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::ellipsoid_signed_distance(p, c, a, out))
+    phi_at_points(py, &points, 3, |p, out| {
+        tubesweep_core::analytic::ellipsoid_signed_distance(p, c, a, out)
+    })
 }
 
 /// The parameters (θ, s) of the closest point on the Möbius band (centre radius `r`, half-width
@@ -1083,7 +1389,8 @@ fn mobius_closest_parameters<'py>(
     let p = points_slice(&points, 3)?;
     let m = points.shape()[0];
     let (mut theta, mut s) = (vec![0.0; m], vec![0.0; m]);
-    py.detach(|| tubesweep_core::mobius::mobius_closest_parameters(p, r, w, iterations, &mut theta, &mut s)).map_err(to_pyerr)?;
+    py.detach(|| tubesweep_core::mobius::mobius_closest_parameters(p, r, w, iterations, &mut theta, &mut s))
+        .map_err(to_pyerr)?;
     Ok((theta.into_pyarray(py), s.into_pyarray(py)))
 }
 
@@ -1103,7 +1410,11 @@ fn open_surface_closest_points<'py>(
         "hemisphere" => hemisphere_closest_points,
         "disc" => disc_closest_points,
         "plane-patch" => plane_patch_closest_points,
-        _ => return Err(PyValueError::new_err(format!("kind must be 'hemisphere', 'disc' or 'plane-patch'; got {kind:?}"))),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "kind must be 'hemisphere', 'disc' or 'plane-patch'; got {kind:?}"
+            )))
+        }
     };
     let c = coords_array::<3>(&centre, "centre")?;
     let p = points_slice(&points, 3)?;
@@ -1118,23 +1429,46 @@ fn open_surface_closest_points<'py>(
 /// to `radius`) about `centre` at the points (M, 3). See
 /// `tubesweep_core::analytic::rounded_cube_signed_distance`.
 #[pyfunction]
-fn rounded_cube_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, centre: Vec<f64>, half_size: f64, radius: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn rounded_cube_signed_distance<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    centre: Vec<f64>,
+    half_size: f64,
+    radius: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let c = coords_array::<3>(&centre, "centre")?;
-    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::rounded_cube_signed_distance(p, c, half_size, radius, out))
+    phi_at_points(py, &points, 3, |p, out| {
+        tubesweep_core::analytic::rounded_cube_signed_distance(p, c, half_size, radius, out)
+    })
 }
 
 /// φ = min of the two torus distances of the double torus at the points (M, 3). See
 /// `tubesweep_core::analytic::double_torus_signed_distance`.
 #[pyfunction]
-fn double_torus_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, major: f64, minor: f64, offset: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    phi_at_points(py, &points, 3, |p, out| tubesweep_core::analytic::double_torus_signed_distance(p, major, minor, offset, out))
+fn double_torus_signed_distance<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    major: f64,
+    minor: f64,
+    offset: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    phi_at_points(py, &points, 3, |p, out| {
+        tubesweep_core::analytic::double_torus_signed_distance(p, major, minor, offset, out)
+    })
 }
 
 /// The exact signed distance to the six-fold star r(θ) = r0 + eps sin²(3θ) at the points (M, 2).
 /// See `tubesweep_core::analytic::star_signed_distance`.
 #[pyfunction]
-fn star_signed_distance<'py>(py: Python<'py>, points: PyReadonlyArray2<'py, f64>, r0: f64, eps: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    phi_at_points(py, &points, 2, |p, out| tubesweep_core::analytic::star_signed_distance(p, r0, eps, out))
+fn star_signed_distance<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    r0: f64,
+    eps: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    phi_at_points(py, &points, 2, |p, out| {
+        tubesweep_core::analytic::star_signed_distance(p, r0, eps, out)
+    })
 }
 
 fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Option<&'a [i32]>> {
@@ -1192,7 +1526,9 @@ fn outward_directions<'py>(
     let dir = c_slice_mut(&mut direction, "direction")?;
     let norms = py
         .detach(|| match table {
-            Some(t) => tubesweep_core::normals::outward_directions_with(&shape, spacing, lin, ph, start..stop, t, rim, dir),
+            Some(t) => {
+                tubesweep_core::normals::outward_directions_with(&shape, spacing, lin, ph, start..stop, t, rim, dir)
+            }
             None => tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir),
         })
         .map_err(to_pyerr)?;
@@ -1213,10 +1549,16 @@ type LinearAndValues<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>
 /// The band `|φ| ≤ half_width` of a φ sampled on the whole grid (`phi` has the grid's shape):
 /// sorted C-order linear indices and φ there. See `tubesweep_core::sampled::band_of_samples`.
 #[pyfunction]
-fn band_of_samples<'py>(py: Python<'py>, phi: PyReadonlyArrayDyn<'py, f64>, half_width: f64) -> PyResult<LinearAndValues<'py>> {
+fn band_of_samples<'py>(
+    py: Python<'py>,
+    phi: PyReadonlyArrayDyn<'py, f64>,
+    half_width: f64,
+) -> PyResult<LinearAndValues<'py>> {
     let shape = phi.shape().to_vec();
     let s = c_slice(&phi, "phi")?;
-    let (linear, values) = py.detach(|| tubesweep_core::sampled::band_of_samples(&shape, s, half_width)).map_err(to_pyerr)?;
+    let (linear, values) = py
+        .detach(|| tubesweep_core::sampled::band_of_samples(&shape, s, half_width))
+        .map_err(to_pyerr)?;
     Ok((linear.into_pyarray(py), values.into_pyarray(py)))
 }
 
@@ -1234,7 +1576,9 @@ fn outward_directions_of_samples<'py>(
     let shape = phi.shape().to_vec();
     let (s, lin) = (c_slice(&phi, "phi")?, c_slice(&linear, "linear")?);
     let dir = c_slice_mut(&mut direction, "direction")?;
-    let norms = py.detach(|| tubesweep_core::sampled::outward_directions_of_samples(&shape, spacing, s, lin, dir)).map_err(to_pyerr)?;
+    let norms = py
+        .detach(|| tubesweep_core::sampled::outward_directions_of_samples(&shape, spacing, s, lin, dir))
+        .map_err(to_pyerr)?;
     Ok(norms.into_pyarray(py))
 }
 
@@ -1244,7 +1588,8 @@ fn outward_directions_of_samples<'py>(
 fn max_gradient_norm_of_samples(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>, spacing: f64) -> PyResult<f64> {
     let shape = phi.shape().to_vec();
     let s = c_slice(&phi, "phi")?;
-    py.detach(|| tubesweep_core::sampled::max_gradient_norm_of_samples(&shape, spacing, s)).map_err(to_pyerr)
+    py.detach(|| tubesweep_core::sampled::max_gradient_norm_of_samples(&shape, spacing, s))
+        .map_err(to_pyerr)
 }
 
 /// The candidates for the re-distanced band of a φ sampled on the whole grid: the nodes with
@@ -1252,15 +1597,26 @@ fn max_gradient_norm_of_samples(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>
 /// node (sorted C-order linear indices and φ there). See
 /// `tubesweep_core::sampled::redistance_candidates_of_samples`.
 #[pyfunction]
-fn redistance_candidates_of_samples<'py>(py: Python<'py>, phi: PyReadonlyArrayDyn<'py, f64>, spacing: f64, half_width: f64) -> PyResult<LinearAndValues<'py>> {
+fn redistance_candidates_of_samples<'py>(
+    py: Python<'py>,
+    phi: PyReadonlyArrayDyn<'py, f64>,
+    spacing: f64,
+    half_width: f64,
+) -> PyResult<LinearAndValues<'py>> {
     let shape = phi.shape().to_vec();
     let s = c_slice(&phi, "phi")?;
-    let (linear, values) = py.detach(|| tubesweep_core::sampled::redistance_candidates_of_samples(&shape, spacing, s, half_width)).map_err(to_pyerr)?;
+    let (linear, values) = py
+        .detach(|| tubesweep_core::sampled::redistance_candidates_of_samples(&shape, spacing, s, half_width))
+        .map_err(to_pyerr)?;
     Ok((linear.into_pyarray(py), values.into_pyarray(py)))
 }
 
 /// Closest points, signed distances and convergence flags.
-type ProjectionArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<bool>>);
+type ProjectionArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+);
 
 /// Closest points of `points` (M, d) on the zero level set of the multilinear interpolant of a
 /// φ sampled on the whole grid (`phi` has the grid's shape; `lower` and `spacing` place it):
@@ -1284,27 +1640,56 @@ fn project_to_sampled_level_set<'py>(
     let shape = phi.shape().to_vec();
     let d = shape.len();
     if points.shape()[1] != d {
-        return Err(PyValueError::new_err(format!("points must have shape (M, {d}) like the grid; got {:?}", points.shape())));
+        return Err(PyValueError::new_err(format!(
+            "points must have shape (M, {d}) like the grid; got {:?}",
+            points.shape()
+        )));
     }
     let (s, p) = (c_slice(&phi, "phi")?, c_slice(&points, "points")?);
-    let options = ProjectionOptions { eps, newton_steps, orthogonality_steps, tol };
-    fn run<const D: usize>(s: &[f64], shape: &[usize], lower: &[f64], spacing: f64, p: &[f64], options: ProjectionOptions) -> PyResult<tubesweep_core::redistance::Projection> {
-        let field = SampledField::<D>::new(s, shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?, spacing).map_err(to_pyerr)?;
+    let options = ProjectionOptions {
+        eps,
+        newton_steps,
+        orthogonality_steps,
+        tol,
+    };
+    fn run<const D: usize>(
+        s: &[f64],
+        shape: &[usize],
+        lower: &[f64],
+        spacing: f64,
+        p: &[f64],
+        options: ProjectionOptions,
+    ) -> PyResult<tubesweep_core::redistance::Projection> {
+        let field = SampledField::<D>::new(s, shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?, spacing)
+            .map_err(to_pyerr)?;
         project_to_zero_level_set(&field, p, options).map_err(to_pyerr)
     }
     let out = py.detach(|| match d {
         2 => run::<2>(s, &shape, &lower, spacing, p, options),
         3 => run::<3>(s, &shape, &lower, spacing, p, options),
-        _ => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+        _ => Err(PyValueError::new_err(format!(
+            "only 2D and 3D grids are supported, got {d}D"
+        ))),
     })?;
     let m = out.signed.len();
-    let closest = numpy::ndarray::Array2::from_shape_vec((m, d), out.closest).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok((closest.into_pyarray(py), out.signed.into_pyarray(py), out.converged.into_pyarray(py)))
+    let closest = numpy::ndarray::Array2::from_shape_vec((m, d), out.closest)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((
+        closest.into_pyarray(py),
+        out.signed.into_pyarray(py),
+        out.converged.into_pyarray(py),
+    ))
 }
 
 /// The band, its structure and its outward directions, of a library surface whose φ is evaluated
 /// in Rust.
-type AnalyticBand<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>, Option<PyBand>, Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>);
+type AnalyticBand<'py> = (
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray1<f64>>,
+    Option<PyBand>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<f32>>,
+);
 
 /// The band of a library surface with a Rust φ (`kind` "sphere", "torus", "ellipsoid", "star",
 /// "rounded-cube" or "double-torus", `parameters` as `tubesweep_core::analytic::AnalyticSurface::from_parameters` takes
@@ -1327,31 +1712,62 @@ fn analytic_level_set_band<'py>(
     use tubesweep_core::analytic::AnalyticSurface;
     let surface = AnalyticSurface::from_parameters(kind, &parameters).map_err(to_pyerr)?;
     if surface.ndim() != shape.len() {
-        return Err(PyValueError::new_err(format!("surface: a {kind} in {}D on a {}D grid", surface.ndim(), shape.len())));
+        return Err(PyValueError::new_err(format!(
+            "surface: a {kind} in {}D on a {}D grid",
+            surface.ndim(),
+            shape.len()
+        )));
     }
     type Found = (Vec<u64>, Vec<f64>, Option<AnyBand>, Vec<f32>, Vec<f32>);
     #[allow(clippy::too_many_arguments)]
-    fn run<const D: usize>(surface: &AnalyticSurface, shape: &[usize], lower: &[f64], spacing: f64, half_width: f64, lipschitz: f64, wrap: fn(NarrowBand<D>) -> AnyBand) -> PyResult<Found> {
+    fn run<const D: usize>(
+        surface: &AnalyticSurface,
+        shape: &[usize],
+        lower: &[f64],
+        spacing: f64,
+        half_width: f64,
+        lipschitz: f64,
+        wrap: fn(NarrowBand<D>) -> AnyBand,
+    ) -> PyResult<Found> {
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
         let phi = |p: &[f64], out: &mut [f64]| surface.signed_distance(p, out);
-        let (linear, values) = tubesweep_core::discovery::discover_band::<D>(shape, lower, spacing, half_width, lipschitz, &phi).map_err(to_pyerr)?;
+        let (linear, values) =
+            tubesweep_core::discovery::discover_band::<D>(shape, lower, spacing, half_width, lipschitz, &phi)
+                .map_err(to_pyerr)?;
         if linear.is_empty() {
             return Ok((linear, values, None, Vec::new(), Vec::new()));
         }
         let band = NarrowBand::<D>::from_sorted_linear(shape, &linear).map_err(to_pyerr)?;
         let mut direction = vec![0.0f32; linear.len() * D];
-        let norms = tubesweep_core::normals::outward_directions_of_function_in_band(&band, &linear, &values, lower, spacing, &phi, &mut direction)
-            .map_err(to_pyerr)?;
+        let norms = tubesweep_core::normals::outward_directions_of_function_in_band(
+            &band,
+            &linear,
+            &values,
+            lower,
+            spacing,
+            &phi,
+            &mut direction,
+        )
+        .map_err(to_pyerr)?;
         Ok((linear, values, Some(wrap(band)), direction, norms))
     }
     let (linear, values, band, direction, norms) = py.detach(|| match shape.len() {
         2 => run::<2>(&surface, &shape, &lower, spacing, half_width, lipschitz, AnyBand::D2),
         3 => run::<3>(&surface, &shape, &lower, spacing, half_width, lipschitz, AnyBand::D3),
-        d => Err(PyValueError::new_err(format!("only 2D and 3D grids are supported, got {d}D"))),
+        d => Err(PyValueError::new_err(format!(
+            "only 2D and 3D grids are supported, got {d}D"
+        ))),
     })?;
     let d = shape.len();
-    let direction = numpy::ndarray::Array2::from_shape_vec((linear.len(), d), direction).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok((linear.into_pyarray(py), values.into_pyarray(py), band.map(|band| PyBand { band }), direction.into_pyarray(py), norms.into_pyarray(py)))
+    let direction = numpy::ndarray::Array2::from_shape_vec((linear.len(), d), direction)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((
+        linear.into_pyarray(py),
+        values.into_pyarray(py),
+        band.map(|band| PyBand { band }),
+        direction.into_pyarray(py),
+        norms.into_pyarray(py),
+    ))
 }
 
 /// The bytes of the sweeps' arrays that the rows of an iteration must hold for the next

@@ -32,7 +32,7 @@ NAMES: Dict[str, str] = {"bunny": "stanford-bunny.obj.gz", "spot": "spot.obj.gz"
 #: One line of credit per bundled mesh (full terms in ``tubesweep/data/README.md``).
 CREDITS: Dict[str, str] = {
     "bunny": "Stanford Bunny: Greg Turk and Marc Levoy (1994), Stanford 3D Scanning Repository, "
-             "Stanford Computer Graphics Laboratory",
+    "Stanford Computer Graphics Laboratory",
     "spot": "Spot: Keenan Crane, Keenan's 3D Model Repository (released into the public domain, CC0)",
 }
 
@@ -68,8 +68,9 @@ def path(name: str) -> Path:
         raise ValueError(f"no bundled mesh named {name!r}; the bundled meshes are {sorted(NAMES)}")
     p = _HERE / NAMES[key]
     if not p.is_file():
-        raise FileNotFoundError(f"the bundled mesh {p} is missing: reinstall tubesweep (its wheel ships "
-                                "tubesweep/data/*.obj.gz)")
+        raise FileNotFoundError(
+            f"the bundled mesh {p} is missing: reinstall tubesweep (its wheel ships tubesweep/data/*.obj.gz)"
+        )
     return p
 
 

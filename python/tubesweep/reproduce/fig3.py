@@ -99,8 +99,10 @@ def run(out_dir: Path, quick: bool) -> dict:
 
     k25 = sel("h/dx=2.5/sqrt2")
     closed_dev = max(abs(r["u11"] - r["closed_form"]) for r in k25)
-    slopes = {g: R.fit_order([r["dx"] for r in sel(f"h=1.5dx^{g:g}")], [r["error"] for r in sel(f"h=1.5dx^{g:g}")])
-              for g in GAMMAS}
+    slopes = {
+        g: R.fit_order([r["dx"] for r in sel(f"h=1.5dx^{g:g}")], [r["error"] for r in sel(f"h=1.5dx^{g:g}")])
+        for g in GAMMAS
+    }
     alg3 = sel("Algorithm 3 (Godunov, 2dx/4dx)")
     alg3_order = R.fit_order([r["dx"] for r in alg3], [r["error"] for r in alg3])
     finest = {k: sel(f"h/dx={k:g}/sqrt2")[-1]["u11"] for k in KS}
@@ -109,32 +111,46 @@ def run(out_dir: Path, quick: bool) -> dict:
     head = ["N"] + [f"k={k:g}" for k in KS] + ["closed form (k=2.5)"]
     body = []
     for i, n in enumerate(ns_fixed):
-        body.append([n] + [f'{sel(f"h/dx={k:g}/sqrt2")[i]["u11"]:.6f}' for k in KS] + [f'{k25[i]["closed_form"]:.6f}'])
+        body.append([n] + [f"{sel(f'h/dx={k:g}/sqrt2')[i]['u11']:.6f}" for k in KS] + [f"{k25[i]['closed_form']:.6f}"])
     gam_head = ["N"] + [f"u(1,1), γ={g:g}" for g in GAMMAS] + [f"error, γ={g:g}" for g in GAMMAS]
     gam_body = []
     for i, n in enumerate(ns_gamma):
-        gam_body.append([n] + [f'{sel(f"h=1.5dx^{g:g}")[i]["u11"]:.6f}' for g in GAMMAS]
-                        + [sel(f"h=1.5dx^{g:g}")[i]["error"] for g in GAMMAS])
+        gam_body.append(
+            [n]
+            + [f"{sel(f'h=1.5dx^{g:g}')[i]['u11']:.6f}" for g in GAMMAS]
+            + [sel(f"h=1.5dx^{g:g}")[i]["error"] for g in GAMMAS]
+        )
     slope_tab = R.markdown_table(
         ["γ", "fitted slope (ours)", "paper", "ratio ours/paper"],
-        [[0.7, slopes[0.7], PAPER_SLOPE_GAMMA07, R.ratio(slopes[0.7], PAPER_SLOPE_GAMMA07)],
-         [0.8, slopes[0.8], "< 0.5 (“slower than O(√Δx)”)", "–"]],
+        [
+            [0.7, slopes[0.7], PAPER_SLOPE_GAMMA07, R.ratio(slopes[0.7], PAPER_SLOPE_GAMMA07)],
+            [0.8, slopes[0.8], "< 0.5 (“slower than O(√Δx)”)", "–"],
+        ],
     )
-    alg3_tab = R.markdown_table(["N", "u(1,1)", "error", "iterations", "band points"],
-                                [[r["N"], f'{r["u11"]:.6f}', r["error"], r["iterations"], r["band_points"]] for r in alg3])
+    alg3_tab = R.markdown_table(
+        ["N", "u(1,1)", "error", "iterations", "band points"],
+        [[r["N"], f"{r['u11']:.6f}", r["error"], r["iterations"], r["band_points"]] for r in alg3],
+    )
     cost_tab = R.markdown_table(
         ["case", "N", "band points", "iterations", "updates", "seconds"],
         [[r["case"], r["N"], r["band_points"], r["iterations"], r["updates"], r["wall_seconds"]] for r in rows],
     )
-    R.write_markdown(out_dir / "fig3.md", "Fig. 3 — the naive tube on the line y = x" + (" (quick)" if quick else ""), [
-        ("", "u(1,1) for Algorithm 2 (naive tube, Godunov, source node), Δx = 1/N on [0,1]², exact √2 = 1.414214. "
-             f"Limit for h/Δx = 5/√8 (k = 2.5): (α₊+√(2−α₋²))/2 = {NAIVE_LIMIT:.6f}. "
-             f"Largest |ours − closed form (Prop. 3.2)| for k = 2.5: {closed_dev:.2e}."),
-        ("Fixed ratio h/Δx = k/√2 (Fig. 3a, b)", R.markdown_table(head, body)),
-        ("h = 1.5 Δx^γ (Fig. 3a, c)", R.markdown_table(gam_head, gam_body) + "\n\n" + slope_tab),
-        ("Algorithm 3 on the same line", alg3_tab + f"\n\nFitted order: {alg3_order:.4f} (converges to √2)."),
-        ("Cost of every run", cost_tab),
-    ])
+    R.write_markdown(
+        out_dir / "fig3.md",
+        "Fig. 3 — the naive tube on the line y = x" + (" (quick)" if quick else ""),
+        [
+            (
+                "",
+                "u(1,1) for Algorithm 2 (naive tube, Godunov, source node), Δx = 1/N on [0,1]², exact √2 = 1.414214. "
+                f"Limit for h/Δx = 5/√8 (k = 2.5): (α₊+√(2−α₋²))/2 = {NAIVE_LIMIT:.6f}. "
+                f"Largest |ours − closed form (Prop. 3.2)| for k = 2.5: {closed_dev:.2e}.",
+            ),
+            ("Fixed ratio h/Δx = k/√2 (Fig. 3a, b)", R.markdown_table(head, body)),
+            ("h = 1.5 Δx^γ (Fig. 3a, c)", R.markdown_table(gam_head, gam_body) + "\n\n" + slope_tab),
+            ("Algorithm 3 on the same line", alg3_tab + f"\n\nFitted order: {alg3_order:.4f} (converges to √2)."),
+            ("Cost of every run", cost_tab),
+        ],
+    )
 
     # --- figure -----------------------------------------------------------------------------
     p = R.plt()
@@ -143,8 +159,9 @@ def run(out_dir: Path, quick: bool) -> dict:
     cmap = p.get_cmap("Blues")
     for j, k in enumerate(KS):
         rr = sel(f"h/dx={k:g}/sqrt2")
-        ax.semilogx([r["dx"] for r in rr], [r["u11"] for r in rr], "o-", color=cmap(0.9 - 0.1 * j), ms=4,
-                    label=f"h/Δx={k:g}/√2")
+        ax.semilogx(
+            [r["dx"] for r in rr], [r["u11"] for r in rr], "o-", color=cmap(0.9 - 0.1 * j), ms=4, label=f"h/Δx={k:g}/√2"
+        )
     for g, mk in zip(GAMMAS, ("s--", "D--")):
         rr = sel(f"h=1.5dx^{g:g}")
         ax.semilogx([r["dx"] for r in rr], [r["u11"] for r in rr], "k" + mk, ms=4, label=f"h=1.5Δx^{g:g}")
@@ -167,14 +184,33 @@ def run(out_dir: Path, quick: bool) -> dict:
     ax.set_title("(b) fixed h/Δx: converged value ≠ √2", fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
-    series = [{"x": [r["dx"] for r in sel(f"h=1.5dx^{g:g}")], "y": [r["error"] for r in sel(f"h=1.5dx^{g:g}")],
-               "label": f"γ={g:g} (slope {slopes[g]:.3f})", "style": mk}
-              for g, mk in zip(GAMMAS, ("ks-", "kD--"))]
-    series.append({"x": [r["dx"] for r in alg3], "y": [r["error"] for r in alg3],
-                   "label": f"Algorithm 3 (slope {alg3_order:.3f})", "style": "g^-"})
-    R.loglog_png(None, series, xlabel="Δx", ylabel="|u(1,1) − √2|", refs=(0.5, 1.0),
-                 title=f"(c) error; paper: slope {PAPER_SLOPE_GAMMA07} for γ=0.7", ax=axs[2],
-                 ref_anchor=(series[0]["x"][0], series[0]["y"][0] * 1.5))
+    series = [
+        {
+            "x": [r["dx"] for r in sel(f"h=1.5dx^{g:g}")],
+            "y": [r["error"] for r in sel(f"h=1.5dx^{g:g}")],
+            "label": f"γ={g:g} (slope {slopes[g]:.3f})",
+            "style": mk,
+        }
+        for g, mk in zip(GAMMAS, ("ks-", "kD--"))
+    ]
+    series.append(
+        {
+            "x": [r["dx"] for r in alg3],
+            "y": [r["error"] for r in alg3],
+            "label": f"Algorithm 3 (slope {alg3_order:.3f})",
+            "style": "g^-",
+        }
+    )
+    R.loglog_png(
+        None,
+        series,
+        xlabel="Δx",
+        ylabel="|u(1,1) − √2|",
+        refs=(0.5, 1.0),
+        title=f"(c) error; paper: slope {PAPER_SLOPE_GAMMA07} for γ=0.7",
+        ax=axs[2],
+        ref_anchor=(series[0]["x"][0], series[0]["y"][0] * 1.5),
+    )
     from matplotlib.ticker import NullFormatter
 
     for a in (axs[0], axs[2]):
@@ -192,8 +228,11 @@ def run(out_dir: Path, quick: bool) -> dict:
         "alg3_finest_error": alg3[-1]["error"],
         "rows": rows,
     }
-    print(f"   k=2.5 u(1,1)={finest[2.5]:.6f} (limit {NAIVE_LIMIT:.6f}); slope γ=0.7 {slopes[0.7]:.4f} "
-          f"(paper {PAPER_SLOPE_GAMMA07}), γ=0.8 {slopes[0.8]:.4f}; Algorithm 3 order {alg3_order:.3f}", flush=True)
+    print(
+        f"   k=2.5 u(1,1)={finest[2.5]:.6f} (limit {NAIVE_LIMIT:.6f}); slope γ=0.7 {slopes[0.7]:.4f} "
+        f"(paper {PAPER_SLOPE_GAMMA07}), γ=0.8 {slopes[0.8]:.4f}; Algorithm 3 order {alg3_order:.3f}",
+        flush=True,
+    )
     return summary
 
 

@@ -53,14 +53,31 @@ def _cases(quick: bool) -> List[Dict[str, Any]]:
     cube = ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
     cases: List[Dict[str, Any]] = []
     sphere = Sphere()
-    cases.append(dict(name="sphere", surface=sphere, grid=Grid(*cube, (n_a,) * 3), source=sphere.default_source,
-                      outer=4.0, up="z", exact=lambda v, s=sphere: s.geodesic_distance(v, s.default_source)))
+    cases.append(
+        dict(
+            name="sphere",
+            surface=sphere,
+            grid=Grid(*cube, (n_a,) * 3),
+            source=sphere.default_source,
+            outer=4.0,
+            up="z",
+            exact=lambda v, s=sphere: s.geodesic_distance(v, s.default_source),
+        )
+    )
     box = ((-0.8, -0.8, -0.3), (0.8, 0.8, 0.3))
     h = 1.6 / (n_a - 1)
     nz = int(np.ceil(0.6 / h)) + 1
-    cases.append(dict(name="torus", surface=LevelSet(_torus, lipschitz=1.0),
-                      grid=Grid(box[0], (0.8, 0.8, -0.3 + h * (nz - 1)), (n_a, n_a, nz)), source=np.array([0.7, 0.0, 0.0]),
-                      outer=4.0, up="z", exact=None))
+    cases.append(
+        dict(
+            name="torus",
+            surface=LevelSet(_torus, lipschitz=1.0),
+            grid=Grid(box[0], (0.8, 0.8, -0.3 + h * (nz - 1)), (n_a, n_a, nz)),
+            source=np.array([0.7, 0.0, 0.0]),
+            outer=4.0,
+            up="z",
+            exact=None,
+        )
+    )
     for name in sorted(REGISTRY):
         if name in ("sphere", "torus"):
             continue
@@ -71,14 +88,31 @@ def _cases(quick: bool) -> List[Dict[str, Any]]:
         if getattr(s, "ndim", None) != 3 or not isinstance(s, LevelSet) or not hasattr(s, "default_source"):
             continue
         lo, hi = getattr(s, "default_box", cube)
-        cases.append(dict(name=name, surface=s, grid=Grid(lo, hi, (n_a,) * 3), source=np.asarray(s.default_source),
-                          outer=4.0, up="z", exact=None))
+        cases.append(
+            dict(
+                name=name,
+                surface=s,
+                grid=Grid(lo, hi, (n_a,) * 3),
+                source=np.asarray(s.default_source),
+                outer=4.0,
+                up="z",
+                exact=None,
+            )
+        )
     for key, n_full, outer in (("bunny", 200, 5.0), ("spot", 150, 4.0)):
         m = from_mesh(data.path(key))
         src = m.default_source_vertex
-        cases.append(dict(name=m.name, surface=m, grid=m.grid(60 if quick else n_full, padding=outer + 3),
-                          source=m.vertices[src], outer=outer, up="y",
-                          exact=lambda v, m=m, src=src: _exact_mesh_geodesics(m.vertices, m.faces, src)))
+        cases.append(
+            dict(
+                name=m.name,
+                surface=m,
+                grid=m.grid(60 if quick else n_full, padding=outer + 3),
+                source=m.vertices[src],
+                outer=outer,
+                up="y",
+                exact=lambda v, m=m, src=src: _exact_mesh_geodesics(m.vertices, m.faces, src),
+            )
+        )
     return cases
 
 
@@ -97,9 +131,19 @@ def run(out_dir: Path, quick: bool) -> dict:
             sol = solve(c["surface"], c["grid"], [c["source"]], inner=2.0, outer=c["outer"])
         wall = time.perf_counter() - t0
         h = c["grid"].spacing
-        row = dict(surface=c["name"], grid="x".join(map(str, c["grid"].shape)), dx=f"{h:.4g}", inner=2, outer=c["outer"],
-                   band_points=sol.stats.band_points, iterations=sol.stats.iterations, seconds=f"{wall:.2f}",
-                   facing_pairs=sol.stats.facing_pairs, err_max_dx="", err_mean_dx="")
+        row = dict(
+            surface=c["name"],
+            grid="x".join(map(str, c["grid"].shape)),
+            dx=f"{h:.4g}",
+            inner=2,
+            outer=c["outer"],
+            band_points=sol.stats.band_points,
+            iterations=sol.stats.iterations,
+            seconds=f"{wall:.2f}",
+            facing_pairs=sol.stats.facing_pairs,
+            err_max_dx="",
+            err_mean_dx="",
+        )
         if c["exact"] is not None:
             v, _ = triangulate(sol)
             ex = c["exact"](v)
@@ -134,10 +178,12 @@ def run(out_dir: Path, quick: bool) -> dict:
         w.writerows(rows)
     with open(out_dir / "fig8.md", "w") as fh:
         fh.write("# Fig. 8 — solutions on implicit surfaces\n\n")
-        fh.write("Errors in grid spacings against the great-circle distance (sphere) and exact polyhedral geodesics "
-                 "(meshes, pygeodesic), at the vertices of the surface's triangulation. `facing_pairs`: neighbouring "
-                 "band nodes across a gap narrower than the tubes, where the solve warned of possible shortcuts "
-                 "(docs/surfaces.md).\n\n")
+        fh.write(
+            "Errors in grid spacings against the great-circle distance (sphere) and exact polyhedral geodesics "
+            "(meshes, pygeodesic), at the vertices of the surface's triangulation. `facing_pairs`: neighbouring "
+            "band nodes across a gap narrower than the tubes, where the solve warned of possible shortcuts "
+            "(docs/surfaces.md).\n\n"
+        )
         fh.write("| " + " | ".join(rows[0]) + " |\n|" + "---|" * len(rows[0]) + "\n")
         for r in rows:
             fh.write("| " + " | ".join(str(v) for v in r.values()) + " |\n")

@@ -58,7 +58,9 @@ def _draw(ax, Poly3DCollection, V, F, u, vmax, source, title, elev, azim, cmap) 
     ax.computed_zorder = False  # keep the source marker on top even where the surface hides it
     coll.set_zorder(1)
     ax.add_collection3d(coll)
-    ax.scatter(*np.asarray(source).reshape(1, 3).T, c="r", s=70, marker="o", edgecolors="w", depthshade=False, zorder=10)
+    ax.scatter(
+        *np.asarray(source).reshape(1, 3).T, c="r", s=70, marker="o", edgecolors="w", depthshade=False, zorder=10
+    )
     lo, hi = V.min(0), V.max(0)
     c = 0.5 * (lo + hi)
     r = 0.5 * (hi - lo).max()
@@ -92,24 +94,53 @@ def run(out_dir: Path, quick: bool = False) -> dict:
             u = sol(Vh)
             e = np.abs(u - exact_h)
             er = np.abs(sol(rim) - hemi.geodesic_distance(rim, h_src))
-            rows.append(dict(surface="hemisphere", hamiltonian=ham, N=n, max_error=float(np.max(e)),
-                             mean_error=float(np.mean(e)), rim_max_error=float(np.max(er)),
-                             iterations=sol.stats.iterations, band_points=sol.stats.band_points, seconds=round(wall, 3)))
+            rows.append(
+                dict(
+                    surface="hemisphere",
+                    hamiltonian=ham,
+                    N=n,
+                    max_error=float(np.max(e)),
+                    mean_error=float(np.mean(e)),
+                    rim_max_error=float(np.max(er)),
+                    iterations=sol.stats.iterations,
+                    band_points=sol.stats.band_points,
+                    seconds=round(wall, 3),
+                )
+            )
             if ham == "godunov":
                 last["hemisphere"] = u
         for n in m_sizes:
             t0 = time.perf_counter()
             sol = solve(mob, Grid(*mob.default_box, (n,) * 3), [m_src], hamiltonian=ham)
             wall = time.perf_counter() - t0
-            row: Dict[str, object] = dict(surface="mobius", hamiltonian=ham, N=n, max_error=np.nan, mean_error=np.nan,
-                                          rim_max_error=np.nan, iterations=sol.stats.iterations,
-                                          band_points=sol.stats.band_points, seconds=round(wall, 3))
+            row: Dict[str, object] = dict(
+                surface="mobius",
+                hamiltonian=ham,
+                N=n,
+                max_error=np.nan,
+                mean_error=np.nan,
+                rim_max_error=np.nan,
+                iterations=sol.stats.iterations,
+                band_points=sol.stats.band_points,
+                seconds=round(wall, 3),
+            )
             if ref is not None:
                 Vr, dr = ref
                 e = np.abs(sol(Vr) - dr)
                 row.update(max_error=float(np.max(e)), mean_error=float(np.mean(e)))
-                bnd = np.abs(np.abs(np.einsum("ij,ij->i", Vr - mob.point(np.arctan2(Vr[:, 1], Vr[:, 0]), 0.0),
-                                              mob._derivs(np.arctan2(Vr[:, 1], Vr[:, 0]), np.zeros(len(Vr)))[2])) - mob.w) < 1e-9
+                bnd = (
+                    np.abs(
+                        np.abs(
+                            np.einsum(
+                                "ij,ij->i",
+                                Vr - mob.point(np.arctan2(Vr[:, 1], Vr[:, 0]), 0.0),
+                                mob._derivs(np.arctan2(Vr[:, 1], Vr[:, 0]), np.zeros(len(Vr)))[2],
+                            )
+                        )
+                        - mob.w
+                    )
+                    < 1e-9
+                )
                 row["rim_max_error"] = float(np.max(e[bnd])) if np.any(bnd) else np.nan
             rows.append(row)
             if ham == "godunov":
@@ -129,21 +160,30 @@ def run(out_dir: Path, quick: bool = False) -> dict:
             out.append(f"{np.log2(ea / eb):.2f}" if np.isfinite(ea) and np.isfinite(eb) and eb > 0 else "–")
         return out
 
-    lines = ["# Fig. 9 — closest-point surfaces (paper Sect. 6.2)", "",
-             "Hemisphere: radius 0.5, source at polar angle π/4, error against the great-circle distance at the "
-             f"{len(Vh)} vertices of its triangulation (rim: the {len(rim)} vertices on the boundary circle). "
-             "Möbius band: R = 0.6, half-width 0.3, source X(π/2, 0); error against exact polyhedral geodesics "
-             + (f"(pygeodesic) on a {len(ref[0])}-vertex triangulation (rim: its boundary vertices)." if ref is not None
-                else "— **skipped: pygeodesic is not installed** (`pip install pygeodesic`)."),
-             "Grid: the cube [-1, 1]³ with N nodes per side; inner/outer widths 2Δx/4Δx; source_init='exact'.", "",
-             "| surface | H | N | max error | order | mean error | rim max error | iterations | band points | seconds |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# Fig. 9 — closest-point surfaces (paper Sect. 6.2)",
+        "",
+        "Hemisphere: radius 0.5, source at polar angle π/4, error against the great-circle distance at the "
+        f"{len(Vh)} vertices of its triangulation (rim: the {len(rim)} vertices on the boundary circle). "
+        "Möbius band: R = 0.6, half-width 0.3, source X(π/2, 0); error against exact polyhedral geodesics "
+        + (
+            f"(pygeodesic) on a {len(ref[0])}-vertex triangulation (rim: its boundary vertices)."
+            if ref is not None
+            else "— **skipped: pygeodesic is not installed** (`pip install pygeodesic`)."
+        ),
+        "Grid: the cube [-1, 1]³ with N nodes per side; inner/outer widths 2Δx/4Δx; source_init='exact'.",
+        "",
+        "| surface | H | N | max error | order | mean error | rim max error | iterations | band points | seconds |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for surface in ("hemisphere", "mobius"):
         for ham in HAMILTONIANS:
             r = [x for x in rows if x["surface"] == surface and x["hamiltonian"] == ham]
             for x, o in zip(r, order(surface, ham, "max_error")):
-                lines.append(f"| {surface} | {ham} | {x['N']} | {x['max_error']:.4g} | {o} | {x['mean_error']:.4g} | "
-                             f"{x['rim_max_error']:.4g} | {x['iterations']} | {x['band_points']} | {x['seconds']} |")
+                lines.append(
+                    f"| {surface} | {ham} | {x['N']} | {x['max_error']:.4g} | {o} | {x['mean_error']:.4g} | "
+                    f"{x['rim_max_error']:.4g} | {x['iterations']} | {x['band_points']} | {x['seconds']} |"
+                )
     (out_dir / "fig9.md").write_text("\n".join(lines) + "\n")
     # ---------------------------------------------------------------- pictures
     plt, Poly3DCollection = _plt()
@@ -165,8 +205,11 @@ def run(out_dir: Path, quick: bool = False) -> dict:
         sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, vmax))
         fig.colorbar(sm, ax=ax, shrink=0.6, label="u (geodesic distance)")
     n_h, n_m = h_sizes[-1], m_sizes[-1]
-    fig.suptitle(f"Fig. 9: Godunov two-layer solutions interpolated onto triangulated surfaces "
-                 f"(hemisphere N={n_h}, Möbius N={n_m}); red dot = source", fontsize=11)
+    fig.suptitle(
+        f"Fig. 9: Godunov two-layer solutions interpolated onto triangulated surfaces "
+        f"(hemisphere N={n_h}, Möbius N={n_m}); red dot = source",
+        fontsize=11,
+    )
     fig.tight_layout()
     fig.savefig(out_dir / "fig9.png", dpi=110)
     plt.close(fig)
@@ -175,8 +218,13 @@ def run(out_dir: Path, quick: bool = False) -> dict:
         for ham, ls in (("godunov", "-"), ("lxf", "--")):
             r = [x for x in rows if x["surface"] == surface and x["hamiltonian"] == ham]
             if all(np.isfinite(float(x["max_error"])) for x in r):  # type: ignore[arg-type]
-                ax.loglog([2.0 / (int(x["N"]) - 1) for x in r], [x["max_error"] for x in r], ls, marker=marker,
-                          label=f"{surface}, {ham}")
+                ax.loglog(
+                    [2.0 / (int(x["N"]) - 1) for x in r],
+                    [x["max_error"] for x in r],
+                    ls,
+                    marker=marker,
+                    label=f"{surface}, {ham}",
+                )
     hs = np.array([2.0 / 40, 2.0 / 320])
     ax.loglog(hs, 2.0 * hs, "k:", label="first order")
     ax.set_xlabel("Δx"), ax.set_ylabel("max error on the triangulation")

@@ -41,9 +41,17 @@ def _rows(name: str, cases, make, exact_fn, pts):
     for n in cases:
         sol = make(n)
         e = np.abs(sol(pts) - exact)
-        rows.append({"case": name, "N": n, "h": sol.grid.spacing, "max_err": float(np.nanmax(e)),
-                     "mean_err": float(np.nanmean(e)), "iterations": sol.stats.iterations,
-                     "seconds": round(sol.stats.seconds, 3)})
+        rows.append(
+            {
+                "case": name,
+                "N": n,
+                "h": sol.grid.spacing,
+                "max_err": float(np.nanmax(e)),
+                "mean_err": float(np.nanmean(e)),
+                "iterations": sol.stats.iterations,
+                "seconds": round(sol.stats.seconds, 3),
+            }
+        )
     for a, b in zip(rows[:-1], rows[1:]):
         b["order_max"] = float(np.log(a["max_err"] / b["max_err"]) / np.log(a["h"] / b["h"]))
         b["order_mean"] = float(np.log(a["mean_err"] / b["mean_err"]) / np.log(a["h"] / b["h"]))
@@ -62,22 +70,44 @@ def run(out_dir: Path, quick: bool) -> dict:
     ps = rng.normal(size=(4000, 3))
     ps = R * ps / np.linalg.norm(ps, axis=1, keepdims=True)
     rows = []
-    rows += _rows("moving medium, rotation, circle", n2,
-                  lambda n: solve(circ, g2(n), [(-R, 0)], speed=1.0, flow=solid_body_rotation(1.0)),
-                  lambda p: rotation_travel_time_circle(p, R, np.pi, 1.0, 1.0), pc)
-    rows += _rows("metric M2, circle", n2,
-                  lambda n: solve(circ, g2(n), [(-R, 0)], hamiltonian=Metric(M2)), _metric_circle_exact, pc)
+    rows += _rows(
+        "moving medium, rotation, circle",
+        n2,
+        lambda n: solve(circ, g2(n), [(-R, 0)], speed=1.0, flow=solid_body_rotation(1.0)),
+        lambda p: rotation_travel_time_circle(p, R, np.pi, 1.0, 1.0),
+        pc,
+    )
+    rows += _rows(
+        "metric M2, circle",
+        n2,
+        lambda n: solve(circ, g2(n), [(-R, 0)], hamiltonian=Metric(M2)),
+        _metric_circle_exact,
+        pc,
+    )
     sph = Sphere(R)
-    rows += _rows("moving medium, rotation, sphere", n3,
-                  lambda n: solve(sph, g3(n), [(-R, 0, 0)], speed=1.0, flow=solid_body_rotation(1.0)),
-                  lambda p: rotation_travel_time_sphere(p, R, (-R, 0, 0), 1.0, 1.0), ps)
-    rows += _rows("isotropic LxF (v = 0), sphere", n3,
-                  lambda n: solve(sph, g3(n), [(-R, 0, 0)], hamiltonian="lxf"),
-                  lambda p: sph.geodesic_distance(p, (-R, 0, 0)), ps)
-    lines = ["| case | N | h | max error | order | mean error | order | iterations |", "|---|---|---|---|---|---|---|---|"]
+    rows += _rows(
+        "moving medium, rotation, sphere",
+        n3,
+        lambda n: solve(sph, g3(n), [(-R, 0, 0)], speed=1.0, flow=solid_body_rotation(1.0)),
+        lambda p: rotation_travel_time_sphere(p, R, (-R, 0, 0), 1.0, 1.0),
+        ps,
+    )
+    rows += _rows(
+        "isotropic LxF (v = 0), sphere",
+        n3,
+        lambda n: solve(sph, g3(n), [(-R, 0, 0)], hamiltonian="lxf"),
+        lambda p: sph.geodesic_distance(p, (-R, 0, 0)),
+        ps,
+    )
+    lines = [
+        "| case | N | h | max error | order | mean error | order | iterations |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        lines.append(f"| {r['case']} | {r['N']} | {r['h']:.4g} | {r['max_err']:.3e} | {r.get('order_max', float('nan')):.2f} | "
-                     f"{r['mean_err']:.3e} | {r.get('order_mean', float('nan')):.2f} | {r['iterations']} |")
+        lines.append(
+            f"| {r['case']} | {r['N']} | {r['h']:.4g} | {r['max_err']:.3e} | {r.get('order_max', float('nan')):.2f} | "
+            f"{r['mean_err']:.3e} | {r.get('order_mean', float('nan')):.2f} | {r['iterations']} |"
+        )
     table = "\n".join(lines)
     (out_dir / "hj_convergence.md").write_text(table + "\n")
     (out_dir / "hj_convergence.json").write_text(json.dumps(rows, indent=1))

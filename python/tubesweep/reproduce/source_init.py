@@ -18,7 +18,7 @@ def run(out_dir: Path, quick: bool) -> dict:
     circle = Circle(0.5)
     pts = circle.sample(2000)
     exact2 = circle.geodesic_distance(pts, circle.default_source)
-    for n in ((101, 201) if quick else (101, 201, 401, 801)):
+    for n in (101, 201) if quick else (101, 201, 401, 801):
         g = Grid((-1, -1), (1, 1), (n, n))
         for ham in ("godunov", "lxf"):
             errs = {}
@@ -28,7 +28,7 @@ def run(out_dir: Path, quick: bool) -> dict:
             rows.append(("circle r=0.5", n, ham, errs["exact"], errs["node"]))
     th = np.linspace(0, 2 * np.pi, 720, endpoint=False)
     ring = np.stack([np.zeros_like(th), 0.5 * np.cos(th), 0.5 * np.sin(th)], 1)
-    for n in ((41, 81) if quick else (81, 101, 151, 201)):
+    for n in (41, 81) if quick else (81, 101, 151, 201):
         g = Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
         for ham in ("godunov", "lxf"):
             errs = {}
@@ -41,7 +41,10 @@ def run(out_dir: Path, quick: bool) -> dict:
         w.writerow(["surface", "N", "hamiltonian", "max_error_exact", "max_error_node", "node_over_exact"])
         for r in rows:
             w.writerow([*r, r[4] / r[3]])
-    lines = ["| surface | N | H | max error, exact | max error, node (paper) | node / exact |", "|---|---|---|---|---|---|"]
+    lines = [
+        "| surface | N | H | max error, exact | max error, node (paper) | node / exact |",
+        "|---|---|---|---|---|---|",
+    ]
     for s, n, h, e, nd in rows:
         lines.append(f"| {s} | {n} | {h} | {e:.3e} | {nd:.3e} | {nd / e:.2f} |")
     (out_dir / "source_init.md").write_text("\n".join(lines) + "\n")

@@ -127,7 +127,9 @@ def _figure(name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, co
             ax = axes[row, col]
             ax.add_patch(plt.Circle((0, 0), RADIUS, fill=False, color="0.3", lw=1.0))
             if row == 0:
-                im = ax.pcolormesh(X, Y, np.minimum(speed, 2 * SPEED), cmap="Blues", vmin=0, vmax=2 * SPEED, shading="auto")
+                im = ax.pcolormesh(
+                    X, Y, np.minimum(speed, 2 * SPEED), cmap="Blues", vmin=0, vmax=2 * SPEED, shading="auto"
+                )
                 ax.contour(X, Y, speed, levels=[SPEED], colors="red", linestyles="--", linewidths=1.0)
                 k = max(1, n_img // 22)
                 vx = (v @ B[0]).reshape(X.shape)
@@ -135,8 +137,16 @@ def _figure(name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, co
                 mag = np.maximum(np.hypot(vx, vy), 1e-12)
                 sl = (slice(k // 2, None, k), slice(k // 2, None, k))
                 msk = inside[sl]
-                ax.quiver(X[sl][msk], Y[sl][msk], (vx / mag)[sl][msk], (vy / mag)[sl][msk], color="0.25", scale=40,
-                          width=0.003, headwidth=3)
+                ax.quiver(
+                    X[sl][msk],
+                    Y[sl][msk],
+                    (vx / mag)[sl][msk],
+                    (vy / mag)[sl][msk],
+                    color="0.25",
+                    scale=40,
+                    width=0.003,
+                    headwidth=3,
+                )
                 ax.contour(X, Y, u, levels=levels, colors="k", linewidths=0.9)
             else:
                 ax.contour(X, Y, other, levels=levels, colors="m", linestyles=":", linewidths=1.2)
@@ -154,12 +164,19 @@ def _figure(name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, co
             ax.set_yticks([])
             wv = np.asarray(w) / np.linalg.norm(w)
             label = "abcd"[2 * row + col]
-            sub = "flow |v| and arrows" if row == 0 else {"still": "magenta: v = 0", "core": f"magenta: core δ = {CORE}"}[compare]
+            sub = (
+                "flow |v| and arrows"
+                if row == 0
+                else {"still": "magenta: v = 0", "core": f"magenta: core δ = {CORE}"}[compare]
+            )
             ax.set_title(f"({label}) view from ({wv[0]:.2f}, {wv[1]:.2f}, {wv[2]:.2f}); {sub}", fontsize=9)
     fig.colorbar(im, ax=axes[0, :], shrink=0.7, label="|v| (clipped at 2F; red dashed: |v| = F)")
     g = res["grid"]
-    fig.suptitle(f"{case['title']} — black: u (step {LEVEL_STEP}), F = {SPEED}, s = {STRENGTH}, grid {g.shape[0]}³, "
-                 "allow_supersonic=True", fontsize=10)
+    fig.suptitle(
+        f"{case['title']} — black: u (step {LEVEL_STEP}), F = {SPEED}, s = {STRENGTH}, grid {g.shape[0]}³, "
+        "allow_supersonic=True",
+        fontsize=10,
+    )
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

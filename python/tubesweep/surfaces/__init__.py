@@ -51,5 +51,20 @@ REGISTRY: Dict[str, Callable[[], Surface]] = {
     "mobius": MobiusBand,
 }
 
-__all__ = ["Circle", "Star", "Ellipse", "Sphere", "Ellipsoid", "Torus", "RoundedCube", "DoubleTorus", "Hemisphere",
-           "Disc", "PlanePatch", "MobiusBand", "MeshSurface", "from_mesh", "REGISTRY"]
+__all__ = [
+    "Circle",
+    "Star",
+    "Ellipse",
+    "Sphere",
+    "Ellipsoid",
+    "Torus",
+    "RoundedCube",
+    "DoubleTorus",
+    "Hemisphere",
+    "Disc",
+    "PlanePatch",
+    "MobiusBand",
+    "MeshSurface",
+    "from_mesh",
+    "REGISTRY",
+]

@@ -44,15 +44,14 @@ def polyline(points: np.ndarray, closed: bool = True) -> Tuple[np.ndarray, np.nd
     return np.asarray(points, dtype=float), seg.astype(np.int64)
 
 
-def marching_cubes(phi: Callable[[np.ndarray], np.ndarray], box: Tuple[Sequence[float], Sequence[float]],
-                   n: int) -> Tuple[np.ndarray, np.ndarray]:
+def marching_cubes(
+    phi: Callable[[np.ndarray], np.ndarray], box: Tuple[Sequence[float], Sequence[float]], n: int
+) -> Tuple[np.ndarray, np.ndarray]:
     """Zero level set of a vectorised φ over ``box`` on an n³ grid (scikit-image marching cubes)."""
     try:
         from skimage.measure import marching_cubes as _mc
     except ImportError as exc:  # pragma: no cover - optional dependency
-        raise ImportError(
-            "triangulating an implicit surface needs scikit-image: pip install tubesweep[mesh]"
-        ) from exc
+        raise ImportError("triangulating an implicit surface needs scikit-image: pip install tubesweep[mesh]") from exc
     lo = np.asarray(box[0], dtype=float)
     hi = np.asarray(box[1], dtype=float)
     axes = [np.linspace(lo[k], hi[k], n) for k in range(3)]

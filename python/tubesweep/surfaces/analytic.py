@@ -241,13 +241,21 @@ class Star(LevelSet):
         # each 1/12 turn between extrema of r is smooth: integrate piecewise with 20-point GL
         xg, wg = np.polynomial.legendre.leggauss(20)
         edges = np.linspace(0, 2 * np.pi, 13)
-        seg_len = np.array([
-            0.5 * (b - a) * np.sum(wg * self.speed(0.5 * (b - a) * xg + 0.5 * (a + b))) for a, b in zip(edges[:-1], edges[1:])
-        ])
+        seg_len = np.array(
+            [
+                0.5 * (b - a) * np.sum(wg * self.speed(0.5 * (b - a) * xg + 0.5 * (a + b)))
+                for a, b in zip(edges[:-1], edges[1:])
+            ]
+        )
         cum = np.concatenate([[0.0], np.cumsum(seg_len)])
         k = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, 11)
         a = edges[k]
-        part = np.array([0.5 * (tt - aa) * np.sum(wg * self.speed(0.5 * (tt - aa) * xg + 0.5 * (aa + tt))) for tt, aa in zip(t.reshape(-1), a.reshape(-1))])
+        part = np.array(
+            [
+                0.5 * (tt - aa) * np.sum(wg * self.speed(0.5 * (tt - aa) * xg + 0.5 * (aa + tt)))
+                for tt, aa in zip(t.reshape(-1), a.reshape(-1))
+            ]
+        )
         return (cum[k].reshape(-1) + part).reshape(t.shape)
 
     @property

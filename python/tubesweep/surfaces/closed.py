@@ -104,8 +104,9 @@ class Ellipsoid(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
-        return _native.ellipsoid_signed_distance(_points(p, 3), [float(c) for c in self.center],
-                                                 [float(a) for a in self.axes])
+        return _native.ellipsoid_signed_distance(
+            _points(p, 3), [float(c) for c in self.center], [float(a) for a in self.axes]
+        )
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
         return ("ellipsoid", [*map(float, self.center), *map(float, self.axes)]) if own_phi(self, Ellipsoid) else None
@@ -187,7 +188,9 @@ class Torus(LevelSet):
         Ro = self.R + self.r
         tol = 1e-6 * Ro
         if abs(s[2]) > tol or abs(np.hypot(s[0], s[1]) - Ro) > tol:
-            raise ValueError(f"source {tuple(s + self.center)} is not on the outer equator (radius R + r = {Ro}, z = 0)")
+            raise ValueError(
+                f"source {tuple(s + self.center)} is not on the outer equator (radius R + r = {Ro}, z = 0)"
+            )
         on = (np.abs(q[:, 2]) <= tol) & (np.abs(np.hypot(q[:, 0], q[:, 1]) - Ro) <= tol)
         dth = np.abs(np.angle(np.exp(1j * (np.arctan2(q[:, 1], q[:, 0]) - np.arctan2(s[1], s[0])))))
         d = Ro * dth
@@ -229,11 +232,16 @@ class RoundedCube(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
-        return _native.rounded_cube_signed_distance(_points(p, 3), [float(c) for c in self.center],
-                                                    self.half_size, self.radius)
+        return _native.rounded_cube_signed_distance(
+            _points(p, 3), [float(c) for c in self.center], self.half_size, self.radius
+        )
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
-        return ("rounded-cube", [*map(float, self.center), self.half_size, self.radius]) if own_phi(self, RoundedCube) else None
+        return (
+            ("rounded-cube", [*map(float, self.center), self.half_size, self.radius])
+            if own_phi(self, RoundedCube)
+            else None
+        )
 
     def _signed_distance_numpy(self, p: np.ndarray) -> np.ndarray:
         """The NumPy formulation of :meth:`signed_distance` (the reference the tests compare with)."""

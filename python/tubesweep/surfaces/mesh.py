@@ -64,8 +64,10 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
         try:
             m = trimesh.load(str(path), force="mesh", process=False, maintain_order=True)
         except (ValueError, IndexError, KeyError, TypeError, AttributeError) as e:
-            raise ValueError(f"{path}: not a readable triangle mesh ({type(e).__name__}: {e}); tubesweep reads OBJ, "
-                             "PLY, STL and OFF files") from None
+            raise ValueError(
+                f"{path}: not a readable triangle mesh ({type(e).__name__}: {e}); tubesweep reads OBJ, "
+                "PLY, STL and OFF files"
+            ) from None
         v = np.asarray(m.vertices, dtype=float)
         f = np.asarray(m.faces, dtype=np.int64)
         if f.size == 0:
@@ -97,8 +99,9 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
 FACE, VERT_A, VERT_B, VERT_C, EDGE_AB, EDGE_AC, EDGE_BC = range(7)
 
 
-def closest_points_on_triangles(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray
-                                ) -> Tuple[np.ndarray, np.ndarray]:
+def closest_points_on_triangles(
+    p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray
+) -> Tuple[np.ndarray, np.ndarray]:
     """Closest point on triangle (a_i, b_i, c_i) to p_i, for arrays of shape (n, 3).
 
     The Voronoi-region test of the triangle (vertices, edges, interior), vectorised. Returns the
@@ -183,8 +186,16 @@ class MeshSurface(Surface):
 
     ndim = 3
 
-    def __init__(self, vertices: np.ndarray, faces: np.ndarray, *, signed: Optional[bool] = None,
-                 name: str = "mesh", scale: float = 1.0, offset: Optional[np.ndarray] = None):
+    def __init__(
+        self,
+        vertices: np.ndarray,
+        faces: np.ndarray,
+        *,
+        signed: Optional[bool] = None,
+        name: str = "mesh",
+        scale: float = 1.0,
+        offset: Optional[np.ndarray] = None,
+    ):
         v = np.ascontiguousarray(real_array(vertices, "vertices"))
         f = np.ascontiguousarray(whole_indices(faces, "faces"))
         if v.ndim != 2 or v.shape[1] != 3:
@@ -278,8 +289,9 @@ class MeshSurface(Surface):
             pseudo = None
             if self.signed:
                 # feature code k of every tree triangle, k = FACE … EDGE_BC
-                pseudo = np.ascontiguousarray(np.stack(
-                    [self._pseudonormal(g, np.full(len(g), k)) for k in range(EDGE_BC + 1)], axis=1))
+                pseudo = np.ascontiguousarray(
+                    np.stack([self._pseudonormal(g, np.full(len(g), k)) for k in range(EDGE_BC + 1)], axis=1)
+                )
             self._band_normals = (face, pseudo)
         return self._band_normals
 
@@ -292,8 +304,9 @@ class MeshSurface(Surface):
             self._tree = _native.TriangleTree(self.vertices, np.ascontiguousarray(self.faces[self._good]))
         return self._tree
 
-    def closest(self, points: Any, max_distance: float = np.inf
-                ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def closest(
+        self, points: Any, max_distance: float = np.inf
+    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Exact closest points on the mesh.
 
         Returns the unsigned distance (M,), the closest points (M, 3), the face index (M,) and the
@@ -346,9 +359,14 @@ class MeshSurface(Surface):
         at the first one within reach)."""
         tree = self.tree
         return coarse_to_fine_candidates(
-            grid, half_width, 1.0, lambda p, reach: self.closest(p, reach)[0],
-            within=lambda p, limits: tree.any_within(np.ascontiguousarray(p, dtype=float),
-                                                     np.ascontiguousarray(limits, dtype=float)))
+            grid,
+            half_width,
+            1.0,
+            lambda p, reach: self.closest(p, reach)[0],
+            within=lambda p, limits: tree.any_within(
+                np.ascontiguousarray(p, dtype=float), np.ascontiguousarray(limits, dtype=float)
+            ),
+        )
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
         d, cp, _, _ = self.closest(points)
@@ -392,8 +410,11 @@ class MeshSurface(Surface):
             Empty grid spacings between the bounding box and the grid's faces on every side; it must
             hold the outer tube (``outer`` = 4 by default, 5 for the paper's bunny) plus one node.
         """
-        if (isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, float, np.integer, np.floating))
-                or not float(n).is_integer()):
+        if (
+            isinstance(n, (bool, np.bool_))
+            or not isinstance(n, (int, float, np.integer, np.floating))
+            or not float(n).is_integer()
+        ):
             raise TypeError(f"n must be a whole number of nodes along the longest axis; got {n!r}")
         n = int(n)
         try:
@@ -403,7 +424,9 @@ class MeshSurface(Surface):
         if not (np.isfinite(pad) and pad >= 0):
             raise ValueError(f"padding must be a finite number >= 0 of grid spacings; got {padding!r}")
         if n < 2 * padding + 3:
-            raise ValueError(f"n = {n} nodes cannot hold {padding} spacings of padding on both sides; use n >= {int(2 * padding + 3)}")
+            raise ValueError(
+                f"n = {n} nodes cannot hold {padding} spacings of padding on both sides; use n >= {int(2 * padding + 3)}"
+            )
         lo, hi = self.bounds
         ext = hi - lo
         h = float(ext.max()) / (n - 1 - 2 * padding)
@@ -429,12 +452,20 @@ class MeshSurface(Surface):
         return (1 - s)[:, None] * a[t] + (s * (1 - r2))[:, None] * b[t] + (s * r2)[:, None] * c[t]
 
     def __repr__(self) -> str:
-        return (f"MeshSurface({self.name!r}, {len(self.vertices)} vertices, {len(self.faces)} faces, "
-                f"closed={self.closed}, signed={self.signed})")
+        return (
+            f"MeshSurface({self.name!r}, {len(self.vertices)} vertices, {len(self.faces)} faces, "
+            f"closed={self.closed}, signed={self.signed})"
+        )
 
 
-def from_mesh(mesh: Union[str, Path, Tuple[Any, Any]], *, normalize: bool = False, size: float = 1.0,
-              center: Sequence[float] = (0.0, 0.0, 0.0), signed: Optional[bool] = None) -> MeshSurface:
+def from_mesh(
+    mesh: Union[str, Path, Tuple[Any, Any]],
+    *,
+    normalize: bool = False,
+    size: float = 1.0,
+    center: Sequence[float] = (0.0, 0.0, 0.0),
+    signed: Optional[bool] = None,
+) -> MeshSurface:
     """A triangle mesh as a surface for :func:`tubesweep.solve` (closest-point representation).
 
     Parameters
@@ -477,8 +508,9 @@ def from_mesh(mesh: Union[str, Path, Tuple[Any, Any]], *, normalize: bool = Fals
         used = v[np.unique(f)]
         lo, hi = used.min(0), used.max(0)
         if not float((hi - lo).max()) > 0:
-            raise ValueError("the mesh's vertices all coincide: it has no extent to normalize (every triangle is "
-                             "degenerate)")
+            raise ValueError(
+                "the mesh's vertices all coincide: it has no extent to normalize (every triangle is degenerate)"
+            )
         scale = float(size) / float((hi - lo).max())
         offset = 0.5 * (lo + hi) - target / scale
         v = (v - offset) * scale

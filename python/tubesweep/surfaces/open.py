@@ -35,9 +35,6 @@ def _native_cp(surface: Any, base: type, kind: str, p: np.ndarray, size: float) 
     return _native.open_surface_closest_points(kind, np.ascontiguousarray(x), [float(c) for c in surface.center], size)
 
 
-
-
-
 class Hemisphere(ClosestPoint):
     """The upper hemisphere ``{|x − c| = radius, z ≥ c_z}`` — an open surface bounded by the
     equator circle (the "rim").
@@ -127,8 +124,11 @@ class Disc(ClosestPoint):
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
         """Euclidean distance between the closest points (exact on a convex flat surface)."""
-        return np.linalg.norm(self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
-                              - self._cp(np.asarray(source, dtype=float).reshape(1, 3)), axis=1)
+        return np.linalg.norm(
+            self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
+            - self._cp(np.asarray(source, dtype=float).reshape(1, 3)),
+            axis=1,
+        )
 
     def triangulation(self, n: int = 32) -> Tuple[np.ndarray, np.ndarray]:
         """Polar-grid triangulation (n rings, 4n sectors): ``(V, F)``."""
@@ -171,8 +171,11 @@ class PlanePatch(ClosestPoint):
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
         """Euclidean distance between the closest points."""
-        return np.linalg.norm(self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
-                              - self._cp(np.asarray(source, dtype=float).reshape(1, 3)), axis=1)
+        return np.linalg.norm(
+            self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
+            - self._cp(np.asarray(source, dtype=float).reshape(1, 3)),
+            axis=1,
+        )
 
     def triangulation(self, n: int = 32) -> Tuple[np.ndarray, np.ndarray]:
         """Regular (n × n quads) triangulation: ``(V, F)``."""
@@ -219,10 +222,15 @@ class MobiusBand(ClosestPoint):
             raise ValueError(f"need 0 < w < R; got R={R}, w={w}")
         self.R = float(R)
         self.w = float(w)
-        if not (isinstance(newton_iterations, (int, np.integer)) and not isinstance(newton_iterations, bool)
-                and 1 <= newton_iterations <= 10_000):
-            raise ValueError(f"newton_iterations must be an integer from 1 to 10,000 (60 is plenty: Newton's method "
-                             f"converges in a few steps); got {newton_iterations!r}")
+        if not (
+            isinstance(newton_iterations, (int, np.integer))
+            and not isinstance(newton_iterations, bool)
+            and 1 <= newton_iterations <= 10_000
+        ):
+            raise ValueError(
+                f"newton_iterations must be an integer from 1 to 10,000 (60 is plenty: Newton's method "
+                f"converges in a few steps); got {newton_iterations!r}"
+            )
         self.newton_iterations = int(newton_iterations)
         super().__init__(self._cp, ndim=3)
 
@@ -239,8 +247,10 @@ class MobiusBand(ClosestPoint):
         X = np.stack([rho * c, rho * si, s * s2], -1)
         Xt = np.stack([-0.5 * s * s2 * c - rho * si, -0.5 * s * s2 * si + rho * c, 0.5 * s * c2], -1)
         Xs = np.stack([c2 * c, c2 * si, s2], -1)
-        Xtt = np.stack([-0.25 * s * c2 * c + s * s2 * si - rho * c, -0.25 * s * c2 * si - s * s2 * c - rho * si,
-                        -0.25 * s * s2], -1)
+        Xtt = np.stack(
+            [-0.25 * s * c2 * c + s * s2 * si - rho * c, -0.25 * s * c2 * si - s * s2 * c - rho * si, -0.25 * s * s2],
+            -1,
+        )
         Xts = np.stack([-0.5 * s2 * c - c2 * si, -0.5 * s2 * si + c2 * c, 0.5 * c2], -1)
         return X, Xt, Xs, Xtt, Xts
 

@@ -17,13 +17,21 @@ pub fn shell_nodes(n: usize, r0: f64, centres: &[f64]) -> (Vec<u64>, Vec<NodeRol
         for j in 0..n {
             for k in 0..n {
                 let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
-                let c = centres.iter().copied().min_by(|a, b| (x[0] - a).abs().total_cmp(&(x[0] - b).abs())).unwrap();
+                let c = centres
+                    .iter()
+                    .copied()
+                    .min_by(|a, b| (x[0] - a).abs().total_cmp(&(x[0] - b).abs()))
+                    .unwrap();
                 let d = [x[0] - c, x[1], x[2]];
                 let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                 let phi = r - r0;
                 if phi.abs() <= 4.0 * h {
                     lin.push(((i * n + j) * n + k) as u64);
-                    roles.push(if phi.abs() <= 2.0 * h { NodeRole::Inner } else { NodeRole::Outer });
+                    roles.push(if phi.abs() <= 2.0 * h {
+                        NodeRole::Inner
+                    } else {
+                        NodeRole::Outer
+                    });
                     let s = phi.signum() / r;
                     dirs.push([(d[0] * s) as f32, (d[1] * s) as f32, (d[2] * s) as f32]);
                 }

@@ -8,7 +8,10 @@ use tubesweep_core::{InnerScheme, NarrowBand, NodeRole, SweepProblem};
 
 /// The source's axis from `SOURCE_AXIS` (0, x, when unset).
 pub fn source_axis_from_env() -> usize {
-    std::env::var("SOURCE_AXIS").ok().and_then(|s| s.parse().ok()).unwrap_or(0)
+    std::env::var("SOURCE_AXIS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0)
 }
 
 /// The sphere band at `n`³ nodes with its source at −0.5 on axis `source_axis` (0 is x, the
@@ -32,7 +35,13 @@ pub fn sphere_with_source(n: usize, source_axis: usize) -> (NarrowBand<3>, Vec<N
 }
 
 /// The sweep problem on that band with unit speed and `scheme` in the inner tube.
-pub fn sphere_problem<'a>(band: &'a NarrowBand<3>, roles: &'a [NodeRole], weights: &'a [[f32; 3]], h: f64, scheme: InnerScheme<'a, 3>) -> SweepProblem<'a, 3> {
+pub fn sphere_problem<'a>(
+    band: &'a NarrowBand<3>,
+    roles: &'a [NodeRole],
+    weights: &'a [[f32; 3]],
+    h: f64,
+    scheme: InnerScheme<'a, 3>,
+) -> SweepProblem<'a, 3> {
     SweepProblem {
         band,
         roles,

@@ -40,7 +40,10 @@ mod tests {
     #[test]
     fn value_and_viscosity() {
         let s = [0.5];
-        let h = Isotropic { slowness: &s, sigma: None };
+        let h = Isotropic {
+            slowness: &s,
+            sigma: None,
+        };
         assert!((Hamiltonian::<2>::value(&h, 7, [3.0, 4.0]) - 4.5).abs() < 1e-15);
         assert_eq!(Hamiltonian::<3>::viscosity(&h, 0), [1.0; 3]);
     }

@@ -74,7 +74,9 @@ impl<'a, const D: usize> Hamiltonian<D> for Metric<'a, D> {
 fn determinant<const D: usize>(mut a: [[f64; D]; D]) -> f64 {
     let mut det = 1.0;
     for c in 0..D {
-        let p = (c..D).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap_or(c);
+        let p = (c..D)
+            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+            .unwrap_or(c);
         if a[p][c] == 0.0 {
             return 0.0;
         }
@@ -101,7 +103,11 @@ mod tests {
     fn identity_metric_is_isotropic() {
         let s = [1.0];
         let m = [[[1.0, 0.0], [0.0, 1.0]]];
-        let h = Metric { slowness: &s, metric: &m, sigma: None };
+        let h = Metric {
+            slowness: &s,
+            metric: &m,
+            sigma: None,
+        };
         assert!((h.value(0, [3.0, 4.0]) - 4.0).abs() < 1e-14);
         assert_eq!(h.viscosity(0), [1.0, 1.0]);
         // λ_min ≥ det/tr = 1/2: a safe (here loose by √2) bound on the true value 1
@@ -112,7 +118,11 @@ mod tests {
     fn slowness_bound_covers_the_slowest_direction() {
         let s = [0.5];
         let m = [[[2.0, 0.6], [0.6, 0.5]]];
-        let h = Metric { slowness: &s, metric: &m, sigma: None };
+        let h = Metric {
+            slowness: &s,
+            metric: &m,
+            sigma: None,
+        };
         let lam_min = (2.5 - ((1.5f64).powi(2) + 4.0 * 0.36).sqrt()) / 2.0;
         assert!(h.slowness_bound().unwrap() >= 0.5 / lam_min.sqrt());
         assert!((determinant([[2.0, 0.6, 0.0], [0.6, 0.5, 0.0], [0.0, 0.0, 3.0]]) - 3.0 * 0.64).abs() < 1e-14);
@@ -122,13 +132,20 @@ mod tests {
     fn viscosity_is_the_supremum_of_the_derivative() {
         let s = [1.0];
         let m = [[[2.0, 0.6], [0.6, 0.5]]];
-        let h = Metric { slowness: &s, metric: &m, sigma: None };
+        let h = Metric {
+            slowness: &s,
+            metric: &m,
+            sigma: None,
+        };
         let sig = h.viscosity(0);
         let mut best = [0.0f64; 2];
         for i in 0..3600 {
             let a = i as f64 * std::f64::consts::PI / 1800.0;
             let p = [a.cos(), a.sin()];
-            let mp = [m[0][0][0] * p[0] + m[0][0][1] * p[1], m[0][1][0] * p[0] + m[0][1][1] * p[1]];
+            let mp = [
+                m[0][0][0] * p[0] + m[0][0][1] * p[1],
+                m[0][1][0] * p[0] + m[0][1][1] * p[1],
+            ];
             let n = (p[0] * mp[0] + p[1] * mp[1]).sqrt();
             for k in 0..2 {
                 best[k] = best[k].max((mp[k] / n).abs());
@@ -149,7 +166,11 @@ mod tests {
         let x: [f64; 2] = [0.3, -0.8];
         let mx: [f64; 2] = [inv[0][0] * x[0] + inv[0][1] * x[1], inv[1][0] * x[0] + inv[1][1] * x[1]];
         let n = (x[0] * mx[0] + x[1] * mx[1]).sqrt();
-        let h = Metric { slowness: &s, metric: &m, sigma: None };
+        let h = Metric {
+            slowness: &s,
+            metric: &m,
+            sigma: None,
+        };
         assert!(h.value(0, [0.5 * mx[0] / n, 0.5 * mx[1] / n]).abs() < 1e-14);
     }
 }

@@ -73,7 +73,11 @@ mod tests {
     fn zero_flow_is_isotropic() {
         let s = [1.0 / 3.0];
         let flow = [[0.0; 3]];
-        let h = MovingMedium { slowness: &s, flow: &flow, sigma: None };
+        let h = MovingMedium {
+            slowness: &s,
+            flow: &flow,
+            sigma: None,
+        };
         assert!((h.value(0, [0.0, 3.0, 4.0]) - (5.0 - 1.0 / 3.0)).abs() < 1e-15);
         assert_eq!(h.viscosity(0), [1.0; 3]);
     }
@@ -84,20 +88,34 @@ mod tests {
         let (f, v) = (3.0, 1.0);
         let s = [1.0 / f];
         let flow = [[v, 0.0]];
-        let h = MovingMedium { slowness: &s, flow: &flow, sigma: None };
+        let h = MovingMedium {
+            slowness: &s,
+            flow: &flow,
+            sigma: None,
+        };
         assert!(h.value(0, [1.0 / (f + v), 0.0]).abs() < 1e-15);
         assert!(h.value(0, [-1.0 / (f - v), 0.0]).abs() < 1e-15);
         assert_eq!(h.viscosity(0), [1.0 + v / f, 1.0]);
         assert!((h.slowness_bound().unwrap() - 1.0 / (f - v)).abs() < 1e-15);
         let fast = [[4.0, 0.0]];
-        assert!(MovingMedium { slowness: &s, flow: &fast, sigma: None }.slowness_bound().is_none());
+        assert!(MovingMedium {
+            slowness: &s,
+            flow: &fast,
+            sigma: None
+        }
+        .slowness_bound()
+        .is_none());
     }
 
     #[test]
     fn viscosity_bounds_the_derivative() {
         let s = [0.4];
         let flow = [[0.7, -1.3]];
-        let h = MovingMedium { slowness: &s, flow: &flow, sigma: None };
+        let h = MovingMedium {
+            slowness: &s,
+            flow: &flow,
+            sigma: None,
+        };
         let sig = h.viscosity(0);
         let eps = 1e-7;
         for i in 0..64 {

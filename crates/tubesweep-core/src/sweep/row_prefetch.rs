@@ -67,7 +67,12 @@ impl<const D: usize> SweepProblem<'_, D> {
 
     /// Whether the iteration after one that visited rows holding `visited_per_sweep` nodes per
     /// sweep prefetches its rows: [`ROW_PREFETCH_AHEAD`] or 0 for [`Limits::prefetch_ahead`].
-    pub(super) fn row_prefetch_ahead(&self, ctx: &SweepContext<'_, D>, visited_per_sweep: u64, above_bytes: usize) -> usize {
+    pub(super) fn row_prefetch_ahead(
+        &self,
+        ctx: &SweepContext<'_, D>,
+        visited_per_sweep: u64,
+        above_bytes: usize,
+    ) -> usize {
         let bytes = visited_per_sweep.saturating_mul(self.swept_bytes_per_node(ctx) as u64);
         if cfg!(target_arch = "x86_64") && bytes > above_bytes as u64 {
             ROW_PREFETCH_AHEAD

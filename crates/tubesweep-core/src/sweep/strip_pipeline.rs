@@ -133,7 +133,11 @@ struct SpinBarrier {
 
 impl SpinBarrier {
     fn new(threads: usize) -> Self {
-        SpinBarrier { threads, arrived: AtomicUsize::new(0), generation: AtomicUsize::new(0) }
+        SpinBarrier {
+            threads,
+            arrived: AtomicUsize::new(0),
+            generation: AtomicUsize::new(0),
+        }
     }
 
     /// Waits until all threads arrived; what each did before is visible to all after.
@@ -170,19 +174,18 @@ mod tests {
             let done: Vec<AtomicU32> = (0..6).map(|_| AtomicU32::new(0)).collect();
             let ids = AtomicU32::new(0);
             let acc = pool.install(|| {
-                run_sweeps_in_one_broadcast(
-                    3,
-                    &ids,
-                    &|s, next, abandoned| {
-                        let id = ids.load(Ordering::Relaxed);
-                        strip_worker(&strip_tiles, &strips, &upstream, &done, id, next, abandoned, &|t| {
-                            if panic_in == Some((s, t)) {
-                                panic!("sweep {s}, tile {t}");
-                            }
-                            Accumulator { updates: 1, ..Accumulator::default() }
-                        })
-                    },
-                )
+                run_sweeps_in_one_broadcast(3, &ids, &|s, next, abandoned| {
+                    let id = ids.load(Ordering::Relaxed);
+                    strip_worker(&strip_tiles, &strips, &upstream, &done, id, next, abandoned, &|t| {
+                        if panic_in == Some((s, t)) {
+                            panic!("sweep {s}, tile {t}");
+                        }
+                        Accumulator {
+                            updates: 1,
+                            ..Accumulator::default()
+                        }
+                    })
+                })
             });
             (acc, done.iter().map(|d| d.load(Ordering::Relaxed)).collect())
         };
@@ -197,7 +200,9 @@ mod tests {
             let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(Some((1, 1)))));
             tx.send(r.is_err()).unwrap();
         });
-        let panicked = rx.recv_timeout(std::time::Duration::from_secs(20)).expect("the pipeline hung");
+        let panicked = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("the pipeline hung");
         assert!(panicked);
     }
 }

@@ -174,7 +174,13 @@ pub(super) struct Accumulator {
 
 impl Default for Accumulator {
     fn default() -> Self {
-        Accumulator { max_change: 0.0, updates: 0, front: f64::INFINITY, waiting: f64::INFINITY, visited: 0 }
+        Accumulator {
+            max_change: 0.0,
+            updates: 0,
+            front: f64::INFINITY,
+            waiting: f64::INFINITY,
+            visited: 0,
+        }
     }
 }
 
@@ -232,7 +238,11 @@ unsafe impl Send for SharedValues<'_> {}
 impl<'a> SharedValues<'a> {
     /// The values of `u`, borrowed mutably for as long as any copy lives.
     pub(super) fn new(u: &'a mut [f64]) -> Self {
-        SharedValues { ptr: u.as_mut_ptr(), len: u.len(), borrowed: std::marker::PhantomData }
+        SharedValues {
+            ptr: u.as_mut_ptr(),
+            len: u.len(),
+            borrowed: std::marker::PhantomData,
+        }
     }
 
     #[inline(always)]
