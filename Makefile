@@ -23,7 +23,7 @@ $(PY):
 
 $(DEPS): pyproject.toml | $(PY)
 	$(PIP) install -q --upgrade pip
-	$(PIP) install -q "maturin>=1.5,<2" "numpy>=1.22" scipy matplotlib scikit-image meshio trimesh tqdm pytest scikit-fmm pygeodesic potpourri3d geographiclib
+	$(PIP) install -q "maturin>=1.5,<2" "numpy>=1.22" scipy matplotlib scikit-image meshio trimesh tqdm pytest scikit-fmm pygeodesic potpourri3d geographiclib "dask>=2023.1" "distributed>=2023.1" "cloudpickle>=2"
 	@touch $@
 
 $(BUILT): $(DEPS) $(RUST_SOURCES)

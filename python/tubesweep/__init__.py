@@ -12,7 +12,8 @@ Quick start::
     sol([(0.5, 0, 0)])            # ≈ π/2 · 0.5
 
 Main entry points: :func:`solve` (surfaces, Algorithms 2 and 3), :class:`Tube` (the same band
-solved on many times: other sources, speeds, Hamiltonians), :func:`travel_time` (the whole
+solved on many times: other sources, speeds, Hamiltonians; :meth:`Tube.solve_many` for many sources at once),
+:func:`distance_matrix` and :func:`farthest_point_sampling` (geodesic, on all cores or a Dask cluster), :func:`travel_time` (the whole
 box, Algorithm 1), :class:`Grid`, :class:`LevelSet`, :class:`ClosestPoint` (open and non-orientable surfaces,
 Sect. 5.2) and the library :mod:`tubesweep.surfaces`; meshes in, results out: :func:`surfaces.from_mesh`,
 :func:`triangulate`, :func:`export`, :func:`plot`.
@@ -26,6 +27,7 @@ from .grid import Grid
 from .output import export, plot, triangulate
 from .solve import Solution, solve
 from .tube import Tube
+from .distances import distance_matrix, farthest_point_sampling
 from .stats import SolveStats
 from .surface import LevelSet, Surface
 from . import data, surfaces
@@ -34,6 +36,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "ClosestPoint",
+    "distance_matrix",
+    "farthest_point_sampling",
     "Grid",
     "LevelSet",
     "Solution",

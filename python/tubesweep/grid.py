@@ -118,6 +118,11 @@ class Grid:
             and np.isclose(self._spacing, other._spacing)
         )
 
+    def __hash__(self) -> int:
+        # equal grids (equal shapes, corners and spacings up to rounding, as __eq__ compares them)
+        # must hash alike: only the shape is exact, so the hash is the shape's
+        return hash(("tubesweep.Grid", self._shape))
+
     # ------------------------------------------------------------------ coordinates
     def axis(self, k: int) -> np.ndarray:
         """Node coordinates along axis ``k``."""

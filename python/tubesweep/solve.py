@@ -113,6 +113,17 @@ class Solution:
         # for a φ array: its values at a sample of the band's nodes (linear indices, values)
         self._phi_sample = phi_sample
 
+    def __getstate__(self) -> dict:
+        # the native band does not pickle: its linear indices do, and rebuild it
+        state = self.__dict__.copy()
+        state["_band"] = np.asarray(self._band.linear(), dtype=np.int64)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        linear = state["_band"]
+        state["_band"] = _native.Band.from_linear(list(state["grid"].shape), np.ascontiguousarray(linear).view(np.uint64))
+        self.__dict__.update(state)
+
     def _check_surface_unchanged(self) -> None:
         """Refuses to go on when the surface's φ array, which the solution uses in place for its
         projections, was changed after the solve (checked at a sample of the band's nodes)."""

@@ -21,6 +21,8 @@ own working arrays (docs/architecture.md) and a copy of the directions.
 from __future__ import annotations
 
 import time
+import uuid
+import warnings
 from typing import Any, Callable, Optional
 
 import numpy as np
@@ -55,6 +57,10 @@ class Tube:
     """
 
     def __init__(self, surface: Any, grid: Any, *, inner: float = 2.0, outer: float = 4.0, method: str = "two-layer"):
+        self._args = (inner, outer, method)
+        # names this tube's band for a Dask worker's cache (tubesweep.distributed): a copy sent to a
+        # worker is built there once and reused by every chunk of sources with the same token
+        self._token = uuid.uuid4().hex
         self.grid: Grid = as_grid(grid)
         self.surface: Surface = as_surface(surface)
         self.surface.check_grid(self.grid)
@@ -63,6 +69,25 @@ class Tube:
         # a change before a later solve projects sources on the changed array (O(band) per solve)
         array = getattr(self.surface, "_array", None)
         self._phi_at_band = None if array is None else array.reshape(-1)[self._tube.linear].copy()
+
+    def _check_phi_unchanged(self) -> None:
+        if self._phi_at_band is not None and not np.array_equal(
+                self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band):  # type: ignore[attr-defined]
+            raise ValueError("the φ array of this Tube's surface was changed after the Tube was built: its band no "
+                             "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
+                             "the array free to change)")
+
+    def __getstate__(self) -> dict:
+        """A tube pickles as its surface, grid and widths (and its token); unpickling builds the band
+        again (the same band, bit for bit), so that a pickle does not carry band arrays."""
+        return {"surface": self.surface, "grid": self.grid, "args": self._args, "token": self._token}
+
+    def __setstate__(self, state: dict) -> None:
+        inner, outer, method = state["args"]
+        with warnings.catch_warnings():  # given when the tube was first built
+            warnings.simplefilter("ignore", RuntimeWarning)
+            self.__init__(state["surface"], state["grid"], inner=inner, outer=outer, method=method)  # type: ignore[misc]
+        self._token = state["token"]
 
     @property
     def method(self) -> str:
@@ -110,14 +135,7 @@ class Tube:
         :func:`tubesweep.solve` (which see), without building the band again.
         ``sol.stats.setup_seconds`` is then the time spent on the sources and the speed."""
         t0 = time.perf_counter()
-        if self._phi_at_band is not None and not np.array_equal(
-            self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band
-        ):  # type: ignore[attr-defined]
-            raise ValueError(
-                "the φ array of this Tube's surface was changed after the Tube was built: its band no "
-                "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
-                "the array free to change)"
-            )
+        self._check_phi_unchanged()
         src = as_sources(sources, self.grid)
         general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
         check_tolerance(tol, max_iterations)
@@ -139,6 +157,58 @@ class Tube:
             t0,
             reuse=True,
         )
+
+    def solve_many(
+        self,
+        sources: Any,
+        *,
+        at: Any = None,
+        hamiltonian: str = "godunov",
+        speed: Any = 1.0,
+        source_init: str = "exact",
+        tol: float = 1e-10,
+        max_iterations: int = 10000,
+        progress: Optional[Callable[[int, int], Any]] = None,
+        infinity: Optional[float] = None,
+        threads: int = 0,
+        paper_sweeps: bool = False,
+        client: Any = None,
+        chunk_size: Optional[int] = None,
+        return_stats: bool = False,
+    ) -> Any:
+        """K independent solves on this band, in parallel across the sources (docs/many-sources.md).
+
+        ``sources`` is an array (K, d) of K point sources, or an array (K, P, d) / a list whose
+        entries are points (d,) or groups (P, d) (a group is one multi-source solve). Returns a
+        (K, band_points) array whose row k equals ``tube.solve(sources[k], ...).values`` bit for
+        bit (``inf`` where never reached), or with ``at=points`` (M, d) the (K, M) values
+        ``tube.solve(sources[k], ...)(points)`` without keeping K band arrays (memory O(band ·
+        threads + K·M)). ``threads`` solves run at once, each on one thread (0: all cores), with
+        the GIL released; ``progress(done, total)`` is called about every 50 ms, and Ctrl-C stops
+        every solve with ``KeyboardInterrupt`` (no partial result). The other options are those of
+        :meth:`solve` (``hamiltonian`` 'godunov' or 'lxf' only).
+
+        With ``client`` (a ``dask.distributed.Client``; ``pip install tubesweep[distributed]``) the
+        sources go to the cluster's workers in chunks of ``chunk_size``: each worker builds this
+        tube once and reuses it for all its chunks, and only the values (at ``at``) come back;
+        the result equals the local one bit for bit. ``return_stats`` also returns a dict of
+        per-source arrays (iterations, converged, last_change, ...).
+        """
+        if client is not None:
+            from .distributed import solve_many_on_client
+
+            return solve_many_on_client(
+                self, sources, client=client, at=at, chunk_size=chunk_size, progress=progress,
+                options=dict(hamiltonian=hamiltonian, speed=speed, source_init=source_init, tol=tol,
+                             max_iterations=max_iterations, infinity=infinity, paper_sweeps=paper_sweeps),
+                threads=threads, return_stats=return_stats)
+        if chunk_size is not None:
+            raise ValueError("chunk_size is for a Dask client (client=...): a local solve_many runs every source at once")
+        from .many import solve_many
+
+        return solve_many(self, sources, at=at, hamiltonian=hamiltonian, speed=speed, source_init=source_init, tol=tol,
+                          max_iterations=max_iterations, progress=progress, infinity=infinity, threads=threads,
+                          paper_sweeps=paper_sweeps, return_stats=return_stats)
 
     @property
     def nbytes(self) -> int:

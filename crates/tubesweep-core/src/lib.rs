@@ -46,6 +46,7 @@ pub mod hamiltonians;
 pub mod interpolate;
 pub mod kernel_stats;
 pub mod lax_friedrichs;
+pub mod many_sources;
 pub mod mesh;
 pub mod mesh_band;
 pub mod mobius;

@@ -3,6 +3,7 @@
 //! helpful message happens in the Python package; the core re-checks what could break it.
 
 mod errors;
+mod many_sources;
 
 use errors::to_pyerr;
 use numpy::{
@@ -1782,6 +1783,7 @@ fn row_prefetch_above() -> usize {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     m.add_class::<PyTriangleTree>()?;
+    many_sources::register(m)?;
     m.add_function(wrap_pyfunction!(split_pair_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(children_radius_max, m)?)?;
     m.add_function(wrap_pyfunction!(block_children, m)?)?;

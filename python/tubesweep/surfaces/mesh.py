@@ -295,6 +295,12 @@ class MeshSurface(Surface):
             self._band_normals = (face, pseudo)
         return self._band_normals
 
+    def __getstate__(self) -> dict:
+        # the native AABB tree does not pickle: a copy builds it again on first use
+        state = self.__dict__.copy()
+        state["_tree"] = None
+        return state
+
     @property
     def tree(self) -> Any:
         """The AABB tree over the non-degenerate triangles (built on first use)."""

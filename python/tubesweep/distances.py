@@ -1,0 +1,172 @@
+"""Geodesic distance matrices and farthest-point sampling: many solves on one band.
+
+:func:`distance_matrix` solves once from each of M points (:meth:`Tube.solve_many` with
+``at=points``, in parallel across the points, or on a Dask cluster) and reads every solution at
+the M points: the one-way estimates ``D[i, j] = u_i(x_j)``. They differ from ``D[j, i]`` by the
+discretisation error, and ``u_i(x_i)`` is the interpolated initialisation near the source, not 0.
+The matrix returned is ``(D + Dᵀ) / 2`` with a zero diagonal: symmetric bit for bit (floating-point
+addition commutes) and zero on the diagonal by construction, and no less accurate than either
+estimate. ``info=True`` also returns the asymmetry removed.
+
+:func:`farthest_point_sampling` picks well-spread points greedily: each new point is the surface
+point farthest (geodesically) from those chosen so far, found from the running minimum of one
+solve per chosen point.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Optional, Tuple, Union
+
+import numpy as np
+
+from ._validate import as_points
+from .solve import ROLE_INNER
+from .tube import Tube
+
+__all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]
+
+
+def _as_tube(surface: Any, grid: Any, inner: float, outer: float) -> Tube:
+    if isinstance(surface, Tube):
+        if grid is not None and grid != surface.grid:
+            raise ValueError("grid: this ts.Tube was built on another grid; pass grid=None (or the tube's grid)")
+        return surface
+    if grid is None:
+        raise ValueError("grid is required (a ts.Grid) unless surface is a ts.Tube")
+    return Tube(surface, grid, inner=inner, outer=outer)
+
+
+def snap_to_surface(tube: Tube, points: Any, name: str = "points") -> np.ndarray:
+    """The closest points on the tube's surface of ``points`` (M, d), each of which must lie
+    within the inner tube (``inner`` grid spacings) of the surface; farther ones are refused."""
+    p = as_points(points, tube.grid.ndim, name)
+    if p.shape[0] == 0:
+        raise ValueError(f"{name} is empty: give at least one point on the surface")
+    inside = tube.grid.contains(p)
+    if not np.all(inside):
+        i = int(np.flatnonzero(~inside)[0])
+        raise ValueError(f"{name}[{i}] = {tuple(float(x) for x in p[i])} lies outside the grid; move it onto the surface")
+    dist, proj = tube.surface.project(p, tube.grid)
+    dist = np.asarray(dist, dtype=float)
+    limit = tube.inner * tube.grid.spacing
+    bad = np.flatnonzero(~(dist <= limit * (1 + 1e-6)) | ~np.all(np.isfinite(proj), axis=1))
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(
+            f"{name}[{i}] = {tuple(float(x) for x in p[i])} is {float(dist[i]):.4g} from the surface, farther than the "
+            f"inner tube (inner·Δx = {limit:.4g}){f' ({bad.size} points in all)' if bad.size > 1 else ''}: points must "
+            "lie on the surface (they are snapped to it from within the inner tube); move them onto it")
+    return np.ascontiguousarray(proj, dtype=float)
+
+
+def distance_matrix(surface: Any, grid: Any, points: Any, *, client: Any = None, inner: float = 2.0,
+                    outer: float = 4.0, hamiltonian: str = "godunov", source_init: str = "exact", tol: float = 1e-10,
+                    max_iterations: int = 10000, threads: int = 0, chunk_size: Optional[int] = None,
+                    progress: Optional[Callable[[int, int], Any]] = None, info: bool = False
+                    ) -> Union[np.ndarray, Tuple[np.ndarray, dict]]:
+    """Geodesic distances (M, M) between ``points`` on the surface.
+
+    Parameters
+    ----------
+    surface : any surface ``ts.solve`` takes, or a :class:`ts.Tube` (then ``grid`` may be None)
+    grid : Grid
+    points : (M, d) points on the surface; each is snapped to its closest point on the surface,
+        and a point farther than the inner tube (``inner`` grid spacings) is refused.
+    client : dask.distributed.Client, optional — run the M solves on the cluster
+        (``pip install tubesweep[distributed]``; see :meth:`Tube.solve_many`).
+    threads : solves run at once locally (0: all cores), each on one thread.
+    progress : callable ``(done, M)``, optional.
+    info : also return a dict: ``asymmetry`` (the largest ``|D[i, j] − D[j, i]|`` of the one-way
+        estimates, removed by the average), ``diagonal`` (the largest one-way ``u_i(x_i)``, set to
+        0), ``points`` (the snapped points), ``seconds``.
+
+    Returns
+    -------
+    D : (M, M) float — symmetric bit for bit, zero diagonal; ``inf`` between points on parts of
+        the surface that no path joins. Accurate to the solver's order (first order in the grid
+        spacing with the default Godunov scheme: docs/many-sources.md).
+    """
+    t0 = time.perf_counter()
+    tube = _as_tube(surface, grid, inner, outer)
+    snapped = snap_to_surface(tube, points)
+    one_way = tube.solve_many(snapped, at=snapped, hamiltonian=hamiltonian, source_init=source_init, tol=tol,
+                              max_iterations=max_iterations, threads=threads, client=client, chunk_size=chunk_size,
+                              progress=progress)
+    if np.isnan(one_way).any():
+        i, j = np.argwhere(np.isnan(one_way))[0]
+        raise RuntimeError(f"the solution from points[{i}] could not be read at points[{j}] (its interpolation stencil "
+                           "leaves the band): increase outer")
+    both = np.isfinite(one_way) & np.isfinite(one_way.T)
+    diff = np.abs(one_way - one_way.T)
+    asymmetry = float(np.max(diff[both], initial=0.0))
+    diagonal = float(np.max(np.abs(np.diag(one_way)), initial=0.0))
+    matrix = 0.5 * (one_way + one_way.T)
+    np.fill_diagonal(matrix, 0.0)
+    if info:
+        return matrix, {"asymmetry": asymmetry, "diagonal": diagonal, "points": snapped,
+                        "seconds": time.perf_counter() - t0}
+    return matrix
+
+
+def farthest_point_sampling(surface: Any, grid: Any, k: int, *, start: Any = None, inner: float = 2.0,
+                            outer: float = 4.0, tol: float = 1e-10, threads: int = 0,
+                            progress: Optional[Callable[[int, int], Any]] = None) -> Tuple[np.ndarray, np.ndarray]:
+    """``k`` well-spread points on the surface by geodesic farthest-point sampling.
+
+    Each new point is the surface point farthest from the points chosen so far: the closest point
+    of the inner-tube node where the running minimum of their distances is largest (one solve
+    per point, the minimum updated incrementally). ``start`` (a point on the surface) is the
+    first point; by default the first point is the farthest from an arbitrary surface point (one
+    extra solve), so the sampling does not depend on the surface's parametrisation.
+
+    Returns
+    -------
+    points : (k, d) — on the surface
+    radii : (k,) — the sampling radius of each step: the geodesic distance from each point to the
+        nearest of those chosen before it (``inf`` for the first); non-increasing, and
+        ``radii[i]`` bounds the distance of every surface point to the first ``i`` points (up to
+        the discretisation error). A point on a part of the surface the others do not reach has
+        radius ``inf``.
+    """
+    if not (isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1):
+        raise ValueError(f"k must be a positive whole number of points; got {k!r}")
+    tube = _as_tube(surface, grid, inner, outer)
+    t = tube._tube
+    g = tube.grid
+    inner_pos = np.flatnonzero(t.roles == ROLE_INNER)
+    if k > inner_pos.size:
+        raise ValueError(f"k = {k} exceeds the {inner_pos.size} inner-tube nodes the points are chosen from; refine the grid")
+    # the surface point each inner node stands for
+    _, candidates = tube.surface.project(g.node_points(t.linear[inner_pos]), g)
+    candidates = np.asarray(candidates, dtype=float)
+    usable = np.all(np.isfinite(candidates), axis=1)
+
+    def distances_from(p: np.ndarray) -> np.ndarray:
+        return tube.solve([p], tol=tol, threads=threads).values[inner_pos]
+
+    if start is None:
+        seed = candidates[int(np.flatnonzero(usable)[0])]
+        first = distances_from(seed)
+        first = np.where(usable & np.isfinite(first), first, -np.inf)
+        current = candidates[int(np.argmax(first))]
+    else:
+        current = snap_to_surface(tube, start, "start")
+        if len(current) != 1:
+            raise ValueError(f"start must be one point of shape ({g.ndim},); got {len(current)} points")
+        current = current[0]
+    points = [current]
+    radii = [np.inf]
+    nearest = np.full(inner_pos.size, np.inf)
+    for step in range(1, k + 1):
+        nearest = np.minimum(nearest, distances_from(points[-1]))
+        if progress is not None:
+            progress(step, k)
+        if step == k:
+            break
+        score = np.where(usable, nearest, -np.inf)
+        best = int(np.argmax(score))
+        points.append(candidates[best])
+        radii.append(float(score[best]))
+    return np.array(points), np.array(radii)
+

@@ -1,0 +1,178 @@
+"""Many sources on a Dask cluster: :meth:`Tube.solve_many` and :func:`distance_matrix` with
+``client=`` (``pip install tubesweep[distributed]``).
+
+The sources are split into chunks, one Dask task each. The tube goes to every worker once, as a
+small description (its surface, grid and widths: no band arrays), scattered with ``broadcast``;
+each worker process builds the band from it on its first chunk and keeps it in a cache keyed by
+the tube's token (:data:`_WORKER_TUBES`), so that its later chunks reuse it. A task returns only
+its rows: the values at ``at`` (or, without ``at``, the chunk's band values). Each row is computed
+by the same code as locally (``Tube.solve_many`` on the worker, one thread per solve), so the
+result equals the local one bit for bit.
+
+A worker that dies mid-run loses its running chunks; the scheduler runs them again elsewhere
+(up to its ``distributed.scheduler.allowed-failures``), and the result is complete. When a chunk
+cannot be completed the call raises ``RuntimeError`` naming the sources of the chunk: a partial
+matrix is never returned.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import uuid
+from collections import OrderedDict
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional
+
+import numpy as np
+
+from ._validate import as_points
+from .many import check_many_progress, fixed_nodes, source_groups
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .tube import Tube
+
+__all__ = ["solve_many_on_client", "clear_worker_cache"]
+
+#: Tubes a worker process keeps, most recently used last (the bands of the last two tubes).
+WORKER_CACHE_SIZE = 2
+_WORKER_TUBES: "OrderedDict[str, Tube]" = OrderedDict()
+_WORKER_LOCK = threading.Lock()
+
+
+class _TubeSpec:
+    """What a worker needs to build a tube: the surface, grid and widths (a pickled ``Tube``
+    would build its band on unpickling, once per task that receives it)."""
+
+    def __init__(self, tube: "Tube"):
+        self.token = tube._token
+        self.surface = tube.surface
+        self.grid = tube.grid
+        self.args = tube._args
+
+
+def _worker_tube(spec: _TubeSpec) -> "Tube":
+    """The tube of ``spec`` in this process, built on first use and cached by its token."""
+    from .tube import Tube
+
+    with _WORKER_LOCK:  # one build per process, even with several threads per worker
+        tube = _WORKER_TUBES.get(spec.token)
+        if tube is None:
+            inner, outer, method = spec.args
+            tube = Tube(spec.surface, spec.grid, inner=inner, outer=outer, method=method)
+            tube._token = spec.token
+            _WORKER_TUBES[spec.token] = tube
+            while len(_WORKER_TUBES) > WORKER_CACHE_SIZE:
+                _WORKER_TUBES.popitem(last=False)
+        _WORKER_TUBES.move_to_end(spec.token)
+        return tube
+
+
+def _solve_chunk(spec: _TubeSpec, groups: List[np.ndarray], at: Optional[np.ndarray], options: Dict[str, Any]) -> Any:
+    """One task: the chunk's sources on the worker's cached tube, one solve per thread."""
+    import warnings
+
+    tube = _worker_tube(spec)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        values, stats = tube.solve_many(groups, at=at, threads=1, return_stats=True, **options)
+    return values, {k: v for k, v in stats.items() if isinstance(v, np.ndarray)}, [str(w.message) for w in caught]
+
+
+def _clear() -> int:
+    with _WORKER_LOCK:
+        n = len(_WORKER_TUBES)
+        _WORKER_TUBES.clear()
+    return n
+
+
+def clear_worker_cache(client: Any) -> Dict[str, int]:
+    """Drops the tubes the workers of ``client`` keep (returns how many each held)."""
+    return client.run(_clear)
+
+
+def as_client(client: Any) -> Any:
+    """``client`` checked to be a ``dask.distributed.Client``."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ImportError("client= needs Dask's distributed scheduler: pip install tubesweep[distributed] "
+                          "(dask, distributed and cloudpickle)") from None
+    if not isinstance(client, Client):
+        raise TypeError(f"client must be a dask.distributed.Client (e.g. Client(LocalCluster()) or "
+                        f"Client('tcp://scheduler:8786')); got {type(client).__name__}")
+    return client
+
+
+def _default_chunk(k: int, workers: int) -> int:
+    # about four chunks per worker thread (the last ones balance the load), at most 64 sources each
+    return max(1, min(64, math.ceil(k / (4 * max(1, workers)))))
+
+
+def solve_many_on_client(tube: "Tube", sources: Any, *, client: Any, at: Any, chunk_size: Optional[int],
+                         progress: Optional[Callable[[int, int], Any]], options: Dict[str, Any], threads: int = 0,
+                         return_stats: bool = False) -> Any:
+    """:meth:`Tube.solve_many` on a Dask cluster (see the module's documentation). ``threads`` is
+    not used: each worker runs as many chunks at once as it has threads, one thread per solve."""
+    from distributed import as_completed
+
+    client = as_client(client)
+    tube._check_phi_unchanged()
+    groups = source_groups(sources, tube.grid.ndim)
+    k = len(groups)
+    if k == 0:
+        raise ValueError("sources is empty: give at least one source (a point, or a group of points)")
+    cb = check_many_progress(progress)
+    points = None if at is None else as_points(at, tube.grid.ndim, "at")
+    # every source checked here, before anything is sent: a bad one is refused with its index
+    fixed_nodes(tube, groups, options.get("speed", 1.0), options.get("source_init", "exact"))
+    nthreads = sum(client.nthreads().values())
+    if nthreads == 0:
+        raise RuntimeError("the Dask cluster has no workers: start some (e.g. LocalCluster(n_workers=2)) or wait for them")
+    if chunk_size is None:
+        chunk_size = _default_chunk(k, nthreads)
+    if not (isinstance(chunk_size, (int, np.integer)) and not isinstance(chunk_size, bool) and chunk_size >= 1):
+        raise ValueError(f"chunk_size must be a positive whole number of sources per task; got {chunk_size!r}")
+    starts = list(range(0, k, int(chunk_size)))
+    run = uuid.uuid4().hex[:12]
+    spec = client.scatter(_TubeSpec(tube), broadcast=True, hash=False)
+    at_data = None if points is None else client.scatter(points, broadcast=True, hash=False)
+    futures = {
+        client.submit(_solve_chunk, spec, groups[a : a + chunk_size], at_data, options,
+                      key=f"tubesweep-solve_many-{run}-{a}", pure=False): a
+        for a in starts
+    }
+    width = tube.band_points if points is None else len(points)
+    out = np.empty((k, width))
+    stats: Dict[str, np.ndarray] = {}
+    messages: List[str] = []
+    done = 0
+    try:
+        for fut in as_completed(futures):
+            a = futures[fut]
+            b = min(a + chunk_size, k)
+            try:
+                values, st, caught = fut.result()
+            except (ValueError, TypeError, KeyboardInterrupt):
+                raise
+            except Exception as e:  # a worker that died on every try (KilledWorker), a lost dependency...
+                raise RuntimeError(f"the Dask cluster could not solve sources {a}..{b - 1}: {type(e).__name__}: {e}. "
+                                   "No partial result is returned; check the workers' logs and memory "
+                                   "(docs/many-sources.md, 'What to size')") from e
+            out[a:b] = values
+            for name, v in st.items():
+                stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
+            messages.extend(caught)
+            done += b - a
+            if cb is not None:
+                cb(done, k)
+    finally:
+        client.cancel(list(futures))
+        del spec, at_data
+    if messages:
+        import warnings
+
+        warnings.warn(f"on the workers: {messages[0]}" + (f" (and {len(messages) - 1} more)" if len(messages) > 1 else ""),
+                      RuntimeWarning, stacklevel=3)
+    if return_stats:
+        return out, stats
+    return out

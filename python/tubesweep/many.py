@@ -1,0 +1,174 @@
+"""Many sources on one band: :meth:`tubesweep.Tube.solve_many`.
+
+K independent solves of Algorithm 3 on a band built once, run in parallel *across* the sources
+(``tubesweep_core::many_sources``): each solve runs on one thread, the sources on ``threads``
+threads at once with the GIL released. Each row is the single ``tube.solve`` of that source, bit
+for bit (the parallel sweeps of one solve are bit-identical to sequential ones, so this holds for
+any ``threads`` of the single solve). With ``at=points`` only the values at the points are kept:
+memory O(band · threads + K · M) instead of K band arrays.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+import warnings
+from typing import TYPE_CHECKING, Any, Callable, List, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+from ._validate import (
+    ACTIVATION_FRACTION,
+    FRONT_WINDOW,
+    as_points,
+    as_sources,
+    check_infinity,
+    check_threads,
+    check_tolerance,
+    check_tolerance_scale,
+    checked_point_speeds,
+    speed_at_points,
+    speed_values,
+)
+from .solve import ROLE_INNER, SOURCE_RADIUS, _check_source_init, _fix_sources, _resolve_scheme
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .tube import Tube
+
+__all__ = ["solve_many", "source_groups"]
+
+
+def source_groups(sources: Any, ndim: int) -> List[np.ndarray]:
+    """The K sources of ``solve_many`` as a list of (P, d) arrays: an array (K, d) is K point
+    sources, an array (K, P, d) or a list whose entries are points (d,) or groups (P, d) of
+    points may mix them (a group is one multi-source solve: the distance to the nearest of its
+    points)."""
+    if isinstance(sources, np.ndarray) and sources.dtype != object:
+        if sources.ndim == 2:
+            p = as_points(sources, ndim, "sources")
+            return [p[i : i + 1] for i in range(len(p))]
+        if sources.ndim == 3:
+            return [as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)]
+        raise ValueError(f"sources must have shape (K, {ndim}) (K point sources), (K, P, {ndim}) (K groups of P points) "
+                         f"or be a list of points and groups; got shape {sources.shape}")
+    if isinstance(sources, (str, bytes)) or not hasattr(sources, "__len__"):
+        raise TypeError(f"sources must be an array (K, {ndim}) or a list of points ({ndim},) and groups (P, {ndim}); "
+                        f"got {type(sources).__name__}")
+    return [as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)]
+
+
+def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
+    """The slowness at points (a source, the closest points near it), as ``ts.solve`` takes it."""
+
+    def at(p: np.ndarray) -> np.ndarray:
+        if callable(speed):
+            return 1.0 / speed_at_points(speed, p, "a source or the closest point of a node near it")
+        if np.ndim(speed) == 0:
+            return np.full(len(p), 1.0 / float(speed))
+        from .euclidean import _interp_dense
+
+        f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
+        return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
+
+    return at
+
+
+def _renamed(e: ValueError, k: int, group: bool) -> ValueError:
+    """A source error of ``_fix_sources`` (which numbers the points of one solve) renamed to the
+    source's place among the K: ``sources[k]`` or ``sources[k][j]``."""
+    text = re.sub(r"sources\[(\d+)\]", (lambda m: f"sources[{k}][{m.group(1)}]") if group else f"sources[{k}]", str(e))
+    return ValueError(text)
+
+
+def fixed_nodes(tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str
+                ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The band positions and values each source fixes, concatenated, and the offsets (K + 1,)
+    of each source's run: ``_fix_sources`` of a single solve, source by source."""
+    t = tube._tube
+    grid, surf = t.grid, t.surface
+    inner_width = t.inner * grid.spacing
+    slowness_at = _slowness_at(speed, grid)
+    n_inner = int(np.count_nonzero(t.roles == ROLE_INNER))
+    positions, values, offsets = [], [], [0]
+    for k, g in enumerate(groups):
+        try:
+            src = as_sources(g, grid)
+            pos, val, _ = _fix_sources(surf, grid, t.band, t.linear, t.roles, src, slowness_at, source_init, inner_width)
+        except ValueError as e:
+            raise _renamed(e, k, len(g) > 1) from None
+        if t.method != "naive" and len(src) == 1 and np.unique(pos).size >= n_inner:
+            raise ValueError(
+                f"sources[{k}]: the grid is too coarse for this surface: every node of the inner tube lies within "
+                f"{SOURCE_RADIUS:g} grid spacings (h = {grid.spacing:.4g}) of the source, so its value is the source's "
+                "initialisation and nothing is solved; refine the grid")
+        positions.append(pos)
+        values.append(val)
+        offsets.append(offsets[-1] + len(pos))
+    return (np.ascontiguousarray(np.concatenate(positions), dtype=np.int64),
+            np.ascontiguousarray(np.concatenate(values), dtype=float), np.asarray(offsets, dtype=np.int64))
+
+
+def check_many_progress(progress: Any) -> Optional[Callable[[int, int], Any]]:
+    if progress is None or progress is False:
+        return None
+    if not callable(progress):
+        raise TypeError("progress must be a callable (done, total) -> None, or None")
+    return progress
+
+
+def solve_many(tube: "Tube", sources: Any, *, at: Any = None, hamiltonian: Any = "godunov", speed: Any = 1.0,
+               source_init: str = "exact", tol: float = 1e-10, max_iterations: int = 10000,
+               progress: Optional[Callable[[int, int], Any]] = None, infinity: Optional[float] = None,
+               threads: int = 0, paper_sweeps: bool = False, return_stats: bool = False) -> Any:
+    """See :meth:`tubesweep.Tube.solve_many` (the local run; a Dask client goes through
+    :mod:`tubesweep.distributed`)."""
+    t0 = time.perf_counter()
+    tube._check_phi_unchanged()
+    t = tube._tube
+    grid = t.grid
+    groups = source_groups(sources, grid.ndim)
+    if len(groups) == 0:
+        raise ValueError("sources is empty: give at least one source (a point, or a group of points)")
+    general, scheme = _resolve_scheme(hamiltonian, None, False)
+    if general is not None:
+        raise ValueError("solve_many takes hamiltonian='godunov' or 'lxf'; for a ts.hamiltonians object solve each "
+                         "source with tube.solve")
+    check_tolerance(tol, max_iterations)
+    cb = check_many_progress(progress)
+    _check_source_init(source_init)
+    if not isinstance(paper_sweeps, (bool, np.bool_)):
+        raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
+    nthreads = check_threads(threads)
+    inf = check_infinity(infinity)
+    points = None if at is None else as_points(at, grid.ndim, "at")
+    linear = t.linear
+    x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
+    speed_nodes = speed_values(speed, grid, x, linear)
+    del x
+    slowness: Any = 1.0 / speed_nodes
+    h = grid.spacing
+    check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
+    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init)
+    missing_policy = "infinity" if (t.method == "naive" and scheme == "godunov") else "extrapolate"
+    directions = t.geom.directions_for_solver()  # a copy: the tube's stay as they are
+    setup = time.perf_counter() - t0
+    out, st = _native.solve_many_on_band(
+        t.band, t.roles, positions, values, offsets, h, slowness, directions, scheme, missing_policy, float(tol),
+        int(max_iterations), inf, cb, nthreads, ACTIVATION_FRACTION * float(tol), not paper_sweeps, not paper_sweeps,
+        0.0 if paper_sweeps else FRONT_WINDOW,
+        points, None if points is None else [float(v) for v in grid.lower])
+    del directions
+    bad = np.flatnonzero(~st["converged"])
+    if bad.size:
+        warnings.warn(
+            f"{bad.size} of {len(groups)} solves did not converge in max_iterations={max_iterations} (sources "
+            f"{bad[:5].tolist()}{'…' if bad.size > 5 else ''}; the largest change in the last iteration "
+            f"{float(np.max(st['last_change'][bad])):.3g}, tol={tol:g}): their rows are the last iterate. Increase "
+            "max_iterations or tol", RuntimeWarning, stacklevel=3)
+    if return_stats:
+        st = dict(st)
+        st["setup_seconds"] = setup
+        st["seconds_total"] = time.perf_counter() - t0
+        return out, st
+    return out
