@@ -282,3 +282,24 @@ def test_dask_failure_is_an_error_not_a_partial_result(client, grid):
     broken = ts.Tube(ts.LevelSet(phi), grid)
     with pytest.raises(RuntimeError, match=r"could not solve sources 0\.\.1.*disk is gone"):
         broken.solve_many(sphere_points(2), at=sphere_points(2), client=client, chunk_size=2)
+
+
+def test_cli_distances(tmp_path):
+    from tubesweep.cli import main
+
+    out = tmp_path / "D.npy"
+    assert main(["distances", "--surface", "sphere", "--n", "41", "--sample", "4", "--out", str(out), "--quiet"]) == 0
+    d = np.load(out)
+    pts = np.load(tmp_path / "D_points.npy")
+    assert d.shape == (4, 4) and np.array_equal(d, d.T) and np.all(np.diag(d) == 0)
+    assert np.abs(d - great_circle(pts, pts)).max() < 0.2
+    np.save(tmp_path / "pts.npy", pts)
+    again = tmp_path / "D2.npy"
+    assert main(["distances", "--surface", "sphere", "--n", "41", "--points", str(tmp_path / "pts.npy"),
+                 "--out", str(again), "--quiet"]) == 0
+    assert np.allclose(np.load(again), d, atol=1e-5)  # the points snapped once more (to about 1e-7)
+    np.save(tmp_path / "off.npy", np.array([[0.0, 0.0, 0.0]]))
+    assert main(["distances", "--surface", "sphere", "--n", "41", "--points", str(tmp_path / "off.npy"),
+                 "--out", str(again), "--quiet"]) == 2
+    assert main(["distances", "--surface", "sphere", "--sample", "2", "--out", str(tmp_path / "D.txt")]) == 2
+    assert main(["distances", "--surface", "sphere", "--sample", "0", "--out", str(out)]) == 2

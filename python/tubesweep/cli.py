@@ -1,7 +1,7 @@
 """The ``tubesweep`` command line.
 
-Sub-commands: ``solve`` (a curve or surface), ``travel-time`` (the whole box), ``demo``,
-``reproduce`` (the paper's experiments) and ``info``. Run ``tubesweep COMMAND --help``.
+Sub-commands: ``solve`` (a curve or surface), ``travel-time`` (the whole box), ``distances`` (a
+geodesic distance matrix, cli_distances.py), ``demo``, ``reproduce`` (the paper's experiments) and ``info``. Run ``tubesweep COMMAND --help``.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import numpy as np
 
 from . import __version__
 from ._progress import make_progress
+from .cli_distances import add_distances_parser, cmd_distances
 
 EPILOG = """examples:
   tubesweep solve --surface sphere --n 101 --png
@@ -187,6 +188,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--out", type=Path, default=Path("out/reproduce"))
 
     sub.add_parser("info", help="version and build information")
+    add_distances_parser(sub)  # `tubesweep distances`, in cli_distances.py
     return parser
 
 
@@ -492,6 +494,8 @@ def _run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
             return cmd_reproduce(args)
         if args.command == "info":
             return cmd_info(args)
+        if args.command == "distances":
+            return cmd_distances(args)
     except KeyboardInterrupt:
         print("\ninterrupted", file=sys.stderr)
         return 130
