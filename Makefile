@@ -52,6 +52,8 @@ bench: build
 	# second per core and 2-core speed-up
 	$(PY) benches/run.py --scale
 	$(PY) benches/microbench.py --sizes 101,201,401 --schemes godunov --repeats 5
+	# issue 33: many sources on one surface (solve_many, Dask, the peers per source, the 1000 x 1000 matrix)
+	$(PY) benches/many_sources.py
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce
