@@ -69,8 +69,10 @@ def print_rates(label: str, band: int, k: int, r: dict) -> None:
     print(f"{label}: {band:,} band nodes, {k} sources")
     print(f"  loop of tube.solve(threads=1)  {r['loop']:7.1f} sources/s")
     print(f"  solve_many(threads=1)          {r['many1']:7.1f} sources/s  ({r['many1'] / r['loop']:.2f}x the loop)")
-    print(f"  solve_many(threads=2)          {r['many2']:7.1f} sources/s  ({r['many2'] / r['loop']:.2f}x the loop; "
-          f"target >= 1.8x)")
+    print(
+        f"  solve_many(threads=2)          {r['many2']:7.1f} sources/s  ({r['many2'] / r['loop']:.2f}x the loop; "
+        f"target >= 1.8x)"
+    )
 
 
 def part_sphere(quick: bool) -> None:
@@ -109,8 +111,12 @@ def part_dask(quick: bool) -> None:
     tube = sphere_tube(n)
     src = R * fibonacci_sphere(k)
     t = time.perf_counter()
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=40) as cluster, Client(cluster) as client:
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=40
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         start = time.perf_counter() - t
         t = time.perf_counter()
         first = tube.solve_many(src, at=src, client=client)
@@ -124,12 +130,15 @@ def part_dask(quick: bool) -> None:
             remote = tube.solve_many(src, at=src, client=client)
             dask_s = min(dask_s, time.perf_counter() - t)
     same = np.array_equal(local.view(np.uint64), remote.view(np.uint64)) and np.array_equal(
-        first.view(np.uint64), local.view(np.uint64))
+        first.view(np.uint64), local.view(np.uint64)
+    )
     print(f"dask LocalCluster (2 worker processes x 1 thread), sphere N = {n}, {k} sources, at = {k} points")
     print(f"  cluster start {start:.2f} s; first call (workers build the tube) {first_s:.2f} s")
-    print(f"  solve_many(threads=2) {local_s:.2f} s ({k / local_s:.1f} sources/s); dask {dask_s:.2f} s "
-          f"({k / dask_s:.1f} sources/s): {dask_s / local_s:.2f}x (target <= 1.3x), overhead {dask_s - local_s:+.2f} s; "
-          f"equal bit for bit: {same}")
+    print(
+        f"  solve_many(threads=2) {local_s:.2f} s ({k / local_s:.1f} sources/s); dask {dask_s:.2f} s "
+        f"({k / dask_s:.1f} sources/s): {dask_s / local_s:.2f}x (target <= 1.3x), overhead {dask_s - local_s:+.2f} s; "
+        f"equal bit for bit: {same}"
+    )
 
 
 def marching_cubes_sphere(n: int) -> "tuple[np.ndarray, np.ndarray]":
@@ -183,8 +192,10 @@ def part_peers(quick: bool) -> None:
         rows.append((f"pygeodesic exact MMP ({kk} sources)", kk / (time.perf_counter() - t), mmp, setup))
     except ImportError:
         print("  pygeodesic: skipped (pip install pygeodesic)")
-    print(f"peers per source on the marching-cubes mesh of the sphere at N = {n} ({len(v):,} vertices, {k} sources); "
-          "error against the great-circle distance at every vertex")
+    print(
+        f"peers per source on the marching-cubes mesh of the sphere at N = {n} ({len(v):,} vertices, {k} sources); "
+        "error against the great-circle distance at every vertex"
+    )
     print(f"  {'method':50s} {'sources/s':>10s} {'set-up s':>9s} {'max err':>9s} {'mean err':>9s}")
     for name, rate, values, setup in rows:
         e = np.abs(values - exact[: len(values)])
@@ -207,13 +218,19 @@ def part_matrix(quick: bool) -> None:
     seconds = time.perf_counter() - t
     peak = _peak_kb(reset)
     band_mb = tube.band_points * 8 / 2**20
-    print(f"{m} x {m} matrix on the bunny at N = {n} ({tube.band_points:,} band nodes), 2 threads: {seconds:.1f} s "
-          f"({m / seconds:.1f} sources/s)")
-    print(f"  peak RSS {peak / 1024:.0f} MB (process before the tube {before / 1024:.0f} MB, after it "
-          f"{after_tube / 1024:.0f} MB); the matrix {d.nbytes / 2**20:.1f} MB; {m} band arrays would be "
-          f"{m * band_mb:.0f} MB")
-    print(f"  asymmetry of the one-way estimates removed {info['asymmetry']:.3g} (largest distance "
-          f"{np.max(d[np.isfinite(d)]):.3g}), their largest diagonal {info['diagonal']:.3g}")
+    print(
+        f"{m} x {m} matrix on the bunny at N = {n} ({tube.band_points:,} band nodes), 2 threads: {seconds:.1f} s "
+        f"({m / seconds:.1f} sources/s)"
+    )
+    print(
+        f"  peak RSS {peak / 1024:.0f} MB (process before the tube {before / 1024:.0f} MB, after it "
+        f"{after_tube / 1024:.0f} MB); the matrix {d.nbytes / 2**20:.1f} MB; {m} band arrays would be "
+        f"{m * band_mb:.0f} MB"
+    )
+    print(
+        f"  asymmetry of the one-way estimates removed {info['asymmetry']:.3g} (largest distance "
+        f"{np.max(d[np.isfinite(d)]):.3g}), their largest diagonal {info['diagonal']:.3g}"
+    )
 
 
 PARTS = {"sphere": part_sphere, "bunny": part_bunny, "dask": part_dask, "peers": part_peers, "matrix": part_matrix}

@@ -220,8 +220,12 @@ def test_surfaces_tube_and_solution_pickle(grid, tube):
 @pytest.fixture(scope="module")
 def client():
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=40) as cluster, distributed.Client(cluster) as c:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=40
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
         yield c
 
 
@@ -295,11 +299,41 @@ def test_cli_distances(tmp_path):
     assert np.abs(d - great_circle(pts, pts)).max() < 0.2
     np.save(tmp_path / "pts.npy", pts)
     again = tmp_path / "D2.npy"
-    assert main(["distances", "--surface", "sphere", "--n", "41", "--points", str(tmp_path / "pts.npy"),
-                 "--out", str(again), "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "distances",
+                "--surface",
+                "sphere",
+                "--n",
+                "41",
+                "--points",
+                str(tmp_path / "pts.npy"),
+                "--out",
+                str(again),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     assert np.allclose(np.load(again), d, atol=1e-5)  # the points snapped once more (to about 1e-7)
     np.save(tmp_path / "off.npy", np.array([[0.0, 0.0, 0.0]]))
-    assert main(["distances", "--surface", "sphere", "--n", "41", "--points", str(tmp_path / "off.npy"),
-                 "--out", str(again), "--quiet"]) == 2
+    assert (
+        main(
+            [
+                "distances",
+                "--surface",
+                "sphere",
+                "--n",
+                "41",
+                "--points",
+                str(tmp_path / "off.npy"),
+                "--out",
+                str(again),
+                "--quiet",
+            ]
+        )
+        == 2
+    )
     assert main(["distances", "--surface", "sphere", "--sample", "2", "--out", str(tmp_path / "D.txt")]) == 2
     assert main(["distances", "--surface", "sphere", "--sample", "0", "--out", str(out)]) == 2

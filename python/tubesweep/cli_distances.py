@@ -24,11 +24,15 @@ def add_distances_parser(sub: Any) -> None:
     from .surfaces import REGISTRY
 
     p = sub.add_parser(
-        "distances", help="geodesic distance matrix between points on a surface (all cores or a Dask cluster)",
+        "distances",
+        help="geodesic distance matrix between points on a surface (all cores or a Dask cluster)",
         description="Geodesic distances between M points on a surface: one solve per point on a band built once, "
         "in parallel across the points (or on a Dask cluster with --scheduler). Writes the (M, M) matrix, "
         "symmetric with a zero diagonal (the average of the two one-way estimates), to --out, and the points to "
-        "<out>_points.npy.", epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+        "<out>_points.npy.",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=sorted(REGISTRY), help="a built-in surface")
     src.add_argument("--mesh", type=Path, help="a triangle mesh (.obj .ply .stl .off)")
@@ -37,11 +41,18 @@ def add_distances_parser(sub: Any) -> None:
     pts.add_argument("--points", type=Path, help="a .npy file with the points (M, d) on the surface")
     pts.add_argument("--sample", type=int, metavar="K", help="K points by geodesic farthest-point sampling")
     p.add_argument("--out", type=Path, required=True, help="the .npy file the matrix is written to")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="a Dask scheduler's address (e.g. tcp://10.0.0.5:8786): the solves run on its workers "
-                   "(pip install tubesweep[distributed])")
-    p.add_argument("--n", type=int, default=None, help="nodes per axis (--surface, default 101) or along the mesh's "
-                   "longest side (--mesh, default 200)")
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="a Dask scheduler's address (e.g. tcp://10.0.0.5:8786): the solves run on its workers "
+        "(pip install tubesweep[distributed])",
+    )
+    p.add_argument(
+        "--n",
+        type=int,
+        default=None,
+        help="nodes per axis (--surface, default 101) or along the mesh's longest side (--mesh, default 200)",
+    )
     p.add_argument("--padding", type=float, default=8.0, help="--mesh: empty grid spacings around the mesh (default 8)")
     p.add_argument("--normalize", action="store_true", help="--mesh: centre the mesh and scale its longest side to 1")
     p.add_argument("--lower", type=float, nargs="+", help="grid lower corner (--phi; optional for --surface)")
@@ -124,7 +135,9 @@ def _client(address: Optional[str]) -> Any:
     try:
         from distributed import Client
     except ImportError:
-        raise ImportError("--scheduler needs Dask's distributed scheduler: pip install tubesweep[distributed]") from None
+        raise ImportError(
+            "--scheduler needs Dask's distributed scheduler: pip install tubesweep[distributed]"
+        ) from None
     return Client(address)
 
 
@@ -146,23 +159,35 @@ def cmd_distances(args: argparse.Namespace) -> int:
     client = _client(args.scheduler)  # connected first: a wrong address fails before any work
     tube = Tube(surface, grid, inner=args.inner, outer=args.outer)
     label = args.surface or (args.mesh or args.phi).name
-    print(f"{label}: grid {grid.shape}, spacing {grid.spacing:.4g}; {tube.band_points:,} band nodes "
-          f"({tube.setup_seconds:.2f} s)")
+    print(
+        f"{label}: grid {grid.shape}, spacing {grid.spacing:.4g}; {tube.band_points:,} band nodes "
+        f"({tube.setup_seconds:.2f} s)"
+    )
     if args.points is not None:
         points = np.load(args.points, allow_pickle=False)
     else:
         bar = _SourcesBar("sampling", args.quiet)
         try:
-            points, radii = farthest_point_sampling(tube, None, args.sample, tol=args.tol, threads=args.threads,
-                                                    progress=bar)
+            points, radii = farthest_point_sampling(
+                tube, None, args.sample, tol=args.tol, threads=args.threads, progress=bar
+            )
         finally:
             bar.close()
         print(f"{len(points)} points by farthest-point sampling, last radius {radii[-1]:.4g}")
     bar = _SourcesBar("distances", args.quiet)
     t1 = time.perf_counter()
     try:
-        matrix, info = distance_matrix(tube, None, points, client=client, tol=args.tol, threads=args.threads,
-                                       chunk_size=args.chunk_size, progress=bar, info=True)
+        matrix, info = distance_matrix(
+            tube,
+            None,
+            points,
+            client=client,
+            tol=args.tol,
+            threads=args.threads,
+            chunk_size=args.chunk_size,
+            progress=bar,
+            info=True,
+        )
     finally:
         bar.close()
         if client is not None:
@@ -172,9 +197,11 @@ def cmd_distances(args: argparse.Namespace) -> int:
     points_file = args.out.with_name(args.out.stem + "_points.npy")
     np.save(points_file, info["points"])
     m = len(matrix)
-    print(f"{m} x {m} distances in {seconds:.2f} s ({m / seconds:.1f} sources/s"
-          f"{', on ' + args.scheduler if args.scheduler else ''}); largest {np.max(matrix[np.isfinite(matrix)]):.4g}; "
-          f"asymmetry of the one-way estimates removed: {info['asymmetry']:.3g}, their largest diagonal "
-          f"{info['diagonal']:.3g}")
+    print(
+        f"{m} x {m} distances in {seconds:.2f} s ({m / seconds:.1f} sources/s"
+        f"{', on ' + args.scheduler if args.scheduler else ''}); largest {np.max(matrix[np.isfinite(matrix)]):.4g}; "
+        f"asymmetry of the one-way estimates removed: {info['asymmetry']:.3g}, their largest diagonal "
+        f"{info['diagonal']:.3g}"
+    )
     print(f"wrote {args.out} and {points_file} ({time.perf_counter() - t0:.2f} s in all)")
     return 0

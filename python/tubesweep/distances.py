@@ -46,7 +46,9 @@ def snap_to_surface(tube: Tube, points: Any, name: str = "points") -> np.ndarray
     inside = tube.grid.contains(p)
     if not np.all(inside):
         i = int(np.flatnonzero(~inside)[0])
-        raise ValueError(f"{name}[{i}] = {tuple(float(x) for x in p[i])} lies outside the grid; move it onto the surface")
+        raise ValueError(
+            f"{name}[{i}] = {tuple(float(x) for x in p[i])} lies outside the grid; move it onto the surface"
+        )
     dist, proj = tube.surface.project(p, tube.grid)
     dist = np.asarray(dist, dtype=float)
     limit = tube.inner * tube.grid.spacing
@@ -56,15 +58,28 @@ def snap_to_surface(tube: Tube, points: Any, name: str = "points") -> np.ndarray
         raise ValueError(
             f"{name}[{i}] = {tuple(float(x) for x in p[i])} is {float(dist[i]):.4g} from the surface, farther than the "
             f"inner tube (inner·Δx = {limit:.4g}){f' ({bad.size} points in all)' if bad.size > 1 else ''}: points must "
-            "lie on the surface (they are snapped to it from within the inner tube); move them onto it")
+            "lie on the surface (they are snapped to it from within the inner tube); move them onto it"
+        )
     return np.ascontiguousarray(proj, dtype=float)
 
 
-def distance_matrix(surface: Any, grid: Any, points: Any, *, client: Any = None, inner: float = 2.0,
-                    outer: float = 4.0, hamiltonian: str = "godunov", source_init: str = "exact", tol: float = 1e-10,
-                    max_iterations: int = 10000, threads: int = 0, chunk_size: Optional[int] = None,
-                    progress: Optional[Callable[[int, int], Any]] = None, info: bool = False
-                    ) -> Union[np.ndarray, Tuple[np.ndarray, dict]]:
+def distance_matrix(
+    surface: Any,
+    grid: Any,
+    points: Any,
+    *,
+    client: Any = None,
+    inner: float = 2.0,
+    outer: float = 4.0,
+    hamiltonian: str = "godunov",
+    source_init: str = "exact",
+    tol: float = 1e-10,
+    max_iterations: int = 10000,
+    threads: int = 0,
+    chunk_size: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
+    info: bool = False,
+) -> Union[np.ndarray, Tuple[np.ndarray, dict]]:
     """Geodesic distances (M, M) between ``points`` on the surface.
 
     Parameters
@@ -90,13 +105,24 @@ def distance_matrix(surface: Any, grid: Any, points: Any, *, client: Any = None,
     t0 = time.perf_counter()
     tube = _as_tube(surface, grid, inner, outer)
     snapped = snap_to_surface(tube, points)
-    one_way = tube.solve_many(snapped, at=snapped, hamiltonian=hamiltonian, source_init=source_init, tol=tol,
-                              max_iterations=max_iterations, threads=threads, client=client, chunk_size=chunk_size,
-                              progress=progress)
+    one_way = tube.solve_many(
+        snapped,
+        at=snapped,
+        hamiltonian=hamiltonian,
+        source_init=source_init,
+        tol=tol,
+        max_iterations=max_iterations,
+        threads=threads,
+        client=client,
+        chunk_size=chunk_size,
+        progress=progress,
+    )
     if np.isnan(one_way).any():
         i, j = np.argwhere(np.isnan(one_way))[0]
-        raise RuntimeError(f"the solution from points[{i}] could not be read at points[{j}] (its interpolation stencil "
-                           "leaves the band): increase outer")
+        raise RuntimeError(
+            f"the solution from points[{i}] could not be read at points[{j}] (its interpolation stencil "
+            "leaves the band): increase outer"
+        )
     both = np.isfinite(one_way) & np.isfinite(one_way.T)
     diff = np.abs(one_way - one_way.T)
     asymmetry = float(np.max(diff[both], initial=0.0))
@@ -104,14 +130,27 @@ def distance_matrix(surface: Any, grid: Any, points: Any, *, client: Any = None,
     matrix = 0.5 * (one_way + one_way.T)
     np.fill_diagonal(matrix, 0.0)
     if info:
-        return matrix, {"asymmetry": asymmetry, "diagonal": diagonal, "points": snapped,
-                        "seconds": time.perf_counter() - t0}
+        return matrix, {
+            "asymmetry": asymmetry,
+            "diagonal": diagonal,
+            "points": snapped,
+            "seconds": time.perf_counter() - t0,
+        }
     return matrix
 
 
-def farthest_point_sampling(surface: Any, grid: Any, k: int, *, start: Any = None, inner: float = 2.0,
-                            outer: float = 4.0, tol: float = 1e-10, threads: int = 0,
-                            progress: Optional[Callable[[int, int], Any]] = None) -> Tuple[np.ndarray, np.ndarray]:
+def farthest_point_sampling(
+    surface: Any,
+    grid: Any,
+    k: int,
+    *,
+    start: Any = None,
+    inner: float = 2.0,
+    outer: float = 4.0,
+    tol: float = 1e-10,
+    threads: int = 0,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> Tuple[np.ndarray, np.ndarray]:
     """``k`` well-spread points on the surface by geodesic farthest-point sampling.
 
     Each new point is the surface point farthest from the points chosen so far: the closest point
@@ -136,7 +175,9 @@ def farthest_point_sampling(surface: Any, grid: Any, k: int, *, start: Any = Non
     g = tube.grid
     inner_pos = np.flatnonzero(t.roles == ROLE_INNER)
     if k > inner_pos.size:
-        raise ValueError(f"k = {k} exceeds the {inner_pos.size} inner-tube nodes the points are chosen from; refine the grid")
+        raise ValueError(
+            f"k = {k} exceeds the {inner_pos.size} inner-tube nodes the points are chosen from; refine the grid"
+        )
     # the surface point each inner node stands for
     _, candidates = tube.surface.project(g.node_points(t.linear[inner_pos]), g)
     candidates = np.asarray(candidates, dtype=float)
@@ -169,4 +210,3 @@ def farthest_point_sampling(surface: Any, grid: Any, k: int, *, start: Any = Non
         points.append(candidates[best])
         radii.append(float(score[best]))
     return np.array(points), np.array(radii)
-

@@ -95,11 +95,15 @@ def as_client(client: Any) -> Any:
     try:
         from distributed import Client
     except ImportError:
-        raise ImportError("client= needs Dask's distributed scheduler: pip install tubesweep[distributed] "
-                          "(dask, distributed and cloudpickle)") from None
+        raise ImportError(
+            "client= needs Dask's distributed scheduler: pip install tubesweep[distributed] "
+            "(dask, distributed and cloudpickle)"
+        ) from None
     if not isinstance(client, Client):
-        raise TypeError(f"client must be a dask.distributed.Client (e.g. Client(LocalCluster()) or "
-                        f"Client('tcp://scheduler:8786')); got {type(client).__name__}")
+        raise TypeError(
+            f"client must be a dask.distributed.Client (e.g. Client(LocalCluster()) or "
+            f"Client('tcp://scheduler:8786')); got {type(client).__name__}"
+        )
     return client
 
 
@@ -108,9 +112,18 @@ def _default_chunk(k: int, workers: int) -> int:
     return max(1, min(64, math.ceil(k / (4 * max(1, workers)))))
 
 
-def solve_many_on_client(tube: "Tube", sources: Any, *, client: Any, at: Any, chunk_size: Optional[int],
-                         progress: Optional[Callable[[int, int], Any]], options: Dict[str, Any], threads: int = 0,
-                         return_stats: bool = False) -> Any:
+def solve_many_on_client(
+    tube: "Tube",
+    sources: Any,
+    *,
+    client: Any,
+    at: Any,
+    chunk_size: Optional[int],
+    progress: Optional[Callable[[int, int], Any]],
+    options: Dict[str, Any],
+    threads: int = 0,
+    return_stats: bool = False,
+) -> Any:
     """:meth:`Tube.solve_many` on a Dask cluster (see the module's documentation). ``threads`` is
     not used: each worker runs as many chunks at once as it has threads, one thread per solve."""
     from distributed import as_completed
@@ -127,7 +140,9 @@ def solve_many_on_client(tube: "Tube", sources: Any, *, client: Any, at: Any, ch
     fixed_nodes(tube, groups, options.get("speed", 1.0), options.get("source_init", "exact"))
     nthreads = sum(client.nthreads().values())
     if nthreads == 0:
-        raise RuntimeError("the Dask cluster has no workers: start some (e.g. LocalCluster(n_workers=2)) or wait for them")
+        raise RuntimeError(
+            "the Dask cluster has no workers: start some (e.g. LocalCluster(n_workers=2)) or wait for them"
+        )
     if chunk_size is None:
         chunk_size = _default_chunk(k, nthreads)
     if not (isinstance(chunk_size, (int, np.integer)) and not isinstance(chunk_size, bool) and chunk_size >= 1):
@@ -137,8 +152,15 @@ def solve_many_on_client(tube: "Tube", sources: Any, *, client: Any, at: Any, ch
     spec = client.scatter(_TubeSpec(tube), broadcast=True, hash=False)
     at_data = None if points is None else client.scatter(points, broadcast=True, hash=False)
     futures = {
-        client.submit(_solve_chunk, spec, groups[a : a + chunk_size], at_data, options,
-                      key=f"tubesweep-solve_many-{run}-{a}", pure=False): a
+        client.submit(
+            _solve_chunk,
+            spec,
+            groups[a : a + chunk_size],
+            at_data,
+            options,
+            key=f"tubesweep-solve_many-{run}-{a}",
+            pure=False,
+        ): a
         for a in starts
     }
     width = tube.band_points if points is None else len(points)
@@ -155,9 +177,11 @@ def solve_many_on_client(tube: "Tube", sources: Any, *, client: Any, at: Any, ch
             except (ValueError, TypeError, KeyboardInterrupt):
                 raise
             except Exception as e:  # a worker that died on every try (KilledWorker), a lost dependency...
-                raise RuntimeError(f"the Dask cluster could not solve sources {a}..{b - 1}: {type(e).__name__}: {e}. "
-                                   "No partial result is returned; check the workers' logs and memory "
-                                   "(docs/many-sources.md, 'What to size')") from e
+                raise RuntimeError(
+                    f"the Dask cluster could not solve sources {a}..{b - 1}: {type(e).__name__}: {e}. "
+                    "No partial result is returned; check the workers' logs and memory "
+                    "(docs/many-sources.md, 'What to size')"
+                ) from e
             out[a:b] = values
             for name, v in st.items():
                 stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
@@ -171,8 +195,11 @@ def solve_many_on_client(tube: "Tube", sources: Any, *, client: Any, at: Any, ch
     if messages:
         import warnings
 
-        warnings.warn(f"on the workers: {messages[0]}" + (f" (and {len(messages) - 1} more)" if len(messages) > 1 else ""),
-                      RuntimeWarning, stacklevel=3)
+        warnings.warn(
+            f"on the workers: {messages[0]}" + (f" (and {len(messages) - 1} more)" if len(messages) > 1 else ""),
+            RuntimeWarning,
+            stacklevel=3,
+        )
     if return_stats:
         return out, stats
     return out

@@ -50,11 +50,15 @@ def source_groups(sources: Any, ndim: int) -> List[np.ndarray]:
             return [p[i : i + 1] for i in range(len(p))]
         if sources.ndim == 3:
             return [as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)]
-        raise ValueError(f"sources must have shape (K, {ndim}) (K point sources), (K, P, {ndim}) (K groups of P points) "
-                         f"or be a list of points and groups; got shape {sources.shape}")
+        raise ValueError(
+            f"sources must have shape (K, {ndim}) (K point sources), (K, P, {ndim}) (K groups of P points) "
+            f"or be a list of points and groups; got shape {sources.shape}"
+        )
     if isinstance(sources, (str, bytes)) or not hasattr(sources, "__len__"):
-        raise TypeError(f"sources must be an array (K, {ndim}) or a list of points ({ndim},) and groups (P, {ndim}); "
-                        f"got {type(sources).__name__}")
+        raise TypeError(
+            f"sources must be an array (K, {ndim}) or a list of points ({ndim},) and groups (P, {ndim}); "
+            f"got {type(sources).__name__}"
+        )
     return [as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)]
 
 
@@ -81,8 +85,9 @@ def _renamed(e: ValueError, k: int, group: bool) -> ValueError:
     return ValueError(text)
 
 
-def fixed_nodes(tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str
-                ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def fixed_nodes(
+    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The band positions and values each source fixes, concatenated, and the offsets (K + 1,)
     of each source's run: ``_fix_sources`` of a single solve, source by source."""
     t = tube._tube
@@ -94,19 +99,25 @@ def fixed_nodes(tube: "Tube", groups: List[np.ndarray], speed: Any, source_init:
     for k, g in enumerate(groups):
         try:
             src = as_sources(g, grid)
-            pos, val, _ = _fix_sources(surf, grid, t.band, t.linear, t.roles, src, slowness_at, source_init, inner_width)
+            pos, val, _ = _fix_sources(
+                surf, grid, t.band, t.linear, t.roles, src, slowness_at, source_init, inner_width
+            )
         except ValueError as e:
             raise _renamed(e, k, len(g) > 1) from None
         if t.method != "naive" and len(src) == 1 and np.unique(pos).size >= n_inner:
             raise ValueError(
                 f"sources[{k}]: the grid is too coarse for this surface: every node of the inner tube lies within "
                 f"{SOURCE_RADIUS:g} grid spacings (h = {grid.spacing:.4g}) of the source, so its value is the source's "
-                "initialisation and nothing is solved; refine the grid")
+                "initialisation and nothing is solved; refine the grid"
+            )
         positions.append(pos)
         values.append(val)
         offsets.append(offsets[-1] + len(pos))
-    return (np.ascontiguousarray(np.concatenate(positions), dtype=np.int64),
-            np.ascontiguousarray(np.concatenate(values), dtype=float), np.asarray(offsets, dtype=np.int64))
+    return (
+        np.ascontiguousarray(np.concatenate(positions), dtype=np.int64),
+        np.ascontiguousarray(np.concatenate(values), dtype=float),
+        np.asarray(offsets, dtype=np.int64),
+    )
 
 
 def check_many_progress(progress: Any) -> Optional[Callable[[int, int], Any]]:
@@ -117,10 +128,22 @@ def check_many_progress(progress: Any) -> Optional[Callable[[int, int], Any]]:
     return progress
 
 
-def solve_many(tube: "Tube", sources: Any, *, at: Any = None, hamiltonian: Any = "godunov", speed: Any = 1.0,
-               source_init: str = "exact", tol: float = 1e-10, max_iterations: int = 10000,
-               progress: Optional[Callable[[int, int], Any]] = None, infinity: Optional[float] = None,
-               threads: int = 0, paper_sweeps: bool = False, return_stats: bool = False) -> Any:
+def solve_many(
+    tube: "Tube",
+    sources: Any,
+    *,
+    at: Any = None,
+    hamiltonian: Any = "godunov",
+    speed: Any = 1.0,
+    source_init: str = "exact",
+    tol: float = 1e-10,
+    max_iterations: int = 10000,
+    progress: Optional[Callable[[int, int], Any]] = None,
+    infinity: Optional[float] = None,
+    threads: int = 0,
+    paper_sweeps: bool = False,
+    return_stats: bool = False,
+) -> Any:
     """See :meth:`tubesweep.Tube.solve_many` (the local run; a Dask client goes through
     :mod:`tubesweep.distributed`)."""
     t0 = time.perf_counter()
@@ -132,8 +155,10 @@ def solve_many(tube: "Tube", sources: Any, *, at: Any = None, hamiltonian: Any =
         raise ValueError("sources is empty: give at least one source (a point, or a group of points)")
     general, scheme = _resolve_scheme(hamiltonian, None, False)
     if general is not None:
-        raise ValueError("solve_many takes hamiltonian='godunov' or 'lxf'; for a ts.hamiltonians object solve each "
-                         "source with tube.solve")
+        raise ValueError(
+            "solve_many takes hamiltonian='godunov' or 'lxf'; for a ts.hamiltonians object solve each "
+            "source with tube.solve"
+        )
     check_tolerance(tol, max_iterations)
     cb = check_many_progress(progress)
     _check_source_init(source_init)
@@ -154,10 +179,28 @@ def solve_many(tube: "Tube", sources: Any, *, at: Any = None, hamiltonian: Any =
     directions = t.geom.directions_for_solver()  # a copy: the tube's stay as they are
     setup = time.perf_counter() - t0
     out, st = _native.solve_many_on_band(
-        t.band, t.roles, positions, values, offsets, h, slowness, directions, scheme, missing_policy, float(tol),
-        int(max_iterations), inf, cb, nthreads, ACTIVATION_FRACTION * float(tol), not paper_sweeps, not paper_sweeps,
+        t.band,
+        t.roles,
+        positions,
+        values,
+        offsets,
+        h,
+        slowness,
+        directions,
+        scheme,
+        missing_policy,
+        float(tol),
+        int(max_iterations),
+        inf,
+        cb,
+        nthreads,
+        ACTIVATION_FRACTION * float(tol),
+        not paper_sweeps,
+        not paper_sweeps,
         0.0 if paper_sweeps else FRONT_WINDOW,
-        points, None if points is None else [float(v) for v in grid.lower])
+        points,
+        None if points is None else [float(v) for v in grid.lower],
+    )
     del directions
     bad = np.flatnonzero(~st["converged"])
     if bad.size:
@@ -165,7 +208,10 @@ def solve_many(tube: "Tube", sources: Any, *, at: Any = None, hamiltonian: Any =
             f"{bad.size} of {len(groups)} solves did not converge in max_iterations={max_iterations} (sources "
             f"{bad[:5].tolist()}{'…' if bad.size > 5 else ''}; the largest change in the last iteration "
             f"{float(np.max(st['last_change'][bad])):.3g}, tol={tol:g}): their rows are the last iterate. Increase "
-            "max_iterations or tol", RuntimeWarning, stacklevel=3)
+            "max_iterations or tol",
+            RuntimeWarning,
+            stacklevel=3,
+        )
     if return_stats:
         st = dict(st)
         st["setup_seconds"] = setup

@@ -121,7 +121,9 @@ class Solution:
 
     def __setstate__(self, state: dict) -> None:
         linear = state["_band"]
-        state["_band"] = _native.Band.from_linear(list(state["grid"].shape), np.ascontiguousarray(linear).view(np.uint64))
+        state["_band"] = _native.Band.from_linear(
+            list(state["grid"].shape), np.ascontiguousarray(linear).view(np.uint64)
+        )
         self.__dict__.update(state)
 
     def _check_surface_unchanged(self) -> None:

@@ -72,10 +72,13 @@ class Tube:
 
     def _check_phi_unchanged(self) -> None:
         if self._phi_at_band is not None and not np.array_equal(
-                self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band):  # type: ignore[attr-defined]
-            raise ValueError("the φ array of this Tube's surface was changed after the Tube was built: its band no "
-                             "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
-                             "the array free to change)")
+            self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band
+        ):  # type: ignore[attr-defined]
+            raise ValueError(
+                "the φ array of this Tube's surface was changed after the Tube was built: its band no "
+                "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
+                "the array free to change)"
+            )
 
     def __getstate__(self) -> dict:
         """A tube pickles as its surface, grid and widths (and its token); unpickling builds the band
@@ -198,17 +201,45 @@ class Tube:
             from .distributed import solve_many_on_client
 
             return solve_many_on_client(
-                self, sources, client=client, at=at, chunk_size=chunk_size, progress=progress,
-                options=dict(hamiltonian=hamiltonian, speed=speed, source_init=source_init, tol=tol,
-                             max_iterations=max_iterations, infinity=infinity, paper_sweeps=paper_sweeps),
-                threads=threads, return_stats=return_stats)
+                self,
+                sources,
+                client=client,
+                at=at,
+                chunk_size=chunk_size,
+                progress=progress,
+                options=dict(
+                    hamiltonian=hamiltonian,
+                    speed=speed,
+                    source_init=source_init,
+                    tol=tol,
+                    max_iterations=max_iterations,
+                    infinity=infinity,
+                    paper_sweeps=paper_sweeps,
+                ),
+                threads=threads,
+                return_stats=return_stats,
+            )
         if chunk_size is not None:
-            raise ValueError("chunk_size is for a Dask client (client=...): a local solve_many runs every source at once")
+            raise ValueError(
+                "chunk_size is for a Dask client (client=...): a local solve_many runs every source at once"
+            )
         from .many import solve_many
 
-        return solve_many(self, sources, at=at, hamiltonian=hamiltonian, speed=speed, source_init=source_init, tol=tol,
-                          max_iterations=max_iterations, progress=progress, infinity=infinity, threads=threads,
-                          paper_sweeps=paper_sweeps, return_stats=return_stats)
+        return solve_many(
+            self,
+            sources,
+            at=at,
+            hamiltonian=hamiltonian,
+            speed=speed,
+            source_init=source_init,
+            tol=tol,
+            max_iterations=max_iterations,
+            progress=progress,
+            infinity=infinity,
+            threads=threads,
+            paper_sweeps=paper_sweeps,
+            return_stats=return_stats,
+        )
 
     @property
     def nbytes(self) -> int:

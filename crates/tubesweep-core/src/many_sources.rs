@@ -39,7 +39,11 @@ pub enum Output<'o, const D: usize> {
     /// The values interpolated at `points` (`M × D`, flattened) on the grid with lower corner
     /// `lower` (as [`interpolate`]): row `k` of `values` (`K × M`). Nodes never reached count as
     /// `+inf` before the interpolation, as in a solution's values.
-    AtPoints { lower: [f64; D], points: &'o [f64], values: &'o mut [f64] },
+    AtPoints {
+        lower: [f64; D],
+        points: &'o [f64],
+        values: &'o mut [f64],
+    },
 }
 
 /// How often the caller's `progress` is called while the solves run.
@@ -65,33 +69,58 @@ pub fn solve_many<const D: usize>(
     let n = template.band.len();
     let k = sources.len();
     if template.roles.len() != n {
-        return Err(Error::invalid("roles", format!("expected {n} roles, got {}", template.roles.len())));
+        return Err(Error::invalid(
+            "roles",
+            format!("expected {n} roles, got {}", template.roles.len()),
+        ));
     }
     if template.roles.contains(&NodeRole::Fixed) {
-        return Err(Error::invalid("roles", "the template's roles must not hold fixed nodes (each source fixes its own)"));
+        return Err(Error::invalid(
+            "roles",
+            "the template's roles must not hold fixed nodes (each source fixes its own)",
+        ));
     }
     for (i, s) in sources.iter().enumerate() {
         if s.positions.len() != s.values.len() {
-            return Err(Error::invalid("sources", format!("source {i}: {} positions but {} values", s.positions.len(), s.values.len())));
+            return Err(Error::invalid(
+                "sources",
+                format!(
+                    "source {i}: {} positions but {} values",
+                    s.positions.len(),
+                    s.values.len()
+                ),
+            ));
         }
         if let Some(&p) = s.positions.iter().find(|&&p| p >= n) {
-            return Err(Error::invalid("sources", format!("source {i}: {p} is not a position in the band of {n} nodes")));
+            return Err(Error::invalid(
+                "sources",
+                format!("source {i}: {p} is not a position in the band of {n} nodes"),
+            ));
         }
     }
     let width = match &output {
         Output::Band(v) => {
             if v.len() != k * n {
-                return Err(Error::invalid("values", format!("expected {k} × {n} values, got {}", v.len())));
+                return Err(Error::invalid(
+                    "values",
+                    format!("expected {k} × {n} values, got {}", v.len()),
+                ));
             }
             n
         }
         Output::AtPoints { points, values, .. } => {
             if points.len() % D != 0 {
-                return Err(Error::invalid("points", format!("expected {D} coordinates per point, got {} numbers", points.len())));
+                return Err(Error::invalid(
+                    "points",
+                    format!("expected {D} coordinates per point, got {} numbers", points.len()),
+                ));
             }
             let m = points.len() / D;
             if values.len() != k * m {
-                return Err(Error::invalid("values", format!("expected {k} × {m} values, got {}", values.len())));
+                return Err(Error::invalid(
+                    "values",
+                    format!("expected {k} × {m} values, got {}", values.len()),
+                ));
             }
             m
         }
@@ -101,13 +130,27 @@ pub fn solve_many<const D: usize>(
         progress(0);
         return Ok(Vec::new());
     }
-    let threads = if threads == 0 { rayon::current_num_threads() } else { threads }.clamp(1, k);
+    let threads = if threads == 0 {
+        rayon::current_num_threads()
+    } else {
+        threads
+    }
+    .clamp(1, k);
     let one = SolveOptions { threads: 1, ..*options };
     let (rows, at) = match &mut output {
-        Output::Band(v) => (v.chunks_mut(width.max(1)).map(|r| Mutex::new(Some(r))).collect::<Vec<_>>(), None),
-        Output::AtPoints { lower, points, values } => {
-            (values.chunks_mut(width.max(1)).map(|r| Mutex::new(Some(r))).collect::<Vec<_>>(), Some((*lower, *points)))
-        }
+        Output::Band(v) => (
+            v.chunks_mut(width.max(1))
+                .map(|r| Mutex::new(Some(r)))
+                .collect::<Vec<_>>(),
+            None,
+        ),
+        Output::AtPoints { lower, points, values } => (
+            values
+                .chunks_mut(width.max(1))
+                .map(|r| Mutex::new(Some(r)))
+                .collect::<Vec<_>>(),
+            Some((*lower, *points)),
+        ),
     };
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
@@ -132,9 +175,13 @@ pub fn solve_many<const D: usize>(
                             if let Some(row) = row {
                                 match at {
                                     None => row.copy_from_slice(&values),
-                                    Some((lower, points)) => {
-                                        row.copy_from_slice(&interpolate(template.band, &values, lower, template.spacing, points))
-                                    }
+                                    Some((lower, points)) => row.copy_from_slice(&interpolate(
+                                        template.band,
+                                        &values,
+                                        lower,
+                                        template.spacing,
+                                        points,
+                                    )),
                                 }
                             }
                             if let Ok(mut slot) = results[i].lock() {
@@ -192,7 +239,10 @@ pub fn solve_many<const D: usize>(
     for (slot, r) in stats.iter_mut().zip(results) {
         *slot = r.into_inner().unwrap_or(None);
     }
-    stats.into_iter().map(|s| s.ok_or(Error::Interrupted { iterations: 0 })).collect()
+    stats
+        .into_iter()
+        .map(|s| s.ok_or(Error::Interrupted { iterations: 0 }))
+        .collect()
 }
 
 /// One source's solve on `roles` (the template's, restored before returning): its nodes fixed
@@ -223,7 +273,13 @@ fn solve_one<const D: usize>(
         scheme: template.scheme,
         missing: template.missing,
     };
-    let mut check = |_: &IterationReport| if stop.load(Ordering::Relaxed) { Control::Stop } else { Control::Continue };
+    let mut check = |_: &IterationReport| {
+        if stop.load(Ordering::Relaxed) {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    };
     let result = problem.solve(&mut values, options, &mut check);
     for &p in src.positions {
         roles[p] = template.roles[p];
@@ -282,10 +338,25 @@ mod tests {
         };
         let pos: Vec<Vec<usize>> = vec![vec![0], vec![41 * 20 + 20], vec![5, 1600], vec![n - 1]];
         let vals: Vec<Vec<f64>> = pos.iter().map(|p| vec![0.0; p.len()]).collect();
-        let sources: Vec<FixedSet> = pos.iter().zip(&vals).map(|(p, v)| FixedSet { positions: p, values: v }).collect();
+        let sources: Vec<FixedSet> = pos
+            .iter()
+            .zip(&vals)
+            .map(|(p, v)| FixedSet {
+                positions: p,
+                values: v,
+            })
+            .collect();
         for threads in [1, 2, 3] {
             let mut out = vec![0.0; sources.len() * n];
-            let st = solve_many(&template, &sources, &options(), threads, Output::Band(&mut out), &mut |_| Control::Continue).unwrap();
+            let st = solve_many(
+                &template,
+                &sources,
+                &options(),
+                threads,
+                Output::Band(&mut out),
+                &mut |_| Control::Continue,
+            )
+            .unwrap();
             assert_eq!(st.len(), sources.len());
             for (i, s) in sources.iter().enumerate() {
                 let mut r = roles.clone();
@@ -293,8 +364,13 @@ mod tests {
                 for &p in s.positions {
                     r[p] = NodeRole::Fixed;
                 }
-                let problem = SweepProblem { roles: &r, ..template_clone(&template) };
-                let one = problem.solve(&mut single, &options(), &mut |_| Control::Continue).unwrap();
+                let problem = SweepProblem {
+                    roles: &r,
+                    ..template_clone(&template)
+                };
+                let one = problem
+                    .solve(&mut single, &options(), &mut |_| Control::Continue)
+                    .unwrap();
                 single.truncate(n);
                 for v in single.iter_mut() {
                     if *v >= one.infinity {
@@ -302,14 +378,25 @@ mod tests {
                     }
                 }
                 let row = &out[i * n..(i + 1) * n];
-                assert!(row.iter().zip(&single).all(|(a, b)| a.to_bits() == b.to_bits()), "source {i}, {threads} threads");
+                assert!(
+                    row.iter().zip(&single).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "source {i}, {threads} threads"
+                );
                 assert_eq!(one.iterations, st[i].iterations);
             }
         }
     }
 
     fn template_clone<'a>(t: &SweepProblem<'a, 2>) -> SweepProblem<'a, 2> {
-        SweepProblem { band: t.band, roles: t.roles, spacing: t.spacing, slowness: t.slowness, extension: t.extension, scheme: t.scheme, missing: t.missing }
+        SweepProblem {
+            band: t.band,
+            roles: t.roles,
+            spacing: t.spacing,
+            slowness: t.slowness,
+            extension: t.extension,
+            scheme: t.scheme,
+            missing: t.missing,
+        }
     }
 
     #[test]
@@ -328,24 +415,68 @@ mod tests {
         };
         let pos = [vec![0usize], vec![n - 1]];
         let vals = [vec![0.0], vec![0.0]];
-        let sources: Vec<FixedSet> = pos.iter().zip(&vals).map(|(p, v)| FixedSet { positions: p, values: v }).collect();
+        let sources: Vec<FixedSet> = pos
+            .iter()
+            .zip(&vals)
+            .map(|(p, v)| FixedSet {
+                positions: p,
+                values: v,
+            })
+            .collect();
         // the corner nodes themselves: the values there are the fixed ones and the far corner's
         let points = [0.0, 0.0, 2.0, 2.0];
         let mut out = vec![0.0; 4];
-        solve_many(&template, &sources, &options(), 2, Output::AtPoints { lower: [0.0, 0.0], points: &points, values: &mut out }, &mut |_| Control::Continue).unwrap();
+        solve_many(
+            &template,
+            &sources,
+            &options(),
+            2,
+            Output::AtPoints {
+                lower: [0.0, 0.0],
+                points: &points,
+                values: &mut out,
+            },
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
         assert_eq!(out[0], 0.0);
         assert_eq!(out[3], 0.0);
         assert!((out[1] - 2.0 * 2f64.sqrt()).abs() < 0.3, "{}", out[1]);
         assert_eq!(out[1].to_bits(), out[2].to_bits());
         // a caller that stops at once gets Interrupted, never a partial result
         let mut out = vec![0.0; 4];
-        let err = solve_many(&template, &sources, &options(), 2, Output::AtPoints { lower: [0.0, 0.0], points: &points, values: &mut out }, &mut |_| Control::Stop);
+        let err = solve_many(
+            &template,
+            &sources,
+            &options(),
+            2,
+            Output::AtPoints {
+                lower: [0.0, 0.0],
+                points: &points,
+                values: &mut out,
+            },
+            &mut |_| Control::Stop,
+        );
         assert!(matches!(err, Err(Error::Interrupted { .. })));
         // a bad position is refused before anything runs
-        let bad = [FixedSet { positions: &[n], values: &[0.0] }];
+        let bad = [FixedSet {
+            positions: &[n],
+            values: &[0.0],
+        }];
         let mut out = vec![0.0; n];
-        assert!(solve_many(&template, &bad, &options(), 1, Output::Band(&mut out), &mut |_| Control::Continue).is_err());
+        assert!(
+            solve_many(&template, &bad, &options(), 1, Output::Band(&mut out), &mut |_| {
+                Control::Continue
+            })
+            .is_err()
+        );
         let mut out: Vec<f64> = Vec::new();
-        assert!(solve_many(&template, &[], &options(), 1, Output::Band(&mut out), &mut |_| Control::Continue).unwrap().is_empty());
+        assert!(
+            solve_many(&template, &[], &options(), 1, Output::Band(&mut out), &mut |_| {
+                Control::Continue
+            })
+            .unwrap()
+            .is_empty()
+        );
     }
 }

@@ -21,13 +21,38 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// seconds, infinity, window_edge.
 fn stats_arrays<'py>(py: Python<'py>, stats: &[SolveStats]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("iterations", stats.iter().map(|s| s.iterations as i64).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("updates", stats.iter().map(|s| s.updates).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("converged", stats.iter().map(|s| s.converged).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("last_change", stats.iter().map(|s| s.last_change).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("seconds", stats.iter().map(|s| s.seconds).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("infinity", stats.iter().map(|s| s.infinity).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("window_edge", stats.iter().map(|s| s.window_edge).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item(
+        "iterations",
+        stats
+            .iter()
+            .map(|s| s.iterations as i64)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item(
+        "updates",
+        stats.iter().map(|s| s.updates).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "converged",
+        stats.iter().map(|s| s.converged).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "last_change",
+        stats.iter().map(|s| s.last_change).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "seconds",
+        stats.iter().map(|s| s.seconds).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "infinity",
+        stats.iter().map(|s| s.infinity).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "window_edge",
+        stats.iter().map(|s| s.window_edge).collect::<Vec<_>>().into_pyarray(py),
+    )?;
     Ok(d)
 }
 
@@ -54,7 +79,9 @@ fn run<'py, const D: usize>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyDict>)> {
     let n = band.len();
     if common.roles.len() != n {
-        return Err(PyValueError::new_err(format!("roles must have one entry per band node ({n})")));
+        return Err(PyValueError::new_err(format!(
+            "roles must have one entry per band node ({n})"
+        )));
     }
     let roles = node_roles(common.roles)?;
     let template = SweepProblem {
@@ -65,7 +92,11 @@ fn run<'py, const D: usize>(
         // the weights of Eq. (5) depend on the roles only through the layer's nodes, which no
         // source fixes: derived once for every source
         extension: extension_in_place::<D>(band, roles, directions, n)?,
-        scheme: if common.scheme == 0 { InnerScheme::Godunov } else { InnerScheme::LaxFriedrichs },
+        scheme: if common.scheme == 0 {
+            InnerScheme::Godunov
+        } else {
+            InnerScheme::LaxFriedrichs
+        },
         missing: common.missing,
     };
     let k = sources.len();
@@ -74,7 +105,9 @@ fn run<'py, const D: usize>(
         None => n,
     };
     let lower: [f64; D] = match at {
-        Some((_, lower)) => lower.try_into().map_err(|_| PyValueError::new_err(format!("lower must have {D} entries")))?,
+        Some((_, lower)) => lower
+            .try_into()
+            .map_err(|_| PyValueError::new_err(format!("lower must have {D} entries")))?,
         None => [0.0; D],
     };
     let mut values = vec![0.0f64; k * width];
@@ -97,7 +130,11 @@ fn run<'py, const D: usize>(
             })
         };
         let output = match at {
-            Some((points, _)) => Output::AtPoints { lower, points, values: &mut values },
+            Some((points, _)) => Output::AtPoints {
+                lower,
+                points,
+                values: &mut values,
+            },
             None => Output::Band(&mut values),
         };
         solve_many(&template, sources, &common.options, common.threads, output, &mut report)
@@ -147,13 +184,17 @@ fn solve_many_on_band<'py>(
     let scheme = parse_scheme(scheme)?;
     let missing = parse_missing(missing)?;
     if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(PyValueError::new_err(format!("spacing must be positive and finite, got {spacing}")));
+        return Err(PyValueError::new_err(format!(
+            "spacing must be positive and finite, got {spacing}"
+        )));
     }
     if !(activation_threshold >= 0.0) {
         return Err(PyValueError::new_err("activation_threshold must be non-negative"));
     }
     if !(front_window >= 0.0 && front_window.is_finite()) {
-        return Err(PyValueError::new_err("front_window must be a non-negative finite number (0 switches the window off)"));
+        return Err(PyValueError::new_err(
+            "front_window must be a non-negative finite number (0 switches the window off)",
+        ));
     }
     let options = SolveOptions {
         tol,
@@ -172,20 +213,37 @@ fn solve_many_on_band<'py>(
     let values = fixed_values.as_slice()?;
     let offsets = offsets.as_slice()?;
     if positions.len() != values.len() {
-        return Err(PyValueError::new_err("fixed_positions and fixed_values must have the same length"));
+        return Err(PyValueError::new_err(
+            "fixed_positions and fixed_values must have the same length",
+        ));
     }
-    if offsets.is_empty() || offsets[0] != 0 || *offsets.last().unwrap_or(&0) as usize != positions.len() || offsets.windows(2).any(|w| w[1] < w[0]) {
-        return Err(PyValueError::new_err("offsets must rise from 0 to the number of fixed positions"));
+    if offsets.is_empty()
+        || offsets[0] != 0
+        || *offsets.last().unwrap_or(&0) as usize != positions.len()
+        || offsets.windows(2).any(|w| w[1] < w[0])
+    {
+        return Err(PyValueError::new_err(
+            "offsets must rise from 0 to the number of fixed positions",
+        ));
     }
     if positions.iter().any(|&p| p < 0) {
-        return Err(PyValueError::new_err("fixed_positions must be non-negative band positions"));
+        return Err(PyValueError::new_err(
+            "fixed_positions must be non-negative band positions",
+        ));
     }
     let positions: Vec<usize> = positions.iter().map(|&p| p as usize).collect();
     let sources: Vec<FixedSet<'_>> = offsets
         .windows(2)
-        .map(|w| FixedSet { positions: &positions[w[0] as usize..w[1] as usize], values: &values[w[0] as usize..w[1] as usize] })
+        .map(|w| FixedSet {
+            positions: &positions[w[0] as usize..w[1] as usize],
+            values: &values[w[0] as usize..w[1] as usize],
+        })
         .collect();
-    let slowness_arr: Option<PyReadonlyArray1<'py, f64>> = if slowness.extract::<f64>().is_ok() { None } else { Some(slowness.extract()?) };
+    let slowness_arr: Option<PyReadonlyArray1<'py, f64>> = if slowness.extract::<f64>().is_ok() {
+        None
+    } else {
+        Some(slowness.extract()?)
+    };
     let slowness = match &slowness_arr {
         Some(a) => Slowness::PerNode(a.as_slice()?),
         None => Slowness::Constant(slowness.extract::<f64>()?),
@@ -196,7 +254,15 @@ fn solve_many_on_band<'py>(
     };
     let lower = lower.unwrap_or_default();
     let at = points.map(|p| (p, &lower[..]));
-    let common = Common { roles: roles.as_slice()?, spacing, slowness, scheme, missing, options, threads };
+    let common = Common {
+        roles: roles.as_slice()?,
+        spacing,
+        slowness,
+        scheme,
+        missing,
+        options,
+        threads,
+    };
     let band = band.get();
     match &band.band {
         AnyBand::D2(b) => run(py, b, common, &mut directions, &sources, at, progress),
