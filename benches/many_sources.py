@@ -75,16 +75,21 @@ def rates(tube: ts.Tube, sources: np.ndarray, at: np.ndarray, rounds: int) -> di
 
 
 def print_rates(label: str, band: int, k: int, r: dict) -> None:
-    print(f"{label}: {band:,} band nodes, {k} sources (cores: the CPU time the process got per wall second)")
-    print(f"  loop of tube.solve(threads=1)  {r['loop']:7.1f} sources/s  cores {r['loop_cores']:.2f}")
     print(
-        f"  solve_many(threads=1)          {r['many1']:7.1f} sources/s  cores {r['many1_cores']:.2f}  "
-        f"({r['many1'] / r['loop']:.2f}x the loop)"
+        f"{label}: {band:,} band nodes, {k} sources (cores: the CPU time the process got per wall second; "
+        "CPU ms/source: the work per source, which stays put when the threads do not slow each other)"
     )
-    print(
-        f"  solve_many(threads=2)          {r['many2']:7.1f} sources/s  cores {r['many2_cores']:.2f}  "
-        f"({r['many2'] / r['loop']:.2f}x the loop; target >= 1.8x)"
+    rows = (
+        ("loop of tube.solve(threads=1)", "loop", ""),
+        ("solve_many(threads=1)", "many1", ""),
+        ("solve_many(threads=2)", "many2", "; target >= 1.8x"),
     )
+    for text, key, target in rows:
+        cpu_ms = 1000.0 * r[key + "_cores"] / r[key]
+        ratio = f"  ({r[key] / r['loop']:.2f}x the loop{target})" if key != "loop" else ""
+        print(
+            f"  {text:30s} {r[key]:7.1f} sources/s  cores {r[key + '_cores']:.2f}  CPU {cpu_ms:6.1f} ms/source{ratio}"
+        )
 
 
 def part_sphere(quick: bool) -> None:
