@@ -360,3 +360,21 @@ def test_ctrl_c_stops_every_solve(tube):
     one = tube.solve_many(sources[:4], at=sources[:3], threads=1, return_stats=True)[1]["seconds"].mean()
     # stopped long before the 400 solves (at least 200 solve times on two threads) could end
     assert elapsed < 0.1 + 0.25 * len(sources) * one, (elapsed, one)
+
+
+def test_bench_script_runs(tmp_path):
+    """benches/many_sources.py --quick (make bench runs it at full size) prints its figures."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "benches" / "many_sources.py"
+    out = subprocess.run(
+        [sys.executable, str(script), "--quick", "--parts", "sphere,peers"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    ).stdout
+    assert "solve_many(threads=2)" in out and "x the loop" in out
+    assert "potpourri3d heat method" in out and "pygeodesic exact MMP" in out

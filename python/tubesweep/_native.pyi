@@ -92,6 +92,29 @@ def ellipsoid_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], axes: List[float]
 ) -> npt.NDArray[np.float64]: ...
 def star_signed_distance(points: npt.NDArray[np.float64], r0: float, eps: float) -> npt.NDArray[np.float64]: ...
+def solve_many_on_band(  # crates/tubesweep-py/src/many_sources.rs: K solves, in parallel across the sources
+    band: "Band",
+    roles: npt.NDArray[np.uint8],  # (n,) without fixed nodes
+    fixed_positions: npt.NDArray[np.int64],  # the sources' fixed nodes, concatenated
+    fixed_values: npt.NDArray[np.float64],
+    offsets: npt.NDArray[np.int64],  # (K + 1,) source k's run is offsets[k]:offsets[k + 1]
+    spacing: float,
+    slowness: Union[float, npt.NDArray[np.float64]],
+    directions: Optional[npt.NDArray[np.float32]],  # (n, d) C-contiguous; overwritten with the extension weights
+    scheme: str,
+    missing: str,
+    tol: float,
+    max_iterations: int,
+    infinity: Optional[float],
+    progress: Optional[Callable[[int, int], Any]] = None,  # (done, K)
+    threads: int = 0,  # solves at once, each on one thread
+    activation_threshold: float = 0.0,
+    coupled: bool = True,
+    defer_outer_rim: bool = True,
+    front_window: float = 0.0,
+    at: Optional[npt.NDArray[np.float64]] = None,  # (M, d): return the values there, (K, M)
+    lower: Optional[List[float]] = None,  # the grid's lower corner, with `at`
+) -> Tuple[npt.NDArray[np.float64], Dict[str, npt.NDArray[Any]]]: ...
 def rounded_cube_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], half_size: float, radius: float
 ) -> npt.NDArray[np.float64]: ...
