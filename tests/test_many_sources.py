@@ -242,6 +242,12 @@ def test_dask_equals_local(client, tube):
     assert set(held.values()) <= {1}
     d_local = ts.distance_matrix(tube, None, pts)
     assert np.array_equal(ts.distance_matrix(tube, None, pts, client=client), d_local)
+    # the options reach the workers (a callable speed through cloudpickle)
+    speed = lambda p: 1.0 + 0.5 * p[:, 2]  # noqa: E731
+    opts = dict(hamiltonian="lxf", speed=speed)
+    assert np.array_equal(
+        bits(tube.solve_many(pts[:3], at=pts, client=client, **opts)), bits(tube.solve_many(pts[:3], at=pts, **opts))
+    )
     # band rows come back too (no at=)
     assert np.array_equal(bits(tube.solve_many(pts[:3], client=client)), bits(tube.solve_many(pts[:3])))
 

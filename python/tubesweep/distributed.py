@@ -151,13 +151,15 @@ def solve_many_on_client(
     run = uuid.uuid4().hex[:12]
     spec = client.scatter(_TubeSpec(tube), broadcast=True, hash=False)
     at_data = None if points is None else client.scatter(points, broadcast=True, hash=False)
+    # the options go once too: a speed given as an array of the grid's shape is as large as a φ array
+    opts = client.scatter([options], broadcast=True, hash=False)[0]
     futures = {
         client.submit(
             _solve_chunk,
             spec,
             groups[a : a + chunk_size],
             at_data,
-            options,
+            opts,
             key=f"tubesweep-solve_many-{run}-{a}",
             pure=False,
         ): a
@@ -191,7 +193,7 @@ def solve_many_on_client(
                 cb(done, k)
     finally:
         client.cancel(list(futures))
-        del spec, at_data
+        del spec, at_data, opts
     if messages:
         import warnings
 
