@@ -58,7 +58,7 @@ fn pipeline_time(
         let mut t_now = free[i];
         for &t in &strip_tiles[strips[s] as usize..strips[s + 1] as usize] {
             let up = upstream[t as usize];
-            let ready = if up == tubesweep_core::schedule::NO_TILE {
+            let ready = if up == tubesweep_core::band::schedule::NO_TILE {
                 0
             } else {
                 finish[up as usize]

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! They count the sweeps only: the one pass that sets the outer rim's values at the end
-//! ([`crate::rim`], with `SolveOptions::defer_outer_rim`) is not in them, so the histogram's
+//! ([`crate::sweep::rim`], with `SolveOptions::defer_outer_rim`) is not in them, so the histogram's
 //! total is `SolveStats::updates` less the rim's updates.
 //!
 //! Each thread counts on its own and adds its counts to process-wide totals after every sweep

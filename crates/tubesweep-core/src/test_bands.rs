@@ -2,7 +2,7 @@
 //! the Rust examples use too (`examples/common/shell.rs`).
 
 use crate::band::NarrowBand;
-use crate::hamiltonian::InnerScheme;
+use crate::scheme::hamiltonian::InnerScheme;
 use crate::sweep::{Extension, MissingNeighbour, NodeRole, Slowness, SweepProblem};
 
 #[path = "../examples/common/shell.rs"]

@@ -14,9 +14,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
-use tubesweep_core::hamiltonians::{Isotropic, Metric, MovingMedium};
-use tubesweep_core::interpolate::interpolate;
-use tubesweep_core::nearest_source::nearest_source_labels;
+use tubesweep_core::scheme::hamiltonians::{Isotropic, Metric, MovingMedium};
+use tubesweep_core::solution::interpolate::interpolate;
+use tubesweep_core::solution::nearest_source::nearest_source_labels;
 use tubesweep_core::sweep::{
     default_row_prefetch_above, extension_weights_in_place, Extension, MissingNeighbour, Slowness,
 };
@@ -116,7 +116,7 @@ fn points_slice<'a>(points: &'a PyReadonlyArray2<'_, f64>, d: usize) -> PyResult
 }
 
 /// φ of a library surface at the points (M, `d`): one value per point, computed by `phi` (a
-/// function of `tubesweep_core::analytic`) without the GIL.
+/// function of `tubesweep_core::surface::analytic`) without the GIL.
 fn phi_at_points<'py>(
     py: Python<'py>,
     points: &PyReadonlyArray2<'py, f64>,
@@ -599,7 +599,7 @@ impl PyBand {
     /// The places where central differences of φ at band nodes `start..stop` need φ off the
     /// band, as the module function `rim_nodes` gives them, read off this band's own neighbours
     /// (it must be the band of those linear indices). See
-    /// `tubesweep_core::normals::rim_nodes_in_band`.
+    /// `tubesweep_core::band::normals::rim_nodes_in_band`.
     fn rim_nodes<'py>(
         &self,
         py: Python<'py>,
@@ -607,7 +607,13 @@ impl PyBand {
         stop: usize,
     ) -> PyResult<(Bound<'py, PyArray1<i64>>, Vec<usize>)> {
         let (nodes, counts) = py
-            .detach(|| with_band!(self, b, tubesweep_core::normals::rim_nodes_in_band(b, start..stop)))
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::band::normals::rim_nodes_in_band(b, start..stop)
+                )
+            })
             .map_err(to_pyerr)?;
         let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
         Ok((nodes.into_pyarray(py), counts))
@@ -616,7 +622,7 @@ impl PyBand {
     /// The outward directions sgn(φ)∇φ/|∇φ| at band nodes `start..stop`, as the module function
     /// `outward_directions` computes them (the same bits), with the neighbours read off this
     /// band; `rim_phi` in the order of [`rim_nodes`](Self::rim_nodes). Returns |∇φ|. See
-    /// `tubesweep_core::normals::outward_directions_in_band`.
+    /// `tubesweep_core::band::normals::outward_directions_in_band`.
     fn outward_directions<'py>(
         &self,
         py: Python<'py>,
@@ -634,7 +640,7 @@ impl PyBand {
                 with_band!(
                     self,
                     b,
-                    tubesweep_core::normals::outward_directions_in_band(b, spacing, ph, start..stop, rim, dir)
+                    tubesweep_core::band::normals::outward_directions_in_band(b, spacing, ph, start..stop, rim, dir)
                 )
             })
             .map_err(to_pyerr)?;
@@ -678,7 +684,7 @@ impl PyBand {
     }
 
     /// The pairs of neighbouring band nodes that straddle a gap between two parts of the surface
-    /// facing each other (see `tubesweep_core::facing_sheets`): `inner` per node, `phi` its
+    /// facing each other (see `tubesweep_core::band::facing_sheets`): `inner` per node, `phi` its
     /// signed or unsigned distance, `direction` (K, d) its outward direction. Returns the pairs'
     /// band positions and their gaps `|cp(a) − cp(b)|`.
     #[allow(clippy::type_complexity)]
@@ -701,8 +707,8 @@ impl PyBand {
         let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
         let pairs = py
             .detach(|| match &self.band {
-                AnyBand::D2(b) => tubesweep_core::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
-                AnyBand::D3(b) => tubesweep_core::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
+                AnyBand::D2(b) => tubesweep_core::band::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
+                AnyBand::D3(b) => tubesweep_core::band::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
             })
             .map_err(to_pyerr)?;
         let node: Vec<i64> = pairs.iter().map(|p| p.node as i64).collect();
@@ -738,7 +744,7 @@ impl PyBand {
     }
 
     /// The label of the source whose front reaches each band node first (see
-    /// `tubesweep_core::nearest_source`): `values` one per band node, the fixed nodes' band
+    /// `tubesweep_core::solution::nearest_source`): `values` one per band node, the fixed nodes' band
     /// positions and the source each was fixed from; -1 where no front arrives.
     fn nearest_source_labels<'py>(
         &self,
@@ -913,10 +919,10 @@ impl PyBand {
 }
 
 /// The compiled core of tubesweep. Use the `tubesweep` package, not this module.
-/// Exact closest points on a triangle mesh (AABB tree, see `tubesweep_core::mesh`).
+/// Exact closest points on a triangle mesh (AABB tree, see `tubesweep_core::surface::mesh`).
 #[pyclass(module = "tubesweep._native", name = "TriangleTree", frozen)]
 struct PyTriangleTree {
-    tree: tubesweep_core::mesh::TriangleTree,
+    tree: tubesweep_core::surface::mesh::TriangleTree,
 }
 
 #[pymethods]
@@ -950,7 +956,7 @@ impl PyTriangleTree {
             tris.push(tri);
         }
         Ok(PyTriangleTree {
-            tree: tubesweep_core::mesh::TriangleTree::new(tris),
+            tree: tubesweep_core::surface::mesh::TriangleTree::new(tris),
         })
     }
 
@@ -965,7 +971,7 @@ impl PyTriangleTree {
 
     /// Whether some triangle lies within `thresholds[i]` of `points[i]` ((M, 3) and (M,)): the
     /// answer of `closest(points, inf)[0] <= thresholds` without finding the closest triangles.
-    /// See `tubesweep_core::mesh::TriangleTree::any_within_many`.
+    /// See `tubesweep_core::surface::mesh::TriangleTree::any_within_many`.
     fn any_within<'py>(
         &self,
         py: Python<'py>,
@@ -986,7 +992,7 @@ impl PyTriangleTree {
     /// `half_width` of the mesh, their distances, signed distances (with `pseudo_normals`
     /// (T, 7, 3), else the distances) and extension directions (K, 3) float32, `face_normals`
     /// (T, 3) where a node lies within `on_surface` of the mesh. T is the tree's number of
-    /// triangles. See `tubesweep_core::mesh_band`.
+    /// triangles. See `tubesweep_core::band::mesh_band`.
     #[allow(clippy::type_complexity)]
     fn band<'py>(
         &self,
@@ -1035,11 +1041,11 @@ impl PyTriangleTree {
         };
         let band = py
             .detach(|| {
-                let normals = tubesweep_core::mesh_band::MeshNormals {
+                let normals = tubesweep_core::band::mesh_band::MeshNormals {
                     face: &face,
                     pseudo: pseudo.as_deref(),
                 };
-                tubesweep_core::mesh_band::mesh_band(&self.tree, p, half_width, on_surface, &normals)
+                tubesweep_core::band::mesh_band::mesh_band(&self.tree, p, half_width, on_surface, &normals)
             })
             .map_err(to_pyerr)?;
         let k = band.kept.len();
@@ -1107,7 +1113,7 @@ impl PyTriangleTree {
 
 /// The last split of the coarse-to-fine band search: the C-order linear indices (sorted) of the
 /// nodes of the 2 × … × 2 blocks with lowest corners `origins` (M, d) (even grid indices, no
-/// repeats, any order), cut to the grid of `shape`. See `tubesweep_core::discovery`.
+/// repeats, any order), cut to the grid of `shape`. See `tubesweep_core::band::discovery`.
 #[pyfunction]
 fn split_pair_blocks<'py>(
     py: Python<'py>,
@@ -1129,8 +1135,14 @@ fn split_pair_blocks<'py>(
     }
     let out = py
         .detach(|| match d {
-            2 => tubesweep_core::discovery::split_pair_blocks::<2>(shape_array(&shape).unwrap(), &blocks::<2>(flat)),
-            3 => tubesweep_core::discovery::split_pair_blocks::<3>(shape_array(&shape).unwrap(), &blocks::<3>(flat)),
+            2 => tubesweep_core::band::discovery::split_pair_blocks::<2>(
+                shape_array(&shape).unwrap(),
+                &blocks::<2>(flat),
+            ),
+            3 => tubesweep_core::band::discovery::split_pair_blocks::<3>(
+                shape_array(&shape).unwrap(),
+                &blocks::<3>(flat),
+            ),
             _ => Err(tubesweep_core::Error::invalid(
                 "grid",
                 format!("only 2D and 3D grids are supported, got {d}D"),
@@ -1174,7 +1186,7 @@ fn coords_array<const D: usize>(v: &[f64], name: &str) -> PyResult<[f64; D]> {
 }
 
 /// The largest `|last − o|` (grid spacings) over the children of blocks of `2·block` nodes per
-/// axis with lowest corners `parents` (M, d). See `tubesweep_core::discovery::children_radius_max`.
+/// axis with lowest corners `parents` (M, d). See `tubesweep_core::band::discovery::children_radius_max`.
 #[pyfunction]
 fn children_radius_max(
     py: Python<'_>,
@@ -1184,12 +1196,12 @@ fn children_radius_max(
 ) -> PyResult<f64> {
     let flat = block_origins(&parents, shape.len(), "parents")?;
     py.detach(|| match shape.len() {
-        2 => tubesweep_core::discovery::children_radius_max::<2>(
+        2 => tubesweep_core::band::discovery::children_radius_max::<2>(
             shape_array(&shape).unwrap(),
             &blocks_of::<2>(flat),
             block,
         ),
-        3 => tubesweep_core::discovery::children_radius_max::<3>(
+        3 => tubesweep_core::band::discovery::children_radius_max::<3>(
             shape_array(&shape).unwrap(),
             &blocks_of::<3>(flat),
             block,
@@ -1210,7 +1222,7 @@ type Children<'py> = (
 
 /// The children (blocks of `block` nodes per axis) of the blocks of `2·block` with lowest corners
 /// `parents` (M, d): `(origins (C, d) int64, centres (C, d), radii (C,))`, centres in world
-/// coordinates. See `tubesweep_core::discovery::block_children`.
+/// coordinates. See `tubesweep_core::band::discovery::block_children`.
 #[pyfunction]
 fn block_children<'py>(
     py: Python<'py>,
@@ -1232,7 +1244,13 @@ fn block_children<'py>(
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
         let (o, c, r) = py
             .detach(|| {
-                tubesweep_core::discovery::block_children::<D>(shape, &blocks_of::<D>(flat), block, lower, spacing)
+                tubesweep_core::band::discovery::block_children::<D>(
+                    shape,
+                    &blocks_of::<D>(flat),
+                    block,
+                    lower,
+                    spacing,
+                )
             })
             .map_err(to_pyerr)?;
         let o: Vec<[i64; D]> = o.into_iter().map(|b| b.map(|x| x as i64)).collect();
@@ -1249,7 +1267,7 @@ fn block_children<'py>(
 
 /// Copies the candidates with |values| ≤ half_width to the fronts of `linear_out` and
 /// `values_out` (C-contiguous, at least as long as the candidates) and returns their number. See
-/// `tubesweep_core::discovery::keep_within`.
+/// `tubesweep_core::band::discovery::keep_within`.
 #[pyfunction]
 fn keep_within<'py>(
     py: Python<'py>,
@@ -1264,12 +1282,12 @@ fn keep_within<'py>(
         c_slice_mut(&mut linear_out, "linear_out")?,
         c_slice_mut(&mut values_out, "values_out")?,
     );
-    py.detach(|| tubesweep_core::discovery::keep_within(lin, val, half_width, lo, vo))
+    py.detach(|| tubesweep_core::band::discovery::keep_within(lin, val, half_width, lo, vo))
         .map_err(to_pyerr)
 }
 
 /// World coordinates (M, d) of the nodes with C-order linear indices `linear` (the arithmetic of
-/// `Grid.points`). See `tubesweep_core::discovery::node_points`.
+/// `Grid.points`). See `tubesweep_core::band::discovery::node_points`.
 #[pyfunction]
 fn node_points<'py>(
     py: Python<'py>,
@@ -1288,7 +1306,7 @@ fn node_points<'py>(
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
         let p = py
-            .detach(|| tubesweep_core::discovery::node_points::<D>(shape, lin, lower, spacing))
+            .detach(|| tubesweep_core::band::discovery::node_points::<D>(shape, lin, lower, spacing))
             .map_err(to_pyerr)?;
         let a = numpy::ndarray::Array2::from_shape_vec((lin.len(), D), p)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -1306,7 +1324,7 @@ fn node_points<'py>(
 /// The neighbour table of band nodes `start..stop`: (2·(d − 1), stop − start) int32, for each
 /// group (axis k = 0, …, d − 2; side +1 then −1) the band position of each node's neighbour less
 /// the node's, or −2^31 where φ there must be supplied (off the band or outside the grid). See
-/// `tubesweep_core::normals::neighbour_table`.
+/// `tubesweep_core::band::normals::neighbour_table`.
 #[pyfunction]
 fn neighbour_table<'py>(
     py: Python<'py>,
@@ -1317,7 +1335,7 @@ fn neighbour_table<'py>(
 ) -> PyResult<Bound<'py, PyArray2<i32>>> {
     let lin = linear.as_slice()?;
     let table = py
-        .detach(|| tubesweep_core::normals::neighbour_table(&shape, lin, start..stop))
+        .detach(|| tubesweep_core::band::normals::neighbour_table(&shape, lin, start..stop))
         .map_err(to_pyerr)?;
     let a = numpy::ndarray::Array2::from_shape_vec((2 * shape.len().saturating_sub(1), stop - start), table)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -1325,7 +1343,7 @@ fn neighbour_table<'py>(
 }
 
 /// `|x − c| − r` at the points (M, d) with d = len(centre) (2 or 3): the exact signed distance
-/// to a circle or sphere. See `tubesweep_core::analytic::sphere_signed_distance`.
+/// to a circle or sphere. See `tubesweep_core::surface::analytic::sphere_signed_distance`.
 #[pyfunction]
 fn sphere_signed_distance<'py>(
     py: Python<'py>,
@@ -1341,12 +1359,12 @@ fn sphere_signed_distance<'py>(
         )));
     }
     phi_at_points(py, &points, centre.len(), |p, out| {
-        tubesweep_core::analytic::sphere_signed_distance(p, &centre, radius, out)
+        tubesweep_core::surface::analytic::sphere_signed_distance(p, &centre, radius, out)
     })
 }
 
 /// `hypot(hypot(q_x, q_y) − R, q_z) − r` with `q = x − c` at the points (M, 3): the exact signed
-/// distance to a torus about the z axis. See `tubesweep_core::analytic::torus_signed_distance`.
+/// distance to a torus about the z axis. See `tubesweep_core::surface::analytic::torus_signed_distance`.
 #[pyfunction]
 fn torus_signed_distance<'py>(
     py: Python<'py>,
@@ -1357,12 +1375,12 @@ fn torus_signed_distance<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let c = coords_array::<3>(&centre, "centre")?;
     phi_at_points(py, &points, 3, |p, out| {
-        tubesweep_core::analytic::torus_signed_distance(p, c, major, minor, out)
+        tubesweep_core::surface::analytic::torus_signed_distance(p, c, major, minor, out)
     })
 }
 
 /// The exact signed distance to the ellipsoid with semi-axes `axes` about `centre` at the points
-/// (M, 3). See `tubesweep_core::analytic::ellipsoid_signed_distance`.
+/// (M, 3). See `tubesweep_core::surface::analytic::ellipsoid_signed_distance`.
 #[pyfunction]
 fn ellipsoid_signed_distance<'py>(
     py: Python<'py>,
@@ -1372,13 +1390,13 @@ fn ellipsoid_signed_distance<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let (c, a) = (coords_array::<3>(&centre, "centre")?, coords_array::<3>(&axes, "axes")?);
     phi_at_points(py, &points, 3, |p, out| {
-        tubesweep_core::analytic::ellipsoid_signed_distance(p, c, a, out)
+        tubesweep_core::surface::analytic::ellipsoid_signed_distance(p, c, a, out)
     })
 }
 
 /// The parameters (θ, s) of the closest point on the Möbius band (centre radius `r`, half-width
 /// `w`) of the points (M, 3), at most `iterations` Newton steps per candidate. See
-/// `tubesweep_core::mobius::mobius_closest_parameters`.
+/// `tubesweep_core::surface::mobius::mobius_closest_parameters`.
 #[pyfunction]
 fn mobius_closest_parameters<'py>(
     py: Python<'py>,
@@ -1390,14 +1408,14 @@ fn mobius_closest_parameters<'py>(
     let p = points_slice(&points, 3)?;
     let m = points.shape()[0];
     let (mut theta, mut s) = (vec![0.0; m], vec![0.0; m]);
-    py.detach(|| tubesweep_core::mobius::mobius_closest_parameters(p, r, w, iterations, &mut theta, &mut s))
+    py.detach(|| tubesweep_core::surface::mobius::mobius_closest_parameters(p, r, w, iterations, &mut theta, &mut s))
         .map_err(to_pyerr)?;
     Ok((theta.into_pyarray(py), s.into_pyarray(py)))
 }
 
 /// The closest points (M, 3) on one of the library's open surfaces (`kind`: "hemisphere" or
 /// "disc" of radius `size`, "plane-patch" of half-side `size`) about `centre` of the points
-/// (M, 3). See `tubesweep_core::open_surfaces`.
+/// (M, 3). See `tubesweep_core::surface::open_surfaces`.
 #[pyfunction]
 fn open_surface_closest_points<'py>(
     py: Python<'py>,
@@ -1406,7 +1424,9 @@ fn open_surface_closest_points<'py>(
     centre: Vec<f64>,
     size: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    use tubesweep_core::open_surfaces::{disc_closest_points, hemisphere_closest_points, plane_patch_closest_points};
+    use tubesweep_core::surface::open_surfaces::{
+        disc_closest_points, hemisphere_closest_points, plane_patch_closest_points,
+    };
     let cp = match kind {
         "hemisphere" => hemisphere_closest_points,
         "disc" => disc_closest_points,
@@ -1428,7 +1448,7 @@ fn open_surface_closest_points<'py>(
 
 /// The exact signed distance to the rounded cube (half-side `half_size`, edges and corners rounded
 /// to `radius`) about `centre` at the points (M, 3). See
-/// `tubesweep_core::analytic::rounded_cube_signed_distance`.
+/// `tubesweep_core::surface::analytic::rounded_cube_signed_distance`.
 #[pyfunction]
 fn rounded_cube_signed_distance<'py>(
     py: Python<'py>,
@@ -1439,12 +1459,12 @@ fn rounded_cube_signed_distance<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let c = coords_array::<3>(&centre, "centre")?;
     phi_at_points(py, &points, 3, |p, out| {
-        tubesweep_core::analytic::rounded_cube_signed_distance(p, c, half_size, radius, out)
+        tubesweep_core::surface::analytic::rounded_cube_signed_distance(p, c, half_size, radius, out)
     })
 }
 
 /// φ = min of the two torus distances of the double torus at the points (M, 3). See
-/// `tubesweep_core::analytic::double_torus_signed_distance`.
+/// `tubesweep_core::surface::analytic::double_torus_signed_distance`.
 #[pyfunction]
 fn double_torus_signed_distance<'py>(
     py: Python<'py>,
@@ -1454,12 +1474,12 @@ fn double_torus_signed_distance<'py>(
     offset: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     phi_at_points(py, &points, 3, |p, out| {
-        tubesweep_core::analytic::double_torus_signed_distance(p, major, minor, offset, out)
+        tubesweep_core::surface::analytic::double_torus_signed_distance(p, major, minor, offset, out)
     })
 }
 
 /// The exact signed distance to the six-fold star r(θ) = r0 + eps sin²(3θ) at the points (M, 2).
-/// See `tubesweep_core::analytic::star_signed_distance`.
+/// See `tubesweep_core::surface::analytic::star_signed_distance`.
 #[pyfunction]
 fn star_signed_distance<'py>(
     py: Python<'py>,
@@ -1468,7 +1488,7 @@ fn star_signed_distance<'py>(
     eps: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     phi_at_points(py, &points, 2, |p, out| {
-        tubesweep_core::analytic::star_signed_distance(p, r0, eps, out)
+        tubesweep_core::surface::analytic::star_signed_distance(p, r0, eps, out)
     })
 }
 
@@ -1479,7 +1499,7 @@ fn table_slice<'a>(table: &'a Option<PyReadonlyArray2<'_, i32>>) -> PyResult<Opt
 /// The places where central differences of φ at band nodes `start..stop` need φ off the band:
 /// `(positions, counts)`, the band positions for each group (axis k = 0, 1, …; side +1 then −1)
 /// concatenated, and the size of each group (2·d). From `neighbours` (their `neighbour_table`)
-/// when given. See `tubesweep_core::normals::rim_nodes`.
+/// when given. See `tubesweep_core::band::normals::rim_nodes`.
 #[pyfunction]
 #[pyo3(signature = (shape, linear, start, stop, neighbours=None))]
 fn rim_nodes<'py>(
@@ -1494,8 +1514,8 @@ fn rim_nodes<'py>(
     let table = table_slice(&neighbours)?;
     let (nodes, counts) = py
         .detach(|| match table {
-            Some(t) => tubesweep_core::normals::rim_nodes_of(&shape, lin, start..stop, t),
-            None => tubesweep_core::normals::rim_nodes(&shape, lin, start..stop),
+            Some(t) => tubesweep_core::band::normals::rim_nodes_of(&shape, lin, start..stop, t),
+            None => tubesweep_core::band::normals::rim_nodes(&shape, lin, start..stop),
         })
         .map_err(to_pyerr)?;
     let nodes: Vec<i64> = nodes.into_iter().map(|n| n as i64).collect();
@@ -1506,7 +1526,7 @@ fn rim_nodes<'py>(
 /// written to `direction` ((stop − start, d) float32, C-contiguous); φ at band nodes from `phi`,
 /// off the band from `rim_phi` (in the order of `rim_nodes`); the neighbours from `neighbours`
 /// (their `neighbour_table`) when given. Returns |∇φ| there. See
-/// `tubesweep_core::normals::outward_directions`.
+/// `tubesweep_core::band::normals::outward_directions`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 #[pyo3(signature = (shape, spacing, linear, phi, start, stop, rim_phi, direction, neighbours=None))]
@@ -1527,28 +1547,35 @@ fn outward_directions<'py>(
     let dir = c_slice_mut(&mut direction, "direction")?;
     let norms = py
         .detach(|| match table {
-            Some(t) => {
-                tubesweep_core::normals::outward_directions_with(&shape, spacing, lin, ph, start..stop, t, rim, dir)
-            }
-            None => tubesweep_core::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir),
+            Some(t) => tubesweep_core::band::normals::outward_directions_with(
+                &shape,
+                spacing,
+                lin,
+                ph,
+                start..stop,
+                t,
+                rim,
+                dir,
+            ),
+            None => tubesweep_core::band::normals::outward_directions(&shape, spacing, lin, ph, start..stop, rim, dir),
         })
         .map_err(to_pyerr)?;
     Ok(norms.into_pyarray(py))
 }
 
 /// The position (in C order) of the first NaN or infinite sample of `phi`, or None. See
-/// `tubesweep_core::sampled::first_non_finite`.
+/// `tubesweep_core::band::sampled::first_non_finite`.
 #[pyfunction]
 fn first_non_finite(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>) -> PyResult<Option<usize>> {
     let s = c_slice(&phi, "phi")?;
-    Ok(py.detach(|| tubesweep_core::sampled::first_non_finite(s)))
+    Ok(py.detach(|| tubesweep_core::band::sampled::first_non_finite(s)))
 }
 
 /// Sorted linear node indices and a value at each, as NumPy arrays.
 type LinearAndValues<'py> = (Bound<'py, PyArray1<u64>>, Bound<'py, PyArray1<f64>>);
 
 /// The band `|φ| ≤ half_width` of a φ sampled on the whole grid (`phi` has the grid's shape):
-/// sorted C-order linear indices and φ there. See `tubesweep_core::sampled::band_of_samples`.
+/// sorted C-order linear indices and φ there. See `tubesweep_core::band::sampled::band_of_samples`.
 #[pyfunction]
 fn band_of_samples<'py>(
     py: Python<'py>,
@@ -1558,14 +1585,14 @@ fn band_of_samples<'py>(
     let shape = phi.shape().to_vec();
     let s = c_slice(&phi, "phi")?;
     let (linear, values) = py
-        .detach(|| tubesweep_core::sampled::band_of_samples(&shape, s, half_width))
+        .detach(|| tubesweep_core::band::sampled::band_of_samples(&shape, s, half_width))
         .map_err(to_pyerr)?;
     Ok((linear.into_pyarray(py), values.into_pyarray(py)))
 }
 
 /// The outward directions sgn(φ)∇φ/|∇φ| of a φ sampled on the whole grid at the band nodes
 /// `linear`, written to `direction` ((len(linear), d) float32, C-contiguous); returns |∇φ|. See
-/// `tubesweep_core::sampled::outward_directions_of_samples`.
+/// `tubesweep_core::band::sampled::outward_directions_of_samples`.
 #[pyfunction]
 fn outward_directions_of_samples<'py>(
     py: Python<'py>,
@@ -1578,25 +1605,25 @@ fn outward_directions_of_samples<'py>(
     let (s, lin) = (c_slice(&phi, "phi")?, c_slice(&linear, "linear")?);
     let dir = c_slice_mut(&mut direction, "direction")?;
     let norms = py
-        .detach(|| tubesweep_core::sampled::outward_directions_of_samples(&shape, spacing, s, lin, dir))
+        .detach(|| tubesweep_core::band::sampled::outward_directions_of_samples(&shape, spacing, s, lin, dir))
         .map_err(to_pyerr)?;
     Ok(norms.into_pyarray(py))
 }
 
 /// The largest |∇φ| over the nodes of a φ sampled on the whole grid (the differences of
-/// `numpy.gradient`). See `tubesweep_core::sampled::max_gradient_norm_of_samples`.
+/// `numpy.gradient`). See `tubesweep_core::band::sampled::max_gradient_norm_of_samples`.
 #[pyfunction]
 fn max_gradient_norm_of_samples(py: Python<'_>, phi: PyReadonlyArrayDyn<'_, f64>, spacing: f64) -> PyResult<f64> {
     let shape = phi.shape().to_vec();
     let s = c_slice(&phi, "phi")?;
-    py.detach(|| tubesweep_core::sampled::max_gradient_norm_of_samples(&shape, spacing, s))
+    py.detach(|| tubesweep_core::band::sampled::max_gradient_norm_of_samples(&shape, spacing, s))
         .map_err(to_pyerr)
 }
 
 /// The candidates for the re-distanced band of a φ sampled on the whole grid: the nodes with
 /// `|φ| ≤ half_width · G`, `G` a bound on the gradient of φ's interpolant within reach of the
 /// node (sorted C-order linear indices and φ there). See
-/// `tubesweep_core::sampled::redistance_candidates_of_samples`.
+/// `tubesweep_core::band::sampled::redistance_candidates_of_samples`.
 #[pyfunction]
 fn redistance_candidates_of_samples<'py>(
     py: Python<'py>,
@@ -1607,7 +1634,7 @@ fn redistance_candidates_of_samples<'py>(
     let shape = phi.shape().to_vec();
     let s = c_slice(&phi, "phi")?;
     let (linear, values) = py
-        .detach(|| tubesweep_core::sampled::redistance_candidates_of_samples(&shape, spacing, s, half_width))
+        .detach(|| tubesweep_core::band::sampled::redistance_candidates_of_samples(&shape, spacing, s, half_width))
         .map_err(to_pyerr)?;
     Ok((linear.into_pyarray(py), values.into_pyarray(py)))
 }
@@ -1623,7 +1650,7 @@ type ProjectionArrays<'py> = (
 /// φ sampled on the whole grid (`phi` has the grid's shape; `lower` and `spacing` place it):
 /// Newton projection and orthogonality iterations, the algorithm of `tubesweep.redistance`.
 /// Returns (closest points (M, d), signed distances (M,), converged (M,)). See
-/// `tubesweep_core::redistance::project_to_zero_level_set`.
+/// `tubesweep_core::surface::redistance::project_to_zero_level_set`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 fn project_to_sampled_level_set<'py>(
@@ -1637,7 +1664,7 @@ fn project_to_sampled_level_set<'py>(
     orthogonality_steps: usize,
     tol: f64,
 ) -> PyResult<ProjectionArrays<'py>> {
-    use tubesweep_core::redistance::{project_to_zero_level_set, ProjectionOptions, SampledField};
+    use tubesweep_core::surface::redistance::{project_to_zero_level_set, ProjectionOptions, SampledField};
     let shape = phi.shape().to_vec();
     let d = shape.len();
     if points.shape()[1] != d {
@@ -1660,7 +1687,7 @@ fn project_to_sampled_level_set<'py>(
         spacing: f64,
         p: &[f64],
         options: ProjectionOptions,
-    ) -> PyResult<tubesweep_core::redistance::Projection> {
+    ) -> PyResult<tubesweep_core::surface::redistance::Projection> {
         let field = SampledField::<D>::new(s, shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?, spacing)
             .map_err(to_pyerr)?;
         project_to_zero_level_set(&field, p, options).map_err(to_pyerr)
@@ -1693,9 +1720,9 @@ type AnalyticBand<'py> = (
 );
 
 /// The band of a library surface with a Rust φ (`kind` "sphere", "torus", "ellipsoid", "star",
-/// "rounded-cube" or "double-torus", `parameters` as `tubesweep_core::analytic::AnalyticSurface::from_parameters` takes
+/// "rounded-cube" or "double-torus", `parameters` as `tubesweep_core::surface::analytic::AnalyticSurface::from_parameters` takes
 /// them), without calling back into Python: the coarse-to-fine search
-/// (`tubesweep_core::discovery::discover_band`), the band structure, φ at its rim and the
+/// (`tubesweep_core::band::discovery::discover_band`), the band structure, φ at its rim and the
 /// outward directions, the same nodes and bits as the callable route. Returns (sorted linear
 /// indices, φ there, the band or None when empty, directions (K, d) float32, |∇φ| (K,) float32).
 #[pyfunction]
@@ -1710,7 +1737,7 @@ fn analytic_level_set_band<'py>(
     half_width: f64,
     lipschitz: f64,
 ) -> PyResult<AnalyticBand<'py>> {
-    use tubesweep_core::analytic::AnalyticSurface;
+    use tubesweep_core::surface::analytic::AnalyticSurface;
     let surface = AnalyticSurface::from_parameters(kind, &parameters).map_err(to_pyerr)?;
     if surface.ndim() != shape.len() {
         return Err(PyValueError::new_err(format!(
@@ -1733,14 +1760,14 @@ fn analytic_level_set_band<'py>(
         let (shape, lower) = (shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?);
         let phi = |p: &[f64], out: &mut [f64]| surface.signed_distance(p, out);
         let (linear, values) =
-            tubesweep_core::discovery::discover_band::<D>(shape, lower, spacing, half_width, lipschitz, &phi)
+            tubesweep_core::band::discovery::discover_band::<D>(shape, lower, spacing, half_width, lipschitz, &phi)
                 .map_err(to_pyerr)?;
         if linear.is_empty() {
             return Ok((linear, values, None, Vec::new(), Vec::new()));
         }
         let band = NarrowBand::<D>::from_sorted_linear(shape, &linear).map_err(to_pyerr)?;
         let mut direction = vec![0.0f32; linear.len() * D];
-        let norms = tubesweep_core::normals::outward_directions_of_function_in_band(
+        let norms = tubesweep_core::band::normals::outward_directions_of_function_in_band(
             &band,
             &linear,
             &values,

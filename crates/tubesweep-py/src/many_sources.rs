@@ -1,4 +1,4 @@
-//! Bindings of `tubesweep_core::many_sources`: many independent solves on one band, in parallel
+//! Bindings of `tubesweep_core::sweep::many_sources`: many independent solves on one band, in parallel
 //! across the sources, with the GIL released; progress and Ctrl-C on the calling thread.
 
 use crate::errors::to_pyerr;
@@ -8,7 +8,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
-use tubesweep_core::many_sources::{solve_many, FixedSet, Output};
+use tubesweep_core::sweep::many_sources::{solve_many, FixedSet, Output};
 use tubesweep_core::sweep::{default_row_prefetch_above, MissingNeighbour, Slowness};
 use tubesweep_core::{Control, InnerScheme, SolveOptions, SolveStats, SweepProblem};
 

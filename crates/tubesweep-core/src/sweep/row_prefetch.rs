@@ -1,6 +1,6 @@
 //! Prefetching a sweep's rows ahead of it, when the data the sweeps read do not fit in the cache.
 //!
-//! The sweeps visit the rows in tiles of 8 × 8 rows ([`crate::schedule`]): eight rows that are
+//! The sweeps visit the rows in tiles of 8 × 8 rows ([`crate::band::schedule`]): eight rows that are
 //! neighbours along the second leading axis lie next to each other in memory, but the next eight
 //! lie a plane of the band away. Every array the kernel reads at a node (its value, role,
 //! neighbour table, upwind weights, flags) is thus read in runs of a few cache lines, too short
@@ -10,7 +10,7 @@
 //! (the whole sweep on one thread, a tile on several: a tile's first rows are not fetched), but
 //! only in an iteration that follows one whose visited rows held more than
 //! [`SolveOptions::row_prefetch_above`] bytes of those arrays (the default is
-//! [`DEFAULT_CACHE_SHARE`] of the last-level cache, [`crate::cache_size`]). Below that the hints
+//! [`DEFAULT_CACHE_SHARE`] of the last-level cache, [`crate::sweep::cache_size`]). Below that the hints
 //! only cost instructions; docs/architecture.md ("Rows fetched ahead") has the measurements.
 //!
 //! A row is fetched only if it looks as if it will run when the hint is issued: its dirty flag
@@ -24,8 +24,8 @@
 
 use super::sweep_state::{Limits, SweepContext};
 use super::{Slowness, SweepProblem};
-use crate::cache_size::last_level_cache_bytes;
 use crate::prefetch::prefetch_range;
+use crate::sweep::cache_size::last_level_cache_bytes;
 
 /// How many rows ahead in the visiting order the sweeps prefetch. Against 2, with the `sphere`
 /// example's paper sweeps alternately (docs/architecture.md, "Rows fetched ahead"): 8 took 0.924

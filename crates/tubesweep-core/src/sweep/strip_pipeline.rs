@@ -1,12 +1,12 @@
 //! The strip pipeline that runs a sweep on several threads (paper Sect. 2's Gauss–Seidel sweeps,
 //! in parallel with the values of the sequential sweep): each thread takes the next strip of
-//! tiles of [`crate::schedule`] and runs its tiles in order, each once the tile of the previous
+//! tiles of [`crate::band::schedule`] and runs its tiles in order, each once the tile of the previous
 //! strip it reads is done in the same sweep; the sweeps of one call run in one rayon broadcast
 //! with a spinning barrier between them. A panic on one thread raises a flag that makes the others
 //! leave their waits, so it reaches the caller instead of leaving a thread spinning.
 
 use super::Accumulator;
-use crate::schedule::NO_TILE;
+use crate::band::schedule::NO_TILE;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering};
 use std::time::Instant;
 

@@ -36,7 +36,7 @@ pub(super) struct SweepContext<'a, const D: usize> {
     /// is run; set again for the row when a node stays active, and for the row and the rows next
     /// to it along the leading axes ([`NarrowBand::row_neighbours`](crate::band::NarrowBand::row_neighbours)) when a node activates its
     /// neighbours. Those rows are never run at the same time as the row (see
-    /// [`crate::schedule`]), so no activation is missed.
+    /// [`crate::band::schedule`]), so no activation is missed.
     pub(super) row_dirty: &'a [AtomicU8],
     /// [`NarrowBand::row_neighbours`](crate::band::NarrowBand::row_neighbours).
     pub(super) row_neighbours: &'a [u32],
@@ -222,7 +222,7 @@ pub(super) struct Limits {
 
 /// The node values, shared by the threads of a parallel sweep. The schedule guarantees that the
 /// tiles processed at the same time write disjoint nodes and read no node another tile writes
-/// (see [`crate::schedule`]), so unsynchronised access is race-free.
+/// (see [`crate::band::schedule`]), so unsynchronised access is race-free.
 /// Copies (held in registers by the row loop) borrow the values for `'a`, like the slice they
 /// were made from.
 #[derive(Clone, Copy)]

@@ -12,17 +12,21 @@
 //! only ever replaced by smaller ones (this is automatic for Godunov and is the paper's explicit
 //! acceptance rule for Lax–Friedrichs, proof of Corollary 1).
 
+use crate::band::schedule::{SweepSchedule, TILE};
 use crate::band::{NarrowBand, NeighbourTable};
 use crate::error::{Error, Result};
-use crate::extension::{extension_apply_upwind, extension_weights};
-use crate::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
-use crate::hamiltonian::InnerScheme;
-use crate::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
-use crate::schedule::{SweepSchedule, TILE};
+use crate::scheme::extension::{extension_apply_upwind, extension_weights};
+use crate::scheme::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
+use crate::scheme::hamiltonian::InnerScheme;
+use crate::scheme::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::time::Instant;
 
+pub mod cache_size;
+pub mod grid_hops;
+pub mod many_sources;
+pub mod rim;
 mod row_prefetch;
 mod spread_threads;
 mod strip_pipeline;
@@ -141,7 +145,7 @@ pub struct SolveOptions {
     pub infinity: Option<f64>,
     /// Worker threads for the solve (the sweeps and their preparation), in a pool of its own: 0 =
     /// rayon's default (all cores, or `RAYON_NUM_THREADS`), 1 = sequential. The result does not depend on it (see
-    /// [`crate::schedule`]).
+    /// [`crate::band::schedule`]).
     pub threads: usize,
     /// Skip nodes none of whose neighbours changed since their last update (default true). The
     /// result is bit-identical either way for the pointwise updates, and identical to rounding
@@ -155,7 +159,7 @@ pub struct SolveOptions {
     /// a deviation of that order for fewer updates in the last iterations.
     pub activation_threshold: f64,
     /// Godunov only: update each inner-tube node together with the extension-layer neighbours
-    /// whose update (5) reads it ([`crate::godunov::godunov_update_coupled`], a block
+    /// whose update (5) reads it ([`crate::scheme::godunov::godunov_update_coupled`], a block
     /// Gauss–Seidel step). The discrete equations and so the solution (to about `tol`) are the
     /// same; the pointwise node ↔ layer cycle that contracts only by the extension weight per
     /// pass is solved at once: on the sphere 22% fewer updates at N = 201, 36% at N = 1001
@@ -166,7 +170,7 @@ pub struct SolveOptions {
     /// depends on (not read by an inner node, nor by a layer node that one reads, and so on)
     /// cannot change the inner tube, so the sweeps first converge the rest of the band with the
     /// rim held still, then the converged values are extended into the rim in one pass in
-    /// dependency order ([`crate::rim`]). The same equations and fixed point; the rim (about a
+    /// dependency order ([`crate::sweep::rim`]). The same equations and fixed point; the rim (about a
     /// third of the layer with the paper's widths) is evaluated about once per node instead of
     /// being swept in every iteration.
     pub defer_outer_rim: bool,
@@ -247,7 +251,7 @@ const THIN_STRIP_RATIO: f64 = 2.0;
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveStats {
     /// Full passes of the 2^d sweep orders; with [`SolveOptions::defer_outer_rim`], one more
-    /// for the rim (its values set from the converged rest of the band, [`crate::rim`]).
+    /// for the rim (its values set from the converged rest of the band, [`crate::sweep::rim`]).
     pub iterations: usize,
     /// Single directional sweeps (2^d per iteration), and the rim's passes (one in dependency
     /// order, more where rim nodes read each other in a cycle).
@@ -404,7 +408,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .enumerate()
             .filter(|(_, &r)| r == NodeRole::Fixed)
             .map(|(i, _)| i);
-        crate::grid_hops::max_grid_hops(self.band, sources)
+        crate::sweep::grid_hops::max_grid_hops(self.band, sources)
     }
 
     /// Whether these options run the front window ([`SolveOptions::front_window`]).
@@ -459,7 +463,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 || hops_needed.then(|| self.grid_hops_from_sources()),
                 || {
                     if rim_last {
-                        crate::rim::outer_rim(self.band, self.roles, weights)
+                        crate::sweep::rim::outer_rim(self.band, self.roles, weights)
                     } else {
                         Vec::new()
                     }
@@ -655,8 +659,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 
     /// [`iterate`](Self::iterate) in two phases: the band without its outer rim (held at the
     /// numerical infinity, read by nobody), then the rim's values in one pass in dependency order
-    /// ([`crate::rim`]). `weights` are [`Self::upwind_weights`], `rim` the
-    /// [`crate::rim::outer_rim`] of them (empty without a layer).
+    /// ([`crate::sweep::rim`]). `weights` are [`Self::upwind_weights`], `rim` the
+    /// [`crate::sweep::rim::outer_rim`] of them (empty without a layer).
     #[allow(clippy::too_many_arguments)]
     fn iterate_rim_last(
         &self,
@@ -693,7 +697,8 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             .saturating_sub(base)
             .max(1)
             .saturating_mul(1 << D);
-        let passes = pool.install(|| crate::rim::extend_into_rim(self.band, rim, weights, u, options.tol, budget));
+        let passes =
+            pool.install(|| crate::sweep::rim::extend_into_rim(self.band, rim, weights, u, options.tol, budget));
         stats.iterations += 1;
         stats.sweeps += passes.passes;
         stats.updates += passes.updates;
@@ -1004,7 +1009,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     }
 
     /// This thread's share of the parallel sweep in orientation `dir`, a pipelined wavefront over
-    /// strips of tiles (see [`crate::schedule`]): it takes the next strip (`next_strip`) and runs
+    /// strips of tiles (see [`crate::band::schedule`]): it takes the next strip (`next_strip`) and runs
     /// its tiles in order, each once the tile of the previous strip it depends on is done in this
     /// sweep (id `ctx.sweep_id`). The values are those of the sequential sweep.
     #[allow(clippy::too_many_arguments)]
@@ -1523,8 +1528,8 @@ fn fill_missing<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hamiltonian::IsotropicEikonal;
-    use crate::schedule::NO_TILE;
+    use crate::band::schedule::NO_TILE;
+    use crate::scheme::hamiltonian::IsotropicEikonal;
     use crate::test_bands::{shell_band, sphere_band, sphere_problem};
 
     fn box_problem<'a>(
@@ -2362,12 +2367,12 @@ mod tests {
         let (band, roles, dirs, h) = sphere_band(61);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let w = p.upwind_weights().into_owned();
-        let rim = crate::rim::outer_rim(&band, &roles, &w);
+        let rim = crate::sweep::rim::outer_rim(&band, &roles, &w);
         let (u, st) = converged(&p, SolveOptions::default());
         assert!(st.converged && st.last_change == 0.0, "{st:?}");
         let mut checked = 0;
         for q in (0..band.len()).filter(|&q| rim[q] && !w[q][0].is_nan()) {
-            let again = crate::extension::extension_apply_upwind(w[q], &band.neighbours_of(q), |i| {
+            let again = crate::scheme::extension::extension_apply_upwind(w[q], &band.neighbours_of(q), |i| {
                 if i == band.sentinel() {
                     st.infinity
                 } else {
@@ -2385,7 +2390,7 @@ mod tests {
         let (band, roles, dirs, h) = sphere_band(41);
         let p = sphere_problem(&band, &roles, &dirs, h, InnerScheme::Godunov);
         let w = p.upwind_weights().into_owned();
-        let rim = crate::rim::outer_rim(&band, &roles, &w);
+        let rim = crate::sweep::rim::outer_rim(&band, &roles, &w);
 
         let n_rim = rim.iter().filter(|&&b| b).count();
         let n_outer = roles.iter().filter(|&&r| r == NodeRole::Outer).count();

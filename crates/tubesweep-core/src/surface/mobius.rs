@@ -14,7 +14,7 @@
 //! and at the few points equidistant from two candidates either may win.
 
 use crate::error::{Error, Result};
-use crate::mesh::{dot, sub};
+use crate::surface::mesh::{dot, sub};
 use rayon::prelude::*;
 
 /// Points per parallel task.

@@ -443,7 +443,8 @@ mod tests {
     fn the_rust_search_finds_every_node_within_the_width() {
         // a sphere off the centre of a non-cubic grid that cuts it, against a scan of every node
         let (shape, lower, h) = ([37usize, 50, 29], [-1.0f64, -1.2, -0.8], 0.05);
-        let surface = crate::analytic::AnalyticSurface::from_parameters("sphere", &[0.1, -0.05, 0.2, 0.62]).unwrap();
+        let surface =
+            crate::surface::analytic::AnalyticSurface::from_parameters("sphere", &[0.1, -0.05, 0.2, 0.62]).unwrap();
         let phi = |p: &[f64], out: &mut [f64]| surface.signed_distance(p, out);
         for half_width in [0.0, 0.07, 0.2] {
             let (linear, values) = discover_band(shape, lower, h, half_width, 1.0, &phi).unwrap();
@@ -467,7 +468,9 @@ mod tests {
             0.1,
             0.05,
             1.0,
-            &|p: &[f64], out: &mut [f64]| crate::analytic::sphere_signed_distance(p, &[0.0, 0.0, 0.0], 0.2, out),
+            &|p: &[f64], out: &mut [f64]| {
+                crate::surface::analytic::sphere_signed_distance(p, &[0.0, 0.0, 0.0], 0.2, out)
+            },
         )
         .unwrap();
         assert!(!linear.is_empty());

@@ -4,7 +4,7 @@
 //! one solve of Algorithm 3 per source on the same band. A single solve at N = 101 is too small to
 //! keep two cores busy inside its sweeps; independent solves are not. [`solve_many`] runs each
 //! source's solve sequentially (`threads = 1`: the same bits as any thread count, see
-//! [`crate::schedule`]) and the sources on `threads` worker threads at once, each thread taking
+//! [`crate::band::schedule`]) and the sources on `threads` worker threads at once, each thread taking
 //! the next source when it finishes one (dynamic hand-off, so one slow source does not hold the
 //! others back). Each solve is [`SweepProblem::solve`] with the template's band, slowness,
 //! extension weights and scheme and the template's roles with the source's nodes made
@@ -18,7 +18,7 @@
 //! O(band · threads + K · M).
 
 use crate::error::{Error, Result};
-use crate::interpolate::interpolate;
+use crate::solution::interpolate::interpolate;
 use crate::sweep::{Control, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -298,7 +298,7 @@ fn solve_one<const D: usize>(
 mod tests {
     use super::*;
     use crate::band::NarrowBand;
-    use crate::hamiltonian::InnerScheme;
+    use crate::scheme::hamiltonian::InnerScheme;
     use crate::sweep::{default_row_prefetch_above, Extension, MissingNeighbour, Slowness};
 
     /// The whole 2D box as a band (Algorithm 1's setting: no layer), point sources at nodes.

@@ -411,7 +411,7 @@ fn nearest_sample(dense: &[[f64; 2]], step: f64, x: f64, y: f64, polar: f64, r_m
 
 /// One of the library's surfaces whose signed distance is evaluated here: what the Python package
 /// hands the core so that the band of such a surface is found without calling back into Python
-/// ([`crate::discovery::discover_band`]).
+/// ([`crate::band::discovery::discover_band`]).
 #[derive(Debug, Clone, PartialEq)]
 pub enum AnalyticSurface {
     /// [`sphere_signed_distance`]: a circle (2 centre coordinates) or a sphere (3).

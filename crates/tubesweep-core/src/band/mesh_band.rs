@@ -10,7 +10,7 @@
 //! took it over, so the band, its distances and its directions are the same bits.
 
 use crate::error::{Error, Result};
-use crate::mesh::{dot, sub, ClosestSearch, TriangleTree, QUERY_BLOCK};
+use crate::surface::mesh::{dot, sub, ClosestSearch, TriangleTree, QUERY_BLOCK};
 use rayon::prelude::*;
 
 /// The normals the band needs, per triangle of the tree (in the tree's triangle order).
@@ -18,7 +18,7 @@ pub struct MeshNormals<'a> {
     /// Each triangle's unit normal: the direction at nodes on the mesh.
     pub face: &'a [[f64; 3]],
     /// For a closed, oriented mesh, per triangle the outward angle-weighted pseudo-normals of its
-    /// seven features, in the order of [`crate::mesh::Feature`] (face, vertices a, b, c, edges
+    /// seven features, in the order of [`crate::surface::mesh::Feature`] (face, vertices a, b, c, edges
     /// ab, ac, bc); `None` for the unsigned closest-point representation.
     pub pseudo: Option<&'a [[[f64; 3]; 7]]>,
 }

@@ -371,7 +371,7 @@ pub fn rim_nodes_in_band<const D: usize>(
 
 /// [`outward_directions_in_band`] for a φ evaluated in Rust (`phi`, the library's analytic
 /// surfaces), in one pass: chunk by chunk, φ at the chunk's off-band neighbours `x ± Δx e_k` is
-/// evaluated at once, with the node coordinates of [`crate::discovery::node_points`], and the
+/// evaluated at once, with the node coordinates of [`crate::band::discovery::node_points`], and the
 /// differences follow. The same points and arithmetic as listing the rim places
 /// ([`rim_nodes_in_band`]), evaluating φ there and calling [`outward_directions_in_band`] (the
 /// callable route of the Python package), so the same bits, without the rim's lists, the
@@ -384,7 +384,7 @@ pub fn outward_directions_of_function_in_band<const D: usize>(
     values: &[f64],
     lower: [f64; D],
     spacing: f64,
-    phi: &crate::discovery::PhiFn<'_>,
+    phi: &crate::band::discovery::PhiFn<'_>,
     direction: &mut [f32],
 ) -> Result<Vec<f32>> {
     let m = band.len();
@@ -405,7 +405,7 @@ pub fn outward_directions_of_function_in_band<const D: usize>(
             let n = norms_out.len();
             let mut norms = vec![0.0f64; n];
             let norms = &mut norms[..];
-            let coords = crate::discovery::node_points(shape, &linear[lo..lo + n], lower, spacing)?;
+            let coords = crate::band::discovery::node_points(shape, &linear[lo..lo + n], lower, spacing)?;
             // the chunk's off-band neighbours, node by node and group by group (axis k, side +1
             // then −1), and φ there
             let mut places: Vec<f64> = Vec::new();
@@ -683,16 +683,17 @@ mod tests {
         // a sphere's φ evaluated in Rust: the fused pass against the rim places, φ there by the
         // node coordinates ± Δx, and the directions from them
         let (shape, lower, h) = ([30usize, 26, 33], [-0.8f64, -0.7, -0.85], 0.05);
-        let phi =
-            |p: &[f64], out: &mut [f64]| crate::analytic::sphere_signed_distance(p, &[0.02, -0.03, 0.0], 0.55, out);
-        let (linear, values) = crate::discovery::discover_band(shape, lower, h, 4.0 * h, 1.0, &phi).unwrap();
+        let phi = |p: &[f64], out: &mut [f64]| {
+            crate::surface::analytic::sphere_signed_distance(p, &[0.02, -0.03, 0.0], 0.55, out)
+        };
+        let (linear, values) = crate::band::discovery::discover_band(shape, lower, h, 4.0 * h, 1.0, &phi).unwrap();
         let band = NarrowBand::<3>::from_sorted_linear(shape, &linear).unwrap();
         let (rim, counts) = rim_nodes_in_band(&band, 0..linear.len()).unwrap();
         let mut rim_phi = Vec::new();
         let mut start = 0;
         for (g, &count) in counts.iter().enumerate() {
             let places: Vec<u64> = rim[start..start + count].iter().map(|&i| linear[i as usize]).collect();
-            let mut x = crate::discovery::node_points(shape, &places, lower, h).unwrap();
+            let mut x = crate::band::discovery::node_points(shape, &places, lower, h).unwrap();
             for p in x.chunks_mut(3) {
                 p[g / 2] += if g % 2 == 0 { h } else { -h };
             }

@@ -86,7 +86,7 @@ pub fn band_of_samples(shape: &[usize], samples: &[f64], half_width: f64) -> Res
             (linear, values)
         })
         .collect();
-    Ok(crate::discovery::concat_band_parts(parts))
+    Ok(crate::band::discovery::concat_band_parts(parts))
 }
 
 /// The outward directions `sgn(φ) g/|g|` (as f32, written to `direction`, one row of `d` per
@@ -310,7 +310,7 @@ pub fn redistance_candidates_of_samples(
             (linear, values)
         })
         .collect();
-    Ok(crate::discovery::concat_band_parts(parts))
+    Ok(crate::band::discovery::concat_band_parts(parts))
 }
 
 /// `Σ_a m_a²` for the cell whose lowest corner is node `l`, `m_a` the largest `|Δφ|` along its

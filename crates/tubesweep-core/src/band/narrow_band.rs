@@ -18,8 +18,8 @@
 //! Cost per band node: 4 bytes of last-axis coordinate and 8·(d − 1) + 1 bytes of neighbour table
 //! (17 in 3D).
 
+use crate::band::schedule::{SweepSchedule, LONG_SIDE, THIN_SIDE};
 use crate::error::{Error, Result};
-use crate::schedule::{SweepSchedule, LONG_SIDE, THIN_SIDE};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -37,7 +37,7 @@ pub struct NarrowBand<const D: usize> {
     along_row: Vec<u8>,
     schedule: SweepSchedule,
     /// 3D only: the parallel sweeps' schedules of rectangular tiles, strips thin along the first
-    /// leading axis (`[0]`) and along the second (`[1]`) (see [`crate::schedule`]); built at the
+    /// leading axis (`[0]`) and along the second (`[1]`) (see [`crate::band::schedule`]); built at the
     /// first parallel solve, so that a band only ever swept on one thread does not hold them.
     strip_schedules: OnceLock<[SweepSchedule; 2]>,
 }
@@ -519,7 +519,7 @@ fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::schedule::NO_TILE;
+    use crate::band::schedule::NO_TILE;
 
     fn linear<const D: usize>(shape: [usize; D], idx: [usize; D]) -> u64 {
         let mut l = 0u64;

@@ -17,7 +17,7 @@
 //! the nodes where the cycles close are within the tolerance of their fixed point.
 
 use crate::band::NarrowBand;
-use crate::extension::extension_apply_upwind;
+use crate::scheme::extension::extension_apply_upwind;
 use crate::sweep::NodeRole;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU8, Ordering};
