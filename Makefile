@@ -1,33 +1,59 @@
 # tubesweep — one-command set-up. Needs only Rust (cargo), Python 3.9+ and pip.
 #   make demo       build, run the built-in examples, write pictures to out/demo
-#   make test       build, run cargo and pytest suites
+#   make test       build, run cargo and pytest suites (installs the test dependencies)
+#   make docs       the user guide, API reference and gallery as HTML in out/site
 #   make bench      benchmarks against scikit-fmm, potpourri3d, pygeodesic (installs them)
 #   make reproduce  every table and figure of the paper into out/reproduce
 PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 PIP    := $(PY) -m pip
-DEPS   := $(VENV)/.deps-installed
+DEPS   := $(VENV)/.deps-runtime
+TEST_DEPS_DONE  := $(VENV)/.deps-test
+DOCS_DEPS_DONE  := $(VENV)/.deps-docs
 BUILT  := $(VENV)/.built
+# what the package needs at run time with its plot, mesh and progress extras (pyproject.toml)
+RUNTIME_DEPS := "maturin>=1.5,<2" "numpy>=1.22" "matplotlib>=3.5" "scipy>=1.8" "scikit-image>=0.19" \
+                "meshio>=5" "trimesh>=3.9" "tqdm>=4"
+# pyproject.toml's test, bench and docs extras
+TEST_DEPS  := "pytest>=7" scikit-fmm pygeodesic potpourri3d geographiclib "dask>=2023.1" "distributed>=2023.1" \
+              "cloudpickle>=2"
+BENCH_DEPS := potpourri3d pygeodesic scikit-fmm geographiclib
+DOCS_DEPS  := "mkdocs>=1.6,<2" "mkdocs-material>=9,<10" "mkdocstrings[python]>=0.26"
+# pip's notes on extras that do not apply ("Ignoring ...: markers") and on what is already there
+export PIP_QUIET := 1
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
 RUST_SOURCES := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml pyproject.toml
 
-.PHONY: all build demo test test-rust test-python bench reproduce reproduce-quick clean help
+.PHONY: all build demo test test-rust test-python docs bench reproduce reproduce-quick clean help
 
 all: build
 
 help:
-	@sed -n '2,6p' Makefile
+	@sed -n '2,7p' Makefile
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 
 $(DEPS): pyproject.toml | $(PY)
-	$(PIP) install -q --upgrade pip
-	$(PIP) install -q "maturin>=1.5,<2" "numpy>=1.22" scipy matplotlib scikit-image meshio trimesh tqdm pytest scikit-fmm pygeodesic potpourri3d geographiclib "dask>=2023.1" "distributed>=2023.1" "cloudpickle>=2"
+	@echo "installing the runtime dependencies into $(VENV)"
+	@$(PIP) install -q --upgrade pip
+	@$(PIP) install -q $(RUNTIME_DEPS)
+	@touch $@
+
+$(TEST_DEPS_DONE): pyproject.toml | $(PY)
+	@echo "installing the test dependencies into $(VENV)"
+	@$(PIP) install -q $(TEST_DEPS)
+	@touch $@
+
+$(DOCS_DEPS_DONE): pyproject.toml | $(PY)
+	@echo "installing the documentation tools into $(VENV)"
+	@$(PIP) install -q $(DOCS_DEPS)
 	@touch $@
 
 $(BUILT): $(DEPS) $(RUST_SOURCES)
-	VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH $(VENV)/bin/maturin develop --release -q
+	@echo "building tubesweep (release; the first build takes a few minutes)"
+	@VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH $(VENV)/bin/maturin develop --release -q
 	@touch $@
 
 build: $(BUILT)
@@ -42,11 +68,15 @@ test-rust:
 	# the kernel-stats counters' test, on its own (its totals are process-wide)
 	cargo test --release -p tubesweep-core --features kernel-stats kernel_stats::
 
-test-python: build
+test-python: build $(TEST_DEPS_DONE)
 	$(PY) -m pytest -q
 
+docs: build $(DOCS_DEPS_DONE)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict -q
+	@echo "wrote out/site/index.html"
+
 bench: build
-	$(PIP) install -q potpourri3d pygeodesic scikit-fmm geographiclib
+	$(PIP) install -q $(BENCH_DEPS)
 	$(PY) benches/run.py
 	# issue 7's other targets: the sphere at N = 1001 and 2001, and the kernel's updates per
 	# second per core and 2-core speed-up

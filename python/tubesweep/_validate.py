@@ -9,6 +9,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from .grid import Grid
+from ._warn import user_stacklevel
 
 HAMILTONIANS = ("godunov", "lxf")
 
@@ -288,7 +289,7 @@ def warn_unconverged(stats: dict, tol: float, max_iterations: int) -> None:
             f"iteration was {stats['last_change']:.3g} (tol={tol:g}){behind}. Increase max_iterations or tol; "
             "the values returned are the last iterate",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -21,10 +21,10 @@ from .cli_distances import add_distances_parser, cmd_distances
 
 EPILOG = """examples:
   tubesweep solve --surface sphere --n 101 --png
-  tubesweep solve --mesh bunny --n 200 --outer 5 --export out/bunny.vtu --png
-  tubesweep solve --mesh spot.obj --source-vertex 0 --export out/spot.ply
+  tubesweep solve --mesh bunny --export out/bunny.vtu --png
+  tubesweep solve --mesh my-part.obj --source-vertex 0 --export out/part.ply
   tubesweep solve --surface star --n 401 --hamiltonian lxf --source 0.5 0 --out out/star
-  tubesweep solve --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0
+  tubesweep solve --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0 --redistance
   tubesweep travel-time --n 201 --dim 2 --source 0 0 --png
   tubesweep reproduce all --quick
 """
@@ -44,11 +44,21 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
         help="numerical Hamiltonian: Godunov (Eq. 3) or Lax-Friedrichs (Eq. 4) (default: godunov)",
     )
     p.add_argument(
-        "--tol", type=float, default=1e-10, help="stop when the largest change in an iteration is below this"
+        "--tol",
+        type=float,
+        default=1e-10,
+        help="stop when no value changes by more than this in an iteration (default: 1e-10; about "
+        "1e-3 × the grid spacing is as accurate and faster)",
     )
-    p.add_argument("--max-iterations", type=int, default=10000)
+    p.add_argument(
+        "--max-iterations",
+        type=int,
+        default=10000,
+        help="stop after this many iterations (2^d sweeps each) even if not converged; the result then "
+        "reports converged=False (default: 10000)",
+    )
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: ./out)")
-    p.add_argument("--png", action="store_true", help="also write a picture (needs matplotlib)")
+    p.add_argument("--png", action="store_true", help="also write a picture into --out (needs matplotlib)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -72,7 +82,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=_surface_names(), help="a built-in curve or surface")
-    src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
+    src.add_argument(
+        "--phi",
+        type=Path,
+        help="a .npy (or one-array .npz) file with a level set function φ sampled on "
+        "the grid given by --lower/--upper; add --redistance if φ is not a signed distance",
+    )
     src.add_argument(
         "--mesh",
         type=Path,
@@ -109,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="+",
         help="grid lower corner (with --phi; default for --surface: the surface's box)",
     )
-    p.add_argument("--upper", type=float, nargs="+", help="grid upper corner")
+    p.add_argument("--upper", type=float, nargs="+", help="grid upper corner (with --lower)")
     p.add_argument(
         "--source",
         type=float,
@@ -125,8 +140,26 @@ def build_parser() -> argparse.ArgumentParser:
         help="two-layer = Algorithm 3 (default); naive = Algorithm 2, the baseline that does not converge",
     )
     p.add_argument("--inner", type=float, default=2.0, help="inner tube half-width in grid spacings (default 2)")
-    p.add_argument("--outer", type=float, default=4.0, help="outer tube half-width in grid spacings (default 4)")
-    p.add_argument("--source-init", choices=["exact", "node"], default="exact")
+    p.add_argument(
+        "--outer",
+        type=float,
+        default=4.0,
+        help="outer tube half-width in grid spacings (default 4; the paper's Fig. 8 uses 5 for the bunny, "
+        "which changes no value on the surface)",
+    )
+    p.add_argument(
+        "--source-init",
+        choices=["exact", "node"],
+        default="exact",
+        help="how point sources start: exact = the exact distance at the nodes within 2 grid spacings "
+        "(default), node = u = 0 at the nearest node only, as in the paper",
+    )
+    p.add_argument(
+        "--redistance",
+        action="store_true",
+        help="--phi: re-distance φ in the band (for a level set function that is not a signed distance, "
+        "e.g. x² + y² + z² − r²)",
+    )
     p.add_argument(
         "--dense", action="store_true", help="also write the dense array solution_dense.npy (NaN off the band)"
     )
@@ -140,7 +173,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=Path,
         action="append",
         metavar="FILE",
-        help="write the surface mesh with u as point data for ParaView: .vtu .vtp .vtk .ply (repeatable)",
+        help="write the surface mesh with u as point data for ParaView to FILE (relative to the current "
+        "directory, like --out): .vtu .vtp .vtk .ply .obj (repeatable)",
     )
     p.add_argument(
         "--path-from",
@@ -163,18 +197,23 @@ def build_parser() -> argparse.ArgumentParser:
     t = sub.add_parser(
         "travel-time",
         help="first-arrival time in the whole box (Algorithm 1)",
-        description="Travel times from point sources in [-1,1]^d with constant speed; writes travel_time.npy.",
+        description="Travel times from point sources in [-1,1]^d with constant speed; writes travel_time.npy "
+        "(and travel_time.png with --png) into --out.",
     )
-    t.add_argument("--n", type=int, default=201)
-    t.add_argument("--dim", type=int, choices=[2, 3], default=2)
+    t.add_argument("--n", type=int, default=201, help="nodes per axis (default: 201)")
+    t.add_argument("--dim", type=int, choices=[2, 3], default=2, help="2 (a square) or 3 (a cube) (default: 2)")
     t.add_argument(
-        "--source", type=float, nargs="+", action="append", help="a source point (repeatable; default: origin)"
+        "--source",
+        type=float,
+        nargs="+",
+        action="append",
+        help="a source point, --dim coordinates (repeatable; default: the origin)",
     )
-    t.add_argument("--speed", type=float, default=1.0)
+    t.add_argument("--speed", type=float, default=1.0, help="constant speed F > 0 (default: 1)")
     _add_solver_options(t)
 
     d = sub.add_parser("demo", help="run the built-in examples, print a table and write pictures")
-    d.add_argument("--out", type=Path, default=Path("out/demo"))
+    d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default: out/demo)")
     d.add_argument("--quick", action="store_true", help="smaller grids")
 
     r = sub.add_parser(
@@ -185,7 +224,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument("names", nargs="+", help="experiment names or 'all' (see 'tubesweep reproduce list')")
     r.add_argument("--quick", action="store_true", help="small grids only (under two minutes in all)")
-    r.add_argument("--out", type=Path, default=Path("out/reproduce"))
+    r.add_argument("--out", type=Path, default=Path("out/reproduce"), help="output folder (default: out/reproduce)")
 
     sub.add_parser("info", help="version and build information")
     add_distances_parser(sub)  # `tubesweep distances`, in cli_distances.py
@@ -275,8 +314,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if args.lower is None or args.upper is None:
             raise UsageError("--phi needs --lower and --upper (the grid's corners)")
         grid = Grid(args.lower, args.upper, phi.shape)
-        surface = LevelSet(phi)
+        surface = LevelSet(phi, redistance=args.redistance)
         name = args.phi.stem
+    if args.redistance and not args.phi:
+        raise UsageError("--redistance applies to --phi only (library surfaces and meshes are distances already)")
     if args.padding is not None and not args.mesh:
         raise UsageError("--padding applies to --mesh only (a --surface or --phi grid is given by its box)")
     bad_arity = [len(p) for p in args.path_from or [] if len(p) != grid.ndim]
@@ -356,9 +397,11 @@ def cmd_solve(args: argparse.Namespace) -> int:
         **labels,
     )
     s = sol.stats
+    # the names of docs/benchmarks.md: wall = the whole solve, sweeps = sol.stats.seconds, set-up = the rest
     print(
         f"{name}: grid {grid.shape}, band {s.band_points} nodes ({s.inner_points} inner, {s.outer_points} outer), "
-        f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}, solve {s.seconds:.3f} s, total {wall:.3f} s"
+        f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}; wall {wall:.3f} s "
+        f"(sweeps {s.seconds:.3f} s, set-up {max(wall - s.seconds, 0.0):.3f} s)"
     )
     print(f"wrote {out / 'solution.npz'}")
     if args.dense:
@@ -374,7 +417,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
         from .output import plot
 
         up = args.up or ("y" if args.mesh else "z")
-        fig = plot(sol, up=up, title=f"{name}, {args.hamiltonian}, grid {'x'.join(map(str, grid.shape))}", paths=paths)
+        fig = plot(
+            sol,
+            up=up,
+            title=f"{name}: geodesic distance from the red star ({args.hamiltonian}, grid {'×'.join(map(str, grid.shape))})",
+            paths=paths,
+        )
         fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
         print(f"wrote {out / 'solution.png'}")
     return 0
@@ -432,12 +480,16 @@ def cmd_travel_time(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     np.save(args.out / "travel_time.npy", u)
     print(
-        f"grid {grid.shape}: {s.iterations} iterations, {s.updates} updates, {s.seconds:.3f} s; wrote {args.out / 'travel_time.npy'}"
+        f"grid {grid.shape}: {s.iterations} iterations, {s.updates} updates, converged={s.converged}; sweeps "
+        f"{s.seconds:.3f} s; wrote {args.out / 'travel_time.npy'}"
     )
     if args.png:
-        from ._figures import field_png
+        from ._plot import plot
 
-        print(f"wrote {field_png(grid, u, args.out / 'travel_time.png', sources, title='travel time')}")
+        plot(u, grid=grid, sources=sources, title="travel time").savefig(
+            args.out / "travel_time.png", dpi=110, bbox_inches="tight"
+        )
+        print(f"wrote {args.out / 'travel_time.png'}")
     return 0
 
 

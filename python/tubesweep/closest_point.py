@@ -76,6 +76,16 @@ class ClosestPoint(Surface):
         (:func:`tubesweep.surface.coarse_to_fine_candidates`). A distance function has constant 1; a larger
         value only makes the search visit more blocks.
 
+    Raises
+    ------
+    ValueError
+        If ``ndim`` is not 2 or 3 or ``lipschitz`` is below 1; at solve time, if ``cp`` returns
+        the wrong shape or non-finite values.
+    TypeError
+        If ``cp`` is not callable.
+
+    Notes
+    -----
     The tube is ``{|x − cp(x)| ≤ h}``; the extension direction at an extension-layer node is
     ``(x − cp(x)) / |x − cp(x)|``. ``BandGeometry.signed`` equals the unsigned distance (a
     closest-point surface has no inside).
@@ -103,21 +113,95 @@ class ClosestPoint(Surface):
         self.ndim = ndim
         self.lipschitz = float(lipschitz)
 
+    def __repr__(self) -> str:
+        return f"ClosestPoint(callable {getattr(self._cp, '__name__', type(self._cp).__name__)}, ndim={self.ndim})"
+
     def closest_point(self, points: np.ndarray) -> np.ndarray:
-        """``cp(points)`` with shape and finiteness checked."""
+        """The user's closest-point function, with the shape and finiteness of its answer checked.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` closest points on the surface.
+
+        Raises
+        ------
+        ValueError
+            If the points are not ``(M, d)`` or ``cp`` returns the wrong shape or non-finite values.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> circle = ts.ClosestPoint(lambda x: 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+        >>> circle.closest_point(np.array([[2.0, 0.0]])).tolist()
+        [[0.5, 0.0]]
+        """
         p = np.asarray(points, dtype=float)
         if p.ndim != 2:
             raise ValueError(f"points must have shape (M, d); got {p.shape}")
         return _evaluate_cp(self._cp, p)
 
     def distance(self, points: np.ndarray) -> np.ndarray:
-        """Unsigned distance ``|x − cp(x)|`` (the paper's ``F``)."""
+        """The unsigned distance ``|x − cp(x)|`` to the surface.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` distances.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`closest_point`.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> circle = ts.ClosestPoint(lambda x: 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+        >>> circle.distance(np.array([[2.0, 0.0]])).tolist()
+        [1.5]
+        """
         p = np.asarray(points, dtype=float)
         return row_norms(p - self.closest_point(p))
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
-        """Band nodes with ``|x − cp(x)| ≤ half_width`` (found coarse-to-fine) and their outward
-        directions ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2)."""
+        """The band of the surface on a grid: the nodes within ``half_width`` of it.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance, not grid spacings).
+
+        Returns
+        -------
+        BandGeometry
+            The band's nodes (C-order linear indices), φ there and the outward extension directions
+            ``n`` of Eq. (8); the solver's input.
+
+        Raises
+        ------
+        ValueError
+            If the surface is of the wrong dimension for the grid, or (level sets) φ is far from a
+            distance function near the surface.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+        >>> geometry = ts.surfaces.Circle(0.5).band(grid, 4 * grid.spacing)
+        """
         from . import _native
 
         self.check_grid(grid)
@@ -148,6 +232,35 @@ class ClosestPoint(Surface):
         return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        """Closest points on the surface, and the distance to them.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points near the surface.
+        grid : Grid
+            The grid (a sampled φ is interpolated on it).
+
+        Returns
+        -------
+        distance : numpy.ndarray
+            ``(M,)`` unsigned distances.
+        closest : numpy.ndarray
+            ``(M, d)`` the closest points.
+
+        Raises
+        ------
+        ValueError
+            If the points have the wrong shape or the surface's function returns non-finite values.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+        >>> d, cp = ts.surfaces.Circle(0.5).project(np.array([[0.6, 0.0]]), grid)
+        >>> np.round(cp, 6).tolist()
+        [[0.5, 0.0]]
+        """
         p = np.asarray(points, dtype=float)
         c = self.closest_point(p)
         return row_norms(p - c), c

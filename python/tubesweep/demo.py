@@ -11,7 +11,7 @@ import numpy as np
 
 
 def run_demo(out: Path, quick: bool = False) -> int:
-    from ._figures import field_png, solution_png
+    from ._plot import plot
     from .euclidean import travel_time
     from .grid import Grid
     from .solve import solve
@@ -33,7 +33,13 @@ def run_demo(out: Path, quick: bool = False) -> int:
         err = np.nanmax(np.abs(sol(ring) - np.pi / 4))
         rows.append(("sphere r=0.5", ham, n3, err, sol.stats, wall))
         if ham == "godunov":
-            solution_png(sol, out / "sphere.png", title=f"geodesic distance on a sphere, N={n3}, Godunov")
+            # the first view faces the source, the second its antipode
+            fig = plot(
+                sol,
+                views=((20.0, -150.0), (20.0, 30.0)),
+                title=f"geodesic distance on a sphere of radius 0.5 from the red star (grid {n3}³)",
+            )
+            fig.savefig(out / "sphere.png", dpi=110, bbox_inches="tight")
 
     # three sources: each start's path runs to the source that reaches it first
     # (on the side the first view faces)
@@ -46,9 +52,9 @@ def run_demo(out: Path, quick: bool = False) -> int:
     lengths = np.array([np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in paths])
     exact = 0.5 * np.arccos(np.clip(starts @ sources.T / 0.25, -1, 1)).min(axis=1)
     path_err, u_err = np.max(np.abs(lengths - exact)), np.max(np.abs(sol(starts) - exact))
-    from .output import plot
-
-    fig = plot(sol, paths=paths, title=f"paths to the nearest of three sources, N={n3}")
+    fig = plot(
+        sol, paths=paths, title=f"shortest paths (from the white circles) to the nearest of three sources, grid {n3}³"
+    )
     fig.savefig(out / "sphere_paths.png", dpi=100, bbox_inches="tight")
 
     star = Star()
@@ -63,24 +69,25 @@ def run_demo(out: Path, quick: bool = False) -> int:
         err = np.nanmax(np.abs(sol(pts) - exact))
         rows.append(("six-fold star", ham, n2, err, sol.stats, wall))
         if ham == "godunov":
-            solution_png(sol, out / "star.png", title=f"arclength on the six-fold star, N={n2}, Godunov")
+            fig = plot(sol, title=f"arclength on the six-fold star from the red star (grid {n2}²)")
+            fig.savefig(out / "star.png", dpi=110, bbox_inches="tight")
 
     # a layered medium in the box: speed 1 below z=0, 2 above, smooth transition
     gridb = Grid((-1, -1), (1, 1), (301, 301))
     speed = lambda p: 1.5 + 0.5 * np.tanh(8 * p[:, 1])  # noqa: E731
     u, st = travel_time(gridb, [(0.0, -0.6)], speed=speed, return_stats=True)
     X, Y = gridb.meshgrid()
-    field_png(
-        gridb,
+    fig = plot(
         u,
-        out / "layered.png",
-        np.array([[0.0, -0.6]]),
-        title="travel time, layered medium",
+        grid=gridb,
+        sources=[(0.0, -0.6)],
         speed=1.5 + 0.5 * np.tanh(8 * Y),
+        title="travel time from the red star: speed 1 below y = 0, 2 above",
     )
+    fig.savefig(out / "layered.png", dpi=110, bbox_inches="tight")
 
     print(
-        f"{'problem':<16} {'H':<8} {'N':>5} {'max error':>10} {'iters':>6} {'band pts':>9} {'sweeps s':>9} {'total s':>8}"
+        f"{'problem':<16} {'H':<8} {'N':>5} {'max error':>10} {'iters':>6} {'band pts':>9} {'sweeps s':>9} {'wall s':>8}"
     )
     for name, ham, n, err, s, wall in rows:
         print(
@@ -90,6 +97,6 @@ def run_demo(out: Path, quick: bool = False) -> int:
         f"geodesic paths on the sphere (5 starts, 3 sources, N={n3}): length error max {path_err:.2e} "
         f"(u at the starts: {u_err:.2e})"
     )
-    print(f"layered medium (box 301^2, Godunov): {st.iterations} iterations, {st.seconds:.3f} s")
+    print(f"layered medium (box 301^2, Godunov): {st.iterations} iterations, sweeps {st.seconds:.3f} s")
     print(f"pictures: {out / 'sphere.png'}, {out / 'sphere_paths.png'}, {out / 'star.png'}, {out / 'layered.png'}")
     return 0

@@ -121,11 +121,13 @@ def travel_time(
     Parameters
     ----------
     grid : Grid
+        The box and its nodes.
     sources : array-like (K, d)
         Source points anywhere in the box.
     speed : float, ndarray of ``grid.shape``, or callable ``f(points (M, d)) -> (M,)``
         Wave speed F > 0.
     hamiltonian : {"godunov", "lxf"}
+        Godunov (Eq. 3) or Lax–Friedrichs (Eq. 4).
     tol : float
         Stop when the largest change in one iteration (2^d sweeps) is below ``tol``.
     max_iterations : int
@@ -145,7 +147,21 @@ def travel_time(
 
     Returns
     -------
-    ndarray of ``grid.shape`` (and :class:`SolveStats` if ``return_stats``)
+    u : numpy.ndarray
+        Travel times, an array of ``grid.shape``.
+    stats : SolveStats
+        Only with ``return_stats=True``.
+
+    Raises
+    ------
+    ValueError
+        For sources outside the box, a speed that is not positive and finite, a bad tolerance,
+        or a box too large for the memory available (use the narrow-band solver for surfaces).
+
+    Warns
+    -----
+    RuntimeWarning
+        If the sweeps have not converged within ``max_iterations``.
 
     Examples
     --------

@@ -32,6 +32,7 @@ import numpy as np
 
 from ._validate import as_points
 from .solve import SOURCE_RADIUS
+from ._warn import user_stacklevel
 
 if TYPE_CHECKING:  # pragma: no cover
     from .solve import Solution
@@ -338,13 +339,13 @@ def trace_paths(
             "the gradient of u vanished, left the band, or u stopped decreasing (a cut locus or a region the "
             f"scheme resolves poorly); refine the grid or start elsewhere{gaps_note}",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     if active.size:
         warnings.warn(
             f"{active.size} geodesic path(s) did not reach a source within max_steps = {max_steps} steps "
             f"(first: starts[{int(active[0])}]); increase max_steps",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     return [np.asarray(path) for path in paths]

@@ -25,6 +25,15 @@ class Grid:
     shape : sequence of int
         Number of nodes along each axis (at least 3).
 
+    Raises
+    ------
+    ValueError
+        If the corners are not finite or not increasing, fewer than 3 nodes lie along an axis,
+        the grid is not 2D or 3D, or the spacing differs between axes (the error gives the
+        ``upper`` that makes it uniform).
+    TypeError
+        If the corners or the shape are not sequences of numbers.
+
     Examples
     --------
     >>> grid = Grid(lower=(-1, -1), upper=(1, 1), shape=(101, 101))
@@ -125,22 +134,98 @@ class Grid:
 
     # ------------------------------------------------------------------ coordinates
     def axis(self, k: int) -> np.ndarray:
-        """Node coordinates along axis ``k``."""
+        """Node coordinates along one axis.
+
+        Parameters
+        ----------
+        k : int
+            The axis (0 is x).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(shape[k],)`` coordinates.
+
+        Raises
+        ------
+        IndexError
+            If ``k`` is not an axis of the grid.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.axis(0).tolist()
+        [-1.0, -0.5, 0.0, 0.5, 1.0]
+        """
         return self._lower[k] + self._spacing * np.arange(self._shape[k])
 
     def meshgrid(self) -> Tuple[np.ndarray, ...]:
-        """Dense coordinate arrays of ``grid.shape`` (allocates the whole box)."""
+        """Dense coordinate arrays of the grid's shape (allocates the whole box).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            One array of ``grid.shape`` per axis, indexed like ``numpy.meshgrid(..., indexing="ij")``.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> X, Y = grid.meshgrid()
+        >>> X.shape
+        (5, 5)
+        """
         return tuple(np.meshgrid(*[self.axis(k) for k in range(self.ndim)], indexing="ij"))
 
     def points(self, indices: "np.ndarray | Sequence[Sequence[int]]") -> np.ndarray:
-        """Coordinates of nodes given by integer indices of shape (M, d)."""
+        """Coordinates of nodes given by their integer indices.
+
+        Parameters
+        ----------
+        indices : array_like
+            ``(M, d)`` node indices.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` coordinates.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.points([[0, 0], [4, 2]]).tolist()
+        [[-1.0, -1.0], [1.0, 0.0]]
+        """
         idx = np.asarray(indices)
         return self._lower + self._spacing * idx.astype(float)
 
     def node_points(self, linear: np.ndarray) -> np.ndarray:
-        """Coordinates (M, d) of the nodes with C-order linear indices ``linear``: the bits of
-        ``points(unravel(linear))``, computed in Rust on all threads without the (M, d) index
-        array (for the band's nodes, in order, one division per grid row)."""
+        """Coordinates of the nodes with the given C-order linear indices (computed in Rust).
+
+        Parameters
+        ----------
+        linear : array_like
+            ``(M,)`` linear indices.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` coordinates, the bits of ``points(unravel(linear))``.
+
+        Raises
+        ------
+        ValueError
+            If an index lies outside the grid.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.node_points([0, 24]).tolist()
+        [[-1.0, -1.0], [1.0, 1.0]]
+        """
         from . import _native
 
         lin = np.ascontiguousarray(linear, dtype=np.int64)
@@ -150,32 +235,157 @@ class Grid:
         )
 
     def continuous_index(self, points: "np.ndarray | Sequence[Sequence[float]]") -> np.ndarray:
-        """Fractional node index of points (M, d)."""
+        """Fractional node index of points.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, d)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` fractional indices (0 at the lower corner).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.continuous_index([[0.25, -1.0]]).tolist()
+        [[2.5, 0.0]]
+        """
         p = np.asarray(points, dtype=float)
         return (p - self._lower) / self._spacing
 
     def nearest_index(self, points: "np.ndarray | Sequence[Sequence[float]]") -> np.ndarray:
-        """Index (M, d) of the node nearest to each point; the points must lie in the box."""
+        """Index of the node nearest to each point.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, d)`` points in the box.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` int64 node indices.
+
+        Raises
+        ------
+        ValueError
+            If a point lies outside the box.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.nearest_index([[0.3, -0.9]]).tolist()
+        [[3, 0]]
+        """
         p = np.atleast_2d(np.asarray(points, dtype=float))
         if not np.all(self.contains(p)):
             raise ValueError("points outside the grid have no nearest node")
         return np.rint(self.continuous_index(p)).astype(np.int64)
 
     def cell_index(self, points: "np.ndarray | Sequence[Sequence[float]]") -> np.ndarray:
-        """Index (M, d) of the lower corner of the cell that holds each point."""
+        """Index of the lower corner of the cell that holds each point.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, d)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` int64 indices, clipped to the box's cells.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.cell_index([[0.3, -0.9]]).tolist()
+        [[2, 0]]
+        """
         t = self.continuous_index(np.atleast_2d(points))
         return np.clip(np.floor(t), 0, np.asarray(self._shape) - 2).astype(np.int64)
 
     def contains(self, points: "np.ndarray | Sequence[Sequence[float]]", tol: float = 1e-9) -> np.ndarray:
-        """Boolean mask (M,): points inside the box (within ``tol`` grid spacings)."""
+        """Which points lie inside the box.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, d)`` points.
+        tol : float
+            Slack in grid spacings (default 1e-9).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` booleans.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.contains([[0.0, 0.0], [2.0, 0.0]]).tolist()
+        [True, False]
+        """
         t = self.continuous_index(np.atleast_2d(points))
         return np.all((t >= -tol) & (t <= np.asarray(self._shape) - 1 + tol), axis=1)
 
     def linear_index(self, indices: np.ndarray) -> np.ndarray:
-        """C-order linear index of node indices (M, d)."""
+        """C-order linear index of node indices.
+
+        Parameters
+        ----------
+        indices : array_like
+            ``(M, d)`` node indices.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` int64 linear indices.
+
+        Raises
+        ------
+        ValueError
+            If an index lies outside the grid.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.linear_index([[1, 2]]).tolist()
+        [7]
+        """
         idx = np.asarray(indices, dtype=np.int64)
         return np.ravel_multi_index(tuple(idx.T), self._shape)
 
     def unravel(self, linear: np.ndarray) -> np.ndarray:
-        """Node indices (M, d) of C-order linear indices."""
+        """Node indices of C-order linear indices.
+
+        Parameters
+        ----------
+        linear : array_like
+            ``(M,)`` linear indices.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` node indices.
+
+        Raises
+        ------
+        ValueError
+            If an index lies outside the grid.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (5, 5))
+        >>> grid.unravel([7]).tolist()
+        [[1, 2]]
+        """
         return np.stack(np.unravel_index(np.asarray(linear, dtype=np.int64), self._shape), axis=1)

@@ -27,6 +27,7 @@ import numpy as np
 
 from .grid import Grid
 from ._validate import check_tolerance_scale, real_array
+from ._warn import user_stacklevel
 
 __all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
 
@@ -245,7 +246,7 @@ class MovingMedium(Hamiltonian):
                 f"max |v| = {vmax:.3g}); the moving-medium equation (Sect. 6.3) assumes v·n = 0. The normal component "
                 "is removed: v is projected onto the tangent plane with the band's normal",
                 RuntimeWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
         v = np.ascontiguousarray(v - vn[:, None] * n)
         speed_v = np.linalg.norm(v, axis=1)
@@ -276,7 +277,7 @@ class MovingMedium(Hamiltonian):
             warnings.warn(
                 msg + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway",
                 RuntimeWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
         return _Prepared(
             self.kind,

@@ -6,9 +6,7 @@
   of the level set φ = 0 restricted to the band (scikit-image).
 * :func:`export` — that mesh with the solution ``u`` as point data, as ``.vtu`` / ``.vtk`` /
   ``.ply`` / ``.obj`` (meshio) or ``.vtp`` (VTK XML PolyData, written here), for ParaView.
-* :func:`plot` — a matplotlib :class:`~matplotlib.figure.Figure`: the solution as a colour map,
-  iso-distance lines and the sources marked; 2D curves and 3D surfaces. It uses no pyplot
-  state, so it displays inline in notebooks and never changes the backend.
+* :func:`plot` — a matplotlib :class:`~matplotlib.figure.Figure` (in :mod:`tubesweep._plot`).
 
 Optional dependencies are imported lazily: ``pip install 'tubesweep[mesh]'`` (meshio,
 scikit-image) and ``pip install 'tubesweep[plot]'`` (matplotlib).
@@ -88,21 +86,44 @@ def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
 
 
 def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np.ndarray, np.ndarray]:
-    """A mesh of the surface of a solution: ``(vertices (n, d), cells)``.
+    """A mesh of the surface a solution lives on.
 
-    Cells are triangles (m, 3) in 3D and line segments (m, 2) in 2D.
+    The surface's own ``triangulation()`` where it has one (the input mesh of
+    :func:`~tubesweep.surfaces.from_mesh`, the library's surfaces). Otherwise a level set is
+    contoured at φ = 0 inside the band: marching cubes (scikit-image) in 3D, with φ's sign
+    continued from the nearest band node off the band (so that the band's edge makes no spurious
+    pieces), marching squares in 2D.
 
     Parameters
     ----------
     sol : Solution
+        A :func:`tubesweep.solve` result.
     mesh : (vertices, faces), optional
-        Use this mesh instead (it is returned unchanged).
+        Use this mesh instead (checked and returned).
 
-    The surface's own ``triangulation()`` is used when it has one (the input mesh for
-    :func:`~tubesweep.surfaces.from_mesh`). Otherwise a level set is contoured at φ = 0 inside
-    the band: marching cubes (scikit-image, Lewiner) in 3D, with φ's sign continued from the
-    nearest band node off the band (so the band's edge makes no spurious pieces), marching squares
-    in 2D (off-band nodes are NaN there). A surface with neither (a bare closest-point function) needs ``mesh=``.
+    Returns
+    -------
+    vertices : numpy.ndarray
+        ``(n, d)`` points.
+    cells : numpy.ndarray
+        ``(m, 3)`` triangles in 3D, ``(m, 2)`` line segments in 2D.
+
+    Raises
+    ------
+    ValueError
+        For a surface with neither a triangulation nor a level set (a bare closest-point function:
+        pass ``mesh=``), or a ``mesh`` whose faces index vertices that are not there.
+    ImportError
+        If contouring a level set needs scikit-image and it is not installed.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source])
+    >>> v, f = ts.triangulate(sol)
+    >>> v.shape[1], f.shape[1]
+    (3, 3)
     """
     if mesh is not None:
         return _checked_mesh(mesh)
@@ -236,7 +257,32 @@ def _umask() -> int:
 
 
 def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, np.ndarray]]:
-    """Reads an ASCII ``.vtp`` written by :func:`export`: points (n, 3), cells, point data."""
+    """Reads an ASCII ``.vtp`` file written by :func:`export`.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(n, 3)`` vertices.
+    cells : numpy.ndarray
+        ``(m, k)`` polygons or lines.
+    point_data : dict
+        Name → per-vertex array.
+
+    Raises
+    ------
+    ValueError
+        If the file is not VTK XML PolyData.
+
+    Examples
+    --------
+    >>> from tubesweep.output import read_vtp
+    >>> points, cells, data = read_vtp("sphere.vtp")  # doctest: +SKIP
+    """
     try:
         root = ET.parse(str(path)).getroot()
     except ET.ParseError as e:
@@ -287,23 +333,47 @@ def export(
     mesh: Optional[Tuple[Any, Any]] = None,
     point_data: Optional[Dict[str, Any]] = None,
 ) -> Path:
-    """Writes the surface of ``sol`` with the solution ``u`` at its vertices, for ParaView.
+    """Writes the surface of a solution with the solution ``u`` at its vertices, for ParaView.
+
+    ``u`` is :meth:`Solution.on_mesh` at the vertices (``inf`` where never reached becomes NaN).
+    With several sources and an isotropic Hamiltonian, ``nearest_source`` (the label of
+    :meth:`Solution.nearest_source`, -1 where no front arrives) is written too. 2D curves are
+    written as line cells with z = 0.
 
     Parameters
     ----------
     sol : Solution
-    path : str or Path ending in ``.vtu``, ``.vtp``, ``.vtk``, ``.ply`` or ``.obj``
-        ``.vtp`` is VTK XML PolyData written here; the others go through meshio
-        (``pip install 'tubesweep[mesh]'``). ``.obj`` keeps no point data.
+        A :func:`tubesweep.solve` result.
+    path : str or pathlib.Path
+        Ending in ``.vtu``, ``.vtp``, ``.vtk``, ``.ply`` or ``.obj``. ``.vtp`` is VTK XML PolyData
+        written here; the others go through meshio (``pip install 'tubesweep[mesh]'``); ``.obj``
+        keeps no point data.
     mesh : (vertices, faces), optional
         The mesh to write instead of :func:`triangulate`'s.
     point_data : dict, optional
-        Further per-vertex arrays to write beside ``u``.
+        Further per-vertex arrays (name → ``(n,)`` or ``(n, k)``) to write beside ``u``.
 
-    ``u`` is :meth:`Solution.on_mesh` at the vertices (``inf`` where never reached becomes NaN).
-    With several sources and an isotropic Hamiltonian, ``nearest_source``
-    (:meth:`Solution.nearest_source` at the vertices, -1 where no front arrives) is written too.
-    2D curves are written as line cells with z = 0.
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    ValueError
+        For an unknown suffix, a 2D curve as ``.ply``, or point data of the wrong length or name.
+    ImportError
+        If the format needs meshio and it is not installed.
+    OSError
+        If the file cannot be written (a half-written file is not left behind).
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source])
+    >>> ts.export(sol, "sphere.vtp")  # doctest: +SKIP
+    PosixPath('sphere.vtp')
     """
     path = Path(path)
     suffix = export_format(path)
@@ -346,243 +416,5 @@ def export(
     return path
 
 
-# ---------------------------------------------------------------------------------------------
-# pictures
-# ---------------------------------------------------------------------------------------------
-def _iso_segments(v: np.ndarray, f: np.ndarray, u: np.ndarray, level: float) -> Tuple[np.ndarray, np.ndarray]:
-    """Marching triangles: segments (s, 2, 3) of the piecewise-linear level line u = level and the
-    faces (s,) they cross."""
-    uf = u[f] - level
-    pts = []
-    for i, j in ((0, 1), (1, 2), (2, 0)):
-        a, b = uf[:, i], uf[:, j]
-        cross = (a * b < 0) & np.isfinite(a) & np.isfinite(b)
-        t = np.where(cross, a / np.where(cross, a - b, 1.0), np.nan)
-        p = v[f[:, i]] + t[:, None] * (v[f[:, j]] - v[f[:, i]])
-        pts.append(np.where(cross[:, None], p, np.nan))
-    pts = np.stack(pts, axis=1)  # (m, 3 edges, 3)
-    have = np.isfinite(pts[:, :, 0])
-    two = have.sum(1) == 2
-    seg = pts[two][have[two]].reshape(-1, 2, 3)
-    return seg, np.flatnonzero(two)
-
-
-def _orientation(f: np.ndarray, v: np.ndarray) -> float:
-    """+1 / −1 if the faces are consistently oriented with normals pointing out / in (by the sign
-    of the enclosed volume), 0 if not consistently oriented (e.g. a Möbius band)."""
-    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]).astype(np.int64)
-    if len(np.unique(e[:, 0] * len(v) + e[:, 1])) != len(e):
-        return 0.0
-    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    vol = float(np.einsum("ij,ij->i", a - v.mean(0), np.cross(b - a, c - a)).sum())
-    return 1.0 if vol >= 0 else -1.0
-
-
-def _nearest_face(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
-    """Index of the face whose centroid is nearest to each point: a k-d tree where SciPy is
-    installed, else in chunks of points small enough that the table of differences stays near a
-    million entries."""
-    if len(points) == 0:
-        return np.zeros(0, dtype=np.int64)
-    try:
-        from scipy.spatial import cKDTree
-    except ImportError:
-        chunk = max(1, 1_000_000 // (3 * max(len(centroids), 1)))
-        out = np.empty(len(points), dtype=np.int64)
-        for lo in range(0, len(points), chunk):
-            p = points[lo : lo + chunk]
-            out[lo : lo + chunk] = np.argmin(((p[:, None, :] - centroids[None, :, :]) ** 2).sum(-1), axis=1)
-        return out
-    return np.asarray(cKDTree(centroids).query(points)[1], dtype=np.int64)
-
-
-def plot(
-    sol: Any,
-    *,
-    ax: Any = None,
-    mesh: Optional[Tuple[Any, Any]] = None,
-    levels: Union[int, Sequence[float]] = 12,
-    cmap: str = "viridis",
-    views: Sequence[Tuple[float, float]] = ((20.0, -60.0), (20.0, 120.0)),
-    title: Optional[str] = None,
-    sources: bool = True,
-    colorbar: bool = True,
-    up: str = "z",
-    paths: Optional[Sequence[Any]] = None,
-) -> Any:
-    """A picture of a solution: a matplotlib :class:`~matplotlib.figure.Figure`.
-
-    2D: the band coloured by ``u``, iso-distance lines, the curve φ = 0 (white) and the sources
-    (red stars). 3D: :func:`triangulate`'s surface coloured by ``u`` (shaded), iso-distance lines,
-    the sources, one panel per ``(elevation, azimuth)`` in ``views``.
-
-    Parameters
-    ----------
-    sol : Solution
-    ax : matplotlib Axes, optional
-        Draw into this axes (a 3D axes for surfaces; only the first view is drawn); default: a
-        new figure.
-    mesh : (vertices, faces), optional — the surface mesh to draw (3D)
-    levels : int or sequence — number of iso-lines, or their values
-    cmap, title, sources, colorbar : as usual
-    up : {"x", "y", "z"}
-        The axis drawn vertically in 3D (many mesh files, the bunny and spot among them, are "y").
-    paths : sequence of (P, d) arrays, optional
-        Polylines drawn in red over the surface, e.g. :meth:`Solution.geodesic_paths` (in 3D a
-        segment on the far side of an oriented surface is drawn faint).
-
-    Returns the Figure (``fig.savefig("u.png")`` to save; it displays inline in notebooks).
-    """
-    _need("matplotlib", "plot", "plotting")
-    from matplotlib.figure import Figure
-    from matplotlib import cm, colors as mcolors
-    from matplotlib.ticker import MaxNLocator
-
-    grid = sol.grid
-    lines = [real_array(q, f"paths[{i}]") for i, q in enumerate(paths or [])]
-    for i, q in enumerate(lines):
-        if q.ndim != 2 or q.shape[1] != grid.ndim or len(q) < 1:
-            raise ValueError(f"paths[{i}] must be an array of shape (P, {grid.ndim}); got shape {q.shape}")
-    finite = sol.values[np.isfinite(sol.values)]
-    umax = float(finite.max()) if finite.size else 1.0
-    if np.ndim(levels) == 0:
-        if isinstance(levels, np.ndarray):
-            levels = levels.item()
-        if (
-            isinstance(levels, (bool, np.bool_))
-            or not isinstance(levels, (int, float, np.integer, np.floating))
-            or not (float(levels).is_integer() and 0 <= levels <= 1000)
-        ):
-            raise ValueError(
-                f"levels must be a number of iso-lines (an integer from 0 to 1000) or a sequence of their values; "
-                f"got {levels!r}"
-            )
-        lv = MaxNLocator(int(levels) + 1).tick_values(0.0, umax) if levels > 0 else np.zeros(0)
-    else:
-        lv = real_array(levels, "levels").reshape(-1)
-        if not np.all(np.isfinite(lv)):
-            raise ValueError(f"levels must be finite values of the solution; got {levels!r}")
-    lv = lv[(lv > 0) & (lv < umax)]
-    import matplotlib
-
-    cmap_obj = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
-    norm = mcolors.Normalize(0.0, umax)
-    if grid.ndim == 2:
-        if ax is None:
-            fig = Figure(figsize=(6, 5.4))
-            ax = fig.add_subplot(1, 1, 1)
-        fig = ax.figure
-        dense = sol.to_dense()
-        dense = np.where(np.isfinite(dense), dense, np.nan)
-        X, Y = grid.meshgrid()
-        m = ax.pcolormesh(X, Y, dense, shading="auto", cmap=cmap_obj, norm=norm)
-        phi = np.full(grid.size, np.nan)
-        phi[sol.linear] = sol.phi
-        if isinstance(sol.surface, LevelSet):
-            ax.contour(X, Y, phi.reshape(grid.shape), levels=[0.0], colors="w", linewidths=1.0)
-        if lv.size:
-            ax.contour(X, Y, dense, levels=lv, colors="k", linewidths=0.5)
-        for q in lines:
-            ax.plot(q[:, 0], q[:, 1], "r-", lw=1.5)
-        if sources:
-            ax.plot(sol.sources[:, 0], sol.sources[:, 1], "r*", ms=13, mec="k", mew=0.5)
-        ax.set_aspect("equal")
-        p = sol.points
-        lo, hi = p.min(0), p.max(0)
-        pad = 0.05 * float((hi - lo).max())
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - pad, hi[1] + pad)
-        if colorbar:
-            fig.colorbar(m, ax=ax, label="u")
-        if title:
-            ax.set_title(title)
-        return fig
-
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
-
-    if up not in ("x", "y", "z"):
-        raise ValueError(f"up must be 'x', 'y' or 'z'; got {up!r}")
-    v, f = triangulate(sol, mesh=mesh)
-    if f.shape[1] == 4:  # quads as two triangles each: the shading and the iso-lines walk triangles
-        f = np.vstack([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
-    u = sol.on_mesh(v)
-    # a cyclic permutation of the axes (keeps orientation) puts `up` last, mplot3d's vertical
-    perm = {"x": [1, 2, 0], "y": [2, 0, 1], "z": [0, 1, 2]}[up]
-    v = v[:, perm]
-    src = sol.sources[:, perm]
-    tri = v[f]
-    finite = np.isfinite(u[f])
-    # the mean of the reached corners (NaN for a face none of whose corners was reached)
-    uface = np.where(finite, u[f], 0.0).sum(axis=1) / np.where(finite.any(axis=1), finite.sum(axis=1), np.nan)
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-    base = cmap_obj(norm(np.nan_to_num(uface, nan=umax)))
-    base[~np.isfinite(uface)] = (0.7, 0.7, 0.7, 1.0)
-    iso = [_iso_segments(v, f, u, c) for c in lv]
-    seg_all = np.concatenate([s for s, _ in iso]) if iso else np.zeros((0, 2, 3))
-    seg_face = np.concatenate([t for _, t in iso]) if iso else np.zeros(0, np.int64)
-    orient = _orientation(f, v)
-    centroids = tri.mean(1)
-    # the paths' segments, and the face next to each (to draw those on the far side faint)
-    segs = [np.stack([q[:-1], q[1:]], axis=1)[:, :, perm] for q in lines if len(q) >= 2]
-    seg = np.concatenate(segs) if segs else np.zeros((0, 2, 3))
-    seg_near = _nearest_face(seg.mean(1), centroids)
-    src_near = _nearest_face(src, centroids)
-    if ax is not None:
-        axes = [ax]
-        fig = ax.figure
-        views = views[:1]
-    else:
-        fig = Figure(figsize=(5.2 * len(views) + 1.0, 5.0))
-        axes = [
-            fig.add_subplot(1, len(views), i + 1, projection="3d", computed_zorder=False) for i in range(len(views))
-        ]
-    ext = np.ptp(v, axis=0)
-    for a, (elev, azim) in zip(axes, views):
-        e, z = np.radians(elev), np.radians(azim)
-        eye = np.array([np.cos(e) * np.cos(z), np.cos(e) * np.sin(z), np.sin(e)])
-        light = eye + np.array([0.3, 0.3, 0.6])
-        light /= np.linalg.norm(light)
-        shade = 0.45 + 0.55 * np.abs(n @ light)
-        fc = base.copy()
-        fc[:, :3] *= shade[:, None]
-        a.add_collection3d(Poly3DCollection(tri, facecolors=fc, edgecolors=fc, linewidths=0.2, zorder=1))
-        # iso-lines drawn over the surface; on an oriented mesh only those on faces that face the eye
-        seen = (n[seg_face] @ eye) * orient > 0 if orient != 0 else np.ones(len(seg_face), bool)
-        if np.any(seen):
-            a.add_collection3d(Line3DCollection(seg_all[seen], colors="k", linewidths=0.6, zorder=2))
-        if len(seg):
-            front = (n[seg_near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(seg), bool)
-            for sel, alpha in ((front, 1.0), (~front, 0.3)):
-                if np.any(sel):
-                    a.add_collection3d(Line3DCollection(seg[sel], colors="r", linewidths=1.6, alpha=alpha, zorder=3))
-        if sources:
-            # a source on the far side of an oriented mesh is drawn faint
-            front = (n[src_near] @ eye) * orient >= 0 if orient != 0 else np.ones(len(src_near), bool)
-            for sel, alpha in ((front, 1.0), (~front, 0.3)):
-                if np.any(sel):
-                    a.scatter(
-                        *src[sel].T,
-                        c="r",
-                        marker="*",
-                        s=160,
-                        edgecolors="k",
-                        linewidths=0.5,
-                        depthshade=False,
-                        zorder=3,
-                        alpha=alpha,
-                    )
-        lo, hi = v.min(0), v.max(0)
-        a.set_xlim(lo[0], hi[0])
-        a.set_ylim(lo[1], hi[1])
-        a.set_zlim(lo[2], hi[2])
-        a.set_box_aspect(tuple(np.maximum(ext, 1e-9 * ext.max())))
-        a.view_init(elev, azim)
-        a.set_axis_off()
-    if colorbar:
-        sm = cm.ScalarMappable(norm=norm, cmap=cmap_obj)
-        sm.set_array([])
-        fig.colorbar(sm, ax=axes, shrink=0.7, label="u")
-    if title:
-        fig.suptitle(title)
-    return fig
+# pictures: tubesweep._plot (kept importable from here)
+from ._plot import plot  # noqa: E402

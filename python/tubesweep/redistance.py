@@ -25,6 +25,7 @@ from __future__ import annotations
 from typing import Callable, Optional, Tuple
 
 import numpy as np
+from ._warn import user_stacklevel
 
 __all__ = ["project_to_level_set", "GRADIENT_STEP", "SAMPLED_GRADIENT_STEP"]
 
@@ -217,7 +218,7 @@ def _warn_if_band_nodes_unprojected(
             "radius of curvature there (refine the grid), or φ's zero level set has a sharp edge or corner there "
             f"(smooth φ: refining does not help), e.g. near {tuple(round(float(c), 6) for c in x[failed][np.argmax(within)])}",
             RuntimeWarning,
-            stacklevel=6,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 import warnings
@@ -34,6 +35,7 @@ from ._validate import (
 from .grid import Grid
 from .stats import SolveStats
 from .surface import BandGeometry, Surface, as_surface, band_neighbours
+from ._warn import user_stacklevel
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
 
@@ -61,15 +63,39 @@ _ROLE_CHUNK = 1 << 18
 class Solution:
     """The result of :func:`solve`: first-arrival times on the band nodes.
 
+    Call it to interpolate (``sol(points)``); print it to see what was solved and how it went.
+
     Attributes
     ----------
     grid : Grid
-    indices : (K, d) int64 — grid indices of the band nodes
-    values : (K,) float — the solution at the band nodes (``inf`` where never reached)
-    roles : (K,) uint8 — 0 fixed (source), 1 inner tube, 2 extension layer
-    phi : (K,) float32 — φ (level set) or ``|x − cp(x)|`` (closest point) at the band nodes
+        The grid solved on.
+    surface : Surface
+        The surface solved on.
+    indices : numpy.ndarray
+        ``(K, d)`` int64 grid indices of the band nodes.
+    values : numpy.ndarray
+        ``(K,)`` the solution at the band nodes (``inf`` where never reached).
+    roles : numpy.ndarray
+        ``(K,)`` uint8: 0 fixed (source), 1 inner tube, 2 extension layer.
+    phi : numpy.ndarray
+        ``(K,)`` float32: φ (level set) or ``|x − cp(x)|`` (closest point) at the band nodes.
     stats : SolveStats
-    sources : (S, d) float
+        What the solve did (iterations, updates, times, convergence).
+    sources : numpy.ndarray
+        ``(S, d)`` the source points.
+    hamiltonian : str
+        ``"godunov"``, ``"lxf"``, ``"moving-medium"``, ``"metric"`` or ``"isotropic"``.
+    method : str
+        ``"two-layer"`` or ``"naive"``.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [s.default_source])
+    >>> sol.stats.converged
+    True
+    >>> u = sol([(0.5, 0.0, 0.0)])  # the antipode: exact π/2
     """
 
     def __init__(
@@ -140,20 +166,41 @@ class Solution:
             )
 
     def narrow_gaps(self) -> Tuple[np.ndarray, np.ndarray]:
-        """Where the surface faces itself across a gap narrower than the tubes (see
-        ``stats.facing_pairs`` and docs/surfaces.md): the midpoints ``(M, d)`` of the pairs of
-        neighbouring band nodes that lie across such a gap, and each gap ``|cp(a) − cp(b)|``
-        ``(M,)``. Travel times beyond these places can be too short; empty where the grid resolves
-        every gap."""
+        """Where the surface faces itself across a gap narrower than the tubes.
+
+        There the front can cross the gap, and travel times beyond it can come out too short (see
+        ``stats.facing_pairs`` and the user guide's surfaces page).
+
+        Returns
+        -------
+        midpoints : numpy.ndarray
+            ``(M, d)`` the midpoints of the pairs of neighbouring band nodes across such a gap.
+        gaps : numpy.ndarray
+            ``(M,)`` each gap's width ``|cp(a) − cp(b)|``. Both are empty where the grid resolves
+            every gap.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source])
+        >>> sol.narrow_gaps()[0].shape
+        (0, 3)
+        """
         node, neighbour, gap = self._facing
         lin = self.linear
         mid = 0.5 * (self.grid.node_points(lin[node]) + self.grid.node_points(lin[neighbour]))
         return mid.reshape(-1, self.grid.ndim), gap.copy()
 
     def __repr__(self) -> str:
+        # what was solved, on what, and how it went: enough to tell two solutions apart when printed
         s = self.stats
+        g = self.grid
+        order = getattr(self, "order", 1)
         return (
-            f"Solution({self.method}, {self.hamiltonian}, band_points={s.band_points}, iterations={s.iterations}, "
+            f"Solution(surface={self.surface!r}, grid={'×'.join(map(str, g.shape))} (spacing {g.spacing:.4g}), "
+            f"band_nodes={s.band_points:,} ({s.inner_points:,} inner), sources={len(self.sources)}, "
+            f"method={self.method!r}, hamiltonian={self.hamiltonian!r}, order={order}, iterations={s.iterations}, "
             f"converged={s.converged})"
         )
 
@@ -177,18 +224,62 @@ class Solution:
         return self.roles != ROLE_OUTER
 
     def __call__(self, points: Any) -> np.ndarray:
-        """Multilinear interpolation at points (M, d); NaN where the stencil leaves the band."""
+        """The solution at points near the surface, by multilinear interpolation of the band values.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, d)`` points (or one point ``(d,)``) on or near the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` values; NaN where the interpolation stencil leaves the band.
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the grid's dimension or are not finite.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [s.default_source])
+        >>> u = sol([(0.0, 0.5, 0.0), (0.5, 0.0, 0.0)])  # exact π/4 and π/2
+        """
         p = as_points(points, self.grid.ndim, "points")
         return self._band.interpolate(self.values, list(self.grid.lower), self.grid.spacing, p)
 
     def on_mesh(self, vertices: Any) -> np.ndarray:
-        """The solution at the vertices (M, d) of a mesh of the surface (e.g. for display or export).
+        """The solution at the vertices of a mesh of the surface (for display or export).
 
         Multilinear interpolation (:meth:`__call__`); where its stencil leaves the band or meets an
         unreached node, the value of the nearest band node within ``outer + 1`` grid spacings (the
-        band values are constant along the normals, Eq. (8), so this is first-order accurate). NaN
-        where there is none, or where that node was not reached (a component of the surface no
-        source reaches, or, in a solve stopped early, a part the front had not reached).
+        band values are constant along the normals, Eq. (8), so this is first-order accurate).
+
+        Parameters
+        ----------
+        vertices : array_like
+            ``(M, d)`` points on the surface, e.g. ``surface.vertices`` of a mesh.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` values; NaN where no band node is near, or where the nearest one was not reached
+            (a component of the surface no source reaches, or a solve stopped early).
+
+        Raises
+        ------
+        ValueError
+            If the vertices do not have the grid's dimension or are not finite.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> sol = ts.solve(spot, spot.grid(60), [spot.vertices[0]])  # doctest: +SKIP
+        >>> u = sol.on_mesh(spot.vertices)  # doctest: +SKIP
         """
         p = as_points(vertices, self.grid.ndim, "vertices")
         out = self(p)
@@ -242,21 +333,39 @@ class Solution:
         return best
 
     def nearest_source(self, points: Any = None) -> np.ndarray:
-        """Which source reaches each place first: indices into :attr:`sources`, -1 where no front
-        arrives (another component of the surface).
+        """Which source reaches each place first: indices into :attr:`sources`.
 
-        Without ``points``, one label per band node (aligned with :attr:`values`); with
-        ``points`` (M, d), e.g. the vertices of a mesh of the surface, the label of the nearest
-        band node within ``outer + 1`` grid spacings of each point (-1 where there is none or it
-        was not reached).
-        For speed 1 the labels partition the surface into the geodesic Voronoi cells of the
-        sources. They are recovered from the solved values (``tubesweep_core::nearest_source``:
-        each node takes the label of its smallest, earlier-reached neighbour) and are first-order
-        accurate like the values: nodes within about a grid spacing of a cell boundary may take the
-        neighbouring cell's label. Only for isotropic Hamiltonians (``"godunov"``, ``"lxf"``,
-        ``Isotropic()``): under a moving medium or a metric the smallest neighbour is not the one
-        the front came from, and a ``ValueError`` says so (with one source the labels are 0
-        wherever a front arrives, for any Hamiltonian).
+        For speed 1 the labels partition the surface into the geodesic Voronoi cells of the sources.
+        They are recovered from the solved values (each node takes the label of its smallest,
+        earlier-reached neighbour) and are first-order accurate like the values: nodes within about a
+        grid spacing of a cell boundary may take the neighbouring cell's label.
+
+        Parameters
+        ----------
+        points : array_like, optional
+            ``(M, d)`` points, e.g. the vertices of a mesh of the surface. Default: one label per band
+            node, aligned with :attr:`values`.
+
+        Returns
+        -------
+        numpy.ndarray
+            Labels (int); -1 where no front arrives (another component of the surface) or, for points,
+            where no band node lies within ``outer + 1`` grid spacings.
+
+        Raises
+        ------
+        ValueError
+            For a solution with several sources under an anisotropic Hamiltonian (a moving medium or
+            a metric), where the smallest neighbour is not the one the front came from: solve each
+            source on one :class:`Tube` and take the argmin of the values instead.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [(0.5, 0, 0), (-0.5, 0, 0)])
+        >>> sol.nearest_source([(0.4, 0.3, 0.0), (-0.4, 0.0, 0.3)]).tolist()
+        [0, 1]
         """
         if not self._isotropic and len(self.sources) > 1:
             raise ValueError(
@@ -278,16 +387,47 @@ class Solution:
         return np.where(pos >= 0, labels[np.maximum(pos, 0)], -1)
 
     def geodesic_path(self, start: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> np.ndarray:
-        """The shortest path on the surface from ``start`` (a point on it) to the source whose front
-        reaches it first, as a polyline (P, d) from the start to that source (where two sources lie
-        within a few grid spacings of each other, the one the path comes within two spacings of
-        first).
+        """The shortest path on the surface from ``start`` to the source whose front reaches it first.
 
         Traced backwards along the characteristics: steps of ``step`` grid spacings against the
         gradient of the solution, each projected back onto the surface (see
-        :mod:`tubesweep.geodesic_paths`). For speed F(x) it is the path of least travel time.
-        Only for isotropic Hamiltonians (``"godunov"``, ``"lxf"``, ``Isotropic()``): under a
-        moving medium or a metric the fastest path does not run against ∇u.
+        :mod:`tubesweep.geodesic_paths`). For speed F(x) it is the path of least travel time. Where
+        two sources lie within a few grid spacings of each other, the path ends at the one it comes
+        within two spacings of first.
+
+        Parameters
+        ----------
+        start : array_like
+            ``(d,)`` a point on the surface (within the inner tube).
+        step : float
+            Step length in grid spacings (default 0.5, at least 0.01).
+        max_steps : int, optional
+            The most steps to take (default: enough for a path four times the largest value).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(P, d)`` the polyline from the start to the source.
+
+        Raises
+        ------
+        ValueError
+            For a start off the surface, outside the band or on a part no source reaches; for an
+            anisotropic Hamiltonian (under a moving medium or a metric the fastest path does not run
+            against ∇u).
+
+        Warns
+        -----
+        RuntimeWarning
+            If the path stopped before reaching a source (a cut locus, a region the scheme resolves
+            poorly, or a gap narrower than the tubes nearby).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [(-0.5, 0, 0)])
+        >>> path = sol.geodesic_path((0.0, 0.5, 0.0))  # a quarter of a great circle, length ≈ π/4
         """
         p = as_points(start, self.grid.ndim, "start")
         if len(p) != 1:
@@ -298,13 +438,64 @@ class Solution:
         return self.geodesic_paths(p, step=step, max_steps=max_steps)[0]
 
     def geodesic_paths(self, starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
-        """:meth:`geodesic_path` from each of the points ``starts`` (M, d), traced together."""
+        """:meth:`geodesic_path` from each of several starts, traced together.
+
+        Parameters
+        ----------
+        starts : array_like
+            ``(M, d)`` points on the surface.
+        step : float
+            Step length in grid spacings (default 0.5).
+        max_steps : int, optional
+            The most steps per path.
+
+        Returns
+        -------
+        list of numpy.ndarray
+            One ``(P_i, d)`` polyline per start.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`geodesic_path`, naming the first bad start.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [(-0.5, 0, 0)])
+        >>> paths = sol.geodesic_paths([(0.0, 0.5, 0.0), (0.0, 0.0, 0.5)])
+        """
         from .geodesic_paths import trace_paths
 
         return trace_paths(self, starts, step=step, max_steps=max_steps)
 
     def to_dense(self, fill: float = np.nan) -> np.ndarray:
-        """The solution as an array of ``grid.shape``, ``fill`` outside the band (allocates the box)."""
+        """The solution as an array of the grid's shape (allocates the whole box).
+
+        Parameters
+        ----------
+        fill : float
+            The value off the band (default NaN).
+
+        Returns
+        -------
+        numpy.ndarray
+            Array of ``grid.shape``.
+
+        Raises
+        ------
+        TypeError
+            If ``fill`` is not a real number.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> c = ts.surfaces.Circle(0.5)
+        >>> sol = ts.solve(c, ts.Grid((-1, -1), (1, 1), (101, 101)), [c.default_source])
+        >>> sol.to_dense().shape
+        (101, 101)
+        """
         value = real_scalar(fill, "fill", "a real number (the value outside the band, NaN by default)")
         out = np.full(self.grid.size, value, dtype=float)
         out[self.linear] = self.values
@@ -419,12 +610,14 @@ def solve(
     ----------
     surface : LevelSet, ClosestPoint, library surface, φ array of ``grid.shape`` or callable φ
     grid : Grid
+        The uniform grid; the surface must lie inside it, a few grid spacings from its sides.
     sources : array-like (K, d)
         Points on the surface (within the inner tube).
     hamiltonian : {"godunov", "lxf"} or a ``ts.hamiltonians`` object
         A :class:`tubesweep.hamiltonians.Hamiltonian` (``Isotropic()``, ``MovingMedium(v)``,
         ``Metric(M)``) solves ``H(x, ∇u) = 0`` with the general Lax–Friedrichs update of Sect. 5.1.
     speed : float, ndarray of ``grid.shape``, or callable ``F(points) -> (M,)``
+        The speed F > 0 (1: geodesic distance).
     flow : callable ``v(points (M, d)) -> (M, d)`` or array of ``grid.shape + (d,)``, optional
         Ambient flow of a moving medium: solves ``|∇u| = |1 − v·∇u| / F`` (Sect. 6.3) with the
         Lax–Friedrichs update of Sect. 5.1 (shorthand for ``hamiltonian=ts.hamiltonians.MovingMedium(flow)``).
@@ -434,6 +627,7 @@ def solve(
     inner, outer : float
         Tube half-widths in grid spacings (paper: 2 and 4; 5 for the bunny).
     method : {"two-layer", "naive"}
+        Algorithm 3 (default) or Algorithm 2, the baseline that does not converge.
     source_init : {"exact", "node"}
         ``"node"`` is the paper's choice (u = 0 at the grid node nearest each source);
         ``"exact"`` fixes the inner nodes whose closest point is within ``SOURCE_RADIUS``·Δx of a
@@ -441,8 +635,11 @@ def solve(
         Lax–Friedrichs, and first order with Godunov on the sphere where ``"node"`` stagnates;
         ``"node"`` is about 25% more accurate with Godunov on a circle and on coarse spheres
         (``tubesweep reproduce source-init``, ``docs/source-initialisation.md``).
-    tol, max_iterations : stopping rule (largest change in one iteration of 2^d sweeps).
-    progress : callable ``(iteration, max_change, updates)``, optional.
+    tol, max_iterations : float, int
+        Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
+        ``max_iterations`` (then ``stats.converged`` is False, with a warning).
+    progress : callable, optional
+        Called after every iteration as ``progress(iteration, max_change, updates)``.
     threads : int
         Worker threads for the sweeps (0: all cores, 1: sequential); the result does not depend
         on it (parallel sweeps are bit-identical to sequential ones).
@@ -468,6 +665,33 @@ def solve(
     Returns
     -------
     Solution
+        The values on the band nodes, with :attr:`Solution.stats`; call it to interpolate.
+
+    Raises
+    ------
+    ValueError
+        For input that cannot give a right answer, with the argument named and the fix: a source
+        off the surface, a grid too coarse for the surface, φ far from a distance function (use
+        ``ts.LevelSet(phi, redistance=True)``), a supersonic flow, bad widths or tolerances, a
+        band larger than the memory available.
+    TypeError
+        For arguments of the wrong type (a surface that is neither φ, a callable nor a Surface).
+
+    Warns
+    -----
+    RuntimeWarning
+        Where the surface faces itself across gaps narrower than the tubes (the front may cross
+        there; :meth:`Solution.narrow_gaps`), where the extension layer had to be widened, or when
+        the sweeps have not converged within ``max_iterations``.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> grid = ts.Grid(lower=(-1, -1, -1), upper=(1, 1, 1), shape=(101, 101, 101))
+    >>> sphere = lambda p: np.linalg.norm(p, axis=1) - 0.5
+    >>> sol = ts.solve(sphere, grid, sources=[(-0.5, 0, 0)])
+    >>> sol([(0, 0.5, 0)])  # exact π/4 = 0.785  # doctest: +ELLIPSIS
+    array([0.77...])
     """
     t0 = time.perf_counter()
     grid = as_grid(grid)
@@ -646,19 +870,29 @@ def _warn_if_tubes_touch(
     if node.size == 0:
         return node, neighbour, gap
     narrowest = int(np.argmin(gap))
-    where = tuple(round(float(v), 6) for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
+    where = ", ".join(f"{float(v):.4g}" for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
     needed = float(gap[narrowest]) / (2 * inner + 2)
+    # how much of the surface: the inner-tube nodes of the pairs among all inner-tube nodes
+    inner_nodes = roles == ROLE_INNER
+    touched = np.unique(np.concatenate([node, neighbour]))
+    share = np.count_nonzero(inner_nodes[touched]) / max(int(np.count_nonzero(inner_nodes)), 1)
     warnings.warn(
-        f"the surface faces itself across gaps narrower than its tubes at {node.size} pair(s) of neighbouring band "
-        f"nodes (the narrowest found, {float(gap[narrowest]):.4g} wide, near {where}): there the inner tube of one side "
-        "touches the band of the other, and where the other side is reached first the front crosses the gap, so "
-        "travel times beyond it can come out too short (stats.facing_pairs; docs/surfaces.md). Refine the grid to a "
-        f"spacing below about {needed:.4g} (now {h:.4g}), gap / (2·inner + 2); a gap that narrows as the grid is "
-        "refined is a sharp concave edge or parts of the surface that touch",
+        f"the surface faces itself across gaps narrower than its tubes at {node.size} node pair(s), about "
+        f"{_percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near ({where})). Distances "
+        "reached across such a gap can come out too short; elsewhere the result holds. sol.narrow_gaps() shows where; "
+        f"a grid spacing below {needed:.3g} (now {h:.3g}) resolves a real gap, while a crease or scan artefact stays "
+        "narrower than any grid",
         RuntimeWarning,
-        stacklevel=4,
+        stacklevel=user_stacklevel(),
     )
     return node, neighbour, gap
+
+
+def _percent(share: float) -> str:
+    """A share as a short percentage: '0.1%', '12%', or '< 0.01%'."""
+    if share < 1e-4:
+        return "< 0.01%"
+    return f"{100 * share:.2g}%" if share < 0.1 else f"{100 * share:.0f}%"
 
 
 def _check_surface_spans_two_cells(
@@ -726,7 +960,9 @@ def _prepare_tube(
     given_bound = getattr(surf, "lipschitz", None) if redistanced else None
     previously_lacking: Optional[np.ndarray] = None
     for attempt in range(_MAX_WIDENINGS + 1):
-        with warnings.catch_warnings():
+        # (catch_warnings only where needed: entering and leaving it resets Python's record of the
+        # warnings already shown, and a solve repeated in a loop would then repeat its warnings)
+        with warnings.catch_warnings() if attempt > 0 else contextlib.nullcontext():
             if attempt > 0:  # a warning about the band's nodes was given at the first attempt
                 warnings.filterwarnings("ignore", message=".*could not be projected onto it", category=RuntimeWarning)
             geom = surf.band(grid, outer_eff * h)
@@ -805,7 +1041,7 @@ def _prepare_tube(
             f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
             f"close to a distance function there. Widening the extension layer to outer = {outer_eff + 1}",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
         outer_eff += 1.0
     facing = _warn_if_tubes_touch(

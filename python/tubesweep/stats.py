@@ -59,6 +59,14 @@ class SolveStats:
         an iteration whose visited rows held more data than a quarter of the last-level cache
         (before the first, every row counts as visited, or none with the front window;
         docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> st = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source]).stats
+    >>> st.converged, st.band_points > 0
+    (True, True)
     """
 
     iterations: int
@@ -85,6 +93,21 @@ class SolveStats:
         return self.updates / self.seconds if self.seconds > 0 else float("nan")
 
     def as_dict(self) -> Dict[str, Any]:
+        """The statistics as a plain dict (for JSON or a table), with ``updates_per_second`` added.
+
+        Returns
+        -------
+        dict
+            Field name → value.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> d = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source]).stats.as_dict()
+        >>> sorted(d)[:3]
+        ['band_bytes', 'band_points', 'converged']
+        """
         d = asdict(self)
         d["updates_per_second"] = self.updates_per_second
         return d

@@ -22,6 +22,7 @@ import numpy as np
 
 from .grid import Grid
 from ._validate import real_array, real_scalar
+from ._warn import user_stacklevel
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
 
@@ -133,20 +134,108 @@ class BandGeometry:
 
 
 class Surface:
-    """Base class for implicit surfaces. Subclasses implement :meth:`band` and
-    :meth:`project`."""
+    """Base class of implicit curves and surfaces: what :func:`tubesweep.solve` needs of one.
+
+    A surface gives its band on a grid (:meth:`band`: the nodes within a distance, with φ and the
+    extension directions) and projects points onto itself (:meth:`project`). :class:`LevelSet`,
+    :class:`ClosestPoint` and the meshes of :func:`tubesweep.surfaces.from_mesh` are surfaces;
+    subclass one of them rather than this class.
+
+    Attributes
+    ----------
+    ndim : int or None
+        2 (a curve) or 3 (a surface); None until known.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> isinstance(ts.surfaces.Sphere(0.5), ts.Surface)
+    True
+    """
 
     #: dimension of the embedding space, or None if it follows the grid
     ndim: Optional[int] = None
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:  # pragma: no cover - interface
+        """The band of the surface on a grid: the nodes within ``half_width`` of it.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance, not grid spacings).
+
+        Returns
+        -------
+        BandGeometry
+            The band's nodes (C-order linear indices), φ there and the outward extension directions
+            ``n`` of Eq. (8); the solver's input.
+
+        Raises
+        ------
+        ValueError
+            If the surface is of the wrong dimension for the grid, or (level sets) φ is far from a
+            distance function near the surface.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+        >>> geometry = ts.surfaces.Circle(0.5).band(grid, 4 * grid.spacing)
+        """
         raise NotImplementedError
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:  # pragma: no cover
-        """Unsigned distance (M,) of points to the surface and their closest points (M, d)."""
+        """Closest points on the surface, and the distance to them.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points near the surface.
+        grid : Grid
+            The grid (a sampled φ is interpolated on it).
+
+        Returns
+        -------
+        distance : numpy.ndarray
+            ``(M,)`` unsigned distances.
+        closest : numpy.ndarray
+            ``(M, d)`` the closest points.
+
+        Raises
+        ------
+        ValueError
+            If the points have the wrong shape or the surface's function returns non-finite values.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+        >>> d, cp = ts.surfaces.Circle(0.5).project(np.array([[0.6, 0.0]]), grid)
+        >>> np.round(cp, 6).tolist()
+        [[0.5, 0.0]]
+        """
         raise NotImplementedError
 
     def check_grid(self, grid: Grid) -> None:
+        """Checks that the grid suits the surface (its dimension; for a φ array, its shape).
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid to solve on.
+
+        Raises
+        ------
+        ValueError
+            If the dimensions or shapes differ; the message says which.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> ts.LevelSet(np.zeros((5, 5))).check_grid(ts.Grid((-1, -1), (1, 1), (5, 5)))
+        """
         if self.ndim is not None and self.ndim != grid.ndim:
             raise ValueError(f"surface is {self.ndim}D but the grid is {grid.ndim}D")
 
@@ -309,9 +398,27 @@ class LevelSet(Surface):
         widths are then true distances and the extension direction is ``(x − cp(x))/|x − cp(x)|``.
         Costs a few dozen φ evaluations per band node.
 
+    Raises
+    ------
+    ValueError
+        If a φ array is not 2D or 3D or holds NaN or inf, or ``lipschitz`` is not a valid bound.
+    TypeError
+        If φ is neither an array nor a callable.
+
+    Notes
+    -----
     The outward normal ``n = ∇φ / |∇φ|`` comes from central differences of φ at the band nodes, as
     in the paper (Sect. 4). The method needs φ close to a signed distance function (``|∇φ| ≈ 1``
     near the surface); far from it the solver raises an error that says so.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> grid = ts.Grid((-1, -1), (1, 1), (101, 101))
+    >>> X, Y = grid.meshgrid()
+    >>> circle = ts.LevelSet(np.hypot(X, Y) - 0.5)                   # a signed distance, sampled
+    >>> squashed = ts.LevelSet(X**2 + Y**2 - 0.25, redistance=True)   # not a distance: re-distanced
+    >>> sol = ts.solve(squashed, grid, [(0.5, 0.0)])
     """
 
     def __init__(
@@ -359,6 +466,23 @@ class LevelSet(Surface):
         return self._array is not None
 
     def check_grid(self, grid: Grid) -> None:
+        """Checks that the grid suits the surface (its dimension; for a φ array, its shape).
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid to solve on.
+
+        Raises
+        ------
+        ValueError
+            If the dimensions or shapes differ; the message says which.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> ts.LevelSet(np.zeros((5, 5))).check_grid(ts.Grid((-1, -1), (1, 1), (5, 5)))
+        """
         super().check_grid(grid)
         if self._array is not None and self._array.shape != grid.shape:
             raise ValueError(
@@ -366,7 +490,32 @@ class LevelSet(Surface):
             )
 
     def phi(self, points: np.ndarray, grid: Grid) -> np.ndarray:
-        """φ at arbitrary points (multilinear interpolation for a sampled φ)."""
+        """φ at arbitrary points: the callable, or the multilinear interpolation of the samples.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points.
+        grid : Grid
+            The grid a sampled φ lives on.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` values of φ.
+
+        Raises
+        ------
+        ValueError
+            If the callable returns values of the wrong shape or non-finite values.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> ls = ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5)
+        >>> ls.phi(np.array([[1.0, 0.0]]), ts.Grid((-1, -1), (1, 1), (5, 5))).tolist()
+        [0.5]
+        """
         if self._fn is not None:
             return _evaluate(self._fn, points, "phi callable")
         from .euclidean import _interp_dense
@@ -408,6 +557,33 @@ class LevelSet(Surface):
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
+        """The band of the surface on a grid: the nodes within ``half_width`` of it.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance, not grid spacings).
+
+        Returns
+        -------
+        BandGeometry
+            The band's nodes (C-order linear indices), φ there and the outward extension directions
+            ``n`` of Eq. (8); the solver's input.
+
+        Raises
+        ------
+        ValueError
+            If the surface is of the wrong dimension for the grid, or (level sets) φ is far from a
+            distance function near the surface.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+        >>> geometry = ts.surfaces.Circle(0.5).band(grid, 4 * grid.spacing)
+        """
         self.check_grid(grid)
         if self.redistance:
             from .redistance import redistanced_band
@@ -475,6 +651,13 @@ class LevelSet(Surface):
         del norms
         return BandGeometry(linear, None, values, direction, consumable=True, native_band=native_band, kink=kink)
 
+    def __repr__(self) -> str:
+        if self._array is not None:
+            what = "array " + "×".join(map(str, self._array.shape))
+        else:
+            what = "callable " + getattr(self._fn, "__name__", type(self._fn).__name__)
+        return f"LevelSet({what}{', redistance=True' if self.redistance else ''})"
+
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
         """For a library surface whose φ is evaluated in Rust (and not replaced by a subclass):
         its kind and parameters for ``tubesweep._native.analytic_level_set_band``; else None."""
@@ -482,10 +665,19 @@ class LevelSet(Surface):
 
     def _check_distance_like(self, lo: float, hi: float) -> None:
         """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface."""
+        if (lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH) and self._native_phi() is not None:
+            # a library surface's φ is an exact distance: only the grid can be at fault
+            raise ValueError(
+                f"the grid is too coarse for this surface: its tube (outer × grid spacing on each side) reaches a point "
+                f"where φ's gradient vanishes (|∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the surface, ≈ 1 expected), "
+                "such as the centre of a sphere not much larger than the tube or the core of a thin torus: refine the "
+                "grid, or make the surface larger than a few grid spacings"
+            )
         if lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH:
             raise ValueError(
                 f"surface: φ is not close to a signed distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the "
-                "surface (it should be ≈ 1). Use ts.LevelSet(phi, redistance=True), which re-distances φ in the band, "
+                "surface (it should be ≈ 1). Use ts.LevelSet(phi, redistance=True) (on the command line: --redistance), which "
+                "re-distances φ in the band, "
                 "or pass a signed distance function; the tube widths are measured in units of φ. If φ is a distance "
                 "function, the grid is too coarse for the surface: the tube (outer × grid spacing on each side) "
                 "reaches a point where ∇φ vanishes, such as the centre of a sphere not much larger than the tube, "
@@ -497,10 +689,39 @@ class LevelSet(Surface):
                 f"φ is only roughly a distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the surface; "
                 "the tube is measured in units of φ, so its real width varies accordingly",
                 RuntimeWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        """Closest points on the surface, and the distance to them.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points near the surface.
+        grid : Grid
+            The grid (a sampled φ is interpolated on it).
+
+        Returns
+        -------
+        distance : numpy.ndarray
+            ``(M,)`` unsigned distances.
+        closest : numpy.ndarray
+            ``(M, d)`` the closest points.
+
+        Raises
+        ------
+        ValueError
+            If the points have the wrong shape or the surface's function returns non-finite values.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+        >>> d, cp = ts.surfaces.Circle(0.5).project(np.array([[0.6, 0.0]]), grid)
+        >>> np.round(cp, 6).tolist()
+        [[0.5, 0.0]]
+        """
         if self.redistance:
             from .redistance import redistanced_project
 

@@ -36,24 +36,50 @@ __all__ = ["Tube"]
 
 
 class Tube:
-    """The band of ``surface`` on ``grid`` for repeated solves: :func:`tubesweep.solve` without
-    rebuilding the band each time.
+    """The band of a surface on a grid, built once for many solves.
+
+    :func:`tubesweep.solve` without rebuilding the band each time: other sources, speeds or
+    Hamiltonians on the same surface and grid (a distance matrix, a sweep over source positions,
+    an inverse problem). Each :meth:`solve` gives the values of ``ts.solve`` bit for bit.
 
     Parameters
     ----------
     surface : LevelSet, ClosestPoint, library surface, φ array of ``grid.shape`` or callable φ
+        The curve or surface.
     grid : Grid
+        The uniform grid.
     inner, outer : float
-        Tube half-widths in grid spacings (paper: 2 and 4; 5 for the bunny). The extension layer
-        is widened, with a warning, where inner nodes lack a neighbour in it, as in ``ts.solve``.
+        Tube half-widths in grid spacings (paper: 2 and 4). The extension layer is widened, with a
+        warning, where inner nodes lack a neighbour in it, as in ``ts.solve``.
     method : {"two-layer", "naive"}
+        Algorithm 3 (default) or Algorithm 2.
 
     Attributes
     ----------
-    grid, surface, method, inner
-    outer : float — the extension layer's half-width in grid spacings after any widening
+    grid : Grid
+    surface : Surface
+    method : str
+    inner : float
+    outer : float
+        The extension layer's half-width in grid spacings after any widening.
     band_points : int
-    setup_seconds : float — the time the band took to build
+        Nodes in the band.
+    setup_seconds : float
+        The time the band took to build.
+
+    Raises
+    ------
+    ValueError
+        As :func:`tubesweep.solve` for the surface and the grid (a grid too coarse for the surface,
+        φ far from a distance function, bad widths, a band larger than the memory available).
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> tube = ts.Tube(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)))
+    >>> a = tube.solve([(0.5, 0, 0)])
+    >>> b = tube.solve([(0, 0.5, 0)], speed=2.0)
     """
 
     def __init__(self, surface: Any, grid: Any, *, inner: float = 2.0, outer: float = 4.0, method: str = "two-layer"):
@@ -134,9 +160,37 @@ class Tube:
         threads: int = 0,
         paper_sweeps: bool = False,
     ) -> Solution:
-        """First-arrival times from ``sources`` on this band: the arguments and the result of
-        :func:`tubesweep.solve` (which see), without building the band again.
-        ``sol.stats.setup_seconds`` is then the time spent on the sources and the speed."""
+        """First-arrival times from ``sources`` on this band, without building the band again.
+
+        The arguments and the result are those of :func:`tubesweep.solve`;
+        ``sol.stats.setup_seconds`` is the time spent on the sources and the speed.
+
+        Parameters
+        ----------
+        sources : array_like
+            ``(K, d)`` points on the surface.
+        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps
+            As for :func:`tubesweep.solve`.
+
+        Returns
+        -------
+        Solution
+            The same values, bit for bit, as ``ts.solve`` with the same arguments.
+
+        Raises
+        ------
+        ValueError
+            As :func:`tubesweep.solve`; also if a φ array the tube was built from has been changed
+            since (build a new Tube).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> tube = ts.Tube(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)))
+        >>> [round(float(tube.solve([p])([(0, 0, 0.5)])[0]), 2) for p in [(0.5, 0, 0), (0, 0.5, 0)]]  # doctest: +SKIP
+        [0.77, 0.77]
+        """
         t0 = time.perf_counter()
         self._check_phi_unchanged()
         src = as_sources(sources, self.grid)

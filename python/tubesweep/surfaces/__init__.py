@@ -35,6 +35,7 @@ from .closed import DoubleTorus, Ellipsoid, RoundedCube, Torus
 from .curves import Ellipse
 from .mesh import MeshSurface, from_mesh
 from .open import Disc, Hemisphere, MobiusBand, PlanePatch
+from ._repr import give_repr
 
 REGISTRY: Dict[str, Callable[[], Surface]] = {
     "circle": Circle,
@@ -50,6 +51,10 @@ REGISTRY: Dict[str, Callable[[], Surface]] = {
     "plane": PlanePatch,
     "mobius": MobiusBand,
 }
+
+give_repr(
+    Circle, Star, Ellipse, Sphere, Ellipsoid, Torus, RoundedCube, DoubleTorus, Hemisphere, Disc, PlanePatch, MobiusBand
+)
 
 __all__ = [
     "Circle",

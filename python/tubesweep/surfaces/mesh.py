@@ -45,7 +45,37 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
     """Vertices (n, 3) float64 and triangles (m, 3) int64 of an OBJ / PLY / STL / OFF file.
 
     Uses trimesh when installed (without merging or re-ordering vertices, so vertex indices are
-    those of the file), otherwise meshio; polygons are fan-triangulated.
+    those of the file), otherwise meshio; polygons are fan-triangulated. ``.obj.gz`` files (the
+    bundled examples) are read with numpy alone.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    vertices : numpy.ndarray
+        ``(n, 3)`` float64.
+    faces : numpy.ndarray
+        ``(m, 3)`` int64.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    IsADirectoryError
+        If the path is a directory.
+    ValueError
+        If the file holds no triangles or cannot be read as a mesh.
+    ImportError
+        If neither trimesh nor meshio is installed.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> from tubesweep.surfaces.mesh import read_mesh
+    >>> v, f = read_mesh(ts.data.spot())
     """
     path = Path(path)
     if path.is_dir():
@@ -178,10 +208,43 @@ def _unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
 class MeshSurface(Surface):
     """A triangle mesh in the closest-point representation (paper Sect. 5.2).
 
-    Build it with :func:`from_mesh`. Attributes: ``vertices`` (n, 3), ``faces`` (m, 3),
-    ``closed`` (every edge shared by exactly two faces, consistently oriented), ``signed``
-    (whether :meth:`band` reports a signed φ), ``scale`` and ``offset`` of the optional
-    normalisation (``x_normalised = (x_file − offset) · scale``).
+    Build it with :func:`from_mesh`. Closest points are exact and come from an AABB tree in the
+    Rust core, computed only at the band's nodes.
+
+    Parameters
+    ----------
+    vertices : numpy.ndarray
+        ``(n, 3)`` vertex coordinates.
+    faces : numpy.ndarray
+        ``(m, 3)`` vertex indices of the triangles.
+    signed : bool, optional
+        Report a signed φ (needs a closed, consistently oriented mesh); default: when closed.
+    name : str
+        A name for printing.
+    scale, offset
+        The normalisation applied by :func:`from_mesh` (``x_normalised = (x_file − offset) · scale``).
+
+    Attributes
+    ----------
+    vertices, faces : numpy.ndarray
+        The mesh.
+    closed : bool
+        Every edge shared by exactly two faces, consistently oriented.
+    signed : bool
+        Whether :meth:`band` reports a signed φ.
+
+    Raises
+    ------
+    ValueError
+        If faces index missing vertices, vertices are not finite, or ``signed=True`` is asked of an
+        open mesh.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+    >>> spot.closed, len(spot.vertices)
+    (True, 2930)
     """
 
     ndim = 3
@@ -315,10 +378,29 @@ class MeshSurface(Surface):
     ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Exact closest points on the mesh.
 
-        Returns the unsigned distance (M,), the closest points (M, 3), the face index (M,) and the
-        feature code (M,) (see :func:`closest_points_on_triangles`). With a finite
-        ``max_distance`` the search stops there: points farther away get distance ``inf``, closest
-        point NaN and face −1.
+        Parameters
+        ----------
+        points : array_like
+            ``(M, 3)`` points.
+        max_distance : float
+            Search no farther: points farther away get distance ``inf``, closest point NaN, face -1.
+
+        Returns
+        -------
+        distance : numpy.ndarray
+            ``(M,)`` unsigned distances.
+        closest : numpy.ndarray
+            ``(M, 3)`` closest points.
+        face : numpy.ndarray
+            ``(M,)`` the face each closest point lies on.
+        feature : numpy.ndarray
+            ``(M,)`` which feature of that face (see :func:`closest_points_on_triangles`).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> d, cp, face, feature = spot.closest([[0.0, 0.0, 0.0]])
         """
         x = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 3))
         d, cp, t, code = self.tree.closest(x, float(max_distance))
@@ -326,8 +408,31 @@ class MeshSurface(Surface):
         return d, cp, face, code
 
     def signed_distance(self, points: Any) -> np.ndarray:
-        """Signed distance (negative inside) for a closed mesh, from the angle-weighted pseudo-normal
-        of the closest feature."""
+        """Signed distance to a closed mesh (negative inside), from the angle-weighted pseudo-normal of
+        the closest feature (Bærentzen & Aanæs 2005).
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances.
+
+        Raises
+        ------
+        ValueError
+            For an open mesh (no inside), or one built with ``signed=False``.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> float(spot.signed_distance([spot.vertices.mean(axis=0)])[0]) < 0
+        True
+        """
         if not self.signed:
             raise ValueError("signed_distance needs a closed mesh built with signed=True (or left to auto-detect)")
         x = np.ascontiguousarray(points, dtype=float).reshape(-1, 3)
@@ -337,14 +442,32 @@ class MeshSurface(Surface):
 
     # ------------------------------------------------------------------ Surface interface
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
-        """Band nodes with ``|x − cp(x)| ≤ half_width``, found coarse-to-fine.
+        """The band nodes within ``half_width`` of the mesh, found coarse-to-fine, with their extension
+        directions ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2; the face normal at nodes on the mesh).
 
-        Blocks of 2^L³ nodes are kept while the distance at their centre is within ``half_width`` +
-        the block's radius (the distance is 1-Lipschitz), then split (:meth:`band_candidates`);
-        each query searches the AABB tree only up to that radius and stops at the first triangle
-        within it, so blocks far from the mesh cost a few box tests. The extension
-        direction is ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2); at nodes on the surface, where it is
-        undefined, the face normal.
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance).
+
+        Returns
+        -------
+        BandGeometry
+            The band's nodes, φ (signed for a closed mesh) and directions.
+
+        Raises
+        ------
+        ValueError
+            If the grid is not 3D.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> grid = spot.grid(40)
+        >>> geometry = spot.band(grid, 4 * grid.spacing)
         """
         self.check_grid(grid)
         h = grid.spacing
@@ -359,10 +482,28 @@ class MeshSurface(Surface):
         return BandGeometry(lin[kept].astype(np.int64), dist, signed, direction, consumable=True)
 
     def band_candidates(self, grid: Grid, half_width: float) -> np.ndarray:
-        """The nodes the coarse-to-fine search keeps (sorted linear indices), a superset of the
-        band's: a block is kept while some triangle lies within ``half_width`` + its radius of
-        its centre, which the AABB tree answers without finding the closest triangle (it stops
-        at the first one within reach)."""
+        """The candidate nodes of the band: the nodes of the blocks that may hold band nodes, found
+        coarse-to-fine with the AABB tree.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance).
+
+        Returns
+        -------
+        numpy.ndarray
+            C-order linear indices of the candidates, sorted.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> grid = spot.grid(40)
+        >>> candidates = spot.band_candidates(grid, 4 * grid.spacing)
+        """
         tree = self.tree
         return coarse_to_fine_candidates(
             grid,
@@ -375,6 +516,28 @@ class MeshSurface(Surface):
         )
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        """Closest points on the mesh and the distances to them.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points.
+        grid : Grid
+            Unused (the mesh needs no grid); for the :class:`~tubesweep.Surface` interface.
+
+        Returns
+        -------
+        distance : numpy.ndarray
+            ``(M,)`` unsigned distances.
+        closest : numpy.ndarray
+            ``(M, 3)`` closest points.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> d, cp = spot.project(spot.vertices[:2] + 0.01, spot.grid(40))
+        """
         d, cp, _, _ = self.closest(points)
         return d, cp
 
@@ -405,16 +568,35 @@ class MeshSurface(Surface):
         return tuple(float(x) for x in g.lower), tuple(float(x) for x in g.upper)
 
     def grid(self, n: int = 200, padding: float = 8.0) -> Grid:
-        """A grid with ``n`` nodes along the longest side of the mesh's bounding box (padding
-        included) and the same spacing in every axis.
+        """A grid around the mesh, with the same spacing in every axis.
 
         Parameters
         ----------
         n : int
-            Nodes along the longest axis, at least ``2·padding + 3``.
+            Nodes along the longest side of the mesh's bounding box, padding included (at least
+            ``2·padding + 3``).
         padding : float
-            Empty grid spacings between the bounding box and the grid's faces on every side; it must
-            hold the outer tube (``outer`` = 4 by default, 5 for the paper's bunny) plus one node.
+            Empty grid spacings between the bounding box and the grid's faces on every side; it must hold
+            the outer tube (``outer`` = 4 by default) plus one node.
+
+        Returns
+        -------
+        Grid
+            ``n`` nodes along the longest axis, fewer along the others.
+
+        Raises
+        ------
+        ValueError
+            If ``n`` cannot hold the padding or the padding is negative or not finite.
+        TypeError
+            If ``n`` is not a whole number.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> spot.grid(100).shape[2]
+        100
         """
         if (
             isinstance(n, (bool, np.bool_))
@@ -443,11 +625,45 @@ class MeshSurface(Surface):
         return Grid(lower, lower + h * (counts - 1), counts)
 
     def triangulation(self) -> Tuple[np.ndarray, np.ndarray]:
-        """The input mesh, ``(vertices, faces)``."""
+        """The input mesh, for pictures and export.
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(n, 3)``.
+        faces : numpy.ndarray
+            ``(m, 3)``.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> v, f = spot.triangulation()
+        """
         return self.vertices, self.faces
 
     def sample(self, n: int = 1000, seed: int = 0) -> np.ndarray:
-        """``n`` points spread over the mesh, area-weighted."""
+        """Random points spread over the mesh, area-weighted.
+
+        Parameters
+        ----------
+        n : int
+            How many points.
+        seed : int
+            Seed of the random generator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n, 3)`` points on the mesh.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> spot.sample(5).shape
+        (5, 3)
+        """
         rng = np.random.default_rng(seed)
         f = self.faces[self._good]
         a, b, c = (self.vertices[f[:, k]] for k in range(3))
@@ -476,22 +692,44 @@ def from_mesh(
 
     Parameters
     ----------
-    mesh : path to an OBJ / PLY / STL / OFF file (or ``.obj.gz``, e.g. :func:`tubesweep.data.bunny`), or a
-        pair ``(vertices (n, 3), faces (m, 3))``
+    mesh : str, pathlib.Path or (vertices, faces)
+        An OBJ / PLY / STL / OFF file (or ``.obj.gz``, e.g. :func:`tubesweep.data.bunny`), or a
+        pair of arrays ``(vertices (n, 3), faces (m, 3))``.
     normalize : bool
         Move the centre of the bounding box to ``center`` and scale the longest side to ``size``.
         The applied map is kept as ``surface.offset`` / ``surface.scale``.
+    size : float
+        With ``normalize``: the length of the longest side (default 1).
+    center : sequence of float
+        With ``normalize``: where the centre of the bounding box goes (default the origin).
     signed : bool, optional
         Report a signed distance as φ (needs a closed, consistently oriented mesh). Default: signed
         exactly when the mesh is closed. The solver itself only needs the unsigned distance and the
         extension direction ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2), so open meshes with holes work.
 
+    Returns
+    -------
+    MeshSurface
+        The mesh as a closest-point surface for :func:`tubesweep.solve`.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    ValueError
+        If the file holds no triangles, faces index missing vertices, vertices are not finite,
+        ``signed=True`` is asked of an open mesh, or ``normalize`` meets a mesh of no extent.
+    ImportError
+        If reading the file needs trimesh or meshio and neither is installed
+        (``pip install 'tubesweep[mesh]'``).
+
     Examples
     --------
+    >>> import tubesweep as ts
     >>> bunny = ts.surfaces.from_mesh(ts.data.bunny())
-    >>> grid = bunny.grid(n=200)
-    >>> sol = ts.solve(bunny, grid, sources=[bunny.default_source], outer=5)
-    >>> u = sol.on_mesh(bunny.vertices)
+    >>> grid = bunny.grid(n=100)
+    >>> sol = ts.solve(bunny, grid, sources=[bunny.default_source])  # doctest: +SKIP
+    >>> u = sol.on_mesh(bunny.vertices)  # doctest: +SKIP
     """
     if isinstance(mesh, (str, Path)):
         v, f = read_mesh(mesh)
