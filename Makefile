@@ -68,7 +68,8 @@ test-rust:
 	# the kernel-stats counters' test, on its own (its totals are process-wide)
 	cargo test --release -p tubesweep-core --features kernel-stats kernel_stats::
 
-test-python: build $(TEST_DEPS_DONE)
+# the tests build the documentation site in strict mode too (tests/test_docs.py), so they need mkdocs
+test-python: build $(TEST_DEPS_DONE) $(DOCS_DEPS_DONE)
 	$(PY) -m pytest -q
 
 docs: build $(DOCS_DEPS_DONE)

@@ -290,10 +290,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
 
         from . import data
 
-        mesh_file = args.mesh
-        if not mesh_file.exists() and str(mesh_file).lower() in data.NAMES:
-            mesh_file = data.path(str(mesh_file))  # a bundled example mesh
-        surface = from_mesh(mesh_file, normalize=args.normalize)
+        surface = from_mesh(data.mesh_file(args.mesh), normalize=args.normalize)  # a file, or bunny / spot
         n = 200 if args.n is None else args.n
         if args.lower is not None or args.upper is not None:
             raise UsageError("--mesh picks its grid from --n and --padding; do not give --lower/--upper")

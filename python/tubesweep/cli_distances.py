@@ -13,8 +13,8 @@ import numpy as np
 
 EXAMPLES = """examples:
   tubesweep distances --surface sphere --n 101 --sample 200 --out D.npy
-  tubesweep distances --mesh bunny.obj --n 161 --points pts.npy --out D.npy
-  tubesweep distances --mesh bunny.obj --sample 1000 --out D.npy --scheduler tcp://10.0.0.5:8786
+  tubesweep distances --mesh bunny --n 161 --points pts.npy --out D.npy
+  tubesweep distances --mesh bunny --sample 1000 --out D.npy --scheduler tcp://10.0.0.5:8786
   tubesweep distances --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --points pts.npy --out D.npy
 """
 
@@ -35,7 +35,9 @@ def add_distances_parser(sub: Any) -> None:
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=sorted(REGISTRY), help="a built-in surface")
-    src.add_argument("--mesh", type=Path, help="a triangle mesh (.obj .ply .stl .off)")
+    src.add_argument(
+        "--mesh", type=Path, help="a triangle mesh (.obj .ply .stl .off .obj.gz), or bunny / spot for the bundled ones"
+    )
     src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
     pts = p.add_mutually_exclusive_group(required=True)
     pts.add_argument("--points", type=Path, help="a .npy file with the points (M, d) on the surface")
@@ -61,7 +63,12 @@ def add_distances_parser(sub: Any) -> None:
     p.add_argument("--outer", type=float, default=4.0, help="outer tube half-width in grid spacings (default 4)")
     p.add_argument("--threads", type=int, default=0, help="solves at once on this machine (default 0: all cores)")
     p.add_argument("--chunk-size", type=int, default=None, help="--scheduler: sources per Dask task")
-    p.add_argument("--tol", type=float, default=1e-10)
+    p.add_argument(
+        "--tol",
+        type=float,
+        default=1e-10,
+        help="stop when no value changes by more than this in an iteration (default 1e-10)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -105,7 +112,9 @@ def _surface_and_grid(args: argparse.Namespace) -> Any:
 
         if args.lower is not None or args.upper is not None:
             raise ValueError("--mesh picks its grid from --n and --padding; do not give --lower/--upper")
-        surface = from_mesh(args.mesh, normalize=args.normalize)
+        from . import data
+
+        surface = from_mesh(data.mesh_file(args.mesh), normalize=args.normalize)  # a file, or bunny / spot
         return surface, surface.grid(200 if args.n is None else args.n, padding=args.padding)
     if args.surface:
         from .surfaces import REGISTRY

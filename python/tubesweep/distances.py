@@ -101,6 +101,20 @@ def distance_matrix(
     D : (M, M) float — symmetric bit for bit, zero diagonal; ``inf`` between points on parts of
         the surface that no path joins. Accurate to the solver's order (first order in the grid
         spacing with the default Godunov scheme: docs/many-sources.md).
+
+    Raises
+    ------
+    ValueError
+        For a point farther from the surface than the inner tube, or as :func:`tubesweep.solve`.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> points = 0.5 * np.eye(3)
+    >>> D = ts.distance_matrix(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), points)
+    >>> D.shape, bool(np.all(D == D.T))
+    ((3, 3), True)
     """
     t0 = time.perf_counter()
     tube = _as_tube(surface, grid, inner, outer)
@@ -159,6 +173,21 @@ def farthest_point_sampling(
     first point; by default the first point is the farthest from an arbitrary surface point (one
     extra solve), so the sampling does not depend on the surface's parametrisation.
 
+    Parameters
+    ----------
+    surface : any surface ``ts.solve`` takes, or a :class:`ts.Tube`
+        The surface (with a Tube, ``grid`` may be None).
+    grid : Grid
+        The grid.
+    k : int
+        How many points.
+    start : array_like, optional
+        The first point, on the surface.
+    inner, outer, tol, threads
+        As for :func:`tubesweep.solve`.
+    progress : callable, optional
+        Called as ``progress(done, k)``.
+
     Returns
     -------
     points : (k, d) — on the surface
@@ -167,6 +196,19 @@ def farthest_point_sampling(
         ``radii[i]`` bounds the distance of every surface point to the first ``i`` points (up to
         the discretisation error). A point on a part of the surface the others do not reach has
         radius ``inf``.
+
+    Raises
+    ------
+    ValueError
+        If ``k`` is not a positive whole number, or ``start`` lies off the surface.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> points, radii = ts.farthest_point_sampling(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), 4)
+    >>> points.shape
+    (4, 3)
     """
     if not (isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1):
         raise ValueError(f"k must be a positive whole number of points; got {k!r}")

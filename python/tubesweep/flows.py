@@ -23,29 +23,46 @@ Flow = Callable[[np.ndarray], np.ndarray]
 
 
 def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
-    """The N-point vortex flow on a sphere centred at the origin (paper Sect. 6.3, after Newton 2001)::
+    """The N-point vortex flow on a sphere centred at the origin (paper Sect. 6.3, after Newton 2001).
 
-        v(x) = (1/2π) Σ_j s_j (x_j × x) / |x_j − x|² · (1 − exp(−|x_j − x|²/δ²))
-
-    ``x_j × x`` is orthogonal to ``x``, so the flow is tangent to every sphere about the origin.
-    On a sphere (any radius) one vortex alone moves points on circles about ``x_j`` at speed
-    ``|v| = (s/4π) cot(θ/2)`` (θ = angle from ``x_j``) for ``δ = 0`` (the paper's flow): it grows
-    without bound near the centre. With F = 3 and s = 4 (Figs. 10–11) ``|v| ≥ F`` within an angle
-    θ ≈ 0.21 of each centre.
-
-    The optional vortex core ``δ = core`` (a length; a Lamb–Oseen core) leaves the flow unchanged
-    to within ``exp(−r²/δ²)`` at chord distances ``r ≫ δ`` from the centres and makes it a solid
-    rotation inside; on a sphere of radius ``R ≫ δ`` a single vortex then peaks at
-    ``|v| ≈ 0.638·|s|R/(2πδ)``, so ``δ > 0.102·|s|R/F`` keeps it subsonic (0.068 for s = 4,
-    R = 0.5, F = 3).
+    ``v(x) = (1/2π) Σ_j s_j (x_j × x) / |x_j − x|² · (1 − exp(−|x_j − x|²/δ²))``. ``x_j × x`` is
+    orthogonal to ``x``, so the flow is tangent to every sphere about the origin.
 
     Parameters
     ----------
-    centers : (N, 3) points on the sphere
-    strengths : (N,) or scalar vortex strengths ``s_j`` (positive = counter-clockwise about ``x_j``)
-    core : float, vortex core radius δ ≥ 0 (0 = the singular flow of the paper)
+    centers : array_like
+        ``(N, 3)`` vortex centres on the sphere.
+    strengths : array_like or float
+        ``(N,)`` vortex strengths ``s_j`` (positive: counter-clockwise about ``x_j``).
+    core : float
+        Vortex core radius δ ≥ 0 (a Lamb–Oseen core; 0, the default, is the singular flow of the
+        paper).
 
-    At ``x = x_j`` the term is taken as 0 (its principal value for δ = 0, its limit for δ > 0).
+    Returns
+    -------
+    Flow
+        A callable ``v(points (M, 3)) -> (M, 3)`` for ``ts.solve(..., flow=v)``.
+
+    Raises
+    ------
+    ValueError
+        If the centres are not ``(N, 3)`` finite points, the strengths do not match them, or
+        ``core`` is negative.
+
+    Notes
+    -----
+    One vortex alone moves points on circles about ``x_j`` at speed ``|v| = (s/4π) cot(θ/2)``
+    (θ the angle from ``x_j``) for δ = 0: unbounded near the centre. With F = 3 and s = 4
+    (Figs. 10–11) ``|v| ≥ F`` within an angle θ ≈ 0.21 of each centre, so the paper's figures need
+    ``allow_supersonic=True``. A core δ keeps a single vortex below ``≈ 0.638·|s|R/(2πδ)``. At
+    ``x = x_j`` the term is taken as 0.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> v = ts.flows.point_vortices([[0, 0, 0.5], [0.5, 0, 0]], [4.0, -4.0], core=0.1)
+    >>> v(np.array([[0.0, 0.5, 0.0]])).shape
+    (1, 3)
     """
     c = real_array(centers, "centers")
     if c.ndim == 1:
@@ -86,13 +103,37 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
 def solid_body_rotation(
     omega: float, axis: Sequence[float] = (0.0, 0.0, 1.0), center: Sequence[float] | None = None
 ) -> Flow:
-    """Rigid rotation of the medium with angular speed ``omega`` about ``axis`` through ``center``:
-    ``v(x) = ω â × (x − c)`` in 3D and ``v(x) = ω (−(y − c_y), x − c_x)`` in 2D (``axis`` ignored).
+    """Rigid rotation of the medium with angular speed ``omega`` about ``axis`` through ``center``.
 
-    It is tangent to every sphere/circle about ``c`` (and every surface of revolution about the
-    axis), and it has an exact moving-medium solution on the sphere and the circle: in the frame
-    co-rotating with the medium the wave front is a geodesic circle of radius ``F t`` about the
-    source (see ``docs/hamiltonians.md`` and :func:`rotation_travel_time_sphere`).
+    ``v(x) = ω â × (x − c)`` in 3D and ``v(x) = ω (−(y − c_y), x − c_x)`` in 2D (``axis`` ignored).
+    It is tangent to every sphere or circle about ``c``, and has an exact moving-medium solution on
+    both (:func:`rotation_travel_time_sphere`, :func:`rotation_travel_time_circle`).
+
+    Parameters
+    ----------
+    omega : float
+        Angular speed (positive: counter-clockwise about ``axis``).
+    axis : sequence of float
+        The rotation axis in 3D (default z).
+    center : sequence of float, optional
+        A point on the axis (default the origin).
+
+    Returns
+    -------
+    Flow
+        A callable ``v(points (M, d)) -> (M, d)``.
+
+    Raises
+    ------
+    ValueError
+        If ``omega`` is not finite or the axis is zero.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> v = ts.flows.solid_body_rotation(2.0)
+    >>> v(np.array([[1.0, 0.0, 0.0]])).tolist()
+    [[0.0, 2.0, 0.0]]
     """
     if not np.isfinite(omega):
         raise ValueError(f"omega must be finite; got {omega!r}")
@@ -120,12 +161,40 @@ def solid_body_rotation(
 def rotation_travel_time_circle(
     points: np.ndarray, radius: float, source_angle: float, speed: float, omega: float
 ) -> np.ndarray:
-    """Exact first-arrival time on the circle ``|x| = radius`` in the medium rotating rigidly
-    with angular speed ``omega`` (counter-clockwise), from a source at angle ``source_angle``::
+    """Exact first-arrival time on the circle ``|x| = radius`` in a medium turning rigidly at ``omega``.
 
-        u(α) = min( R α / (F + ωR),  R (2π − α) / (F − ωR) ),   α = angle from the source ∈ [0, 2π)
+    ``u(α) = min(R α / (F + ωR), R (2π − α) / (F − ωR))`` with α the angle from the source,
+    counter-clockwise: the wave runs with the flow at ``F + ωR`` and against it at ``F − ωR``.
 
-    (the wave runs with the flow at ``F + ωR`` and against it at ``F − ωR``). Needs ``|ω| R < F``.
+    Parameters
+    ----------
+    points : numpy.ndarray
+        ``(M, 2)`` points (projected radially onto the circle).
+    radius : float
+        R.
+    source_angle : float
+        The source's polar angle.
+    speed : float
+        F.
+    omega : float
+        Angular speed of the medium, ``|ω| R < F``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(M,)`` arrival times.
+
+    Raises
+    ------
+    ValueError
+        If ``|ω| R ≥ F`` (supersonic: no such formula).
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> u = ts.flows.rotation_travel_time_circle(np.array([[0.0, 0.5]]), 0.5, 0.0, 1.0, 1.0)
+    >>> round(float(u[0]), 4)  # a quarter turn downstream at speed 1 + 0.5
+    0.5236
     """
     p = np.asarray(points, dtype=float)
     a = np.mod(np.arctan2(p[:, 1], p[:, 0]) - source_angle, 2 * np.pi)
@@ -138,14 +207,43 @@ def rotation_travel_time_circle(
 def rotation_travel_time_sphere(
     points: np.ndarray, radius: float, source: Sequence[float], speed: float, omega: float, iterations: int = 80
 ) -> np.ndarray:
-    """Exact first-arrival time on the sphere ``|x| = radius`` in the medium rotating rigidly about
-    the z axis with angular speed ``omega``, from ``source`` (on the sphere).
+    """Exact first-arrival time on the sphere ``|x| = radius`` in a medium turning rigidly about z.
 
     In the co-rotating frame the wave speed is F in every direction, so the front at time ``t`` is
-    the geodesic circle of radius ``F t`` about the source, carried by the rotation: ``x`` is reached
-    at the root ``t`` of ``g(t) = d(R_{−ωt} x, x_s) − F t`` (``d`` great-circle distance, ``R_θ`` the
-    rotation about z). Since ``|ω| R < F``, ``g`` is strictly decreasing and the root unique; it
-    is found by bisection to machine precision.
+    the geodesic circle of radius ``F t`` about the source, carried by the rotation: ``x`` is
+    reached at the root of ``g(t) = d(R_{−ωt} x, x_s) − F t``, found by bisection.
+
+    Parameters
+    ----------
+    points : numpy.ndarray
+        ``(M, 3)`` points (projected radially onto the sphere).
+    radius : float
+        R.
+    source : sequence of float
+        The source (projected onto the sphere).
+    speed : float
+        F.
+    omega : float
+        Angular speed of the medium about z, ``|ω| R < F``.
+    iterations : int
+        Bisection steps (default 80: machine precision).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(M,)`` arrival times.
+
+    Raises
+    ------
+    ValueError
+        If ``|ω| R ≥ F``.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> u = ts.flows.rotation_travel_time_sphere(np.array([[0.0, 0.5, 0.0]]), 0.5, (0.5, 0, 0), 1.0, 0.0)
+    >>> round(float(u[0]), 6)  # still medium: the great-circle distance π/4
+    0.785398
     """
     x = np.asarray(points, dtype=float)
     x = radius * x / np.linalg.norm(x, axis=1, keepdims=True)

@@ -141,8 +141,33 @@ def _regions(linear: np.ndarray, grid: Grid, select: np.ndarray) -> list:
 
 
 class Hamiltonian:
-    """Base class of the built-in Hamiltonians (the equation is defined by the Rust core; this
-    class prepares its per-node data). ``label`` names the solver in ``Solution.hamiltonian``."""
+    """Base class of the built-in Hamiltonians for ``ts.solve(..., hamiltonian=...)``.
+
+    The equation itself is evaluated in the Rust core; this class prepares its per-node data.
+    Use :class:`Isotropic`, :class:`MovingMedium` or :class:`Metric`.
+
+    Parameters
+    ----------
+    sigma : float or sequence of float, optional
+        Constant viscosities σ_k of the Lax–Friedrichs update (Sect. 5.1), overriding the
+        automatic per-node ones.
+
+    Attributes
+    ----------
+    label : str
+        The name in ``Solution.hamiltonian``.
+
+    Raises
+    ------
+    ValueError
+        If ``sigma`` is not positive and finite.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> isinstance(ts.hamiltonians.Isotropic(), ts.hamiltonians.Hamiltonian)
+    True
+    """
 
     kind: str = ""
     label: str = ""
@@ -160,12 +185,68 @@ class Hamiltonian:
         slowness: np.ndarray,
         roles: np.ndarray,
     ) -> _Prepared:  # pragma: no cover - interface
+        """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
+
+        Parameters
+        ----------
+        surface : Surface
+            The surface solved on.
+        grid : Grid
+            The grid.
+        linear : numpy.ndarray
+            The band nodes' linear indices.
+        x : numpy.ndarray
+            Their closest points on the surface.
+        direction : numpy.ndarray
+            Their unit normals.
+        slowness : numpy.ndarray
+            1/F at the nodes.
+        roles : numpy.ndarray
+            Their roles (fixed, inner, extension layer).
+
+        Returns
+        -------
+        _Prepared
+            The arrays the Rust core reads.
+
+        Raises
+        ------
+        ValueError
+            Where the equation cannot be solved as given (e.g. a supersonic flow).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         raise NotImplementedError
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        """Travel time from a source to band ``nodes`` at small displacements ``disp`` (M, d)
-        (closest point minus source), for a locally constant Hamiltonian. Used to fix the
-        nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``)."""
+        """Travel time from a source to nearby band nodes, for a locally constant Hamiltonian.
+
+        Used to fix the nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``).
+
+        Parameters
+        ----------
+        prep : _Prepared
+            The data from :meth:`prepare`.
+        nodes : numpy.ndarray
+            Band positions of the nodes.
+        disp : numpy.ndarray
+            ``(M, d)`` displacements, closest point minus source.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` travel times.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         return np.linalg.norm(disp, axis=1) * prep.slowness[nodes]
 
     def _sigma(self, d: int) -> Optional[np.ndarray]:
@@ -176,13 +257,69 @@ class Hamiltonian:
 
 
 class Isotropic(Hamiltonian):
-    """``H(x, p) = |p| − 1/F(x)``: the eikonal equation (1) through the general update of
-    Sect. 5.1 (σ_k = 1), identical to ``hamiltonian="lxf"`` (Eq. 4). Mainly a reference."""
+    """``H(x, p) = |p| − 1/F(x)``: the eikonal equation through the general update of Sect. 5.1.
+
+    With σ_k = 1 it is identical to ``hamiltonian="lxf"`` (Eq. 4); mainly a reference for the
+    general solver.
+
+    Parameters
+    ----------
+    sigma : float or sequence of float, optional
+        Constant viscosities (default 1).
+
+    Raises
+    ------
+    ValueError
+        If ``sigma`` is not positive and finite.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+    >>> sol.hamiltonian
+    'isotropic'
+    """
 
     kind = "isotropic"
     label = "isotropic"
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+        """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
+
+        Parameters
+        ----------
+        surface : Surface
+            The surface solved on.
+        grid : Grid
+            The grid.
+        linear : numpy.ndarray
+            The band nodes' linear indices.
+        x : numpy.ndarray
+            Their closest points on the surface.
+        direction : numpy.ndarray
+            Their unit normals.
+        slowness : numpy.ndarray
+            1/F at the nodes.
+        roles : numpy.ndarray
+            Their roles (fixed, inner, extension layer).
+
+        Returns
+        -------
+        _Prepared
+            The arrays the Rust core reads.
+
+        Raises
+        ------
+        ValueError
+            Where the equation cannot be solved as given (e.g. a supersonic flow).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         return _Prepared(self.kind, slowness, sigma=self._sigma(grid.ndim))
 
 
@@ -196,8 +333,9 @@ class MovingMedium(Hamiltonian):
 
     Parameters
     ----------
-    flow : callable ``v(points (M, d)) -> (M, d)`` (e.g. :func:`tubesweep.flows.point_vortices`),
-        an array of ``grid.shape + (d,)``, or a constant vector. A callable is evaluated at the
+    flow : callable, numpy.ndarray or sequence of float
+        ``v(points (M, d)) -> (M, d)`` (e.g. :func:`tubesweep.flows.point_vortices`), an array of
+        ``grid.shape + (d,)``, or a constant vector. A callable is evaluated at the
         closest points ``cp(x)`` of the band nodes (the flow lives on the surface and is extended
         constantly along normals); an array is read at the nodes.
     allow_supersonic : bool
@@ -206,11 +344,33 @@ class MovingMedium(Hamiltonian):
         propagation). By default that is a ``ValueError`` saying where and by how much;
         ``True`` computes the Lax–Friedrichs solution of the equation as written anyway, with a
         ``RuntimeWarning``.
-    sigma : optional constant viscosities overriding the per-node ``1 + |v_k|/F``.
+    sigma : float or sequence of float, optional
+        Constant viscosities overriding the per-node ``1 + |v_k|/F``.
 
+    Raises
+    ------
+    ValueError
+        At solve time, where ``|v| ≥ F`` in the inner tube (unless ``allow_supersonic``), or if the
+        flow has the wrong shape or non-finite values.
+
+    Warns
+    -----
+    RuntimeWarning
+        When the flow's normal component, which is removed, exceeds ``NORMAL_FLOW_RTOL`` times the
+        largest ``|v|``, or when a supersonic flow is solved anyway.
+
+    Notes
+    -----
     The paper assumes ``v·n = 0``. The normal component of ``v`` (with the band's normal) is always
     removed — ``v ← v − (v·n) n`` — and a ``RuntimeWarning`` is raised when it is larger than
     ``NORMAL_FLOW_RTOL`` times the largest ``|v|``.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> medium = ts.hamiltonians.MovingMedium(ts.flows.solid_body_rotation(1.0))
+    >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=medium)
     """
 
     kind = "moving_medium"
@@ -229,6 +389,41 @@ class MovingMedium(Hamiltonian):
         return f"MovingMedium(flow={getattr(self.flow, '__name__', type(self.flow).__name__)}, allow_supersonic={self.allow_supersonic})"
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+        """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
+
+        Parameters
+        ----------
+        surface : Surface
+            The surface solved on.
+        grid : Grid
+            The grid.
+        linear : numpy.ndarray
+            The band nodes' linear indices.
+        x : numpy.ndarray
+            Their closest points on the surface.
+        direction : numpy.ndarray
+            Their unit normals.
+        slowness : numpy.ndarray
+            1/F at the nodes.
+        roles : numpy.ndarray
+            Their roles (fixed, inner, extension layer).
+
+        Returns
+        -------
+        _Prepared
+            The arrays the Rust core reads.
+
+        Raises
+        ------
+        ValueError
+            Where the equation cannot be solved as given (e.g. a supersonic flow).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         d = grid.ndim
         if callable(self.flow):
             _, cp = surface.project(x, grid)
@@ -291,8 +486,30 @@ class MovingMedium(Hamiltonian):
         )
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        """Arrival time at displacement ``d`` from a point source in a uniform flow ``v``: the front
-        is the circle ``|y − v t| = F t``, so ``t = (−d·v + sqrt((d·v)² + (F² − |v|²)|d|²)) / (F² − |v|²)``."""
+        """Travel time from a source to nearby band nodes, for a locally constant Hamiltonian.
+
+        Used to fix the nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``).
+
+        Parameters
+        ----------
+        prep : _Prepared
+            The data from :meth:`prepare`.
+        nodes : numpy.ndarray
+            Band positions of the nodes.
+        disp : numpy.ndarray
+            ``(M, d)`` displacements, closest point minus source.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` travel times.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         assert prep.flow is not None
         v = prep.flow[nodes]
         f = 1.0 / prep.slowness[nodes]
@@ -313,14 +530,28 @@ class Metric(Hamiltonian):
 
     Parameters
     ----------
-    M : (d, d) constant, array of ``grid.shape + (d, d)``, or callable ``M(points (K, d)) -> (K, d, d)``
-        (evaluated at the closest points of the band nodes).
+    M : array_like or callable
+        A constant ``(d, d)`` matrix, an array of ``grid.shape + (d, d)``, or a callable
+        ``M(points (K, d)) -> (K, d, d)`` (evaluated at the closest points of the band nodes).
     tangential : bool
         On a surface only the tangential block of ``M`` matters. With ``True`` (default) the
         normal–tangent coupling is removed, ``M ← P M P + (nᵀMn) n nᵀ`` with ``P = I − n nᵀ``, so
         that the small normal component of the extrinsic gradient cannot leak into the tangential
         metric. ``False`` uses ``M`` as given (right for a full-box solve).
-    sigma : optional constant viscosities overriding the per-node ``sqrt(M_kk)``.
+    sigma : float or sequence of float, optional
+        Constant viscosities overriding the per-node ``sqrt(M_kk)``.
+
+    Raises
+    ------
+    ValueError
+        If ``M`` is not symmetric positive definite or has the wrong shape.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> grid = ts.Grid((-1, -1), (1, 1), (101, 101))
+    >>> M = np.diag([4.0, 1.0])  # travel is twice as slow along x
+    >>> sol = ts.solve(ts.surfaces.Circle(0.5), grid, [(0.5, 0.0)], hamiltonian=ts.hamiltonians.Metric(M))
     """
 
     kind = "metric"
@@ -335,6 +566,41 @@ class Metric(Hamiltonian):
         return f"Metric(tangential={self.tangential})"
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+        """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
+
+        Parameters
+        ----------
+        surface : Surface
+            The surface solved on.
+        grid : Grid
+            The grid.
+        linear : numpy.ndarray
+            The band nodes' linear indices.
+        x : numpy.ndarray
+            Their closest points on the surface.
+        direction : numpy.ndarray
+            Their unit normals.
+        slowness : numpy.ndarray
+            1/F at the nodes.
+        roles : numpy.ndarray
+            Their roles (fixed, inner, extension layer).
+
+        Returns
+        -------
+        _Prepared
+            The arrays the Rust core reads.
+
+        Raises
+        ------
+        ValueError
+            Where the equation cannot be solved as given (e.g. a supersonic flow).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         d = grid.ndim
         if callable(self.M):
             _, cp = surface.project(x, grid)
@@ -368,7 +634,30 @@ class Metric(Hamiltonian):
         return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), extra={"inverse": inverse})
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        """``s · sqrt(dᵀ M⁻¹ d)`` with the node's (tangential) metric."""
+        """Travel time from a source to nearby band nodes, for a locally constant Hamiltonian.
+
+        Used to fix the nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``).
+
+        Parameters
+        ----------
+        prep : _Prepared
+            The data from :meth:`prepare`.
+        nodes : numpy.ndarray
+            Band positions of the nodes.
+        disp : numpy.ndarray
+            ``(M, d)`` displacements, closest point minus source.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` travel times.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
+        """
         inv = prep.extra["inverse"][nodes]
         return prep.slowness[nodes] * np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", disp, inv, disp), 0.0))
 

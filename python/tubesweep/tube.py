@@ -235,6 +235,45 @@ class Tube:
     ) -> Any:
         """K independent solves on this band, in parallel across the sources (docs/many-sources.md).
 
+        Parameters
+        ----------
+        sources : array_like or list
+            ``(K, d)`` K point sources, or ``(K, P, d)`` / a list of points ``(d,)`` or groups
+            ``(P, d)`` (a group is one multi-source solve).
+        at : array_like, optional
+            ``(M, d)`` points: return the values there instead of on the whole band.
+        hamiltonian : {"godunov", "lxf"}
+            The scheme.
+        speed, source_init, tol, max_iterations, infinity, paper_sweeps
+            As for :meth:`solve`.
+        progress : callable, optional
+            Called as ``progress(done, total)`` about every 50 ms.
+        threads : int
+            Solves at once, each on one thread (0: all cores).
+        client : dask.distributed.Client, optional
+            Run the solves on a cluster (``pip install tubesweep[distributed]``).
+        chunk_size : int, optional
+            Sources per cluster task.
+        return_stats : bool
+            Also return per-source statistics.
+
+        Returns
+        -------
+        values : numpy.ndarray
+            ``(K, band_points)`` (or ``(K, M)`` with ``at``); row k equals
+            ``tube.solve(sources[k], ...).values`` (or its values at ``at``) bit for bit.
+        stats : dict
+            Only with ``return_stats``: per-source arrays (iterations, converged, last_change, ...).
+
+        Raises
+        ------
+        ValueError
+            For sources off the surface, an unsupported Hamiltonian, or as :meth:`solve`.
+        KeyboardInterrupt
+            On Ctrl-C, which stops every solve (no partial result).
+
+        Notes
+        -----
         ``sources`` is an array (K, d) of K point sources, or an array (K, P, d) / a list whose
         entries are points (d,) or groups (P, d) (a group is one multi-source solve). Returns a
         (K, band_points) array whose row k equals ``tube.solve(sources[k], ...).values`` bit for
@@ -250,6 +289,14 @@ class Tube:
         tube once and reuses it for all its chunks, and only the values (at ``at``) come back;
         the result equals the local one bit for bit. ``return_stats`` also returns a dict of
         per-source arrays (iterations, converged, last_change, ...).
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> tube = ts.Tube(ts.surfaces.Sphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3))
+        >>> U = tube.solve_many(0.5 * np.eye(3), at=[(0.0, 0.0, -0.5)])
+        >>> U.shape
+        (3, 1)
         """
         if client is not None:
             from .distributed import solve_many_on_client

@@ -22,7 +22,7 @@ from typing import Dict, Tuple, Union
 
 import numpy as np
 
-__all__ = ["bunny", "spot", "path", "load", "read_obj", "NAMES", "CREDITS"]
+__all__ = ["bunny", "spot", "path", "load", "read_obj", "mesh_file", "NAMES", "CREDITS"]
 
 _HERE = Path(__file__).resolve().parent
 
@@ -71,6 +71,36 @@ def path(name: str) -> Path:
         raise FileNotFoundError(
             f"the bundled mesh {p} is missing: reinstall tubesweep (its wheel ships tubesweep/data/*.obj.gz)"
         )
+    return p
+
+
+def mesh_file(name_or_path: Union[str, Path]) -> Path:
+    """A mesh file named on the command line: the file itself, or a bundled mesh by its name.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path
+        A path, or ``"bunny"`` / ``"spot"`` (used only when no file of that name exists).
+
+    Returns
+    -------
+    pathlib.Path
+        The file to read.
+
+    Raises
+    ------
+    FileNotFoundError
+        If a bundled mesh is missing from the installation.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> ts.data.mesh_file("spot").name
+    'spot.obj.gz'
+    """
+    p = Path(name_or_path)
+    if not p.exists() and str(name_or_path).lower() in NAMES:
+        return path(str(name_or_path))
     return p
 
 

@@ -51,7 +51,27 @@ def _points(p: np.ndarray, d: int) -> np.ndarray:
 
 
 class Circle(LevelSet):
-    """Circle of ``radius`` about ``center``; φ = |x − c| − r (exact signed distance)."""
+    """Circle of ``radius`` about ``center``: φ = |x − c| − r, the exact signed distance.
+
+    Parameters
+    ----------
+    radius : float
+        The radius (default 0.5).
+    center : sequence of float
+        The centre, 2 coordinates (default the origin).
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> c = ts.surfaces.Circle(0.5)
+    >>> sol = ts.solve(c, ts.Grid((-1, -1), (1, 1), (101, 101)), [c.default_source])
+    """
 
     default_box = ((-1.0, -1.0), (1.0, 1.0))
 
@@ -63,6 +83,30 @@ class Circle(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, with the arithmetic of row_norms(p - center) - radius
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 2)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Circle(0.5)
+        >>> s.signed_distance(np.zeros((1, 2))).shape
+        (1,)
+        """
         return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
@@ -73,23 +117,110 @@ class Circle(LevelSet):
         return self.center + np.array([-self.radius, 0.0])
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
-        """Exact arclength on the circle between the projections of ``points`` and ``source``."""
+        """Exact arclength on the circle between the projections of ``points`` and ``source``.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 2)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Circle(0.5)
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         a = np.arctan2(*(np.asarray(points) - self.center).T[::-1])
         s = np.asarray(source, dtype=float) - self.center
         b = np.arctan2(s[1], s[0])
         return self.radius * np.abs(np.angle(np.exp(1j * (a - b))))
 
     def sample(self, n: int = 1000) -> np.ndarray:
+        """Points spread over the curve.
+
+        Parameters
+        ----------
+        n : int
+            How many points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n, 2)`` points on the curve.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Circle(0.5)
+        >>> s.sample(10).shape
+        (10, 2)
+        """
         t = np.linspace(0, 2 * np.pi, n, endpoint=False)
         return self.center + self.radius * np.stack([np.cos(t), np.sin(t)], axis=1)
 
     def triangulation(self, n: int = 400) -> Tuple[np.ndarray, np.ndarray]:
-        """The curve as a closed polyline: vertices (n, 2) and segments (n, 2)."""
+        """The curve as a closed polyline: vertices (n, 2) and segments (n, 2).
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Circle(0.5)
+        >>> v, f = s.triangulation()
+        """
         return polyline(self.sample(n))
 
 
 class Sphere(LevelSet):
-    """Sphere of ``radius`` about ``center``; φ = |x − c| − r (exact signed distance)."""
+    """Sphere of ``radius`` about ``center``: φ = |x − c| − r, the exact signed distance.
+
+    Parameters
+    ----------
+    radius : float
+        The radius (default 0.5).
+    center : sequence of float
+        The centre, 3 coordinates (default the origin).
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [s.default_source])
+    """
 
     default_box = ((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0))
 
@@ -101,6 +232,30 @@ class Sphere(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, with the arithmetic of row_norms(p - center) - radius
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> s.signed_distance(np.zeros((1, 3))).shape
+        (1,)
+        """
         return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
@@ -111,7 +266,31 @@ class Sphere(LevelSet):
         return self.center + np.array([-self.radius, 0.0, 0.0])
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
-        """Great-circle distance between the radial projections of ``points`` and ``source``."""
+        """Great-circle distance between the radial projections of ``points`` and ``source``.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         a = np.asarray(points, dtype=float) - self.center
         a = a / np.linalg.norm(a, axis=1, keepdims=True)
         b = np.asarray(source, dtype=float) - self.center
@@ -119,25 +298,66 @@ class Sphere(LevelSet):
         return self.radius * np.arccos(np.clip(a @ b, -1.0, 1.0))
 
     def triangulation(self, n: int = 64) -> Tuple[np.ndarray, np.ndarray]:
-        """Latitude–longitude triangulation (n rings, 2n sectors, poles merged): ``(V, F)``."""
+        """Latitude–longitude triangulation (n rings, 2n sectors, poles merged): ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> v, f = s.triangulation()
+        """
         th, ph = np.meshgrid(np.linspace(0, np.pi, n + 1), np.linspace(0, 2 * np.pi, 2 * n + 1), indexing="ij")
         P = self.radius * np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1) + self.center
         return grid_mesh(P)
 
 
 class Star(LevelSet):
-    """The six-fold star of the paper's Sect. 6.1: r(θ) = r0 + ε sin²(3θ) (r0 = 0.5, ε = 0.2).
-
-    The paper prints ``sin²(3πθ)``, a misprint: with θ the polar angle, six-fold symmetry and
-    r = 0.5 at the source (0.5, 0) need ``sin²(3θ)``.
+    """The six-fold star of the paper's Sect. 6.1: r(θ) = r0 + ε sin²(3θ).
 
     Parameters
     ----------
-    r0, eps : float
+    r0 : float
+        The smallest radius (default 0.5).
+    eps : float
+        The depth of the lobes (default 0.2).
     exact : bool
-        True: φ is the exact signed distance to the curve (computed by projecting onto a dense
-        sampling of the curve and refining with Newton's method). False: φ = |x| − r(θ), the
-        simple level set, which is only roughly a distance (|∇φ| up to ≈ 1.6).
+        True (default): φ is the exact signed distance to the curve (a projection onto a dense
+        sampling of the curve refined by Newton's method). False: φ = |x| − r(θ), the simple level
+        set, only roughly a distance (|∇φ| up to ≈ 1.6).
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
+    The paper prints ``sin²(3πθ)``, a misprint: with θ the polar angle, six-fold symmetry and
+    r = 0.5 at the source (0.5, 0) need ``sin²(3θ)``.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> star = ts.surfaces.Star()
+    >>> sol = ts.solve(star, ts.Grid((-1, -1), (1, 1), (201, 201)), [star.default_source])
     """
 
     default_box = ((-1.0, -1.0), (1.0, 1.0))
@@ -161,20 +381,114 @@ class Star(LevelSet):
 
     # --- geometry ---------------------------------------------------------------------------
     def r(self, t: np.ndarray) -> np.ndarray:
+        """The radius r(θ) = r0 + ε sin²(3θ).
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Polar angles θ.
+
+        Returns
+        -------
+        numpy.ndarray
+            The values at each θ.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.r(np.array([0.0])).shape
+        (1,)
+        """
         return self.r0 + self.eps * np.sin(3 * t) ** 2
 
     def dr(self, t: np.ndarray) -> np.ndarray:
+        """The derivative r'(θ).
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Polar angles θ.
+
+        Returns
+        -------
+        numpy.ndarray
+            The values at each θ.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.dr(np.array([0.0])).shape
+        (1,)
+        """
         return 3 * self.eps * np.sin(6 * t)
 
     def d2r(self, t: np.ndarray) -> np.ndarray:
+        """The second derivative r''(θ).
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Polar angles θ.
+
+        Returns
+        -------
+        numpy.ndarray
+            The values at each θ.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.d2r(np.array([0.0])).shape
+        (1,)
+        """
         return 18 * self.eps * np.cos(6 * t)
 
     def curve(self, t: np.ndarray) -> np.ndarray:
+        """The curve's point at each parameter.
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            ``(M,)`` parameters (the polar angle θ for the star).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, 2)`` points.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.curve(np.array([0.0])).shape
+        (1, 2)
+        """
         r = self.r(t)
         return np.stack([r * np.cos(t), r * np.sin(t)], axis=-1)
 
     def speed(self, t: np.ndarray) -> np.ndarray:
-        """|γ'(θ)| = sqrt(r² + r'²)."""
+        """The speed of the parametrisation |γ'(θ)| = sqrt(r² + r'²).
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Polar angles θ.
+
+        Returns
+        -------
+        numpy.ndarray
+            The values at each θ.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.speed(np.array([0.0])).shape
+        (1,)
+        """
         return np.sqrt(self.r(t) ** 2 + self.dr(t) ** 2)
 
     @property
@@ -182,11 +496,47 @@ class Star(LevelSet):
         return np.array([self.r(np.array(0.0)) * 1.0, 0.0])
 
     def simple_phi(self, p: np.ndarray) -> np.ndarray:
+        """The simple level set φ = |x| − r(θ) (only roughly a distance).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 2)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` values.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.simple_phi(np.array([[0.5, 0.0]])).tolist()
+        [0.0]
+        """
         p = np.asarray(p, dtype=float)
         return np.hypot(p[:, 0], p[:, 1]) - self.r(np.arctan2(p[:, 1], p[:, 0]))
 
     def closest_parameter(self, p: np.ndarray) -> np.ndarray:
-        """Polar angle θ of the closest point on the curve to each point of p (M, 2)."""
+        """Polar angle θ of the closest point on the curve to each point of p (M, 2).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 2)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` curve parameters of the closest points.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> t = s.closest_parameter(np.array([[1.0, 0.0]]))
+        """
         p = np.asarray(p, dtype=float)
         out = np.empty(len(p))
         # Points with |simple φ| ≤ 0.2 are within 0.2 of the curve, so their closest point is
@@ -221,6 +571,30 @@ class Star(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads: the algorithm of _signed_distance_numpy (equal to rounding)
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 2)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.signed_distance(np.zeros((1, 2))).shape
+        (1,)
+        """
         return _native.star_signed_distance(_points(p, 2), self.r0, self.eps)
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
@@ -236,7 +610,25 @@ class Star(LevelSet):
 
     # --- exact geodesic distance --------------------------------------------------------------
     def arclength(self, t: np.ndarray) -> np.ndarray:
-        """Arclength from θ = 0 to θ = t (t in [0, 2π]), by composite Gauss–Legendre quadrature."""
+        """Arclength from θ = 0 to θ = t (t in [0, 2π]), by composite Gauss–Legendre quadrature.
+
+        Parameters
+        ----------
+        t : numpy.ndarray
+            Curve parameters in [0, 2π].
+
+        Returns
+        -------
+        numpy.ndarray
+            Arclengths from parameter 0 to each ``t``.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> float(s.arclength(np.array([2 * np.pi]))[0]) > 0
+        True
+        """
         t = np.asarray(t, dtype=float)
         # each 1/12 turn between extrema of r is smooth: integrate piecewise with 20-point GL
         xg, wg = np.polynomial.legendre.leggauss(20)
@@ -263,8 +655,31 @@ class Star(LevelSet):
         return float(self.arclength(np.array([2 * np.pi]))[0])
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float] = (0.5, 0.0)) -> np.ndarray:
-        """Exact arclength (the shorter way round) between the closest curve points of ``points``
-        and ``source``."""
+        """Exact arclength (the shorter way round) between the closest curve points of ``points`` and ``source``.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 2)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         t = np.mod(self.closest_parameter(np.asarray(points, dtype=float)), 2 * np.pi)
         ts = np.mod(self.closest_parameter(np.asarray(source, dtype=float).reshape(1, 2))[0], 2 * np.pi)
         L = self.perimeter
@@ -272,8 +687,51 @@ class Star(LevelSet):
         return np.minimum(d, L - d)
 
     def sample(self, n: int = 2000) -> np.ndarray:
+        """Points spread over the curve.
+
+        Parameters
+        ----------
+        n : int
+            How many points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n, 2)`` points on the curve.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> s.sample(10).shape
+        (10, 2)
+        """
         return self.curve(np.linspace(0, 2 * np.pi, n, endpoint=False))
 
     def triangulation(self, n: int = 600) -> Tuple[np.ndarray, np.ndarray]:
-        """The curve as a closed polyline: vertices (n, 2) and segments (n, 2)."""
+        """The curve as a closed polyline: vertices (n, 2) and segments (n, 2).
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Star()
+        >>> v, f = s.triangulation()
+        """
         return polyline(self.sample(n))

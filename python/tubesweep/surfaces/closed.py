@@ -26,14 +26,27 @@ class Ellipsoid(LevelSet):
     ----------
     a, b, c : float
         Semi-axes along x, y, z (defaults 0.6, 0.45, 0.3).
-    center : (3,) float
+    center : sequence of float
+        The centre, 3 coordinates.
 
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
     The closest point is ``y_i = a_i² x_i / (a_i² + t)`` with t the root in ``(−min a_i², ∞)`` of
-    ``Σ (a_i x_i / (a_i² + t))² = 1`` (a convex decreasing function of t: Newton's method from the
-    left, which never passes the root, to the last bits),
-    with the degenerate case of interior points on the plane of the shortest axis handled
-    explicitly. There is no closed-form geodesic distance on a triaxial ellipsoid, so this class has
-    no ``geodesic_distance``; tests compare against fine-grid solutions instead.
+    ``Σ (a_i x_i / (a_i² + t))² = 1``, a convex decreasing function of t: Newton's method from the
+    left never passes the root. There is no closed-form geodesic distance on a triaxial ellipsoid,
+    so this class has no ``geodesic_distance``.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> e = ts.surfaces.Ellipsoid(0.5, 0.5, 0.4)
+    >>> sol = ts.solve(e, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [e.default_source])
     """
 
     default_box = _CUBE
@@ -45,7 +58,25 @@ class Ellipsoid(LevelSet):
         self.ndim = 3
 
     def closest_point(self, p: np.ndarray) -> np.ndarray:
-        """Exact closest point on the ellipsoid of each point of p (M, 3)."""
+        """Exact closest point on the ellipsoid of each point of p (M, 3).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, 3)`` closest points on the surface.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Ellipsoid()
+        >>> s.closest_point(np.array([[1.0, 0.0, 0.0]])).round(6).tolist()
+        [[0.6, 0.0, 0.0]]
+        """
         x = np.asarray(p, dtype=float).reshape(-1, 3) - self.center
         ax = self.axes
         a2 = ax * ax
@@ -104,6 +135,30 @@ class Ellipsoid(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Ellipsoid()
+        >>> s.signed_distance(np.zeros((1, 3))).shape
+        (1,)
+        """
         return _native.ellipsoid_signed_distance(
             _points(p, 3), [float(c) for c in self.center], [float(a) for a in self.axes]
         )
@@ -124,14 +179,38 @@ class Ellipsoid(LevelSet):
         return self.center + np.array([-self.axes[0], 0.0, 0.0])
 
     def triangulation(self, n: int = 64) -> Tuple[np.ndarray, np.ndarray]:
-        """Latitude–longitude triangulation with about 2n² triangles: ``(V, F)``."""
+        """Latitude–longitude triangulation with about 2n² triangles: ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Ellipsoid()
+        >>> v, f = s.triangulation()
+        """
         th, ph = np.meshgrid(np.linspace(0, np.pi, n + 1), np.linspace(0, 2 * np.pi, 2 * n + 1), indexing="ij")
         P = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1) * self.axes + self.center
         return grid_mesh(P)
 
 
 class Torus(LevelSet):
-    """Torus about the z axis: ``φ = sqrt((sqrt(x² + y²) − R)² + z²) − r`` (exact signed distance).
+    """Torus about the z axis: ``φ = sqrt((sqrt(x² + y²) − R)² + z²) − r``, the exact signed distance.
 
     Parameters
     ----------
@@ -139,8 +218,17 @@ class Torus(LevelSet):
         Distance from the centre to the tube's centre circle (default 0.5).
     r : float
         Tube radius (default 0.2), ``0 < r < R``.
-    center : (3,) float
+    center : sequence of float
+        The centre, 3 coordinates.
 
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
     :meth:`geodesic_distance` is exact along the *outer equator* (the circle of radius R + r in the
     plane z = 0), which is a geodesic by the mirror symmetry z → −z. It is the shortest path between
     two of its points only while they are closer (along it) than the first conjugate point, at
@@ -149,6 +237,12 @@ class Torus(LevelSet):
     Checked against exact polyhedral geodesics (pygeodesic, 12,800-vertex triangulation, defaults
     R = 0.5, r = 0.2): equal to within 2.4e-4 (the inscribed polygon's chord error) up to the conjugate
     arclength 1.175; beyond it shorter paths leave the equator (by 0.021 at arclength 1.32).
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> t = ts.surfaces.Torus(0.5, 0.25)
+    >>> sol = ts.solve(t, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [t.default_source])
     """
 
     default_box = _CUBE
@@ -165,6 +259,30 @@ class Torus(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads: hypot(hypot(q_x, q_y) − R, q_z) − r with q = p − center
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Torus()
+        >>> s.signed_distance(np.zeros((1, 3))).shape
+        (1,)
+        """
         return _native.torus_signed_distance(_points(p, 3), [float(c) for c in self.center], self.R, self.r)
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
@@ -180,9 +298,31 @@ class Torus(LevelSet):
         return float(np.pi * np.sqrt(self.r * (self.R + self.r)))
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
-        """Exact distance between points on (or near) the outer equator and a source on it: the
-        arclength ``(R + r)·|Δθ|`` of the azimuth difference; NaN for points that are not on the
-        outer equator (more than 1e-6 off it) or farther than :attr:`conjugate_arclength`."""
+        """Exact distance between points on (or near) the outer equator and a source on it: the arclength ``(R + r)·|Δθ|`` of the azimuth difference; NaN for points that are not on the outer equator (more than 1e-6 off it) or farther than :attr:`conjugate_arclength`.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Torus()
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         q = np.asarray(points, dtype=float).reshape(-1, 3) - self.center
         s = np.asarray(source, dtype=float).reshape(3) - self.center
         Ro = self.R + self.r
@@ -197,7 +337,31 @@ class Torus(LevelSet):
         return np.where(on & (d <= self.conjugate_arclength), d, np.nan)
 
     def triangulation(self, n: int = 48) -> Tuple[np.ndarray, np.ndarray]:
-        """Parameter-grid triangulation (4n × 2n quads): ``(V, F)``."""
+        """Parameter-grid triangulation (4n × 2n quads): ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Torus()
+        >>> v, f = s.triangulation()
+        """
         th, ps = np.meshgrid(np.linspace(0, 2 * np.pi, 4 * n + 1), np.linspace(0, 2 * np.pi, 2 * n + 1), indexing="ij")
         rho = self.R + self.r * np.cos(ps)
         P = np.stack([rho * np.cos(th), rho * np.sin(th), self.r * np.sin(ps)], -1) + self.center
@@ -205,17 +369,34 @@ class Torus(LevelSet):
 
 
 class RoundedCube(LevelSet):
-    """Cube of half-side ``half_size`` with edges and corners rounded to ``radius`` — a surface with
-    sharp-ish features (curvature 1/radius along the edges, flat faces).
-
-    φ is the exact signed distance ``|max(q, 0)| + min(max_k q_k, 0) − radius`` with
-    ``q = |x − c| − (half_size − radius)`` componentwise. No closed-form geodesic distance.
+    """Cube of half-side ``half_size`` with edges and corners rounded to ``radius``.
 
     Parameters
     ----------
-    half_size : float (default 0.5)
-    radius : float (default 0.1), ``0 < radius ≤ half_size``
-    center : (3,) float
+    half_size : float
+        Half the side (default 0.5).
+    radius : float
+        Rounding radius (default 0.1), ``0 < radius ≤ half_size``.
+    center : sequence of float
+        The centre, 3 coordinates.
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
+    A surface with sharp-ish features (curvature 1/radius along the edges, flat faces). φ is the
+    exact signed distance ``|max(q, 0)| + min(max_k q_k, 0) − radius`` with
+    ``q = |x − c| − (half_size − radius)`` componentwise. No closed-form geodesic distance.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> cube = ts.surfaces.RoundedCube()
+    >>> sol = ts.solve(cube, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [cube.default_source])
     """
 
     default_box = _CUBE
@@ -232,6 +413,30 @@ class RoundedCube(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.RoundedCube()
+        >>> s.signed_distance(np.zeros((1, 3))).shape
+        (1,)
+        """
         return _native.rounded_cube_signed_distance(
             _points(p, 3), [float(c) for c in self.center], self.half_size, self.radius
         )
@@ -253,7 +458,31 @@ class RoundedCube(LevelSet):
         return self.center + np.array([-self.half_size, 0.0, 0.0])
 
     def triangulation(self, n: int = 96) -> Tuple[np.ndarray, np.ndarray]:
-        """Marching cubes of φ on an n³ grid over the bounding box (needs scikit-image)."""
+        """Marching cubes of φ on an n³ grid over the bounding box (needs scikit-image).
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.RoundedCube()
+        >>> v, f = s.triangulation()
+        """
         e = self.half_size * 1.1
         return marching_cubes(self.signed_distance, (self.center - e, self.center + e), n)
 
@@ -261,17 +490,31 @@ class RoundedCube(LevelSet):
 class DoubleTorus(LevelSet):
     """A genus-2 surface: the union of two ring tori about the z axis centred at ``(±offset, 0, 0)``.
 
-    φ = min(φ₁, φ₂) of the two exact torus distances. It is the exact signed distance outside the
-    solid; inside, near the two creases where the tori meet, ``|φ|`` may under-estimate the distance
-    (φ stays 1-Lipschitz with ``|∇φ| = 1`` almost everywhere, which is all the method needs). The
-    creases are sharp features: geodesics bend over them.
-
     Parameters
     ----------
     R, r : float
         Centre-circle and tube radii of each torus (defaults 0.35, 0.12).
     offset : float
         Half the distance between the two torus centres (default 0.36, so the tubes overlap).
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
+    φ = min(φ₁, φ₂) of the two exact torus distances. It is the exact signed distance outside the
+    solid; inside, near the two creases where the tori meet, ``|φ|`` may under-estimate the distance
+    (φ stays 1-Lipschitz with ``|∇φ| = 1`` almost everywhere, which is all the method needs). The
+    creases are sharp features: geodesics bend over them.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> dt = ts.surfaces.DoubleTorus()
+    >>> sol = ts.solve(dt, ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81)), [dt.default_source])  # doctest: +SKIP
     """
 
     default_box = _CUBE
@@ -288,6 +531,30 @@ class DoubleTorus(LevelSet):
 
     def signed_distance(self, p: np.ndarray) -> np.ndarray:
         # in Rust on all threads, the arithmetic (and bits) of _signed_distance_numpy
+        """The exact signed distance of points to the surface (negative inside).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` signed distances (negative inside).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.DoubleTorus()
+        >>> s.signed_distance(np.zeros((1, 3))).shape
+        (1,)
+        """
         return _native.double_torus_signed_distance(_points(p, 3), self.R, self.r, self.offset)
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
@@ -313,6 +580,30 @@ class DoubleTorus(LevelSet):
         return None
 
     def triangulation(self, n: int = 128) -> Tuple[np.ndarray, np.ndarray]:
-        """Marching cubes of φ on an n³ grid over the bounding box (needs scikit-image)."""
+        """Marching cubes of φ on an n³ grid over the bounding box (needs scikit-image).
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.DoubleTorus()
+        >>> v, f = s.triangulation()
+        """
         ex = self.offset + self.R + self.r + 0.05
         return marching_cubes(self.signed_distance, ((-ex, -ex, -ex), (ex, ex, ex)), n)

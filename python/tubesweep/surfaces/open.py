@@ -36,19 +36,32 @@ def _native_cp(surface: Any, base: type, kind: str, p: np.ndarray, size: float) 
 
 
 class Hemisphere(ClosestPoint):
-    """The upper hemisphere ``{|x − c| = radius, z ≥ c_z}`` — an open surface bounded by the
-    equator circle (the "rim").
+    """The upper hemisphere ``{|x − c| = radius, z ≥ c_z}``: an open surface bounded by its rim.
 
     Parameters
     ----------
-    radius : float (default 0.5)
-    center : (3,) float
+    radius : float
+        The radius (default 0.5).
+    center : sequence of float
+        The centre, 3 coordinates.
 
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
     Closest point: the radial projection when it lands on the upper half, else the nearest point of
     the rim circle. :meth:`geodesic_distance` is the great-circle distance, exact because a closed
-    hemisphere is geodesically convex (the shorter great-circle arc between two of its points stays
-    in it). The default source sits at polar angle π/4 in the x–z plane, so that distances up to
-    the rim take every value from 0.39 to 1.18.
+    hemisphere is geodesically convex. The default source sits at polar angle π/4 in the x–z plane.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> h = ts.surfaces.Hemisphere(0.5)
+    >>> sol = ts.solve(h, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [h.default_source])
     """
 
     default_box = _CUBE
@@ -75,30 +88,93 @@ class Hemisphere(ClosestPoint):
         return self.center + self.radius * np.array([-s, 0.0, s])
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
-        """Great-circle distance between the closest points of ``points`` and of ``source``."""
+        """Great-circle distance between the closest points of ``points`` and of ``source``.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Hemisphere()
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         a = self._cp(np.asarray(points, dtype=float).reshape(-1, 3)) - self.center
         b = self._cp(np.asarray(source, dtype=float).reshape(1, 3))[0] - self.center
         c = (a @ b) / self.radius**2
         return self.radius * np.arccos(np.clip(c, -1.0, 1.0))
 
     def triangulation(self, n: int = 48) -> Tuple[np.ndarray, np.ndarray]:
-        """Latitude–longitude triangulation (n rings, 4n sectors): ``(V, F)``."""
+        """Latitude–longitude triangulation (n rings, 4n sectors): ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Hemisphere()
+        >>> v, f = s.triangulation()
+        """
         th, ph = np.meshgrid(np.linspace(0, 0.5 * np.pi, n + 1), np.linspace(0, 2 * np.pi, 4 * n + 1), indexing="ij")
         P = self.radius * np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1) + self.center
         return grid_mesh(P)
 
 
 class Disc(ClosestPoint):
-    """Flat disc of ``radius`` in the plane z = c_z about ``center`` — an open surface with a
-    circular boundary.
+    """Flat disc of ``radius`` in the plane z = c_z about ``center``: an open surface.
 
     Parameters
     ----------
-    radius : float (default 0.6)
-    center : (3,) float
+    radius : float
+        The radius (default 0.6).
+    center : sequence of float
+        The centre, 3 coordinates.
 
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
     Closest point: drop z, then clip the in-plane offset to the radius. :meth:`geodesic_distance`
     is the Euclidean distance between closest points (exact: the disc is convex).
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> d = ts.surfaces.Disc()
+    >>> sol = ts.solve(d, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [d.default_source])
     """
 
     default_box = _CUBE
@@ -123,7 +199,31 @@ class Disc(ClosestPoint):
         return self.center + np.array([-0.5 * self.radius, 0.0, 0.0])
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
-        """Euclidean distance between the closest points (exact on a convex flat surface)."""
+        """Euclidean distance between the closest points (exact on a convex flat surface).
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Disc()
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         return np.linalg.norm(
             self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
             - self._cp(np.asarray(source, dtype=float).reshape(1, 3)),
@@ -131,7 +231,31 @@ class Disc(ClosestPoint):
         )
 
     def triangulation(self, n: int = 32) -> Tuple[np.ndarray, np.ndarray]:
-        """Polar-grid triangulation (n rings, 4n sectors): ``(V, F)``."""
+        """Polar-grid triangulation (n rings, 4n sectors): ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Disc()
+        >>> v, f = s.triangulation()
+        """
         rr, ph = np.meshgrid(np.linspace(0, self.radius, n + 1), np.linspace(0, 2 * np.pi, 4 * n + 1), indexing="ij")
         P = np.stack([rr * np.cos(ph), rr * np.sin(ph), np.zeros_like(rr)], -1) + self.center
         return grid_mesh(P)
@@ -140,13 +264,29 @@ class Disc(ClosestPoint):
 class PlanePatch(ClosestPoint):
     """Square plane patch ``[−s, s]² × {0}`` about ``center`` (open, with corners).
 
+    Parameters
+    ----------
+    half_size : float
+        Half the side s (default 0.6).
+    center : sequence of float
+        The centre, 3 coordinates.
+
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
     Closest point: drop z and clip x, y to ``[−s, s]``. :meth:`geodesic_distance` is Euclidean
     (exact: the square is convex).
 
-    Parameters
-    ----------
-    half_size : float (default 0.6)
-    center : (3,) float
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> p = ts.surfaces.PlanePatch()
+    >>> sol = ts.solve(p, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [p.default_source])
     """
 
     default_box = _CUBE
@@ -170,7 +310,31 @@ class PlanePatch(ClosestPoint):
         return self.center + np.array([-0.5 * self.half_size, -0.5 * self.half_size, 0.0])
 
     def geodesic_distance(self, points: np.ndarray, source: Sequence[float]) -> np.ndarray:
-        """Euclidean distance between the closest points."""
+        """Euclidean distance between the closest points.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points on (or near) the surface.
+        source : sequence of float
+            A point on the surface.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` exact geodesic distances (NaN where the formula does not apply).
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the surface's dimension.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.PlanePatch()
+        >>> d = s.geodesic_distance(np.atleast_2d(s.default_source), s.default_source)
+        """
         return np.linalg.norm(
             self._cp(np.asarray(points, dtype=float).reshape(-1, 3))
             - self._cp(np.asarray(source, dtype=float).reshape(1, 3)),
@@ -178,7 +342,31 @@ class PlanePatch(ClosestPoint):
         )
 
     def triangulation(self, n: int = 32) -> Tuple[np.ndarray, np.ndarray]:
-        """Regular (n × n quads) triangulation: ``(V, F)``."""
+        """Regular (n × n quads) triangulation: ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.PlanePatch()
+        >>> v, f = s.triangulation()
+        """
         s = self.half_size
         x, y = np.meshgrid(np.linspace(-s, s, n + 1), np.linspace(-s, s, n + 1), indexing="ij")
         return grid_mesh(np.stack([x, y, np.zeros_like(x)], -1) + self.center)
@@ -190,10 +378,7 @@ _MOBIUS_NUMPY_METHODS = ("point", "_derivs", "_interior", "_boundary", "_closest
 
 
 class MobiusBand(ClosestPoint):
-    """The Möbius band ``X(θ, s) = ((R + s cos(θ/2)) cos θ, (R + s cos(θ/2)) sin θ, s sin(θ/2))``,
-    ``θ ∈ [0, 2π)``, ``|s| ≤ w`` — open (its boundary is one closed curve, ``s = ±w``) and
-    non-orientable, so it has no signed distance; the extension direction ``(x − cp(x)) / |x − cp(x)|``
-    of Sect. 5.2 needs no orientation.
+    """The Möbius band: an open, non-orientable surface (no signed distance; none is needed).
 
     Parameters
     ----------
@@ -202,16 +387,29 @@ class MobiusBand(ClosestPoint):
     w : float
         Half-width of the band (default 0.3), ``0 < w < R``.
     newton_iterations : int
-        At most this many Newton steps per candidate (each point stops when its step falls below
-        1e-13; near the band 4–6 steps suffice).
+        At most this many Newton steps per point in the closest-point projection (each point
+        stops when its step falls below 1e-13; near the band 4–6 steps suffice).
 
-    Closest point by numerical projection, point by point in Rust (the NumPy formulation stays as
-    ``_closest_parameters_numpy``): the interior critical point of
-    ``½|X(θ, s) − x|²`` by Newton's method in (θ, s) from θ₀ = atan2(y, x) and s₀ the projection
-    on the ruling, and the nearest point of the boundary curve by Newton's method in θ with
-    s = ±w; the nearer admissible candidate wins (a minimum over a closed band is either an
-    interior critical point or on the boundary). There is no closed-form geodesic distance; the
-    tests compare with exact polyhedral geodesics on a fine :meth:`triangulation` (pygeodesic).
+    Raises
+    ------
+    ValueError
+        If a size is not positive and finite (or the sizes are inconsistent, e.g. a tube radius not
+        below the centre-circle radius), or the centre is not finite.
+
+    Notes
+    -----
+    ``X(θ, s) = ((R + s cos(θ/2)) cos θ, (R + s cos(θ/2)) sin θ, s sin(θ/2))``, ``θ ∈ [0, 2π)``,
+    ``|s| ≤ w``; its boundary is one closed curve (``s = ±w``). The extension direction
+    ``(x − cp(x)) / |x − cp(x)|`` of Sect. 5.2 needs no orientation. The closest point is found
+    point by point in Rust: Newton's method in (θ, s) for the interior critical point and in θ on
+    the boundary curve, the nearer admissible candidate winning. There is no closed-form geodesic
+    distance.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> m = ts.surfaces.MobiusBand()
+    >>> sol = ts.solve(m, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [m.default_source])
     """
 
     default_box = _CUBE
@@ -236,6 +434,27 @@ class MobiusBand(ClosestPoint):
 
     # --- parametrisation and derivatives ----------------------------------------------------
     def point(self, th: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """The band's point X(θ, s).
+
+        Parameters
+        ----------
+        th : numpy.ndarray
+            Angles θ.
+        s : numpy.ndarray
+            Offsets across the band, ``|s| ≤ w``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, 3)`` points.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.MobiusBand()
+        >>> s.point(np.array([0.0]), np.array([0.0])).round(6).tolist()
+        [[0.6, 0.0, 0.0]]
+        """
         th, s = np.broadcast_arrays(np.asarray(th, float), np.asarray(s, float))
         rho = self.R + s * np.cos(0.5 * th)
         return np.stack([rho * np.cos(th), rho * np.sin(th), s * np.sin(0.5 * th)], -1)
@@ -302,9 +521,26 @@ class MobiusBand(ClosestPoint):
         return th
 
     def closest_parameters(self, p: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-        """Parameters (θ, s) of the closest point of the band to each point of p (M, 3): the
-        algorithm of :meth:`_closest_parameters_numpy`, point by point in Rust on all threads
-        (``tubesweep_core::mobius``; equal to the NumPy version to rounding)."""
+        """Parameters (θ, s) of the closest point of the band to each point (in Rust, on all threads).
+
+        Parameters
+        ----------
+        p : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        theta : numpy.ndarray
+            ``(M,)`` angles.
+        s : numpy.ndarray
+            ``(M,)`` offsets across the band.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.MobiusBand()
+        >>> th, off = s.closest_parameters(np.array([[0.7, 0.0, 0.0]]))
+        """
         x = np.ascontiguousarray(np.asarray(p, dtype=float).reshape(-1, 3))
         if not all(getattr(type(self), m) is getattr(MobiusBand, m) for m in _MOBIUS_NUMPY_METHODS):
             # a subclass changed the band or its projection: the NumPy route follows the change
@@ -340,6 +576,30 @@ class MobiusBand(ClosestPoint):
         return np.array([self.R, 0.0, 0.0])
 
     def triangulation(self, n: int = 48) -> Tuple[np.ndarray, np.ndarray]:
-        """Parameter-grid triangulation (8n × n quads) with the half-twist seam merged: ``(V, F)``."""
+        """Parameter-grid triangulation (8n × n quads) with the half-twist seam merged: ``(V, F)``.
+
+        Parameters
+        ----------
+        n : int
+            Resolution (rings, sectors or polyline points; see the summary).
+
+        Returns
+        -------
+        vertices : numpy.ndarray
+            ``(V, d)`` points on the surface.
+        faces : numpy.ndarray
+            ``(F, 3)`` triangles (``(F, 2)`` segments for a curve).
+
+        Raises
+        ------
+        ValueError
+            If ``n`` is too small to make a mesh.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.MobiusBand()
+        >>> v, f = s.triangulation()
+        """
         th, s = np.meshgrid(np.linspace(0, 2 * np.pi, 8 * n + 1), np.linspace(-self.w, self.w, n + 1), indexing="ij")
         return grid_mesh(self.point(th, s))
