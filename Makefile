@@ -16,7 +16,7 @@ BUILT  := $(VENV)/.built
 RUNTIME_DEPS := "maturin>=1.5,<2" "numpy>=1.22" "matplotlib>=3.5" "scipy>=1.8" "scikit-image>=0.19" \
                 "meshio>=5" "trimesh>=3.9" "tqdm>=4"
 # pyproject.toml's test, bench and docs extras
-TEST_DEPS  := "pytest>=7" scikit-fmm pygeodesic potpourri3d geographiclib "dask>=2023.1" "distributed>=2023.1" \
+TEST_DEPS  := "pytest>=7" "hypothesis>=6" scikit-fmm pygeodesic potpourri3d geographiclib "dask>=2023.1" "distributed>=2023.1" \
               "cloudpickle>=2"
 BENCH_DEPS := potpourri3d pygeodesic scikit-fmm geographiclib
 DOCS_DEPS  := "mkdocs>=1.6,<2" "mkdocs-material>=9,<10" "mkdocstrings[python]>=0.26"

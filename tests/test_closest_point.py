@@ -131,7 +131,7 @@ def test_closest_point_validation():
     with pytest.raises(ValueError, match="NaN or inf"):
         ts.ClosestPoint(lambda x: x * np.nan).band(grid, 0.1)
     with pytest.raises(ValueError, match="2D but the grid is 3D|surface is 2D"):
-        ts.ClosestPoint(lambda x: x, ndim=2).band(grid, 0.1)
+        ts.ClosestPoint(lambda x: x[:, :2] * 0, ndim=2).band(grid, 0.1)
 
 
 # ---------------------------------------------------------------------------------- Möbius band

@@ -205,8 +205,11 @@ def test_errors_for_bad_surfaces_and_sources():
     with pytest.raises(ValueError, match="empty"):
         ts.solve(lambda p: np.linalg.norm(p, axis=1) - 5.0, g, [(0.5, 0.0)])
     bad = np.linalg.norm(np.stack(g.meshgrid(), -1), axis=-1) - 0.5
-    bad[3, 4] = np.nan
-    with pytest.raises(ValueError, match="NaN"):
+    bad[3, 4] = np.nan  # far from the circle: φ may be undefined there
+    far = ts.solve(bad, g, [(0.5, 0.0)])
+    assert np.array_equal(far.values, ts.solve(np.nan_to_num(bad, nan=1.0), g, [(0.5, 0.0)]).values)
+    bad[30, 20] = np.nan  # (0.5, 0): on the circle
+    with pytest.raises(ValueError, match="NaN or inf next to the surface"):
         ts.solve(bad, g, [(0.5, 0.0)])
     with pytest.raises(ValueError, match="NaN"):
         ts.solve(lambda p: np.where(p[:, 0] > 0.4, np.nan, np.linalg.norm(p, axis=1) - 0.5), g, [(-0.5, 0.0)])

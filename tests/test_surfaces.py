@@ -394,8 +394,13 @@ def test_sampled_phi_with_nan_or_inf_names_the_first_bad_index():
     phi = np.linspace(-1, 1, 21 * 22 * 23).reshape(21, 22, 23)
     phi[3, 4, 5] = np.inf
     phi[7, 0, 1] = np.nan
+    # refused where the band reads it (every node of this φ is within the tube of its zero set),
+    # or everywhere when re-distancing
+    grid = ts.Grid((-1, -1, -1), (1, 1.1, 1.2), (21, 22, 23))
+    with pytest.raises(ValueError, match=r"phi contains NaN or inf next to the surface"):
+        ts.LevelSet(phi).band(grid, 100.0)
     with pytest.raises(ValueError, match=r"phi contains NaN or inf \(first at index \(3, 4, 5\)\)"):
-        ts.LevelSet(phi)
+        ts.LevelSet(phi, redistance=True)
 
 
 @pytest.mark.parametrize(

@@ -25,6 +25,59 @@ ACTIVATION_FRACTION = 0.01
 FRONT_WINDOW = 2.0
 
 
+#: The largest magnitude of a travel time, a numerical infinity, a grid coordinate or a spacing,
+#: and the smallest spacing: the local updates square travel times across a cell (Lax–Friedrichs
+#: squares differences of neighbouring values, which overflow beyond about 1e154) and distances
+#: between coordinates (squares of 1e-200 underflow to 0), so the valid range keeps those squares,
+#: divided or multiplied by a spacing, inside the float64 range.
+MAX_MAGNITUDE = 1e100
+MIN_SPACING = 1e-100
+
+
+class ArgumentTypeError(TypeError, ValueError):
+    """A numeric argument of the wrong type (a bool, a string, None, a sequence): a ``TypeError``
+    that is also a ``ValueError``, so that code catching the argument's value errors catches it
+    too. Every numeric argument refuses the same types with it (see :func:`real_scalar` and
+    :func:`whole_number`)."""
+
+
+def _type_name(value: Any) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "a bool"
+    if isinstance(value, (str, bytes)):
+        return "a string"
+    if value is None:
+        return "None"
+    if np.ndim(value) != 0:
+        return f"an array of shape {np.shape(value)}"
+    return f"a {type(value).__name__}"
+
+
+def whole_number(value: Any, name: str, what: str = "a whole number") -> int:
+    """``value`` as an int: a Python or NumPy integer, a 0-d integer array, or a float with no
+    fraction. A bool, a string, None, a sequence, a complex number or a float with a fraction is
+    an :class:`ArgumentTypeError` that says ``name`` must be ``what``."""
+    if (
+        value is None
+        or isinstance(value, (bool, np.bool_, str, bytes))
+        or np.ndim(value) != 0
+        or np.iscomplexobj(value)
+        or np.asarray(value).dtype == bool
+    ):
+        raise ArgumentTypeError(f"{name} must be {what}; got {value!r} ({_type_name(value)})")
+    try:
+        if isinstance(value, (int, np.integer)) or (
+            isinstance(value, np.ndarray) and np.issubdtype(value.dtype, np.integer)
+        ):
+            return int(value)
+        f = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ArgumentTypeError(f"{name} must be {what}; got {value!r} ({_type_name(value)})") from None
+    if not (np.isfinite(f) and f == int(f)):
+        raise ArgumentTypeError(f"{name} must be {what}; got {value!r}")
+    return int(f)
+
+
 def as_grid(grid: Any) -> Grid:
     if not isinstance(grid, Grid):
         raise TypeError(
@@ -63,14 +116,26 @@ def real_scalar(value: Any, name: str, what: str = "a real number") -> float:
         or isinstance(value, (bool, np.bool_, str, bytes))
         or np.ndim(value) != 0
         or np.iscomplexobj(value)
+        or np.asarray(value).dtype == bool
     ):
-        raise TypeError(f"{name} must be {what}; got {value!r}")
+        raise ArgumentTypeError(f"{name} must be {what}; got {value!r} ({_type_name(value)})")
     try:
         return float(value)
     except OverflowError:
         return float("inf") if value > 0 else float("-inf")
     except (TypeError, ValueError):
-        raise TypeError(f"{name} must be {what}; got {value!r}") from None
+        raise ArgumentTypeError(f"{name} must be {what}; got {value!r} ({_type_name(value)})") from None
+
+
+def call_on_points(fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str) -> np.ndarray:
+    """A user's vectorised callable (φ, closest point, speed, flow, metric) at ``points``, as a
+    float array of its own. The callable gets a private copy of the points, so one that modifies
+    its argument in place cannot change the solver's coordinates (or the sources' closest points
+    they may be views of); what it returns is copied, so a view of its argument or an array it
+    keeps and changes later cannot change the solver's values; integers become floats. ``name``
+    (e.g. "cp's values") names it in the errors of :func:`real_array`."""
+    out = fn(np.array(points, dtype=float, copy=True))
+    return np.array(real_array(out, name), dtype=float, copy=True)
 
 
 def whole_indices(value: Any, name: str) -> np.ndarray:
@@ -126,16 +191,12 @@ MAX_ITERATIONS_LIMIT = 10**9
 
 
 def check_tolerance(tol: float, max_iterations: int) -> None:
-    if not (isinstance(tol, (int, float, np.floating)) and not isinstance(tol, bool) and np.isfinite(tol) and tol > 0):
-        raise ValueError(
-            f"tol must be a positive finite number (the sweeps stop once no value changes by more in an "
-            f"iteration); got {tol!r}"
-        )
-    if not (
-        isinstance(max_iterations, (int, np.integer))
-        and not isinstance(max_iterations, bool)
-        and 1 <= max_iterations <= MAX_ITERATIONS_LIMIT
-    ):
+    what = "a positive finite number (the sweeps stop once no value changes by more in an iteration)"
+    t = real_scalar(tol, "tol", what)
+    if not (np.isfinite(t) and t > 0):
+        raise ValueError(f"tol must be {what}; got {tol!r}")
+    m = whole_number(max_iterations, "max_iterations", f"an integer from 1 to {MAX_ITERATIONS_LIMIT:,}")
+    if not 1 <= m <= MAX_ITERATIONS_LIMIT:
         raise ValueError(
             f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}"
         )
@@ -163,6 +224,13 @@ def check_tolerance_scale(
             f"{cell:.3g} across one grid cell: {cell_time}); rescale the units of the grid or {rescale} so that "
             f"they are below about 1e100"
         )
+    if not scale > 1.0 / MAX_MAGNITUDE:
+        # their squares underflow: the Godunov update loses them (at speed 1e300 it was 15× short)
+        raise ValueError(
+            f"the travel times of this problem are too small to compute (about {scale:.3g} across the grid, "
+            f"{cell:.3g} across one grid cell: {cell_time}); rescale the units of the grid or {rescale} so that "
+            f"they are above about {1.0 / MAX_MAGNITUDE:g}"
+        )
     if tol >= 1e-2 * scale:
         raise ValueError(
             f"tol={tol:g} is not small against the travel times of this problem (about {scale:.3g} across the grid, "
@@ -175,7 +243,7 @@ def check_tolerance_scale(
 def speed_at_points(speed: Any, points: np.ndarray, what: str) -> np.ndarray:
     """A speed callable's values at ``points`` (source points, their closest points), checked as
     the values at the nodes are: one per point, finite and positive."""
-    vals = real_array(speed(points), "speed callable's values")
+    vals = call_on_points(speed, points, "speed callable's values")
     if vals.shape != (points.shape[0],):
         raise ValueError(
             f"speed callable must map points of shape (M, {points.shape[1]}) to values of shape (M,); "
@@ -203,21 +271,14 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
     callable ``f(points (M, d)) -> (M,)``.
     """
     if callable(speed):
-        vals = real_array(speed(points), "speed callable's values")
+        vals = call_on_points(speed, points, "speed callable's values")
         if vals.shape != (points.shape[0],):
             raise ValueError(
                 f"speed callable must map points of shape (M, {grid.ndim}) to values of shape (M,); "
                 f"returned shape {vals.shape} for M = {points.shape[0]}"
             )
     elif np.ndim(speed) == 0:
-        if np.iscomplexobj(speed):
-            raise TypeError(f"speed must be a real number; got {speed!r}")
-        try:
-            f = float(speed)
-        except (TypeError, ValueError):
-            raise TypeError(
-                f"speed must be a number, an array of grid.shape or a callable; got {type(speed).__name__}"
-            ) from None
+        f = real_scalar(speed, "speed", "a real number > 0, an array of grid.shape or a callable")
         if not np.isfinite(f) or f <= 0:
             raise ValueError(
                 f"speed must be positive and finite; got {f}. The speed F(x) > 0 is the wave speed in |∇u| = 1/F"
@@ -306,14 +367,21 @@ def check_infinity(infinity: Optional[float]) -> Optional[float]:
     that must be positive and finite."""
     if infinity is None:
         return None
-    if not (isinstance(infinity, (int, float, np.floating)) and np.isfinite(infinity) and infinity > 0):
-        raise ValueError(f"infinity must be a positive finite number (a 'numerical infinity'); got {infinity!r}")
-    return float(infinity)
+    what = f"a positive finite number up to {MAX_MAGNITUDE:g} (a 'numerical infinity' above every travel time)"
+    v = real_scalar(infinity, "infinity", what)
+    if not (np.isfinite(v) and 0 < v <= MAX_MAGNITUDE):
+        raise ValueError(
+            f"infinity must be {what}; got {infinity!r}. The Lax–Friedrichs update squares differences of "
+            f"values (beyond about 1e154 they overflow); leave it None for a safe bound derived from the band"
+        )
+    return v
 
 
 def check_threads(threads: int) -> int:
-    if not (isinstance(threads, (int, np.integer)) and not isinstance(threads, bool) and threads >= 0):
+    n = whole_number(threads, "threads", "a non-negative integer (0 = all cores)")
+    if n < 0:
         raise ValueError(f"threads must be a non-negative integer (0 = all cores); got {threads!r}")
+    threads = n
     # more threads than cores gain nothing (and thousands take minutes to start); the result is the
     # same bits for any count, so a larger request runs on all cores
     return min(int(threads), os.cpu_count() or 1)

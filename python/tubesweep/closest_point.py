@@ -27,7 +27,8 @@ from typing import Callable, Optional, Tuple
 import numpy as np
 
 from ._linalg import row_norms
-from ._validate import real_array
+from ._cp_checks import BAND_SAMPLE, check_band_sample, check_box_sample
+from ._validate import call_on_points
 from .grid import Grid
 from .surface import EVAL_CHUNK, BandGeometry, Surface, coarse_to_fine_candidates
 
@@ -38,24 +39,47 @@ __all__ = ["ClosestPoint", "DIRECTION_EPS"]
 DIRECTION_EPS = 1e-9
 
 
-def _evaluate_cp(cp: Callable[[np.ndarray], np.ndarray], points: np.ndarray) -> np.ndarray:
+def _evaluate_cp(cp: Callable[[np.ndarray], np.ndarray], points: np.ndarray, finite: bool = True) -> np.ndarray:
     m, d = points.shape
     out = np.empty((m, d))
     for s in range(0, m, EVAL_CHUNK):
         chunk = points[s : s + EVAL_CHUNK]
-        v = real_array(cp(chunk), "cp's values")
+        v = call_on_points(cp, chunk, "cp's values")
         if v.shape != chunk.shape:
             raise ValueError(
                 f"cp must map points of shape (M, {d}) to closest points of shape (M, {d}); it returned shape {v.shape} "
                 f"for M = {chunk.shape[0]}"
             )
         out[s : s + EVAL_CHUNK] = v
-    if not np.all(np.isfinite(out)):
+    if finite and not np.all(np.isfinite(out)):
         bad = int(np.flatnonzero(~np.isfinite(out).all(axis=1))[0])
         raise ValueError(
             f"cp returned NaN or inf at {tuple(float(x) for x in points[bad])}; it must be finite at every point near the surface"
         )
     return out
+
+
+def _refuse_undefined_next_to(grid: Grid, undefined: np.ndarray, linear: np.ndarray) -> None:
+    """Refuses candidate nodes where cp is not finite (``undefined``, linear indices) that are
+    grid neighbours of band nodes (``linear``, sorted): cp may be undefined far from the surface,
+    but such a node next to the band may be a band node lost."""
+    if undefined.size == 0 or linear.size == 0:
+        return
+    idx = grid.unravel(undefined)
+    for k in range(grid.ndim):
+        for side in (1, -1):
+            moved = idx.copy()
+            moved[:, k] += side
+            inside = (moved[:, k] >= 0) & (moved[:, k] < grid.shape[k])
+            lin = grid.linear_index(moved[inside])
+            at = np.minimum(np.searchsorted(linear, lin), len(linear) - 1)
+            hit = linear[at] == lin
+            if np.any(hit):
+                p = grid.points(idx[inside][hit][:1])[0]
+                raise ValueError(
+                    f"cp returned NaN or inf at {tuple(float(c) for c in p)}, next to the band; it must be "
+                    "finite at every point near the surface (it may be undefined far from it)"
+                )
 
 
 class ClosestPoint(Surface):
@@ -110,6 +134,8 @@ class ClosestPoint(Surface):
         if not (np.isfinite(lipschitz) and lipschitz >= 1.0):
             raise ValueError(f"lipschitz must be >= 1 (|x − cp(x)| is 1-Lipschitz for an exact cp); got {lipschitz}")
         self._cp = cp
+        #: the map's noise near the surface found by the last band (grid units; see _cp_checks)
+        self._noise = 0.0
         self.ndim = ndim
         self.lipschitz = float(lipschitz)
 
@@ -174,6 +200,13 @@ class ClosestPoint(Surface):
         p = np.asarray(points, dtype=float)
         return row_norms(p - self.closest_point(p))
 
+    def _far_distance(self, points: np.ndarray) -> np.ndarray:
+        """``|x − cp(x)|`` for the band search's samples, 0 where cp is not finite (such a block
+        may hold band nodes: it is kept and split)."""
+        p = np.asarray(points, dtype=float)
+        d = row_norms(p - _evaluate_cp(self._cp, p, finite=False))
+        return np.where(np.isfinite(d), d, 0.0)
+
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """The band of the surface on a grid: the nodes within ``half_width`` of it.
 
@@ -206,17 +239,22 @@ class ClosestPoint(Surface):
 
         self.check_grid(grid)
         d = grid.ndim
-        candidates = coarse_to_fine_candidates(grid, half_width, self.lipschitz, lambda p, reach: self.distance(p))
+        # cp may be NaN far from the surface (undefined there, e.g. on an axis): a coarse block whose
+        # centre has no closest point is kept and split; the candidates are checked below
+        # the identity, or a map whose points are not on a surface, refused before the search
+        check_box_sample(lambda p: _evaluate_cp(self._cp, p, finite=False), grid)
+        candidates = coarse_to_fine_candidates(grid, half_width, self.lipschitz, lambda p, reach: self._far_distance(p))
         # cp once per candidate, chunk by chunk: the distances select the band, and the kept
         # offsets x − cp(x) give its directions (no second cp evaluation at the band's nodes)
         shape, lower = list(grid.shape), [float(x) for x in grid.lower]
-        parts_lin, parts_norm, parts_diff = [], [], []
+        parts_lin, parts_norm, parts_diff, undefined = [], [], [], []
         for s0 in range(0, len(candidates), EVAL_CHUNK):
             lin = candidates[s0 : s0 + EVAL_CHUNK]
             x = _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing)
-            diff = x - self.closest_point(x)
+            diff = x - _evaluate_cp(self._cp, x, finite=False)
             norm = row_norms(diff)
-            keep = norm <= half_width
+            keep = norm <= half_width  # (False where cp is not finite)
+            undefined.append(lin[~np.isfinite(norm)])
             parts_lin.append(lin[keep])
             parts_norm.append(norm[keep])
             parts_diff.append(diff[keep])
@@ -226,6 +264,12 @@ class ClosestPoint(Surface):
         linear = np.concatenate(parts_lin)
         norm = np.concatenate(parts_norm)
         diff = np.concatenate(parts_diff)
+        _refuse_undefined_next_to(grid, np.concatenate(undefined), linear)
+        # a sample of the band: idempotence and the nearest-point property near the surface, and
+        # the map's noise there (for the facing-sheets test, solve._warn_if_tubes_touch)
+        pick = np.linspace(0, len(linear) - 1, min(len(linear), BAND_SAMPLE)).astype(np.int64)
+        xs = grid.node_points(linear[pick])
+        self._noise = check_band_sample(lambda p: _evaluate_cp(self._cp, p, finite=False), xs, xs - diff[pick], grid)
         ok = norm > DIRECTION_EPS * grid.spacing
         direction = np.zeros((len(linear), d))
         direction[ok] = diff[ok] / norm[ok, None]

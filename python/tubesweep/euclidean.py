@@ -24,6 +24,7 @@ from ._validate import (
     speed_values,
     warn_unconverged,
 )
+from ._result_check import check_values
 from .grid import Grid
 from .stats import SolveStats
 
@@ -34,7 +35,9 @@ __all__ = ["travel_time", "SOURCE_RADIUS"]
 #: costs no O(1) error (scikit-fmm's 1.707 instead of √2 one cell off a source).
 SOURCE_RADIUS = 2.0
 
-_BYTES_PER_BOX_NODE = 8 + 4 + 1 + 8  # values + last index + role + output copy (the fixed values are sparse)
+# values + output copy + role + the box's band (last index 4, neighbour table 4·2(d − 1) ≤ 16, row
+# flags 1, schedule about 1); the fixed values are sparse
+_BYTES_PER_BOX_NODE = 8 + 8 + 1 + 4 + 16 + 1 + 1
 
 
 @lru_cache(maxsize=2)
@@ -175,9 +178,10 @@ def travel_time(
     scheme = check_hamiltonian(hamiltonian)
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
-    check_memory(
-        grid.size * _BYTES_PER_BOX_NODE, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver"
-    )
+    # before anything of the box's size is allocated (a callable speed also takes the nodes'
+    # coordinates, twice: the meshgrid and the stacked points)
+    per_node = _BYTES_PER_BOX_NODE + (16 * grid.ndim if callable(speed) else 0)
+    check_memory(grid.size * per_node, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver")
 
     if callable(speed) or np.ndim(speed) > 0:
         pts = (
@@ -223,6 +227,7 @@ def travel_time(
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf
+    check_values(grid, band, values, None, st, _infinity(infinity))  # every node of the box is reachable
     u = values.reshape(grid.shape)
     if not return_stats:
         return u

@@ -2,13 +2,27 @@
 
 from __future__ import annotations
 
+import math
 from typing import Sequence, Tuple
 
 import numpy as np
 
-__all__ = ["Grid"]
+__all__ = ["Grid", "MAX_NODES", "MAX_COORDINATE", "MIN_SPACING", "RESOLUTION"]
 
 _SPACING_RTOL = 1e-9
+
+#: The most nodes a grid may have: its C-order linear indices are int64 (and the core's u64),
+#: counted with Python integers so that no product of the shape wraps.
+MAX_NODES = 2**63 - 1
+#: The valid range of the coordinates and the spacing: the solver keeps φ in single precision
+#: (float32 holds 1.2e-38 to 3.4e38; at coordinates of 1e60 the band's φ overflowed to inf), and
+#: squares distances and travel times (``_validate.MAX_MAGNITUDE``).
+MAX_COORDINATE = 1e30
+MIN_SPACING = 1e-30
+#: The smallest spacing relative to the largest coordinate magnitude of the box: float64 holds a
+#: coordinate to about 1.1e-16 of it, so a spacing of 1e-11 of it keeps the nodes' positions and
+#: the differences of φ between neighbours accurate to about 2e-5 of a spacing.
+RESOLUTION = 1e-11
 
 
 class Grid:
@@ -42,20 +56,41 @@ class Grid:
     """
 
     def __init__(self, lower: Sequence[float], upper: Sequence[float], shape: Sequence[int]):
-        try:
-            lo = np.asarray(lower, dtype=float).reshape(-1)
-            hi = np.asarray(upper, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise TypeError(f"lower and upper must be sequences of real numbers; got {lower!r} and {upper!r}") from None
-        try:
-            if isinstance(shape, (str, bytes)):
+        from ._validate import ArgumentTypeError, whole_number
+
+        def numbers(corner: Sequence[float]) -> np.ndarray:
+            # every element one real number: not a bool, string, None or sequence (NumPy would read
+            # True as 1, "1" as 1.0 and None as NaN)
+            items = (
+                [corner]
+                if isinstance(corner, (str, bytes)) or corner is None
+                else list(np.asarray(corner, dtype=object).reshape(-1))
+            )
+            if not items or any(
+                x is None or isinstance(x, (str, bytes, bool, np.bool_)) or np.ndim(x) != 0 for x in items
+            ):
                 raise TypeError
-            whole = all(not isinstance(n, bool) and float(n) == int(n) for n in shape)
-            shp = tuple(int(n) for n in shape)
-        except (TypeError, ValueError, OverflowError):
-            raise TypeError(f"shape must be a sequence of whole numbers of nodes per axis, got {shape!r}") from None
-        if not whole:
-            raise ValueError(f"shape must hold whole numbers of nodes per axis, got {shape!r}")
+            return np.asarray(corner, dtype=float).reshape(-1)
+
+        try:
+            lo, hi = numbers(lower), numbers(upper)
+        except (TypeError, ValueError):
+            raise ArgumentTypeError(
+                f"lower and upper must be sequences of real numbers (not bools, strings or None); got "
+                f"{lower!r} and {upper!r}"
+            ) from None
+        try:
+            if isinstance(shape, (str, bytes)) or np.ndim(shape) != 1:
+                raise TypeError
+            items = list(shape)
+        except (TypeError, ValueError):
+            raise ArgumentTypeError(
+                f"shape must be a sequence of whole numbers of nodes per axis, got {shape!r}"
+            ) from None
+        try:
+            shp = tuple(whole_number(n, "shape", "whole numbers of nodes per axis") for n in items)
+        except ArgumentTypeError:
+            raise ArgumentTypeError(f"shape must hold whole numbers of nodes per axis, got {shape!r}") from None
         if not (lo.size == hi.size == len(shp)):
             raise ValueError(
                 f"lower, upper and shape must have the same length (2 or 3); got {lo.size}, {hi.size}, {len(shp)}"
@@ -64,13 +99,38 @@ class Grid:
             raise ValueError(f"only 2D and 3D grids are supported; got {len(shp)} axes")
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
             raise ValueError("lower and upper must be finite")
+        big = float(max(np.max(np.abs(lo)), np.max(np.abs(hi))))
+        if big > MAX_COORDINATE:
+            raise ValueError(
+                f"the grid's coordinates must lie within ±{MAX_COORDINATE:g}; got a corner at {big:.3g}. The "
+                "solver squares distances and travel times, which overflow beyond that: rescale the units"
+            )
+        nodes = math.prod(shp)
+        if nodes > MAX_NODES:
+            raise ValueError(
+                f"shape {shp} has {nodes:.3g} nodes; at most 2^63 - 1 are supported (64-bit node indices). "
+                "Use fewer nodes per axis"
+            )
         for k, n in enumerate(shp):
             if n < 3:
                 raise ValueError(f"shape[{k}] = {n}: every axis needs at least 3 nodes")
             if not hi[k] > lo[k]:
                 raise ValueError(f"upper[{k}] = {hi[k]} must be greater than lower[{k}] = {lo[k]}")
-        steps = (hi - lo) / (np.asarray(shp) - 1)
+        steps = (hi - lo) / (np.asarray(shp, dtype=float) - 1)
         h = steps[0]
+        if not MIN_SPACING <= h:
+            raise ValueError(
+                f"the grid spacing {h:.3g} is below {MIN_SPACING:g}: the solver keeps φ in single precision "
+                "(float32), which cannot resolve it. Rescale the units of the grid (and of the surface)"
+            )
+        if h < RESOLUTION * big:
+            raise ValueError(
+                f"the grid spacing {h:.3g} is below the resolution of its coordinates: float64 stores a coordinate of "
+                f"magnitude {big:.3g} to about {big * 2.2e-16:.2g}, so the nodes' positions and φ's differences between "
+                f"neighbours would be mostly rounding. The spacing must be at least {RESOLUTION:g} × the largest "
+                f"coordinate ({RESOLUTION * big:.3g}): shift the coordinates (e.g. subtract the box's centre) or use "
+                "fewer nodes"
+            )
         for k in range(1, len(shp)):
             if abs(steps[k] - h) > _SPACING_RTOL * h:
                 fix_n = (hi[k] - lo[k]) / h + 1
@@ -111,7 +171,7 @@ class Grid:
     @property
     def size(self) -> int:
         """Number of nodes in the box."""
-        return int(np.prod(self._shape))
+        return math.prod(self._shape)  # a Python int: no int64 product to wrap
 
     def __repr__(self) -> str:
         return (

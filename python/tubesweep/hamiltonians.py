@@ -26,7 +26,7 @@ from typing import Any, Callable, Dict, Optional, Sequence
 import numpy as np
 
 from .grid import Grid
-from ._validate import check_tolerance_scale, real_array
+from ._validate import call_on_points, check_tolerance_scale, real_array
 from ._warn import user_stacklevel
 
 __all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
@@ -83,7 +83,7 @@ def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail:
     """A per-node field from a constant, an array of ``grid.shape + tail``, or a callable on points."""
     want = (len(linear),) + tail
     if callable(value):
-        out = real_array(value(points), f"{name} callable's values")
+        out = call_on_points(value, points, f"{name} callable's values")
         if out.shape != want:
             raise ValueError(
                 f"{name} callable must map points (M, {grid.ndim}) to an array of shape (M,)+{tail}; "

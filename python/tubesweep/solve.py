@@ -32,6 +32,7 @@ from ._validate import (
     speed_values,
     warn_unconverged,
 )
+from ._result_check import check_values
 from .grid import Grid
 from .stats import SolveStats
 from .surface import BandGeometry, Surface, as_surface, band_neighbours
@@ -497,6 +498,11 @@ class Solution:
         (101, 101)
         """
         value = real_scalar(fill, "fill", "a real number (the value outside the band, NaN by default)")
+        check_memory(
+            8 * self.grid.size,
+            f"the dense {self.grid.shape} array",
+            "keep the band's values (sol.values) or interpolate at the points you need (sol(points))",
+        )
         out = np.full(self.grid.size, value, dtype=float)
         out[self.linear] = self.values
         return out.reshape(self.grid.shape)
@@ -845,6 +851,7 @@ def _warn_if_tubes_touch(
     direction: np.ndarray,
     inner: float,
     kink: Optional[np.ndarray] = None,
+    noise: float = 0.0,
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
@@ -858,6 +865,13 @@ def _warn_if_tubes_touch(
         np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim),
         h,
     )
+    if noise > 0 and node.size:
+        # a noisy closest-point map (``_cp_checks``): nodes within a few times its noise of the
+        # surface have directions the noise can turn around, which the facing test would read as
+        # two sheets (at noise 0.01 spacings, 13 pairs on a sphere); they are left out
+        clear = 4.0 * noise
+        keep = (np.abs(phi[node]) > clear) & (np.abs(phi[neighbour]) > clear)
+        node, neighbour, gap = node[keep], neighbour[keep], gap[keep]
     ridge = _ridge_pairs(grid, band, linear, roles, phi, kink)
     if ridge[0].size:
         node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip((node, neighbour, gap), ridge))
@@ -916,12 +930,41 @@ def _check_surface_spans_two_cells(
     if closest.size == 0:
         return
     extent = float(np.max(np.ptp(closest, axis=0)))
+    if extent == 0.0:
+        raise ValueError(
+            "the surface is a single point: every node of the inner tube has the same closest point "
+            f"{tuple(float(x) for x in closest[0])}, so there is no curve or surface to solve on (for a "
+            "closest-point map, check that cp returns the nearest point of the surface)"
+        )
     if extent < 2.0 * h:
         raise ValueError(
             f"the grid is too coarse for this surface: the surface spans only {extent:.3g} along the longest side of "
             f"its bounding box (from the inner tube's closest points), less than two grid spacings (h = {h:.4g}), so the "
             f"grid cannot resolve it; refine the grid to a spacing below {extent / 2:.3g}, or shrink the box"
         )
+
+
+def _widening_message(missing: np.ndarray, phi: np.ndarray, h: float, inner: float, outer: float) -> str:
+    """Why inner-tube nodes (band positions ``missing``) lack a neighbour in the band of half-width
+    ``outer`` spacings. For a distance function a neighbour lies at most one spacing farther from
+    the surface, so an inner node within ``outer − 1`` spacings of it whose neighbour falls
+    outside says φ is not a distance function there; when every such node lies beyond that (only
+    possible when ``outer − inner`` is about 1) the extension layer is merely too thin to hold the
+    neighbours, rounding included, and φ is not to blame."""
+    far = np.abs(phi[missing].astype(float)) > (outer - 1.0) * h * (1 - 1e-6)
+    widen = f"Widening the extension layer to outer = {outer + 1}"
+    if np.all(far):
+        return (
+            f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: the extension "
+            f"layer (outer − inner = {outer - inner:g} grid spacings) is too thin to hold every neighbour of the inner "
+            f"tube (a neighbour can lie a full spacing farther out, and rounding puts some just beyond). {widen}; "
+            "pass outer ≥ inner + 2 to avoid this"
+        )
+    return (
+        f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: φ is not close to a "
+        f"distance function there (at {int(np.count_nonzero(~far))} of them the neighbour is more than one spacing "
+        f"farther out in φ). {widen}"
+    )
 
 
 def _prepare_tube(
@@ -933,13 +976,13 @@ def _prepare_tube(
     t0 = time.perf_counter()
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
+    widths = []
     for name, val in (("inner", inner), ("outer", outer)):
-        if not (
-            isinstance(val, (int, float, np.floating, np.integer))
-            and not isinstance(val, (bool, np.bool_))
-            and np.isfinite(val)
-        ):
+        w = real_scalar(val, name, "a finite number of grid spacings")
+        if not np.isfinite(w):
             raise ValueError(f"{name} must be a finite number of grid spacings; got {val!r}")
+        widths.append(w)
+    inner, outer = widths
     if inner < 1.0:
         raise ValueError(
             f"inner = {inner} grid spacings is thinner than the grid can resolve: the inner tube needs at least 1 "
@@ -1038,14 +1081,19 @@ def _prepare_tube(
                 )
             )
         warnings.warn(
-            f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer_eff}: φ is not "
-            f"close to a distance function there. Widening the extension layer to outer = {outer_eff + 1}",
-            RuntimeWarning,
-            stacklevel=user_stacklevel(),
+            _widening_message(missing, phi, h, inner, outer_eff), RuntimeWarning, stacklevel=user_stacklevel()
         )
         outer_eff += 1.0
     facing = _warn_if_tubes_touch(
-        grid, band, linear, roles, phi, direction if direction is not None else geom.direction, inner, kink
+        grid,
+        band,
+        linear,
+        roles,
+        phi,
+        direction if direction is not None else geom.direction,
+        inner,
+        kink,
+        float(getattr(surf, "_noise", 0.0)),
     )
     return _PreparedTube(
         grid,
@@ -1186,6 +1234,16 @@ def _solve_on_tube(
         )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
+    # no NaN, and no inf next to a reached node in a solve reported converged
+    check_values(
+        grid,
+        band,
+        values,
+        roles != ROLE_OUTER,
+        st,
+        _infinity(infinity),
+        reachability=general is None or general.label == "isotropic",
+    )
     n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
     # held per node during the sweeps: values (f64), role, active flag and coupling mask, φ (f32),
     # extension weights (d × f32), per-node slowness (f64) when the speed varies; per row a lower

@@ -21,7 +21,7 @@ from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 import numpy as np
 
 from .grid import Grid
-from ._validate import real_array, real_scalar
+from ._validate import call_on_points, real_array, real_scalar
 from ._warn import user_stacklevel
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
@@ -241,21 +241,22 @@ class Surface:
 
 
 def _evaluate(
-    fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, out_shape: Tuple[int, ...] = ()
+    fn: Callable[[np.ndarray], Any], points: np.ndarray, name: str, out_shape: Tuple[int, ...] = (), finite: bool = True
 ) -> np.ndarray:
-    """Calls a user's vectorised function in chunks and checks what comes back."""
+    """Calls a user's vectorised function in chunks and checks what comes back (NaN and inf are
+    refused unless ``finite`` is False: the band search's samples far from the surface)."""
     m = points.shape[0]
     out = np.empty((m,) + out_shape)
     for s in range(0, m, EVAL_CHUNK):
         chunk = points[s : s + EVAL_CHUNK]
-        v = real_array(fn(chunk), f"the values of the {name}")
+        v = call_on_points(fn, chunk, f"the values of the {name}")
         if v.shape != (chunk.shape[0],) + out_shape:
             raise ValueError(
                 f"{name} must map points of shape (M, {points.shape[1]}) to an array of shape (M{''.join(', ' + str(n) for n in out_shape)}); "
                 f"it returned shape {v.shape} for M = {chunk.shape[0]}"
             )
         out[s : s + EVAL_CHUNK] = v
-    if not np.all(np.isfinite(out)):
+    if finite and not np.all(np.isfinite(out)):
         bad = np.flatnonzero(~np.isfinite(out.reshape(m, -1)).all(axis=1))[0]
         raise ValueError(
             f"{name} returned NaN or inf at {tuple(float(x) for x in points[bad])}; it must be finite near the surface"
@@ -332,7 +333,16 @@ def discover_band(
     """Grid nodes with ``|fn| ≤ half_width`` for a level set function ``fn``, found coarse-to-fine
     (:func:`coarse_to_fine_candidates`). Returns sorted linear indices and the values of ``fn``
     there."""
-    candidates = coarse_to_fine_candidates(grid, half_width, lipschitz, lambda p, reach: np.abs(_evaluate(fn, p, name)))
+
+    # φ may be NaN or inf far from the surface (undefined there): a block whose centre has no
+    # finite value may still hold band nodes, so it is kept and split (the search's work then grows
+    # with the volume where φ is not finite), and the nodes without a value are left out at the
+    # end; the nodes next to the band are checked at its rim (LevelSet.band)
+    def distance(p: np.ndarray, reach: float) -> np.ndarray:
+        v = np.abs(_evaluate(fn, p, name, finite=False))
+        return np.where(np.isfinite(v), v, 0.0)
+
+    candidates = coarse_to_fine_candidates(grid, half_width, lipschitz, distance)
     from . import _native
 
     shape, lower = list(grid.shape), [float(x) for x in grid.lower]
@@ -345,7 +355,7 @@ def discover_band(
     for s0 in range(0, len(candidates), EVAL_CHUNK):
         lin = candidates[s0 : s0 + EVAL_CHUNK]
         # the node coordinates in Rust (the bits of Grid.points, without the (M, d) int64 indices)
-        v = _evaluate(fn, _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing), name)
+        v = _evaluate(fn, _native.node_points(shape, lin.view(np.uint64), lower, grid.spacing), name, finite=False)
         # the nodes with |φ| ≤ half_width, copied in order to the fronts of the outputs (in Rust)
         kept += _native.keep_within(lin.view(np.uint64), v, half_width, linear[kept:].view(np.uint64), values[kept:])
     del candidates, lin  # (lin is a view of them)
@@ -428,6 +438,7 @@ class LevelSet(Surface):
         lipschitz: Optional[float] = None,
         redistance: bool = False,
     ):
+        self._non_finite: Optional[tuple] = None
         if callable(phi):
             self._fn: Optional[Callable[[np.ndarray], np.ndarray]] = phi
             self._array: Optional[np.ndarray] = None
@@ -435,14 +446,20 @@ class LevelSet(Surface):
             from . import _native
 
             # C order, as the core reads it (no copy for a C-ordered float64 array)
-            arr = np.ascontiguousarray(real_array(phi, "phi array"))
-            if arr.ndim not in (2, 3):
-                raise ValueError(f"phi array must be 2D or 3D (the grid's shape); got {arr.ndim} dimensions")
-            bad = _native.first_non_finite(arr)
-            if bad is not None:
-                i = np.unravel_index(bad, arr.shape)
+            arr = real_array(phi, "phi array")
+            if arr.ndim not in (2, 3):  # before ascontiguousarray, which makes a 0-d array 1-d
                 raise ValueError(
-                    f"phi contains NaN or inf (first at index {tuple(int(x) for x in i)}); φ must be finite"
+                    f"phi array must be 2D or 3D (the grid's shape); got {arr.ndim} dimensions (shape {arr.shape})"
+                )
+            arr = np.ascontiguousarray(arr)
+            # NaN or inf far from the surface (φ undefined there) is fine: the band never reads it,
+            # and the band's search checks that none lies next to the band (see band())
+            bad = _native.first_non_finite(arr)
+            self._non_finite = None if bad is None else tuple(int(x) for x in np.unravel_index(bad, arr.shape))
+            if self._non_finite is not None and redistance:
+                raise ValueError(
+                    f"phi contains NaN or inf (first at index {self._non_finite}); with redistance=True "
+                    "φ must be finite everywhere"
                 )
             self._fn = None
             self._array = arr
@@ -627,6 +644,11 @@ class LevelSet(Surface):
         else:
             linear, values = discover_band(self._fn, grid, half_width, self.lipschitz)  # type: ignore[arg-type]
         if linear.size == 0:
+            if self._non_finite is not None:
+                raise ValueError(
+                    f"phi contains NaN or inf (first at index {self._non_finite}) and no grid node with a "
+                    "finite φ lies within the tube: φ must be finite near the surface"
+                )
             return BandGeometry(linear, values, values, np.zeros((0, grid.ndim), np.float32))
         # the solver's band structure, built now: the solver takes it over (and for a callable φ
         # its neighbours give the outward directions, no separate neighbour search)
@@ -644,6 +666,15 @@ class LevelSet(Surface):
             else:
                 norm = self._outward_directions(grid, linear, values, lo, hi, direction[lo:hi], native_band)
             norms[lo:hi] = norm
+        if self._non_finite is not None and not np.all(np.isfinite(norms)):
+            # a NaN or inf sample next to a band node (its central differences read it)
+            at = int(np.flatnonzero(~np.isfinite(norms))[0])
+            where = tuple(int(x) for x in np.unravel_index(int(linear[at]), grid.shape))
+            raise ValueError(
+                f"phi contains NaN or inf next to the surface: a neighbour of the band node at index {where} (within "
+                f"{half_width / grid.spacing:g} grid spacings of the surface) is not finite. φ may be NaN far from the "
+                "surface, but must be finite within the tube and one grid spacing beyond it"
+            )
         # bounded in single precision, as the library surfaces' band call returns |∇φ|
         self._check_distance_like(*_norm_bounds(values, norms, half_width)[:2])
         # distance = |φ|, not stored

@@ -212,25 +212,10 @@ def read_obj(file: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
     >>> int(f.max()) < len(v)
     True
     """
+    from ..surfaces._mesh_files import read_obj_file
+
     file = Path(file)
     if not file.is_file():
         raise FileNotFoundError(f"mesh file {str(file)!r} does not exist")
-    opener = gzip.open if file.suffix == ".gz" else open
-    verts = []
-    tris = []
-    with opener(file, "rt", encoding="utf-8", errors="replace") as fh:
-        for line in fh:
-            if line.startswith("v "):
-                verts.append(line.split()[1:4])
-            elif line.startswith("f "):
-                idx = [int(t.split("/")[0]) for t in line.split()[1:]]
-                n = len(verts)
-                idx = [i - 1 if i > 0 else n + i for i in idx]  # OBJ: 1-based, negative = relative
-                tris.extend([idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1))
-    if not verts or not tris:
-        raise ValueError(f"{file}: no {'vertices' if not verts else 'faces'} found in this OBJ file")
-    v = np.asarray(verts, dtype=float)
-    f = np.asarray(tris, dtype=np.int64)
-    if f.min() < 0 or f.max() >= len(v):
-        raise ValueError(f"{file}: a face refers to a vertex that does not exist")
-    return v, f
+    # the robust reader (indentation, tabs, comments; dropped records reported)
+    return read_obj_file(file)

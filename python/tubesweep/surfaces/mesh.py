@@ -23,6 +23,7 @@ meshio). ``(V, F)`` arrays need nothing beyond numpy.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any, List, Optional, Sequence, Tuple, Union
 
@@ -31,11 +32,13 @@ import numpy as np
 from ..grid import Grid
 from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
 from .._validate import real_array, real_scalar, whole_indices
+from ..grid import MAX_COORDINATE
+from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_library
 from .analytic import finite_center, size_parameter
 
 __all__ = ["from_mesh", "MeshSurface", "read_mesh", "closest_points_on_triangles"]
 
-_MESH_EXTRA = "pip install 'tubesweep[mesh]'"
+_MESH_EXTRA = MESH_EXTRA
 
 
 # ---------------------------------------------------------------------------------------------
@@ -44,9 +47,12 @@ _MESH_EXTRA = "pip install 'tubesweep[mesh]'"
 def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
     """Vertices (n, 3) float64 and triangles (m, 3) int64 of an OBJ / PLY / STL / OFF file.
 
-    Uses trimesh when installed (without merging or re-ordering vertices, so vertex indices are
-    those of the file), otherwise meshio; polygons are fan-triangulated. ``.obj.gz`` files (the
-    bundled examples) are read with numpy alone.
+    OBJ and OFF (also gzip-compressed, ``.obj.gz``) are read with numpy only, line by line
+    (:mod:`tubesweep.surfaces._mesh_files`: indentation, tabs, comments, polygons and relative
+    indices are fine, and a record that cannot be used is an error or a warning that says how many
+    were dropped); PLY and STL need trimesh or meshio (the ``mesh`` extra), and the counts their
+    headers declare are checked. Vertex indices are those of the file; polygons are
+    fan-triangulated.
 
     Parameters
     ----------
@@ -82,44 +88,12 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
         raise IsADirectoryError(f"mesh file {str(path)!r} is a directory, not a mesh file")
     if not path.is_file():
         raise FileNotFoundError(f"mesh file {str(path)!r} does not exist")
-    if path.name.lower().endswith(".obj.gz"):  # the bundled example meshes (tubesweep.data)
-        from ..data import read_obj
-
-        return read_obj(path)
-    try:
-        import trimesh  # noqa: F401
-    except ImportError:
-        trimesh = None
-    if trimesh is not None:
-        try:
-            m = trimesh.load(str(path), force="mesh", process=False, maintain_order=True)
-        except (ValueError, IndexError, KeyError, TypeError, AttributeError) as e:
-            raise ValueError(
-                f"{path}: not a readable triangle mesh ({type(e).__name__}: {e}); tubesweep reads OBJ, "
-                "PLY, STL and OFF files"
-            ) from None
-        v = np.asarray(m.vertices, dtype=float)
-        f = np.asarray(m.faces, dtype=np.int64)
-        if f.size == 0:
-            raise ValueError(f"{path}: no triangles found (is it a point cloud?)")
-        return v, f
-    try:
-        import meshio
-    except ImportError:
-        raise ImportError(f"reading {path.suffix or 'mesh'} files needs trimesh or meshio: {_MESH_EXTRA}") from None
-    m = meshio.read(str(path))
-    v = np.asarray(m.points, dtype=float)[:, :3]
-    tris: List[np.ndarray] = []
-    for block in m.cells:
-        data = np.asarray(block.data, dtype=np.int64)
-        if block.type == "triangle":
-            tris.append(data)
-        elif block.type in ("quad", "polygon") or data.shape[1] > 3:
-            for k in range(1, data.shape[1] - 1):  # fan triangulation of convex polygons
-                tris.append(data[:, [0, k, k + 1]])
-    if not tris:
-        raise ValueError(f"{path}: no triangles or polygons found")
-    return v, np.concatenate(tris)
+    name = path.name.lower()
+    if name.endswith(".obj") or name.endswith(".obj.gz"):
+        return read_obj_file(path)
+    if name.endswith(".off") or name.endswith(".off.gz"):
+        return read_off_file(path)
+    return read_with_library(path)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -259,18 +233,47 @@ class MeshSurface(Surface):
         scale: float = 1.0,
         offset: Optional[np.ndarray] = None,
     ):
-        v = np.ascontiguousarray(real_array(vertices, "vertices"))
-        f = np.ascontiguousarray(whole_indices(faces, "faces"))
+        v = real_array(vertices, "vertices")
+        f = whole_indices(faces, "faces")
+        # the shapes before ascontiguousarray, which makes a 0-d array 1-d
         if v.ndim != 2 or v.shape[1] != 3:
-            raise ValueError(f"vertices must have shape (n, 3); got {v.shape}")
+            raise ValueError(f"vertices must have shape (n, 3); got {v.shape} ({v.ndim} dimensions)")
         if f.ndim != 2 or f.shape[1] != 3:
             raise ValueError(f"faces must be triangles, shape (m, 3); got {f.shape} (triangulate polygons first)")
+        v, f = np.ascontiguousarray(v), np.ascontiguousarray(f)
         if f.size == 0:
             raise ValueError("the mesh has no faces")
         if f.min() < 0 or f.max() >= len(v):
             raise ValueError(f"faces index vertices 0..{len(v) - 1} but contain {int(f.min())}..{int(f.max())}")
-        if not np.all(np.isfinite(v)):
-            raise ValueError("vertices contain NaN or inf")
+        finite = np.all(np.isfinite(v), axis=1)
+        if not np.all(finite):
+            bad = np.flatnonzero(~finite)
+            used = int(np.count_nonzero(np.isin(f, bad).any(axis=1)))
+            raise ValueError(
+                f"vertices contain NaN or inf: {bad.size} vertices (the first, index {int(bad[0])}: "
+                f"{tuple(float(x) for x in v[bad[0]])}), used by {used} faces. Every vertex must be finite "
+                "(drop the unused ones, or repair the file)"
+            )
+        big = float(np.max(np.abs(v))) if v.size else 0.0
+        if big > MAX_COORDINATE:
+            raise ValueError(
+                f"vertices have coordinates up to {big:.3g}; they must lie within ±{MAX_COORDINATE:g} "
+                "(the solver keeps distances in single precision). Rescale the mesh, e.g. "
+                "from_mesh(..., normalize=True)"
+            )
+        # a triangle listed twice (the same three vertices) adds nothing to the surface, but would
+        # count its edges twice and make a closed mesh look open: kept once, with a warning
+        _, first = np.unique(np.sort(f, axis=1), axis=0, return_index=True)
+        #: the number of repeated triangles dropped from ``faces``
+        self.duplicate_faces = int(len(f) - len(first))
+        if self.duplicate_faces:
+            warnings.warn(
+                f"the mesh lists {self.duplicate_faces} triangles more than once (the same three vertices); "
+                "each is kept once (surface.faces holds the rest, in the file's order)",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+            f = np.ascontiguousarray(f[np.sort(first)])
         self.vertices = v
         self.faces = f
         self.name = name

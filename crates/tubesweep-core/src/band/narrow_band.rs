@@ -19,6 +19,7 @@
 //! (17 in 3D).
 
 use crate::band::schedule::{SweepSchedule, LONG_SIDE, THIN_SIDE};
+use crate::error::try_filled;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -89,8 +90,7 @@ impl<const D: usize> NarrowBand<D> {
     /// Builds the band from the C-order linear indices of its nodes, which must be strictly
     /// increasing (sorted, no duplicates) and inside the grid of shape `shape`.
     pub fn from_sorted_linear(shape: [usize; D], linear: &[u64]) -> Result<Self> {
-        check_shape(&shape)?;
-        let total: u64 = shape.iter().map(|&n| n as u64).product();
+        let total = check_shape(&shape)?;
         if linear.len() >= u32::MAX as usize {
             return Err(Error::invalid(
                 "indices",
@@ -130,42 +130,52 @@ impl<const D: usize> NarrowBand<D> {
             last.push((l - row_begin) as u32);
         }
         row_start.push(linear.len() as u32);
-        Ok(Self::assemble(shape, row_keys, row_start, last))
+        Self::assemble(shape, row_keys, row_start, last)
     }
 
     /// The whole box as a band (used by the Euclidean solver of Sect. 2).
     pub fn full_box(shape: [usize; D]) -> Result<Self> {
-        check_shape(&shape)?;
-        let n_last = shape[D - 1];
-        let n_rows: usize = shape[..D - 1].iter().product();
-        let total = n_rows * n_last;
-        if total >= u32::MAX as usize {
+        let total = check_shape(&shape)?;
+        if total >= u32::MAX as u64 {
             return Err(Error::invalid(
                 "grid",
                 format!("the grid has {total} nodes; at most {} are supported", u32::MAX - 1),
             ));
         }
-        let row_keys: Vec<u64> = (0..n_rows as u64).collect();
-        let row_start: Vec<u32> = (0..=n_rows).map(|r| (r * n_last) as u32).collect();
-        let last: Vec<u32> = (0..total).map(|p| (p % n_last) as u32).collect();
-        Ok(Self::assemble(shape, row_keys, row_start, last))
+        let total = total as usize;
+        let n_last = shape[D - 1];
+        let n_rows = total / n_last;
+        // sized by the shape alone: allocated fallibly (an Err, not an abort, when it does not fit)
+        let mut row_keys = try_filled("the box's band", n_rows, 0u64)?;
+        row_keys.iter_mut().enumerate().for_each(|(r, k)| *k = r as u64);
+        let mut row_start = try_filled("the box's band", n_rows + 1, 0u32)?;
+        row_start
+            .iter_mut()
+            .enumerate()
+            .for_each(|(r, s)| *s = (r * n_last) as u32);
+        let mut last = try_filled("the box's band", total, 0u32)?;
+        last.iter_mut().enumerate().for_each(|(p, l)| *l = (p % n_last) as u32);
+        Self::assemble(shape, row_keys, row_start, last)
     }
 
-    fn assemble(shape: [usize; D], row_keys: Vec<u64>, row_start: Vec<u32>, last: Vec<u32>) -> Self {
+    fn assemble(shape: [usize; D], row_keys: Vec<u64>, row_start: Vec<u32>, last: Vec<u32>) -> Result<Self> {
         let len = last.len();
+        // the neighbour table and the flags: allocated fallibly (an Err, not an abort)
+        let lead = try_filled("the band's neighbour table", len * 2 * (D - 1), len as u32)?;
+        let along_row = try_filled("the band's neighbour table", len, 0)?;
         let mut band = NarrowBand {
             shape,
             row_keys,
             row_start,
             last,
-            lead: vec![len as u32; len * 2 * (D - 1)],
-            along_row: vec![0; len],
+            lead,
+            along_row,
             schedule: SweepSchedule::default(),
             strip_schedules: OnceLock::new(),
         };
         band.build_neighbours();
         band.schedule = SweepSchedule::new(&band.row_leads(), band.shape);
-        band
+        Ok(band)
     }
 
     /// Number of band nodes.
@@ -498,7 +508,10 @@ impl<const D: usize> NarrowBand<D> {
     }
 }
 
-fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
+/// Checks the shape and returns the number of grid nodes, which must be below 2^63 (the linear
+/// indices are 64-bit, signed in NumPy): computed with checked arithmetic, so that a shape whose
+/// product overflows is refused instead of wrapping.
+fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<u64> {
     if !(2..=3).contains(&D) {
         return Err(Error::invalid(
             "grid",
@@ -513,7 +526,13 @@ fn check_shape<const D: usize>(shape: &[usize; D]) -> Result<()> {
             ));
         }
     }
-    Ok(())
+    match shape.iter().try_fold(1u64, |p, &n| p.checked_mul(n as u64)) {
+        Some(total) if total <= i64::MAX as u64 => Ok(total),
+        _ => Err(Error::invalid(
+            "shape",
+            format!("the grid {shape:?} has 2^63 nodes or more; at most 2^63 - 1 are supported"),
+        )),
+    }
 }
 
 #[cfg(test)]
