@@ -16,6 +16,7 @@ from typing import Any, Optional
 import numpy as np
 
 from .grid import Grid
+from ._warn import user_stacklevel
 
 
 def _first_point(grid: Grid, band: Any, positions: np.ndarray) -> tuple:
@@ -97,5 +98,5 @@ def check_values(
         f"{stranded.size} reachable band nodes (the first near {where}) were left at the numerical infinity next to "
         f"nodes the front reached: the solve is reported as not converged, and those values are inf",
         RuntimeWarning,
-        stacklevel=4,
+        stacklevel=user_stacklevel(),
     )

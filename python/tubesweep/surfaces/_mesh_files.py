@@ -19,6 +19,8 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
+from .._warn import user_stacklevel
+
 MESH_EXTRA = "pip install 'tubesweep[mesh]'"
 
 
@@ -51,7 +53,7 @@ def _fan(poly: List[int]) -> List[List[int]]:
 
 def _warn_dropped(path: Path, dropped: int, what: str) -> None:
     if dropped:
-        warnings.warn(f"{path}: {dropped} {what} dropped", RuntimeWarning, stacklevel=4)
+        warnings.warn(f"{path}: {dropped} {what} dropped", RuntimeWarning, stacklevel=user_stacklevel())
 
 
 def read_obj_file(path: Path) -> Tuple[np.ndarray, np.ndarray]:
@@ -236,7 +238,7 @@ def read_with_library(path: Path) -> Tuple[np.ndarray, np.ndarray]:
                 f"{path}: the header declares {nf} faces but only {len(f)} triangles were read "
                 f"({nf - len(f)} or more faces lost)",
                 RuntimeWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
     elif suffix == ".stl":
         n = _stl_count(path)
@@ -245,6 +247,6 @@ def read_with_library(path: Path) -> Tuple[np.ndarray, np.ndarray]:
                 f"{path}: the file holds {n} triangles but {len(f)} were read ({abs(n - len(f))} "
                 f"{'lost' if n > len(f) else 'extra'})",
                 RuntimeWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
     return _checked(path, v, f)

@@ -33,6 +33,7 @@ from ..grid import Grid
 from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
 from .._validate import real_array, real_scalar, whole_indices
 from ..grid import MAX_COORDINATE
+from .._warn import user_stacklevel
 from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_library
 from .analytic import finite_center, size_parameter
 
@@ -271,7 +272,7 @@ class MeshSurface(Surface):
                 f"the mesh lists {self.duplicate_faces} triangles more than once (the same three vertices); "
                 "each is kept once (surface.faces holds the rest, in the file's order)",
                 RuntimeWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
             f = np.ascontiguousarray(f[np.sort(first)])
         self.vertices = v
