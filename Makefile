@@ -85,6 +85,8 @@ bench: build
 	$(PY) benches/microbench.py --sizes 101,201,401 --schemes godunov --repeats 5
 	# issue 33: many sources on one surface (solve_many, Dask, the peers per source, the 1000 x 1000 matrix)
 	$(PY) benches/many_sources.py
+	# issue 31: travel_time order=1 against order=2 in the box, cubic against multilinear evaluation
+	$(PY) benches/box_order2.py
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

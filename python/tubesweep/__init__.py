@@ -22,6 +22,7 @@ Sect. 5.2) and the library :mod:`tubesweep.surfaces`; meshes in, results out: :f
 from ._native import __version__ as _core_version
 from . import flows, hamiltonians
 from .closest_point import ClosestPoint
+from .box_solution import BoxSolution
 from .euclidean import travel_time
 from .grid import Grid
 from .output import export, plot, triangulate
@@ -35,6 +36,7 @@ from . import data, surfaces
 __version__ = "0.1.0"
 
 __all__ = [
+    "BoxSolution",
     "ClosestPoint",
     "distance_matrix",
     "farthest_point_sampling",

@@ -115,6 +115,26 @@ def solve_many_on_band(  # crates/tubesweep-py/src/many_sources.rs: K solves, in
     at: Optional[npt.NDArray[np.float64]] = None,  # (M, d): return the values there, (K, M)
     lower: Optional[List[float]] = None,  # the grid's lower corner, with `at`
 ) -> Tuple[npt.NDArray[np.float64], Dict[str, npt.NDArray[Any]]]: ...
+def factored_box_solve(  # crates/tubesweep-py/src/box_order2.rs: travel_time(..., order=2)
+    shape: List[int],
+    lower: List[float],
+    spacing: float,
+    slowness: Union[float, npt.NDArray[np.float64]],  # a float or one per node (C order)
+    sources: npt.NDArray[np.float64],  # (K, d)
+    source_slowness: npt.NDArray[np.float64],  # (K,)
+    fixed_nodes: npt.NDArray[np.int64],  # linear indices
+    fixed_values: npt.NDArray[np.float64],
+    tol: float,
+    max_iterations: int,
+    second_order: bool = True,
+    ramp_length: float = 1.0,
+    threads: int = 0,
+    progress: Optional[Callable[[int, float, int], Any]] = None,
+    activation_threshold: float = 0.0,
+) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
+def band_interpolate_cubic(  # crates/tubesweep-py/src/box_order2.rs: Catmull-Rom, multilinear where incomplete
+    band: "Band", values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
 def rounded_cube_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], half_size: float, radius: float
 ) -> npt.NDArray[np.float64]: ...

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 from functools import lru_cache
 from typing import Any, Callable, Literal, Optional, Tuple, Union, overload
 
@@ -25,6 +26,9 @@ from ._validate import (
     warn_unconverged,
 )
 from ._result_check import check_values
+from ._warn import user_stacklevel
+from .box_order2 import check_order, order2_tol, solve_order2
+from .box_solution import BoxSolution
 from .grid import Grid
 from .stats import SolveStats
 
@@ -81,10 +85,14 @@ def travel_time(
     *,
     speed: Any = ...,
     hamiltonian: str = ...,
-    tol: float = ...,
+    tol: Optional[float] = ...,
     max_iterations: int = ...,
     return_stats: Literal[False] = ...,
     progress: Any = ...,
+    infinity: Optional[float] = ...,
+    threads: int = ...,
+    order: int = ...,
+    return_solution: Literal[False] = ...,
 ) -> np.ndarray: ...
 @overload
 def travel_time(
@@ -93,11 +101,31 @@ def travel_time(
     *,
     speed: Any = ...,
     hamiltonian: str = ...,
-    tol: float = ...,
+    tol: Optional[float] = ...,
     max_iterations: int = ...,
     return_stats: Literal[True],
     progress: Any = ...,
+    infinity: Optional[float] = ...,
+    threads: int = ...,
+    order: int = ...,
+    return_solution: Literal[False] = ...,
 ) -> Tuple[np.ndarray, SolveStats]: ...
+@overload
+def travel_time(
+    grid: Grid,
+    sources: Any,
+    *,
+    speed: Any = ...,
+    hamiltonian: str = ...,
+    tol: Optional[float] = ...,
+    max_iterations: int = ...,
+    return_stats: Literal[False] = ...,
+    progress: Any = ...,
+    infinity: Optional[float] = ...,
+    threads: int = ...,
+    order: int = ...,
+    return_solution: Literal[True],
+) -> BoxSolution: ...
 
 
 def travel_time(
@@ -106,13 +134,15 @@ def travel_time(
     *,
     speed: Union[float, np.ndarray, Callable[[np.ndarray], np.ndarray]] = 1.0,
     hamiltonian: str = "godunov",
-    tol: float = 1e-10,
+    tol: Optional[float] = None,
     max_iterations: int = 1000,
     return_stats: bool = False,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
     threads: int = 0,
-) -> Union[np.ndarray, Tuple[np.ndarray, SolveStats]]:
+    order: int = 1,
+    return_solution: bool = False,
+) -> Union[np.ndarray, Tuple[np.ndarray, SolveStats], BoxSolution, Tuple[BoxSolution, SolveStats]]:
     """First-arrival time ``u`` with ``|∇u| = 1/F`` in the whole box, from point sources.
 
     The fast sweeping method (paper Sect. 2, Algorithm 1): Gauss–Seidel sweeps in the 2^d
@@ -131,8 +161,11 @@ def travel_time(
         Wave speed F > 0.
     hamiltonian : {"godunov", "lxf"}
         Godunov (Eq. 3) or Lax–Friedrichs (Eq. 4).
-    tol : float
-        Stop when the largest change in one iteration (2^d sweeps) is below ``tol``.
+    tol : float, optional
+        Stop when the largest change in one iteration (2^d sweeps) is below ``tol``. Default
+        1e-10 with ``order=1``; with ``order=2`` each phase stops below
+        ``1e-3 · s̄ · Δx² / L`` (``s̄`` the mean slowness, ``L`` the box's longest side), far below
+        its O(Δx²) error.
     max_iterations : int
         A ``RuntimeWarning`` is issued if the sweeps have not converged by then.
     return_stats : bool
@@ -146,12 +179,23 @@ def travel_time(
         The finite "numerical infinity" that unknown values start at (default
         derived from the band: twice the cost of the longest grid path from a source, a safe upper
         bound on every travel time). It only matters for Lax–Friedrichs, whose update averages
-        neighbours: a larger value costs more iterations.
+        neighbours: a larger value costs more iterations. Not used by ``order=2``.
+    order : {1, 2}
+        1: the first-order scheme of the paper (Algorithm 1). 2: the factored eikonal equation
+        ``u = u₀ + w`` (``u₀`` the distance to the nearest source times the slowness there) with
+        the limited second-order Godunov update, a monotone first-order phase and a second-order
+        phase with a stagnation safeguard (``stats.order2``); Godunov only. Errors
+        are O(Δx²) also for variable speed, and exact (up to the stopping test) for a constant
+        speed and one source (docs/box-second-order.md).
+    return_solution : bool
+        Return a :class:`BoxSolution` (the values with point evaluation, ``sol(points,
+        interpolation="linear" | "cubic")``, exactly 0 at a source) instead of the array.
 
     Returns
     -------
-    u : numpy.ndarray
-        Travel times, an array of ``grid.shape``.
+    u : numpy.ndarray or BoxSolution
+        Travel times, an array of ``grid.shape``; with ``return_solution=True`` a
+        :class:`BoxSolution` holding it, with point evaluation.
     stats : SolveStats
         Only with ``return_stats=True``.
 
@@ -159,7 +203,8 @@ def travel_time(
     ------
     ValueError
         For sources outside the box, a speed that is not positive and finite, a bad tolerance,
-        or a box too large for the memory available (use the narrow-band solver for surfaces).
+        ``order`` other than 1 or 2 (or ``order=2`` with Lax–Friedrichs), or a box too large for
+        the memory available (use the narrow-band solver for surfaces).
 
     Warns
     -----
@@ -171,12 +216,20 @@ def travel_time(
     >>> import tubesweep as ts
     >>> grid = ts.Grid((-1, -1), (1, 1), (201, 201))
     >>> u = ts.travel_time(grid, [(0.013, -0.2)], speed=2.0)
+    >>> sol = ts.travel_time(grid, [(0.013, -0.2)], speed=lambda p: 2 + p[:, 0], order=2, return_solution=True)
+    >>> float(sol([(0.013, -0.2)])[0])  # exactly 0 at the source
+    0.0
     """
     t0 = time.perf_counter()
     grid = as_grid(grid)
     src = as_sources(sources, grid)
     scheme = check_hamiltonian(hamiltonian)
-    check_tolerance(tol, max_iterations)
+    order = check_order(order)
+    if order == 2 and scheme != "godunov":
+        raise ValueError("order=2 uses the Godunov update: pass hamiltonian='godunov', or order=1 for Lax–Friedrichs")
+    if tol is None and order == 1:
+        tol = 1e-10
+    check_tolerance(1.0 if tol is None else tol, max_iterations)
     cb = progress_callback(progress)
     # before anything of the box's size is allocated (a callable speed also takes the nodes'
     # coordinates, twice: the meshgrid and the stacked points)
@@ -193,6 +246,8 @@ def travel_time(
     else:
         slowness = 1.0 / speed_values(speed, grid, np.empty((0, grid.ndim)), None)
 
+    if tol is None:
+        tol = order2_tol(grid, float(np.mean(slowness)))
     check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))
 
     def slowness_at(x: np.ndarray) -> np.ndarray:
@@ -204,6 +259,22 @@ def travel_time(
         return _interp_dense(np.asarray(slowness).reshape(grid.shape), grid, x)
 
     lin, val = _source_nodes(grid, src, slowness_at)
+    if order == 2:
+        return _order2(
+            grid,
+            src,
+            slowness,
+            slowness_at,
+            lin,
+            val,
+            tol,
+            max_iterations,
+            cb,
+            _threads(threads),
+            t0,
+            return_stats,
+            return_solution,
+        )
     band = _box_band(grid.shape)
     roles = np.ones(grid.size, dtype=np.uint8)
     roles[lin] = 0
@@ -229,7 +300,7 @@ def travel_time(
     values[values >= st["infinity"]] = np.inf
     check_values(grid, band, values, None, st, _infinity(infinity))  # every node of the box is reachable
     u = values.reshape(grid.shape)
-    if not return_stats:
+    if not (return_stats or return_solution):
         return u
     stats = SolveStats(
         iterations=st["iterations"],
@@ -247,7 +318,93 @@ def travel_time(
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
     )
-    return u, stats
+    return _result(grid, u, src, slowness_at, stats, 1, return_stats, return_solution)
+
+
+def _result(
+    grid: Grid,
+    u: np.ndarray,
+    src: np.ndarray,
+    slowness_at: Callable[[np.ndarray], np.ndarray],
+    stats: SolveStats,
+    order: int,
+    return_stats: bool,
+    return_solution: bool,
+) -> Any:
+    if not return_solution:
+        return (u, stats) if return_stats else u
+    sol = BoxSolution(grid, u, src, np.asarray(slowness_at(src), float), slowness_at, stats, order, SOURCE_RADIUS)
+    return (sol, stats) if return_stats else sol
+
+
+def _order2(
+    grid: Grid,
+    src: np.ndarray,
+    slowness: Any,
+    slowness_at: Callable[[np.ndarray], np.ndarray],
+    lin: np.ndarray,
+    val: np.ndarray,
+    tol: float,
+    max_iterations: int,
+    cb: Any,
+    threads: int,
+    t0: float,
+    return_stats: bool,
+    return_solution: bool,
+) -> Any:
+    """``order=2``: the factored second-order sweeps (box_order2.py); the same fixed nodes as order 1."""
+    setup = time.perf_counter() - t0
+    values, st, _ = solve_order2(grid, src, slowness, slowness_at, lin, val, tol, max_iterations, cb, threads)
+    if not st["converged"]:
+        safeguard = (
+            f"; the stagnation safeguard switched to accepting decreases only after iteration "
+            f"{st['safeguard_iteration']}"
+            if st["safeguard_iteration"] is not None
+            else ""
+        )
+        warnings.warn(
+            f"the second-order sweeps did not converge in max_iterations={max_iterations}: the largest change in "
+            f"the last iteration was {st['last_change']:.3g} (tol={tol:g}, {st['first_order_iterations']} first-order "
+            f"and {st['second_order_iterations']} second-order iterations{safeguard}). Increase max_iterations or "
+            f"tol; the values returned are the last iterate",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+    if np.any(np.isnan(values)):
+        raise FloatingPointError(
+            "the second-order solve produced NaN: the travel times left the float64 range in the local updates. "
+            "Rescale the units of the grid or the speed so that the travel times lie between about 1e-100 and 1e100"
+        )
+    u = values.reshape(grid.shape)
+    if not (return_stats or return_solution):
+        return u
+    stats = SolveStats(
+        iterations=st["iterations"],
+        sweeps=st["sweeps"],
+        updates=st["updates"],
+        converged=st["converged"],
+        last_change=st["last_change"],
+        seconds=st["seconds"],
+        band_points=grid.size,
+        inner_points=grid.size - len(lin),
+        outer_points=0,
+        fixed_points=len(lin),
+        setup_seconds=setup,
+        # values, factor, source, fixed flag, two sweep stamps; the slowness if per node
+        band_bytes=grid.size * (8 + 8 + 4 + 1 + 8) + (0 if np.ndim(slowness) == 0 else 8 * grid.size),
+        order=2,
+        order2={
+            "first_order_iterations": st["first_order_iterations"],
+            "second_order_iterations": st["second_order_iterations"],
+            "fallback_iteration": (
+                None if st["safeguard_iteration"] is None else st["safeguard_iteration"] - st["first_order_iterations"]
+            ),
+            "unreached": int(np.count_nonzero(~np.isfinite(values))),
+            "tol": float(tol),
+            "fix_radius": SOURCE_RADIUS * grid.spacing,
+        },
+    )
+    return _result(grid, u, src, slowness_at, stats, 2, return_stats, return_solution)
 
 
 def _interp_dense(arr: np.ndarray, grid: Grid, x: np.ndarray) -> np.ndarray:

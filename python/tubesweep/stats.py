@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, asdict
-from typing import Any, Dict, Tuple
+from typing import Any, Dict, Optional, Tuple
 
 
 @dataclass(frozen=True)
@@ -59,6 +59,15 @@ class SolveStats:
         an iteration whose visited rows held more data than a quarter of the last-level cache
         (before the first, every row counts as visited, or none with the front window;
         docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
+    order : int
+        The scheme's order: 1 (the paper's) or 2 (``travel_time(..., order=2)``,
+        docs/box-second-order.md).
+    order2 : dict or None
+        For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
+        phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
+        switched to accepting decreases only, None when it did not fire), ``unreached`` (nodes
+        never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of
+        nodes fixed around each source).
 
     Examples
     --------
@@ -86,6 +95,8 @@ class SolveStats:
     narrowest_gap: float = float("inf")
     thin_strip_iterations: Tuple[int, int] = (0, 0)
     prefetch_iterations: int = 0
+    order: int = 1
+    order2: Optional[Dict[str, Any]] = None
 
     @property
     def updates_per_second(self) -> float:

@@ -2,6 +2,7 @@
 //! progress and Ctrl-C, and error mapping (in `errors.rs`). All validation a user sees with a
 //! helpful message happens in the Python package; the core re-checks what could break it.
 
+mod box_order2;
 mod errors;
 mod many_sources;
 
@@ -1811,6 +1812,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     m.add_class::<PyTriangleTree>()?;
     many_sources::register(m)?;
+    box_order2::register(m)?;
     m.add_function(wrap_pyfunction!(split_pair_blocks, m)?)?;
     m.add_function(wrap_pyfunction!(children_radius_max, m)?)?;
     m.add_function(wrap_pyfunction!(block_children, m)?)?;

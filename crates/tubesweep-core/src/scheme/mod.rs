@@ -10,5 +10,6 @@ pub mod godunov;
 pub mod hamiltonian;
 pub mod hamiltonians;
 pub mod lax_friedrichs;
+pub mod limited_godunov;
 
 pub use hamiltonian::{Hamiltonian, InnerScheme};

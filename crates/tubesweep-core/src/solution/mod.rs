@@ -2,4 +2,5 @@
 //! in the band, and which source reaches each node first (nearest-source labels).
 
 pub mod interpolate;
+pub mod interpolate_cubic;
 pub mod nearest_source;

@@ -24,6 +24,7 @@ use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicU8, AtomicUsize,
 use std::time::Instant;
 
 pub mod cache_size;
+pub mod factored_box;
 pub mod grid_hops;
 pub mod many_sources;
 pub mod rim;

@@ -1,0 +1,76 @@
+"""``travel_time(..., order=2)``: the factored eikonal equation in the whole box with the limited
+second-order Godunov update (``tubesweep_core::factored_box``; docs/second-order.md)."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+from ._validate import ACTIVATION_FRACTION
+from .grid import Grid
+
+__all__ = ["ORDERS", "ORDER2_TOL", "check_order", "order2_tol", "solve_order2"]
+
+ORDERS = (1, 2)
+
+#: Default stopping tolerance of ``order=2``: a phase stops when no value changes by more than
+#: ``ORDER2_TOL · s̄ · Δx² / L`` in an iteration (``s̄`` the mean slowness, ``L`` the box's longest
+#: side): far below the O(Δx²) discretisation error, far above rounding.
+ORDER2_TOL = 1e-3
+
+
+def check_order(order: Any) -> int:
+    if isinstance(order, (bool, np.bool_)) or not isinstance(order, (int, np.integer)) or int(order) not in ORDERS:
+        raise ValueError(
+            f"order must be 1 (the paper's first-order scheme, the default) or 2 (the factored "
+            f"second-order scheme, hamiltonian='godunov' only); got {order!r}"
+        )
+    return int(order)
+
+
+def box_length(grid: Grid) -> float:
+    return float(np.max(np.asarray(grid.upper) - np.asarray(grid.lower)))
+
+
+def order2_tol(grid: Grid, mean_slowness: float) -> float:
+    return ORDER2_TOL * mean_slowness * grid.spacing**2 / box_length(grid)
+
+
+def solve_order2(
+    grid: Grid,
+    sources: np.ndarray,
+    slowness: Any,
+    slowness_at: Callable[[np.ndarray], np.ndarray],
+    fixed_nodes: np.ndarray,
+    fixed_values: np.ndarray,
+    tol: float,
+    max_iterations: int,
+    progress: Optional[Callable[[int, float, int], None]],
+    threads: int,
+) -> Tuple[np.ndarray, dict, np.ndarray]:
+    """Runs the native two-phase solve; the values (flat, C order), its stats dict and the
+    slowness at each source."""
+    source_slowness = np.ascontiguousarray(slowness_at(sources), dtype=float)
+    slow: Any = (
+        float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(np.asarray(slowness, float).reshape(-1))
+    )
+    values, st = _native.factored_box_solve(
+        list(grid.shape),
+        [float(x) for x in grid.lower],
+        grid.spacing,
+        slow,
+        np.ascontiguousarray(sources, float),
+        source_slowness,
+        np.ascontiguousarray(fixed_nodes, dtype=np.int64),
+        np.ascontiguousarray(fixed_values, float),
+        float(tol),
+        int(max_iterations),
+        True,
+        box_length(grid),
+        int(threads),
+        progress,
+        ACTIVATION_FRACTION * float(tol),
+    )
+    return values, st, source_slowness
