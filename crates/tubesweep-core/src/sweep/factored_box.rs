@@ -788,6 +788,68 @@ mod tests {
     }
 
     #[test]
+    fn threads_do_not_change_the_bits_on_an_uneven_box() {
+        // levels of c0 + c1 with n0 ≠ n1 (rows clipped at both ends), two sources, a source on a face
+        let shape = [9, 14, 11];
+        let h = 0.1;
+        let sources = [[0.35, 0.52, 0.0], [0.71, 1.18, 0.64]];
+        let point = |m: usize| {
+            [
+                (m / (14 * 11)) as f64 * h,
+                (m / 11 % 14) as f64 * h,
+                (m % 11) as f64 * h,
+            ]
+        };
+        let n = 9 * 14 * 11;
+        let slow: Vec<f64> = (0..n)
+            .map(|m| 1.0 / (1.5 + 0.4 * point(m)[0] - 0.3 * point(m)[2]))
+            .collect();
+        let (mut fixed, mut vals) = (vec![], vec![]);
+        for m in 0..n {
+            let d = sources
+                .iter()
+                .map(|xs| dist(&point(m), xs))
+                .fold(f64::INFINITY, f64::min);
+            if d <= 2.0 * h {
+                fixed.push(m);
+                vals.push(d * slow[m]);
+            }
+        }
+        let ss: Vec<f64> = sources.iter().map(|x| 1.0 / (1.5 + 0.4 * x[0] - 0.3 * x[2])).collect();
+        let p = FactoredBox::<3> {
+            shape,
+            lower: [0.0; 3],
+            h,
+            slowness: Slowness::PerNode(&slow),
+            sources: &sources,
+            source_slowness: &ss,
+            fixed_nodes: &fixed,
+            fixed_values: &vals,
+        };
+        let run = |threads| {
+            let opts = FactoredOptions {
+                tol: 1e-7,
+                threads,
+                parallel_min_nodes: 1,
+                activation_threshold: 1e-9,
+                ..Default::default()
+            };
+            p.solve(&opts, &mut |_| Control::Continue).unwrap()
+        };
+        let (u1, st1) = run(1);
+        let (u2, st2) = run(2);
+        assert!(st1.converged && u1.iter().all(|v| v.is_finite()));
+        assert_eq!(
+            st1,
+            FactoredStats {
+                seconds: st1.seconds,
+                ..st2
+            }
+        );
+        assert!(u1.iter().zip(&u2).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+
+    #[test]
     fn bad_arguments_are_errors_not_panics() {
         let p = FactoredBox::<2> {
             shape: [5, 5],
