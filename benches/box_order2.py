@@ -136,7 +136,7 @@ def sphere_table(sizes):
                 lambda q: np.linalg.norm(q, axis=1) - R, ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), sources=[src], order=2
             )
             solves.append(("order=2", {"order": 2}))
-        except TypeError:  # ts.solve has no order=2 (yet)
+        except (TypeError, ValueError):  # ts.solve has no order=2 (yet), or not for this surface
             pass
         for name, kw in solves:
             sol = ts.solve(lambda q: np.linalg.norm(q, axis=1) - R, grid, sources=[src], **kw)
