@@ -44,7 +44,7 @@ def test_zero_flow_reproduces_the_isotropic_solution_on_a_sphere():
     s = Sphere(R)
     g = ts.Grid(lower=(-0.7,) * 3, upper=(0.7,) * 3, shape=(29,) * 3)
     a = ts.solve(s, g, [(-R, 0, 0)], hamiltonian="lxf", speed=3.0)
-    b = ts.solve(s, g, [(-R, 0, 0)], speed=3.0, flow=lambda p: np.zeros_like(p))
+    b = ts.solve(s, g, [(-R, 0, 0)], speed=3.0, flow=lambda p: np.zeros_like(p), hamiltonian="lxf")
     assert b.hamiltonian == "moving-medium"
     assert a.stats.converged and b.stats.converged
     assert np.max(np.abs(a.values - b.values)) < 1e-9
@@ -61,7 +61,7 @@ def test_solid_body_rotation_on_a_circle_converges_at_first_order():
     exact = rotation_travel_time_circle(pts, R, np.pi, F, omega)
     errs = []
     for n in (101, 201, 401):
-        sol = ts.solve(c, _grid2(n), [(-R, 0)], speed=F, flow=solid_body_rotation(omega))
+        sol = ts.solve(c, _grid2(n), [(-R, 0)], speed=F, flow=solid_body_rotation(omega), hamiltonian="lxf")
         assert sol.stats.converged
         errs.append(float(np.nanmax(np.abs(sol(pts) - exact))))
     # measured: 0.0348, 0.0160, 0.0074 (orders 1.12, 1.11)
@@ -88,7 +88,7 @@ def test_solid_body_rotation_on_a_sphere_matches_the_rotating_frame_solution():
     errs = []
     for n in (29, 57):
         g = ts.Grid(lower=(-0.7,) * 3, upper=(0.7,) * 3, shape=(n,) * 3)
-        sol = ts.solve(s, g, [(-R, 0, 0)], speed=F, flow=solid_body_rotation(omega))
+        sol = ts.solve(s, g, [(-R, 0, 0)], speed=F, flow=solid_body_rotation(omega), hamiltonian="lxf")
         errs.append(float(np.nanmean(np.abs(sol(p) - exact))))
     # measured mean errors 0.049, 0.039 (the isotropic LxF has 0.033, 0.027 on the same grids)
     assert errs[1] < errs[0] < 0.06
@@ -115,7 +115,7 @@ def test_constant_metric_on_a_circle_converges():
     exact = _metric_circle_exact(pts, M)
     errs = []
     for n in (101, 201, 401):
-        sol = ts.solve(c, _grid2(n), [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(M))
+        sol = ts.solve(c, _grid2(n), [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(M, scheme="lxf"))
         assert sol.stats.converged
         errs.append(float(np.nanmax(np.abs(sol(pts) - exact))))
     # measured: 0.0170, 0.0060, 0.0023
@@ -137,7 +137,7 @@ def test_constant_metric_on_a_tilted_plane_gives_straight_geodesics():
     errs = []
     for N in (21, 41):
         g = ts.Grid(lower=(-1,) * 3, upper=(1,) * 3, shape=(N,) * 3)
-        sol = ts.solve(plane, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M))
+        sol = ts.solve(plane, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M, scheme="lxf"))
         errs.append(float(np.nanmean(np.abs(sol(q) - exact))))
     # measured mean errors 0.068, 0.057 (isotropic LxF on the same plane: 0.056, 0.047)
     assert errs[1] < errs[0] < 0.08
@@ -178,7 +178,7 @@ def test_normal_flow_component_warns_and_is_projected_out():
     c = Circle(R)
     g = _grid2(101)
     with pytest.warns(RuntimeWarning, match="normal component"):
-        a = ts.solve(c, g, [(-R, 0)], flow=lambda p: 0.5 * p)  # radial: purely normal
+        a = ts.solve(c, g, [(-R, 0)], flow=lambda p: 0.5 * p, hamiltonian="lxf")  # radial: purely normal
     b = ts.solve(c, g, [(-R, 0)], hamiltonian="lxf")
     inner = a.roles != 2
     assert np.max(np.abs(a.values[inner] - b.values[inner])) < 1e-3
@@ -189,8 +189,8 @@ def test_flow_array_on_the_grid_matches_the_callable():
     g = _grid2(101)
     v = solid_body_rotation(1.0)
     arr = v(g.points(g.unravel(np.arange(g.size)))).reshape(g.shape + (2,))
-    a = ts.solve(c, g, [(-R, 0)], flow=v)
-    b = ts.solve(c, g, [(-R, 0)], flow=arr)
+    a = ts.solve(c, g, [(-R, 0)], flow=v, hamiltonian="lxf")
+    b = ts.solve(c, g, [(-R, 0)], flow=arr, hamiltonian="lxf")
     pts = c.sample(500)
     # an array is read at the nodes, a callable at their closest points: an O(h) difference,
     # measured 0.0076, well below the discretisation error (0.035 at this grid)
@@ -204,7 +204,7 @@ def test_sigma_override_larger_viscosity_still_converges_and_wrong_size_raises()
     g = _grid2(201)
     pts = c.sample(1000)
     exact = rotation_travel_time_circle(pts, R, np.pi, 1.0, 1.0)
-    auto = ts.solve(c, g, [(-R, 0)], flow=solid_body_rotation(1.0))
+    auto = ts.solve(c, g, [(-R, 0)], flow=solid_body_rotation(1.0), hamiltonian="lxf")
     big = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.MovingMedium(solid_body_rotation(1.0), sigma=2.0))
     e_auto = np.nanmax(np.abs(auto(pts) - exact))
     e_big = np.nanmax(np.abs(big(pts) - exact))

@@ -84,7 +84,7 @@ def travel_time(
     sources: Any,
     *,
     speed: Any = ...,
-    hamiltonian: str = ...,
+    hamiltonian: Any = ...,
     tol: Optional[float] = ...,
     max_iterations: int = ...,
     return_stats: Literal[False] = ...,
@@ -93,6 +93,8 @@ def travel_time(
     threads: int = ...,
     order: int = ...,
     return_solution: Literal[False] = ...,
+    flow: Any = ...,
+    allow_supersonic: bool = ...,
 ) -> np.ndarray: ...
 @overload
 def travel_time(
@@ -100,7 +102,7 @@ def travel_time(
     sources: Any,
     *,
     speed: Any = ...,
-    hamiltonian: str = ...,
+    hamiltonian: Any = ...,
     tol: Optional[float] = ...,
     max_iterations: int = ...,
     return_stats: Literal[True],
@@ -109,6 +111,8 @@ def travel_time(
     threads: int = ...,
     order: int = ...,
     return_solution: Literal[False] = ...,
+    flow: Any = ...,
+    allow_supersonic: bool = ...,
 ) -> Tuple[np.ndarray, SolveStats]: ...
 @overload
 def travel_time(
@@ -133,7 +137,7 @@ def travel_time(
     sources: Any,
     *,
     speed: Union[float, np.ndarray, Callable[[np.ndarray], np.ndarray]] = 1.0,
-    hamiltonian: str = "godunov",
+    hamiltonian: Any = "godunov",
     tol: Optional[float] = None,
     max_iterations: int = 1000,
     return_stats: bool = False,
@@ -142,6 +146,8 @@ def travel_time(
     threads: int = 0,
     order: int = 1,
     return_solution: bool = False,
+    flow: Any = None,
+    allow_supersonic: bool = False,
 ) -> Union[np.ndarray, Tuple[np.ndarray, SolveStats], BoxSolution, Tuple[BoxSolution, SolveStats]]:
     """First-arrival time ``u`` with ``|∇u| = 1/F`` in the whole box, from point sources.
 
@@ -159,8 +165,17 @@ def travel_time(
         Source points anywhere in the box.
     speed : float, ndarray of ``grid.shape``, or callable ``f(points (M, d)) -> (M,)``
         Wave speed F > 0.
-    hamiltonian : {"godunov", "lxf"}
-        Godunov (Eq. 3) or Lax–Friedrichs (Eq. 4).
+    hamiltonian : {"godunov", "lxf"} or a ``ts.hamiltonians`` object
+        ``ts.hamiltonians.Metric(M)`` solves ``sqrt(∇uᵀ M ∇u) = 1/F`` (``M`` constant, an array of
+        ``grid.shape + (d, d)`` or a callable on points), ``MovingMedium(v)`` the moving medium;
+        both with the upwind local solver by default (``scheme="lxf"`` for Sect. 5.1's update).
+    flow : callable ``v(points (M, d)) -> (M, d)``, array of ``grid.shape + (d,)`` or a vector, optional
+        A moving medium: ``|∇u| = |1 − v·∇u| / F``, a front with normal ``n`` advancing at
+        ``F + v·n``; with ``hamiltonian="godunov"`` (default) the upwind local solver, with
+        ``"lxf"`` the Lax–Friedrichs update. ``|v| ≥ F`` is a ``ValueError`` unless
+        ``allow_supersonic=True`` (then Lax–Friedrichs, with a warning).
+    allow_supersonic : bool
+        Solve a flow with ``|v| ≥ F`` somewhere anyway (Lax–Friedrichs, with a ``RuntimeWarning``).
     tol : float, optional
         Stop when the largest change in one iteration (2^d sweeps) is below ``tol``. Default
         1e-10 with ``order=1``; with ``order=2`` each phase stops below
@@ -223,11 +238,22 @@ def travel_time(
     t0 = time.perf_counter()
     grid = as_grid(grid)
     src = as_sources(sources, grid)
-    scheme = check_hamiltonian(hamiltonian)
+    from . import hamiltonians as _hams
+
+    general = _hams.resolve(hamiltonian, flow, allow_supersonic)
+    scheme = check_hamiltonian(hamiltonian) if general is None else general.label
     order = check_order(order)
     if order == 2 and scheme != "godunov":
-        raise ValueError("order=2 uses the Godunov update: pass hamiltonian='godunov', or order=1 for Lax–Friedrichs")
-    if tol is None and order == 1:
+        raise ValueError(
+            "order=2 uses the eikonal Godunov update: pass hamiltonian='godunov' (without flow= or a Hamiltonian "
+            "object), or order=1 for Lax–Friedrichs and the anisotropic Hamiltonians"
+        )
+    if general is not None and return_solution:
+        raise ValueError(
+            "return_solution=True is for the eikonal equation; with flow= or a Hamiltonian object "
+            "travel_time returns the array (pass return_solution=False)"
+        )
+    if tol is None and (order == 1 or general is not None):
         tol = 1e-10
     check_tolerance(1.0 if tol is None else tol, max_iterations)
     cb = progress_callback(progress)
@@ -246,6 +272,24 @@ def travel_time(
     else:
         slowness = 1.0 / speed_values(speed, grid, np.empty((0, grid.ndim)), None)
 
+    if general is not None:
+        from .anisotropic_box import travel_time_general
+
+        return travel_time_general(
+            grid,
+            src,
+            general,
+            slowness,
+            tol,
+            max_iterations,
+            return_stats,
+            cb,
+            _infinity(infinity),
+            _threads(threads),
+            _box_band(grid.shape),
+            SOURCE_RADIUS,
+            t0,
+        )
     if tol is None:
         tol = order2_tol(grid, float(np.mean(slowness)))
     check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))

@@ -1,6 +1,7 @@
-"""General static Hamilton–Jacobi equations ``H(x, ∇_Σ u) = 0`` on surfaces, solved with the
-Lax–Friedrichs sweeping update of the paper's Sect. 5.1 in the inner tube and the usual
-extension (Eq. 5 applied to Eq. 8) in the outer layer.
+"""General static Hamilton–Jacobi equations ``H(x, ∇_Σ u) = 0`` on surfaces, solved in the inner
+tube with an upwind (Godunov-type) local solver (``scheme="godunov"``, the default for
+:class:`MovingMedium` and :class:`Metric`) or the Lax–Friedrichs sweeping update of the paper's
+Sect. 5.1 (``scheme="lxf"``), and the usual extension (Eq. 5 applied to Eq. 8) in the outer layer.
 
 Pass one of these objects as ``ts.solve(..., hamiltonian=...)``:
 
@@ -9,7 +10,10 @@ Pass one of these objects as ``ts.solve(..., hamiltonian=...)``:
   moving medium of Sect. 6.3 (also reached with ``ts.solve(..., flow=v)``);
 * :class:`Metric` — ``sqrt(∇uᵀ M(x) ∇u) = 1/F`` with ``M`` symmetric positive definite.
 
-Following Sect. 5.1, the intrinsic gradient is replaced by the extrinsic one in the tube. Each
+Following Sect. 5.1, the intrinsic gradient is replaced by the extrinsic one in the tube. The upwind
+solver takes, at every node, the minimum over the upwind simplices of the exact local solution
+(quadratics for both built-in anisotropic Hamiltonians; Tsai, Cheng, Osher & Zhao 2003, the paper's
+ref. [35]); it is monotone and as accurate as the isotropic Godunov update. For ``scheme="lxf"`` each
 Hamiltonian gets artificial viscosities ``σ_k ≥ max_p |∂H/∂p_k|`` computed exactly per node by the
 Rust core (``1`` isotropic, ``1 + |v_k|/F`` moving medium, ``sqrt(M_kk)`` metric); ``sigma=``
 overrides them with constants (they must be at least as large, or the update is not monotone).
@@ -44,6 +48,8 @@ class _Prepared:
     flow: Optional[np.ndarray] = None
     metric: Optional[np.ndarray] = None
     sigma: Optional[np.ndarray] = None
+    #: the local solver this solve uses: "godunov" (upwind) or "lxf" (Sect. 5.1)
+    scheme: str = "lxf"
     extra: Dict[str, Any] = field(default_factory=dict)
 
 
@@ -172,8 +178,21 @@ class Hamiltonian:
     kind: str = ""
     label: str = ""
 
-    def __init__(self, sigma: Any = None):
+    #: the local solver when neither ``scheme`` nor ``sigma`` is given
+    default_scheme: str = "godunov"
+
+    def __init__(self, sigma: Any = None, scheme: Optional[str] = None):
         self.sigma = _check_sigma(sigma)
+        if scheme is None:
+            scheme = "lxf" if sigma is not None else self.default_scheme
+        if not isinstance(scheme, str) or scheme.lower() not in ("godunov", "lxf"):
+            raise ValueError(f"scheme must be 'godunov' (the upwind local solver) or 'lxf' (Sect. 5.1); got {scheme!r}")
+        self.scheme = scheme.lower()
+        if self.scheme == "godunov" and sigma is not None:
+            raise ValueError(
+                "sigma (the Lax–Friedrichs viscosities of Sect. 5.1) only applies to scheme='lxf'; "
+                "drop sigma, or pass scheme='lxf'"
+            )
 
     def prepare(
         self,
@@ -260,12 +279,15 @@ class Isotropic(Hamiltonian):
     """``H(x, p) = |p| − 1/F(x)``: the eikonal equation through the general update of Sect. 5.1.
 
     With σ_k = 1 it is identical to ``hamiltonian="lxf"`` (Eq. 4); mainly a reference for the
-    general solver.
+    general solver. With ``scheme="godunov"`` it is the Godunov update (3) through the
+    upwind-solver interface.
 
     Parameters
     ----------
     sigma : float or sequence of float, optional
         Constant viscosities (default 1).
+    scheme : {"lxf", "godunov"}, optional
+        The local solver (default ``"lxf"``, Sect. 5.1).
 
     Raises
     ------
@@ -283,6 +305,10 @@ class Isotropic(Hamiltonian):
 
     kind = "isotropic"
     label = "isotropic"
+    default_scheme = "lxf"
+
+    def __init__(self, sigma: Any = None, *, scheme: Optional[str] = None):
+        super().__init__(sigma, scheme)
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
         """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
@@ -320,7 +346,7 @@ class Isotropic(Hamiltonian):
         >>> s = ts.surfaces.Sphere(0.5)
         >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
         """
-        return _Prepared(self.kind, slowness, sigma=self._sigma(grid.ndim))
+        return _Prepared(self.kind, slowness, sigma=self._sigma(grid.ndim), scheme=self.scheme)
 
 
 class MovingMedium(Hamiltonian):
@@ -343,9 +369,12 @@ class MovingMedium(Hamiltonian):
         first-arrival problem changes character (the equation loses the monotone front
         propagation). By default that is a ``ValueError`` saying where and by how much;
         ``True`` computes the Lax–Friedrichs solution of the equation as written anyway, with a
-        ``RuntimeWarning``.
+        ``RuntimeWarning`` (also with ``scheme="godunov"``: the upwind solver needs ``|v| < F``).
+    scheme : {"godunov", "lxf"}
+        The local solver in the inner tube: the upwind solver (default) or the Lax–Friedrichs
+        update of Sect. 5.1 (the default when ``sigma`` is given).
     sigma : float or sequence of float, optional
-        Constant viscosities overriding the per-node ``1 + |v_k|/F``.
+        Constant viscosities overriding the per-node ``1 + |v_k|/F`` (``scheme="lxf"``).
 
     Raises
     ------
@@ -376,8 +405,8 @@ class MovingMedium(Hamiltonian):
     kind = "moving_medium"
     label = "moving-medium"
 
-    def __init__(self, flow: Any, *, allow_supersonic: bool = False, sigma: Any = None):
-        super().__init__(sigma)
+    def __init__(self, flow: Any, *, allow_supersonic: bool = False, scheme: Optional[str] = None, sigma: Any = None):
+        super().__init__(sigma, scheme)
         if flow is None:
             raise ValueError(
                 "MovingMedium needs a flow: a callable v(points) -> (M, d), an array of grid.shape + (d,) or a vector"
@@ -386,15 +415,21 @@ class MovingMedium(Hamiltonian):
         self.allow_supersonic = bool(allow_supersonic)
 
     def __repr__(self) -> str:
-        return f"MovingMedium(flow={getattr(self.flow, '__name__', type(self.flow).__name__)}, allow_supersonic={self.allow_supersonic})"
+        return (
+            f"MovingMedium(flow={getattr(self.flow, '__name__', type(self.flow).__name__)}, "
+            f"allow_supersonic={self.allow_supersonic}, scheme={self.scheme!r})"
+        )
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
         """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
 
+        ``surface=None`` for the whole box (:func:`tubesweep.travel_time`): the flow is read at the
+        nodes and kept whole.
+
         Parameters
         ----------
-        surface : Surface
-            The surface solved on.
+        surface : Surface or None
+            The surface solved on (None: the whole box).
         grid : Grid
             The grid.
         linear : numpy.ndarray
@@ -425,12 +460,12 @@ class MovingMedium(Hamiltonian):
         >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
         """
         d = grid.ndim
-        if callable(self.flow):
+        if callable(self.flow) and surface is not None:
             _, cp = surface.project(x, grid)
             v = _field(self.flow, grid, linear, cp, (d,), "flow")
         else:
             v = _field(self.flow, grid, linear, x, (d,), "flow")
-        n = _normals(surface, grid, x, direction)
+        n = _normals(surface, grid, x, direction) if surface is not None else np.zeros_like(v)
         vn = np.sum(v * n, axis=1)
         speed_v = np.linalg.norm(v, axis=1)
         vmax = float(speed_v.max()) if speed_v.size else 0.0
@@ -470,15 +505,19 @@ class MovingMedium(Hamiltonian):
                     "anyway, or make the flow subsonic (e.g. a vortex core: ts.flows.point_vortices(..., core=δ))"
                 )
             warnings.warn(
-                msg + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway",
+                msg
+                + " allow_supersonic=True: computing the Lax–Friedrichs solution anyway"
+                + (" (the upwind solver needs |v| < F everywhere)" if self.scheme == "godunov" else ""),
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
+        scheme = "lxf" if np.any(bad) else self.scheme
         return _Prepared(
             self.kind,
             slowness,
             flow=v,
             sigma=self._sigma(d),
+            scheme=scheme,
             extra={
                 "max_mach": float(ratio[active].max()) if np.any(active) else 0.0,
                 "supersonic_nodes": int(np.count_nonzero(bad)),
@@ -538,8 +577,11 @@ class Metric(Hamiltonian):
         normal–tangent coupling is removed, ``M ← P M P + (nᵀMn) n nᵀ`` with ``P = I − n nᵀ``, so
         that the small normal component of the extrinsic gradient cannot leak into the tangential
         metric. ``False`` uses ``M`` as given (right for a full-box solve).
+    scheme : {"godunov", "lxf"}
+        The local solver in the inner tube: the upwind solver (default) or the Lax–Friedrichs
+        update of Sect. 5.1 (the default when ``sigma`` is given).
     sigma : float or sequence of float, optional
-        Constant viscosities overriding the per-node ``sqrt(M_kk)``.
+        Constant viscosities overriding the per-node ``sqrt(M_kk)`` (``scheme="lxf"``).
 
     Raises
     ------
@@ -557,13 +599,13 @@ class Metric(Hamiltonian):
     kind = "metric"
     label = "metric"
 
-    def __init__(self, M: Any, *, tangential: bool = True, sigma: Any = None):
-        super().__init__(sigma)
+    def __init__(self, M: Any, *, tangential: bool = True, scheme: Optional[str] = None, sigma: Any = None):
+        super().__init__(sigma, scheme)
         self.M = M
         self.tangential = bool(tangential)
 
     def __repr__(self) -> str:
-        return f"Metric(tangential={self.tangential})"
+        return f"Metric(tangential={self.tangential}, scheme={self.scheme!r})"
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
         """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
@@ -602,7 +644,7 @@ class Metric(Hamiltonian):
         >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
         """
         d = grid.ndim
-        if callable(self.M):
+        if callable(self.M) and surface is not None:
             _, cp = surface.project(x, grid)
             m = _field(self.M, grid, linear, cp, (d, d), "M")
         else:
@@ -616,7 +658,7 @@ class Metric(Hamiltonian):
         if np.any(lam <= 0):
             i = int(np.argmin(lam))
             raise ValueError(f"M must be positive definite; at {_fmt(x[i])} its smallest eigenvalue is {lam[i]:.3g}")
-        if self.tangential:
+        if self.tangential and surface is not None:
             n = _normals(surface, grid, x, direction)
             has = np.linalg.norm(n, axis=1) > 0.5
             P = np.eye(d)[None] - n[:, :, None] * n[:, None, :]
@@ -631,7 +673,9 @@ class Metric(Hamiltonian):
                 "M is numerically singular at some band node (after its tangential part was taken): "
                 "its eigenvalues span too many orders of magnitude; rescale M or use tangential=False"
             ) from None
-        return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), extra={"inverse": inverse})
+        return _Prepared(
+            self.kind, slowness, metric=m, sigma=self._sigma(d), scheme=self.scheme, extra={"inverse": inverse}
+        )
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
         """Travel time from a source to nearby band nodes, for a locally constant Hamiltonian.
@@ -680,7 +724,7 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
     if flow is not None:
         if not (isinstance(hamiltonian, str) and hamiltonian.lower() in ("godunov", "lxf")):
             raise ValueError(f"hamiltonian must be 'godunov', 'lxf' or a ts.hamiltonians object; got {hamiltonian!r}")
-        return MovingMedium(flow, allow_supersonic=allow_supersonic)
+        return MovingMedium(flow, allow_supersonic=allow_supersonic, scheme=hamiltonian.lower())
     if allow_supersonic:
         raise ValueError("allow_supersonic=True needs a flow (the moving-medium equation); pass flow=v")
     return None
@@ -723,7 +767,8 @@ def solve_band(
     defer_outer_rim: bool = True,
 ) -> tuple:
     """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
-    travel time (for ``exact_sources``), and runs the general Lax–Friedrichs sweeps (Sect. 5.1)."""
+    travel time (for ``exact_sources``), and runs the sweeps with the upwind local solver or the
+    general Lax–Friedrichs update (Sect. 5.1), as ``prep.scheme`` says."""
     x = grid.node_points(geom.linear)
     slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
     prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
@@ -767,7 +812,9 @@ def solve_band(
         skip_inactive=True,
         activation_threshold=float(activation_threshold),
         defer_outer_rim=bool(defer_outer_rim),
+        scheme=prep.scheme,
     )
     st = dict(st)
+    st["local_solver"] = prep.scheme
     st.update(prep.extra if "inverse" not in prep.extra else {})
     return values, st

@@ -32,7 +32,7 @@ mod test_bands;
 
 pub use band::NarrowBand;
 pub use error::{Error, Result};
-pub use scheme::{Hamiltonian, InnerScheme};
+pub use scheme::{Hamiltonian, InnerScheme, LocalSolver};
 pub use sweep::{Control, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem};
 
 /// The default "numerical infinity": large enough to dominate any travel time a user will meet
@@ -45,7 +45,7 @@ pub const DEFAULT_INFINITY: f64 = 1.0e6;
 #[doc(hidden)]
 pub use {
     band::{discovery, facing_sheets, mesh_band, normals, sampled, schedule},
-    scheme::{extension, godunov, hamiltonian, hamiltonians, lax_friedrichs},
+    scheme::{extension, godunov, hamiltonian, hamiltonians, lax_friedrichs, upwind},
     solution::{interpolate, nearest_source},
     surface::{analytic, mesh, mobius, open_surfaces, redistance},
     sweep::{cache_size, grid_hops, many_sources, rim},

@@ -22,7 +22,7 @@ use tubesweep_core::sweep::{
     default_row_prefetch_above, extension_weights_in_place, Extension, MissingNeighbour, Slowness,
 };
 use tubesweep_core::{
-    Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem,
+    Control, Hamiltonian, InnerScheme, IterationReport, LocalSolver, NodeRole, SolveOptions, SolveStats, SweepProblem,
 };
 
 enum AnyBand {
@@ -395,6 +395,7 @@ fn solve_general_generic<'py, const D: usize>(
     missing: MissingNeighbour,
     options: SolveOptions,
     progress: Option<Bound<'py, PyAny>>,
+    upwind: bool,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
     let n = band.len();
     if roles.len() != n {
@@ -444,13 +445,13 @@ fn solve_general_generic<'py, const D: usize>(
     let iso;
     let mm;
     let met;
-    let ham: &dyn Hamiltonian<D> = match inputs.kind.as_str() {
+    let (ham, solver): (&dyn Hamiltonian<D>, &dyn LocalSolver<D>) = match inputs.kind.as_str() {
         "isotropic" => {
             iso = Isotropic {
                 slowness: inputs.slowness,
                 sigma: inputs.sigma,
             };
-            &iso
+            (&iso, &iso)
         }
         "moving_medium" => {
             if flow.is_empty() && n > 0 {
@@ -461,7 +462,7 @@ fn solve_general_generic<'py, const D: usize>(
                 flow,
                 sigma: inputs.sigma,
             };
-            &mm
+            (&mm, &mm)
         }
         "metric" => {
             if metric.is_empty() && n > 0 {
@@ -472,7 +473,7 @@ fn solve_general_generic<'py, const D: usize>(
                 metric: &metric,
                 sigma: inputs.sigma,
             };
-            &met
+            (&met, &met)
         }
         other => {
             return Err(PyValueError::new_err(format!(
@@ -486,9 +487,14 @@ fn solve_general_generic<'py, const D: usize>(
         band,
         roles,
         spacing,
-        slowness: Slowness::Constant(1.0), // unused by InnerScheme::General
+        slowness: Slowness::Constant(1.0), // unused by InnerScheme::General and ::Upwind
         extension,
-        scheme: InnerScheme::General(ham),
+        // the upwind local solver of `tubesweep_core::upwind`, or the Lax–Friedrichs update of Sect. 5.1
+        scheme: if upwind {
+            InnerScheme::Upwind(solver)
+        } else {
+            InnerScheme::General(ham)
+        },
         missing,
     };
     run_sweeps(py, &problem, fixed, &options, progress)
@@ -844,7 +850,7 @@ impl PyBand {
     /// `flow` (K, d)) or `"metric"` (`sqrt(pᵀMp) − s`, needs `metric` (K, d, d)). `slowness` has
     /// 1 or K entries; `sigma` (d,) overrides the automatic per-node viscosities. Fixed nodes as in
     /// `solve`.
-    #[pyo3(signature = (roles, fixed_positions, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, defer_outer_rim=true))]
+    #[pyo3(signature = (roles, fixed_positions, fixed_values, spacing, hamiltonian, slowness, directions, missing, tol, max_iterations, infinity, flow=None, metric=None, sigma=None, progress=None, threads=0, skip_inactive=true, activation_threshold=0.0, defer_outer_rim=true, scheme="lxf"))]
     #[allow(clippy::too_many_arguments)]
     fn solve_general<'py>(
         &self,
@@ -868,12 +874,27 @@ impl PyBand {
         skip_inactive: bool,
         activation_threshold: f64,
         defer_outer_rim: bool,
+        scheme: &str,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyDict>)> {
         let missing = parse_missing(missing)?;
         if !(activation_threshold >= 0.0) {
             return Err(PyValueError::new_err("activation_threshold must be non-negative"));
         }
-        // the coupled update is Godunov's; the general Hamiltonians use Lax–Friedrichs
+        let upwind = match scheme {
+            "godunov" => true,
+            "lxf" => false,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "scheme must be 'godunov' (upwind) or 'lxf'; got {other:?}"
+                )))
+            }
+        };
+        if upwind && sigma.is_some() {
+            return Err(PyValueError::new_err(
+                "sigma (the Lax–Friedrichs viscosities) does not apply to scheme='godunov'",
+            ));
+        }
+        // the coupled update is the eikonal Godunov one's; the general Hamiltonians use their own
         let options = SolveOptions {
             tol,
             max_iterations,
@@ -910,10 +931,10 @@ impl PyBand {
         };
         match &self.band {
             AnyBand::D2(b) => solve_general_generic(
-                py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress,
+                py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress, upwind,
             ),
             AnyBand::D3(b) => solve_general_generic(
-                py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress,
+                py, b, roles, &fixed, spacing, inputs, directions, missing, options, progress, upwind,
             ),
         }
     }

@@ -26,6 +26,9 @@ pub enum InnerScheme<'a, const D: usize> {
     LaxFriedrichs,
     /// Lax–Friedrichs update of Sect. 5.1 for a general Hamiltonian, with monotone acceptance.
     General(&'a dyn Hamiltonian<D>),
+    /// An upwind (Godunov-type) local solver for a convex Hamiltonian ([`crate::scheme::upwind`]):
+    /// monotone, so no acceptance rule is needed beyond keeping the smaller value.
+    Upwind(&'a dyn crate::scheme::upwind::LocalSolver<D>),
 }
 
 /// The isotropic eikonal Hamiltonian `H(x, p) = |p| − s(x)` with slowness `s = 1/F`. With

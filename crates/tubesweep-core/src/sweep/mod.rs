@@ -318,6 +318,8 @@ macro_rules! specialised {
             (InnerScheme::LaxFriedrichs, true, _, false) => $this.$method::<LXF, true, false, false>($($arg),*),
             (InnerScheme::General(_), _, _, true) => $this.$method::<GENERAL, false, false, true>($($arg),*),
             (InnerScheme::General(_), _, _, false) => $this.$method::<GENERAL, false, false, false>($($arg),*),
+            (InnerScheme::Upwind(_), _, _, true) => $this.$method::<UPWIND, false, false, true>($($arg),*),
+            (InnerScheme::Upwind(_), _, _, false) => $this.$method::<UPWIND, false, false, false>($($arg),*),
         }
     }};
 }
@@ -380,6 +382,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     fn infinity_from_hops(&self, hops: &dyn Fn() -> u32, fixed_values: &[f64]) -> f64 {
         let s_max = match (self.scheme, self.slowness) {
             (InnerScheme::General(ham), _) => match ham.slowness_bound() {
+                Some(s) => s,
+                None => return crate::DEFAULT_INFINITY,
+            },
+            (InnerScheme::Upwind(solver), _) => match solver.slowness_bound() {
                 Some(s) => s,
                 None => return crate::DEFAULT_INFINITY,
             },
@@ -1340,7 +1346,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // NaN only for a per-node slowness dispatched with P = false, which the general
         // Hamiltonian (taking its slowness from the Hamiltonian) alone may be
         debug_assert!(
-            S == GENERAL || !f.is_nan(),
+            S == GENERAL || S == UPWIND || !f.is_nan(),
             "a per-node slowness dispatched with P = false"
         );
         let mut self_dependent = false;
@@ -1375,6 +1381,11 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 }
                 godunov_update_coupled(mins, coef, f)
             }
+        } else if S == UPWIND {
+            let InnerScheme::Upwind(solver) = self.scheme else {
+                return None;
+            };
+            solver.update(n, minus, plus, h, old)
         } else if S == LXF {
             if self.missing == MissingNeighbour::Extrapolate {
                 self_dependent = fill_missing(nb, arr.table.sentinel(), old, inf, f, &mut minus, &mut plus);
@@ -1477,6 +1488,7 @@ impl LocalUpdate {
 const GODUNOV: u8 = 0;
 const LXF: u8 = 1;
 const GENERAL: u8 = 2;
+const UPWIND: u8 = 3;
 
 /// Replaces the values of absent neighbours by a linear extrapolation through the node,
 /// `2 u − u_opposite`, limited to `[u − f, u + f]` with `f = h · s` the largest change a solution

@@ -1,0 +1,260 @@
+//! The upwind local solver for the Riemannian eikonal equation `sqrt(∇uᵀ M ∇u) = 1/F`,
+//! `G(p) = F sqrt(pᵀ M p) = 1`, `M` symmetric positive definite.
+//!
+//! *Projection on a face.* `min_q (P + q)ᵀ M (P + q)` over `q` off the face's axes `K` is
+//! `Pᵀ S_K P` with the Schur complement `S_K = M_KK − M_K⊥ M_⊥⊥⁻¹ M_⊥K` (computed by eliminating
+//! the off-face axes one by one; positive definite with `M`). Equivalently `S_K = ((M⁻¹)_KK)⁻¹`:
+//! the travel time along a displacement `d` in the face is `s sqrt(dᵀ M⁻¹ d)`.
+//!
+//! *The quadratic.* With `u_j = base + w_j`, `μ = base + t`, sides `σ_j` and
+//! `C_ij = σ_i σ_j (S_K)_ij`, the equation `Pᵀ S_K P = s²`, `P_j = σ_j (t − w_j)/h`, reads
+//!
+//! ```text
+//!     Σ_ij C_ij (t − w_i)(t − w_j) = s² h²,
+//! ```
+//!
+//! `A t² − 2 B t + C = 0` with `A = Σ C_ij`, `B = Σ_ij C_ij w_j`, `C = Σ C_ij w_i w_j − s²h²`. The
+//! characteristic `∂G/∂P ∝ S_K P` enters from the face iff `(C (t − w))_j ≥ 0` for every `j`. On a
+//! vertex `t = s h / sqrt((S_K)_kk) = s h sqrt((M⁻¹)_kk)`.
+
+use super::{larger_root_below, upwind_min, Faces, LocalSolver};
+use crate::scheme::hamiltonians::{slowness_at, Metric};
+use crate::Hamiltonian;
+
+struct Riemann<const D: usize> {
+    m: [[f64; D]; D],
+    s: f64,
+}
+
+impl<const D: usize> Faces<D> for Riemann<D> {
+    /// `S_K` in its first `m` rows and columns.
+    type Projected = [[f64; D]; D];
+
+    #[inline(always)]
+    fn least_slowness(&self) -> f64 {
+        // λ_max(M) ≤ tr M
+        let tr: f64 = (0..D).map(|k| self.m[k][k]).sum();
+        self.s / tr.sqrt()
+    }
+
+    /// `φ(d) = s sqrt(dᵀAd)`, `A = M⁻¹`, even. Mirroring `d_k` changes `dᵀAd` by
+    /// `4 |d_k| |A_k⊥·d_⊥|`, and `sqrt(dᵀAd) ≥ |d| / sqrt(λ_max(M))`, so
+    /// `τ_k = 2 s sqrt(tr M) Σ_{l≠k} |A_kl|` (0 when `A`'s row k is diagonal); and by the triangle
+    /// inequality `τ_k = 2 s sqrt(A_kk)`. The smaller of the two, for both sides.
+    #[inline(always)]
+    fn mirror_slack(&self) -> [[f64; 2]; D] {
+        let m = &self.m;
+        let tr: f64 = (0..D).map(|k| m[k][k]).sum();
+        let (off, diag) = inverse_rows(m);
+        core::array::from_fn(|k| {
+            let t = if off[k] == 0.0 {
+                0.0
+            } else {
+                2.0 * self.s * (tr.sqrt() * off[k]).min(diag[k].sqrt())
+            };
+            [t, t]
+        })
+    }
+
+    #[inline(always)]
+    fn project(&self, mask: u32) -> Option<[[f64; D]; D]> {
+        let m = &self.m;
+        let mut out = [[0.0; D]; D];
+        let full = (1u32 << D) - 1;
+        if mask == full {
+            return (m[0][0] > 0.0).then_some(*m);
+        }
+        let off = (full & !mask).count_ones();
+        if off == 1 {
+            // one axis j off the face: S = M_KK − M_Kj M_jK / M_jj
+            let j = (full & !mask).trailing_zeros() as usize;
+            let piv = m[j][j];
+            if !(piv > 0.0) {
+                return None;
+            }
+            let mut a = 0;
+            for r in 0..D {
+                if r == j {
+                    continue;
+                }
+                let mut b = 0;
+                for c in 0..D {
+                    if c == j {
+                        continue;
+                    }
+                    out[a][b] = m[r][c] - m[r][j] * m[j][c] / piv;
+                    b += 1;
+                }
+                a += 1;
+            }
+        } else {
+            // D = 3, a vertex k: S = 1 / (M⁻¹)_kk = det M / (the cofactor of M_kk)
+            let k = mask.trailing_zeros() as usize;
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let cof = m[i][i] * m[j][j] - m[i][j] * m[j][i];
+            let det = m[k][k] * cof - m[k][i] * (m[i][k] * m[j][j] - m[i][j] * m[j][k])
+                + m[k][j] * (m[i][k] * m[j][i] - m[i][i] * m[j][k]);
+            if !(cof > 0.0) {
+                return None;
+            }
+            out[0][0] = det / cof;
+        }
+        (out[0][0] > 0.0).then_some(out)
+    }
+
+    #[inline(always)]
+    fn solve<const M: usize>(
+        &self,
+        sk: &[[f64; D]; D],
+        w: &[f64; M],
+        sg: &[f64; M],
+        h: f64,
+        below: f64,
+    ) -> Option<f64> {
+        let sh = self.s * h;
+        if M == 1 {
+            return (sh * sh < below * below * sk[0][0]).then(|| sh / sk[0][0].sqrt());
+        }
+        let mut c = [[0.0; M]; M];
+        let (mut a, mut b, mut cc) = (0.0, 0.0, -sh * sh);
+        for i in 0..M {
+            for j in 0..M {
+                c[i][j] = sg[i] * sg[j] * sk[i][j];
+                a += c[i][j];
+                b += c[i][j] * w[j];
+                cc += c[i][j] * w[i] * w[j];
+            }
+        }
+        if !(a > 0.0) {
+            return None;
+        }
+        // the causality weights (C (t − w))_i sum to a t − b
+        let t = larger_root_below(a, b, cc, below)?;
+        let causal = (0..M).fold(true, |ok, i| {
+            ok & ((0..M).map(|j| c[i][j] * (t - w[j])).sum::<f64>() >= 0.0)
+        });
+        causal.then_some(t)
+    }
+}
+
+/// `Σ_{l≠k} |(M⁻¹)_kl|` and `(M⁻¹)_kk` per row, for `D ≤ 3` (by cofactors); infinite if `M` is
+/// singular.
+#[inline(always)]
+fn inverse_rows<const D: usize>(m: &[[f64; D]; D]) -> ([f64; D], [f64; D]) {
+    let mut out = [0.0; D];
+    let mut diag = [f64::INFINITY; D];
+    if D == 2 {
+        let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+        let a = (m[0][1].abs() + m[1][0].abs()) * 0.5 / det.abs();
+        out[0] = a;
+        out[1] = a;
+        diag[0] = m[1][1] / det.abs();
+        diag[1] = m[0][0] / det.abs();
+    } else if D == 3 {
+        // cofactor C_ij (of M_ij); (M⁻¹)_kl = C_lk / det
+        let c = |i: usize, j: usize| {
+            let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+            let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+            m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+        };
+        let det = m[0][0] * c(0, 0) + m[0][1] * c(0, 1) + m[0][2] * c(0, 2);
+        for k in 0..3 {
+            out[k] = (c((k + 1) % 3, k).abs() + c((k + 2) % 3, k).abs()) / det.abs();
+            diag[k] = c(k, k) / det.abs();
+        }
+    } else {
+        out = [f64::INFINITY; D];
+    }
+    if out.iter().chain(&diag).all(|x| x.is_finite() && *x >= 0.0) {
+        (out, diag)
+    } else {
+        ([f64::INFINITY; D], [f64::INFINITY; D])
+    }
+}
+
+impl<'a, const D: usize> LocalSolver<D> for Metric<'a, D> {
+    #[inline]
+    fn update(&self, node: usize, minus: [f64; D], plus: [f64; D], h: f64, old: f64) -> f64 {
+        let faces = Riemann {
+            m: self.metric[node],
+            s: slowness_at(self.slowness, node),
+        };
+        upwind_min(&faces, minus, plus, h, old)
+    }
+
+    fn slowness_bound(&self) -> Option<f64> {
+        Hamiltonian::<D>::slowness_bound(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scheme::godunov::godunov_update;
+    use crate::scheme::upwind::tests::linear_neighbours;
+
+    #[test]
+    fn identity_metric_is_the_isotropic_godunov_update() {
+        let s = [1.3];
+        let m = [[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]];
+        let met = Metric {
+            slowness: &s,
+            metric: &m,
+            sigma: None,
+        };
+        let h = 0.1;
+        for (minus, plus) in [
+            ([1.0, 1.02, 1.5], [1.3, 1.1, 1.01]),
+            ([1.0, 1.03, 1.05], [1.3, 1.04, 1.02]),
+        ] {
+            let mins: [f64; 3] = core::array::from_fn(|k| f64::min(minus[k], plus[k]));
+            let want = godunov_update(mins, h * s[0]);
+            assert!((met.update(0, minus, plus, h, 1e6) - want).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn exact_on_plane_waves_of_a_tilted_metric() {
+        // u = q·x with qᵀ M q = s²
+        let s = [0.8];
+        let m3 = [[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]];
+        let met = Metric {
+            slowness: &s,
+            metric: &[m3],
+            sigma: None,
+        };
+        let h = 0.05;
+        for i in 0..60 {
+            let (a, b) = (i as f64 * 0.7, i as f64 * 0.29);
+            let n = [a.cos() * b.sin(), a.sin() * b.sin(), b.cos()];
+            let mut q2 = 0.0;
+            for r in 0..3 {
+                for c in 0..3 {
+                    q2 += n[r] * m3[r][c] * n[c];
+                }
+            }
+            let q = core::array::from_fn(|k| s[0] * n[k] / q2.sqrt());
+            let (minus, plus) = linear_neighbours(q, h);
+            let got = met.update(0, minus, plus, h, 1e6);
+            assert!(got.abs() < 1e-13, "n {n:?}: {got}");
+        }
+    }
+
+    #[test]
+    fn schur_complement_is_the_inverse_of_the_inverse_block() {
+        let m3 = [[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]];
+        let r = Riemann { m: m3, s: 1.0 };
+        // vertex along x: S = 1/(M⁻¹)_00 = det M / (M11 M22 − M12²)
+        let det = 2.0 * (0.9 * 0.5 - 0.04) - 0.6 * (0.6 * 0.5 + 0.06) + (-0.3) * (0.6 * 0.2 + 0.27);
+        let p = r.project(1).unwrap();
+        assert!((p[0][0] - det / (0.9 * 0.5 - 0.04)).abs() < 1e-14);
+        // edge (x, y): S = M_KK − M_K2 M_2K / M_22
+        let e = r.project(3).unwrap();
+        assert!((e[0][1] - (0.6 - (-0.3) * 0.2 / 0.5)).abs() < 1e-15 && (e[1][1] - (0.9 - 0.04 / 0.5)).abs() < 1e-15);
+    }
+}
+
+#[cfg(test)]
+pub(crate) fn tests_faces<const D: usize>(s: f64, m: [[f64; D]; D]) -> impl Faces<D> {
+    Riemann { m, s }
+}
