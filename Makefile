@@ -87,6 +87,9 @@ bench: build
 	$(PY) benches/many_sources.py
 	# issue 31: travel_time order=1 against order=2 in the box, cubic against multilinear evaluation
 	$(PY) benches/box_order2.py
+	# issue 32: the upwind solver for the moving medium and metrics against LxF and isotropic Godunov
+	$(PY) benches/upwind.py
+	cargo run --release -q -p tubesweep-core --example upwind_cost
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

@@ -221,3 +221,11 @@ def test_box_travel_time_with_a_uniform_flow_and_a_metric():
     assert errs[1] < 0.7 * errs[0] and merrs[1] < 0.7 * merrs[0], (errs, merrs)
     ul = ts.travel_time(ts.Grid((-1, -1), (1, 1), (81, 81)), [src], flow=v, hamiltonian="lxf")
     assert np.max(np.abs(ul.ravel() - exact)) > 2 * errs[1]
+
+
+def test_isotropic_through_the_upwind_interface_is_the_godunov_update():
+    c = Circle(R)
+    g = ts.Grid((-1, -1), (1, 1), (81, 81))
+    a = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(scheme="godunov"))
+    b = ts.solve(c, g, [(-R, 0)])
+    assert a.stats.converged and np.max(np.abs(a.values - b.values)) < 1e-8

@@ -14,7 +14,10 @@ angle θ ≈ 0.21 of each centre. We therefore compute
 Each figure has four orthographic views of the sphere: (a, b) contours of u (black) over the flow
 (arrows, coloured by |v|; the red dashed line is |v| = F, red stars are the vortex centres,
 the green dot the source); (c, d) the same contours against the unperturbed ones (magenta
-dotted). A second figure ``<name>_core.png`` compares the singular and the cored flow.
+dotted). A second figure ``<name>_core.png`` compares the singular and the cored flow. All of these
+use the paper's Lax–Friedrichs update (Sect. 5.1; ``hamiltonian="lxf"``). A third figure
+``<name>_upwind.png`` shows the cored flow solved with the upwind local solver (the default for
+``flow=``; it needs a subsonic flow) against the same flow with Lax–Friedrichs (magenta).
 """
 
 from __future__ import annotations
@@ -102,14 +105,17 @@ def _solve_all(centers: np.ndarray, n: int) -> Dict[str, Any]:
     out: Dict[str, Any] = {"grid": grid, "flow": raw, "flow_core": cored}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        out["raw"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=raw, allow_supersonic=True)
+        out["raw"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=raw, allow_supersonic=True, hamiltonian="lxf")
     out["supersonic_warning"] = next((str(w.message) for w in caught if "outruns" in str(w.message)), "")
-    out["core"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored)
+    out["core"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored, hamiltonian="lxf")
+    out["core_upwind"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored)
     out["still"] = solve(sphere, grid, [SOURCE], speed=SPEED, hamiltonian="lxf")
     return out
 
 
-def _figure(name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, compare: str, n_img: int) -> None:
+def _figure(
+    name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, compare: str, n_img: int, main: str = "raw"
+) -> None:
     plt = _plt()
     centers = np.asarray(case["centers"])
     fig, axes = plt.subplots(2, 2, figsize=(10, 9.6), layout="constrained")
@@ -117,7 +123,7 @@ def _figure(name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, co
     for col, w in enumerate(case["views"]):
         B = _view_basis(w)
         X, Y, inside, pts = _disk(B, n_img)
-        u = _image(res["raw"], pts, inside)
+        u = _image(res[main], pts, inside)
         other = _image(res[compare], pts, inside)
         v = np.zeros_like(pts)
         v[inside.reshape(-1)] = res["flow"](pts[inside.reshape(-1)])
@@ -167,14 +173,17 @@ def _figure(name: str, case: Dict[str, Any], res: Dict[str, Any], path: Path, co
             sub = (
                 "flow |v| and arrows"
                 if row == 0
-                else {"still": "magenta: v = 0", "core": f"magenta: core δ = {CORE}"}[compare]
+                else {
+                    "still": "magenta: v = 0",
+                    "core": f"magenta: core δ = {CORE}" + (", Lax–Friedrichs" if main != "raw" else ""),
+                }[compare]
             )
             ax.set_title(f"({label}) view from ({wv[0]:.2f}, {wv[1]:.2f}, {wv[2]:.2f}); {sub}", fontsize=9)
     fig.colorbar(im, ax=axes[0, :], shrink=0.7, label="|v| (clipped at 2F; red dashed: |v| = F)")
     g = res["grid"]
     fig.suptitle(
         f"{case['title']} — black: u (step {LEVEL_STEP}), F = {SPEED}, s = {STRENGTH}, grid {g.shape[0]}³, "
-        "allow_supersonic=True",
+        + ("allow_supersonic=True, Lax–Friedrichs" if main == "raw" else f"core δ = {CORE}, upwind solver"),
         fontsize=10,
     )
     fig.savefig(path, dpi=110)
@@ -201,19 +210,23 @@ def _run(name: str, out_dir: Path, quick: bool) -> dict:
     summary = {
         "grid": n,
         "spacing": res["grid"].spacing,
-        "iterations": {k: res[k].stats.iterations for k in ("raw", "core", "still")},
-        "converged": {k: bool(res[k].stats.converged) for k in ("raw", "core", "still")},
-        "seconds": {k: round(res[k].stats.seconds, 3) for k in ("raw", "core", "still")},
+        "iterations": {k: res[k].stats.iterations for k in ("raw", "core", "still", "core_upwind")},
+        "converged": {k: bool(res[k].stats.converged) for k in ("raw", "core", "still", "core_upwind")},
+        "seconds": {k: round(res[k].stats.seconds, 3) for k in ("raw", "core", "still", "core_upwind")},
         "max_u": float(np.nanmax(u)),
         "max_abs_u_minus_unperturbed": float(np.nanmax(np.abs(u - u0))),
         "max_abs_raw_minus_core": float(np.nanmax(np.abs(u - uc))),
         "max_abs_raw_minus_core_far_from_vortices": float(np.nanmax(np.abs(u - uc)[far])),
         "mean_abs_raw_minus_core": float(np.nanmean(np.abs(u - uc))),
+        # the cored flow with the upwind solver against Lax–Friedrichs
+        "max_abs_core_upwind_minus_core_lxf": float(np.nanmax(np.abs(res["core_upwind"](p) - uc))),
+        "mean_abs_core_upwind_minus_core_lxf": float(np.nanmean(np.abs(res["core_upwind"](p) - uc))),
         "supersonic_warning": res["supersonic_warning"],
     }
     n_img = 161 if quick else 241
     _figure(name, case, res, out_dir / f"{name}.png", "still", n_img)
     _figure(name, case, res, out_dir / f"{name}_core.png", "core", n_img)
+    _figure(name, case, res, out_dir / f"{name}_upwind.png", "core", n_img, main="core_upwind")
     summary["seconds_total"] = round(time.perf_counter() - t0, 2)
     (out_dir / f"{name}.json").write_text(json.dumps(summary, indent=2))
     print(json.dumps({k: v for k, v in summary.items() if k != "supersonic_warning"}, indent=1))
