@@ -126,7 +126,7 @@ def _figure(
         u = _image(res[main], pts, inside)
         other = _image(res[compare], pts, inside)
         v = np.zeros_like(pts)
-        v[inside.reshape(-1)] = res["flow"](pts[inside.reshape(-1)])
+        v[inside.reshape(-1)] = res["flow" if main == "raw" else "flow_core"](pts[inside.reshape(-1)])
         speed = np.linalg.norm(v, axis=1).reshape(X.shape)
         speed[~inside] = np.nan
         for row in range(2):
@@ -175,7 +175,7 @@ def _figure(
                 if row == 0
                 else {
                     "still": "magenta: v = 0",
-                    "core": f"magenta: core δ = {CORE}" + (", Lax–Friedrichs" if main != "raw" else ""),
+                    "core": f"magenta: core δ = {CORE}" if main == "raw" else "magenta: Lax–Friedrichs",
                 }[compare]
             )
             ax.set_title(f"({label}) view from ({wv[0]:.2f}, {wv[1]:.2f}, {wv[2]:.2f}); {sub}", fontsize=9)
