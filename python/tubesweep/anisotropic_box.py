@@ -11,6 +11,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from ._result_check import check_values
 from ._validate import ACTIVATION_FRACTION, check_tolerance_scale, warn_unconverged
 from .grid import Grid
 from .stats import SolveStats
@@ -103,6 +104,7 @@ def travel_time_general(
     )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf
+    check_values(grid, band, values, None, st, infinity, reachability=False)  # no NaN (as ts.solve for these H)
     u = values.reshape(grid.shape)
     if not return_stats:
         return u
