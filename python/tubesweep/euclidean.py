@@ -245,7 +245,7 @@ def travel_time(
     order = check_order(order)
     if order == 2 and scheme != "godunov":
         raise ValueError(
-            "order=2 uses the eikonal Godunov update: pass hamiltonian='godunov' (without flow= or a Hamiltonian "
+            "order=2 uses the Godunov update (of the eikonal equation): pass hamiltonian='godunov' (without flow= or a Hamiltonian "
             "object), or order=1 for Lax–Friedrichs and the anisotropic Hamiltonians"
         )
     if general is not None and return_solution:
