@@ -229,3 +229,13 @@ def test_isotropic_through_the_upwind_interface_is_the_godunov_update():
     a = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(scheme="godunov"))
     b = ts.solve(c, g, [(-R, 0)])
     assert a.stats.converged and np.max(np.abs(a.values - b.values)) < 1e-8
+
+
+def test_parallel_sweeps_and_the_tube_give_the_same_bits():
+    s = Sphere(R)
+    g = _sphere_grid(29)
+    v = solid_body_rotation(1.0)
+    one = ts.solve(s, g, [(-R, 0, 0)], flow=v, threads=1)
+    two = ts.solve(s, g, [(-R, 0, 0)], flow=v, threads=2)
+    tube = ts.Tube(s, g).solve([(-R, 0, 0)], flow=v, threads=2)
+    assert np.array_equal(one.values, two.values) and np.array_equal(one.values, tube.values)
