@@ -93,7 +93,7 @@ def print_rates(label: str, band: int, k: int, r: dict) -> None:
 
 
 def part_sphere(quick: bool) -> None:
-    n, k = (61, 12) if quick else (101, 50)
+    n, k = (41, 8) if quick else (101, 50)
     tube = sphere_tube(n)
     src = R * fibonacci_sphere(k)
     r = rates(tube, src, src, 1 if quick else 3)
@@ -175,7 +175,7 @@ def great_circle(p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def part_peers(quick: bool) -> None:
-    n, k = (61, 3) if quick else (101, 10)
+    n, k = (41, 2) if quick else (101, 10)
     v, f = marching_cubes_sphere(n)
     idx = np.random.default_rng(2).choice(len(v), size=k, replace=False)
     exact = great_circle(v[idx], v)  # (k, V)

@@ -39,11 +39,11 @@ def tube(grid):
 
 @pytest.mark.parametrize("threads", [1, 2])
 def test_rows_equal_single_solves_bit_for_bit(tube, threads):
-    pts = sphere_points(4)
+    pts = sphere_points(2)
     group = np.array([[R, 0, 0], [0, 0, -R]])
     sources = [p for p in pts] + [group]
     many = tube.solve_many(sources, threads=threads)
-    assert many.shape == (5, tube.band_points)
+    assert many.shape == (3, tube.band_points)
     for k, s in enumerate(sources):
         for single_threads in (1, 2):
             single = tube.solve(np.atleast_2d(s), threads=single_threads).values
@@ -51,7 +51,7 @@ def test_rows_equal_single_solves_bit_for_bit(tube, threads):
     # at= gives the solutions read at the points, without the band rows
     at = np.vstack([pts, [[0, R, 0]]])
     values = tube.solve_many(sources, at=at, threads=threads)
-    assert values.shape == (5, 5)
+    assert values.shape == (3, 3)
     for k, s in enumerate(sources):
         assert np.array_equal(bits(values[k]), bits(tube.solve(np.atleast_2d(s))(at)))
 
@@ -185,8 +185,9 @@ def test_surfaces_tube_and_solution_pickle(grid, tube):
     cloudpickle = pytest.importorskip("cloudpickle")
     src = [[R, 0, 0]]
     reference = tube.solve(src).values
-    vertices, faces = ts.surfaces.Sphere(R).triangulation(24)
-    phi_array = np.linalg.norm(np.stack(grid.meshgrid(), axis=-1), axis=-1) - R
+    vertices, faces = ts.surfaces.Sphere(R).triangulation(16)
+    coarse = ts.Grid((-1, -1, -1), (1, 1, 1), (25, 25, 25))
+    phi_array = np.linalg.norm(np.stack(coarse.meshgrid(), axis=-1), axis=-1) - R
     surfaces = [
         ts.surfaces.Sphere(R),
         ts.LevelSet(phi_array),
@@ -195,10 +196,10 @@ def test_surfaces_tube_and_solution_pickle(grid, tube):
         ts.surfaces.from_mesh((vertices, faces)),
     ]
     for surf in surfaces:
-        ref = ts.solve(surf, grid, src).values
+        ref = ts.solve(surf, coarse, src).values
         copy = cloudpickle.loads(cloudpickle.dumps(surf))
         assert type(copy) is type(surf)
-        assert np.array_equal(bits(ts.solve(copy, grid, src).values), bits(ref)), type(surf).__name__
+        assert np.array_equal(bits(ts.solve(copy, coarse, src).values), bits(ref)), type(surf).__name__
     # a Tube pickles small (its surface, grid and widths) and builds the same band again
     blob = pickle.dumps(tube)
     assert len(blob) < 10_000
