@@ -168,22 +168,32 @@ pub fn solve_many<const D: usize>(
                         break;
                     }
                     let src = sources[i];
-                    match solve_one(template, &mut roles, src, &one, &stop) {
-                        Ok((values, st)) => {
-                            // the row is taken once, by the one thread that solved source i
-                            let row = rows.get(i).and_then(|r| r.lock().ok()?.take());
-                            if let Some(row) = row {
-                                match at {
-                                    None => row.copy_from_slice(&values),
-                                    Some((lower, points)) => row.copy_from_slice(&interpolate(
-                                        template.band,
-                                        &values,
-                                        lower,
-                                        template.spacing,
-                                        points,
-                                    )),
-                                }
+                    // a panic (a bug) ends this call with an error, not a hang or an abort
+                    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        let (values, st) = solve_one(template, &mut roles, src, &one, &stop)?;
+                        // the row is taken once, by the one thread that solved source i
+                        let row = rows.get(i).and_then(|r| r.lock().ok()?.take());
+                        if let Some(row) = row {
+                            match at {
+                                None => row.copy_from_slice(&values),
+                                Some((lower, points)) => row.copy_from_slice(&interpolate(
+                                    template.band,
+                                    &values,
+                                    lower,
+                                    template.spacing,
+                                    points,
+                                )),
                             }
+                        }
+                        Ok(st)
+                    }))
+                    .unwrap_or_else(|_| {
+                        Err(Error::BadBand {
+                            message: format!("the solve of source {i} failed unexpectedly (a bug)"),
+                        })
+                    });
+                    match outcome {
+                        Ok(st) => {
                             if let Ok(mut slot) = results[i].lock() {
                                 *slot = Some(st);
                             }
