@@ -246,7 +246,8 @@ def part_matrix(quick: bool) -> None:
         f"{m * band_mb:.0f} MB"
     )
     print(
-        f"  asymmetry of the one-way estimates removed {info['asymmetry']:.3g} (largest distance "
+        f"  asymmetry of the one-way estimates removed {info['asymmetry']:.3g} "
+        f"(mean {info['asymmetry_mean']:.3g}; largest distance "
         f"{np.max(d[np.isfinite(d)]):.3g}), their largest diagonal {info['diagonal']:.3g}"
     )
 

@@ -118,6 +118,7 @@ def test_distance_matrix_on_the_sphere(grid):
     assert err.max() < 0.2 and err.mean() < 0.06, (err.max(), err.mean())
     # what the average removed: the one-way estimates differ (0.021) and their diagonal is not 0 (0.033)
     assert 0 < info["asymmetry"] < 0.05 and 0 < info["diagonal"] < 0.05
+    assert 0 < info["asymmetry_mean"] < info["asymmetry"]
     fine = ts.distance_matrix(ts.surfaces.Sphere(R), ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81)), pts)
     assert np.abs(fine - exact).max() < 0.5 * err.max()
     assert np.abs(fine - exact).mean() < 0.5 * err.mean()

@@ -93,8 +93,9 @@ def distance_matrix(
     threads : solves run at once locally (0: all cores), each on one thread.
     progress : callable ``(done, M)``, optional.
     info : also return a dict: ``asymmetry`` (the largest ``|D[i, j] − D[j, i]|`` of the one-way
-        estimates, removed by the average), ``diagonal`` (the largest one-way ``u_i(x_i)``, set to
-        0), ``points`` (the snapped points), ``seconds``.
+        estimates, removed by the average; ``asymmetry_mean`` its mean over the pairs),
+        ``diagonal`` (the largest one-way ``u_i(x_i)``, set to 0), ``points`` (the snapped
+        points), ``seconds``.
 
     Returns
     -------
@@ -140,12 +141,15 @@ def distance_matrix(
     both = np.isfinite(one_way) & np.isfinite(one_way.T)
     diff = np.abs(one_way - one_way.T)
     asymmetry = float(np.max(diff[both], initial=0.0))
+    off = both & ~np.eye(len(one_way), dtype=bool)
+    asymmetry_mean = float(np.mean(diff[off])) if np.any(off) else 0.0
     diagonal = float(np.max(np.abs(np.diag(one_way)), initial=0.0))
     matrix = 0.5 * (one_way + one_way.T)
     np.fill_diagonal(matrix, 0.0)
     if info:
         return matrix, {
             "asymmetry": asymmetry,
+            "asymmetry_mean": asymmetry_mean,
             "diagonal": diagonal,
             "points": snapped,
             "seconds": time.perf_counter() - t0,
