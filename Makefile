@@ -90,6 +90,8 @@ bench: build
 	# issue 32: the upwind solver for the moving medium and metrics against LxF and isotropic Godunov
 	$(PY) benches/upwind.py
 	cargo run --release -q -p tubesweep-core --example upwind_cost
+	# issue 35: the default thread count against threads=1 and all cores, quiet and with cores kept busy
+	$(PY) benches/under_load.py
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

@@ -32,6 +32,7 @@ mod row_prefetch;
 mod spread_threads;
 mod strip_pipeline;
 mod sweep_state;
+mod thread_choice;
 pub use row_prefetch::{default_row_prefetch_above, DEFAULT_CACHE_SHARE};
 use strip_pipeline::{run_sweeps_in_one_broadcast, strip_worker};
 use sweep_state::{order_key, Accumulator, Limits, SharedValues, SweepContext, KEEP_ROW, REFUSED, WAKE_ROWS};
@@ -448,8 +449,16 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // caller's: the sweeps hold all the pool's threads at their barriers, which a caller's
         // pool busy with other work (or with another solve) could not give. The progress
         // callback runs on the caller's thread.
+        // The default thread count (0) takes only the cores other tasks leave idle: on a busy
+        // machine the preparation's parallel steps and the pipelined sweeps wait on descheduled
+        // threads (`thread_choice`); the same values for any count.
+        let threads = if options.threads == 0 {
+            thread_choice::threads_for_default()
+        } else {
+            options.threads
+        };
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads)
+            .num_threads(threads)
             .build()
             .map_err(|e| Error::invalid("threads", format!("could not start {} threads: {e}", options.threads)))?;
         let pool = &pool;
@@ -862,6 +871,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             f64::INFINITY
         };
         stats.window_edge = f64::INFINITY;
+        // with the default thread count, each iteration in parallel or on this thread, whichever
+        // measures faster (a busy machine: `thread_choice`); the same bits either way
+        let mut choice = thread_choice::ThreadChoice::new(parallel, options.threads == 0, threads);
         while stats.iterations < options.max_iterations {
             let lim = Limits {
                 inf,
@@ -877,7 +889,9 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             let mut waiting = f64::INFINITY;
             let mut updates = 0u64;
             let mut visited = 0u64;
-            if parallel {
+            let run_parallel = choice.parallel(parallel);
+            choice.start(run_parallel);
+            if run_parallel {
                 // all 2^d sweeps of the iteration in one visit to the pool's threads, with a
                 // barrier between sweeps (waking the threads once per sweep costs more than a
                 // small sweep's work)
@@ -917,6 +931,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             if all_active {
                 updates = updated_per_sweep * n_orient as u64;
             }
+            choice.finish(updates);
             visited_per_sweep = visited / n_orient as u64;
             if lim.prefetch_ahead > 0 {
                 stats.prefetch_iterations += 1;
