@@ -66,13 +66,20 @@ PRESETS: Dict[str, Dict[str, List[int]]] = {
 #: method -> largest N run in a preset (the slow ones); absent = no limit
 CAPS: Dict[str, Dict[str, int]] = {
     "quick": {},
-    "default": {"mmp": 201, "tubesweep-lxf": 201, "mmp@ellipsoid": 121},
+    "default": {
+        "mmp": 201,
+        "tubesweep-lxf": 201,
+        "mmp@ellipsoid": 121,
+        "tubesweep-godunov-order2": 201,
+        "tubesweep-godunov-order2@star": 1601,
+    },
     "full": {},
 }
 #: dimension of each problem (the mesh peers apply to surfaces in 3D only)
 PROBLEM_DIMS = {"sphere": 3, "ellipsoid": 3, "star": 2, "torus": 3, "bunny": 3}
 METHOD_ORDER = [
     "tubesweep-godunov",
+    "tubesweep-godunov-order2",
     "tubesweep-godunov-tolh",
     "tubesweep-godunov-1t",
     "tubesweep-lxf",
@@ -81,6 +88,10 @@ METHOD_ORDER = [
     "mmp",
 ]
 SCALE_SIZES = [1001, 2001]
+#: distance from the source and from the largest distance below which errors are not "far"
+FAR = 0.1
+#: the accuracies whose cost :func:`time_to_accuracy` reads off each method's sizes
+TARGETS = (("mean_err", 1e-3), ("mean_err", 2e-4), ("far_max_err", 1e-2), ("far_max_err", 2e-3))
 
 
 # --------------------------------------------------------------------------------------------
@@ -146,6 +157,11 @@ def run_case(problem_name: str, n: int, method_name: str, repeats: int) -> Dict[
     vals = np.asarray(outcome.values, dtype=float)
     sel = np.isfinite(exact)
     err = np.abs(vals[sel] - exact[sel])
+    # "far": at least 0.1 from the source and from the farthest distances (the cut locus on the
+    # sphere and the star; a rough stand-in for it on the other surfaces)
+    ex = exact[sel]
+    far = (ex >= FAR) & (ex <= np.max(ex) - FAR) if ex.size else ex.astype(bool)
+    far_err = err[far]
     n_nan = int(np.count_nonzero(~np.isfinite(err)))
     st = dict(outcome.stats)
     st.pop("wall", None)
@@ -154,6 +170,7 @@ def run_case(problem_name: str, n: int, method_name: str, repeats: int) -> Dict[
         status="ok",
         max_err=float(np.nanmax(err)) if err.size and n_nan < err.size else math.nan,
         mean_err=float(np.nanmean(err)) if err.size and n_nan < err.size else math.nan,
+        far_max_err=float(np.nanmax(far_err)) if far_err.size and np.isfinite(far_err).any() else math.nan,
         n_eval=int(sel.sum()),
         n_nan=n_nan,
         wall_s=float(np.median(walls)),
@@ -164,6 +181,9 @@ def run_case(problem_name: str, n: int, method_name: str, repeats: int) -> Dict[
         rss_method="VmHWM after clear_refs" if reset_ok else "ru_maxrss (not reset)",
         notes=problem.notes,
     )
+    # the time to the answer with the set-up the method needs (marching cubes for the mesh peers;
+    # tubesweep's and scikit-fmm's band searches are in their wall time already)
+    rec["total_s"] = rec["wall_s"] + float(st.get("mesh_s", 0.0))
     if "updates" in st and rec["sweep_s"] > 0:
         rec["updates_per_s"] = st["updates"] / rec["sweep_s"]
     return rec
@@ -341,6 +361,56 @@ def equal_error(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
     return rows
 
 
+def time_to_accuracy(records: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
+    """For each problem and method, the time (set-up included: ``total_s``) it needs to reach
+    each of :data:`TARGETS`, read off its own sizes in this run by :func:`time_at_error`, or a
+    bound (``"<t"``: more accurate at its cheapest size, which took t; ``">t"``: not reached at
+    its most accurate size, which took t)."""
+    ok = [r for r in records if r.get("status") == "ok"]
+    rows: List[Dict[str, Any]] = []
+    for prob in dict.fromkeys(r["problem"] for r in ok):
+        for m in METHOD_ORDER:
+            recs = sorted((r for r in ok if r["problem"] == prob and r["method"] == m), key=lambda r: r["n"])
+            if not recs:
+                continue
+            row: Dict[str, Any] = dict(problem=prob, method=m, sizes=",".join(str(r["n"]) for r in recs))
+            for key, target in TARGETS:
+                curve = [(r.get(key, math.nan), r["total_s"]) for r in recs]
+                t = time_at_error(curve, target)
+                if t is not None:
+                    row[f"{key}@{target:g}"] = f"{t:.3g}"
+                    continue
+                bound = time_bound_at_error(curve, target)
+                # time_bound_at_error's signs are those of a ratio over it: ">" = reached sooner
+                row[f"{key}@{target:g}"] = (
+                    "—" if bound is None else ("≤" if bound[0] == ">" else ">") + f"{bound[1]:.3g}"
+                )
+            rows.append(row)
+    return rows
+
+
+def time_to_accuracy_table(rows: List[Dict[str, Any]]) -> str:
+    keys = [f"{k}@{t:g}" for k, t in TARGETS]
+    heads = [("mean" if k == "mean_err" else "far max") + f" {t:g}" for k, t in TARGETS]
+    out = [
+        "| problem | method | sizes | " + " | ".join(f"s to {h}" for h in heads) + " |",
+        "|---|---|---|" + "---:|" * len(keys),
+    ]
+    for r in rows:
+        out.append(
+            f"| {r['problem']} | {r['method']} | {r['sizes']} | " + " | ".join(r.get(k, "—") for k in keys) + " |"
+        )
+    return "\n".join(out)
+
+
+TIME_TO_ACCURACY_NOTE = (
+    "Time to accuracy: the seconds each method needs (its set-up included: marching cubes for the mesh "
+    "peers) to reach a mean error and a far max error (points at least 0.1 from the source and from the "
+    "largest distances), interpolated log–log between its sizes in this run; '≤t' where its cheapest "
+    "size is already more accurate, '>t' where its most accurate size is not accurate enough."
+)
+
+
 EQUAL_ERROR_COLUMNS = [
     ("problem", "problem", "str"),
     ("method", "method", "str"),
@@ -396,6 +466,7 @@ COLUMNS = [
     ("N", "n", "str"),
     ("method", "method", "str"),
     ("max err", "max_err", "err"),
+    ("far max", "far_max_err", "err"),
     ("mean err", "mean_err", "err"),
     ("wall ms", "wall_s", "ms"),
     ("× ts", "ratio", "ratio"),
@@ -416,7 +487,9 @@ def table(records: List[Dict[str, Any]]) -> str:
     rows = [head, sep]
     for r in records:
         if r.get("status") != "ok":
-            cells = [str(r["problem"]), str(r["n"]), str(r["method"]), f"{r.get('status')}: {r.get('note', '')}"]
+            # (a child's error note joins its last lines with " | ": not a column separator here)
+            note = str(r.get("note", "")).replace("|", "¦")
+            cells = [str(r["problem"]), str(r["n"]), str(r["method"]), f"{r.get('status')}: {note}"]
             cells += [""] * (len(COLUMNS) - len(cells))
         else:
             cells = [_fmt(r.get(key), kind) for _, key, kind in COLUMNS]
@@ -440,6 +513,7 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
         return None
     style = {
         "tubesweep-godunov": ("C0", "o", "-"),
+        "tubesweep-godunov-order2": ("C5", "*", "-"),
         "tubesweep-godunov-tolh": ("C4", "o", ":"),
         "tubesweep-godunov-1t": ("C7", "o", "-."),
         "tubesweep-lxf": ("C0", "s", "--"),
@@ -534,6 +608,8 @@ def run_bench(
     tab = table(records)
     at_equal_error = equal_error(records)
     eq_tab = equal_error_table(at_equal_error)
+    to_accuracy = time_to_accuracy(records)
+    acc_tab = time_to_accuracy_table(to_accuracy)
     elapsed = time.perf_counter() - t0
     out.mkdir(parents=True, exist_ok=True)
     png = plot(records, out / "time_vs_error.png") if make_plot else None
@@ -547,6 +623,7 @@ def run_bench(
                 repeats=repeats,
                 records=records,
                 equal_error=at_equal_error,
+                time_to_accuracy=to_accuracy,
                 notes=all_notes,
                 seconds=elapsed,
             ),
@@ -567,6 +644,12 @@ def run_bench(
         "",
         eq_tab,
         "",
+        "## Time to accuracy",
+        "",
+        TIME_TO_ACCURACY_NOTE,
+        "",
+        acc_tab,
+        "",
     ] + [f"- {nt}" for nt in all_notes]
     (out / "results.md").write_text("\n".join(md) + "\n")
     if verbose:
@@ -580,10 +663,20 @@ def run_bench(
         print(EQUAL_ERROR_NOTE)
         print(eq_tab)
         print()
+        print(TIME_TO_ACCURACY_NOTE)
+        print(acc_tab)
+        print()
         print(f"wrote {out / 'results.md'}, {out / 'results.json'}" + (f", {png}" if png else ""))
         print(f"total {elapsed:.0f} s")
     return dict(
-        records=records, notes=all_notes, table=tab, plot=png, equal_error=at_equal_error, equal_error_table=eq_tab
+        records=records,
+        notes=all_notes,
+        table=tab,
+        plot=png,
+        equal_error=at_equal_error,
+        equal_error_table=eq_tab,
+        time_to_accuracy=to_accuracy,
+        time_to_accuracy_table=acc_tab,
     )
 
 

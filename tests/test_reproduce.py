@@ -121,3 +121,20 @@ def test_fig7_solution_range(results):
 def test_sphere_circle_points_lie_on_the_sphere():
     c = sphere.circle_points(100)
     assert np.allclose(np.linalg.norm(c, axis=1), 0.5) and np.allclose(c[:, 0], 0)
+
+
+# --- beyond the paper: order=2 ----------------------------------------------------------------
+def test_second_order_table_beats_the_first_order_scheme(results):
+    out, res = results
+    rows = res["second-order"]["rows"]
+    assert (out / "second_order.csv").stat().st_size > 100
+    assert "| six-fold star |" in (out / "second_order.md").read_text()
+    by = {(r["surface"], r["N"], r["order"]): r for r in rows}
+    for (surface, n, o), r in by.items():
+        if o == 2:
+            first = by[(surface, n, 1)]
+            assert r["mean"] < first["mean"] / 3 and r["far_max"] < first["far_max"], (surface, n)
+            assert r["fallback"] is None
+    fitted = {(o["surface"], o["order"]): o for o in res["second-order"]["orders"]}
+    assert fitted[("circle", 2)]["far_max_order"] > 1.8 and fitted[("circle", 1)]["far_max_order"] < 1.5
+    assert fitted[("six-fold star", 2)]["mean_order"] > 1.9

@@ -140,6 +140,8 @@ class Solution:
         self._facing = facing if facing is not None else (empty, empty, np.empty(0))
         # for a φ array: its values at a sample of the band's nodes (linear indices, values)
         self._phi_sample = phi_sample
+        # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
+        self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None
 
     def __getstate__(self) -> dict:
         # the native band does not pickle: its linear indices do, and rebuild it
@@ -258,7 +260,12 @@ class Solution:
         >>> v = sol([(0.0, 0.5, 0.0)], interpolation="cubic")
         """
         p = as_points(points, self.grid.ndim, "points")
-        return interpolate_band(self._band, self.values, self.grid, p, interpolation)
+        out = interpolate_band(self._band, self.values, self.grid, p, interpolation)
+        if self._factoring is not None:
+            from .second_order import factored_values
+
+            out = factored_values(self, p, out, interpolation)
+        return out
 
     def on_mesh(self, vertices: Any) -> np.ndarray:
         """The solution at the vertices of a mesh of the surface (for display or export).
@@ -601,12 +608,13 @@ def solve(
     outer: float = 4.0,
     method: str = "two-layer",
     source_init: str = "exact",
-    tol: float = 1e-10,
+    tol: Optional[float] = None,
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
     threads: int = 0,
     paper_sweeps: bool = False,
+    order: int = 1,
 ) -> Solution:
     """First-arrival time (geodesic distance for ``speed=1``) on an implicit curve or surface.
 
@@ -651,7 +659,8 @@ def solve(
         (``tubesweep reproduce source-init``, ``docs/source-initialisation.md``).
     tol, max_iterations : float, int
         Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
-        ``max_iterations`` (then ``stats.converged`` is False, with a warning).
+        ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol`` defaults
+        to 1e-10 for ``order=1`` and to ``1e-3 Δx²`` times the mean slowness for ``order=2``.
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
     threads : int
@@ -675,6 +684,15 @@ def solve(
         smallest still-changing value are updated, and the band fills from the sources outwards):
         3× fewer local updates on the sphere at N=201, 5× at N=1001, and 2–4× less time
         (``benches/sweep_variants.py``).
+
+    order : {1, 2}
+        1: the paper's first-order scheme (the default). 2: second order (docs/second-order.md):
+        the metric-corrected tube equation with limited BDF2 differences and factored point
+        sources, for level sets (arrays, callables, library surfaces) with the Godunov update;
+        ``sol.stats.order2`` reports its phases. A surface whose curvature the tube does not
+        resolve (``outer·Δx·κ ≥ 1``), a φ that is not a signed distance (without
+        ``redistance=True``) and closest-point surfaces (meshes, open surfaces) are refused with
+        a ``ValueError``.
 
     Returns
     -------
@@ -708,11 +726,25 @@ def solve(
     array([0.77...])
     """
     t0 = time.perf_counter()
+    order = _check_order(order)
     grid = as_grid(grid)
     surf = as_surface(surface)
     surf.check_grid(grid)
     src = as_sources(sources, grid)
     general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
+    if order == 2:
+        from . import second_order as _so
+
+        if tol is not None:
+            check_tolerance(tol, max_iterations)
+        else:
+            check_tolerance(1.0, max_iterations)
+        cb = progress_callback(progress)
+        _check_source_init(source_init)
+        _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
+        tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
+        return _so.solve_on_tube(tube, src, speed, tol, max_iterations, cb, threads, t0)
+    tol = 1e-10 if tol is None else tol
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)
@@ -735,6 +767,12 @@ def solve(
         t0,
         reuse=False,
     )
+
+
+def _check_order(order: Any) -> int:
+    from .second_order import check_order
+
+    return check_order(order)
 
 
 def _resolve_scheme(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Tuple[Any, str]:

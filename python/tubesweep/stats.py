@@ -60,14 +60,15 @@ class SolveStats:
         (before the first, every row counts as visited, or none with the front window;
         docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
     order : int
-        The scheme's order: 1 (the paper's) or 2 (``travel_time(..., order=2)``,
-        docs/box-second-order.md).
+        The scheme's order: 1 (the paper's) or 2 (docs/second-order.md on surfaces,
+        docs/box-second-order.md for ``travel_time(..., order=2)``).
     order2 : dict or None
         For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
         phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
         switched to accepting decreases only, None when it did not fire), ``unreached`` (nodes
         never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of
-        nodes fixed around each source).
+        nodes fixed around each source); on surfaces also ``max_curvature`` (the largest principal
+        curvature found in the tube) and ``grad_norm_range`` (|∇φ| in the inner tube).
 
     Examples
     --------

@@ -29,7 +29,7 @@ import numpy as np
 
 from ._validate import as_grid, as_sources, check_tolerance, progress_callback
 from .grid import Grid
-from .solve import Solution, _check_source_init, _prepare_tube, _resolve_scheme, _solve_on_tube
+from .solve import Solution, _check_order, _check_source_init, _prepare_tube, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
 
 __all__ = ["Tube"]
@@ -153,12 +153,13 @@ class Tube:
         flow: Any = None,
         allow_supersonic: bool = False,
         source_init: str = "exact",
-        tol: float = 1e-10,
+        tol: Optional[float] = None,
         max_iterations: int = 10000,
         progress: Optional[Callable[[int, float, int], None]] = None,
         infinity: Optional[float] = None,
         threads: int = 0,
         paper_sweeps: bool = False,
+        order: int = 1,
     ) -> Solution:
         """First-arrival times from ``sources`` on this band, without building the band again.
 
@@ -193,8 +194,18 @@ class Tube:
         """
         t0 = time.perf_counter()
         self._check_phi_unchanged()
+        order = _check_order(order)
         src = as_sources(sources, self.grid)
         general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
+        if order == 2:
+            from . import second_order as _so
+
+            check_tolerance(1.0 if tol is None else tol, max_iterations)
+            cb = progress_callback(progress)
+            _check_source_init(source_init)
+            _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
+            return _so.solve_on_tube(self._tube, src, speed, tol, max_iterations, cb, threads, t0)
+        tol = 1e-10 if tol is None else tol
         check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)

@@ -12,6 +12,7 @@
 //! | [`band`] | the narrow band (inner tube + extension layer), its discovery, directions, facing sheets, row schedule | Fig. 4, Eq. (8) |
 //! | [`scheme`] | the local solvers: Godunov, Lax–Friedrichs, the extension update, Hamiltonians | Eqs. (3), (4), (5), Sect. 5.1 |
 //! | [`sweep`] | the Gauss–Seidel sweeps over the band (Algorithms 1–3), in parallel, the rim, the front window, many sources on one band | Algorithms 1–3 |
+//! | [`second_order`] | `order=2`: the metric-corrected tube equation, its geometry, factored sources, BDF2 local solvers and sweeps | beyond the paper (docs/second-order.md) |
 //! | [`solution`] | interpolation in the band, nearest-source labels | — |
 //! | [`error`], [`kernel_stats`] | the error type; profiling counters (feature `kernel-stats`, empty without it) | — |
 //!
@@ -24,6 +25,7 @@ pub mod error;
 pub mod kernel_stats;
 mod prefetch;
 pub mod scheme;
+pub mod second_order;
 pub mod solution;
 pub mod surface;
 pub mod sweep;

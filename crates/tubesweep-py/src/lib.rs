@@ -5,6 +5,7 @@
 mod box_order2;
 mod errors;
 mod many_sources;
+mod second_order;
 
 use errors::to_pyerr;
 use numpy::{
@@ -1858,6 +1859,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mobius_closest_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(open_surface_closest_points, m)?)?;
     m.add_function(wrap_pyfunction!(star_signed_distance, m)?)?;
+    second_order::register(m)?;
     m.add("DEFAULT_INFINITY", tubesweep_core::DEFAULT_INFINITY)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

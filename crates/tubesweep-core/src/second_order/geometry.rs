@@ -1,0 +1,341 @@
+//! Per-node geometry of the tube for the second-order solver, computed once per band from φ at
+//! the band nodes (docs/second-order.md, "The corrected equation").
+//!
+//! At an inner-tube node the metric-corrected eikonal equation reads |B ∇u| = 1/F with
+//! B = (I − φ D²φ)⁻¹: its exact solution is the normal extension of the surface solution, which
+//! the paper's |∇u| = 1/F (its Eq. (1) in the tube) is not, by O(φκ) = O(Δx) at every inner node.
+//! n = ∇φ/|∇φ| and D²φ come from central differences of φ (the mixed derivatives from the four
+//! diagonal neighbours, reached through the band's neighbour table), B from the 3×3 (2×2)
+//! inverse. The principal curvatures at the foot point follow from the eigenvalues λ of D²φ at
+//! height φ, κ = λ / (1 − φλ); the tube must stay inside the focal distance, h_out·κ < 1.
+
+use crate::band::NarrowBand;
+use crate::error::{Error, Result};
+use crate::sweep::NodeRole;
+
+/// What the second-order sweeps read at one node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeGeometry {
+    /// Inner tube: ∇φ/|∇φ| (the first `D` entries) by central differences of φ (the given
+    /// direction times sgn(φ) where the stencil is incomplete). Extension layer: the given outward
+    /// direction sgn(φ) n, which the extension update follows.
+    pub normal: [f32; 3],
+    /// B = (I − φ D²φ)⁻¹, symmetric, packed as (00, 01, 02, 11, 12, 22) (2D: 00, 01, 11 in the
+    /// places 0, 1, 3). The identity at extension-layer nodes (not read there).
+    pub b: [f32; 6],
+}
+
+/// Index of entry (k, l) of a packed symmetric matrix.
+#[inline(always)]
+pub(crate) const fn sym(k: usize, l: usize) -> usize {
+    const IDX: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+    IDX[k][l]
+}
+
+/// What the geometry pass found about the surface, for the caller's checks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeometrySummary {
+    /// The largest principal curvature |κ| at the foot points of the inner-tube nodes.
+    pub max_curvature: f64,
+    /// The smallest and largest |∇φ| (central differences) at the inner-tube nodes.
+    pub grad_norm_min: f64,
+    pub grad_norm_max: f64,
+    /// Inner-tube nodes whose 3^D-stencil of φ was not all in the band (their geometry falls back
+    /// to the given direction and B = I).
+    pub incomplete_stencils: usize,
+}
+
+/// The geometry of every band node and the surface summary.
+pub struct TubeGeometry {
+    pub nodes: Vec<NodeGeometry>,
+    /// |φ| per node (apart from the rest: the extension update compares it between neighbours).
+    pub abs_phi: Vec<f32>,
+    pub summary: GeometrySummary,
+}
+
+/// Eigenvalues of a symmetric D×D matrix (2 or 3), unordered.
+pub(crate) fn symmetric_eigenvalues<const D: usize>(m: &[[f64; D]; D]) -> [f64; 3] {
+    if D == 2 {
+        let (a, b, d) = (m[0][0], m[0][1], m[1][1]);
+        let mean = 0.5 * (a + d);
+        let r = (0.25 * (a - d) * (a - d) + b * b).sqrt();
+        return [mean + r, mean - r, 0.0];
+    }
+    // Smith's trigonometric method for a real symmetric 3×3 matrix
+    let p1 = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+    let q = (m[0][0] + m[1][1] + m[2][2]) / 3.0;
+    if p1 == 0.0 {
+        return [m[0][0], m[1][1], m[2][2]];
+    }
+    let p2 = (m[0][0] - q).powi(2) + (m[1][1] - q).powi(2) + (m[2][2] - q).powi(2) + 2.0 * p1;
+    let p = (p2 / 6.0).sqrt();
+    let mut bm = [[0.0; 3]; 3];
+    for k in 0..3 {
+        for l in 0..3 {
+            bm[k][l] = (m[k][l] - if k == l { q } else { 0.0 }) / p;
+        }
+    }
+    let det = bm[0][0] * (bm[1][1] * bm[2][2] - bm[1][2] * bm[2][1])
+        - bm[0][1] * (bm[1][0] * bm[2][2] - bm[1][2] * bm[2][0])
+        + bm[0][2] * (bm[1][0] * bm[2][1] - bm[1][1] * bm[2][0]);
+    let r = (det / 2.0).clamp(-1.0, 1.0);
+    let phi = r.acos() / 3.0;
+    let e1 = q + 2.0 * p * phi.cos();
+    let e3 = q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos();
+    [e1, 3.0 * q - e1 - e3, e3]
+}
+
+/// Inverse of a symmetric D×D matrix, or None when it is (nearly) singular.
+pub(crate) fn symmetric_inverse<const D: usize>(m: &[[f64; D]; D]) -> Option<[[f64; D]; D]> {
+    let mut out = [[0.0; D]; D];
+    if D == 2 {
+        let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+        if !(det.abs() > 1e-12) {
+            return None;
+        }
+        out[0][0] = m[1][1] / det;
+        out[1][1] = m[0][0] / det;
+        out[0][1] = -m[0][1] / det;
+        out[1][0] = -m[1][0] / det;
+        return Some(out);
+    }
+    let c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+    let c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+    let c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+    let det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
+    if !(det.abs() > 1e-12) {
+        return None;
+    }
+    let inv = [
+        [
+            c00,
+            m[0][2] * m[2][1] - m[0][1] * m[2][2],
+            m[0][1] * m[1][2] - m[0][2] * m[1][1],
+        ],
+        [
+            c01,
+            m[0][0] * m[2][2] - m[0][2] * m[2][0],
+            m[0][2] * m[1][0] - m[0][0] * m[1][2],
+        ],
+        [
+            c02,
+            m[0][1] * m[2][0] - m[0][0] * m[2][1],
+            m[0][0] * m[1][1] - m[0][1] * m[1][0],
+        ],
+    ];
+    for k in 0..D {
+        for l in 0..D {
+            out[k][l] = inv[k][l] / det;
+        }
+    }
+    Some(out)
+}
+
+/// φ's central-difference gradient and Hessian at node `n`, or None when a node of its
+/// 3^D-stencil (axis and diagonal neighbours) is not in the band.
+pub(crate) fn gradient_and_hessian<const D: usize>(
+    band: &NarrowBand<D>,
+    phi: &[f64],
+    n: usize,
+    h: f64,
+) -> Option<([f64; D], [[f64; D]; D])> {
+    let sentinel = band.sentinel();
+    let nb = band.neighbours_of(n);
+    let mut g = [0.0; D];
+    let mut hess = [[0.0; D]; D];
+    let p0 = phi[n];
+    for k in 0..D {
+        let (m, p) = (nb[k][0], nb[k][1]);
+        if m == sentinel || p == sentinel {
+            return None;
+        }
+        let (pm, pp) = (phi[m as usize], phi[p as usize]);
+        g[k] = (pp - pm) / (2.0 * h);
+        hess[k][k] = (pp - 2.0 * p0 + pm) / (h * h);
+        for l in k + 1..D {
+            // φ(x ± h e_k ± h e_l) through the neighbours' neighbours along l
+            let mut corner = [[0.0; 2]; 2];
+            for (sk, &a) in [m, p].iter().enumerate() {
+                let nba = band.neighbours_of(a as usize);
+                for sl in 0..2 {
+                    let c = nba[l][sl];
+                    if c == sentinel {
+                        return None;
+                    }
+                    corner[sk][sl] = phi[c as usize];
+                }
+            }
+            let v = (corner[1][1] - corner[1][0] - corner[0][1] + corner[0][0]) / (4.0 * h * h);
+            hess[k][l] = v;
+            hess[l][k] = v;
+        }
+    }
+    Some((g, hess))
+}
+
+/// The geometry of every node of `band`: `phi` (signed, per node), `directions` the outward unit
+/// directions sgn(φ) n the solver's extension reads (per node), `roles` to know the inner tube.
+pub fn tube_geometry<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    phi: &[f64],
+    directions: &[[f32; D]],
+    spacing: f64,
+) -> Result<TubeGeometry> {
+    let n = band.len();
+    if roles.len() != n || phi.len() != n || directions.len() != n {
+        return Err(Error::invalid(
+            "phi",
+            format!("roles, phi and directions need one entry per band node ({n})"),
+        ));
+    }
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Err(Error::invalid(
+            "spacing",
+            format!("must be positive and finite, got {spacing}"),
+        ));
+    }
+    let mut summary = GeometrySummary {
+        max_curvature: 0.0,
+        grad_norm_min: f64::INFINITY,
+        grad_norm_max: 0.0,
+        incomplete_stencils: 0,
+    };
+    let mut nodes = Vec::with_capacity(n);
+    let mut identity = [0.0f32; 6];
+    for k in 0..D {
+        identity[sym(k, k)] = 1.0;
+    }
+    for i in 0..n {
+        let p = phi[i];
+        let sign = if p < 0.0 { -1.0f32 } else { 1.0 };
+        let mut geo = NodeGeometry {
+            normal: [0.0; 3],
+            b: identity,
+        };
+        for k in 0..D {
+            geo.normal[k] = if roles[i] == NodeRole::Outer {
+                directions[i][k]
+            } else {
+                sign * directions[i][k]
+            };
+        }
+        if roles[i] != NodeRole::Outer {
+            match gradient_and_hessian(band, phi, i, spacing) {
+                None => summary.incomplete_stencils += 1,
+                Some((g, hess)) => {
+                    let norm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    summary.grad_norm_min = summary.grad_norm_min.min(norm);
+                    summary.grad_norm_max = summary.grad_norm_max.max(norm);
+                    if norm > 0.0 {
+                        for k in 0..D {
+                            geo.normal[k] = (g[k] / norm) as f32;
+                        }
+                    }
+                    // principal curvatures at the foot point from the eigenvalues at height φ
+                    for lam in symmetric_eigenvalues(&hess).iter().take(D) {
+                        let den = 1.0 - p * lam;
+                        let kappa = if den > 0.0 { (lam / den).abs() } else { f64::INFINITY };
+                        summary.max_curvature = summary.max_curvature.max(kappa);
+                    }
+                    let mut m = [[0.0; D]; D];
+                    for k in 0..D {
+                        for l in 0..D {
+                            m[k][l] = if k == l { 1.0 } else { 0.0 } - p * hess[k][l];
+                        }
+                    }
+                    match symmetric_inverse(&m) {
+                        Some(b) => {
+                            for k in 0..D {
+                                for l in k..D {
+                                    geo.b[sym(k, l)] = (0.5 * (b[k][l] + b[l][k])) as f32;
+                                }
+                            }
+                        }
+                        None => summary.max_curvature = f64::INFINITY,
+                    }
+                }
+            }
+        }
+        nodes.push(geo);
+    }
+    if !summary.grad_norm_min.is_finite() {
+        summary.grad_norm_min = 0.0;
+    }
+    let abs_phi = phi.iter().map(|p| p.abs() as f32).collect();
+    Ok(TubeGeometry {
+        nodes,
+        abs_phi,
+        summary,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eigenvalues_of_a_rotated_diagonal_matrix() {
+        // R diag(1, 2, 4) Rᵀ with a rotation about z by 0.3 rad
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let r = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        let d = [1.0, 2.0, 4.0];
+        let mut m = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] = (0..3).map(|k| r[i][k] * d[k] * r[j][k]).sum();
+            }
+        }
+        let mut e = symmetric_eigenvalues(&m);
+        e.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        for (a, b) in e.iter().zip(d) {
+            assert!((a - b).abs() < 1e-12, "{e:?}");
+        }
+        let inv = symmetric_inverse(&m).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                let v: f64 = (0..3).map(|k| m[i][k] * inv[k][j]).sum();
+                assert!((v - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn sphere_geometry_has_b_equal_to_one_plus_phi_kappa_tangentially() {
+        // sphere of radius 0.5 on 41³ nodes over [−1, 1]³: B's tangential eigenvalues are 1 + φ/R,
+        // its normal one 1, to the central differences' O(h²)
+        let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
+        let idx = band.indices();
+        let phi: Vec<f64> = idx
+            .iter()
+            .map(|i| {
+                let x: Vec<f64> = i.iter().map(|&c| -1.0 + h * c as f64).collect();
+                (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 0.5
+            })
+            .collect();
+        let geo = tube_geometry(&band, &roles, &phi, &dirs, h).unwrap();
+        assert_eq!(geo.summary.incomplete_stencils, 0);
+        assert!((geo.summary.max_curvature - 2.0).abs() < 0.05, "{:?}", geo.summary);
+        assert!((geo.summary.grad_norm_max - 1.0).abs() < 0.01 && (geo.summary.grad_norm_min - 1.0).abs() < 0.01);
+        let mut worst: f64 = 0.0;
+        for (i, g) in geo.nodes.iter().enumerate() {
+            if roles[i] != NodeRole::Inner {
+                continue;
+            }
+            let mut m = [[0.0; 3]; 3];
+            for k in 0..3 {
+                for l in 0..3 {
+                    m[k][l] = g.b[sym(k, l)] as f64;
+                }
+            }
+            let mut e = symmetric_eigenvalues(&m);
+            e.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            let t = 1.0 + phi[i] / 0.5;
+            let want = if t < 1.0 { [t, t, 1.0] } else { [1.0, t, t] };
+            for (a, b) in e.iter().zip(want) {
+                worst = worst.max((a - b).abs());
+            }
+        }
+        assert!(worst < 0.01, "worst B eigenvalue deviation {worst}");
+    }
+}

@@ -1,0 +1,175 @@
+//! Second-order accuracy on surfaces (`order=2`, docs/second-order.md): the scheme "S2".
+//!
+//! The paper's tube equation, |∇u| = 1/F at every inner-tube node (its Sect. 4 with Eq. (3)),
+//! is a *model* error of size φκ = O(Δx) off the surface, so no stencil makes it second order.
+//! This module solves instead the metric-corrected equation |B∇u| = 1/F, B = (I − φD²φ)⁻¹,
+//! whose exact solution in the tube is the normal extension of the surface solution, with:
+//!
+//! * [`geometry`]: n, D²φ (central differences of φ) and B per node, once per band, and the
+//!   curvature the tube must resolve (h_out·κ < 1);
+//! * [`factoring`]: u = u₀ + w with u₀ the chord distance to the nearest point source, the nodes
+//!   within a small ball of a source fixed at u₀;
+//! * [`local`]: the limited BDF2 Godunov update (a continuous ramp between first and second
+//!   order, Newton's method for the unequal steps) and the second-order extension update;
+//! * [`solver`]: phase 1 (first order, monotone) then phase 2 (second order, assignment), with
+//!   the stagnation safeguard.
+//!
+//! The first-order solver ([`crate::sweep`]) is untouched: `order=1` is the paper's scheme.
+
+pub mod factoring;
+pub mod geometry;
+pub mod local;
+pub mod solver;
+pub mod start;
+
+pub use factoring::{factor_sources, Factoring};
+pub use geometry::{tube_geometry, GeometrySummary, NodeGeometry, TubeGeometry};
+pub use solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
+pub use start::first_order_start;
+
+/// |∇φ| at the inner nodes must be within this of 1 (B uses D²φ, which is the surface's
+/// curvature only for a signed distance).
+pub const GRAD_NORM_TOLERANCE: f64 = 0.05;
+
+/// Refuses a surface the second-order scheme cannot handle on this tube: an incomplete stencil
+/// of φ at an inner node, φ not a signed distance, or a principal curvature κ with
+/// `outer_width`·κ ≥ 1 (B is singular at φ = −1/κ: the tube reaches a focal point).
+pub fn check_geometry(summary: &GeometrySummary, outer_width: f64, spacing: f64) -> crate::Result<()> {
+    use crate::error::Error;
+    if summary.incomplete_stencils > 0 {
+        return Err(Error::invalid(
+            "surface",
+            format!(
+                "order=2: {} inner-tube nodes lack a neighbour (axis or diagonal) in the band for the Hessian of φ; φ is not \
+                 a signed distance near the surface (pass redistance=True) or the grid does not resolve the surface (refine it)",
+                summary.incomplete_stencils
+            ),
+        ));
+    }
+    let kappa = summary.max_curvature;
+    if !(outer_width * kappa < 1.0) {
+        return Err(Error::invalid(
+            "grid",
+            format!(
+                "order=2: the surface's largest curvature ({kappa:.4}, radius {:.4}) is not resolved by the tube: \
+                 outer·Δx·κ = {:.3} ≥ 1 (the tube reaches a focal point, where the corrected equation is singular). \
+                 Refine the grid to a spacing below {:.4}, or use order=1",
+                1.0 / kappa,
+                outer_width * kappa,
+                spacing / (outer_width * kappa) * 0.999
+            ),
+        ));
+    }
+    if (summary.grad_norm_min - 1.0).abs() > GRAD_NORM_TOLERANCE
+        || (summary.grad_norm_max - 1.0).abs() > GRAD_NORM_TOLERANCE
+    {
+        return Err(Error::invalid(
+            "surface",
+            format!(
+                "order=2 needs φ to be a signed distance near the surface (it uses D²φ as the curvature): |∇φ| ranges \
+                 over [{:.3}, {:.3}] in the inner tube. Pass ts.LevelSet(phi, redistance=True), or use order=1",
+                summary.grad_norm_min, summary.grad_norm_max
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The starting values: u₀ at the fixed nodes, +∞ elsewhere.
+pub fn starting_values<const D: usize>(factoring: &Factoring<D>) -> Vec<f64> {
+    factoring
+        .roles
+        .iter()
+        .zip(&factoring.u0)
+        .map(|(&r, &u0)| {
+            if r == crate::sweep::NodeRole::Fixed {
+                u0
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sweep::{Control, NodeRole, Slowness};
+
+    /// The sphere of radius 0.5 on n³ nodes over [−1, 1]³, source (−0.5, 0, 0): the max error
+    /// at the inner nodes' foot points against the great-circle distance, away from the source
+    /// and the antipode.
+    fn sphere_error(n: usize) -> (f64, f64, SecondOrderStats) {
+        let (band, roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
+        let idx = band.indices();
+        let pts: Vec<[f64; 3]> = idx
+            .iter()
+            .map(|i| [-1.0 + h * i[0] as f64, -1.0 + h * i[1] as f64, -1.0 + h * i[2] as f64])
+            .collect();
+        let phi: Vec<f64> = pts
+            .iter()
+            .map(|x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 0.5)
+            .collect();
+        let geo = tube_geometry(&band, &roles, &phi, &dirs, h).unwrap();
+        let fac = factor_sources(
+            &band,
+            &roles,
+            &phi,
+            &geo.nodes,
+            [-1.0; 3],
+            h,
+            &[[-0.5, 0.0, 0.0]],
+            &[1.0],
+            2.0 * h,
+        )
+        .unwrap();
+        let mut values = starting_values(&fac);
+        let options = SecondOrderOptions {
+            tol_first: 1e-3 * h * h,
+            tol: 1e-3 * h * h,
+            max_iterations: 500,
+            stall_ratio: 0.9,
+            stall_window: 10,
+            own_first_phase: true,
+        };
+        let stats = sweep_second_order(
+            &band,
+            &geo,
+            &fac,
+            Slowness::Constant(1.0),
+            h,
+            &mut values,
+            &options,
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        let (mut worst, mut sum, mut count): (f64, f64, f64) = (0.0, 0.0, 0.0);
+        for (i, x) in pts.iter().enumerate() {
+            if roles[i] == NodeRole::Outer || phi[i].abs() > h {
+                continue;
+            }
+            let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+            let exact = 0.5 * (-x[0] / r).clamp(-1.0, 1.0).acos();
+            if exact < 0.2 || exact > 0.5 * std::f64::consts::PI - 0.2 {
+                continue;
+            }
+            worst = worst.max((values[i] - exact).abs());
+            sum += (values[i] - exact).abs();
+            count += 1.0;
+        }
+        (worst, sum / count, stats)
+    }
+
+    #[test]
+    fn sphere_converges_at_second_order() {
+        let (e1, m1, s1) = sphere_error(41);
+        let (e2, m2, s2) = sphere_error(81);
+        assert!(s1.converged && s2.converged, "{s1:?} {s2:?}");
+        let order = (e1 / e2).ln() / (80.0f64 / 40.0).ln();
+        let mean_order = (m1 / m2).ln() / (80.0f64 / 40.0).ln();
+        assert!(
+            order > 1.5 && mean_order > 1.75 && m2 < 1e-4,
+            "max errors {e1:.3e} {e2:.3e}, order {order:.2}; mean {m1:.3e} {m2:.3e}, order {mean_order:.2}"
+        );
+    }
+}

@@ -1,0 +1,248 @@
+//! Bindings of the second-order surface solver (`tubesweep_core::second_order`, `order=2`).
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use tubesweep_core::band::NarrowBand;
+use tubesweep_core::second_order::{
+    check_geometry, factor_sources, first_order_start, starting_values, sweep_second_order, tube_geometry,
+    SecondOrderOptions,
+};
+use tubesweep_core::sweep::Slowness;
+use tubesweep_core::{Control, IterationReport};
+
+use crate::errors::to_pyerr;
+use crate::{c_slice, node_roles, node_vectors, AnyBand, PyBand};
+
+type Solved<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<u8>>,
+    Bound<'py, PyDict>,
+);
+
+/// Everything the solve reads, borrowed from NumPy.
+struct Inputs<'s> {
+    roles: &'s [u8],
+    phi: &'s [f64],
+    directions: &'s [f32],
+    lower: Vec<f64>,
+    spacing: f64,
+    sources: &'s [f64],
+    source_slowness: &'s [f64],
+    slowness: Option<&'s [f64]>,
+    constant_slowness: f64,
+    fix_radius: f64,
+    outer_width: f64,
+    options: SecondOrderOptions,
+    threads: usize,
+    front_window: f64,
+}
+
+fn run<'py, const D: usize>(
+    py: Python<'py>,
+    band: &NarrowBand<D>,
+    inp: &Inputs<'_>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Solved<'py>> {
+    let n = band.len();
+    let roles = node_roles(inp.roles)?;
+    if roles.len() != n || inp.phi.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "roles and phi need one entry per band node ({n})"
+        )));
+    }
+    let directions = node_vectors::<f32, D>(inp.directions, n, "directions")?;
+    let sources = node_vectors::<f64, D>(inp.sources, inp.sources.len() / D, "sources")?;
+    let lower: [f64; D] = inp
+        .lower
+        .as_slice()
+        .try_into()
+        .map_err(|_| PyValueError::new_err(format!("lower must have {D} entries")))?;
+    let slowness = match inp.slowness {
+        Some(s) => Slowness::PerNode(s),
+        None => Slowness::Constant(inp.constant_slowness),
+    };
+    let mut py_error: Option<PyErr> = None;
+    let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
+    let result = py.detach(|| {
+        let geometry = tube_geometry(band, roles, inp.phi, directions, inp.spacing)?;
+        check_geometry(&geometry.summary, inp.outer_width, inp.spacing)?;
+        let factoring = factor_sources(
+            band,
+            roles,
+            inp.phi,
+            &geometry.nodes,
+            lower,
+            inp.spacing,
+            sources,
+            inp.source_slowness,
+            inp.fix_radius,
+        )?;
+        let mut values = starting_values(&factoring);
+        let mut callback = |r: &IterationReport| -> Control {
+            Python::attach(|py| {
+                if let Err(e) = py.check_signals() {
+                    py_error = Some(e);
+                    return Control::Stop;
+                }
+                if let Some(cb) = &progress_ref {
+                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
+                        py_error = Some(e);
+                        return Control::Stop;
+                    }
+                }
+                Control::Continue
+            })
+        };
+        let mut first_seconds = 0.0;
+        let mut first_iterations = 0;
+        if !inp.options.own_first_phase {
+            let st = first_order_start(
+                band,
+                &geometry.nodes,
+                &factoring,
+                directions,
+                slowness,
+                inp.spacing,
+                inp.options.tol_first,
+                inp.options.max_iterations,
+                inp.threads,
+                inp.front_window,
+                &mut values,
+                &mut callback,
+            )?;
+            first_seconds = st.seconds;
+            first_iterations = st.iterations;
+        }
+        let mut stats = sweep_second_order(
+            band,
+            &geometry,
+            &factoring,
+            slowness,
+            inp.spacing,
+            &mut values,
+            &inp.options,
+            &mut callback,
+        )?;
+        if !inp.options.own_first_phase {
+            stats.first_order_iterations = first_iterations;
+            stats.seconds += first_seconds;
+        }
+        let bytes = geometry.nodes.capacity() * std::mem::size_of_val(&geometry.nodes[0])
+            + factoring.u0.capacity() * 8
+            + factoring.grad_u0.capacity() * 4 * D
+            + factoring.roles.capacity()
+            + values.capacity() * 8
+            + n; // the active flags
+        let roles_out: Vec<u8> = factoring.roles.iter().map(|&r| r as u8).collect();
+        Ok::<_, tubesweep_core::Error>((values, factoring.u0, roles_out, stats, geometry.summary, bytes))
+    });
+    if let Some(e) = py_error {
+        return Err(e);
+    }
+    let (values, u0, roles_out, stats, summary, bytes) = result.map_err(to_pyerr)?;
+    let d = PyDict::new(py);
+    d.set_item(
+        "iterations",
+        stats.first_order_iterations + stats.second_order_iterations,
+    )?;
+    d.set_item("first_order_iterations", stats.first_order_iterations)?;
+    d.set_item("second_order_iterations", stats.second_order_iterations)?;
+    d.set_item("updates", stats.updates)?;
+    d.set_item("converged", stats.converged)?;
+    d.set_item("last_change", stats.last_change)?;
+    d.set_item("seconds", stats.seconds)?;
+    d.set_item("fallback_iteration", stats.fallback_iteration)?;
+    d.set_item("unreached", stats.unreached)?;
+    d.set_item("max_curvature", summary.max_curvature)?;
+    d.set_item("grad_norm_range", (summary.grad_norm_min, summary.grad_norm_max))?;
+    d.set_item("solver_bytes", bytes)?;
+    Ok((
+        values.into_pyarray(py),
+        u0.into_pyarray(py),
+        roles_out.into_pyarray(py),
+        d,
+    ))
+}
+
+/// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
+/// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
+#[pyfunction]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=10, threads=0, front_window=2.0, own_first_phase=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn second_order_solve<'py>(
+    py: Python<'py>,
+    band: PyRef<'py, PyBand>,
+    roles: PyReadonlyArray1<'py, u8>,
+    phi: PyReadonlyArray1<'py, f64>,
+    directions: PyReadonlyArray2<'py, f32>,
+    lower: Vec<f64>,
+    spacing: f64,
+    sources: PyReadonlyArray2<'py, f64>,
+    source_slowness: PyReadonlyArray1<'py, f64>,
+    slowness: Bound<'py, PyAny>,
+    fix_radius: f64,
+    outer_width: f64,
+    tol_first: f64,
+    tol: f64,
+    max_iterations: usize,
+    progress: Option<Bound<'py, PyAny>>,
+    stall_ratio: f64,
+    stall_window: usize,
+    threads: usize,
+    front_window: f64,
+    own_first_phase: bool,
+) -> PyResult<Solved<'py>> {
+    if !(tol > 0.0 && tol_first > 0.0) {
+        return Err(PyValueError::new_err("tol must be positive"));
+    }
+    let per_node: Option<PyReadonlyArray1<'py, f64>> = if slowness.is_instance_of::<pyo3::types::PyFloat>() {
+        None
+    } else {
+        Some(slowness.extract()?)
+    };
+    let constant_slowness: f64 = if per_node.is_none() { slowness.extract()? } else { 1.0 };
+    if sources.shape()[1] != band.ndim() {
+        return Err(PyValueError::new_err(format!(
+            "sources must have shape (S, {})",
+            band.ndim()
+        )));
+    }
+    let inputs = Inputs {
+        roles: c_slice(&roles, "roles")?,
+        phi: c_slice(&phi, "phi")?,
+        directions: c_slice(&directions, "directions")?,
+        lower,
+        spacing,
+        sources: c_slice(&sources, "sources")?,
+        source_slowness: c_slice(&source_slowness, "source_slowness")?,
+        slowness: match &per_node {
+            Some(a) => Some(c_slice(a, "slowness")?),
+            None => None,
+        },
+        constant_slowness,
+        fix_radius,
+        outer_width,
+        options: SecondOrderOptions {
+            tol_first,
+            tol,
+            max_iterations,
+            stall_ratio,
+            stall_window,
+            own_first_phase,
+        },
+        threads,
+        front_window,
+    };
+    match &band.band {
+        AnyBand::D2(b) => run(py, b, &inputs, progress),
+        AnyBand::D3(b) => run(py, b, &inputs, progress),
+    }
+}
+
+/// Registers the functions of this file in the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(second_order_solve, m)?)
+}

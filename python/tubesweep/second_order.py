@@ -1,0 +1,259 @@
+"""``order=2``: the second-order surface solver (docs/second-order.md).
+
+The paper's tube equation ``|∇u| = 1/F`` is wrong by ``φκ = O(Δx)`` off the surface, so its
+scheme is first order whatever the stencil. ``order=2`` solves the metric-corrected equation
+``|B∇u| = 1/F``, ``B = (I − φD²φ)⁻¹`` (whose exact solution is the normal extension of the
+surface solution) with limited BDF2 upwind differences, a second-order extension layer and point
+sources factored as ``u = u₀ + w``, ``u₀`` the chord distance to the source
+(``tubesweep_core::second_order``)."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _native
+from ._validate import FRONT_WINDOW, check_threads as _threads, checked_point_speeds, speed_at_points, speed_values
+from .stats import SolveStats
+
+__all__ = ["ORDERS", "check_order", "FIX_RADIUS", "FACTORED_RADIUS", "default_tol"]
+
+ORDERS = (1, 2)
+
+#: Inner-tube nodes whose closest point is within this many grid spacings of a source are fixed
+#: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there).
+FIX_RADIUS = 2.0
+
+#: ``sol(points)`` evaluates ``w + σ|P − x_s|`` (interpolated ``w = u − u₀``) at points within
+#: this many grid spacings of a source: the value at a source is exactly 0.
+FACTORED_RADIUS = 3.0
+
+#: Phase 1 (first order, monotone) stops at this times ``Δx² × mean slowness``; phase 2 (second
+#: order) at ``TOL_FACTOR`` times it unless ``tol`` is given.
+TOL_FIRST_FACTOR = 1e-2
+TOL_FACTOR = 1e-3
+
+# phase 1 by the second-order module's own sweeps (the factored scheme with the full anisotropic
+# correction) instead of the first-order driver (for measurements)
+_OWN_FIRST_PHASE = True
+
+
+def check_order(order: Any) -> int:
+    """``order`` as 1 or 2, or a ValueError naming it."""
+    if isinstance(order, (bool, np.bool_)) or not isinstance(order, (int, np.integer)) or int(order) not in ORDERS:
+        raise ValueError(
+            f"order must be 1 (the paper's first-order scheme) or 2 (second order, docs/second-order.md); got {order!r}"
+        )
+    return int(order)
+
+
+def default_tol(spacing: float, mean_slowness: float) -> float:
+    """Phase 2's stopping tolerance when none is given: ``1e-3 Δx²`` times the mean slowness,
+    far below the scheme's O(Δx²) error and far above machine precision."""
+    return TOL_FACTOR * spacing * spacing * mean_slowness
+
+
+def check_supported(
+    surf: Any, general: Any, scheme: str, method: str, source_init_given: Optional[str], paper_sweeps: bool
+) -> None:
+    """Refuses, with the reason and the fix, what ``order=2`` does not do."""
+    from .surface import LevelSet
+
+    if general is not None or scheme != "godunov":
+        raise ValueError(
+            "order=2 solves the isotropic eikonal equation with the Godunov update only "
+            f"(hamiltonian={scheme!r} given); use order=1 for Lax–Friedrichs, flows and general Hamiltonians"
+        )
+    if method != "two-layer":
+        raise ValueError(f"order=2 needs method='two-layer' (got {method!r}); the naive tube is the paper's baseline")
+    if paper_sweeps:
+        raise ValueError("paper_sweeps=True runs the paper's first-order sweeps; it cannot be combined with order=2")
+    if source_init_given == "node":
+        raise ValueError(
+            "order=2 factors the point sources (u = u₀ + w); source_init='node' is the paper's first-order "
+            "initialisation: use order=1 for it"
+        )
+    if not isinstance(surf, LevelSet):
+        kind = type(surf).__name__
+        raise ValueError(
+            f"order=2 needs a level set (φ as an array, a callable or a library level-set surface); {kind} gives "
+            "closest points only"
+            + (
+                " of a triangle mesh, which is piecewise flat: its curvature is not there to correct, and second order "
+                "cannot be reached on it"
+                if "Mesh" in kind
+                else ", and open surfaces' boundary rim is not second order"
+            )
+            + ". Use order=1 for it"
+        )
+
+
+def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: str = "linear") -> np.ndarray:
+    """``sol(points)`` of a second-order solution near a point source: ``w = u − u₀``
+    interpolated plus ``σ_s |P − x_s|`` at the points within ``FACTORED_RADIUS`` grid spacings of
+    a source, so that the source's cone is not interpolated (the value at a source is exactly 0)."""
+    u0, feet, slowness = sol._factoring
+    grid = sol.grid
+    h = grid.spacing
+    if len(p) == 0:
+        return values
+    dist = np.sqrt(((p[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2))
+    near = np.argmin(dist, axis=1)
+    nearest = dist[np.arange(len(p)), near]
+    close = nearest <= FACTORED_RADIUS * h
+    if np.any(close):
+        from .solve import interpolate_band
+
+        w = interpolate_band(sol._band, sol.values - u0, grid, p[close], interpolation)
+        values[close] = w + slowness[near[close]] * nearest[close]
+    return values
+
+
+def solve_on_tube(
+    tube: Any, src: np.ndarray, speed: Any, tol: Optional[float], max_iterations: int, cb: Any, threads: int, t0: float
+) -> Any:
+    """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept)."""
+    from .solve import ROLE_OUTER
+
+    grid, surf, band, geom = tube.grid, tube.surface, tube.band, tube.geom
+    h = grid.spacing
+    d = grid.ndim
+    if tube.outer_eff < tube.inner + 2.0 - 1e-9:
+        raise ValueError(
+            f"order=2 needs two band neighbours on each side of every inner-tube node: outer ≥ inner + 2 grid spacings "
+            f"(got inner={tube.inner:g}, outer={tube.outer_eff:g}); the defaults are inner=2, outer=4"
+        )
+    linear = tube.linear
+    x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
+    speed_nodes = speed_values(speed, grid, x, linear)
+    del x
+    slowness: Any = 1.0 / speed_nodes
+    mean_slowness = float(np.mean(slowness))
+    if tol is None:
+        tol = default_tol(h, mean_slowness)
+    dist, proj = surf.project(src, grid)
+    inner_width = tube.inner * h
+    for i, (dd, s) in enumerate(zip(dist, src)):
+        if not dd <= inner_width * (1 + 1e-6):
+            raise ValueError(
+                f"sources[{i}] = {tuple(float(c) for c in s)} is {dd:.4g} from the surface, farther than the inner tube "
+                f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
+            )
+    # a source given on the surface is kept as given (its foot point differs by rounding only)
+    on = np.linalg.norm(proj - src, axis=1) <= 1e-9 * h
+    feet = np.where(on[:, None], src, proj)
+    if callable(speed):
+        src_slowness = 1.0 / speed_at_points(speed, feet, "a source")
+    elif np.ndim(speed) == 0:
+        src_slowness = np.full(len(feet), 1.0 / float(speed))
+    else:
+        from .euclidean import _interp_dense
+
+        src_slowness = 1.0 / checked_point_speeds(
+            _interp_dense(np.asarray(speed, dtype=float), grid, feet),
+            feet,
+            "interpolated from the speed array at a source",
+        )
+    roles = tube.roles
+    directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
+    setup = time.perf_counter() - t0
+    values, u0, roles_out, st = _native.second_order_solve(
+        band,
+        np.ascontiguousarray(roles),
+        np.ascontiguousarray(geom.signed, dtype=np.float64),
+        np.ascontiguousarray(directions),
+        [float(c) for c in grid.lower],
+        h,
+        np.ascontiguousarray(feet, dtype=float),
+        np.ascontiguousarray(src_slowness, dtype=float),
+        float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
+        FIX_RADIUS * h,
+        tube.outer_eff * h,
+        TOL_FIRST_FACTOR * h * h * mean_slowness,
+        float(tol),
+        int(max_iterations),
+        cb,
+        threads=_threads(threads),
+        front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
+        own_first_phase=_OWN_FIRST_PHASE,
+    )
+    if not st["converged"]:
+        warnings.warn(
+            f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
+            f"iteration was {st['last_change']:.3g} (tol={tol:g}). Increase max_iterations or tol; the values returned "
+            "are the last iterate",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
+    positions = np.flatnonzero(roles_out == 0)
+    order2 = {
+        k: st[k]
+        for k in (
+            "first_order_iterations",
+            "second_order_iterations",
+            "fallback_iteration",
+            "unreached",
+            "max_curvature",
+            "grad_norm_range",
+        )
+    }
+    order2["tol"] = float(tol)
+    order2["fix_radius"] = FIX_RADIUS * h
+    stats = SolveStats(
+        iterations=st["iterations"],
+        sweeps=st["iterations"] * 2**d,
+        updates=st["updates"],
+        converged=st["converged"],
+        last_change=st["last_change"],
+        seconds=st["seconds"],
+        band_points=len(roles_out),
+        inner_points=len(roles_out) - n_outer,
+        outer_points=n_outer,
+        fixed_points=len(positions),
+        setup_seconds=setup,
+        band_bytes=band.nbytes + st["solver_bytes"] + 8 * band.n_rows,
+        facing_pairs=int(tube.facing[0].size),
+        narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
+        order=2,
+        order2=order2,
+    )
+    # the source of each fixed node: the nearest foot point
+    fixed_pts = grid.node_points(linear[positions])
+    labels = (
+        np.argmin(np.linalg.norm(fixed_pts[:, None, :] - feet[None, :, :], axis=2), axis=1)
+        if len(positions)
+        else np.empty(0, np.int64)
+    )
+    del fixed_pts
+    array = getattr(surf, "_array", None)
+    phi_sample = None
+    if array is not None:
+        pick = linear[:: max(1, len(linear) // 4096)].copy()
+        phi_sample = (pick, array.reshape(-1)[pick].copy())
+    from .solve import Solution
+
+    sol = Solution(
+        grid,
+        band,
+        values,
+        roles_out,
+        tube.phi,
+        stats,
+        src,
+        surf,
+        "godunov",
+        tube.method,
+        tube.inner,
+        tube.outer_eff,
+        (positions, labels.astype(np.int64)),
+        True,
+        tube.facing,
+        phi_sample,
+    )
+    sol._factoring = (u0, feet, np.asarray(src_slowness, dtype=float))
+    sol.order = 2
+    return sol

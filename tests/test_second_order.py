@@ -1,0 +1,214 @@
+"""order=2 on surfaces (docs/second-order.md): convergence orders against exact geodesic
+distances (sphere, oblate spheroid via geographiclib, circle, six-fold star), the factored point
+sources, the refusals, and order=1 unchanged. Coarse grids keep it fast; the N = 201 figures are
+measured by `tubesweep reproduce second-order` and `make bench`."""
+
+import importlib.util
+import warnings
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from conftest import fit_order
+
+
+def fibonacci_sphere(n, radius=0.5):
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    r = np.sqrt(1 - z * z)
+    t = np.pi * (1 + 5**0.5) * i
+    return radius * np.stack([r * np.cos(t), r * np.sin(t), z], axis=1)
+
+
+SRC = np.array([-0.5, 0.0, 0.0])
+POINTS = fibonacci_sphere(4000)
+SPHERE = ts.surfaces.Sphere(0.5)
+EXACT = SPHERE.geodesic_distance(POINTS, SRC)
+FAR = (EXACT >= 0.1) & (EXACT <= 0.5 * np.pi - 0.1)
+
+
+def box(n, d=3):
+    return ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
+
+
+def sphere_errors(n, **kw):
+    sol = ts.solve(SPHERE, box(n), [SRC], order=2, **kw)
+    e = np.abs(sol(POINTS) - EXACT)
+    return e[FAR].max(), e.mean(), sol
+
+
+def test_sphere_is_second_order():
+    ns = [51, 76, 101]
+    far, mean = [], []
+    for n in ns:
+        f, m, sol = sphere_errors(n)
+        assert sol.stats.converged and sol.stats.order == 2
+        assert sol.stats.order2["fallback_iteration"] is None and sol.stats.order2["unreached"] == 0
+        far.append(f)
+        mean.append(m)
+    hs = [2.0 / (n - 1) for n in ns]
+    assert fit_order(hs, far) >= 1.6, far
+    assert fit_order(hs, mean) >= 1.8, mean
+    # at N = 101 already far below the first-order scheme (far max 3.8e-2, mean 1.2e-2 there)
+    assert far[-1] < 1.5e-3 and mean[-1] < 1.5e-4, (far, mean)
+    assert np.all(np.isfinite(sol(POINTS)))
+
+
+def test_value_at_an_off_node_source_is_exactly_zero():
+    src = np.array([-0.3, 0.2, 0.0])
+    src = 0.5 * src / np.linalg.norm(src)  # on the sphere, between the nodes
+    sol = ts.solve(SPHERE, box(41), [src], order=2)
+    assert sol([src])[0] == 0.0
+    # and the factored evaluation joins the interpolation continuously: at 3 and 3.1 spacings
+    h = box(41).spacing
+    t = np.cross(src, [0, 0, 1.0])
+    t /= np.linalg.norm(t)
+    near = [np.cos(a) * src + np.sin(a) * 0.5 * t for a in (2.99 * h / 0.5, 3.01 * h / 0.5)]
+    v = sol(near)
+    exact = SPHERE.geodesic_distance(np.array(near), src)
+    assert np.all(np.abs(v - exact) < 2e-3), (v, exact)
+    # order=1 reads about 0.7 Δx there
+    assert ts.solve(SPHERE, box(41), [src])([src])[0] > 0.01
+
+
+def test_order_one_is_the_first_order_scheme_bit_for_bit():
+    g = box(41)
+    a = ts.solve(SPHERE, g, [SRC])
+    b = ts.solve(SPHERE, g, [SRC], order=1, tol=1e-10)
+    c = ts.Tube(SPHERE, g).solve([SRC], order=1)
+    assert np.array_equal(a.values, b.values) and np.array_equal(a.values, c.values)
+    assert a.stats.order == 1 and a.stats.order2 is None
+    # the second-order solution is another one (and the Tube gives the same bits as ts.solve)
+    d = ts.solve(SPHERE, g, [SRC], order=2)
+    e = ts.Tube(SPHERE, g).solve([SRC], order=2)
+    assert np.array_equal(d.values, e.values)
+    assert not np.allclose(a.values, d.values, atol=1e-3, equal_nan=True)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("geographiclib") is None, reason="geographiclib not installed")
+def test_oblate_spheroid_against_geographiclib():
+    from geographiclib.geodesic import Geodesic
+
+    a, c = 0.6, 0.4
+    surf = ts.surfaces.Ellipsoid(a, a, c)
+    geod = Geodesic(a, 1.0 - c / a)
+    rng = np.random.default_rng(3)
+    lat = np.degrees(np.arcsin(rng.uniform(-1, 1, 1500)))
+    lon = rng.uniform(-180, 180, 1500)
+    # points on the spheroid from their geodetic latitude and longitude
+    phi, lam = np.radians(lat), np.radians(lon)
+    nu = a * a / np.sqrt(a * a * np.cos(phi) ** 2 + c * c * np.sin(phi) ** 2)
+    pts = np.stack(
+        [nu * np.cos(phi) * np.cos(lam), nu * np.cos(phi) * np.sin(lam), (c * c / (a * a)) * nu * np.sin(phi)], 1
+    )
+    src = np.array([-a, 0.0, 0.0])
+    exact = np.array([geod.Inverse(0.0, 180.0, float(p), float(q), Geodesic.DISTANCE)["s12"] for p, q in zip(lat, lon)])
+    # far from the source and from the cut locus (an arc of the equator about the antipode),
+    # where the errors of these coarse grids are not asymptotic yet
+    far = (exact >= 0.2) & ~((np.abs(pts[:, 2]) < 0.15) & (np.abs(lon) < 80))
+    ns = [61, 81, 121]
+    fars, means = [], []
+    for n in ns:
+        sol = ts.solve(surf, box(n), [src], order=2)
+        assert sol.stats.converged
+        e = np.abs(sol(pts) - exact)
+        fars.append(e[far].max())
+        means.append(e.mean())
+    hs = [2.0 / (n - 1) for n in ns]
+    assert fit_order(hs, fars) >= 1.8, fars
+    # the mean over every point, the neighbourhoods of the source and of the cut locus included
+    assert fit_order(hs, means) >= 1.7, means
+    assert fars[-1] < 5e-4 and means[-1] < 1e-4, (fars, means)
+
+
+def test_circle_is_second_order():
+    circle = ts.surfaces.Circle(0.5)
+    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
+    src = np.array([-0.5, 0.0])
+    exact = circle.geodesic_distance(pts, src)
+    far = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    ns = [101, 201, 401]
+    errs = []
+    for n in ns:
+        sol = ts.solve(circle, box(n, 2), [src], order=2)
+        errs.append(np.abs(sol(pts) - exact)[far].max())
+    assert fit_order([2.0 / (n - 1) for n in ns], errs) >= 1.9, errs
+
+
+def test_star_is_second_order():
+    star = ts.surfaces.Star()
+    pts = star.sample(1500)
+    src = np.array([0.5, 0.0])
+    exact = star.geodesic_distance(pts, src)
+    far = (exact >= 0.1) & (exact <= exact.max() - 0.1)
+    ns = [201, 401, 801]
+    errs = []
+    for n in ns:
+        sol = ts.solve(star, box(n, 2), [src], order=2)
+        assert sol.stats.converged
+        errs.append(np.abs(sol(pts) - exact)[far].max())
+    assert fit_order([2.0 / (n - 1) for n in ns], errs) >= 1.9, errs
+
+
+def test_speed_scales_and_several_sources():
+    g = box(41)
+    one = ts.solve(SPHERE, g, [SRC], order=2)
+    two = ts.solve(SPHERE, g, [SRC], order=2, speed=2.0)
+    ok = np.isfinite(one.values)
+    # the same to the stopping tolerance (1e-3 Δx² = 2.5e-6 here, from different iterates)
+    assert np.max(np.abs(two.values[ok] - one.values[ok] / 2)) < 5e-5
+    # a callable speed runs through the same path
+    var = ts.solve(SPHERE, g, [SRC], order=2, speed=lambda p: 1.0 + 0.0 * p[:, 0])
+    assert np.max(np.abs(var.values[ok] - one.values[ok])) < 1e-9
+    # two sources: the distance to the nearer
+    srcs = np.array([[-0.5, 0, 0], [0, 0, 0.5]])
+    sol = ts.solve(SPHERE, box(61), srcs, order=2)
+    exact = np.minimum(SPHERE.geodesic_distance(POINTS, srcs[0]), SPHERE.geodesic_distance(POINTS, srcs[1]))
+    e = np.abs(sol(POINTS) - exact)
+    assert e.mean() < 1e-3 and np.all(sol(srcs) == 0.0), e.mean()
+
+
+def test_level_set_array_and_redistance():
+    g = box(41)
+    x = g.points(np.indices(g.shape).reshape(3, -1).T)
+    r = np.linalg.norm(x, axis=1)
+    phi = (r - 0.5).reshape(g.shape)
+    a = ts.solve(phi, g, [SRC], order=2)
+    b = ts.solve(SPHERE, g, [SRC], order=2)
+    assert np.max(np.abs(a(POINTS) - b(POINTS))) < 1e-9
+    # not a distance: refused without redistance, solved with it
+    quad = (r * r - 0.25).reshape(g.shape) * 3.0
+    with pytest.raises(ValueError, match="redistance=True"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ts.solve(quad, g, [SRC], order=2)
+    c = ts.solve(ts.LevelSet(quad, redistance=True), g, [SRC], order=2)
+    # second order too (1.6e-3 at N = 41, 4.1e-4 at N = 81), from a re-distanced φ's differences
+    assert np.abs(c(POINTS) - EXACT).mean() < 3 * np.abs(b(POINTS) - EXACT).mean()
+
+
+def test_refusals():
+    g = box(41)
+    for bad in (3, 0, 1.5, True, "2"):
+        with pytest.raises(ValueError, match="order must be 1"):
+            ts.solve(SPHERE, g, [SRC], order=bad)
+    # curvature not resolved by the tube: a sphere of radius 3 spacings (outer·Δx·κ = 1.33)
+    small = ts.surfaces.Sphere(0.12)
+    with pytest.raises(ValueError, match="order=2.*curvature.*Refine the grid"):
+        ts.solve(small, box(51), [(-0.12, 0, 0)], order=2)
+    with pytest.raises(ValueError, match="Godunov"):
+        ts.solve(SPHERE, g, [SRC], order=2, hamiltonian="lxf")
+    with pytest.raises(ValueError, match="source_init"):
+        ts.solve(SPHERE, g, [SRC], order=2, source_init="node")
+    with pytest.raises(ValueError, match="paper_sweeps"):
+        ts.solve(SPHERE, g, [SRC], order=2, paper_sweeps=True)
+    with pytest.raises(ValueError, match="outer ≥ inner"):
+        ts.solve(SPHERE, g, [SRC], order=2, inner=2.5, outer=4)
+    hemi = ts.surfaces.Hemisphere()
+    with pytest.raises(ValueError, match="order=1"):
+        ts.solve(hemi, g, [(0, 0, 0.5)], order=2)
+    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(16))
+    with pytest.raises(ValueError, match="piecewise flat"):
+        ts.solve(mesh, g, [SRC], order=2)
