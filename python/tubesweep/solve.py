@@ -39,6 +39,10 @@ from .stats import SolveStats
 from .surface import BandGeometry, Surface, as_surface, band_neighbours
 from ._warn import user_stacklevel
 
+#: The default stopping tolerance of the first-order sweeps (with ``order=2`` it stands for the
+#: second-order default, ``second_order.default_tol``).
+DEFAULT_TOL = 1e-10
+
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
 
 METHODS = ("two-layer", "naive")
@@ -608,7 +612,7 @@ def solve(
     outer: float = 4.0,
     method: str = "two-layer",
     source_init: str = "exact",
-    tol: Optional[float] = None,
+    tol: float = DEFAULT_TOL,
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
@@ -735,16 +739,12 @@ def solve(
     if order == 2:
         from . import second_order as _so
 
-        if tol is not None:
-            check_tolerance(tol, max_iterations)
-        else:
-            check_tolerance(1.0, max_iterations)
+        check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
         _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
         tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
-        return _so.solve_on_tube(tube, src, speed, tol, max_iterations, cb, threads, t0)
-    tol = 1e-10 if tol is None else tol
+        return _so.solve_on_tube(tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0)
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)

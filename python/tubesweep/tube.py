@@ -29,7 +29,15 @@ import numpy as np
 
 from ._validate import as_grid, as_sources, check_tolerance, progress_callback
 from .grid import Grid
-from .solve import Solution, _check_order, _check_source_init, _prepare_tube, _resolve_scheme, _solve_on_tube
+from .solve import (
+    DEFAULT_TOL,
+    Solution,
+    _check_order,
+    _check_source_init,
+    _prepare_tube,
+    _resolve_scheme,
+    _solve_on_tube,
+)
 from .surface import Surface, as_surface
 
 __all__ = ["Tube"]
@@ -153,7 +161,7 @@ class Tube:
         flow: Any = None,
         allow_supersonic: bool = False,
         source_init: str = "exact",
-        tol: Optional[float] = None,
+        tol: float = DEFAULT_TOL,
         max_iterations: int = 10000,
         progress: Optional[Callable[[int, float, int], None]] = None,
         infinity: Optional[float] = None,
@@ -200,12 +208,13 @@ class Tube:
         if order == 2:
             from . import second_order as _so
 
-            check_tolerance(1.0 if tol is None else tol, max_iterations)
+            check_tolerance(tol, max_iterations)
             cb = progress_callback(progress)
             _check_source_init(source_init)
             _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
-            return _so.solve_on_tube(self._tube, src, speed, tol, max_iterations, cb, threads, t0)
-        tol = 1e-10 if tol is None else tol
+            return _so.solve_on_tube(
+                self._tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
+            )
         check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
