@@ -29,7 +29,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from tubesweep.surface import coarse_to_fine_candidates  # noqa: E402
+from tubesweep.band import coarse_to_fine_candidates  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from problems import PROBLEMS  # noqa: E402

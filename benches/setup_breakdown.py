@@ -32,9 +32,9 @@ import numpy as np  # noqa: E402
 
 import tubesweep as ts  # noqa: E402
 from tubesweep import _native  # noqa: E402
-from tubesweep.surface import _kinks, coarse_to_fine_candidates, discover_band  # noqa: E402
+from tubesweep.band import _kinks, coarse_to_fine_candidates, discover_band  # noqa: E402
 
-solve_module = importlib.import_module("tubesweep.solve")  # (``tubesweep.solve`` the attribute is the function)
+solve_module = importlib.import_module("tubesweep._prepare")  # the roles and the checks of the tube
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from problems import PROBLEMS  # noqa: E402

@@ -62,7 +62,7 @@ def redistance_candidates(surface: ts.LevelSet, grid: ts.Grid) -> dict:
     w = 4 * grid.spacing
     L = rd.estimate_lipschitz(surface, grid)
     if not surface.is_dense:  # a callable: found coarse-to-fine, then narrowed where that exists
-        from tubesweep.surface import discover_band
+        from tubesweep.band import discover_band
 
         cand, values = discover_band(surface._fn, grid, L * w, L)
         out = {"whole_box_candidates": len(cand)}

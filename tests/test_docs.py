@@ -22,6 +22,7 @@ MODULES = [
     "tubesweep.closest_point", "tubesweep.euclidean", "tubesweep.output", "tubesweep._plot", "tubesweep.data",
     "tubesweep.flows", "tubesweep.hamiltonians", "tubesweep.surfaces.analytic", "tubesweep.surfaces.closed",
     "tubesweep.surfaces.curves", "tubesweep.surfaces.open", "tubesweep.surfaces.mesh", "tubesweep.distances",
+    "tubesweep.solution", "tubesweep.band", "tubesweep._triangulate",
     "tubesweep.box_solution",
 ]  # fmt: skip
 

@@ -124,7 +124,7 @@ def test_band_matches_brute_force_and_directions_are_unit():
 
 
 def test_any_within_answers_as_the_closest_distance_and_the_search_keeps_the_same_nodes():
-    from tubesweep.surface import coarse_to_fine_candidates
+    from tubesweep.band import coarse_to_fine_candidates
 
     v, f = icosphere(3)
     m = MeshSurface(v, f)

@@ -88,7 +88,8 @@ def test_the_analytic_band_s_gradient_norms_are_single_precision_and_bound_like_
     """|∇φ| comes back in float32 (4 bytes per node at the set-up's peak, not 8), and
     ``surface._norm_bounds``, which works chunk by chunk, gives the range of the whole band: over
     the nodes within half the band of the surface when there are any, over all of them when not."""
-    from tubesweep.surface import EVAL_CHUNK, _norm_bounds
+    from tubesweep.band import EVAL_CHUNK
+    from tubesweep.surface import _norm_bounds
 
     n = 61
     h = 2.0 / (n - 1)

@@ -112,7 +112,7 @@ class _CpSphere(Surface):
     ndim = 3
 
     def band(self, grid, half_width):
-        from tubesweep.surface import BandGeometry
+        from tubesweep.band import BandGeometry
 
         x = grid.points(grid.unravel(np.arange(grid.size)))
         r = np.linalg.norm(x, axis=1)

@@ -282,7 +282,7 @@ def test_callable_redistance_narrows_its_candidates_and_finds_the_same_band(d, n
     # at the candidates then narrows them; the band, distances and directions are those of the
     # whole box's bound alone (given as `lipschitz`), from fewer candidates
     from tubesweep.redistance import _narrowed_by_candidate_gradients, estimate_lipschitz
-    from tubesweep.surface import discover_band
+    from tubesweep.band import discover_band
 
     grid = ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
     f = lambda p: (np.sum(p**2, axis=1) - 0.25) * (1 + 0.3 * p[:, 0]) + 0.05 * np.sin(3 * p[:, 1])  # noqa: E731
@@ -444,7 +444,7 @@ def test_a_subclass_that_changes_phi_takes_the_callable_route():
 
 
 def test_candidates_of_the_coarse_to_fine_search_are_sorted_and_cover_the_band():
-    from tubesweep.surface import coarse_to_fine_candidates
+    from tubesweep.band import coarse_to_fine_candidates
 
     s = Sphere(0.6, center=(0.1, -0.05, 0.0))
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (37, 37, 37))  # odd: blocks cut at the upper edge
@@ -489,7 +489,7 @@ def _reference_candidates(grid, half_width, lipschitz, distance):
 def test_coarse_to_fine_candidates_match_the_straightforward_search(shape):
     """Same candidates, φ asked at the same points (bit for bit) with the same reach per level, on
     odd and even grid shapes in 2D and 3D (blocks cut at the upper edges)."""
-    from tubesweep.surface import coarse_to_fine_candidates
+    from tubesweep.band import coarse_to_fine_candidates
 
     d = len(shape)
     grid = ts.Grid((-1.0,) * d, tuple(-1.0 + 0.07 * (n - 1) for n in shape), shape)

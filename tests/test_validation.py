@@ -266,7 +266,7 @@ def test_a_band_too_large_for_the_memory_is_refused_before_the_search():
     ],
 )
 def test_the_memory_check_s_band_estimate_is_close_to_the_band(surface, grid):
-    from tubesweep.solve import _estimated_band_nodes
+    from tubesweep._prepare import _estimated_band_nodes
 
     sol = ts.solve(surface, grid, [surface.default_source])
     estimate = _estimated_band_nodes(surface, grid, 4 * grid.spacing)
@@ -287,7 +287,7 @@ def test_grid_shapes_are_whole_numbers_and_flags_are_booleans():
 
 
 def test_the_band_estimate_survives_a_closest_point_map_undefined_far_from_the_surface():
-    from tubesweep.solve import _estimated_band_nodes
+    from tubesweep._prepare import _estimated_band_nodes
 
     def cp(x):  # the upper hemisphere, NaN on the axis below it and at the centre (far from it)
         with np.errstate(invalid="ignore", divide="ignore"):

@@ -330,7 +330,7 @@ def _plot_curve(
     from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
-    from .output import triangulate
+    from ._triangulate import triangulate
 
     grid = sol.grid
     cmap_obj = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
@@ -495,7 +495,7 @@ def _plot_surface(
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-    from .output import triangulate
+    from ._triangulate import triangulate
 
     cmap_obj = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
     norm = mcolors.Normalize(0.0, umax)

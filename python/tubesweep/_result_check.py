@@ -28,7 +28,7 @@ def stranded_nodes(grid: Grid, band: Any, values: np.ndarray, inner: Optional[np
     """Band positions of the inner-tube nodes at ``inf`` with an inner-tube neighbour that the
     front reached (finite). Costs nothing when every node was reached; otherwise O(unreached)
     neighbour look-ups and the band's linear indices (8 bytes per node, for the look-ups)."""
-    from .surface import band_neighbours
+    from .band import band_neighbours
 
     unreached = np.flatnonzero(~np.isfinite(values))
     if inner is not None:

@@ -30,7 +30,8 @@ from ._linalg import row_norms
 from ._cp_checks import BAND_SAMPLE, check_band_sample, check_box_sample
 from ._validate import call_on_points
 from .grid import Grid
-from .surface import EVAL_CHUNK, BandGeometry, Surface, coarse_to_fine_candidates
+from .band import EVAL_CHUNK, BandGeometry, coarse_to_fine_candidates
+from .surface import Surface
 
 __all__ = ["ClosestPoint", "DIRECTION_EPS"]
 

@@ -21,7 +21,7 @@ from typing import Any, Callable, Optional, Tuple, Union
 import numpy as np
 
 from ._validate import as_points
-from .solve import ROLE_INNER
+from ._prepare import ROLE_INNER
 from .tube import Tube
 
 __all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]

@@ -45,6 +45,7 @@ class _TubeSpec:
 
     def __init__(self, tube: "Tube"):
         self.token = tube._token
+        self.cls = type(tube)  # the class travels by name: this module need not import tube.py
         self.surface = tube.surface
         self.grid = tube.grid
         self.args = tube._args
@@ -52,13 +53,11 @@ class _TubeSpec:
 
 def _worker_tube(spec: _TubeSpec) -> "Tube":
     """The tube of ``spec`` in this process, built on first use and cached by its token."""
-    from .tube import Tube
-
     with _WORKER_LOCK:  # one build per process, even with several threads per worker
         tube = _WORKER_TUBES.get(spec.token)
         if tube is None:
             inner, outer, method = spec.args
-            tube = Tube(spec.surface, spec.grid, inner=inner, outer=outer, method=method)
+            tube = spec.cls(spec.surface, spec.grid, inner=inner, outer=outer, method=method)
             tube._token = spec.token
             _WORKER_TUBES[spec.token] = tube
             while len(_WORKER_TUBES) > WORKER_CACHE_SIZE:

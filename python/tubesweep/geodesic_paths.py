@@ -31,11 +31,11 @@ from typing import TYPE_CHECKING, Any, List, Optional, Tuple
 import numpy as np
 
 from ._validate import as_points
-from .solve import SOURCE_RADIUS
+from ._sources import SOURCE_RADIUS
 from ._warn import user_stacklevel
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .solve import Solution
+    from .solution import Solution
 
 __all__ = ["trace_paths"]
 

@@ -56,7 +56,7 @@ class Grid:
     """
 
     def __init__(self, lower: Sequence[float], upper: Sequence[float], shape: Sequence[int]):
-        from ._validate import ArgumentTypeError, whole_number
+        from ._numbers import ArgumentTypeError, whole_number
 
         def numbers(corner: Sequence[float]) -> np.ndarray:
             # every element one real number: not a bool, string, None or sequence (NumPy would read

@@ -31,7 +31,9 @@ from ._validate import (
     speed_at_points,
     speed_values,
 )
-from .solve import ROLE_INNER, SOURCE_RADIUS, _check_source_init, _fix_sources, _resolve_scheme
+from ._prepare import ROLE_INNER
+from ._sources import SOURCE_RADIUS, _fix_sources
+from .solve import _check_source_init, _resolve_scheme
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube

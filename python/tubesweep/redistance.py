@@ -176,7 +176,7 @@ def _narrowed_by_candidate_gradients(
     (:data:`CANDIDATE_BOUND_PASSES` in all, stopping when the bound does not fall). The same
     estimate as the whole box's, taken where the band is: for ``|x|² − r²`` the whole box's
     steepest part is its corners, several times the gradient at the surface."""
-    from .surface import EVAL_CHUNK
+    from .band import EVAL_CHUNK
 
     fn = lambda p: surface.phi(p, grid)  # noqa: E731
     for _ in range(CANDIDATE_BOUND_PASSES):
@@ -246,7 +246,7 @@ def redistanced_band(surface, grid, half_width: float):
     candidates. Otherwise L is the given bound or :func:`estimate_lipschitz`, and a callable's
     candidates are found coarse-to-fine; without a given bound they are then narrowed by the
     gradient at the candidates themselves (:func:`_narrowed_by_candidate_gradients`)."""
-    from .surface import BandGeometry, discover_band
+    from .band import BandGeometry, discover_band
 
     d = grid.ndim
     if surface.is_dense:

@@ -105,7 +105,7 @@ def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: 
     nearest = dist[np.arange(len(p)), near]
     close = nearest <= FACTORED_RADIUS * h
     if np.any(close):
-        from .solve import interpolate_band
+        from ._interpolation import interpolate_band
 
         w = interpolate_band(sol._band, sol.values - u0, grid, p[close], interpolation)
         values[close] = w + slowness[near[close]] * nearest[close]
@@ -116,7 +116,7 @@ def solve_on_tube(
     tube: Any, src: np.ndarray, speed: Any, tol: Optional[float], max_iterations: int, cb: Any, threads: int, t0: float
 ) -> Any:
     """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept)."""
-    from .solve import ROLE_OUTER
+    from ._prepare import ROLE_OUTER
 
     grid, surf, band, geom = tube.grid, tube.surface, tube.band, tube.geom
     h = grid.spacing
@@ -234,7 +234,7 @@ def solve_on_tube(
     if array is not None:
         pick = linear[:: max(1, len(linear) // 4096)].copy()
         phi_sample = (pick, array.reshape(-1)[pick].copy())
-    from .solve import Solution
+    from .solution import Solution
 
     sol = Solution(
         grid,

@@ -29,15 +29,9 @@ import numpy as np
 
 from ._validate import as_grid, as_sources, check_tolerance, progress_callback
 from .grid import Grid
-from .solve import (
-    DEFAULT_TOL,
-    Solution,
-    _check_order,
-    _check_source_init,
-    _prepare_tube,
-    _resolve_scheme,
-    _solve_on_tube,
-)
+from ._prepare import _prepare_tube
+from .solution import Solution
+from .solve import DEFAULT_TOL, _check_order, _check_source_init, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
 
 __all__ = ["Tube"]

@@ -1,8 +1,8 @@
 //! Bindings of the second-order box solver (`tubesweep_core::sweep::factored_box`) and of the cubic
 //! interpolation in a band (`tubesweep_core::solution::interpolate_cubic`). Registered by [`register`].
 
+use crate::band::{AnyBand, PyBand};
 use crate::errors::to_pyerr;
-use crate::{AnyBand, PyBand};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

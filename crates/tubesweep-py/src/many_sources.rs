@@ -1,8 +1,10 @@
 //! Bindings of `tubesweep_core::sweep::many_sources`: many independent solves on one band, in parallel
 //! across the sources, with the GIL released; progress and Ctrl-C on the calling thread.
 
+use crate::band::{AnyBand, PyBand};
+use crate::convert::{c_slice, node_roles};
 use crate::errors::to_pyerr;
-use crate::{c_slice, extension_in_place, node_roles, parse_missing, parse_scheme, AnyBand, PyBand};
+use crate::sweep::{extension_in_place, parse_missing, parse_scheme};
 use numpy::{IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

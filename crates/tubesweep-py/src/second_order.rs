@@ -12,8 +12,9 @@ use tubesweep_core::second_order::{
 use tubesweep_core::sweep::Slowness;
 use tubesweep_core::{Control, IterationReport};
 
+use crate::band::{AnyBand, PyBand};
+use crate::convert::{c_slice, node_roles, node_vectors};
 use crate::errors::to_pyerr;
-use crate::{c_slice, node_roles, node_vectors, AnyBand, PyBand};
 
 type Solved<'py> = (
     Bound<'py, PyArray1<f64>>,

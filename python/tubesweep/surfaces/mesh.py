@@ -30,7 +30,8 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ..grid import Grid
-from ..surface import BandGeometry, Surface, coarse_to_fine_candidates
+from ..band import BandGeometry, coarse_to_fine_candidates
+from ..surface import Surface
 from .._validate import real_array, real_scalar, whole_indices
 from ..grid import MAX_COORDINATE
 from .._warn import user_stacklevel

@@ -16,9 +16,9 @@
 //! in passes, each in an order that is the dependency order except where a cycle closes, until
 //! the nodes where the cycles close are within the tolerance of their fixed point.
 
+use super::problem::NodeRole;
 use crate::band::NarrowBand;
 use crate::scheme::extension::extension_apply_upwind;
-use crate::sweep::NodeRole;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU8, Ordering};
 

@@ -22,8 +22,8 @@
 //!
 //! [`SolveOptions::row_prefetch_above`]: super::SolveOptions::row_prefetch_above
 
+use super::problem::{Slowness, SweepProblem};
 use super::sweep_state::{Limits, SweepContext};
-use super::{Slowness, SweepProblem};
 use crate::prefetch::prefetch_range;
 use crate::sweep::cache_size::last_level_cache_bytes;
 
@@ -49,7 +49,8 @@ impl<const D: usize> SweepProblem<'_, D> {
     /// slowness.
     pub(super) fn swept_bytes_per_node(&self, ctx: &SweepContext<'_, D>) -> usize {
         use std::mem::size_of;
-        let mut bytes = size_of::<f64>() + size_of::<crate::NodeRole>() + self.band.neighbour_table_bytes_per_node();
+        let mut bytes =
+            size_of::<f64>() + size_of::<super::problem::NodeRole>() + self.band.neighbour_table_bytes_per_node();
         if !ctx.weights.is_empty() {
             bytes += size_of::<[f32; D]>();
         }

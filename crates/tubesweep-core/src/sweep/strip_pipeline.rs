@@ -5,7 +5,7 @@
 //! with a spinning barrier between them. A panic on one thread raises a flag that makes the others
 //! leave their waits, so it reaches the caller instead of leaving a thread spinning.
 
-use super::Accumulator;
+use super::sweep_state::Accumulator;
 use crate::band::schedule::NO_TILE;
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering};
 use std::time::Instant;

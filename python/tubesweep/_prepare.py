@@ -1,0 +1,419 @@
+"""Building the computational tube for a solve (paper Fig. 4): the band of a surface, the role of
+each node (inner tube, extension layer; Algorithm 2 or 3), the checks that the grid resolves the
+surface (memory, tubes of facing sheets that touch, a surface thinner than two cells), and the
+band structure the sweeps run on. Shared by :func:`tubesweep.solve` and :class:`tubesweep.Tube`."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import time
+import warnings
+from typing import Any, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+from ._validate import (
+    available_memory_bytes,
+    check_memory,
+    real_scalar,
+)
+from .grid import Grid
+from .band import BandGeometry, band_neighbours
+from .surface import Surface
+from ._warn import user_stacklevel
+
+METHODS = ("two-layer", "naive")
+#: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
+#: tolerance makes nodes that sit exactly on the inner radius (up to rounding, common on
+#: symmetric grids) consistently inner.
+ROLE_RTOL = 1e-9
+
+ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
+
+
+def _widening_message(missing: np.ndarray, phi: np.ndarray, h: float, inner: float, outer: float) -> str:
+    """Why inner-tube nodes (band positions ``missing``) lack a neighbour in the band of half-width
+    ``outer`` spacings. For a distance function a neighbour lies at most one spacing farther from
+    the surface, so an inner node within ``outer − 1`` spacings of it whose neighbour falls
+    outside says φ is not a distance function there; when every such node lies beyond that (only
+    possible when ``outer − inner`` is about 1) the extension layer is merely too thin to hold the
+    neighbours, rounding included, and φ is not to blame."""
+    far = np.abs(phi[missing].astype(float)) > (outer - 1.0) * h * (1 - 1e-6)
+    widen = f"Widening the extension layer to outer = {outer + 1}"
+    if np.all(far):
+        return (
+            f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: the extension "
+            f"layer (outer − inner = {outer - inner:g} grid spacings) is too thin to hold every neighbour of the inner "
+            f"tube (a neighbour can lie a full spacing farther out, and rounding puts some just beyond). {widen}; "
+            "pass outer ≥ inner + 2 to avoid this"
+        )
+    return (
+        f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: φ is not close to a "
+        f"distance function there (at {int(np.count_nonzero(~far))} of them the neighbour is more than one spacing "
+        f"farther out in φ). {widen}"
+    )
+
+
+def _percent(share: float) -> str:
+    """A share as a short percentage: '0.1%', '12%', or '< 0.01%'."""
+    if share < 1e-4:
+        return "< 0.01%"
+    return f"{100 * share:.2g}%" if share < 0.1 else f"{100 * share:.0f}%"
+
+
+_MAX_WIDENINGS = 4
+_ROLE_CHUNK = 1 << 18
+
+
+def _tube_roles(geom: BandGeometry, inner_width: float, method: str) -> np.ndarray:
+    """Roles of the band nodes: inner tube where ``|φ| ≤ inner·Δx`` (every node for the naive
+    method), else extension layer; chunk by chunk, without K-sized temporaries."""
+    roles = np.full(len(geom.linear), ROLE_INNER if method == "naive" else ROLE_OUTER, np.uint8)
+    if method != "naive":
+        limit = inner_width * (1 + ROLE_RTOL)
+        for lo in range(0, len(roles), _ROLE_CHUNK):
+            part = roles[lo : lo + _ROLE_CHUNK]
+            part[geom.unsigned(lo, lo + _ROLE_CHUNK) <= limit] = ROLE_INNER
+    return roles
+
+
+@dataclasses.dataclass
+class _PreparedTube:
+    """The band of a surface on a grid with what every solve on it needs: the sorted linear
+    indices, the roles before the sources are fixed, the native band, φ in single precision, and
+    either the directions the solver may overwrite (``direction``; one solve) or the whole
+    geometry (``geom``, never modified; a general Hamiltonian reads it, and a :class:`Tube`
+    solves many times). ``seconds``: the time the preparation took."""
+
+    grid: Grid
+    surface: Surface
+    inner: float
+    outer_eff: float
+    method: str
+    geom: Optional[BandGeometry]
+    linear: np.ndarray
+    roles: np.ndarray
+    band: Any
+    phi: np.ndarray
+    direction: Optional[np.ndarray]
+    seconds: float
+    #: the pairs of neighbouring nodes across a gap narrower than the tubes: their band positions
+    #: and their gaps (``_warn_if_tubes_touch``)
+    facing: Tuple[np.ndarray, np.ndarray, np.ndarray] = (np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0))
+
+
+# The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
+# N = 1001 and 2001 (`benches/run.py --scale`), more through `ts.Tube` and the general Hamiltonians
+# (up to about 110 B at N = 301).
+_BAND_BYTES_PER_NODE = 110
+# Points per axis (along the box's longest side) of the coarse sample that estimates the band.
+_BAND_ESTIMATE_POINTS = 17
+
+
+def _check_band_memory(surf: Surface, grid: Grid, half_width: float) -> None:
+    """Raises MemoryError before the band search when the band would not fit in memory. Skipped
+    when even a band filling the whole box would fit (every grid up to a few hundred nodes per
+    axis); otherwise the surface's area is estimated from its distance at a coarse sample of the
+    box (the nodes within one coarse spacing H of it fill a shell of volume ≈ 2·H·area), and the
+    band of half-width w holds about 2·w·area / h^d nodes."""
+    avail = available_memory_bytes()
+    if avail is None or grid.size * _BAND_BYTES_PER_NODE <= 0.9 * avail or getattr(surf, "redistance", False):
+        return
+    nodes = _estimated_band_nodes(surf, grid, half_width)
+    check_memory(
+        nodes * _BAND_BYTES_PER_NODE,
+        f"the band (about {nodes:.3g} nodes at grid spacing {grid.spacing:.3g})",
+        "use a coarser grid (fewer nodes per axis) or a thinner tube",
+    )
+
+
+def _estimated_band_nodes(surf: Surface, grid: Grid, half_width: float) -> float:
+    """About how many nodes of ``grid`` lie within ``half_width`` of ``surf`` (see
+    :func:`_check_band_memory`), from the surface's distance at a coarse sample of the box."""
+    lower, upper = np.asarray(grid.lower, dtype=float), np.asarray(grid.upper, dtype=float)
+    big_h = float(np.max(upper - lower)) / (_BAND_ESTIMATE_POINTS - 1)
+    axes = [np.minimum(np.arange(lo, hi + 0.5 * big_h, big_h), hi) for lo, hi in zip(lower, upper)]
+    points = np.stack([c.reshape(-1) for c in np.meshgrid(*axes, indexing="ij")], axis=1)
+    try:
+        dist = np.asarray(surf.project(points, grid)[0], dtype=float)
+    except Exception:  # a surface undefined at some sample far from it: no estimate, the search decides
+        return 0.0
+    area = np.count_nonzero(np.isfinite(dist) & (dist <= big_h)) * big_h**grid.ndim / (2 * big_h)
+    return 2 * half_width * area / grid.spacing**grid.ndim
+
+
+def _lacking_neighbours(grid: Grid, band: Any, linear: np.ndarray, missing: np.ndarray) -> np.ndarray:
+    """The linear indices (sorted, unique) of the in-grid neighbours that the band nodes
+    ``missing`` (band positions) lack in the band."""
+    lacking = [np.empty(0, np.int64)]
+    for moved, inside, pos in band_neighbours(grid, band, linear, missing):
+        absent = moved[inside & (pos < 0)]
+        lacking.append(np.ravel_multi_index(tuple(absent.T), grid.shape).astype(np.int64))
+    return np.unique(np.concatenate(lacking))
+
+
+def _ridge_pairs(
+    grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray, kink: Optional[np.ndarray]
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pairs of neighbouring band nodes of which one straddles a kink of a level set's φ (a
+    ridge between facing parts, ``BandGeometry.kink``) and one lies in the inner tube, with the
+    gap ``2|φ|`` at the kink's node. There the central differences give no reliable direction,
+    so the directions' tests of ``Band.facing_sheet_pairs`` can miss the pair (two spheres
+    ``min(d₁, d₂)`` 5 spacings apart were crossed without a word)."""
+    empty = np.empty(0, np.int64)
+    if kink is None or not np.any(kink):
+        return empty, empty, np.empty(0)
+    at = np.flatnonzero(kink)
+    nodes, neighbours = [], []
+    for _, _, pos in band_neighbours(grid, band, linear, at):
+        ok = pos >= 0
+        a, b = at[ok], pos[ok]
+        ok = (roles[a] == ROLE_INNER) | (roles[b] == ROLE_INNER)
+        a, b = a[ok], b[ok]
+        nodes.append(np.minimum(a, b))
+        neighbours.append(np.maximum(a, b))
+    node, neighbour = np.concatenate(nodes), np.concatenate(neighbours)
+    gap = 2.0 * np.abs(phi[np.where(kink[node], node, neighbour)]).astype(float)
+    return node, neighbour, gap
+
+
+def _warn_if_tubes_touch(
+    grid: Grid,
+    band: Any,
+    linear: np.ndarray,
+    roles: np.ndarray,
+    phi: np.ndarray,
+    direction: np.ndarray,
+    inner: float,
+    kink: Optional[np.ndarray] = None,
+    noise: float = 0.0,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Warns where two parts of the surface face each other across a gap so narrow that the inner
+    tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
+    ``tubesweep_core::facing_sheets``): the eikonal equation crosses the gap there and the travel
+    times beyond it come out too short, a shortcut the surface does not have. Returns the pairs'
+    band positions and their gaps."""
+    h = grid.spacing
+    node, neighbour, gap = band.facing_sheet_pairs(
+        roles == ROLE_INNER,
+        np.ascontiguousarray(phi, dtype=np.float32),
+        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim),
+        h,
+    )
+    if noise > 0 and node.size:
+        # a noisy closest-point map (``_cp_checks``): nodes within a few times its noise of the
+        # surface have directions the noise can turn around, which the facing test would read as
+        # two sheets (at noise 0.01 spacings, 13 pairs on a sphere); they are left out
+        clear = 4.0 * noise
+        keep = (np.abs(phi[node]) > clear) & (np.abs(phi[neighbour]) > clear)
+        node, neighbour, gap = node[keep], neighbour[keep], gap[keep]
+    ridge = _ridge_pairs(grid, band, linear, roles, phi, kink)
+    if ridge[0].size:
+        node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip((node, neighbour, gap), ridge))
+        # a pair found both ways counts once (the smaller gap)
+        order = np.lexsort((gap, neighbour, node))
+        node, neighbour, gap = node[order], neighbour[order], gap[order]
+        first = np.ones(node.size, bool)
+        first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
+        node, neighbour, gap = node[first], neighbour[first], gap[first]
+    if node.size == 0:
+        return node, neighbour, gap
+    narrowest = int(np.argmin(gap))
+    where = ", ".join(f"{float(v):.4g}" for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
+    needed = float(gap[narrowest]) / (2 * inner + 2)
+    # how much of the surface: the inner-tube nodes of the pairs among all inner-tube nodes
+    inner_nodes = roles == ROLE_INNER
+    touched = np.unique(np.concatenate([node, neighbour]))
+    share = np.count_nonzero(inner_nodes[touched]) / max(int(np.count_nonzero(inner_nodes)), 1)
+    warnings.warn(
+        f"the surface faces itself across gaps narrower than its tubes at {node.size} node pair(s), about "
+        f"{_percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near ({where})). Distances "
+        "reached across such a gap can come out too short; elsewhere the result holds. sol.narrow_gaps() shows where; "
+        f"a grid spacing below {needed:.3g} (now {h:.3g}) resolves a real gap, while a crease or scan artefact stays "
+        "narrower than any grid",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )
+    return node, neighbour, gap
+
+
+def _check_surface_spans_two_cells(
+    surf: Surface, grid: Grid, linear: np.ndarray, roles: np.ndarray, inner: float
+) -> None:
+    """Refuses a surface that the grid cannot resolve: one whose closest points from the inner
+    tube span less than two grid spacings along every axis of their bounding box (a disc or plane
+    patch smaller than a cell; on a disc of radius 0.02Δx the distances came out 29% short, with
+    no warning; a closed mesh or closest-point curve that small too, while a level set that small
+    is refused earlier, by the distance check, its tube reaching the centre). The inner tube of a surface that small has at most ``(2·inner + 3)^d`` nodes, so the
+    closest points are computed only for a band that small: nothing is added to other solves."""
+    h = grid.spacing
+    # counted before they are listed: the list of a large band's inner nodes (8 bytes per inner
+    # node) would raise the set-up's peak memory
+    n_inner = int(np.count_nonzero(roles == ROLE_INNER))
+    if n_inner == 0 or n_inner > (2 * int(np.ceil(inner)) + 3) ** grid.ndim:
+        return
+    inner_nodes = np.flatnonzero(roles == ROLE_INNER)
+    _, closest = surf.project(grid.node_points(linear[inner_nodes]), grid)
+    closest = closest[np.all(np.isfinite(closest), axis=1)]
+    if closest.size == 0:
+        return
+    extent = float(np.max(np.ptp(closest, axis=0)))
+    if extent == 0.0:
+        raise ValueError(
+            "the surface is a single point: every node of the inner tube has the same closest point "
+            f"{tuple(float(x) for x in closest[0])}, so there is no curve or surface to solve on (for a "
+            "closest-point map, check that cp returns the nearest point of the surface)"
+        )
+    if extent < 2.0 * h:
+        raise ValueError(
+            f"the grid is too coarse for this surface: the surface spans only {extent:.3g} along the longest side of "
+            f"its bounding box (from the inner tube's closest points), less than two grid spacings (h = {h:.4g}), so the "
+            f"grid cannot resolve it; refine the grid to a spacing below {extent / 2:.3g}, or shrink the box"
+        )
+
+
+def _prepare_tube(
+    surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool, reusable: bool = False
+) -> _PreparedTube:
+    """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
+    single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
+    keeps the geometry unmodified for many solves (:class:`Tube`)."""
+    t0 = time.perf_counter()
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}; got {method!r}")
+    widths = []
+    for name, val in (("inner", inner), ("outer", outer)):
+        w = real_scalar(val, name, "a finite number of grid spacings")
+        if not np.isfinite(w):
+            raise ValueError(f"{name} must be a finite number of grid spacings; got {val!r}")
+        widths.append(w)
+    inner, outer = widths
+    if inner < 1.0:
+        raise ValueError(
+            f"inner = {inner} grid spacings is thinner than the grid can resolve: the inner tube needs at least 1 "
+            "(the paper uses 2)"
+        )
+    if method == "two-layer" and outer < inner + 1.0:
+        raise ValueError(
+            f"outer = {outer} must exceed inner = {inner} by at least 1 grid spacing so that the extension layer "
+            "holds every neighbour of the inner tube (the paper uses inner=2, outer=4)"
+        )
+    h = grid.spacing
+    inner_width = inner * h
+    outer_eff = float(outer) if method == "two-layer" else float(inner)
+
+    _check_band_memory(surf, grid, outer_eff * h)
+    # a re-distanced band, and the bound on |∇φ| its candidates were found with when the user gave it
+    redistanced = bool(getattr(surf, "redistance", False))
+    given_bound = getattr(surf, "lipschitz", None) if redistanced else None
+    previously_lacking: Optional[np.ndarray] = None
+    for attempt in range(_MAX_WIDENINGS + 1):
+        # (catch_warnings only where needed: entering and leaving it resets Python's record of the
+        # warnings already shown, and a solve repeated in a loop would then repeat its warnings)
+        with warnings.catch_warnings() if attempt > 0 else contextlib.nullcontext():
+            if attempt > 0:  # a warning about the band's nodes was given at the first attempt
+                warnings.filterwarnings("ignore", message=".*could not be projected onto it", category=RuntimeWarning)
+            geom = surf.band(grid, outer_eff * h)
+        if geom.linear.size == 0:
+            raise ValueError(
+                "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
+                "and that φ is in the grid's units"
+            )
+        roles = _tube_roles(geom, inner_width, method)
+        linear = geom.linear
+        if attempt == 0:
+            _check_surface_spans_two_cells(surf, grid, linear, roles, inner)
+        band = geom.native_band  # built by the surface, or None
+        # The float64 φ (and |φ| where stored) only decide the roles: from here on the solver
+        # keeps φ in single precision, and the band is built without them (memory is per band
+        # node: see docs/architecture.md).
+        phi = geom.signed.astype(np.float32)
+        kink = geom.kink
+        direction: Optional[np.ndarray] = None
+        if reusable:
+            # kept for every solve: the solver gets copies of its directions
+            geom = dataclasses.replace(geom, consumable=False)
+        elif not keep_geometry:
+            direction = geom.directions_for_solver()
+            geom = None  # type: ignore[assignment]
+        if band is None or len(band) != len(linear):
+            band = _native.Band.from_linear(
+                list(grid.shape), np.ascontiguousarray(linear, dtype=np.int64).view(np.uint64)
+            )
+        if method == "naive":
+            break
+        missing = band.nodes_missing_neighbours(roles == ROLE_INNER)
+        if missing.size == 0:
+            break
+        lacking = _lacking_neighbours(grid, band, linear, missing)
+        if (
+            redistanced
+            and given_bound is None
+            and previously_lacking is not None
+            and np.all(np.isin(previously_lacking, lacking))
+        ):
+            # A re-distanced band, its candidates found with an estimated bound on |∇φ|, holds the
+            # nodes within the layer that could be projected onto the zero level set; the layer
+            # was widened and none of the missing neighbours came in, so they are nodes the
+            # projection cannot place (the box's |x|_∞ − r at N = 41 widened four times in 13 s
+            # before ending in the error below). Going on without them gave wrong answers
+            # elsewhere (a circle 3 spacings in radius came out far short at its antipode), so the
+            # solve stops here. With a given bound below |∇φ| the candidates depend on the
+            # layer's width and a later widening can still bring them in: widened as for any φ.
+            raise ValueError(
+                f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
+                "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
+                "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
+                "there (round the edges over a few grid spacings), pass a signed distance function, or refine the grid"
+            )
+        previously_lacking = lacking
+        if attempt == _MAX_WIDENINGS:
+            raise ValueError(
+                f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
+                "inner nodes lack a neighbour. "
+                + (
+                    ""
+                    if redistanced
+                    else "φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or "
+                )
+                + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
+                "than the tube: refine the grid)"
+                + (
+                    ""
+                    if given_bound is None
+                    else f", or the lipschitz bound given, {given_bound:g}, is below |∇φ| near "
+                    "the surface and keeps nodes from the band's candidates (leave it out to have it estimated)"
+                )
+            )
+        warnings.warn(
+            _widening_message(missing, phi, h, inner, outer_eff), RuntimeWarning, stacklevel=user_stacklevel()
+        )
+        outer_eff += 1.0
+    facing = _warn_if_tubes_touch(
+        grid,
+        band,
+        linear,
+        roles,
+        phi,
+        direction if direction is not None else geom.direction,
+        inner,
+        kink,
+        float(getattr(surf, "_noise", 0.0)),
+    )
+    return _PreparedTube(
+        grid,
+        surf,
+        float(inner),
+        outer_eff,
+        method,
+        geom,
+        linear,
+        roles,
+        band,
+        phi,
+        direction,
+        time.perf_counter() - t0,
+        facing,
+    )

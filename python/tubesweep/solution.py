@@ -1,0 +1,481 @@
+"""What a solve returns: :class:`Solution`, the values on the band and what is read from them
+(interpolation, the solution on a mesh, nearest-source labels, geodesic paths)."""
+
+from __future__ import annotations
+
+from typing import Any, List, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+from ._validate import (
+    check_memory,
+    as_points,
+    real_scalar,
+)
+from ._interpolation import interpolate_band
+from .grid import Grid
+from .stats import SolveStats
+from .surface import Surface
+from ._prepare import ROLE_OUTER
+
+
+class Solution:
+    """The result of :func:`solve`: first-arrival times on the band nodes.
+
+    Call it to interpolate (``sol(points)``); print it to see what was solved and how it went.
+
+    Attributes
+    ----------
+    grid : Grid
+        The grid solved on.
+    surface : Surface
+        The surface solved on.
+    indices : numpy.ndarray
+        ``(K, d)`` int64 grid indices of the band nodes.
+    values : numpy.ndarray
+        ``(K,)`` the solution at the band nodes (``inf`` where never reached).
+    roles : numpy.ndarray
+        ``(K,)`` uint8: 0 fixed (source), 1 inner tube, 2 extension layer.
+    phi : numpy.ndarray
+        ``(K,)`` float32: φ (level set) or ``|x − cp(x)|`` (closest point) at the band nodes.
+    stats : SolveStats
+        What the solve did (iterations, updates, times, convergence).
+    sources : numpy.ndarray
+        ``(S, d)`` the source points.
+    hamiltonian : str
+        ``"godunov"``, ``"lxf"``, ``"moving-medium"``, ``"metric"`` or ``"isotropic"``.
+    method : str
+        ``"two-layer"`` or ``"naive"``.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> s = ts.surfaces.Sphere(0.5)
+    >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [s.default_source])
+    >>> sol.stats.converged
+    True
+    >>> u = sol([(0.5, 0.0, 0.0)])  # the antipode: exact π/2
+    """
+
+    def __init__(
+        self,
+        grid: Grid,
+        band: Any,
+        values: np.ndarray,
+        roles: np.ndarray,
+        phi: np.ndarray,
+        stats: SolveStats,
+        sources: np.ndarray,
+        surface: Surface,
+        hamiltonian: str,
+        method: str,
+        inner: float,
+        outer: float,
+        fixed: Tuple[np.ndarray, np.ndarray],
+        isotropic: bool,
+        facing: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None,
+        phi_sample: Optional[Tuple[np.ndarray, np.ndarray]] = None,
+    ):
+        self.grid = grid
+        self._band = band
+        self.values = values
+        self.roles = roles
+        self.phi = phi
+        self.stats = stats
+        self.sources = sources
+        self.surface = surface
+        self.hamiltonian = hamiltonian
+        self.method = method
+        self.inner = inner
+        self.outer = outer
+        # the nodes fixed by the sources (band positions) and the source of each
+        self._fixed = fixed
+        self._isotropic = isotropic
+        self._labels: Optional[np.ndarray] = None
+        # the pairs of band nodes across gaps narrower than the tubes (positions, positions, gaps)
+        empty = np.empty(0, np.int64)
+        self._facing = facing if facing is not None else (empty, empty, np.empty(0))
+        # for a φ array: its values at a sample of the band's nodes (linear indices, values)
+        self._phi_sample = phi_sample
+        # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
+        self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None
+
+    def __getstate__(self) -> dict:
+        # the native band does not pickle: its linear indices do, and rebuild it
+        state = self.__dict__.copy()
+        state["_band"] = np.asarray(self._band.linear(), dtype=np.int64)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        linear = state["_band"]
+        state["_band"] = _native.Band.from_linear(
+            list(state["grid"].shape), np.ascontiguousarray(linear).view(np.uint64)
+        )
+        self.__dict__.update(state)
+
+    def _check_surface_unchanged(self) -> None:
+        """Refuses to go on when the surface's φ array, which the solution uses in place for its
+        projections, was changed after the solve (checked at a sample of the band's nodes)."""
+        if self._phi_sample is None:
+            return
+        pick, values = self._phi_sample
+        if not np.array_equal(self.surface._array.reshape(-1)[pick], values):  # type: ignore[attr-defined]
+            raise ValueError(
+                "the φ array of this solution's surface was changed after the solve: its projections onto the surface "
+                "no longer match the solution. Solve again for the new φ (pass phi.copy() to LevelSet to keep the "
+                "array free to change)"
+            )
+
+    def narrow_gaps(self) -> Tuple[np.ndarray, np.ndarray]:
+        """Where the surface faces itself across a gap narrower than the tubes.
+
+        There the front can cross the gap, and travel times beyond it can come out too short (see
+        ``stats.facing_pairs`` and the user guide's surfaces page).
+
+        Returns
+        -------
+        midpoints : numpy.ndarray
+            ``(M, d)`` the midpoints of the pairs of neighbouring band nodes across such a gap.
+        gaps : numpy.ndarray
+            ``(M,)`` each gap's width ``|cp(a) − cp(b)|``. Both are empty where the grid resolves
+            every gap.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source])
+        >>> sol.narrow_gaps()[0].shape
+        (0, 3)
+        """
+        node, neighbour, gap = self._facing
+        lin = self.linear
+        mid = 0.5 * (self.grid.node_points(lin[node]) + self.grid.node_points(lin[neighbour]))
+        return mid.reshape(-1, self.grid.ndim), gap.copy()
+
+    def __repr__(self) -> str:
+        # what was solved, on what, and how it went: enough to tell two solutions apart when printed
+        s = self.stats
+        g = self.grid
+        order = getattr(self, "order", 1)
+        return (
+            f"Solution(surface={self.surface!r}, grid={'×'.join(map(str, g.shape))} (spacing {g.spacing:.4g}), "
+            f"band_nodes={s.band_points:,} ({s.inner_points:,} inner), sources={len(self.sources)}, "
+            f"method={self.method!r}, hamiltonian={self.hamiltonian!r}, order={order}, iterations={s.iterations}, "
+            f"converged={s.converged})"
+        )
+
+    @property
+    def linear(self) -> np.ndarray:
+        """C-order linear grid indices (K,) of the band nodes, increasing (computed from the band on
+        each access: the solution does not hold them)."""
+        return self._band.linear()
+
+    @property
+    def indices(self) -> np.ndarray:
+        return self.grid.unravel(self.linear)
+
+    @property
+    def points(self) -> np.ndarray:
+        """Coordinates (K, d) of the band nodes."""
+        return self.grid.points(self.indices)
+
+    @property
+    def inner_mask(self) -> np.ndarray:
+        return self.roles != ROLE_OUTER
+
+    def __call__(self, points: Any, interpolation: str = "linear") -> np.ndarray:
+        """The solution at points near the surface, by interpolation of the band values.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(M, d)`` points (or one point ``(d,)``) on or near the surface.
+        interpolation : {"linear", "cubic"}
+            ``"linear"`` (the default): multilinear over the point's cell. ``"cubic"``:
+            Catmull–Rom cubics over the 4^d nodes around the point where they are all in the band
+            and reached, the multilinear value elsewhere (docs/box-second-order.md has the gain
+            measured: it pays with second-order values, not with the first-order scheme's).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` values; NaN where the cell's corners leave the band.
+
+        Raises
+        ------
+        ValueError
+            If the points do not have the grid's dimension or are not finite, or
+            ``interpolation`` is not one of the two.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [s.default_source])
+        >>> u = sol([(0.0, 0.5, 0.0), (0.5, 0.0, 0.0)])  # exact π/4 and π/2
+        >>> v = sol([(0.0, 0.5, 0.0)], interpolation="cubic")
+        """
+        p = as_points(points, self.grid.ndim, "points")
+        out = interpolate_band(self._band, self.values, self.grid, p, interpolation)
+        if self._factoring is not None:
+            from .second_order import factored_values
+
+            out = factored_values(self, p, out, interpolation)
+        return out
+
+    def on_mesh(self, vertices: Any) -> np.ndarray:
+        """The solution at the vertices of a mesh of the surface (for display or export).
+
+        Multilinear interpolation (:meth:`__call__`); where its stencil leaves the band or meets an
+        unreached node, the value of the nearest band node within ``outer + 1`` grid spacings (the
+        band values are constant along the normals, Eq. (8), so this is first-order accurate).
+
+        Parameters
+        ----------
+        vertices : array_like
+            ``(M, d)`` points on the surface, e.g. ``surface.vertices`` of a mesh.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M,)`` values; NaN where no band node is near, or where the nearest one was not reached
+            (a component of the surface no source reaches, or a solve stopped early).
+
+        Raises
+        ------
+        ValueError
+            If the vertices do not have the grid's dimension or are not finite.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> sol = ts.solve(spot, spot.grid(60), [spot.vertices[0]])  # doctest: +SKIP
+        >>> u = sol.on_mesh(spot.vertices)  # doctest: +SKIP
+        """
+        p = as_points(vertices, self.grid.ndim, "vertices")
+        out = self(p)
+        bad = np.flatnonzero(~np.isfinite(out))
+        if bad.size:
+            pos = self._nearest_reached(p[bad])
+            out[bad] = np.where(pos >= 0, self.values[np.maximum(pos, 0)], np.nan)
+        return out
+
+    def _nearest_reached(self, p: np.ndarray) -> np.ndarray:
+        """Band position (M,) of the band node nearest to each point within ``outer + 1`` grid
+        spacings of it, -1 where there is none or where that node was not reached (a component
+        of the surface no source reaches: the nearest *reached* node would lie on another
+        component's band, whose value and source the point does not have). The offsets from the
+        point's nearest node are tried in increasing length, and a point is settled once no
+        longer offset can hold a nearer node."""
+        d = self.grid.ndim
+        r = int(np.ceil(self.outer)) + 1
+        best = np.full(len(p), -1, dtype=np.int64)
+        ci = self.grid.continuous_index(p)
+        # points beyond reach of the grid's nodes are left at -1 (and never cast to indices)
+        near = np.flatnonzero(np.all((ci > -(r + 1)) & (ci < np.asarray(self.grid.shape) + r), axis=1))
+        if near.size == 0:
+            return best
+        ci = ci[near]
+        base = np.rint(ci).astype(np.int64)
+        offs = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+        lengths = np.sqrt((offs * offs).sum(1))
+        order = np.argsort(lengths, kind="stable")
+        # |ci − base| ≤ √d/2, so a node at offset o lies at least |o| − √d/2 from the point
+        slack = 0.5 * np.sqrt(d)
+        open_ = np.arange(len(near))
+        bd = np.full(len(near), np.inf)
+        bp = np.full(len(near), -1, dtype=np.int64)
+        for o, length in zip(offs[order], lengths[order]):
+            open_ = open_[bd[open_] > length - slack]
+            if open_.size == 0:
+                break
+            idx = base[open_] + o
+            pos = self._band.find(np.ascontiguousarray(idx))
+            ok = pos >= 0
+            if not np.any(ok):
+                continue
+            dist = np.linalg.norm(idx - ci[open_], axis=1)
+            take = ok & (dist < bd[open_]) & (dist <= self.outer + 1)
+            bp[open_[take]] = pos[take]
+            bd[open_[take]] = dist[take]
+        found = bp >= 0
+        bp[found & ~np.isfinite(self.values[np.maximum(bp, 0)])] = -1
+        best[near] = bp
+        return best
+
+    def nearest_source(self, points: Any = None) -> np.ndarray:
+        """Which source reaches each place first: indices into :attr:`sources`.
+
+        For speed 1 the labels partition the surface into the geodesic Voronoi cells of the sources.
+        They are recovered from the solved values (each node takes the label of its smallest,
+        earlier-reached neighbour) and are first-order accurate like the values: nodes within about a
+        grid spacing of a cell boundary may take the neighbouring cell's label.
+
+        Parameters
+        ----------
+        points : array_like, optional
+            ``(M, d)`` points, e.g. the vertices of a mesh of the surface. Default: one label per band
+            node, aligned with :attr:`values`.
+
+        Returns
+        -------
+        numpy.ndarray
+            Labels (int); -1 where no front arrives (another component of the surface) or, for points,
+            where no band node lies within ``outer + 1`` grid spacings.
+
+        Raises
+        ------
+        ValueError
+            For a solution with several sources under an anisotropic Hamiltonian (a moving medium or
+            a metric), where the smallest neighbour is not the one the front came from: solve each
+            source on one :class:`Tube` and take the argmin of the values instead.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [(0.5, 0, 0), (-0.5, 0, 0)])
+        >>> sol.nearest_source([(0.4, 0.3, 0.0), (-0.4, 0.0, 0.3)]).tolist()
+        [0, 1]
+        """
+        if not self._isotropic and len(self.sources) > 1:
+            raise ValueError(
+                f"nearest_source needs an isotropic Hamiltonian (godunov, lxf or Isotropic()); this solution is "
+                f"{self.hamiltonian!r}. Solve each source on one ts.Tube and take the argmin of the values instead"
+            )
+        if self._labels is None:
+            positions, sources = self._fixed
+            self._labels = self._band.nearest_source_labels(
+                np.ascontiguousarray(self.values, dtype=float),
+                np.ascontiguousarray(positions, dtype=np.int64),
+                np.ascontiguousarray(sources, dtype=np.int64),
+            )
+        labels: np.ndarray = self._labels
+        if points is None:
+            return labels.copy()
+        p = as_points(points, self.grid.ndim, "points")
+        pos = self._nearest_reached(p)
+        return np.where(pos >= 0, labels[np.maximum(pos, 0)], -1)
+
+    def geodesic_path(self, start: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> np.ndarray:
+        """The shortest path on the surface from ``start`` to the source whose front reaches it first.
+
+        Traced backwards along the characteristics: steps of ``step`` grid spacings against the
+        gradient of the solution, each projected back onto the surface (see
+        :mod:`tubesweep.geodesic_paths`). For speed F(x) it is the path of least travel time. Where
+        two sources lie within a few grid spacings of each other, the path ends at the one it comes
+        within two spacings of first.
+
+        Parameters
+        ----------
+        start : array_like
+            ``(d,)`` a point on the surface (within the inner tube).
+        step : float
+            Step length in grid spacings (default 0.5, at least 0.01).
+        max_steps : int, optional
+            The most steps to take (default: enough for a path four times the largest value).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(P, d)`` the polyline from the start to the source.
+
+        Raises
+        ------
+        ValueError
+            For a start off the surface, outside the band or on a part no source reaches; for an
+            anisotropic Hamiltonian (under a moving medium or a metric the fastest path does not run
+            against ∇u).
+
+        Warns
+        -----
+        RuntimeWarning
+            If the path stopped before reaching a source (a cut locus, a region the scheme resolves
+            poorly, or a gap narrower than the tubes nearby).
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [(-0.5, 0, 0)])
+        >>> path = sol.geodesic_path((0.0, 0.5, 0.0))  # a quarter of a great circle, length ≈ π/4
+        """
+        p = as_points(start, self.grid.ndim, "start")
+        if len(p) != 1:
+            raise ValueError(
+                f"start must be one point of shape ({self.grid.ndim},); got {len(p)} points "
+                "(use geodesic_paths for several)"
+            )
+        return self.geodesic_paths(p, step=step, max_steps=max_steps)[0]
+
+    def geodesic_paths(self, starts: Any, *, step: float = 0.5, max_steps: Optional[int] = None) -> List[np.ndarray]:
+        """:meth:`geodesic_path` from each of several starts, traced together.
+
+        Parameters
+        ----------
+        starts : array_like
+            ``(M, d)`` points on the surface.
+        step : float
+            Step length in grid spacings (default 0.5).
+        max_steps : int, optional
+            The most steps per path.
+
+        Returns
+        -------
+        list of numpy.ndarray
+            One ``(P_i, d)`` polyline per start.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`geodesic_path`, naming the first bad start.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [(-0.5, 0, 0)])
+        >>> paths = sol.geodesic_paths([(0.0, 0.5, 0.0), (0.0, 0.0, 0.5)])
+        """
+        from .geodesic_paths import trace_paths
+
+        return trace_paths(self, starts, step=step, max_steps=max_steps)
+
+    def to_dense(self, fill: float = np.nan) -> np.ndarray:
+        """The solution as an array of the grid's shape (allocates the whole box).
+
+        Parameters
+        ----------
+        fill : float
+            The value off the band (default NaN).
+
+        Returns
+        -------
+        numpy.ndarray
+            Array of ``grid.shape``.
+
+        Raises
+        ------
+        TypeError
+            If ``fill`` is not a real number.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> c = ts.surfaces.Circle(0.5)
+        >>> sol = ts.solve(c, ts.Grid((-1, -1), (1, 1), (101, 101)), [c.default_source])
+        >>> sol.to_dense().shape
+        (101, 101)
+        """
+        value = real_scalar(fill, "fill", "a real number (the value outside the band, NaN by default)")
+        check_memory(
+            8 * self.grid.size,
+            f"the dense {self.grid.shape} array",
+            "keep the band's values (sol.values) or interpolate at the points you need (sol(points))",
+        )
+        out = np.full(self.grid.size, value, dtype=float)
+        out[self.linear] = self.values
+        return out.reshape(self.grid.shape)
