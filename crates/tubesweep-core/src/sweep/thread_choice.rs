@@ -160,12 +160,22 @@ fn own_runnable() -> Option<usize> {
 
 /// The pool's size for the default thread count: rayon's default number (the cores, or
 /// `RAYON_NUM_THREADS`), but no more than the idle cores ([`idle_cores`]), and at least one.
+/// The count is a snapshot: when it finds fewer idle cores than that, it is read again up to four
+/// times 0.25 ms apart and the most idle taken, so that a task running for an instant does not
+/// put a whole solve on one thread (a process that keeps a core busy is there at every read).
 pub fn threads_for_default() -> usize {
     let n = rayon::current_num_threads().max(1);
-    match idle_cores() {
-        Some(idle) => n.min(idle).max(1),
-        None => n,
+    let Some(mut idle) = idle_cores() else {
+        return n;
+    };
+    for _ in 0..4 {
+        if idle >= n {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(250));
+        idle = idle.max(idle_cores().unwrap_or(0));
     }
+    n.min(idle).max(1)
 }
 
 #[cfg(test)]
