@@ -8,8 +8,10 @@
 //! Every iteration gives the same bits whichever way it runs ([`crate::band::schedule`]), so
 //! the choice can change between iterations without changing the solution.
 //!
-//! With the default thread count (`threads = 0`), an iteration runs sequentially whenever the
-//! machine has fewer idle cores than the pool has threads: on Linux, the runnable tasks of
+//! With the default thread count (`threads = 0`), no iteration runs in parallel before the parallel
+//! sweeps have been timed once while the machine has fewer idle cores than the pool has threads
+//! (after that the timings alone decide: a reading is a snapshot, and another task's instant on a
+//! core must not keep a quiet machine's solve on one thread): on Linux, the runnable tasks of
 //! `/proc/loadavg` that are not this process's threads (read before each iteration, tens of
 //! microseconds), against the cores. That alone decides under a steady load: one parallel iteration timed as a probe cost
 //! 80–170 ms where a sequential one took 2–4 ms (the sphere at N = 201, one of two cores kept
@@ -72,9 +74,14 @@ impl ThreadChoice {
         if !self.adaptive {
             return true;
         }
-        if let Some(idle) = idle_cores() {
-            if idle < self.threads {
-                return false;
+        // The load reading only keeps the first parallel iteration (the probe) off a busy
+        // machine; once both modes are timed, the timings decide: a reading is a snapshot, and
+        // another task's instant on a core must not send a quiet machine's solve to one thread.
+        if self.per_update[1].is_none() {
+            if let Some(idle) = idle_cores() {
+                if idle < self.threads {
+                    return false;
+                }
             }
         }
         match self.per_update {
