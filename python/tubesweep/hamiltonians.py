@@ -311,41 +311,6 @@ class Isotropic(Hamiltonian):
         super().__init__(sigma, scheme)
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
-        """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
-
-        Parameters
-        ----------
-        surface : Surface
-            The surface solved on.
-        grid : Grid
-            The grid.
-        linear : numpy.ndarray
-            The band nodes' linear indices.
-        x : numpy.ndarray
-            Their closest points on the surface.
-        direction : numpy.ndarray
-            Their unit normals.
-        slowness : numpy.ndarray
-            1/F at the nodes.
-        roles : numpy.ndarray
-            Their roles (fixed, inner, extension layer).
-
-        Returns
-        -------
-        _Prepared
-            The arrays the Rust core reads.
-
-        Raises
-        ------
-        ValueError
-            Where the equation cannot be solved as given (e.g. a supersonic flow).
-
-        Examples
-        --------
-        >>> import tubesweep as ts
-        >>> s = ts.surfaces.Sphere(0.5)
-        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
-        """
         return _Prepared(self.kind, slowness, sigma=self._sigma(grid.ndim), scheme=self.scheme)
 
 
@@ -608,41 +573,6 @@ class Metric(Hamiltonian):
         return f"Metric(tangential={self.tangential}, scheme={self.scheme!r})"
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
-        """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
-
-        Parameters
-        ----------
-        surface : Surface
-            The surface solved on.
-        grid : Grid
-            The grid.
-        linear : numpy.ndarray
-            The band nodes' linear indices.
-        x : numpy.ndarray
-            Their closest points on the surface.
-        direction : numpy.ndarray
-            Their unit normals.
-        slowness : numpy.ndarray
-            1/F at the nodes.
-        roles : numpy.ndarray
-            Their roles (fixed, inner, extension layer).
-
-        Returns
-        -------
-        _Prepared
-            The arrays the Rust core reads.
-
-        Raises
-        ------
-        ValueError
-            Where the equation cannot be solved as given (e.g. a supersonic flow).
-
-        Examples
-        --------
-        >>> import tubesweep as ts
-        >>> s = ts.surfaces.Sphere(0.5)
-        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
-        """
         d = grid.ndim
         if callable(self.M) and surface is not None:
             _, cp = surface.project(x, grid)
