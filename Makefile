@@ -1,6 +1,7 @@
 # tubesweep — one-command set-up. Needs only Rust (cargo), Python 3.9+ and pip.
 #   make demo       build, run the built-in examples, write pictures to out/demo
-#   make test       build, run cargo and pytest suites (installs the test dependencies)
+#   make test       build, lint, run cargo and pytest suites (installs the test dependencies)
+#   make lint       cargo fmt --check, clippy -D warnings, ruff, mypy, the import-cycle check
 #   make docs       the user guide, API reference and gallery as HTML in out/site
 #   make bench      benchmarks against scikit-fmm, potpourri3d, pygeodesic (installs them)
 #   make reproduce  every table and figure of the paper into out/reproduce
@@ -11,6 +12,7 @@ PIP    := $(PY) -m pip
 DEPS   := $(VENV)/.deps-runtime
 TEST_DEPS_DONE  := $(VENV)/.deps-test
 DOCS_DEPS_DONE  := $(VENV)/.deps-docs
+LINT_DEPS_DONE  := $(VENV)/.deps-lint
 BUILT  := $(VENV)/.built
 # what the package needs at run time with its plot, mesh and progress extras (pyproject.toml)
 RUNTIME_DEPS := "maturin>=1.5,<2" "numpy>=1.22" "matplotlib>=3.5" "scipy>=1.8" "scikit-image>=0.19" \
@@ -19,18 +21,20 @@ RUNTIME_DEPS := "maturin>=1.5,<2" "numpy>=1.22" "matplotlib>=3.5" "scipy>=1.8" "
 TEST_DEPS  := "pytest>=7" "hypothesis>=6" scikit-fmm pygeodesic potpourri3d geographiclib "dask>=2023.1" "distributed>=2023.1" \
               "cloudpickle>=2"
 BENCH_DEPS := potpourri3d pygeodesic scikit-fmm geographiclib
+# pyproject.toml's lint extra, pinned so that every run checks the same rules
+LINT_DEPS  := "ruff==0.17.6" "mypy==2.4.1"
 DOCS_DEPS  := "mkdocs>=1.6,<2" "mkdocs-material>=9,<10" "mkdocstrings[python]>=0.26"
 # pip's notes on extras that do not apply ("Ignoring ...: markers") and on what is already there
 export PIP_QUIET := 1
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 RUST_SOURCES := $(shell find crates -name '*.rs' -o -name Cargo.toml) Cargo.toml pyproject.toml
 
-.PHONY: all build demo test test-rust test-python docs bench reproduce reproduce-quick clean help
+.PHONY: all build demo test lint test-rust test-python docs bench reproduce reproduce-quick clean help
 
 all: build
 
 help:
-	@sed -n '2,7p' Makefile
+	@sed -n '2,8p' Makefile
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -44,6 +48,11 @@ $(DEPS): pyproject.toml | $(PY)
 $(TEST_DEPS_DONE): pyproject.toml | $(PY)
 	@echo "installing the test dependencies into $(VENV)"
 	@$(PIP) install -q $(TEST_DEPS)
+	@touch $@
+
+$(LINT_DEPS_DONE): pyproject.toml | $(PY)
+	@echo "installing the linters into $(VENV)"
+	@$(PIP) install -q $(LINT_DEPS)
 	@touch $@
 
 $(DOCS_DEPS_DONE): pyproject.toml | $(PY)
@@ -61,7 +70,16 @@ build: $(BUILT)
 demo: build
 	$(PY) -m tubesweep demo --out out/demo
 
-test: build test-rust test-python
+test: build lint test-rust test-python
+
+# mypy reads numpy's types from the runtime dependencies
+lint: $(LINT_DEPS_DONE) $(DEPS)
+	cargo fmt --all --check
+	cargo clippy --workspace --all-targets -- -D warnings
+	$(VENV)/bin/ruff check python tests benches tools examples mkdocs_hooks.py
+	$(VENV)/bin/ruff format --check python tests benches tools examples mkdocs_hooks.py
+	$(VENV)/bin/mypy
+	$(PY) tools/import_cycles.py
 
 test-rust:
 	cargo test --release -p tubesweep-core

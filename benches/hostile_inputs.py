@@ -40,7 +40,6 @@ import tempfile
 import textwrap
 import time
 from collections import Counter
-from pathlib import Path
 from typing import Dict, List, Optional, Tuple
 
 BAD = ("wrong", "unclean", "crash", "hang")

@@ -658,7 +658,7 @@ def run_bench(
         print()
         for nt in all_notes:
             print("note:", nt)
-        print(f"× ts = median wall time / tubesweep-godunov's on the same problem and N (side by side in this run)")
+        print("× ts = median wall time / tubesweep-godunov's on the same problem and N (side by side in this run)")
         print()
         print(EQUAL_ERROR_NOTE)
         print(eq_tab)

@@ -16,6 +16,7 @@ import pytest
 
 BENCHES = Path(__file__).resolve().parents[1] / "benches"
 sys.path.insert(0, str(BENCHES))
+sys.path.insert(0, str(BENCHES / "experiments"))  # the one-off studies it also runs
 
 import run as bench  # noqa: E402
 from problems import Spheroid, Torus, ellipse_closest  # noqa: E402
@@ -365,7 +366,7 @@ def test_microbench_splits_the_speed_ups_of_rounds_at_two_core_to_core_latencies
 
 
 def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(capsys):
-    """benches/front_window_surfaces.py at a small size: every surface prints a row, the two
+    """benches/experiments/front_window_surfaces.py at a small size: every surface prints a row, the two
     solutions agree to far below the tolerance's scale, and the window is left at its default."""
     import front_window_surfaces
 
@@ -378,7 +379,7 @@ def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(cap
 
 
 def test_oblique_planes_bench_axis_aligned_surfaces_settle_at_once_and_tilted_ones_do_not():
-    """benches/oblique_planes.py at small sizes: along an axis the paper's sweeps converge in one
+    """benches/experiments/oblique_planes.py at small sizes: along an axis the paper's sweeps converge in one
     iteration (and one to confirm it) at under 3.5 updates per node; a tilted line takes many;
     the coupled update brings the 45° line down to a few iterations but not the 16.7° one."""
     import oblique_planes
@@ -394,7 +395,7 @@ def test_oblique_planes_bench_axis_aligned_surfaces_settle_at_once_and_tilted_on
 
 
 def test_dependency_cycles_bench_finds_the_pairs_the_coupled_update_removes(capsys):
-    """benches/dependency_cycles.py: the gain around a hand-made 2-cycle and 4-cycle; on the
+    """benches/experiments/dependency_cycles.py: the gain around a hand-made 2-cycle and 4-cycle; on the
     tilted line, the paper's update leaves inner–layer pairs that read each other, and with the
     coupled update folded in no cycle is left."""
     import dependency_cycles as dc

@@ -153,8 +153,11 @@ def test_cubic_interpolation_in_a_band():
     lin, cub = sol(p), sol(p, interpolation="cubic")
     assert np.all(np.isfinite(cub))
     assert 0 < np.max(np.abs(cub - lin)) < 0.3 * grid.spacing  # measured 0.18Δx, within the first-order error
+
     # reproduces quadratics where the stencil is complete
-    q = lambda x: 0.3 + x[:, 0] - 2 * x[:, 1] * x[:, 2] + 0.7 * x[:, 0] ** 2
+    def q(x):
+        return 0.3 + x[:, 0] - 2 * x[:, 1] * x[:, 2] + 0.7 * x[:, 0] ** 2
+
     sol.values = q(sol.points)
     _, used = ts._native.band_interpolate_cubic(sol._band, sol.values, list(grid.lower), grid.spacing, p)
     assert used.mean() > 0.9

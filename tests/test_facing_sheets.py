@@ -133,7 +133,7 @@ def test_the_plate_on_the_advised_grid_gives_no_warning_and_first_order_distance
     assert sol.stats.facing_pairs == 0 and sol.stats.narrowest_gap == np.inf
     assert sol.narrow_gaps()[0].shape == (0, 3)
     u = sol(np.array([[0.0, 0.0, -PLATE / 2]]))[0]
-    # two convex edges on the way, each about 4.5 spacings short (benches/facing_gaps.py)
+    # two convex edges on the way, each about 4.5 spacings short (benches/experiments/facing_gaps.py)
     assert 1 + PLATE - 10 * grid.spacing < u < 1 + PLATE
 
 

@@ -1,7 +1,6 @@
 """The surface eikonal solver: Algorithm 3 (two-layer tube) and Algorithm 2 (naive tube)."""
 
 import tracemalloc
-import warnings
 
 import numpy as np
 import pytest

@@ -19,7 +19,7 @@ Sect. 5.2) and the library :mod:`tubesweep.surfaces`; meshes in, results out: :f
 :func:`triangulate`, :func:`export`, :func:`plot`.
 """
 
-from ._native import __version__ as _core_version
+from ._native import __version__ as _core_version  # noqa: F401  (fails early without the compiled core)
 from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .box_solution import BoxSolution

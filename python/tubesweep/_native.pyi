@@ -132,6 +132,28 @@ def factored_box_solve(  # crates/tubesweep-py/src/box_order2.rs: travel_time(..
     progress: Optional[Callable[[int, float, int], Any]] = None,
     activation_threshold: float = 0.0,
 ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
+def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., order=2) on a band
+    band: "Band",
+    roles: npt.NDArray[np.uint8],
+    phi: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float32],  # (K, d)
+    lower: List[float],
+    spacing: float,
+    sources: npt.NDArray[np.float64],  # (S, d) foot points
+    source_slowness: npt.NDArray[np.float64],  # (S,)
+    slowness: Union[float, npt.NDArray[np.float64]],  # a float or one per band node
+    fix_radius: float,
+    outer_width: float,
+    tol_first: float,
+    tol: float,
+    max_iterations: int,
+    progress: Optional[Callable[[int, float, int], Any]] = None,
+    stall_ratio: float = 0.9,
+    stall_window: int = 10,
+    threads: int = 0,
+    front_window: float = 2.0,
+    own_first_phase: bool = False,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], Dict[str, Any]]: ...
 def band_interpolate_cubic(  # crates/tubesweep-py/src/box_order2.rs: Catmull-Rom, multilinear where incomplete
     band: "Band", values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...

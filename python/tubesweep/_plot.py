@@ -55,7 +55,7 @@ def _levels(levels: Any, umax: float) -> np.ndarray:
         lv = real_array(levels, "levels").reshape(-1)
         if not np.all(np.isfinite(lv)):
             raise ValueError(f"levels must be finite values of the solution; got {levels!r}")
-    return lv[(lv > 0) & (lv < umax)]
+    return lv[(lv > 0) & (lv < umax)]  # type: ignore[index, operator, return-value]
 
 
 def _label_text(value: float) -> str:
@@ -343,12 +343,12 @@ def _plot_curve(
     dense = sol.to_dense()
     dense = np.where(np.isfinite(dense), dense, np.nan)
     X, Y = grid.meshgrid()
-    m = ax.pcolormesh(X, Y, dense, shading="auto", cmap=cmap_obj, norm=norm, alpha=0.35)
+    ax.pcolormesh(X, Y, dense, shading="auto", cmap=cmap_obj, norm=norm, alpha=0.35)
     try:
         v, seg = triangulate(sol)
     except (ValueError, ImportError):
         v, seg = None, None
-    if v is not None and len(seg):
+    if v is not None and len(seg):  # type: ignore[arg-type]
         u = sol.on_mesh(v)
         ends = v[seg]
         useg = np.nanmean(u[seg], axis=1)
@@ -357,8 +357,8 @@ def _plot_curve(
             cols = _label_colors(lab)
         else:
             cols = cmap_obj(norm(np.nan_to_num(useg, nan=umax)))
-        ax.add_collection(LineCollection(ends, colors=cols, linewidths=4.0, capstyle="round", zorder=2))
-        _curve_ticks(ax, v, seg, u, lv, grid.spacing)
+        ax.add_collection(LineCollection(ends, colors=cols, linewidths=4.0, capstyle="round", zorder=2))  # type: ignore[arg-type]
+        _curve_ticks(ax, v, seg, u, lv, grid.spacing)  # type: ignore[arg-type]
     elif lv.size:
         ax.contour(X, Y, dense, levels=lv, colors="k", linewidths=0.5)
     for q in lines:
@@ -433,8 +433,8 @@ def _iso_segments(v: np.ndarray, f: np.ndarray, u: np.ndarray, level: float) -> 
         t = np.where(cross, a / np.where(cross, a - b, 1.0), np.nan)
         p = v[f[:, i]] + t[:, None] * (v[f[:, j]] - v[f[:, i]])
         pts.append(np.where(cross[:, None], p, np.nan))
-    pts = np.stack(pts, axis=1)  # (m, 3 edges, 3)
-    have = np.isfinite(pts[:, :, 0])
+    pts = np.stack(pts, axis=1)  # type: ignore[assignment]  # (m, 3 edges, 3)
+    have = np.isfinite(pts[:, :, 0])  # type: ignore[call-overload]
     two = have.sum(1) == 2
     seg = pts[two][have[two]].reshape(-1, 2, 3)
     return seg, np.flatnonzero(two)
@@ -523,7 +523,7 @@ def _plot_surface(
         _draw_mesh(
             sol,
             v,
-            f,
+            f,  # type: ignore[arg-type]
             axes,
             views,
             perm,

@@ -19,6 +19,6 @@ def user_stacklevel() -> int:
     frame = sys._getframe(1)
     level = 1
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE_DIR):
-        frame = frame.f_back
+        frame = frame.f_back  # type: ignore[assignment]
         level += 1
     return level

@@ -303,7 +303,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if (args.lower is None) != (args.upper is None):
             raise UsageError("give both --lower and --upper (the grid's corners), or neither for the surface's own box")
 
-        surface = REGISTRY[args.surface]()
+        surface = REGISTRY[args.surface]()  # type: ignore[assignment]
         grid = _grid_for(surface, 101 if args.n is None else args.n, args.lower, args.upper)
         name = args.surface
     else:
@@ -311,7 +311,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if args.lower is None or args.upper is None:
             raise UsageError("--phi needs --lower and --upper (the grid's corners)")
         grid = Grid(args.lower, args.upper, phi.shape)
-        surface = LevelSet(phi, redistance=args.redistance)
+        surface = LevelSet(phi, redistance=args.redistance)  # type: ignore[assignment]
         name = args.phi.stem
     if args.redistance and not args.phi:
         raise UsageError("--redistance applies to --phi only (library surfaces and meshes are distances already)")
@@ -391,7 +391,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         upper=grid.upper,
         shape=np.array(grid.shape),
         sources=sol.sources,
-        **labels,
+        **labels,  # type: ignore[arg-type]
     )
     s = sol.stats
     # the names of docs/benchmarks.md: wall = the whole solve, sweeps = sol.stats.seconds, set-up = the rest

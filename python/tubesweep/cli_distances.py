@@ -119,7 +119,7 @@ def _surface_and_grid(args: argparse.Namespace) -> Any:
     if args.surface:
         from .surfaces import REGISTRY
 
-        surface = REGISTRY[args.surface]()
+        surface = REGISTRY[args.surface]()  # type: ignore[assignment]
         if (args.lower is None) != (args.upper is None):
             raise ValueError("give both --lower and --upper, or neither for the surface's own box")
         lower, upper = (args.lower, args.upper) if args.lower is not None else surface.default_box

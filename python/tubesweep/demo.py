@@ -61,7 +61,7 @@ def run_demo(out: Path, quick: bool = False) -> int:
     n2 = 201 if quick else 801
     grid2 = Grid((-1, -1), (1, 1), (n2, n2))
     pts = star.sample(2000)
-    exact = star.geodesic_distance(pts, star.default_source)
+    exact = star.geodesic_distance(pts, star.default_source)  # type: ignore[arg-type]
     for ham in ("godunov", "lxf"):
         t0 = time.perf_counter()
         sol = solve(star, grid2, [star.default_source], hamiltonian=ham)

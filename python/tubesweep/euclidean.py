@@ -282,7 +282,7 @@ def travel_time(
             src,
             general,
             slowness,
-            tol,
+            tol,  # type: ignore[arg-type]
             max_iterations,
             return_stats,
             cb,

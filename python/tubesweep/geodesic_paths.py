@@ -58,7 +58,7 @@ FINISH_RADIUS = SOURCE_RADIUS
 #: A stalled path whose end lies within this many grid spacings (plus half the gap) of the midpoint
 #: of a pair of band nodes across a gap narrower than the tubes (``Solution.narrow_gaps``) is
 #: reported as stopped at such a gap: of the paths that stalled on Spot at grid 81 and the bunny
-#: at grid 101 every one did, and 8 of 10 on the bunny at grid 201 (``benches/facing_gaps.py``).
+#: at grid 101 every one did, and 8 of 10 on the bunny at grid 201 (``benches/experiments/facing_gaps.py``).
 GAP_REACH = 3.0
 
 
@@ -265,7 +265,7 @@ def trace_paths(
             f"inner tube ({sol.inner:g} grid spacings = {sol.inner * h:.4g}); start the path on the surface"
         )
     u = sol(x)
-    for i in np.flatnonzero(~np.isfinite(u)):
+    for i in np.flatnonzero(~np.isfinite(u)):  # type: ignore[assignment]
         raise ValueError(
             f"starts[{int(i)}] = {tuple(float(v) for v in p[i])} "
             + (
@@ -299,7 +299,7 @@ def trace_paths(
         active = active[~done]
         if active.size == 0 or taken == max_steps:
             break
-        g = _gradient(sol, cur[active], ucur[active], cells, None if cells is None else target[active])
+        g = _gradient(sol, cur[active], ucur[active], cells, None if cells is None else target[active])  # type: ignore[index]
         gn = np.linalg.norm(g, axis=1)
         bad = ~(gn > 0) | ~np.all(np.isfinite(g), axis=1)
         stalled.extend(int(i) for i in active[bad])

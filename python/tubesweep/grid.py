@@ -181,7 +181,7 @@ class Grid:
 
     def __eq__(self, other: object) -> bool:
         return (
-            isinstance(other, Grid)
+            isinstance(other, Grid)  # type: ignore[return-value]
             and self._shape == other._shape
             and np.allclose(self._lower, other._lower)
             and np.isclose(self._spacing, other._spacing)

@@ -25,7 +25,7 @@ from __future__ import annotations
 import copy
 import warnings
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Optional, Sequence
+from typing import Any, Callable, Dict, Optional
 
 import numpy as np
 
@@ -310,7 +310,7 @@ class Isotropic(Hamiltonian):
     def __init__(self, sigma: Any = None, *, scheme: Optional[str] = None):
         super().__init__(sigma, scheme)
 
-    def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+    def prepare(self, surface, grid, linear, x, direction, slowness, roles):
         return _Prepared(self.kind, slowness, sigma=self._sigma(grid.ndim), scheme=self.scheme)
 
 
@@ -385,7 +385,7 @@ class MovingMedium(Hamiltonian):
             f"allow_supersonic={self.allow_supersonic}, scheme={self.scheme!r})"
         )
 
-    def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+    def prepare(self, surface, grid, linear, x, direction, slowness, roles):
         """Per-node data for the solver (called by :func:`tubesweep.solve`, not by users).
 
         ``surface=None`` for the whole box (:func:`tubesweep.travel_time`): the flow is read at the
@@ -572,7 +572,7 @@ class Metric(Hamiltonian):
     def __repr__(self) -> str:
         return f"Metric(tangential={self.tangential}, scheme={self.scheme!r})"
 
-    def prepare(self, surface, grid, linear, x, direction, slowness, roles):  # type: ignore[override]
+    def prepare(self, surface, grid, linear, x, direction, slowness, roles):
         d = grid.ndim
         if callable(self.M) and surface is not None:
             _, cp = surface.project(x, grid)

@@ -178,7 +178,7 @@ def solve_many(
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     positions, values, offsets = fixed_nodes(tube, groups, speed, source_init)
     missing_policy = "infinity" if (t.method == "naive" and scheme == "godunov") else "extrapolate"
-    directions = t.geom.directions_for_solver()  # a copy: the tube's stay as they are
+    directions = t.geom.directions_for_solver()  # type: ignore[union-attr]  # a copy: the tube's stay as they are
     setup = time.perf_counter() - t0
     out, st = _native.solve_many_on_band(
         t.band,
@@ -216,7 +216,7 @@ def solve_many(
         )
     if return_stats:
         st = dict(st)
-        st["setup_seconds"] = setup
-        st["seconds_total"] = time.perf_counter() - t0
+        st["setup_seconds"] = setup  # type: ignore[assignment]
+        st["seconds_total"] = time.perf_counter() - t0  # type: ignore[assignment]
         return out, st
     return out

@@ -161,8 +161,8 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
     data = {}
     for el in piece.findall("PointData/DataArray"):
         a = values(el, float)
-        data[el.get("Name")] = a.reshape(-1, int(el.get("NumberOfComponents"))) if el.get("NumberOfComponents") else a
-    return points, conn.reshape(-1, k), data
+        data[el.get("Name")] = a.reshape(-1, int(el.get("NumberOfComponents"))) if el.get("NumberOfComponents") else a  # type: ignore[arg-type]
+    return points, conn.reshape(-1, k), data  # type: ignore[return-value]
 
 
 def export_format(path: Union[str, Path], curve: bool = False) -> str:

@@ -16,6 +16,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import _native
+from ._factoring import FACTORED_RADIUS
 from ._validate import FRONT_WINDOW, check_threads as _threads, checked_point_speeds, speed_at_points, speed_values
 from .stats import SolveStats
 
@@ -26,10 +27,6 @@ ORDERS = (1, 2)
 #: Inner-tube nodes whose closest point is within this many grid spacings of a source are fixed
 #: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there).
 FIX_RADIUS = 2.0
-
-#: ``sol(points)`` evaluates ``w + σ|P − x_s|`` (interpolated ``w = u − u₀``) at points within
-#: this many grid spacings of a source: the value at a source is exactly 0.
-FACTORED_RADIUS = 3.0
 
 #: Phase 1 (first order, monotone) stops at this times ``Δx² × mean slowness``; phase 2 (second
 #: order) at ``TOL_FACTOR`` times it unless ``tol`` is given.
@@ -89,27 +86,6 @@ def check_supported(
             )
             + ". Use order=1 for it"
         )
-
-
-def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: str = "linear") -> np.ndarray:
-    """``sol(points)`` of a second-order solution near a point source: ``w = u − u₀``
-    interpolated plus ``σ_s |P − x_s|`` at the points within ``FACTORED_RADIUS`` grid spacings of
-    a source, so that the source's cone is not interpolated (the value at a source is exactly 0)."""
-    u0, feet, slowness = sol._factoring
-    grid = sol.grid
-    h = grid.spacing
-    if len(p) == 0:
-        return values
-    dist = np.sqrt(((p[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2))
-    near = np.argmin(dist, axis=1)
-    nearest = dist[np.arange(len(p)), near]
-    close = nearest <= FACTORED_RADIUS * h
-    if np.any(close):
-        from ._interpolation import interpolate_band
-
-        w = interpolate_band(sol._band, sol.values - u0, grid, p[close], interpolation)
-        values[close] = w + slowness[near[close]] * nearest[close]
-    return values
 
 
 def solve_on_tube(

@@ -13,6 +13,7 @@ from ._validate import (
     as_points,
     real_scalar,
 )
+from ._factoring import factored_values
 from ._interpolation import interpolate_band
 from .grid import Grid
 from .stats import SolveStats
@@ -47,6 +48,8 @@ class Solution:
         ``"godunov"``, ``"lxf"``, ``"moving-medium"``, ``"metric"`` or ``"isotropic"``.
     method : str
         ``"two-layer"`` or ``"naive"``.
+    order : int
+        The order of the scheme solved with: 1, or 2 for ``solve(..., order=2)``.
 
     Examples
     --------
@@ -100,6 +103,7 @@ class Solution:
         self._phi_sample = phi_sample
         # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
         self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None
+        self.order = 1
 
     def __getstate__(self) -> dict:
         # the native band does not pickle: its linear indices do, and rebuild it
@@ -220,8 +224,6 @@ class Solution:
         p = as_points(points, self.grid.ndim, "points")
         out = interpolate_band(self._band, self.values, self.grid, p, interpolation)
         if self._factoring is not None:
-            from .second_order import factored_values
-
             out = factored_values(self, p, out, interpolation)
         return out
 

@@ -141,7 +141,7 @@ def solve(
         the sweeps run behind a *front window* (only nodes within a few front steps of the
         smallest still-changing value are updated, and the band fills from the sources outwards):
         3× fewer local updates on the sphere at N=201, 5× at N=1001, and 2–4× less time
-        (``benches/sweep_variants.py``).
+        (``benches/experiments/sweep_variants.py``).
 
     Returns
     -------
@@ -303,7 +303,7 @@ def _solve_on_tube(
         # sparsely; the directions are converted to the extension weights in place (no second
         # K×d buffer).
         if reuse:
-            directions = tube.geom.directions_for_solver()  # a copy: the tube's stay as they are
+            directions = tube.geom.directions_for_solver()  # type: ignore[union-attr]  # a copy: the tube's stay as they are
         else:
             directions = tube.direction  # overwritten by the solver (a copy unless the geometry is consumable)
             tube.direction = tube.linear = tube.roles = None  # type: ignore[assignment]

@@ -397,8 +397,8 @@ class LevelSet(Surface):
                 [float(x) for x in grid.lower],
                 grid.spacing,
                 float(half_width),
-                float(self.lipschitz),
-            )  # type: ignore[arg-type]
+                float(self.lipschitz),  # type: ignore[arg-type]
+            )
             linear = ulinear.view(np.int64)
             if linear.size == 0:
                 return BandGeometry(linear, values, values, direction)
@@ -436,7 +436,7 @@ class LevelSet(Surface):
             hi = min(len(linear), lo + EVAL_CHUNK)
             if self._array is not None:
                 # central differences of the samples, one-sided at the grid's faces
-                norm = _native.outward_directions_of_samples(
+                norm = _native.outward_directions_of_samples(  # type: ignore[assignment]
                     self._array, grid.spacing, linear[lo:hi].view(np.uint64), direction[lo:hi]
                 )
             else:

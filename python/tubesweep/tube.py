@@ -100,8 +100,9 @@ class Tube:
 
     def _check_phi_unchanged(self) -> None:
         if self._phi_at_band is not None and not np.array_equal(
-            self.surface._array.reshape(-1)[self._tube.linear], self._phi_at_band
-        ):  # type: ignore[attr-defined]
+            self.surface._array.reshape(-1)[self._tube.linear],  # type: ignore[attr-defined]
+            self._phi_at_band,
+        ):
             raise ValueError(
                 "the φ array of this Tube's surface was changed after the Tube was built: its band no "
                 "longer matches it. Build a new ts.Tube for the new φ (pass phi.copy() to LevelSet to keep "
@@ -361,5 +362,5 @@ class Tube:
         """Bytes the tube holds in its arrays (the band structure included)."""
         t = self._tube
         g = t.geom
-        arrays = [t.linear, t.roles, t.phi, g.signed, g.direction] + ([g.distance] if g.distance is not None else [])
+        arrays = [t.linear, t.roles, t.phi, g.signed, g.direction] + ([g.distance] if g.distance is not None else [])  # type: ignore[union-attr]
         return int(sum(np.asarray(a).nbytes for a in arrays) + t.band.nbytes)

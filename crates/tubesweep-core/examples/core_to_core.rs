@@ -127,7 +127,7 @@ fn round_trip_ns(a: usize, b: usize, trips: u64) -> Result<f64, String> {
                 return Err("the echo thread stopped".to_string());
             }
             done += 1;
-            if done % 1024 == 0 && t0.elapsed().as_secs_f64() > ROUND_BUDGET_S {
+            if done.is_multiple_of(1024) && t0.elapsed().as_secs_f64() > ROUND_BUDGET_S {
                 break;
             }
         }

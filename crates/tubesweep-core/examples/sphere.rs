@@ -33,7 +33,7 @@ fn main() {
     let plain = std::env::var_os("PLAIN").is_some();
     // Python's `paper_sweeps=True`: the paper's sweeps with the active flags kept
     let paper = std::env::var_os("PAPER").is_some();
-    let coupled = !plain && !paper && args.get(4).map_or(true, |s| s != "pointwise");
+    let coupled = !plain && !paper && args.get(4).is_none_or(|s| s != "pointwise");
     let defer_outer_rim = !plain && !paper && std::env::var_os("RIM_IN_EVERY_SWEEP").is_none();
     let source_axis = sphere_source::source_axis_from_env();
     let (band, roles, dirs, h, build) = sphere_source::sphere_with_source(n, source_axis);

@@ -10,10 +10,10 @@
 //! |---|---|---|
 //! | [`surface`] | evaluating Σ: analytic signed distances, closest points on meshes and open surfaces, re-distancing | Sect. 4, 5.2 |
 //! | [`band`] | the narrow band (inner tube + extension layer), its discovery, directions, facing sheets, row schedule | Fig. 4, Eq. (8) |
-//! | [`scheme`] | the local solvers: Godunov, Lax–Friedrichs, the extension update, Hamiltonians | Eqs. (3), (4), (5), Sect. 5.1 |
-//! | [`sweep`] | the Gauss–Seidel sweeps over the band (Algorithms 1–3), in parallel, the rim, the front window, many sources on one band | Algorithms 1–3 |
+//! | [`scheme`] | the local solvers: Godunov, Lax–Friedrichs, the extension update, Hamiltonians, the upwind solvers of general Hamiltonians, the limited second-order Godunov | Eqs. (3), (4), (5), Sect. 5.1 |
+//! | [`sweep`] | the Gauss–Seidel sweeps over the band (Algorithms 1–3), in parallel, the rim, the front window, many sources on one band, the second-order factored box | Algorithms 1–3 |
 //! | [`second_order`] | `order=2`: the metric-corrected tube equation, its geometry, factored sources, BDF2 local solvers and sweeps | beyond the paper (docs/second-order.md) |
-//! | [`solution`] | interpolation in the band, nearest-source labels | — |
+//! | [`solution`] | interpolation in the band (multilinear, cubic), nearest-source labels | — |
 //! | [`error`], [`kernel_stats`] | the error type; profiling counters (feature `kernel-stats`, empty without it) | — |
 //!
 //! Grids are uniform with spacing `h` in every axis; node `(i, j[, k])` sits at

@@ -16,7 +16,6 @@ arrays. On the command line, ``tubesweep solve --mesh bunny`` and ``--mesh spot`
 
 from __future__ import annotations
 
-import gzip
 from pathlib import Path
 from typing import Dict, Tuple, Union
 

@@ -31,9 +31,9 @@ __all__ = [
 def fit_order(h: Sequence[float], err: Sequence[float]) -> float:
     """Least-squares slope of ``log err`` against ``log h`` (the convergence order for errors; for
     iteration counts pass ``h = N`` to get the growth exponent). NaN with fewer than two points."""
-    h = np.asarray(h, dtype=float)
-    err = np.asarray(err, dtype=float)
-    ok = np.isfinite(h) & np.isfinite(err) & (h > 0) & (err > 0)
+    h = np.asarray(h, dtype=float)  # type: ignore[assignment]
+    err = np.asarray(err, dtype=float)  # type: ignore[assignment]
+    ok = np.isfinite(h) & np.isfinite(err) & (h > 0) & (err > 0)  # type: ignore[operator]
     if np.count_nonzero(ok) < 2:
         return float("nan")
     return float(np.polyfit(np.log(h[ok]), np.log(err[ok]), 1)[0])

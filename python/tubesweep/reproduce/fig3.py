@@ -202,7 +202,7 @@ def run(out_dir: Path, quick: bool) -> dict:
         }
     )
     R.loglog_png(
-        None,
+        None,  # type: ignore[arg-type]
         series,
         xlabel="Δx",
         ylabel="|u(1,1) − √2|",

@@ -15,7 +15,7 @@ from __future__ import annotations
 import csv
 import time
 from pathlib import Path
-from typing import Dict, List, Optional
+from typing import Dict, List
 
 import numpy as np
 
@@ -77,12 +77,12 @@ def run(out_dir: Path, quick: bool = False) -> dict:
     hemi = Hemisphere()
     mob = MobiusBand()
     h_src = hemi.default_source
-    m_src = mob.point(np.pi / 2, 0.0)
+    m_src = mob.point(np.pi / 2, 0.0)  # type: ignore[arg-type]
     h_sizes = (41, 81) if quick else (41, 81, 161, 321)
     m_sizes = (41, 81) if quick else (41, 81, 161)
     Vh, Fh = hemi.triangulation(48)
     rim = Vh[np.abs(Vh[:, 2] - hemi.center[2]) < 1e-12]
-    exact_h = hemi.geodesic_distance(Vh, h_src)
+    exact_h = hemi.geodesic_distance(Vh, h_src)  # type: ignore[arg-type]
     ref = mobius_reference(mob, m_src, 16 if quick else 32)
     rows: List[Dict[str, object]] = []
     last: Dict[str, np.ndarray] = {}
@@ -93,7 +93,7 @@ def run(out_dir: Path, quick: bool = False) -> dict:
             wall = time.perf_counter() - t0
             u = sol(Vh)
             e = np.abs(u - exact_h)
-            er = np.abs(sol(rim) - hemi.geodesic_distance(rim, h_src))
+            er = np.abs(sol(rim) - hemi.geodesic_distance(rim, h_src))  # type: ignore[arg-type]
             rows.append(
                 dict(
                     surface="hemisphere",
@@ -219,7 +219,7 @@ def run(out_dir: Path, quick: bool = False) -> dict:
             r = [x for x in rows if x["surface"] == surface and x["hamiltonian"] == ham]
             if all(np.isfinite(float(x["max_error"])) for x in r):  # type: ignore[arg-type]
                 ax.loglog(
-                    [2.0 / (int(x["N"]) - 1) for x in r],
+                    [2.0 / (int(x["N"]) - 1) for x in r],  # type: ignore[call-overload]
                     [x["max_error"] for x in r],
                     ls,
                     marker=marker,
@@ -235,8 +235,8 @@ def run(out_dir: Path, quick: bool = False) -> dict:
     fig.savefig(out_dir / "fig9_convergence.png", dpi=110)
     plt.close(fig)
     files = ["fig9.png", "fig9_convergence.png", "fig9_errors.csv", "fig9.md"]
-    for f in files:
-        print(f"wrote {out_dir / f}")
+    for f in files:  # type: ignore[assignment]
+        print(f"wrote {out_dir / f}")  # type: ignore[operator]
     return {"rows": rows, "files": [str(out_dir / f) for f in files]}
 
 

@@ -40,7 +40,7 @@ def sphere_case() -> Case:
     surf = Sphere(0.5)
     src = np.array([-0.5, 0.0, 0.0])
     pts = fibonacci_sphere(4000)
-    exact = surf.geodesic_distance(pts, src)
+    exact = surf.geodesic_distance(pts, src.tolist())
     far = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
     th = np.linspace(0, 2 * np.pi, 720, endpoint=False)
     ring = np.stack([np.zeros_like(th), 0.5 * np.cos(th), 0.5 * np.sin(th)], 1)
@@ -78,7 +78,7 @@ def circle_case() -> Case:
     surf = Circle(0.5)
     src = np.array([-0.5, 0.0])
     pts = surf.sample(2000)
-    exact = surf.geodesic_distance(pts, src)
+    exact = surf.geodesic_distance(pts, src.tolist())
     return surf, src, pts, exact, (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1), {}
 
 
@@ -88,7 +88,7 @@ def star_case() -> Case:
     surf = Star()
     src = np.array([0.5, 0.0])
     pts = surf.sample(2000)
-    exact = surf.geodesic_distance(pts, src)
+    exact = surf.geodesic_distance(pts, src.tolist())
     return surf, src, pts, exact, (exact >= 0.1) & (exact <= exact.max() - 0.1), {}
 
 

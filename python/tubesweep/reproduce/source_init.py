@@ -17,7 +17,7 @@ def run(out_dir: Path, quick: bool) -> dict:
     rows = []
     circle = Circle(0.5)
     pts = circle.sample(2000)
-    exact2 = circle.geodesic_distance(pts, circle.default_source)
+    exact2 = circle.geodesic_distance(pts, circle.default_source)  # type: ignore[arg-type]
     for n in (101, 201) if quick else (101, 201, 401, 801):
         g = Grid((-1, -1), (1, 1), (n, n))
         for ham in ("godunov", "lxf"):

@@ -239,7 +239,7 @@ def run_fig7(out_dir: Path, quick: bool) -> dict:
         {"x": dxp, "y": PAPER_T3, "label": f"paper LxF (order {R.fit_order(dxp, PAPER_T3):.3f})", "style": "kv:"}
     )
     R.loglog_png(
-        None,
+        None,  # type: ignore[arg-type]
         series,
         xlabel="Δx",
         ylabel="max error on the circle x = 0",

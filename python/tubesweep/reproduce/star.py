@@ -158,7 +158,7 @@ def _strip(rec: Dict[str, Any]) -> Dict[str, Any]:
 
 def _main(quick: bool) -> Dict[str, List[Dict[str, Any]]]:
     return {
-        h: [star_run(n, h, MATCH["phi"], MATCH["source_init"], MATCH["tol"], MATCH["infinity"]) for n in _ns(quick)]
+        h: [star_run(n, h, MATCH["phi"], MATCH["source_init"], MATCH["tol"], MATCH["infinity"]) for n in _ns(quick)]  # type: ignore[arg-type]
         for h in HAMS
     }
 
@@ -186,7 +186,7 @@ def run_table1(out_dir: Path, quick: bool) -> dict:
     var: Dict[Tuple[str, str, str], List[Dict[str, Any]]] = {}
     for phi, src in variants:
         for h in HAMS:
-            var[phi, src, h] = [star_run(n, h, phi, src, MATCH["tol"], MATCH["infinity"]) for n in ns_var]
+            var[phi, src, h] = [star_run(n, h, phi, src, MATCH["tol"], MATCH["infinity"]) for n in ns_var]  # type: ignore[arg-type]
             for i, r in enumerate(var[phi, src, h]):
                 rows.append(
                     {
@@ -328,7 +328,7 @@ def run_table2(out_dir: Path, quick: bool) -> dict:
         for inf in SENS_INFS:
             per_n = []
             for n in ns:
-                r = star_run(n, h, MATCH["phi"], MATCH["source_init"], min(SENS_TOLS) * 0.99, inf, node_error=False)
+                r = star_run(n, h, MATCH["phi"], MATCH["source_init"], min(SENS_TOLS) * 0.99, inf, node_error=False)  # type: ignore[arg-type]
                 counts = [iterations_at(r["trace"], t) for t in SENS_TOLS]
                 per_n.append(counts)
                 for t, c in zip(SENS_TOLS, counts):
@@ -434,7 +434,7 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
     p = R.plt()
     fig, axs = p.subplots(1, 3, figsize=(16, 5))
     # (a) set-up on a coarse grid so that the nodes are visible
-    star = _star(MATCH["phi"])
+    star = _star(MATCH["phi"])  # type: ignore[arg-type]
     grid = Grid((-1.0, -1.0), (1.0, 1.0), (41, 41))
     sol = solve(
         star,
@@ -442,8 +442,8 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
         [SOURCE],
         hamiltonian="godunov",
         source_init="node",
-        tol=MATCH["tol"],
-        infinity=MATCH["infinity"],
+        tol=MATCH["tol"],  # type: ignore[arg-type]
+        infinity=MATCH["infinity"],  # type: ignore[arg-type]
         paper_sweeps=True,
     )
     ax = axs[0]
@@ -476,7 +476,7 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
         for h, st in zip(HAMS, ("b^:", "rv:"))
     ]
     R.loglog_png(
-        None,
+        None,  # type: ignore[arg-type]
         series,
         xlabel="Δx",
         ylabel="max error on the curve",
@@ -495,7 +495,7 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
         for h, st in zip(HAMS, ("b^:", "rv:"))
     ]
     R.loglog_png(
-        None,
+        None,  # type: ignore[arg-type]
         series,
         xlabel="N",
         ylabel="iterations",

@@ -71,8 +71,8 @@ def _plt() -> Any:
 
 
 def _view_basis(w: Sequence[float]) -> np.ndarray:
-    w = np.asarray(w, dtype=float)
-    w = w / np.linalg.norm(w)
+    w = np.asarray(w, dtype=float)  # type: ignore[assignment]
+    w = w / np.linalg.norm(w)  # type: ignore[operator]
     up = np.array([0.0, 0.0, 1.0]) if abs(w[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
     e1 = np.cross(up, w)
     e1 /= np.linalg.norm(e1)

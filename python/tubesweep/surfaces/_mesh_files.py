@@ -198,18 +198,18 @@ def read_with_library(path: Path) -> Tuple[np.ndarray, np.ndarray]:
     try:
         import trimesh
     except ImportError:
-        trimesh = None
+        trimesh = None  # type: ignore[assignment]
     meshio = None
     if trimesh is None:
         try:
-            import meshio
+            import meshio  # type: ignore[no-redef]
         except ImportError:
             raise ImportError(f"reading {path.suffix or 'mesh'} files needs trimesh or meshio: {MESH_EXTRA}") from None
     try:
         if trimesh is not None:
             m = trimesh.load(str(path), force="mesh", process=False, maintain_order=True)
-            v = np.asarray(m.vertices, dtype=float)
-            f = np.asarray(m.faces, dtype=np.int64)
+            v = np.asarray(m.vertices, dtype=float)  # type: ignore[attr-defined, type-var]
+            f = np.asarray(m.faces, dtype=np.int64)  # type: ignore[attr-defined]
         else:
             m = meshio.read(str(path))
             v = np.asarray(m.points, dtype=float)[:, :3]

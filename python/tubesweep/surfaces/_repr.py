@@ -39,4 +39,4 @@ def give_repr(*classes: type) -> None:
     """Sets :func:`library_repr` as ``__repr__`` of each class that does not define its own."""
     for cls in classes:
         if "__repr__" not in cls.__dict__:
-            cls.__repr__ = library_repr  # type: ignore[method-assign]
+            cls.__repr__ = library_repr  # type: ignore[method-assign, assignment]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Callable, Sequence, Tuple
+from typing import Any, Callable, Tuple
 
 import numpy as np
 
@@ -45,7 +45,7 @@ def polyline(points: np.ndarray, closed: bool = True) -> Tuple[np.ndarray, np.nd
 
 
 def marching_cubes(
-    phi: Callable[[np.ndarray], np.ndarray], box: Tuple[Sequence[float], Sequence[float]], n: int
+    phi: Callable[[np.ndarray], np.ndarray], box: Tuple[Any, Any], n: int
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Zero level set of a vectorised φ over ``box`` on an n³ grid (scikit-image marching cubes)."""
     try:

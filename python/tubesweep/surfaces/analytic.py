@@ -18,7 +18,7 @@ __all__ = ["Circle", "Sphere", "Star"]
 def own_phi(surface: Any, cls: type) -> bool:
     """Whether ``surface``'s φ is ``cls.signed_distance`` itself (not replaced or overridden by a
     subclass), so that the core may evaluate it without calling back into Python."""
-    return type(surface).signed_distance is cls.signed_distance and surface._fn == surface.signed_distance
+    return type(surface).signed_distance is getattr(cls, "signed_distance") and surface._fn == surface.signed_distance
 
 
 def size_parameter(name: str, value: Any) -> float:
@@ -107,7 +107,7 @@ class Circle(LevelSet):
         >>> s.signed_distance(np.zeros((1, 2))).shape
         (1,)
         """
-        return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)
+        return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)  # type: ignore[arg-type]
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
         return ("sphere", [*map(float, self.center), self.radius]) if own_phi(self, Circle) else None
@@ -256,7 +256,7 @@ class Sphere(LevelSet):
         >>> s.signed_distance(np.zeros((1, 3))).shape
         (1,)
         """
-        return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)
+        return _native.sphere_signed_distance(_points(p, self.ndim), [float(c) for c in self.center], self.radius)  # type: ignore[arg-type]
 
     def _native_phi(self) -> Optional[Tuple[str, List[float]]]:
         return ("sphere", [*map(float, self.center), self.radius]) if own_phi(self, Sphere) else None

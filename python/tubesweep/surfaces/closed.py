@@ -4,7 +4,7 @@ distance function (exact, or 1-Lipschitz with |∇φ| = 1 almost everywhere for 
 
 from __future__ import annotations
 
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -563,7 +563,7 @@ class DoubleTorus(LevelSet):
     def _signed_distance_numpy(self, p: np.ndarray) -> np.ndarray:
         """The NumPy formulation of :meth:`signed_distance` (the reference the tests compare with)."""
         p = np.asarray(p, dtype=float)
-        out = None
+        out: Any = None
         for cx in (-self.offset, self.offset):
             phi = np.hypot(np.hypot(p[:, 0] - cx, p[:, 1]) - self.R, p[:, 2]) - self.r
             out = phi if out is None else np.minimum(out, phi)

@@ -5,7 +5,7 @@ orientable), so φ is not defined — the tube is ``{|x − cp(x)| ≤ h}``."""
 
 from __future__ import annotations
 
-from typing import Any, Sequence, Tuple
+from typing import Any, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -433,7 +433,7 @@ class MobiusBand(ClosestPoint):
         super().__init__(self._cp, ndim=3)
 
     # --- parametrisation and derivatives ----------------------------------------------------
-    def point(self, th: np.ndarray, s: np.ndarray) -> np.ndarray:
+    def point(self, th: np.ndarray, s: Union[float, np.ndarray]) -> np.ndarray:
         """The band's point X(θ, s).
 
         Parameters

@@ -47,7 +47,7 @@ pub fn mesh_band(
     on_surface: f64,
     normals: &MeshNormals<'_>,
 ) -> Result<MeshBand> {
-    if points.len() % 3 != 0 {
+    if !points.len().is_multiple_of(3) {
         return Err(Error::invalid("points", "expected an (M, 3) array"));
     }
     if points.len() / 3 > u32::MAX as usize {

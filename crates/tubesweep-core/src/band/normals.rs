@@ -284,7 +284,7 @@ pub fn outward_directions_with(
     // is `c_last`), if it is a band node
     let first = range.start;
     let neighbour = |o: usize, c_last: u32, g: usize| -> Option<usize> {
-        let (k, sign) = (g / 2, if g % 2 == 0 { 1i64 } else { -1 });
+        let (k, sign) = (g / 2, if g.is_multiple_of(2) { 1i64 } else { -1 });
         let i = first + o;
         if k + 1 < d {
             let delta = table[g * m + o];

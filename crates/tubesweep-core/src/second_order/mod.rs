@@ -150,7 +150,7 @@ mod tests {
             }
             let r = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
             let exact = 0.5 * (-x[0] / r).clamp(-1.0, 1.0).acos();
-            if exact < 0.2 || exact > 0.5 * std::f64::consts::PI - 0.2 {
+            if !(0.2..=0.5 * std::f64::consts::PI - 0.2).contains(&exact) {
                 continue;
             }
             worst = worst.max((values[i] - exact).abs());

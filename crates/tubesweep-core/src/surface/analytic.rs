@@ -11,7 +11,7 @@ use rayon::prelude::*;
 const CHUNK: usize = 1 << 13;
 
 fn check_points(points: &[f64], d: usize, out: &[f64]) -> Result<()> {
-    if d == 0 || points.len() % d != 0 {
+    if d == 0 || !points.len().is_multiple_of(d) {
         return Err(Error::invalid("points", format!("expected an (M, {d}) array")));
     }
     if out.len() != points.len() / d {

@@ -117,7 +117,7 @@ pub fn mobius_closest_parameters(
     theta: &mut [f64],
     s: &mut [f64],
 ) -> Result<()> {
-    if points.len() % 3 != 0 {
+    if !points.len().is_multiple_of(3) {
         return Err(Error::invalid("points", "expected an (M, 3) array"));
     }
     let m = points.len() / 3;

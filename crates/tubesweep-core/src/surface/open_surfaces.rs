@@ -28,7 +28,7 @@ fn safe_unit(v: V3, fallback: V3) -> V3 {
 
 /// Applies `cp` to every row of `points` (M × 3) into `out` (M × 3), on all threads.
 fn map_points(points: &[f64], out: &mut [f64], cp: impl Fn(V3) -> V3 + Sync) -> Result<()> {
-    if points.len() % 3 != 0 {
+    if !points.len().is_multiple_of(3) {
         return Err(Error::invalid("points", "expected an (M, 3) array"));
     }
     if out.len() != points.len() {

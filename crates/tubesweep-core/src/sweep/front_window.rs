@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 /// The default [`SolveOptions::front_window`]: the window is `2 h s̄ sqrt(H)` wide. From 1.5 to 3
 /// the sweep times measured within about 20% of each other on the sphere from N = 161 to 1001 and
-/// on the library's surfaces at N = 161 (`benches/front_window_surfaces.py --windows 1,1.5,2,3`;
+/// on the library's surfaces at N = 161 (`benches/experiments/front_window_surfaces.py --windows 1,1.5,2,3`;
 /// `WINDOW=c cargo run --release --example sphere -- N godunov 2`); narrower windows take more
 /// iterations, wider ones more updates.
 pub const DEFAULT_FRONT_WINDOW: f64 = 2.0;

@@ -48,7 +48,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 .into_par_iter()
                 .map(|i| {
                     let updated =
-                        i < n && self.roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan());
+                        i < n && self.roles[i] != NodeRole::Fixed && weights.get(i).is_none_or(|w| !w[0].is_nan());
                     AtomicU8::new(updated as u8)
                 })
                 .collect();

@@ -138,7 +138,7 @@ pub struct SolveOptions {
     /// Gauss–Seidel step). The discrete equations and so the solution (to about `tol`) are the
     /// same; the pointwise node ↔ layer cycle that contracts only by the extension weight per
     /// pass is solved at once: on the sphere 22% fewer updates at N = 201, 36% at N = 1001
-    /// (`benches/sweep_variants.py`). `false` runs the
+    /// (`benches/experiments/sweep_variants.py`). `false` runs the
     /// paper's pointwise sweeps (its Table 2 iteration counts).
     pub coupled: bool,
     /// Leave the *outer rim* to the end: the extension-layer nodes that no inner-tube node
@@ -171,7 +171,7 @@ pub struct SolveOptions {
     /// their values. The stopping test only counts iterations over the whole band, so the fixed
     /// point is the same to about `tol`. A solve stopped earlier (`max_iterations`, interrupted)
     /// leaves the nodes beyond the window unreached ([`SolveStats::window_edge`]). On the sphere at
-    /// N = 1001, 5× fewer local updates than without it (`benches/sweep_variants.py`). 0 switches
+    /// N = 1001, 5× fewer local updates than without it (`benches/experiments/sweep_variants.py`). 0 switches
     /// it off. Lax–Friedrichs has no such front (its values near the sources keep moving, and a
     /// window there multiplied the iterations); on curves (2D bands, a few ms) it saved little on a
     /// circle and cost 1–3× the time on the six-fold star, whose front stalls at the arms.
@@ -280,7 +280,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 return Err(Error::invalid("speed", format!("expected {n} values, got {}", s.len())));
             }
         }
-        if self.roles.iter().any(|&r| r == NodeRole::Outer) {
+        if self.roles.contains(&NodeRole::Outer) {
             match self.extension {
                 Extension::None => {
                     return Err(Error::invalid(
@@ -309,7 +309,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
     pub(super) fn upwind_weights(&self) -> std::borrow::Cow<'a, [[f32; D]]> {
         use std::borrow::Cow;
         match self.extension {
-            _ if !self.roles.iter().any(|&r| r == NodeRole::Outer) => Cow::Borrowed(&[]),
+            _ if !self.roles.contains(&NodeRole::Outer) => Cow::Borrowed(&[]),
             Extension::None => Cow::Borrowed(&[]),
             Extension::Weights(w) => Cow::Borrowed(w),
             Extension::Directions(d) => {

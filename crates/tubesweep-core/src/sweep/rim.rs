@@ -328,7 +328,7 @@ mod tests {
         let band = row(6);
         let inf = 9.0;
         // node 0 fixed, each layer node reading its minus neighbour: the chain runs upwards
-        let mut roles = vec![NodeRole::Outer; 6];
+        let mut roles = [NodeRole::Outer; 6];
         roles[0] = NodeRole::Fixed;
         let mut weights = vec![[0.0f32, 1.0]; 6];
         weights[0] = [0.0, 0.0];
@@ -341,7 +341,7 @@ mod tests {
             (1, 5, inf - 1.5, 0.0, true)
         );
         // the other way: node 5 fixed, every layer node reading its plus neighbour
-        let mut roles = vec![NodeRole::Outer; 6];
+        let mut roles = [NodeRole::Outer; 6];
         roles[5] = NodeRole::Fixed;
         let mut weights = vec![[0.0f32, -1.0]; 6];
         weights[5] = [0.0, 0.0];
@@ -358,7 +358,7 @@ mod tests {
         // from the fixed nodes 5 and 6 below them), node 3 reads node 2. Fixed point:
         // u1 = (a + u2)/2, u2 = (b + u1)/2, so u1 = (2a + b)/3, u2 = (a + 2b)/3; u3 = u2.
         let band = NarrowBand::<2>::from_sorted_linear([3, 4], &(0..8).collect::<Vec<u64>>()).unwrap();
-        let mut roles = vec![NodeRole::Fixed; 8];
+        let mut roles = [NodeRole::Fixed; 8];
         let mut weights = vec![[0.0f32, 0.0]; 8];
         for q in [1usize, 2, 3] {
             roles[q] = NodeRole::Outer;
@@ -393,7 +393,7 @@ mod tests {
         // inner node 0, layer nodes 1 .. 5, each reading its minus neighbour: only node 1, next
         // to the inner node, is needed
         let band = row(6);
-        let mut roles = vec![NodeRole::Outer; 6];
+        let mut roles = [NodeRole::Outer; 6];
         roles[0] = NodeRole::Inner;
         let mut weights = vec![[0.0f32, 1.0]; 6];
         weights[0] = [0.0, 0.0];

@@ -188,6 +188,11 @@ impl<'a, const D: usize> LocalSolver<D> for Metric<'a, D> {
 }
 
 #[cfg(test)]
+pub(crate) fn tests_faces<const D: usize>(s: f64, m: [[f64; D]; D]) -> impl Faces<D> {
+    Riemann { m, s }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::scheme::godunov::godunov_update;
@@ -252,9 +257,4 @@ mod tests {
         let e = r.project(3).unwrap();
         assert!((e[0][1] - (0.6 - (-0.3) * 0.2 / 0.5)).abs() < 1e-15 && (e[1][1] - (0.9 - 0.04 / 0.5)).abs() < 1e-15);
     }
-}
-
-#[cfg(test)]
-pub(crate) fn tests_faces<const D: usize>(s: f64, m: [[f64; D]; D]) -> impl Faces<D> {
-    Riemann { m, s }
 }

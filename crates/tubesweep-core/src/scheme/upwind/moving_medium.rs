@@ -140,6 +140,11 @@ impl<'a, const D: usize> LocalSolver<D> for MovingMedium<'a, D> {
 }
 
 #[cfg(test)]
+pub(crate) fn tests_faces<const D: usize>(f: f64, v: [f64; D]) -> impl Faces<D> {
+    Randers { f2: f * f, f, v }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::scheme::godunov::godunov_update;
@@ -228,9 +233,4 @@ mod tests {
         let flow = [[1.2, 0.0]];
         assert_eq!(solver(&s, &flow).update(0, [0.0, 0.0], [0.0, 0.0], 0.1, 5.0), 5.0);
     }
-}
-
-#[cfg(test)]
-pub(crate) fn tests_faces<const D: usize>(f: f64, v: [f64; D]) -> impl Faces<D> {
-    Randers { f2: f * f, f, v }
 }

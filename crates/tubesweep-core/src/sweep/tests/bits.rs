@@ -284,7 +284,7 @@ fn parallel_and_skipping_sweeps_are_bit_identical_to_the_plain_sequential_sweep(
         // an upwind neighbour, in every one of the 2^3 sweeps of every iteration
         let weights = p.upwind_weights();
         let updated = (0..band.len())
-            .filter(|&i| roles[i] != NodeRole::Fixed && weights.get(i).map_or(true, |w| !w[0].is_nan()))
+            .filter(|&i| roles[i] != NodeRole::Fixed && weights.get(i).is_none_or(|w| !w[0].is_nan()))
             .count() as u64;
         let opts = SolveOptions {
             threads: 2,

@@ -3,7 +3,7 @@
 
 Usage::
 
-    .venv/bin/python benches/oblique_planes.py [--n2 201] [--n3 101]
+    .venv/bin/python benches/experiments/oblique_planes.py [--n2 201] [--n3 101]
 
 A line or plane through the box with a source on it has an exact solution that is linear along
 the surface, so the only thing that changes between the rows is the angle between the surface

@@ -7,7 +7,7 @@ and the largest difference between the two solutions (the window changes the ord
 updates, not the fixed point). Curves (2D) are included: the window is off there, so both columns
 agree.
 
-    .venv/bin/python benches/front_window_surfaces.py [--n 121] [--repeats 2] [--windows 1,1.5,3]
+    .venv/bin/python benches/experiments/front_window_surfaces.py [--n 121] [--repeats 2] [--windows 1,1.5,3]
 
 ``--windows`` compares other values of the constant with the window off (one line each).
 """

@@ -4,8 +4,8 @@ there, against exact distances.
 
 Usage::
 
-    .venv/bin/python benches/facing_gaps.py            # about 8 s
-    .venv/bin/python benches/facing_gaps.py --skip-meshes
+    .venv/bin/python benches/experiments/facing_gaps.py            # about 8 s
+    .venv/bin/python benches/experiments/facing_gaps.py --skip-meshes
 
 Sections:
 

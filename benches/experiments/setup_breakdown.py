@@ -2,8 +2,8 @@
 
 Usage::
 
-    .venv/bin/python benches/setup_breakdown.py                 # sphere, N = 201
-    .venv/bin/python benches/setup_breakdown.py --surface star --n 801 --repeats 15
+    .venv/bin/python benches/experiments/setup_breakdown.py                 # sphere, N = 201
+    .venv/bin/python benches/experiments/setup_breakdown.py --surface star --n 801 --repeats 15
 
 Each piece runs ``--repeats`` times in a warm process (after one untimed run) and the median is
 printed, with the whole solve's ``sol.stats.setup_seconds`` and ``sol.stats.seconds`` for scale.
@@ -36,7 +36,7 @@ from tubesweep.band import _kinks, coarse_to_fine_candidates, discover_band  # n
 
 solve_module = importlib.import_module("tubesweep._prepare")  # the roles and the checks of the tube
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benches/: problems.py, methods.py
 from problems import PROBLEMS  # noqa: E402
 
 

@@ -7,7 +7,7 @@ interleaved (one run of every variant, then the next round), so that a drift in 
 speed affects all of them alike; the median and the minimum over the rounds are printed, with the
 paper sweeps' median over each variant's median ("× paper" > 1: faster than the paper's sweeps).
 
-    .venv/bin/python benches/sweep_variants.py [--sizes 201,401] [--threads 1,2] [--repeats 5]
+    .venv/bin/python benches/experiments/sweep_variants.py [--sizes 201,401] [--threads 1,2] [--repeats 5]
 
 It builds and runs ``cargo run --release --example sphere -- N godunov THREADS [coupled|pointwise]``
 (``RIM_IN_EVERY_SWEEP=1`` sweeps the rim in every iteration; ``WINDOW=c`` sets
@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 EXAMPLE = REPO / "target" / "release" / "examples" / "sphere"
 
 #: name -> (coupled, rim swept last, front window; None: the example's default,

@@ -4,8 +4,8 @@ re-distancing retry timed on and off.
 
 Usage::
 
-    .venv/bin/python benches/input_checks.py            # every case, 4 alternating rounds of the retry
-    .venv/bin/python benches/input_checks.py --rounds 2 --skip-spot
+    .venv/bin/python benches/experiments/input_checks.py            # every case, 4 alternating rounds of the retry
+    .venv/bin/python benches/experiments/input_checks.py --rounds 2 --skip-spot
 
 Sections:
 

@@ -6,7 +6,7 @@ whole band: the front window (which exploits what this shows) is switched off he
 2. Iterations against N on a tilted plane (no curvature) for the two-layer tube, the naive tube
    (no extension layer) and the paper's plain sweeps.
 
-    .venv/bin/python benches/convergence_front.py [--n 201]
+    .venv/bin/python benches/experiments/convergence_front.py [--n 201]
 """
 
 from __future__ import annotations

@@ -7,9 +7,9 @@ closest triangle's distance), then every candidate node is queried once more for
 grid, ``surface.grid(n)``), medians of warm runs, with the thread count of ``RAYON_NUM_THREADS``
 (all cores by default)::
 
-    .venv/bin/python benches/closest_points.py                  # N = 201, 5 runs
-    RAYON_NUM_THREADS=1 .venv/bin/python benches/closest_points.py --n 101
-    .venv/bin/python benches/closest_points.py --split          # also by where the candidates lie
+    .venv/bin/python benches/experiments/closest_points.py                  # N = 201, 5 runs
+    RAYON_NUM_THREADS=1 .venv/bin/python benches/experiments/closest_points.py --n 101
+    .venv/bin/python benches/experiments/closest_points.py --split          # also by where the candidates lie
 
 To compare two commits, build each in its own checkout (``make build``) and run the script in
 both, alternately or at once on separate cores (``RAYON_NUM_THREADS=1 taskset -c 0 ...`` and
@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 
 from tubesweep.band import coarse_to_fine_candidates  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benches/: problems.py, methods.py
 from problems import PROBLEMS  # noqa: E402
 
 

@@ -3,8 +3,8 @@ those reads form cycles before and after the coupled Godunov update.
 
 Usage::
 
-    .venv/bin/python benches/dependency_cycles.py                       # the 2D and 3D cases below
-    .venv/bin/python benches/dependency_cycles.py --case plane3 --n 61
+    .venv/bin/python benches/experiments/dependency_cycles.py                       # the 2D and 3D cases below
+    .venv/bin/python benches/experiments/dependency_cycles.py --case plane3 --n 61
 
 At the converged values every node's update is a function of a few neighbours: an inner node's
 Godunov update (Eq. (3)) of its upwind neighbours along each axis, weighted by the derivative
@@ -37,7 +37,7 @@ from scipy.sparse.csgraph import connected_components  # noqa: E402
 
 import tubesweep as ts  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benches/: problems.py, methods.py
 from problems import sphere  # noqa: E402
 
 OFFSET = 0.0131  # the planes and lines pass this far from the origin, off the grid's nodes
