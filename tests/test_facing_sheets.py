@@ -1,5 +1,5 @@
 """Parts of a surface that face each other across a gap narrower than the tubes
-(``solve._warn_if_tubes_touch``, ``tubesweep_core::facing_sheets``): the solve warns, says where
+(``_prepare._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``): the solve warns, says where
 and how narrow, and records it in ``SolveStats``; surfaces the grid resolves give no pair."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Nearest-source labels (Solution.nearest_source; tubesweep_core::nearest_source)."""
+"""Nearest-source labels (Solution.nearest_source; tubesweep_core::solution::nearest_source)."""
 
 from __future__ import annotations
 

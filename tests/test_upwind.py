@@ -1,4 +1,4 @@
-"""The upwind local solver (issue 32; tubesweep_core::upwind) for the moving medium F|p| + v·p = 1
+"""The upwind local solver (issue 32; tubesweep_core::scheme::upwind) for the moving medium F|p| + v·p = 1
 and the Riemannian metric sqrt(pᵀMp) = 1/F, on surfaces, curves and in the box."""
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ printed, with the whole solve's ``sol.stats.setup_seconds`` and ``sol.stats.seco
 The pieces are those of ``LevelSet.band`` for a callable φ (docs/architecture.md): the
 coarse-to-fine band search (candidates, then φ at them and the filter), the band structure,
 the rim places, φ there, the outward directions and the check for gaps narrower than the tubes
-(the kinks of φ, then ``solve._warn_if_tubes_touch``); then the whole of it for the surface's φ
+(the kinks of φ, then ``_prepare._warn_if_tubes_touch``); then the whole of it for the surface's φ
 as a plain callable, and for the library surface itself, whose band is found in Rust in one
 call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENBLAS_NUM_THREADS=1`` as
 ``make bench`` does (see README).
@@ -88,7 +88,7 @@ def main() -> int:
         "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(
             lambda: _kinks(norm, grid, linear, band), r
         ),
-        "gaps narrower than the tubes: the pairs (solve._warn_if_tubes_touch)": median_ms(
+        "gaps narrower than the tubes: the pairs (_prepare._warn_if_tubes_touch)": median_ms(
             lambda: solve_module._warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r
         ),
         "LevelSet.band of the same φ as a callable, all of the above": median_ms(

@@ -257,7 +257,7 @@ class Band:
         skip_inactive: bool = True,
         activation_threshold: float = 0.0,
         defer_outer_rim: bool = True,
-        scheme: str = "lxf",  # "godunov": the upwind local solver (tubesweep_core::upwind); "lxf": Sect. 5.1
+        scheme: str = "lxf",  # "godunov": the upwind local solver (tubesweep_core::scheme::upwind); "lxf": Sect. 5.1
     ) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
 
 class TriangleTree:

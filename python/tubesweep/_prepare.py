@@ -192,7 +192,7 @@ def _warn_if_tubes_touch(
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
-    ``tubesweep_core::facing_sheets``): the eikonal equation crosses the gap there and the travel
+    ``tubesweep_core::band::facing_sheets``): the eikonal equation crosses the gap there and the travel
     times beyond it come out too short, a shortcut the surface does not have. Returns the pairs'
     band positions and their gaps."""
     h = grid.spacing

@@ -95,7 +95,7 @@ class BandGeometry:
         For a level set, the nodes whose central differences of φ straddle a kink where φ's
         gradient turns by more than about 140° (``|∇φ|`` below :data:`KINK_FRACTION` of the
         band's typical value): a ridge between two parts of the surface that face each other,
-        where the direction is not reliable (see ``solve._warn_if_tubes_touch``). None otherwise.
+        where the direction is not reliable (see ``_prepare._warn_if_tubes_touch``). None otherwise.
     """
 
     linear: np.ndarray

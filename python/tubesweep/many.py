@@ -1,7 +1,7 @@
 """Many sources on one band: :meth:`tubesweep.Tube.solve_many`.
 
 K independent solves of Algorithm 3 on a band built once, run in parallel *across* the sources
-(``tubesweep_core::many_sources``): each solve runs on one thread, the sources on ``threads``
+(``tubesweep_core::sweep::many_sources``): each solve runs on one thread, the sources on ``threads``
 threads at once with the GIL released. Each row is the single ``tube.solve`` of that source, bit
 for bit (the parallel sweeps of one solve are bit-identical to sequential ones, so this holds for
 any ``threads`` of the single solve). With ``at=points`` only the values at the points are kept:

@@ -14,9 +14,9 @@ closest-point direction of Sect. 5.2). Gradients are central differences of φ w
 ``GRADIENT_STEP · Δx`` (a callable φ) or ``0.5 Δx`` (a sampled φ, multilinearly interpolated).
 
 For a sampled φ (an array) the same iterations, with the same arithmetic and bits, run in Rust on
-all threads (``tubesweep_core::redistance``), with the points kept in the grid's box, where φ is
+all threads (``tubesweep_core::surface::redistance``), with the points kept in the grid's box, where φ is
 known (``box`` of :func:`project_to_level_set`), and the band's candidates come from two passes over
-the samples with a bound on |∇φ| near each node (``tubesweep_core::sampled``); this module's NumPy
+the samples with a bound on |∇φ| near each node (``tubesweep_core::band::sampled``); this module's NumPy
 code runs them for a callable φ, which only Python can evaluate.
 """
 
@@ -70,7 +70,7 @@ def project_to_level_set(
 
     ``box`` (lower, upper corners): where φ is known, for a φ sampled on a grid; the Newton steps
     then keep the points in it (clamped before the first step and after each), as the Rust
-    projection of a sampled φ does (``tubesweep_core::redistance``). A callable φ, known
+    projection of a sampled φ does (``tubesweep_core::surface::redistance``). A callable φ, known
     everywhere, is projected without one.
 
     Returns ``(cp (M, d), signed distance (M,), converged (M,) bool)``. ``converged`` is False
@@ -241,7 +241,7 @@ def redistanced_band(surface, grid, half_width: float):
     signed distance by :func:`project_to_level_set`; keep ``|d| ≤ half_width``.
 
     For an array without a given ``lipschitz``, L is a bound on the gradient of φ's interpolant
-    near each node (per block of nodes, ``tubesweep_core::sampled::redistance_candidates_of_samples``):
+    near each node (per block of nodes, ``tubesweep_core::band::sampled::redistance_candidates_of_samples``):
     a bound over the whole box would take φ's steepest part anywhere and make several times the
     candidates. Otherwise L is the given bound or :func:`estimate_lipschitz`, and a callable's
     candidates are found coarse-to-fine; without a given bound they are then narrowed by the

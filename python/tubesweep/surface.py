@@ -414,7 +414,7 @@ class LevelSet(Surface):
             )
         if self._array is not None:
             # one pass over the samples in Rust, on all threads, with no temporary of the grid's
-            # size (tubesweep_core::sampled)
+            # size (tubesweep_core::band::sampled)
             ulinear, values = _native.band_of_samples(self._array, half_width)
             linear = ulinear.view(np.int64)  # below 2^63: the same bits
         else:

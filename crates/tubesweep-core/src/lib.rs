@@ -41,14 +41,3 @@ pub use sweep::{Control, IterationReport, NodeRole, SolveOptions, SolveStats, Sw
 /// in a unit-sized box, small enough that the Lax–Friedrichs update (which averages neighbours)
 /// never overflows or produces NaN. See [`SolveOptions::infinity`].
 pub const DEFAULT_INFINITY: f64 = 1.0e6;
-
-/// The module paths before the concept folders (issue 36), kept while other branches rebase onto
-/// them; new code names the folders.
-#[doc(hidden)]
-pub use {
-    band::{discovery, facing_sheets, mesh_band, normals, sampled, schedule},
-    scheme::{extension, godunov, hamiltonian, hamiltonians, lax_friedrichs, upwind},
-    solution::{interpolate, nearest_source},
-    surface::{analytic, mesh, mobius, open_surfaces, redistance},
-    sweep::{cache_size, grid_hops, many_sources, rim},
-};

@@ -393,7 +393,7 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
         spacing,
         slowness: Slowness::Constant(1.0), // unused by InnerScheme::General and ::Upwind
         extension,
-        // the upwind local solver of `tubesweep_core::upwind`, or the Lax–Friedrichs update of Sect. 5.1
+        // the upwind local solver of `tubesweep_core::scheme::upwind`, or the Lax–Friedrichs update of Sect. 5.1
         scheme: if upwind {
             InnerScheme::Upwind(solver)
         } else {

@@ -110,7 +110,7 @@ class Ellipsoid(LevelSet):
         ``t``, at most 100 steps (the core's ``ELLIPSOID_NEWTON_STEPS``: keep the two equal); a term
         with ``x_i = 0``, or with ``a_i² + t`` exactly 0 (``t₀`` rounded onto the pole for
         ``|x_kmin|`` below about 1e-17), is 0. The arithmetic of the core's
-        ``tubesweep_core::analytic::ellipsoid_root``, operation for operation (the same bits)."""
+        ``tubesweep_core::surface::analytic::ellipsoid_root``, operation for operation (the same bits)."""
         ax_x = ax * x
         t = np.maximum(np.max(ax * np.abs(x) - a2, axis=1), -a2[kmin])
         active = np.ones(len(x), dtype=bool)

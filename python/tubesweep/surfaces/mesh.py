@@ -13,7 +13,7 @@ through the closest-point function ``cp(x) = argmin_{z ∈ Σ} |x − z|`` evalu
 
 Closest points are computed exactly and only at the nodes of the band, which is found
 coarse-to-fine like :func:`tubesweep.surface.discover_band`. The spatial index is an AABB tree in
-the Rust core (``tubesweep_core::mesh``, exposed as ``tubesweep._native.TriangleTree``): a binary
+the Rust core (``tubesweep_core::surface::mesh``, exposed as ``tubesweep._native.TriangleTree``): a binary
 tree of boxes over the triangles, searched nearer-child-first and pruned by box distance, with a
 search radius so that far-away points cost almost nothing; queries run in parallel.
 
@@ -348,7 +348,7 @@ class MeshSurface(Surface):
     def _tree_normals(self) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """Per triangle of the tree: its unit normal (T, 3) and, on a closed mesh, the outward
         pseudo-normals of its seven features (T, 7, 3) in the order of the feature codes, which
-        the core's band reads (``tubesweep_core::mesh_band``). Built on first use and kept with
+        the core's band reads (``tubesweep_core::band::mesh_band``). Built on first use and kept with
         the surface: 24 bytes per triangle, 192 on a closed mesh (the bunny, open, 69,451
         triangles: 1.7 MB)."""
         if self._band_normals is None:
@@ -481,7 +481,7 @@ class MeshSurface(Surface):
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
         x = grid.node_points(lin)
         # the closest points, the distances, signs and directions of the candidates within the
-        # half-width, in Rust on all threads (tubesweep_core::mesh_band)
+        # half-width, in Rust on all threads (tubesweep_core::band::mesh_band)
         face, pseudo = self._tree_normals()
         kept, dist, signed, direction = self.tree.band(x, float(half_width), 1e-12 * h, face, pseudo)
         return BandGeometry(lin[kept].astype(np.int64), dist, signed, direction, consumable=True)
