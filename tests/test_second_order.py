@@ -212,3 +212,72 @@ def test_refusals():
     mesh = ts.surfaces.from_mesh(SPHERE.triangulation(16))
     with pytest.raises(ValueError, match="piecewise flat"):
         ts.solve(mesh, g, [SRC], order=2)
+
+
+def _sphere_cp(x):
+    r = np.linalg.norm(x, axis=1, keepdims=True)
+    return 0.5 * x / np.where(r > 0, r, 1.0)
+
+
+def test_closest_point_surfaces_are_second_order():
+    # the sphere and the circle given as closest-point maps: the same orders as the level sets
+    # (n and D²φ from the map's local signed distance, docs/second-order.md)
+    sphere = ts.ClosestPoint(_sphere_cp)
+    ns = [51, 76, 101]
+    far, mean = [], []
+    for n in ns:
+        sol = ts.solve(sphere, box(n), [SRC], order=2)
+        assert sol.stats.converged and sol.stats.order2["fallback_iteration"] is None
+        e = np.abs(sol(POINTS) - EXACT)
+        far.append(e[FAR].max())
+        mean.append(e.mean())
+    hs = [2.0 / (n - 1) for n in ns]
+    assert fit_order(hs, far) >= 1.6 and fit_order(hs, mean) >= 1.8, (far, mean)
+    # as accurate as the level set (1.334e-3 and 1.282e-4 at N = 101), and far below order=1
+    lev = sphere_errors(101)[0]
+    assert abs(far[-1] - lev) < 0.01 * lev and mean[-1] < 1.5e-4, (far, lev, mean)
+    assert sol([SRC])[0] == 0.0
+    circle = ts.ClosestPoint(lambda x: 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
+    src = np.array([-0.5, 0.0])
+    exact = ts.surfaces.Circle(0.5).geodesic_distance(pts, src)
+    cfar = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    ns = [101, 201, 401]
+    errs = []
+    for n in ns:
+        sol = ts.solve(circle, box(n, 2), [src], order=2)
+        errs.append(np.abs(sol(pts) - exact)[cfar].max())
+        # the level set's values to O(Δx³) (u₀ from the map's exact closest points, not x − φ n with
+        # n from differences): 2.7 Δx³, 2.3 Δx³, 2.1 Δx³
+        lev = ts.solve(ts.surfaces.Circle(0.5), box(n, 2), [src], order=2)
+        assert np.nanmax(np.abs(lev.values - sol.values)) < 4.0 * (2.0 / (n - 1)) ** 3
+    assert fit_order([2.0 / (n - 1) for n in ns], errs) >= 1.9, errs
+
+
+def test_closest_point_refusals():
+    g = box(41)
+
+    def hemisphere(x):  # the upper hemisphere, its rim below
+        up = _sphere_cp(x)
+        rho = np.linalg.norm(x[:, :2], axis=1, keepdims=True)
+        rim = np.c_[0.5 * x[:, :2] / np.where(rho > 0, rho, 1.0), 0 * x[:, 2]]
+        return np.where(x[:, 2:] >= 0, up, rim)
+
+    with pytest.raises(ValueError, match="open or has edges"):
+        ts.solve(ts.ClosestPoint(hemisphere), g, [(0, 0, 0.5)], order=2)
+    # a mesh's closest points: piecewise flat, the curvature on the edges
+    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(16))
+    with pytest.raises(ValueError, match="piecewise flat"):
+        ts.solve(ts.ClosestPoint(lambda x: mesh.project(x, g)[1]), g, [SRC], order=2)
+    # the radial projection onto an ellipsoid is not the nearest point
+    axes = np.array([0.6, 0.5, 0.4])
+    radial = ts.ClosestPoint(lambda x: x / np.sqrt(((x / axes) ** 2).sum(1, keepdims=True)))
+    with pytest.raises(ValueError, match="true closest-point map"):
+        ts.solve(radial, g, [(-0.6, 0, 0)], order=2)
+    # curvature not resolved: radius 0.25 with outer·Δx = 0.267
+    small = ts.ClosestPoint(lambda x: 0.5 * _sphere_cp(x))
+    with pytest.raises(ValueError, match="curvature.*spacing below"):
+        ts.solve(small, box(31), [(-0.25, 0, 0)], order=2)
+    with pytest.raises(ValueError, match="closed surface: Disc is open"):
+        ts.solve(ts.surfaces.Disc(), g, [(0, 0, 0)], order=2)

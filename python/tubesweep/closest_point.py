@@ -127,6 +127,11 @@ class ClosestPoint(Surface):
     >>> surf = ts.ClosestPoint(cp)
     """
 
+    #: True for the library's open surfaces (``order=2`` refuses them: their rim is not second
+    #: order); a user's map is taken as closed, and ``order=2`` refuses it when its closest points
+    #: show a rim or an edge (docs/second-order.md)
+    open_surface: bool = False
+
     def __init__(self, cp: Callable[[np.ndarray], np.ndarray], *, ndim: Optional[int] = None, lipschitz: float = 1.0):
         if not callable(cp):
             raise TypeError(f"cp must be a callable cp(points (M, d)) -> (M, d); got {type(cp).__name__}")

@@ -57,6 +57,7 @@ def check_supported(
     surf: Any, general: Any, scheme: str, method: str, source_init_given: Optional[str], paper_sweeps: bool
 ) -> None:
     """Refuses, with the reason and the fix, what ``order=2`` does not do."""
+    from .closest_point import ClosestPoint
     from .surface import LevelSet
 
     if general is not None or scheme != "godunov":
@@ -73,16 +74,22 @@ def check_supported(
             "order=2 factors the point sources (u = u₀ + w); source_init='node' is the paper's first-order "
             "initialisation: use order=1 for it"
         )
-    if not isinstance(surf, LevelSet):
-        kind = type(surf).__name__
+    kind = type(surf).__name__
+    if isinstance(surf, ClosestPoint) and getattr(surf, "open_surface", False):
         raise ValueError(
-            f"order=2 needs a level set (φ as an array, a callable or a library level-set surface); {kind} gives "
-            "closest points only"
+            f"order=2 needs a closed surface: {kind} is open, and beyond its boundary rim the closest points lie on "
+            "the boundary curve, where the corrected equation does not hold (the rim is not second order). "
+            "Use order=1 for it"
+        )
+    if not isinstance(surf, (LevelSet, ClosestPoint)):
+        raise ValueError(
+            f"order=2 needs a level set (φ as an array, a callable or a library surface) or a closed smooth "
+            f"closest-point surface; {kind} gives closest points"
             + (
-                " of a triangle mesh, which is piecewise flat: its curvature is not there to correct, and second order "
-                "cannot be reached on it"
+                " of a triangle mesh, which is piecewise flat: its curvature is not there to correct (it is all on "
+                "the edges), and second order cannot be reached on it"
                 if "Mesh" in kind
-                else ", and open surfaces' boundary rim is not second order"
+                else " the second-order geometry cannot read"
             )
             + ". Use order=1 for it"
         )
@@ -133,6 +140,15 @@ def solve_on_tube(
             feet,
             "interpolated from the speed array at a source",
         )
+    offsets = None
+    from .closest_point import ClosestPoint
+
+    if isinstance(surf, ClosestPoint):
+        # x − cp(x) at the band nodes in float64 (the band keeps only float32 directions): n and
+        # D²φ come from its local signed distance (tubesweep_core::second_order::implicit)
+        nodes = grid.node_points(linear)
+        offsets = np.ascontiguousarray(nodes - surf.closest_point(nodes))
+        del nodes
     roles = tube.roles
     directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
     setup = time.perf_counter() - t0
@@ -155,6 +171,7 @@ def solve_on_tube(
         threads=_threads(threads),
         front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
         own_first_phase=_OWN_FIRST_PHASE,
+        offsets=offsets,
     )
     if not st["converged"]:
         warnings.warn(

@@ -124,11 +124,11 @@ def solve(
     order : {1, 2}
         1: the paper's first-order scheme (the default). 2: second order (docs/second-order.md):
         the metric-corrected tube equation with limited BDF2 differences and factored point
-        sources, for level sets (arrays, callables, library surfaces) with the Godunov update;
-        ``sol.stats.order2`` reports its phases. A surface whose curvature the tube does not
-        resolve (``outer·Δx·κ ≥ 1``), a φ that is not a signed distance (without
-        ``redistance=True``) and closest-point surfaces (meshes, open surfaces) are refused with
-        a ``ValueError``.
+        sources, for level sets (arrays, callables, library surfaces) and closed smooth
+        closest-point surfaces with the Godunov update; ``sol.stats.order2`` reports its phases.
+        A surface whose curvature the tube does not resolve (``outer·Δx·κ ≥ 1``), a φ that is
+        not a signed distance (without ``redistance=True``), meshes and open surfaces are
+        refused with a ``ValueError``.
     paper_sweeps : bool
         ``True`` runs the paper's plain sweeps: pointwise Gauss–Seidel updates over the whole band
         in every iteration (nodes none of whose neighbours changed are still skipped, which changes

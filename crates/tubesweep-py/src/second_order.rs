@@ -6,8 +6,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
 use tubesweep_core::second_order::{
-    check_geometry, factor_sources, first_order_start, starting_values, sweep_second_order, tube_geometry,
-    SecondOrderOptions,
+    check_geometry_of, factor_sources_of, first_order_start, starting_values, sweep_second_order, tube_geometry_of,
+    Implicit, SecondOrderOptions,
 };
 use tubesweep_core::sweep::Slowness;
 use tubesweep_core::{Control, IterationReport};
@@ -27,6 +27,8 @@ type Solved<'py> = (
 struct Inputs<'s> {
     roles: &'s [u8],
     phi: &'s [f64],
+    /// x − cp(x) per band node for a closest-point surface (then `phi` is |x − cp(x)|)
+    offsets: Option<&'s [f64]>,
     directions: &'s [f32],
     lower: Vec<f64>,
     spacing: f64,
@@ -55,6 +57,10 @@ fn run<'py, const D: usize>(
         )));
     }
     let directions = node_vectors::<f32, D>(inp.directions, n, "directions")?;
+    let surface = match inp.offsets {
+        Some(o) => Implicit::ClosestPoint(node_vectors::<f64, D>(o, n, "offsets")?),
+        None => Implicit::LevelSet(inp.phi),
+    };
     let sources = node_vectors::<f64, D>(inp.sources, inp.sources.len() / D, "sources")?;
     let lower: [f64; D] = inp
         .lower
@@ -68,12 +74,17 @@ fn run<'py, const D: usize>(
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
-        let geometry = tube_geometry(band, roles, inp.phi, directions, inp.spacing)?;
-        check_geometry(&geometry.summary, inp.outer_width, inp.spacing)?;
-        let factoring = factor_sources(
+        let geometry = tube_geometry_of(band, roles, &surface, directions, inp.spacing)?;
+        check_geometry_of(
+            &geometry.summary,
+            inp.outer_width,
+            inp.spacing,
+            surface.is_closest_point(),
+        )?;
+        let factoring = factor_sources_of(
             band,
             roles,
-            inp.phi,
+            &surface,
             &geometry.nodes,
             lower,
             inp.spacing,
@@ -171,7 +182,7 @@ fn run<'py, const D: usize>(
 /// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
 /// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=10, threads=0, front_window=2.0, own_first_phase=false))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=10, threads=0, front_window=2.0, own_first_phase=false, offsets=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve<'py>(
     py: Python<'py>,
@@ -195,6 +206,7 @@ pub fn second_order_solve<'py>(
     threads: usize,
     front_window: f64,
     own_first_phase: bool,
+    offsets: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<Solved<'py>> {
     if !(tol > 0.0 && tol_first > 0.0) {
         return Err(PyValueError::new_err("tol must be positive"));
@@ -214,6 +226,10 @@ pub fn second_order_solve<'py>(
     let inputs = Inputs {
         roles: c_slice(&roles, "roles")?,
         phi: c_slice(&phi, "phi")?,
+        offsets: match &offsets {
+            Some(a) => Some(c_slice(a, "offsets")?),
+            None => None,
+        },
         directions: c_slice(&directions, "directions")?,
         lower,
         spacing,

@@ -64,6 +64,8 @@ class Hemisphere(ClosestPoint):
     >>> sol = ts.solve(h, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [h.default_source])
     """
 
+    open_surface = True
+
     default_box = _CUBE
 
     def __init__(self, radius: float = 0.5, center: Sequence[float] = (0.0, 0.0, 0.0)):
@@ -177,6 +179,8 @@ class Disc(ClosestPoint):
     >>> sol = ts.solve(d, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [d.default_source])
     """
 
+    open_surface = True
+
     default_box = _CUBE
 
     def __init__(self, radius: float = 0.6, center: Sequence[float] = (0.0, 0.0, 0.0)):
@@ -288,6 +292,8 @@ class PlanePatch(ClosestPoint):
     >>> p = ts.surfaces.PlanePatch()
     >>> sol = ts.solve(p, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [p.default_source])
     """
+
+    open_surface = True
 
     default_box = _CUBE
 
@@ -411,6 +417,8 @@ class MobiusBand(ClosestPoint):
     >>> m = ts.surfaces.MobiusBand()
     >>> sol = ts.solve(m, ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61)), [m.default_source])
     """
+
+    open_surface = True
 
     default_box = _CUBE
 

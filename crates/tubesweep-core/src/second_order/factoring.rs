@@ -10,7 +10,8 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
-use super::geometry::{gradient_and_hessian, NodeGeometry};
+use super::geometry::NodeGeometry;
+use super::implicit::Implicit;
 
 /// u₀ at every node, ∂u₀ at the inner nodes, and the roles with the fixed nodes marked.
 pub struct Factoring<const D: usize> {
@@ -31,6 +32,33 @@ pub fn factor_sources<const D: usize>(
     band: &NarrowBand<D>,
     roles: &[NodeRole],
     phi: &[f64],
+    geometry: &[NodeGeometry],
+    lower: [f64; D],
+    spacing: f64,
+    sources: &[[f64; D]],
+    source_slowness: &[f64],
+    fix_radius: f64,
+) -> Result<Factoring<D>> {
+    factor_sources_of(
+        band,
+        roles,
+        &Implicit::LevelSet(phi),
+        geometry,
+        lower,
+        spacing,
+        sources,
+        source_slowness,
+        fix_radius,
+    )
+}
+
+/// As [`factor_sources`] for a level set or a closest-point map ([`Implicit`]): for a map, the
+/// foot points are its own closest points.
+#[allow(clippy::too_many_arguments)]
+pub fn factor_sources_of<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
     geometry: &[NodeGeometry],
     lower: [f64; D],
     spacing: f64,
@@ -60,30 +88,26 @@ pub fn factor_sources<const D: usize>(
         }
         let inner = roles[i] != NodeRole::Outer;
         // closest point: x − φ ∇φ/|∇φ|² from f64 differences where the stencil allows
-        let gh = if inner {
-            gradient_and_hessian(band, phi, i, spacing)
-        } else {
-            None
-        };
-        // ∇φ/|∇φ| (the layer's geometry holds the outward direction sgn(φ) n)
-        let sign = if inner || phi[i] >= 0.0 { 1.0 } else { -1.0 };
+        let local = if inner { surface.local(band, i, spacing) } else { None };
+        // φ in the orientation of the differences, ∇φ/|∇φ| (the layer's geometry holds the
+        // outward direction sgn(φ) n)
+        let mut phi_i = surface.phi(i);
+        let sign = if inner || phi_i >= 0.0 { 1.0 } else { -1.0 };
         let mut nrm = [0.0; D];
         for k in 0..D {
             nrm[k] = sign * geometry[i].normal[k] as f64;
         }
-        if let Some((g, _)) = &gh {
-            let g2: f64 = g.iter().map(|v| v * v).sum();
+        if let Some(l) = &local {
+            phi_i = l.phi;
+            let g2: f64 = l.gradient.iter().map(|v| v * v).sum();
             if g2 > 0.0 {
                 let gn = g2.sqrt();
                 for k in 0..D {
-                    nrm[k] = g[k] / gn;
+                    nrm[k] = l.gradient[k] / gn;
                 }
             }
         }
-        let mut cp = [0.0; D];
-        for k in 0..D {
-            cp[k] = x[k] - phi[i] * nrm[k];
-        }
+        let cp = surface.closest_point(i, &x, &nrm);
         let mut best = (f64::INFINITY, 0usize, 0.0);
         for (s, (xs, &sl)) in sources.iter().zip(source_slowness).enumerate() {
             let c: f64 = (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt();
@@ -115,8 +139,8 @@ pub fn factor_sources<const D: usize>(
                 let ne: f64 = (0..D).map(|k| nrm[k] * e[k]).sum();
                 for k in 0..D {
                     let mut v = e[k] - nrm[k] * ne;
-                    if let Some((_, hess)) = &gh {
-                        v -= phi[i] * (0..D).map(|l| hess[k][l] * e[l]).sum::<f64>();
+                    if let Some(l) = &local {
+                        v -= phi_i * (0..D).map(|m| l.hessian[k][m] * e[m]).sum::<f64>();
                     }
                     grad_u0[i][k] = (source_slowness[s] * v) as f32;
                 }

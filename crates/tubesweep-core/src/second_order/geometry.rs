@@ -13,6 +13,8 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
+use super::implicit::Implicit;
+
 /// What the second-order sweeps read at one node.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeGeometry {
@@ -131,25 +133,25 @@ pub(crate) fn symmetric_inverse<const D: usize>(m: &[[f64; D]; D]) -> Option<[[f
     Some(out)
 }
 
-/// φ's central-difference gradient and Hessian at node `n`, or None when a node of its
-/// 3^D-stencil (axis and diagonal neighbours) is not in the band.
-pub(crate) fn gradient_and_hessian<const D: usize>(
+/// φ's central-difference gradient and Hessian at node `n`, φ at band node j being `phi(j)`, or
+/// None when a node of its 3^D-stencil (axis and diagonal neighbours) is not in the band.
+pub(crate) fn gradient_and_hessian_by<const D: usize>(
     band: &NarrowBand<D>,
-    phi: &[f64],
     n: usize,
     h: f64,
+    phi: impl Fn(usize) -> f64,
 ) -> Option<([f64; D], [[f64; D]; D])> {
     let sentinel = band.sentinel();
     let nb = band.neighbours_of(n);
     let mut g = [0.0; D];
     let mut hess = [[0.0; D]; D];
-    let p0 = phi[n];
+    let p0 = phi(n);
     for k in 0..D {
         let (m, p) = (nb[k][0], nb[k][1]);
         if m == sentinel || p == sentinel {
             return None;
         }
-        let (pm, pp) = (phi[m as usize], phi[p as usize]);
+        let (pm, pp) = (phi(m as usize), phi(p as usize));
         g[k] = (pp - pm) / (2.0 * h);
         hess[k][k] = (pp - 2.0 * p0 + pm) / (h * h);
         for l in k + 1..D {
@@ -162,7 +164,7 @@ pub(crate) fn gradient_and_hessian<const D: usize>(
                     if c == sentinel {
                         return None;
                     }
-                    corner[sk][sl] = phi[c as usize];
+                    corner[sk][sl] = phi(c as usize);
                 }
             }
             let v = (corner[1][1] - corner[1][0] - corner[0][1] + corner[0][0]) / (4.0 * h * h);
@@ -182,8 +184,19 @@ pub fn tube_geometry<const D: usize>(
     directions: &[[f32; D]],
     spacing: f64,
 ) -> Result<TubeGeometry> {
+    tube_geometry_of(band, roles, &Implicit::LevelSet(phi), directions, spacing)
+}
+
+/// As [`tube_geometry`] for a level set or a closest-point map ([`Implicit`]).
+pub fn tube_geometry_of<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    directions: &[[f32; D]],
+    spacing: f64,
+) -> Result<TubeGeometry> {
     let n = band.len();
-    if roles.len() != n || phi.len() != n || directions.len() != n {
+    if roles.len() != n || surface.len() != n || directions.len() != n {
         return Err(Error::invalid(
             "phi",
             format!("roles, phi and directions need one entry per band node ({n})"),
@@ -207,7 +220,7 @@ pub fn tube_geometry<const D: usize>(
         identity[sym(k, k)] = 1.0;
     }
     for i in 0..n {
-        let p = phi[i];
+        let mut p = surface.phi(i);
         let sign = if p < 0.0 { -1.0f32 } else { 1.0 };
         let mut geo = NodeGeometry {
             normal: [0.0; 3],
@@ -221,9 +234,12 @@ pub fn tube_geometry<const D: usize>(
             };
         }
         if roles[i] != NodeRole::Outer {
-            match gradient_and_hessian(band, phi, i, spacing) {
+            match surface.local(band, i, spacing) {
                 None => summary.incomplete_stencils += 1,
-                Some((g, hess)) => {
+                Some(local) => {
+                    let (g, hess) = (local.gradient, local.hessian);
+                    // φ in the orientation of the differences (the same as phi(i) for a level set)
+                    p = local.phi;
                     let norm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
                     summary.grad_norm_min = summary.grad_norm_min.min(norm);
                     summary.grad_norm_max = summary.grad_norm_max.max(norm);
@@ -262,7 +278,7 @@ pub fn tube_geometry<const D: usize>(
     if !summary.grad_norm_min.is_finite() {
         summary.grad_norm_min = 0.0;
     }
-    let abs_phi = phi.iter().map(|p| p.abs() as f32).collect();
+    let abs_phi = (0..n).map(|i| surface.phi(i).abs() as f32).collect();
     Ok(TubeGeometry {
         nodes,
         abs_phi,

@@ -18,12 +18,14 @@
 
 pub mod factoring;
 pub mod geometry;
+pub mod implicit;
 pub mod local;
 pub mod solver;
 pub mod start;
 
-pub use factoring::{factor_sources, Factoring};
-pub use geometry::{tube_geometry, GeometrySummary, NodeGeometry, TubeGeometry};
+pub use factoring::{factor_sources, factor_sources_of, Factoring};
+pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometry, TubeGeometry};
+pub use implicit::Implicit;
 pub use solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
 pub use start::first_order_start;
 
@@ -35,7 +37,23 @@ pub const GRAD_NORM_TOLERANCE: f64 = 0.05;
 /// of φ at an inner node, φ not a signed distance, or a principal curvature κ with
 /// `outer_width`·κ ≥ 1 (B is singular at φ = −1/κ: the tube reaches a focal point).
 pub fn check_geometry(summary: &GeometrySummary, outer_width: f64, spacing: f64) -> crate::Result<()> {
+    check_geometry_of(summary, outer_width, spacing, false)
+}
+
+/// As [`check_geometry`], the messages worded for a closest-point map when `closest_point`: there
+/// the curvature found also flags an open surface (beyond its rim the map returns points of the
+/// boundary curve, and |x − cp(x)| is the distance to a curve, of curvature 1/|x − cp(x)|) or an
+/// edge, and |∇|x − cp(x)|| off 1 a map whose points are not the nearest ones.
+pub fn check_geometry_of(
+    summary: &GeometrySummary,
+    outer_width: f64,
+    spacing: f64,
+    closest_point: bool,
+) -> crate::Result<()> {
     use crate::error::Error;
+    if closest_point {
+        return check_closest_point_geometry(summary, outer_width, spacing);
+    }
     if summary.incomplete_stencils > 0 {
         return Err(Error::invalid(
             "surface",
@@ -68,6 +86,58 @@ pub fn check_geometry(summary: &GeometrySummary, outer_width: f64, spacing: f64)
             format!(
                 "order=2 needs φ to be a signed distance near the surface (it uses D²φ as the curvature): |∇φ| ranges \
                  over [{:.3}, {:.3}] in the inner tube. Pass ts.LevelSet(phi, redistance=True), or use order=1",
+                summary.grad_norm_min, summary.grad_norm_max
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn check_closest_point_geometry(summary: &GeometrySummary, outer_width: f64, spacing: f64) -> crate::Result<()> {
+    use crate::error::Error;
+    if summary.incomplete_stencils > 0 {
+        return Err(Error::invalid(
+            "surface",
+            format!(
+                "order=2: {} inner-tube nodes lack a neighbour (axis or diagonal) in the band for the differences of \
+                 |x − cp(x)|; the closest-point map is not accurate near the surface or the grid does not resolve the \
+                 surface (refine it)",
+                summary.incomplete_stencils
+            ),
+        ));
+    }
+    let kappa = summary.max_curvature;
+    if !(outer_width * kappa < 1.0) {
+        return Err(Error::invalid(
+            "surface",
+            format!(
+                "order=2: the closest-point map gives a curvature of {kappa:.4} (radius {:.4}) in the tube: \
+                 outer·Δx·κ = {:.3} ≥ 1. Either the surface is open or has edges or corners (beyond an open \
+                 surface's rim cp(x) lies on the boundary curve, and the corrected equation does not hold there; a \
+                 mesh's closest points are piecewise flat, with all their curvature on the edges), or its curvature \
+                 is not resolved by the tube{}. order=2 needs a closed smooth surface; use order=1 otherwise",
+                1.0 / kappa,
+                outer_width * kappa,
+                if kappa.is_finite() {
+                    format!(
+                        " (then a spacing below {:.4} would be)",
+                        spacing / (outer_width * kappa) * 0.999
+                    )
+                } else {
+                    String::new()
+                }
+            ),
+        ));
+    }
+    if (summary.grad_norm_min - 1.0).abs() > GRAD_NORM_TOLERANCE
+        || (summary.grad_norm_max - 1.0).abs() > GRAD_NORM_TOLERANCE
+    {
+        return Err(Error::invalid(
+            "surface",
+            format!(
+                "order=2: cp does not behave as a true closest-point map near the surface: |∇|x − cp(x)|| ranges \
+                 over [{:.3}, {:.3}] in the inner tube (1 for the nearest points). cp must return the nearest point \
+                 of the surface to within well below Δx²; use order=1 otherwise",
                 summary.grad_norm_min, summary.grad_norm_max
             ),
         ));
