@@ -153,6 +153,7 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
     threads: int = 0,
     front_window: float = 2.0,
     own_first_phase: bool = False,
+    offsets: Optional[npt.NDArray[np.float64]] = None,  # (K, d) x − cp(x) for a closest-point surface
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], Dict[str, Any]]: ...
 def band_interpolate_cubic(  # crates/tubesweep-py/src/box_order2.rs: Catmull-Rom, multilinear where incomplete
     band: "Band", values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
