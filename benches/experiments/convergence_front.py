@@ -1,5 +1,6 @@
-"""Where the two-layer sweeps still spend their iterations (docs/architecture.md), over the
-whole band: the front window (which exploits what this shows) is switched off here.
+"""Where the two-layer sweeps still spend their iterations, over the whole band (docs/development/
+performance-history.md, "What still makes iterations grow with N"): the front window (which exploits
+what this shows) is switched off here.
 
 1. The residual after k iterations by angle from the source on the sphere: the difference from
    the converged solution (tol 1e-12) after 3, 5 and 7 iterations, largest per 20° band.

@@ -11,7 +11,7 @@ Godunov update (Eq. (3)) of its upwind neighbours along each axis, weighted by t
 (ū − a_k) / Σ_j (ū − a_j); an extension-layer node's update (5) of its upwind neighbours toward the
 surface, with the weights of Eq. (5). Gauss–Seidel sweeps converge in finitely many sweeps on
 the nodes that lie on no cycle of this graph, and only geometrically on its strongly connected
-components. The coupled update (docs/architecture.md, "The coupled Godunov update") solves an
+components. The coupled update (docs/architecture.md, "Invariants") solves an
 inner node together with each layer neighbour that reads it; the script folds those pairs in
 (the inner node then reads the layer node's other neighbours) and counts the cycles again. The
 last column is the largest gain around a cycle of two to four nodes: the product of its weights,

@@ -12,7 +12,7 @@ and the grid's axes. For each it prints the iterations and the local updates per
 copies values straight across the tube and every node settles in one or two iterations; tilted,
 the layer's upwind neighbours (toward the surface) and the inner tube's (toward the source) lie
 on different sides, and the values settle over several iterations. The numbers are quoted in
-docs/architecture.md ("What still makes iterations grow with N").
+docs/development/performance-history.md ("What still makes iterations grow with N").
 """
 
 from __future__ import annotations

@@ -52,13 +52,13 @@ class SolveStats:
     thin_strip_iterations : tuple of two ints
         Parallel iterations (3D, more than one thread) whose sweeps ran strips thin across the
         first and across the second leading axis of the grid, where the iteration's work crossed
-        that axis; the others ran square tiles (docs/architecture.md, "Strips thin across the
+        that axis; the others ran square tiles (docs/development/performance-history.md, "Strips thin across the
         front"). ``(0, 0)`` on one thread and in 2D. The values do not depend on it.
     prefetch_iterations : int
         Iterations whose sweeps fetched the rows' data ahead into the cache (x86-64): those after
         an iteration whose visited rows held more data than a quarter of the last-level cache
         (before the first, every row counts as visited, or none with the front window;
-        docs/architecture.md, "Rows fetched ahead"). The values do not depend on it.
+        docs/development/performance-history.md, "Rows fetched ahead"). The values do not depend on it.
     order : int
         The scheme's order: 1 (the paper's) or 2 (docs/second-order.md on surfaces,
         docs/box-second-order.md for ``travel_time(..., order=2)``).

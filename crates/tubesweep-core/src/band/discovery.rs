@@ -311,7 +311,7 @@ pub fn discover_band<const D: usize>(
     // the buffers' pages past a slice's kept nodes are never touched (zeroed allocations), and
     // each buffer is one allocation, returned whole. (A pair of vectors per slice, joined at the
     // end, left the allocator holding their freed memory: about 15 bytes per band node at the
-    // set-up's peak at N = 2001; docs/architecture.md, "The narrow band".)
+    // set-up's peak at N = 2001; docs/development/performance-history.md, "The narrow band's set-up memory".)
     let slice = EVAL_CHUNK / 8;
     let (mut linear, mut values) = (vec![0u64; candidates.len()], vec![0.0f64; candidates.len()]);
     let kept: Vec<usize> = candidates

@@ -46,7 +46,7 @@ pub struct NarrowBand<const D: usize> {
 /// A borrowed view of a band's neighbour table: the arrays' addresses and the sentinel. The sweep
 /// kernel copies it once per row, so that the table's addresses stay in registers instead of
 /// being loaded from the band again at every node after each write of a value
-/// (docs/architecture.md, "The kernel's arrays in registers").
+/// (docs/development/performance-history.md, "The kernel's arrays in registers").
 #[derive(Clone, Copy)]
 pub struct NeighbourTable<'a, const D: usize> {
     lead: &'a [u32],

@@ -377,7 +377,7 @@ pub fn rim_nodes_in_band<const D: usize>(
 /// callable route of the Python package), so the same bits, without the rim's lists, the
 /// prefix sums and a second pass over the band. `linear` are the band's sorted linear indices and
 /// `values` φ at its nodes; returns |∇φ| per node, in single precision (what the checks on it
-/// need, and 4 bytes per node less at the set-up's peak: docs/architecture.md, "The narrow band").
+/// need, and 4 bytes per node less at the set-up's peak: docs/development/performance-history.md, "The narrow band's set-up memory").
 pub fn outward_directions_of_function_in_band<const D: usize>(
     band: &NarrowBand<D>,
     linear: &[u64],

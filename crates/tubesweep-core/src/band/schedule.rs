@@ -26,7 +26,7 @@
 //! rectangular tiles, [`THIN_SIDE`] rows along one leading axis and [`LONG_SIDE`] along the
 //! other, and pick one per iteration: the strips thin along the axis in which the iteration's
 //! work is concentrated (a front crossing that axis), so that more strips share it
-//! (docs/architecture.md, "Strips thin across the front"). The values stay those of the
+//! (docs/development/performance-history.md, "Strips thin across the front"). The values stay those of the
 //! sequential sweep whichever is picked.
 
 use rayon::prelude::*;

@@ -384,7 +384,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
 /// The values are written through a raw pointer ([`SharedValues`]); read through the problem and
 /// the context, these addresses were loaded again from memory at every node after such a write
 /// (seen in the generated row loop), while held in locals they stay in registers: the same bits,
-/// 0.97–0.99 of the sweep time (docs/architecture.md, "The kernel's arrays in registers").
+/// 0.97–0.99 of the sweep time (docs/development/performance-history.md, "The kernel's arrays in registers").
 #[derive(Clone, Copy)]
 pub(super) struct NodeArrays<'k, const D: usize> {
     u: SharedValues<'k>,

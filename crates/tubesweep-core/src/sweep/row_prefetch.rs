@@ -11,7 +11,7 @@
 //! only in an iteration that follows one whose visited rows held more than
 //! [`SolveOptions::row_prefetch_above`] bytes of those arrays (the default is
 //! [`DEFAULT_CACHE_SHARE`] of the last-level cache, [`crate::sweep::cache_size`]). Below that the hints
-//! only cost instructions; docs/architecture.md ("Rows fetched ahead") has the measurements.
+//! only cost instructions; docs/development/performance-history.md ("Rows fetched ahead") has the measurements.
 //!
 //! A row is fetched only if it looks as if it will run when the hint is issued: its dirty flag
 //! set (with the active flags) and its lower bound inside the front window. A row that the rows
@@ -28,7 +28,7 @@ use crate::prefetch::prefetch_range;
 use crate::sweep::cache_size::last_level_cache_bytes;
 
 /// How many rows ahead in the visiting order the sweeps prefetch. Against 2, with the `sphere`
-/// example's paper sweeps alternately (docs/architecture.md, "Rows fetched ahead"): 8 took 0.924
+/// example's paper sweeps alternately (docs/development/performance-history.md, "Rows fetched ahead"): 8 took 0.924
 /// of the time at N = 401 on one thread, 0.939 on two and 0.893 at N = 301; 12 and 16 gained
 /// 1–4% more than 8 on one thread, and 16 lost 5% on two (a tile's first rows go unfetched).
 pub(super) const ROW_PREFETCH_AHEAD: usize = 8;

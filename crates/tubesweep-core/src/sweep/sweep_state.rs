@@ -1,7 +1,7 @@
 //! What the threads of a sweep share, and the bookkeeping per row that lets them skip work:
 //! the rows' dirty flags (a row none of whose nodes is active is skipped whole), the rows' lower
 //! bounds behind the front window (a row whose bound lies beyond the window waits), the
-//! per-iteration limits and the per-sweep totals (docs/architecture.md, "The front window").
+//! per-iteration limits and the per-sweep totals (docs/architecture.md, "Invariants").
 //! The sweep loop itself is in [`super`].
 
 use std::sync::atomic::{AtomicU32, AtomicU64, AtomicU8, Ordering};
