@@ -11,25 +11,50 @@ import numpy as np
 
 from ._interpolation import interpolate_band
 
-#: ``sol(points)`` evaluates ``w + σ|P − x_s|`` (interpolated ``w = u − u₀``) at points within
-#: this many grid spacings of a source: the value at a source is exactly 0.
+#: ``sol(points)`` evaluates ``w + σ|cp(P) − x_s|`` (interpolated ``w = u − u₀``) at points within
+#: this many grid spacings of a source at least: the value at a source is exactly 0.
 FACTORED_RADIUS = 3.0
+
+#: ... and within this many curvature radii 1/κ (κ the largest principal curvature found in the
+#: tube). Multilinear interpolation errs by about Δx²/8 times the second derivative: u's across the
+#: geodesic, cot(κr)κ on a sphere (the source's cone, 1/r near it), against w's (w = u − u₀, the
+#: geodesic minus the chord: about rκ²/4). They cross at r ≈ 1.26/κ, a chord of ≈ 1.2/κ; beyond,
+#: u itself is interpolated (its curvature falls to 0 at the source's equator, w's does not).
+#: Surfaces only: on a curve the distance along it has no cone beyond the source's own kink.
+FACTORED_CURVATURE_RADII = 1.2
+
+
+def factored_reach(spacing: float, max_curvature: float, ndim: int) -> float:
+    """The distance from a source within which ``sol(points)`` evaluates the factored form (on
+    surfaces whose closest points are known to rounding: the solver passes ``FACTORED_RADIUS``
+    grid spacings for a sampled φ)."""
+    reach = FACTORED_RADIUS * spacing
+    if ndim == 3 and max_curvature > 0 and np.isfinite(max_curvature):
+        reach = max(reach, FACTORED_CURVATURE_RADII / max_curvature)
+    return reach
 
 
 def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: str = "linear") -> np.ndarray:
     """``sol(points)`` of a second-order solution near a point source: ``w = u − u₀``
-    interpolated plus ``σ_s |P − x_s|`` at the points within ``FACTORED_RADIUS`` grid spacings of
-    a source, so that the source's cone is not interpolated (the value at a source is exactly 0)."""
-    u0, feet, slowness = sol._factoring
+    interpolated plus ``σ_s |cp(P) − x_s|`` (``u₀`` at the point: the chord from the source to
+    its closest point on the surface, the point itself when it is on the surface) at the points
+    within :func:`factored_reach` of a source, so that the source's cone is not interpolated (the
+    value at a source is exactly 0)."""
+    u0, feet, slowness, reach = sol._factoring
     grid = sol.grid
     h = grid.spacing
     if len(p) == 0:
         return values
     dist = np.sqrt(((p[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2))
-    near = np.argmin(dist, axis=1)
-    nearest = dist[np.arange(len(p)), near]
-    close = nearest <= FACTORED_RADIUS * h
+    close = dist.min(axis=1) <= reach
     if np.any(close):
-        w = interpolate_band(sol._band, sol.values - u0, grid, p[close], interpolation)
-        values[close] = w + slowness[near[close]] * nearest[close]
+        q = p[close]
+        foot = q
+        if reach > FACTORED_RADIUS * h * (1 + 1e-9):
+            # the points' closest points: the point itself when it is on the surface (to rounding)
+            d_surface, foot = sol.surface.project(q, grid)
+            foot = np.where((d_surface <= 1e-9 * h)[:, None], q, foot)
+        chord = np.sqrt(((foot[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2)) * slowness[None, :]
+        w = interpolate_band(sol._band, sol.values - u0, grid, q, interpolation)
+        values[close] = w + chord.min(axis=1)
     return values

@@ -16,7 +16,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import _native
-from ._factoring import FACTORED_RADIUS
+from ._factoring import FACTORED_RADIUS, factored_reach
 from ._validate import FRONT_WINDOW, check_threads as _threads, checked_point_speeds, speed_at_points, speed_values
 from .stats import SolveStats
 
@@ -247,6 +247,16 @@ def solve_on_tube(
         tube.facing,
         phi_sample,
     )
-    sol._factoring = (u0, feet, np.asarray(src_slowness, dtype=float))
+    sol._factoring = (
+        u0,
+        feet,
+        np.asarray(src_slowness, dtype=float),
+        # beyond 3Δx, sol(points) needs the points' closest points: only where the surface gives
+        # them to rounding (a closest-point map, a φ callable; not a sampled φ, whose multilinear
+        # interpolation errs by about Δx²κ/8 along the normal)
+        factored_reach(h, float(st["max_curvature"]), d)
+        if isinstance(surf, ClosestPoint) or (getattr(surf, "_fn", None) is not None and not surf.redistance)
+        else FACTORED_RADIUS * h,
+    )
     sol.order = 2
     return sol

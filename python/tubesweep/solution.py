@@ -102,7 +102,7 @@ class Solution:
         # for a φ array: its values at a sample of the band's nodes (linear indices, values)
         self._phi_sample = phi_sample
         # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
-        self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray]] = None
+        self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray, float]] = None
         self.order = 1
 
     def __getstate__(self) -> dict:
