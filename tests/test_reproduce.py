@@ -14,7 +14,7 @@ import pytest
 pytest.importorskip("matplotlib")
 
 from tubesweep import reproduce  # noqa: E402
-from tubesweep.reproduce import fig3, sphere, star  # noqa: E402
+from tubesweep.reproduce import fig3, second_order, sphere, star  # noqa: E402
 
 NAMES = ("fig3", "table1", "table2", "fig6", "table3", "fig7")
 
@@ -138,3 +138,13 @@ def test_second_order_table_beats_the_first_order_scheme(results):
     fitted = {(o["surface"], o["order"]): o for o in res["second-order"]["orders"]}
     assert fitted[("circle", 2)]["far_max_order"] > 1.8 and fitted[("circle", 1)]["far_max_order"] < 1.5
     assert fitted[("six-fold star", 2)]["mean_order"] > 1.9
+    # the closest-point maps give the level sets' figures (to 1%)
+    for name in ("sphere", "circle"):
+        for n in {r["N"] for r in rows if r["surface"] == name}:
+            a, b = by[(name, n, 2)], by[(f"{name} (closest-point map)", n, 2)]
+            assert abs(a["far_max"] - b["far_max"]) < 0.01 * a["far_max"], (name, n)
+    # the targets' table (full runs only) reads the rows and the fits
+    lines = second_order.target_lines(rows, res["second-order"]["orders"])
+    assert lines[0].startswith("| surface | target") and len(lines) > 10
+    assert all(line.endswith(("| yes |", "| no |")) for line in lines[2:])
+    assert "| circle | far max order ≥ 1.9 |" in "\n".join(lines)

@@ -1,7 +1,8 @@
 """Beyond the paper: ``order=2`` (docs/second-order.md). ``tubesweep reproduce second-order``
 measures the second-order scheme next to the paper's first-order one on the sphere (great-circle
 distances), an oblate spheroid (geodesics from geographiclib, when installed), the circle and the
-six-fold star, with the fitted orders, and writes ``second_order.csv`` / ``second_order.md``.
+six-fold star, and the sphere and circle given as closest-point maps, with the fitted orders and
+the issue's targets (met or not), and writes ``second_order.csv`` / ``second_order.md``.
 
 "far" errors leave out the points within 0.1 of the source and of the cut locus (the antipode,
 or the arc of the equator about it on the spheroid), where no grid method converges at its order
@@ -82,6 +83,22 @@ def circle_case() -> Case:
     return surf, src, pts, exact, (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1), {}
 
 
+def sphere_cp_case() -> Case:
+    """The sphere of :func:`sphere_case` given as a closest-point map (``ts.ClosestPoint``)."""
+    from ..closest_point import ClosestPoint
+
+    _, src, pts, exact, far, extra = sphere_case()
+    return ClosestPoint(lambda x: 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)), src, pts, exact, far, extra
+
+
+def circle_cp_case() -> Case:
+    """The circle of :func:`circle_case` given as a closest-point map."""
+    from ..closest_point import ClosestPoint
+
+    _, src, pts, exact, far, extra = circle_case()
+    return ClosestPoint(lambda x: 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)), src, pts, exact, far, extra
+
+
 def star_case() -> Case:
     from ..surfaces import Star
 
@@ -112,6 +129,8 @@ def measure(case: Case, n: int, order: int) -> Dict[str, Any]:
         "iterations": sol.stats.iterations,
         "seconds": seconds,
         "fallback": (sol.stats.order2 or {}).get("fallback_iteration"),
+        # how well the tube resolves the tightest curvature (order=2 needs < 1)
+        "outer_kappa": sol.outer * g.spacing * sol.stats.order2["max_curvature"] if order == 2 else None,
     }
     for name, ring in extra.items():
         row[name] = float(np.max(np.abs(sol(ring) - np.pi / 4)))
@@ -123,8 +142,53 @@ CASES: Dict[str, Tuple[Callable[[], Case], Tuple[int, ...], Tuple[int, ...]]] = 
     "sphere": (sphere_case, (51, 101, 151, 201), (31, 51)),
     "spheroid 0.6/0.6/0.4": (spheroid_case, (51, 101, 151, 201), (41, 61)),
     "circle": (circle_case, (51, 101, 201, 401), (101, 201)),
+    # from N = 201, where the tube resolves the tips' curvature with margin (outer·Δx·κ = 0.49 there)
     "six-fold star": (star_case, (201, 401, 801, 1601), (201, 401)),
+    "sphere (closest-point map)": (sphere_cp_case, (51, 101, 151, 201), (31, 51)),
+    "circle (closest-point map)": (circle_cp_case, (51, 101, 201, 401), (101, 201)),
 }
+
+#: The targets of issue 31 on surfaces: (surface, what, bound, "max" or "min").
+TARGETS = [
+    ("sphere", "far max at N = 201", 4e-4, "max"),
+    ("sphere", "mean at N = 201", 4e-5, "max"),
+    ("sphere", "circle x=0 max at N = 201", 3e-5, "max"),
+    ("sphere", "far max order", 1.7, "min"),
+    ("sphere", "mean order", 1.85, "min"),
+    ("spheroid 0.6/0.6/0.4", "far max order", 1.8, "min"),
+    ("spheroid 0.6/0.6/0.4", "mean order", 1.85, "min"),
+    ("circle", "far max order", 1.9, "min"),
+    ("circle", "mean order", 1.9, "min"),
+    ("six-fold star", "far max order", 1.9, "min"),
+    ("six-fold star", "mean order", 1.9, "min"),
+    ("sphere (closest-point map)", "far max order", 1.7, "min"),
+    ("sphere (closest-point map)", "mean order", 1.85, "min"),
+    ("circle (closest-point map)", "far max order", 1.9, "min"),
+    ("circle (closest-point map)", "mean order", 1.9, "min"),
+]
+
+
+def target_lines(rows: List[Dict[str, Any]], orders: List[Dict[str, Any]]) -> List[str]:
+    """The targets' table: each target, the figure measured for order=2 and whether it is met."""
+    lines = ["| surface | target | measured (order=2) | met |", "|---|---|---|---|"]
+    for surface, what, bound, kind in TARGETS:
+        value = None
+        if "N = 201" in what:
+            key = {"far max": "far_max", "mean": "mean", "circle x=0 max": "circle x=0"}[what.split(" at")[0]]
+            value = next(
+                (r.get(key) for r in rows if r["surface"] == surface and r["order"] == 2 and r["N"] == 201), None
+            )
+        else:
+            key = "far_max_order" if what.startswith("far") else "mean_order"
+            value = next((o[key] for o in orders if o["surface"] == surface and o["order"] == 2), None)
+        if value is None:
+            continue
+        met = value <= bound if kind == "max" else value >= bound
+        shown = f"{value:.3g}" if "N = 201" in what else f"{value:.2f}"
+        lines.append(
+            f"| {surface} | {what} {'≤' if kind == 'max' else '≥'} {bound:g} | {shown} | {'yes' if met else 'no'} |"
+        )
+    return lines
 
 
 def run(out_dir: Path, quick: bool) -> dict:
@@ -152,20 +216,32 @@ def run(out_dir: Path, quick: bool) -> dict:
             if case[5]:
                 fitted["circle_order"] = fit_order(hs, [m["circle x=0"] for m in measured])
             orders.append(fitted)
-    columns = ["surface", "N", "order", "far_max", "mean", "circle x=0", "iterations", "seconds", "fallback"]
+    columns = [
+        "surface",
+        "N",
+        "order",
+        "far_max",
+        "mean",
+        "circle x=0",
+        "outer_kappa",
+        "iterations",
+        "seconds",
+        "fallback",
+    ]
     write_csv(out_dir / "second_order.csv", [{c: r.get(c, "") for c in columns} for r in rows])
     lines = [
         "Errors of `sol(points)` against exact geodesic distances; far: at least 0.1 from the source and "
         "the cut locus. Seconds: `ts.solve` including the band's set-up, on this machine.",
         "",
-        "| surface | N | order | far max | mean | circle x=0 max | iterations | seconds |",
-        "|---|---|---|---|---|---|---|---|",
+        "| surface | N | order | far max | mean | circle x=0 max | outer·Δx·κ | iterations | seconds |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         ring = f"{r['circle x=0']:.3e}" if "circle x=0" in r else ""
+        resolved = f"{r['outer_kappa']:.2f}" if r.get("outer_kappa") is not None else ""
         lines.append(
             f"| {r['surface']} | {r['N']} | {r['order']} | {r['far_max']:.3e} | {r['mean']:.3e} | {ring} | "
-            f"{r['iterations']} | {r['seconds']:.3f} |"
+            f"{resolved} | {r['iterations']} | {r['seconds']:.3f} |"
         )
     lines += [
         "",
@@ -177,6 +253,8 @@ def run(out_dir: Path, quick: bool) -> dict:
         lines.append(
             f"| {o['surface']} | {o['N']} | {o['order']} | {o['far_max_order']:.2f} | {o['mean_order']:.2f} | {ring} |"
         )
+    if not quick:
+        lines += ["", "Targets (issue 31, surfaces):", ""] + target_lines(rows, orders)
     write_markdown(
         out_dir / "second_order.md", "order=2: errors and fitted orders (beyond the paper)", [("", "\n".join(lines))]
     )
