@@ -130,7 +130,7 @@ def measure(case: Case, n: int, order: int) -> Dict[str, Any]:
         "seconds": seconds,
         "fallback": (sol.stats.order2 or {}).get("fallback_iteration"),
         # how well the tube resolves the tightest curvature (order=2 needs < 1)
-        "outer_kappa": sol.outer * g.spacing * sol.stats.order2["max_curvature"] if order == 2 else None,
+        "outer_kappa": sol.outer * g.spacing * sol.stats.order2["max_curvature"] if sol.stats.order2 else None,
     }
     for name, ring in extra.items():
         row[name] = float(np.max(np.abs(sol(ring) - np.pi / 4)))
