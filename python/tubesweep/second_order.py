@@ -37,6 +37,9 @@ TOL_FACTOR = 1e-3
 # correction) instead of the first-order driver (for measurements)
 _OWN_FIRST_PHASE = True
 
+# the front windows of the two phases (factors of the first-order driver's width; 0: none)
+WINDOWS = (2.0, 2.0)
+
 
 def check_order(order: Any) -> int:
     """``order`` as 1 or 2, or a ValueError naming it."""
@@ -172,6 +175,8 @@ def solve_on_tube(
         front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
         own_first_phase=_OWN_FIRST_PHASE,
         offsets=offsets,
+        window_first=WINDOWS[0] if d == 3 else 0.0,
+        window_second=WINDOWS[1] if d == 3 else 0.0,
     )
     if not st["converged"]:
         warnings.warn(

@@ -182,7 +182,7 @@ fn run<'py, const D: usize>(
 /// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
 /// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=10, threads=0, front_window=2.0, own_first_phase=false, offsets=None))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=10, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve<'py>(
     py: Python<'py>,
@@ -207,6 +207,8 @@ pub fn second_order_solve<'py>(
     front_window: f64,
     own_first_phase: bool,
     offsets: Option<PyReadonlyArray2<'py, f64>>,
+    window_first: f64,
+    window_second: f64,
 ) -> PyResult<Solved<'py>> {
     if !(tol > 0.0 && tol_first > 0.0) {
         return Err(PyValueError::new_err("tol must be positive"));
@@ -249,6 +251,8 @@ pub fn second_order_solve<'py>(
             stall_ratio,
             stall_window,
             own_first_phase,
+            window_first,
+            window_second,
         },
         threads,
         front_window,

@@ -169,7 +169,7 @@ mod tests {
     /// The sphere of radius 0.5 on n³ nodes over [−1, 1]³, source (−0.5, 0, 0): the max error
     /// at the inner nodes' foot points against the great-circle distance, away from the source
     /// and the antipode.
-    fn sphere_error(n: usize) -> (f64, f64, SecondOrderStats) {
+    fn sphere_error(n: usize, window: f64) -> (f64, f64, SecondOrderStats) {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
         let idx = band.indices();
         let pts: Vec<[f64; 3]> = idx
@@ -201,6 +201,8 @@ mod tests {
             stall_ratio: 0.9,
             stall_window: 10,
             own_first_phase: true,
+            window_first: window,
+            window_second: window,
         };
         let stats = sweep_second_order(
             &band,
@@ -232,14 +234,34 @@ mod tests {
 
     #[test]
     fn sphere_converges_at_second_order() {
-        let (e1, m1, s1) = sphere_error(41);
-        let (e2, m2, s2) = sphere_error(81);
+        let (e1, m1, s1) = sphere_error(41, 0.0);
+        let (e2, m2, s2) = sphere_error(81, 0.0);
         assert!(s1.converged && s2.converged, "{s1:?} {s2:?}");
         let order = (e1 / e2).ln() / (80.0f64 / 40.0).ln();
         let mean_order = (m1 / m2).ln() / (80.0f64 / 40.0).ln();
         assert!(
             order > 1.5 && mean_order > 1.75 && m2 < 1e-4,
             "max errors {e1:.3e} {e2:.3e}, order {order:.2}; mean {m1:.3e} {m2:.3e}, order {mean_order:.2}"
+        );
+    }
+
+    #[test]
+    fn the_front_windows_keep_the_errors_and_save_updates() {
+        let (e, m, plain) = sphere_error(81, 0.0);
+        let (ew, mw, windowed) = sphere_error(81, 2.0);
+        assert!(
+            windowed.converged && windowed.fallback_iteration.is_none(),
+            "{windowed:?}"
+        );
+        assert!(
+            (ew - e).abs() < 0.01 * e && (mw - m).abs() < 0.01 * m,
+            "max {e:.4e} / {ew:.4e}, mean {m:.4e} / {mw:.4e}"
+        );
+        assert!(
+            (windowed.updates as f64) < 0.6 * plain.updates as f64,
+            "{} updates windowed, {} plain",
+            windowed.updates,
+            plain.updates
         );
     }
 }
