@@ -253,6 +253,7 @@ pub fn second_order_solve<'py>(
             own_first_phase,
             window_first,
             window_second,
+            threads,
         },
         threads,
         front_window,

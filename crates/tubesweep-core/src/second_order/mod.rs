@@ -20,6 +20,7 @@ pub mod factoring;
 pub mod geometry;
 pub mod implicit;
 pub mod local;
+mod pipeline;
 pub mod solver;
 pub mod start;
 
@@ -170,6 +171,12 @@ mod tests {
     /// at the inner nodes' foot points against the great-circle distance, away from the source
     /// and the antipode.
     fn sphere_error(n: usize, window: f64) -> (f64, f64, SecondOrderStats) {
+        let (e, m, stats, _) = sphere_solve(n, window, 1);
+        (e, m, stats)
+    }
+
+    /// The same, with the values, on `threads` threads.
+    fn sphere_solve(n: usize, window: f64, threads: usize) -> (f64, f64, SecondOrderStats, Vec<f64>) {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
         let idx = band.indices();
         let pts: Vec<[f64; 3]> = idx
@@ -203,6 +210,7 @@ mod tests {
             own_first_phase: true,
             window_first: window,
             window_second: window,
+            threads,
         };
         let stats = sweep_second_order(
             &band,
@@ -229,7 +237,7 @@ mod tests {
             sum += (values[i] - exact).abs();
             count += 1.0;
         }
-        (worst, sum / count, stats)
+        (worst, sum / count, stats, values)
     }
 
     #[test]
@@ -263,5 +271,20 @@ mod tests {
             windowed.updates,
             plain.updates
         );
+    }
+
+    #[test]
+    fn any_thread_count_gives_the_same_bits() {
+        let (_, _, one, a) = sphere_solve(61, 2.0, 1);
+        let (_, _, two, b) = sphere_solve(61, 2.0, 2);
+        let (_, _, three, c) = sphere_solve(61, 2.0, 3);
+        assert_eq!(
+            (one.updates, one.first_order_iterations),
+            (two.updates, two.first_order_iterations)
+        );
+        assert_eq!(three.second_order_iterations, one.second_order_iterations);
+        for ((x, y), z) in a.iter().zip(&b).zip(&c) {
+            assert_eq!((x.to_bits(), x.to_bits()), (y.to_bits(), z.to_bits()));
+        }
     }
 }

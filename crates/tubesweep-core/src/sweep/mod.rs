@@ -73,11 +73,11 @@ pub mod rim;
 mod rim_last;
 mod row_prefetch;
 mod spread_threads;
-mod strip_pipeline;
-mod sweep_state;
+pub(crate) mod strip_pipeline;
+pub(crate) mod sweep_state;
 #[cfg(test)]
 mod tests;
-mod thread_choice;
+pub(crate) mod thread_choice;
 
 pub use front_window::DEFAULT_FRONT_WINDOW;
 pub use problem::{

@@ -15,7 +15,7 @@ use std::time::Instant;
 /// and mark it done. Gives up (returns early) when `abandoned` is raised, so that a panic on
 /// another thread reaches the caller instead of leaving this one spinning.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn strip_worker(
+pub(crate) fn strip_worker(
     strip_tiles: &[u32],
     strips: &[u32],
     upstream: &[u32],
@@ -79,7 +79,7 @@ fn spin_until(ready: impl Fn() -> bool, abandoned: &AtomicBool) -> bool {
 /// sweep id (one thread takes the next id from `ids`, then all meet at a barrier), and a barrier
 /// after it. A panic on one thread raises `abandoned`, which makes the others leave their waits,
 /// so the panic reaches the caller.
-pub(super) fn run_sweeps_in_one_broadcast(
+pub(crate) fn run_sweeps_in_one_broadcast(
     n_sweeps: usize,
     ids: &AtomicU32,
     per_sweep: &(dyn Fn(usize, &AtomicUsize, &AtomicBool) -> Accumulator + Sync),

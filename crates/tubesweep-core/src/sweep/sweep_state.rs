@@ -158,18 +158,18 @@ pub(super) fn from_order_key(k: u64) -> f64 {
 
 /// Per-sweep totals.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Accumulator {
-    pub(super) max_change: f64,
-    pub(super) updates: u64,
+pub(crate) struct Accumulator {
+    pub(crate) max_change: f64,
+    pub(crate) updates: u64,
     /// The smallest new value of a node that changed by more than `Limits::settled` (infinite
     /// when none did): where the unconverged part of the band begins.
-    pub(super) front: f64,
+    pub(crate) front: f64,
     /// A lower bound of the values of the active nodes left beyond the front window (infinite
     /// when none were): where the window goes next when nothing in it moved.
-    pub(super) waiting: f64,
+    pub(crate) waiting: f64,
     /// The nodes of the rows that ran (all nodes of every row without the flags): what the
     /// sweep read, for the next iteration's [`Limits::prefetch_ahead`].
-    pub(super) visited: u64,
+    pub(crate) visited: u64,
 }
 
 impl Default for Accumulator {
@@ -185,7 +185,7 @@ impl Default for Accumulator {
 }
 
 impl Accumulator {
-    pub(super) fn merge(self, o: Accumulator) -> Accumulator {
+    pub(crate) fn merge(self, o: Accumulator) -> Accumulator {
         Accumulator {
             max_change: self.max_change.max(o.max_change),
             updates: self.updates + o.updates,
@@ -226,7 +226,7 @@ pub(super) struct Limits {
 /// Copies (held in registers by the row loop) borrow the values for `'a`, like the slice they
 /// were made from.
 #[derive(Clone, Copy)]
-pub(super) struct SharedValues<'a> {
+pub(crate) struct SharedValues<'a> {
     ptr: *mut f64,
     len: usize,
     borrowed: std::marker::PhantomData<&'a [std::cell::Cell<f64>]>,
@@ -237,7 +237,7 @@ unsafe impl Send for SharedValues<'_> {}
 
 impl<'a> SharedValues<'a> {
     /// The values of `u`, borrowed mutably for as long as any copy lives.
-    pub(super) fn new(u: &'a mut [f64]) -> Self {
+    pub(crate) fn new(u: &'a mut [f64]) -> Self {
         SharedValues {
             ptr: u.as_mut_ptr(),
             len: u.len(),
@@ -246,7 +246,7 @@ impl<'a> SharedValues<'a> {
     }
 
     #[inline(always)]
-    pub(super) fn get(&self, i: usize) -> f64 {
+    pub(crate) fn get(&self, i: usize) -> f64 {
         debug_assert!(i < self.len);
         unsafe { *self.ptr.add(i) }
     }
@@ -256,7 +256,7 @@ impl<'a> SharedValues<'a> {
         crate::prefetch::prefetch_raw_range(self.ptr as *const f64, self.len, start, end);
     }
     #[inline(always)]
-    pub(super) fn set(&self, i: usize, v: f64) {
+    pub(crate) fn set(&self, i: usize, v: f64) {
         debug_assert!(i < self.len);
         unsafe { *self.ptr.add(i) = v }
     }
