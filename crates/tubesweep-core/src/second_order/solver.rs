@@ -352,7 +352,7 @@ pub fn sweep_second_order<const D: usize>(
         let lim = Limits {
             second: false,
             decreases_only: true,
-            threshold: 0.1 * options.tol_first,
+            threshold: options.tol_first,
             window: f64::INFINITY,
             settled: options.tol_first,
         };
@@ -378,7 +378,7 @@ pub fn sweep_second_order<const D: usize>(
     let lim = Limits {
         second: true,
         decreases_only: false,
-        threshold: 0.1 * options.tol,
+        threshold: options.tol,
         window: f64::INFINITY,
         settled: options.tol,
     };
