@@ -105,6 +105,8 @@ bench: build
 	$(PY) benches/many_sources.py
 	# issue 31: travel_time order=1 against order=2 in the box, cubic against multilinear evaluation
 	$(PY) benches/box_order2.py
+	# issue 31's cost targets: order=2 / order=1 time and memory per band node on the closed library surfaces
+	$(PY) benches/order2_cost.py --surfaces sphere,ellipsoid,torus,rounded-cube
 	# issue 32: the upwind solver for the moving medium and metrics against LxF and isotropic Godunov
 	$(PY) benches/upwind.py
 	cargo run --release -q -p tubesweep-core --example upwind_cost

@@ -407,9 +407,9 @@ pub fn sweep_second_order<const D: usize>(
 }
 
 /// One phase's iterations (each the 2^D sweeps) until the largest change of an iteration with the
-/// window fully open is below `lim.settled`; returns whether it got there. With `window_width`
-/// > 0 the sweeps leave out the nodes whose value lies beyond an edge that starts at the smallest
-/// fixed value plus the width and moves on to the iteration's front (the smallest value that
+/// window fully open is below `lim.settled`; returns whether it got there. With a positive
+/// `window_width` the sweeps leave out the nodes whose value lies beyond an edge that starts at
+/// the smallest fixed value plus the width and moves on to the iteration's front (the smallest value that
 /// still changed by more than `settled`) plus the width, or on by a width to the nearest node
 /// left out when nothing in the window moved; it opens fully when no node was left out, or when
 /// the edge has not moved for `stall_window` iterations. Once it is open, the stagnation test
