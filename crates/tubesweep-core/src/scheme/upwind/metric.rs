@@ -17,7 +17,7 @@
 //! characteristic `∂G/∂P ∝ S_K P` enters from the face iff `(C (t − w))_j ≥ 0` for every `j`. On a
 //! vertex `t = s h / sqrt((S_K)_kk) = s h sqrt((M⁻¹)_kk)`.
 
-use super::{larger_root_below, upwind_min, Faces, LocalSolver};
+use super::{larger_root, upwind_min, weight_floor, Faces, LocalSolver};
 use crate::scheme::hamiltonians::{slowness_at, Metric};
 use crate::Hamiltonian;
 
@@ -35,6 +35,21 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         // λ_max(M) ≤ tr M
         let tr: f64 = (0..D).map(|k| self.m[k][k]).sum();
         self.s / tr.sqrt()
+    }
+
+    /// `∂G/∂p ∝ M p`.
+    #[inline(always)]
+    fn velocity(&self, p: [f64; D]) -> [f64; D] {
+        core::array::from_fn(|k| (0..D).map(|l| self.m[k][l] * p[l]).sum())
+    }
+
+    #[inline(always)]
+    fn inside(&self, p: [f64; D]) -> bool {
+        let q: f64 = (0..D)
+            .map(|k| p[k] * (0..D).map(|l| self.m[k][l] * p[l]).sum::<f64>())
+            .sum();
+        let r = self.s * (1.0 - 1e-12);
+        q <= r * r
     }
 
     /// `φ(d) = s sqrt(dᵀAd)`, `A = M⁻¹`, even. Mirroring `d_k` changes `dᵀAd` by
@@ -103,7 +118,7 @@ impl<const D: usize> Faces<D> for Riemann<D> {
     }
 
     #[inline(always)]
-    fn solve<const M: usize>(
+    fn solve<const M: usize, const STRICT: bool>(
         &self,
         sk: &[[f64; D]; D],
         w: &[f64; M],
@@ -113,7 +128,7 @@ impl<const D: usize> Faces<D> for Riemann<D> {
     ) -> Option<f64> {
         let sh = self.s * h;
         if M == 1 {
-            return (sh * sh < below * below * sk[0][0]).then(|| sh / sk[0][0].sqrt());
+            return (STRICT || sh * sh < below * below * sk[0][0]).then(|| sh / sk[0][0].sqrt());
         }
         let mut c = [[0.0; M]; M];
         let (mut a, mut b, mut cc) = (0.0, 0.0, -sh * sh);
@@ -129,9 +144,10 @@ impl<const D: usize> Faces<D> for Riemann<D> {
             return None;
         }
         // the causality weights (C (t − w))_i sum to a t − b
-        let t = larger_root_below(a, b, cc, below)?;
+        let t = larger_root::<STRICT>(a, b, cc, below)?;
+        let floor = weight_floor::<STRICT>(a * t - b);
         let causal = (0..M).fold(true, |ok, i| {
-            ok & ((0..M).map(|j| c[i][j] * (t - w[j])).sum::<f64>() >= 0.0)
+            ok & ((0..M).map(|j| c[i][j] * (t - w[j])).sum::<f64>() >= floor)
         });
         causal.then_some(t)
     }

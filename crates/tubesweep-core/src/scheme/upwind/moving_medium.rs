@@ -25,7 +25,7 @@
 //! keeps its value. The Python layer refuses such flows for this solver (the Lax–Friedrichs
 //! update of the equation as written is used with `allow_supersonic=True`).
 
-use super::{larger_root_below, upwind_min, Faces, LocalSolver};
+use super::{larger_root, upwind_min, weight_floor, Faces, LocalSolver};
 use crate::scheme::hamiltonians::{slowness_at, MovingMedium};
 use crate::Hamiltonian;
 
@@ -52,26 +52,50 @@ impl<const D: usize> Faces<D> for Randers<D> {
         1.0 / (self.f + self.v.iter().map(|x| x.abs()).sum::<f64>())
     }
 
+    /// The signs of `∂G/∂p = F p/|p| + v` (±1, 0), without the square root: where `p_k` and
+    /// `v_k` differ in sign, `F |p_k|` against `|p| |v_k|`.
+    #[inline(always)]
+    fn velocity(&self, p: [f64; D]) -> [f64; D] {
+        let n2 = p.iter().map(|x| x * x).sum::<f64>();
+        core::array::from_fn(|k| {
+            let (a, b) = (p[k], self.v[k]);
+            if (a >= 0.0) == (b >= 0.0) {
+                a + b
+            } else if self.f2 * a * a >= n2 * b * b {
+                a
+            } else {
+                b
+            }
+        })
+    }
+
+    #[inline(always)]
+    fn inside(&self, p: [f64; D]) -> bool {
+        // F|p| ≤ r = 1 − 1e-12 − v·p, without the square root
+        let r = 1.0 - 1e-12 - (0..D).map(|k| self.v[k] * p[k]).sum::<f64>();
+        r >= 0.0 && self.f2 * p.iter().map(|x| x * x).sum::<f64>() <= r * r
+    }
+
     /// `φ(d) = (−v·d + R(d)) / (F² − |v|²)`, `R = sqrt((v·d)² + (F² − |v|²)|d|²)`. Mirroring `d_k`
-    /// keeps `|d|` and changes `v·d` by `Δ = −2 v_k d_k`; `R` is `|v|/F`-Lipschitz in `v·d`
-    /// (`|v·d| / R ≤ |v|/F`). So `φ(d') − φ(d) ≤ (−Δ + |Δ| |v|/F) / (F² − |v|²)`: at most 0 when
-    /// `Δ ≥ 0` (the mirrored path runs less against the flow), else `τ_k |d_k|` with
-    /// `τ_k = 2 |v_k| / (F (F − |v|))`. `d_k > 0` from the minus neighbour, so the minus side has
-    /// slack only when `v_k > 0` (the flow comes from there), the plus side when `v_k < 0`.
-    /// Infinite when supersonic.
+    /// keeps `|d|` and changes `v·d` by `−2 v_k d_k`, and
+    /// `R' − R = −2 v_k d_k (v·d + v·d') / (R + R')`, so
+    /// `φ(d') − φ(d) = 2 v_k d_k β / (F² − |v|²)` with `β = 1 − (v·d + v·d')/(R + R')` in
+    /// `[1 − |v|/F, 1 + |v|/F]` (`|v·d| ≤ R |v|/F`). When `v_k d_k > 0` (the path from that
+    /// side runs with the flow) mirroring costs at most `τ |d_k|`, `τ = 2 |v_k| / (F (F − |v|))`;
+    /// when `v_k d_k < 0` it gains at least `2 |v_k| |d_k| / (F (F + |v|))`: a negative slack.
+    /// `d_k > 0` from the minus neighbour. Infinite when supersonic.
     #[inline(always)]
     fn mirror_slack(&self) -> [[f64; 2]; D] {
         let speed = self.v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let r = if self.f > speed {
-            2.0 / (self.f * (self.f - speed))
-        } else {
-            f64::INFINITY
-        };
+        if !(self.f > speed) {
+            return [[f64::INFINITY; 2]; D];
+        }
+        let (up, down) = (2.0 / (self.f * (self.f - speed)), -2.0 / (self.f * (self.f + speed)));
         core::array::from_fn(|k| {
-            let t = r * self.v[k].abs();
+            let a = self.v[k].abs();
             match self.v[k] {
-                x if x > 0.0 => [t, 0.0],
-                x if x < 0.0 => [0.0, t],
+                x if x > 0.0 => [up * a, down * a],
+                x if x < 0.0 => [down * a, up * a],
                 _ => [0.0, 0.0],
             }
         })
@@ -98,12 +122,19 @@ impl<const D: usize> Faces<D> for Randers<D> {
     }
 
     #[inline(always)]
-    fn solve<const M: usize>(&self, p: &Face<D>, w: &[f64; M], sg: &[f64; M], h: f64, below: f64) -> Option<f64> {
+    fn solve<const M: usize, const STRICT: bool>(
+        &self,
+        p: &Face<D>,
+        w: &[f64; M],
+        sg: &[f64; M],
+        h: f64,
+        below: f64,
+    ) -> Option<f64> {
         if M == 1 {
             // t = h / (F_K + ω) < T  ⟺  h − T ω < T F_K
             let om = sg[0] * p.vk[0];
             let r = h - below * om;
-            return (r < 0.0 || r * r < below * below * p.fk2).then(|| h / (p.fk2.sqrt() + om));
+            return (STRICT || r < 0.0 || r * r < below * below * p.fk2).then(|| h / (p.fk2.sqrt() + om));
         }
         let om: [f64; M] = core::array::from_fn(|j| sg[j] * p.vk[j]);
         let (mut big_w, mut q, mut u1, mut u2) = (0.0, 0.0, 0.0, 0.0);
@@ -118,9 +149,10 @@ impl<const D: usize> Faces<D> for Randers<D> {
         let b = p.fk2 * u1 - big_w * hq;
         let c = p.fk2 * u2 - hq * hq;
         // the causality weights F_K²(t − w_j) + ω_j g sum to a t − b
-        let t = larger_root_below(a, b, c, below)?;
+        let t = larger_root::<STRICT>(a, b, c, below)?;
         let g = hq - big_w * t;
-        let causal = (0..M).fold(g > 0.0, |ok, j| ok & (p.fk2 * (t - w[j]) + om[j] * g >= 0.0));
+        let floor = weight_floor::<STRICT>(a * t - b);
+        let causal = (0..M).fold(g > 0.0, |ok, j| ok & (p.fk2 * (t - w[j]) + om[j] * g >= floor));
         causal.then_some(t)
     }
 }
