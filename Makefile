@@ -110,6 +110,9 @@ bench: build
 	# issue 32: the upwind solver for the moving medium and metrics against LxF and isotropic Godunov
 	$(PY) benches/upwind.py
 	cargo run --release -q -p tubesweep-core --example upwind_cost
+	# the cost per node update against the isotropic Godunov update: same band, threads and sweep mode
+	cargo run --release -q -p tubesweep-core --example upwind_sweep -- 101 1
+	cargo run --release -q -p tubesweep-core --example upwind_sweep -- 161 1
 	# issue 35: the default thread count against threads=1 and all cores, quiet and with cores kept busy
 	$(PY) benches/under_load.py
 

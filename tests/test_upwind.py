@@ -239,3 +239,38 @@ def test_parallel_sweeps_and_the_tube_give_the_same_bits():
     two = ts.solve(s, g, [(-R, 0, 0)], flow=v, threads=2)
     tube = ts.Tube(s, g).solve([(-R, 0, 0)], flow=v, threads=2)
     assert np.array_equal(one.values, two.values) and np.array_equal(one.values, tube.values)
+
+
+def test_stats_say_which_local_solver_ran():
+    c = Circle(R)
+    g = ts.Grid((-1, -1), (1, 1), (41, 41))
+    src = [(-R, 0)]
+    rot = solid_body_rotation(0.3)
+    M = np.array([[2.0, 0.3], [0.3, 1.0]])
+    runs = {
+        "godunov": ts.solve(c, g, src),
+        "lxf": ts.solve(c, g, src, hamiltonian="lxf"),
+        "upwind": ts.solve(c, g, src, flow=rot),
+        "lxf flow": ts.solve(c, g, src, flow=rot, hamiltonian="lxf"),
+        "upwind metric": ts.solve(c, g, src, hamiltonian=ts.hamiltonians.Metric(M)),
+        "lxf metric": ts.solve(c, g, src, hamiltonian=ts.hamiltonians.Metric(M, scheme="lxf")),
+    }
+    assert {k: s.stats.local_solver for k, s in runs.items()} == {
+        "godunov": "godunov",
+        "lxf": "lxf",
+        "upwind": "upwind",
+        "lxf flow": "lxf",
+        "upwind metric": "upwind",
+        "lxf metric": "lxf",
+    }
+    # the equation stays on Solution.hamiltonian
+    assert [runs[k].hamiltonian for k in ("godunov", "upwind", "upwind metric")] == [
+        "godunov",
+        "moving-medium",
+        "metric",
+    ]
+    box = {
+        k: ts.travel_time(g, [(0.01, 0.02)], return_stats=True, **kw)[1].local_solver
+        for k, kw in (("iso", {}), ("flow", dict(flow=np.array([0.3, 0.1]))), ("lxf", dict(hamiltonian="lxf")))
+    }
+    assert box == {"iso": "godunov", "flow": "upwind", "lxf": "lxf"}

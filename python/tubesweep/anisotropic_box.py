@@ -125,5 +125,6 @@ def travel_time_general(
         + 8 * band.n_rows,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
+        local_solver="lxf" if prep.scheme == "lxf" else ("godunov" if prep.kind == "isotropic" else "upwind"),
     )
     return u, stats

@@ -361,6 +361,7 @@ def travel_time(
         fixed_points=len(lin),
         setup_seconds=setup,
         band_bytes=band.nbytes + grid.size * 10 + 8 * band.n_rows,  # values, role, active flag; per row a lower bound
+        local_solver=scheme,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
     )

@@ -745,6 +745,7 @@ def solve_band(
         scheme=prep.scheme,
     )
     st = dict(st)
-    st["local_solver"] = prep.scheme
+    # "upwind" for the moving medium and metrics, Eq. (3) itself for the isotropic Hamiltonian
+    st["local_solver"] = "lxf" if prep.scheme == "lxf" else ("godunov" if prep.kind == "isotropic" else "upwind")
     st.update(prep.extra if "inverse" not in prep.extra else {})
     return values, st

@@ -45,7 +45,10 @@ class Solution:
     sources : numpy.ndarray
         ``(S, d)`` the source points.
     hamiltonian : str
-        ``"godunov"``, ``"lxf"``, ``"moving-medium"``, ``"metric"`` or ``"isotropic"``.
+        The equation and scheme asked for: the eikonal scheme (``"godunov"`` or ``"lxf"``) for the
+        eikonal equation, else the general Hamiltonian's label (``"moving-medium"``,
+        ``"metric"`` or ``"isotropic"``). Which local solver ran is ``stats.local_solver``
+        (``"godunov"``, ``"lxf"`` or ``"upwind"``).
     method : str
         ``"two-layer"`` or ``"naive"``.
     order : int

@@ -392,6 +392,7 @@ def _solve_on_tube(
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
+        local_solver=st.get("local_solver", scheme),
     )
     return Solution(
         grid,

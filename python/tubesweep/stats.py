@@ -59,6 +59,11 @@ class SolveStats:
         an iteration whose visited rows held more data than a quarter of the last-level cache
         (before the first, every row counts as visited, or none with the front window;
         docs/development/performance-history.md, "Rows fetched ahead"). The values do not depend on it.
+    local_solver : str
+        The local solver that ran in the inner tube: ``"godunov"`` (the Godunov update, Eq. (3)),
+        ``"lxf"`` (Lax–Friedrichs: Eq. (4) for the eikonal equation, Sect. 5.1 for the moving
+        medium and metrics) or ``"upwind"`` (the upwind, Godunov-type solver of the moving medium
+        and metrics, docs/hamiltonians.md).
     order : int
         The scheme's order: 1 (the paper's) or 2 (docs/second-order.md on surfaces,
         docs/box-second-order.md for ``travel_time(..., order=2)``).
@@ -96,6 +101,7 @@ class SolveStats:
     narrowest_gap: float = float("inf")
     thin_strip_iterations: Tuple[int, int] = (0, 0)
     prefetch_iterations: int = 0
+    local_solver: str = "godunov"
     order: int = 1
     order2: Optional[Dict[str, Any]] = None
 

@@ -13,6 +13,7 @@
 //! iterations; the fastest of `REPS` (default 5) rounds, the cases alternating.
 //!
 //!     cargo run --release -p tubesweep-core --example upwind_sweep -- [N=101] [threads=1]
+//!   (`SOURCE_AXIS=1` or `2` puts the source on the y or z axis, as in the other examples)
 #[path = "common/shell.rs"]
 mod shell;
 #[path = "common/sphere_source.rs"]
@@ -39,7 +40,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(101);
     let threads: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
-    let (band, roles, weights, h, _) = sphere_source::sphere_with_source(n, 0);
+    let (band, roles, weights, h, _) = sphere_source::sphere_with_source(n, sphere_source::source_axis_from_env());
     let idx = band.indices();
     // the rotation about z at each node's closest point on the sphere (R = 0.5), tangent there
     let flow: Vec<[f64; 3]> = idx
@@ -100,7 +101,7 @@ fn main() {
             for (i, (_, scheme)) in cases.iter().enumerate() {
                 let p = sphere_source::sphere_problem(&band, &roles, &weights, h, *scheme);
                 let st = run(&band, &p, plain, threads);
-                if best[i].as_ref().map_or(true, |b| st.seconds < b.seconds) {
+                if best[i].as_ref().is_none_or(|b| st.seconds < b.seconds) {
                     best[i] = Some(st);
                 }
             }
