@@ -27,9 +27,11 @@ def _fix_sources(
     slowness_at: Callable[[np.ndarray], np.ndarray],
     source_init: str,
     inner_width: float,
+    radius: float = SOURCE_RADIUS,
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions in the band and values of the nodes fixed by the point sources, and the index of
-    the source each node's value comes from (the nearest, where several sources fix one node)."""
+    the source each node's value comes from (the nearest, where several sources fix one node).
+    ``radius``: the exact initialisation's reach in grid spacings."""
     h = grid.spacing
     d = grid.ndim
     dist, proj = surface.project(sources, grid)
@@ -40,7 +42,7 @@ def _fix_sources(
                 f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
             )
     best: dict = {}
-    r = int(np.ceil(SOURCE_RADIUS + inner_width / h)) + 1
+    r = int(np.ceil(radius + inner_width / h)) + 1
     offsets = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
     for i, (s, sp) in enumerate(zip(sources, proj)):
         if source_init == "node":
@@ -64,7 +66,7 @@ def _fix_sources(
         x = grid.points(grid.unravel(linear[pos]))
         _, cp = surface.project(x, grid)
         geo = np.linalg.norm(cp - sp, axis=1)
-        near = geo <= SOURCE_RADIUS * h
+        near = geo <= radius * h
         if not np.any(near):
             near = geo <= geo.min()
         slow = 0.5 * (slowness_at(cp[near]) + slowness_at(sp[None])[0])

@@ -539,9 +539,11 @@ class Metric(Hamiltonian):
         ``M(points (K, d)) -> (K, d, d)`` (evaluated at the closest points of the band nodes).
     tangential : bool
         On a surface only the tangential block of ``M`` matters. With ``True`` (default) the
-        normal–tangent coupling is removed, ``M ← P M P + (nᵀMn) n nᵀ`` with ``P = I − n nᵀ``, so
+        normal–tangent coupling is removed, ``M ← P M P + m_n n nᵀ`` with ``P = I − n nᵀ``, so
         that the small normal component of the extrinsic gradient cannot leak into the tangential
-        metric. ``False`` uses ``M`` as given (right for a full-box solve).
+        metric; the normal entry ``m_n`` is the mean of the tangential block's eigenvalues
+        (``tr(PMP)/(d − 1)``) with the upwind solver, ``nᵀMn`` with ``scheme="lxf"``. ``False``
+        uses ``M`` as given (right for a full-box solve).
     scheme : {"godunov", "lxf"}
         The local solver in the inner tube: the upwind solver (default) or the Lax–Friedrichs
         update of Sect. 5.1 (the default when ``sigma`` is given).
@@ -557,7 +559,7 @@ class Metric(Hamiltonian):
     --------
     >>> import numpy as np, tubesweep as ts
     >>> grid = ts.Grid((-1, -1), (1, 1), (101, 101))
-    >>> M = np.diag([4.0, 1.0])  # travel is twice as slow along x
+    >>> M = np.diag([4.0, 1.0])  # travel is twice as fast along x (u = sqrt(dᵀM⁻¹d))
     >>> sol = ts.solve(ts.surfaces.Circle(0.5), grid, [(0.5, 0.0)], hamiltonian=ts.hamiltonians.Metric(M))
     """
 
@@ -592,8 +594,15 @@ class Metric(Hamiltonian):
             n = _normals(surface, grid, x, direction)
             has = np.linalg.norm(n, axis=1) > 0.5
             P = np.eye(d)[None] - n[:, :, None] * n[:, None, :]
-            mnn = np.einsum("ki,kij,kj->k", n, m, n)
-            mt = P @ m @ P + mnn[:, None, None] * n[:, :, None] * n[:, None, :]
+            pmp = P @ m @ P
+            if self.scheme == "lxf":
+                mnn = np.einsum("ki,kij,kj->k", n, m, n)
+            else:
+                # the normal block is free (the surface's equation does not see it): the tangential
+                # mean makes the tube as isotropic across as the eikonal solver's, so the front cuts
+                # the curved tube's inner side no faster than it does there (docs/hamiltonians.md)
+                mnn = np.trace(pmp, axis1=1, axis2=2) / (d - 1)
+            mt = pmp + mnn[:, None, None] * n[:, :, None] * n[:, None, :]
             m = np.where(has[:, None, None], mt, m)
         m = np.ascontiguousarray(m)
         try:
