@@ -219,7 +219,7 @@ def solve_on_tube(
         outer_points=n_outer,
         fixed_points=len(positions),
         setup_seconds=setup,
-        band_bytes=band.nbytes + st["solver_bytes"] + 8 * band.n_rows,
+        band_bytes=band.nbytes + st["solver_bytes"],
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         order=2,

@@ -85,7 +85,7 @@ fn run<'py, const D: usize>(
             band,
             roles,
             &surface,
-            &geometry.nodes,
+            directions,
             lower,
             inp.spacing,
             sources,
@@ -132,6 +132,7 @@ fn run<'py, const D: usize>(
             band,
             &geometry,
             &factoring,
+            directions,
             slowness,
             inp.spacing,
             &mut values,
@@ -142,12 +143,17 @@ fn run<'py, const D: usize>(
             stats.first_order_iterations = first_iterations;
             stats.seconds += first_seconds;
         }
-        let bytes = geometry.nodes.capacity() * std::mem::size_of_val(&geometry.nodes[0])
-            + factoring.u0.capacity() * 8
+        // what the solve holds besides the band and the arrays it borrows from the tube (φ,
+        // the directions, the roles given): the inner nodes' geometry and ∂u₀, u₀, |φ|, the
+        // roles with the fixed nodes, the values, the active flags, per row an offset
+        let bytes = geometry.nodes.capacity() * std::mem::size_of::<tubesweep_core::second_order::NodeGeometry>()
             + factoring.grad_u0.capacity() * 4 * D
+            + factoring.u0.capacity() * 8
+            + geometry.abs_phi.capacity() * 4
             + factoring.roles.capacity()
             + values.capacity() * 8
-            + n; // the active flags
+            + n
+            + 4 * (band.n_rows() + 1);
         let roles_out: Vec<u8> = factoring.roles.iter().map(|&r| r as u8).collect();
         Ok::<_, tubesweep_core::Error>((values, factoring.u0, roles_out, stats, geometry.summary, bytes))
     });

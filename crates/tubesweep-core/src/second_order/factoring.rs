@@ -10,29 +10,31 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
-use super::geometry::NodeGeometry;
 use super::implicit::Implicit;
 
-/// u₀ at every node, ∂u₀ at the inner nodes, and the roles with the fixed nodes marked.
+/// u₀ at every node, ∂u₀ at the nodes not in the extension layer, and the roles with the fixed
+/// nodes marked.
 pub struct Factoring<const D: usize> {
     pub u0: Vec<f64>,
     /// ∇u₀ = σ_s Dcpᵀ (cp − x_s)/|cp − x_s| with Dcp = I − nnᵀ − φD²φ (the Jacobian of the
-    /// closest point of a signed distance), exact up to the differences of φ. Zero at the
-    /// extension-layer nodes (not read there) and at fixed nodes.
+    /// closest point of a signed distance), exact up to the differences of φ. One entry per node
+    /// not in the extension layer, in band order, like [`super::TubeGeometry::nodes`] (zero at
+    /// the fixed nodes).
     pub grad_u0: Vec<[f32; D]>,
     pub roles: Vec<NodeRole>,
     /// Nodes fixed by each source.
     pub fixed_per_source: Vec<usize>,
 }
 
-/// `lower`, `spacing`: the grid; `phi` (signed) and `geometry` per node; `sources` the sources'
+/// `lower`, `spacing`: the grid; `phi` (signed) and `directions` (the outward unit directions
+/// sgn(φ) n) per node; `sources` the sources'
 /// foot points on the surface and `source_slowness` σ_s at each.
 #[allow(clippy::too_many_arguments)]
 pub fn factor_sources<const D: usize>(
     band: &NarrowBand<D>,
     roles: &[NodeRole],
     phi: &[f64],
-    geometry: &[NodeGeometry],
+    directions: &[[f32; D]],
     lower: [f64; D],
     spacing: f64,
     sources: &[[f64; D]],
@@ -43,7 +45,7 @@ pub fn factor_sources<const D: usize>(
         band,
         roles,
         &Implicit::LevelSet(phi),
-        geometry,
+        directions,
         lower,
         spacing,
         sources,
@@ -59,7 +61,7 @@ pub fn factor_sources_of<const D: usize>(
     band: &NarrowBand<D>,
     roles: &[NodeRole],
     surface: &Implicit<'_, D>,
-    geometry: &[NodeGeometry],
+    directions: &[[f32; D]],
     lower: [f64; D],
     spacing: f64,
     sources: &[[f64; D]],
@@ -77,7 +79,7 @@ pub fn factor_sources_of<const D: usize>(
         ));
     }
     let mut u0 = vec![0.0; n];
-    let mut grad_u0 = vec![[0.0f32; D]; n];
+    let mut grad_u0 = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     let mut out_roles = roles.to_vec();
     let mut fixed_per_source = vec![0usize; sources.len()];
     let indices = band.indices();
@@ -92,10 +94,10 @@ pub fn factor_sources_of<const D: usize>(
         // φ in the orientation of the differences, ∇φ/|∇φ| (the layer's geometry holds the
         // outward direction sgn(φ) n)
         let mut phi_i = surface.phi(i);
-        let sign = if inner || phi_i >= 0.0 { 1.0 } else { -1.0 };
+        let sign = if phi_i < 0.0 { -1.0 } else { 1.0 };
         let mut nrm = [0.0; D];
         for k in 0..D {
-            nrm[k] = sign * geometry[i].normal[k] as f64;
+            nrm[k] = sign * directions[i][k] as f64;
         }
         if let Some(l) = &local {
             phi_i = l.phi;
@@ -118,6 +120,8 @@ pub fn factor_sources_of<const D: usize>(
         let (value, s, chord) = best;
         u0[i] = value;
         if inner {
+            grad_u0.push([0.0f32; D]);
+            let g = grad_u0.last_mut().expect("just pushed");
             // the nodes within fix_radius of some source are fixed (the nearest's value)
             let near = sources
                 .iter()
@@ -142,7 +146,7 @@ pub fn factor_sources_of<const D: usize>(
                     if let Some(l) = &local {
                         v -= phi_i * (0..D).map(|m| l.hessian[k][m] * e[m]).sum::<f64>();
                     }
-                    grad_u0[i][k] = (source_slowness[s] * v) as f32;
+                    g[k] = (source_slowness[s] * v) as f32;
                 }
             }
         }

@@ -15,15 +15,15 @@ use crate::sweep::NodeRole;
 
 use super::implicit::Implicit;
 
-/// What the second-order sweeps read at one node.
+/// What the second-order sweeps read at one inner-tube node (the extension layer's nodes read
+/// only the given directions).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeGeometry {
-    /// Inner tube: ∇φ/|∇φ| (the first `D` entries) by central differences of φ (the given
-    /// direction times sgn(φ) where the stencil is incomplete). Extension layer: the given outward
-    /// direction sgn(φ) n, which the extension update follows.
+    /// ∇φ/|∇φ| (the first `D` entries) by central differences of φ (the given direction times
+    /// sgn(φ) where the stencil is incomplete).
     pub normal: [f32; 3],
     /// B = (I − φ D²φ)⁻¹, symmetric, packed as (00, 01, 02, 11, 12, 22) (2D: 00, 01, 11 in the
-    /// places 0, 1, 3). The identity at extension-layer nodes (not read there).
+    /// places 0, 1, 3).
     pub b: [f32; 6],
 }
 
@@ -47,8 +47,10 @@ pub struct GeometrySummary {
     pub incomplete_stencils: usize,
 }
 
-/// The geometry of every band node and the surface summary.
+/// The geometry of the inner-tube nodes and the surface summary.
 pub struct TubeGeometry {
+    /// One entry per node that is not in the extension layer, in band order (the k-th such node's
+    /// is `nodes[k]`: the sweeps count them along each row, [`crate::second_order::solver`]).
     pub nodes: Vec<NodeGeometry>,
     /// |φ| per node (apart from the rest: the extension update compares it between neighbours).
     pub abs_phi: Vec<f32>,
@@ -175,7 +177,8 @@ pub(crate) fn gradient_and_hessian_by<const D: usize>(
     Some((g, hess))
 }
 
-/// The geometry of every node of `band`: `phi` (signed, per node), `directions` the outward unit
+/// The geometry of the inner-tube nodes of `band` (the nodes not in the extension layer, in band
+/// order): `phi` (signed, per node), `directions` the outward unit
 /// directions sgn(φ) n the solver's extension reads (per node), `roles` to know the inner tube.
 pub fn tube_geometry<const D: usize>(
     band: &NarrowBand<D>,
@@ -214,7 +217,7 @@ pub fn tube_geometry_of<const D: usize>(
         grad_norm_max: 0.0,
         incomplete_stencils: 0,
     };
-    let mut nodes = Vec::with_capacity(n);
+    let mut nodes = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     let mut identity = [0.0f32; 6];
     for k in 0..D {
         identity[sym(k, k)] = 1.0;
@@ -273,8 +276,11 @@ pub fn tube_geometry_of<const D: usize>(
                 }
             }
         }
-        nodes.push(geo);
+        if roles[i] != NodeRole::Outer {
+            nodes.push(geo);
+        }
     }
+    nodes.shrink_to_fit();
     if !summary.grad_norm_min.is_finite() {
         summary.grad_norm_min = 0.0;
     }
@@ -334,7 +340,8 @@ mod tests {
         assert!((geo.summary.max_curvature - 2.0).abs() < 0.05, "{:?}", geo.summary);
         assert!((geo.summary.grad_norm_max - 1.0).abs() < 0.01 && (geo.summary.grad_norm_min - 1.0).abs() < 0.01);
         let mut worst: f64 = 0.0;
-        for (i, g) in geo.nodes.iter().enumerate() {
+        let inner = (0..band.len()).filter(|&i| roles[i] != NodeRole::Outer);
+        for (i, g) in inner.zip(&geo.nodes) {
             if roles[i] != NodeRole::Inner {
                 continue;
             }

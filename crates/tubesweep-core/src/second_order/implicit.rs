@@ -163,18 +163,20 @@ mod tests {
         assert!((a.summary.max_curvature - b.summary.max_curvature).abs() < 1e-9);
         assert!((b.summary.grad_norm_max - 1.0).abs() < 0.01 && (b.summary.grad_norm_min - 1.0).abs() < 0.01);
         let (mut worst_b, mut worst_n): (f64, f64) = (0.0, 0.0);
-        for i in 0..band.len() {
+        // (the geometries hold the nodes that are not in the extension layer, in band order)
+        let inner = (0..band.len()).filter(|&i| roles[i] != NodeRole::Outer);
+        for ((i, ga), gb) in inner.zip(&a.nodes).zip(&b.nodes) {
             if roles[i] != NodeRole::Inner {
                 continue;
             }
             for k in 0..3 {
                 for l in k..3 {
                     let s = sym(k, l);
-                    worst_b = worst_b.max((a.nodes[i].b[s] - b.nodes[i].b[s]).abs() as f64);
+                    worst_b = worst_b.max((ga.b[s] - gb.b[s]).abs() as f64);
                 }
             }
             // the normals agree up to sign (a closest-point map's orientation is local)
-            let dot: f32 = (0..3).map(|k| a.nodes[i].normal[k] * b.nodes[i].normal[k]).sum();
+            let dot: f32 = (0..3).map(|k| ga.normal[k] * gb.normal[k]).sum();
             worst_n = worst_n.max(1.0 - dot.abs() as f64);
         }
         assert!(worst_b < 1e-5 && worst_n < 1e-6, "B {worst_b:e}, normals {worst_n:e}");

@@ -87,7 +87,10 @@ struct Limits {
 struct Sweeper<'a, const D: usize> {
     table: NeighbourTable<'a, D>,
     roles: &'a [NodeRole],
+    /// Per node not in the extension layer, in band order (`k` below).
     geometry: &'a [NodeGeometry],
+    /// The outward unit directions sgn(φ) n per node, which the extension update follows.
+    directions: &'a [[f32; D]],
     u0: &'a [f64],
     grad_u0: &'a [[f32; D]],
     slowness: Slowness<'a>,
@@ -107,7 +110,7 @@ impl<const D: usize> Sweeper<'_, D> {
 
     /// The inner-tube update at node `i` (u, not w), None when no side is known yet.
     #[inline(always)]
-    fn inner(&self, u: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
+    fn inner(&self, u: &SharedValues<'_>, i: usize, k_inner: usize, second: bool) -> Option<f64> {
         let table = self.table;
         let sentinel = table.sentinel();
         // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives
@@ -117,7 +120,7 @@ impl<const D: usize> Sweeper<'_, D> {
         let mut grad = [0.0; D];
         let ui = u.get(i);
         for k in 0..D {
-            let du0 = self.grad_u0[i][k] as f64;
+            let du0 = self.grad_u0[k_inner][k] as f64;
             let mut near = [f64::NAN; 2];
             for side in 0..2 {
                 let j1 = nb[k][side];
@@ -149,7 +152,7 @@ impl<const D: usize> Sweeper<'_, D> {
                 _ => 0.0,
             };
         }
-        let s = corrected_slowness::<D>(&self.geometry[i], grad, self.sigma(i));
+        let s = corrected_slowness::<D>(&self.geometry[k_inner], grad, self.sigma(i));
         let w = if second {
             godunov_newton(&sides, s * h)
         } else {
@@ -169,11 +172,11 @@ impl<const D: usize> Sweeper<'_, D> {
         let sentinel = table.sentinel();
         // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives
         let nb = unsafe { table.neighbours_of_unchecked(i) };
-        let geo = &self.geometry[i];
+        let direction = &self.directions[i];
         let abs_phi = self.abs_phi[i];
         let (mut num, mut den) = (0.0, 0.0);
         for k in 0..D {
-            let nk = geo.normal[k];
+            let nk = direction[k];
             if nk == 0.0 {
                 continue;
             }
@@ -219,7 +222,16 @@ impl<const D: usize> Sweeper<'_, D> {
 
     /// Updates node `i` if it is active and its value lies within the window; records the change.
     #[inline(always)]
-    fn visit(&self, u: &SharedValues<'_>, active: &[AtomicU8], i: usize, lim: Limits, change: &mut Accumulator) {
+    #[allow(clippy::too_many_arguments)]
+    fn visit(
+        &self,
+        u: &SharedValues<'_>,
+        active: &[AtomicU8],
+        i: usize,
+        k_inner: usize,
+        lim: Limits,
+        change: &mut Accumulator,
+    ) {
         if active[i].load(Ordering::Relaxed) == 0 {
             return;
         }
@@ -232,7 +244,7 @@ impl<const D: usize> Sweeper<'_, D> {
         active[i].store(0, Ordering::Relaxed);
         let new = match self.roles[i] {
             NodeRole::Fixed => return,
-            NodeRole::Inner => self.inner(u, i, lim.second),
+            NodeRole::Inner => self.inner(u, i, k_inner, lim.second),
             NodeRole::Outer => self.outer(u, i, lim.second),
         };
         change.updates += 1;
@@ -288,6 +300,7 @@ pub fn sweep_second_order<const D: usize>(
     band: &NarrowBand<D>,
     geometry: &TubeGeometry,
     factoring: &Factoring<D>,
+    directions: &[[f32; D]],
     slowness: Slowness<'_>,
     spacing: f64,
     values: &mut [f64],
@@ -297,7 +310,14 @@ pub fn sweep_second_order<const D: usize>(
     let start = Instant::now();
     let n = band.len();
     let (abs_phi, geometry) = (&geometry.abs_phi[..], &geometry.nodes[..]);
-    if values.len() != n || geometry.len() != n || abs_phi.len() != n || factoring.u0.len() != n {
+    let n_inner = factoring.roles.iter().filter(|&&r| r != NodeRole::Outer).count();
+    if values.len() != n
+        || abs_phi.len() != n
+        || factoring.u0.len() != n
+        || directions.len() != n
+        || geometry.len() != n_inner
+        || factoring.grad_u0.len() != n_inner
+    {
         return Err(Error::invalid(
             "values",
             format!("one value per band node ({n}) is needed"),
@@ -315,6 +335,7 @@ pub fn sweep_second_order<const D: usize>(
         table: band.neighbour_table(),
         roles: &factoring.roles,
         geometry,
+        directions,
         u0: &factoring.u0,
         grad_u0: &factoring.grad_u0,
         slowness,
@@ -323,6 +344,16 @@ pub fn sweep_second_order<const D: usize>(
         abs_phi,
     };
     let roles = sw.roles;
+    // per row, the nodes before it that are not in the extension layer (the rows cover the band
+    // in order): the index of a node's geometry, counted along the row as the sweeps walk it
+    let mut row_inner = Vec::with_capacity(band.n_rows() + 1);
+    let mut count = 0u32;
+    for r in 0..band.n_rows() {
+        let (s, e) = band.row_range(r);
+        row_inner.push(count);
+        count += roles[s..e].iter().filter(|&&r| r != NodeRole::Outer).count() as u32;
+    }
+    row_inner.push(count);
     let unit = if options.window_first > 0.0 || options.window_second > 0.0 {
         let sigma = match slowness {
             Slowness::Constant(s) => s,
@@ -361,6 +392,7 @@ pub fn sweep_second_order<const D: usize>(
             band,
             values,
             &active,
+            &row_inner,
             &mut pipeline,
             lim,
             options.window_first * unit,
@@ -388,6 +420,7 @@ pub fn sweep_second_order<const D: usize>(
         band,
         values,
         &active,
+        &row_inner,
         &mut pipeline,
         lim,
         options.window_second * unit,
@@ -420,6 +453,7 @@ fn run_phase<const D: usize>(
     band: &NarrowBand<D>,
     values: &mut [f64],
     active: &[AtomicU8],
+    row_inner: &[u32],
     pipeline: &mut Pipeline,
     mut lim: Limits,
     window_width: f64,
@@ -448,9 +482,19 @@ fn run_phase<const D: usize>(
             let mut acc = Accumulator::default();
             for &r in rows {
                 let (s, e) = band.row_range(r as usize);
-                for step in 0..e - s {
-                    let i = if backwards { e - 1 - step } else { s + step };
-                    sw.visit(&shared, active, i, lim_now, &mut acc);
+                let roles = &sw.roles[s..e];
+                if backwards {
+                    let mut k = row_inner[r as usize + 1] as usize;
+                    for (i, &role) in (s..e).zip(roles).rev() {
+                        k -= (role != NodeRole::Outer) as usize;
+                        sw.visit(&shared, active, i, k, lim_now, &mut acc);
+                    }
+                } else {
+                    let mut k = row_inner[r as usize] as usize;
+                    for (i, &role) in (s..e).zip(roles) {
+                        sw.visit(&shared, active, i, k, lim_now, &mut acc);
+                        k += (role != NodeRole::Outer) as usize;
+                    }
                 }
             }
             acc

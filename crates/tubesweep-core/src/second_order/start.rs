@@ -21,11 +21,12 @@ fn isotropic_slowness<const D: usize>(
     roles: &[NodeRole],
     slowness: Slowness<'_>,
 ) -> Vec<f64> {
-    geometry
+    // the geometry holds the nodes not in the extension layer, in band order
+    let mut inner = geometry.iter();
+    roles
         .iter()
-        .zip(roles)
         .enumerate()
-        .map(|(i, (g, &r))| {
+        .map(|(i, &r)| {
             let sigma = match slowness {
                 Slowness::Constant(s) => s,
                 Slowness::PerNode(s) => s[i],
@@ -33,6 +34,7 @@ fn isotropic_slowness<const D: usize>(
             if r == NodeRole::Outer {
                 return sigma;
             }
+            let Some(g) = inner.next() else { return sigma };
             let b = |k: usize, l: usize| g.b[sym(k.min(l), k.max(l))] as f64;
             let (mut tr, mut bn2) = (0.0, 0.0);
             for k in 0..D {
