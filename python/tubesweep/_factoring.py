@@ -46,7 +46,9 @@ def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: 
     if len(p) == 0:
         return values
     dist = np.sqrt(((p[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2))
-    close = dist.min(axis=1) <= reach
+    # (points off the band read NaN as before: their closest points are not asked for, a map
+    # may be undefined there)
+    close = (dist.min(axis=1) <= reach) & np.isfinite(values)
     if np.any(close):
         q = p[close]
         foot = q
