@@ -85,8 +85,34 @@ def _normals(surface: Any, grid: Grid, x: np.ndarray, direction: np.ndarray) -> 
     return n
 
 
-def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail: tuple, name: str) -> np.ndarray:
-    """A per-node field from a constant, an array of ``grid.shape + tail``, or a callable on points."""
+def _interp_nodes(arr: np.ndarray, grid: Grid, x: np.ndarray) -> np.ndarray:
+    """Multilinear interpolation of an array of ``grid.shape + tail`` at points x (M, d): (M,) + tail."""
+    d = grid.ndim
+    tail = arr.shape[d:]
+    flat = arr.reshape(tuple(grid.shape) + (-1,))
+    t = grid.continuous_index(x)
+    base = np.clip(np.floor(t), 0, np.asarray(grid.shape) - 2).astype(np.int64)
+    frac = np.clip(t - base, 0.0, 1.0)
+    out = np.zeros((len(x), flat.shape[-1]))
+    for corner in range(1 << d):
+        bits = np.array([(corner >> k) & 1 for k in range(d)])
+        w = np.prod(np.where(bits == 1, frac, 1 - frac), axis=1)
+        out += w[:, None] * flat[tuple((base + bits).T)]
+    return out.reshape((len(x),) + tail)
+
+
+def _field(
+    value: Any,
+    grid: Grid,
+    linear: np.ndarray,
+    points: np.ndarray,
+    tail: tuple,
+    name: str,
+    interpolate: bool = False,
+) -> np.ndarray:
+    """A per-node field from a constant, an array of ``grid.shape + tail``, or a callable on points.
+    An array is read at the nodes, or with ``interpolate`` interpolated (multilinearly) at
+    ``points`` — the nodes' closest points, where a callable is evaluated too."""
     want = (len(linear),) + tail
     if callable(value):
         out = call_on_points(value, points, f"{name} callable's values")
@@ -100,7 +126,7 @@ def _field(value: Any, grid: Grid, linear: np.ndarray, points: np.ndarray, tail:
         if arr.shape == tail:
             out = np.broadcast_to(arr, want).copy()
         elif arr.shape == tuple(grid.shape) + tail:
-            out = arr.reshape((-1,) + tail)[linear]
+            out = _interp_nodes(arr, grid, points) if interpolate else arr.reshape((-1,) + tail)[linear]
         else:
             raise ValueError(
                 f"{name} must be a constant of shape {tail}, an array of shape grid.shape + {tail} = "
@@ -328,7 +354,9 @@ class MovingMedium(Hamiltonian):
         ``v(points (M, d)) -> (M, d)`` (e.g. :func:`tubesweep.flows.point_vortices`), an array of
         ``grid.shape + (d,)``, or a constant vector. A callable is evaluated at the
         closest points ``cp(x)`` of the band nodes (the flow lives on the surface and is extended
-        constantly along normals); an array is read at the nodes.
+        constantly along normals); so is an array with the upwind solver (multilinear
+        interpolation at ``cp(x)``: the array and the callable give the same field), while with
+        ``scheme="lxf"`` an array is read at the nodes, as it always was.
     allow_supersonic : bool
         The paper assumes ``|v| ≪ F``. Where ``|v| ≥ F`` the medium outruns the wave and the
         first-arrival problem changes character (the equation loses the monotone front
@@ -425,9 +453,12 @@ class MovingMedium(Hamiltonian):
         >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
         """
         d = grid.ndim
-        if callable(self.flow) and surface is not None:
+        # a callable at the closest points; an array too with the upwind solver (interpolated there,
+        # so that both forms give the same field), at the nodes with LxF (as it always was)
+        at_cp = surface is not None and (callable(self.flow) or (self.scheme != "lxf" and np.ndim(self.flow) > 1))
+        if at_cp:
             _, cp = surface.project(x, grid)
-            v = _field(self.flow, grid, linear, cp, (d,), "flow")
+            v = _field(self.flow, grid, linear, cp, (d,), "flow", interpolate=True)
         else:
             v = _field(self.flow, grid, linear, x, (d,), "flow")
         n = _normals(surface, grid, x, direction) if surface is not None else np.zeros_like(v)
@@ -536,7 +567,8 @@ class Metric(Hamiltonian):
     ----------
     M : array_like or callable
         A constant ``(d, d)`` matrix, an array of ``grid.shape + (d, d)``, or a callable
-        ``M(points (K, d)) -> (K, d, d)`` (evaluated at the closest points of the band nodes).
+        ``M(points (K, d)) -> (K, d, d)`` (evaluated at the closest points of the band nodes; an
+        array is interpolated there with the upwind solver, read at the nodes with ``"lxf"``).
     tangential : bool
         On a surface only the tangential block of ``M`` matters. With ``True`` (default) the
         normal–tangent coupling is removed, ``M ← P M P + m_n n nᵀ`` with ``P = I − n nᵀ``, so
@@ -576,9 +608,10 @@ class Metric(Hamiltonian):
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):
         d = grid.ndim
-        if callable(self.M) and surface is not None:
+        if surface is not None and (callable(self.M) or (self.scheme != "lxf" and np.ndim(self.M) > 2)):
+            # at the closest points, an array interpolated there (as the flow, above)
             _, cp = surface.project(x, grid)
-            m = _field(self.M, grid, linear, cp, (d, d), "M")
+            m = _field(self.M, grid, linear, cp, (d, d), "M", interpolate=True)
         else:
             m = _field(self.M, grid, linear, x, (d, d), "M")
         asym = np.abs(m - np.swapaxes(m, 1, 2)).max(axis=(1, 2))

@@ -43,6 +43,15 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         core::array::from_fn(|k| (0..D).map(|l| self.m[k][l] * p[l]).sum())
     }
 
+    /// `q* = −(M_off,K · P) / M_off,off`.
+    #[inline(always)]
+    fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
+        let r = &self.m[off];
+        let mut out = p;
+        out[off] = -(0..D).filter(|&k| k != off).map(|k| r[k] * p[k]).sum::<f64>() / r[off];
+        out
+    }
+
     #[inline(always)]
     fn inside(&self, p: [f64; D]) -> bool {
         let q: f64 = (0..D)

@@ -79,6 +79,10 @@ pub(crate) trait Faces<const D: usize> {
     fn velocity(&self, p: [f64; D]) -> [f64; D];
     /// Whether `G(p) ≤ 1 − 1e-12`: `p` lies inside the unit ball `{G ≤ 1}` with a margin.
     fn inside(&self, p: [f64; D]) -> bool;
+    /// The full gradient `(P, q*)` of a solution on the face of the `D − 1` axes other than
+    /// `off`: `P` (given in place, `p[off]` ignored) and the off-face component `q*` that
+    /// minimises `G(P + q e_off)` (the projection of [`Faces::project`]), so that `G = 1` there.
+    fn complete(&self, p: [f64; D], off: usize) -> [f64; D];
     /// `τ_k`, per axis and side, bounding how much the travel time `φ(d)` can grow when the
     /// component `d_k` of a displacement towards the node from that side's neighbour is mirrored
     /// (pointed from the other neighbour): `φ(d') − φ(d) ≤ τ_k |d_k|` (0 where `φ` is even in
@@ -247,7 +251,20 @@ fn natural_orthant<const D: usize, F: Faces<D>>(
     }
     let inv_h = 1.0 / h;
     let gp: [f64; D] = core::array::from_fn(|k| sg[k] * (mu - u[k]) * inv_h);
-    // every non-empty subset of the deficit axes
+    Some((mu, moved_inside(faces, gp, &deficit, def, &sg, inv_h)))
+}
+
+/// Whether `p − Σ_{k∈S} s_k deficit_k e_k / h` lies inside the unit ball for every non-empty subset
+/// `S` of the axes in `def` (the deficit axes of [`natural_orthant`]).
+#[inline(always)]
+fn moved_inside<const D: usize, F: Faces<D>>(
+    faces: &F,
+    gp: [f64; D],
+    deficit: &[f64; D],
+    def: usize,
+    sg: &[f64; D],
+    inv_h: f64,
+) -> bool {
     let mut sub = def;
     while sub != 0 {
         let p: [f64; D] = core::array::from_fn(|k| {
@@ -258,11 +275,101 @@ fn natural_orthant<const D: usize, F: Faces<D>>(
             }
         });
         if !faces.inside(p) {
-            return Some((mu, false));
+            return false;
         }
         sub = (sub - 1) & def;
     }
-    Some((mu, true))
+    true
+}
+
+/// The fast path's second chance, when the natural orthant's simplex has no critical point
+/// inside it (the characteristic runs along one of its faces, as along a symmetry plane or
+/// where one axis is nearly across the characteristic): its faces of dimension `D − 2`, the
+/// simplices of `D − 1` of its neighbours, each solved until one is proved as in
+/// [`natural_orthant`], with the full gradient `(P, q*)` of the face ([`Faces::complete`],
+/// `G = 1`): the two neighbours on the face's missing axis must give `c ≥ μ + η`, and the other
+/// sides of its own axes too, with `p` moved inwards where they fall short, as there. Every face is then at least `μ`, and the faces holding the minimiser
+/// (the face itself, and the two simplices around it, whose critical points have a negative
+/// weight on the missing axis) do not tie with it. `Some(μ)` when proved.
+#[inline(always)]
+fn natural_faces<const D: usize, F: Faces<D>>(
+    faces: &F,
+    nb: &[[f64; 2]; D],
+    o: usize,
+    h: f64,
+    best: &mut f64,
+) -> Option<f64> {
+    if D < 2 {
+        return None;
+    }
+    let full = (1u32 << D) - 1;
+    for off in 0..D {
+        let mask = full & !(1 << off);
+        let pk = faces.project(mask)?;
+        // the face's axes in increasing order, M = D − 1 of them
+        let solved = match D {
+            2 => face_value::<D, 1, F>(faces, &pk, nb, o, mask, h),
+            _ => face_value::<D, 2, F>(faces, &pk, nb, o, mask, h),
+        };
+        let Some(mu) = solved else { continue };
+        if mu < *best {
+            *best = mu;
+        }
+        let eta = 1e-11 * mu.abs();
+        let inv_h = 1.0 / h;
+        let p: [f64; D] = core::array::from_fn(|k| {
+            let side = o >> k & 1;
+            (1.0 - 2.0 * side as f64) * (mu - nb[k][side]) * inv_h
+        });
+        let p = faces.complete(p, off);
+        if !(nb[off][0] + h * p[off] >= mu + eta && nb[off][1] - h * p[off] >= mu + eta) {
+            continue;
+        }
+        // the other sides of the face's own axes, as in `natural_orthant`
+        let mut deficit = [0.0; D];
+        let mut def = 0usize;
+        for k in 0..D {
+            let side = o >> k & 1;
+            let d = 2.0 * mu + eta - nb[k][1 - side] - nb[k][side];
+            if k != off && d > 0.0 {
+                deficit[k] = d;
+                def |= 1 << k;
+            }
+        }
+        let sg: [f64; D] = core::array::from_fn(|k| 1.0 - 2.0 * (o >> k & 1) as f64);
+        if def == 0 || moved_inside(faces, p, &deficit, def, &sg, inv_h) {
+            return Some(mu);
+        }
+    }
+    None
+}
+
+/// The value on the face of orthant `o` spanning the axes of `mask` (`M` of them), if its
+/// critical point lies strictly inside it.
+#[inline(always)]
+fn face_value<const D: usize, const M: usize, F: Faces<D>>(
+    faces: &F,
+    proj: &F::Projected,
+    nb: &[[f64; 2]; D],
+    o: usize,
+    mask: u32,
+    h: f64,
+) -> Option<f64> {
+    let mut u = [0.0; M];
+    let mut sg = [0.0; M];
+    let mut j = 0;
+    for k in 0..D {
+        if mask >> k & 1 == 1 {
+            let side = o >> k & 1;
+            u[j] = nb[k][side];
+            sg[j] = 1.0 - 2.0 * side as f64;
+            j += 1;
+        }
+    }
+    let base = u.iter().cloned().fold(f64::INFINITY, f64::min);
+    let w: [f64; M] = core::array::from_fn(|j| u[j] - base);
+    let t = faces.solve::<M, true>(proj, &w, &sg, h, f64::INFINITY)?;
+    Some(base + t)
 }
 
 /// The minimum of `old` and the face values (see the module documentation). `old` may be the
@@ -312,13 +419,18 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     let o0: usize = (0..D).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
     let mut best = old;
     let mut proved = 0u32;
-    if let Some((mu, done)) = natural_orthant(faces, &pf, &nb, o0, h) {
-        if done {
-            return mu.min(old);
+    match natural_orthant(faces, &pf, &nb, o0, h) {
+        Some((mu, true)) => return mu.min(old),
+        Some((mu, false)) => {
+            proved |= 1 << o0;
+            if mu < best {
+                best = mu;
+            }
         }
-        proved |= 1 << o0;
-        if mu < best {
-            best = mu;
+        None => {
+            if let Some(mu) = natural_faces(faces, &nb, o0, h, &mut best) {
+                return mu.min(old);
+            }
         }
     }
     let tau = faces.mirror_slack();
@@ -466,6 +578,9 @@ mod pruning_tests {
         fn inside(&self, _p: [f64; D]) -> bool {
             false
         }
+        fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
+            self.0.complete(p, off)
+        }
         fn mirror_slack(&self) -> [[f64; 2]; D] {
             [[f64::INFINITY; 2]; D]
         }
@@ -575,5 +690,71 @@ mod pruning_tests {
         }
         // the test must exercise the proof, not only the enumeration
         assert!(fast * 2 > total, "the natural orthant settled {fast} of {total}");
+    }
+
+    /// Characteristics along a coordinate plane (as on a symmetry plane of the problem), where the
+    /// natural orthant's simplex has no critical point inside and its faces are tried.
+    #[test]
+    fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
+        let mut x = 0.271_f64;
+        let mut r = move || {
+            x = (x * 997.0 + 0.2718).fract();
+            x
+        };
+        let h = 0.02;
+        let (mut fast, mut total) = (0, 0);
+        for i in 0..20000 {
+            let a = 6.3 * r();
+            let off = i % 3;
+            let mut n = [0.0; 3];
+            n[(off + 1) % 3] = a.cos();
+            n[(off + 2) % 3] = a.sin();
+            let bend: [f64; 3] = core::array::from_fn(|k| (0.5 + 2.0 * r() + 2.0 * (k == off) as u8 as f64) * h * h);
+            let old = if i % 2 == 0 { 1e6 } else { 1.0 + 0.02 * (r() - 0.5) };
+            let nb = |q: [f64; 3]| -> ([f64; 3], [f64; 3]) {
+                (
+                    core::array::from_fn(|k| 1.0 - q[k] * h + bend[k]),
+                    core::array::from_fn(|k| 1.0 + q[k] * h + bend[k]),
+                )
+            };
+            // the flow in the plane too, so that the characteristic stays in it
+            let mut v = [0.6 * (r() - 0.5), 0.6 * (r() - 0.5), 0.6 * (r() - 0.5)];
+            v[off] = 0.0;
+            let f = 1.3;
+            let c = f + v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+            let (minus, plus) = nb(core::array::from_fn(|k| n[k] / c));
+            let randers = moving_medium::tests_faces(f, v);
+            let got = upwind_min(&randers, minus, plus, h, old);
+            assert_eq!(
+                got,
+                upwind_min(&NoPruning(&randers), minus, plus, h, old),
+                "moving medium"
+            );
+            let nbs: [[f64; 2]; 3] = core::array::from_fn(|k| [minus[k], plus[k]]);
+            let vel = randers.velocity(core::array::from_fn(|k| plus[k] - minus[k]));
+            let o0: usize = (0..3).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
+            let mut b = f64::INFINITY;
+            fast += natural_faces(&randers, &nbs, o0, h, &mut b).is_some() as usize;
+            total += 1;
+            // a metric whose characteristic M p lies in the plane: p_off = −(M_off,· p)/M_off,off
+            let q = [
+                [1.0 + r(), 0.3 * r(), -0.2 * r()],
+                [0.0, 0.5 + r(), 0.4 * r()],
+                [0.0, 0.0, 0.3 + r()],
+            ];
+            let m: [[f64; 3]; 3] =
+                core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+            let mut p = n;
+            p[off] = -(0..3).filter(|&k| k != off).map(|k| m[off][k] * n[k]).sum::<f64>() / m[off][off];
+            let pmp: f64 = (0..3).map(|a| (0..3).map(|b| p[a] * m[a][b] * p[b]).sum::<f64>()).sum();
+            let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
+            let riem = metric::tests_faces(0.8, m);
+            let got = upwind_min(&riem, minus, plus, h, old);
+            assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+        }
+        assert!(
+            fast * 2 > total,
+            "the natural orthant's faces settled {fast} of {total}"
+        );
     }
 }

@@ -69,6 +69,16 @@ impl<const D: usize> Faces<D> for Randers<D> {
         })
     }
 
+    /// `q* = −v_off |P| / F_K`, `F_K = sqrt(F² − v_off²)` (see the projection above).
+    #[inline(always)]
+    fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
+        let n2: f64 = (0..D).filter(|&k| k != off).map(|k| p[k] * p[k]).sum();
+        let fk2 = self.f2 - self.v[off] * self.v[off];
+        let mut out = p;
+        out[off] = -self.v[off] * (n2 / fk2).sqrt();
+        out
+    }
+
     #[inline(always)]
     fn inside(&self, p: [f64; D]) -> bool {
         // F|p| ≤ r = 1 − 1e-12 − v·p, without the square root
