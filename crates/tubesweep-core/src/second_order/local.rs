@@ -151,6 +151,49 @@ pub fn godunov_newton<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> Option
     Some(w)
 }
 
+/// The same root as [`godunov_newton`] in closed form: per axis the side whose difference turns
+/// positive first (the smaller b/c), the axes added in that order while the root of
+/// (Σ c_k²) w² − 2 (Σ c_k b_k) w + Σ b_k² = (sΔx)² stays above the next one's b/c (the classical
+/// update with unequal steps). Where a side not chosen would be the larger at the root (possible
+/// only when its c is larger), [`godunov_newton`] decides. None when every side is missing.
+#[inline(always)]
+pub fn godunov_closed_form<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> Option<f64> {
+    // per axis: (b/c, c, b) of the side that turns positive first
+    let mut axes = [(f64::INFINITY, 1.0, f64::INFINITY); D];
+    for k in 0..D {
+        let [m, p] = sides[k];
+        let (tm, tp) = (m.b / m.c, p.b / p.c);
+        axes[k] = if tm <= tp { (tm, m.c, m.b) } else { (tp, p.c, p.b) };
+    }
+    axes.sort_unstable_by(|x, y| x.0.partial_cmp(&y.0).unwrap_or(std::cmp::Ordering::Equal));
+    if !axes[0].0.is_finite() {
+        return None;
+    }
+    let target = sh * sh;
+    let (mut cc, mut cb, mut bb) = (0.0, 0.0, 0.0);
+    let mut w = f64::INFINITY;
+    for &(tau, c, b) in &axes {
+        if !(tau < w) {
+            break;
+        }
+        cc += c * c;
+        cb += c * b;
+        bb += b * b;
+        let disc = (cb * cb - cc * (bb - target)).max(0.0);
+        w = (cb + disc.sqrt()) / cc;
+    }
+    // the sides not chosen must not be the larger at the root
+    for k in 0..D {
+        let [m, p] = sides[k];
+        let (vm, vp) = (m.c * w - m.b, p.c * w - p.b);
+        let (chosen, other) = if m.b / m.c <= p.b / p.c { (vm, vp) } else { (vp, vm) };
+        if other > chosen.max(0.0) {
+            return godunov_newton(sides, sh);
+        }
+    }
+    Some(w)
+}
+
 /// The first-order Godunov update (every c = 1): the classical closed form (sort the per-axis
 /// minima, add axes while the root stays above the next one). None when every side is missing.
 #[inline(always)]
@@ -197,6 +240,38 @@ mod tests {
         // the root: two axes active
         let r: f64 = ((b - 0.3) / h).powi(2) + ((b - 0.32) / h).powi(2);
         assert!((r - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_closed_form_finds_newtons_root() {
+        // pseudo-random sides (a linear congruential sequence), some missing, c in [1, 1.5]
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let h = 0.01;
+        for _ in 0..20000 {
+            let mut sides = [[Side::MISSING; 2]; 3];
+            for axis in sides.iter_mut() {
+                for side in axis.iter_mut() {
+                    if next() < 0.8 {
+                        *side = Side {
+                            c: 1.0 + 0.5 * next(),
+                            b: 0.5 + 0.02 * next(),
+                        };
+                    }
+                }
+            }
+            let a = godunov_closed_form(&sides, h);
+            let b = godunov_newton(&sides, h);
+            match (a, b) {
+                (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-13, "{a} {b} {sides:?}"),
+                (a, b) => assert_eq!(a, b),
+            }
+        }
     }
 
     #[test]

@@ -30,7 +30,7 @@ use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 
 use super::factoring::Factoring;
 use super::geometry::{NodeGeometry, TubeGeometry};
-use super::local::{corrected_slowness, godunov_first_order, godunov_newton, reconstruct, Side};
+use super::local::{corrected_slowness, godunov_closed_form, godunov_first_order, reconstruct, Side};
 use super::pipeline::Pipeline;
 
 /// Stopping rules of the two phases.
@@ -159,7 +159,7 @@ impl<const D: usize> Sweeper<'_, D> {
         }
         let s = corrected_slowness::<D>(&self.geometry[k_inner], grad, self.sigma(i));
         let w = if second {
-            godunov_newton(&sides, s * h)
+            godunov_closed_form(&sides, s * h)
         } else {
             godunov_first_order(&sides, s * h)
         }?;
