@@ -218,6 +218,12 @@ def test_refusals():
     small = ts.surfaces.Sphere(0.12)
     with pytest.raises(ValueError, match="order=2.*curvature.*Refine the grid"):
         ts.solve(small, box(51), [(-0.12, 0, 0)], order=2)
+    # a crease (the double torus is φ = min of two tori): named as such, not as a spacing to reach
+    dt = ts.surfaces.DoubleTorus()
+    lo, hi = dt.default_box
+    with pytest.raises(ValueError, match="order=2.*crease.*use order=1") as info:
+        ts.solve(dt, ts.Grid(lower=lo, upper=hi, shape=(61, 61, 61)), [dt.default_source], order=2)
+    assert "spacing below" not in str(info.value)
     with pytest.raises(ValueError, match="Godunov"):
         ts.solve(SPHERE, g, [SRC], order=2, hamiltonian="lxf")
     with pytest.raises(ValueError, match="source_init"):
