@@ -13,7 +13,8 @@
 //! iterations; the fastest of `REPS` (default 5) rounds, the cases alternating.
 //!
 //!     cargo run --release -p tubesweep-core --example upwind_sweep -- [N=101] [threads=1]
-//!   (`SOURCE_AXIS=1` or `2` puts the source on the y or z axis, as in the other examples)
+//!   (`SOURCE_AXIS=1` or `2` puts the source on the y or z axis, as in the other examples; `CASE=text`
+//!   runs only the cases whose name contains it, beside Eq. (3))
 #[path = "common/shell.rs"]
 mod shell;
 #[path = "common/sphere_source.rs"]
@@ -98,7 +99,11 @@ fn main() {
         );
         let mut best: Vec<Option<SolveStats>> = vec![None; cases.len()];
         for _ in 0..reps {
-            for (i, (_, scheme)) in cases.iter().enumerate() {
+            for (i, (name, scheme)) in cases.iter().enumerate() {
+                // `CASE=text` runs Eq. (3) and the cases whose name contains it (for profiling)
+                if i > 0 && std::env::var("CASE").is_ok_and(|c| !name.contains(c.as_str())) {
+                    continue;
+                }
                 let p = sphere_source::sphere_problem(&band, &roles, &weights, h, *scheme);
                 let st = run(&band, &p, plain, threads);
                 if best[i].as_ref().is_none_or(|b| st.seconds < b.seconds) {
@@ -109,7 +114,7 @@ fn main() {
         let ns = |st: &SolveStats| 1e9 * st.seconds / st.updates.max(1) as f64;
         let iso = ns(best[0].as_ref().unwrap());
         for ((name, _), st) in cases.iter().zip(&best) {
-            let st = st.as_ref().unwrap();
+            let Some(st) = st.as_ref() else { continue };
             println!(
                 "{name:<34} {:7.1} ns/update ({:4.2}x)  {:>10} updates  {:3} iterations  {:.3} s",
                 ns(st),

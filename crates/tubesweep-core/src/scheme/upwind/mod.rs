@@ -428,8 +428,10 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
             }
         }
         None => {
-            if let Some(mu) = natural_faces(faces, &nb, o0, h, &mut best) {
-                return mu.min(old);
+            // `best` holds the proved face's value (and any lower one tried before it, which the
+            // proof says cannot be, short of rounding)
+            if natural_faces(faces, &nb, o0, h, &mut best).is_some() {
+                return best;
             }
         }
     }
