@@ -3,7 +3,9 @@
 //! the same sweep mode: the sphere of radius 0.5 in [−1,1]^3 (the band of the other examples), one
 //! source at (−0.5, 0, 0), unit speed, and
 //!
-//! * the isotropic Godunov update (3) through the solver's own kernel (`InnerScheme::Godunov`);
+//! * the isotropic Godunov update (3) through the solver's own kernel (`InnerScheme::Godunov`), and
+//!   through the upwind solvers' interface (`InnerScheme::Upwind` with `Isotropic`: the same
+//!   dispatch, Eq. (3) as the local solve);
 //! * the upwind moving medium with the rigid rotation `v = ω e_z × x̂ R` (ω = 1), and with v = 0;
 //! * the upwind metric: a constant tilted `M` (eigenvalues 0.3–2.3), and `M = I`.
 //!
@@ -20,7 +22,7 @@ mod shell;
 #[path = "common/sphere_source.rs"]
 mod sphere_source;
 
-use tubesweep_core::scheme::hamiltonians::{Metric, MovingMedium};
+use tubesweep_core::scheme::hamiltonians::{Isotropic, Metric, MovingMedium};
 #[allow(unused_imports)]
 use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SolveStats};
 
@@ -77,8 +79,13 @@ fn main() {
         metric: &ident,
         sigma: None,
     };
-    let cases: [(&str, InnerScheme<'_, 3>); 5] = [
+    let iso = Isotropic {
+        slowness: &s,
+        sigma: None,
+    };
+    let cases: [(&str, InnerScheme<'_, 3>); 6] = [
         ("isotropic Godunov (3)", InnerScheme::Godunov),
+        ("Eq. (3) through the upwind interface", InnerScheme::Upwind(&iso)),
         ("upwind moving medium, rotation", InnerScheme::Upwind(&rot)),
         ("upwind moving medium, v = 0", InnerScheme::Upwind(&still)),
         ("upwind metric, tilted M", InnerScheme::Upwind(&met)),
