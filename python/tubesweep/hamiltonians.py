@@ -356,7 +356,7 @@ class MovingMedium(Hamiltonian):
         closest points ``cp(x)`` of the band nodes (the flow lives on the surface and is extended
         constantly along normals); so is an array with the upwind solver (multilinear
         interpolation at ``cp(x)``: the array and the callable give the same field), while with
-        ``scheme="lxf"`` an array is read at the nodes, as it always was.
+        ``scheme="lxf"`` an array is read at the nodes (the paper's Sect. 6.3 set-up).
     allow_supersonic : bool
         The paper assumes ``|v| ≪ F``. Where ``|v| ≥ F`` the medium outruns the wave and the
         first-arrival problem changes character (the equation loses the monotone front
@@ -454,7 +454,7 @@ class MovingMedium(Hamiltonian):
         """
         d = grid.ndim
         # a callable at the closest points; an array too with the upwind solver (interpolated there,
-        # so that both forms give the same field), at the nodes with LxF (as it always was)
+        # so that both forms give the same field), at the nodes with LxF (the paper's set-up, bit for bit)
         at_cp = surface is not None and (callable(self.flow) or (self.scheme != "lxf" and np.ndim(self.flow) > 1))
         if at_cp:
             _, cp = surface.project(x, grid)

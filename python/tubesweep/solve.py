@@ -88,12 +88,15 @@ def solve(
         Points on the surface (within the inner tube).
     hamiltonian : {"godunov", "lxf"} or a ``ts.hamiltonians`` object
         A :class:`tubesweep.hamiltonians.Hamiltonian` (``Isotropic()``, ``MovingMedium(v)``,
-        ``Metric(M)``) solves ``H(x, ∇u) = 0`` with the general Lax–Friedrichs update of Sect. 5.1.
+        ``Metric(M)``) solves ``H(x, ∇u) = 0``: ``MovingMedium`` and ``Metric`` with the upwind
+        (Godunov-type) local solver by default, or with the general Lax–Friedrichs update of
+        Sect. 5.1 when built with ``scheme="lxf"``.
     speed : float, ndarray of ``grid.shape``, or callable ``F(points) -> (M,)``
         The speed F > 0 (1: geodesic distance).
     flow : callable ``v(points (M, d)) -> (M, d)`` or array of ``grid.shape + (d,)``, optional
         Ambient flow of a moving medium: solves ``|∇u| = |1 − v·∇u| / F`` (Sect. 6.3) with the
-        Lax–Friedrichs update of Sect. 5.1 (shorthand for ``hamiltonian=ts.hamiltonians.MovingMedium(flow)``).
+        upwind local solver (shorthand for ``hamiltonian=ts.hamiltonians.MovingMedium(flow)``;
+        ``hamiltonian="lxf"`` with a flow uses the paper's Lax–Friedrichs update of Sect. 5.1).
         ``|v| ≥ F`` anywhere in the inner tube is a ``ValueError``; see ``allow_supersonic``.
     allow_supersonic : bool
         Compute the moving-medium solution even where ``|v| ≥ F`` (with a warning).
@@ -123,7 +126,9 @@ def solve(
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
     threads : int
-        Worker threads for the sweeps (0: all cores, 1: sequential); the result does not depend
+        Worker threads for the sweeps (0, the default: the cores that are idle when the solve
+        starts, all of them on a quiet machine, and each iteration runs in parallel only where
+        that was measured to be faster; 1: sequential; k: k threads); the result does not depend
         on it (parallel sweeps are bit-identical to sequential ones).
     infinity : float, optional
         The finite numerical infinity unknown values start at (default: derived from the band, a

@@ -148,7 +148,7 @@ CASES: Dict[str, Tuple[Callable[[], Case], Tuple[int, ...], Tuple[int, ...]]] = 
     "circle (closest-point map)": (circle_cp_case, (51, 101, 201, 401), (101, 201)),
 }
 
-#: The targets of issue 31 on surfaces: (surface, what, bound, "max" or "min").
+#: The accuracy targets set for order=2 on surfaces: (surface, what, bound, "max" or "min").
 TARGETS = [
     ("sphere", "far max at N = 201", 4e-4, "max"),
     ("sphere", "mean at N = 201", 4e-5, "max"),
@@ -254,7 +254,7 @@ def run(out_dir: Path, quick: bool) -> dict:
             f"| {o['surface']} | {o['N']} | {o['order']} | {o['far_max_order']:.2f} | {o['mean_order']:.2f} | {ring} |"
         )
     if not quick:
-        lines += ["", "Targets (issue 31, surfaces):", ""] + target_lines(rows, orders)
+        lines += ["", "Targets for order=2 on surfaces (met or not):", ""] + target_lines(rows, orders)
     write_markdown(
         out_dir / "second_order.md", "order=2: errors and fitted orders (beyond the paper)", [("", "\n".join(lines))]
     )

@@ -71,7 +71,9 @@ pub fn check_geometry_of(
         // resolved by any grid never gives; φ = min(φ₁, φ₂) of two distances (a crease) does.
         return Err(Error::invalid(
             "surface",
-            "order=2: the curvature of φ's level sets is unbounded in the tube (I − φD²φ is singular at a node):              the surface has a crease or a corner, e.g. where φ = min(φ₁, φ₂) joins two surfaces, and no grid              resolves it. order=2 needs a smooth (twice differentiable) surface; use order=1"
+            "order=2: the curvature of φ's level sets is unbounded in the tube (I − φD²φ is singular at a node): \
+             the surface has a crease or a corner, e.g. where φ = min(φ₁, φ₂) joins two surfaces, and no grid \
+             resolves it. order=2 needs a smooth (twice differentiable) surface; use order=1"
                 .to_string(),
         ));
     }
