@@ -550,9 +550,21 @@ def plot(records: List[Dict[str, Any]], path: Path) -> Optional[Path]:
         ax.set_xlabel("median wall time [s]")
         ax.set_ylabel("max error on the surface")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    for ax in list(axes.flat)[len(problems) :]:
+    # one legend for every panel, in the first spare panel (or below the panels), so that no
+    # legend hides a line
+    handles: Dict[str, Any] = {}
+    for ax in list(axes.flat)[: len(problems)]:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    spare = list(axes.flat)[len(problems) :]
+    for ax in spare:
         ax.set_visible(False)
+    if spare:
+        spare[0].set_visible(True)
+        spare[0].axis("off")
+        spare[0].legend(list(handles.values()), list(handles.keys()), loc="center", fontsize=9, frameon=False)
+    else:
+        fig.legend(list(handles.values()), list(handles.keys()), loc="lower center", ncol=4, fontsize=8)
     fig.suptitle("Time vs error (log–log); each line: one method over grid sizes N", fontsize=10)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
