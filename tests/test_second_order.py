@@ -309,3 +309,23 @@ def test_closest_point_refusals():
         ts.solve(small, box(31), [(-0.25, 0, 0)], order=2)
     with pytest.raises(ValueError, match="closed surface: Disc is open"):
         ts.solve(ts.surfaces.Disc(), g, [(0, 0, 0)], order=2)
+
+
+def test_a_runaway_second_phase_falls_back_to_first_order(monkeypatch):
+    # phase 1 stopped far too early (64·Δx² in 3D): from that start the second-order sweeps run
+    # away (values to −1e6 and beyond, for minutes until max_iterations); they are abandoned at
+    # the first value below −σ̄Δx, with a warning, and the first phase's values are returned
+    import tubesweep.second_order as so
+
+    monkeypatch.setitem(so.TOL_FIRST_FACTOR, 3, 64.0)
+    with pytest.warns(RuntimeWarning, match="ran away"):
+        sol = ts.solve(SPHERE, box(101), [SRC], order=2)
+    assert sol.stats.order2["runaway_iteration"] is not None
+    assert sol.stats.converged
+    err = np.abs(sol(POINTS) - EXACT)
+    assert np.all(np.isfinite(err))
+    # first-order accuracy, not second (3.8e-4 / 2.8e-5 at N = 201 with order=2), not garbage
+    assert 1e-3 < err.mean() < 2e-2, err.mean()
+    # the default tolerance does not run away
+    monkeypatch.setitem(so.TOL_FIRST_FACTOR, 3, 1.0)
+    assert ts.solve(SPHERE, box(61), [SRC], order=2).stats.order2["runaway_iteration"] is None

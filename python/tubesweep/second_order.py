@@ -192,6 +192,14 @@ def solve_on_tube(
             RuntimeWarning,
             stacklevel=3,
         )
+    if st["runaway_iteration"] is not None:
+        warnings.warn(
+            f"order=2: the second-order sweeps ran away at their iteration {st['runaway_iteration']} (a travel time "
+            "fell below zero) and were abandoned: the values returned are the first-order factored solution (order 1). "
+            "sol.stats.order2['runaway_iteration'] records it; a finer grid or order=1 avoids it",
+            RuntimeWarning,
+            stacklevel=3,
+        )
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
     order2 = {
@@ -200,6 +208,7 @@ def solve_on_tube(
             "first_order_iterations",
             "second_order_iterations",
             "fallback_iteration",
+            "runaway_iteration",
             "unreached",
             "max_curvature",
             "grad_norm_range",

@@ -70,7 +70,10 @@ class SolveStats:
     order2 : dict or None
         For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
         phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
-        switched to accepting decreases only, None when it did not fire), ``unreached`` (nodes
+        switched to accepting decreases only, None when it did not fire), on surfaces ``runaway_iteration``
+        (the phase-2 iteration at which a value fell below zero and the second-order sweeps were
+        abandoned for the first phase's values, with a warning; None when they were not),
+        ``unreached`` (nodes
         never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of
         nodes fixed around each source); on surfaces also ``max_curvature`` (the largest principal
         curvature found in the tube) and ``grad_norm_range`` (|∇φ| in the inner tube).

@@ -188,6 +188,16 @@ mod tests {
 
     /// The same, with the values, on `threads` threads.
     fn sphere_solve(n: usize, window: f64, threads: usize) -> (f64, f64, SecondOrderStats, Vec<f64>) {
+        sphere_solve_with(n, window, threads, 1e-3)
+    }
+
+    /// The same, with phase 1 stopped at `first_tol`·Δx².
+    fn sphere_solve_with(
+        n: usize,
+        window: f64,
+        threads: usize,
+        first_tol: f64,
+    ) -> (f64, f64, SecondOrderStats, Vec<f64>) {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
         let idx = band.indices();
         let pts: Vec<[f64; 3]> = idx
@@ -213,7 +223,7 @@ mod tests {
         .unwrap();
         let mut values = starting_values(&fac);
         let options = SecondOrderOptions {
-            tol_first: 1e-3 * h * h,
+            tol_first: first_tol * h * h,
             tol: 1e-3 * h * h,
             max_iterations: 500,
             stall_ratio: 0.9,
@@ -283,6 +293,23 @@ mod tests {
             windowed.updates,
             plain.updates
         );
+    }
+
+    #[test]
+    fn a_runaway_second_phase_is_abandoned_for_the_first_phase() {
+        // phase 1 stopped far too early (64·Δx²): the second-order sweeps from that start run
+        // away (values to −1e6 and beyond); they are stopped at the first value below −σ̄Δx and
+        // the first phase's monotone values are returned, converged, instead of running to
+        // max_iterations
+        let (e, m, stats, values) = sphere_solve_with(101, 2.0, 1, 64.0);
+        let runaway = stats
+            .runaway_iteration
+            .expect("this start ran away when the guard was written");
+        assert!(runaway < 100, "{stats:?}");
+        assert!(stats.converged, "{stats:?}");
+        assert!(values.iter().all(|&v| v >= 0.0), "a negative value was returned");
+        // first-order accuracy (the second-order solve's max error is about 1e-3 here)
+        assert!(e < 5e-2 && m < 2e-2 && e > 2e-3, "max {e:.3e}, mean {m:.3e}, {stats:?}");
     }
 
     #[test]

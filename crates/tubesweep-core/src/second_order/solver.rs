@@ -72,7 +72,16 @@ pub struct SecondOrderStats {
     /// Non-fixed nodes never reached (another component of the surface, or an extension-layer
     /// node with no upwind neighbour of smaller |φ|).
     pub unreached: usize,
+    /// The phase-2 iteration at which the second-order sweeps ran away (a value fell below
+    /// [`RUNAWAY_FLOOR`] mean slownesses times Δx: travel times are never negative) and were
+    /// abandoned: the values returned are then the first phase's, recomputed from the sources
+    /// (first order, monotone). None when they did not.
+    pub runaway_iteration: Option<usize>,
 }
+
+/// A phase-2 value below `-RUNAWAY_FLOOR·σ̄·Δx` is a runaway: the solution is non-negative and
+/// the nodes next to a source are fixed, so no converging iterate comes near it.
+pub const RUNAWAY_FLOOR: f64 = 1.0;
 
 /// [`Sweeper::visit`]: the node stays active (beyond the window).
 const KEEP: u8 = 1;
@@ -87,6 +96,8 @@ struct Limits {
     threshold: f64,
     window: f64,
     settled: f64,
+    /// A value changed to below this ends the phase as a runaway (phase 2 only; −∞ otherwise).
+    floor: f64,
 }
 
 struct Sweeper<'a, const D: usize> {
@@ -393,6 +404,7 @@ pub fn sweep_second_order<const D: usize>(
             threshold: options.tol_first,
             window: f64::INFINITY,
             settled: options.tol_first,
+            floor: f64::NEG_INFINITY,
         };
         run_phase(
             &sw,
@@ -414,12 +426,17 @@ pub fn sweep_second_order<const D: usize>(
         }
         pipeline.new_phase();
     }
+    let sigma_mean = match slowness {
+        Slowness::Constant(s) => s,
+        Slowness::PerNode(s) => s.iter().sum::<f64>() / n.max(1) as f64,
+    };
     let lim = Limits {
         second: true,
         decreases_only: false,
         threshold: options.tol,
         window: f64::INFINITY,
         settled: options.tol,
+        floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
     };
     let before = iteration;
     stats.converged = run_phase(
@@ -437,6 +454,43 @@ pub fn sweep_second_order<const D: usize>(
         control,
     )?;
     stats.second_order_iterations = iteration - before;
+    if stats.runaway_iteration.is_some() {
+        // the second-order iterate is lost: the first phase again, from the sources (monotone,
+        // so it converges), and its first-order values are the result
+        for ((v, a), &r) in values.iter_mut().zip(&active).zip(roles) {
+            if r != NodeRole::Fixed {
+                *v = f64::INFINITY;
+            }
+            a.store((r != NodeRole::Fixed) as u8, Ordering::Relaxed);
+        }
+        pipeline.new_phase();
+        // to the second phase's tolerance: these values are the result
+        let tol = options.tol.min(options.tol_first);
+        let lim = Limits {
+            second: false,
+            decreases_only: true,
+            threshold: tol,
+            window: f64::INFINITY,
+            settled: tol,
+            floor: f64::NEG_INFINITY,
+        };
+        let before = iteration;
+        stats.converged = run_phase(
+            &sw,
+            band,
+            values,
+            &active,
+            &row_inner,
+            &mut pipeline,
+            lim,
+            options.window_first * unit,
+            options,
+            &mut iteration,
+            &mut stats,
+            control,
+        )?;
+        stats.first_order_iterations += iteration - before;
+    }
     stats.unreached = values
         .iter()
         .zip(roles)
@@ -538,6 +592,12 @@ fn run_phase<const D: usize>(
         }) == Control::Stop
         {
             return Err(Error::Interrupted { iterations: *iteration });
+        }
+        // `front` is the smallest value that changed by more than `settled`: a runaway's values
+        // fall by ever larger steps, so it is among them
+        if change.front < lim.floor {
+            stats.runaway_iteration = Some(*iteration - stats.first_order_iterations);
+            return Ok(false);
         }
         if lim.window == f64::INFINITY {
             if change.max_change < tol {
