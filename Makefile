@@ -23,7 +23,7 @@ TEST_DEPS  := "pytest>=7" "hypothesis>=6" scikit-fmm pygeodesic potpourri3d geog
 BENCH_DEPS := potpourri3d pygeodesic scikit-fmm geographiclib
 # pyproject.toml's lint extra, pinned so that every run checks the same rules
 LINT_DEPS  := "ruff==0.17.6" "mypy==2.4.1"
-DOCS_DEPS  := "mkdocs>=1.6,<2" "mkdocs-material>=9,<10" "mkdocstrings[python]>=0.26"
+DOCS_DEPS  := "mkdocs>=1.6,<2" "mkdocs-material>=9,<10" "mkdocstrings[python]>=0.26" "griffe-inherited-docstrings>=1.1"
 # pip's notes on extras that do not apply ("Ignoring ...: markers") and on what is already there
 export PIP_QUIET := 1
 export PIP_DISABLE_PIP_VERSION_CHECK := 1

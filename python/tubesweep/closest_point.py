@@ -214,33 +214,6 @@ class ClosestPoint(Surface):
         return np.where(np.isfinite(d), d, 0.0)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
-        """The band of the surface on a grid: the nodes within ``half_width`` of it.
-
-        Parameters
-        ----------
-        grid : Grid
-            The grid.
-        half_width : float
-            The band's half-width (a distance, not grid spacings).
-
-        Returns
-        -------
-        BandGeometry
-            The band's nodes (C-order linear indices), φ there and the outward extension directions
-            ``n`` of Eq. (8); the solver's input.
-
-        Raises
-        ------
-        ValueError
-            If the surface is of the wrong dimension for the grid, or (level sets) φ is far from a
-            distance function near the surface.
-
-        Examples
-        --------
-        >>> import tubesweep as ts
-        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
-        >>> geometry = ts.surfaces.Circle(0.5).band(grid, 4 * grid.spacing)
-        """
         from . import _native
 
         self.check_grid(grid)
@@ -282,35 +255,6 @@ class ClosestPoint(Surface):
         return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
 
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
-        """Closest points on the surface, and the distance to them.
-
-        Parameters
-        ----------
-        points : numpy.ndarray
-            ``(M, d)`` points near the surface.
-        grid : Grid
-            The grid (a sampled φ is interpolated on it).
-
-        Returns
-        -------
-        distance : numpy.ndarray
-            ``(M,)`` unsigned distances.
-        closest : numpy.ndarray
-            ``(M, d)`` the closest points.
-
-        Raises
-        ------
-        ValueError
-            If the points have the wrong shape or the surface's function returns non-finite values.
-
-        Examples
-        --------
-        >>> import numpy as np, tubesweep as ts
-        >>> grid = ts.Grid((-1, -1), (1, 1), (41, 41))
-        >>> d, cp = ts.surfaces.Circle(0.5).project(np.array([[0.6, 0.0]]), grid)
-        >>> np.round(cp, 6).tolist()
-        [[0.5, 0.0]]
-        """
         p = np.asarray(points, dtype=float)
         c = self.closest_point(p)
         return row_norms(p - c), c

@@ -521,30 +521,6 @@ class MovingMedium(Hamiltonian):
         )
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        """Travel time from a source to nearby band nodes, for a locally constant Hamiltonian.
-
-        Used to fix the nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``).
-
-        Parameters
-        ----------
-        prep : _Prepared
-            The data from :meth:`prepare`.
-        nodes : numpy.ndarray
-            Band positions of the nodes.
-        disp : numpy.ndarray
-            ``(M, d)`` displacements, closest point minus source.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(M,)`` travel times.
-
-        Examples
-        --------
-        >>> import tubesweep as ts
-        >>> s = ts.surfaces.Sphere(0.5)
-        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
-        """
         assert prep.flow is not None
         v = prep.flow[nodes]
         f = 1.0 / prep.slowness[nodes]
@@ -650,30 +626,6 @@ class Metric(Hamiltonian):
         )
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        """Travel time from a source to nearby band nodes, for a locally constant Hamiltonian.
-
-        Used to fix the nodes within ``SOURCE_RADIUS``·Δx of a source (``source_init="exact"``).
-
-        Parameters
-        ----------
-        prep : _Prepared
-            The data from :meth:`prepare`.
-        nodes : numpy.ndarray
-            Band positions of the nodes.
-        disp : numpy.ndarray
-            ``(M, d)`` displacements, closest point minus source.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(M,)`` travel times.
-
-        Examples
-        --------
-        >>> import tubesweep as ts
-        >>> s = ts.surfaces.Sphere(0.5)
-        >>> sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [s.default_source], hamiltonian=ts.hamiltonians.Isotropic())
-        """
         inv = prep.extra["inverse"][nodes]
         return prep.slowness[nodes] * np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", disp, inv, disp), 0.0))
 
