@@ -100,6 +100,20 @@ struct Limits {
     floor: f64,
 }
 
+impl Limits {
+    /// The first phase's: first order, monotone, to `tol`.
+    fn first_order(tol: f64) -> Self {
+        Limits {
+            second: false,
+            decreases_only: true,
+            threshold: tol,
+            window: f64::INFINITY,
+            settled: tol,
+            floor: f64::NEG_INFINITY,
+        }
+    }
+}
+
 struct Sweeper<'a, const D: usize> {
     table: NeighbourTable<'a, D>,
     roles: &'a [NodeRole],
@@ -372,18 +386,18 @@ pub fn sweep_second_order<const D: usize>(
         count += roles[s..e].iter().filter(|&&r| r != NodeRole::Outer).count() as u32;
     }
     row_inner.push(count);
+    let sigma_mean = match slowness {
+        Slowness::Constant(s) => s,
+        Slowness::PerNode(s) => s.iter().sum::<f64>() / n.max(1) as f64,
+    };
     let unit = if options.window_first > 0.0 || options.window_second > 0.0 {
-        let sigma = match slowness {
-            Slowness::Constant(s) => s,
-            Slowness::PerNode(s) => s.iter().sum::<f64>() / n.max(1) as f64,
-        };
         let fixed = roles
             .iter()
             .enumerate()
             .filter(|(_, &r)| r == NodeRole::Fixed)
             .map(|(i, _)| i);
         let hops = crate::sweep::grid_hops::max_grid_hops(band, fixed);
-        spacing * sigma * (hops as f64).sqrt()
+        spacing * sigma_mean * (hops as f64).sqrt()
     } else {
         0.0
     };
@@ -397,39 +411,36 @@ pub fn sweep_second_order<const D: usize>(
         ..Default::default()
     };
     let mut iteration = 0;
-    if options.own_first_phase {
-        let lim = Limits {
-            second: false,
-            decreases_only: true,
-            threshold: options.tol_first,
-            window: f64::INFINITY,
-            settled: options.tol_first,
-            floor: f64::NEG_INFINITY,
+    // one phase: every non-fixed node active again, the thread choice's timings forgotten after
+    // an earlier phase (an update of the other phase costs differently)
+    let mut phase =
+        |values: &mut [f64], lim: Limits, width: f64, iteration: &mut usize, stats: &mut SecondOrderStats| {
+            if *iteration > 0 {
+                for (a, &r) in active.iter().zip(roles) {
+                    a.store((r != NodeRole::Fixed) as u8, Ordering::Relaxed);
+                }
+                pipeline.new_phase();
+            }
+            run_phase(
+                &sw,
+                band,
+                values,
+                &active,
+                &row_inner,
+                &mut pipeline,
+                lim,
+                width,
+                options,
+                iteration,
+                stats,
+                control,
+            )
         };
-        run_phase(
-            &sw,
-            band,
-            values,
-            &active,
-            &row_inner,
-            &mut pipeline,
-            lim,
-            options.window_first * unit,
-            options,
-            &mut iteration,
-            &mut stats,
-            control,
-        )?;
+    if options.own_first_phase {
+        let lim = Limits::first_order(options.tol_first);
+        phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
         stats.first_order_iterations = iteration;
-        for (a, &r) in active.iter().zip(roles) {
-            a.store((r != NodeRole::Fixed) as u8, Ordering::Relaxed);
-        }
-        pipeline.new_phase();
     }
-    let sigma_mean = match slowness {
-        Slowness::Constant(s) => s,
-        Slowness::PerNode(s) => s.iter().sum::<f64>() / n.max(1) as f64,
-    };
     let lim = Limits {
         second: true,
         decreases_only: false,
@@ -439,56 +450,19 @@ pub fn sweep_second_order<const D: usize>(
         floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
     };
     let before = iteration;
-    stats.converged = run_phase(
-        &sw,
-        band,
-        values,
-        &active,
-        &row_inner,
-        &mut pipeline,
-        lim,
-        options.window_second * unit,
-        options,
-        &mut iteration,
-        &mut stats,
-        control,
-    )?;
+    stats.converged = phase(values, lim, options.window_second * unit, &mut iteration, &mut stats)?;
     stats.second_order_iterations = iteration - before;
     if stats.runaway_iteration.is_some() {
         // the second-order iterate is lost: the first phase again, from the sources (monotone,
-        // so it converges), and its first-order values are the result
-        for ((v, a), &r) in values.iter_mut().zip(&active).zip(roles) {
+        // so it converges), to the second phase's tolerance: its first-order values are the result
+        for (v, &r) in values.iter_mut().zip(roles) {
             if r != NodeRole::Fixed {
                 *v = f64::INFINITY;
             }
-            a.store((r != NodeRole::Fixed) as u8, Ordering::Relaxed);
         }
-        pipeline.new_phase();
-        // to the second phase's tolerance: these values are the result
-        let tol = options.tol.min(options.tol_first);
-        let lim = Limits {
-            second: false,
-            decreases_only: true,
-            threshold: tol,
-            window: f64::INFINITY,
-            settled: tol,
-            floor: f64::NEG_INFINITY,
-        };
+        let lim = Limits::first_order(options.tol.min(options.tol_first));
         let before = iteration;
-        stats.converged = run_phase(
-            &sw,
-            band,
-            values,
-            &active,
-            &row_inner,
-            &mut pipeline,
-            lim,
-            options.window_first * unit,
-            options,
-            &mut iteration,
-            &mut stats,
-            control,
-        )?;
+        stats.converged = phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
         stats.first_order_iterations += iteration - before;
     }
     stats.unreached = values
