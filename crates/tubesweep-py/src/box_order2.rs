@@ -97,19 +97,7 @@ fn factored_box_solve<'py>(
     let mut py_error: Option<PyErr> = None;
     let result = py.detach(|| {
         let mut callback = |r: &IterationReport| -> Control {
-            Python::attach(|py| {
-                if let Err(e) = py.check_signals() {
-                    py_error = Some(e);
-                    return Control::Stop;
-                }
-                if let Some(cb) = &progress_ref {
-                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
-                        py_error = Some(e);
-                        return Control::Stop;
-                    }
-                }
-                Control::Continue
-            })
+            crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))
         };
         match d {
             2 => {

@@ -24,6 +24,7 @@ mod box_order2;
 mod convert;
 mod errors;
 mod many_sources;
+mod progress;
 mod second_order;
 mod surface;
 mod sweep;

@@ -116,21 +116,8 @@ fn run<'py, const D: usize>(
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
-        let mut report = |done: usize| -> Control {
-            Python::attach(|py| {
-                if let Err(e) = py.check_signals() {
-                    py_error = Some(e);
-                    return Control::Stop;
-                }
-                if let Some(cb) = &progress_ref {
-                    if let Err(e) = cb.call1(py, (done, k)) {
-                        py_error = Some(e);
-                        return Control::Stop;
-                    }
-                }
-                Control::Continue
-            })
-        };
+        let mut report =
+            |done: usize| -> Control { crate::progress::check_in(&progress_ref, &mut py_error, (done, k)) };
         let output = match at {
             Some((points, _)) => Output::AtPoints {
                 lower,

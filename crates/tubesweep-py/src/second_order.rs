@@ -94,19 +94,7 @@ fn run<'py, const D: usize>(
         )?;
         let mut values = starting_values(&factoring);
         let mut callback = |r: &IterationReport| -> Control {
-            Python::attach(|py| {
-                if let Err(e) = py.check_signals() {
-                    py_error = Some(e);
-                    return Control::Stop;
-                }
-                if let Some(cb) = &progress_ref {
-                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
-                        py_error = Some(e);
-                        return Control::Stop;
-                    }
-                }
-                Control::Continue
-            })
+            crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))
         };
         let mut first_seconds = 0.0;
         let mut first_iterations = 0;

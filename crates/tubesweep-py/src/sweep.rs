@@ -162,19 +162,7 @@ pub(crate) fn run_sweeps<'py, const D: usize>(
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
         let mut callback = |r: &IterationReport| -> Control {
-            Python::attach(|py| {
-                if let Err(e) = py.check_signals() {
-                    py_error = Some(e);
-                    return Control::Stop;
-                }
-                if let Some(cb) = &progress_ref {
-                    if let Err(e) = cb.call1(py, (r.iteration, r.max_change, r.updates)) {
-                        py_error = Some(e);
-                        return Control::Stop;
-                    }
-                }
-                Control::Continue
-            })
+            crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))
         };
         problem.solve(&mut values, options, &mut callback)
     });
