@@ -3,7 +3,7 @@ second-order Godunov update (``tubesweep_core::factored_box``; docs/second-order
 
 from __future__ import annotations
 
-from typing import Any, Callable, Optional, Tuple
+from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
 
@@ -13,7 +13,7 @@ from .grid import Grid
 
 __all__ = ["ORDERS", "ORDER2_TOL", "check_order", "order2_tol", "solve_order2"]
 
-ORDERS = (1, 2)
+ORDERS = (1, 2, "auto")
 
 #: Default stopping tolerance of ``order=2``: a phase stops when no value changes by more than
 #: ``ORDER2_TOL · s̄ · Δx² / L`` in an iteration (``s̄`` the mean slowness, ``L`` the box's longest
@@ -21,11 +21,21 @@ ORDERS = (1, 2)
 ORDER2_TOL = 1e-3
 
 
-def check_order(order: Any) -> int:
-    if isinstance(order, (bool, np.bool_)) or not isinstance(order, (int, np.integer)) or int(order) not in ORDERS:
+#: Why ``order=2`` does not apply in the box with Lax–Friedrichs, a flow or a Hamiltonian object
+#: (the ``ValueError`` of an explicit ``order=2``; ``stats.order_fallback`` with ``order="auto"``).
+NOT_GODUNOV = (
+    "order=2 uses the Godunov update (of the eikonal equation): pass hamiltonian='godunov' (without flow= or a "
+    "Hamiltonian object), or order=1 for Lax–Friedrichs and the anisotropic Hamiltonians"
+)
+
+
+def check_order(order: Any) -> Union[int, str]:
+    if isinstance(order, str) and order == "auto":
+        return "auto"
+    if isinstance(order, (bool, np.bool_)) or not isinstance(order, (int, np.integer)) or int(order) not in (1, 2):
         raise ValueError(
-            f"order must be 1 (the paper's first-order scheme, the default) or 2 (the factored "
-            f"second-order scheme, hamiltonian='godunov' only); got {order!r}"
+            "order must be 1 (the paper's first-order scheme, the default), 2 (the factored second-order scheme, "
+            f"hamiltonian='godunov' only) or 'auto' (2 with the Godunov update, 1 otherwise); got {order!r}"
         )
     return int(order)
 

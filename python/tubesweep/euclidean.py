@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from functools import lru_cache
@@ -27,7 +28,7 @@ from ._validate import (
 )
 from ._result_check import check_values
 from ._warn import user_stacklevel
-from .box_order2 import check_order, order2_tol, solve_order2
+from .box_order2 import NOT_GODUNOV, check_order, order2_tol, solve_order2
 from .box_solution import BoxSolution
 from .grid import Grid
 from .stats import SolveStats
@@ -91,7 +92,7 @@ def travel_time(
     progress: Any = ...,
     infinity: Optional[float] = ...,
     threads: int = ...,
-    order: int = ...,
+    order: Union[int, str] = ...,
     return_solution: Literal[False] = ...,
     flow: Any = ...,
     allow_supersonic: bool = ...,
@@ -109,7 +110,7 @@ def travel_time(
     progress: Any = ...,
     infinity: Optional[float] = ...,
     threads: int = ...,
-    order: int = ...,
+    order: Union[int, str] = ...,
     return_solution: Literal[False] = ...,
     flow: Any = ...,
     allow_supersonic: bool = ...,
@@ -127,7 +128,7 @@ def travel_time(
     progress: Any = ...,
     infinity: Optional[float] = ...,
     threads: int = ...,
-    order: int = ...,
+    order: Union[int, str] = ...,
     return_solution: Literal[True],
 ) -> BoxSolution: ...
 
@@ -144,7 +145,7 @@ def travel_time(
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
     threads: int = 0,
-    order: int = 1,
+    order: Union[int, str] = 1,
     return_solution: bool = False,
     flow: Any = None,
     allow_supersonic: bool = False,
@@ -195,13 +196,15 @@ def travel_time(
         derived from the band: twice the cost of the longest grid path from a source, a safe upper
         bound on every travel time). It only matters for Lax–Friedrichs, whose update averages
         neighbours: a larger value costs more iterations. Not used by ``order=2``.
-    order : {1, 2}
+    order : {1, 2, "auto"}
         1: the first-order scheme of the paper (Algorithm 1). 2: the factored eikonal equation
         ``u = u₀ + w`` (``u₀`` the distance to the nearest source times the slowness there) with
         the limited second-order Godunov update, a monotone first-order phase and a second-order
         phase with a stagnation safeguard (``stats.order2``); Godunov only. Errors
         are O(Δx²) also for variable speed, and exact (up to the stopping test) for a constant
-        speed and one source (docs/box-second-order.md).
+        speed and one source (docs/box-second-order.md). ``"auto"``: 2 with the Godunov update,
+        1 with Lax–Friedrichs, a flow or a Hamiltonian object (``stats.order`` says which ran,
+        ``stats.order_fallback`` why not 2).
     return_solution : bool
         Return a :class:`BoxSolution` (the values with point evaluation, ``sol(points,
         interpolation="linear" | "cubic")``, exactly 0 at a source) instead of the array.
@@ -218,7 +221,7 @@ def travel_time(
     ------
     ValueError
         For sources outside the box, a speed that is not positive and finite, a bad tolerance,
-        ``order`` other than 1 or 2 (or ``order=2`` with Lax–Friedrichs), or a box too large for
+        ``order`` other than 1, 2 or ``"auto"`` (or ``order=2`` with Lax–Friedrichs), or a box too large for
         the memory available (use the narrow-band solver for surfaces).
 
     Warns
@@ -243,11 +246,12 @@ def travel_time(
     general = _hams.resolve(hamiltonian, flow, allow_supersonic)
     scheme = check_hamiltonian(hamiltonian) if general is None else general.label
     order = check_order(order)
-    if order == 2 and scheme != "godunov":
-        raise ValueError(
-            "order=2 uses the Godunov update (of the eikonal equation): pass hamiltonian='godunov' (without flow= or a Hamiltonian "
-            "object), or order=1 for Lax–Friedrichs and the anisotropic Hamiltonians"
-        )
+    fallback: Optional[str] = None
+    if order != 1 and scheme != "godunov":
+        if order == 2:
+            raise ValueError(NOT_GODUNOV)
+        fallback = NOT_GODUNOV  # order="auto": the first-order scheme, the reason in the stats
+    order = 1 if order == "auto" and fallback is not None else (2 if order == "auto" else order)
     if general is not None and return_solution:
         raise ValueError(
             "return_solution=True is for the eikonal equation; with flow= or a Hamiltonian object "
@@ -277,7 +281,7 @@ def travel_time(
     if general is not None:
         from .anisotropic_box import travel_time_general
 
-        return travel_time_general(
+        result = travel_time_general(
             grid,
             src,
             general,
@@ -292,6 +296,9 @@ def travel_time(
             SOURCE_RADIUS,
             t0,
         )
+        if return_stats and fallback is not None:
+            result = (result[0], dataclasses.replace(result[1], order_fallback=fallback))
+        return result
     if tol is None:
         tol = order2_tol(grid, float(np.mean(slowness)))
     check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))
@@ -364,6 +371,7 @@ def travel_time(
         local_solver=scheme,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
+        order_fallback=fallback,
     )
     return _result(grid, u, src, slowness_at, stats, 1, return_stats, return_solution)
 

@@ -9,9 +9,10 @@ sources factored as ``u = u₀ + w``, ``u₀`` the chord distance to the source
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -20,9 +21,20 @@ from ._factoring import FACTORED_RADIUS, factored_reach
 from ._validate import FRONT_WINDOW, check_threads as _threads, checked_point_speeds, speed_at_points, speed_values
 from .stats import SolveStats
 
-__all__ = ["ORDERS", "check_order", "FIX_RADIUS", "FACTORED_RADIUS", "default_tol"]
+__all__ = ["ORDERS", "Order2NotApplicable", "check_order", "FIX_RADIUS", "FACTORED_RADIUS", "default_tol"]
 
-ORDERS = (1, 2)
+#: The values of ``order``: the paper's first-order scheme, second order, or ``"auto"`` (second
+#: order where it applies, first order otherwise, the reason in ``sol.stats.order_fallback``).
+ORDERS = (1, 2, "auto")
+
+
+class Order2NotApplicable(ValueError):
+    """``order=2`` does not apply to this surface, grid or these options (a mesh, an open surface,
+    a crease, a curvature the tube does not resolve, a φ that is not a distance, a Hamiltonian or
+    an option of the first-order scheme). The message says why and what to do; with
+    ``order="auto"`` the solve uses ``order=1`` instead and records the message in
+    ``sol.stats.order_fallback``."""
+
 
 #: Inner-tube nodes whose closest point is within this many grid spacings of a source are fixed
 #: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there).
@@ -47,13 +59,23 @@ _OWN_FIRST_PHASE = True
 WINDOWS = (2.0, 2.0)
 
 
-def check_order(order: Any) -> int:
-    """``order`` as 1 or 2, or a ValueError naming it."""
-    if isinstance(order, (bool, np.bool_)) or not isinstance(order, (int, np.integer)) or int(order) not in ORDERS:
+def check_order(order: Any) -> Union[int, str]:
+    """``order`` as 1, 2 or ``"auto"``, or a ValueError naming it and the choices."""
+    if isinstance(order, str) and order == "auto":
+        return "auto"
+    if isinstance(order, (bool, np.bool_)) or not isinstance(order, (int, np.integer)) or int(order) not in (1, 2):
         raise ValueError(
-            f"order must be 1 (the paper's first-order scheme) or 2 (second order, docs/second-order.md); got {order!r}"
+            "order must be 1 (the paper's first-order scheme), 2 (second order, docs/second-order.md) or 'auto' "
+            f"(second order where it applies, first order otherwise); got {order!r}"
         )
     return int(order)
+
+
+def with_fallback(sol: Any, reason: str) -> Any:
+    """``sol`` (an ``order=1`` solution) with ``stats.order_fallback`` set to why ``order=2`` did
+    not apply."""
+    sol.stats = dataclasses.replace(sol.stats, order_fallback=reason)
+    return sol
 
 
 def default_tol(spacing: float, mean_slowness: float) -> float:
@@ -70,28 +92,32 @@ def check_supported(
     from .surface import LevelSet
 
     if general is not None or scheme != "godunov":
-        raise ValueError(
+        raise Order2NotApplicable(
             "order=2 solves the isotropic eikonal equation with the Godunov update only "
             f"(hamiltonian={scheme!r} given); use order=1 for Lax–Friedrichs, flows and general Hamiltonians"
         )
     if method != "two-layer":
-        raise ValueError(f"order=2 needs method='two-layer' (got {method!r}); the naive tube is the paper's baseline")
+        raise Order2NotApplicable(
+            f"order=2 needs method='two-layer' (got {method!r}); the naive tube is the paper's baseline"
+        )
     if paper_sweeps:
-        raise ValueError("paper_sweeps=True runs the paper's first-order sweeps; it cannot be combined with order=2")
+        raise Order2NotApplicable(
+            "paper_sweeps=True runs the paper's first-order sweeps; it cannot be combined with order=2"
+        )
     if source_init_given == "node":
-        raise ValueError(
+        raise Order2NotApplicable(
             "order=2 factors the point sources (u = u₀ + w); source_init='node' is the paper's first-order "
             "initialisation: use order=1 for it"
         )
     kind = type(surf).__name__
     if isinstance(surf, ClosestPoint) and getattr(surf, "open_surface", False):
-        raise ValueError(
+        raise Order2NotApplicable(
             f"order=2 needs a closed surface: {kind} is open, and beyond its boundary rim the closest points lie on "
             "the boundary curve, where the corrected equation does not hold (the rim is not second order). "
             "Use order=1 for it"
         )
     if not isinstance(surf, (LevelSet, ClosestPoint)):
-        raise ValueError(
+        raise Order2NotApplicable(
             f"order=2 needs a level set (φ as an array, a callable or a library surface) or a closed smooth "
             f"closest-point surface; {kind} gives closest points"
             + (
@@ -104,6 +130,18 @@ def check_supported(
         )
 
 
+def _native_solve(*args: Any, **kwargs: Any) -> Any:
+    """``_native.second_order_solve``, its refusals of the geometry (``order=2: ...``: a crease, a
+    curvature the tube does not resolve, a φ that is not a distance, a closest-point map of an open
+    surface or with edges) raised as :class:`Order2NotApplicable`."""
+    try:
+        return _native.second_order_solve(*args, **kwargs)
+    except ValueError as e:
+        if "order=2" in str(e):
+            raise Order2NotApplicable(str(e)) from None
+        raise
+
+
 def solve_on_tube(
     tube: Any, src: np.ndarray, speed: Any, tol: Optional[float], max_iterations: int, cb: Any, threads: int, t0: float
 ) -> Any:
@@ -114,7 +152,7 @@ def solve_on_tube(
     h = grid.spacing
     d = grid.ndim
     if tube.outer_eff < tube.inner + 2.0 - 1e-9:
-        raise ValueError(
+        raise Order2NotApplicable(
             f"order=2 needs two band neighbours on each side of every inner-tube node: outer ≥ inner + 2 grid spacings "
             f"(got inner={tube.inner:g}, outer={tube.outer_eff:g}); the defaults are inner=2, outer=4"
         )
@@ -161,7 +199,7 @@ def solve_on_tube(
     roles = tube.roles
     directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
     setup = time.perf_counter() - t0
-    values, u0, roles_out, st = _native.second_order_solve(
+    values, u0, roles_out, st = _native_solve(
         band,
         np.ascontiguousarray(roles),
         np.ascontiguousarray(geom.signed, dtype=np.float64),

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import time
-from typing import Any, Callable, Optional, Tuple
+from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
 
@@ -60,7 +60,7 @@ def solve(
     source_init: str = "exact",
     source_radius: Optional[float] = None,
     tol: float = DEFAULT_TOL,
-    order: int = 1,
+    order: Union[int, str] = 1,
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
@@ -195,25 +195,37 @@ def solve(
     surf.check_grid(grid)
     src = as_sources(sources, grid)
     general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-    if order == 2:
-        from . import second_order as _so
-
-        if source_radius is not None:
-            raise ValueError("source_radius applies to order=1 (order=2 factors the point source itself); leave it out")
-        check_tolerance(tol, max_iterations)
-        cb = progress_callback(progress)
-        _check_source_init(source_init)
-        _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
-        tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
-        return _so.solve_on_tube(tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0)
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)
+    tube: Optional[_PreparedTube] = None
+    fallback: Optional[str] = None
+    if order != 1:
+        from . import second_order as _so
+
+        try:
+            if source_radius is not None:
+                raise _so.Order2NotApplicable(
+                    "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
+                )
+            _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
+            tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
+            return _so.solve_on_tube(
+                tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
+            )
+        except _so.Order2NotApplicable as e:
+            if order == 2:
+                raise
+            fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
     _check_source_radius(source_radius, source_init)
     # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
-    # (unless a general Hamiltonian needs it) and the directions become the extension weights
-    tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
-    return _solve_on_tube(
+    # (unless a general Hamiltonian needs it) and the directions become the extension weights;
+    # with order="auto" refused by the second-order geometry, the tube it built is solved on as a
+    # Tube's is (the same values)
+    reuse = tube is not None
+    if tube is None:
+        tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
+    sol = _solve_on_tube(
         tube,
         src,
         general,
@@ -227,9 +239,14 @@ def solve(
         threads,
         paper_sweeps,
         t0,
-        reuse=False,
+        reuse=reuse,
         source_radius=source_radius,
     )
+    if fallback is not None:
+        from .second_order import with_fallback
+
+        return with_fallback(sol, fallback)
+    return sol
 
 
 def _check_source_radius(source_radius: Any, source_init: str) -> None:
@@ -245,7 +262,7 @@ def _check_source_radius(source_radius: Any, source_init: str) -> None:
         )
 
 
-def _check_order(order: Any) -> int:
+def _check_order(order: Any) -> Union[int, str]:
     from .second_order import check_order
 
     return check_order(order)

@@ -65,8 +65,14 @@ class SolveStats:
         medium and metrics) or ``"upwind"`` (the upwind, Godunov-type solver of the moving medium
         and metrics, docs/hamiltonians.md).
     order : int
-        The scheme's order: 1 (the paper's) or 2 (docs/second-order.md on surfaces,
-        docs/box-second-order.md for ``travel_time(..., order=2)``).
+        The order of the scheme that ran: 1 (the paper's) or 2 (docs/second-order.md on surfaces,
+        docs/box-second-order.md for ``travel_time(..., order=2)``). With ``order="auto"``, 2
+        where it applies and 1 where it does not (then ``order_fallback`` says why).
+    order_fallback : str or None
+        With ``order="auto"``, when second order did not apply and the solve ran ``order=1``: the
+        reason, the text of the ``ValueError`` an explicit ``order=2`` raises (a mesh, an open
+        surface, a crease, a curvature the tube does not resolve, a Hamiltonian or option of the
+        first-order scheme, ...). None otherwise.
     order2 : dict or None
         For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
         phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
@@ -107,6 +113,7 @@ class SolveStats:
     local_solver: str = "godunov"
     order: int = 1
     order2: Optional[Dict[str, Any]] = None
+    order_fallback: Optional[str] = None
 
     @property
     def updates_per_second(self) -> float:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import time
 import uuid
 import warnings
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
@@ -97,6 +97,8 @@ class Tube:
         # a change before a later solve projects sources on the changed array (O(band) per solve)
         array = getattr(self.surface, "_array", None)
         self._phi_at_band = None if array is None else array.reshape(-1)[self._tube.linear].copy()
+        # why order=2 refused this band's geometry (a crease, an unresolved curvature, ...), once found
+        self._order2_refusal: Optional[str] = None
 
     def _check_phi_unchanged(self) -> None:
         if self._phi_at_band is not None and not np.array_equal(
@@ -162,7 +164,7 @@ class Tube:
         infinity: Optional[float] = None,
         threads: int = 0,
         paper_sweeps: bool = False,
-        order: int = 1,
+        order: Union[int, str] = 1,
     ) -> Solution:
         """First-arrival times from ``sources`` on this band, without building the band again.
 
@@ -173,7 +175,7 @@ class Tube:
         ----------
         sources : array_like
             ``(K, d)`` points on the surface.
-        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps
+        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps, order
             As for :func:`tubesweep.solve`.
 
         Returns
@@ -200,20 +202,29 @@ class Tube:
         order = _check_order(order)
         src = as_sources(sources, self.grid)
         general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-        if order == 2:
-            from . import second_order as _so
-
-            check_tolerance(tol, max_iterations)
-            cb = progress_callback(progress)
-            _check_source_init(source_init)
-            _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
-            return _so.solve_on_tube(
-                self._tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
-            )
         check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
-        return _solve_on_tube(
+        fallback: Optional[str] = None
+        if order != 1:
+            from . import second_order as _so
+
+            try:
+                _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
+                if self._order2_refusal is not None:  # this band's geometry, refused before
+                    raise _so.Order2NotApplicable(self._order2_refusal)
+                try:
+                    return _so.solve_on_tube(
+                        self._tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
+                    )
+                except _so.Order2NotApplicable as e:
+                    self._order2_refusal = str(e)  # depends on the band only: not computed again
+                    raise
+            except _so.Order2NotApplicable as e:
+                if order == 2:
+                    raise
+                fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
+        sol = _solve_on_tube(
             self._tube,
             src,
             general,
@@ -229,6 +240,11 @@ class Tube:
             t0,
             reuse=True,
         )
+        if fallback is not None:
+            from .second_order import with_fallback
+
+            return with_fallback(sol, fallback)
+        return sol
 
     def solve_many(
         self,

@@ -1,0 +1,138 @@
+"""order="auto" (docs/second-order.md, "order='auto'"): second order where it applies, bit for
+bit the explicit order=2; the first-order scheme where it does not, bit for bit the explicit
+order=1, with the reason an explicit order=2 gives recorded in sol.stats.order_fallback."""
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+
+SPHERE = ts.surfaces.Sphere(0.5)
+SRC = (-0.5, 0.0, 0.0)
+
+
+def box(n, d=3):
+    return ts.Grid((-1.0,) * d, (1.0,) * d, (n,) * d)
+
+
+def _sphere_cp(x):
+    r = np.linalg.norm(x, axis=1, keepdims=True)
+    return 0.5 * x / np.where(r > 0, r, 1.0)
+
+
+def _refusal(surface, grid, sources, **kw):
+    with pytest.raises(ValueError) as info:
+        ts.solve(surface, grid, sources, order=2, **kw)
+    return str(info.value)
+
+
+@pytest.mark.parametrize(
+    "surface, grid, src",
+    [
+        (SPHERE, box(41), SRC),
+        (ts.ClosestPoint(_sphere_cp), box(41), SRC),
+        (ts.surfaces.Circle(0.5), box(101, 2), (-0.5, 0.0)),
+    ],
+    ids=["sphere level set", "sphere closest-point map", "circle"],
+)
+def test_auto_is_order_two_where_it_applies(surface, grid, src):
+    two = ts.solve(surface, grid, [src], order=2)
+    auto = ts.solve(surface, grid, [src], order="auto")
+    assert auto.stats.order == 2 and auto.stats.order_fallback is None
+    assert np.array_equal(auto.values, two.values)
+    assert auto.stats.order2["second_order_iterations"] == two.stats.order2["second_order_iterations"]
+    pts = np.array([src])
+    assert auto(pts)[0] == 0.0  # the factored evaluation came along
+    tube = ts.Tube(surface, grid)
+    assert np.array_equal(tube.solve([src], order="auto").values, two.values)
+
+
+def _cases():
+    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(16))
+    dt = ts.surfaces.DoubleTorus()
+    g41 = box(41)
+    return [
+        # (surface, grid, source, options, the refusal's words)
+        (mesh, g41, SRC, {}, "piecewise flat"),
+        (ts.surfaces.Hemisphere(), g41, (0, 0, 0.5), {}, "closed surface"),
+        (ts.surfaces.Disc(), g41, (0, 0, 0), {}, "Disc is open"),
+        (dt, ts.Grid(*dt.default_box, (61, 61, 61)), dt.default_source, {}, "crease"),
+        # radius 0.25 at Δx = 1/15: outer·Δx·κ = 1.07, the curvature not resolved by the tube
+        (ts.surfaces.Sphere(0.25), box(31), (-0.25, 0, 0), {}, "Refine the grid"),
+        (SPHERE, g41, SRC, {"hamiltonian": "lxf"}, "Godunov"),
+        (SPHERE, g41, SRC, {"source_init": "node"}, "source_init"),
+        (SPHERE, g41, SRC, {"paper_sweeps": True}, "paper_sweeps"),
+        (SPHERE, g41, SRC, {"method": "naive", "max_iterations": 20}, "two-layer"),
+        (SPHERE, g41, SRC, {"inner": 2.5, "outer": 4}, "outer ≥ inner"),
+    ]
+
+
+@pytest.mark.parametrize(
+    "case",
+    _cases(),
+    ids=[
+        "mesh",
+        "hemisphere",
+        "disc",
+        "double torus",
+        "unresolved curvature",
+        "lxf",
+        "node",
+        "paper",
+        "naive",
+        "outer",
+    ],
+)
+def test_auto_falls_back_to_order_one_with_the_reason(case):
+    surface, grid, src, kw, words = case
+    reason = _refusal(surface, grid, [src], **kw)
+    assert words in reason
+    one = ts.solve(surface, grid, [src], order=1, **kw)
+    auto = ts.solve(surface, grid, [src], order="auto", **kw)
+    assert auto.stats.order == 1 and one.stats.order == 1
+    assert auto.stats.order_fallback == reason and one.stats.order_fallback is None
+    assert np.array_equal(auto.values, one.values)
+    if kw.get("method") != "naive":
+        tube = ts.Tube(surface, grid, **{k: v for k, v in kw.items() if k in ("inner", "outer")})
+        opts = {k: v for k, v in kw.items() if k not in ("inner", "outer", "method", "max_iterations")}
+        for _ in range(2):  # the second time from the refusal the tube remembers
+            t = tube.solve([src], order="auto", **opts)
+            assert t.stats.order_fallback == reason and np.array_equal(t.values, one.values)
+
+
+def test_source_radius_is_first_order():
+    reason = _refusal(SPHERE, box(41), [SRC], source_radius=0.1)
+    auto = ts.solve(SPHERE, box(41), [SRC], order="auto", source_radius=0.1)
+    assert auto.stats.order_fallback == reason and "source_radius" in reason
+    assert np.array_equal(auto.values, ts.solve(SPHERE, box(41), [SRC], order=1, source_radius=0.1).values)
+
+
+def test_other_errors_are_not_fallbacks():
+    # a source off the surface is an error whatever the order, not a reason to fall back
+    for order in (1, 2, "auto"):
+        with pytest.raises(ValueError, match="sources"):
+            ts.solve(SPHERE, box(41), [(0.0, 0.0, 0.0)], order=order)
+
+
+@pytest.mark.parametrize("bad", [3, 0, 1.5, True, "2", "Auto", None, "second"])
+def test_bad_order_values(bad):
+    for call in (
+        lambda: ts.solve(SPHERE, box(21), [SRC], order=bad),
+        lambda: ts.Tube(SPHERE, box(21)).solve([SRC], order=bad),
+        lambda: ts.travel_time(box(11, 2), [(0.0, 0.0)], order=bad),
+    ):
+        with pytest.raises(ValueError, match=r"order must be 1 .* or 'auto'.*got"):
+            call()
+
+
+def test_travel_time_auto():
+    g = box(41, 2)
+    src = [(0.013, -0.2)]
+    two, s2 = ts.travel_time(g, src, order=2, return_stats=True)
+    auto, sa = ts.travel_time(g, src, order="auto", return_stats=True)
+    assert sa.order == 2 and sa.order_fallback is None and np.array_equal(auto, two)
+    with pytest.raises(ValueError) as info:
+        ts.travel_time(g, src, order=2, hamiltonian="lxf")
+    one = ts.travel_time(g, src, order=1, hamiltonian="lxf")
+    auto, sa = ts.travel_time(g, src, order="auto", hamiltonian="lxf", return_stats=True)
+    assert sa.order == 1 and sa.order_fallback == str(info.value) and np.array_equal(auto, one)
