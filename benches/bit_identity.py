@@ -73,48 +73,52 @@ def _octahedron_mesh():
 def cases():
     sphere = Sphere(0.5)
     g = _cube(41)
-    s = ts.solve(sphere, g, [(-0.5, 0, 0)])
+    s = ts.solve(sphere, g, [(-0.5, 0, 0)], order=1)
     yield "sphere godunov", _solution(s) + [s([(0.5, 0, 0), (0, 0.5, 0), (0.3, 0.3, 0.1)])]
-    yield "sphere lxf", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], hamiltonian="lxf"))
-    yield "sphere callable phi", _solution(ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, g, [(-0.5, 0, 0)]))
-    yield "sphere naive", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], method="naive", max_iterations=30))
-    yield "sphere paper sweeps", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], paper_sweeps=True))
-    yield "sphere one thread", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], threads=1))
+    yield "sphere lxf", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], hamiltonian="lxf", order=1))
+    yield (
+        "sphere callable phi",
+        _solution(ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, g, [(-0.5, 0, 0)], order=1)),
+    )
+    yield "sphere naive", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], method="naive", max_iterations=30, order=1))
+    yield "sphere paper sweeps", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], paper_sweeps=True, order=1))
+    yield "sphere one thread", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], threads=1, order=1))
     g101 = _cube(101)
     for threads in (1, 2):  # big enough for the parallel strips, the front window and the row prefetch
-        yield f"sphere N=101 {threads}t", _solution(ts.solve(sphere, g101, [(-0.5, 0, 0)], threads=threads))
+        yield f"sphere N=101 {threads}t", _solution(ts.solve(sphere, g101, [(-0.5, 0, 0)], threads=threads, order=1))
         yield (
             f"sphere N=101 lxf {threads}t",
-            _solution(ts.solve(sphere, g101, [(-0.5, 0, 0)], hamiltonian="lxf", threads=threads)),
+            _solution(ts.solve(sphere, g101, [(-0.5, 0, 0)], hamiltonian="lxf", threads=threads, order=1)),
         )
-    yield "sphere speed", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], speed=lambda p: 1.0 + 0.5 * p[:, 2]))
+    yield "sphere speed", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], speed=lambda p: 1.0 + 0.5 * p[:, 2], order=1))
 
     srcs = [(-0.5, 0, 0), (0, 0.5, 0), (0, 0, -0.5)]
-    m = ts.solve(sphere, g, srcs)
+    m = ts.solve(sphere, g, srcs, order=1)
     yield "sphere three sources + labels", _solution(m) + [m.nearest_source(), m.nearest_source([(0.5, 0, 0)])]
     yield "geodesic paths", [m.geodesic_path((0.5, 0.0, 0.0))] + m.geodesic_paths([(0.1, -0.48, 0.1), (0.3, 0.3, 0.3)])
 
     tube = ts.Tube(sphere, g)
     yield (
         "tube re-solve",
-        _solution(tube.solve([(0, 0, 0.5)])) + _solution(tube.solve([(0, 0, 0.5)], hamiltonian="lxf")),
+        _solution(tube.solve([(0, 0, 0.5)], order=1))
+        + _solution(tube.solve([(0, 0, 0.5)], hamiltonian="lxf", order=1)),
     )
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        rd = ts.solve(ts.LevelSet(lambda p: np.sum(p * p, axis=1) - 0.25, redistance=True), g, [(-0.5, 0, 0)])
+        rd = ts.solve(ts.LevelSet(lambda p: np.sum(p * p, axis=1) - 0.25, redistance=True), g, [(-0.5, 0, 0)], order=1)
     yield "redistanced phi", _solution(rd)
 
     torus = Torus()
-    yield "torus", _solution(ts.solve(torus, _cube(41), [torus.default_source]))
+    yield "torus", _solution(ts.solve(torus, _cube(41), [torus.default_source], order=1))
 
     star = Star()
     g2 = _cube(161, 2)
-    st = ts.solve(star, g2, [star.default_source])
+    st = ts.solve(star, g2, [star.default_source], order=1)
     yield "star curve", _solution(st) + [st.geodesic_path(-np.asarray(star.default_source))]
     yield (
         "circle moving medium",
-        _solution(ts.solve(ts.surfaces.Circle(0.5), g2, [(-0.5, 0)], flow=solid_body_rotation(0.5))),
+        _solution(ts.solve(ts.surfaces.Circle(0.5), g2, [(-0.5, 0)], flow=solid_body_rotation(0.5), order=1)),
     )
     yield (
         "circle metric",
@@ -128,15 +132,15 @@ def cases():
         ),
     )
     vort = point_vortices([(0.3, 0.2, 0.0), (-0.2, -0.3, 0.0)], [0.1, -0.1], core=0.05)
-    yield "sphere vortices", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], flow=vort))
+    yield "sphere vortices", _solution(ts.solve(sphere, g, [(-0.5, 0, 0)], flow=vort, order=1))
 
     hemi = Hemisphere()
-    h = ts.solve(hemi, _cube(41), [hemi.default_source])
+    h = ts.solve(hemi, _cube(41), [hemi.default_source], order=1)
     yield "hemisphere cp", _solution(h) + [h([(0.0, 0.0, 0.5)])]
 
     v, f = _octahedron_mesh()
     mesh = ts.surfaces.from_mesh((v, f))
-    ms = ts.solve(mesh, _cube(41), [tuple(v[0])])
+    ms = ts.solve(mesh, _cube(41), [tuple(v[0])], order=1)
     yield "mesh surface", _solution(ms) + [ms.on_mesh(v)]
 
     gb = _cube(81, 2)
@@ -155,7 +159,7 @@ def cases():
 
     # the paper's configuration (Sect. 6.1): the unit-radius sphere, two-layer tube, Godunov, plain sweeps
     pg = ts.Grid((-2, -2, -2), (2, 2, 2), (41, 41, 41))
-    yield "paper sphere", _solution(ts.solve(Sphere(1.0), pg, [(-1.0, 0, 0)], paper_sweeps=True))
+    yield "paper sphere", _solution(ts.solve(Sphere(1.0), pg, [(-1.0, 0, 0)], paper_sweeps=True, order=1))
 
 
 def main() -> int:

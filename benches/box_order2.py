@@ -130,7 +130,7 @@ def sphere_table(sizes):
     circle = np.stack([np.zeros_like(a), R * np.cos(a), R * np.sin(a)], axis=1)
     for n in sizes:
         grid = ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3)
-        solves = [("default", {})]
+        solves = [("order=1", {"order": 1})]
         try:
             ts.solve(
                 lambda q: np.linalg.norm(q, axis=1) - R, ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), sources=[src], order=2

@@ -63,7 +63,7 @@ def rates(tube: ts.Tube, sources: np.ndarray, at: np.ndarray, rounds: int) -> di
     for _ in range(rounds):
         t, c = time.perf_counter(), time.process_time()
         for s in sources:
-            tube.solve([s], threads=1)(at)
+            tube.solve([s], threads=1, order=1)(at)
         keep("loop", time.perf_counter() - t, time.process_time() - c)
         for name, threads in (("many1", 1), ("many2", 2)):
             t, c = time.perf_counter(), time.process_time()

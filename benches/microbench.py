@@ -59,7 +59,7 @@ def _child(n: int, hamiltonian: str, repeats: int, paper: bool) -> Dict[str, Any
     secs: List[float] = []
     st = None
     for _ in range(repeats):
-        sol = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], hamiltonian=hamiltonian, paper_sweeps=paper)
+        sol = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], hamiltonian=hamiltonian, paper_sweeps=paper, order=1)
         st = sol.stats
         secs.append(st.seconds)
     assert st is not None

@@ -51,7 +51,7 @@ def main(sizes: list) -> int:
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
         h = g.spacing
-        sol = ts.solve(ts.surfaces.Sphere(R), g, [src])
+        sol = ts.solve(ts.surfaces.Sphere(R), g, [src], order=1)
         st = starts(40, src)
         t = time.perf_counter()
         paths = sol.geodesic_paths(st)
@@ -75,7 +75,7 @@ def main(sizes: list) -> int:
     print("|---|---|---|---|---|")
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
-        sol = ts.solve(ts.surfaces.Sphere(R), g, sources)
+        sol = ts.solve(ts.surfaces.Sphere(R), g, sources, order=1)
         t = time.perf_counter()
         lab = sol.nearest_source()
         took = time.perf_counter() - t
@@ -95,7 +95,7 @@ def main(sizes: list) -> int:
     print("|---|---|---|")
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
-        sol = ts.solve(ts.surfaces.Sphere(R), g, sources[:3])
+        sol = ts.solve(ts.surfaces.Sphere(R), g, sources[:3], order=1)
         two = np.array([0.0, -0.3, -0.4])
         lengths = [np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in sol.geodesic_paths([two, (0.0, R, 0.0)])]
         e = [abs(v - np.pi / 4) / g.spacing for v in lengths]
@@ -128,13 +128,13 @@ def bunny_rows(sizes: list) -> None:
         if n > 201:
             continue
         g = bunny.grid(n)
-        sol = ts.solve(bunny, g, [v[0]])
+        sol = ts.solve(bunny, g, [v[0]], order=1)
         lengths = np.array([np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in sol.geodesic_paths(v[targets])])
         u = sol.on_mesh(v[targets])
         el, eu = np.abs(lengths - exact) / g.spacing, np.abs(u - exact) / g.spacing
         print(f"| {n} | {g.spacing:.3g} | {el.mean():.2f} | {el.max():.2f} | {eu.mean():.2f} | {eu.max():.2f} |")
     nb = max((n for n in sizes if n <= 201), default=161)
-    two = ts.solve(bunny, bunny.grid(nb), v[[0, 20000]])
+    two = ts.solve(bunny, bunny.grid(nb), v[[0, 20000]], order=1)
     t = time.perf_counter()
     two.nearest_source()
     t1 = time.perf_counter()

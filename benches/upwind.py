@@ -59,7 +59,7 @@ def sphere(ns):
             ("isotropic godunov, same sweeps", dict(hamiltonian=ts.hamiltonians.Isotropic(scheme="godunov")), geo),
             ("upwind, v = 0", dict(flow=lambda q: np.zeros_like(q)), geo),
         ):
-            sol = ts.solve(s, g, [(-R, 0, 0)], threads=1, **kw)
+            sol = ts.solve(s, g, [(-R, 0, 0)], threads=1, **kw, order=1)
             e = np.abs(sol(p) - ex)
             row[name] = {
                 "max": float(np.nanmax(e)),
@@ -100,9 +100,11 @@ def plane(ns):
         g = ts.Grid(lower=(-0.6,) * 3, upper=(0.6,) * 3, shape=(n,) * 3)
         r = {"N": n, "h": g.spacing}
         for ball, rad in (("", None), (", fixed ball 0.1", 0.1)):
-            up = ts.solve(pl, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M), source_radius=rad)
-            lxf = ts.solve(pl, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M, scheme="lxf"), source_radius=rad)
-            iso = ts.solve(pl, g, [(0, 0, 0)], source_radius=rad)
+            up = ts.solve(pl, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M), source_radius=rad, order=1)
+            lxf = ts.solve(
+                pl, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M, scheme="lxf"), source_radius=rad, order=1
+            )
+            iso = ts.solve(pl, g, [(0, 0, 0)], source_radius=rad, order=1)
             for k, sol, ex in (("upwind", up, exact), ("lxf", lxf, exact), ("isotropic godunov", iso, dist)):
                 e = np.abs(sol(q) - ex)
                 r[k + ball] = {
@@ -135,8 +137,8 @@ def circle(ns):
     rows = []
     for n in ns:
         g = ts.Grid((-1, -1), (1, 1), (n, n))
-        up = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(M))
-        iso = ts.solve(c, g, [(-R, 0)])
+        up = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(M), order=1)
+        iso = ts.solve(c, g, [(-R, 0)], order=1)
         r = {"N": n, "h": g.spacing}
         for k, sol, ex in (("upwind", up, exact), ("isotropic godunov", iso, arc)):
             e = np.abs(sol(pts) - ex)

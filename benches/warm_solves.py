@@ -123,11 +123,11 @@ def main() -> int:
         extra["tube_build_ms"] = round(1e3 * (time.perf_counter() - t), 1)
 
         def run() -> ts.Solution:
-            return tube.solve([p.source])
+            return tube.solve([p.source], order=1)
     else:
 
         def run() -> ts.Solution:
-            return ts.solve(surface, p.grid, sources=[p.source])
+            return ts.solve(surface, p.grid, sources=[p.source], order=1)
 
     # the peak resident memory the first solve adds, as benches/run.py measures it ("ΔRSS")
     reset_ok = _reset_peak()

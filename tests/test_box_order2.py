@@ -147,7 +147,7 @@ def test_threads_do_not_change_the_bits():
 def test_cubic_interpolation_in_a_band():
     # a surface solve: cubic where the 4^3 stencil is in the band, the multilinear value elsewhere
     grid = box(41)
-    sol = ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, grid, sources=[(-0.5, 0, 0)])
+    sol = ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, grid, sources=[(-0.5, 0, 0)], order=1)
     v = np.random.default_rng(3).normal(size=(300, 3))
     p = 0.5 * v / np.linalg.norm(v, axis=1)[:, None]
     lin, cub = sol(p), sol(p, interpolation="cubic")

@@ -75,7 +75,7 @@ def test_library_surfaces_and_solutions_explain_themselves():
         "grid=41×41×41 (spacing 0.05)",
         f"band_nodes={sol.stats.band_points:,}",
         "hamiltonian='godunov'",
-        "order=1",
+        f"order={sol.stats.order}",
         f"iterations={sol.stats.iterations}",
         "converged=True",
     ):

@@ -63,9 +63,9 @@ def test_an_infinity_out_of_range_is_refused(infinity):
 @pytest.mark.parametrize(
     "solve",
     [
-        lambda inf: ts.solve(SPHERE, G3, [(0.5, 0, 0)], infinity=inf),
+        lambda inf: ts.solve(SPHERE, G3, [(0.5, 0, 0)], infinity=inf, order=1),
         lambda inf: ts.solve(SPHERE, G3, [(0.5, 0, 0)], hamiltonian="lxf", infinity=inf),
-        lambda inf: ts.Tube(SPHERE, G3).solve([(0.5, 0, 0)], infinity=inf),
+        lambda inf: ts.Tube(SPHERE, G3).solve([(0.5, 0, 0)], infinity=inf, order=1),
         lambda inf: ts.travel_time(G2, [(0.1, 0.2)], infinity=inf),
     ],
 )
@@ -114,9 +114,9 @@ def test_grids_beyond_the_float_range_or_resolution_are_refused(lower, upper, ma
 
 @pytest.mark.parametrize("scale", [1e-25, 1e25])
 def test_grids_in_other_units_give_the_same_digits(scale):
-    ref = ts.solve(SPHERE, G3, [(0.5, 0, 0)])
+    ref = ts.solve(SPHERE, G3, [(0.5, 0, 0)], order=1)
     g = ts.Grid((-scale,) * 3, (scale,) * 3, (31,) * 3)
-    sol = ts.solve(ts.surfaces.Sphere(0.5 * scale), g, [(0.5 * scale, 0, 0)], tol=1e-10 * scale)
+    sol = ts.solve(ts.surfaces.Sphere(0.5 * scale), g, [(0.5 * scale, 0, 0)], tol=1e-10 * scale, order=1)
     assert sol.stats.converged and np.max(np.abs(sol.values / scale - ref.values)) < 1e-9
 
 

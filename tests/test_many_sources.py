@@ -46,14 +46,14 @@ def test_rows_equal_single_solves_bit_for_bit(tube, threads):
     assert many.shape == (3, tube.band_points)
     for k, s in enumerate(sources):
         for single_threads in (1, 2):
-            single = tube.solve(np.atleast_2d(s), threads=single_threads).values
+            single = tube.solve(np.atleast_2d(s), threads=single_threads, order=1).values
             assert np.array_equal(bits(many[k]), bits(single)), (k, single_threads)
     # at= gives the solutions read at the points, without the band rows
     at = np.vstack([pts, [[0, R, 0]]])
     values = tube.solve_many(sources, at=at, threads=threads)
     assert values.shape == (3, 3)
     for k, s in enumerate(sources):
-        assert np.array_equal(bits(values[k]), bits(tube.solve(np.atleast_2d(s))(at)))
+        assert np.array_equal(bits(values[k]), bits(tube.solve(np.atleast_2d(s), order=1)(at)))
 
 
 def test_lxf_and_varying_speed_bit_for_bit(tube):
@@ -61,7 +61,7 @@ def test_lxf_and_varying_speed_bit_for_bit(tube):
     speed = lambda p: 1.0 + 0.5 * p[:, 2]  # noqa: E731
     many = tube.solve_many(pts, hamiltonian="lxf", speed=speed, threads=2)
     for k, s in enumerate(pts):
-        assert np.array_equal(bits(many[k]), bits(tube.solve([s], hamiltonian="lxf", speed=speed).values))
+        assert np.array_equal(bits(many[k]), bits(tube.solve([s], hamiltonian="lxf", speed=speed, order=1).values))
 
 
 def test_progress_and_interrupt(tube):

@@ -69,7 +69,7 @@ def test_value_at_an_off_node_source_is_exactly_zero():
     exact = SPHERE.geodesic_distance(np.array(near), src)
     assert np.all(np.abs(v - exact) < 2e-3), (v, exact)
     # order=1 reads about 0.7 Δx there
-    assert ts.solve(SPHERE, box(41), [src])([src])[0] > 0.01
+    assert ts.solve(SPHERE, box(41), [src], order=1)([src])[0] > 0.01
 
 
 def test_factored_evaluation_removes_the_source_cone():
@@ -90,7 +90,7 @@ def test_factored_evaluation_removes_the_source_cone():
 
 def test_order_one_is_the_first_order_scheme_bit_for_bit():
     g = box(41)
-    a = ts.solve(SPHERE, g, [SRC])
+    a = ts.solve(SPHERE, g, [SRC], order=1)
     b = ts.solve(SPHERE, g, [SRC], order=1, tol=1e-10)
     c = ts.Tube(SPHERE, g).solve([SRC], order=1)
     assert np.array_equal(a.values, b.values) and np.array_equal(a.values, c.values)

@@ -12,7 +12,7 @@ from tubesweep.surfaces import Circle, Sphere
 def circle_error(n, ham, init="exact"):
     c = Circle(0.5)
     g = ts.Grid((-1, -1), (1, 1), (n, n))
-    sol = ts.solve(c, g, [c.default_source], hamiltonian=ham, source_init=init)
+    sol = ts.solve(c, g, [c.default_source], hamiltonian=ham, source_init=init, order=1)
     pts = c.sample(2000)
     return np.max(np.abs(sol(pts) - c.geodesic_distance(pts, c.default_source))), g.spacing, sol
 
@@ -25,7 +25,7 @@ RING = np.stack(
 def sphere_error(n, ham, init="exact"):
     s = Sphere(0.5)
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
-    sol = ts.solve(s, g, [(-0.5, 0, 0)], hamiltonian=ham, source_init=init)
+    sol = ts.solve(s, g, [(-0.5, 0, 0)], hamiltonian=ham, source_init=init, order=1)
     return np.max(np.abs(sol(RING) - np.pi / 4)), g.spacing, sol
 
 
@@ -270,8 +270,8 @@ def test_accelerated_sweeps_give_the_papers_solution_with_less_work(dim, ham):
         surf, grid, src = Circle(0.5), ts.Grid((-1, -1), (1, 1), (201, 201)), [(-0.5, 0.0)]
     else:
         surf, grid, src = Sphere(0.5), ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81)), [(-0.5, 0, 0)]
-    fast = ts.solve(surf, grid, src, hamiltonian=ham, tol=1e-12)
-    paper = ts.solve(surf, grid, src, hamiltonian=ham, tol=1e-12, paper_sweeps=True)
+    fast = ts.solve(surf, grid, src, hamiltonian=ham, tol=1e-12, order=1)
+    paper = ts.solve(surf, grid, src, hamiltonian=ham, tol=1e-12, paper_sweeps=True, order=1)
     assert fast.stats.converged and paper.stats.converged
     np.testing.assert_array_equal(fast.indices, paper.indices)
     assert np.max(np.abs(fast.values - paper.values)) < 1e-9
@@ -312,13 +312,13 @@ def test_a_surface_that_caches_its_band_geometry_is_not_modified_by_the_solver()
     cached = CachedSphere()
     geom = cached.band(g, 4.0 * g.spacing)  # the geometry solve() will get, cached
     before = geom.direction.copy()
-    first = ts.solve(cached, g, [(-0.5, 0, 0)])
-    second = ts.solve(cached, g, [(-0.5, 0, 0)], inner=1.5)
+    first = ts.solve(cached, g, [(-0.5, 0, 0)], order=1)
+    second = ts.solve(cached, g, [(-0.5, 0, 0)], inner=1.5, order=1)
     assert len(cached.cache) == 1
     np.testing.assert_array_equal(geom.direction, before)
-    fresh = ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)], inner=1.5)
+    fresh = ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)], inner=1.5, order=1)
     np.testing.assert_array_equal(second.values, fresh.values)
-    np.testing.assert_array_equal(first.values, ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)]).values)
+    np.testing.assert_array_equal(first.values, ts.solve(Sphere(0.5), g, [(-0.5, 0, 0)], order=1).values)
 
 
 def test_a_tolerance_tied_to_the_grid_stops_earlier_within_a_few_tol_of_the_converged_solution():
@@ -328,9 +328,9 @@ def test_a_tolerance_tied_to_the_grid_stops_earlier_within_a_few_tol_of_the_conv
     below tol and the activation threshold is tol/100)."""
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81))
     sphere = Sphere(radius=0.5)
-    full = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)])
+    full = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], order=1)
     tol = 1e-3 * grid.spacing
-    loose = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], tol=tol)
+    loose = ts.solve(sphere, grid, sources=[(-0.5, 0.0, 0.0)], tol=tol, order=1)
     assert loose.stats.converged and loose.stats.last_change < tol
     assert loose.stats.iterations < full.stats.iterations and loose.stats.updates < full.stats.updates
     dev = np.max(np.abs(loose.values - full.values))
@@ -350,11 +350,11 @@ def test_a_solve_stopped_before_the_front_window_opened_says_so():
     nodes beyond it unreached (inf), and the warning says so."""
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81))
     with pytest.warns(RuntimeWarning, match="front window had reached u = .*not reached yet"):
-        sol = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], max_iterations=4)
+        sol = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], max_iterations=4, order=1)
     assert not sol.stats.converged
     edge = sol.stats.window_edge
     assert 0.0 < edge < np.pi * 0.5
-    full = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)])
+    full = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], order=1)
     assert full.stats.converged and full.stats.window_edge == np.inf
     reached = np.isfinite(sol.values)
     assert 0.05 < reached.mean() < 0.5
@@ -380,9 +380,9 @@ def test_the_front_window_also_pays_on_a_non_orientable_surface(monkeypatch):
     surf = MobiusBand()
     lo, hi = surf.default_box
     grid = ts.Grid(lo, hi, (81, 81, 81))
-    on = ts.solve(surf, grid, [surf.default_source])
+    on = ts.solve(surf, grid, [surf.default_source], order=1)
     monkeypatch.setattr(solve_module, "FRONT_WINDOW", 0.0)
-    off = ts.solve(surf, grid, [surf.default_source])
+    off = ts.solve(surf, grid, [surf.default_source], order=1)
     assert on.stats.converged and off.stats.converged
     reached = np.isfinite(off.values)
     np.testing.assert_array_equal(np.isfinite(on.values), reached)
@@ -395,8 +395,8 @@ def test_stats_say_how_the_sweeps_ran_without_changing_the_values():
     shapes and the rows fetched ahead; one thread runs square tiles only, and the values are the
     same bits for any thread count."""
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81))
-    one = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], threads=1)
-    two = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], threads=2)
+    one = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], threads=1, order=1)
+    two = ts.solve(Sphere(0.5), grid, [(-0.5, 0, 0)], threads=2, order=1)
     assert one.stats.thin_strip_iterations == (0, 0)
     # the ring about a source on the first axis crosses it: strips thin across it in some
     # iterations, never across the second

@@ -51,7 +51,7 @@ def test_ellipse_converges_at_first_order_and_is_symmetric():
     pts = e.sample(400)
     err = []
     for n in (101, 201, 401):
-        sol = ts.solve(e, ts.Grid(*e.default_box, (n, n)), [e.default_source])
+        sol = ts.solve(e, ts.Grid(*e.default_box, (n, n)), [e.default_source], order=1)
         err.append(np.max(np.abs(sol(pts) - e.geodesic_distance(pts, e.default_source))))
         mirrored = pts * np.array([1.0, -1.0])
         np.testing.assert_allclose(sol(pts), sol(mirrored), atol=1e-12)
@@ -77,7 +77,7 @@ def test_ellipsoid_symmetry_and_convergence_to_a_fine_grid_reference():
     el = Ellipsoid()
     src = el.default_source  # (−a, 0, 0): u is even in y and in z
     V, _ = el.triangulation(16)
-    sols = {n: ts.solve(el, ts.Grid(*el.default_box, (n,) * 3), [src]) for n in (41, 81, 161)}
+    sols = {n: ts.solve(el, ts.Grid(*el.default_box, (n,) * 3), [src], order=1) for n in (41, 81, 161)}
     for n, sol in sols.items():
         u = sol(V)
         assert not np.any(np.isnan(u))
@@ -134,19 +134,19 @@ def test_redistance_reproduces_the_exact_distance_solution_2d_and_3d():
     geom = ls.band(grid, 4 * grid.spacing)
     x = grid.points(grid.unravel(geom.linear))
     np.testing.assert_allclose(geom.signed, np.linalg.norm(x, axis=1) - 0.5, atol=1e-10)
-    a = ts.solve(ls, grid, [(-0.5, 0)])
-    b = ts.solve(Circle(), grid, [(-0.5, 0)])
+    a = ts.solve(ls, grid, [(-0.5, 0)], order=1)
+    b = ts.solve(Circle(), grid, [(-0.5, 0)], order=1)
     pts = Circle().sample(200)
     assert np.max(np.abs(a(pts) - b(pts))) < 1e-4
     # sampled φ (a dense array) too
     X = np.stack(np.meshgrid(*[np.linspace(-1, 1, 101)] * 2, indexing="ij"), -1).reshape(-1, 2)
-    c = ts.solve(ts.LevelSet(f(X).reshape(101, 101), redistance=True), grid, [(-0.5, 0)])
+    c = ts.solve(ts.LevelSet(f(X).reshape(101, 101), redistance=True), grid, [(-0.5, 0)], order=1)
     assert np.max(np.abs(c(pts) - b(pts))) < 2e-3
     # 3D: a squashed, scaled quadric with |∇φ| between 0.6 and 3.4 near the surface
     g3 = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
     q = lambda p: 3 * (np.sum(p**2, axis=1) - 0.25) * (1 + 0.5 * p[:, 0])  # noqa: E731
-    s3 = ts.solve(ts.LevelSet(q, redistance=True), g3, [(-0.5, 0, 0)])
-    r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)])
+    s3 = ts.solve(ts.LevelSet(q, redistance=True), g3, [(-0.5, 0, 0)], order=1)
+    r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)], order=1)
     V, _ = Sphere().triangulation(12)
     assert np.max(np.abs(s3(V) - r3(V))) < 1e-3
 
@@ -207,9 +207,9 @@ def test_redistancing_next_to_the_box_s_side_finds_the_whole_band():
     L, n = 0.55, 15
     grid = ts.Grid((-L, -L), (L, L), (n, n))
     X, Y = grid.meshgrid()
-    exact = ts.solve(ts.surfaces.Circle(0.5), grid, [(-0.5, 0.0)])
+    exact = ts.solve(ts.surfaces.Circle(0.5), grid, [(-0.5, 0.0)], order=1)
     for phi in (X**2 + Y**2 - 0.25, lambda p: np.sum(p * p, axis=1) - 0.25):
-        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.5, 0.0)])
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.5, 0.0)], order=1)
         assert np.array_equal(sol.linear, exact.linear)
         assert np.all(np.isfinite(sol.values))
         assert np.max(np.abs(sol.values - exact.values)) < 0.05
@@ -232,8 +232,8 @@ def test_a_lipschitz_bound_below_the_gradient_still_widens_until_the_band_closes
     phi = lambda x: np.sum(x**2, -1) - 0.25  # noqa: E731
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        low = ts.solve(ts.LevelSet(phi, redistance=True, lipschitz=0.9), grid, [(0.5, 0.0)])
-        free = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(0.5, 0.0)])
+        low = ts.solve(ts.LevelSet(phi, redistance=True, lipschitz=0.9), grid, [(0.5, 0.0)], order=1)
+        free = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(0.5, 0.0)], order=1)
     far = np.array([(-0.5, 0.0), (0.0, 0.5)])
     assert np.allclose(low(far), free(far), rtol=0, atol=1e-9)
 
@@ -304,8 +304,8 @@ def test_sampled_redistance_in_3d_matches_the_sphere():
     g3 = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
     X = np.stack(np.meshgrid(*[np.linspace(-1, 1, 41)] * 3, indexing="ij"), -1).reshape(-1, 3)
     phi = (3 * (np.sum(X**2, axis=1) - 0.25) * (1 + 0.5 * X[:, 0])).reshape((41,) * 3)
-    s3 = ts.solve(ts.LevelSet(phi, redistance=True), g3, [(-0.5, 0, 0)])
-    r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)])
+    s3 = ts.solve(ts.LevelSet(phi, redistance=True), g3, [(-0.5, 0, 0)], order=1)
+    r3 = ts.solve(Sphere(), g3, [(-0.5, 0, 0)], order=1)
     V, _ = Sphere().triangulation(12)
     assert np.max(np.abs(s3(V) - r3(V))) < 1e-3  # 1.9e-4 (the interpolant's zero set is not the sphere's)
 

@@ -31,7 +31,7 @@ def _sphere_points(m: int = 2000) -> np.ndarray:
 def test_zero_flow_and_identity_metric_reproduce_the_isotropic_godunov_solution():
     s = Sphere(R)
     g = _sphere_grid(29)
-    iso = ts.solve(s, g, [(-R, 0, 0)], speed=2.0)
+    iso = ts.solve(s, g, [(-R, 0, 0)], speed=2.0, order=1)
     flow = ts.solve(s, g, [(-R, 0, 0)], speed=2.0, flow=lambda p: np.zeros_like(p))
     met = ts.solve(s, g, [(-R, 0, 0)], speed=2.0, hamiltonian=ts.hamiltonians.Metric(np.eye(3)))
     assert flow.stats.converged and met.stats.converged
@@ -52,7 +52,7 @@ def test_rotating_medium_on_the_sphere_is_as_accurate_as_the_isotropic_solver():
         g = _sphere_grid(n)
         up = ts.solve(s, g, [(-R, 0, 0)], flow=solid_body_rotation(1.0))
         lxf = ts.solve(s, g, [(-R, 0, 0)], flow=solid_body_rotation(1.0), hamiltonian="lxf")
-        iso = ts.solve(s, g, [(-R, 0, 0)])
+        iso = ts.solve(s, g, [(-R, 0, 0)], order=1)
         assert up.stats.converged
         e = np.abs(up(p) - exact)
         errs.append(float(np.nanmax(e)))
@@ -82,7 +82,7 @@ def test_rotating_medium_on_a_circle_converges_at_first_order():
     for n in (51, 101):
         g = ts.Grid((-1, -1), (1, 1), (n, n))
         errs.append(float(np.nanmax(np.abs(ts.solve(c, g, [(-R, 0)], flow=solid_body_rotation(1.0))(pts) - exact))))
-        iso.append(float(np.nanmax(np.abs(ts.solve(c, g, [(-R, 0)])(pts) - _arc(pts)))))
+        iso.append(float(np.nanmax(np.abs(ts.solve(c, g, [(-R, 0)], order=1)(pts) - _arc(pts)))))
     # measured: 0.099, 0.048 (order 1.05), isotropic Godunov 0.089, 0.041; both largest at the kink
     # opposite the source (LxF, smoother there: 0.071, 0.035)
     assert _fitted_order([2 / 50, 2 / 100], errs) > 0.9, errs
@@ -106,7 +106,7 @@ def test_constant_metric_on_a_tilted_plane_is_within_the_isotropic_solver_s_erro
     for N in (21, 31):
         g = ts.Grid(lower=(-1,) * 3, upper=(1,) * 3, shape=(N,) * 3)
         up = ts.solve(plane, g, [(0, 0, 0)], hamiltonian=ts.hamiltonians.Metric(M))
-        iso = ts.solve(plane, g, [(0, 0, 0)])
+        iso = ts.solve(plane, g, [(0, 0, 0)], order=1)
         e_up, e_iso = np.abs(up(q) - exact), np.abs(iso(q) - dist)
         # measured at N = 21, 31: max 0.051, 0.041 against 0.048, 0.037; mean 0.020, 0.017 against
         # 0.021, 0.017 (LxF: max 0.15, 0.13)
@@ -136,7 +136,7 @@ def test_constant_metric_on_a_circle_converges_like_the_isotropic_solver():
         sol = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(M))
         assert sol.stats.converged
         errs.append(float(np.nanmax(np.abs(sol(pts) - exact))))
-        iso_errs.append(float(np.nanmax(np.abs(ts.solve(c, g, [(-R, 0)])(pts) - arc))))
+        iso_errs.append(float(np.nanmax(np.abs(ts.solve(c, g, [(-R, 0)], order=1)(pts) - arc))))
     assert _fitted_order([2 / 50, 2 / 100], errs) > 0.9, errs
     assert all(e < 1.5 * i for e, i in zip(errs, iso_errs)), (errs, iso_errs)
 
@@ -191,7 +191,7 @@ def test_bad_metric_and_flow_input_name_the_argument_and_the_place():
         ts.solve(c, g, [(-R, 0)], flow=lambda p: np.full_like(p, np.inf))
     with pytest.warns(RuntimeWarning, match="normal component .* removed"):
         a = ts.solve(c, g, [(-R, 0)], flow=lambda p: 0.3 * p)  # radial: purely normal, removed
-    b = ts.solve(c, g, [(-R, 0)])
+    b = ts.solve(c, g, [(-R, 0)], order=1)
     assert np.max(np.abs(a.values - b.values)[a.roles != 2]) < 1e-3
     # the box checks the same
     with pytest.raises(ValueError, match="M must be positive definite"):
@@ -227,7 +227,7 @@ def test_isotropic_through_the_upwind_interface_is_the_godunov_update():
     c = Circle(R)
     g = ts.Grid((-1, -1), (1, 1), (81, 81))
     a = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(scheme="godunov"))
-    b = ts.solve(c, g, [(-R, 0)])
+    b = ts.solve(c, g, [(-R, 0)], order=1)
     assert a.stats.converged and np.max(np.abs(a.values - b.values)) < 1e-8
 
 

@@ -116,15 +116,15 @@ def test_a_tol_not_small_against_a_cell_s_travel_time_is_refused(speed):
     # at speed 1e15 the default tol 1e-10 exceeds every travel time: the sweeps stopped at once,
     # half the band at the numerical infinity, reported converged
     with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel times of this problem"):
-        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed)
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, order=1)
     with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel times"):
-        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, hamiltonian=ts.hamiltonians.Isotropic())
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, hamiltonian=ts.hamiltonians.Isotropic(), order=1)
     with pytest.raises(ValueError, match="travel times"):
         ts.travel_time(G2, [(0, 0)], speed=speed)
     # the fix the message names works, and gives the speed-1 answer scaled
     cell = G3.spacing / speed
-    u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, tol=1e-10 * cell)([(0.5, 0, 0)])[0]
-    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)])([(0.5, 0, 0)])[0]
+    u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, tol=1e-10 * cell, order=1)([(0.5, 0, 0)])[0]
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], order=1)([(0.5, 0, 0)])[0]
     assert abs(u * speed - u1) < 1e-6 * u1
 
 
@@ -148,9 +148,11 @@ def test_a_small_grid_in_small_units_needs_a_tol_in_those_units():
     s = 1e-12
     grid = ts.Grid((-s,) * 3, (s,) * 3, (31,) * 3)
     with pytest.raises(ValueError, match="tol"):
-        ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)])
-    u = ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], tol=1e-10 * grid.spacing)([(0.5 * s, 0, 0)])[0]
-    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)])([(0.5, 0, 0)])[0]
+        ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], order=1)
+    u = ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], tol=1e-10 * grid.spacing, order=1)(
+        [(0.5 * s, 0, 0)]
+    )[0]
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], order=1)([(0.5, 0, 0)])[0]
     assert abs(u / s - u1) < 1e-6
 
 
@@ -204,8 +206,8 @@ def test_threads_beyond_the_cores_run_on_all_cores():
 def test_the_grid_tied_tolerance_and_many_seeds_are_accepted():
     # the README's tol = 1e-3 h at a high speed, and 40 seeds that fix every inner node of a circle
     g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
-    fast = ts.solve(SPHERE, g, [(-0.5, 0, 0)], speed=100.0, tol=1e-3 * g.spacing)([(0.5, 0, 0)])[0]
-    slow = ts.solve(SPHERE, g, [(-0.5, 0, 0)])([(0.5, 0, 0)])[0]
+    fast = ts.solve(SPHERE, g, [(-0.5, 0, 0)], speed=100.0, tol=1e-3 * g.spacing, order=1)([(0.5, 0, 0)])[0]
+    slow = ts.solve(SPHERE, g, [(-0.5, 0, 0)], order=1)([(0.5, 0, 0)])[0]
     assert abs(100 * fast - slow) < 1e-3
     t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     seeds = 0.5 * np.c_[np.cos(t), np.sin(t)]

@@ -32,13 +32,13 @@ def residual_by_angle(n: int) -> None:
     warnings.simplefilter("ignore")
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
     sphere = ts.surfaces.Sphere(0.5)
-    final = ts.solve(sphere, g, [(-0.5, 0, 0)], tol=1e-12)
+    final = ts.solve(sphere, g, [(-0.5, 0, 0)], tol=1e-12, order=1)
     x = final.points
     ang = np.degrees(np.arccos(np.clip(-x[:, 0] / np.linalg.norm(x, axis=1), -1, 1)))
     print(f"sphere N={n}: largest |u_k − u| after k iterations, per angle from the source")
     print("   k " + " ".join(f"{a:>3d}–{a + 20:<3d}" for a in range(0, 180, 20)))
     for k in (3, 5, 7):
-        s = ts.solve(sphere, g, [(-0.5, 0, 0)], max_iterations=k, tol=1e-12)
+        s = ts.solve(sphere, g, [(-0.5, 0, 0)], max_iterations=k, tol=1e-12, order=1)
         d = s.values - final.values
         print(f"  {k:2d} " + " ".join(f"{d[(ang >= a) & (ang < a + 20)].max():7.0e}" for a in range(0, 180, 20)))
 
@@ -51,7 +51,7 @@ def tilted_plane(sizes: Sequence[int]) -> None:
     for n in sizes:
         g = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
         its = [
-            ts.solve(lambda p: p @ normal, g, [(0, 0, 0)], **kw).stats.iterations
+            ts.solve(lambda p: p @ normal, g, [(0, 0, 0)], **kw, order=1).stats.iterations
             for kw in ({}, {"method": "naive"}, {"paper_sweeps": True})
         ]
         print(f"{n:5d} {its[0]:10d} {its[1]:6d} {its[2]:13d}")

@@ -155,7 +155,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         n = args.n or (201 if name == "line2" else 41)
         surface, grid, source = case(name, n)
         tube = ts.Tube(surface, grid)
-        sol = tube.solve([source])
+        sol = tube.solve([source], order=1)
         geometry = surface.band(grid, tube.outer * grid.spacing)
         assert np.array_equal(geometry.linear, sol.linear), "the band the solve ran on"
         graph = reads(sol, geometry.direction)

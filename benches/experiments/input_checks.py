@@ -73,7 +73,7 @@ def disc() -> None:
     with patched(solve, "_check_surface_spans_two_cells", lambda *a: None):
         for k in (0.02, 0.5, 1.0, 2.0):
             r = k * h
-            u = ts.solve(ts.surfaces.Disc(radius=r), grid, [(r, 0, 0), (-r, 0, 0)])([(0, r, 0)])[0]
+            u = ts.solve(ts.surfaces.Disc(radius=r), grid, [(r, 0, 0), (-r, 0, 0)], order=1)([(0, r, 0)])[0]
             print(f"  {k:5.2f}  {u:.5g}  {np.sqrt(2) * r:.5g}  {abs(u - np.sqrt(2) * r) / (np.sqrt(2) * r):.3f}")
 
 
@@ -103,8 +103,8 @@ def box_side() -> None:
     L, n = 0.55, 15
     grid = ts.Grid((-L, -L), (L, L), (n, n))
     X, Y = grid.meshgrid()
-    exact = ts.solve(ts.surfaces.Circle(0.5), grid, [(-0.5, 0.0)])
-    sol = ts.solve(ts.LevelSet(X**2 + Y**2 - 0.25, redistance=True), grid, [(-0.5, 0.0)])
+    exact = ts.solve(ts.surfaces.Circle(0.5), grid, [(-0.5, 0.0)], order=1)
+    sol = ts.solve(ts.LevelSet(X**2 + Y**2 - 0.25, redistance=True), grid, [(-0.5, 0.0)], order=1)
     print(
         f"box side: re-distanced band {len(sol.linear)} nodes against the circle's {len(exact.linear)}, "
         f"{int(np.count_nonzero(~np.isfinite(sol.values)))} at inf, converged={sol.stats.converged}"
@@ -161,7 +161,7 @@ def sharp_box(sizes: tuple, rounds: int) -> None:
                     warnings.simplefilter("ignore")
                     t = time.perf_counter()
                     try:
-                        ts.solve(surface, grid, [(0.0, 0.0, 0.5)])
+                        ts.solve(surface, grid, [(0.0, 0.0, 0.5)], order=1)
                         outcome[label] = "solved"
                     except ValueError as e:
                         outcome[label] = f"ValueError: {str(e)[:60]}..."
@@ -181,7 +181,7 @@ def spot() -> None:
         print("spot: skipped (the bundled spot mesh is missing)")
         return
     mesh = ts.surfaces.from_mesh(SPOT)
-    sol = ts.solve(mesh, mesh.grid(81), mesh.vertices[[285, 0, 1000]])
+    sol = ts.solve(mesh, mesh.grid(81), mesh.vertices[[285, 0, 1000]], order=1)
     for label, fraction in (("off", 0.0), ("on", geodesic_paths.PROGRESS_FRACTION)):
         with patched(geodesic_paths, "PROGRESS_FRACTION", fraction), warnings.catch_warnings():
             warnings.simplefilter("ignore")

@@ -230,7 +230,7 @@ def farthest_point_sampling(
     usable = np.all(np.isfinite(candidates), axis=1)
 
     def distances_from(p: np.ndarray) -> np.ndarray:
-        return tube.solve([p], tol=tol, threads=threads).values[inner_pos]
+        return tube.solve([p], tol=tol, threads=threads, order=1).values[inner_pos]
 
     if start is None:
         seed = candidates[int(np.flatnonzero(usable)[0])]

@@ -18,7 +18,14 @@ import numpy as np
 
 from . import _native
 from ._factoring import FACTORED_RADIUS, factored_reach
-from ._validate import FRONT_WINDOW, check_threads as _threads, checked_point_speeds, speed_at_points, speed_values
+from ._validate import (
+    FRONT_WINDOW,
+    check_threads as _threads,
+    check_tolerance_scale,
+    checked_point_speeds,
+    speed_at_points,
+    speed_values,
+)
 from .stats import SolveStats
 
 __all__ = ["ORDERS", "Order2NotApplicable", "check_order", "FIX_RADIUS", "FACTORED_RADIUS", "default_tol"]
@@ -164,6 +171,9 @@ def solve_on_tube(
     mean_slowness = float(np.mean(slowness))
     if tol is None:
         tol = default_tol(h, mean_slowness)
+    # travel times too large or too small for the local updates' squares, a tol not small against
+    # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
+    check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
     dist, proj = surf.project(src, grid)
     inner_width = tube.inner * h
     for i, (dd, s) in enumerate(zip(dist, src)):

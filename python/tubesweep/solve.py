@@ -134,15 +134,19 @@ def solve(
         The finite numerical infinity unknown values start at (default: derived from the band, a
         safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
         A user value must exceed every travel time: values within a millionth of it count as
-        never reached and are returned as ``inf``.
-    order : {1, 2}
+        never reached and are returned as ``inf``. Not used by ``order=2``.
+    order : {1, 2, "auto"}
         1: the paper's first-order scheme (the default). 2: second order (docs/second-order.md):
         the metric-corrected tube equation with limited BDF2 differences and factored point
         sources, for level sets (arrays, callables, library surfaces) and closed smooth
         closest-point surfaces with the Godunov update; ``sol.stats.order2`` reports its phases.
         A surface whose curvature the tube does not resolve (``outer·Δx·κ ≥ 1``), a φ that is
-        not a signed distance (without ``redistance=True``), meshes and open surfaces are
-        refused with a ``ValueError``.
+        not a signed distance (without ``redistance=True``), a crease, meshes, open surfaces,
+        Lax–Friedrichs, flows and Hamiltonian objects, ``method="naive"``, ``paper_sweeps``,
+        ``source_init="node"``, ``source_radius`` and ``outer < inner + 2`` are refused with a
+        ``ValueError`` saying why. ``"auto"``: 2 where it applies, and where it does not the
+        first-order scheme, the same values as ``order=1``, with ``sol.stats.order_fallback``
+        holding the text of the error ``order=2`` gives (``sol.stats.order`` says which ran).
     paper_sweeps : bool
         ``True`` runs the paper's plain sweeps: pointwise Gauss–Seidel updates over the whole band
         in every iteration (nodes none of whose neighbours changed are still skipped, which changes

@@ -264,7 +264,9 @@ class Tube:
         chunk_size: Optional[int] = None,
         return_stats: bool = False,
     ) -> Any:
-        """K independent solves on this band, in parallel across the sources (docs/many-sources.md).
+        """K independent solves on this band, in parallel across the sources (docs/many-sources.md),
+        with the paper's first-order scheme (``order=1``; for second order, loop over
+        :meth:`solve` with ``order=2``).
 
         Parameters
         ----------
@@ -292,7 +294,7 @@ class Tube:
         -------
         values : numpy.ndarray
             ``(K, band_points)`` (or ``(K, M)`` with ``at``); row k equals
-            ``tube.solve(sources[k], ...).values`` (or its values at ``at``) bit for bit.
+            ``tube.solve(sources[k], order=1, ...).values`` (or its values at ``at``) bit for bit.
         stats : dict
             Only with ``return_stats``: per-source arrays (iterations, converged, last_change, ...).
 
@@ -307,9 +309,9 @@ class Tube:
         -----
         ``sources`` is an array (K, d) of K point sources, or an array (K, P, d) / a list whose
         entries are points (d,) or groups (P, d) (a group is one multi-source solve). Returns a
-        (K, band_points) array whose row k equals ``tube.solve(sources[k], ...).values`` bit for
+        (K, band_points) array whose row k equals ``tube.solve(sources[k], order=1, ...).values`` bit for
         bit (``inf`` where never reached), or with ``at=points`` (M, d) the (K, M) values
-        ``tube.solve(sources[k], ...)(points)`` without keeping K band arrays (memory O(band ·
+        ``tube.solve(sources[k], order=1, ...)(points)`` without keeping K band arrays (memory O(band ·
         threads + K·M)). ``threads`` solves run at once, each on one thread (0: all cores), with
         the GIL released; ``progress(done, total)`` is called about every 50 ms, and Ctrl-C stops
         every solve with ``KeyboardInterrupt`` (no partial result). The other options are those of

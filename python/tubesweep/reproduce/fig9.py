@@ -89,7 +89,7 @@ def run(out_dir: Path, quick: bool = False) -> dict:
     for ham in HAMILTONIANS:
         for n in h_sizes:
             t0 = time.perf_counter()
-            sol = solve(hemi, Grid(*hemi.default_box, (n,) * 3), [h_src], hamiltonian=ham)
+            sol = solve(hemi, Grid(*hemi.default_box, (n,) * 3), [h_src], hamiltonian=ham, order=1)
             wall = time.perf_counter() - t0
             u = sol(Vh)
             e = np.abs(u - exact_h)
@@ -111,7 +111,7 @@ def run(out_dir: Path, quick: bool = False) -> dict:
                 last["hemisphere"] = u
         for n in m_sizes:
             t0 = time.perf_counter()
-            sol = solve(mob, Grid(*mob.default_box, (n,) * 3), [m_src], hamiltonian=ham)
+            sol = solve(mob, Grid(*mob.default_box, (n,) * 3), [m_src], hamiltonian=ham, order=1)
             wall = time.perf_counter() - t0
             row: Dict[str, object] = dict(
                 surface="mobius",

@@ -75,14 +75,16 @@ def run(out_dir: Path, quick: bool) -> dict:
         rows += _rows(
             f"moving medium, rotation, circle, {label}",
             n2,
-            lambda n: solve(circ, g2(n), [(-R, 0)], speed=1.0, flow=solid_body_rotation(1.0), hamiltonian=scheme),
+            lambda n: solve(
+                circ, g2(n), [(-R, 0)], speed=1.0, flow=solid_body_rotation(1.0), hamiltonian=scheme, order=1
+            ),
             lambda p: rotation_travel_time_circle(p, R, np.pi, 1.0, 1.0),
             pc,
         )
         rows += _rows(
             f"metric M2, circle, {label}",
             n2,
-            lambda n: solve(circ, g2(n), [(-R, 0)], hamiltonian=Metric(M2, scheme=scheme)),
+            lambda n: solve(circ, g2(n), [(-R, 0)], hamiltonian=Metric(M2, scheme=scheme), order=1),
             _metric_circle_exact,
             pc,
         )
@@ -91,14 +93,16 @@ def run(out_dir: Path, quick: bool) -> dict:
         rows += _rows(
             f"moving medium, rotation, sphere, {'LxF' if scheme == 'lxf' else 'upwind'}",
             n3,
-            lambda n: solve(sph, g3(n), [(-R, 0, 0)], speed=1.0, flow=solid_body_rotation(1.0), hamiltonian=scheme),
+            lambda n: solve(
+                sph, g3(n), [(-R, 0, 0)], speed=1.0, flow=solid_body_rotation(1.0), hamiltonian=scheme, order=1
+            ),
             lambda p: rotation_travel_time_sphere(p, R, (-R, 0, 0), 1.0, 1.0),
             ps,
         )
     rows += _rows(
         "isotropic LxF (v = 0), sphere",
         n3,
-        lambda n: solve(sph, g3(n), [(-R, 0, 0)], hamiltonian="lxf"),
+        lambda n: solve(sph, g3(n), [(-R, 0, 0)], hamiltonian="lxf", order=1),
         lambda p: sph.geodesic_distance(p, (-R, 0, 0)),
         ps,
     )

@@ -23,7 +23,7 @@ def run(out_dir: Path, quick: bool) -> dict:
         for ham in ("godunov", "lxf"):
             errs = {}
             for init in ("exact", "node"):
-                sol = solve(circle, g, [circle.default_source], hamiltonian=ham, source_init=init)
+                sol = solve(circle, g, [circle.default_source], hamiltonian=ham, source_init=init, order=1)
                 errs[init] = float(np.max(np.abs(sol(pts) - exact2)))
             rows.append(("circle r=0.5", n, ham, errs["exact"], errs["node"]))
     th = np.linspace(0, 2 * np.pi, 720, endpoint=False)
@@ -33,7 +33,7 @@ def run(out_dir: Path, quick: bool) -> dict:
         for ham in ("godunov", "lxf"):
             errs = {}
             for init in ("exact", "node"):
-                sol = solve(Sphere(0.5), g, [(-0.5, 0, 0)], hamiltonian=ham, source_init=init)
+                sol = solve(Sphere(0.5), g, [(-0.5, 0, 0)], hamiltonian=ham, source_init=init, order=1)
                 errs[init] = float(np.max(np.abs(sol(ring) - np.pi / 4)))
             rows.append(("sphere r=0.5", n, ham, errs["exact"], errs["node"]))
     with open(out_dir / "source_init.csv", "w", newline="") as f:

@@ -69,6 +69,7 @@ def sphere_run(n: int, hamiltonian: str, source_init: str = "node", keep: bool =
         inner=2.0,
         outer=4.0,
         method="two-layer",
+        order=1,
         source_init=source_init,
         tol=TOL,
         infinity=INFINITY,

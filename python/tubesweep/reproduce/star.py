@@ -109,6 +109,7 @@ def star_run(
         inner=2.0,
         outer=4.0,
         method="two-layer",
+        order=1,
         source_init=source_init,
         tol=tol,
         infinity=infinity,
@@ -442,6 +443,7 @@ def run_fig6(out_dir: Path, quick: bool) -> dict:
         [SOURCE],
         hamiltonian="godunov",
         source_init="node",
+        order=1,
         tol=MATCH["tol"],  # type: ignore[arg-type]
         infinity=MATCH["infinity"],  # type: ignore[arg-type]
         paper_sweeps=True,

@@ -105,11 +105,13 @@ def _solve_all(centers: np.ndarray, n: int) -> Dict[str, Any]:
     out: Dict[str, Any] = {"grid": grid, "flow": raw, "flow_core": cored}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        out["raw"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=raw, allow_supersonic=True, hamiltonian="lxf")
+        out["raw"] = solve(
+            sphere, grid, [SOURCE], speed=SPEED, flow=raw, allow_supersonic=True, hamiltonian="lxf", order=1
+        )
     out["supersonic_warning"] = next((str(w.message) for w in caught if "outruns" in str(w.message)), "")
-    out["core"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored, hamiltonian="lxf")
-    out["core_upwind"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored)
-    out["still"] = solve(sphere, grid, [SOURCE], speed=SPEED, hamiltonian="lxf")
+    out["core"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored, hamiltonian="lxf", order=1)
+    out["core_upwind"] = solve(sphere, grid, [SOURCE], speed=SPEED, flow=cored, order=1)
+    out["still"] = solve(sphere, grid, [SOURCE], speed=SPEED, hamiltonian="lxf", order=1)
     return out
 
 
