@@ -308,3 +308,14 @@ def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, ca
     lines = [ln for ln in err.splitlines() if "faces itself" in ln]
     assert len(lines) == 1 and lines[0].startswith("warning: the surface faces itself")
     assert "RuntimeWarning" not in err and "sol = solve(" not in err
+
+
+def test_solve_order_auto_says_which_order_ran_and_why(tmp_path, capsys):
+    argv = ["solve", "--n", "41", "--out", str(tmp_path), "--quiet", "--order", "auto"]
+    assert main([*argv, "--surface", "sphere"]) == 0
+    assert "order 2" in capsys.readouterr().out
+    assert main([*argv, "--surface", "circle", "--hamiltonian", "lxf"]) == 0
+    out = capsys.readouterr().out
+    assert "order 1" in out and "order=2 does not apply, so order 1 ran: order=2 solves the isotropic" in out
+    assert main(["solve", "--surface", "sphere", "--n", "41", "--out", str(tmp_path), "--quiet", "--order", "1"]) == 0
+    assert "order 1" in capsys.readouterr().out
