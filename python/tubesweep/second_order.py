@@ -47,12 +47,14 @@ class Order2NotApplicable(ValueError):
 #: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there).
 FIX_RADIUS = 2.0
 
-#: Phase 1 (first order, monotone) stops at this times ``Δx² × mean slowness``, in 2D and 3D: it
+#: Phase 1 (first order, monotone) stops at this times ``Δx² × mean slowness / ℓ`` (``ℓ`` half the
+#: grid's longest side, ``ramp_length``), in 2D and 3D: it
 #: is only the start of phase 2, which moves every value by O(Δx). In 3D, 1e-2 took 20% more
 #: updates for the same errors on the sphere, spheroid, ellipsoid, torus and rounded cube; in 2D
 #: the star at N = 1601 needs the tighter start (from 1.0 its phase 2 stalled into the safeguard,
 #: far max 5.6e-4 instead of 1.2e-5). Phase 2 (second order) stops at ``TOL_FACTOR`` times
-#: ``Δx² × mean slowness`` unless ``tol`` is given.
+#: ``Δx² × mean slowness / ℓ`` unless ``tol`` is given. Dividing by ``ℓ`` makes both tolerances
+#: the same fraction of the travel times in any units.
 TOL_FIRST_FACTOR = {2: 1e-2, 3: 1.0}
 TOL_FACTOR = 1e-3
 
@@ -85,10 +87,18 @@ def with_fallback(sol: Any, reason: str) -> Any:
     return sol
 
 
-def default_tol(spacing: float, mean_slowness: float) -> float:
-    """Phase 2's stopping tolerance when none is given: ``1e-3 Δx²`` times the mean slowness,
-    far below the scheme's O(Δx²) error and far above machine precision."""
-    return TOL_FACTOR * spacing * spacing * mean_slowness
+def ramp_length(grid: Any) -> float:
+    """The length ``ℓ`` that makes the limiter and the tolerances independent of units: half the
+    grid's longest side (1 for the library's ``[-1, 1]`` grids). The limiter's ramp has width
+    ``ε = σΔx²/ℓ`` (crates/tubesweep-core/src/second_order/local.rs, ``reconstruct``)."""
+    return 0.5 * float(np.max(np.asarray(grid.upper, dtype=float) - np.asarray(grid.lower, dtype=float)))
+
+
+def default_tol(spacing: float, mean_slowness: float, length: float) -> float:
+    """Phase 2's stopping tolerance when none is given: ``1e-3 Δx²/ℓ`` times the mean slowness
+    (``ℓ`` = :func:`ramp_length`), far below the scheme's O(Δx²) error and far above machine
+    precision, in any units."""
+    return TOL_FACTOR * spacing * spacing * mean_slowness / length
 
 
 def check_supported(
@@ -169,8 +179,9 @@ def solve_on_tube(
     del x
     slowness: Any = 1.0 / speed_nodes
     mean_slowness = float(np.mean(slowness))
+    length = ramp_length(grid)
     if tol is None:
-        tol = default_tol(h, mean_slowness)
+        tol = default_tol(h, mean_slowness, length)
     # travel times too large or too small for the local updates' squares, a tol not small against
     # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
     check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
@@ -221,7 +232,7 @@ def solve_on_tube(
         float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
         FIX_RADIUS * h,
         tube.outer_eff * h,
-        TOL_FIRST_FACTOR[d] * h * h * mean_slowness,
+        TOL_FIRST_FACTOR[d] * h * h * mean_slowness / length,
         float(tol),
         int(max_iterations),
         cb,
@@ -231,6 +242,7 @@ def solve_on_tube(
         offsets=offsets,
         window_first=WINDOWS[0] if d == 3 else 0.0,
         window_second=WINDOWS[1] if d == 3 else 0.0,
+        ramp_length=length,
     )
     if not st["converged"]:
         warnings.warn(

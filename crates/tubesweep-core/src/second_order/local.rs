@@ -23,7 +23,9 @@ impl Side {
 
 /// The limited one-sided difference of one side (`minus`: the neighbours at −e_k), as a
 /// [`Side`]: neighbour values `u1`, `u2` (u) and `w1`, `w2` (w) at distance 1 and 2, `u2` NaN
-/// when missing, `du0` = ∂_k u₀ at the node. t = clip((u1 − u2)/Δx², 0, 1) ramps continuously
+/// when missing, `du0` = ∂_k u₀ at the node. t = clip((u1 − u2)·inv_eps, 0, 1), with
+/// ε = σᵢΔx²/ℓ ([`super::solver::SecondOrderOptions::ramp_length`]: the same for a problem in
+/// any units or at any speed scale), ramps continuously
 /// from first order (t = 0, where the side is not upwind or the gradient along the axis
 /// vanishes) to BDF2 (t = 1): c = 1 + t/2, and the difference is
 /// (c w − w1 − (t/2)(2w1 − w2))/Δx ± ∂_k u₀ (+ on the minus side: u − u_left over the step).
@@ -36,12 +38,12 @@ pub fn reconstruct(
     w2: f64,
     du0: f64,
     spacing: f64,
-    inv_h2: f64,
+    inv_eps: f64,
     minus: bool,
     second: bool,
 ) -> Side {
     let t = if second && u2.is_finite() {
-        ((u1 - u2) * inv_h2).clamp(0.0, 1.0)
+        ((u1 - u2) * inv_eps).clamp(0.0, 1.0)
     } else {
         0.0
     };

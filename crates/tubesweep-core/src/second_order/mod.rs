@@ -232,6 +232,7 @@ mod tests {
             window_first: window,
             window_second: window,
             threads,
+            ramp_length: 1.0,
         };
         let stats = sweep_second_order(
             &band,

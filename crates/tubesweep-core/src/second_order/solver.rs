@@ -55,6 +55,11 @@ pub struct SecondOrderOptions {
     pub window_second: f64,
     /// Threads of the sweeps (0: the default, see [`super::pipeline`]); the same values for any.
     pub threads: usize,
+    /// The limiter's length ℓ: the ramp t = clip((u1 − u2)/ε, 0, 1) of [`reconstruct`] has width
+    /// ε = σᵢ·Δx²/ℓ, σᵢ the node's slowness, so that t depends on the problem's shape only, not on
+    /// its units or its speed's scale (the same problem in metres or millimetres, or with a speed
+    /// of 1 or 100, is limited alike). The Python package passes half the grid's longest side.
+    pub ramp_length: f64,
 }
 
 /// What the solve did.
@@ -126,7 +131,10 @@ struct Sweeper<'a, const D: usize> {
     slowness: Slowness<'a>,
     abs_phi: &'a [f32],
     spacing: f64,
-    inv_h2: f64,
+    /// ℓ/Δx² ([`SecondOrderOptions::ramp_length`]); the ramp's 1/ε is this over σᵢ.
+    ramp_scale: f64,
+    /// 1/ε for a constant slowness.
+    ramp_constant: f64,
 }
 
 impl<const D: usize> Sweeper<'_, D> {
@@ -149,6 +157,10 @@ impl<const D: usize> Sweeper<'_, D> {
         let mut sides = [[Side::MISSING; 2]; D];
         let mut grad = [0.0; D];
         let ui = u.get(i);
+        let (sigma, inv_eps) = match self.slowness {
+            Slowness::Constant(s) => (s, self.ramp_constant),
+            Slowness::PerNode(s) => (s[i], self.ramp_scale / s[i]),
+        };
         for k in 0..D {
             let du0 = self.grad_u0[k_inner][k] as f64;
             let mut near = [f64::NAN; 2];
@@ -172,7 +184,7 @@ impl<const D: usize> Sweeper<'_, D> {
                         w2 = u2 - self.u0[j2 as usize];
                     }
                 }
-                sides[k][side] = reconstruct(u1, w1, u2, w2, du0, h, self.inv_h2, side == 0, second);
+                sides[k][side] = reconstruct(u1, w1, u2, w2, du0, h, inv_eps, side == 0, second);
             }
             // the direction of ∇u for the metric: central differences, one-sided at a gap
             grad[k] = match (near[0].is_finite(), near[1].is_finite()) {
@@ -182,7 +194,7 @@ impl<const D: usize> Sweeper<'_, D> {
                 _ => 0.0,
             };
         }
-        let s = corrected_slowness::<D>(&self.geometry[k_inner], grad, self.sigma(i));
+        let s = corrected_slowness::<D>(&self.geometry[k_inner], grad, sigma);
         let w = if second {
             godunov_closed_form(&sides, s * h)
         } else {
@@ -355,6 +367,9 @@ pub fn sweep_second_order<const D: usize>(
             format!("one value per band node ({n}) is needed"),
         ));
     }
+    if !(options.ramp_length.is_finite() && options.ramp_length > 0.0) {
+        return Err(Error::invalid("ramp_length", "must be finite and positive"));
+    }
     if let Slowness::PerNode(s) = slowness {
         if s.len() != n {
             return Err(Error::invalid(
@@ -372,7 +387,11 @@ pub fn sweep_second_order<const D: usize>(
         grad_u0: &factoring.grad_u0,
         slowness,
         spacing,
-        inv_h2: 1.0 / (spacing * spacing),
+        ramp_scale: options.ramp_length / (spacing * spacing),
+        ramp_constant: match slowness {
+            Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
+            Slowness::PerNode(_) => f64::NAN,
+        },
         abs_phi,
     };
     let roles = sw.roles;
