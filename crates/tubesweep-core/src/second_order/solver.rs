@@ -157,9 +157,10 @@ impl<const D: usize> Sweeper<'_, D> {
         let mut sides = [[Side::MISSING; 2]; D];
         let mut grad = [0.0; D];
         let ui = u.get(i);
-        let (sigma, inv_eps) = match self.slowness {
-            Slowness::Constant(s) => (s, self.ramp_constant),
-            Slowness::PerNode(s) => (s[i], self.ramp_scale / s[i]),
+        let sigma = self.sigma(i);
+        let inv_eps = match self.slowness {
+            Slowness::Constant(_) => self.ramp_constant,
+            Slowness::PerNode(_) => self.ramp_scale / sigma,
         };
         for k in 0..D {
             let du0 = self.grad_u0[k_inner][k] as f64;
