@@ -352,3 +352,17 @@ def test_order2_accuracy_does_not_depend_on_units_or_speed_scale(scale, speed):
     e_ref = np.mean(np.abs(ref(p) - exact))
     e = np.mean(np.abs(sol(p * scale) * speed / scale - exact))
     assert e == pytest.approx(e_ref, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    "scale, speed", [(2.0**60, 1.0), (2.0**-60, 1.0), (1.0, 2.0**200), (1.0, 2.0**-280), (2.0**60, 2.0**-200)]
+)
+def test_order2_at_extreme_units_and_speeds_gives_the_same_bits(scale, speed):
+    # the per-node data kept in f32 (∇u₀, |φ|) is stored in units of a power of two near its
+    # size: at a speed of 2^200 ∇u₀ underflowed f32 (answers 1.6x off, reported converged), at
+    # 2^-280 it overflowed (every node but the fixed ones unreached, reported converged)
+    ref = ts.solve(SPHERE, G3, [(0.5, 0, 0)], order=2)
+    g = ts.Grid((-scale,) * 3, (scale,) * 3, (31,) * 3)
+    sol = ts.solve(ts.surfaces.Sphere(0.5 * scale), g, [(0.5 * scale, 0, 0)], order=2, speed=speed)
+    assert sol.stats.converged
+    assert np.array_equal(sol.values * speed / scale, ref.values)

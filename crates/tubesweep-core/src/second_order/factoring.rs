@@ -10,6 +10,7 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
+use super::geometry::power_of_two_near;
 use super::implicit::Implicit;
 
 /// u₀ at every node, ∂u₀ at the nodes not in the extension layer, and the roles with the fixed
@@ -19,8 +20,11 @@ pub struct Factoring<const D: usize> {
     /// ∇u₀ = σ_s Dcpᵀ (cp − x_s)/|cp − x_s| with Dcp = I − nnᵀ − φD²φ (the Jacobian of the
     /// closest point of a signed distance), exact up to the differences of φ. One entry per node
     /// not in the extension layer, in band order, like [`super::TubeGeometry::nodes`] (zero at
-    /// the fixed nodes).
+    /// the fixed nodes). Stored over [`Self::grad_u0_unit`], so that f32 holds it at any speed
+    /// scale (σ ∇u₀ under- or overflowed f32 beyond speeds of about 1e±38).
     pub grad_u0: Vec<[f32; D]>,
+    /// A power of two near the largest source slowness: ∇u₀ = `grad_u0` × this, exactly.
+    pub grad_u0_unit: f64,
     pub roles: Vec<NodeRole>,
     /// Nodes fixed by each source.
     pub fixed_per_source: Vec<usize>,
@@ -78,6 +82,7 @@ pub fn factor_sources_of<const D: usize>(
             "one positive finite slowness per source",
         ));
     }
+    let unit = power_of_two_near(source_slowness.iter().fold(0.0f64, |a, &b| a.max(b)));
     let mut u0 = vec![0.0; n];
     let mut grad_u0 = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     let mut out_roles = roles.to_vec();
@@ -146,7 +151,7 @@ pub fn factor_sources_of<const D: usize>(
                     if let Some(l) = &local {
                         v -= phi_i * (0..D).map(|m| l.hessian[k][m] * e[m]).sum::<f64>();
                     }
-                    g[k] = (source_slowness[s] * v) as f32;
+                    g[k] = (source_slowness[s] * v / unit) as f32;
                 }
             }
         }
@@ -160,6 +165,7 @@ pub fn factor_sources_of<const D: usize>(
     Ok(Factoring {
         u0,
         grad_u0,
+        grad_u0_unit: unit,
         roles: out_roles,
         fixed_per_source,
     })

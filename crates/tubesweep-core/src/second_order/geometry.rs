@@ -52,7 +52,8 @@ pub struct TubeGeometry {
     /// One entry per node that is not in the extension layer, in band order (the k-th such node's
     /// is `nodes[k]`: the sweeps count them along each row, [`crate::second_order::solver`]).
     pub nodes: Vec<NodeGeometry>,
-    /// |φ| per node (apart from the rest: the extension update compares it between neighbours).
+    /// |φ| per node, in units of a power of two near the spacing ([`power_of_two_near`]), apart
+    /// from the rest: the extension update only compares it between neighbours.
     pub abs_phi: Vec<f32>,
     pub summary: GeometrySummary,
 }
@@ -284,12 +285,21 @@ pub fn tube_geometry_of<const D: usize>(
     if !summary.grad_norm_min.is_finite() {
         summary.grad_norm_min = 0.0;
     }
-    let abs_phi = (0..n).map(|i| surface.phi(i).abs() as f32).collect();
+    // in units of a power of two near the spacing: f32 then holds |φ| on a grid in any units
+    // (it under- or overflowed beyond about 1e±38), and the comparisons keep their bits
+    let abs_phi_unit = power_of_two_near(spacing);
+    let abs_phi = (0..n).map(|i| (surface.phi(i).abs() / abs_phi_unit) as f32).collect();
     Ok(TubeGeometry {
         nodes,
         abs_phi,
         summary,
     })
+}
+
+/// The power of two nearest `x` (> 0, finite) in the log: dividing by it is exact, so a quantity
+/// of size about `x` is stored in f32 with the same bits as before, in any units.
+pub(crate) fn power_of_two_near(x: f64) -> f64 {
+    2f64.powi((x.log2().round() as i32).clamp(-1000, 1000))
 }
 
 #[cfg(test)]

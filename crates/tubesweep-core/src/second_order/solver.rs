@@ -128,6 +128,8 @@ struct Sweeper<'a, const D: usize> {
     directions: &'a [[f32; D]],
     u0: &'a [f64],
     grad_u0: &'a [[f32; D]],
+    /// ∇u₀ = `grad_u0` × this ([`Factoring::grad_u0_unit`]).
+    grad_u0_unit: f64,
     slowness: Slowness<'a>,
     abs_phi: &'a [f32],
     spacing: f64,
@@ -163,7 +165,7 @@ impl<const D: usize> Sweeper<'_, D> {
             Slowness::PerNode(_) => self.ramp_scale / sigma,
         };
         for k in 0..D {
-            let du0 = self.grad_u0[k_inner][k] as f64;
+            let du0 = self.grad_u0[k_inner][k] as f64 * self.grad_u0_unit;
             let mut near = [f64::NAN; 2];
             for side in 0..2 {
                 let j1 = nb[k][side];
@@ -386,6 +388,7 @@ pub fn sweep_second_order<const D: usize>(
         directions,
         u0: &factoring.u0,
         grad_u0: &factoring.grad_u0,
+        grad_u0_unit: factoring.grad_u0_unit,
         slowness,
         spacing,
         ramp_scale: options.ramp_length / (spacing * spacing),
