@@ -351,7 +351,6 @@ def test_ctrl_c_stops_every_solve(tube):
     """Ctrl-C (SIGINT, here raised by interrupt_main) during solve_many: KeyboardInterrupt soon,
     no result."""
     import _thread
-    import time
 
     sources = sphere_points(400, seed=5)
     calls = []
@@ -363,14 +362,11 @@ def test_ctrl_c_stops_every_solve(tube):
         if len(calls) == 1:
             _thread.interrupt_main()
 
-    t0 = time.perf_counter()
     with pytest.raises(KeyboardInterrupt):
         tube.solve_many(sources, at=sources[:3], threads=2, progress=progress)
-    assert calls and calls[-1] < len(sources)
-    elapsed = time.perf_counter() - t0
-    one = tube.solve_many(sources[:4], at=sources[:3], threads=1, return_stats=True)[1]["seconds"].mean()
-    # stopped long before the 400 solves (at least 200 solve times on two threads) could end
-    assert elapsed < 0.1 + 0.25 * len(sources) * one, (elapsed, one)
+    # stopped at the next check-in, long before the 400 solves could end (a count, not a timing:
+    # timings fail on a loaded machine)
+    assert calls and calls[-1] < len(sources) // 2, calls[-5:]
 
 
 def test_bench_script_runs(tmp_path):
