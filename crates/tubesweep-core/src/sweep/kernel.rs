@@ -11,6 +11,7 @@ use crate::scheme::extension::extension_apply_upwind;
 use crate::scheme::godunov::{coupled_axis, fmin, godunov_update, godunov_update_coupled};
 use crate::scheme::hamiltonian::InnerScheme;
 use crate::scheme::lax_friedrichs::{central_gradient, lxf_eikonal_update, lxf_general_update};
+use crate::scheme::upwind::{Builtin, LocalSolver};
 use std::sync::atomic::{AtomicU8, Ordering};
 
 impl<'a, const D: usize> SweepProblem<'a, D> {
@@ -106,7 +107,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         acc.visited += (e - s) as u64;
         let mut low = f64::INFINITY;
         let mut marks = 0u8;
-        let arrays = self.node_arrays(ctx);
+        let arrays = self.node_arrays::<S>(ctx);
         if backwards {
             for n in (s..e).rev() {
                 self.visit::<S, P, W, K>(ctx, &arrays, n, lim, acc, &mut low, &mut marks);
@@ -119,9 +120,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         ctx.finish_row::<W, K>(r, low, marks);
     }
 
-    /// The arrays the kernel reads at a node, copied into locals for a row ([`NodeArrays`]).
+    /// The arrays the kernel reads at a node, copied into locals for a row ([`NodeArrays`]), with
+    /// the built-in upwind solver of scheme `S`.
     #[inline(always)]
-    pub(super) fn node_arrays<'k>(&'k self, ctx: &SweepContext<'k, D>) -> NodeArrays<'k, D> {
+    pub(super) fn node_arrays<'k, const S: u8>(&'k self, ctx: &SweepContext<'k, D>) -> NodeArrays<'k, D> {
         NodeArrays {
             u: *ctx.u,
             roles: self.roles,
@@ -139,6 +141,10 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
                 Slowness::PerNode(_) => f64::NAN,
             },
             spacing: self.spacing,
+            upwind: match self.scheme {
+                InnerScheme::Upwind(solver) if S == UPWIND_MOVING_MEDIUM || S == UPWIND_METRIC => solver.builtin(),
+                _ => Builtin::Other,
+            },
         }
     }
 
@@ -311,7 +317,7 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
         // NaN only for a per-node slowness dispatched with P = false, which the general
         // Hamiltonian (taking its slowness from the Hamiltonian) alone may be
         debug_assert!(
-            S == GENERAL || S == UPWIND || !f.is_nan(),
+            S == GENERAL || S >= UPWIND || !f.is_nan(),
             "a per-node slowness dispatched with P = false"
         );
         let mut self_dependent = false;
@@ -348,6 +354,17 @@ impl<'a, const D: usize> SweepProblem<'a, D> {
             }
         } else if S == UPWIND {
             let InnerScheme::Upwind(solver) = self.scheme else {
+                return None;
+            };
+            solver.update(n, minus, plus, h, old)
+        } else if S == UPWIND_MOVING_MEDIUM {
+            // the same solver as through the trait object, inlined (static dispatch)
+            let Builtin::MovingMedium(solver) = arr.upwind else {
+                return None;
+            };
+            solver.update(n, minus, plus, h, old)
+        } else if S == UPWIND_METRIC {
+            let Builtin::Metric(solver) = arr.upwind else {
                 return None;
             };
             solver.update(n, minus, plus, h, old)
@@ -401,6 +418,8 @@ pub(super) struct NodeArrays<'k, const D: usize> {
     /// and a general Hamiltonian, which takes its slowness from the Hamiltonian, reads neither).
     h_times_constant_slowness: f64,
     spacing: f64,
+    /// The built-in upwind solver when the row loop is specialised for one (`Other` otherwise).
+    upwind: Builtin<'k, D>,
 }
 
 impl<const D: usize> NodeArrays<'_, D> {
@@ -502,3 +521,6 @@ pub(super) const GODUNOV: u8 = 0;
 pub(super) const LXF: u8 = 1;
 pub(super) const GENERAL: u8 = 2;
 pub(super) const UPWIND: u8 = 3;
+/// The built-in upwind solvers, dispatched statically ([`Builtin`]).
+pub(super) const UPWIND_MOVING_MEDIUM: u8 = 4;
+pub(super) const UPWIND_METRIC: u8 = 5;

@@ -34,7 +34,7 @@
 //! are set by the caller (`tubesweep.solve`'s `_tube_roles`).
 
 /// Calls `$this.$method::<S, P, W, K>($args)` with the row loop specialised for the problem:
-/// the scheme `S`, a per-node slowness `P`, the front window `W` and the active flags `K`
+/// the scheme `S` (the built-in upwind solvers each their own, [`crate::scheme::upwind::Builtin`]), a per-node slowness `P`, the front window `W` and the active flags `K`
 /// (see [`SweepContext::skip_inactive`]), so that nothing is dispatched inside the hot loop. The
 /// window runs only with the flags (see `SweepProblem::windowed`).
 macro_rules! specialised {
@@ -53,8 +53,17 @@ macro_rules! specialised {
             (InnerScheme::LaxFriedrichs, true, _, false) => $this.$method::<LXF, true, false, false>($($arg),*),
             (InnerScheme::General(_), _, _, true) => $this.$method::<GENERAL, false, false, true>($($arg),*),
             (InnerScheme::General(_), _, _, false) => $this.$method::<GENERAL, false, false, false>($($arg),*),
-            (InnerScheme::Upwind(_), _, _, true) => $this.$method::<UPWIND, false, false, true>($($arg),*),
-            (InnerScheme::Upwind(_), _, _, false) => $this.$method::<UPWIND, false, false, false>($($arg),*),
+            // the built-in upwind solvers inlined into the row loop, any other through its trait object
+            (InnerScheme::Upwind(u), _, _, true) => match u.builtin() {
+                $crate::scheme::upwind::Builtin::MovingMedium(_) => $this.$method::<UPWIND_MOVING_MEDIUM, false, false, true>($($arg),*),
+                $crate::scheme::upwind::Builtin::Metric(_) => $this.$method::<UPWIND_METRIC, false, false, true>($($arg),*),
+                $crate::scheme::upwind::Builtin::Other => $this.$method::<UPWIND, false, false, true>($($arg),*),
+            },
+            (InnerScheme::Upwind(u), _, _, false) => match u.builtin() {
+                $crate::scheme::upwind::Builtin::MovingMedium(_) => $this.$method::<UPWIND_MOVING_MEDIUM, false, false, false>($($arg),*),
+                $crate::scheme::upwind::Builtin::Metric(_) => $this.$method::<UPWIND_METRIC, false, false, false>($($arg),*),
+                $crate::scheme::upwind::Builtin::Other => $this.$method::<UPWIND, false, false, false>($($arg),*),
+            },
         }
     }};
 }

@@ -198,7 +198,7 @@ fn inverse_rows<const D: usize>(m: &[[f64; D]; D]) -> ([f64; D], [f64; D]) {
 }
 
 impl<'a, const D: usize> LocalSolver<D> for Metric<'a, D> {
-    #[inline]
+    #[inline(always)]
     fn update(&self, node: usize, minus: [f64; D], plus: [f64; D], h: f64, old: f64) -> f64 {
         let faces = Riemann {
             m: self.metric[node],
@@ -209,6 +209,10 @@ impl<'a, const D: usize> LocalSolver<D> for Metric<'a, D> {
 
     fn slowness_bound(&self) -> Option<f64> {
         Hamiltonian::<D>::slowness_bound(self)
+    }
+
+    fn builtin(&self) -> super::Builtin<'_, D> {
+        super::Builtin::Metric(self)
     }
 }
 

@@ -54,8 +54,11 @@
 //! the best value so far, or when its mirror on some axis is provably no worse. Skipping is
 //! exact: it never changes the result.
 
+mod builtin;
 pub mod metric;
 pub mod moving_medium;
+
+pub use builtin::Builtin;
 
 /// An upwind local solver: the new value of a node from its neighbour values (Sect. 5.1's
 /// interface, with a Godunov-type update in place of Lax–Friedrichs).
@@ -66,6 +69,11 @@ pub trait LocalSolver<const D: usize>: Sync {
     fn update(&self, node: usize, minus: [f64; D], plus: [f64; D], h: f64, old: f64) -> f64;
     /// An upper bound on the travel time per unit length (as [`crate::Hamiltonian::slowness_bound`]).
     fn slowness_bound(&self) -> Option<f64>;
+    /// Which built-in solver this is, for the sweep's static dispatch ([`Builtin`]); `Other` (the
+    /// default) for any other.
+    fn builtin(&self) -> Builtin<'_, D> {
+        Builtin::Other
+    }
 }
 
 /// One node's Hamiltonian as seen by [`upwind_min`]: the projection on a face and the solve there.
@@ -398,7 +406,7 @@ fn face_value<const D: usize, const M: usize, F: Faces<D>>(
 /// face's value is at least one that is computed. (A face of a proving simplex is above the
 /// simplex's value by a margin that grows with the square of the smallest weight, so
 /// [`STRICT_WEIGHT`] keeps rounding from deciding.)
-#[inline]
+#[inline(always)]
 pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     faces: &F,
     minus: [f64; D],
@@ -417,11 +425,33 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     // the direction of the gradient matters)
     let vel = faces.velocity(core::array::from_fn(|k| plus[k] - minus[k]));
     let o0: usize = (0..D).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
+    // the fast path, inlined where the solver is (the sweep's row loop); the rest out of line
+    let first = natural_orthant(faces, &pf, &nb, o0, h);
+    if let Some((mu, true)) = first {
+        return mu.min(old);
+    }
+    upwind_min_rest(faces, &pf, &nb, o0, first, h, old)
+}
+
+/// [`upwind_min`] after the natural orthant `o0`'s simplex (`first`, [`natural_orthant`]) did not
+/// settle the node alone: its faces, then the other faces not ruled out. Out of line: a few
+/// percent of the visits come here.
+#[inline(never)]
+fn upwind_min_rest<const D: usize, F: Faces<D>>(
+    faces: &F,
+    pf: &F::Projected,
+    nb: &[[f64; 2]; D],
+    o0: usize,
+    first: Option<(f64, bool)>,
+    h: f64,
+    old: f64,
+) -> f64 {
+    let nb = *nb;
+    let pf = *pf;
     let mut best = old;
     let mut proved = 0u32;
-    match natural_orthant(faces, &pf, &nb, o0, h) {
-        Some((mu, true)) => return mu.min(old),
-        Some((mu, false)) => {
+    match first {
+        Some((mu, _)) => {
             proved |= 1 << o0;
             if mu < best {
                 best = mu;
@@ -438,7 +468,7 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     let tau = faces.mirror_slack();
     // the side (0: minus, 1: plus) whose faces are dominated by their mirrors, 2 for neither
     let dominated: [usize; D] = core::array::from_fn(|k| {
-        let delta = plus[k] - minus[k];
+        let delta = nb[k][1] - nb[k][0];
         if delta >= h * tau[k][1] {
             1
         } else if -delta >= h * tau[k][0] {

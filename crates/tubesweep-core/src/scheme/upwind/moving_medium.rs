@@ -168,7 +168,7 @@ impl<const D: usize> Faces<D> for Randers<D> {
 }
 
 impl<'a, const D: usize> LocalSolver<D> for MovingMedium<'a, D> {
-    #[inline]
+    #[inline(always)]
     fn update(&self, node: usize, minus: [f64; D], plus: [f64; D], h: f64, old: f64) -> f64 {
         let f = 1.0 / slowness_at(self.slowness, node);
         let v = self.flow[node];
@@ -178,6 +178,10 @@ impl<'a, const D: usize> LocalSolver<D> for MovingMedium<'a, D> {
 
     fn slowness_bound(&self) -> Option<f64> {
         Hamiltonian::<D>::slowness_bound(self)
+    }
+
+    fn builtin(&self) -> super::Builtin<'_, D> {
+        super::Builtin::MovingMedium(self)
     }
 }
 
