@@ -85,6 +85,13 @@ pub(crate) trait Faces<const D: usize> {
     /// A positive multiple of the characteristic velocity `∂G/∂p` at a positive multiple of `p`
     /// (only its signs are used: from which side of each axis the characteristic comes).
     fn velocity(&self, p: [f64; D]) -> [f64; D];
+    /// The orthant the characteristic comes from at a positive multiple of `p`: bit `k` set where
+    /// the velocity [`Faces::velocity`] is negative (`∂G/∂p_k < 0`: from the plus side).
+    #[inline(always)]
+    fn upwind_orthant(&self, p: [f64; D]) -> usize {
+        let vel = self.velocity(p);
+        (0..D).map(|k| ((vel[k] < 0.0) as usize) << k).sum()
+    }
     /// Whether `G(p) ≤ 1 − 1e-12`: `p` lies inside the unit ball `{G ≤ 1}` with a margin.
     fn inside(&self, p: [f64; D]) -> bool;
     /// The full gradient `(P, q*)` of a solution on the face of the `D − 1` axes other than
@@ -147,6 +154,16 @@ const CONTAINING_ORTHANTS: [[u8; 8]; 8] = {
     t
 };
 
+/// The sign of a side: `+1` for the minus neighbour (`side = 0`), `−1` for the plus neighbour.
+#[inline(always)]
+fn side_sign(side: usize) -> f64 {
+    if side == 0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
 /// `1 / sqrt(m)` for `m = 0..=3`.
 const INV_SQRT: [f64; 4] = [0.0, 1.0, std::f64::consts::FRAC_1_SQRT_2, 0.577_350_269_189_625_8];
 
@@ -184,7 +201,7 @@ fn faces_on<const D: usize, const M: usize, F: Faces<D>>(
         for j in 0..M {
             let side = (sides >> j & 1) as usize;
             u[j] = nb[axes[j]][side];
-            sg[j] = 1.0 - 2.0 * side as f64;
+            sg[j] = side_sign(side);
             skip |= dominated[axes[j]] == side;
             s |= side << axes[j];
         }
@@ -239,7 +256,7 @@ fn natural_orthant<const D: usize, F: Faces<D>>(
     let u: [f64; D] = core::array::from_fn(|k| nb[k][o >> k & 1]);
     let base = u.iter().cloned().fold(f64::INFINITY, f64::min);
     let w: [f64; D] = core::array::from_fn(|k| u[k] - base);
-    let sg: [f64; D] = core::array::from_fn(|k| 1.0 - 2.0 * (o >> k & 1) as f64);
+    let sg: [f64; D] = core::array::from_fn(|k| side_sign(o >> k & 1));
     let t = faces.solve::<D, true>(pf, &w, &sg, h, f64::INFINITY)?;
     let mu = base + t;
     // the rounding margin: far above the rounding of the values, far below their differences
@@ -273,15 +290,11 @@ fn moved_inside<const D: usize, F: Faces<D>>(
     sg: &[f64; D],
     inv_h: f64,
 ) -> bool {
+    // each axis's moved component once (the same bits in every subset that moves it)
+    let moved: [f64; D] = core::array::from_fn(|k| gp[k] - sg[k] * deficit[k] * inv_h);
     let mut sub = def;
     while sub != 0 {
-        let p: [f64; D] = core::array::from_fn(|k| {
-            if sub >> k & 1 == 1 {
-                gp[k] - sg[k] * deficit[k] * inv_h
-            } else {
-                gp[k]
-            }
-        });
+        let p: [f64; D] = core::array::from_fn(|k| if sub >> k & 1 == 1 { moved[k] } else { gp[k] });
         if !faces.inside(p) {
             return false;
         }
@@ -327,7 +340,7 @@ fn natural_faces<const D: usize, F: Faces<D>>(
         let inv_h = 1.0 / h;
         let p: [f64; D] = core::array::from_fn(|k| {
             let side = o >> k & 1;
-            (1.0 - 2.0 * side as f64) * (mu - nb[k][side]) * inv_h
+            (side_sign(side)) * (mu - nb[k][side]) * inv_h
         });
         let p = faces.complete(p, off);
         if !(nb[off][0] + h * p[off] >= mu + eta && nb[off][1] - h * p[off] >= mu + eta) {
@@ -344,7 +357,7 @@ fn natural_faces<const D: usize, F: Faces<D>>(
                 def |= 1 << k;
             }
         }
-        let sg: [f64; D] = core::array::from_fn(|k| 1.0 - 2.0 * (o >> k & 1) as f64);
+        let sg: [f64; D] = core::array::from_fn(|k| side_sign(o >> k & 1));
         if def == 0 || moved_inside(faces, p, &deficit, def, &sg, inv_h) {
             return Some(mu);
         }
@@ -370,7 +383,7 @@ fn face_value<const D: usize, const M: usize, F: Faces<D>>(
         if mask >> k & 1 == 1 {
             let side = o >> k & 1;
             u[j] = nb[k][side];
-            sg[j] = 1.0 - 2.0 * side as f64;
+            sg[j] = side_sign(side);
             j += 1;
         }
     }
@@ -415,6 +428,12 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     old: f64,
 ) -> f64 {
     debug_assert!((1..=3).contains(&D));
+    // every face's value exceeds its smallest vertex value (φ > 0): when no neighbour is below
+    // `old` (an unreached node among unreached ones), nothing can be
+    let lowest = (0..D).fold(f64::INFINITY, |m, k| m.min(minus[k]).min(plus[k]));
+    if lowest >= old {
+        return old;
+    }
     let nb: [[f64; 2]; D] = core::array::from_fn(|k| [minus[k], plus[k]]);
     let full = (1u32 << D) - 1;
     let Some(pf) = faces.project(full) else {
@@ -423,8 +442,7 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     };
     // the orthant the characteristic comes from, by the central differences (times 2h: only
     // the direction of the gradient matters)
-    let vel = faces.velocity(core::array::from_fn(|k| plus[k] - minus[k]));
-    let o0: usize = (0..D).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
+    let o0 = faces.upwind_orthant(core::array::from_fn(|k| plus[k] - minus[k]));
     // the fast path, inlined where the solver is (the sweep's row loop); the rest out of line
     let first = natural_orthant(faces, &pf, &nb, o0, h);
     if let Some((mu, true)) = first {
@@ -492,7 +510,7 @@ fn upwind_min_rest<const D: usize, F: Faces<D>>(
         }
         let Some(p) = proj else { break };
         let w: [f64; D] = core::array::from_fn(|k| u[k] - base);
-        let sg: [f64; D] = core::array::from_fn(|k| 1.0 - 2.0 * (o >> k & 1) as f64);
+        let sg: [f64; D] = core::array::from_fn(|k| side_sign(o >> k & 1));
         if let Some(t) = faces.solve::<D, true>(&p, &w, &sg, h, f64::INFINITY) {
             proved |= 1 << o;
             let mu = base + t;

@@ -69,6 +69,21 @@ impl<const D: usize> Faces<D> for Randers<D> {
         })
     }
 
+    /// [`Faces::velocity`]'s signs without branches: where `p_k` and `v_k` agree in sign, that
+    /// sign; otherwise the sign of the larger of `F |p_k|` and `|p| |v_k|` (`p_k`'s on a tie).
+    #[inline(always)]
+    fn upwind_orthant(&self, p: [f64; D]) -> usize {
+        let n2 = p.iter().map(|x| x * x).sum::<f64>();
+        let mut o = 0;
+        for k in 0..D {
+            let (a, b) = (p[k], self.v[k]);
+            let pick_a = ((a >= 0.0) == (b >= 0.0)) | (self.f2 * a * a >= n2 * b * b);
+            let negative = (pick_a & (a < 0.0)) | (!pick_a & (b < 0.0));
+            o |= (negative as usize) << k;
+        }
+        o
+    }
+
     /// `q* = −v_off |P| / F_K`, `F_K = sqrt(F² − v_off²)` (see the projection above).
     #[inline(always)]
     fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
