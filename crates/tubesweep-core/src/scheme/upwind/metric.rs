@@ -61,6 +61,28 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         q <= r * r
     }
 
+    /// [`Faces::inside`] at the corners with the products `M_kl p_l` of both choices per axis
+    /// computed once (the same bits as at each corner alone).
+    #[inline(always)]
+    fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
+        let choice = |k: usize, sub: usize| if sub >> k & 1 == 1 { moved[k] } else { p[k] };
+        let mp: [[[f64; 2]; D]; D] =
+            core::array::from_fn(|k| core::array::from_fn(|l| [self.m[k][l] * p[l], self.m[k][l] * moved[l]]));
+        let r = self.s * (1.0 - 1e-12);
+        let mut sub = def;
+        while sub != 0 {
+            let q: f64 = (0..D)
+                .map(|k| choice(k, sub) * (0..D).map(|l| mp[k][l][sub >> l & 1]).sum::<f64>())
+                .sum();
+            debug_assert_eq!(q <= r * r, self.inside(core::array::from_fn(|k| choice(k, sub))));
+            if !(q <= r * r) {
+                return false;
+            }
+            sub = (sub - 1) & def;
+        }
+        true
+    }
+
     /// `φ(d) = s sqrt(dᵀAd)`, `A = M⁻¹`, even. Mirroring `d_k` changes `dᵀAd` by
     /// `4 |d_k| |A_k⊥·d_⊥|`, and `sqrt(dᵀAd) ≥ |d| / sqrt(λ_max(M))`, so
     /// `τ_k = 2 s sqrt(tr M) Σ_{l≠k} |A_kl|` (0 when `A`'s row k is diagonal); and by the triangle

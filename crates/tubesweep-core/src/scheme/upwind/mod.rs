@@ -82,8 +82,9 @@ pub(crate) trait Faces<const D: usize> {
     type Projected: Copy;
     /// The least travel time per unit length over all directions (a positive lower bound).
     fn least_slowness(&self) -> f64;
-    /// A positive multiple of the characteristic velocity `∂G/∂p` at a positive multiple of `p`
-    /// (only its signs are used: from which side of each axis the characteristic comes).
+    /// A positive multiple of the characteristic velocity `∂G/∂p` at a positive multiple of `p`:
+    /// its signs say from which side of each axis the characteristic comes, its smallest component
+    /// which axis it is most nearly across.
     fn velocity(&self, p: [f64; D]) -> [f64; D];
     /// The orthant the characteristic comes from at a positive multiple of `p`: bit `k` set where
     /// the velocity [`Faces::velocity`] is negative (`∂G/∂p_k < 0`: from the plus side).
@@ -94,6 +95,23 @@ pub(crate) trait Faces<const D: usize> {
     }
     /// Whether `G(p) ≤ 1 − 1e-12`: `p` lies inside the unit ball `{G ≤ 1}` with a margin.
     fn inside(&self, p: [f64; D]) -> bool;
+    /// Whether [`Faces::inside`] holds at every `p_S`, `S` a non-empty subset of the axes in the
+    /// bit mask `def`, `p_S` taking `moved[k]` on the axes of `S` and `p[k]` on the others (the
+    /// corners of a box, for the deficit proof of [`natural_orthant`]). Implementations may share
+    /// work between the corners; the answer is that of [`Faces::inside`] at each.
+    #[inline(always)]
+    fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
+        let mut sub = def;
+        while sub != 0 {
+            if !self.inside(core::array::from_fn(
+                |k| if sub >> k & 1 == 1 { moved[k] } else { p[k] },
+            )) {
+                return false;
+            }
+            sub = (sub - 1) & def;
+        }
+        true
+    }
     /// The full gradient `(P, q*)` of a solution on the face of the `D − 1` axes other than
     /// `off`: `P` (given in place, `p[off]` ignored) and the off-face component `q*` that
     /// minimises `G(P + q e_off)` (the projection of [`Faces::project`]), so that `G = 1` there.
@@ -292,15 +310,7 @@ fn moved_inside<const D: usize, F: Faces<D>>(
 ) -> bool {
     // each axis's moved component once (the same bits in every subset that moves it)
     let moved: [f64; D] = core::array::from_fn(|k| gp[k] - sg[k] * deficit[k] * inv_h);
-    let mut sub = def;
-    while sub != 0 {
-        let p: [f64; D] = core::array::from_fn(|k| if sub >> k & 1 == 1 { moved[k] } else { gp[k] });
-        if !faces.inside(p) {
-            return false;
-        }
-        sub = (sub - 1) & def;
-    }
-    true
+    faces.inside_corners(gp, moved, def)
 }
 
 /// The fast path's second chance, when the natural orthant's simplex has no critical point
@@ -324,7 +334,21 @@ fn natural_faces<const D: usize, F: Faces<D>>(
         return None;
     }
     let full = (1u32 << D) - 1;
-    for off in 0..D {
+    // the face without the axis the characteristic is most nearly across (the smallest velocity
+    // component at the central differences) first: on a symmetry plane, the one that proves
+    let vel = faces.velocity(core::array::from_fn(|k| nb[k][1] - nb[k][0]));
+    let mut first = 0;
+    for k in 1..D {
+        if vel[k].abs() < vel[first].abs() {
+            first = k;
+        }
+    }
+    for i in 0..D {
+        let off = match i {
+            0 => first,
+            _ if i <= first => i - 1,
+            _ => i,
+        };
         let mask = full & !(1 << off);
         let pk = faces.project(mask)?;
         // the face's axes in increasing order, M = D − 1 of them

@@ -52,25 +52,17 @@ impl<const D: usize> Faces<D> for Randers<D> {
         1.0 / (self.f + self.v.iter().map(|x| x.abs()).sum::<f64>())
     }
 
-    /// The signs of `∂G/∂p = F p/|p| + v` (±1, 0), without the square root: where `p_k` and
-    /// `v_k` differ in sign, `F |p_k|` against `|p| |v_k|`.
+    /// `∂G/∂p = F p/|p| + v` (`v` where `p = 0`).
     #[inline(always)]
     fn velocity(&self, p: [f64; D]) -> [f64; D] {
-        let n2 = p.iter().map(|x| x * x).sum::<f64>();
-        core::array::from_fn(|k| {
-            let (a, b) = (p[k], self.v[k]);
-            if (a >= 0.0) == (b >= 0.0) {
-                a + b
-            } else if self.f2 * a * a >= n2 * b * b {
-                a
-            } else {
-                b
-            }
-        })
+        let n = p.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let scale = if n > 0.0 { self.f / n } else { 0.0 };
+        core::array::from_fn(|k| scale * p[k] + self.v[k])
     }
 
-    /// [`Faces::velocity`]'s signs without branches: where `p_k` and `v_k` agree in sign, that
-    /// sign; otherwise the sign of the larger of `F |p_k|` and `|p| |v_k|` (`p_k`'s on a tie).
+    /// The signs of [`Faces::velocity`] without the square root and without branches: where `p_k`
+    /// and `v_k` agree in sign, that sign; otherwise the sign of the larger of `F |p_k|` and
+    /// `|p| |v_k|` (`p_k`'s on a tie).
     #[inline(always)]
     fn upwind_orthant(&self, p: [f64; D]) -> usize {
         let n2 = p.iter().map(|x| x * x).sum::<f64>();
@@ -99,6 +91,26 @@ impl<const D: usize> Faces<D> for Randers<D> {
         // F|p| ≤ r = 1 − 1e-12 − v·p, without the square root
         let r = 1.0 - 1e-12 - (0..D).map(|k| self.v[k] * p[k]).sum::<f64>();
         r >= 0.0 && self.f2 * p.iter().map(|x| x * x).sum::<f64>() <= r * r
+    }
+
+    /// [`Faces::inside`] at the corners with the products `v_k p_k` and `p_k²` of both choices per
+    /// axis computed once (the same bits as at each corner alone).
+    #[inline(always)]
+    fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
+        let choice = |k: usize, sub: usize| if sub >> k & 1 == 1 { moved[k] } else { p[k] };
+        let vp: [[f64; 2]; D] = core::array::from_fn(|k| [self.v[k] * p[k], self.v[k] * moved[k]]);
+        let pp: [[f64; 2]; D] = core::array::from_fn(|k| [p[k] * p[k], moved[k] * moved[k]]);
+        let mut sub = def;
+        while sub != 0 {
+            let r = 1.0 - 1e-12 - (0..D).map(|k| vp[k][sub >> k & 1]).sum::<f64>();
+            if !(r >= 0.0 && self.f2 * (0..D).map(|k| pp[k][sub >> k & 1]).sum::<f64>() <= r * r) {
+                debug_assert!(!self.inside(core::array::from_fn(|k| choice(k, sub))));
+                return false;
+            }
+            debug_assert!(self.inside(core::array::from_fn(|k| choice(k, sub))));
+            sub = (sub - 1) & def;
+        }
+        true
     }
 
     /// `φ(d) = (−v·d + R(d)) / (F² − |v|²)`, `R = sqrt((v·d)² + (F² − |v|²)|d|²)`. Mirroring `d_k`
