@@ -13,6 +13,7 @@ use std::sync::atomic::AtomicU8;
 mod bits;
 mod front_window;
 mod rim;
+mod upwind_dispatch;
 
 fn box_problem<'a>(
     band: &'a NarrowBand<2>,

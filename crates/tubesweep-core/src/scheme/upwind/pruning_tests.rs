@@ -1,0 +1,246 @@
+//! The skipping of faces in [`super::upwind_min`] never changes its result: the same bits as with every face
+//! solved, on random, near-smooth and coordinate-plane configurations.
+
+use super::*;
+use crate::scheme::upwind::{metric, moving_medium};
+
+/// The same faces with every skip switched off (no mirror slack, no lower bound).
+struct NoPruning<'a, F>(&'a F);
+
+impl<'a, const D: usize, F: Faces<D>> Faces<D> for NoPruning<'a, F> {
+    type Projected = F::Projected;
+    fn least_slowness(&self) -> f64 {
+        0.0
+    }
+    fn velocity(&self, p: [f64; D]) -> [f64; D] {
+        self.0.velocity(p)
+    }
+    fn inside(&self, _p: [f64; D]) -> bool {
+        false
+    }
+    fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
+        self.0.complete(p, off)
+    }
+    fn mirror_slack(&self) -> [[f64; 2]; D] {
+        [[f64::INFINITY; 2]; D]
+    }
+    fn project(&self, mask: u32) -> Option<F::Projected> {
+        self.0.project(mask)
+    }
+    fn solve<const M: usize, const STRICT: bool>(
+        &self,
+        p: &F::Projected,
+        w: &[f64; M],
+        sg: &[f64; M],
+        h: f64,
+        below: f64,
+    ) -> Option<f64> {
+        // no full face proves anything: every face is enumerated
+        if STRICT {
+            return None;
+        }
+        self.0.solve::<M, false>(p, w, sg, h, below)
+    }
+}
+
+#[test]
+fn skipping_faces_never_changes_the_result() {
+    let mut x = 0.377_f64;
+    let mut r = move || {
+        x = (x * 997.0 + 0.1234).fract();
+        x
+    };
+    for i in 0..20000 {
+        let h = 0.05;
+        let minus: [f64; 3] = core::array::from_fn(|_| 0.1 * r());
+        let plus: [f64; 3] = core::array::from_fn(|_| 0.1 * r());
+        let old = if i % 2 == 0 { 1e6 } else { 0.05 + 0.1 * r() };
+        let v = [r() - 0.5, r() - 0.5, 0.6 * (r() - 0.5)];
+        let randers = moving_medium::tests_faces(1.3, v);
+        let a = upwind_min(&randers, minus, plus, h, old);
+        let b = upwind_min(&NoPruning(&randers), minus, plus, h, old);
+        assert_eq!(a, b, "moving medium {minus:?} {plus:?} {v:?}");
+        let q = [
+            [1.0 + r(), 0.3 * r(), -0.2 * r()],
+            [0.0, 0.5 + r(), 0.4 * r()],
+            [0.0, 0.0, 0.3 + r()],
+        ];
+        // M = QᵀQ (positive definite), tilted
+        let m: [[f64; 3]; 3] =
+            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let riem = metric::tests_faces(0.8, m);
+        let a = upwind_min(&riem, minus, plus, h, old);
+        let b = upwind_min(&NoPruning(&riem), minus, plus, h, old);
+        assert_eq!(a, b, "metric {minus:?} {plus:?} {m:?}");
+    }
+}
+
+/// Near a smooth solution (a plane wave plus a convex or concave bend per axis, as in the
+/// sweeps), where the natural orthant's proof runs, with and without deficits.
+#[test]
+fn skipping_faces_never_changes_the_result_near_smooth_solutions() {
+    let mut x = 0.611_f64;
+    let mut r = move || {
+        x = (x * 997.0 + 0.4321).fract();
+        x
+    };
+    let h = 0.02;
+    let (mut fast, mut total) = (0, 0);
+    for i in 0..20000 {
+        let (a, b) = (6.3 * r(), 3.1 * r());
+        let n = [a.cos() * b.sin(), a.sin() * b.sin(), b.cos()];
+        let bend: [f64; 3] = core::array::from_fn(|_| 4.0 * (r() - 0.5) * h * h);
+        let old = if i % 2 == 0 { 1e6 } else { 1.0 + 0.02 * (r() - 0.5) };
+        let nb = |q: [f64; 3]| -> ([f64; 3], [f64; 3]) {
+            (
+                core::array::from_fn(|k| 1.0 - q[k] * h + bend[k]),
+                core::array::from_fn(|k| 1.0 + q[k] * h + bend[k]),
+            )
+        };
+        let v = [0.7 * (r() - 0.5), 0.7 * (r() - 0.5), 0.5 * (r() - 0.5)];
+        let f = 1.3;
+        let c = f + v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+        let (minus, plus) = nb(core::array::from_fn(|k| n[k] / c));
+        let randers = moving_medium::tests_faces(f, v);
+        let got = upwind_min(&randers, minus, plus, h, old);
+        assert_eq!(
+            got,
+            upwind_min(&NoPruning(&randers), minus, plus, h, old),
+            "moving medium"
+        );
+        let q = [
+            [1.0 + r(), 0.3 * r(), -0.2 * r()],
+            [0.0, 0.5 + r(), 0.4 * r()],
+            [0.0, 0.0, 0.3 + r()],
+        ];
+        let m: [[f64; 3]; 3] =
+            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let nmn: f64 = (0..3).map(|a| (0..3).map(|b| n[a] * m[a][b] * n[b]).sum::<f64>()).sum();
+        let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * n[k] / nmn.sqrt()));
+        let riem = metric::tests_faces(0.8, m);
+        let got = upwind_min(&riem, minus, plus, h, old);
+        assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+        // how often the natural orthant settles it alone
+        let pf = riem.project(7).unwrap();
+        let vel = riem.velocity(core::array::from_fn(|k| (plus[k] - minus[k]) / (2.0 * h)));
+        let o0: usize = (0..3).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
+        let nbs: [[f64; 2]; 3] = core::array::from_fn(|k| [minus[k], plus[k]]);
+        fast += matches!(natural_orthant(&riem, &pf, &nbs, o0, h), Some((_, true))) as usize;
+        total += 1;
+    }
+    // the test must exercise the proof, not only the enumeration
+    assert!(fast * 2 > total, "the natural orthant settled {fast} of {total}");
+}
+
+/// Characteristics along a coordinate plane (as on a symmetry plane of the problem), where the
+/// natural orthant's simplex has no critical point inside and its faces are tried.
+#[test]
+fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
+    let mut x = 0.271_f64;
+    let mut r = move || {
+        x = (x * 997.0 + 0.2718).fract();
+        x
+    };
+    let h = 0.02;
+    let (mut fast, mut total) = (0, 0);
+    for i in 0..20000 {
+        let a = 6.3 * r();
+        let off = i % 3;
+        let mut n = [0.0; 3];
+        n[(off + 1) % 3] = a.cos();
+        n[(off + 2) % 3] = a.sin();
+        let bend: [f64; 3] = core::array::from_fn(|k| (0.5 + 2.0 * r() + 2.0 * (k == off) as u8 as f64) * h * h);
+        let old = if i % 2 == 0 { 1e6 } else { 1.0 + 0.02 * (r() - 0.5) };
+        let nb = |q: [f64; 3]| -> ([f64; 3], [f64; 3]) {
+            (
+                core::array::from_fn(|k| 1.0 - q[k] * h + bend[k]),
+                core::array::from_fn(|k| 1.0 + q[k] * h + bend[k]),
+            )
+        };
+        // the flow in the plane too, so that the characteristic stays in it
+        let mut v = [0.6 * (r() - 0.5), 0.6 * (r() - 0.5), 0.6 * (r() - 0.5)];
+        v[off] = 0.0;
+        let f = 1.3;
+        let c = f + v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+        let (minus, plus) = nb(core::array::from_fn(|k| n[k] / c));
+        let randers = moving_medium::tests_faces(f, v);
+        let got = upwind_min(&randers, minus, plus, h, old);
+        assert_eq!(
+            got,
+            upwind_min(&NoPruning(&randers), minus, plus, h, old),
+            "moving medium"
+        );
+        let nbs: [[f64; 2]; 3] = core::array::from_fn(|k| [minus[k], plus[k]]);
+        let vel = randers.velocity(core::array::from_fn(|k| plus[k] - minus[k]));
+        let o0: usize = (0..3).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
+        let mut b = f64::INFINITY;
+        fast += natural_faces(&randers, &nbs, o0, h, &mut b).is_some() as usize;
+        total += 1;
+        // a metric whose characteristic M p lies in the plane: p_off = −(M_off,· p)/M_off,off
+        let q = [
+            [1.0 + r(), 0.3 * r(), -0.2 * r()],
+            [0.0, 0.5 + r(), 0.4 * r()],
+            [0.0, 0.0, 0.3 + r()],
+        ];
+        let m: [[f64; 3]; 3] =
+            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let mut p = n;
+        p[off] = -(0..3).filter(|&k| k != off).map(|k| m[off][k] * n[k]).sum::<f64>() / m[off][off];
+        let pmp: f64 = (0..3).map(|a| (0..3).map(|b| p[a] * m[a][b] * p[b]).sum::<f64>()).sum();
+        let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
+        let riem = metric::tests_faces(0.8, m);
+        let got = upwind_min(&riem, minus, plus, h, old);
+        assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+    }
+    assert!(
+        fast * 2 > total,
+        "the natural orthant's faces settled {fast} of {total}"
+    );
+}
+
+/// The deficit proof's corners evaluated together ([`Faces::inside_corners`]) answer as
+/// [`Faces::inside`] at each corner does.
+#[test]
+fn inside_corners_is_inside_at_every_corner() {
+    let mut x = 0.5772_f64;
+    let mut r = move || {
+        x = (x * 997.0 + 0.1618).fract();
+        x
+    };
+    let (mut yes, mut no) = (0, 0);
+    for _ in 0..20000 {
+        let p: [f64; 3] = core::array::from_fn(|_| 1.6 * (r() - 0.5));
+        let moved: [f64; 3] = core::array::from_fn(|k| p[k] - 0.3 * r() * p[k].signum());
+        let def = 1 + (7.0 * r()) as usize % 7;
+        let each = |f: &dyn Fn([f64; 3]) -> bool| {
+            (1..8usize)
+                .filter(|s| s & !def == 0)
+                .all(|s| f(core::array::from_fn(|k| if s >> k & 1 == 1 { moved[k] } else { p[k] })))
+        };
+        let v = [r() - 0.5, r() - 0.5, 0.6 * (r() - 0.5)];
+        let randers = moving_medium::tests_faces(1.3, v);
+        let want = each(&|q| randers.inside(q));
+        assert_eq!(
+            randers.inside_corners(p, moved, def),
+            want,
+            "moving medium {p:?} {moved:?} {def}"
+        );
+        if want {
+            yes += 1
+        } else {
+            no += 1
+        }
+        let q = [
+            [1.0 + r(), 0.3 * r(), -0.2 * r()],
+            [0.0, 0.5 + r(), 0.4 * r()],
+            [0.0, 0.0, 0.3 + r()],
+        ];
+        let m: [[f64; 3]; 3] =
+            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let riem = metric::tests_faces(0.8, m);
+        let want = each(&|q| riem.inside(q));
+        assert_eq!(riem.inside_corners(p, moved, def), want, "metric {p:?} {moved:?} {def}");
+    }
+    // both answers occur
+    assert!(yes > 1000 && no > 1000, "{yes} inside, {no} not");
+}
