@@ -6,8 +6,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
 use tubesweep_core::second_order::{
-    check_geometry_of, factor_sources_of, first_order_start, starting_values, sweep_second_order, tube_geometry_of,
-    Implicit, SecondOrderOptions,
+    check_geometry_of, first_order_start, starting_values, sweep_second_order, tube_setup_of, Implicit,
+    SecondOrderOptions,
 };
 use tubesweep_core::sweep::Slowness;
 use tubesweep_core::{Control, IterationReport};
@@ -74,14 +74,7 @@ fn run<'py, const D: usize>(
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
-        let geometry = tube_geometry_of(band, roles, &surface, directions, inp.spacing)?;
-        check_geometry_of(
-            &geometry.summary,
-            inp.outer_width,
-            inp.spacing,
-            surface.is_closest_point(),
-        )?;
-        let factoring = factor_sources_of(
+        let (geometry, factoring) = tube_setup_of(
             band,
             roles,
             &surface,
@@ -91,7 +84,15 @@ fn run<'py, const D: usize>(
             sources,
             inp.source_slowness,
             inp.fix_radius,
+            inp.threads,
         )?;
+        check_geometry_of(
+            &geometry.summary,
+            inp.outer_width,
+            inp.spacing,
+            surface.is_closest_point(),
+        )?;
+        let factoring = factoring?;
         let mut values = starting_values(&factoring);
         let mut callback = |r: &IterationReport| -> Control {
             crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))

@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
 use super::geometry::power_of_two_near;
-use super::implicit::Implicit;
+use super::implicit::{Implicit, LocalGeometry};
 
 /// u₀ at every node, ∂u₀ at the nodes not in the extension layer, and the roles with the fixed
 /// nodes marked.
@@ -94,74 +94,29 @@ pub fn factor_sources_of<const D: usize>(
             x[k] = lower[k] + spacing * indices[i][k] as f64;
         }
         let inner = roles[i] != NodeRole::Outer;
-        // closest point: x − φ ∇φ/|∇φ|² from f64 differences where the stencil allows
         let local = if inner { surface.local(band, i, spacing) } else { None };
-        // φ in the orientation of the differences, ∇φ/|∇φ| (the layer's geometry holds the
-        // outward direction sgn(φ) n)
-        let mut phi_i = surface.phi(i);
-        let sign = if phi_i < 0.0 { -1.0 } else { 1.0 };
-        let mut nrm = [0.0; D];
-        for k in 0..D {
-            nrm[k] = sign * directions[i][k] as f64;
-        }
-        if let Some(l) = &local {
-            phi_i = l.phi;
-            let g2: f64 = l.gradient.iter().map(|v| v * v).sum();
-            if g2 > 0.0 {
-                let gn = g2.sqrt();
-                for k in 0..D {
-                    nrm[k] = l.gradient[k] / gn;
-                }
-            }
-        }
-        let cp = surface.closest_point(i, &x, &nrm);
-        let mut best = (f64::INFINITY, 0usize, 0.0);
-        for (s, (xs, &sl)) in sources.iter().zip(source_slowness).enumerate() {
-            let c: f64 = (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt();
-            if sl * c < best.0 {
-                best = (sl * c, s, c);
-            }
-        }
-        let (value, s, chord) = best;
-        u0[i] = value;
+        let node = node_factor(
+            surface,
+            i,
+            &x,
+            &directions[i],
+            inner,
+            local.as_ref(),
+            sources,
+            source_slowness,
+            unit,
+            fix_radius,
+            &mut fixed_per_source,
+        );
+        u0[i] = node.u0;
         if inner {
-            grad_u0.push([0.0f32; D]);
-            let g = grad_u0.last_mut().expect("just pushed");
-            // the nodes within fix_radius of some source are fixed (the nearest's value)
-            let near = sources
-                .iter()
-                .enumerate()
-                .filter(|(_, xs)| (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt() <= fix_radius);
-            let mut any = false;
-            for (t, _) in near {
-                fixed_per_source[t] += 1;
-                any = true;
-            }
-            if any {
-                out_roles[i] = NodeRole::Fixed;
-            } else if chord > 0.0 {
-                let mut e = [0.0; D];
-                for k in 0..D {
-                    e[k] = (cp[k] - sources[s][k]) / chord;
-                }
-                // Dcp e = e − n (n·e) − φ H e
-                let ne: f64 = (0..D).map(|k| nrm[k] * e[k]).sum();
-                for k in 0..D {
-                    let mut v = e[k] - nrm[k] * ne;
-                    if let Some(l) = &local {
-                        v -= phi_i * (0..D).map(|m| l.hessian[k][m] * e[m]).sum::<f64>();
-                    }
-                    g[k] = (source_slowness[s] * v / unit) as f32;
-                }
-            }
+            grad_u0.push(node.grad_u0);
+        }
+        if node.fixed {
+            out_roles[i] = NodeRole::Fixed;
         }
     }
-    if let Some(s) = fixed_per_source.iter().position(|&c| c == 0) {
-        return Err(Error::invalid(
-            "sources",
-            format!("sources[{s}] has no inner-tube node within {fix_radius:.3} of it; put the source on the surface or refine the grid"),
-        ));
-    }
+    check_sources_fixed(&fixed_per_source, fix_radius)?;
     Ok(Factoring {
         u0,
         grad_u0,
@@ -169,4 +124,106 @@ pub fn factor_sources_of<const D: usize>(
         roles: out_roles,
         fixed_per_source,
     })
+}
+
+/// The error for a source that fixed no inner-tube node.
+pub(crate) fn check_sources_fixed(fixed_per_source: &[usize], fix_radius: f64) -> Result<()> {
+    if let Some(s) = fixed_per_source.iter().position(|&c| c == 0) {
+        return Err(Error::invalid(
+            "sources",
+            format!("sources[{s}] has no inner-tube node within {fix_radius:.3} of it; put the source on the surface or refine the grid"),
+        ));
+    }
+    Ok(())
+}
+
+/// What the factoring gives one node.
+pub(crate) struct NodeFactor<const D: usize> {
+    pub(crate) u0: f64,
+    /// ∇u₀ over the unit (zero at a fixed node; not used in the extension layer).
+    pub(crate) grad_u0: [f32; D],
+    /// Within `fix_radius` of a source (inner-tube nodes only).
+    pub(crate) fixed: bool,
+}
+
+/// u₀ and ∇u₀ at node `i` at `x`, with its outward direction sgn(φ) n, whether it is an
+/// inner-tube node, and φ's differences there (`local`, [`Implicit::local`]; None in the extension
+/// layer or for an incomplete stencil), ∇u₀ over `unit` ([`Factoring::grad_u0_unit`]); counts into
+/// `fixed_per_source` the sources it is within `fix_radius` of.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn node_factor<const D: usize>(
+    surface: &Implicit<'_, D>,
+    i: usize,
+    x: &[f64; D],
+    direction: &[f32; D],
+    inner: bool,
+    local: Option<&LocalGeometry<D>>,
+    sources: &[[f64; D]],
+    source_slowness: &[f64],
+    unit: f64,
+    fix_radius: f64,
+    fixed_per_source: &mut [usize],
+) -> NodeFactor<D> {
+    // closest point: x − φ ∇φ/|∇φ|² from f64 differences where the stencil allows;
+    // φ in the orientation of the differences, ∇φ/|∇φ| (the layer's geometry holds the
+    // outward direction sgn(φ) n)
+    let mut phi_i = surface.phi(i);
+    let sign = if phi_i < 0.0 { -1.0 } else { 1.0 };
+    let mut nrm = [0.0; D];
+    for k in 0..D {
+        nrm[k] = sign * direction[k] as f64;
+    }
+    if let Some(l) = local {
+        phi_i = l.phi;
+        let g2: f64 = l.gradient.iter().map(|v| v * v).sum();
+        if g2 > 0.0 {
+            let gn = g2.sqrt();
+            for k in 0..D {
+                nrm[k] = l.gradient[k] / gn;
+            }
+        }
+    }
+    let cp = surface.closest_point(i, x, &nrm);
+    let mut best = (f64::INFINITY, 0usize, 0.0);
+    for (s, (xs, &sl)) in sources.iter().zip(source_slowness).enumerate() {
+        let c: f64 = (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt();
+        if sl * c < best.0 {
+            best = (sl * c, s, c);
+        }
+    }
+    let (value, s, chord) = best;
+    let mut node = NodeFactor {
+        u0: value,
+        grad_u0: [0.0f32; D],
+        fixed: false,
+    };
+    if !inner {
+        return node;
+    }
+    // the nodes within fix_radius of some source are fixed (the nearest's value)
+    let near = sources
+        .iter()
+        .enumerate()
+        .filter(|(_, xs)| (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt() <= fix_radius);
+    for (t, _) in near {
+        fixed_per_source[t] += 1;
+        node.fixed = true;
+    }
+    if !node.fixed && chord > 0.0 {
+        let mut e = [0.0; D];
+        for k in 0..D {
+            e[k] = (cp[k] - sources[s][k]) / chord;
+        }
+        // Dcp e = e − n (n·e) − φ H e
+        let ne: f64 = (0..D).map(|k| nrm[k] * e[k]).sum();
+        for k in 0..D {
+            let mut v = e[k] - nrm[k] * ne;
+            if let Some(l) = local {
+                v -= phi_i * (0..D).map(|m| l.hessian[k][m] * e[m]).sum::<f64>();
+            }
+            node.grad_u0[k] = (source_slowness[s] * v / unit) as f32;
+        }
+    }
+    node
 }

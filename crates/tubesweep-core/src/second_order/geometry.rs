@@ -13,7 +13,7 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
-use super::implicit::Implicit;
+use super::implicit::{Implicit, LocalGeometry};
 
 /// What the second-order sweeps read at one inner-tube node (the extension layer's nodes read
 /// only the given directions).
@@ -45,6 +45,97 @@ pub struct GeometrySummary {
     /// Inner-tube nodes whose 3^D-stencil of φ was not all in the band (their geometry falls back
     /// to the given direction and B = I).
     pub incomplete_stencils: usize,
+}
+
+impl GeometrySummary {
+    /// Nothing seen yet ([`Self::merge`]'s identity).
+    pub(crate) fn empty() -> Self {
+        GeometrySummary {
+            max_curvature: 0.0,
+            grad_norm_min: f64::INFINITY,
+            grad_norm_max: 0.0,
+            incomplete_stencils: 0,
+        }
+    }
+
+    /// Both parts' nodes (maxima, minima and counts: the same whatever the split).
+    pub(crate) fn merge(self, other: Self) -> Self {
+        GeometrySummary {
+            max_curvature: self.max_curvature.max(other.max_curvature),
+            grad_norm_min: self.grad_norm_min.min(other.grad_norm_min),
+            grad_norm_max: self.grad_norm_max.max(other.grad_norm_max),
+            incomplete_stencils: self.incomplete_stencils + other.incomplete_stencils,
+        }
+    }
+
+    /// After the last node: no node with a stencil gives a minimum |∇φ| of 0.
+    pub(crate) fn finish(&mut self) {
+        if !self.grad_norm_min.is_finite() {
+            self.grad_norm_min = 0.0;
+        }
+    }
+}
+
+/// The geometry of one inner-tube node from φ there (`phi`, signed), its outward direction
+/// sgn(φ) n and φ's differences `local` ([`Implicit::local`], None for an incomplete stencil:
+/// then the normal is the direction times sgn(φ) and B = I); what it finds about the surface goes
+/// into `summary`.
+pub(crate) fn node_geometry<const D: usize>(
+    phi: f64,
+    direction: &[f32; D],
+    local: Option<&LocalGeometry<D>>,
+    summary: &mut GeometrySummary,
+) -> NodeGeometry {
+    let mut identity = [0.0f32; 6];
+    for k in 0..D {
+        identity[sym(k, k)] = 1.0;
+    }
+    let sign = if phi < 0.0 { -1.0f32 } else { 1.0 };
+    let mut geo = NodeGeometry {
+        normal: [0.0; 3],
+        b: identity,
+    };
+    for k in 0..D {
+        geo.normal[k] = sign * direction[k];
+    }
+    let Some(local) = local else {
+        summary.incomplete_stencils += 1;
+        return geo;
+    };
+    let (g, hess) = (local.gradient, local.hessian);
+    // φ in the orientation of the differences (the same as `phi` for a level set)
+    let p = local.phi;
+    let norm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
+    summary.grad_norm_min = summary.grad_norm_min.min(norm);
+    summary.grad_norm_max = summary.grad_norm_max.max(norm);
+    if norm > 0.0 {
+        for k in 0..D {
+            geo.normal[k] = (g[k] / norm) as f32;
+        }
+    }
+    // principal curvatures at the foot point from the eigenvalues at height φ
+    for lam in symmetric_eigenvalues(&hess).iter().take(D) {
+        let den = 1.0 - p * lam;
+        let kappa = if den > 0.0 { (lam / den).abs() } else { f64::INFINITY };
+        summary.max_curvature = summary.max_curvature.max(kappa);
+    }
+    let mut m = [[0.0; D]; D];
+    for k in 0..D {
+        for l in 0..D {
+            m[k][l] = if k == l { 1.0 } else { 0.0 } - p * hess[k][l];
+        }
+    }
+    match symmetric_inverse(&m) {
+        Some(b) => {
+            for k in 0..D {
+                for l in k..D {
+                    geo.b[sym(k, l)] = (0.5 * (b[k][l] + b[l][k])) as f32;
+                }
+            }
+        }
+        None => summary.max_curvature = f64::INFINITY,
+    }
+    geo
 }
 
 /// The geometry of the inner-tube nodes and the surface summary.
@@ -212,88 +303,36 @@ pub fn tube_geometry_of<const D: usize>(
             format!("must be positive and finite, got {spacing}"),
         ));
     }
-    let mut summary = GeometrySummary {
-        max_curvature: 0.0,
-        grad_norm_min: f64::INFINITY,
-        grad_norm_max: 0.0,
-        incomplete_stencils: 0,
-    };
+    let mut summary = GeometrySummary::empty();
     let mut nodes = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
-    let mut identity = [0.0f32; 6];
-    for k in 0..D {
-        identity[sym(k, k)] = 1.0;
-    }
     for i in 0..n {
-        let mut p = surface.phi(i);
-        let sign = if p < 0.0 { -1.0f32 } else { 1.0 };
-        let mut geo = NodeGeometry {
-            normal: [0.0; 3],
-            b: identity,
-        };
-        for k in 0..D {
-            geo.normal[k] = if roles[i] == NodeRole::Outer {
-                directions[i][k]
-            } else {
-                sign * directions[i][k]
-            };
-        }
         if roles[i] != NodeRole::Outer {
-            match surface.local(band, i, spacing) {
-                None => summary.incomplete_stencils += 1,
-                Some(local) => {
-                    let (g, hess) = (local.gradient, local.hessian);
-                    // φ in the orientation of the differences (the same as phi(i) for a level set)
-                    p = local.phi;
-                    let norm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
-                    summary.grad_norm_min = summary.grad_norm_min.min(norm);
-                    summary.grad_norm_max = summary.grad_norm_max.max(norm);
-                    if norm > 0.0 {
-                        for k in 0..D {
-                            geo.normal[k] = (g[k] / norm) as f32;
-                        }
-                    }
-                    // principal curvatures at the foot point from the eigenvalues at height φ
-                    for lam in symmetric_eigenvalues(&hess).iter().take(D) {
-                        let den = 1.0 - p * lam;
-                        let kappa = if den > 0.0 { (lam / den).abs() } else { f64::INFINITY };
-                        summary.max_curvature = summary.max_curvature.max(kappa);
-                    }
-                    let mut m = [[0.0; D]; D];
-                    for k in 0..D {
-                        for l in 0..D {
-                            m[k][l] = if k == l { 1.0 } else { 0.0 } - p * hess[k][l];
-                        }
-                    }
-                    match symmetric_inverse(&m) {
-                        Some(b) => {
-                            for k in 0..D {
-                                for l in k..D {
-                                    geo.b[sym(k, l)] = (0.5 * (b[k][l] + b[l][k])) as f32;
-                                }
-                            }
-                        }
-                        None => summary.max_curvature = f64::INFINITY,
-                    }
-                }
-            }
-        }
-        if roles[i] != NodeRole::Outer {
-            nodes.push(geo);
+            let local = surface.local(band, i, spacing);
+            nodes.push(node_geometry(
+                surface.phi(i),
+                &directions[i],
+                local.as_ref(),
+                &mut summary,
+            ));
         }
     }
     nodes.shrink_to_fit();
-    if !summary.grad_norm_min.is_finite() {
-        summary.grad_norm_min = 0.0;
-    }
-    // in units of a power of two near the spacing: f32 then holds |φ| on a grid in any units
-    // (it under- or overflowed beyond about 1e±38), and the comparisons keep their bits
-    let abs_phi_unit = power_of_two_near(spacing);
-    let abs_phi = (0..n).map(|i| (surface.phi(i).abs() / abs_phi_unit) as f32).collect();
+    summary.finish();
+    let abs_phi = abs_phi_of(surface, spacing);
     Ok(TubeGeometry {
         nodes,
         abs_phi,
         summary,
     })
+}
+
+/// |φ| per node in units of a power of two near the spacing: f32 then holds |φ| on a grid in
+/// any units (it under- or overflowed beyond about 1e±38), and the comparisons keep their bits.
+pub(crate) fn abs_phi_of<const D: usize>(surface: &Implicit<'_, D>, spacing: f64) -> Vec<f32> {
+    let unit = power_of_two_near(spacing);
+    (0..surface.len())
+        .map(|i| (surface.phi(i).abs() / unit) as f32)
+        .collect()
 }
 
 /// The power of two nearest `x` (> 0, finite) in the log: dividing by it is exact, so a quantity

@@ -9,6 +9,7 @@
 //!   curvature the tube must resolve (h_out·κ < 1);
 //! * [`factoring`]: u = u₀ + w with u₀ the chord distance to the nearest point source, the nodes
 //!   within a small ball of a source fixed at u₀;
+//! * [`setup`]: both in one parallel pass over the band;
 //! * [`local`]: the limited BDF2 Godunov update (a continuous ramp between first and second
 //!   order, Newton's method for the unequal steps) and the second-order extension update;
 //! * [`solver`]: phase 1 (first order, monotone) then phase 2 (second order, assignment), with
@@ -21,12 +22,14 @@ pub mod geometry;
 pub mod implicit;
 pub mod local;
 mod pipeline;
+pub mod setup;
 pub mod solver;
 pub mod start;
 
 pub use factoring::{factor_sources, factor_sources_of, Factoring};
 pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometry, TubeGeometry};
 pub use implicit::Implicit;
+pub use setup::tube_setup_of;
 pub use solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
 pub use start::first_order_start;
 
