@@ -83,7 +83,14 @@ pub fn corrected_slowness<const D: usize>(geo: &NodeGeometry, grad: [f64; D], si
         e2 += e[k] * e[k];
     }
     let b = |k: usize, l: usize| geo.b[sym(k.min(l), k.max(l))] as f64;
-    let q = ((e2.sqrt() / sigma - DIRECTION_NONE) / (DIRECTION_FULL - DIRECTION_NONE)).clamp(0.0, 1.0);
+    // q = 1 without its square root and divisions where |e| clearly exceeds DIRECTION_FULL·σ (a
+    // relative margin of 1e-9, far above the rounding of q's four operations: the same q)
+    let full = DIRECTION_FULL * sigma;
+    let q = if e2 > full * full * (1.0 + 1e-9) {
+        1.0
+    } else {
+        ((e2.sqrt() / sigma - DIRECTION_NONE) / (DIRECTION_FULL - DIRECTION_NONE)).clamp(0.0, 1.0)
+    };
     let along = if q > 0.0 {
         let mut be2 = 0.0;
         for k in 0..D {
@@ -167,7 +174,7 @@ pub fn godunov_closed_form<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> O
         let (tm, tp) = (m.b / m.c, p.b / p.c);
         axes[k] = if tm <= tp { (tm, m.c, m.b) } else { (tp, p.c, p.b) };
     }
-    axes.sort_unstable_by(|x, y| x.0.partial_cmp(&y.0).unwrap_or(std::cmp::Ordering::Equal));
+    sort_by_first(&mut axes);
     if !axes[0].0.is_finite() {
         return None;
     }
@@ -204,7 +211,7 @@ pub fn godunov_first_order<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> O
     for k in 0..D {
         a[k] = sides[k][0].b.min(sides[k][1].b);
     }
-    a.sort_unstable_by(|x, y| x.partial_cmp(y).unwrap_or(std::cmp::Ordering::Equal));
+    sort_by_first(&mut a);
     if !a[0].is_finite() {
         return None;
     }
@@ -221,6 +228,48 @@ pub fn godunov_first_order<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> O
         w = (s1 + disc.sqrt()) / mf;
     }
     Some(w)
+}
+
+/// What [`sort_by_first`] orders by.
+trait Key: Copy {
+    fn key(&self) -> f64;
+}
+
+impl Key for f64 {
+    #[inline(always)]
+    fn key(&self) -> f64 {
+        *self
+    }
+}
+
+impl Key for (f64, f64, f64) {
+    #[inline(always)]
+    fn key(&self) -> f64 {
+        self.0
+    }
+}
+
+/// Sorts 2 or 3 entries by their key, stably (equal keys keep their order, as the insertion sort
+/// of `sort_unstable_by` on so short a slice does), without branches: the compare-exchanges of
+/// neighbours (0, 1), (1, 2), (0, 1), each a select, so that the order of the data costs no
+/// mispredicted jumps (the first-order kernel's `sort_small`).
+#[inline(always)]
+fn sort_by_first<T: Key, const D: usize>(a: &mut [T; D]) {
+    #[inline(always)]
+    fn exchange<T: Key>(x: T, y: T) -> (T, T) {
+        let swap = y.key() < x.key();
+        (if swap { y } else { x }, if swap { x } else { y })
+    }
+    if D >= 2 {
+        (a[0], a[1]) = exchange(a[0], a[1]);
+    }
+    if D >= 3 {
+        (a[1], a[2]) = exchange(a[1], a[2]);
+        (a[0], a[1]) = exchange(a[0], a[1]);
+    }
+    if D > 3 {
+        a.sort_by(|x, y| x.key().partial_cmp(&y.key()).unwrap_or(std::cmp::Ordering::Equal));
+    }
 }
 
 #[cfg(test)]
@@ -272,6 +321,24 @@ mod tests {
             match (a, b) {
                 (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-13, "{a} {b} {sides:?}"),
                 (a, b) => assert_eq!(a, b),
+            }
+        }
+    }
+
+    #[test]
+    fn the_sorting_network_orders_as_the_insertion_sort_did() {
+        // every arrangement of keys from {0, 1, 2, +inf} (ties included), each entry tagged with
+        // its place: the same order as sort_unstable_by's (an insertion sort at this length)
+        let keys = [0.0, 1.0, 2.0, f64::INFINITY];
+        for a in keys {
+            for b in keys {
+                for c in keys {
+                    let mut x = [(a, 0.0, 0.0), (b, 1.0, 0.0), (c, 2.0, 0.0)];
+                    let mut y = x;
+                    sort_by_first(&mut x);
+                    y.sort_unstable_by(|p, q| p.0.partial_cmp(&q.0).unwrap());
+                    assert_eq!(x, y);
+                }
             }
         }
     }
