@@ -312,12 +312,14 @@ def test_closest_point_refusals():
 
 
 def test_a_runaway_second_phase_falls_back_to_first_order(monkeypatch):
-    # phase 1 stopped far too early (64·Δx² in 3D): from that start the second-order sweeps run
-    # away (values to −1e6 and beyond, for minutes until max_iterations); they are abandoned at
-    # the first value below −σ̄Δx, with a warning, and the first phase's values are returned
+    # phase 1 stopped far too early (64·Δx² in 3D) and the extension's BDF2 correction unlimited:
+    # from that start the second-order sweeps run away (values to −1e6 and beyond, for minutes
+    # until max_iterations); they are abandoned at the first value below −σ̄Δx, with a warning,
+    # and the first phase's values are returned
     import tubesweep.second_order as so
 
     monkeypatch.setitem(so.TOL_FIRST_FACTOR, 3, 64.0)
+    monkeypatch.setattr(so, "EXTENSION_LIMIT", np.inf)
     with pytest.warns(RuntimeWarning, match="ran away"):
         sol = ts.solve(SPHERE, box(101), [SRC], order=2)
     assert sol.stats.order2["runaway_iteration"] is not None
@@ -329,3 +331,23 @@ def test_a_runaway_second_phase_falls_back_to_first_order(monkeypatch):
     # the default tolerance does not run away
     monkeypatch.setitem(so.TOL_FIRST_FACTOR, 3, 1.0)
     assert ts.solve(SPHERE, box(61), [SRC], order=2).stats.order2["runaway_iteration"] is None
+
+
+@pytest.mark.parametrize("first", [64.0, 1.0])
+def test_the_limited_extension_converges_from_a_poor_start(monkeypatch, first):
+    # the same start with the extension's correction limited (the default) converges at second
+    # order, like the default solve (which has no first phase in 3D) and one from a full first phase
+    import tubesweep.second_order as so
+
+    far0, mean0, sol0 = sphere_errors(101)
+    assert sol0.stats.order2["first_order_iterations"] == 0
+    monkeypatch.setitem(so.TOL_FIRST_FACTOR, 3, first)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        far, mean, sol = sphere_errors(101)
+    o = sol.stats.order2
+    assert sol.stats.converged and o["runaway_iteration"] is None and o["fallback_iteration"] is None
+    assert o["first_order_iterations"] > 0
+    # second order: 1.3e-3 / 1.07e-4 at N = 101 (first order: 3.8e-2 / 1.2e-2)
+    assert far < 1.5e-3 and mean < 1.2e-4, (far, mean)
+    assert abs(far - far0) < 0.01 * far0 and abs(mean - mean0) < 0.01 * mean0, (far, far0, mean, mean0)

@@ -157,6 +157,7 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
     window_first: float = 0.0,  # front windows of the two phases (factors of the first-order width)
     window_second: float = 0.0,
     ramp_length: float = 1.0,  # ℓ: the limiter's ramp width is σΔx²/ℓ (second_order.ramp_length)
+    extension_limit: float = ...,  # the extension's BDF2 correction limited beyond this many σΔx (default ∞)
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], Dict[str, Any]]: ...
 def band_interpolate_cubic(  # crates/tubesweep-py/src/box_order2.rs: Catmull-Rom, multilinear where incomplete
     band: "Band", values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]

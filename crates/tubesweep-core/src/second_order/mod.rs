@@ -191,15 +191,16 @@ mod tests {
 
     /// The same, with the values, on `threads` threads.
     fn sphere_solve(n: usize, window: f64, threads: usize) -> (f64, f64, SecondOrderStats, Vec<f64>) {
-        sphere_solve_with(n, window, threads, 1e-3)
+        sphere_solve_with(n, window, threads, 1e-3, 2.0)
     }
 
-    /// The same, with phase 1 stopped at `first_tol`·Δx².
+    /// The same, with phase 1 stopped at `first_tol`·Δx² (+∞: none) and the extension's limit.
     fn sphere_solve_with(
         n: usize,
         window: f64,
         threads: usize,
         first_tol: f64,
+        extension_limit: f64,
     ) -> (f64, f64, SecondOrderStats, Vec<f64>) {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
         let idx = band.indices();
@@ -234,6 +235,7 @@ mod tests {
             own_first_phase: true,
             window_first: window,
             window_second: window,
+            extension_limit,
             threads,
             ramp_length: 1.0,
         };
@@ -301,11 +303,11 @@ mod tests {
 
     #[test]
     fn a_runaway_second_phase_is_abandoned_for_the_first_phase() {
-        // phase 1 stopped far too early (64·Δx²): the second-order sweeps from that start run
-        // away (values to −1e6 and beyond); they are stopped at the first value below −σ̄Δx and
-        // the first phase's monotone values are returned, converged, instead of running to
-        // max_iterations
-        let (e, m, stats, values) = sphere_solve_with(101, 2.0, 1, 64.0);
+        // phase 1 stopped far too early (64·Δx²) and the extension's BDF2 correction unlimited:
+        // the second-order sweeps from that start run away (values to −1e6 and beyond); they are
+        // stopped at the first value below −σ̄Δx and the first phase's monotone values are
+        // returned, converged, instead of running to max_iterations
+        let (e, m, stats, values) = sphere_solve_with(101, 2.0, 1, 64.0, f64::INFINITY);
         let runaway = stats
             .runaway_iteration
             .expect("this start ran away when the guard was written");
@@ -314,6 +316,45 @@ mod tests {
         assert!(values.iter().all(|&v| v >= 0.0), "a negative value was returned");
         // first-order accuracy (the second-order solve's max error is about 1e-3 here)
         assert!(e < 5e-2 && m < 2e-2 && e > 2e-3, "max {e:.3e}, mean {m:.3e}, {stats:?}");
+    }
+
+    #[test]
+    fn the_limited_extension_converges_from_a_poor_start() {
+        // the start above with the extension's correction limited (the default): no runaway,
+        // no fallback, and the errors of the solve from a full first phase
+        let (e, m, stats, _) = sphere_solve_with(101, 2.0, 1, 64.0, 2.0);
+        let (e_full, m_full, full, _) = sphere_solve_with(101, 2.0, 1, 1.0, 2.0);
+        for s in [&stats, &full] {
+            assert!(
+                s.converged && s.runaway_iteration.is_none() && s.fallback_iteration.is_none(),
+                "{s:?}"
+            );
+        }
+        assert!(
+            (e - e_full).abs() < 0.01 * e_full && (m - m_full).abs() < 0.01 * m_full && e < 2e-3,
+            "max {e:.4e} / {e_full:.4e}, mean {m:.4e} / {m_full:.4e}"
+        );
+    }
+
+    #[test]
+    fn without_a_first_phase_the_errors_stay_and_updates_fall() {
+        // tol_first = ∞: the second-order sweeps start from the fixed nodes, behind the window
+        let (e, m, none, _) = sphere_solve_with(81, 2.0, 1, f64::INFINITY, 2.0);
+        let (e1, m1, first, _) = sphere_solve_with(81, 2.0, 1, 1.0, 2.0);
+        assert!(
+            none.converged && none.first_order_iterations == 0 && none.fallback_iteration.is_none(),
+            "{none:?}"
+        );
+        assert!(
+            (e - e1).abs() < 0.01 * e1 && (m - m1).abs() < 0.01 * m1 && m < 1e-4,
+            "max {e:.4e} / {e1:.4e}, mean {m:.4e} / {m1:.4e}"
+        );
+        assert!(
+            (none.updates as f64) < 0.85 * first.updates as f64,
+            "{} updates without phase 1, {} with it",
+            none.updates,
+            first.updates
+        );
     }
 
     #[test]
@@ -328,6 +369,13 @@ mod tests {
         assert_eq!(three.second_order_iterations, one.second_order_iterations);
         for ((x, y), z) in a.iter().zip(&b).zip(&c) {
             assert_eq!((x.to_bits(), x.to_bits()), (y.to_bits(), z.to_bits()));
+        }
+        // without a first phase too
+        let (_, _, one, a) = sphere_solve_with(61, 2.0, 1, f64::INFINITY, 2.0);
+        let (_, _, two, b) = sphere_solve_with(61, 2.0, 2, f64::INFINITY, 2.0);
+        assert_eq!(one.updates, two.updates);
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.to_bits(), y.to_bits());
         }
     }
 }

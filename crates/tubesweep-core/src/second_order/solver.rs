@@ -36,7 +36,8 @@ use super::pipeline::Pipeline;
 /// Stopping rules of the two phases.
 #[derive(Debug, Clone, Copy)]
 pub struct SecondOrderOptions {
-    /// Phase 1 stops when the largest change of an iteration is below this.
+    /// Phase 1 stops when the largest change of an iteration is below this; +∞: no phase 1 (with
+    /// `own_first_phase`: the second-order sweeps start from the fixed nodes, behind the window).
     pub tol_first: f64,
     /// Phase 2 stops when the largest change of an iteration is below this.
     pub tol: f64,
@@ -53,6 +54,9 @@ pub struct SecondOrderOptions {
     /// mean slowness (the first-order driver's width, [`crate::sweep::DEFAULT_FRONT_WINDOW`]).
     pub window_first: f64,
     pub window_second: f64,
+    /// The extension layer's BDF2 correction is limited where the two neighbours' w differ by
+    /// more than this many σΔx (see [`Sweeper::outer`]); +∞: never.
+    pub extension_limit: f64,
     /// Threads of the sweeps (0: the default, see [`super::pipeline`]); the same values for any.
     pub threads: usize,
     /// The limiter's length ℓ: the ramp t = clip((u1 − u2)/ε, 0, 1) of [`reconstruct`] has width
@@ -137,6 +141,7 @@ struct Sweeper<'a, const D: usize> {
     ramp_scale: f64,
     /// 1/ε for a constant slowness.
     ramp_constant: f64,
+    extension_limit: f64,
 }
 
 impl<const D: usize> Sweeper<'_, D> {
@@ -211,6 +216,14 @@ impl<const D: usize> Sweeper<'_, D> {
     /// and has strictly smaller |φ| (so that no two layer nodes wait on each other); BDF2
     /// (weight 1.5|n_k|) when the next one along is there too, else first order (|n_k|).
     /// None while a used neighbour is not reached, or when no neighbour qualifies.
+    ///
+    /// The BDF2 correction is limited like the inner sides' (`reconstruct`): with δ = w₁ − w₂ and
+    /// L = `extension_limit`·σΔx, t = clip(2 − |δ|/L, 0, 1) ramps from BDF2 (t = 1, |δ| ≤ L) to
+    /// first order (t = 0, |δ| ≥ 2L): weight (1 + t/2)|n_k| on w₁ + (t/2)(2w₁ − w₂). On a
+    /// resolved solution |∂_k w| ≤ |∇u| + |∇u₀| ≈ 2σ, so the default L = 2σΔx leaves BDF2 alone
+    /// there; what it cuts is an iterate far from smooth, from which the unlimited extrapolation
+    /// (4w₁ − w₂)/3 (gain 5/3), read back by the inner nodes' distance-2 stencils, ran away:
+    /// the sphere at N = 101 from a first phase stopped at 64Δx² went to −1e11.
     #[inline(always)]
     fn outer(&self, u: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
         let table = self.table;
@@ -219,6 +232,7 @@ impl<const D: usize> Sweeper<'_, D> {
         let nb = unsafe { table.neighbours_of_unchecked(i) };
         let direction = &self.directions[i];
         let abs_phi = self.abs_phi[i];
+        let limit = self.extension_limit * self.sigma(i) * self.spacing;
         let (mut num, mut den) = (0.0, 0.0);
         for k in 0..D {
             let nk = direction[k];
@@ -249,9 +263,18 @@ impl<const D: usize> Sweeper<'_, D> {
                     let u2 = u.get(j2);
                     if u2.is_finite() && self.abs_phi[j2] < phi1 {
                         let w2 = u2 - self.u0[j2];
-                        num += 1.5 * weight * (4.0 * w1 - w2) / 3.0;
-                        den += 1.5 * weight;
-                        continue;
+                        let t = (2.0 - (w1 - w2).abs() / limit).clamp(0.0, 1.0);
+                        if t >= 1.0 {
+                            num += 1.5 * weight * (4.0 * w1 - w2) / 3.0;
+                            den += 1.5 * weight;
+                            continue;
+                        }
+                        if t > 0.0 {
+                            let half = 0.5 * t;
+                            num += weight * (w1 + half * (2.0 * w1 - w2));
+                            den += weight * (1.0 + half);
+                            continue;
+                        }
                     }
                 }
             }
@@ -397,6 +420,7 @@ pub fn sweep_second_order<const D: usize>(
             Slowness::PerNode(_) => f64::NAN,
         },
         abs_phi,
+        extension_limit: options.extension_limit,
     };
     let roles = sw.roles;
     // per row, the nodes before it that are not in the extension layer (the rows cover the band
@@ -459,7 +483,7 @@ pub fn sweep_second_order<const D: usize>(
                 control,
             )
         };
-    if options.own_first_phase {
+    if options.own_first_phase && options.tol_first.is_finite() {
         let lim = Limits::first_order(options.tol_first);
         phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
         stats.first_order_iterations = iteration;
