@@ -3,7 +3,8 @@
 //! changed. Phase 1 is the first-order scheme (t = 0) on the corrected, factored equation, made
 //! monotone (a value is only replaced by a smaller one), to convergence (here, or on the
 //! first-order driver: [`super::start`]); phase 2 the limited BDF2 scheme with plain assignment,
-//! from phase 1's values, until the largest change of an iteration is below `tol` (≪ Δx²). The
+//! from phase 1's values (or from the fixed nodes alone when `tol_first` is +∞, the Python
+//! package's choice in 3D: the window reaches every node anyway, in 20–30% fewer updates), until the largest change of an iteration is below `tol` (≪ Δx²). The
 //! second-order sweeps are not monotone: when the change stops shrinking (the change of an
 //! iteration above `stall_ratio` times that `stall_window` iterations earlier), they fall back
 //! to accepting decreases only, which ends any limit cycle.
