@@ -56,7 +56,7 @@ def main(argv: Any = None) -> int:
             f.write(f"{' '.join(repr(float(c)) for c in feet[0])} {float(src_slowness[0])!r} {float(slowness)!r}\n")
             f.write(
                 f"{fix_radius!r} {outer!r} {tol_first!r} {tol!r} {kw['window_first']!r} {kw['window_second']!r} "
-                f"{kw['ramp_length']!r}\n"
+                f"{kw['ramp_length']!r} {kw.get('extension_limit', float('inf'))!r}\n"
             )
         return native(
             band, roles, phi, directions, lower, h, feet, src_slowness, slowness, fix_radius, outer, *rest, **kw

@@ -78,6 +78,8 @@ fn main() {
     let (source_slowness, slowness) = (lines[1][3], lines[1][4]);
     let (fix_radius, outer_width, tol_first, tol) = (lines[2][0], lines[2][1], lines[2][2], lines[2][3]);
     let (window_first, window_second, ramp_length) = (lines[2][4], lines[2][5], lines[2][6]);
+    // the extension's limit (older dumps: none, the unlimited BDF2)
+    let extension_limit = lines[2].get(7).copied().unwrap_or(f64::INFINITY);
     let linear: Vec<u64> = read_bytes(dir, "linear")
         .chunks_exact(8)
         .map(|c| u64::from_le_bytes(c.try_into().unwrap()))
@@ -119,6 +121,7 @@ fn main() {
         window_second,
         threads,
         ramp_length,
+        extension_limit,
     };
     let (mut setup, mut p1, mut p2, mut ns1, mut ns2) = (vec![], vec![], vec![], vec![], vec![]);
     for round in 0..rounds {
