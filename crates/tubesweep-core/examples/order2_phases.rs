@@ -182,7 +182,9 @@ fn main() {
         .expect("solve");
         let total = since(t, cpu);
         let k = stats.first_order_iterations;
-        let (t1, u1) = (marks[k - 1].0, marks[..k].iter().map(|m| m.1).sum::<u64>());
+        // (no phase 1 when tol_first is +∞, the package's choice in 3D: 0 s, 0 updates)
+        let t1 = if k == 0 { 0.0 } else { marks[k - 1].0 };
+        let u1 = marks[..k].iter().map(|m| m.1).sum::<u64>();
         let u2: u64 = marks[k..].iter().map(|m| m.1).sum::<u64>().max(1);
         let t2 = total - t1;
         let digest = values.iter().fold(0u64, |a, v| a.rotate_left(5) ^ v.to_bits());
@@ -190,7 +192,7 @@ fn main() {
             "round {round}: set-up {:.4} s (geometry {t_geo:.4}, factoring {t_fac:.4}); phase 1 {t1:.4} s, {u1} updates, \
              {:.1} ns; phase 2 {t2:.4} s, {u2} updates, {:.1} ns; {} + {} iterations, converged {}, digest {digest:016x}",
             t_geo + t_fac,
-            t1 / u1 as f64 * 1e9,
+            t1 / u1.max(1) as f64 * 1e9,
             t2 / u2 as f64 * 1e9,
             stats.first_order_iterations,
             stats.second_order_iterations,
@@ -199,7 +201,7 @@ fn main() {
         setup.push(t_geo + t_fac);
         p1.push(t1);
         p2.push(t2);
-        ns1.push(t1 / u1 as f64 * 1e9);
+        ns1.push(t1 / u1.max(1) as f64 * 1e9);
         ns2.push(t2 / u2 as f64 * 1e9);
     }
     println!(
