@@ -65,16 +65,17 @@ impl<const D: usize> Faces<D> for Riemann<D> {
     /// computed once (the same bits as at each corner alone).
     #[inline(always)]
     fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
-        let choice = |k: usize, sub: usize| if sub >> k & 1 == 1 { moved[k] } else { p[k] };
+        // both choices per axis, indexed by the corner's bit (a load, not a branch)
+        let pm: [[f64; 2]; D] = core::array::from_fn(|k| [p[k], moved[k]]);
         let mp: [[[f64; 2]; D]; D] =
             core::array::from_fn(|k| core::array::from_fn(|l| [self.m[k][l] * p[l], self.m[k][l] * moved[l]]));
         let r = self.s * (1.0 - 1e-12);
         let mut sub = def;
         while sub != 0 {
             let q: f64 = (0..D)
-                .map(|k| choice(k, sub) * (0..D).map(|l| mp[k][l][sub >> l & 1]).sum::<f64>())
+                .map(|k| pm[k][sub >> k & 1] * (0..D).map(|l| mp[k][l][sub >> l & 1]).sum::<f64>())
                 .sum();
-            debug_assert_eq!(q <= r * r, self.inside(core::array::from_fn(|k| choice(k, sub))));
+            debug_assert_eq!(q <= r * r, self.inside(core::array::from_fn(|k| pm[k][sub >> k & 1])));
             if !(q <= r * r) {
                 return false;
             }

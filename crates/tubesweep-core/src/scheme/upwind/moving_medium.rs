@@ -97,17 +97,23 @@ impl<const D: usize> Faces<D> for Randers<D> {
     /// axis computed once (the same bits as at each corner alone).
     #[inline(always)]
     fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
-        let choice = |k: usize, sub: usize| if sub >> k & 1 == 1 { moved[k] } else { p[k] };
         let vp: [[f64; 2]; D] = core::array::from_fn(|k| [self.v[k] * p[k], self.v[k] * moved[k]]);
         let pp: [[f64; 2]; D] = core::array::from_fn(|k| [p[k] * p[k], moved[k] * moved[k]]);
         let mut sub = def;
         while sub != 0 {
             let r = 1.0 - 1e-12 - (0..D).map(|k| vp[k][sub >> k & 1]).sum::<f64>();
-            if !(r >= 0.0 && self.f2 * (0..D).map(|k| pp[k][sub >> k & 1]).sum::<f64>() <= r * r) {
-                debug_assert!(!self.inside(core::array::from_fn(|k| choice(k, sub))));
+            let inside = r >= 0.0 && self.f2 * (0..D).map(|k| pp[k][sub >> k & 1]).sum::<f64>() <= r * r;
+            debug_assert_eq!(
+                inside,
+                self.inside(core::array::from_fn(|k| if sub >> k & 1 == 1 {
+                    moved[k]
+                } else {
+                    p[k]
+                }))
+            );
+            if !inside {
                 return false;
             }
-            debug_assert!(self.inside(core::array::from_fn(|k| choice(k, sub))));
             sub = (sub - 1) & def;
         }
         true
