@@ -170,8 +170,16 @@ impl<const D: usize> Sweeper<'_, D> {
             Slowness::Constant(_) => self.ramp_constant,
             Slowness::PerNode(_) => self.ramp_scale / sigma,
         };
+        // SAFETY: `k_inner` counts the nodes before `i` not in the extension layer, fewer than
+        // the inner geometries and ∇u₀'s (checked equal to that count); u₀ has one value per node
+        let (geometry, grad_u0) = unsafe {
+            (
+                self.geometry.get_unchecked(k_inner),
+                self.grad_u0.get_unchecked(k_inner),
+            )
+        };
         for k in 0..D {
-            let du0 = self.grad_u0[k_inner][k] as f64 * self.grad_u0_unit;
+            let du0 = grad_u0[k] as f64 * self.grad_u0_unit;
             let mut near = [f64::NAN; 2];
             for side in 0..2 {
                 let j1 = nb[k][side];
@@ -184,13 +192,13 @@ impl<const D: usize> Sweeper<'_, D> {
                     continue;
                 }
                 near[side] = u1;
-                let w1 = u1 - self.u0[j1];
+                let w1 = u1 - unsafe { *self.u0.get_unchecked(j1) };
                 let (mut u2, mut w2) = (f64::NAN, f64::NAN);
                 if second {
                     let j2 = unsafe { table.neighbours_of_unchecked(j1) }[k][side];
                     if j2 != sentinel {
                         u2 = u.get(j2 as usize);
-                        w2 = u2 - self.u0[j2 as usize];
+                        w2 = u2 - unsafe { *self.u0.get_unchecked(j2 as usize) };
                     }
                 }
                 sides[k][side] = reconstruct(u1, w1, u2, w2, du0, h, inv_eps, side == 0, second);
@@ -203,13 +211,13 @@ impl<const D: usize> Sweeper<'_, D> {
                 _ => 0.0,
             };
         }
-        let s = corrected_slowness::<D>(&self.geometry[k_inner], grad, sigma);
+        let s = corrected_slowness::<D>(geometry, grad, sigma);
         let w = if second {
             godunov_closed_form(&sides, s * h)
         } else {
             godunov_first_order(&sides, s * h)
         }?;
-        Some(self.u0[i] + w)
+        Some(unsafe { *self.u0.get_unchecked(i) } + w)
     }
 
     /// The extension update at layer node `i`: per axis along which the outward direction
@@ -354,10 +362,11 @@ impl<const D: usize> Sweeper<'_, D> {
             for side in 0..2 {
                 let j = nb[k][side];
                 if j != sentinel {
-                    active[j as usize].store(1, Ordering::Relaxed);
+                    // SAFETY: `active` has one flag per band node, and `j`, `j2` are band nodes
+                    unsafe { active.get_unchecked(j as usize) }.store(1, Ordering::Relaxed);
                     let j2 = unsafe { table.neighbours_of_unchecked(j as usize) }[k][side];
                     if j2 != sentinel {
-                        active[j2 as usize].store(1, Ordering::Relaxed);
+                        unsafe { active.get_unchecked(j2 as usize) }.store(1, Ordering::Relaxed);
                     }
                 }
             }
