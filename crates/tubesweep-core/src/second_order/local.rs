@@ -1,12 +1,13 @@
-//! The local solvers of the second-order scheme "S2" (docs/second-order.md): the limited BDF2
-//! Godunov update of the metric-corrected eikonal equation at inner-tube nodes, and the
+//! The local solvers of the second-order scheme "S2" (docs/second-order.md): the limited
+//! BDF2/BDF3 Godunov update of the metric-corrected eikonal equation at inner-tube nodes, and the
 //! second-order upwind extension (the paper's Eq. (8), discretised like its Eq. (5) but with
 //! BDF2 differences) at extension-layer nodes. Both work on w = u − u₀ (see [`super::factoring`]).
 
 use super::geometry::{sym, NodeGeometry};
 
 /// Per axis and side, the one-sided difference as a linear function of w, scaled by Δx:
-/// Δx·D = c·w − b, with c = 1 + t/2 (1 for first order, 3/2 for BDF2) and b folding in the
+/// Δx·D = c·w − b, with c = 1 + t/2 + t·t₃/3 (1 for first order, 3/2 for BDF2, 11/6 for BDF3;
+/// see [`reconstruct`]) and b folding in the
 /// neighbours and the factored part's derivative (b = +∞ for a missing side).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Side {
@@ -21,38 +22,72 @@ impl Side {
     };
 }
 
+/// The neighbours one side of a node reads, along one axis: u and w = u − u₀ at distance 1, 2
+/// and 3 (NaN when missing or not read), and the node's own current w (`w0`, for the kink test).
+#[derive(Clone, Copy, Debug)]
+pub struct Upwind {
+    pub u1: f64,
+    pub w1: f64,
+    pub u2: f64,
+    pub w2: f64,
+    pub u3: f64,
+    pub w3: f64,
+    pub w0: f64,
+}
+
+/// Above this |Δ²w₁ − Δ²w₂|/ε (the second differences of w at the first and second neighbours,
+/// ε the ramp's width) the BDF3 ramp t₃ starts to close; it is closed at twice this. On the
+/// six-fold star (201–1601) 0.5 gives fitted orders 2.19 / 2.16 (far max / mean), 1 gave 1.96 /
+/// 1.89 and 2 gave 1.92 / 1.90; at 0.5 the sphere's far max rises by 24% (its mean by 5%), the
+/// spheroid's figures move by under 1%.
+pub const KINK: f64 = 0.5;
+
 /// The limited one-sided difference of one side (`minus`: the neighbours at −e_k), as a
-/// [`Side`]: neighbour values `u1`, `u2` (u) and `w1`, `w2` (w) at distance 1 and 2, `u2` NaN
-/// when missing, `du0` = ∂_k u₀ at the node. t = clip((u1 − u2)·inv_eps, 0, 1), with
-/// ε = σᵢΔx²/ℓ ([`super::solver::SecondOrderOptions::ramp_length`]: the same for a problem in
-/// any units or at any speed scale), ramps continuously
-/// from first order (t = 0, where the side is not upwind or the gradient along the axis
-/// vanishes) to BDF2 (t = 1): c = 1 + t/2, and the difference is
-/// (c w − w1 − (t/2)(2w1 − w2))/Δx ± ∂_k u₀ (+ on the minus side: u − u_left over the step).
-/// `second`: false forces t = 0 (first order).
+/// [`Side`]. Two ramps of width ε = σᵢΔx²/ℓ (`inv_eps` = 1/ε;
+/// [`super::solver::SecondOrderOptions::ramp_length`]: the same for a problem in any units or at
+/// any speed scale) raise the order step by step along an upwind run of neighbours:
+///
+/// * t = clip((u1 − u2)/ε, 0, 1), from first order (t = 0, where the side is not upwind or the
+///   gradient along the axis vanishes) to BDF2 (t = 1), the scheme "S2" of the design note
+///   `second-order-tube.md` (Sect. 2, "Inner update");
+/// * t₃ = clip((u2 − u3)/ε, 0, 1)·clip(2 − |Δ²w₁ − Δ²w₂|/(K ε), 0, 1) (K = [`KINK`]), from BDF2 to
+///   BDF3: it removes BDF2's O(Δx²) truncation error of w, which the characteristics accumulate
+///   (0.26Δx² on the sphere's circle x = 0, docs/second-order.md), and is closed where the
+///   upwind second differences of w disagree by more than O(ε), at a kink (the cut locus, where
+///   fronts meet), where a third-order stencil across the kink ran away. The design note's
+///   third-order variant (Sect. 3) had t₃ but no kink ramp, and stalled on the star.
+///
+/// The difference is Δx·D = c w − b ± Δx ∂_k u₀ (+ on the minus side: u − u_left over the step)
+/// with c = 1 + t/2 + t·t₃/3 and b = w1 + (t/2)(2w1 − w2) + (t·t₃/3)(3w1 − 3w2 + w3): the BDF
+/// formulas (3/2, 11/6 at t = 1, t₃ = 1) of the paper's one-sided differences (Eq. (5)) applied
+/// to w. `second`: false forces t = 0 (first order).
 #[inline(always)]
-pub fn reconstruct(
-    u1: f64,
-    w1: f64,
-    u2: f64,
-    w2: f64,
-    du0: f64,
-    spacing: f64,
-    inv_eps: f64,
-    minus: bool,
-    second: bool,
-) -> Side {
-    let t = if second && u2.is_finite() {
-        ((u1 - u2) * inv_eps).clamp(0.0, 1.0)
+pub fn reconstruct(n: &Upwind, du0: f64, spacing: f64, inv_eps: f64, minus: bool, second: bool) -> Side {
+    let t = if second && n.u2.is_finite() {
+        ((n.u1 - n.u2) * inv_eps).clamp(0.0, 1.0)
     } else {
         0.0
     };
     let half = 0.5 * t;
-    // (t = 0 without w2, which may be NaN)
-    let b = if t > 0.0 { w1 + half * (2.0 * w1 - w2) } else { w1 };
+    // (t = 0 without w2, which may be NaN; t₃ = 0 without w3 or w0)
+    let mut b = if t > 0.0 {
+        n.w1 + half * (2.0 * n.w1 - n.w2)
+    } else {
+        n.w1
+    };
+    let mut c = 1.0 + half;
+    if t > 0.0 && n.u3 < n.u2 && n.w0.is_finite() {
+        let jump = ((n.w0 - 2.0 * n.w1 + n.w2) - (n.w1 - 2.0 * n.w2 + n.w3)).abs() * inv_eps * (1.0 / KINK);
+        let t3 = ((n.u2 - n.u3) * inv_eps).min(1.0) * (2.0 - jump).clamp(0.0, 1.0);
+        if t3 > 0.0 {
+            let third = t * t3 * (1.0 / 3.0);
+            b += third * (3.0 * n.w1 - 3.0 * n.w2 + n.w3);
+            c += third;
+        }
+    }
     let hd = spacing * du0;
     Side {
-        c: 1.0 + half,
+        c,
         b: if minus { b - hd } else { b + hd },
     }
 }
@@ -325,6 +360,19 @@ mod tests {
         }
     }
 
+    /// The neighbours of one side, w = u (no factoring), without a third neighbour.
+    fn up(u1: f64, u2: f64, w2: f64) -> Upwind {
+        Upwind {
+            u1,
+            w1: u1,
+            u2,
+            w2,
+            u3: f64::NAN,
+            w3: f64::NAN,
+            w0: f64::NAN,
+        }
+    }
+
     #[test]
     fn the_sorting_network_orders_as_the_insertion_sort_did() {
         // every arrangement of keys from {0, 1, 2, +inf} (ties included), each entry tagged with
@@ -347,23 +395,65 @@ mod tests {
     fn bdf2_difference_is_exact_for_quadratics() {
         // u = x² at x = 0.3 from the left: u1 = u(0.2), u2 = u(0.1): (c u − b)/h = u'(0.3)
         let h = 0.1;
+        let e = 1.0 / (h * h);
         let f = |x: f64| x * x;
-        let s = reconstruct(f(0.2), f(0.2), f(0.1), f(0.1), 0.0, h, 1.0 / (h * h), true, true);
+        let s = reconstruct(&up(f(0.2), f(0.1), f(0.1)), 0.0, h, e, true, true);
         assert!(((s.c * f(0.3) - s.b) / h - 0.6).abs() < 1e-12);
         // the ramp: a side that is not upwind (u2 > u1) is first order
-        let s = reconstruct(0.2, 0.2, 0.3, 0.3, 0.0, h, 1.0 / (h * h), true, true);
+        let s = reconstruct(&up(0.2, 0.3, 0.3), 0.0, h, e, true, true);
         assert_eq!((s.c, s.b), (1.0, 0.2));
         // and so is a side whose second neighbour is missing (NaN), or the first-order phase
         assert_eq!(
-            reconstruct(0.2, 0.2, f64::NAN, f64::NAN, 0.0, h, 1.0 / (h * h), true, true),
+            reconstruct(&up(0.2, f64::NAN, f64::NAN), 0.0, h, e, true, true),
             Side { c: 1.0, b: 0.2 }
         );
         assert_eq!(
-            reconstruct(0.2, 0.2, 0.1, f64::NAN, 0.0, h, 1.0 / (h * h), true, false),
+            reconstruct(&up(0.2, 0.1, f64::NAN), 0.0, h, e, true, false),
             Side { c: 1.0, b: 0.2 }
         );
         // the factored part: u = u0 = x (w = 0) gives the difference 1 from either side
-        let s = reconstruct(0.2, 0.0, 0.1, 0.0, 1.0, h, 1.0 / (h * h), true, true);
+        let s = reconstruct(
+            &Upwind {
+                w1: 0.0,
+                w2: 0.0,
+                ..up(0.2, 0.1, 0.0)
+            },
+            1.0,
+            h,
+            e,
+            true,
+            true,
+        );
         assert!(((s.c * 0.0 - s.b) / h - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bdf3_difference_is_exact_for_cubics_and_off_at_a_kink() {
+        // u = x + x³/4 at x = 0.3 from the left, every ramp open (u rises by > ε per step):
+        // (c u − b)/h = u'(0.3) exactly, where BDF2 is off by O(h²)
+        let h = 0.1;
+        let e = 1.0 / (h * h);
+        let f = |x: f64| x + 0.25 * x * x * x;
+        let side = Upwind {
+            u1: f(0.2),
+            w1: f(0.2),
+            u2: f(0.1),
+            w2: f(0.1),
+            u3: f(0.0),
+            w3: f(0.0),
+            w0: f(0.3),
+        };
+        let exact = 1.0 + 0.75 * 0.09;
+        let s = reconstruct(&side, 0.0, h, e, true, true);
+        assert!(((s.c * f(0.3) - s.b) / h - exact).abs() < 1e-12);
+        assert!((s.c - 11.0 / 6.0).abs() < 1e-15);
+        let bdf2 = reconstruct(&Upwind { u3: f64::NAN, ..side }, 0.0, h, e, true, true);
+        assert!(((bdf2.c * f(0.3) - bdf2.b) / h - exact).abs() > 1e-3);
+        // a kink: the second differences of w disagree by more than 2ε: BDF2 again
+        let kinked = Upwind {
+            w0: f(0.3) + 0.5,
+            ..side
+        };
+        assert_eq!(reconstruct(&kinked, 0.0, h, e, true, true).c, 1.5);
     }
 }
