@@ -3,7 +3,7 @@
 The paper's tube equation ``|∇u| = 1/F`` is wrong by ``φκ = O(Δx)`` off the surface, so its
 scheme is first order whatever the stencil. ``order=2`` solves the metric-corrected equation
 ``|B∇u| = 1/F``, ``B = (I − φD²φ)⁻¹`` (whose exact solution is the normal extension of the
-surface solution) with limited BDF2 upwind differences, a second-order extension layer and point
+surface solution) with limited BDF2–BDF3 upwind differences, a second-order extension layer and point
 sources factored as ``u = u₀ + w``, ``u₀`` the chord distance to the source
 (``tubesweep_core::second_order``)."""
 

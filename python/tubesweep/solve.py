@@ -138,7 +138,7 @@ def solve(
         never reached and are returned as ``inf``. Not used by ``order=2``.
     order : {1, 2, "auto"}
         1: the paper's first-order scheme (the default). 2: second order (docs/second-order.md):
-        the metric-corrected tube equation with limited BDF2 differences and factored point
+        the metric-corrected tube equation with limited BDF2–BDF3 differences and factored point
         sources, for level sets (arrays, callables, library surfaces) and closed smooth
         closest-point surfaces with the Godunov update; ``sol.stats.order2`` reports its phases.
         A surface whose curvature the tube does not resolve (``outer·Δx·κ ≥ 1``), a φ that is
