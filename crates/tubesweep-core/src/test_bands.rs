@@ -29,6 +29,26 @@ pub(crate) fn sphere_band(n: usize) -> (NarrowBand<3>, Vec<NodeRole>, Vec<[f32; 
     (band, roles, dirs, h)
 }
 
+/// The sphere of radius 0.5 at the nodes of a band over [−1,1]^3 with spacing `h`, as a level
+/// set (φ = |x| − 0.5) and as a closest-point map (the offsets x − cp(x)).
+pub(crate) fn sphere_phi_and_offsets(band: &NarrowBand<3>, h: f64) -> (Vec<f64>, Vec<[f64; 3]>) {
+    let pts: Vec<[f64; 3]> = band
+        .indices()
+        .iter()
+        .map(|i| [-1.0 + h * i[0] as f64, -1.0 + h * i[1] as f64, -1.0 + h * i[2] as f64])
+        .collect();
+    let norm = |x: &[f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    let phi = pts.iter().map(|x| norm(x) - 0.5).collect();
+    let offsets = pts
+        .iter()
+        .map(|x| {
+            let r = norm(x);
+            [x[0] - 0.5 * x[0] / r, x[1] - 0.5 * x[1] / r, x[2] - 0.5 * x[2] / r]
+        })
+        .collect();
+    (phi, offsets)
+}
+
 /// The two-layer problem on such a band: unit speed, the outward directions, `scheme` in the
 /// inner tube, absent neighbours extrapolated.
 pub(crate) fn sphere_problem<'a>(

@@ -73,16 +73,8 @@ pub fn factor_sources_of<const D: usize>(
     fix_radius: f64,
 ) -> Result<Factoring<D>> {
     let n = band.len();
-    if sources.is_empty() {
-        return Err(Error::invalid("sources", "at least one source is needed"));
-    }
-    if source_slowness.len() != sources.len() || source_slowness.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(Error::invalid(
-            "source_slowness",
-            "one positive finite slowness per source",
-        ));
-    }
-    let unit = power_of_two_near(source_slowness.iter().fold(0.0f64, |a, &b| a.max(b)));
+    check_source_arguments(sources, source_slowness)?;
+    let unit = grad_u0_unit_of(source_slowness);
     let mut u0 = vec![0.0; n];
     let mut grad_u0 = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     let mut out_roles = roles.to_vec();
@@ -124,6 +116,25 @@ pub fn factor_sources_of<const D: usize>(
         roles: out_roles,
         fixed_per_source,
     })
+}
+
+/// At least one source, and one positive finite slowness per source.
+pub(crate) fn check_source_arguments<const D: usize>(sources: &[[f64; D]], source_slowness: &[f64]) -> Result<()> {
+    if sources.is_empty() {
+        return Err(Error::invalid("sources", "at least one source is needed"));
+    }
+    if source_slowness.len() != sources.len() || source_slowness.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(Error::invalid(
+            "source_slowness",
+            "one positive finite slowness per source",
+        ));
+    }
+    Ok(())
+}
+
+/// [`Factoring::grad_u0_unit`]: a power of two near the largest source slowness.
+pub(crate) fn grad_u0_unit_of(source_slowness: &[f64]) -> f64 {
+    power_of_two_near(source_slowness.iter().fold(0.0f64, |a, &b| a.max(b)))
 }
 
 /// The error for a source that fixed no inner-tube node.

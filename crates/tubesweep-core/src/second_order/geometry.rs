@@ -291,18 +291,7 @@ pub fn tube_geometry_of<const D: usize>(
     spacing: f64,
 ) -> Result<TubeGeometry> {
     let n = band.len();
-    if roles.len() != n || surface.len() != n || directions.len() != n {
-        return Err(Error::invalid(
-            "phi",
-            format!("roles, phi and directions need one entry per band node ({n})"),
-        ));
-    }
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(Error::invalid(
-            "spacing",
-            format!("must be positive and finite, got {spacing}"),
-        ));
-    }
+    check_tube_inputs(n, roles, surface, directions, spacing)?;
     let mut summary = GeometrySummary::empty();
     let mut nodes = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     for i in 0..n {
@@ -324,6 +313,30 @@ pub fn tube_geometry_of<const D: usize>(
         abs_phi,
         summary,
     })
+}
+
+/// One role, φ and direction per band node (`n`), and a positive finite spacing: what the
+/// geometry ([`tube_geometry_of`]) and the one-pass set-up ([`super::tube_setup_of`]) read.
+pub(crate) fn check_tube_inputs<const D: usize>(
+    n: usize,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    directions: &[[f32; D]],
+    spacing: f64,
+) -> Result<()> {
+    if roles.len() != n || surface.len() != n || directions.len() != n {
+        return Err(Error::invalid(
+            "phi",
+            format!("roles, phi and directions need one entry per band node ({n})"),
+        ));
+    }
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Err(Error::invalid(
+            "spacing",
+            format!("must be positive and finite, got {spacing}"),
+        ));
+    }
+    Ok(())
 }
 
 /// |φ| per node in units of a power of two near the spacing: f32 then holds |φ| on a grid in

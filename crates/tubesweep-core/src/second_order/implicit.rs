@@ -144,19 +144,7 @@ mod tests {
     #[test]
     fn closest_point_map_gives_the_level_sets_metric() {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
-        let pts: Vec<[f64; 3]> = band
-            .indices()
-            .iter()
-            .map(|i| [-1.0 + h * i[0] as f64, -1.0 + h * i[1] as f64, -1.0 + h * i[2] as f64])
-            .collect();
-        let phi: Vec<f64> = pts.iter().map(|x| norm(x) - 0.5).collect();
-        let offsets: Vec<[f64; 3]> = pts
-            .iter()
-            .map(|x| {
-                let r = norm(x);
-                [x[0] - 0.5 * x[0] / r, x[1] - 0.5 * x[1] / r, x[2] - 0.5 * x[2] / r]
-            })
-            .collect();
+        let (phi, offsets) = crate::test_bands::sphere_phi_and_offsets(&band, h);
         let a = tube_geometry_of(&band, &roles, &Implicit::LevelSet(&phi), &dirs, h).unwrap();
         let b = tube_geometry_of(&band, &roles, &Implicit::ClosestPoint(&offsets), &dirs, h).unwrap();
         assert_eq!(b.summary.incomplete_stencils, 0);

@@ -13,8 +13,8 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
-use super::factoring::{check_sources_fixed, node_factor, Factoring};
-use super::geometry::{abs_phi_of, node_geometry, power_of_two_near, GeometrySummary, NodeGeometry, TubeGeometry};
+use super::factoring::{check_source_arguments, check_sources_fixed, grad_u0_unit_of, node_factor, Factoring};
+use super::geometry::{abs_phi_of, check_tube_inputs, node_geometry, GeometrySummary, NodeGeometry, TubeGeometry};
 use super::implicit::Implicit;
 
 /// Nodes per chunk of the parallel pass.
@@ -50,32 +50,11 @@ pub fn tube_setup_of<const D: usize>(
     threads: usize,
 ) -> Result<(TubeGeometry, Result<Factoring<D>>)> {
     let n = band.len();
-    if roles.len() != n || surface.len() != n || directions.len() != n {
-        return Err(Error::invalid(
-            "phi",
-            format!("roles, phi and directions need one entry per band node ({n})"),
-        ));
-    }
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(Error::invalid(
-            "spacing",
-            format!("must be positive and finite, got {spacing}"),
-        ));
-    }
+    check_tube_inputs(n, roles, surface, directions, spacing)?;
     let abs_phi = abs_phi_of(surface, spacing);
-    let factoring_arguments = if sources.is_empty() {
-        Err(Error::invalid("sources", "at least one source is needed"))
-    } else if source_slowness.len() != sources.len() || source_slowness.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        Err(Error::invalid(
-            "source_slowness",
-            "one positive finite slowness per source",
-        ))
-    } else {
-        Ok(())
-    };
+    let factoring_arguments = check_source_arguments(sources, source_slowness);
     let factor = factoring_arguments.is_ok();
-    // ∇u₀ is stored over a power of two near the largest source slowness (as factor_sources_of does)
-    let unit = power_of_two_near(source_slowness.iter().fold(0.0f64, |a, &b| a.max(b)));
+    let unit = grad_u0_unit_of(source_slowness);
     let indices = band.indices();
     let chunk = |c: usize| -> Chunk<D> {
         let (s, e) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
@@ -200,20 +179,7 @@ mod tests {
     #[test]
     fn one_pass_gives_the_two_functions_values() {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
-        let pts: Vec<[f64; 3]> = band
-            .indices()
-            .iter()
-            .map(|i| [-1.0 + h * i[0] as f64, -1.0 + h * i[1] as f64, -1.0 + h * i[2] as f64])
-            .collect();
-        let norm = |x: &[f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-        let phi: Vec<f64> = pts.iter().map(|x| norm(x) - 0.5).collect();
-        let offsets: Vec<[f64; 3]> = pts
-            .iter()
-            .map(|x| {
-                let r = norm(x);
-                [x[0] - 0.5 * x[0] / r, x[1] - 0.5 * x[1] / r, x[2] - 0.5 * x[2] / r]
-            })
-            .collect();
+        let (phi, offsets) = crate::test_bands::sphere_phi_and_offsets(&band, h);
         let sources = [[-0.5, 0.0, 0.0], [0.0, 0.5, 0.0]];
         let slowness = [1.0, 1.5];
         for surface in [Implicit::LevelSet(&phi), Implicit::ClosestPoint(&offsets)] {
