@@ -361,6 +361,23 @@ mod tests {
     }
 
     #[test]
+    fn the_start_wakes_only_the_readers_of_reached_nodes() {
+        // every non-fixed node active at the start: the same bits, the visits that found no
+        // neighbour reached more (with and without a first phase)
+        for first_tol in [f64::INFINITY, 1.0] {
+            let (_, _, few, a) = sphere_solve_with(61, 2.0, 1, first_tol, 2.0);
+            solver::ALL_ACTIVE_START.with(|f| f.set(true));
+            let (_, _, all, b) = sphere_solve_with(61, 2.0, 1, first_tol, 2.0);
+            solver::ALL_ACTIVE_START.with(|f| f.set(false));
+            assert!(few.updates < all.updates, "{} / {}", few.updates, all.updates);
+            assert_eq!(few.second_order_iterations, all.second_order_iterations);
+            for (x, y) in a.iter().zip(&b) {
+                assert_eq!(x.to_bits(), y.to_bits());
+            }
+        }
+    }
+
+    #[test]
     fn any_thread_count_gives_the_same_bits() {
         let (_, _, one, a) = sphere_solve(61, 2.0, 1);
         let (_, _, two, b) = sphere_solve(61, 2.0, 2);
