@@ -55,13 +55,13 @@ FIX_RADIUS = 2.0
 #: spheroid, ellipsoid, torus and rounded cube, values as close to the converged ones. In 2D (no
 #: window) the star at N = 1601 needs a tight start (from 1.0 its phase 2 stalled into the
 #: safeguard, far max 5.6e-4 instead of 1.2e-5). Phase 2 (second order) stops at ``TOL_FACTOR[d]``
-#: times ``Δx² × mean slowness / ℓ`` unless ``tol`` is given: in 3D 2e-4, as without phase 1 the
-#: last changes are spread over more of the band (1e-3 left the sphere's circle x = 0 at 3.30e-5
-#: instead of 3.28e-5; 2e-4 lands within 2e-7·Δx² of the converged values on the five surfaces
-#: above). Dividing by ``ℓ`` makes both tolerances the same fraction of the travel times in any
-#: units.
+#: times ``Δx² × mean slowness / ℓ`` unless ``tol`` is given: in 3D 5e-4 (at N = 201 the values
+#: come within 6e-7–2.0e-6 of the converged ones on the sphere, ellipsoid, torus and rounded cube,
+#: 0.04–3.4% of their far max errors, 7e-8–1.2e-7 in the mean; 2e-4 took 4–7% more updates for
+#: 2.5–8.1e-7, and 1e-3 left the torus 7.4e-6 away, 12% of its far max error). Dividing by ``ℓ``
+#: makes both tolerances the same fraction of the travel times in any units.
 TOL_FIRST_FACTOR = {2: 1e-2, 3: math.inf}
-TOL_FACTOR = {2: 1e-3, 3: 2e-4}
+TOL_FACTOR = {2: 1e-3, 3: 5e-4}
 
 #: The extension layer's BDF2 correction ramps to first order where the two neighbours' w differ
 #: by more than this many ``σΔx`` (fully at twice it; ∞: never): a resolved solution has
@@ -106,7 +106,7 @@ def ramp_length(grid: Any) -> float:
 
 
 def default_tol(spacing: float, mean_slowness: float, length: float, ndim: int = 3) -> float:
-    """Phase 2's stopping tolerance when none is given: ``2e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
+    """Phase 2's stopping tolerance when none is given: ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
     times the mean slowness (``ℓ`` = :func:`ramp_length`), far below the scheme's O(Δx²) error and
     far above machine precision, in any units."""
     return TOL_FACTOR[ndim] * spacing * spacing * mean_slowness / length

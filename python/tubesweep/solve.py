@@ -122,7 +122,7 @@ def solve(
     tol, max_iterations : float, int
         Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
         ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol`` defaults
-        to 1e-10 for ``order=1`` and for ``order=2`` to ``2e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
+        to 1e-10 for ``order=1`` and for ``order=2`` to ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
         times the mean slowness, ℓ half the grid's longest side.
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
