@@ -84,6 +84,24 @@ impl<const D: usize> NeighbourTable<'_, D> {
         }
         nb
     }
+
+    /// One entry of [`Self::neighbours_of_unchecked`]: the neighbour of node `n` along `axis` on
+    /// `side` (0: minus, 1: plus), or the sentinel, without building the other entries (along the
+    /// last axis a presence bit and n ± 1).
+    ///
+    /// # Safety
+    /// `n` is a node of the band, `axis < D`, `side < 2`.
+    #[inline(always)]
+    pub unsafe fn neighbour_unchecked(&self, n: usize, axis: usize, side: usize) -> u32 {
+        debug_assert!(n < self.sentinel as usize && axis < D && side < 2);
+        if axis + 1 < D {
+            *self.lead.get_unchecked(n * 2 * (D - 1) + 2 * axis + side)
+        } else if (*self.along_row.get_unchecked(n) >> side) & 1 != 0 {
+            (n + 2 * side).wrapping_sub(1) as u32
+        } else {
+            self.sentinel
+        }
+    }
 }
 
 impl<const D: usize> NarrowBand<D> {

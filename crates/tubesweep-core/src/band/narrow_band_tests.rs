@@ -25,6 +25,10 @@ fn full_box_neighbours_match_arithmetic() {
                 j[k] += if side == 0 { -1 } else { 1 };
                 let expect = band.find(j).map(|p| p as u32).unwrap_or(band.sentinel());
                 assert_eq!(band.neighbours_of(n)[k][side], expect);
+                assert_eq!(
+                    unsafe { band.neighbour_table().neighbour_unchecked(n, k, side) },
+                    expect
+                );
                 if let Some(p) = band.find(j) {
                     assert_eq!(
                         linear(shape, band.index_of(p)),
@@ -110,6 +114,8 @@ fn sparse_band_neighbours() {
                         .is_ok();
                 let nb = band.neighbours_of(n)[k][side];
                 assert_eq!(nb != band.sentinel(), inset, "node {idx:?} axis {k} side {side}");
+                // the one entry without the others (the second-order sweeps' reads)
+                assert_eq!(unsafe { band.neighbour_table().neighbour_unchecked(n, k, side) }, nb);
             }
         }
     }

@@ -22,17 +22,18 @@ impl Side {
     };
 }
 
-/// The neighbours one side of a node reads, along one axis: u and w = u − u₀ at distance 1, 2
-/// and 3 (NaN when missing or not read), and the node's own current w (`w0`, for the kink test).
+/// The neighbours one side of a node reads, along one axis: w = u − u₀ at distance 1, 2 and 3
+/// (NaN when missing or not read), the node's own current w (`w0`, for the kink test), and the
+/// steps of u along the run towards the node, `d1` = u1 − u2 and `d2` = u2 − u3 (NaN when not
+/// read), which the ramps of [`reconstruct`] read.
 #[derive(Clone, Copy, Debug)]
 pub struct Upwind {
-    pub u1: f64,
     pub w1: f64,
-    pub u2: f64,
     pub w2: f64,
-    pub u3: f64,
     pub w3: f64,
     pub w0: f64,
+    pub d1: f64,
+    pub d2: f64,
 }
 
 /// Above this |Δ²w₁ − Δ²w₂|/ε (the second differences of w at the first and second neighbours,
@@ -47,15 +48,21 @@ pub const KINK: f64 = 0.5;
 /// [`super::solver::SecondOrderOptions::ramp_length`]: the same for a problem in any units or at
 /// any speed scale) raise the order step by step along an upwind run of neighbours:
 ///
-/// * t = clip((u1 − u2)/ε, 0, 1), from first order (t = 0, where the side is not upwind or the
+/// * t = clip(d₁/ε, 0, 1), from first order (t = 0, where the side is not upwind or the
 ///   gradient along the axis vanishes) to BDF2 (t = 1), the scheme "S2" of the design note
 ///   `second-order-tube.md` (Sect. 2, "Inner update");
-/// * t₃ = clip((u2 − u3)/ε, 0, 1)·clip(2 − |Δ²w₁ − Δ²w₂|/(K ε), 0, 1) (K = [`KINK`]), from BDF2 to
+/// * t₃ = clip(d₂/ε, 0, 1)·clip(2 − |Δ²w₁ − Δ²w₂|/(K ε), 0, 1) (K = [`KINK`]), from BDF2 to
 ///   BDF3: it removes BDF2's O(Δx²) truncation error of w, which the characteristics accumulate
 ///   (0.26Δx² on the sphere's circle x = 0, docs/second-order.md), and is closed where the
 ///   upwind second differences of w disagree by more than O(ε), at a kink (the cut locus, where
 ///   fronts meet), where a third-order stencil across the kink ran away. The design note's
 ///   third-order variant (Sect. 3) had t₃ but no kink ramp, and stalled on the star.
+///
+/// d₁ = u1 − u2 and d₂ = u2 − u3 are the steps of the nodal u along the run. (Taking u₀'s part
+/// of them as Δx ∂_k u₀ at the node instead, which spares the sweeps u₀'s values at the
+/// neighbours, moves the ramps where u is nearly flat along an axis: at N = 101–201 the sphere's
+/// circle x = 0 came out 3.5× smaller and the torus's far max 4–23% smaller, but the spheroid's
+/// far max 9% larger and the ellipsoid's mean 25–30% larger, so the nodal steps stayed.)
 ///
 /// The difference is Δx·D = c w − b ± Δx ∂_k u₀ (+ on the minus side: u − u_left over the step)
 /// with c = 1 + t/2 + t·t₃/3 and b = w1 + (t/2)(2w1 − w2) + (t·t₃/3)(3w1 − 3w2 + w3): the BDF
@@ -63,25 +70,27 @@ pub const KINK: f64 = 0.5;
 /// to w. `second`: false forces t = 0 (first order).
 #[inline(always)]
 pub fn reconstruct(n: &Upwind, du0: f64, spacing: f64, inv_eps: f64, minus: bool, second: bool) -> Side {
-    let t = if second && n.u2.is_finite() {
-        ((n.u1 - n.u2) * inv_eps).clamp(0.0, 1.0)
+    let t = if second && n.w2.is_finite() {
+        (n.d1 * inv_eps).clamp(0.0, 1.0)
     } else {
         0.0
     };
     let half = 0.5 * t;
-    // (t = 0 without w2, which may be NaN; t₃ = 0 without w3 or w0)
+    // (t = 0 without w2, which may be NaN; t₃ = 0 without w3 (d2 NaN) or w0)
     let mut b = if t > 0.0 {
         n.w1 + half * (2.0 * n.w1 - n.w2)
     } else {
         n.w1
     };
     let mut c = 1.0 + half;
-    if t > 0.0 && n.u3 < n.u2 && n.w0.is_finite() {
-        let jump = ((n.w0 - 2.0 * n.w1 + n.w2) - (n.w1 - 2.0 * n.w2 + n.w3)).abs() * inv_eps * (1.0 / KINK);
-        let t3 = ((n.u2 - n.u3) * inv_eps).min(1.0) * (2.0 - jump).clamp(0.0, 1.0);
+    if t > 0.0 && n.d2 > 0.0 && n.w0.is_finite() {
+        // Δ²w₁ − Δ²w₂ = (w0 − 2w1 + w2) − (w1 − 2w2 + w3) = w0 − w3 − 3(w1 − w2)
+        let d12 = 3.0 * (n.w1 - n.w2);
+        let jump = (n.w0 - n.w3 - d12).abs() * (inv_eps * (1.0 / KINK));
+        let t3 = (n.d2 * inv_eps).min(1.0) * (2.0 - jump).clamp(0.0, 1.0);
         if t3 > 0.0 {
             let third = t * t3 * (1.0 / 3.0);
-            b += third * (3.0 * n.w1 - 3.0 * n.w2 + n.w3);
+            b += third * (d12 + n.w3);
             c += third;
         }
     }
@@ -98,47 +107,57 @@ pub fn reconstruct(n: &Upwind, du0: f64, spacing: f64, inv_eps: f64, minus: bool
 pub const DIRECTION_NONE: f64 = 0.05;
 pub const DIRECTION_FULL: f64 = 0.25;
 
-/// The effective slowness of the corrected equation, s = σ / |B ê|, with ê the unit tangential
+/// The square of the effective slowness of the corrected equation, s² = σ² / |B ê|², as a
+/// fraction (numerator, denominator > 0): the local solver needs only s², and its first
+/// decisions compare against it by products, so that the division runs beside them. ê is the
+/// unit tangential
 /// direction of `grad` (the current iterate's central differences) projected with I − nnᵀ.
 /// Where that projection is short (|P grad| < [`DIRECTION_FULL`]·σ), |Bê|² is blended with the
 /// mean of B²'s tangential part, tr(PB²P)/(D − 1), so that s stays a continuous function of the
 /// data: a direction taken from differences of nearly equal values flips from sweep to sweep,
 /// and on a spheroid's cut point that held the sweeps in a limit cycle of 1.7e-3 (N = 81).
+/// `inv_sigma` = 1/σ: the gradient is taken over σ first, so that no product of four
+/// slownesses forms (it overflowed at a slowness of 2^280).
 #[inline(always)]
-pub fn corrected_slowness<const D: usize>(geo: &NodeGeometry, grad: [f64; D], sigma: f64) -> f64 {
+pub fn corrected_slowness_squared<const D: usize>(
+    geo: &NodeGeometry,
+    grad: [f64; D],
+    sigma: f64,
+    inv_sigma: f64,
+) -> (f64, f64) {
     let n = geo.normal;
+    let mut g = [0.0; D];
     let mut gn = 0.0;
     for k in 0..D {
-        gn += grad[k] * n[k] as f64;
+        g[k] = grad[k] * inv_sigma;
+        gn += g[k] * n[k] as f64;
     }
     let mut e = [0.0; D];
     let mut e2 = 0.0;
     for k in 0..D {
-        e[k] = grad[k] - gn * n[k] as f64;
+        e[k] = g[k] - gn * n[k] as f64;
         e2 += e[k] * e[k];
     }
     let b = |k: usize, l: usize| geo.b[sym(k.min(l), k.max(l))] as f64;
-    // q = 1 without its square root and divisions where |e| clearly exceeds DIRECTION_FULL·σ (a
-    // relative margin of 1e-9, far above the rounding of q's four operations: the same q)
-    let full = DIRECTION_FULL * sigma;
-    let q = if e2 > full * full * (1.0 + 1e-9) {
+    // q = 1 without its square root and division where |e|/σ clearly exceeds DIRECTION_FULL (a
+    // relative margin of 1e-9, far above the rounding of q's operations)
+    let q = if e2 > DIRECTION_FULL * DIRECTION_FULL * (1.0 + 1e-9) {
         1.0
     } else {
-        ((e2.sqrt() / sigma - DIRECTION_NONE) / (DIRECTION_FULL - DIRECTION_NONE)).clamp(0.0, 1.0)
+        ((e2.sqrt() - DIRECTION_NONE) / (DIRECTION_FULL - DIRECTION_NONE)).clamp(0.0, 1.0)
     };
-    let along = if q > 0.0 {
-        let mut be2 = 0.0;
+    let mut be2 = 0.0;
+    if q > 0.0 {
         for k in 0..D {
             let v: f64 = (0..D).map(|l| b(k, l) * e[l]).sum();
             be2 += v * v;
         }
-        be2 / e2
-    } else {
-        0.0
-    };
-    if q >= 1.0 {
-        return sigma / along.sqrt();
     }
+    let sigma2 = sigma * sigma;
+    if q >= 1.0 {
+        return (sigma2 * e2, be2);
+    }
+    let along = if q > 0.0 { be2 / e2 } else { 0.0 };
     // tr(B²) − nᵀB²n over the D − 1 tangential directions
     let mut tr = 0.0;
     let mut bn2 = 0.0;
@@ -152,7 +171,7 @@ pub fn corrected_slowness<const D: usize>(geo: &NodeGeometry, grad: [f64; D], si
     }
     let mean = ((tr - bn2) / (D as f64 - 1.0)).max(1e-12);
     let weight = q * q * (3.0 - 2.0 * q);
-    sigma / (weight * along + (1.0 - weight) * mean).sqrt()
+    (sigma2, weight * along + (1.0 - weight) * mean)
 }
 
 /// Solves Σ_k max(0, c⁻_k w − b⁻_k, c⁺_k w − b⁺_k)² = (s Δx)² for w (None when every side is
@@ -195,44 +214,55 @@ pub fn godunov_newton<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> Option
     Some(w)
 }
 
-/// The same root as [`godunov_newton`] in closed form: per axis the side whose difference turns
-/// positive first (the smaller b/c), the axes added in that order while the root of
-/// (Σ c_k²) w² − 2 (Σ c_k b_k) w + Σ b_k² = (sΔx)² stays above the next one's b/c (the classical
-/// update with unequal steps). Where a side not chosen would be the larger at the root (possible
-/// only when its c is larger), [`godunov_newton`] decides. None when every side is missing.
+/// The same root as [`godunov_newton`] in closed form, with (sΔx)² = `num`/`den` (`den` > 0):
+/// per axis the side whose difference turns positive first (the smaller τ = b/c, compared as
+/// products: c > 0), the axes in increasing τ; axis m + 1 joins while the sum over the first m,
+/// Σ (c_l τ − b_l)², is still below (sΔx)² at its τ (the root of the first m then lies above
+/// it: the classical update with unequal steps, its count decided by squares and products, so
+/// that only the final root takes a square root and a division). Where a side not chosen would
+/// be the larger at the root (possible only when its c is larger: c_o ≤ c_c and τ_o ≥ τ_c give
+/// c_o(w − τ_o) ≤ c_c(w − τ_c) wherever the former is positive), [`godunov_newton`] decides.
+/// None when every side is missing.
 #[inline(always)]
-pub fn godunov_closed_form<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> Option<f64> {
+pub fn godunov_closed_form<const D: usize>(sides: &[[Side; 2]; D], num: f64, den: f64) -> Option<f64> {
     // per axis: (b/c, c, b) of the side that turns positive first
     let mut axes = [(f64::INFINITY, 1.0, f64::INFINITY); D];
+    let mut plus = [false; D];
     for k in 0..D {
         let [m, p] = sides[k];
-        let (tm, tp) = (m.b / m.c, p.b / p.c);
-        axes[k] = if tm <= tp { (tm, m.c, m.b) } else { (tp, p.c, p.b) };
+        plus[k] = p.b * m.c < m.b * p.c;
+        let s = if plus[k] { p } else { m };
+        axes[k] = (s.b / s.c, s.c, s.b);
     }
     sort_by_first(&mut axes);
     if !axes[0].0.is_finite() {
         return None;
     }
-    let target = sh * sh;
-    let (mut cc, mut cb, mut bb) = (0.0, 0.0, 0.0);
-    let mut w = f64::INFINITY;
-    for &(tau, c, b) in &axes {
-        if !(tau < w) {
+    let (_, c, b) = axes[0];
+    let (mut cc, mut cb, mut bb) = (c * c, c * b, b * b);
+    for m in 1..D {
+        let (tau, c, b) = axes[m];
+        let mut f = 0.0;
+        for &(_, cl, bl) in &axes[..m] {
+            let d = cl * tau - bl;
+            f += d * d;
+        }
+        if !(f * den < num) {
             break;
         }
         cc += c * c;
         cb += c * b;
         bb += b * b;
-        let disc = (cb * cb - cc * (bb - target)).max(0.0);
-        w = (cb + disc.sqrt()) / cc;
     }
+    let target = num / den;
+    let disc = (cb * cb - cc * (bb - target)).max(0.0);
+    let w = (cb + disc.sqrt()) * (1.0 / cc);
     // the sides not chosen must not be the larger at the root
     for k in 0..D {
         let [m, p] = sides[k];
-        let (vm, vp) = (m.c * w - m.b, p.c * w - p.b);
-        let (chosen, other) = if m.b / m.c <= p.b / p.c { (vm, vp) } else { (vp, vm) };
-        if other > chosen.max(0.0) {
-            return godunov_newton(sides, sh);
+        let (chosen, other) = if plus[k] { (p, m) } else { (m, p) };
+        if other.c > chosen.c && other.c * w - other.b > (chosen.c * w - chosen.b).max(0.0) {
+            return godunov_newton(sides, target.sqrt());
         }
     }
     Some(w)
@@ -351,7 +381,7 @@ mod tests {
                     }
                 }
             }
-            let a = godunov_closed_form(&sides, h);
+            let a = godunov_closed_form(&sides, h * h, 1.0);
             let b = godunov_newton(&sides, h);
             match (a, b) {
                 (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-13, "{a} {b} {sides:?}"),
@@ -361,15 +391,14 @@ mod tests {
     }
 
     /// The neighbours of one side, w = u (no factoring), without a third neighbour.
-    fn up(u1: f64, u2: f64, w2: f64) -> Upwind {
+    fn up(w1: f64, w2: f64) -> Upwind {
         Upwind {
-            u1,
-            w1: u1,
-            u2,
+            w1,
             w2,
-            u3: f64::NAN,
             w3: f64::NAN,
             w0: f64::NAN,
+            d1: w1 - w2,
+            d2: f64::NAN,
         }
     }
 
@@ -397,33 +426,24 @@ mod tests {
         let h = 0.1;
         let e = 1.0 / (h * h);
         let f = |x: f64| x * x;
-        let s = reconstruct(&up(f(0.2), f(0.1), f(0.1)), 0.0, h, e, true, true);
+        let s = reconstruct(&up(f(0.2), f(0.1)), 0.0, h, e, true, true);
         assert!(((s.c * f(0.3) - s.b) / h - 0.6).abs() < 1e-12);
         // the ramp: a side that is not upwind (u2 > u1) is first order
-        let s = reconstruct(&up(0.2, 0.3, 0.3), 0.0, h, e, true, true);
+        let s = reconstruct(&up(0.2, 0.3), 0.0, h, e, true, true);
         assert_eq!((s.c, s.b), (1.0, 0.2));
         // and so is a side whose second neighbour is missing (NaN), or the first-order phase
         assert_eq!(
-            reconstruct(&up(0.2, f64::NAN, f64::NAN), 0.0, h, e, true, true),
+            reconstruct(&up(0.2, f64::NAN), 0.0, h, e, true, true),
             Side { c: 1.0, b: 0.2 }
         );
         assert_eq!(
-            reconstruct(&up(0.2, 0.1, f64::NAN), 0.0, h, e, true, false),
+            reconstruct(&up(0.2, 0.1), 0.0, h, e, true, false),
             Side { c: 1.0, b: 0.2 }
         );
-        // the factored part: u = u0 = x (w = 0) gives the difference 1 from either side
-        let s = reconstruct(
-            &Upwind {
-                w1: 0.0,
-                w2: 0.0,
-                ..up(0.2, 0.1, 0.0)
-            },
-            1.0,
-            h,
-            e,
-            true,
-            true,
-        );
+        // the factored part: u = u0 = x (w = 0, u rising towards the node by Δx > ε) gives
+        // the difference 1, at BDF2
+        let s = reconstruct(&Upwind { d1: h, ..up(0.0, 0.0) }, 1.0, h, e, true, true);
+        assert_eq!(s.c, 1.5);
         assert!(((s.c * 0.0 - s.b) / h - 1.0).abs() < 1e-12);
     }
 
@@ -435,19 +455,18 @@ mod tests {
         let e = 1.0 / (h * h);
         let f = |x: f64| x + 0.25 * x * x * x;
         let side = Upwind {
-            u1: f(0.2),
             w1: f(0.2),
-            u2: f(0.1),
             w2: f(0.1),
-            u3: f(0.0),
             w3: f(0.0),
             w0: f(0.3),
+            d1: f(0.2) - f(0.1),
+            d2: f(0.1) - f(0.0),
         };
         let exact = 1.0 + 0.75 * 0.09;
         let s = reconstruct(&side, 0.0, h, e, true, true);
         assert!(((s.c * f(0.3) - s.b) / h - exact).abs() < 1e-12);
         assert!((s.c - 11.0 / 6.0).abs() < 1e-15);
-        let bdf2 = reconstruct(&Upwind { u3: f64::NAN, ..side }, 0.0, h, e, true, true);
+        let bdf2 = reconstruct(&Upwind { d2: f64::NAN, ..side }, 0.0, h, e, true, true);
         assert!(((bdf2.c * f(0.3) - bdf2.b) / h - exact).abs() > 1e-3);
         // a kink: the second differences of w disagree by more than 2ε: BDF2 again
         let kinked = Upwind {

@@ -32,7 +32,7 @@ use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 
 use super::factoring::Factoring;
 use super::geometry::{NodeGeometry, TubeGeometry};
-use super::local::{corrected_slowness, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
+use super::local::{corrected_slowness_squared, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
 use super::pipeline::Pipeline;
 
 /// Stopping rules of the two phases.
@@ -156,6 +156,8 @@ struct Sweeper<'a, const D: usize> {
     ramp_scale: f64,
     /// 1/ε for a constant slowness.
     ramp_constant: f64,
+    /// 1/σ for a constant slowness.
+    inv_sigma_constant: f64,
     extension_limit: f64,
 }
 
@@ -168,73 +170,86 @@ impl<const D: usize> Sweeper<'_, D> {
         }
     }
 
-    /// The inner-tube update at node `i` (u, not w), None when no side is known yet.
+    /// The inner-tube update at node `i`: its new w, None when no side is known yet. The sweeps
+    /// hold w = u − u₀ (see [`sweep_second_order`]); u = w + u₀ at a neighbour feeds the ramps
+    /// and the metric's direction.
+    ///
+    /// A side is reconstructed at second order ([`reconstruct`]) only where it is upwind of the
+    /// node's current value (u1 < uᵢ, or the node not reached): a side with u1 ≥ uᵢ is not taken
+    /// by the Godunov update at a root ≤ uᵢ at first order nor at second (its BDF2 difference
+    /// (3/2)(u − u1) − (1/2)(u1 − u2) is then below its first-order one u − u1 ≤ 0; BDF3 is off
+    /// there), so the fixed points are the same; only a value on its way up takes such a side at
+    /// first order for one update. On the sphere at N = 201 that leaves out the second and third
+    /// neighbours of about a third of the sides, with the same errors to three digits.
     #[inline(always)]
-    fn inner(&self, u: &SharedValues<'_>, i: usize, k_inner: usize, second: bool) -> Option<f64> {
+    fn inner(&self, w: &SharedValues<'_>, i: usize, k_inner: usize, second: bool) -> Option<f64> {
         let table = self.table;
         let sentinel = table.sentinel();
-        // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives
-        let nb = unsafe { table.neighbours_of_unchecked(i) };
         let h = self.spacing;
         let mut sides = [[Side::MISSING; 2]; D];
         let mut grad = [0.0; D];
-        let ui = u.get(i);
+        let wi = w.get(i);
+        // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives;
+        // u₀ has one value per node
+        let u0 = |j: usize| unsafe { *self.u0.get_unchecked(j) };
+        let ui = wi + u0(i);
         let sigma = self.sigma(i);
-        let inv_eps = match self.slowness {
-            Slowness::Constant(_) => self.ramp_constant,
-            Slowness::PerNode(_) => self.ramp_scale / sigma,
+        let (inv_eps, inv_sigma) = match self.slowness {
+            Slowness::Constant(_) => (self.ramp_constant, self.inv_sigma_constant),
+            Slowness::PerNode(_) => (self.ramp_scale / sigma, 1.0 / sigma),
         };
         // SAFETY: `k_inner` counts the nodes before `i` not in the extension layer, fewer than
-        // the inner geometries and ∇u₀'s (checked equal to that count); u₀ has one value per node
+        // the inner geometries and ∇u₀'s (checked equal to that count)
         let (geometry, grad_u0) = unsafe {
             (
                 self.geometry.get_unchecked(k_inner),
                 self.grad_u0.get_unchecked(k_inner),
             )
         };
-        let w0 = ui - unsafe { *self.u0.get_unchecked(i) };
         for k in 0..D {
             let du0 = grad_u0[k] as f64 * self.grad_u0_unit;
             let mut near = [f64::NAN; 2];
             for side in 0..2 {
-                let j1 = nb[k][side];
+                let j1 = unsafe { table.neighbour_unchecked(i, k, side) };
                 if j1 == sentinel {
                     continue;
                 }
                 let j1 = j1 as usize;
-                let u1 = u.get(j1);
-                if !u1.is_finite() {
+                let w1 = w.get(j1);
+                if !w1.is_finite() {
                     continue;
                 }
+                let u1 = w1 + u0(j1);
                 near[side] = u1;
                 let mut up = Upwind {
-                    u1,
-                    w1: u1 - unsafe { *self.u0.get_unchecked(j1) },
-                    u2: f64::NAN,
+                    w1,
                     w2: f64::NAN,
-                    u3: f64::NAN,
                     w3: f64::NAN,
-                    w0,
+                    w0: wi,
+                    d1: f64::NAN,
+                    d2: f64::NAN,
                 };
-                if second {
-                    let j2 = unsafe { table.neighbours_of_unchecked(j1) }[k][side];
+                let upwind = second && u1 < ui;
+                if upwind {
+                    let j2 = unsafe { table.neighbour_unchecked(j1, k, side) };
                     if j2 != sentinel {
-                        up.u2 = u.get(j2 as usize);
-                        up.w2 = up.u2 - unsafe { *self.u0.get_unchecked(j2 as usize) };
+                        let j2 = j2 as usize;
+                        up.w2 = w.get(j2);
+                        let u2 = up.w2 + u0(j2);
+                        up.d1 = u1 - u2;
                         // the third neighbour only where the BDF3 ramp can open: an upwind run
-                        // (u2 < u1) on an upwind side (u1 < the node's value, which is reached:
-                        // the kink test needs it; the downwind side, which the Godunov update
-                        // does not take, stays BDF2)
-                        if u1 > up.u2 && u1 < ui && ui.is_finite() {
-                            let j3 = unsafe { table.neighbours_of_unchecked(j2 as usize) }[k][side];
+                        // (u2 < u1), the node reached (the kink test needs its value)
+                        if u1 > u2 && ui.is_finite() {
+                            let j3 = unsafe { table.neighbour_unchecked(j2, k, side) };
                             if j3 != sentinel {
-                                up.u3 = u.get(j3 as usize);
-                                up.w3 = up.u3 - unsafe { *self.u0.get_unchecked(j3 as usize) };
+                                let j3 = j3 as usize;
+                                up.w3 = w.get(j3);
+                                up.d2 = u2 - (up.w3 + u0(j3));
                             }
                         }
                     }
                 }
-                sides[k][side] = reconstruct(&up, du0, h, inv_eps, side == 0, second);
+                sides[k][side] = reconstruct(&up, du0, h, inv_eps, side == 0, upwind);
             }
             // the direction of ∇u for the metric: central differences, one-sided at a gap
             grad[k] = match (near[0].is_finite(), near[1].is_finite()) {
@@ -244,20 +259,20 @@ impl<const D: usize> Sweeper<'_, D> {
                 _ => 0.0,
             };
         }
-        let s = corrected_slowness::<D>(geometry, grad, sigma);
-        let w = if second {
-            godunov_closed_form(&sides, s * h)
+        let (num, den) = corrected_slowness_squared::<D>(geometry, grad, sigma, inv_sigma);
+        if second {
+            godunov_closed_form(&sides, num * (h * h), den)
         } else {
-            godunov_first_order(&sides, s * h)
-        }?;
-        Some(unsafe { *self.u0.get_unchecked(i) } + w)
+            godunov_first_order(&sides, (num / den).sqrt() * h)
+        }
     }
 
     /// The extension update at layer node `i`: per axis along which the outward direction
     /// sgn(φ) n has a component, the neighbour towards the surface, used only if it is in the band
     /// and has strictly smaller |φ| (so that no two layer nodes wait on each other); BDF2
     /// (weight 1.5|n_k|) when the next one along is there too, else first order (|n_k|).
-    /// None while a used neighbour is not reached, or when no neighbour qualifies.
+    /// None while a used neighbour is not reached, or when no neighbour qualifies. Like
+    /// [`Self::inner`], on w and returning the new w.
     ///
     /// The BDF2 correction is limited like the inner sides' (`reconstruct`): with δ = w₁ − w₂ and
     /// L = `extension_limit`·σΔx, t = clip(2 − |δ|/L, 0, 1) ramps from BDF2 (t = 1, |δ| ≤ L) to
@@ -267,7 +282,7 @@ impl<const D: usize> Sweeper<'_, D> {
     /// (4w₁ − w₂)/3 (gain 5/3), read back by the inner nodes' distance-2 stencils, ran away:
     /// the sphere at N = 101 from a first phase stopped at 64Δx² went to −1e11.
     #[inline(always)]
-    fn outer(&self, u: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
+    fn outer(&self, w: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
         let table = self.table;
         let sentinel = table.sentinel();
         // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives
@@ -292,19 +307,17 @@ impl<const D: usize> Sweeper<'_, D> {
             if !(phi1 < abs_phi) {
                 continue;
             }
-            let u1 = u.get(j1);
-            if !u1.is_finite() {
+            let w1 = w.get(j1);
+            if !w1.is_finite() {
                 return None;
             }
-            let w1 = u1 - self.u0[j1];
             let weight = nk.abs() as f64;
             if second {
                 let j2 = unsafe { table.neighbours_of_unchecked(j1) }[k][side];
                 if j2 != sentinel {
                     let j2 = j2 as usize;
-                    let u2 = u.get(j2);
-                    if u2.is_finite() && self.abs_phi[j2] < phi1 {
-                        let w2 = u2 - self.u0[j2];
+                    let w2 = w.get(j2);
+                    if w2.is_finite() && self.abs_phi[j2] < phi1 {
                         let t = (2.0 - (w1 - w2).abs() / limit).clamp(0.0, 1.0);
                         if t >= 1.0 {
                             num += 1.5 * weight * (4.0 * w1 - w2) / 3.0;
@@ -324,18 +337,26 @@ impl<const D: usize> Sweeper<'_, D> {
             den += weight;
         }
         if den > 0.0 {
-            Some(self.u0[i] + num / den)
+            Some(num / den)
         } else {
             None
         }
     }
 
+    /// u = u₀ + w at node `i` (the window, the front and the rows' lower bounds are in u).
+    #[inline(always)]
+    fn u_at(&self, w: &SharedValues<'_>, i: usize) -> f64 {
+        // SAFETY: `i` is a band node, and u₀ has one value per node
+        w.get(i) + unsafe { *self.u0.get_unchecked(i) }
+    }
+
     /// Updates node `i` if it is active and its value lies within the window; records the change.
+    /// `w` holds w = u − u₀; the window, `waiting` and `front` are in u.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn visit(
         &self,
-        u: &SharedValues<'_>,
+        w: &SharedValues<'_>,
         active: &[AtomicU8],
         i: usize,
         k_inner: usize,
@@ -345,38 +366,40 @@ impl<const D: usize> Sweeper<'_, D> {
         if active[i].load(Ordering::Relaxed) == 0 {
             return 0;
         }
-        let old = u.get(i);
-        if old > lim.window && old.is_finite() {
+        let old = w.get(i);
+        // SAFETY: u₀ has one value per node
+        let u0 = unsafe { *self.u0.get_unchecked(i) };
+        if old + u0 > lim.window && old.is_finite() {
             // beyond the window: stays active for a later iteration
-            change.waiting = change.waiting.min(old);
+            change.waiting = change.waiting.min(old + u0);
             return KEEP;
         }
         active[i].store(0, Ordering::Relaxed);
         let new = match self.roles[i] {
             NodeRole::Fixed => return 0,
-            NodeRole::Inner => self.inner(u, i, k_inner, lim.second),
-            NodeRole::Outer => self.outer(u, i, lim.second),
+            NodeRole::Inner => self.inner(w, i, k_inner, lim.second),
+            NodeRole::Outer => self.outer(w, i, lim.second),
         };
         change.updates += 1;
         let Some(new) = new else { return 0 };
         if new == old || (lim.decreases_only && !(new < old)) || !new.is_finite() {
             return 0;
         }
-        if new > lim.window && !old.is_finite() {
+        if new + u0 > lim.window && !old.is_finite() {
             // reached, but beyond the window: not taken yet
             active[i].store(1, Ordering::Relaxed);
-            change.waiting = change.waiting.min(new);
+            change.waiting = change.waiting.min(new + u0);
             return KEEP;
         }
-        u.set(i, new);
+        w.set(i, new);
         let c = if old.is_finite() {
             (new - old).abs()
         } else {
             f64::INFINITY
         };
         change.max_change = change.max_change.max(c);
-        if c > lim.settled && new < change.front {
-            change.front = new;
+        if c > lim.settled && new + u0 < change.front {
+            change.front = new + u0;
         }
         if c > lim.threshold {
             self.activate(active, i);
@@ -492,6 +515,10 @@ pub fn sweep_second_order<const D: usize>(
             Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
             Slowness::PerNode(_) => f64::NAN,
         },
+        inv_sigma_constant: match slowness {
+            Slowness::Constant(s) => 1.0 / s,
+            Slowness::PerNode(_) => f64::NAN,
+        },
         abs_phi,
         extension_limit: options.extension_limit,
     };
@@ -522,7 +549,18 @@ pub fn sweep_second_order<const D: usize>(
         0.0
     };
     let active: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
+    // the sweeps hold w = u − u₀ (the extension update reads no u₀, the inner one only to form u
+    // for its ramps and the metric); the fixed nodes' given values are put back as they were
+    let fixed_values: Vec<(usize, f64)> = roles
+        .iter()
+        .enumerate()
+        .filter(|(_, &r)| r == NodeRole::Fixed)
+        .map(|(i, _)| (i, values[i]))
+        .collect();
     let mut pipeline = Pipeline::new(band, options.threads)?;
+    for (v, &u0) in values.iter_mut().zip(sw.u0) {
+        *v -= u0;
+    }
     let mut stats = SecondOrderStats {
         last_change: f64::INFINITY,
         ..Default::default()
@@ -551,35 +589,47 @@ pub fn sweep_second_order<const D: usize>(
                 control,
             )
         };
-    if options.own_first_phase && options.tol_first.is_finite() {
-        let lim = Limits::first_order(options.tol_first);
-        phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
-        stats.first_order_iterations = iteration;
-    }
-    let lim = Limits {
-        second: true,
-        decreases_only: false,
-        threshold: options.tol,
-        window: f64::INFINITY,
-        settled: options.tol,
-        floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
-    };
-    let before = iteration;
-    stats.converged = phase(values, lim, options.window_second * unit, &mut iteration, &mut stats)?;
-    stats.second_order_iterations = iteration - before;
-    if stats.runaway_iteration.is_some() {
-        // the second-order iterate is lost: the first phase again, from the sources (monotone,
-        // so it converges), to the second phase's tolerance: its first-order values are the result
-        for (v, &r) in values.iter_mut().zip(roles) {
-            if r != NodeRole::Fixed {
-                *v = f64::INFINITY;
-            }
+    // the phases; w back to u whatever their outcome (an interrupted solve's values included)
+    let mut phases = || -> Result<()> {
+        if options.own_first_phase && options.tol_first.is_finite() {
+            let lim = Limits::first_order(options.tol_first);
+            phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
+            stats.first_order_iterations = iteration;
         }
-        let lim = Limits::first_order(options.tol.min(options.tol_first));
+        let lim = Limits {
+            second: true,
+            decreases_only: false,
+            threshold: options.tol,
+            window: f64::INFINITY,
+            settled: options.tol,
+            floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
+        };
         let before = iteration;
-        stats.converged = phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
-        stats.first_order_iterations += iteration - before;
+        stats.converged = phase(values, lim, options.window_second * unit, &mut iteration, &mut stats)?;
+        stats.second_order_iterations = iteration - before;
+        if stats.runaway_iteration.is_some() {
+            // the second-order iterate is lost: the first phase again, from the sources (monotone,
+            // so it converges), to the second phase's tolerance: its first-order values are the result
+            for (v, &r) in values.iter_mut().zip(roles) {
+                if r != NodeRole::Fixed {
+                    *v = f64::INFINITY;
+                }
+            }
+            let lim = Limits::first_order(options.tol.min(options.tol_first));
+            let before = iteration;
+            stats.converged = phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
+            stats.first_order_iterations += iteration - before;
+        }
+        Ok(())
+    };
+    let outcome = phases();
+    for (v, &u0) in values.iter_mut().zip(sw.u0) {
+        *v += u0;
     }
+    for (i, v) in fixed_values {
+        values[i] = v;
+    }
+    outcome?;
     stats.unreached = values
         .iter()
         .zip(roles)
@@ -616,13 +666,14 @@ fn run_phase<const D: usize>(
     if window_width > 0.0 {
         let first = values
             .iter()
+            .zip(sw.u0)
             .zip(sw.roles)
             .filter(|(_, &r)| r == NodeRole::Fixed)
-            .map(|(&v, _)| v)
+            .map(|((&w, &u0), _)| w + u0)
             .fold(f64::INFINITY, f64::min);
         lim.window = first + window_width;
     }
-    let rows_state = RowsState::new(band, values);
+    let rows_state = RowsState::new(band, values, sw.u0);
     let shared = SharedValues::new(values);
     let mut history: Vec<f64> = Vec::new();
     let mut unmoved = 0usize;
@@ -651,13 +702,13 @@ fn run_phase<const D: usize>(
                     for (i, &role) in (s..e).zip(roles).rev() {
                         k -= (role != NodeRole::Outer) as usize;
                         status |= sw.visit(&shared, active, i, k, lim_now, &mut acc);
-                        low = low.min(shared.get(i));
+                        low = low.min(sw.u_at(&shared, i));
                     }
                 } else {
                     let mut k = row_inner[r] as usize;
                     for (i, &role) in (s..e).zip(roles) {
                         status |= sw.visit(&shared, active, i, k, lim_now, &mut acc);
-                        low = low.min(shared.get(i));
+                        low = low.min(sw.u_at(&shared, i));
                         k += (role != NodeRole::Outer) as usize;
                     }
                 }
@@ -733,12 +784,16 @@ struct RowsState {
 }
 
 impl RowsState {
-    fn new<const D: usize>(band: &NarrowBand<D>, values: &[f64]) -> Self {
+    /// `values`: w, and u₀, per node (the lower bounds are of u = u₀ + w).
+    fn new<const D: usize>(band: &NarrowBand<D>, values: &[f64], u0: &[f64]) -> Self {
         let rows = band.n_rows();
         let low = (0..rows)
             .map(|r| {
                 let (s, e) = band.row_range(r);
-                let m = values[s..e].iter().fold(f64::INFINITY, |m, &v| m.min(v));
+                let m = values[s..e]
+                    .iter()
+                    .zip(&u0[s..e])
+                    .fold(f64::INFINITY, |m, (&w, &u0)| m.min(w + u0));
                 std::sync::atomic::AtomicU64::new(m.to_bits())
             })
             .collect();
