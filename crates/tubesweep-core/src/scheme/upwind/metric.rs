@@ -162,26 +162,35 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         if M == 1 {
             return (STRICT || sh * sh < below * below * sk[0][0]).then(|| sh / sk[0][0].sqrt());
         }
-        let mut c = [[0.0; M]; M];
-        let (mut a, mut b, mut cc) = (0.0, 0.0, -sh * sh);
-        for i in 0..M {
-            for j in 0..M {
-                c[i][j] = sg[i] * sg[j] * sk[i][j];
-                a += c[i][j];
-                b += c[i][j] * w[j];
-                cc += c[i][j] * w[i] * w[j];
-            }
-        }
+        // C_ij = σ_i σ_j S_ij (σ_i² = 1: the diagonal as it is); its row sums r = C 1 and z = C w
+        // give A = Σ r, B = Σ z, C = w·z − s²h² and the causality weights (C (t − w))_i = t r_i − z_i:
+        // sums of M terms, not of M² (a shorter chain, and other rounding than the sums over i, j)
+        let c: [[f64; M]; M] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| if i == j { sk[i][i] } else { sg[i] * sg[j] * sk[i][j] })
+        });
+        let r: [f64; M] = core::array::from_fn(|i| tree_sum::<M>(core::array::from_fn(|j| c[i][j])));
+        let z: [f64; M] = core::array::from_fn(|i| tree_sum::<M>(core::array::from_fn(|j| c[i][j] * w[j])));
+        let a = tree_sum::<M>(r);
         if !(a > 0.0) {
             return None;
         }
-        // the causality weights (C (t − w))_i sum to a t − b
+        let b = tree_sum::<M>(z);
+        let cc = tree_sum::<M>(core::array::from_fn(|i| w[i] * z[i])) - sh * sh;
+        // the causality weights sum to a t − b
         let t = larger_root::<STRICT>(a, b, cc, below)?;
         let floor = weight_floor::<STRICT>(a * t - b);
-        let causal = (0..M).fold(true, |ok, i| {
-            ok & ((0..M).map(|j| c[i][j] * (t - w[j])).sum::<f64>() >= floor)
-        });
+        let causal = (0..M).fold(true, |ok, i| ok & (t * r[i] - z[i] >= floor));
         causal.then_some(t)
+    }
+}
+
+/// The sum of `M ≤ 3` terms, left to right (the quadratic's sums each have `M` terms, not `M²`).
+#[inline(always)]
+fn tree_sum<const M: usize>(x: [f64; M]) -> f64 {
+    match M {
+        1 => x[0],
+        2 => x[0] + x[1],
+        _ => x.iter().skip(2).fold(x[0] + x[1], |s, v| s + v),
     }
 }
 
