@@ -43,12 +43,24 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         core::array::from_fn(|k| (0..D).map(|l| self.m[k][l] * p[l]).sum())
     }
 
-    /// `q* = −(M_off,K · P) / M_off,off`.
+    /// `q* = −(M_off,K · P) / M_off,off` for one axis off the face; for two (`a < b`, the face a
+    /// vertex `k`) the 2×2 system `M_⊥⊥ q* = −M_⊥k P_k` by Cramer's rule.
     #[inline(always)]
-    fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
-        let r = &self.m[off];
+    fn complete(&self, p: [f64; D], off: u32) -> [f64; D] {
+        let m = &self.m;
         let mut out = p;
-        out[off] = -(0..D).filter(|&k| k != off).map(|k| r[k] * p[k]).sum::<f64>() / r[off];
+        if off.count_ones() == 1 {
+            let j = off.trailing_zeros() as usize;
+            let r = &m[j];
+            out[j] = -(0..D).filter(|&k| k != j).map(|k| r[k] * p[k]).sum::<f64>() / r[j];
+        } else if D == 3 {
+            let k = (7 & !off).trailing_zeros() as usize;
+            let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+            let (ra, rb) = (m[a][k] * p[k], m[b][k] * p[k]);
+            let det = m[a][a] * m[b][b] - m[a][b] * m[b][a];
+            out[a] = -(m[b][b] * ra - m[a][b] * rb) / det;
+            out[b] = -(m[a][a] * rb - m[b][a] * ra) / det;
+        }
         out
     }
 

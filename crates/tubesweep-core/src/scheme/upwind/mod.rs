@@ -46,13 +46,15 @@
 //! characteristic comes from (by the central differences) is solved, and when its critical point
 //! lies strictly inside it a duality bound proves, with `D` comparisons (and in concave places a
 //! few evaluations of `G`), that no other face does better — one quadratic and one square root,
-//! as the three-term branch of Eq. (3). Otherwise the minimum is searched with the node's current
-//! value `old` as the bound (the sweep keeps the smaller value anyway): the other orthants' full
-//! faces first, then the faces not yet ruled out by increasing dimension, and a face is skipped,
-//! before anything is solved, when its smallest vertex value plus `h s_lo / sqrt(m)` (a lower
-//! bound of `φ` over the face, `s_lo` the node's least travel time per unit length) is not below
-//! the best value so far, or when its mirror on some axis is provably no worse. Skipping is
-//! exact: it never changes the result.
+//! as the three-term branch of Eq. (3). When that simplex has no critical point inside, its faces
+//! and then (in 3D) its vertex on the axis the characteristic is most nearly along are tried and
+//! proved the same way ([`natural_faces`]: Eq. (3)'s two- and one-term branches). Otherwise the
+//! minimum is searched with the node's current value `old` as the bound (the sweep keeps the
+//! smaller value anyway): the other orthants' full faces first, then the faces not yet ruled out
+//! by increasing dimension, and a face is skipped, before anything is solved, when its smallest
+//! vertex value plus `h s_lo / sqrt(m)` (a lower bound of `φ` over the face, `s_lo` the node's
+//! least travel time per unit length) is not below the best value so far, or when its mirror on
+//! some axis is provably no worse. Skipping is exact: it never changes the result.
 
 mod builtin;
 pub mod metric;
@@ -112,10 +114,11 @@ pub(crate) trait Faces<const D: usize> {
         }
         true
     }
-    /// The full gradient `(P, q*)` of a solution on the face of the `D − 1` axes other than
-    /// `off`: `P` (given in place, `p[off]` ignored) and the off-face component `q*` that
-    /// minimises `G(P + q e_off)` (the projection of [`Faces::project`]), so that `G = 1` there.
-    fn complete(&self, p: [f64; D], off: usize) -> [f64; D];
+    /// The full gradient `(P, q*)` of a solution on the face of the axes not in the bit mask
+    /// `off` (one or two axes, not all): `P` (given in place, `p`'s components on `off` ignored)
+    /// and the off-face components `q*` that minimise `G(P + q)` (the projection of
+    /// [`Faces::project`]), so that `G = 1` there.
+    fn complete(&self, p: [f64; D], off: u32) -> [f64; D];
     /// `τ_k`, per axis and side, bounding how much the travel time `φ(d)` can grow when the
     /// component `d_k` of a displacement towards the node from that side's neighbour is mirrored
     /// (pointed from the other neighbour): `φ(d') − φ(d) ≤ τ_k |d_k|` (0 where `φ` is even in
@@ -316,12 +319,10 @@ fn moved_inside<const D: usize, F: Faces<D>>(
 /// The fast path's second chance, when the natural orthant's simplex has no critical point
 /// inside it (the characteristic runs along one of its faces, as along a symmetry plane or
 /// where one axis is nearly across the characteristic): its faces of dimension `D − 2`, the
-/// simplices of `D − 1` of its neighbours, each solved until one is proved as in
-/// [`natural_orthant`], with the full gradient `(P, q*)` of the face ([`Faces::complete`],
-/// `G = 1`): the two neighbours on the face's missing axis must give `c ≥ μ + η`, and the other
-/// sides of its own axes too, with `p` moved inwards where they fall short, as there. Every face is then at least `μ`, and the faces holding the minimiser
-/// (the face itself, and the two simplices around it, whose critical points have a negative
-/// weight on the missing axis) do not tie with it. `Some(μ)` when proved.
+/// simplices of `D − 1` of its neighbours, each solved until one is proved ([`prove_face`]);
+/// then, in 3D, its vertex on the axis the characteristic is most nearly along (where two axes
+/// are nearly across it, as on the great circle half-way round a sphere from a point source).
+/// `Some(μ)` when proved.
 #[inline(always)]
 fn natural_faces<const D: usize, F: Faces<D>>(
     faces: &F,
@@ -337,10 +338,13 @@ fn natural_faces<const D: usize, F: Faces<D>>(
     // the face without the axis the characteristic is most nearly across (the smallest velocity
     // component at the central differences) first: on a symmetry plane, the one that proves
     let vel = faces.velocity(core::array::from_fn(|k| nb[k][1] - nb[k][0]));
-    let mut first = 0;
+    let (mut first, mut along) = (0, 0);
     for k in 1..D {
         if vel[k].abs() < vel[first].abs() {
             first = k;
+        }
+        if vel[k].abs() > vel[along].abs() {
+            along = k;
         }
     }
     for i in 0..D {
@@ -349,44 +353,71 @@ fn natural_faces<const D: usize, F: Faces<D>>(
             _ if i <= first => i - 1,
             _ => i,
         };
-        let mask = full & !(1 << off);
-        let pk = faces.project(mask)?;
         // the face's axes in increasing order, M = D − 1 of them
-        let solved = match D {
-            2 => face_value::<D, 1, F>(faces, &pk, nb, o, mask, h),
-            _ => face_value::<D, 2, F>(faces, &pk, nb, o, mask, h),
+        let proved = match D {
+            2 => prove_face::<D, 1, F>(faces, nb, o, full & !(1 << off), h, best)?,
+            _ => prove_face::<D, 2, F>(faces, nb, o, full & !(1 << off), h, best)?,
         };
-        let Some(mu) = solved else { continue };
-        if mu < *best {
-            *best = mu;
-        }
-        let eta = 1e-11 * mu.abs();
-        let inv_h = 1.0 / h;
-        let p: [f64; D] = core::array::from_fn(|k| {
-            let side = o >> k & 1;
-            (side_sign(side)) * (mu - nb[k][side]) * inv_h
-        });
-        let p = faces.complete(p, off);
-        if !(nb[off][0] + h * p[off] >= mu + eta && nb[off][1] - h * p[off] >= mu + eta) {
-            continue;
-        }
-        // the other sides of the face's own axes, as in `natural_orthant`
-        let mut deficit = [0.0; D];
-        let mut def = 0usize;
-        for k in 0..D {
-            let side = o >> k & 1;
-            let d = 2.0 * mu + eta - nb[k][1 - side] - nb[k][side];
-            if k != off && d > 0.0 {
-                deficit[k] = d;
-                def |= 1 << k;
-            }
-        }
-        let sg: [f64; D] = core::array::from_fn(|k| side_sign(o >> k & 1));
-        if def == 0 || moved_inside(faces, p, &deficit, def, &sg, inv_h) {
-            return Some(mu);
+        if proved.is_some() {
+            return proved;
         }
     }
+    if D == 3 {
+        return prove_face::<D, 1, F>(faces, nb, o, 1 << along, h, best)?;
+    }
     None
+}
+
+/// The face of orthant `o` on the axes of `mask` (`M` of them), proved as in
+/// [`natural_orthant`] with the full gradient `(P, q*)` of the face ([`Faces::complete`],
+/// `G = 1`): the two neighbours on each axis off the face must give `c ≥ μ + η`, and the other
+/// sides of its own axes too, with `p` moved inwards where they fall short, as there. Every face
+/// is then at least `μ`, and the faces holding the minimiser (the face itself, and the simplices
+/// around it, whose critical points have a negative weight on an axis off it) do not tie with
+/// it. `None` when the face has no projection (no face has a solution), `Some(Some(μ))` when
+/// proved (`best` lowered to `μ` whenever the face has a value).
+#[inline(always)]
+fn prove_face<const D: usize, const M: usize, F: Faces<D>>(
+    faces: &F,
+    nb: &[[f64; 2]; D],
+    o: usize,
+    mask: u32,
+    h: f64,
+    best: &mut f64,
+) -> Option<Option<f64>> {
+    let pk = faces.project(mask)?;
+    let Some(mu) = face_value::<D, M, F>(faces, &pk, nb, o, mask, h) else {
+        return Some(None);
+    };
+    if mu < *best {
+        *best = mu;
+    }
+    let eta = 1e-11 * mu.abs();
+    let inv_h = 1.0 / h;
+    let p: [f64; D] = core::array::from_fn(|k| {
+        let side = o >> k & 1;
+        (side_sign(side)) * (mu - nb[k][side]) * inv_h
+    });
+    let full = (1u32 << D) - 1;
+    let p = faces.complete(p, full & !mask);
+    for k in 0..D {
+        if mask >> k & 1 == 0 && !(nb[k][0] + h * p[k] >= mu + eta && nb[k][1] - h * p[k] >= mu + eta) {
+            return Some(None);
+        }
+    }
+    // the other sides of the face's own axes, as in `natural_orthant`
+    let mut deficit = [0.0; D];
+    let mut def = 0usize;
+    for k in 0..D {
+        let side = o >> k & 1;
+        let d = 2.0 * mu + eta - nb[k][1 - side] - nb[k][side];
+        if mask >> k & 1 == 1 && d > 0.0 {
+            deficit[k] = d;
+            def |= 1 << k;
+        }
+    }
+    let sg: [f64; D] = core::array::from_fn(|k| side_sign(o >> k & 1));
+    Some((def == 0 || moved_inside(faces, p, &deficit, def, &sg, inv_h)).then_some(mu))
 }
 
 /// The value on the face of orthant `o` spanning the axes of `mask` (`M` of them), if its

@@ -76,14 +76,15 @@ impl<const D: usize> Faces<D> for Randers<D> {
         o
     }
 
-    /// `q* = −v_off |P| / F_K`, `F_K = sqrt(F² − v_off²)` (see the projection above).
+    /// `q* = −v_off |P| / F_K`, `F_K = sqrt(F² − |v_off|²)` (see the projection above).
     #[inline(always)]
-    fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
-        let n2: f64 = (0..D).filter(|&k| k != off).map(|k| p[k] * p[k]).sum();
-        let fk2 = self.f2 - self.v[off] * self.v[off];
-        let mut out = p;
-        out[off] = -self.v[off] * (n2 / fk2).sqrt();
-        out
+    fn complete(&self, p: [f64; D], off: u32) -> [f64; D] {
+        let n2: f64 = (0..D).filter(|&k| off >> k & 1 == 0).map(|k| p[k] * p[k]).sum();
+        let fk2 = (0..D)
+            .filter(|&k| off >> k & 1 == 1)
+            .fold(self.f2, |a, k| a - self.v[k] * self.v[k]);
+        let scale = (n2 / fk2).sqrt();
+        core::array::from_fn(|k| if off >> k & 1 == 1 { -self.v[k] * scale } else { p[k] })
     }
 
     #[inline(always)]

@@ -18,7 +18,7 @@ impl<'a, const D: usize, F: Faces<D>> Faces<D> for NoPruning<'a, F> {
     fn inside(&self, _p: [f64; D]) -> bool {
         false
     }
-    fn complete(&self, p: [f64; D], off: usize) -> [f64; D] {
+    fn complete(&self, p: [f64; D], off: u32) -> [f64; D] {
         self.0.complete(p, off)
     }
     fn mirror_slack(&self) -> [[f64; 2]; D] {
@@ -195,6 +195,90 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
     assert!(
         fast * 2 > total,
         "the natural orthant's faces settled {fast} of {total}"
+    );
+}
+
+/// Characteristics along a coordinate axis (as half-way round a sphere from a point source), where
+/// neither the natural orthant's simplex nor its faces have a critical point inside and its vertex
+/// on that axis is tried.
+#[test]
+fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
+    let mut x = 0.1414_f64;
+    let mut r = move || {
+        x = (x * 997.0 + 0.1732).fract();
+        x
+    };
+    let h = 0.02;
+    let (mut fast, mut total) = (0, 0);
+    for i in 0..20000 {
+        let along = i % 3;
+        let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+        // convex across the axis (the value there rises both ways), either way along it
+        let bend: [f64; 3] = core::array::from_fn(|k| {
+            if k == along {
+                4.0 * (r() - 0.5) * h * h
+            } else {
+                (0.5 + 2.0 * r()) * h * h
+            }
+        });
+        let old = if i % 4 < 2 { 1e6 } else { 1.0 + 0.02 * (r() - 0.5) };
+        let nb = |q: [f64; 3]| -> ([f64; 3], [f64; 3]) {
+            (
+                core::array::from_fn(|k| 1.0 - q[k] * h + bend[k]),
+                core::array::from_fn(|k| 1.0 + q[k] * h + bend[k]),
+            )
+        };
+        // the flow along the axis too, so that the characteristic stays on it
+        let mut v = [0.0; 3];
+        v[along] = 0.8 * (r() - 0.5);
+        let f = 1.3;
+        let (minus, plus) = nb(core::array::from_fn(|k| {
+            if k == along {
+                sign / (f + sign * v[k])
+            } else {
+                0.0
+            }
+        }));
+        let randers = moving_medium::tests_faces(f, v);
+        let got = upwind_min(&randers, minus, plus, h, old);
+        assert_eq!(
+            got,
+            upwind_min(&NoPruning(&randers), minus, plus, h, old),
+            "moving medium"
+        );
+        let nbs: [[f64; 2]; 3] = core::array::from_fn(|k| [minus[k], plus[k]]);
+        let o0 = randers.upwind_orthant(core::array::from_fn(|k| plus[k] - minus[k]));
+        let mut b = f64::INFINITY;
+        fast += natural_faces(&randers, &nbs, o0, h, &mut b).is_some() as usize;
+        total += 1;
+        // a metric whose characteristic M p lies along the axis: p = M⁻¹ e_along, scaled
+        let q = [
+            [1.0 + r(), 0.3 * r(), -0.2 * r()],
+            [0.0, 0.5 + r(), 0.4 * r()],
+            [0.0, 0.0, 0.3 + r()],
+        ];
+        let m: [[f64; 3]; 3] =
+            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let (c0, c1) = ((along + 1) % 3, (along + 2) % 3);
+        // the column `along` of M⁻¹ (up to det M > 0): cofactors
+        let cof = |i: usize, j: usize| {
+            let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+            let (k0, k1) = ((j + 1) % 3, (j + 2) % 3);
+            m[r0][k0] * m[r1][k1] - m[r0][k1] * m[r1][k0]
+        };
+        let mut p = [0.0; 3];
+        for k in [along, c0, c1] {
+            p[k] = sign * cof(along, k);
+        }
+        let pmp: f64 = (0..3).map(|a| (0..3).map(|b| p[a] * m[a][b] * p[b]).sum::<f64>()).sum();
+        let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
+        let riem = metric::tests_faces(0.8, m);
+        let got = upwind_min(&riem, minus, plus, h, old);
+        assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+    }
+    assert!(
+        fast * 2 > total,
+        "the natural orthant's faces and vertex settled {fast} of {total}"
     );
 }
 
