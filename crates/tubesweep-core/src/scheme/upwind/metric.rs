@@ -73,27 +73,40 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         q <= r * r
     }
 
-    /// [`Faces::inside`] at the corners with the products `M_kl p_l` of both choices per axis
-    /// computed once (the same bits as at each corner alone).
+    /// [`Faces::inside`] at the corners, expanded about `p`: with `d = p − moved` (0 off `def`),
+    /// `q(S) = pᵀMp + Σ_{k∈S} d_k (d_k M_kk − g_k) + Σ_{k<l∈S} d_k d_l (M_kl + M_lk)`,
+    /// `g = (M + Mᵀ) p`; every corner evaluated (no branch on `def` or on the answers) and those
+    /// of `def` picked ([`super::SUBSETS_OF`]). The same answer as [`Faces::inside`] at each corner
+    /// but where `q` lies within rounding (~1e-15 of `s²`) of the bound `s²(1 − 1e-12)²`: either
+    /// answer is then a correct proof (the margin is 1e-12).
     #[inline(always)]
     fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
-        // both choices per axis, indexed by the corner's bit (a load, not a branch)
-        let pm: [[f64; 2]; D] = core::array::from_fn(|k| [p[k], moved[k]]);
-        let mp: [[[f64; 2]; D]; D] =
-            core::array::from_fn(|k| core::array::from_fn(|l| [self.m[k][l] * p[l], self.m[k][l] * moved[l]]));
+        let m = &self.m;
+        let d: [f64; D] = core::array::from_fn(|k| p[k] - moved[k]);
+        let g: [f64; D] = core::array::from_fn(|k| (0..D).map(|l| (m[k][l] + m[l][k]) * p[l]).sum::<f64>());
+        let q0 = 0.5 * (0..D).map(|k| p[k] * g[k]).sum::<f64>();
+        let e: [f64; D] = core::array::from_fn(|k| d[k] * (d[k] * m[k][k] - g[k]));
+        let c: [[f64; D]; D] = core::array::from_fn(|k| core::array::from_fn(|l| d[k] * d[l] * (m[k][l] + m[l][k])));
         let r = self.s * (1.0 - 1e-12);
-        let mut sub = def;
-        while sub != 0 {
-            let q: f64 = (0..D)
-                .map(|k| pm[k][sub >> k & 1] * (0..D).map(|l| mp[k][l][sub >> l & 1]).sum::<f64>())
-                .sum();
-            debug_assert_eq!(q <= r * r, self.inside(core::array::from_fn(|k| pm[k][sub >> k & 1])));
-            if !(q <= r * r) {
-                return false;
+        let lim = r * r - q0;
+        let mut fails = 0u32;
+        for sub in 1..(1usize << D) {
+            let mut q = 0.0;
+            for k in 0..D {
+                if sub >> k & 1 == 1 {
+                    q += e[k];
+                    for l in k + 1..D {
+                        if sub >> l & 1 == 1 {
+                            q += c[k][l];
+                        }
+                    }
+                }
             }
-            sub = (sub - 1) & def;
+            fails |= ((q > lim) as u32) << sub;
         }
-        true
+        let ok = fails & super::SUBSETS_OF[def] as u32 == 0;
+        debug_assert!(ok == self.exact_corners(p, moved, def) || self.near_the_bound(p, moved, def));
+        ok
     }
 
     /// `φ(d) = s sqrt(dᵀAd)`, `A = M⁻¹`, even. Mirroring `d_k` changes `dᵀAd` by
@@ -193,6 +206,37 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         let floor = weight_floor::<STRICT>(a * t - b);
         let causal = (0..M).fold(true, |ok, i| ok & (t * r[i] - z[i] >= floor));
         causal.then_some(t)
+    }
+}
+
+impl<const D: usize> Riemann<D> {
+    /// [`Faces::inside`] at every corner of `def` (the check of [`Faces::inside_corners`]).
+    fn exact_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
+        let mut sub = def;
+        let mut all = true;
+        while sub != 0 {
+            all &= self.inside(core::array::from_fn(
+                |k| if sub >> k & 1 == 1 { moved[k] } else { p[k] },
+            ));
+            sub = (sub - 1) & def;
+        }
+        all
+    }
+
+    /// Whether some corner's `pᵀMp` lies within 1e-14 `s²` of the bound of [`Faces::inside`].
+    fn near_the_bound(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
+        let r = self.s * (1.0 - 1e-12);
+        let mut sub = def;
+        let mut near = false;
+        while sub != 0 {
+            let x: [f64; D] = core::array::from_fn(|k| if sub >> k & 1 == 1 { moved[k] } else { p[k] });
+            let q: f64 = (0..D)
+                .map(|k| x[k] * (0..D).map(|l| self.m[k][l] * x[l]).sum::<f64>())
+                .sum();
+            near |= (q - r * r).abs() <= 1e-14 * self.s * self.s;
+            sub = (sub - 1) & def;
+        }
+        near
     }
 }
 

@@ -175,6 +175,25 @@ const CONTAINING_ORTHANTS: [[u8; 8]; 8] = {
     t
 };
 
+/// For a bit mask `def` of axes (`D ≤ 3`): its non-empty subsets `S`, as a bit mask over `S` (bit
+/// `S` set when `S ≠ ∅` and `S ⊆ def`). The deficit proof's corners ([`Faces::inside_corners`]) are
+/// evaluated for every `S` without branches and this picks those that count.
+pub(crate) const SUBSETS_OF: [u8; 8] = {
+    let mut t = [0u8; 8];
+    let mut def = 0;
+    while def < 8 {
+        let mut sub = 1;
+        while sub < 8 {
+            if sub & !def == 0 {
+                t[def] |= 1 << sub;
+            }
+            sub += 1;
+        }
+        def += 1;
+    }
+    t
+};
+
 /// The sign of a side: `+1` for the minus neighbour (`side = 0`), `−1` for the plus neighbour.
 #[inline(always)]
 fn side_sign(side: usize) -> f64 {

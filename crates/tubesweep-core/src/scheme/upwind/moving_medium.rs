@@ -95,29 +95,31 @@ impl<const D: usize> Faces<D> for Randers<D> {
     }
 
     /// [`Faces::inside`] at the corners with the products `v_k p_k` and `p_k²` of both choices per
-    /// axis computed once (the same bits as at each corner alone).
+    /// axis computed once (the same bits as at each corner alone), every corner evaluated (no
+    /// branch on `def` or on the answers) and those of `def` picked ([`super::SUBSETS_OF`]).
     #[inline(always)]
     fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
         let vp: [[f64; 2]; D] = core::array::from_fn(|k| [self.v[k] * p[k], self.v[k] * moved[k]]);
         let pp: [[f64; 2]; D] = core::array::from_fn(|k| [p[k] * p[k], moved[k] * moved[k]]);
-        let mut sub = def;
-        while sub != 0 {
+        let mut fails = 0u32;
+        for sub in 1..(1usize << D) {
             let r = 1.0 - 1e-12 - (0..D).map(|k| vp[k][sub >> k & 1]).sum::<f64>();
-            let inside = r >= 0.0 && self.f2 * (0..D).map(|k| pp[k][sub >> k & 1]).sum::<f64>() <= r * r;
-            debug_assert_eq!(
-                inside,
-                self.inside(core::array::from_fn(|k| if sub >> k & 1 == 1 {
-                    moved[k]
-                } else {
-                    p[k]
-                }))
-            );
-            if !inside {
-                return false;
-            }
-            sub = (sub - 1) & def;
+            let inside = (r >= 0.0) & (self.f2 * (0..D).map(|k| pp[k][sub >> k & 1]).sum::<f64>() <= r * r);
+            fails |= (!inside as u32) << sub;
         }
-        true
+        let ok = fails & super::SUBSETS_OF[def] as u32 == 0;
+        debug_assert_eq!(ok, {
+            let mut all = true;
+            let mut sub = def;
+            while sub != 0 {
+                all &= self.inside(core::array::from_fn(
+                    |k| if sub >> k & 1 == 1 { moved[k] } else { p[k] },
+                ));
+                sub = (sub - 1) & def;
+            }
+            all
+        });
+        ok
     }
 
     /// `φ(d) = (−v·d + R(d)) / (F² − |v|²)`, `R = sqrt((v·d)² + (F² − |v|²)|d|²)`. Mirroring `d_k`
