@@ -23,7 +23,10 @@ pub(super) type RunRows<'f> = dyn Fn(&[u32], bool) -> Accumulator + Sync + 'f;
 
 /// The thread pool and the tiles' done marks of one solve.
 pub(super) struct Pipeline {
-    pool: rayon::ThreadPool,
+    /// Built only when the sweeps can run on several threads (a 3D band, more than one thread):
+    /// on one thread or in 2D every iteration runs on the calling thread, and a pool there was a
+    /// thread started and stopped per solve for nothing.
+    pool: Option<rayon::ThreadPool>,
     tiles_done: Vec<AtomicU32>,
     sweep_id: AtomicU32,
     choice: ThreadChoice,
@@ -36,13 +39,19 @@ impl Pipeline {
     /// `threads`: 0 for the default (the idle cores, then per iteration by measurement).
     pub(super) fn new<const D: usize>(band: &NarrowBand<D>, threads: usize) -> Result<Self> {
         let count = if threads == 0 { threads_for_default() } else { threads };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(count)
-            .build()
-            .map_err(|e| Error::invalid("threads", format!("could not start {count} threads: {e}")))?;
-        let count = pool.current_num_threads();
         // only a 3D band has strips of tiles that can run side by side
-        let parallel = D == 3 && count > 1;
+        let pool = if D == 3 && count > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(count)
+                    .build()
+                    .map_err(|e| Error::invalid("threads", format!("could not start {count} threads: {e}")))?,
+            )
+        } else {
+            None
+        };
+        let count = pool.as_ref().map_or(count, |p| p.current_num_threads());
+        let parallel = pool.is_some() && count > 1;
         let tiles_done = if parallel {
             let sched = band.schedule();
             let most = (0..1usize << (D - 1)).map(|o| sched.tiles(o).len()).max().unwrap_or(0);
@@ -74,7 +83,7 @@ impl Pipeline {
         let sched = band.schedule();
         let run_parallel = self.choice.parallel(self.parallel);
         self.choice.start(run_parallel);
-        let acc = if run_parallel {
+        let acc = if let (true, Some(pool)) = (run_parallel, &self.pool) {
             let (tiles_done, ids) = (&self.tiles_done[..], &self.sweep_id);
             let per_sweep = |s: usize, next_strip: &AtomicUsize, abandoned: &AtomicBool| {
                 let orient = s ^ (s >> 1);
@@ -93,8 +102,7 @@ impl Pipeline {
                     &run_tile,
                 )
             };
-            self.pool
-                .install(|| run_sweeps_in_one_broadcast(orientations, ids, &per_sweep))
+            pool.install(|| run_sweeps_in_one_broadcast(orientations, ids, &per_sweep))
         } else {
             (0..orientations).fold(Accumulator::default(), |acc, s| {
                 let orient = s ^ (s >> 1);
