@@ -285,10 +285,11 @@ impl<const D: usize> Sweeper<'_, D> {
     fn outer(&self, w: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
         let table = self.table;
         let sentinel = table.sentinel();
-        // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives
-        let nb = unsafe { table.neighbours_of_unchecked(i) };
-        let direction = &self.directions[i];
-        let abs_phi = self.abs_phi[i];
+        // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives;
+        // the directions and |φ| have one entry per node (checked)
+        let abs_phi_of = |j: usize| unsafe { *self.abs_phi.get_unchecked(j) };
+        let direction = unsafe { self.directions.get_unchecked(i) };
+        let abs_phi = abs_phi_of(i);
         let limit = self.extension_limit * self.sigma(i) * self.spacing;
         let (mut num, mut den) = (0.0, 0.0);
         for k in 0..D {
@@ -298,12 +299,12 @@ impl<const D: usize> Sweeper<'_, D> {
             }
             // outward along +e_k: the upwind neighbour is at −e_k
             let side = if nk > 0.0 { 0 } else { 1 };
-            let j1 = nb[k][side];
+            let j1 = unsafe { table.neighbour_unchecked(i, k, side) };
             if j1 == sentinel {
                 continue;
             }
             let j1 = j1 as usize;
-            let phi1 = self.abs_phi[j1];
+            let phi1 = abs_phi_of(j1);
             if !(phi1 < abs_phi) {
                 continue;
             }
@@ -313,11 +314,11 @@ impl<const D: usize> Sweeper<'_, D> {
             }
             let weight = nk.abs() as f64;
             if second {
-                let j2 = unsafe { table.neighbours_of_unchecked(j1) }[k][side];
+                let j2 = unsafe { table.neighbour_unchecked(j1, k, side) };
                 if j2 != sentinel {
                     let j2 = j2 as usize;
                     let w2 = w.get(j2);
-                    if w2.is_finite() && self.abs_phi[j2] < phi1 {
+                    if w2.is_finite() && abs_phi_of(j2) < phi1 {
                         let t = (2.0 - (w1 - w2).abs() / limit).clamp(0.0, 1.0);
                         if t >= 1.0 {
                             num += 1.5 * weight * (4.0 * w1 - w2) / 3.0;
@@ -351,7 +352,8 @@ impl<const D: usize> Sweeper<'_, D> {
     }
 
     /// Updates node `i` if it is active and its value lies within the window; records the change.
-    /// `w` holds w = u − u₀; the window, `waiting` and `front` are in u.
+    /// `w` holds w = u − u₀; the window, `waiting` and `front` are in u. `role`: node `i`'s (the
+    /// row walk has it at hand).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn visit(
@@ -359,6 +361,7 @@ impl<const D: usize> Sweeper<'_, D> {
         w: &SharedValues<'_>,
         active: &[AtomicU8],
         i: usize,
+        role: NodeRole,
         k_inner: usize,
         lim: Limits,
         change: &mut Accumulator,
@@ -375,7 +378,7 @@ impl<const D: usize> Sweeper<'_, D> {
             return KEEP;
         }
         active[i].store(0, Ordering::Relaxed);
-        let new = match self.roles[i] {
+        let new = match role {
             NodeRole::Fixed => return 0,
             NodeRole::Inner => self.inner(w, i, k_inner, lim.second),
             NodeRole::Outer => self.outer(w, i, lim.second),
@@ -439,22 +442,23 @@ impl<const D: usize> Sweeper<'_, D> {
     }
 
     /// Marks the nodes that read node `i`: its neighbours at distance 1 and 2 along each axis.
+    /// Without branches: a missing neighbour is the sentinel, whose flag is the sink at the end
+    /// of `active`, and a missing first neighbour's own neighbour is taken from `i` (the same
+    /// sentinel), so that the twelve stores cost no mispredicted jumps.
     #[inline(always)]
     fn activate(&self, active: &[AtomicU8], i: usize) {
         let table = self.table;
         let sentinel = table.sentinel();
-        let nb = unsafe { table.neighbours_of_unchecked(i) };
+        debug_assert_eq!(active.len(), sentinel as usize + 1);
         for k in 0..D {
             for side in 0..2 {
-                let j = nb[k][side];
-                if j != sentinel {
-                    // SAFETY: `active` has one flag per band node, and `j`, `j2` are band nodes
-                    unsafe { active.get_unchecked(j as usize) }.store(1, Ordering::Relaxed);
-                    let j2 = unsafe { table.neighbours_of_unchecked(j as usize) }[k][side];
-                    if j2 != sentinel {
-                        unsafe { active.get_unchecked(j2 as usize) }.store(1, Ordering::Relaxed);
-                    }
-                }
+                // SAFETY: `i` and `from` are band nodes; `active` has one flag per band node and
+                // one for the sentinel
+                let j = unsafe { table.neighbour_unchecked(i, k, side) };
+                let from = if j == sentinel { i } else { j as usize };
+                let j2 = unsafe { table.neighbour_unchecked(from, k, side) };
+                unsafe { active.get_unchecked(j as usize) }.store(1, Ordering::Relaxed);
+                unsafe { active.get_unchecked(j2 as usize) }.store(1, Ordering::Relaxed);
             }
         }
     }
@@ -548,7 +552,8 @@ pub fn sweep_second_order<const D: usize>(
     } else {
         0.0
     };
-    let active: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
+    // one flag per node, and a sink for the sentinel ([`Sweeper::activate`])
+    let active: Vec<AtomicU8> = (0..=n).map(|_| AtomicU8::new(0)).collect();
     // the sweeps hold w = u − u₀ (the extension update reads no u₀, the inner one only to form u
     // for its ramps and the metric); the fixed nodes' given values are put back as they were
     let fixed_values: Vec<(usize, f64)> = roles
@@ -701,13 +706,13 @@ fn run_phase<const D: usize>(
                     let mut k = row_inner[r + 1] as usize;
                     for (i, &role) in (s..e).zip(roles).rev() {
                         k -= (role != NodeRole::Outer) as usize;
-                        status |= sw.visit(&shared, active, i, k, lim_now, &mut acc);
+                        status |= sw.visit(&shared, active, i, role, k, lim_now, &mut acc);
                         low = low.min(sw.u_at(&shared, i));
                     }
                 } else {
                     let mut k = row_inner[r] as usize;
                     for (i, &role) in (s..e).zip(roles) {
-                        status |= sw.visit(&shared, active, i, k, lim_now, &mut acc);
+                        status |= sw.visit(&shared, active, i, role, k, lim_now, &mut acc);
                         low = low.min(sw.u_at(&shared, i));
                         k += (role != NodeRole::Outer) as usize;
                     }
