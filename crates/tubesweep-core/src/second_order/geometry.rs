@@ -113,11 +113,14 @@ pub(crate) fn node_geometry<const D: usize>(
             geo.normal[k] = (g[k] / norm) as f32;
         }
     }
-    // principal curvatures at the foot point from the eigenvalues at height φ
-    for lam in symmetric_eigenvalues(&hess).iter().take(D) {
-        let den = 1.0 - p * lam;
-        let kappa = if den > 0.0 { (lam / den).abs() } else { f64::INFINITY };
-        summary.max_curvature = summary.max_curvature.max(kappa);
+    // principal curvatures at the foot point from the eigenvalues at height φ, needed only where
+    // they may raise the largest found so far
+    if !curvatures_below(&hess, p, summary.max_curvature) {
+        for lam in symmetric_eigenvalues(&hess).iter().take(D) {
+            let den = 1.0 - p * lam;
+            let kappa = if den > 0.0 { (lam / den).abs() } else { f64::INFINITY };
+            summary.max_curvature = summary.max_curvature.max(kappa);
+        }
     }
     let mut m = [[0.0; D]; D];
     for k in 0..D {
@@ -147,6 +150,42 @@ pub struct TubeGeometry {
     /// from the rest: the extension update only compares it between neighbours.
     pub abs_phi: Vec<f32>,
     pub summary: GeometrySummary,
+}
+
+/// Relative margin of [`curvatures_below`]: a node whose curvatures come within it of the bound
+/// gets its eigenvalues computed (far above the eigenvalues' rounding, ~1e-15 relative).
+const CURVATURE_MARGIN: f64 = 1e-6;
+
+/// Whether every principal curvature κ = λ/(1 − φλ) at a 3D node (λ the eigenvalues of the
+/// symmetric `hess`, φ = `p`) is below `bound`·(1 − [`CURVATURE_MARGIN`]) in size, decided
+/// without the eigenvalues: where 1 − φλ > 0, κ increases with λ, so |κ| ≤ k exactly when λ lies
+/// in [−k/(1 − φk), k/(1 + φk)] (an interval inside that domain), which Sylvester's criterion
+/// checks on D²φ − λ₋I and λ₊I − D²φ (positive leading minors). False (compute them) in 2D, where
+/// the eigenvalues are cheap, and whenever it cannot decide.
+///
+/// Such a node cannot raise the set-up's largest curvature, which is therefore the same with or
+/// without the test and whatever the order or split of the nodes: on the sphere at N = 201 all
+/// but a few hundred inner nodes skip the eigenvalues (one `acos` and two `cos` each).
+#[inline]
+pub(crate) fn curvatures_below<const D: usize>(hess: &[[f64; D]; D], p: f64, bound: f64) -> bool {
+    if D != 3 || !(bound > 0.0 && bound.is_finite() && p.is_finite()) {
+        return false;
+    }
+    let k = bound * (1.0 - CURVATURE_MARGIN);
+    let (den_hi, den_lo) = (1.0 + p * k, 1.0 - p * k);
+    if !(den_hi > 0.0 && den_lo > 0.0) {
+        return false;
+    }
+    let (hi, lo) = (k / den_hi, -k / den_lo);
+    let positive_definite = |shift: f64, sign: f64| {
+        let m = |r: usize, c: usize| sign * (hess[r][c] - if r == c { shift } else { 0.0 });
+        let d1 = m(0, 0);
+        let d2 = m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0);
+        let d3 = m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1)) - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
+            + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0));
+        d1 > 0.0 && d2 > 0.0 && d3 > 0.0
+    };
+    positive_definite(lo, 1.0) && positive_definite(hi, -1.0)
 }
 
 /// Eigenvalues of a symmetric D×D matrix (2 or 3), unordered.
@@ -357,6 +396,84 @@ pub(crate) fn power_of_two_near(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_curvature_test_never_skips_a_node_that_could_raise_the_bound() {
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut skipped, mut computed_below) = (0, 0);
+        for _ in 0..200_000 {
+            let mut m = [[0.0; 3]; 3];
+            for r in 0..3 {
+                for c in r..3 {
+                    m[r][c] = 4.0 * next() - 2.0;
+                    m[c][r] = m[r][c];
+                }
+            }
+            let p = 0.2 * next() - 0.1;
+            let curvature = symmetric_eigenvalues(&m)
+                .iter()
+                .map(|&lam| {
+                    let den = 1.0 - p * lam;
+                    if den > 0.0 {
+                        (lam / den).abs()
+                    } else {
+                        f64::INFINITY
+                    }
+                })
+                .fold(0.0, f64::max);
+            // bounds near the node's own curvature, where a wrong answer would show
+            let bound = if curvature.is_finite() {
+                curvature * (0.999 + 0.002 * next())
+            } else {
+                10.0 * next()
+            };
+            if curvatures_below(&m, p, bound) {
+                skipped += 1;
+                assert!(
+                    curvature < bound * (1.0 - 0.5 * CURVATURE_MARGIN),
+                    "{m:?} {p} {bound} {curvature}"
+                );
+            } else if curvature < bound * (1.0 - 2.0 * CURVATURE_MARGIN) {
+                computed_below += 1;
+            }
+        }
+        // it decides nearly every node clearly below the bound without the eigenvalues
+        assert!(skipped > 95_000, "{skipped}");
+        assert!(computed_below <= 10, "{computed_below} {skipped}");
+        // 2D, a zero or infinite bound: never skipped
+        assert!(!curvatures_below(&[[0.1, 0.0], [0.0, 0.1]], 0.0, 1.0));
+        assert!(!curvatures_below(&[[0.0; 3]; 3], 0.0, 0.0));
+        assert!(!curvatures_below(&[[0.0; 3]; 3], 0.0, f64::INFINITY));
+    }
+
+    /// The set-up's largest curvature is the one every node's eigenvalues give, bit for bit.
+    #[test]
+    fn the_largest_curvature_is_every_nodes_maximum() {
+        let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
+        let (phi, _) = crate::test_bands::sphere_phi_and_offsets(&band, h);
+        let surface = Implicit::LevelSet(&phi);
+        let geo = tube_geometry_of(&band, &roles, &surface, &dirs, h).unwrap();
+        let mut max = 0.0f64;
+        for i in 0..band.len() {
+            if roles[i] == NodeRole::Outer {
+                continue;
+            }
+            if let Some(local) = surface.local(&band, i, h) {
+                for lam in symmetric_eigenvalues(&local.hessian) {
+                    let den = 1.0 - local.phi * lam;
+                    max = max.max(if den > 0.0 { (lam / den).abs() } else { f64::INFINITY });
+                }
+            }
+        }
+        assert_eq!(geo.summary.max_curvature.to_bits(), max.to_bits());
+        assert!((max - 2.0).abs() < 0.1, "{max}");
+    }
 
     #[test]
     fn eigenvalues_of_a_rotated_diagonal_matrix() {
