@@ -22,6 +22,7 @@ pub mod geometry;
 pub mod implicit;
 pub mod local;
 mod pipeline;
+mod rows;
 pub mod setup;
 pub mod solver;
 pub mod start;
@@ -371,6 +372,26 @@ mod tests {
             solver::ALL_ACTIVE_START.with(|f| f.set(false));
             assert!(few.updates < all.updates, "{} / {}", few.updates, all.updates);
             assert_eq!(few.second_order_iterations, all.second_order_iterations);
+            for (x, y) in a.iter().zip(&b) {
+                assert_eq!(x.to_bits(), y.to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn the_x86_64_v3_walk_gives_the_baseline_bits() {
+        // where the CPU has x86-64-v3 the sweeps run the walk compiled for it: the same values,
+        // updates and iterations as the baseline walk (one and two threads, with and without a
+        // first phase)
+        for (threads, first_tol) in [(1, f64::INFINITY), (2, f64::INFINITY), (1, 1.0)] {
+            let (_, _, fast, a) = sphere_solve_with(61, 2.0, threads, first_tol, 2.0);
+            rows::FORCE_BASELINE.with(|f| f.set(true));
+            let (_, _, base, b) = sphere_solve_with(61, 2.0, threads, first_tol, 2.0);
+            rows::FORCE_BASELINE.with(|f| f.set(false));
+            assert_eq!(
+                (fast.updates, fast.first_order_iterations, fast.second_order_iterations),
+                (base.updates, base.first_order_iterations, base.second_order_iterations)
+            );
             for (x, y) in a.iter().zip(&b) {
                 assert_eq!(x.to_bits(), y.to_bits());
             }

@@ -34,6 +34,7 @@ use super::factoring::Factoring;
 use super::geometry::{NodeGeometry, TubeGeometry};
 use super::local::{corrected_slowness_squared, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
 use super::pipeline::Pipeline;
+use super::rows::{Isa, RowWalk, RowsState};
 
 /// Stopping rules of the two phases.
 #[derive(Debug, Clone, Copy)]
@@ -108,17 +109,17 @@ thread_local! {
 }
 
 /// [`Sweeper::visit`]: the node stays active (beyond the window).
-const KEEP: u8 = 1;
+pub(super) const KEEP: u8 = 1;
 /// [`Sweeper::visit`]: the node woke the nodes that read it.
-const WOKE: u8 = 2;
+pub(super) const WOKE: u8 = 2;
 
 /// What one iteration's visits compare against.
 #[derive(Clone, Copy)]
-struct Limits {
+pub(super) struct Limits {
     second: bool,
     decreases_only: bool,
     threshold: f64,
-    window: f64,
+    pub(super) window: f64,
     settled: f64,
     /// A value changed to below this ends the phase as a runaway (phase 2 only; −∞ otherwise).
     floor: f64,
@@ -138,9 +139,9 @@ impl Limits {
     }
 }
 
-struct Sweeper<'a, const D: usize> {
+pub(super) struct Sweeper<'a, const D: usize> {
     table: NeighbourTable<'a, D>,
-    roles: &'a [NodeRole],
+    pub(super) roles: &'a [NodeRole],
     /// Per node not in the extension layer, in band order (`k` below).
     geometry: &'a [NodeGeometry],
     /// The outward unit directions sgn(φ) n per node, which the extension update follows.
@@ -346,7 +347,7 @@ impl<const D: usize> Sweeper<'_, D> {
 
     /// u = u₀ + w at node `i` (the window, the front and the rows' lower bounds are in u).
     #[inline(always)]
-    fn u_at(&self, w: &SharedValues<'_>, i: usize) -> f64 {
+    pub(super) fn u_at(&self, w: &SharedValues<'_>, i: usize) -> f64 {
         // SAFETY: `i` is a band node, and u₀ has one value per node
         w.get(i) + unsafe { *self.u0.get_unchecked(i) }
     }
@@ -356,7 +357,7 @@ impl<const D: usize> Sweeper<'_, D> {
     /// row walk has it at hand).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn visit(
+    pub(super) fn visit(
         &self,
         w: &SharedValues<'_>,
         active: &[AtomicU8],
@@ -679,6 +680,7 @@ fn run_phase<const D: usize>(
         lim.window = first + window_width;
     }
     let rows_state = RowsState::new(band, values, sw.u0);
+    let isa = Isa::for_this_solve();
     let shared = SharedValues::new(values);
     let mut history: Vec<f64> = Vec::new();
     let mut unmoved = 0usize;
@@ -686,46 +688,16 @@ fn run_phase<const D: usize>(
         *iteration += 1;
         let lim_now = lim;
         let run_rows = |rows: &[u32], backwards: bool| -> Accumulator {
-            let mut acc = Accumulator::default();
-            for &r in rows {
-                let r = r as usize;
-                if rows_state.dirty[r].load(Ordering::Relaxed) == 0 {
-                    continue;
-                }
-                let low = f64::from_bits(rows_state.low[r].load(Ordering::Relaxed));
-                if low > lim_now.window && low.is_finite() {
-                    // every value of the row lies beyond the window (a lower bound)
-                    acc.waiting = acc.waiting.min(low);
-                    continue;
-                }
-                rows_state.dirty[r].store(0, Ordering::Relaxed);
-                let (s, e) = band.row_range(r);
-                let roles = &sw.roles[s..e];
-                let (mut status, mut low) = (0u8, f64::INFINITY);
-                if backwards {
-                    let mut k = row_inner[r + 1] as usize;
-                    for (i, &role) in (s..e).zip(roles).rev() {
-                        k -= (role != NodeRole::Outer) as usize;
-                        status |= sw.visit(&shared, active, i, role, k, lim_now, &mut acc);
-                        low = low.min(sw.u_at(&shared, i));
-                    }
-                } else {
-                    let mut k = row_inner[r] as usize;
-                    for (i, &role) in (s..e).zip(roles) {
-                        status |= sw.visit(&shared, active, i, role, k, lim_now, &mut acc);
-                        low = low.min(sw.u_at(&shared, i));
-                        k += (role != NodeRole::Outer) as usize;
-                    }
-                }
-                rows_state.low[r].store(low.to_bits(), Ordering::Relaxed);
-                if status != 0 {
-                    rows_state.dirty[r].store(1, Ordering::Relaxed);
-                }
-                if status & WOKE != 0 {
-                    rows_state.wake_around(r);
-                }
-            }
-            acc
+            let walk = RowWalk {
+                sw,
+                band,
+                rows_state: &rows_state,
+                shared: &shared,
+                active,
+                row_inner,
+                lim: lim_now,
+            };
+            walk.run(isa, rows, backwards)
         };
         let change = pipeline.iteration(band, &run_rows);
         stats.updates += change.updates;
@@ -775,56 +747,4 @@ fn run_phase<const D: usize>(
         }
     }
     Ok(false)
-}
-
-/// Per row: whether a node of it may be active, and a lower bound of its finite values (the
-/// sweeps skip a row that has no active node, or whose values all lie beyond the window: on the
-/// sphere at N = 201 the rows held 12 times as many node visits as updates).
-struct RowsState {
-    dirty: Vec<AtomicU8>,
-    low: Vec<std::sync::atomic::AtomicU64>,
-    /// [`NarrowBand::row_neighbours`]: per row the rows next to it along each leading axis.
-    neighbours: Vec<u32>,
-    per: usize,
-}
-
-impl RowsState {
-    /// `values`: w, and u₀, per node (the lower bounds are of u = u₀ + w).
-    fn new<const D: usize>(band: &NarrowBand<D>, values: &[f64], u0: &[f64]) -> Self {
-        let rows = band.n_rows();
-        let low = (0..rows)
-            .map(|r| {
-                let (s, e) = band.row_range(r);
-                let m = values[s..e]
-                    .iter()
-                    .zip(&u0[s..e])
-                    .fold(f64::INFINITY, |m, (&w, &u0)| m.min(w + u0));
-                std::sync::atomic::AtomicU64::new(m.to_bits())
-            })
-            .collect();
-        RowsState {
-            dirty: (0..=rows).map(|_| AtomicU8::new(1)).collect(),
-            low,
-            neighbours: band.row_neighbours(),
-            per: 2 * (D - 1),
-        }
-    }
-
-    /// Marks the rows whose nodes a node of row `r` wakes: along each leading axis the rows at
-    /// distance 1 and 2 (its own row is marked by the caller).
-    #[inline]
-    fn wake_around(&self, r: usize) {
-        let sentinel = self.dirty.len() - 1;
-        for d in 0..self.per {
-            let q = self.neighbours[r * self.per + d] as usize;
-            if q == sentinel {
-                continue;
-            }
-            self.dirty[q].store(1, Ordering::Relaxed);
-            let q2 = self.neighbours[q * self.per + d] as usize;
-            if q2 != sentinel {
-                self.dirty[q2].store(1, Ordering::Relaxed);
-            }
-        }
-    }
 }
