@@ -45,6 +45,7 @@ struct Face<const D: usize> {
 
 impl<const D: usize> Faces<D> for Randers<D> {
     type Projected = Face<D>;
+    const JUMP: bool = true;
 
     #[inline(always)]
     fn least_slowness(&self) -> f64 {
