@@ -193,7 +193,7 @@ class Tubesweep(Method):
             f"tubesweep ({'Godunov' if hamiltonian == 'godunov' else 'Lax–Friedrichs'}, two-layer"
             + ("" if tol_h is None else f", tol = {tol_h:g}·Δx")
             + ("" if threads == 0 else f", {threads} thread" + ("s" if threads > 1 else ""))
-            + ("" if order == 1 else f", order={order}")
+            + (", order=1: the paper's scheme" if order == 1 else f", order={order}: the default's choice here")
             + ")"
         )
 

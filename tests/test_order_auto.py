@@ -136,3 +136,15 @@ def test_travel_time_auto():
     one = ts.travel_time(g, src, order=1, hamiltonian="lxf")
     auto, sa = ts.travel_time(g, src, order="auto", hamiltonian="lxf", return_stats=True)
     assert sa.order == 1 and sa.order_fallback == str(info.value) and np.array_equal(auto, one)
+
+
+def test_the_default_is_auto():
+    # ts.solve and Tube.solve without order=: second order where it applies, order=1 elsewhere
+    g = box(31)
+    default, auto = ts.solve(SPHERE, g, [SRC]), ts.solve(SPHERE, g, [SRC], order="auto")
+    assert default.stats.order == 2 and np.array_equal(default.values, auto.values)
+    assert np.array_equal(ts.Tube(SPHERE, g).solve([SRC]).values, auto.values)
+    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(12))
+    default = ts.solve(mesh, g, [SRC])
+    assert default.stats.order == 1 and "piecewise flat" in default.stats.order_fallback
+    assert np.array_equal(default.values, ts.solve(mesh, g, [SRC], order=1).values)

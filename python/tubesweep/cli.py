@@ -142,10 +142,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--order",
         choices=["1", "2", "auto"],
-        default="1",
+        default="auto",
         help="1 = the paper's first-order scheme; 2 = second order on smooth closed level sets and closest-point "
         "surfaces (refuses meshes, open surfaces, creases, Lax-Friedrichs); auto = 2 where it applies, 1 otherwise, "
-        "with the reason printed (default: 1)",
+        "with the reason printed (default: auto)",
     )
     p.add_argument("--inner", type=float, default=2.0, help="inner tube half-width in grid spacings (default 2)")
     p.add_argument(

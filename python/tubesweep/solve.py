@@ -60,7 +60,7 @@ def solve(
     source_init: str = "exact",
     source_radius: Optional[float] = None,
     tol: float = DEFAULT_TOL,
-    order: Union[int, str] = 1,
+    order: Union[int, str] = "auto",
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
     infinity: Optional[float] = None,
@@ -75,6 +75,10 @@ def solve(
     ``[sgn(φ) n]·∇u = 0`` in the layer ``inner·Δx < |φ| ≤ outer·Δx`` with the upwind update (5).
     ``method="naive"`` is Algorithm 2 (one tube ``|φ| ≤ inner·Δx``, numerical infinity outside);
     it is kept as the baseline that does not converge for a tube of width O(Δx) (Sect. 3).
+    That is the paper's first-order scheme, ``order=1``. By default (``order="auto"``) smooth
+    closed level sets and closest-point surfaces are solved to second order instead (the
+    metric-corrected tube equation, docs/second-order.md), and everything else with ``order=1``;
+    ``sol.stats.order`` says which ran and ``sol.stats.order_fallback`` why not 2.
 
     Only the band nodes are stored and swept; for a callable φ the band is found coarse-to-fine,
     so memory and work are O(N^(d−1)).
@@ -136,8 +140,9 @@ def solve(
         safe upper bound on every travel time); it only affects the Lax–Friedrichs iteration count.
         A user value must exceed every travel time: values within a millionth of it count as
         never reached and are returned as ``inf``. Not used by ``order=2``.
-    order : {1, 2, "auto"}
-        1: the paper's first-order scheme (the default). 2: second order (docs/second-order.md):
+    order : {"auto", 1, 2}
+        ``"auto"`` (the default): second order where it applies, the paper's first-order scheme
+        where it does not (below). 1: the paper's first-order scheme. 2: second order (docs/second-order.md):
         the metric-corrected tube equation with limited BDF2–BDF3 differences and factored point
         sources, for level sets (arrays, callables, library surfaces) and closed smooth
         closest-point surfaces with the Godunov update; ``sol.stats.order2`` reports its phases.
@@ -145,9 +150,10 @@ def solve(
         not a signed distance (without ``redistance=True``), a crease, meshes, open surfaces,
         Lax–Friedrichs, flows and Hamiltonian objects, ``method="naive"``, ``paper_sweeps``,
         ``source_init="node"``, ``source_radius`` and ``outer < inner + 2`` are refused with a
-        ``ValueError`` saying why. ``"auto"``: 2 where it applies, and where it does not the
-        first-order scheme, the same values as ``order=1``, with ``sol.stats.order_fallback``
-        holding the text of the error ``order=2`` gives (``sol.stats.order`` says which ran).
+        ``ValueError`` saying why. ``"auto"`` runs 2 where it applies (the same values) and where it
+        does not the first-order scheme (the same values as ``order=1``), with
+        ``sol.stats.order_fallback`` holding the text of the error ``order=2`` gives
+        (``sol.stats.order`` says which ran).
     paper_sweeps : bool
         ``True`` runs the paper's plain sweeps: pointwise Gauss–Seidel updates over the whole band
         in every iteration (nodes none of whose neighbours changed are still skipped, which changes
@@ -190,8 +196,10 @@ def solve(
     >>> grid = ts.Grid(lower=(-1, -1, -1), upper=(1, 1, 1), shape=(101, 101, 101))
     >>> sphere = lambda p: np.linalg.norm(p, axis=1) - 0.5
     >>> sol = ts.solve(sphere, grid, sources=[(-0.5, 0, 0)])
-    >>> sol([(0, 0.5, 0)])  # exact π/4 = 0.785  # doctest: +ELLIPSIS
-    array([0.77...])
+    >>> sol([(0, 0.5, 0)])  # exact π/4 = 0.785398  # doctest: +ELLIPSIS
+    array([0.7854...])
+    >>> sol.stats.order, ts.solve(sphere, grid, sources=[(-0.5, 0, 0)], order=1)([(0, 0.5, 0)])  # doctest: +ELLIPSIS
+    (2, array([0.77...]))
     """
     t0 = time.perf_counter()
     order = _check_order(order)

@@ -164,7 +164,7 @@ class Tube:
         infinity: Optional[float] = None,
         threads: int = 0,
         paper_sweeps: bool = False,
-        order: Union[int, str] = 1,
+        order: Union[int, str] = "auto",
     ) -> Solution:
         """First-arrival times from ``sources`` on this band, without building the band again.
 
