@@ -95,6 +95,10 @@ def test_demo_quick(tmp_path, capsys):
     assert main(["demo", "--quick", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "sphere" in out and "star" in out
+    # the default runs second order with Godunov and the paper's first order with Lax–Friedrichs
+    rows = [line.split() for line in out.splitlines() if " godunov " in line or " lxf " in line]
+    assert len(rows) == 4
+    assert all(int(r[3]) == (2 if r[2] == "godunov" else 1) for r in rows), rows
     # the paths' lengths against great circles at N = 61 (h = 1/30)
     err = float(out.split("length error max ")[1].split()[0])
     assert err < 0.5 / 30

@@ -87,11 +87,11 @@ def run_demo(out: Path, quick: bool = False) -> int:
     fig.savefig(out / "layered.png", dpi=110, bbox_inches="tight")
 
     print(
-        f"{'problem':<16} {'H':<8} {'N':>5} {'max error':>10} {'iters':>6} {'band pts':>9} {'sweeps s':>9} {'wall s':>8}"
+        f"{'problem':<16} {'H':<8} {'order':>5} {'N':>5} {'max error':>10} {'iters':>6} {'band pts':>9} {'sweeps s':>9} {'wall s':>8}"
     )
     for name, ham, n, err, s, wall in rows:
         print(
-            f"{name:<16} {ham:<8} {n:>5} {err:>10.2e} {s.iterations:>6} {s.band_points:>9} {s.seconds:>9.3f} {wall:>8.3f}"
+            f"{name:<16} {ham:<8} {s.order:>5} {n:>5} {err:>10.2e} {s.iterations:>6} {s.band_points:>9} {s.seconds:>9.3f} {wall:>8.3f}"
         )
     print(
         f"geodesic paths on the sphere (5 starts, 3 sources, N={n3}): length error max {path_err:.2e} "
