@@ -43,13 +43,33 @@ impl<'a, const D: usize, F: Faces<D>> Faces<D> for NoPruning<'a, F> {
     }
 }
 
+/// A pseudo-random sequence in [0, 1) from `seed` (each test its own).
+fn sequence(seed: f64, step: f64) -> impl FnMut() -> f64 {
+    let mut x = seed;
+    move || {
+        x = (x * 997.0 + step).fract();
+        x
+    }
+}
+
+/// A tilted positive definite metric M = QᵀQ, Q upper triangular from six draws of `r`.
+fn random_metric(r: &mut impl FnMut() -> f64) -> [[f64; 3]; 3] {
+    let q = [
+        [1.0 + r(), 0.3 * r(), -0.2 * r()],
+        [0.0, 0.5 + r(), 0.4 * r()],
+        [0.0, 0.0, 0.3 + r()],
+    ];
+    core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()))
+}
+
+/// pᵀ M p.
+fn quadratic_form(p: [f64; 3], m: [[f64; 3]; 3]) -> f64 {
+    (0..3).map(|a| (0..3).map(|b| p[a] * m[a][b] * p[b]).sum::<f64>()).sum()
+}
+
 #[test]
 fn skipping_faces_never_changes_the_result() {
-    let mut x = 0.377_f64;
-    let mut r = move || {
-        x = (x * 997.0 + 0.1234).fract();
-        x
-    };
+    let mut r = sequence(0.377, 0.1234);
     for i in 0..20000 {
         let h = 0.05;
         let minus: [f64; 3] = core::array::from_fn(|_| 0.1 * r());
@@ -60,14 +80,7 @@ fn skipping_faces_never_changes_the_result() {
         let a = upwind_min(&randers, minus, plus, h, old);
         let b = upwind_min(&NoPruning(&randers), minus, plus, h, old);
         assert_eq!(a, b, "moving medium {minus:?} {plus:?} {v:?}");
-        let q = [
-            [1.0 + r(), 0.3 * r(), -0.2 * r()],
-            [0.0, 0.5 + r(), 0.4 * r()],
-            [0.0, 0.0, 0.3 + r()],
-        ];
-        // M = QᵀQ (positive definite), tilted
-        let m: [[f64; 3]; 3] =
-            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let m = random_metric(&mut r);
         let riem = metric::tests_faces(0.8, m);
         let a = upwind_min(&riem, minus, plus, h, old);
         let b = upwind_min(&NoPruning(&riem), minus, plus, h, old);
@@ -79,11 +92,7 @@ fn skipping_faces_never_changes_the_result() {
 /// sweeps), where the natural orthant's proof runs, with and without deficits.
 #[test]
 fn skipping_faces_never_changes_the_result_near_smooth_solutions() {
-    let mut x = 0.611_f64;
-    let mut r = move || {
-        x = (x * 997.0 + 0.4321).fract();
-        x
-    };
+    let mut r = sequence(0.611, 0.4321);
     let h = 0.02;
     let (mut fast, mut total) = (0, 0);
     for i in 0..20000 {
@@ -108,14 +117,8 @@ fn skipping_faces_never_changes_the_result_near_smooth_solutions() {
             upwind_min(&NoPruning(&randers), minus, plus, h, old),
             "moving medium"
         );
-        let q = [
-            [1.0 + r(), 0.3 * r(), -0.2 * r()],
-            [0.0, 0.5 + r(), 0.4 * r()],
-            [0.0, 0.0, 0.3 + r()],
-        ];
-        let m: [[f64; 3]; 3] =
-            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
-        let nmn: f64 = (0..3).map(|a| (0..3).map(|b| n[a] * m[a][b] * n[b]).sum::<f64>()).sum();
+        let m = random_metric(&mut r);
+        let nmn = quadratic_form(n, m);
         let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * n[k] / nmn.sqrt()));
         let riem = metric::tests_faces(0.8, m);
         let got = upwind_min(&riem, minus, plus, h, old);
@@ -136,11 +139,7 @@ fn skipping_faces_never_changes_the_result_near_smooth_solutions() {
 /// natural orthant's simplex has no critical point inside and its faces are tried.
 #[test]
 fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
-    let mut x = 0.271_f64;
-    let mut r = move || {
-        x = (x * 997.0 + 0.2718).fract();
-        x
-    };
+    let mut r = sequence(0.271, 0.2718);
     let h = 0.02;
     let (mut fast, mut total) = (0, 0);
     for i in 0..20000 {
@@ -177,16 +176,10 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
         fast += natural_faces(&randers, &nbs, o0, h, &mut b).is_some() as usize;
         total += 1;
         // a metric whose characteristic M p lies in the plane: p_off = −(M_off,· p)/M_off,off
-        let q = [
-            [1.0 + r(), 0.3 * r(), -0.2 * r()],
-            [0.0, 0.5 + r(), 0.4 * r()],
-            [0.0, 0.0, 0.3 + r()],
-        ];
-        let m: [[f64; 3]; 3] =
-            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let m = random_metric(&mut r);
         let mut p = n;
         p[off] = -(0..3).filter(|&k| k != off).map(|k| m[off][k] * n[k]).sum::<f64>() / m[off][off];
-        let pmp: f64 = (0..3).map(|a| (0..3).map(|b| p[a] * m[a][b] * p[b]).sum::<f64>()).sum();
+        let pmp = quadratic_form(p, m);
         let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
         let riem = metric::tests_faces(0.8, m);
         let got = upwind_min(&riem, minus, plus, h, old);
@@ -203,11 +196,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
 /// on that axis is tried.
 #[test]
 fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
-    let mut x = 0.1414_f64;
-    let mut r = move || {
-        x = (x * 997.0 + 0.1732).fract();
-        x
-    };
+    let mut r = sequence(0.1414, 0.1732);
     let h = 0.02;
     let (mut fast, mut total) = (0, 0);
     for i in 0..20000 {
@@ -252,13 +241,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
         fast += natural_faces(&randers, &nbs, o0, h, &mut b).is_some() as usize;
         total += 1;
         // a metric whose characteristic M p lies along the axis: p = M⁻¹ e_along, scaled
-        let q = [
-            [1.0 + r(), 0.3 * r(), -0.2 * r()],
-            [0.0, 0.5 + r(), 0.4 * r()],
-            [0.0, 0.0, 0.3 + r()],
-        ];
-        let m: [[f64; 3]; 3] =
-            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let m = random_metric(&mut r);
         let (c0, c1) = ((along + 1) % 3, (along + 2) % 3);
         // the column `along` of M⁻¹ (up to det M > 0): cofactors
         let cof = |i: usize, j: usize| {
@@ -270,7 +253,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
         for k in [along, c0, c1] {
             p[k] = sign * cof(along, k);
         }
-        let pmp: f64 = (0..3).map(|a| (0..3).map(|b| p[a] * m[a][b] * p[b]).sum::<f64>()).sum();
+        let pmp = quadratic_form(p, m);
         let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
         let riem = metric::tests_faces(0.8, m);
         let got = upwind_min(&riem, minus, plus, h, old);
@@ -286,11 +269,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
 /// [`Faces::inside`] at each corner does.
 #[test]
 fn inside_corners_is_inside_at_every_corner() {
-    let mut x = 0.5772_f64;
-    let mut r = move || {
-        x = (x * 997.0 + 0.1618).fract();
-        x
-    };
+    let mut r = sequence(0.5772, 0.1618);
     let (mut yes, mut no) = (0, 0);
     for _ in 0..20000 {
         let p: [f64; 3] = core::array::from_fn(|_| 1.6 * (r() - 0.5));
@@ -314,13 +293,7 @@ fn inside_corners_is_inside_at_every_corner() {
         } else {
             no += 1
         }
-        let q = [
-            [1.0 + r(), 0.3 * r(), -0.2 * r()],
-            [0.0, 0.5 + r(), 0.4 * r()],
-            [0.0, 0.0, 0.3 + r()],
-        ];
-        let m: [[f64; 3]; 3] =
-            core::array::from_fn(|a| core::array::from_fn(|b| (0..3).map(|k| q[k][a] * q[k][b]).sum()));
+        let m = random_metric(&mut r);
         let riem = metric::tests_faces(0.8, m);
         let want = each(&|q| riem.inside(q));
         assert_eq!(riem.inside_corners(p, moved, def), want, "metric {p:?} {moved:?} {def}");
