@@ -43,6 +43,22 @@ impl<'a, const D: usize, F: Faces<D>> Faces<D> for NoPruning<'a, F> {
     }
 }
 
+/// [`upwind_min`] gives the same bits with its skips as with every face solved (`what` names the
+/// case in the failure message).
+#[track_caller]
+fn same_as_unpruned<F: Faces<3>>(
+    faces: &F,
+    minus: [f64; 3],
+    plus: [f64; 3],
+    h: f64,
+    old: f64,
+    what: impl Fn() -> String,
+) {
+    let a = upwind_min(faces, minus, plus, h, old);
+    let b = upwind_min(&NoPruning(faces), minus, plus, h, old);
+    assert_eq!(a, b, "{} {minus:?} {plus:?}", what());
+}
+
 /// A pseudo-random sequence in [0, 1) from `seed` (each test its own).
 fn sequence(seed: f64, step: f64) -> impl FnMut() -> f64 {
     let mut x = seed;
@@ -77,14 +93,10 @@ fn skipping_faces_never_changes_the_result() {
         let old = if i % 2 == 0 { 1e6 } else { 0.05 + 0.1 * r() };
         let v = [r() - 0.5, r() - 0.5, 0.6 * (r() - 0.5)];
         let randers = moving_medium::tests_faces(1.3, v);
-        let a = upwind_min(&randers, minus, plus, h, old);
-        let b = upwind_min(&NoPruning(&randers), minus, plus, h, old);
-        assert_eq!(a, b, "moving medium {minus:?} {plus:?} {v:?}");
+        same_as_unpruned(&randers, minus, plus, h, old, || format!("moving medium {v:?}"));
         let m = random_metric(&mut r);
         let riem = metric::tests_faces(0.8, m);
-        let a = upwind_min(&riem, minus, plus, h, old);
-        let b = upwind_min(&NoPruning(&riem), minus, plus, h, old);
-        assert_eq!(a, b, "metric {minus:?} {plus:?} {m:?}");
+        same_as_unpruned(&riem, minus, plus, h, old, || format!("metric {m:?}"));
     }
 }
 
@@ -111,18 +123,12 @@ fn skipping_faces_never_changes_the_result_near_smooth_solutions() {
         let c = f + v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
         let (minus, plus) = nb(core::array::from_fn(|k| n[k] / c));
         let randers = moving_medium::tests_faces(f, v);
-        let got = upwind_min(&randers, minus, plus, h, old);
-        assert_eq!(
-            got,
-            upwind_min(&NoPruning(&randers), minus, plus, h, old),
-            "moving medium"
-        );
+        same_as_unpruned(&randers, minus, plus, h, old, || "moving medium".into());
         let m = random_metric(&mut r);
         let nmn = quadratic_form(n, m);
         let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * n[k] / nmn.sqrt()));
         let riem = metric::tests_faces(0.8, m);
-        let got = upwind_min(&riem, minus, plus, h, old);
-        assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+        same_as_unpruned(&riem, minus, plus, h, old, || "metric".into());
         // how often the natural orthant settles it alone
         let pf = riem.project(7).unwrap();
         let vel = riem.velocity(core::array::from_fn(|k| (plus[k] - minus[k]) / (2.0 * h)));
@@ -163,12 +169,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
         let c = f + v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
         let (minus, plus) = nb(core::array::from_fn(|k| n[k] / c));
         let randers = moving_medium::tests_faces(f, v);
-        let got = upwind_min(&randers, minus, plus, h, old);
-        assert_eq!(
-            got,
-            upwind_min(&NoPruning(&randers), minus, plus, h, old),
-            "moving medium"
-        );
+        same_as_unpruned(&randers, minus, plus, h, old, || "moving medium".into());
         let nbs: [[f64; 2]; 3] = core::array::from_fn(|k| [minus[k], plus[k]]);
         let vel = randers.velocity(core::array::from_fn(|k| plus[k] - minus[k]));
         let o0: usize = (0..3).map(|k| ((vel[k] < 0.0) as usize) << k).sum();
@@ -182,8 +183,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_plane() {
         let pmp = quadratic_form(p, m);
         let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
         let riem = metric::tests_faces(0.8, m);
-        let got = upwind_min(&riem, minus, plus, h, old);
-        assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+        same_as_unpruned(&riem, minus, plus, h, old, || "metric".into());
     }
     assert!(
         fast * 2 > total,
@@ -229,12 +229,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
             }
         }));
         let randers = moving_medium::tests_faces(f, v);
-        let got = upwind_min(&randers, minus, plus, h, old);
-        assert_eq!(
-            got,
-            upwind_min(&NoPruning(&randers), minus, plus, h, old),
-            "moving medium"
-        );
+        same_as_unpruned(&randers, minus, plus, h, old, || "moving medium".into());
         let nbs: [[f64; 2]; 3] = core::array::from_fn(|k| [minus[k], plus[k]]);
         let o0 = randers.upwind_orthant(core::array::from_fn(|k| plus[k] - minus[k]));
         let mut b = f64::INFINITY;
@@ -256,8 +251,7 @@ fn skipping_faces_never_changes_the_result_along_a_coordinate_axis() {
         let pmp = quadratic_form(p, m);
         let (minus, plus) = nb(core::array::from_fn(|k| 0.8 * p[k] / pmp.sqrt()));
         let riem = metric::tests_faces(0.8, m);
-        let got = upwind_min(&riem, minus, plus, h, old);
-        assert_eq!(got, upwind_min(&NoPruning(&riem), minus, plus, h, old), "metric");
+        same_as_unpruned(&riem, minus, plus, h, old, || "metric".into());
     }
     assert!(
         fast * 2 > total,
