@@ -31,6 +31,8 @@ pub mod surface;
 pub mod sweep;
 #[cfg(test)]
 mod test_bands;
+#[cfg(test)]
+mod test_random;
 
 pub use band::NarrowBand;
 pub use error::{Error, Result};

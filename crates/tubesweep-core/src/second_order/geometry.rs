@@ -399,13 +399,7 @@ mod tests {
 
     #[test]
     fn the_curvature_test_never_skips_a_node_that_could_raise_the_bound() {
-        let mut state = 7u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_random::uniform(7);
         let (mut skipped, mut computed_below) = (0, 0);
         for _ in 0..200_000 {
             let mut m = [[0.0; 3]; 3];

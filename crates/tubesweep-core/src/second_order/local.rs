@@ -361,13 +361,7 @@ mod tests {
     #[test]
     fn the_closed_form_finds_newtons_root() {
         // pseudo-random sides (a linear congruential sequence), some missing, c in [1, 1.5]
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_random::uniform(12345);
         let h = 0.01;
         for _ in 0..20000 {
             let mut sides = [[Side::MISSING; 2]; 3];

@@ -692,11 +692,7 @@ mod tests {
     fn the_star_window_narrowed_to_reach_gives_the_whole_window_bits() {
         // points up to the window's limit (0.2) from the curve, for the paper's star and a
         // spikier one: the narrowed window starts Newton where the whole one does
-        let mut seed = 99u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_random::uniform(99);
         for (r0, eps) in [(0.5, 0.2), (0.3, 0.5), (1.0, 0.05)] {
             let mut p = Vec::new();
             for _ in 0..100_000 {
@@ -731,11 +727,8 @@ mod tests {
                 [r * t.cos(), r * t.sin()]
             })
             .collect();
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut uniform = crate::test_random::uniform(12345);
+        let mut next = || uniform() * 2.0 - 1.0;
         for _ in 0..20_000 {
             let (x, y) = (next() * 1.2, next() * 1.2);
             let full = (0..m)

@@ -534,6 +534,7 @@ impl<'a> ClosestSearch<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_random::next_uniform as lcg;
 
     fn brute(p: V3, tris: &[[V3; 3]]) -> f64 {
         tris.iter()
@@ -543,13 +544,6 @@ mod tests {
                 dot(d, d).sqrt()
             })
             .fold(f64::INFINITY, f64::min)
-    }
-
-    fn lcg(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*state >> 11) as f64) / ((1u64 << 53) as f64)
     }
 
     fn close(p: V3, q: V3) -> bool {
