@@ -219,7 +219,7 @@ pub fn godunov_newton<const D: usize>(sides: &[[Side; 2]; D], sh: f64) -> Option
 /// products: c > 0), the axes in increasing τ; axis m + 1 joins while the sum over the first m,
 /// Σ (c_l τ − b_l)², is still below (sΔx)² at its τ (the root of the first m then lies above
 /// it: the classical update with unequal steps, its count decided by squares and products, so
-/// that only the final root takes a square root and a division). Where a side not chosen would
+/// that no candidate count takes a square root: only the final root does). Where a side not chosen would
 /// be the larger at the root (possible only when its c is larger: c_o ≤ c_c and τ_o ≥ τ_c give
 /// c_o(w − τ_o) ≤ c_c(w − τ_c) wherever the former is positive), [`godunov_newton`] decides.
 /// None when every side is missing.
