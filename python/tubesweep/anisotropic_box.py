@@ -61,7 +61,7 @@ def travel_time_general(
     t0: float,
 ) -> Any:
     """The box solve of :func:`tubesweep.travel_time` for a general Hamiltonian ``ham``."""
-    from .hamiltonians import _mean_cell_time
+    from .hamiltonians import _mean_cell_time, _coefficient_bytes
 
     linear = np.arange(grid.size, dtype=np.int64)
     x = np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1)
@@ -120,9 +120,7 @@ def travel_time_general(
         outer_points=0,
         fixed_points=len(lin),
         setup_seconds=setup,
-        band_bytes=band.nbytes
-        + grid.size * (10 + 8 * grid.ndim * (grid.ndim if prep.metric is not None else 1))
-        + 8 * band.n_rows,
+        band_bytes=band.nbytes + grid.size * 10 + _coefficient_bytes(prep, grid.size, grid.ndim) + 8 * band.n_rows,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver="lxf" if prep.scheme == "lxf" else ("godunov" if prep.kind == "isotropic" else "upwind"),

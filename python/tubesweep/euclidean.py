@@ -265,7 +265,7 @@ def travel_time(
     # coordinates, twice: the meshgrid and the stacked points)
     per_node = _BYTES_PER_BOX_NODE + (16 * grid.ndim if callable(speed) else 0)
     if general is not None:  # the nodes' coordinates, the slowness and the flow or metric per node
-        per_node += 8 * grid.ndim + 8 + 8 * grid.ndim * grid.ndim
+        per_node += 8 * grid.ndim + 8 + general._box_bytes_per_node(grid.ndim)
     check_memory(grid.size * per_node, f"a {grid.shape} box", "use a coarser grid or the narrow-band surface solver")
 
     if callable(speed) or np.ndim(speed) > 0:

@@ -220,6 +220,10 @@ class Hamiltonian:
                 "drop sigma, or pass scheme='lxf'"
             )
 
+    def _box_bytes_per_node(self, d: int) -> int:
+        """Bytes per box node of the flow or metric, for the memory check of a box solve."""
+        return 8 * d * d
+
     def prepare(
         self,
         surface: Any,
@@ -588,6 +592,10 @@ class Metric(Hamiltonian):
             # at the closest points, an array interpolated there (as the flow, above)
             _, cp = surface.project(x, grid)
             m = _field(self.M, grid, linear, cp, (d, d), "M", interpolate=True)
+        elif self._constant():
+            # one matrix for all nodes (1, d, d): the upwind solver stores it once, the native
+            # Lax–Friedrichs update repeats it per node
+            m = _field(self.M, grid, linear[:1], x[:1], (d, d), "M")
         else:
             m = _field(self.M, grid, linear, x, (d, d), "M")
         asym = np.abs(m - np.swapaxes(m, 1, 2)).max(axis=(1, 2))
@@ -600,6 +608,7 @@ class Metric(Hamiltonian):
             i = int(np.argmin(lam))
             raise ValueError(f"M must be positive definite; at {_fmt(x[i])} its smallest eigenvalue is {lam[i]:.3g}")
         if self.tangential and surface is not None:
+            m = np.broadcast_to(m, (len(linear), d, d))  # the tangential part is per node
             n = _normals(surface, grid, x, direction)
             has = np.linalg.norm(n, axis=1) > 0.5
             P = np.eye(d)[None] - n[:, :, None] * n[:, None, :]
@@ -625,8 +634,17 @@ class Metric(Hamiltonian):
             self.kind, slowness, metric=m, sigma=self._sigma(d), scheme=self.scheme, extra={"inverse": inverse}
         )
 
+    def _constant(self) -> bool:
+        """Whether ``M`` is one ``(d, d)`` matrix (stored once unless the tangential part makes it per node)."""
+        return not callable(self.M) and np.ndim(self.M) == 2
+
+    def _box_bytes_per_node(self, d: int) -> int:
+        # the upwind solver stores a constant M once, the Lax–Friedrichs update per node
+        return 0 if self._constant() and self.scheme != "lxf" else 8 * d * d
+
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        inv = prep.extra["inverse"][nodes]
+        inv = prep.extra["inverse"]
+        inv = np.broadcast_to(inv[0], (len(nodes),) + inv.shape[1:]) if len(inv) == 1 else inv[nodes]
         return prep.slowness[nodes] * np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", disp, inv, disp), 0.0))
 
 
@@ -652,6 +670,18 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
     if allow_supersonic:
         raise ValueError("allow_supersonic=True needs a flow (the moving-medium equation); pass flow=v")
     return None
+
+
+def _coefficient_bytes(prep: _Prepared, n_nodes: int, d: int) -> int:
+    """The bytes of the flow or metric the native solver holds for ``n_nodes`` nodes: the flow
+    ``8 d`` per node; the metric ``8 d²`` per node with the Lax–Friedrichs update (M as given), and
+    with the upwind solver its symmetric part packed, ``8 d(d+1)/2`` per matrix stored (one for a
+    constant M)."""
+    if prep.metric is None:
+        return 8 * d * n_nodes
+    if prep.scheme == "lxf":
+        return 8 * d * d * n_nodes
+    return 8 * (d * (d + 1) // 2) * len(prep.metric)
 
 
 def _mean_cell_time(ham: Hamiltonian, prep: _Prepared, n_nodes: int, grid: Grid) -> float:

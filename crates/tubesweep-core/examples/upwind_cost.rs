@@ -7,7 +7,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 use tubesweep_core::scheme::godunov::godunov_update;
-use tubesweep_core::scheme::hamiltonians::{Metric, MovingMedium};
+use tubesweep_core::scheme::hamiltonians::{MovingMedium, SymmetricMetric};
 use tubesweep_core::LocalSolver;
 
 const N: usize = 4096;
@@ -63,11 +63,7 @@ fn main() {
     };
     let m3 = [[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]];
     let metric = vec![m3; N];
-    let met = Metric {
-        slowness: &s,
-        metric: &metric,
-        sigma: None,
-    };
+    let met = SymmetricMetric::new(&s, &metric);
     let iso = cases(|_, n| n, h);
     let rand = cases(
         |i, n| {

@@ -7,7 +7,9 @@
 //!   through the upwind solvers' interface (`InnerScheme::Upwind` with `Isotropic`: the same
 //!   dispatch, Eq. (3) as the local solve);
 //! * the upwind moving medium with the rigid rotation `v = ω e_z × x̂ R` (ω = 1), and with v = 0;
-//! * the upwind metric: a constant tilted `M` (eigenvalues 0.3–2.3), and `M = I`.
+//! * the upwind metric: a constant tilted `M` (eigenvalues 0.3–2.3), and `M = I`, both stored per
+//!   node (`D(D+1)/2 = 6` numbers, 48 bytes: a surface's tangential `M` is per node, so this is the
+//!   realistic cost), and the tilted `M` stored once for all nodes (a constant `M` off a surface).
 //!
 //! Each in two sweep modes: the plain sweeps (`skip_inactive: false`, every node in every sweep)
 //! and the default sweeps of the general Hamiltonians (active flags, the rim last, no coupling,
@@ -25,7 +27,7 @@ mod shell;
 #[path = "common/sphere_source.rs"]
 mod sphere_source;
 
-use tubesweep_core::scheme::hamiltonians::{Isotropic, Metric, MovingMedium};
+use tubesweep_core::scheme::hamiltonians::{Isotropic, MovingMedium, SymmetricMetric};
 #[allow(unused_imports)]
 use tubesweep_core::{Control, InnerScheme, NarrowBand, NodeRole, SolveOptions, SolveStats};
 
@@ -89,27 +91,21 @@ fn main() {
         flow: &zero,
         sigma: None,
     };
-    let met = Metric {
-        slowness: &s,
-        metric: &tilted,
-        sigma: None,
-    };
-    let eye = Metric {
-        slowness: &s,
-        metric: &ident,
-        sigma: None,
-    };
+    let met = SymmetricMetric::new(&s, &tilted);
+    let eye = SymmetricMetric::new(&s, &ident);
+    let one = SymmetricMetric::new(&s, &[m3]);
     let iso = Isotropic {
         slowness: &s,
         sigma: None,
     };
-    let cases: [(&str, InnerScheme<'_, 3>); 6] = [
+    let cases: [(&str, InnerScheme<'_, 3>); 7] = [
         ("isotropic Godunov (3)", InnerScheme::Godunov),
         ("Eq. (3) through the upwind interface", InnerScheme::Upwind(&iso)),
         ("upwind moving medium, rotation", InnerScheme::Upwind(&rot)),
         ("upwind moving medium, v = 0", InnerScheme::Upwind(&still)),
         ("upwind metric, tilted M", InnerScheme::Upwind(&met)),
         ("upwind metric, M = I", InnerScheme::Upwind(&eye)),
+        ("upwind metric, one tilted M for all", InnerScheme::Upwind(&one)),
     ];
     println!("sphere N={n}, band {} nodes, {threads} thread(s)", band.len());
     // the cases alternate, round after round, and each keeps its fastest round: the machine is

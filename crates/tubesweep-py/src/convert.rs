@@ -68,6 +68,22 @@ pub(crate) fn node_vectors<'a, T, const D: usize>(flat: &'a [T], n: usize, name:
     Ok(unsafe { std::slice::from_raw_parts(flat.as_ptr() as *const [T; D], n) })
 }
 
+/// A flat (K·D·D) row-major array viewed as K D×D matrices, without copying: K = n (one per band
+/// node) or K = 1 (one for all nodes).
+pub(crate) fn node_matrices<'a, const D: usize>(
+    flat: &'a [f64],
+    n: usize,
+    name: &str,
+) -> PyResult<&'a [[[f64; D]; D]]> {
+    if flat.len() != n * D * D && flat.len() != D * D {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape ({n}, {D}, {D}) (one matrix per band node) or (1, {D}, {D}) (one for all)"
+        )));
+    }
+    // SAFETY: [[f64; D]; D] has the layout of D·D consecutive f64 and the alignment of f64.
+    Ok(unsafe { std::slice::from_raw_parts(flat.as_ptr() as *const [[f64; D]; D], flat.len() / (D * D)) })
+}
+
 pub(crate) fn flat_2d<'py, T: numpy::Element, const D: usize>(
     py: Python<'py>,
     rows: Vec<[T; D]>,

@@ -7,13 +7,14 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadwriteArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::borrow::Cow;
 use tubesweep_core::band::NarrowBand;
-use tubesweep_core::scheme::hamiltonians::{Isotropic, Metric, MovingMedium};
+use tubesweep_core::scheme::hamiltonians::{Isotropic, Metric, MovingMedium, SymmetricMetric};
 use tubesweep_core::sweep::{
     default_row_prefetch_above, extension_weights_in_place, Extension, MissingNeighbour, Slowness,
 };
 use tubesweep_core::{
-    Control, Hamiltonian, InnerScheme, IterationReport, LocalSolver, NodeRole, SolveOptions, SolveStats, SweepProblem,
+    Control, Hamiltonian, InnerScheme, IterationReport, NodeRole, SolveOptions, SolveStats, SweepProblem,
 };
 
 pub(crate) fn parse_scheme(name: &str) -> PyResult<u8> {
@@ -314,17 +315,21 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
         Some(f) => node_vectors::<f64, D>(f, n, "flow")?,
         None => &[],
     };
-    let metric: Vec<[[f64; D]; D]> = match inputs.metric {
-        Some(m) if m.len() == n * D * D => m
-            .chunks_exact(D * D)
-            .map(|c| core::array::from_fn(|i| core::array::from_fn(|j| c[i * D + j])))
-            .collect(),
-        Some(_) => return Err(PyValueError::new_err(format!("metric must have shape ({n}, {D}, {D})"))),
-        None => Vec::new(),
+    // M per node, or one for all nodes: the upwind solver packs its symmetric part (one matrix stays
+    // one); the Lax–Friedrichs update reads it as given, per node, borrowed from NumPy (one matrix
+    // repeated for all nodes)
+    let metric: &[[[f64; D]; D]] = match inputs.metric {
+        Some(m) => node_matrices::<D>(m, n, "metric")?,
+        None => &[],
+    };
+    let lxf_metric: Cow<'_, [[[f64; D]; D]]> = if !upwind && metric.len() == 1 && n > 1 {
+        Cow::Owned(vec![metric[0]; n])
+    } else {
+        Cow::Borrowed(metric)
     };
     // the smallest admissible constant viscosities: the default (exact) σ of every node, per axis
     if let Some(sig) = inputs.sigma {
-        let needed = required_sigma::<D>(&inputs, flow, &metric, n);
+        let needed = required_sigma::<D>(&inputs, flow, &lxf_metric, n);
         if let Some(k) = (0..D).find(|&k| sig[k] < needed[k]) {
             return Err(PyValueError::new_err(format!(
                 "sigma[{k}] = {} is below max |∂H/∂p_{k}| = {} over the band (Sect. 5.1): the Lax–Friedrichs update would \
@@ -337,13 +342,19 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
     let iso;
     let mm;
     let met;
-    let (ham, solver): (&dyn Hamiltonian<D>, &dyn LocalSolver<D>) = match inputs.kind.as_str() {
+    let sym;
+    // the upwind local solver of `tubesweep_core::scheme::upwind`, or the Lax–Friedrichs update of Sect. 5.1
+    let scheme: InnerScheme<'_, D> = match inputs.kind.as_str() {
         "isotropic" => {
             iso = Isotropic {
                 slowness: inputs.slowness,
                 sigma: inputs.sigma,
             };
-            (&iso, &iso)
+            if upwind {
+                InnerScheme::Upwind(&iso)
+            } else {
+                InnerScheme::General(&iso)
+            }
         }
         "moving_medium" => {
             if flow.is_empty() && n > 0 {
@@ -354,18 +365,27 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
                 flow,
                 sigma: inputs.sigma,
             };
-            (&mm, &mm)
+            if upwind {
+                InnerScheme::Upwind(&mm)
+            } else {
+                InnerScheme::General(&mm)
+            }
         }
         "metric" => {
             if metric.is_empty() && n > 0 {
                 return Err(PyValueError::new_err("hamiltonian 'metric' needs metric (K, d, d)"));
             }
-            met = Metric {
-                slowness: inputs.slowness,
-                metric: &metric,
-                sigma: inputs.sigma,
-            };
-            (&met, &met)
+            if upwind {
+                sym = SymmetricMetric::new(inputs.slowness, metric);
+                InnerScheme::Upwind(&sym)
+            } else {
+                met = Metric {
+                    slowness: inputs.slowness,
+                    metric: &lxf_metric,
+                    sigma: inputs.sigma,
+                };
+                InnerScheme::General(&met)
+            }
         }
         other => {
             return Err(PyValueError::new_err(format!(
@@ -381,12 +401,7 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
         spacing,
         slowness: Slowness::Constant(1.0), // unused by InnerScheme::General and ::Upwind
         extension,
-        // the upwind local solver of `tubesweep_core::scheme::upwind`, or the Lax–Friedrichs update of Sect. 5.1
-        scheme: if upwind {
-            InnerScheme::Upwind(solver)
-        } else {
-            InnerScheme::General(ham)
-        },
+        scheme,
         missing,
     };
     run_sweeps(py, &problem, fixed, &options, progress)

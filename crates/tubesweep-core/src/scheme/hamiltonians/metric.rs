@@ -16,7 +16,8 @@
 use super::slowness_at;
 use crate::Hamiltonian;
 
-/// `sqrt(pᵀ M(x) p) − s(x)`.
+/// `sqrt(pᵀ M(x) p) − s(x)`, for the Lax–Friedrichs update of Sect. 5.1 (`M` read as given, a full
+/// matrix per node). The upwind local solver takes [`super::SymmetricMetric`] (the symmetric part, packed).
 pub struct Metric<'a, const D: usize> {
     /// Slowness `1/F` per band node (or a single value for all nodes).
     pub slowness: &'a [f64],
@@ -71,7 +72,7 @@ impl<'a, const D: usize> Hamiltonian<D> for Metric<'a, D> {
 }
 
 /// Determinant by Gaussian elimination with partial pivoting.
-fn determinant<const D: usize>(mut a: [[f64; D]; D]) -> f64 {
+pub(super) fn determinant<const D: usize>(mut a: [[f64; D]; D]) -> f64 {
     let mut det = 1.0;
     for c in 0..D {
         let p = (c..D)

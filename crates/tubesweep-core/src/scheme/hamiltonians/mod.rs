@@ -12,6 +12,9 @@
 //! | [`MovingMedium`] | `|∇u| = |1 − v·∇u| / F` | Sect. 6.3 |
 //! | [`Metric`] | `sqrt(∇uᵀ M ∇u) = 1/F` | Sect. 5.1 (anisotropic) |
 //!
+//! [`SymmetricMetric`] is the metric as the upwind local solver ([`crate::scheme::upwind`]) reads
+//! it: `(M + Mᵀ)/2` packed, `D(D+1)/2` numbers per node, or one matrix for all nodes.
+//!
 //! Viscosities are the exact per-node suprema of `|∂H/∂p_k|` over all `p` (so the local
 //! Lax–Friedrichs update is monotone at every node); each type accepts a constant override
 //! `sigma`, which must be at least as large to keep the scheme monotone.
@@ -19,10 +22,12 @@
 pub mod isotropic;
 pub mod metric;
 pub mod moving_medium;
+pub mod symmetric_metric;
 
 pub use isotropic::Isotropic;
 pub use metric::Metric;
 pub use moving_medium::MovingMedium;
+pub use symmetric_metric::SymmetricMetric;
 
 /// Slowness `1/F` at a node from a per-node slice, or a constant when the slice has length 1.
 #[inline(always)]

@@ -5,7 +5,7 @@
 //! solvers (and [`crate::scheme::hamiltonians::Isotropic`] through this interface) keep the call
 //! through the trait object. Either way the values are the same bits.
 
-use crate::scheme::hamiltonians::{Metric, MovingMedium};
+use crate::scheme::hamiltonians::{MovingMedium, SymmetricMetric};
 
 /// Which built-in solver a [`super::LocalSolver`] is ([`super::LocalSolver::builtin`]).
 #[derive(Clone, Copy)]
@@ -13,7 +13,7 @@ pub enum Builtin<'s, const D: usize> {
     /// The moving medium `F|p| + v·p = 1` ([`super::moving_medium`]).
     MovingMedium(&'s MovingMedium<'s, D>),
     /// The Riemannian metric `F sqrt(pᵀ M p) = 1` ([`super::metric`]).
-    Metric(&'s Metric<'s, D>),
+    Metric(&'s SymmetricMetric<'s, D>),
     /// Any other solver: called through the trait object.
     Other,
 }

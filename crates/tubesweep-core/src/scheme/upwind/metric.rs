@@ -18,8 +18,7 @@
 //! vertex `t = s h / sqrt((S_K)_kk) = s h sqrt((M⁻¹)_kk)`.
 
 use super::{larger_root, upwind_min, weight_floor, Faces, LocalSolver};
-use crate::scheme::hamiltonians::{slowness_at, Metric};
-use crate::Hamiltonian;
+use crate::scheme::hamiltonians::SymmetricMetric;
 
 struct Riemann<const D: usize> {
     m: [[f64; D]; D],
@@ -285,18 +284,20 @@ fn inverse_rows<const D: usize>(m: &[[f64; D]; D]) -> ([f64; D], [f64; D]) {
     }
 }
 
-impl<'a, const D: usize> LocalSolver<D> for Metric<'a, D> {
+impl<'a, const D: usize> LocalSolver<D> for SymmetricMetric<'a, D> {
+    /// The node's `(M + Mᵀ)/2` unpacked from its `D(D+1)/2` numbers into the full (exactly
+    /// symmetric) matrix.
     #[inline(always)]
     fn update(&self, node: usize, minus: [f64; D], plus: [f64; D], h: f64, old: f64) -> f64 {
         let faces = Riemann {
-            m: self.metric[node],
-            s: slowness_at(self.slowness, node),
+            m: self.at(node),
+            s: self.slowness_at(node),
         };
         upwind_min(&faces, minus, plus, h, old)
     }
 
     fn slowness_bound(&self) -> Option<f64> {
-        Hamiltonian::<D>::slowness_bound(self)
+        SymmetricMetric::slowness_bound(self)
     }
 
     fn builtin(&self) -> super::Builtin<'_, D> {
@@ -319,11 +320,7 @@ mod tests {
     fn identity_metric_is_the_isotropic_godunov_update() {
         let s = [1.3];
         let m = [[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]];
-        let met = Metric {
-            slowness: &s,
-            metric: &m,
-            sigma: None,
-        };
+        let met = SymmetricMetric::new(&s, &m);
         let h = 0.1;
         for (minus, plus) in [
             ([1.0, 1.02, 1.5], [1.3, 1.1, 1.01]),
@@ -340,11 +337,7 @@ mod tests {
         // u = q·x with qᵀ M q = s²
         let s = [0.8];
         let m3 = [[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]];
-        let met = Metric {
-            slowness: &s,
-            metric: &[m3],
-            sigma: None,
-        };
+        let met = SymmetricMetric::new(&s, &[m3]);
         let h = 0.05;
         for i in 0..60 {
             let (a, b) = (i as f64 * 0.7, i as f64 * 0.29);

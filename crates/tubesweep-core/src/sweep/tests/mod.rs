@@ -13,6 +13,7 @@ use std::sync::atomic::AtomicU8;
 mod bits;
 mod front_window;
 mod rim;
+mod symmetric_metric;
 mod upwind_dispatch;
 
 fn box_problem<'a>(

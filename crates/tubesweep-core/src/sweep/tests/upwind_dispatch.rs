@@ -2,7 +2,7 @@
 //! the bits of the same solvers called through the trait object.
 
 use super::*;
-use crate::scheme::hamiltonians::{Metric, MovingMedium};
+use crate::scheme::hamiltonians::{MovingMedium, SymmetricMetric};
 use crate::scheme::upwind::LocalSolver;
 
 /// A solver that forwards to another through the trait, hiding which built-in it is (so the
@@ -38,11 +38,7 @@ fn the_inlined_upwind_solvers_give_the_bits_of_the_trait_object() {
         sigma: None,
     };
     let m = vec![[[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]]; band.len()];
-    let met = Metric {
-        slowness: &s,
-        metric: &m,
-        sigma: None,
-    };
+    let met = SymmetricMetric::new(&s, &m);
     let solvers: [&dyn LocalSolver<3>; 2] = [&rot, &met];
     for solver in solvers {
         let hidden = Hidden(solver);
