@@ -623,16 +623,14 @@ class Metric(Hamiltonian):
             mt = pmp + mnn[:, None, None] * n[:, :, None] * n[:, None, :]
             m = np.where(has[:, None, None], mt, m)
         m = np.ascontiguousarray(m)
-        try:
-            inverse = np.linalg.inv(m)
-        except np.linalg.LinAlgError:
+        # M⁻¹ is formed only where a local travel time is asked for (local_time), not per node: here
+        # only whether it exists (the LU factorisation np.linalg.inv would run, without a zero pivot)
+        if np.any(np.linalg.slogdet(m)[0] == 0):
             raise ValueError(
                 "M is numerically singular at some band node (after its tangential part was taken): "
                 "its eigenvalues span too many orders of magnitude; rescale M or use tangential=False"
-            ) from None
-        return _Prepared(
-            self.kind, slowness, metric=m, sigma=self._sigma(d), scheme=self.scheme, extra={"inverse": inverse}
-        )
+            )
+        return _Prepared(self.kind, slowness, metric=m, sigma=self._sigma(d), scheme=self.scheme)
 
     def _constant(self) -> bool:
         """Whether ``M`` is one ``(d, d)`` matrix (stored once unless the tangential part makes it per node)."""
@@ -643,8 +641,11 @@ class Metric(Hamiltonian):
         return 0 if self._constant() and self.scheme != "lxf" else 8 * d * d
 
     def local_time(self, prep: _Prepared, nodes: np.ndarray, disp: np.ndarray) -> np.ndarray:
-        inv = prep.extra["inverse"]
-        inv = np.broadcast_to(inv[0], (len(nodes),) + inv.shape[1:]) if len(inv) == 1 else inv[nodes]
+        m = prep.metric
+        assert m is not None
+        # one matrix for all nodes (1, d, d), or the nodes' own
+        inv = np.linalg.inv(m if len(m) == 1 else m[nodes])
+        inv = np.broadcast_to(inv, (len(nodes),) + inv.shape[1:])
         return prep.slowness[nodes] * np.sqrt(np.maximum(np.einsum("ki,kij,kj->k", disp, inv, disp), 0.0))
 
 
