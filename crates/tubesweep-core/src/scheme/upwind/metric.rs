@@ -16,6 +16,11 @@
 //! `A t² − 2 B t + C = 0` with `A = Σ C_ij`, `B = Σ_ij C_ij w_j`, `C = Σ C_ij w_i w_j − s²h²`. The
 //! characteristic `∂G/∂P ∝ S_K P` enters from the face iff `(C (t − w))_j ≥ 0` for every `j`. On a
 //! vertex `t = s h / sqrt((S_K)_kk) = s h sqrt((M⁻¹)_kk)`.
+//!
+//! *Symmetry.* `M` must be exactly symmetric (the equation sees only its symmetric part, and the
+//! Python layer passes `(M + Mᵀ)/2`): `C` is built from the entries above the diagonal, and the
+//! deficit proof of the natural orthant ([`Faces::deficit_proved`]) reads `M P` off the causality
+//! weights, `W = C (t − w) = σ h M P`, instead of forming `M P` again.
 
 use super::{larger_root, upwind_min, weight_floor, Faces, LocalSolver};
 use crate::scheme::hamiltonians::SymmetricMetric;
@@ -182,15 +187,95 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         h: f64,
         below: f64,
     ) -> Option<f64> {
+        self.quadratic::<M, STRICT>(sk, w, sg, h, below).map(|(t, _)| t)
+    }
+
+    type Strict = Weights<D>;
+
+    #[inline(always)]
+    fn solve_strict(&self, sk: &[[f64; D]; D], w: &[f64; D], sg: &[f64; D], h: f64) -> Option<(f64, Weights<D>)> {
+        let (t, weights) = self.quadratic::<D, true>(sk, w, sg, h, f64::INFINITY)?;
+        Some((
+            t,
+            Weights {
+                weights,
+                t,
+                w: *w,
+                sh: self.s * h,
+            },
+        ))
+    }
+
+    /// With `d = Σ_{k∈S} σ_k δ_k e_k / h` (the deficit axes `S ⊆ def` moved inwards) and
+    /// `W = σ h M P` (the causality weights, [`Weights`]; `M` symmetric):
+    ///
+    /// ```text
+    ///     h² q(P − d) = h² q(P) − 2 Σ_S δ_k W_k + Σ_{k,l∈S} σ_k σ_l δ_k δ_l M_kl,
+    /// ```
+    ///
+    /// and the last sum is at most `(Σ_S δ_k sqrt(M_kk))² ≤ D Σ_S δ_k² M_kk` (`|M_kl| ≤
+    /// sqrt(M_kk M_ll)`, then Cauchy–Schwarz). So every corner lies inside the margin of
+    /// [`Faces::inside`] when every deficit axis gives `δ_k (2 W_k − D δ_k M_kk) ≥ max(L, 0)`,
+    /// `L = h² q(P) − (s h (1 − 1e-12))²` (a sum of such terms then reaches `L`): `D` products
+    /// and comparisons instead of the `2^D − 1` corners. Where the deficits are rounding-sized
+    /// (the discrete solution linear along an axis: most visits) the linear term decides;
+    /// larger ones fall back to the corners.
+    #[inline(always)]
+    fn deficit_proved(&self, st: &Weights<D>, deficit: &[f64; D], def: usize) -> bool {
+        let q0 = tree_sum::<D>(core::array::from_fn(|k| (st.t - st.w[k]) * st.weights[k]));
+        let r = st.sh * (1.0 - 1e-12);
+        let need = (q0 - r * r).max(0.0);
+        let dd = D as f64;
+        // the least slack over the axes, those off `def` at 0 (their deficit is 0): without a
+        // branch, so that `def = 0` (every slack 0) passes too
+        let slack = (0..D).fold(f64::INFINITY, |least, k| {
+            let gain = deficit[k] * (2.0 * st.weights[k] - dd * deficit[k] * self.m[k][k]);
+            least.min(gain - need * ((def >> k & 1) as f64))
+        });
+        slack >= 0.0
+    }
+}
+
+/// What the strict solve of a full face leaves for [`Faces::deficit_proved`]: the causality
+/// weights `W = C (t − w)` (`W_k = σ_k h (M P)_k`, `P` the face's gradient), `t`, `w` and `s h`.
+#[derive(Clone, Copy)]
+pub(crate) struct Weights<const D: usize> {
+    weights: [f64; D],
+    t: f64,
+    w: [f64; D],
+    sh: f64,
+}
+
+impl<const D: usize> Riemann<D> {
+    /// The face's value `t` and its causality weights `W = C (t − w)` ([`Faces::solve`]).
+    #[inline(always)]
+    fn quadratic<const M: usize, const STRICT: bool>(
+        &self,
+        sk: &[[f64; D]; D],
+        w: &[f64; M],
+        sg: &[f64; M],
+        h: f64,
+        below: f64,
+    ) -> Option<(f64, [f64; M])> {
         let sh = self.s * h;
         if M == 1 {
-            return (STRICT || sh * sh < below * below * sk[0][0]).then(|| sh / sk[0][0].sqrt());
+            let ok = STRICT || sh * sh < below * below * sk[0][0];
+            // one axis: the weight is the value times S_kk (> 0)
+            return ok.then(|| {
+                let t = sh / sk[0][0].sqrt();
+                (t, [t * sk[0][0]; M])
+            });
         }
         // C_ij = σ_i σ_j S_ij (σ_i² = 1: the diagonal as it is); its row sums r = C 1 and z = C w
         // give A = Σ r, B = Σ z, C = w·z − s²h² and the causality weights (C (t − w))_i = t r_i − z_i:
         // sums of M terms, not of M² (a shorter chain, and other rounding than the sums over i, j)
+        // (M symmetric: the entries above the diagonal, mirrored)
         let c: [[f64; M]; M] = core::array::from_fn(|i| {
-            core::array::from_fn(|j| if i == j { sk[i][i] } else { sg[i] * sg[j] * sk[i][j] })
+            core::array::from_fn(|j| match i.cmp(&j) {
+                core::cmp::Ordering::Equal => sk[i][i],
+                core::cmp::Ordering::Less => sg[i] * sg[j] * sk[i][j],
+                core::cmp::Ordering::Greater => sg[j] * sg[i] * sk[j][i],
+            })
         });
         let r: [f64; M] = core::array::from_fn(|i| tree_sum::<M>(core::array::from_fn(|j| c[i][j])));
         let z: [f64; M] = core::array::from_fn(|i| tree_sum::<M>(core::array::from_fn(|j| c[i][j] * w[j])));
@@ -203,12 +288,10 @@ impl<const D: usize> Faces<D> for Riemann<D> {
         // the causality weights sum to a t − b
         let t = larger_root::<STRICT>(a, b, cc, below)?;
         let floor = weight_floor::<STRICT>(a * t - b);
-        let causal = (0..M).fold(true, |ok, i| ok & (t * r[i] - z[i] >= floor));
-        causal.then_some(t)
+        let weights: [f64; M] = core::array::from_fn(|i| t * r[i] - z[i]);
+        let causal = (0..M).fold(true, |ok, i| ok & (weights[i] >= floor));
+        causal.then_some((t, weights))
     }
-}
-
-impl<const D: usize> Riemann<D> {
     /// [`Faces::inside`] at every corner of `def` (the check of [`Faces::inside_corners`]).
     fn exact_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
         let mut sub = def;

@@ -202,6 +202,13 @@ impl<const D: usize> Faces<D> for Randers<D> {
         let causal = (0..M).fold(g > 0.0, |ok, j| ok & (p.fk2 * (t - w[j]) + om[j] * g >= floor));
         causal.then_some(t)
     }
+
+    type Strict = ();
+
+    #[inline(always)]
+    fn solve_strict(&self, p: &Face<D>, w: &[f64; D], sg: &[f64; D], h: f64) -> Option<(f64, ())> {
+        self.solve::<D, true>(p, w, sg, h, f64::INFINITY).map(|t| (t, ()))
+    }
 }
 
 impl<'a, const D: usize> LocalSolver<D> for MovingMedium<'a, D> {

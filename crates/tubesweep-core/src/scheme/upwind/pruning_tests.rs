@@ -41,6 +41,10 @@ impl<'a, const D: usize, F: Faces<D>> Faces<D> for NoPruning<'a, F> {
         }
         self.0.solve::<M, false>(p, w, sg, h, below)
     }
+    type Strict = F::Strict;
+    fn solve_strict(&self, _p: &F::Projected, _w: &[f64; D], _sg: &[f64; D], _h: f64) -> Option<(f64, F::Strict)> {
+        None
+    }
 }
 
 /// [`upwind_min`] gives the same bits with its skips as with every face solved (`what` names the
@@ -294,4 +298,55 @@ fn inside_corners_is_inside_at_every_corner() {
     }
     // both answers occur
     assert!(yes > 1000 && no > 1000, "{yes} inside, {no} not");
+}
+
+/// The metric's quick deficit proof ([`Faces::deficit_proved`]) is sufficient: whenever it holds,
+/// every corner of the deficit box lies inside ([`Faces::inside`] at each). On random tilted
+/// metrics, full faces solved strictly, and deficits from rounding-sized to a tenth of a cell.
+#[test]
+fn quick_deficit_proof_implies_every_corner_inside() {
+    let mut r = sequence(0.6917, 0.1414);
+    let h = 0.02;
+    let (mut quick, mut fallback, mut solved) = (0, 0, 0);
+    for i in 0..40000 {
+        let m = random_metric(&mut r);
+        let riem = metric::tests_faces(0.8, m);
+        let pf = riem.project(7).unwrap();
+        let w: [f64; 3] = core::array::from_fn(|_| 0.01 * r());
+        let sg: [f64; 3] = core::array::from_fn(|_| if r() < 0.5 { 1.0 } else { -1.0 });
+        let Some((t, strict)) = riem.solve_strict(&pf, &w, &sg, h) else {
+            continue;
+        };
+        solved += 1;
+        let p: [f64; 3] = core::array::from_fn(|k| sg[k] * (t - w[k]) / h);
+        let def = 1 + i % 7;
+        // deficits of every size: rounding (1e-11), small, up to a tenth of a cell's value
+        let scale = [1e-11, 1e-6, 1e-4, 2e-3][i / 7 % 4];
+        let deficit: [f64; 3] = core::array::from_fn(|k| if def >> k & 1 == 1 { scale * (0.1 + r()) } else { 0.0 });
+        if !riem.deficit_proved(&strict, &deficit, def) {
+            fallback += 1;
+            continue;
+        }
+        quick += 1;
+        let moved: [f64; 3] = core::array::from_fn(|k| p[k] - sg[k] * deficit[k] / h);
+        for s in (1..8usize).filter(|s| s & !def == 0) {
+            let corner: [f64; 3] = core::array::from_fn(|k| if s >> k & 1 == 1 { moved[k] } else { p[k] });
+            assert!(
+                riem.inside(corner),
+                "m {m:?} w {w:?} sg {sg:?} deficit {deficit:?} corner {s}"
+            );
+        }
+    }
+    // both outcomes occur, and the test exercises the proof
+    assert!(
+        quick > 5000 && fallback > 500,
+        "{quick} proved quickly, {fallback} not, of {solved}"
+    );
+    // with no deficit axis the quick proof holds (the default's `def == 0`)
+    let riem = metric::tests_faces(0.8, random_metric(&mut r));
+    let pf = riem.project(7).unwrap();
+    let (_, strict) = riem
+        .solve_strict(&pf, &[0.0, 0.001, 0.002], &[1.0, -1.0, 1.0], h)
+        .unwrap();
+    assert!(riem.deficit_proved(&strict, &[0.0; 3], 0));
 }
