@@ -53,6 +53,10 @@ fn run(
         coupled: false,
         front_window: 0.0,
         defer_outer_rim: !plain,
+        row_prefetch_above: std::env::var("PREFETCH_ABOVE")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(tubesweep_core::sweep::default_row_prefetch_above),
         ..Default::default()
     };
     let mut u = sphere_source::starting_values(band);

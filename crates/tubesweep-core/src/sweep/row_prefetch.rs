@@ -17,14 +17,17 @@
 //! set (with the active flags) and its lower bound inside the front window. A row that the rows
 //! just before it wake is then missed; fetching the clean rows too (two rows ahead) made the default
 //! sweeps at N = 1001 on two threads 1.47× slower (6 alternating rounds) and Python's paper sweeps at
-//! N = 401 no faster (1.009×). A general Hamiltonian's own per-node data (a metric, a flow) are
-//! neither counted nor fetched. On other architectures than x86-64 the sweeps never prefetch.
+//! N = 401 no faster (1.009×). An upwind solver's own per-node data (a metric, a flow, its
+//! slowness) are counted and fetched with the rest ([`crate::LocalSolver::bytes_per_node`],
+//! [`crate::LocalSolver::prefetch_nodes`]); a Lax–Friedrichs general Hamiltonian's are neither.
+//! On other architectures than x86-64 the sweeps never prefetch.
 //!
 //! [`SolveOptions::row_prefetch_above`]: super::SolveOptions::row_prefetch_above
 
 use super::problem::{Slowness, SweepProblem};
 use super::sweep_state::{Limits, SweepContext};
 use crate::prefetch::prefetch_range;
+use crate::scheme::hamiltonian::InnerScheme;
 use crate::sweep::cache_size::last_level_cache_bytes;
 
 /// How many rows ahead in the visiting order the sweeps prefetch. Against 2, with the `sphere`
@@ -62,6 +65,9 @@ impl<const D: usize> SweepProblem<'_, D> {
         }
         if let Slowness::PerNode(_) = self.slowness {
             bytes += size_of::<f64>();
+        }
+        if let InnerScheme::Upwind(solver) = self.scheme {
+            bytes += solver.bytes_per_node();
         }
         bytes
     }
@@ -101,6 +107,9 @@ impl<const D: usize> SweepProblem<'_, D> {
         prefetch_range(ctx.coupling, s, e);
         if let Slowness::PerNode(slow) = self.slowness {
             prefetch_range(slow, s, e);
+        }
+        if let InnerScheme::Upwind(solver) = self.scheme {
+            solver.prefetch_nodes(s, e);
         }
     }
 }

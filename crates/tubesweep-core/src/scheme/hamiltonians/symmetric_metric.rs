@@ -58,6 +58,20 @@ impl<'a, const D: usize> SymmetricMetric<'a, D> {
         self.packed.len() * core::mem::size_of::<f64>()
     }
 
+    /// The bytes an update of one node reads of the packed matrices and the slowness (0 for
+    /// one value for all nodes), for the sweeps' row prefetch (`sweep/row_prefetch.rs`).
+    pub(crate) fn bytes_per_node(&self) -> usize {
+        self.stride * core::mem::size_of::<f64>() + crate::scheme::upwind::per_node_bytes(self.slowness)
+    }
+
+    /// Asks for the cache lines of the matrices and slowness of the nodes `start..end`.
+    pub(crate) fn prefetch_nodes(&self, start: usize, end: usize) {
+        if self.stride > 0 {
+            crate::prefetch::prefetch_range(&self.packed, start * self.stride, end * self.stride);
+        }
+        crate::scheme::upwind::prefetch_per_node(self.slowness, start, end);
+    }
+
     /// `(M + Mᵀ)/2` at a band node, unpacked.
     #[inline(always)]
     pub fn at(&self, node: usize) -> [[f64; D]; D] {

@@ -386,6 +386,14 @@ impl<'a, const D: usize> LocalSolver<D> for SymmetricMetric<'a, D> {
     fn builtin(&self) -> super::Builtin<'_, D> {
         super::Builtin::Metric(self)
     }
+
+    fn bytes_per_node(&self) -> usize {
+        SymmetricMetric::bytes_per_node(self)
+    }
+
+    fn prefetch_nodes(&self, start: usize, end: usize) {
+        SymmetricMetric::prefetch_nodes(self, start, end)
+    }
 }
 
 #[cfg(test)]

@@ -76,6 +76,15 @@ pub trait LocalSolver<const D: usize>: Sync {
     fn builtin(&self) -> Builtin<'_, D> {
         Builtin::Other
     }
+    /// The bytes of the solver's own per-node data (a metric, a flow, a slowness) that an update
+    /// of one node reads: counted with the kernel's arrays when the sweeps decide whether to fetch
+    /// rows ahead (`sweep/row_prefetch.rs`). 0 (the default) when it has none.
+    fn bytes_per_node(&self) -> usize {
+        0
+    }
+    /// Asks for the cache lines of the per-node data of the nodes `start..end` (a row the sweep
+    /// will visit soon; `sweep/row_prefetch.rs`). The default fetches nothing.
+    fn prefetch_nodes(&self, _start: usize, _end: usize) {}
 }
 
 /// One node's Hamiltonian as seen by [`upwind_min`]: the projection on a face and the solve there.
@@ -211,6 +220,24 @@ pub(crate) const SUBSETS_OF: [u8; 8] = {
     }
     t
 };
+
+/// The bytes per node of a solver's array given per node, 0 for one value for all nodes (a
+/// slice of length 1, as [`crate::scheme::hamiltonians::slowness_at`] reads it).
+pub(crate) fn per_node_bytes<T>(data: &[T]) -> usize {
+    if data.len() > 1 {
+        std::mem::size_of::<T>()
+    } else {
+        0
+    }
+}
+
+/// [`crate::prefetch::prefetch_range`] of a solver's array given per node (nothing for one value
+/// for all nodes).
+pub(crate) fn prefetch_per_node<T>(data: &[T], start: usize, end: usize) {
+    if data.len() > 1 {
+        crate::prefetch::prefetch_range(data, start, end);
+    }
+}
 
 /// The sign of a side: `+1` for the minus neighbour (`side = 0`), `−1` for the plus neighbour.
 #[inline(always)]

@@ -25,7 +25,7 @@
 //! keeps its value. The Python layer refuses such flows for this solver (the Lax–Friedrichs
 //! update of the equation as written is used with `allow_supersonic=True`).
 
-use super::{larger_root, upwind_min, weight_floor, Faces, LocalSolver};
+use super::{larger_root, per_node_bytes, prefetch_per_node, upwind_min, weight_floor, Faces, LocalSolver};
 use crate::scheme::hamiltonians::{slowness_at, MovingMedium};
 use crate::Hamiltonian;
 
@@ -226,6 +226,15 @@ impl<'a, const D: usize> LocalSolver<D> for MovingMedium<'a, D> {
 
     fn builtin(&self) -> super::Builtin<'_, D> {
         super::Builtin::MovingMedium(self)
+    }
+
+    fn bytes_per_node(&self) -> usize {
+        per_node_bytes(self.flow) + per_node_bytes(self.slowness)
+    }
+
+    fn prefetch_nodes(&self, start: usize, end: usize) {
+        prefetch_per_node(self.flow, start, end);
+        prefetch_per_node(self.slowness, start, end);
     }
 }
 

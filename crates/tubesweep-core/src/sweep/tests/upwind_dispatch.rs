@@ -67,3 +67,41 @@ fn the_inlined_upwind_solvers_give_the_bits_of_the_trait_object() {
         }
     }
 }
+
+/// An upwind solver's own per-node data (the packed metric's 48 bytes a node) count when the sweeps
+/// decide whether to fetch rows ahead, and fetching them (and the rows) changes no bit. (Only
+/// x86-64 prefetches.)
+#[test]
+#[cfg(target_arch = "x86_64")]
+fn the_upwind_solvers_data_count_for_prefetching_and_change_no_bit() {
+    let (band, roles, dirs, h) = sphere_band(33);
+    let s = [1.0];
+    let m = vec![[[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]]; band.len()];
+    let met = SymmetricMetric::new(&s, &m);
+    assert_eq!(LocalSolver::<3>::bytes_per_node(&met), 48);
+    assert_eq!(LocalSolver::<3>::bytes_per_node(&SymmetricMetric::new(&s, &m[..1])), 0);
+    let run = |scheme, above: usize| {
+        let opts = SolveOptions {
+            threads: 1,
+            skip_inactive: false,
+            row_prefetch_above: above,
+            ..Default::default()
+        };
+        let p = sphere_problem(&band, &roles, &dirs, h, scheme);
+        let mut u = vec![0.0; band.len()];
+        let st = p.solve(&mut u, &opts, &mut |_| Control::Continue).unwrap();
+        assert!(st.converged);
+        (u, st)
+    };
+    // between the kernel's own arrays (under 60 bytes a node) and those with the metric (over
+    // 90): the metric's solve fetches ahead (from its second iteration on), Eq. (3)'s does not
+    let above = 80 * band.len();
+    let (_, god) = run(InnerScheme::Godunov, above);
+    assert_eq!(god.prefetch_iterations, 0);
+    let (a, st) = run(InnerScheme::Upwind(&met), above);
+    assert_eq!(st.prefetch_iterations, st.iterations - 1);
+    let (b, never) = run(InnerScheme::Upwind(&met), usize::MAX);
+    assert_eq!(never.prefetch_iterations, 0);
+    assert_eq!((st.iterations, st.updates), (never.iterations, never.updates));
+    assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+}
