@@ -622,11 +622,6 @@ class Metric(Hamiltonian):
                 mnn = np.trace(pmp, axis1=1, axis2=2) / (d - 1)
             mt = pmp + mnn[:, None, None] * n[:, :, None] * n[:, None, :]
             m = np.where(has[:, None, None], mt, m)
-        if self.scheme != "lxf":
-            # the upwind solver takes M exactly symmetric (its proofs use W = C (t − w) for
-            # M P); the equation only sees the symmetric part, and P M P is symmetric only up to
-            # rounding. The Lax–Friedrichs update reads M as given (the paper's bits).
-            m = 0.5 * (m + np.swapaxes(m, 1, 2))
         m = np.ascontiguousarray(m)
         # M⁻¹ is formed only where a local travel time is asked for (local_time), not per node: here
         # only whether it exists (the LU factorisation np.linalg.inv would run, without a zero pivot)

@@ -17,8 +17,8 @@
 //! characteristic `∂G/∂P ∝ S_K P` enters from the face iff `(C (t − w))_j ≥ 0` for every `j`. On a
 //! vertex `t = s h / sqrt((S_K)_kk) = s h sqrt((M⁻¹)_kk)`.
 //!
-//! *Symmetry.* `M` must be exactly symmetric (the equation sees only its symmetric part, and the
-//! Python layer passes `(M + Mᵀ)/2`): `C` is built from the entries above the diagonal, and the
+//! *Symmetry.* `M` is exactly symmetric (the equation sees only its symmetric part, which
+//! [`SymmetricMetric`] stores): `C` is built from the entries above the diagonal, and the
 //! deficit proof of the natural orthant ([`Faces::deficit_proved`]) reads `M P` off the causality
 //! weights, `W = C (t − w) = σ h M P`, instead of forming `M P` again.
 
