@@ -185,8 +185,8 @@ pub struct SolveOptions {
     /// reads (before the first iteration every row counts as visited, or none with the front
     /// window): with the band's data beyond the last-level cache the tiles' short runs through
     /// memory would wait on it; within, the hints only cost instructions
-    /// (`sweep/row_prefetch.rs`). Default [`default_row_prefetch_above`], a share of the
-    /// last-level cache; 0 prefetches in every iteration that follows one that visited a row
+    /// (`sweep/row_prefetch.rs`; an upwind solver's sweeps count their bytes twice). Default
+    /// [`default_row_prefetch_above`], a share of the last-level cache; 0 prefetches in every iteration that follows one that visited a row
     /// (and in the first unless the window is on), `usize::MAX` never; x86-64 only. The same
     /// values either way.
     pub row_prefetch_above: usize,
