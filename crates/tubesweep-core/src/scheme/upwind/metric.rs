@@ -25,6 +25,16 @@
 use super::{larger_root, upwind_min, weight_floor, Faces, LocalSolver};
 use crate::scheme::hamiltonians::SymmetricMetric;
 
+/// The larger of two values as a plain compare-select (no NaN handling).
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 struct Riemann<const D: usize> {
     m: [[f64; D]; D],
     s: f64,
@@ -224,15 +234,15 @@ impl<const D: usize> Faces<D> for Riemann<D> {
     fn deficit_proved(&self, st: &Weights<D>, deficit: &[f64; D], def: usize) -> bool {
         let q0 = tree_sum::<D>(core::array::from_fn(|k| (st.t - st.w[k]) * st.weights[k]));
         let r = st.sh * (1.0 - 1e-12);
-        let need = (q0 - r * r).max(0.0);
+        let need = fmax(q0 - r * r, 0.0);
         let dd = D as f64;
-        // the least slack over the axes, those off `def` at 0 (their deficit is 0): without a
-        // branch, so that `def = 0` (every slack 0) passes too
-        let slack = (0..D).fold(f64::INFINITY, |least, k| {
+        // each axis's test, those off `def` against 0 (their deficit is 0): without a branch,
+        // so that `def = 0` (every gain 0) passes too; a NaN fails
+        let fails = (0..D).fold(0u32, |fails, k| {
             let gain = deficit[k] * (2.0 * st.weights[k] - dd * deficit[k] * self.m[k][k]);
-            least.min(gain - need * ((def >> k & 1) as f64))
+            fails | !(gain >= need * ((def >> k & 1) as f64)) as u32
         });
-        slack >= 0.0
+        fails == 0
     }
 }
 

@@ -62,6 +62,9 @@ pub mod moving_medium;
 
 pub use builtin::Builtin;
 
+// the plain compare-select minimum (no NaN handling: the sweeps hold no NaN), as in Eq. (3)
+use crate::scheme::godunov::fmin;
+
 /// An upwind local solver: the new value of a node from its neighbour values (Sect. 5.1's
 /// interface, with a Godunov-type update in place of Lax–Friedrichs).
 pub trait LocalSolver<const D: usize>: Sync {
@@ -290,7 +293,7 @@ fn faces_on<const D: usize, const M: usize, F: Faces<D>>(
         if skip || containing[s] as u32 & proved != 0 {
             continue;
         }
-        let base = u.iter().cloned().fold(f64::INFINITY, f64::min);
+        let base = u.iter().cloned().fold(f64::INFINITY, fmin);
         if !(base + bound < *best) {
             continue;
         }
@@ -336,7 +339,7 @@ fn natural_orthant<const D: usize, F: Faces<D>>(
     h: f64,
 ) -> Option<(f64, bool)> {
     let u: [f64; D] = core::array::from_fn(|k| nb[k][o >> k & 1]);
-    let base = u.iter().cloned().fold(f64::INFINITY, f64::min);
+    let base = u.iter().cloned().fold(f64::INFINITY, fmin);
     let w: [f64; D] = core::array::from_fn(|k| u[k] - base);
     let sg: [f64; D] = core::array::from_fn(|k| side_sign(o >> k & 1));
     let (t, strict) = faces.solve_strict(pf, &w, &sg, h)?;
@@ -505,7 +508,7 @@ fn face_value<const D: usize, const M: usize, F: Faces<D>>(
             j += 1;
         }
     }
-    let base = u.iter().cloned().fold(f64::INFINITY, f64::min);
+    let base = u.iter().cloned().fold(f64::INFINITY, fmin);
     let w: [f64; M] = core::array::from_fn(|j| u[j] - base);
     let t = faces.solve::<M, true>(proj, &w, &sg, h, f64::INFINITY)?;
     Some(base + t)
@@ -548,7 +551,7 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
     debug_assert!((1..=3).contains(&D));
     // every face's value exceeds its smallest vertex value (φ > 0): when no neighbour is below
     // `old` (an unreached node among unreached ones), nothing can be
-    let lowest = (0..D).fold(f64::INFINITY, |m, k| m.min(minus[k]).min(plus[k]));
+    let lowest = (0..D).fold(f64::INFINITY, |m, k| fmin(fmin(m, minus[k]), plus[k]));
     if lowest >= old {
         return old;
     }
@@ -580,7 +583,7 @@ pub(crate) fn upwind_min<const D: usize, F: Faces<D>>(
         natural_orthant(faces, &pf, &nb, o0, h)
     };
     if let Some((mu, true)) = first {
-        return mu.min(old);
+        return fmin(mu, old);
     }
     upwind_min_rest(faces, &pf, &nb, o0, first, h, old)
 }
@@ -637,7 +640,7 @@ fn upwind_min_rest<const D: usize, F: Faces<D>>(
             continue;
         }
         let u: [f64; D] = core::array::from_fn(|k| nb[k][o >> k & 1]);
-        let base = u.iter().cloned().fold(f64::INFINITY, f64::min);
+        let base = u.iter().cloned().fold(f64::INFINITY, fmin);
         if !(base + lo * INV_SQRT[D] < best) {
             // neither this simplex nor any of its faces can do better (their bounds are larger)
             continue;
