@@ -137,6 +137,31 @@ def test_unconverged_second_order_solve_warns_and_says_so():
     assert np.all(np.isfinite(u))
 
 
+def test_a_runaway_on_a_sharp_speed_contrast_falls_back_to_order_1_with_a_warning():
+    # the source in a slow half, the other half 100× faster (3D; 30× suffices): the factored update is
+    # not causal there and its sweeps fell below zero (to −35 after max_iterations, converged=False) before
+    # the runaway guard; now they are abandoned for the plain first-order sweeps, with a warning
+    grid = box(21)
+    speed = np.where(np.indices(grid.shape)[0] < 10, 1.0, 100.0)
+    src = [(-0.8, -0.8, -0.8)]
+    with pytest.warns(RuntimeWarning, match="ran away"):
+        sol, st = ts.travel_time(grid, src, speed=speed, order=2, return_solution=True, return_stats=True)
+    o2 = st.order2
+    assert st.converged and o2["runaway_iteration"] is not None and o2["runaway_iteration"] < 20, o2
+    assert o2["plain_iterations"] >= 2 and st.iterations == o2["runaway_iteration"] + o2["plain_iterations"]
+    u = sol.values
+    assert np.all(np.isfinite(u)) and u.min() >= 0.0
+    first = ts.travel_time(grid, src, speed=speed, order=1)
+    assert np.abs(u - first).max() < 1e-6 * first.max()  # the same scheme, to the stopping tests
+    assert sol(src)[0] == 0.0
+    # a checkerboard of speeds 1 and 1e6 does not run away: converged, non-negative, no warning
+    checker = np.where(np.indices(grid.shape).sum(0) % 2 == 0, 1.0, 1e6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        u, st = ts.travel_time(grid, [(0.0, 0.0, 0.0)], speed=checker, order=2, return_stats=True)
+    assert st.converged and st.order2["runaway_iteration"] is None and np.all(np.isfinite(u)) and u.min() >= 0.0
+
+
 def test_threads_do_not_change_the_bits():
     grid = box(25)
     a = ts.travel_time(grid, [XS], speed=linear_speed, order=2, threads=1)

@@ -227,7 +227,9 @@ def travel_time(
     Warns
     -----
     RuntimeWarning
-        If the sweeps have not converged within ``max_iterations``.
+        If the sweeps have not converged within ``max_iterations``; with ``order=2``, also if the
+        factored sweeps ran away on a sharp speed contrast (the values are then ``order=1``'s,
+        ``stats.order2["runaway_iteration"]``).
 
     Examples
     --------
@@ -425,6 +427,15 @@ def _order2(
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
+    if st["runaway_iteration"] is not None:
+        warnings.warn(
+            f"order=2: the factored sweeps ran away at iteration {st['runaway_iteration']} (a travel time fell below "
+            "zero: the speed varies too sharply for the factored update, e.g. a region far faster than the source's) "
+            "and were abandoned: the values returned are the plain first-order scheme's (order=1). "
+            "stats.order2['runaway_iteration'] records it; a smoother speed or order=1 avoids it",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
     if np.any(np.isnan(values)):
         raise FloatingPointError(
             "the second-order solve produced NaN: the travel times left the float64 range in the local updates. "
@@ -454,6 +465,8 @@ def _order2(
             "fallback_iteration": (
                 None if st["safeguard_iteration"] is None else st["safeguard_iteration"] - st["first_order_iterations"]
             ),
+            "runaway_iteration": st["runaway_iteration"],
+            "plain_iterations": st["plain_iterations"],
             "unreached": int(np.count_nonzero(~np.isfinite(values))),
             "tol": float(tol),
             "fix_radius": SOURCE_RADIUS * grid.spacing,

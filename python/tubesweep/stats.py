@@ -76,9 +76,11 @@ class SolveStats:
     order2 : dict or None
         For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
         phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
-        switched to accepting decreases only, None when it did not fire), on surfaces ``runaway_iteration``
-        (the phase-2 iteration at which a value fell below zero and the second-order sweeps were
-        abandoned for the first phase's values, with a warning; None when they were not),
+        switched to accepting decreases only, None when it did not fire), ``runaway_iteration``
+        (on surfaces the phase-2 iteration at which a value fell below zero and the second-order sweeps were
+        abandoned for the first phase's values; in the box the iteration, both phases counted, at which the
+        factored sweeps fell below zero and were abandoned for the plain first-order scheme, whose
+        ``plain_iterations`` follow; with a warning; None when they were not),
         ``unreached`` (nodes
         never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of
         nodes fixed around each source); on surfaces also ``max_curvature`` (the largest principal

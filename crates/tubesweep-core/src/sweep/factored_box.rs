@@ -18,6 +18,15 @@
 //! accepting decreases only, which ends any limit cycle; [`FactoredStats::safeguard_iteration`]
 //! records it.
 //!
+//! **Runaway guard.** The factored first-order update is not causal everywhere: where the local
+//! slowness is far below the source's (a fast region next to a source in a slow one, contrasts of
+//! about 30× in 3D and 100× in 2D), the factor's curvature term `sⱼΔx²/r` outweighs the local
+//! `sΔx`, two neighbours each lower the other, and the monotone phase 1 (or phase 2) falls without
+//! bound. Travel times are never negative, so a value below [`RUNAWAY_FLOOR`]`·s_min·Δx` ends the
+//! factored solve: the sweeps start again from the fixed nodes with the plain first-order update
+//! (no factor: the paper's Eq. (3), monotone and causal, so it converges) and its values are
+//! returned; [`FactoredStats::runaway_iteration`] records it.
+//!
 //! **Parallel sweeps, same bits.** A sweep visits the grid's rows (the last axis) in the order of
 //! the sweep's orientation. A node reads only its axis neighbours at distances 1 and 2, so in 3D
 //! the rows whose first two oriented indices have the same sum read none of each other and are
@@ -101,7 +110,43 @@ pub struct FactoredStats {
     /// The iteration after which phase 2 fell back to accepting decreases only (the stagnation
     /// safeguard), if it did.
     pub safeguard_iteration: Option<usize>,
+    /// The iteration (phases 1 and 2 counted together) after which a value fell below
+    /// [`RUNAWAY_FLOOR`]`·s_min·Δx` and the factored sweeps were abandoned for the plain
+    /// first-order ones (the module's note); None when they were not.
+    pub runaway_iteration: Option<usize>,
+    /// Iterations of the plain first-order sweeps after a runaway (0 without one).
+    pub plain_iterations: usize,
     pub seconds: f64,
+}
+
+/// A value below `-RUNAWAY_FLOOR·s_min·Δx` (`s_min` the smallest slowness) is a runaway: travel
+/// times are never negative, and the nodes next to a source are fixed at positive values, so no
+/// converging iterate comes near it.
+pub const RUNAWAY_FLOOR: f64 = 1.0;
+
+/// What a row, a sweep or an iteration did: the largest change, the number of updates and the
+/// smallest value it changed a node to.
+#[derive(Clone, Copy)]
+struct Outcome {
+    change: f64,
+    updates: u64,
+    lowest: f64,
+}
+
+impl Outcome {
+    const NONE: Outcome = Outcome {
+        change: 0.0,
+        updates: 0,
+        lowest: f64::INFINITY,
+    };
+    #[inline(always)]
+    fn and(self, o: Outcome) -> Outcome {
+        Outcome {
+            change: self.change.max(o.change),
+            updates: self.updates + o.updates,
+            lowest: self.lowest.min(o.lowest),
+        }
+    }
 }
 
 /// The node values, written by one row's worker and read by the others (see the module's note
@@ -155,6 +200,8 @@ struct Sweeper<'p, 'a, const D: usize> {
     ramp_length: f64,
     parallel_min_nodes: usize,
     activation_threshold: f64,
+    /// `false` after a runaway: `u₀ = 0` and no factor gradient (the plain Eq. (3)).
+    factored: bool,
 }
 
 impl<'a, const D: usize> FactoredBox<'a, D> {
@@ -290,7 +337,7 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
         for k in (0..D - 1).rev() {
             stride[k] = stride[k + 1] * self.shape[k + 1];
         }
-        let sw = Sweeper {
+        let mut sw = Sweeper {
             p: self,
             stride,
             u0,
@@ -299,7 +346,13 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
             ramp_length: options.ramp_length,
             parallel_min_nodes: options.parallel_min_nodes,
             activation_threshold: options.activation_threshold,
+            factored: true,
         };
+        let min_slowness = match self.slowness {
+            Slowness::Constant(s) => s,
+            Slowness::PerNode(v) => v.iter().copied().fold(f64::INFINITY, f64::min),
+        };
+        let floor = -RUNAWAY_FLOOR * min_slowness * self.h;
         let pool = if options.threads > 1 {
             Some(
                 rayon::ThreadPoolBuilder::new()
@@ -330,8 +383,7 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
         // the first sweep of the current phase (or mode): every node is updated in it
         let mut phase_start = 1u32;
         while stats.iterations < options.max_iterations {
-            let mut change = 0.0f64;
-            let mut updates = 0u64;
+            let mut out = Outcome::NONE;
             for orientation in 0..(1usize << D) {
                 let sweep = Sweep {
                     index: stats.sweeps as u32 + 1 + orientation as u32,
@@ -340,18 +392,19 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
                     monotone,
                 };
                 let run = || sw.sweep(shared, stamps, orientation, sweep, parallel);
-                let (c, m) = match &pool {
+                out = out.and(match &pool {
                     Some(pool) => pool.install(run),
                     None => run(),
-                };
-                change = change.max(c);
-                updates += m;
+                });
             }
+            let (change, updates) = (out.change, out.updates);
             stats.iterations += 1;
             stats.sweeps += 1 << D;
             stats.updates += updates;
             stats.last_change = change;
-            if second {
+            if !sw.factored {
+                stats.plain_iterations += 1;
+            } else if second {
                 stats.second_order_iterations += 1;
             } else {
                 stats.first_order_iterations += 1;
@@ -366,9 +419,24 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
                     iterations: stats.iterations,
                 });
             }
+            if sw.factored && out.lowest < floor {
+                // a runaway: the plain first-order sweeps from the fixed nodes again
+                stats.runaway_iteration = Some(stats.iterations);
+                sw.factored = false;
+                sw.u0.iter_mut().for_each(|v| *v = 0.0);
+                for (i, f) in sw.fixed.iter().enumerate() {
+                    if !f {
+                        shared.set(i, f64::INFINITY);
+                    }
+                }
+                second = false;
+                monotone = true;
+                phase_start = stats.sweeps as u32 + 1;
+                continue;
+            }
             if !second {
                 if change < options.tol {
-                    if !options.second_order {
+                    if !options.second_order || !sw.factored {
                         stats.converged = true;
                         break;
                     }
@@ -408,22 +476,21 @@ fn dist<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
 impl<const D: usize> Sweeper<'_, '_, D> {
     /// One sweep in the orientation whose bit `k` reverses axis `k`; the largest change and the
     /// number of updates.
-    fn sweep(&self, u: Shared, stamps: Stamps, orientation: usize, sweep: Sweep, parallel: bool) -> (f64, u64) {
+    fn sweep(&self, u: Shared, stamps: Stamps, orientation: usize, sweep: Sweep, parallel: bool) -> Outcome {
         let shape = self.p.shape;
         let oriented = |k: usize, c: usize| if orientation >> k & 1 == 1 { shape[k] - 1 - c } else { c };
         if D == 2 {
-            let mut out = (0.0f64, 0u64);
+            let mut out = Outcome::NONE;
             for c0 in 0..shape[0] {
                 let mut prefix = [0usize; D];
                 prefix[0] = oriented(0, c0);
-                let r = self.row(u, stamps, prefix, orientation, sweep);
-                out = (out.0.max(r.0), out.1 + r.1);
+                out = out.and(self.row(u, stamps, prefix, orientation, sweep));
             }
             return out;
         }
         // D == 3: levels of c0 + c1, the rows of a level in parallel
         let (n0, n1) = (shape[0], shape[1]);
-        let mut out = (0.0f64, 0u64);
+        let mut out = Outcome::NONE;
         for level in 0..(n0 + n1 - 1) {
             let lo = level.saturating_sub(n1 - 1);
             let hi = level.min(n0 - 1);
@@ -438,13 +505,11 @@ impl<const D: usize> Sweeper<'_, '_, D> {
                 (lo..=hi)
                     .into_par_iter()
                     .map(one)
-                    .reduce(|| (0.0, 0), |a, b| (a.0.max(b.0), a.1 + b.1))
+                    .reduce(|| Outcome::NONE, Outcome::and)
             } else {
-                (lo..=hi)
-                    .map(one)
-                    .fold((0.0f64, 0u64), |a, b| (a.0.max(b.0), a.1 + b.1))
+                (lo..=hi).map(one).fold(Outcome::NONE, Outcome::and)
             };
-            out = (out.0.max(r.0), out.1 + r.1);
+            out = out.and(r);
         }
         out
     }
@@ -473,7 +538,7 @@ impl<const D: usize> Sweeper<'_, '_, D> {
     }
 
     /// Updates the row (the last axis) whose other indices are `prefix[..D-1]`.
-    fn row(&self, u: Shared, stamps: Stamps, prefix: [usize; D], orientation: usize, sweep: Sweep) -> (f64, u64) {
+    fn row(&self, u: Shared, stamps: Stamps, prefix: [usize; D], orientation: usize, sweep: Sweep) -> Outcome {
         let last = self.p.shape[D - 1];
         let reversed = orientation >> (D - 1) & 1 == 1;
         let mut base = 0;
@@ -483,6 +548,7 @@ impl<const D: usize> Sweeper<'_, '_, D> {
         let mut idx = prefix;
         let mut change = 0.0f64;
         let mut updates = 0u64;
+        let mut lowest = f64::INFINITY;
         for c in 0..last {
             let i = if reversed { last - 1 - c } else { c };
             let n = base + i;
@@ -512,12 +578,17 @@ impl<const D: usize> Sweeper<'_, '_, D> {
                 u.set(n, new);
                 let d = (new - old).abs();
                 change = change.max(d);
+                lowest = lowest.min(new);
                 if !(d <= self.activation_threshold) {
                     unsafe { *stamps.changed.add(n) = sweep.index };
                 }
             }
         }
-        (change, updates)
+        Outcome {
+            change,
+            updates,
+            lowest,
+        }
     }
 
     /// The local update at node `n` (grid index `idx`): `u₀ + w`, `w` the root of the limited
@@ -530,7 +601,13 @@ impl<const D: usize> Sweeper<'_, '_, D> {
         let ss = p.source_slowness[src as usize];
         let x: [f64; D] = std::array::from_fn(|k| p.lower[k] + p.h * idx[k] as f64);
         let r = dist(&x, xs);
-        let g: [f64; D] = std::array::from_fn(|k| if r > 0.0 { ss * (x[k] - xs[k]) / r } else { 0.0 });
+        let g: [f64; D] = std::array::from_fn(|k| {
+            if self.factored && r > 0.0 {
+                ss * (x[k] - xs[k]) / r
+            } else {
+                0.0
+            }
+        });
         let s = match p.slowness {
             Slowness::Constant(s) => s,
             Slowness::PerNode(v) => v[n],
@@ -538,7 +615,9 @@ impl<const D: usize> Sweeper<'_, '_, D> {
         let eps = s * p.h * p.h / self.ramp_length;
         // the factor at node m = n + off·e_k, by the node's own source
         let factor = |m: usize, k: usize, off: f64| -> f64 {
-            if self.source_of[m] == src {
+            if !self.factored {
+                0.0
+            } else if self.source_of[m] == src {
                 self.u0[m]
             } else {
                 let mut y = x;
