@@ -429,8 +429,8 @@ def _order2(
         )
     if st["runaway_iteration"] is not None:
         warnings.warn(
-            f"order=2: the factored sweeps ran away at iteration {st['runaway_iteration']} (a travel time fell below "
-            "zero: the speed varies too sharply for the factored update, e.g. a region far faster than the source's) "
+            f"order=2: the factored sweeps ran away at iteration {st['runaway_iteration']} (travel times falling without "
+            "bound: the speed varies too sharply for the factored update, e.g. a region far faster than the source's) "
             "and were abandoned: the values returned are the plain first-order scheme's (order=1). "
             "stats.order2['runaway_iteration'] records it; a smoother speed or order=1 avoids it",
             RuntimeWarning,

@@ -79,7 +79,7 @@ class SolveStats:
         switched to accepting decreases only, None when it did not fire), ``runaway_iteration``
         (on surfaces the phase-2 iteration at which a value fell below zero and the second-order sweeps were
         abandoned for the first phase's values; in the box the iteration, both phases counted, at which the
-        factored sweeps fell below zero and were abandoned for the plain first-order scheme, whose
+        factored sweeps fell without bound and were abandoned for the plain first-order scheme, whose
         ``plain_iterations`` follow; with a warning; None when they were not),
         ``unreached`` (nodes
         never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of

@@ -23,9 +23,11 @@
 //! about 30× in 3D and 100× in 2D), the factor's curvature term `sⱼΔx²/r` outweighs the local
 //! `sΔx`, two neighbours each lower the other, and the monotone phase 1 (or phase 2) falls without
 //! bound. Travel times are never negative, so a value below [`RUNAWAY_FLOOR`]`·s_min·Δx` ends the
-//! factored solve: the sweeps start again from the fixed nodes with the plain first-order update
-//! (no factor: the paper's Eq. (3), monotone and causal, so it converges) and its values are
-//! returned; [`FactoredStats::runaway_iteration`] records it.
+//! factored solve, and so does a monotone iteration (phase 1, or phase 2 after the safeguard)
+//! whose change stops shrinking ([`DRIFT_WINDOW`], [`DRIFT_RATIO`]: a slow fall, long before it
+//! reaches the floor): the sweeps start again from the fixed nodes with the plain first-order
+//! update (no factor: the paper's Eq. (3), monotone and causal, so it converges) and its values
+//! are returned; [`FactoredStats::runaway_iteration`] records it.
 //!
 //! **Parallel sweeps, same bits.** A sweep visits the grid's rows (the last axis) in the order of
 //! the sweep's orientation. A node reads only its axis neighbours at distances 1 and 2, so in 3D
@@ -111,8 +113,9 @@ pub struct FactoredStats {
     /// safeguard), if it did.
     pub safeguard_iteration: Option<usize>,
     /// The iteration (phases 1 and 2 counted together) after which a value fell below
-    /// [`RUNAWAY_FLOOR`]`·s_min·Δx` and the factored sweeps were abandoned for the plain
-    /// first-order ones (the module's note); None when they were not.
+    /// [`RUNAWAY_FLOOR`]`·s_min·Δx`, or the monotone sweeps drifted ([`DRIFT_WINDOW`]), and the
+    /// factored sweeps were abandoned for the plain first-order ones (the module's note); None
+    /// when they were not.
     pub runaway_iteration: Option<usize>,
     /// Iterations of the plain first-order sweeps after a runaway (0 without one).
     pub plain_iterations: usize,
@@ -123,6 +126,14 @@ pub struct FactoredStats {
 /// times are never negative, and the nodes next to a source are fixed at positive values, so no
 /// converging iterate comes near it.
 pub const RUNAWAY_FLOOR: f64 = 1.0;
+
+/// The monotone sweeps (phase 1, or phase 2 after the stagnation safeguard) drift, which is a
+/// runaway too, when an iteration's change exceeds `DRIFT_RATIO` times that of `DRIFT_WINDOW`
+/// iterations earlier (both finite and at least `tol`): a monotone causal iteration's changes
+/// shrink, a drift's stay (a cycle of nodes lowering each other loses the same amount every
+/// iteration, slower than the floor can catch: 1.5e-4 per iteration at 81² with a 50× contrast).
+pub const DRIFT_WINDOW: usize = 10;
+pub const DRIFT_RATIO: f64 = 0.9;
 
 /// What a row, a sweep or an iteration did: the largest change, the number of updates and the
 /// smallest value it changed a node to.
@@ -368,6 +379,8 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
         let mut second = false;
         let mut monotone = true;
         let mut history: Vec<f64> = Vec::new();
+        // the finite changes of the current monotone mode's iterations
+        let mut drift: Vec<f64> = Vec::new();
         let shared = Shared {
             ptr: u.as_mut_ptr(),
             len: u.len(),
@@ -419,9 +432,20 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
                     iterations: stats.iterations,
                 });
             }
-            if sw.factored && out.lowest < floor {
+            // the monotone sweeps (phase 1, or phase 2 after the safeguard) converge unless they
+            // drift: a change that stops shrinking there is a runaway too
+            let drifting = monotone
+                && change.is_finite()
+                && change >= options.tol
+                && drift.len() >= DRIFT_WINDOW
+                && change > DRIFT_RATIO * drift[drift.len() - DRIFT_WINDOW];
+            if monotone && change.is_finite() {
+                drift.push(change);
+            }
+            if sw.factored && (out.lowest < floor || drifting) {
                 // a runaway: the plain first-order sweeps from the fixed nodes again
                 stats.runaway_iteration = Some(stats.iterations);
+                drift.clear();
                 sw.factored = false;
                 sw.u0.iter_mut().for_each(|v| *v = 0.0);
                 for (i, f) in sw.fixed.iter().enumerate() {
@@ -442,6 +466,7 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
                     }
                     second = true;
                     monotone = false;
+                    drift.clear();
                     phase_start = stats.sweeps as u32 + 1;
                 }
                 continue;
@@ -454,6 +479,7 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
             let w = options.stagnation_window;
             if !monotone && history.len() > w && change > options.stagnation_ratio * history[history.len() - 1 - w] {
                 monotone = true;
+                drift.clear();
                 phase_start = stats.sweeps as u32 + 1;
                 stats.safeguard_iteration = Some(stats.iterations);
             }

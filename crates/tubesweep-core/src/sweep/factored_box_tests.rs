@@ -299,12 +299,11 @@ fn bad_arguments_are_errors_not_panics() {
     assert!(matches!(e, Err(Error::InvalidArgument { argument: "tol", .. })));
 }
 
-/// A 41×41 box [0, 1]² with the slowness `slow(i, j)` per node and one source at `xs` (the nodes
+/// An n×n box [0, 1]² with the slowness `slow(i, j)` per node and one source at `xs` (the nodes
 /// within 2Δx fixed at `|x − xs|·(s(x) + s(xs))/2`): the factored solve's values and stats, and
 /// the plain first-order values (Eq. (3), Gauss–Seidel sweeps to a change of 1e-14) from the same
 /// fixed nodes.
-fn hostile_2d(slow: impl Fn(usize, usize) -> f64, xs: [f64; 2]) -> (Vec<f64>, FactoredStats, Vec<f64>) {
-    let n = 41;
+fn hostile_2d(n: usize, slow: impl Fn(usize, usize) -> f64, xs: [f64; 2]) -> (Vec<f64>, FactoredStats, Vec<f64>) {
     let h = 1.0 / (n - 1) as f64;
     let s: Vec<f64> = (0..n * n).map(|m| slow(m / n, m % n)).collect();
     let s0 = slow((xs[0] / h).round() as usize, (xs[1] / h).round() as usize);
@@ -376,25 +375,30 @@ fn a_runaway_is_abandoned_for_the_plain_first_order_sweeps() {
     // causal there (its curvature term s₀Δx²/r outweighs sΔx), and before the guard phase 1 fell
     // without bound (values below −60 after max_iterations, converged = false); now the first
     // value below −s_min·Δx ends the factored solve and the plain first-order values are returned
-    let (u, st, plain) = hostile_2d(|i, _| if i < 20 { 1.0 } else { 1e-3 }, [0.1, 0.1]);
-    let runaway = st
-        .runaway_iteration
-        .expect("the factored sweeps ran away when the guard was written");
-    assert!(runaway < 30 && st.converged && st.plain_iterations >= 2, "{st:?}");
-    assert_eq!(st.iterations, runaway + st.plain_iterations, "{st:?}");
-    assert!(
-        u.iter().all(|v| v.is_finite() && *v >= 0.0),
-        "a negative or unreached value"
-    );
-    let e = u.iter().zip(&plain).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-    assert!(e < 1e-6, "{e:e}"); // the plain sweeps to tol = 1e-3Δx²
+    // (and the same with a 50× contrast at 81²: the fall is slow, 1.5e-4 per iteration, and reached
+    // the floor only at iteration 1911; the drift test ends it at iteration 13)
+    for (n, contrast, xs) in [(41, 1e-3, [0.1, 0.1]), (81, 0.02, [0.2, 0.2])] {
+        let (u, st, plain) = hostile_2d(n, |i, _| if i < n / 2 { 1.0 } else { contrast }, xs);
+        let runaway = st
+            .runaway_iteration
+            .expect("the factored sweeps ran away when the guard was written");
+        assert!(runaway < 30 && st.converged && st.plain_iterations >= 2, "{st:?}");
+        assert_eq!(st.iterations, runaway + st.plain_iterations, "{st:?}");
+        assert!(
+            u.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "a negative or unreached value"
+        );
+        let e = u.iter().zip(&plain).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(e < 1e-6, "{e:e}"); // the plain sweeps to tol = 1e-3Δx²
+    }
 }
 
 #[test]
 fn hostile_speeds_that_do_not_run_away_converge_to_finite_non_negative_values() {
     // checkerboards of slowness 1 and 1e-6 (the source in the slow, then in the fast cells), the
     // source in the fast half, a slow wall in a fast medium: the factored sweeps converge, without
-    // a runaway, to non-negative values within 0.5× of the plain first-order ones
+    // a runaway, to non-negative values within 0.5× of the plain first-order ones (measured: 0.28,
+    // 0.38, 0.075, 0.075)
     type Case = (fn(usize, usize) -> f64, [f64; 2]);
     let cases: [Case; 4] = [
         (|i, j| if (i + j) % 2 == 0 { 1.0 } else { 1e-6 }, [0.5, 0.5]),
@@ -403,7 +407,7 @@ fn hostile_speeds_that_do_not_run_away_converge_to_finite_non_negative_values() 
         (|i, _| if i == 13 { 1.0 } else { 1e-3 }, [0.9, 0.9]),
     ];
     for (k, (slow, xs)) in cases.into_iter().enumerate() {
-        let (u, st, plain) = hostile_2d(slow, xs);
+        let (u, st, plain) = hostile_2d(41, slow, xs);
         assert!(st.converged && st.runaway_iteration.is_none(), "case {k}: {st:?}");
         assert!(u.iter().all(|v| v.is_finite() && *v >= 0.0), "case {k}");
         let worst = u
@@ -411,7 +415,6 @@ fn hostile_speeds_that_do_not_run_away_converge_to_finite_non_negative_values() 
             .zip(&plain)
             .map(|(a, b)| if *b > 0.0 { (a / b - 1.0).abs() } else { 0.0 })
             .fold(0.0, f64::max);
-        println!("case {k}: {st:?} worst {worst:.3}");
         assert!(worst < 0.5, "case {k}: {worst}");
     }
 }
