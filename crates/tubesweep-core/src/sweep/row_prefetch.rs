@@ -17,9 +17,11 @@
 //! set (with the active flags) and its lower bound inside the front window. A row that the rows
 //! just before it wake is then missed; fetching the clean rows too (two rows ahead) made the default
 //! sweeps at N = 1001 on two threads 1.47× slower (6 alternating rounds) and Python's paper sweeps at
-//! N = 401 no faster (1.009×). An upwind solver's own per-node data (a metric, a flow, its
-//! slowness) are counted and fetched with the rest ([`crate::LocalSolver::bytes_per_node`],
-//! [`crate::LocalSolver::prefetch_nodes`]); a Lax–Friedrichs general Hamiltonian's are neither.
+//! N = 401 no faster (1.009×). The built-in upwind solvers' own per-node data (the metric, the
+//! flow, a per-node slowness) are counted and fetched with the rest
+//! ([`crate::LocalSolver::bytes_per_node`], [`crate::LocalSolver::prefetch_nodes`]; other solvers,
+//! `Isotropic` through the upwind interface among them, report none); a Lax–Friedrichs general
+//! Hamiltonian's are neither.
 //! On other architectures than x86-64 the sweeps never prefetch.
 //!
 //! [`SolveOptions::row_prefetch_above`]: super::SolveOptions::row_prefetch_above
