@@ -23,7 +23,18 @@ pub struct SymmetricMetric<'a, const D: usize> {
     packed: Vec<f64>,
     /// `PACKED` per node, or 0 with one matrix for all nodes (the node's first entry is `node · stride`).
     stride: usize,
+    /// Whether every matrix's eigenvalues span at most [`QUICK_PROOF_CONDITION`] (by the bound
+    /// `λ_max / λ_min ≤ (tr S)^D / det S`): the upwind solver's quick deficit proof is used only then.
+    well_conditioned: bool,
 }
+
+/// The largest eigenvalue ratio of `M` for which the upwind metric's quick deficit proof
+/// ([`crate::scheme::upwind::metric`]) keeps its rounding within the proofs' margin (1e-12 of `s²`):
+/// measured overshoots of the bound at its own edge were 6e-16 at a ratio of 1, 5.5e-13 at 1e4,
+/// 3.6e-12 at 1e6. Above it (by the bound `tr^D / det`, which may exceed the ratio up to `D^D`
+/// times) the corners are tested one by one, whose rounding stays within the margin further (at
+/// a ratio of 1e8 it overshoots 40 times less).
+pub const QUICK_PROOF_CONDITION: f64 = 1e4;
 
 impl<'a, const D: usize> SymmetricMetric<'a, D> {
     /// The numbers stored per matrix, `D(D+1)/2`.
@@ -41,10 +52,14 @@ impl<'a, const D: usize> SymmetricMetric<'a, D> {
                 }
             }
         }
+        let well_conditioned = packed
+            .chunks_exact(Self::PACKED)
+            .all(|p| quick_proof_applies(unpack::<D>(p)));
         Self {
             slowness,
             packed,
             stride: if metric.len() == 1 { 0 } else { Self::PACKED },
+            well_conditioned,
         }
     }
 
@@ -76,19 +91,13 @@ impl<'a, const D: usize> SymmetricMetric<'a, D> {
     #[inline(always)]
     pub fn at(&self, node: usize) -> [[f64; D]; D] {
         let start = node * self.stride;
-        let p = &self.packed[start..start + Self::PACKED];
-        let mut m = [[0.0; D]; D];
-        let mut k = 0;
-        for i in 0..D {
-            m[i][i] = p[k];
-            k += 1;
-            for j in i + 1..D {
-                m[i][j] = p[k];
-                m[j][i] = p[k];
-                k += 1;
-            }
-        }
-        m
+        unpack::<D>(&self.packed[start..start + Self::PACKED])
+    }
+
+    /// Whether every matrix's eigenvalue ratio is provably at most [`QUICK_PROOF_CONDITION`].
+    #[inline(always)]
+    pub fn well_conditioned(&self) -> bool {
+        self.well_conditioned
     }
 
     /// The slowness at a band node.
@@ -124,6 +133,31 @@ impl<'a, const D: usize> SymmetricMetric<'a, D> {
     }
 }
 
+/// Whether the symmetric positive definite `m`'s eigenvalue ratio is provably at most
+/// [`QUICK_PROOF_CONDITION`]: `λ_max ≤ tr`, `λ_min ≥ det / tr^(D−1)`, so the ratio is at most
+/// `tr^D / det`.
+pub(crate) fn quick_proof_applies<const D: usize>(m: [[f64; D]; D]) -> bool {
+    let tr: f64 = (0..D).map(|k| m[k][k]).sum();
+    tr.powi(D as i32) <= QUICK_PROOF_CONDITION * determinant(m)
+}
+
+/// The full symmetric matrix of one packed upper triangle.
+#[inline(always)]
+fn unpack<const D: usize>(p: &[f64]) -> [[f64; D]; D] {
+    let mut m = [[0.0; D]; D];
+    let mut k = 0;
+    for i in 0..D {
+        m[i][i] = p[k];
+        k += 1;
+        for j in i + 1..D {
+            m[i][j] = p[k];
+            m[j][i] = p[k];
+            k += 1;
+        }
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,6 +179,22 @@ mod tests {
         assert_eq!((one.matrices(), one.bytes()), (1, 24));
         assert_eq!(one.at(0), one.at(12345));
         assert_eq!(SymmetricMetric::<1>::new(&s, &[[[4.0]]]).bytes(), 8);
+    }
+
+    #[test]
+    fn the_quick_proof_applies_only_to_well_conditioned_metrics() {
+        let s = [1.0];
+        // M3: bound tr³/det = 81; diag(1, 1, 1e-3): ratio 1e3, bound 8.0e3; diag(1, 1, 1e-4): 1e4, 8.0e4
+        assert!(SymmetricMetric::new(&s, &[M3]).well_conditioned());
+        assert!(
+            SymmetricMetric::<3>::new(&s, &[[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1e-3]]]).well_conditioned()
+        );
+        let ill = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1e-4]];
+        assert!(!SymmetricMetric::<3>::new(&s, &[ill]).well_conditioned());
+        // one ill-conditioned node among well-conditioned ones switches it off for the solve
+        assert!(!SymmetricMetric::<3>::new(&s, &[M3, ill, M3]).well_conditioned());
+        assert!(SymmetricMetric::<2>::new(&s, &[[[1.0, 0.0], [0.0, 1e-3]]]).well_conditioned());
+        assert!(!SymmetricMetric::<2>::new(&s, &[[[1.0, 0.0], [0.0, 1e-4]]]).well_conditioned());
     }
 
     #[test]

@@ -38,6 +38,10 @@ fn fmax(a: f64, b: f64) -> f64 {
 struct Riemann<const D: usize> {
     m: [[f64; D]; D],
     s: f64,
+    /// 0 when [`Faces::deficit_proved`] may use its quick test (the solve's metrics are well
+    /// conditioned, [`SymmetricMetric::well_conditioned`]); `f64::MAX` otherwise, which no axis in
+    /// `def` reaches, so that it decides only `def = 0`.
+    refuse: f64,
 }
 
 impl<const D: usize> Faces<D> for Riemann<D> {
@@ -234,7 +238,7 @@ impl<const D: usize> Faces<D> for Riemann<D> {
     fn deficit_proved(&self, st: &Weights<D>, deficit: &[f64; D], def: usize) -> bool {
         let q0 = tree_sum::<D>(core::array::from_fn(|k| (st.t - st.w[k]) * st.weights[k]));
         let r = st.sh * (1.0 - 1e-12);
-        let need = fmax(q0 - r * r, 0.0);
+        let need = fmax(q0 - r * r, 0.0) + self.refuse;
         let dd = D as f64;
         // each axis's test, those off `def` against 0 (their deficit is 0): without a branch,
         // so that `def = 0` (every gain 0) passes too; a NaN fails
@@ -385,6 +389,7 @@ impl<'a, const D: usize> LocalSolver<D> for SymmetricMetric<'a, D> {
         let faces = Riemann {
             m: self.at(node),
             s: self.slowness_at(node),
+            refuse: if self.well_conditioned() { 0.0 } else { f64::MAX },
         };
         upwind_min(&faces, minus, plus, h, old)
     }
@@ -408,7 +413,15 @@ impl<'a, const D: usize> LocalSolver<D> for SymmetricMetric<'a, D> {
 
 #[cfg(test)]
 pub(crate) fn tests_faces<const D: usize>(s: f64, m: [[f64; D]; D]) -> impl Faces<D> {
-    Riemann { m, s }
+    Riemann {
+        m,
+        s,
+        refuse: if crate::scheme::hamiltonians::symmetric_metric::quick_proof_applies(m) {
+            0.0
+        } else {
+            f64::MAX
+        },
+    }
 }
 
 #[cfg(test)]
@@ -459,7 +472,11 @@ mod tests {
     #[test]
     fn schur_complement_is_the_inverse_of_the_inverse_block() {
         let m3 = [[2.0, 0.6, -0.3], [0.6, 0.9, 0.2], [-0.3, 0.2, 0.5]];
-        let r = Riemann { m: m3, s: 1.0 };
+        let r = Riemann {
+            m: m3,
+            s: 1.0,
+            refuse: 0.0,
+        };
         // vertex along x: S = 1/(M⁻¹)_00 = det M / (M11 M22 − M12²)
         let det = 2.0 * (0.9 * 0.5 - 0.04) - 0.6 * (0.6 * 0.5 + 0.06) + (-0.3) * (0.6 * 0.2 + 0.27);
         let p = r.project(1).unwrap();

@@ -475,3 +475,22 @@ fn quick_deficit_proof_holds_at_its_edge() {
     // the proof's edge is reached in most cases of each dimension
     assert!(edges.iter().all(|&e| e > 1000), "edges reached {edges:?}");
 }
+
+/// With a metric whose eigenvalues may span more than `QUICK_PROOF_CONDITION`, the quick deficit
+/// proof decides only an empty deficit: the corners decide the rest.
+#[test]
+fn an_ill_conditioned_metric_leaves_the_deficit_proof_to_the_corners() {
+    let h = 0.02;
+    for (m, quick) in [
+        ([[1.0, 0.2, 0.0], [0.2, 1.0, 0.0], [0.0, 0.0, 0.5]], true),
+        // eigenvalues 2 − 1e-5, 1, 1e-5
+        ([[1.0, 0.99999, 0.0], [0.99999, 1.0, 0.0], [0.0, 0.0, 1.0]], false),
+    ] {
+        let riem = metric::tests_faces(0.8, m);
+        let pf = riem.project(7).unwrap();
+        let (_, strict) = riem.solve_strict(&pf, &[0.0; 3], &[1.0; 3], h).unwrap();
+        // a rounding-sized deficit on one axis: the quick test settles it when it may
+        assert_eq!(riem.deficit_proved(&strict, &[1e-11, 0.0, 0.0], 1), quick);
+        assert!(riem.deficit_proved(&strict, &[0.0; 3], 0));
+    }
+}
