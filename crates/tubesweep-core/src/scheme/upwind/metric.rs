@@ -84,11 +84,8 @@ impl<const D: usize> Faces<D> for Riemann<D> {
 
     #[inline(always)]
     fn inside(&self, p: [f64; D]) -> bool {
-        let q: f64 = (0..D)
-            .map(|k| p[k] * (0..D).map(|l| self.m[k][l] * p[l]).sum::<f64>())
-            .sum();
         let r = self.s * (1.0 - 1e-12);
-        q <= r * r
+        self.form(p) <= r * r
     }
 
     /// [`Faces::inside`] at the corners, expanded about `p`: with `d = p − moved` (0 off `def`),
@@ -123,7 +120,7 @@ impl<const D: usize> Faces<D> for Riemann<D> {
             fails |= ((q > lim) as u32) << sub;
         }
         let ok = fails & super::SUBSETS_OF[def] as u32 == 0;
-        debug_assert!(ok == self.exact_corners(p, moved, def) || self.near_the_bound(p, moved, def));
+        debug_assert!(ok == super::every_corner_inside(self, p, moved, def) || self.near_the_bound(p, moved, def));
         ok
     }
 
@@ -306,17 +303,12 @@ impl<const D: usize> Riemann<D> {
         let causal = (0..M).fold(true, |ok, i| ok & (weights[i] >= floor));
         causal.then_some((t, weights))
     }
-    /// [`Faces::inside`] at every corner of `def` (the check of [`Faces::inside_corners`]).
-    fn exact_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
-        let mut sub = def;
-        let mut all = true;
-        while sub != 0 {
-            all &= self.inside(core::array::from_fn(
-                |k| if sub >> k & 1 == 1 { moved[k] } else { p[k] },
-            ));
-            sub = (sub - 1) & def;
-        }
-        all
+    /// `pᵀ M p` (the same sums in the same order wherever it is evaluated).
+    #[inline(always)]
+    fn form(&self, p: [f64; D]) -> f64 {
+        (0..D)
+            .map(|k| p[k] * (0..D).map(|l| self.m[k][l] * p[l]).sum::<f64>())
+            .sum()
     }
 
     /// Whether some corner's `pᵀMp` lies within 1e-14 `s²` of the bound of [`Faces::inside`].
@@ -325,11 +317,7 @@ impl<const D: usize> Riemann<D> {
         let mut sub = def;
         let mut near = false;
         while sub != 0 {
-            let x: [f64; D] = core::array::from_fn(|k| if sub >> k & 1 == 1 { moved[k] } else { p[k] });
-            let q: f64 = (0..D)
-                .map(|k| x[k] * (0..D).map(|l| self.m[k][l] * x[l]).sum::<f64>())
-                .sum();
-            near |= (q - r * r).abs() <= 1e-14 * self.s * self.s;
+            near |= (self.form(super::corner(p, moved, sub)) - r * r).abs() <= 1e-14 * self.s * self.s;
             sub = (sub - 1) & def;
         }
         near

@@ -118,16 +118,7 @@ pub(crate) trait Faces<const D: usize> {
     /// work between the corners; the answer is that of [`Faces::inside`] at each.
     #[inline(always)]
     fn inside_corners(&self, p: [f64; D], moved: [f64; D], def: usize) -> bool {
-        let mut sub = def;
-        while sub != 0 {
-            if !self.inside(core::array::from_fn(
-                |k| if sub >> k & 1 == 1 { moved[k] } else { p[k] },
-            )) {
-                return false;
-            }
-            sub = (sub - 1) & def;
-        }
-        true
+        every_corner_inside(self, p, moved, def)
     }
     /// The full gradient `(P, q*)` of a solution on the face of the axes not in the bit mask
     /// `off` (one or two axes, not all): `P` (given in place, `p`'s components on `off` ignored)
@@ -223,6 +214,31 @@ pub(crate) const SUBSETS_OF: [u8; 8] = {
     }
     t
 };
+
+/// The corner `p_S` of [`Faces::inside_corners`]: `moved[k]` on the axes of the bit mask `sub`,
+/// `p[k]` on the others.
+#[inline(always)]
+pub(crate) fn corner<const D: usize>(p: [f64; D], moved: [f64; D], sub: usize) -> [f64; D] {
+    core::array::from_fn(|k| if sub >> k & 1 == 1 { moved[k] } else { p[k] })
+}
+
+/// [`Faces::inside`] at every corner of `def`, one by one: the default of
+/// [`Faces::inside_corners`] and the reference its shared evaluations are checked against.
+pub(crate) fn every_corner_inside<const D: usize, F: Faces<D> + ?Sized>(
+    faces: &F,
+    p: [f64; D],
+    moved: [f64; D],
+    def: usize,
+) -> bool {
+    let mut sub = def;
+    while sub != 0 {
+        if !faces.inside(corner(p, moved, sub)) {
+            return false;
+        }
+        sub = (sub - 1) & def;
+    }
+    true
+}
 
 /// The bytes per node of a solver's array given per node, 0 for one value for all nodes (a
 /// slice of length 1, as [`crate::scheme::hamiltonians::slowness_at`] reads it).

@@ -109,17 +109,7 @@ impl<const D: usize> Faces<D> for Randers<D> {
             fails |= (!inside as u32) << sub;
         }
         let ok = fails & super::SUBSETS_OF[def] as u32 == 0;
-        debug_assert_eq!(ok, {
-            let mut all = true;
-            let mut sub = def;
-            while sub != 0 {
-                all &= self.inside(core::array::from_fn(
-                    |k| if sub >> k & 1 == 1 { moved[k] } else { p[k] },
-                ));
-                sub = (sub - 1) & def;
-            }
-            all
-        });
+        debug_assert_eq!(ok, super::every_corner_inside(self, p, moved, def));
         ok
     }
 
