@@ -284,6 +284,8 @@ def solve_on_tube(
             "unreached",
             "max_curvature",
             "grad_norm_range",
+            "first_order_nodes",
+            "first_order_reasons",
         )
     }
     order2["tol"] = float(tol)

@@ -128,7 +128,7 @@ fn main() {
         // TWO_PASSES=1: the geometry and the factoring by their own functions, one after the other
         let t = now(cpu);
         let (geometry, factoring, t_geo) = if std::env::var("TWO_PASSES").is_ok() {
-            let geometry = tube_geometry_of(&band, &roles, &surface, &dirs, h).expect("geometry");
+            let geometry = tube_geometry_of(&band, &roles, &surface, &dirs, h, outer_width).expect("geometry");
             let t_geo = since(t, cpu);
             let factoring = factor_sources_of(
                 &band,
@@ -151,6 +151,7 @@ fn main() {
                 &dirs,
                 lower,
                 h,
+                outer_width,
                 &[source],
                 &[source_slowness],
                 fix_radius,

@@ -9,7 +9,7 @@ use tubesweep_core::second_order::{
     check_geometry_of, first_order_start, starting_values, sweep_second_order, tube_setup_of, Implicit,
     SecondOrderOptions,
 };
-use tubesweep_core::sweep::Slowness;
+use tubesweep_core::sweep::{NodeRole, Slowness};
 use tubesweep_core::{Control, IterationReport};
 
 use crate::band::{AnyBand, PyBand};
@@ -81,6 +81,7 @@ fn run<'py, const D: usize>(
             directions,
             lower,
             inp.spacing,
+            inp.outer_width,
             sources,
             inp.source_slowness,
             inp.fix_radius,
@@ -144,12 +145,27 @@ fn run<'py, const D: usize>(
             + n
             + 4 * (band.n_rows() + 1);
         let roles_out: Vec<u8> = factoring.roles.iter().map(|&r| r as u8).collect();
-        Ok::<_, tubesweep_core::Error>((values, factoring.u0, roles_out, stats, geometry.summary, bytes))
+        // where the update ran first order (band positions), node by node
+        let first_order: Vec<u32> = (0..n)
+            .filter(|&i| roles[i] != NodeRole::Outer)
+            .zip(&geometry.nodes)
+            .filter(|(_, g)| g.first_order != 0)
+            .map(|(i, _)| i as u32)
+            .collect();
+        Ok::<_, tubesweep_core::Error>((
+            values,
+            factoring.u0,
+            roles_out,
+            stats,
+            geometry.summary,
+            bytes,
+            first_order,
+        ))
     });
     if let Some(e) = py_error {
         return Err(e);
     }
-    let (values, u0, roles_out, stats, summary, bytes) = result.map_err(to_pyerr)?;
+    let (values, u0, roles_out, stats, summary, bytes, first_order) = result.map_err(to_pyerr)?;
     let d = PyDict::new(py);
     d.set_item(
         "iterations",
@@ -167,6 +183,14 @@ fn run<'py, const D: usize>(
     d.set_item("max_curvature", summary.max_curvature)?;
     d.set_item("grad_norm_range", (summary.grad_norm_min, summary.grad_norm_max))?;
     d.set_item("solver_bytes", bytes)?;
+    d.set_item("first_order_nodes", summary.first_order_nodes())?;
+    d.set_item("inner_nodes", summary.inner_nodes)?;
+    let reasons = PyDict::new(py);
+    reasons.set_item("stencil", summary.incomplete_stencils)?;
+    reasons.set_item("gradient", summary.off_distance)?;
+    reasons.set_item("curvature", summary.unresolved_curvature)?;
+    d.set_item("first_order_reasons", reasons)?;
+    d.set_item("first_order_positions", first_order.into_pyarray(py))?;
     Ok((
         values.into_pyarray(py),
         u0.into_pyarray(py),

@@ -23,8 +23,27 @@ pub struct NodeGeometry {
     /// sgn(φ) where the stencil is incomplete).
     pub normal: [f32; 3],
     /// B = (I − φ D²φ)⁻¹, symmetric, packed as (00, 01, 02, 11, 12, 22) (2D: 00, 01, 11 in the
-    /// places 0, 1, 3).
+    /// places 0, 1, 3); I at a first-order node.
     pub b: [f32; 6],
+    /// Why the node runs the paper's first-order update (Eq. (3), B = I) instead of the
+    /// second-order one: 0 where the local geometry is resolved, else one of the
+    /// [`Unresolved`] reasons. Decided node by node ([`node_geometry`]): a crease, a corner, a
+    /// noise spike, an unresolved curvature, a stencil cut by the box or the band's edge, or the
+    /// rim of an open surface turns off second order only where it is.
+    pub first_order: u8,
+}
+
+/// Why a node's geometry is not resolved (the values of [`NodeGeometry::first_order`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Unresolved {
+    /// A node of its 3^D stencil of φ is not in the band (the band's edge, the box's faces).
+    Stencil = 1,
+    /// |∇φ| is off 1 by more than [`super::GRAD_NORM_TOLERANCE`]: φ is not a distance there.
+    Gradient = 2,
+    /// A principal curvature κ with `outer_width`·κ ≥ 1, or I − φD²φ singular: a crease, a
+    /// corner, noise, a curvature the tube does not resolve, or beyond an open surface's rim.
+    Curvature = 3,
 }
 
 /// Index of entry (k, l) of a packed symmetric matrix.
@@ -45,6 +64,13 @@ pub struct GeometrySummary {
     /// Inner-tube nodes whose 3^D-stencil of φ was not all in the band (their geometry falls back
     /// to the given direction and B = I).
     pub incomplete_stencils: usize,
+    /// Inner-tube nodes (fixed ones included) whose |∇φ| is off 1 by more than
+    /// [`super::GRAD_NORM_TOLERANCE`], and those whose curvature the tube does not resolve
+    /// ([`Unresolved`]): with the incomplete stencils, the nodes that run first order.
+    pub off_distance: usize,
+    pub unresolved_curvature: usize,
+    /// All inner-tube nodes (the fraction's denominator).
+    pub inner_nodes: usize,
 }
 
 impl GeometrySummary {
@@ -55,6 +81,9 @@ impl GeometrySummary {
             grad_norm_min: f64::INFINITY,
             grad_norm_max: 0.0,
             incomplete_stencils: 0,
+            off_distance: 0,
+            unresolved_curvature: 0,
+            inner_nodes: 0,
         }
     }
 
@@ -65,7 +94,15 @@ impl GeometrySummary {
             grad_norm_min: self.grad_norm_min.min(other.grad_norm_min),
             grad_norm_max: self.grad_norm_max.max(other.grad_norm_max),
             incomplete_stencils: self.incomplete_stencils + other.incomplete_stencils,
+            off_distance: self.off_distance + other.off_distance,
+            unresolved_curvature: self.unresolved_curvature + other.unresolved_curvature,
+            inner_nodes: self.inner_nodes + other.inner_nodes,
         }
+    }
+
+    /// The inner-tube nodes that run the first-order update (every [`Unresolved`] reason).
+    pub fn first_order_nodes(&self) -> usize {
+        self.incomplete_stencils + self.off_distance + self.unresolved_curvature
     }
 
     /// After the last node: no node with a stencil gives a minimum |∇φ| of 0.
@@ -77,13 +114,19 @@ impl GeometrySummary {
 }
 
 /// The geometry of one inner-tube node from φ there (`phi`, signed), its outward direction
-/// sgn(φ) n and φ's differences `local` ([`Implicit::local`], None for an incomplete stencil:
-/// then the normal is the direction times sgn(φ) and B = I); what it finds about the surface goes
-/// into `summary`.
+/// sgn(φ) n and φ's differences `local` ([`Implicit::local`], None for an incomplete stencil),
+/// decided node by node: where the local geometry is resolved — a complete stencil, |∇φ| within
+/// [`super::GRAD_NORM_TOLERANCE`] of 1 and every principal curvature κ at the foot point with
+/// `outer_width`·κ < 1 — n = ∇φ/|∇φ| and B = (I − φD²φ)⁻¹ for the second-order update;
+/// elsewhere the node is marked [`NodeGeometry::first_order`] with its reason, and gets the
+/// given direction times sgn(φ) and B = I (the paper's Eq. (3) at that node). What it finds
+/// goes into `summary`: the counts, and the extremes of |∇φ| and κ over the resolved nodes
+/// (those of the whole tube when none is resolved).
 pub(crate) fn node_geometry<const D: usize>(
     phi: f64,
     direction: &[f32; D],
     local: Option<&LocalGeometry<D>>,
+    outer_width: f64,
     summary: &mut GeometrySummary,
 ) -> NodeGeometry {
     let mut identity = [0.0f32; 6];
@@ -94,33 +137,39 @@ pub(crate) fn node_geometry<const D: usize>(
     let mut geo = NodeGeometry {
         normal: [0.0; 3],
         b: identity,
+        first_order: 0,
     };
     for k in 0..D {
         geo.normal[k] = sign * direction[k];
     }
+    summary.inner_nodes += 1;
     let Some(local) = local else {
         summary.incomplete_stencils += 1;
+        geo.first_order = Unresolved::Stencil as u8;
         return geo;
     };
     let (g, hess) = (local.gradient, local.hessian);
     // φ in the orientation of the differences (the same as `phi` for a level set)
     let p = local.phi;
     let norm = g.iter().map(|v| v * v).sum::<f64>().sqrt();
-    summary.grad_norm_min = summary.grad_norm_min.min(norm);
-    summary.grad_norm_max = summary.grad_norm_max.max(norm);
-    if norm > 0.0 {
-        for k in 0..D {
-            geo.normal[k] = (g[k] / norm) as f32;
-        }
+    if !((norm - 1.0).abs() <= super::GRAD_NORM_TOLERANCE) {
+        summary.off_distance += 1;
+        geo.first_order = Unresolved::Gradient as u8;
+        return geo;
     }
-    // principal curvatures at the foot point from the eigenvalues at height φ, needed only where
-    // they may raise the largest found so far
-    if !curvatures_below(&hess, p, summary.max_curvature) {
+    // principal curvatures at the foot point from the eigenvalues at height φ: this node's
+    // largest, needed only where it may reach the tube's bound 1/outer_width or raise the
+    // largest found so far
+    let bound = 1.0 / outer_width;
+    let mut resolved = true;
+    let mut node_kappa = 0.0f64;
+    if !curvatures_below(&hess, p, summary.max_curvature.min(bound)) {
         for lam in symmetric_eigenvalues(&hess).iter().take(D) {
             let den = 1.0 - p * lam;
             let kappa = if den > 0.0 { (lam / den).abs() } else { f64::INFINITY };
-            summary.max_curvature = summary.max_curvature.max(kappa);
+            node_kappa = node_kappa.max(kappa);
         }
+        resolved = node_kappa < bound;
     }
     let mut m = [[0.0; D]; D];
     for k in 0..D {
@@ -128,15 +177,22 @@ pub(crate) fn node_geometry<const D: usize>(
             m[k][l] = if k == l { 1.0 } else { 0.0 } - p * hess[k][l];
         }
     }
-    match symmetric_inverse(&m) {
-        Some(b) => {
-            for k in 0..D {
-                for l in k..D {
-                    geo.b[sym(k, l)] = (0.5 * (b[k][l] + b[l][k])) as f32;
-                }
-            }
+    let b = if resolved { symmetric_inverse(&m) } else { None };
+    let Some(b) = b else {
+        summary.unresolved_curvature += 1;
+        geo.first_order = Unresolved::Curvature as u8;
+        return geo;
+    };
+    summary.max_curvature = summary.max_curvature.max(node_kappa);
+    summary.grad_norm_min = summary.grad_norm_min.min(norm);
+    summary.grad_norm_max = summary.grad_norm_max.max(norm);
+    for k in 0..D {
+        geo.normal[k] = (g[k] / norm) as f32;
+    }
+    for k in 0..D {
+        for l in k..D {
+            geo.b[sym(k, l)] = (0.5 * (b[k][l] + b[l][k])) as f32;
         }
-        None => summary.max_curvature = f64::INFINITY,
     }
     geo
 }
@@ -310,15 +366,18 @@ pub(crate) fn gradient_and_hessian_by<const D: usize>(
 
 /// The geometry of the inner-tube nodes of `band` (the nodes not in the extension layer, in band
 /// order): `phi` (signed, per node), `directions` the outward unit
-/// directions sgn(φ) n the solver's extension reads (per node), `roles` to know the inner tube.
+/// directions sgn(φ) n the solver's extension reads (per node), `roles` to know the inner tube,
+/// `outer_width` the tube's half-width (outer·Δx), which bounds the curvature a node may have
+/// and still run second order ([`node_geometry`]).
 pub fn tube_geometry<const D: usize>(
     band: &NarrowBand<D>,
     roles: &[NodeRole],
     phi: &[f64],
     directions: &[[f32; D]],
     spacing: f64,
+    outer_width: f64,
 ) -> Result<TubeGeometry> {
-    tube_geometry_of(band, roles, &Implicit::LevelSet(phi), directions, spacing)
+    tube_geometry_of(band, roles, &Implicit::LevelSet(phi), directions, spacing, outer_width)
 }
 
 /// As [`tube_geometry`] for a level set or a closest-point map ([`Implicit`]).
@@ -328,9 +387,10 @@ pub fn tube_geometry_of<const D: usize>(
     surface: &Implicit<'_, D>,
     directions: &[[f32; D]],
     spacing: f64,
+    outer_width: f64,
 ) -> Result<TubeGeometry> {
     let n = band.len();
-    check_tube_inputs(n, roles, surface, directions, spacing)?;
+    check_tube_inputs(n, roles, surface, directions, spacing, outer_width)?;
     let mut summary = GeometrySummary::empty();
     let mut nodes = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     for i in 0..n {
@@ -340,6 +400,7 @@ pub fn tube_geometry_of<const D: usize>(
                 surface.phi(i),
                 &directions[i],
                 local.as_ref(),
+                outer_width,
                 &mut summary,
             ));
         }
@@ -362,6 +423,7 @@ pub(crate) fn check_tube_inputs<const D: usize>(
     surface: &Implicit<'_, D>,
     directions: &[[f32; D]],
     spacing: f64,
+    outer_width: f64,
 ) -> Result<()> {
     if roles.len() != n || surface.len() != n || directions.len() != n {
         return Err(Error::invalid(
@@ -373,6 +435,12 @@ pub(crate) fn check_tube_inputs<const D: usize>(
         return Err(Error::invalid(
             "spacing",
             format!("must be positive and finite, got {spacing}"),
+        ));
+    }
+    if !(outer_width > 0.0 && outer_width.is_finite()) {
+        return Err(Error::invalid(
+            "outer_width",
+            format!("must be positive and finite, got {outer_width}"),
         ));
     }
     Ok(())
@@ -452,7 +520,7 @@ mod tests {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
         let (phi, _) = crate::test_bands::sphere_phi_and_offsets(&band, h);
         let surface = Implicit::LevelSet(&phi);
-        let geo = tube_geometry_of(&band, &roles, &surface, &dirs, h).unwrap();
+        let geo = tube_geometry_of(&band, &roles, &surface, &dirs, h, 4.0 * h).unwrap();
         let mut max = 0.0f64;
         for i in 0..band.len() {
             if roles[i] == NodeRole::Outer {
@@ -508,7 +576,7 @@ mod tests {
                 (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 0.5
             })
             .collect();
-        let geo = tube_geometry(&band, &roles, &phi, &dirs, h).unwrap();
+        let geo = tube_geometry(&band, &roles, &phi, &dirs, h, 4.0 * h).unwrap();
         assert_eq!(geo.summary.incomplete_stencils, 0);
         assert!((geo.summary.max_curvature - 2.0).abs() < 0.05, "{:?}", geo.summary);
         assert!((geo.summary.grad_norm_max - 1.0).abs() < 0.01 && (geo.summary.grad_norm_min - 1.0).abs() < 0.01);

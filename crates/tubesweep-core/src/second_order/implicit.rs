@@ -145,8 +145,8 @@ mod tests {
     fn closest_point_map_gives_the_level_sets_metric() {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
         let (phi, offsets) = crate::test_bands::sphere_phi_and_offsets(&band, h);
-        let a = tube_geometry_of(&band, &roles, &Implicit::LevelSet(&phi), &dirs, h).unwrap();
-        let b = tube_geometry_of(&band, &roles, &Implicit::ClosestPoint(&offsets), &dirs, h).unwrap();
+        let a = tube_geometry_of(&band, &roles, &Implicit::LevelSet(&phi), &dirs, h, 4.0 * h).unwrap();
+        let b = tube_geometry_of(&band, &roles, &Implicit::ClosestPoint(&offsets), &dirs, h, 4.0 * h).unwrap();
         assert_eq!(b.summary.incomplete_stencils, 0);
         assert!((a.summary.max_curvature - b.summary.max_curvature).abs() < 1e-9);
         assert!((b.summary.grad_norm_max - 1.0).abs() < 0.01 && (b.summary.grad_norm_min - 1.0).abs() < 0.01);

@@ -28,27 +28,34 @@ pub mod solver;
 pub mod start;
 
 pub use factoring::{factor_sources, factor_sources_of, Factoring};
-pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometry, TubeGeometry};
+pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometry, TubeGeometry, Unresolved};
 pub use implicit::Implicit;
 pub use setup::tube_setup_of;
 pub use solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
 pub use start::first_order_start;
 
-/// |∇φ| at the inner nodes must be within this of 1 (B uses D²φ, which is the surface's
-/// curvature only for a signed distance).
+/// |∇φ| at an inner node must be within this of 1 for its second-order update (B uses D²φ,
+/// which is the surface's curvature only for a signed distance); elsewhere the node runs first
+/// order ([`geometry::Unresolved::Gradient`]).
 pub const GRAD_NORM_TOLERANCE: f64 = 0.05;
 
-/// Refuses a surface the second-order scheme cannot handle on this tube: an incomplete stencil
-/// of φ at an inner node, φ not a signed distance, or a principal curvature κ with
-/// `outer_width`·κ ≥ 1 (B is singular at φ = −1/κ: the tube reaches a focal point).
+/// Second order is refused for the whole tube (and `order="auto"` runs the paper's scheme) when
+/// more than this fraction of the inner-tube nodes would run the first-order update: the surface
+/// is then not resolved by the grid at all, and the first-order scheme is the cheaper one.
+pub const MAX_FIRST_ORDER_FRACTION: f64 = 0.5;
+
+/// Refuses a tube on which second order cannot run: when more than
+/// [`MAX_FIRST_ORDER_FRACTION`] of the inner-tube nodes are unresolved (an incomplete stencil of
+/// φ, φ not a signed distance, or a principal curvature κ with `outer_width`·κ ≥ 1, where B is
+/// singular or the tube reaches a focal point). Fewer unresolved nodes do not refuse it: they
+/// run the first-order update node by node ([`geometry::node_geometry`]).
 pub fn check_geometry(summary: &GeometrySummary, outer_width: f64, spacing: f64) -> crate::Result<()> {
     check_geometry_of(summary, outer_width, spacing, false)
 }
 
-/// As [`check_geometry`], the messages worded for a closest-point map when `closest_point`: there
-/// the curvature found also flags an open surface (beyond its rim the map returns points of the
-/// boundary curve, and |x − cp(x)| is the distance to a curve, of curvature 1/|x − cp(x)|) or an
-/// edge, and |∇|x − cp(x)|| off 1 a map whose points are not the nearest ones.
+/// As [`check_geometry`], the message worded for a closest-point map when `closest_point` (there
+/// an unresolved curvature also flags an open surface, beyond whose rim cp(x) lies on the
+/// boundary curve, or an edge; |∇|x − cp(x)|| off 1 a map whose points are not the nearest ones).
 pub fn check_geometry_of(
     summary: &GeometrySummary,
     outer_width: f64,
@@ -56,109 +63,49 @@ pub fn check_geometry_of(
     closest_point: bool,
 ) -> crate::Result<()> {
     use crate::error::Error;
-    if closest_point {
-        return check_closest_point_geometry(summary, outer_width, spacing);
+    let total = summary.inner_nodes.max(1);
+    let unresolved = summary.first_order_nodes();
+    if (unresolved as f64) <= MAX_FIRST_ORDER_FRACTION * total as f64 {
+        return Ok(());
     }
+    let what = if closest_point { "|x − cp(x)|" } else { "φ" };
+    let mut reasons = Vec::new();
     if summary.incomplete_stencils > 0 {
-        return Err(Error::invalid(
-            "surface",
-            format!(
-                "order=2: {} inner-tube nodes lack a neighbour (axis or diagonal) in the band for the Hessian of φ; φ is not \
-                 a signed distance near the surface (pass redistance=True) or the grid does not resolve the surface (refine it)",
-                summary.incomplete_stencils
-            ),
+        reasons.push(format!(
+            "{} lack a band neighbour for the differences of {what} (the band or the box cuts the stencil)",
+            summary.incomplete_stencils
         ));
     }
-    let kappa = summary.max_curvature;
-    if !(outer_width * kappa).is_finite() {
-        // A focal point on the grid itself: I − φD²φ is singular there, which a smooth surface
-        // resolved by any grid never gives; φ = min(φ₁, φ₂) of two distances (a crease) does.
-        return Err(Error::invalid(
-            "surface",
-            "order=2: the curvature of φ's level sets is unbounded in the tube (I − φD²φ is singular at a node): \
-             the surface has a crease or a corner, e.g. where φ = min(φ₁, φ₂) joins two surfaces, and no grid \
-             resolves it. order=2 needs a smooth (twice differentiable) surface; use order=1"
-                .to_string(),
+    if summary.off_distance > 0 {
+        reasons.push(format!(
+            "{} have |∇{what}| off 1 by more than {GRAD_NORM_TOLERANCE} ({})",
+            summary.off_distance,
+            if closest_point {
+                "cp does not return the nearest points there"
+            } else {
+                "φ is not a signed distance there: pass redistance=True"
+            }
         ));
     }
-    if !(outer_width * kappa < 1.0) {
-        return Err(Error::invalid(
-            "grid",
-            format!(
-                "order=2: the surface's largest curvature ({kappa:.4}, radius {:.4}) is not resolved by the tube: \
-                 outer·Δx·κ = {:.3} ≥ 1 (the tube reaches a focal point, where the corrected equation is singular). \
-                 Refine the grid to a spacing below {:.4}, or use order=1",
-                1.0 / kappa,
-                outer_width * kappa,
-                spacing / (outer_width * kappa) * 0.999
-            ),
+    if summary.unresolved_curvature > 0 {
+        reasons.push(format!(
+            "{} have a curvature the tube does not resolve (outer·Δx·κ ≥ 1: a crease, a corner, noise, {}or a grid \
+             too coarse: spacing {spacing:.4}, outer·Δx = {outer_width:.4})",
+            summary.unresolved_curvature,
+            if closest_point { "an open surface's rim, " } else { "" }
         ));
     }
-    if (summary.grad_norm_min - 1.0).abs() > GRAD_NORM_TOLERANCE
-        || (summary.grad_norm_max - 1.0).abs() > GRAD_NORM_TOLERANCE
-    {
-        return Err(Error::invalid(
-            "surface",
-            format!(
-                "order=2 needs φ to be a signed distance near the surface (it uses D²φ as the curvature): |∇φ| ranges \
-                 over [{:.3}, {:.3}] in the inner tube. Pass ts.LevelSet(phi, redistance=True), or use order=1",
-                summary.grad_norm_min, summary.grad_norm_max
-            ),
-        ));
-    }
-    Ok(())
-}
-
-fn check_closest_point_geometry(summary: &GeometrySummary, outer_width: f64, spacing: f64) -> crate::Result<()> {
-    use crate::error::Error;
-    if summary.incomplete_stencils > 0 {
-        return Err(Error::invalid(
-            "surface",
-            format!(
-                "order=2: {} inner-tube nodes lack a neighbour (axis or diagonal) in the band for the differences of \
-                 |x − cp(x)|; the closest-point map is not accurate near the surface or the grid does not resolve the \
-                 surface (refine it)",
-                summary.incomplete_stencils
-            ),
-        ));
-    }
-    let kappa = summary.max_curvature;
-    if !(outer_width * kappa < 1.0) {
-        return Err(Error::invalid(
-            "surface",
-            format!(
-                "order=2: the closest-point map gives a curvature of {kappa:.4} (radius {:.4}) in the tube: \
-                 outer·Δx·κ = {:.3} ≥ 1. Either the surface is open or has edges or corners (beyond an open \
-                 surface's rim cp(x) lies on the boundary curve, and the corrected equation does not hold there; a \
-                 mesh's closest points are piecewise flat, with all their curvature on the edges), or its curvature \
-                 is not resolved by the tube{}. order=2 needs a closed smooth surface; use order=1 otherwise",
-                1.0 / kappa,
-                outer_width * kappa,
-                if kappa.is_finite() {
-                    format!(
-                        " (then a spacing below {:.4} would be)",
-                        spacing / (outer_width * kappa) * 0.999
-                    )
-                } else {
-                    String::new()
-                }
-            ),
-        ));
-    }
-    if (summary.grad_norm_min - 1.0).abs() > GRAD_NORM_TOLERANCE
-        || (summary.grad_norm_max - 1.0).abs() > GRAD_NORM_TOLERANCE
-    {
-        return Err(Error::invalid(
-            "surface",
-            format!(
-                "order=2: cp does not behave as a true closest-point map near the surface: |∇|x − cp(x)|| ranges \
-                 over [{:.3}, {:.3}] in the inner tube (1 for the nearest points). cp must return the nearest point \
-                 of the surface to within well below Δx²; use order=1 otherwise",
-                summary.grad_norm_min, summary.grad_norm_max
-            ),
-        ));
-    }
-    Ok(())
+    Err(Error::invalid(
+        "grid",
+        format!(
+            "order=2: {unresolved} of the {} inner-tube nodes ({:.0}%) cannot run the second-order update: {}. Second \
+             order runs node by node where the geometry is resolved, but here most of the tube is not: refine the grid, \
+             or use order=1",
+            summary.inner_nodes,
+            100.0 * unresolved as f64 / total as f64,
+            reasons.join("; ")
+        ),
+    ))
 }
 
 /// The starting values: u₀ at the fixed nodes, +∞ elsewhere.
@@ -213,7 +160,7 @@ mod tests {
             .iter()
             .map(|x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 0.5)
             .collect();
-        let geo = tube_geometry(&band, &roles, &phi, &dirs, h).unwrap();
+        let geo = tube_geometry(&band, &roles, &phi, &dirs, h, 4.0 * h).unwrap();
         let fac = factor_sources(
             &band,
             &roles,

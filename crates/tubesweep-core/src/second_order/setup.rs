@@ -44,13 +44,14 @@ pub fn tube_setup_of<const D: usize>(
     directions: &[[f32; D]],
     lower: [f64; D],
     spacing: f64,
+    outer_width: f64,
     sources: &[[f64; D]],
     source_slowness: &[f64],
     fix_radius: f64,
     threads: usize,
 ) -> Result<(TubeGeometry, Result<Factoring<D>>)> {
     let n = band.len();
-    check_tube_inputs(n, roles, surface, directions, spacing)?;
+    check_tube_inputs(n, roles, surface, directions, spacing, outer_width)?;
     let abs_phi = abs_phi_of(surface, spacing);
     let factoring_arguments = check_source_arguments(sources, source_slowness);
     let factor = factoring_arguments.is_ok();
@@ -79,6 +80,7 @@ pub fn tube_setup_of<const D: usize>(
                     surface.phi(i),
                     &directions[i],
                     local.as_ref(),
+                    outer_width,
                     &mut out.summary,
                 ));
             }
@@ -183,7 +185,7 @@ mod tests {
         let sources = [[-0.5, 0.0, 0.0], [0.0, 0.5, 0.0]];
         let slowness = [1.0, 1.5];
         for surface in [Implicit::LevelSet(&phi), Implicit::ClosestPoint(&offsets)] {
-            let geo = tube_geometry_of(&band, &roles, &surface, &dirs, h).unwrap();
+            let geo = tube_geometry_of(&band, &roles, &surface, &dirs, h, 4.0 * h).unwrap();
             let fac = factor_sources_of(
                 &band,
                 &roles,
@@ -204,6 +206,7 @@ mod tests {
                     &dirs,
                     [-1.0; 3],
                     h,
+                    4.0 * h,
                     &sources,
                     &slowness,
                     2.0 * h,
@@ -230,6 +233,7 @@ mod tests {
             &dirs,
             [-1.0; 3],
             h,
+            4.0 * h,
             &[[0.0, 0.0, 0.0]],
             &[1.0],
             2.0 * h,

@@ -207,8 +207,18 @@ impl<const D: usize> Sweeper<'_, D> {
                 self.grad_u0.get_unchecked(k_inner),
             )
         };
+        // a node whose geometry is not resolved runs the paper's first-order update (B = I
+        // there), on u itself: its ∂u₀ came from differences of φ across the crease, the corner
+        // or the rim that made it unresolved (O(1/Δx) there: on two spheres joined by `min` the
+        // factored update fell by 1.6Δx every sweep), so the sides read u₀ at the neighbours
+        let resolved = geometry.first_order == 0;
+        let second = second && resolved;
         for k in 0..D {
-            let du0 = grad_u0[k] as f64 * self.grad_u0_unit;
+            let du0 = if resolved {
+                grad_u0[k] as f64 * self.grad_u0_unit
+            } else {
+                0.0
+            };
             let mut near = [f64::NAN; 2];
             for side in 0..2 {
                 let j1 = unsafe { table.neighbour_unchecked(i, k, side) };
@@ -221,6 +231,8 @@ impl<const D: usize> Sweeper<'_, D> {
                     continue;
                 }
                 let u1 = w1 + u0(j1);
+                // unresolved: w at the neighbour as seen from this node's u₀, u1 − u₀(i)
+                let w1 = if resolved { w1 } else { u1 - u0(i) };
                 near[side] = u1;
                 let mut up = Upwind {
                     w1,
