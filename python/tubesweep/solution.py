@@ -106,6 +106,7 @@ class Solution:
         self._phi_sample = phi_sample
         # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
         self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray, float]] = None
+        self._first_order_positions: Optional[np.ndarray] = None
         self.order = 1
 
     def __getstate__(self) -> dict:
@@ -133,6 +134,34 @@ class Solution:
                 "no longer match the solution. Solve again for the new φ (pass phi.copy() to LevelSet to keep the "
                 "array free to change)"
             )
+
+    def first_order_points(self) -> np.ndarray:
+        """Where the second-order solve ran the paper's first-order update (``order=2``).
+
+        Second order is decided node by node: at inner-tube nodes whose local geometry the grid
+        does not resolve (a crease, a corner, noise, the rim of an open surface, a stencil cut by
+        the box) the update is first order; ``stats.order2["first_order_nodes"]`` counts them and
+        ``stats.order2["first_order_reasons"]`` says why. Errors near these points, and
+        downstream of them, are first order in the grid spacing.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` the grid points of those nodes; empty for an ``order=1`` solution and where
+            every node ran second order.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> s = ts.surfaces.Sphere(0.5)
+        >>> sol = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source])
+        >>> sol.first_order_points().shape
+        (0, 3)
+        """
+        positions = self._first_order_positions
+        if positions is None or len(positions) == 0:
+            return np.empty((0, self.grid.ndim))
+        return self.grid.node_points(self.linear[positions])
 
     def narrow_gaps(self) -> Tuple[np.ndarray, np.ndarray]:
         """Where the surface faces itself across a gap narrower than the tubes.

@@ -190,6 +190,7 @@ fn run<'py, const D: usize>(
     reasons.set_item("gradient", summary.off_distance)?;
     reasons.set_item("curvature", summary.unresolved_curvature)?;
     d.set_item("first_order_reasons", reasons)?;
+    d.set_item("geometry_fitted", summary.fitted_everywhere)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
     Ok((
         values.into_pyarray(py),

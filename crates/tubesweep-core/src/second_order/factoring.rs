@@ -195,7 +195,7 @@ pub(crate) fn node_factor<const D: usize>(
             }
         }
     }
-    let cp = surface.closest_point(i, x, &nrm);
+    let cp = surface.closest_point(i, x, phi_i, &nrm);
     let mut best = (f64::INFINITY, 0usize, 0.0);
     for (s, (xs, &sl)) in sources.iter().zip(source_slowness).enumerate() {
         let c: f64 = (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt();

@@ -15,6 +15,7 @@
 use crate::band::NarrowBand;
 
 use super::geometry::gradient_and_hessian_by;
+use super::local_fit::fitted_gradient_and_hessian_by;
 
 /// A level set or a closest-point map, per band node.
 #[derive(Clone, Copy)]
@@ -64,14 +65,29 @@ impl<const D: usize> Implicit<'_, D> {
     /// φ, ∇φ and D²φ at node `i` by central differences (the 3^D stencil through the band's
     /// neighbour table), or None when a stencil node is not in the band.
     pub fn local(&self, band: &NarrowBand<D>, i: usize, h: f64) -> Option<LocalGeometry<D>> {
+        self.local_by(band, i, |phi| {
+            gradient_and_hessian_by(band, i, h, phi).map(|(g, hess)| (phi(i), g, hess))
+        })
+    }
+
+    /// As [`Self::local`], φ, ∇φ and D²φ from the least-squares quadratic over the nodes within
+    /// two grid steps ([`super::local_fit`]): robust to noise in φ.
+    pub fn local_fitted(&self, band: &NarrowBand<D>, i: usize, h: f64) -> Option<LocalGeometry<D>> {
+        self.local_by(band, i, |phi| fitted_gradient_and_hessian_by(band, i, h, phi))
+    }
+
+    /// φ, ∇φ and D²φ at node `i` as `differences` gives them from the (locally signed) φ.
+    #[allow(clippy::type_complexity)]
+    fn local_by(
+        &self,
+        band: &NarrowBand<D>,
+        i: usize,
+        differences: impl Fn(&dyn Fn(usize) -> f64) -> Option<(f64, [f64; D], [[f64; D]; D])>,
+    ) -> Option<LocalGeometry<D>> {
         match self {
             Implicit::LevelSet(phi) => {
-                let (gradient, hessian) = gradient_and_hessian_by(band, i, h, |j| phi[j])?;
-                Some(LocalGeometry {
-                    phi: phi[i],
-                    gradient,
-                    hessian,
-                })
+                let (phi, gradient, hessian) = differences(&|j| phi[j])?;
+                Some(LocalGeometry { phi, gradient, hessian })
             }
             Implicit::ClosestPoint(d) => {
                 let sentinel = band.sentinel();
@@ -97,25 +113,22 @@ impl<const D: usize> Implicit<'_, D> {
                         l
                     }
                 };
-                let (gradient, hessian) = gradient_and_hessian_by(band, i, h, local)?;
-                Some(LocalGeometry {
-                    phi: local(i),
-                    gradient,
-                    hessian,
-                })
+                let (phi, gradient, hessian) = differences(&local)?;
+                Some(LocalGeometry { phi, gradient, hessian })
             }
         }
     }
 
     /// The closest point of node `i` at `x`: the map's own for a closest-point map, x − φ n for a
-    /// level set (`normal` = ∇φ/|∇φ| in the orientation of φ).
+    /// level set (`phi` its value there, the node's own or a fitted one; `normal` = ∇φ/|∇φ| in
+    /// the orientation of φ).
     #[inline]
-    pub fn closest_point(&self, i: usize, x: &[f64; D], normal: &[f64; D]) -> [f64; D] {
+    pub fn closest_point(&self, i: usize, x: &[f64; D], phi: f64, normal: &[f64; D]) -> [f64; D] {
         let mut cp = [0.0; D];
         match self {
-            Implicit::LevelSet(phi) => {
+            Implicit::LevelSet(_) => {
                 for k in 0..D {
-                    cp[k] = x[k] - phi[i] * normal[k];
+                    cp[k] = x[k] - phi * normal[k];
                 }
             }
             Implicit::ClosestPoint(d) => {

@@ -21,6 +21,7 @@ pub mod factoring;
 pub mod geometry;
 pub mod implicit;
 pub mod local;
+mod local_fit;
 mod pipeline;
 mod rows;
 pub mod setup;

@@ -57,7 +57,7 @@ pub fn tube_setup_of<const D: usize>(
     let factor = factoring_arguments.is_ok();
     let unit = grad_u0_unit_of(source_slowness);
     let indices = band.indices();
-    let chunk = |c: usize| -> Chunk<D> {
+    let chunk = |c: usize, fitted: bool| -> Chunk<D> {
         let (s, e) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
         let inner = roles[s..e].iter().filter(|&&r| r != NodeRole::Outer).count();
         let mut out = Chunk {
@@ -66,11 +66,14 @@ pub fn tube_setup_of<const D: usize>(
             u0: Vec::with_capacity(if factor { e - s } else { 0 }),
             fixed: Vec::new(),
             fixed_per_source: vec![0; sources.len()],
-            summary: GeometrySummary::empty(),
+            summary: GeometrySummary {
+                fitted_everywhere: fitted,
+                ..GeometrySummary::empty()
+            },
         };
         for i in s..e {
             let is_inner = roles[i] != NodeRole::Outer;
-            let local = if is_inner {
+            let mut local = if is_inner {
                 surface.local(band, i, spacing)
             } else {
                 None
@@ -79,9 +82,10 @@ pub fn tube_setup_of<const D: usize>(
                 out.nodes.push(node_geometry(
                     surface.phi(i),
                     &directions[i],
-                    local.as_ref(),
+                    &mut local,
                     outer_width,
                     &mut out.summary,
+                    || surface.local_fitted(band, i, spacing),
                 ));
             }
             if !factor {
@@ -120,15 +124,28 @@ pub fn tube_setup_of<const D: usize>(
     } else {
         threads
     };
-    let parts: Vec<Chunk<D>> = if count > 1 && chunks > 1 {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(count)
-            .build()
-            .map_err(|e| Error::invalid("threads", format!("could not start {count} threads: {e}")))?;
-        pool.install(|| (0..chunks).into_par_iter().map(chunk).collect())
+    let pool = if count > 1 && chunks > 1 {
+        Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(count)
+                .build()
+                .map_err(|e| Error::invalid("threads", format!("could not start {count} threads: {e}")))?,
+        )
     } else {
-        (0..chunks).map(chunk).collect()
+        None
     };
+    let pass = |fitted: bool| -> Vec<Chunk<D>> {
+        match &pool {
+            Some(pool) => pool.install(|| (0..chunks).into_par_iter().map(|c| chunk(c, fitted)).collect()),
+            None => (0..chunks).map(|c| chunk(c, fitted)).collect(),
+        }
+    };
+    let mut parts = pass(false);
+    // φ noisy: every node's derivatives again, from the local fits (geometry::NOISY_FRACTION)
+    let first = parts.iter().fold(GeometrySummary::empty(), |a, p| a.merge(p.summary));
+    if first.noisy() {
+        parts = pass(true);
+    }
     drop(indices);
     let n_inner: usize = parts.iter().map(|p| p.nodes.len()).sum();
     let mut nodes = Vec::with_capacity(n_inner);
