@@ -24,6 +24,7 @@ from ._validate import (
     check_threads as _threads,
     check_tolerance_scale,
     checked_point_speeds,
+    tolerance_slowness,
     speed_at_points,
     speed_values,
 )
@@ -59,7 +60,8 @@ FIX_RADIUS = 2.0
 #: come within 6e-7–2.0e-6 of the converged ones on the sphere, ellipsoid, torus and rounded cube,
 #: 0.04–3.4% of their far max errors, 7e-8–1.2e-7 in the mean; 2e-4 took 4–7% more updates for
 #: 2.5–8.1e-7, and 1e-3 left the torus 7.4e-6 away, 12% of its far max error). Dividing by ``ℓ``
-#: makes both tolerances the same fraction of the travel times in any units.
+#: makes both tolerances the same fraction of the travel times in any units. "Mean slowness" is
+#: ``_validate.tolerance_slowness``: the mean, capped at twice the lower quartile (obstacles).
 TOL_FIRST_FACTOR = {2: 1e-2, 3: math.inf}
 TOL_FACTOR = {2: 1e-3, 3: 5e-4}
 
@@ -105,11 +107,12 @@ def ramp_length(grid: Any) -> float:
     return 0.5 * float(np.max(np.asarray(grid.upper, dtype=float) - np.asarray(grid.lower, dtype=float)))
 
 
-def default_tol(spacing: float, mean_slowness: float, length: float, ndim: int = 3) -> float:
+def default_tol(spacing: float, slowness: float, length: float, ndim: int = 3) -> float:
     """Phase 2's stopping tolerance when none is given: ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
-    times the mean slowness (``ℓ`` = :func:`ramp_length`), far below the scheme's O(Δx²) error and
-    far above machine precision, in any units."""
-    return TOL_FACTOR[ndim] * spacing * spacing * mean_slowness / length
+    times the slowness scale ``slowness`` (``ℓ`` = :func:`ramp_length`), far below the scheme's
+    O(Δx²) error and far above machine precision, in any units. The solve passes
+    ``_validate.tolerance_slowness``: the mean slowness, capped where an obstacle pulls it up."""
+    return TOL_FACTOR[ndim] * spacing * spacing * slowness / length
 
 
 def check_supported(
@@ -190,9 +193,11 @@ def solve_on_tube(
     del x
     slowness: Any = 1.0 / speed_nodes
     mean_slowness = float(np.mean(slowness))
+    # the tolerances' slowness: the mean unless an obstacle pulls it up (_validate.tolerance_slowness)
+    tol_slowness = tolerance_slowness(slowness)
     length = ramp_length(grid)
     if tol is None:
-        tol = default_tol(h, mean_slowness, length, d)
+        tol = default_tol(h, tol_slowness, length, d)
     # travel times too large or too small for the local updates' squares, a tol not small against
     # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
     check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
@@ -243,7 +248,7 @@ def solve_on_tube(
         float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
         FIX_RADIUS * h,
         tube.outer_eff * h,
-        TOL_FIRST_FACTOR[d] * h * h * mean_slowness / length,
+        TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
         float(tol),
         int(max_iterations),
         cb,

@@ -1,0 +1,73 @@
+"""Issue 44, "nothing silently wrong": obstacles at second order, a grid box that cuts the
+surface, ``source_radius`` bounds, distances never negative, farthest-point sampling near its
+limit, the ``outer`` rule of ``order=2``, and messages for a surface given as points or a path."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep._validate import tolerance_slowness
+from tubesweep.second_order import default_tol, ramp_length
+
+SPHERE = ts.surfaces.Sphere(0.5)
+G41 = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+THETA = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+RING = np.stack([0 * THETA, 0.5 * np.cos(THETA), 0.5 * np.sin(THETA)], axis=1)  # the circle x = 0
+
+
+# ------------------------------------------------------------------- 1. obstacles at second order
+def _sphere_speed(kind: str) -> np.ndarray:
+    x = np.stack(G41.meshgrid(), axis=-1)
+    speed = np.ones(G41.shape)
+    if kind == "cap":
+        speed[x[..., 0] > 0.3] = 1e-6
+    else:
+        speed[tuple(G41.nearest_index(np.array([[0.35, 0.35, 0.0]]))[0])] = float(kind)
+    return speed
+
+
+@pytest.mark.parametrize("kind", ["cap", "1e-30", "1e-90"])
+def test_order2_default_tolerance_is_not_loosened_by_an_obstacle(kind):
+    # the cap x > 0.3 at speed 1e-6 (or one node at 1e-30, 1e-90) pulled the mean slowness, and the
+    # tolerance with it, up by 5 to 86 orders of magnitude: the sweeps stopped after 1-2 iterations,
+    # 0.123 off on the circle x = 0, which the obstacle does not touch (1.2e-4 without it)
+    sol = ts.solve(SPHERE, G41, [(-0.5, 0, 0)], speed=_sphere_speed(kind), order=2)
+    err = float(np.max(np.abs(sol(RING) - np.pi / 4)))
+    assert err <= 1e-3, err
+    clean = ts.solve(SPHERE, G41, [(-0.5, 0, 0)], order=2)
+    assert err <= 1.1 * float(np.max(np.abs(clean(RING) - np.pi / 4)))
+    assert sol.stats.order2["tol"] <= 2.0 * clean.stats.order2["tol"]
+
+
+def test_order2_tolerance_on_constant_and_smooth_speeds_is_the_mean_slowness_bit_for_bit():
+    rng = np.random.default_rng(0)
+    for s in [np.full(1000, 0.37), 1.0 / (1.0 + 0.5 * rng.random(5000)), np.full(10, 3.0)]:
+        assert tolerance_slowness(s) == float(np.mean(s))
+    assert tolerance_slowness(2.5) == 2.5
+    sol = ts.solve(SPHERE, G41, [(-0.5, 0, 0)], speed=2.0, order=2)
+    assert sol.stats.order2["tol"] == default_tol(G41.spacing, 0.5, ramp_length(G41), 3)
+    # an obstacle: capped at twice the lower quartile
+    s = np.ones(1000)
+    s[:300] = 1e6
+    assert tolerance_slowness(s) == 2.0
+
+
+def test_box_order2_with_a_slow_node_or_disc_matches_the_converged_solution():
+    grid = ts.Grid((-1, -1), (1, 1), (101, 101))
+    x = np.stack(grid.meshgrid(), axis=-1)
+    exact = np.hypot(x[..., 0] + 0.5, x[..., 1])
+    before = x[..., 0] < -0.1  # straight rays from the source
+    node = np.ones(grid.shape)
+    node[tuple(grid.nearest_index(np.array([[0.0, 0.02]]))[0])] = 1e-30
+    u = ts.travel_time(grid, [(-0.5, 0.0)], speed=node, order=2)
+    # the mean-based tolerance left 0.022 there; the factored scheme is exact at constant speed
+    assert float(np.max(np.abs(u - exact)[before])) <= 1e-12
+    disc = np.ones(grid.shape)
+    disc[np.hypot(x[..., 0] - 0.2, x[..., 1]) < 0.3] = 1e-6
+    u = ts.travel_time(grid, [(-0.5, 0.0)], speed=disc, order=2)
+    ref = ts.travel_time(grid, [(-0.5, 0.0)], speed=disc, order=2, tol=1e-13)
+    assert float(np.max(np.abs(u - ref)[disc == 1.0])) <= 1e-6  # 1.8e-4 with the mean-based tolerance
