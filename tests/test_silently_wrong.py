@@ -71,3 +71,45 @@ def test_box_order2_with_a_slow_node_or_disc_matches_the_converged_solution():
     u = ts.travel_time(grid, [(-0.5, 0.0)], speed=disc, order=2)
     ref = ts.travel_time(grid, [(-0.5, 0.0)], speed=disc, order=2, tol=1e-13)
     assert float(np.max(np.abs(u - ref)[disc == 1.0])) <= 1e-6  # 1.8e-4 with the mean-based tolerance
+
+
+# --------------------------------------------------------------------- 3. source_radius bounds
+G61 = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+
+
+@pytest.mark.parametrize("radius", [1e6, 30.0])
+def test_source_radius_beyond_the_grid_is_refused_by_name(radius):
+    # 1e6: "broadcast dimensions too large"; 30 at N = 61: a MemoryError of 44 GiB
+    with pytest.raises(ValueError, match="source_radius = .* exceeds the grid's diagonal"):
+        ts.solve(SPHERE, G61, [(-0.5, 0, 0)], order=1, source_radius=radius)
+
+
+@pytest.mark.parametrize("sources", [[(-0.5, 0, 0)], [(-0.5, 0, 0), (0.5, 0, 0)]])
+def test_source_radius_where_the_chord_is_not_the_surface_distance_is_refused(sources):
+    # radius 1 on a sphere of radius 0.5: every node within it, set to the straight-line distance
+    # (0.078 off with two antipodal sources, no warning; "refine the grid" with one)
+    with pytest.raises(ValueError, match="source_radius = 1 is too large") as e:
+        ts.solve(SPHERE, G61, sources, order=1, source_radius=1.0)
+    # the radius it proposes: where the chord's error c³/(24R²) reaches 0.1 grid spacing, 0.27
+    fit = float(str(e.value).split("source_radius < ")[1].split(",")[0])
+    assert 0.24 <= fit <= 0.3
+    ts.solve(SPHERE, G61, sources, order=1, source_radius=0.9 * fit)
+
+
+def test_source_radius_on_a_plane_is_exact_and_bounded_by_the_tube():
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    plane = ts.LevelSet(lambda p: p[:, 2] - 0.013)
+    with pytest.warns(RuntimeWarning, match=r"sources\[0\] and sources\[1\] overlap .* source_radius < 0\.15"):
+        ts.solve(plane, grid, [(0, 0, 0.013), (0.3, 0, 0.013)], order=1, source_radius=0.2)
+    with pytest.raises(ValueError, match="source_radius = 1.5 covers the whole inner tube"):
+        ts.solve(plane, grid, [(0, 0, 0.013)], order=1, source_radius=1.5)
+
+
+def test_tube_solve_takes_source_radius_as_ts_solve_does():
+    tube = ts.Tube(SPHERE, G41)
+    a = tube.solve([(-0.5, 0, 0)], source_radius=0.1)
+    b = ts.solve(SPHERE, G41, [(-0.5, 0, 0)], source_radius=0.1)
+    assert a.stats.order == b.stats.order == 1 and "source_radius" in a.stats.order_fallback
+    assert np.array_equal(a.values, b.values) and a.stats.fixed_points == b.stats.fixed_points > 33
+    with pytest.raises(ValueError, match="too large"):
+        tube.solve([(-0.5, 0, 0)], source_radius=1.0, order=1)
