@@ -113,3 +113,32 @@ def test_tube_solve_takes_source_radius_as_ts_solve_does():
     assert np.array_equal(a.values, b.values) and a.stats.fixed_points == b.stats.fixed_points > 33
     with pytest.raises(ValueError, match="too large"):
         tube.solve([(-0.5, 0, 0)], source_radius=1.0, order=1)
+
+
+# ------------------------------------------------------- 6. a surface given as points, a path, a list
+def test_points_as_the_surface_name_the_point_and_mesh_constructors():
+    pts = np.random.default_rng(0).normal(size=(100, 3))
+    with pytest.raises(ValueError, match=r"shape \(100, 3\).* looks like 100 points .*from_points.*from_mesh"):
+        ts.solve(pts, G41, [(0.5, 0, 0)])
+    g2 = ts.Grid((-1, -1), (1, 1), (41, 41))
+    with pytest.raises(ValueError, match=r"shape \(7, 2\).*from_points\(points\) \(a point cloud\)$"):
+        ts.solve(np.zeros((7, 2)), g2, [(0, 0)])
+
+
+def test_a_mesh_path_as_the_surface_points_to_from_mesh(tmp_path):
+    for path in ["bunny.obj", tmp_path / "x.off"]:
+        with pytest.raises(TypeError, match=r"is a (path|string): .*ts\.surfaces\.from_mesh\(path\)"):
+            ts.solve(path, G41, [(0.5, 0, 0)])
+        with pytest.raises(TypeError, match="from_mesh"):
+            ts.Tube(path, G41)
+
+
+def test_a_list_phi_is_taken_as_ts_levelset_takes_it():
+    g2 = ts.Grid((-1, -1), (1, 1), (41, 41))
+    x, y = g2.meshgrid()
+    phi = np.hypot(x, y) - 0.5
+    ref = ts.solve(phi, g2, [(-0.5, 0)])
+    for like in [phi.tolist(), tuple(map(tuple, phi))]:
+        assert np.array_equal(ts.solve(like, g2, [(-0.5, 0)]).values, ref.values)
+        assert np.array_equal(ts.Tube(like, g2).solve([(-0.5, 0)]).values, ref.values)
+    assert abs(float(ref([(0.5, 0)])[0]) - np.pi / 2) < 2e-3
