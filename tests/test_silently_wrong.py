@@ -142,3 +142,18 @@ def test_a_list_phi_is_taken_as_ts_levelset_takes_it():
         assert np.array_equal(ts.solve(like, g2, [(-0.5, 0)]).values, ref.values)
         assert np.array_equal(ts.Tube(like, g2).solve([(-0.5, 0)]).values, ref.values)
     assert abs(float(ref([(0.5, 0)])[0]) - np.pi / 2) < 2e-3
+
+
+# ------------------------------------------------------- 5. farthest-point sampling near its limit
+def test_farthest_point_sampling_never_repeats_a_point_and_refuses_more_than_the_grid_resolves():
+    grid = ts.Grid((-1, -1), (1, 1), (21, 21))
+    tube = ts.Tube(ts.surfaces.Circle(0.5), grid)
+    # 124 inner nodes: k = 119 gave 96 distinct points, the last ones repeated with radius 2.4e-3
+    with pytest.raises(ValueError, match=r"k = 119 exceeds the (\d+) distinct surface points") as e:
+        ts.farthest_point_sampling(tube, None, 119)
+    most = int(str(e.value).split("exceeds the ")[1].split()[0])
+    assert 96 < most < 119
+    points, radii = ts.farthest_point_sampling(tube, None, most)
+    gaps = np.linalg.norm(points[:, None] - points[None], axis=2) + np.eye(most)
+    assert gaps.min() > 1e-6 * grid.spacing  # no point twice
+    assert np.all(radii[1:] >= 0) and np.all(np.diff(radii[1:]) <= 0)
