@@ -157,3 +157,17 @@ def test_farthest_point_sampling_never_repeats_a_point_and_refuses_more_than_the
     gaps = np.linalg.norm(points[:, None] - points[None], axis=2) + np.eye(most)
     assert gaps.min() > 1e-6 * grid.spacing  # no point twice
     assert np.all(radii[1:] >= 0) and np.all(np.diff(radii[1:]) <= 0)
+
+
+# --------------------------------------------------------------- 5. the outer rule of order=2
+@pytest.mark.parametrize("outer", [3, 3.5])
+def test_order2_refuses_outer_below_inner_plus_2_as_given_widened_or_not(outer):
+    # outer=3 was widened to 4 (an inner node lacked a neighbour) and accepted, 3.5 refused
+    with pytest.raises(ts.second_order.Order2NotApplicable, match=r"outer ≥ inner \+ 2 .*pass outer=4 or more"):
+        ts.solve(SPHERE, G41, [(-0.5, 0, 0)], order=2, outer=outer)
+    for make in (lambda: ts.solve(SPHERE, G41, [(-0.5, 0, 0)], outer=outer), lambda: ts.Tube(SPHERE, G41, outer=outer)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # the widening of outer=3
+            made = make()
+        sol = made if isinstance(made, ts.Solution) else made.solve([(-0.5, 0, 0)])
+        assert sol.stats.order == 1 and "outer ≥ inner + 2" in sol.stats.order_fallback

@@ -161,6 +161,23 @@ def check_supported(
         )
 
 
+def check_widths(inner: Any, outer: Any) -> None:
+    """Refuses ``outer < inner + 2`` as given (before any widening of the extension layer), so that
+    whether ``order=2`` applies depends on the arguments and not on the grid: a layer widened
+    from ``outer = 3`` to 4 where some inner node lacked a neighbour was accepted, ``outer = 3.5``
+    (never widened) refused. Widths that are not numbers are left to the tube's own checks."""
+    numbers = all(
+        isinstance(w, (int, float, np.integer, np.floating)) and not isinstance(w, (bool, np.bool_)) and np.isfinite(w)
+        for w in (inner, outer)
+    )
+    if numbers and float(outer) < float(inner) + 2.0 - 1e-9:
+        raise Order2NotApplicable(
+            f"order=2 needs two band neighbours on each side of every inner-tube node: outer ≥ inner + 2 grid spacings "
+            f"(got inner={float(inner):g}, outer={float(outer):g}); pass outer={float(inner) + 2.0:g} or more (the "
+            "defaults are inner=2, outer=4), or order=1"
+        )
+
+
 def _native_solve(*args: Any, **kwargs: Any) -> Any:
     """``_native.second_order_solve``, its refusals of the geometry (``order=2: ...``: a crease, a
     curvature the tube does not resolve, a φ that is not a distance, a closest-point map of an open

@@ -223,6 +223,7 @@ def solve(
                     "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
                 )
             _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
+            _so.check_widths(inner, outer)
             tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
             return _so.solve_on_tube(
                 tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0

@@ -216,6 +216,7 @@ class Tube:
                         "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
                     )
                 _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
+                _so.check_widths(self._args[0], self._args[1])
                 if self._order2_refusal is not None:  # this band's geometry, refused before
                     raise _so.Order2NotApplicable(self._order2_refusal)
                 try:
