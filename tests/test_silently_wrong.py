@@ -171,3 +171,21 @@ def test_order2_refuses_outer_below_inner_plus_2_as_given_widened_or_not(outer):
             made = make()
         sol = made if isinstance(made, ts.Solution) else made.solve([(-0.5, 0, 0)])
         assert sol.stats.order == 1 and "outer ≥ inner + 2" in sol.stats.order_fallback
+
+
+# ------------------------------------------------------------------ 4. distances never negative
+def test_order2_values_next_to_a_source_are_never_negative():
+    grid = ts.Grid((-1, -1), (1, 1), (41, 41))
+    h = grid.spacing
+    circle = ts.surfaces.Circle(4 * h)  # radius 4Δx, where the fuzz found u = u₀ + w = −9e-22
+    src = np.array([[4 * h * np.cos(0.3), 4 * h * np.sin(0.3)]])
+    sol = ts.solve(circle, grid, src, order=2)
+    assert sol.stats.order == 2 and np.all(sol.values[np.isfinite(sol.values)] >= 0)
+    near = src + np.random.default_rng(0).normal(scale=0.05 * h, size=(50, 2))
+    assert float(sol(src)[0]) == 0.0 and np.all(sol(near) >= 0)
+    # w = u − u₀ rounding below 0 at the nodes around the source: the value there stays at 0
+    sol.values = sol.values - 1e-18
+    assert float(sol(src)[0]) == 0.0
+    box = ts.travel_time(grid, src, order=2, return_solution=True)
+    box.values = box.values - 1e-18
+    assert float(box(src)[0]) == 0.0 and np.all(box(near) >= 0)

@@ -92,7 +92,10 @@ def main() -> None:
                 tol = order2_tol(grid, float(np.mean(1.0 / speed)))
             u = ts.travel_time(grid, [SOURCE2], speed=speed, order=2, **({} if tol is None else {"tol": tol}))
             row[label] = (float(np.max(np.abs(u - ref)[free])), float(np.max(np.abs(u - exact)[before])))
-        print(f"  {kind:11s} " + "  ".join(f"{k}: {a:.3g} from converged, {b:.3g} from exact" for k, (a, b) in row.items()))
+        print(
+            f"  {kind:11s} "
+            + "  ".join(f"{k}: {a:.3g} from converged, {b:.3g} from exact" for k, (a, b) in row.items())
+        )
     print(
         "tolerance slowness (mean -> used): cap "
         + ", ".join(

@@ -85,4 +85,7 @@ def solve_order2(
         progress,
         ACTIVATION_FRACTION * float(tol),
     )
+    # u = u₀ + w rounds to just below 0 next to a source (a runaway, far below, is handled by the
+    # core): a travel time is never negative
+    np.maximum(values, 0.0, out=values)
     return values, st, source_slowness

@@ -278,6 +278,10 @@ def solve_on_tube(
         ramp_length=length,
         extension_limit=EXTENSION_LIMIT,
     )
+    # u = u₀ + w rounds to just below 0 next to a source (−9e-22 on a circle of radius 4Δx): a
+    # travel time is never negative. Clamped here, not in the sweeps, whose runaway guard reads the
+    # sign (a value below −Δx times the mean slowness)
+    np.maximum(values, 0.0, out=values)
     if not st["converged"]:
         warnings.warn(
             f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
