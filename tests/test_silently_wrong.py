@@ -189,3 +189,49 @@ def test_order2_values_next_to_a_source_are_never_negative():
     box = ts.travel_time(grid, src, order=2, return_solution=True)
     box.values = box.values - 1e-18
     assert float(box(src)[0]) == 0.0 and np.all(box(near) >= 0)
+
+
+# ------------------------------------------------------------ 2. a grid box that cuts the surface
+def test_a_surface_leaving_the_box_is_warned_with_the_length_of_the_cut():
+    grid = ts.Grid((-1, -1, -1), (0.3, 1, 1), (66, 101, 101))  # the torus's part x > 0.3 cut away
+    with pytest.warns(RuntimeWarning, match=r"grid box cuts the surface: it crosses the box's boundary x = 0\.3 along"):
+        sol = ts.solve(ts.surfaces.Torus(0.6, 0.25), grid, [(-0.85, 0, 0)])
+    cut = sol.stats.box_cut
+    assert cut["surface_cut"] and cut["faces"] == ["x = 0.3"]
+    # the cut: two ovals (|(x, y)| − 0.6)² + z² = 0.25² in the plane x = 0.3
+    t = np.linspace(0, 2 * np.pi, 20001)
+    rho = 0.6 + 0.25 * np.cos(t)
+    oval = np.stack([np.sqrt(rho**2 - 0.09), 0.25 * np.sin(t)], axis=1)
+    length = 2 * float(np.sum(np.linalg.norm(np.diff(oval, axis=0), axis=1)))
+    assert abs(cut["cut_length"] - length) <= 0.1 * length, (cut["cut_length"], length)
+    g2 = ts.Grid((-1, -1), (0.3, 1), (66, 101))
+    with pytest.warns(RuntimeWarning, match="x = 0.3 at 2 points"):
+        assert ts.solve(ts.surfaces.Circle(0.6), g2, [(-0.6, 0)]).stats.box_cut["cut_points"] == 2
+
+
+def test_a_tube_cut_by_the_box_around_a_surface_inside_it_is_recorded_and_named():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # the surface is inside: no warning
+        sol = ts.solve(ts.surfaces.Sphere(0.97), G61, [(-0.97, 0, 0)], order=1)
+    cut = sol.stats.box_cut
+    assert not cut["surface_cut"] and abs(cut["gap"] - 0.03) < 1e-6 and len(cut["faces"]) == 6
+    assert ts.solve(SPHERE, G41, [(-0.5, 0, 0)]).stats.box_cut is None
+    # order=2's refusal of the geometry there named φ and the resolution; it names the box
+    try:
+        ts.solve(ts.surfaces.Sphere(0.97), G61, [(-0.97, 0, 0)], order=2)
+    except ts.second_order.Order2NotApplicable as e:
+        assert "the grid box cuts the tube" in str(e) and "redistance" not in str(e)
+
+
+def test_a_plane_or_a_sampled_phi_crossing_the_box_is_recorded_without_a_warning():
+    x, y, z = G41.meshgrid()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        for plane in (lambda p: p[:, 2] - 0.013, z - 0.013):
+            cut = ts.solve(plane, G41, [(0, 0, 0.013)], order=1).stats.box_cut
+            assert cut["surface_cut"] and len(cut["faces"]) == 4
+            assert abs(cut["cut_length"] - 8.0) <= 0.25 * 8.0  # the square's perimeter: 8
+    torus = lambda p: np.hypot(np.hypot(p[:, 0], p[:, 1]) - 0.6, p[:, 2]) - 0.25  # noqa: E731
+    grid = ts.Grid((-1, -1, -1), (0.3, 1, 1), (66, 101, 101))
+    with pytest.warns(RuntimeWarning, match="grid box cuts the surface"):
+        ts.solve(torus, grid, [(-0.85, 0, 0)], order=1)

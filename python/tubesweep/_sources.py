@@ -76,11 +76,11 @@ def _fix_sources(
             continue
         corner = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64)
         if band_index is None:
-            pos = band.find(np.ascontiguousarray(corner + offsets))
-            pos = pos[pos >= 0]
+            found = band.find(np.ascontiguousarray(corner + offsets))
+            found = found[found >= 0]
         else:
-            pos = np.flatnonzero(np.all(np.abs(band_index - corner) <= r, axis=1))
-        pos = pos[roles[pos] == ROLE_INNER]
+            found = np.flatnonzero(np.all(np.abs(band_index - corner) <= r, axis=1))
+        pos = found[roles[found] == ROLE_INNER]
         if pos.size == 0:
             raise ValueError(f"sources[{i}] has no inner-tube node near it; refine the grid or increase `inner`")
         x = grid.points(grid.unravel(linear[pos]))

@@ -18,6 +18,7 @@ from typing import Any, Optional, Union
 import numpy as np
 
 from . import _native
+from ._box_cut import box_reason
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._validate import (
     FRONT_WINDOW,
@@ -253,31 +254,35 @@ def solve_on_tube(
     roles = tube.roles
     directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
     setup = time.perf_counter() - t0
-    values, u0, roles_out, st = _native_solve(
-        band,
-        np.ascontiguousarray(roles),
-        np.ascontiguousarray(geom.signed, dtype=np.float64),
-        np.ascontiguousarray(directions),
-        [float(c) for c in grid.lower],
-        h,
-        np.ascontiguousarray(feet, dtype=float),
-        np.ascontiguousarray(src_slowness, dtype=float),
-        float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
-        FIX_RADIUS * h,
-        tube.outer_eff * h,
-        TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
-        float(tol),
-        int(max_iterations),
-        cb,
-        threads=_threads(threads),
-        front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
-        own_first_phase=_OWN_FIRST_PHASE,
-        offsets=offsets,
-        window_first=WINDOWS[0] if d == 3 else 0.0,
-        window_second=WINDOWS[1] if d == 3 else 0.0,
-        ramp_length=length,
-        extension_limit=EXTENSION_LIMIT,
-    )
+    try:
+        values, u0, roles_out, st = _native_solve(
+            band,
+            np.ascontiguousarray(roles),
+            np.ascontiguousarray(geom.signed, dtype=np.float64),
+            np.ascontiguousarray(directions),
+            [float(c) for c in grid.lower],
+            h,
+            np.ascontiguousarray(feet, dtype=float),
+            np.ascontiguousarray(src_slowness, dtype=float),
+            float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
+            FIX_RADIUS * h,
+            tube.outer_eff * h,
+            TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
+            float(tol),
+            int(max_iterations),
+            cb,
+            threads=_threads(threads),
+            front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
+            own_first_phase=_OWN_FIRST_PHASE,
+            offsets=offsets,
+            window_first=WINDOWS[0] if d == 3 else 0.0,
+            window_second=WINDOWS[1] if d == 3 else 0.0,
+            ramp_length=length,
+            extension_limit=EXTENSION_LIMIT,
+        )
+    except Order2NotApplicable as e:
+        # a tube cut by the grid box: the reason names the box, not φ or the resolution
+        raise Order2NotApplicable(box_reason(tube.box_cut, str(e), tube.outer_eff * h)) from None
     # u = u₀ + w rounds to just below 0 next to a source (−9e-22 on a circle of radius 4Δx): a
     # travel time is never negative. Clamped here, not in the sweeps, whose runaway guard reads the
     # sign (a value below −Δx times the mean slowness)
@@ -331,6 +336,7 @@ def solve_on_tube(
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         order=2,
         order2=order2,
+        box_cut=tube.box_cut,
     )
     # the source of each fixed node: the nearest foot point
     fixed_pts = grid.node_points(linear[positions])

@@ -476,6 +476,7 @@ def _solve_on_tube(
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver=st.get("local_solver", scheme),
+        box_cut=tube.box_cut,
     )
     return Solution(
         grid,
