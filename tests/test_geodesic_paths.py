@@ -194,7 +194,8 @@ def test_paths_to_many_sources_off_the_nodes_end_at_a_source():
 def test_a_path_starting_at_the_edge_of_the_grid_uses_one_sided_differences():
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
     for sources in ([(0.0, 0.0, 0.0)], [(0.0, 0.0, 0.0), (-0.8, 0.8, 0.0)]):
-        sol = ts.solve(ts.surfaces.PlanePatch(1.5), g, sources)
+        with pytest.warns(RuntimeWarning, match="the grid box cuts the surface"):  # the patch is wider than the box
+            sol = ts.solve(ts.surfaces.PlanePatch(1.5), g, sources)
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             path = sol.geodesic_path((0.98, 0.98, 0.0))
@@ -205,7 +206,8 @@ def test_a_path_starting_at_the_edge_of_the_grid_uses_one_sided_differences():
     # the cut, so the path ends at the grid's edge, with a warning.
     cut = ts.Grid((-1, -1, -0.2), (1, 1, 1), (41, 41, 25))
     sources = np.array([[0.3, 0, 0.4], [-0.4743, 0, -0.1581]])
-    sol = ts.solve(ts.surfaces.Sphere(R), cut, sources)
+    with pytest.warns(RuntimeWarning, match="the grid box cuts the surface"):
+        sol = ts.solve(ts.surfaces.Sphere(R), cut, sources)
     with pytest.warns(RuntimeWarning, match="stopped before reaching a source"):
         path = sol.geodesic_path((0.0934, 0.4672, -0.1516))
     u = sol(path)
@@ -298,7 +300,8 @@ def test_a_stall_away_from_any_narrow_gap_does_not_mention_one():
     # a sphere cut by the grid (as above): the path leaves the grid, with no narrow gap anywhere
     cut = ts.Grid((-1, -1, -0.2), (1, 1, 1), (41, 41, 25))
     sources = np.array([[0.3, 0, 0.4], [-0.4743, 0, -0.1581]])
-    sol = ts.solve(ts.surfaces.Sphere(0.5), cut, sources)
+    with pytest.warns(RuntimeWarning, match="the grid box cuts the surface"):
+        sol = ts.solve(ts.surfaces.Sphere(0.5), cut, sources)
     assert sol.narrow_gaps()[0].shape == (0, 3)
     with pytest.warns(RuntimeWarning, match="stopped before reaching a source") as caught:
         sol.geodesic_path((0.0934, 0.4672, -0.1516))

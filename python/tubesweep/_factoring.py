@@ -58,5 +58,6 @@ def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: 
             foot = np.where((d_surface <= 1e-9 * h)[:, None], q, foot)
         chord = np.sqrt(((foot[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2)) * slowness[None, :]
         w = interpolate_band(sol._band, sol.values - u0, grid, q, interpolation)
-        values[close] = w + chord.min(axis=1)
+        # never negative: w interpolated at a source rounds to ±1e-21 (the chord is 0 there)
+        values[close] = np.maximum(w + chord.min(axis=1), 0.0)
     return values

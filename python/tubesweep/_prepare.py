@@ -9,7 +9,7 @@ import contextlib
 import dataclasses
 import time
 import warnings
-from typing import Any, Optional, Tuple
+from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
@@ -23,6 +23,7 @@ from .grid import Grid
 from .band import BandGeometry, band_neighbours
 from .surface import Surface
 from ._warn import user_stacklevel
+from ._box_cut import box_cut, warn_box_cut
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -102,6 +103,8 @@ class _PreparedTube:
     #: the pairs of neighbouring nodes across a gap narrower than the tubes: their band positions
     #: and their gaps (``_warn_if_tubes_touch``)
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray] = (np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0))
+    #: where the grid box cuts the tube (``_box_cut.box_cut``), None where it does not
+    box_cut: Optional[Dict[str, Any]] = None
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -391,6 +394,9 @@ def _prepare_tube(
             _widening_message(missing, phi, h, inner, outer_eff), RuntimeWarning, stacklevel=user_stacklevel()
         )
         outer_eff += 1.0
+    # a surface that leaves the grid box: the distances are those of the part inside (warned)
+    cut = box_cut(grid, linear, phi, inner_width)
+    warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
     facing = _warn_if_tubes_touch(
         grid,
         band,
@@ -416,4 +422,5 @@ def _prepare_tube(
         direction,
         time.perf_counter() - t0,
         facing,
+        cut,
     )

@@ -3,6 +3,7 @@ source (docs/source-initialisation.md)."""
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Callable, Tuple
 
 import numpy as np
@@ -10,11 +11,18 @@ import numpy as np
 from .grid import Grid
 from .surface import Surface
 from ._prepare import ROLE_INNER
+from ._warn import user_stacklevel
 
 #: With ``source_init="exact"``, inner-tube nodes whose closest point lies within this many grid
 #: spacings of a source are fixed to the exact local distance ``|cp(x) − x_s|`` times the mean
 #: slowness.
 SOURCE_RADIUS = 2.0
+
+#: A ``source_radius`` is refused where the chord distance the nodes within it are fixed to is
+#: estimated to differ from the distance along the surface by more than this many grid spacings
+#: (a tenth of a spacing: a small share of the first-order scheme's own error, which is of the
+#: order of a spacing).
+CHORD_TOLERANCE = 0.1
 
 
 def _fix_sources(
@@ -43,7 +51,17 @@ def _fix_sources(
             )
     best: dict = {}
     r = int(np.ceil(radius + inner_width / h)) + 1
-    offsets = np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+    # the nodes around a source: a box of (2r + 1)^d offsets, or for a box larger than the band
+    # (a large source_radius) the band's nodes within it: memory of the band's size, not the box's
+    band_index = grid.unravel(linear) if (2 * r + 1) ** d > len(linear) else None
+    offsets = (
+        np.stack(np.meshgrid(*([np.arange(-r, r + 1)] * d), indexing="ij"), axis=-1).reshape(-1, d)
+        if band_index is None
+        else None
+    )
+    # the largest estimated chord error in the balls, and the shortest chord where it exceeds
+    # CHORD_TOLERANCE spacings (checked below)
+    chord_error, chord_fit = 0.0, np.inf
     for i, (s, sp) in enumerate(zip(sources, proj)):
         if source_init == "node":
             idx = grid.nearest_index(s[None])
@@ -56,11 +74,13 @@ def _fix_sources(
             if pos not in best or best[pos][0] > 0.0:
                 best[pos] = (0.0, i)
             continue
-        idx = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64) + offsets
-        pos = band.find(np.ascontiguousarray(idx))
-        ok = pos >= 0
-        pos = pos[ok]
-        pos = pos[roles[pos] == ROLE_INNER]
+        corner = np.floor(grid.continuous_index(s[None])[0]).astype(np.int64)
+        if band_index is None:
+            found = band.find(np.ascontiguousarray(corner + offsets))
+            found = found[found >= 0]
+        else:
+            found = np.flatnonzero(np.all(np.abs(band_index - corner) <= r, axis=1))
+        pos = found[roles[found] == ROLE_INNER]
         if pos.size == 0:
             raise ValueError(f"sources[{i}] has no inner-tube node near it; refine the grid or increase `inner`")
         x = grid.points(grid.unravel(linear[pos]))
@@ -69,6 +89,13 @@ def _fix_sources(
         near = geo <= radius * h
         if not np.any(near):
             near = geo <= geo.min()
+        if radius > SOURCE_RADIUS:
+            err = _chord_errors(surface, grid, sp, cp[near], geo[near])
+            if err.size:
+                chord_error = max(chord_error, float(err.max()))
+                over = err > CHORD_TOLERANCE * h
+                if np.any(over):
+                    chord_fit = min(chord_fit, float(geo[near][over].min()))
         slow = 0.5 * (slowness_at(cp[near]) + slowness_at(sp[None])[0])
         for p, v in zip(pos[near], geo[near] * slow):
             if p not in best or v < best[p][0]:
@@ -76,4 +103,49 @@ def _fix_sources(
     positions = np.fromiter(best.keys(), dtype=np.int64, count=len(best))
     values = np.fromiter((v for v, _ in best.values()), dtype=float, count=len(best))
     labels = np.fromiter((k for _, k in best.values()), dtype=np.int64, count=len(best))
+    if radius > SOURCE_RADIUS:
+        _check_source_balls(grid, proj, radius * h, chord_error, chord_fit)
     return positions, values, labels
+
+
+def _chord_errors(surface: Surface, grid: Grid, foot: np.ndarray, cp: np.ndarray, chord: np.ndarray) -> np.ndarray:
+    """The error of each chord ``|cp − foot|`` as the distance along the surface, estimated by
+    Richardson extrapolation from the two chords through the surface point nearest the chord's
+    midpoint (on a sphere of radius R the chord is short by c³/(24R²), the two chords by a
+    quarter of it); non-finite estimates (a projection that failed) count as 0."""
+    if len(cp) == 0:
+        return np.empty(0)
+    _, mid = surface.project(0.5 * (cp + foot[None, :]), grid)
+    two = np.linalg.norm(mid - foot[None, :], axis=1) + np.linalg.norm(cp - mid, axis=1)
+    err = (two - chord) * (4.0 / 3.0)
+    return np.where(np.isfinite(err), err, 0.0)
+
+
+def _check_source_balls(grid: Grid, feet: np.ndarray, reach: float, chord_error: float, chord_fit: float) -> None:
+    """With a ``source_radius`` beyond the default: refuses a radius within which the chord is not
+    the distance along the surface (the surface curves), and warns when the balls of two sources
+    overlap (their nodes take the nearer source's chord, and the fronts' meeting line is not
+    solved for)."""
+    h = grid.spacing
+    if chord_error > CHORD_TOLERANCE * h:
+        # the shortest chord whose error exceeds the tolerance: a radius below it keeps every chord
+        fit = chord_fit
+        raise ValueError(
+            f"source_radius = {reach:.4g} is too large for this surface: within it the straight (chord) distance "
+            f"the nodes are fixed to differs from the distance along the surface by up to about {chord_error:.3g} "
+            f"({chord_error / h:.2g} grid spacings; the surface curves within the radius). Use source_radius < "
+            f"{fit:.3g}, or leave it out (the default, {SOURCE_RADIUS:g} grid spacings)"
+        )
+    if len(feet) > 1:
+        gaps = np.linalg.norm(feet[:, None, :] - feet[None, :, :], axis=2)
+        gaps[np.diag_indices(len(feet))] = np.inf
+        i, j = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
+        if gaps[i, j] < 2.0 * reach:
+            warnings.warn(
+                f"source_radius = {reach:.4g}: the balls of exact values around sources[{min(i, j)}] and "
+                f"sources[{max(i, j)}] overlap (they are {gaps[i, j]:.4g} apart, less than twice the radius): the nodes "
+                f"in both are fixed to the nearer chord and where the two fronts meet is not solved for. Use "
+                f"source_radius < {0.5 * gaps[i, j]:.4g} to keep the sources' balls apart",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )

@@ -16,7 +16,8 @@ __all__ = ["ORDERS", "ORDER2_TOL", "check_order", "order2_tol", "solve_order2"]
 ORDERS = (1, 2, "auto")
 
 #: Default stopping tolerance of ``order=2``: a phase stops when no value changes by more than
-#: ``ORDER2_TOL · s̄ · Δx² / L`` in an iteration (``s̄`` the mean slowness, ``L`` the box's longest
+#: ``ORDER2_TOL · s̄ · Δx² / L`` in an iteration (``s̄`` the mean slowness, capped at twice its lower
+#: quartile where an obstacle pulls it up: ``_validate.tolerance_slowness``; ``L`` the box's longest
 #: side): far below the O(Δx²) discretisation error, far above rounding.
 ORDER2_TOL = 1e-3
 
@@ -44,8 +45,9 @@ def box_length(grid: Grid) -> float:
     return float(np.max(np.asarray(grid.upper) - np.asarray(grid.lower)))
 
 
-def order2_tol(grid: Grid, mean_slowness: float) -> float:
-    return ORDER2_TOL * mean_slowness * grid.spacing**2 / box_length(grid)
+def order2_tol(grid: Grid, slowness: float) -> float:
+    """The default tolerance for the slowness scale ``slowness`` (``_validate.tolerance_slowness``)."""
+    return ORDER2_TOL * slowness * grid.spacing**2 / box_length(grid)
 
 
 def solve_order2(
@@ -83,4 +85,7 @@ def solve_order2(
         progress,
         ACTIVATION_FRACTION * float(tol),
     )
+    # u = u₀ + w rounds to just below 0 next to a source (a runaway, far below, is handled by the
+    # core): a travel time is never negative
+    np.maximum(values, 0.0, out=values)
     return values, st, source_slowness

@@ -143,4 +143,6 @@ class BoxSolution:
             local = r[near] * 0.5 * (self._slowness_at(p[near]) + slow[j[near]])
             lam = np.clip(self._source_radius - r[near] / h, 0.0, 1.0)
             out[near] = lam * local + (1.0 - lam) * out[near]
+        # never negative: u₀ + w interpolated rounds to just below 0 next to a source (NaN stays)
+        np.maximum(out, 0.0, out=out)
         return out

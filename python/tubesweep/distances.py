@@ -157,6 +157,11 @@ def distance_matrix(
     return matrix
 
 
+#: Closest points within this many grid spacings of each other stand for the same surface point in
+#: :func:`farthest_point_sampling` (rounding of the projections, not a resolved distance).
+_SAME_POINT = 1e-6
+
+
 def farthest_point_sampling(
     surface: Any,
     grid: Any,
@@ -204,7 +209,9 @@ def farthest_point_sampling(
     Raises
     ------
     ValueError
-        If ``k`` is not a positive whole number, or ``start`` lies off the surface.
+        If ``k`` is not a positive whole number or exceeds the number of distinct surface points
+        the grid resolves (the closest points of the inner-tube nodes; no point is chosen twice),
+        or ``start`` lies off the surface.
 
     Examples
     --------
@@ -220,14 +227,18 @@ def farthest_point_sampling(
     t = tube._tube
     g = tube.grid
     inner_pos = np.flatnonzero(t.roles == ROLE_INNER)
-    if k > inner_pos.size:
-        raise ValueError(
-            f"k = {k} exceeds the {inner_pos.size} inner-tube nodes the points are chosen from; refine the grid"
-        )
     # the surface point each inner node stands for
     _, candidates = tube.surface.project(g.node_points(t.linear[inner_pos]), g)
     candidates = np.asarray(candidates, dtype=float)
     usable = np.all(np.isfinite(candidates), axis=1)
+    # nodes whose closest points coincide (to rounding) stand for one point: a point is never
+    # chosen twice, so k is at most the number of distinct ones
+    distinct = int(np.unique(np.round(candidates[usable] / (_SAME_POINT * g.spacing)), axis=0).shape[0])
+    if k > distinct:
+        raise ValueError(
+            f"k = {k} exceeds the {distinct} distinct surface points the grid resolves (the closest points of its "
+            f"{inner_pos.size} inner-tube nodes): pass k ≤ {distinct} or refine the grid"
+        )
 
     def distances_from(p: np.ndarray) -> np.ndarray:
         return tube.solve([p], tol=tol, threads=threads, order=1).values[inner_pos]
@@ -245,14 +256,24 @@ def farthest_point_sampling(
     points = [current]
     radii = [np.inf]
     nearest = np.full(inner_pos.size, np.inf)
+    # candidates standing for a chosen point (or too close to one to be told apart): never chosen
+    taken = ~usable
     for step in range(1, k + 1):
         nearest = np.minimum(nearest, distances_from(points[-1]))
+        taken |= np.linalg.norm(candidates - points[-1], axis=1) <= _SAME_POINT * g.spacing
         if progress is not None:
             progress(step, k)
         if step == k:
             break
-        score = np.where(usable, nearest, -np.inf)
+        score = np.where(taken, -np.inf, nearest)
         best = int(np.argmax(score))
+        if score[best] == -np.inf:  # every candidate taken (k was checked against the distinct points)
+            raise ValueError(
+                f"k = {k}: only {step} distinct surface points could be chosen on this grid; pass k ≤ {step} or "
+                "refine the grid"
+            )
         points.append(candidates[best])
-        radii.append(float(score[best]))
+        # the discrete distances near a chosen point are of the size of the scheme's error, not 0:
+        # the radius is at least 0
+        radii.append(max(float(score[best]), 0.0))
     return np.array(points), np.array(radii)

@@ -21,6 +21,7 @@ from ._validate import (
     check_memory,
     check_tolerance,
     check_tolerance_scale,
+    tolerance_slowness,
     speed_at_points,
     progress_callback,
     speed_values,
@@ -180,8 +181,8 @@ def travel_time(
     tol : float, optional
         Stop when the largest change in one iteration (2^d sweeps) is below ``tol``. Default
         1e-10 with ``order=1``; with ``order=2`` each phase stops below
-        ``1e-3 · s̄ · Δx² / L`` (``s̄`` the mean slowness, ``L`` the box's longest side), far below
-        its O(Δx²) error.
+        ``1e-3 · s̄ · Δx² / L`` (``s̄`` the mean slowness, at most twice its lower quartile so that an
+        obstacle does not loosen it; ``L`` the box's longest side), far below its O(Δx²) error.
     max_iterations : int
         A ``RuntimeWarning`` is issued if the sweeps have not converged by then.
     return_stats : bool
@@ -302,7 +303,8 @@ def travel_time(
             result = (result[0], dataclasses.replace(result[1], order_fallback=fallback))
         return result
     if tol is None:
-        tol = order2_tol(grid, float(np.mean(slowness)))
+        # the mean slowness, capped where an obstacle pulls it up (_validate.tolerance_slowness)
+        tol = order2_tol(grid, tolerance_slowness(slowness))
     check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))
 
     def slowness_at(x: np.ndarray) -> np.ndarray:

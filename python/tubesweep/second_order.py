@@ -18,12 +18,14 @@ from typing import Any, Optional, Union
 import numpy as np
 
 from . import _native
+from ._box_cut import box_reason
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._validate import (
     FRONT_WINDOW,
     check_threads as _threads,
     check_tolerance_scale,
     checked_point_speeds,
+    tolerance_slowness,
     speed_at_points,
     speed_values,
 )
@@ -64,7 +66,8 @@ FIX_RADIUS = 2.0
 #: come within 6e-7–2.0e-6 of the converged ones on the sphere, ellipsoid, torus and rounded cube,
 #: 0.04–3.4% of their far max errors, 7e-8–1.2e-7 in the mean; 2e-4 took 4–7% more updates for
 #: 2.5–8.1e-7, and 1e-3 left the torus 7.4e-6 away, 12% of its far max error). Dividing by ``ℓ``
-#: makes both tolerances the same fraction of the travel times in any units.
+#: makes both tolerances the same fraction of the travel times in any units. "Mean slowness" is
+#: ``_validate.tolerance_slowness``: the mean, capped at twice the lower quartile (obstacles).
 TOL_FIRST_FACTOR = {2: 1e-2, 3: math.inf}
 TOL_FACTOR = {2: 1e-3, 3: 5e-4}
 
@@ -110,11 +113,12 @@ def ramp_length(grid: Any) -> float:
     return 0.5 * float(np.max(np.asarray(grid.upper, dtype=float) - np.asarray(grid.lower, dtype=float)))
 
 
-def default_tol(spacing: float, mean_slowness: float, length: float, ndim: int = 3) -> float:
+def default_tol(spacing: float, slowness: float, length: float, ndim: int = 3) -> float:
     """Phase 2's stopping tolerance when none is given: ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
-    times the mean slowness (``ℓ`` = :func:`ramp_length`), far below the scheme's O(Δx²) error and
-    far above machine precision, in any units."""
-    return TOL_FACTOR[ndim] * spacing * spacing * mean_slowness / length
+    times the slowness scale ``slowness`` (``ℓ`` = :func:`ramp_length`), far below the scheme's
+    O(Δx²) error and far above machine precision, in any units. The solve passes
+    ``_validate.tolerance_slowness``: the mean slowness, capped where an obstacle pulls it up."""
+    return TOL_FACTOR[ndim] * spacing * spacing * slowness / length
 
 
 def check_supported(
@@ -157,6 +161,23 @@ def check_supported(
         )
 
 
+def check_widths(inner: Any, outer: Any) -> None:
+    """Refuses ``outer < inner + 2`` as given (before any widening of the extension layer), so that
+    whether ``order=2`` applies depends on the arguments and not on the grid: a layer widened
+    from ``outer = 3`` to 4 where some inner node lacked a neighbour was accepted, ``outer = 3.5``
+    (never widened) refused. Widths that are not numbers are left to the tube's own checks."""
+    numbers = all(
+        isinstance(w, (int, float, np.integer, np.floating)) and not isinstance(w, (bool, np.bool_)) and np.isfinite(w)
+        for w in (inner, outer)
+    )
+    if numbers and float(outer) < float(inner) + 2.0 - 1e-9:
+        raise Order2NotApplicable(
+            f"order=2 needs two band neighbours on each side of every inner-tube node: outer ≥ inner + 2 grid spacings "
+            f"(got inner={float(inner):g}, outer={float(outer):g}); pass outer={float(inner) + 2.0:g} or more (the "
+            "defaults are inner=2, outer=4), or order=1"
+        )
+
+
 def _native_solve(*args: Any, **kwargs: Any) -> Any:
     """``_native.second_order_solve``, its refusals of the geometry (``order=2: ...``: a crease, a
     curvature the tube does not resolve, a φ that is not a distance, a closest-point map of an open
@@ -189,9 +210,11 @@ def solve_on_tube(
     del x
     slowness: Any = 1.0 / speed_nodes
     mean_slowness = float(np.mean(slowness))
+    # the tolerances' slowness: the mean unless an obstacle pulls it up (_validate.tolerance_slowness)
+    tol_slowness = tolerance_slowness(slowness)
     length = ramp_length(grid)
     if tol is None:
-        tol = default_tol(h, mean_slowness, length, d)
+        tol = default_tol(h, tol_slowness, length, d)
     # travel times too large or too small for the local updates' squares, a tol not small against
     # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
     check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
@@ -230,31 +253,39 @@ def solve_on_tube(
     roles = tube.roles
     directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
     setup = time.perf_counter() - t0
-    values, u0, roles_out, st = _native_solve(
-        band,
-        np.ascontiguousarray(roles),
-        np.ascontiguousarray(geom.signed, dtype=np.float64),
-        np.ascontiguousarray(directions),
-        [float(c) for c in grid.lower],
-        h,
-        np.ascontiguousarray(feet, dtype=float),
-        np.ascontiguousarray(src_slowness, dtype=float),
-        float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
-        FIX_RADIUS * h,
-        tube.outer_eff * h,
-        TOL_FIRST_FACTOR[d] * h * h * mean_slowness / length,
-        float(tol),
-        int(max_iterations),
-        cb,
-        threads=_threads(threads),
-        front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
-        own_first_phase=_OWN_FIRST_PHASE,
-        offsets=offsets,
-        window_first=WINDOWS[0] if d == 3 else 0.0,
-        window_second=WINDOWS[1] if d == 3 else 0.0,
-        ramp_length=length,
-        extension_limit=EXTENSION_LIMIT,
-    )
+    try:
+        values, u0, roles_out, st = _native_solve(
+            band,
+            np.ascontiguousarray(roles),
+            np.ascontiguousarray(geom.signed, dtype=np.float64),
+            np.ascontiguousarray(directions),
+            [float(c) for c in grid.lower],
+            h,
+            np.ascontiguousarray(feet, dtype=float),
+            np.ascontiguousarray(src_slowness, dtype=float),
+            float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
+            FIX_RADIUS * h,
+            tube.outer_eff * h,
+            TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
+            float(tol),
+            int(max_iterations),
+            cb,
+            threads=_threads(threads),
+            front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
+            own_first_phase=_OWN_FIRST_PHASE,
+            offsets=offsets,
+            window_first=WINDOWS[0] if d == 3 else 0.0,
+            window_second=WINDOWS[1] if d == 3 else 0.0,
+            ramp_length=length,
+            extension_limit=EXTENSION_LIMIT,
+        )
+    except Order2NotApplicable as e:
+        # a tube cut by the grid box: the reason names the box, not φ or the resolution
+        raise Order2NotApplicable(box_reason(tube.box_cut, str(e), tube.outer_eff * h)) from None
+    # u = u₀ + w rounds to just below 0 next to a source (−9e-22 on a circle of radius 4Δx): a
+    # travel time is never negative. Clamped here, not in the sweeps, whose runaway guard reads the
+    # sign (a value below −Δx times the mean slowness)
+    np.maximum(values, 0.0, out=values)
     if not st["converged"]:
         warnings.warn(
             f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
@@ -320,6 +351,7 @@ def solve_on_tube(
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         order=2,
         order2=order2,
+        box_cut=tube.box_cut,
     )
     # the source of each fixed node: the nearest foot point
     fixed_pts = grid.node_points(linear[positions])

@@ -127,7 +127,8 @@ def solve(
         Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
         ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol`` defaults
         to 1e-10 for ``order=1`` and for ``order=2`` to ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
-        times the mean slowness, ℓ half the grid's longest side.
+        times the mean slowness (at most twice its lower quartile, so that an obstacle does not
+        loosen it), ℓ half the grid's longest side.
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
     threads : int
@@ -222,6 +223,7 @@ def solve(
                     "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
                 )
             _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
+            _so.check_widths(inner, outer)
             tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
             return _so.solve_on_tube(
                 tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
@@ -230,7 +232,7 @@ def solve(
             if order == 2:
                 raise
             fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
-    _check_source_radius(source_radius, source_init)
+    _check_source_radius(source_radius, source_init, grid)
     # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
     # (unless a general Hamiltonian needs it) and the directions become the extension weights;
     # with order="auto" refused by the second-order geometry, the tube it built is solved on as a
@@ -262,13 +264,24 @@ def solve(
     return sol
 
 
-def _check_source_radius(source_radius: Any, source_init: str) -> None:
+def _check_source_radius(source_radius: Any, source_init: str, grid: Optional[Grid] = None) -> None:
+    """``source_radius``: a positive distance, with ``source_init="exact"``, below the grid's
+    diagonal (the chord's validity within it is checked with the surface, ``_sources``)."""
     if source_radius is None:
         return
     if isinstance(source_radius, bool) or not isinstance(source_radius, (int, float, np.integer, np.floating)):
         raise TypeError(f"source_radius must be a number (a distance) or None; got {source_radius!r}")
     if not (np.isfinite(source_radius) and source_radius > 0):
         raise ValueError(f"source_radius must be a positive finite distance; got {source_radius!r}")
+    if grid is not None:
+        diagonal = float(np.linalg.norm(np.asarray(grid.upper, float) - np.asarray(grid.lower, float)))
+        if source_radius > diagonal:
+            raise ValueError(
+                f"source_radius = {source_radius:g} exceeds the grid's diagonal ({diagonal:.4g}): it is the radius of the "
+                "ball around each source whose nodes are fixed to the straight (chord) distance, which is the "
+                "distance along the surface only where the surface is flat. Use a few grid spacings "
+                f"(h = {grid.spacing:.4g}) up to a small fraction of the surface's size, or leave it out"
+            )
     if source_init != "exact":
         raise ValueError(
             "source_radius applies to source_init='exact' (the nodes near a source fixed to the exact time)"
@@ -345,6 +358,12 @@ def _solve_on_tube(
         surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width, radius
     )
     roles[positions] = ROLE_FIXED
+    if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER) and radius > SOURCE_RADIUS:
+        raise ValueError(
+            f"source_radius = {source_radius:g} covers the whole inner tube: every node lies within it of the source, so "
+            f"its value is the source's initialisation and nothing is solved; use a smaller source_radius (a few "
+            f"grid spacings, h = {h:.4g}, up to a small fraction of the surface's size) or leave it out"
+        )
     if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER):
         raise ValueError(
             f"the grid is too coarse for this surface: every node of the inner tube lies within {radius:g} grid "
@@ -457,6 +476,7 @@ def _solve_on_tube(
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver=st.get("local_solver", scheme),
+        box_cut=tube.box_cut,
     )
     return Solution(
         grid,

@@ -85,6 +85,13 @@ class SolveStats:
         never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of
         nodes fixed around each source); on surfaces also ``max_curvature`` (the largest principal
         curvature found in the tube) and ``grad_norm_range`` (|∇φ| in the inner tube).
+    box_cut : dict or None
+        On surfaces, where the grid box cuts the tube (None where the band stays inside it):
+        ``surface_cut`` (the surface itself crosses the box's boundary, with a ``RuntimeWarning``:
+        the distances are those of the part inside the box), ``faces`` (the faces it crosses, or
+        the tube touches), ``cut_length`` (3D: the length of the curve along which it crosses them)
+        or ``cut_points`` (2D: the crossings), ``inner_on_boundary`` (inner-tube nodes on the
+        boundary) and ``gap`` (the smallest |φ| on the boundary).
 
     Examples
     --------
@@ -116,6 +123,7 @@ class SolveStats:
     order: int = 1
     order2: Optional[Dict[str, Any]] = None
     order_fallback: Optional[str] = None
+    box_cut: Optional[Dict[str, Any]] = None
 
     @property
     def updates_per_second(self) -> float:
@@ -135,8 +143,8 @@ class SolveStats:
         >>> import tubesweep as ts
         >>> s = ts.surfaces.Sphere(0.5)
         >>> d = ts.solve(s, ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41)), [s.default_source]).stats.as_dict()
-        >>> sorted(d)[:3]
-        ['band_bytes', 'band_points', 'converged']
+        >>> sorted(d)[:2]
+        ['band_bytes', 'band_points']
         """
         d = asdict(self)
         d["updates_per_second"] = self.updates_per_second

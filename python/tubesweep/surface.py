@@ -14,6 +14,7 @@ A surface hands the solver, for the grid nodes within a half-width of it (the ba
 
 from __future__ import annotations
 
+import os
 import warnings
 from typing import Any, Callable, List, Optional, Tuple, Union
 
@@ -259,6 +260,19 @@ class LevelSet(Surface):
         return self._array is not None
 
     def check_grid(self, grid: Grid) -> None:
+        if (
+            self._array is not None
+            and self._array.ndim == 2
+            and self._array.shape[1] == grid.ndim
+            and self._array.shape != grid.shape
+        ):
+            m, d = self._array.shape
+            raise ValueError(
+                f"the surface is an array of shape ({m}, {d}), which looks like {m} points or mesh vertices, not φ "
+                f"sampled on the grid (shape {grid.shape}): build a surface from them with "
+                "ts.surfaces.from_points(points) (a point cloud)"
+                + (" or ts.surfaces.from_mesh((vertices, faces)) (a triangle mesh)" if d == 3 else "")
+            )
         super().check_grid(grid)
         if self._array is not None and self._array.shape != grid.shape:
             raise ValueError(
@@ -474,10 +488,18 @@ class LevelSet(Surface):
 
 
 def as_surface(surface: Any) -> Surface:
-    """Accepts a Surface, a φ array, or a φ callable."""
+    """Accepts a Surface, a φ array (or array-like: nested lists, as ``LevelSet`` does), or a φ
+    callable. A path is refused with a pointer to ``ts.surfaces.from_mesh``."""
     if isinstance(surface, Surface):
         return surface
-    if callable(surface) or isinstance(surface, np.ndarray):
+    if isinstance(surface, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"surface {str(surface)!r} is a {'path' if isinstance(surface, os.PathLike) else 'string'}: a mesh file is "
+            "loaded with ts.surfaces.from_mesh(path) (OBJ, PLY, STL, OFF), e.g. "
+            "ts.solve(ts.surfaces.from_mesh(path), grid, sources); the library's surfaces are classes, e.g. "
+            "ts.surfaces.Sphere(0.5)"
+        )
+    if callable(surface) or isinstance(surface, (np.ndarray, list, tuple)) or hasattr(surface, "__array__"):
         return LevelSet(surface)
     raise TypeError(
         "surface must be a tubesweep.LevelSet / ClosestPoint / library surface, a φ array of grid.shape, "

@@ -31,7 +31,7 @@ from ._validate import as_grid, as_sources, check_tolerance, progress_callback
 from .grid import Grid
 from ._prepare import _prepare_tube
 from .solution import Solution
-from .solve import DEFAULT_TOL, _check_order, _check_source_init, _resolve_scheme, _solve_on_tube
+from .solve import DEFAULT_TOL, _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
 
 __all__ = ["Tube"]
@@ -165,6 +165,7 @@ class Tube:
         threads: int = 0,
         paper_sweeps: bool = False,
         order: Union[int, str] = "auto",
+        source_radius: Optional[float] = None,
     ) -> Solution:
         """First-arrival times from ``sources`` on this band, without building the band again.
 
@@ -175,7 +176,7 @@ class Tube:
         ----------
         sources : array_like
             ``(K, d)`` points on the surface.
-        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps, order
+        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps, order, source_radius
             As for :func:`tubesweep.solve`.
 
         Returns
@@ -210,7 +211,12 @@ class Tube:
             from . import second_order as _so
 
             try:
+                if source_radius is not None:
+                    raise _so.Order2NotApplicable(
+                        "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
+                    )
                 _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
+                _so.check_widths(self._args[0], self._args[1])
                 if self._order2_refusal is not None:  # this band's geometry, refused before
                     raise _so.Order2NotApplicable(self._order2_refusal)
                 try:
@@ -224,6 +230,7 @@ class Tube:
                 if order == 2:
                     raise
                 fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
+        _check_source_radius(source_radius, source_init, self.grid)
         sol = _solve_on_tube(
             self._tube,
             src,
@@ -239,6 +246,7 @@ class Tube:
             paper_sweeps,
             t0,
             reuse=True,
+            source_radius=source_radius,
         )
         if fallback is not None:
             from .second_order import with_fallback
