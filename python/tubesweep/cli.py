@@ -501,7 +501,7 @@ def _write_npz(path: Path, sol: Any) -> None:
         upper=grid.upper,
         shape=np.array(grid.shape),
         sources=sol.sources,
-        **labels,  # type: ignore[arg-type]
+        **labels,
     )
 
 
