@@ -304,11 +304,10 @@ def _check_phi_box(phi: np.ndarray, grid: Any, sources: np.ndarray, args: argpar
             f"--source {_fmt_point(sources[outside[0]])}: outside the grid box {box}; the box must be the one "
             f"φ ({args.phi}) was sampled on, and the sources on its zero level set inside it"
         )
-    from scipy.interpolate import RegularGridInterpolator
+    from ._interpolation import interpolate_dense
 
     h = grid.spacing
-    axes = [grid.axis(k) for k in range(grid.ndim)]
-    at_sources = RegularGridInterpolator(axes, phi, bounds_error=False, fill_value=np.nan)(sources)
+    at_sources = interpolate_dense(np.asarray(phi, dtype=float), grid, np.asarray(sources, dtype=float), "linear")
     off = np.flatnonzero(~(np.abs(at_sources) <= args.inner * h))
     if not off.size:
         return
