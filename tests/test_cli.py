@@ -310,6 +310,7 @@ def test_an_unknown_experiment_is_an_error_line_with_exit_status_2(capsys):
     assert "unknown experiment" in capsys.readouterr().err
 
 
+@pytest.mark.filterwarnings("default::RuntimeWarning")  # the CLI prints what a user sees: the default filter
 def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, capsys):
     # a plate 0.08 thick meshed as 12 triangles, on a grid too coarse for it: the solve warns that
     # the surface faces itself across a narrow gap

@@ -220,6 +220,7 @@ def _shell_lines(page: Path):
                 yield cmd, line
 
 
+@pytest.mark.filterwarnings("default::RuntimeWarning")  # the commands print what a user sees
 @pytest.mark.parametrize("page", [p for p in USER_PAGES if any(True for _ in _shell_lines(p))], ids=_page_id)
 def test_the_shell_blocks_of_a_user_page_run_as_printed(page, tmp_path, monkeypatch, capsys):
     import shlex
