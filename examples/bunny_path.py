@@ -5,12 +5,19 @@ needed). The geodesic path runs from its start (white circle) against the gradie
 distance to the source (red star).
 """
 
+import argparse
+from pathlib import Path
+
 import numpy as np
 
 import tubesweep as ts
-from _common import options, save
 
-args = options(__doc__, n=120)
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--n", type=int, default=120, help="grid nodes per axis (default: 120)")
+parser.add_argument("--out", type=Path, default=Path("out/gallery"), help="folder for the picture")
+args = parser.parse_args()
+args.out.mkdir(parents=True, exist_ok=True)
+
 bunny = ts.surfaces.from_mesh(ts.data.bunny())
 grid = bunny.grid(args.n)
 source = bunny.default_source  # the vertex farthest from the centroid: the tip of an ear
@@ -28,4 +35,5 @@ print(
 fig = ts.plot(
     sol, up="y", paths=[path], title="the Stanford bunny: distance from the red star, the path from the farthest point"
 )
-save(fig, args.out, "bunny_path.png")
+fig.savefig(args.out / "bunny_path.png", dpi=110, bbox_inches="tight")
+print(f"wrote {args.out / 'bunny_path.png'}")

@@ -6,15 +6,23 @@ symmetrises the one-way estimates. The same by hand: ``tube = ts.Tube(surface, g
 circles.
 """
 
+import argparse
+from pathlib import Path
+
 import numpy as np
 
 import tubesweep as ts
-from _common import options, save, sphere_points
 
-args = options(__doc__, n=61)
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--n", type=int, default=61, help="grid nodes per axis (default: 61)")
+parser.add_argument("--out", type=Path, default=Path("out/gallery"), help="folder for the picture")
+args = parser.parse_args()
+args.out.mkdir(parents=True, exist_ok=True)
+
 sphere = ts.surfaces.Sphere(0.5)
 grid = ts.Grid((-1, -1, -1), (1, 1, 1), (args.n,) * 3)
-points = sphere_points(12, seed=1)
+points = np.random.default_rng(1).normal(size=(12, 3))  # random points on the sphere of radius 0.5
+points = 0.5 * points / np.linalg.norm(points, axis=1, keepdims=True)
 
 D, info = ts.distance_matrix(sphere, grid, points, info=True)  # one band, one solve per point
 exact = np.array([sphere.geodesic_distance(points, p) for p in points])
@@ -33,4 +41,5 @@ for k, (M, name) in enumerate(((D, "tubesweep"), (exact, "great circles"))):
     ax.set_xlabel("point")
     ax.set_ylabel("point")
 fig.colorbar(m, ax=fig.axes, shrink=0.8, label="geodesic distance")
-save(fig, args.out, "distance_matrix.png")
+fig.savefig(args.out / "distance_matrix.png", dpi=110, bbox_inches="tight")
+print(f"wrote {args.out / 'distance_matrix.png'}")

@@ -4,12 +4,19 @@ Speed 1 below y = 0 and 2 above, with a smooth transition: the fronts speed up a
 the fast layer, and waves that run along it overtake the direct ones (head waves).
 """
 
+import argparse
+from pathlib import Path
+
 import numpy as np
 
 import tubesweep as ts
-from _common import options, save
 
-args = options(__doc__, n=301)
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--n", type=int, default=301, help="grid nodes per axis (default: 301)")
+parser.add_argument("--out", type=Path, default=Path("out/gallery"), help="folder for the picture")
+args = parser.parse_args()
+args.out.mkdir(parents=True, exist_ok=True)
+
 grid = ts.Grid((-1, -1), (1, 1), (args.n, args.n))
 source = (0.0, -0.6)
 
@@ -30,6 +37,7 @@ fig = ts.plot(
     grid=grid,
     sources=[source],
     speed=speed(np.c_[X.ravel(), Y.ravel()]).reshape(X.shape),
-    title="travel time from the red star: speed 1 below y = 0, 2 above",
+    title="travel time from the red star, speed 1.5 + 0.5 tanh(8y)",
 )
-save(fig, args.out, "layered_travel_time.png")
+fig.savefig(args.out / "layered_travel_time.png", dpi=110, bbox_inches="tight")
+print(f"wrote {args.out / 'layered_travel_time.png'}")

@@ -5,12 +5,19 @@ with ``v = ω ẑ × x``. Downstream the front runs ahead, upstream it lags. The
 (``ts.flows.rotation_travel_time_sphere``) checks the answer.
 """
 
+import argparse
+from pathlib import Path
+
 import numpy as np
 
 import tubesweep as ts
-from _common import options, save, sphere_points
 
-args = options(__doc__, n=81)
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--n", type=int, default=81, help="grid nodes per axis (default: 81)")
+parser.add_argument("--out", type=Path, default=Path("out/gallery"), help="folder for the picture")
+args = parser.parse_args()
+args.out.mkdir(parents=True, exist_ok=True)
+
 omega = 1.0
 sphere = ts.surfaces.Sphere(0.5)
 grid = ts.Grid((-1, -1, -1), (1, 1, 1), (args.n,) * 3)
@@ -20,7 +27,8 @@ sol = ts.solve(sphere, grid, [source], flow=flow)
 still = ts.solve(sphere, grid, [source])
 print(sol)
 
-points = sphere_points(2000)
+points = np.random.default_rng(0).normal(size=(2000, 3))  # random points on the sphere of radius 0.5
+points = 0.5 * points / np.linalg.norm(points, axis=1, keepdims=True)
 exact = ts.flows.rotation_travel_time_sphere(points, 0.5, source, 1.0, omega)
 error = np.abs(sol(points) - exact)
 print(
@@ -36,4 +44,5 @@ fig = ts.plot(
     label="travel time",
     title=f"travel time on a sphere turning anticlockwise about z (seen from above), ω = {omega:g}",
 )
-save(fig, args.out, "moving_medium.png")
+fig.savefig(args.out / "moving_medium.png", dpi=110, bbox_inches="tight")
+print(f"wrote {args.out / 'moving_medium.png'}")

@@ -5,20 +5,29 @@ method with the Godunov Hamiltonian. Prints the largest and the mean error on th
 grid spacings.
 """
 
+import argparse
+from pathlib import Path
+
 import numpy as np
 
 import tubesweep as ts
-from _common import options, save, sphere_points
 
-args = options(__doc__, n=101)
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("--n", type=int, default=101, help="grid nodes per axis (default: 101)")
+parser.add_argument("--out", type=Path, default=Path("out/gallery"), help="folder for the picture")
+args = parser.parse_args()
+args.out.mkdir(parents=True, exist_ok=True)
+
 sphere = ts.surfaces.Sphere(0.5)
 grid = ts.Grid((-1, -1, -1), (1, 1, 1), (args.n,) * 3)
 sol = ts.solve(sphere, grid, sources=[sphere.default_source])
 print(sol)
 
-points = sphere_points(2000)  # random points on the surface
+points = np.random.default_rng(0).normal(size=(2000, 3))  # random points on the sphere of radius 0.5
+points = 0.5 * points / np.linalg.norm(points, axis=1, keepdims=True)
 error = np.abs(sol(points) - sphere.geodesic_distance(points, sphere.default_source)) / grid.spacing
 print(f"error in grid spacings: max {error.max():.2f}, mean {error.mean():.2f}")
 
-fig = ts.plot(sol, views=((20, -150), (20, 30)), title="geodesic distance on a sphere from the red star")
-save(fig, args.out, "sphere.png")
+fig = ts.plot(sol, title="geodesic distance on a sphere from the red star")  # the source side and the far side
+fig.savefig(args.out / "sphere.png", dpi=110, bbox_inches="tight")
+print(f"wrote {args.out / 'sphere.png'}")

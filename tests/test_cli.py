@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from tubesweep.cli import main
+from tubesweep.cli import build_parser, main
 
 
 def test_help_explains_itself(capsys):
@@ -21,7 +21,22 @@ def test_help_explains_itself(capsys):
 def test_solve_builtin_circle_writes_band_and_picture(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     assert (
-        main(["solve", "--surface", "circle", "--n", "101", "--out", str(tmp_path), "--png", "--dense", "--quiet"]) == 0
+        main(
+            [
+                "solve",
+                "--surface",
+                "circle",
+                "--n",
+                "101",
+                "--out",
+                str(tmp_path),
+                "--png",
+                "--dense",
+                "--npz",
+                "--quiet",
+            ]
+        )
+        == 0
     )
     data = np.load(tmp_path / "solution.npz")
     idx, vals = data["indices"], data["values"]
@@ -132,6 +147,7 @@ def test_solve_traces_paths_and_labels_cells(tmp_path, capsys):
         "--out",
         str(tmp_path),
         "--quiet",
+        "--npz",
     ]
     assert main(args) == 0
     out = capsys.readouterr().out.splitlines()
@@ -294,6 +310,7 @@ def test_an_unknown_experiment_is_an_error_line_with_exit_status_2(capsys):
     assert "unknown experiment" in capsys.readouterr().err
 
 
+@pytest.mark.filterwarnings("default::RuntimeWarning")  # the CLI prints what a user sees: the default filter
 def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, capsys):
     # a plate 0.08 thick meshed as 12 triangles, on a grid too coarse for it: the solve warns that
     # the surface faces itself across a narrow gap
@@ -315,11 +332,80 @@ def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, ca
 
 
 def test_solve_order_auto_says_which_order_ran_and_why(tmp_path, capsys):
-    argv = ["solve", "--n", "41", "--out", str(tmp_path), "--quiet", "--order", "auto"]
-    assert main([*argv, "--surface", "sphere"]) == 0
+    argv = ["solve", "--n", "41", "--out", str(tmp_path), "--order", "auto"]
+    assert main([*argv, "--quiet", "--surface", "sphere"]) == 0
     assert "order 2" in capsys.readouterr().out
     assert main([*argv, "--surface", "circle", "--hamiltonian", "lxf"]) == 0
     out = capsys.readouterr().out
     assert "order 1" in out and "order=2 does not apply, so order 1 ran: order=2 solves the isotropic" in out
+    # --quiet keeps the summary line (which says order 1) and drops the note
+    assert main([*argv, "--quiet", "--surface", "circle", "--hamiltonian", "lxf"]) == 0
+    out = capsys.readouterr().out
+    assert "order 1" in out and "does not apply" not in out and "Use order=1" not in out
     assert main(["solve", "--surface", "sphere", "--n", "41", "--out", str(tmp_path), "--quiet", "--order", "1"]) == 0
     assert "order 1" in capsys.readouterr().out
+
+
+def test_solve_writes_the_band_values_only_when_asked_or_when_nothing_else_is(tmp_path, capsys):
+    pytest.importorskip("matplotlib")
+    argv = ["solve", "--surface", "circle", "--n", "51", "--quiet"]
+    assert main([*argv, "--out", str(tmp_path / "a")]) == 0  # nothing else asked: the band values
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["solution.npz"]
+    assert main([*argv, "--out", str(tmp_path / "b"), "--png"]) == 0  # a picture only
+    assert sorted(p.name for p in (tmp_path / "b").iterdir()) == ["solution.png"]
+    assert main([*argv, "--out", str(tmp_path / "c"), "--export", str(tmp_path / "c" / "u.vtp")]) == 0
+    assert sorted(p.name for p in (tmp_path / "c").iterdir()) == ["u.vtp"]
+    assert main([*argv, "--out", str(tmp_path / "d"), "--png", "--npz"]) == 0  # both asked for
+    assert sorted(p.name for p in (tmp_path / "d").iterdir()) == ["solution.npz", "solution.png"]
+    assert "solution.npz" in build_parser()._subparsers._group_actions[0].choices["solve"].format_help()
+
+
+def test_a_phi_box_that_is_not_phis_own_is_named_as_the_cause(tmp_path, capsys):
+    x = np.linspace(-1, 1, 41)
+    X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+    np.save(tmp_path / "phi.npy", np.sqrt(X**2 + Y**2 + Z**2) - 0.5)  # sampled on [-1, 1]^3
+    argv = ["solve", "--phi", str(tmp_path / "phi.npy"), "--source", "0.5", "0", "0", "--out", str(tmp_path), "--quiet"]
+    # the box twice too large: φ falls by 0.5 per unit, the source is 0.25 inside the surface
+    assert main([*argv, "--lower", "-2", "-2", "-2", "--upper", "2", "2", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "φ is -0.25 there on the grid --lower -2 -2 -2 --upper 2 2 2" in err
+    assert "changes by 0.499 per unit length" in err and "sampled on a box 0.499 times this one's size" in err
+    assert "Check that --lower/--upper are the corners of the grid φ was sampled on (φ has shape 41×41×41)" in err
+    # a source outside the box
+    assert main([*argv[:4], "3", "0", "0", *argv[7:], "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]) == 2
+    assert "--source 3 0 0: outside the grid box --lower -1 -1 -1 --upper 1 1 1" in capsys.readouterr().err
+    # a box that cuts the surface: a sphere of radius 0.5 in [-0.4, 0.4]^3 (the same spacing)
+    y = np.linspace(-0.4, 0.4, 17)
+    X, Y, Z = np.meshgrid(y, y, y, indexing="ij")
+    np.save(tmp_path / "cut.npy", np.sqrt(X**2 + Y**2 + Z**2) - 0.5)
+    cut = ["solve", "--phi", str(tmp_path / "cut.npy"), "--source", "0.4", "0.4", "0.4", "--out", str(tmp_path)]
+    assert main([*cut, "--quiet", "--lower", "-0.4", "-0.4", "-0.4", "--upper", "0.4", "0.4", "0.4"]) == 2
+    assert "φ's zero level set reaches the box's faces (the box cuts the surface)" in capsys.readouterr().err
+    # the right box solves
+    assert main([*argv, "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]) == 0
+
+
+def test_distances_reads_points_from_numpy_and_text_files(tmp_path, capsys):
+    pts = 0.5 * np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]])
+    np.save(tmp_path / "p.npy", pts)
+    np.savetxt(tmp_path / "p.txt", pts)
+    np.savetxt(tmp_path / "p.csv", pts, delimiter=",", header="x,y,z")
+    (tmp_path / "p.bin").write_bytes(b"\x00\x01")
+    base = ["distances", "--surface", "sphere", "--n", "41", "--quiet"]
+    results = []
+    for name in ("p.npy", "p.txt", "p.csv"):
+        out = tmp_path / f"D_{name.replace('.', '_')}.npy"
+        assert main([*base, "--points", str(tmp_path / name), "--out", str(out)]) == 0
+        results.append(np.load(out))
+    assert np.array_equal(results[0], results[1]) and np.array_equal(results[0], results[2])
+    assert results[0][0, 1] == pytest.approx(np.pi / 4, abs=0.05)  # a quarter great circle, within a spacing
+    capsys.readouterr()
+    assert main([*base, "--points", str(tmp_path / "p.bin"), "--out", str(tmp_path / "D.npy")]) == 2
+    err = capsys.readouterr().err
+    assert "give a .npy file (numpy.save) or a text file (.txt .csv .xyz .dat)" in err and "allow_pickle" not in err
+    (tmp_path / "two.txt").write_text("0.5 0\n0 0.5\n")
+    assert main([*base, "--points", str(tmp_path / "two.txt"), "--out", str(tmp_path / "D.npy")]) == 2
+    assert "needs M points of 3 coordinates (an (M, 3) array); got shape (2, 2)" in capsys.readouterr().err
+    (tmp_path / "words.txt").write_text("a b c\n")
+    assert main([*base, "--points", str(tmp_path / "words.txt"), "--out", str(tmp_path / "D.npy")]) == 2
+    assert "not a text file of numbers with 3 per line" in capsys.readouterr().err

@@ -54,6 +54,7 @@ def test_data_errors_name_the_choices(tmp_path):
         ts.data.read_obj(bad)
 
 
+@pytest.mark.filterwarnings("default::RuntimeWarning")  # the CLI prints what a user sees: the default filter
 def test_the_command_line_names_the_bundled_meshes(tmp_path, capsys):
     from tubesweep.cli import main
 

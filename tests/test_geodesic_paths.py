@@ -252,7 +252,8 @@ def test_path_lengths_on_the_bunny_match_exact_polyhedral_geodesics():
         [geodesic.PyGeodesicAlgorithmExact(v, bunny.faces).geodesicDistance(0, int(t))[0] for t in targets]
     )
     g = bunny.grid(81)
-    sol = ts.solve(bunny, g, [v[0]])
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):  # the ears at this grid
+        sol = ts.solve(bunny, g, [v[0]])
     paths = sol.geodesic_paths(v[targets])
     lengths = np.array([_length(p) for p in paths])
     # measured (benches/paths_and_labels.py): mean 0.11 h, max 0.31 h; u itself is off by up to 2.7 h
@@ -283,7 +284,8 @@ def test_a_path_caught_where_u_barely_decreases_stalls_instead_of_running_in_pla
     # fell only at the rounding level: rounding-level decreases reset the stall count, and it ran
     # on in place, 136 of its 299 points repeating the last one
     spot = ts.surfaces.from_mesh(ts.data.spot())
-    sol = ts.solve(spot, spot.grid(81), spot.vertices[[285, 0, 1000]])
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):  # 0.22% of Spot at this grid
+        sol = ts.solve(spot, spot.grid(81), spot.vertices[[285, 0, 1000]])
     with pytest.warns(RuntimeWarning, match="stopped before reaching a source") as caught:
         path = sol.geodesic_path(spot.vertices[2000])
     steps = np.linalg.norm(np.diff(path, axis=0), axis=1)

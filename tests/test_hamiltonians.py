@@ -256,3 +256,30 @@ def test_a_sigma_below_the_hamiltonian_s_bound_is_refused_with_the_bound():
     # exactly the bound is admissible, and gives the per-node default's answer up to viscosity
     ok = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(sigma=1.0))
     assert ok.stats.converged and np.all(np.isfinite(ok(c.sample(200))))
+
+
+def test_metric_on_a_surface_has_two_readings_each_converging_to_its_own_exact_value():
+    # M = diag(2, 1, 1) on the sphere of radius 0.5, from (-0.5, 0, 0) to (0, 0.5, 0) along the
+    # equator (a geodesic by the z -> -z symmetry). restrict="gradient": M's tangential block on the
+    # surface gradient, u = 0.5 ∫ dθ / sqrt(1 + sin²θ) = 0.5 K(-1); restrict="length": the length
+    # metric M⁻¹ restricted to the surface, u = 0.5 ∫ sqrt(1 - sin²θ / 2) dθ = 0.5 E(1/2)
+    from scipy.special import ellipe, ellipk
+
+    exact = {"gradient": 0.5 * ellipk(-1.0), "length": 0.5 * ellipe(0.5)}
+    assert exact["gradient"] == pytest.approx(0.65551, abs=1e-5) and exact["length"] == pytest.approx(0.67532, abs=1e-5)
+    s = ts.surfaces.Sphere(0.5)
+    values = {}
+    for n in (81, 161):
+        grid = ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3)
+        for restrict in ("gradient", "length"):
+            M = ts.hamiltonians.Metric(np.diag([2.0, 1.0, 1.0]), restrict=restrict)
+            values[n, restrict] = ts.solve(s, grid, [(-0.5, 0, 0)], hamiltonian=M)([(0, 0.5, 0)])[0]
+    for restrict, u in exact.items():
+        errors = [abs(values[n, restrict] - u) for n in (81, 161)]
+        assert errors[1] < 0.6 * errors[0] and errors[1] < 0.01, (restrict, errors)  # first order
+    # the readings differ by 3 %, and the solver resolves the difference (0.0198) at N = 161
+    assert values[161, "length"] - values[161, "gradient"] == pytest.approx(
+        exact["length"] - exact["gradient"], abs=1e-3
+    )
+    with pytest.raises(ValueError, match="restrict must be 'gradient'"):
+        ts.hamiltonians.Metric(np.eye(3), restrict="induced")

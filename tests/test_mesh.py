@@ -245,7 +245,8 @@ def test_bunny_coarse_against_exact_geodesics():
     assert not bunny.closed  # scanned, holes at the base
     grid = bunny.grid(60)
     src = bunny.default_source_vertex
-    sol = ts.solve(bunny, grid, [bunny.vertices[src]], outer=5.0)
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):  # the ears at this grid
+        sol = ts.solve(bunny, grid, [bunny.vertices[src]], outer=5.0)
     used = bunny.used_vertices
     u = sol.on_mesh(bunny.vertices)[used]
     assert np.all(np.isfinite(u))
@@ -294,7 +295,7 @@ def test_cli_solve_mesh(tmp_path, capsys):
     assert rc == 0
     m = meshio.read(str(out / "ball.vtu"))
     assert m.points.shape == (len(v), 3) and 0 <= m.point_data["u"][0] < 0.5 / 24
-    assert (out / "solution.npz").is_file()
+    assert not (out / "solution.npz").exists()  # only what was asked for: the export
     assert main(["solve", "--mesh", str(p), "--n", "41", "--source-vertex", "99999", "--quiet", "--out", str(out)]) == 2
     assert "vertices 0" in capsys.readouterr().err
     assert main(["solve", "--mesh", str(tmp_path / "nope.obj"), "--quiet", "--out", str(out)]) == 2

@@ -106,3 +106,83 @@ def test_nearest_source_cells_are_coloured_per_source_with_a_legend():
     assert len(hues) >= 3
     with pytest.raises(ValueError, match="color must be"):
         ts.plot(sol, color="labels")
+
+
+def _eye(elev, azim):
+    e, a = np.radians(elev), np.radians(azim)
+    return np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+
+
+def test_the_default_views_look_at_the_source_and_at_the_far_side(sphere_sol):
+    fig = ts.plot(sphere_sol)
+    views = fig.axes[:2]
+    # the first view faces the source, the second the far side, both from 20° above
+    eyes = [_eye(a.elev, a.azim) for a in views]
+    src = sphere_sol.sources[0] / np.linalg.norm(sphere_sol.sources[0])
+    assert eyes[0] @ src == pytest.approx(np.cos(np.radians(20.0)))
+    assert eyes[1] @ -src == pytest.approx(np.cos(np.radians(20.0)))
+    stars = [[len(c.get_offsets()) for c in a.collections if c.get_gid() == "sources"] for a in views]
+    assert stars == [[1], []]
+    # iso-line labels stay clear of the source's star: the line 0.05 around it goes unlabelled
+    fig = ts.plot(sphere_sol, levels=[0.05, 0.3, 0.6])
+    labels = [(t.get_text(), np.array(t.get_position_3d())) for a in fig.axes[:2] for t in a.texts]
+    assert {text for text, _ in labels} == {"0.6"}
+    size = 1.0  # the sphere's diameter
+    assert all(np.linalg.norm(p - sphere_sol.sources[0]) > 0.15 * size for _, p in labels)
+
+
+def test_a_spheroid_with_the_source_at_the_pole_is_seen_whole():
+    # both former fixed views looked at it from 20° above the equator: the far half never shown
+    from tubesweep._plot import _default_views
+    from tubesweep._triangulate import triangulate
+
+    s = ts.surfaces.Ellipsoid(0.25, 0.25, 0.5)
+    sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [(0, 0, 0.5)])
+    v, f = triangulate(sol)
+    views = _default_views(sol, v, [0, 1, 2])
+    eyes = [_eye(*view) for view in views]
+    tri = v[f]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n *= np.sign(np.einsum("ij,ij->i", n, tri.mean(1)))[:, None]  # outward
+    seen = [(n @ e) > 0 for e in eyes]
+    assert np.mean(seen[0] | seen[1]) > 0.99  # every face but the silhouette's
+    far = sol.on_mesh(tri.mean(1)) > 0.9 * np.nanmax(sol.values)  # around the far pole
+    assert np.all(seen[1][far]) and not np.any(seen[0][far])
+    assert seen[0][np.argmax(tri.mean(1)[:, 2])]  # the source's pole in the first view
+
+
+def test_an_elongated_surface_is_framed_whole():
+    # two spheres side by side (φ = the smaller of their distances), a source at the right end: the
+    # former fixed zoom cut off the right sphere and the source
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from mpl_toolkits.mplot3d import proj3d
+
+    c1, c2, r = np.array([-0.45, 0, 0]), np.array([0.45, 0, 0]), 0.35
+    phi = lambda p: np.minimum(np.linalg.norm(p - c1, axis=1) - r, np.linalg.norm(p - c2, axis=1) - r)  # noqa: E731
+    grid = ts.Grid((-1, -0.5, -0.5), (1, 0.5, 0.5), (81, 41, 41))
+    sol = ts.solve(phi, grid, [(0.8, 0, 0), (-0.45, 0, 0.35)], order=1)
+    fig = ts.plot(sol)
+    FigureCanvasAgg(fig).draw()
+    ends = np.array([[-0.8, 0, 0], [0.8, 0, 0], [-0.45, 0, 0.35], [0.45, 0, -0.35]])  # the extremes
+    for a in fig.axes[:2]:
+        x, y, _ = proj3d.proj_transform(*ends.T, a.get_proj())
+        px = a.transData.transform(np.c_[x, y])
+        box = a.get_window_extent()
+        assert np.all((px[:, 0] > box.x0) & (px[:, 0] < box.x1) & (px[:, 1] > box.y0) & (px[:, 1] < box.y1))
+        assert np.ptp(px[:, 0]) > 0.6 * box.width  # and not drawn small
+    stars = [sum(len(c.get_offsets()) for c in a.collections if c.get_gid() == "sources") for a in fig.axes[:2]]
+    assert stars[0] == 2  # the first view sees both sources
+
+
+def test_a_box_solution_is_drawn_as_its_field():
+    grid = ts.Grid((-1, -1), (1, 1), (61, 61))
+    sol = ts.travel_time(grid, [(0.2, -0.1)], order=2, return_solution=True)
+    fig = ts.plot(sol, levels=[0.25, 0.5])
+    assert fig.axes[1].get_ylabel() == "travel time" and {"0.25", "0.5"} <= set(_texts(fig))
+    stars = [c for c in fig.axes[0].collections if c.get_gid() == "sources"]
+    assert len(stars) == 1 and np.allclose(stars[0].get_offsets(), [[0.2, -0.1]])
+    g3 = ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3)
+    fig3 = ts.plot(ts.travel_time(g3, [(0.0, 0.0, 0.0)], order=2, return_solution=True))
+    assert "slice z = 0" in fig3.axes[0].get_title()
+    with pytest.raises(ValueError, match="carries its own grid"):
+        ts.plot(sol, grid=ts.Grid((-1, -1), (1, 1), (31, 31)))

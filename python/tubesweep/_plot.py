@@ -13,6 +13,7 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._validate import real_array
+from .box_solution import BoxSolution
 from .surface import LevelSet
 
 __all__ = ["plot"]
@@ -23,6 +24,10 @@ TIME_LABEL = "travel time"
 
 _SOURCE_STYLE = dict(c="r", marker="*", edgecolors="k", linewidths=0.6, gid="sources")
 _START_STYLE = dict(marker="o", facecolors="w", edgecolors="r", linewidths=1.4, gid="path starts")
+#: Iso-line labels keep this share of the surface's size away from the sources' stars.
+LABEL_CLEARANCE = 0.15
+#: Contour labels of a travel-time field keep this share of the box's size away from the stars.
+FIELD_LABEL_CLEARANCE = 0.08
 _LABEL_BOX = dict(boxstyle="round,pad=0.12", fc="w", ec="none", alpha=0.75)
 
 
@@ -85,7 +90,7 @@ def plot(
     mesh: Optional[Tuple[Any, Any]] = None,
     levels: Union[int, Sequence[float]] = 12,
     cmap: str = "viridis",
-    views: Sequence[Tuple[float, float]] = ((20.0, -60.0), (20.0, 120.0)),
+    views: Optional[Sequence[Tuple[float, float]]] = None,
     title: Optional[str] = None,
     sources: Any = True,
     colorbar: bool = True,
@@ -105,9 +110,10 @@ def plot(
 
     Parameters
     ----------
-    sol : Solution or numpy.ndarray
-        A :func:`tubesweep.solve` result, or a :func:`tubesweep.travel_time` array (then ``grid`` is
-        needed).
+    sol : Solution, BoxSolution or numpy.ndarray
+        A :func:`tubesweep.solve` result, a :func:`tubesweep.travel_time` result with
+        ``return_solution=True`` (its grid and sources come with it), or a travel-time array
+        (then ``grid`` is needed).
     grid : Grid, optional
         The grid of a travel-time array.
     ax : matplotlib Axes, optional
@@ -120,8 +126,12 @@ def plot(
         How many iso-lines (round values are chosen), or their values.
     cmap : str
         A matplotlib colour map for the distance.
-    views : sequence of (elevation, azimuth)
-        One 3D panel per view, in degrees.
+    views : sequence of (elevation, azimuth), optional
+        One 3D panel per view, in degrees. Default: two panels from opposite sides, 20° above
+        the horizon, the first at the (first) source's azimuth, the second at the far side; for a
+        source near the top or bottom, from 45° above and below (the far pole in the second); a
+        surface elongated across the view seen from the side. Each panel frames the whole
+        surface with equal scales on the three axes.
     title : str, optional
         The figure's title.
     sources : bool or array
@@ -166,6 +176,12 @@ def plot(
     _need_matplotlib()
     if color not in ("distance", "nearest_source"):
         raise ValueError(f"color must be 'distance' or 'nearest_source'; got {color!r}")
+    if isinstance(sol, BoxSolution):  # travel_time(..., return_solution=True): its field, grid and sources
+        if grid is not None and grid != sol.grid:
+            raise ValueError("a travel-time solution carries its own grid; leave out grid= (or pass sol.values)")
+        grid = sol.grid
+        sources = sol.sources if sources is True else (None if sources is False else sources)
+        sol = sol.values
     if isinstance(sol, np.ndarray) or (grid is not None and not hasattr(sol, "surface")):
         return _plot_field(
             np.asarray(sol, dtype=float),
@@ -271,7 +287,13 @@ def _plot_field(
         cs = ax.contour(x, y, u.T, levels=lv, colors=line_color, linewidths=0.8)
         if back is not None:  # white lines outlined, readable on light and dark layers alike
             cs.set_path_effects([patheffects.withStroke(linewidth=1.8, foreground="k")])
-        for t in ax.clabel(cs, fmt=_label_text, fontsize=7, inline=True, colors="k"):
+        src = (
+            np.atleast_2d(np.asarray(sources, dtype=float))[:, :2]
+            if sources is not None and not isinstance(sources, bool)
+            else np.zeros((0, 2))
+        )
+        at = _field_label_places(cs, src, float(max(x[-1] - x[0], y[-1] - y[0])))
+        for t in ax.clabel(cs, fmt=_label_text, fontsize=7, inline=True, colors="k", manual=at):
             t.set_bbox(_LABEL_BOX)
     for q in _check_paths(paths, 2):
         ax.plot(q[:, 0], q[:, 1], "r-", lw=1.5)
@@ -289,6 +311,26 @@ def _plot_field(
                 cb.ax.axhline(c, color="k", lw=0.7)
     ax.set_title((title or "") + where if (title or where) else "")
     return fig
+
+
+def _field_label_places(cs: Any, sources: np.ndarray, size: float) -> List[Tuple[float, float]]:
+    """One place per contour line for its label: the middle of its longest piece among the points
+    ``FIELD_LABEL_CLEARANCE · size`` or more from every source (a line closer than that all round,
+    such as a small circle about a source, goes unlabelled: its label would cover the star)."""
+    places = []
+    for level_segs in cs.allsegs:
+        best: Optional[np.ndarray] = None
+        for seg in level_segs:
+            seg = np.asarray(seg, dtype=float).reshape(-1, 2)
+            if len(sources):
+                far = np.min(np.linalg.norm(seg[:, None, :] - sources[None, :, :], axis=2), axis=1)
+                seg = seg[far >= FIELD_LABEL_CLEARANCE * size]
+            if len(seg) and (best is None or len(seg) > len(best)):
+                best = seg
+        if best is not None:
+            p = best[len(best) // 2]
+            places.append((float(p[0]), float(p[1])))
+    return places
 
 
 # ---------------------------------------------------------------------------------------------
@@ -358,7 +400,7 @@ def _plot_curve(
         else:
             cols = cmap_obj(norm(np.nan_to_num(useg, nan=umax)))
         ax.add_collection(LineCollection(ends, colors=cols, linewidths=4.0, capstyle="round", zorder=2))  # type: ignore[arg-type]
-        _curve_ticks(ax, v, seg, u, lv, grid.spacing)  # type: ignore[arg-type]
+        _curve_ticks(ax, v, seg, u, lv, sol.sources if sources else np.zeros((0, 2)))  # type: ignore[arg-type]
     elif lv.size:
         ax.contour(X, Y, dense, levels=lv, colors="k", linewidths=0.5)
     for q in lines:
@@ -387,9 +429,9 @@ def _plot_curve(
     return fig
 
 
-def _curve_ticks(ax: Any, v: np.ndarray, seg: np.ndarray, u: np.ndarray, lv: np.ndarray, h: float) -> None:
+def _curve_ticks(ax: Any, v: np.ndarray, seg: np.ndarray, u: np.ndarray, lv: np.ndarray, avoid: np.ndarray) -> None:
     """A short black tick across the curve where it crosses each iso-value, and the value beside
-    every other one (so that the labels do not crowd)."""
+    every other one (so that the labels do not crowd), away from the sources' stars (``avoid``)."""
     if not lv.size:
         return
     a, b = u[seg[:, 0]], u[seg[:, 1]]
@@ -413,8 +455,9 @@ def _curve_ticks(ax: Any, v: np.ndarray, seg: np.ndarray, u: np.ndarray, lv: np.
                 lw=1.0,
                 zorder=3,
             )
-            if i % 2 == 0 and all(np.linalg.norm(p - q) > 0.15 * size for q in placed):
-                q = p + 0.07 * size * n
+            q = p + 0.07 * size * n
+            clear = not np.any(np.linalg.norm(avoid - q, axis=1) < LABEL_CLEARANCE * size)
+            if i % 2 == 0 and clear and all(np.linalg.norm(p - q) > 0.15 * size for q in placed):
                 ax.text(q[0], q[1], _label_text(c), fontsize=7, ha="center", va="center", zorder=4, bbox=_LABEL_BOX)
                 placed.append(p)
 
@@ -470,7 +513,44 @@ def _nearest_face(points: np.ndarray, centroids: np.ndarray) -> np.ndarray:
 
 
 def _view_title(elev: float, azim: float) -> str:
-    return f"seen from azimuth {azim:g}°, elevation {elev:g}°"
+    return f"seen from azimuth {azim:.0f}°, elevation {elev:.0f}°"
+
+
+#: The default views look from this many degrees above the horizon.
+VIEW_TILT = 20.0
+#: A surface whose longest side is this many times its second longest is seen from the side.
+ELONGATED = 1.5
+
+
+def _default_views(sol: Any, v: Optional[np.ndarray], perm: List[int]) -> Tuple[Tuple[float, float], ...]:
+    """Two views (elevation, azimuth) from opposite sides: the first at the azimuth of the first
+    source seen from the centre of the surface's bounding box, the second at the opposite azimuth,
+    both ``VIEW_TILT`` degrees above the horizon; for a source near the top or the bottom (more
+    than 45° up or down) from 45° above and 45° below instead, so that the far pole is seen."""
+    pts = v if v is not None else sol.points
+    pts = np.asarray(pts, dtype=float)[:, perm]
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    ext = np.ptp(pts, axis=0)
+    d = np.asarray(sol.sources, dtype=float)[:1, perm].reshape(-1)
+    d = d - centre if d.size == 3 else np.zeros(3)
+    longest = np.argsort(ext)[::-1]
+    k = int(longest[0])
+    if k != 2 and ext[k] > ELONGATED * ext[longest[1]]:
+        # a surface elongated across the view is seen from the side, turned at most 30° towards the
+        # source's end: looking along its length would hide most of it
+        other = 1 - k
+        d[k] = np.clip(d[k], -np.tan(np.radians(30.0)) * abs(d[other]), np.tan(np.radians(30.0)) * abs(d[other]))
+        if abs(d[other]) <= 0.05 * float(ext.max()):
+            d[other] = -1.0 if k == 0 else 1.0  # the source at an end: from the front
+            d[k] = np.sign(d[k]) * np.tan(np.radians(30.0))
+    horizontal = float(np.hypot(d[0], d[1]))
+    azim = float(np.degrees(np.arctan2(d[1], d[0]))) if horizontal > 0.05 * float(ext.max() or 1.0) else -60.0
+    far = azim + 180.0 if azim <= 0 else azim - 180.0
+    elev = float(np.degrees(np.arctan2(d[2], horizontal)))
+    if abs(elev) > 45.0 and np.linalg.norm(d) > 0.05 * float(ext.max() or 1.0):
+        up = 45.0 if elev > 0 else -45.0
+        return ((up, azim), (-up, far))
+    return ((VIEW_TILT, azim), (VIEW_TILT, far))
 
 
 def _plot_surface(
@@ -481,7 +561,7 @@ def _plot_surface(
     ax: Any,
     mesh: Any,
     cmap: str,
-    views: Sequence[Tuple[float, float]],
+    views: Optional[Sequence[Tuple[float, float]]],
     title: Optional[str],
     sources: bool,
     colorbar: bool,
@@ -506,6 +586,8 @@ def _plot_surface(
         if mesh is not None or isinstance(sol.surface, LevelSet):
             raise
         v, f = None, None  # a bare closest-point surface: drawn as its points
+    if views is None:
+        views = _default_views(sol, v, perm)
     if ax is not None:
         axes = [ax]
         fig = ax.figure
@@ -619,7 +701,10 @@ def _draw_mesh(
                 mids = s_all[seen].mean(axis=1)
                 score = (n[s_face[seen]] @ eye) * (orient if orient != 0 else 1.0)
                 for j in np.argsort(-score)[:50]:
-                    if all(np.linalg.norm(mids[j] - q) > 0.12 * size for q in placed):
+                    # apart from the other labels, and not under a source's star
+                    if all(np.linalg.norm(mids[j] - q) > 0.12 * size for q in placed) and not (
+                        sources and np.any(np.linalg.norm(src - mids[j], axis=1) < LABEL_CLEARANCE * size)
+                    ):
                         a.text(
                             *mids[j],
                             _label_text(lv[k]),
@@ -683,12 +768,34 @@ def _draw_point_cloud(
         _frame(a, p, ext, elev, azim)
 
 
+#: The share of the projected bounding box (which mplot3d fits into the panel) that the surface spans.
+FILL = 0.95
+
+
 def _frame(a: Any, v: np.ndarray, ext: np.ndarray, elev: float, azim: float) -> None:
+    """The whole surface in the panel: the axes' limits its bounding box, equal scales on the three
+    axes, and the zoom chosen so that the projected surface spans ``FILL`` of the projected box."""
+    from mpl_toolkits.mplot3d import proj3d
+
     lo, hi = v.min(0), v.max(0)
     a.set_xlim(lo[0], hi[0])
     a.set_ylim(lo[1], hi[1])
     a.set_zlim(lo[2], hi[2])
-    a.set_box_aspect(tuple(np.maximum(ext, 1e-9 * ext.max())), zoom=1.3)
+    aspect = tuple(np.maximum(ext, 1e-9 * ext.max()))
     a.view_init(elev, azim)
     a.set_axis_off()
     a.set_title(_view_title(elev, azim), fontsize=9)
+    a.set_box_aspect(aspect, zoom=1.0)
+    # at zoom 1 the projected bounding box fits the panel; the zoom scales the projection about the
+    # box's centre: scale until the projected surface (not its box's corners) spans FILL of it
+    corners = np.array(np.meshgrid(*zip(lo, hi), indexing="ij")).reshape(3, -1)
+    sample = v[:: max(1, len(v) // 20000)].T
+    M = a.get_proj()
+    bx, by, _ = proj3d.proj_transform(*corners, M)
+    x, y, _ = proj3d.proj_transform(*sample, M)
+    cx, cy = 0.5 * (bx.min() + bx.max()), 0.5 * (by.min() + by.max())
+    reach = max(
+        float(np.max(np.abs(x - cx))) / max(0.5 * float(np.ptp(bx)), 1e-300),
+        float(np.max(np.abs(y - cy))) / max(0.5 * float(np.ptp(by)), 1e-300),
+    )
+    a.set_box_aspect(aspect, zoom=FILL / max(reach, 1e-3))

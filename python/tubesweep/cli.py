@@ -58,8 +58,13 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
         "reports converged=False (default: 10000)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: ./out)")
-    p.add_argument("--png", action="store_true", help="also write a picture into --out (needs matplotlib)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--png", action="store_true", help="write a picture into --out (needs matplotlib)")
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress bar and no notes (such as why order 1 ran where order 2 was asked for or chosen "
+        "by --order auto); the summary line, warnings and errors are still printed",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -77,8 +82,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "solve",
         help="first-arrival time on a curve/surface (two-layer tube, Algorithm 3)",
-        description="Solve |grad_S u| = 1/F on an implicit curve or surface and write the band values "
-        "(solution.npz: indices, values, roles, phi, grid) and optionally a PNG.",
+        description="Solve |grad_S u| = 1/F on an implicit curve or surface and write what is asked for into "
+        "--out: a picture (--png), a mesh for ParaView (--export), the dense array (--dense), geodesic paths "
+        "(--path-from), the band values (--npz: solution.npz). With none of these, solution.npz is written.",
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--surface", choices=_surface_names(), help="a built-in curve or surface")
@@ -168,8 +174,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="--phi: re-distance φ in the band (for a level set function that is not a signed distance, "
         "e.g. x² + y² + z² − r²)",
     )
+    p.add_argument("--dense", action="store_true", help="write the dense array solution_dense.npy (NaN off the band)")
     p.add_argument(
-        "--dense", action="store_true", help="also write the dense array solution_dense.npy (NaN off the band)"
+        "--npz",
+        action="store_true",
+        help="write the band values to solution.npz (indices, values, roles, phi, the grid, the sources and, with "
+        "several sources, nearest_source); the default when no other output (--png, --export, --dense, "
+        "--path-from) is asked for",
     )
     p.add_argument(
         "--up",
@@ -278,6 +289,53 @@ def _load_phi(path: Path) -> np.ndarray:
     return np.asarray(data)
 
 
+def _fmt_point(p: Sequence[float]) -> str:
+    return " ".join(f"{float(v):g}" for v in p)
+
+
+def _check_phi_box(phi: np.ndarray, grid: Any, sources: np.ndarray, args: argparse.Namespace) -> None:
+    """A source off φ's zero level set, with --phi, is most often a box (--lower/--upper) that is
+    not the one φ was sampled on: says so, with what points to it (sources outside the box, the
+    zero level set cut by the box's faces, |∇φ| ≠ 1 for a φ that should be a distance)."""
+    box = f"--lower {_fmt_point(grid.lower)} --upper {_fmt_point(grid.upper)}"
+    outside = np.flatnonzero(~grid.contains(sources))
+    if outside.size:
+        raise UsageError(
+            f"--source {_fmt_point(sources[outside[0]])}: outside the grid box {box}; the box must be the one "
+            f"φ ({args.phi}) was sampled on, and the sources on its zero level set inside it"
+        )
+    from ._interpolation import interpolate_dense
+
+    h = grid.spacing
+    at_sources = interpolate_dense(np.asarray(phi, dtype=float), grid, np.asarray(sources, dtype=float), "linear")
+    off = np.flatnonzero(~(np.abs(at_sources) <= args.inner * h))
+    if not off.size:
+        return
+    i = int(off[0])
+    hints = []
+    faces = [np.take(phi, [0, -1], axis=k) for k in range(phi.ndim)]
+    if any(np.any(np.abs(f) <= h) or (np.nanmin(f) < 0 < np.nanmax(f)) for f in faces):
+        hints.append("φ's zero level set reaches the box's faces (the box cuts the surface)")
+    if not args.redistance:
+        near = np.abs(phi) <= 2 * h
+        if np.count_nonzero(near) >= 4:
+            g = np.gradient(phi.astype(float), h)
+            slope = float(np.median(np.sqrt(sum(gk[near] ** 2 for gk in g))))
+            if abs(slope - 1.0) > 0.1:
+                hints.append(
+                    f"φ changes by {slope:.3g} per unit length near its zero level set, where a signed distance "
+                    f"changes by 1: if φ is a distance, it was sampled on a box {slope:.3g} times this one's size"
+                )
+    raise UsageError(
+        f"--source {_fmt_point(sources[i])}: φ is {float(at_sources[i]):.4g} there on the grid {box}, so the source "
+        f"is {abs(float(at_sources[i])) / h:.3g} grid spacings off the surface"
+        + (" and " if hints else "")
+        + "; ".join(hints)
+        + ". Check that --lower/--upper are the corners of the grid φ was sampled on (φ has shape "
+        f"{'×'.join(map(str, phi.shape))}), then that the source lies on the surface"
+    )
+
+
 def cmd_solve(args: argparse.Namespace) -> int:
     from .grid import Grid
     from .solve import solve
@@ -365,6 +423,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
         sources = np.atleast_2d(surface.default_source)
     else:
         raise UsageError("give --source")
+    if args.phi:
+        _check_phi_box(phi, grid, sources, args)
     progress = make_progress(f"solve {name}", args.quiet)
     t0 = time.perf_counter()
     try:
@@ -389,19 +449,6 @@ def cmd_solve(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
-    labels = {"nearest_source": sol.nearest_source()} if len(sol.sources) > 1 and sol._isotropic else {}
-    np.savez_compressed(
-        out / "solution.npz",
-        indices=sol.indices,
-        values=sol.values,
-        roles=sol.roles,
-        phi=sol.phi,
-        lower=grid.lower,
-        upper=grid.upper,
-        shape=np.array(grid.shape),
-        sources=sol.sources,
-        **labels,  # type: ignore[arg-type]
-    )
     s = sol.stats
     # the names of docs/benchmarks.md: wall = the whole solve, sweeps = sol.stats.seconds, set-up = the rest
     print(
@@ -409,9 +456,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
         f"{s.iterations} iterations, {s.updates} updates, converged={s.converged}; wall {wall:.3f} s "
         f"(sweeps {s.seconds:.3f} s, set-up {max(wall - s.seconds, 0.0):.3f} s), order {s.order}"
     )
-    if s.order_fallback is not None:
+    if s.order_fallback is not None and not args.quiet:
         print(f"order=2 does not apply, so order 1 ran: {s.order_fallback}")
-    print(f"wrote {out / 'solution.npz'}")
+    asked = args.png or args.dense or args.export or args.path_from or args.path_from_vertex
+    if args.npz or not asked:
+        _write_npz(out / "solution.npz", sol)
+        print(f"wrote {out / 'solution.npz'}")
     if args.dense:
         np.save(out / "solution_dense.npy", sol.to_dense())
         print(f"wrote {out / 'solution_dense.npy'}")
@@ -434,6 +484,24 @@ def cmd_solve(args: argparse.Namespace) -> int:
         fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
         print(f"wrote {out / 'solution.png'}")
     return 0
+
+
+def _write_npz(path: Path, sol: Any) -> None:
+    """The band values with what is needed to place them on the grid (``--npz``)."""
+    grid = sol.grid
+    labels = {"nearest_source": sol.nearest_source()} if len(sol.sources) > 1 and sol._isotropic else {}
+    np.savez_compressed(
+        path,
+        indices=sol.indices,
+        values=sol.values,
+        roles=sol.roles,
+        phi=sol.phi,
+        lower=grid.lower,
+        upper=grid.upper,
+        shape=np.array(grid.shape),
+        sources=sol.sources,
+        **labels,
+    )
 
 
 def _trace_paths(args: argparse.Namespace, surface: Any, sol: Any, out: Path) -> list:

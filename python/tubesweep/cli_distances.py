@@ -40,7 +40,12 @@ def add_distances_parser(sub: Any) -> None:
     )
     src.add_argument("--phi", type=Path, help="a .npy file with a level set function sampled on the grid")
     pts = p.add_mutually_exclusive_group(required=True)
-    pts.add_argument("--points", type=Path, help="a .npy file with the points (M, d) on the surface")
+    pts.add_argument(
+        "--points",
+        type=Path,
+        help="the points (M, d) on the surface: a .npy file (numpy.save), or a text file (.txt .csv .xyz .dat: "
+        "one point per line, coordinates separated by spaces or commas, '#' comments)",
+    )
     pts.add_argument("--sample", type=int, metavar="K", help="K points by geodesic farthest-point sampling")
     p.add_argument("--out", type=Path, required=True, help="the .npy file the matrix is written to")
     p.add_argument(
@@ -138,6 +143,46 @@ def _surface_and_grid(args: argparse.Namespace) -> Any:
     return LevelSet(phi), Grid(args.lower, args.upper, phi.shape)
 
 
+TEXT_SUFFIXES = (".txt", ".csv", ".xyz", ".dat")
+
+
+def load_points(path: Path, ndim: int) -> np.ndarray:
+    """The (M, ndim) points of ``--points``: a ``.npy`` file read by :func:`numpy.load`, a text file
+    (one point per line, separated by spaces or commas) by :func:`numpy.loadtxt`."""
+    suffix = path.suffix.lower()
+    if suffix == ".npy":
+        try:
+            points = np.load(path, allow_pickle=False)
+        except ValueError:
+            raise ValueError(
+                f"--points {path}: not a NumPy .npy file of numbers; save the points with numpy.save, or give a "
+                f"text file ({' '.join(TEXT_SUFFIXES)}) with one point per line"
+            ) from None
+    elif suffix in TEXT_SUFFIXES:
+        with open(path) as f:
+            first = next((ln for ln in f if ln.strip() and not ln.lstrip().startswith("#")), "")
+        try:
+            points = np.loadtxt(path, delimiter="," if "," in first else None, ndmin=2, comments="#")
+        except ValueError as e:
+            raise ValueError(
+                f"--points {path}: not a text file of numbers with {ndim} per line, separated by spaces or commas "
+                f"(numpy.loadtxt: {e})"
+            ) from None
+    else:
+        raise ValueError(
+            f"--points {path}: give a .npy file (numpy.save) or a text file ({' '.join(TEXT_SUFFIXES)}) with one "
+            f"point per line; '{path.suffix}' is neither"
+        )
+    points = np.asarray(points)
+    if points.ndim != 2 or points.shape[1] != ndim or len(points) == 0:
+        raise ValueError(
+            f"--points {path}: needs M points of {ndim} coordinates (an (M, {ndim}) array); got shape {points.shape}"
+        )
+    if not np.issubdtype(points.dtype, np.number):
+        raise ValueError(f"--points {path}: the points must be numbers; got {points.dtype}")
+    return points.astype(float)
+
+
 def _client(address: Optional[str]) -> Any:
     if address is None:
         return None
@@ -173,7 +218,7 @@ def cmd_distances(args: argparse.Namespace) -> int:
         f"({tube.setup_seconds:.2f} s)"
     )
     if args.points is not None:
-        points = np.load(args.points, allow_pickle=False)
+        points = load_points(args.points, grid.ndim)
     else:
         bar = _SourcesBar("sampling", args.quiet)
         try:

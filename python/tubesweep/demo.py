@@ -33,10 +33,9 @@ def run_demo(out: Path, quick: bool = False) -> int:
         err = np.nanmax(np.abs(sol(ring) - np.pi / 4))
         rows.append(("sphere r=0.5", ham, n3, err, sol.stats, wall))
         if ham == "godunov":
-            # the first view faces the source, the second its antipode
+            # the default views: the first faces the source, the second its antipode
             fig = plot(
                 sol,
-                views=((20.0, -150.0), (20.0, 30.0)),
                 title=f"geodesic distance on a sphere of radius 0.5 from the red star (grid {n3}³)",
             )
             fig.savefig(out / "sphere.png", dpi=110, bbox_inches="tight")
@@ -72,7 +71,7 @@ def run_demo(out: Path, quick: bool = False) -> int:
             fig = plot(sol, title=f"arclength on the six-fold star from the red star (grid {n2}²)")
             fig.savefig(out / "star.png", dpi=110, bbox_inches="tight")
 
-    # a layered medium in the box: speed 1 below z=0, 2 above, smooth transition
+    # a layered medium in the box: speed from 1 below y = 0 to 2 above, a tanh ramp
     gridb = Grid((-1, -1), (1, 1), (301, 301))
     speed = lambda p: 1.5 + 0.5 * np.tanh(8 * p[:, 1])  # noqa: E731
     u, st = travel_time(gridb, [(0.0, -0.6)], speed=speed, return_stats=True)
@@ -82,7 +81,7 @@ def run_demo(out: Path, quick: bool = False) -> int:
         grid=gridb,
         sources=[(0.0, -0.6)],
         speed=1.5 + 0.5 * np.tanh(8 * Y),
-        title="travel time from the red star: speed 1 below y = 0, 2 above",
+        title="travel time from the red star, speed 1.5 + 0.5 tanh(8y)",
     )
     fig.savefig(out / "layered.png", dpi=110, bbox_inches="tight")
 

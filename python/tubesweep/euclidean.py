@@ -205,7 +205,12 @@ def travel_time(
         are O(Δx²) also for variable speed, and exact (up to the stopping test) for a constant
         speed and one source (docs/box-second-order.md). ``"auto"``: 2 with the Godunov update,
         1 with Lax–Friedrichs, a flow or a Hamiltonian object (``stats.order`` says which ran,
-        ``stats.order_fallback`` why not 2).
+        ``stats.order_fallback`` why not 2). The default is 1, where :func:`tubesweep.solve`'s is
+        ``"auto"``: in the box, the paper's Algorithm 1 is the reference every table and benchmark
+        of the box compares against, and the box is where sharp speed contrasts (layers,
+        obstacles) are common, on which the factored sweeps can run away and fall back to
+        order 1 (``stats.order2["runaway_iteration"]``); ``order=2`` also costs 3–10× the time
+        per solve. On a surface the default's choice is made from the geometry alone.
     return_solution : bool
         Return a :class:`BoxSolution` (the values with point evaluation, ``sol(points,
         interpolation="linear" | "cubic")``, exactly 0 at a source) instead of the array.

@@ -549,6 +549,16 @@ class Metric(Hamiltonian):
         A constant ``(d, d)`` matrix, an array of ``grid.shape + (d, d)``, or a callable
         ``M(points (K, d)) -> (K, d, d)`` (evaluated at the closest points of the band nodes; an
         array is interpolated there with the upwind solver, read at the nodes with ``"lxf"``).
+    restrict : {"gradient", "length"}
+        What the equation means on a surface, where ``M`` (given in the ambient space) has to be
+        restricted to the tangent plane. ``"gradient"`` (default): ``M``'s tangential block acts
+        on the surface gradient, ``sqrt(∇_Σuᵀ P M P ∇_Σu) = 1/F``. ``"length"``: the ambient
+        length metric ``M⁻¹`` restricted to the surface (the induced Riemannian metric: a path's
+        length is ``∫ sqrt(ẋᵀ M⁻¹ ẋ)`` along it), whose dual on gradients is
+        ``M − (Mn)(Mn)ᵀ / (nᵀMn)``. The two agree where the normal ``n`` is an eigenvector of
+        ``M`` and differ elsewhere: ``M = diag(2, 1, 1)`` on the sphere of radius 0.5, from
+        ``(−0.5, 0, 0)`` to ``(0, 0.5, 0)``, gives 0.6555 and 0.6753 (docs/hamiltonians.md). In
+        the box (:func:`tubesweep.travel_time`) there is nothing to restrict.
     tangential : bool
         On a surface only the tangential block of ``M`` matters. With ``True`` (default) the
         normal–tangent coupling is removed, ``M ← P M P + m_n n nᵀ`` with ``P = I − n nᵀ``, so
@@ -578,13 +588,32 @@ class Metric(Hamiltonian):
     kind = "metric"
     label = "metric"
 
-    def __init__(self, M: Any, *, tangential: bool = True, scheme: Optional[str] = None, sigma: Any = None):
+    def __init__(
+        self,
+        M: Any,
+        *,
+        restrict: str = "gradient",
+        tangential: bool = True,
+        scheme: Optional[str] = None,
+        sigma: Any = None,
+    ):
         super().__init__(sigma, scheme)
+        if restrict not in ("gradient", "length"):
+            raise ValueError(
+                f"restrict must be 'gradient' (M's tangential block acts on the surface gradient) or 'length' "
+                f"(the length metric M⁻¹ restricted to the surface); got {restrict!r}"
+            )
+        if restrict == "length" and not tangential:
+            raise ValueError(
+                "restrict='length' takes the surface's tangent plane from its normals: it needs tangential=True"
+            )
         self.M = M
+        self.restrict = restrict
         self.tangential = bool(tangential)
 
     def __repr__(self) -> str:
-        return f"Metric(tangential={self.tangential}, scheme={self.scheme!r})"
+        extra = ", restrict='length'" if self.restrict == "length" else ""
+        return f"Metric(tangential={self.tangential}{extra}, scheme={self.scheme!r})"
 
     def prepare(self, surface, grid, linear, x, direction, slowness, roles):
         d = grid.ndim
@@ -613,7 +642,17 @@ class Metric(Hamiltonian):
             has = np.linalg.norm(n, axis=1) > 0.5
             P = np.eye(d)[None] - n[:, :, None] * n[:, None, :]
             pmp = P @ m @ P
-            if self.scheme == "lxf":
+            if self.restrict == "length":
+                # the dual of M⁻¹ restricted to the tangent plane, (P M⁻¹ P)⁺ = M − (Mn)(Mn)ᵀ/(nᵀMn)
+                # (a Schur complement: no inverse formed); it annihilates n, so P·P changes nothing
+                mn = np.einsum("kij,kj->ki", m, n)
+                nmn = np.einsum("ki,ki->k", n, mn)
+                pmp = np.where(
+                    has[:, None, None],
+                    m - mn[:, :, None] * mn[:, None, :] / np.where(has, nmn, 1.0)[:, None, None],
+                    pmp,
+                )
+            if self.scheme == "lxf" and self.restrict == "gradient":
                 mnn = np.einsum("ki,kij,kj->k", n, m, n)
             else:
                 # the normal block is free (the surface's equation does not see it): the tangential
