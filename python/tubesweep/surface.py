@@ -254,6 +254,48 @@ class LevelSet(Surface):
                 raise ValueError(f"lipschitz must be >= 1 (a distance function has |∇φ| = 1); got {lipschitz}")
             self.lipschitz = float(lipschitz)
 
+    @classmethod
+    def from_mask(cls, mask: Any, grid: Grid, *, smooth: float = 0.0) -> "LevelSet":
+        """The surface of a voxel mask (a segmentation) on the grid's nodes.
+
+        Parameters
+        ----------
+        mask : ndarray of ``grid.shape``, boolean or of 0 and 1
+            True (1) inside the object, False (0) outside. The object must not touch the grid's
+            boundary (pad the mask with outside voxels).
+        grid : Grid
+            The grid whose nodes are the mask's voxels.
+        smooth : float
+            The width σ, in voxels, of a Gaussian smoothing of the mask before its surface is taken
+            (0, the default: none). It removes the voxel steps and moves curved parts inward by
+            about σ²κ/2 (σ in length units, κ the sum of the principal curvatures). Needs scipy.
+
+        Returns
+        -------
+        LevelSet
+            The zero level set of ``0.5 − mask`` (smoothed), interpolated multilinearly between the
+            nodes (half-way between inside and outside nodes), re-distanced in the band
+            (``redistance=True``).
+
+        Raises
+        ------
+        ValueError
+            If the mask's shape is not the grid's, it holds values other than 0 and 1, it is all
+            inside or all outside, the object touches the grid's boundary, or ``smooth`` is negative
+            or erases the object.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+        >>> X, Y, Z = grid.meshgrid()
+        >>> ball = ts.LevelSet.from_mask(X**2 + Y**2 + Z**2 < 0.25, grid)
+        >>> sol = ts.solve(ball, grid, [(-0.5, 0, 0)])
+        """
+        from .mask import level_set_from_mask
+
+        return level_set_from_mask(mask, grid, smooth)
+
     @property
     def is_dense(self) -> bool:
         return self._array is not None
