@@ -12,7 +12,9 @@
 //! 2. **Closest points, layer by layer.** The nodes within `reach` cells of a crossed cell
 //!    ([`NodeSet`]) are ordered by their number of face steps from a crossed cell's corner. A
 //!    corner takes the nearest edge crossing of its crossed cells, a node of a later layer the
-//!    nearest closest point of its face neighbours of the layer before, as its starting point.
+//!    nearest closest point of its face neighbours of the layer before, as its starting point,
+//!    or the point Newton steps from the node reach on the zero level set if that is nearer
+//!    (where φ is smooth it lies next to the closest point, and the refinement is short).
 //! 3. **Refinement on the interpolant.** From that point on the zero level set, the
 //!    orthogonality iterations of the projection: `y ← P(y + (I − n nᵀ)(x − y))`, a move in the
 //!    tangent plane towards the foot of the node (the normal `n` from central differences of φ
@@ -22,8 +24,9 @@
 //!    `1e-9 · Δx · |∇φ|`), otherwise the tangential move is halved (three times at most), and
 //!    failing that the iterations stop. So every iterate is a point of the zero level set, whose
 //!    distance from the node bounds the node's distance from above, and ∇φ is only read next to
-//!    the zero level set, where the sign change makes it non-zero: never on a plateau. A node
-//!    whose iterations do not settle keeps the iterate nearest to it.
+//!    the zero level set, where the sign change makes it non-zero: never on a plateau. The
+//!    iterations stop when their moves no longer shrink (they circle among the kinks of a mask's
+//!    voxel steps); a node whose iterations do not settle keeps the iterate nearest to it.
 //!
 //! Where φ is smooth the iterations settle on the same closest point as the projection from the
 //! node itself (the same fixed point, `x − y` along the central-difference normal), so the
@@ -75,8 +78,16 @@ pub struct RedistanceOptions {
 /// at most `tol`), each with Newton steps, so a settled point is on it to rounding.
 const ON_ZERO_SET: f64 = 1e-9;
 
+/// The refinement stops when [`STALLED_STEPS`] moves in a row are each more than [`STALL_RATIO`]
+/// times the one before.
+const STALL_RATIO: f64 = 0.9;
+const STALLED_STEPS: usize = 3;
+
 /// Halvings of a tangential move that does not land on the zero level set closer to the node.
 const HALVINGS: usize = 3;
+
+/// The Newton steps of the projection from the node (`tubesweep.redistance.NEWTON_STEPS`).
+const PROJECTION_NEWTON_STEPS: usize = 6;
 
 /// The most Newton steps that take a point back onto the zero level set after a tangential move.
 const NEWTON_STEPS: usize = 8;
@@ -127,6 +138,7 @@ fn refine<const D: usize>(
     };
     let mut y = start;
     let (mut nearest, mut best) = (start, distance(&start));
+    let (mut last_move, mut stalled) = (f64::INFINITY, 0);
     for _ in 0..options.max_steps {
         let g = field.gradient(&y, options.eps);
         let n2 = sum_of_squares(&g);
@@ -178,6 +190,15 @@ fn refine<const D: usize>(
         if dz < best {
             (nearest, best) = (y, dz);
         }
+        // moves that no longer shrink: the iterates circle among the kinks of the interface (a
+        // mask's voxel steps) instead of settling; where they settle they shrink by the ratio of
+        // the node's distance to the radius of curvature per step
+        let moved = sum_of_squares(&step).sqrt();
+        stalled = if moved > STALL_RATIO * last_move { stalled + 1 } else { 0 };
+        if stalled >= STALLED_STEPS {
+            break;
+        }
+        last_move = moved;
     }
     (nearest, false)
 }
@@ -307,6 +328,17 @@ pub fn redistanced_band_of_samples<const D: usize>(
                             consider(closest[q]);
                         }
                     });
+                }
+                // and the Newton projection of the node itself, where ∇φ lets it reach the zero
+                // level set (where φ is smooth, near the node's closest point: few refinements)
+                // (the projection's first Newton steps, with the central differences, whose
+                // direction at the node points at its closest point where φ is smooth)
+                let mut own = x;
+                if field.newton(&mut own, PROJECTION_NEWTON_STEPS, options.eps) {
+                    let (_, g) = field.value_and_gradient(&own);
+                    if onto_zero_set(field, &mut own, ON_ZERO_SET * h * sum_of_squares(&g).sqrt()) {
+                        consider(own);
+                    }
                 }
                 let start = start.expect("a corner of a crossed cell, or a neighbour of the layer before");
                 refine(field, &x, start, &options, settled)
