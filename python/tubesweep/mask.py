@@ -47,7 +47,7 @@ def _checked_mask(mask: Any, grid: Grid) -> np.ndarray:
     if not np.all(inside | (arr == 0)):
         bad = tuple(int(i) for i in np.argwhere(~(inside | (arr == 0)))[0])
         raise ValueError(
-            f"mask must hold only 0 and 1 (or be boolean); got {arr[bad]!r} at index {bad}. For a label image "
+            f"mask must hold only 0 and 1 (or be boolean); got {arr[bad].item()!r} at index {bad}. For a label image "
             "pass labels == k; for a soft mask or a probability map p in [0, 1] pass "
             "ts.LevelSet(0.5 - p, redistance=True)"
         )

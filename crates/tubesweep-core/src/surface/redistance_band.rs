@@ -21,7 +21,7 @@
 //!    with step `eps`, as the projection takes it), then Newton steps `P` back onto the level
 //!    set with the exact gradient of the cell's interpolant (quadratic convergence), until
 //!    `x − y` is along the normal. Each step must land on the zero level set (|φ| below
-//!    `1e-9 · Δx · |∇φ|`), otherwise the tangential move is halved (three times at most), and
+//!    `1e-9 · Δx · |∇φ|`), otherwise the tangential move is halved (once), and
 //!    failing that the iterations stop. So every iterate is a point of the zero level set, whose
 //!    distance from the node bounds the node's distance from above, and ∇φ is only read next to
 //!    the zero level set, where the sign change makes it non-zero: never on a plateau. The
@@ -69,7 +69,8 @@ pub struct RedistanceOptions {
     pub eps: f64,
     /// The most refinement iterations per node.
     pub max_steps: usize,
-    /// A point has settled when an iteration moves it by at most `tol · max(1, max |corner|)`.
+    /// A point has settled when an iteration moves it by at most `tol · Δx` (its distance is then
+    /// within about `(tol · Δx)² / |x − cp(x)|` of the fixed point's).
     pub tol: f64,
 }
 
@@ -81,16 +82,16 @@ const ON_ZERO_SET: f64 = 1e-9;
 /// The refinement stops when [`STALLED_STEPS`] moves in a row are each more than [`STALL_RATIO`]
 /// times the one before.
 const STALL_RATIO: f64 = 0.9;
-const STALLED_STEPS: usize = 3;
+const STALLED_STEPS: usize = 2;
 
 /// Halvings of a tangential move that does not land on the zero level set closer to the node.
-const HALVINGS: usize = 3;
+const HALVINGS: usize = 1;
 
 /// The Newton steps of the projection from the node (`tubesweep.redistance.NEWTON_STEPS`).
 const PROJECTION_NEWTON_STEPS: usize = 6;
 
 /// The most Newton steps that take a point back onto the zero level set after a tangential move.
-const NEWTON_STEPS: usize = 8;
+const NEWTON_STEPS: usize = 4;
 
 /// Newton steps from `z` onto the zero level set of the multilinear interpolant, with its exact
 /// gradient in the cell that holds the point (quadratic convergence within a cell; the points kept
@@ -263,15 +264,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
         }
         layers.push(std::mem::replace(&mut frontier, next));
     }
-    let scale = (0..D)
-        .map(|a| {
-            field
-                .coordinate(a, 0)
-                .abs()
-                .max(field.coordinate(a, shape[a] - 1).abs())
-        })
-        .fold(1.0f64, f64::max);
-    let settled = options.tol * scale;
+    let settled = options.tol * h;
     let node_of = |p: usize| -> ([usize; D], [f64; D]) {
         let mut l = linear[p] as usize;
         let mut idx = [0usize; D];
