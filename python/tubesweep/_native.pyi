@@ -49,7 +49,7 @@ def redistanced_band_of_samples(
     eps: float,
     max_steps: int,
     tol: float,
-) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.float32], int, int]: ...
+) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.float32], int, int, int]: ...
 def analytic_level_set_band(
     kind: str,  # "sphere", "torus", "ellipsoid", "star", "rounded-cube" or "double-torus"
     parameters: List[float],

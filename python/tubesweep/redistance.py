@@ -297,7 +297,7 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     from . import _native
     from .band import BandGeometry
 
-    linear, signed, direction, crossed, _ = _native.redistanced_band_of_samples(
+    linear, signed, direction, crossed, _, medial = _native.redistanced_band_of_samples(
         surface._array,
         [float(c) for c in grid.lower],
         grid.spacing,
@@ -312,6 +312,17 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
             + ("> 0" if np.min(surface._array) > 0 else "≤ 0")
             + "), so its zero level set does not cross the grid and there is no surface to re-distance: pass a φ that "
             "is negative inside the surface and positive outside, on a grid that holds the surface"
+        )
+    if medial:
+        import warnings
+
+        warnings.warn(
+            f"{medial} nodes within {0.5 * half_width:.3g} of the zero level set lie near points "
+            "equidistant from two parts of it (their neighbours' closest points are more than 5 grid spacings apart): "
+            "the tube is about as wide as the surface's radius of curvature there, or two sheets of the surface face "
+            "each other within the tube; the travel times there may be wrong. Refine the grid",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
         )
     return BandGeometry(linear.view(np.int64), None, signed, direction, consumable=True)
 

@@ -441,7 +441,7 @@ pub(crate) fn project_to_sampled_level_set<'py>(
 /// crosses the grid (a mask, plateaus, φ far from a distance): sub-cell interface points on the
 /// crossed cells' edges, closest points carried layer by layer and refined on the multilinear
 /// interpolant (`tubesweep_core::surface::redistance_band`). Returns (linear indices (M,) uint64,
-/// signed distances (M,), directions (M, d) float32, crossed cells, unsettled nodes).
+/// signed distances (M,), directions (M, d) float32, crossed cells, unsettled nodes, medial nodes).
 #[pyfunction]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub(crate) fn redistanced_band_of_samples<'py>(
@@ -457,6 +457,7 @@ pub(crate) fn redistanced_band_of_samples<'py>(
     Bound<'py, PyArray1<u64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray2<f32>>,
+    usize,
     usize,
     usize,
 )> {
@@ -500,6 +501,7 @@ pub(crate) fn redistanced_band_of_samples<'py>(
         direction.into_pyarray(py),
         out.crossed_cells,
         out.unsettled,
+        out.medial,
     ))
 }
 

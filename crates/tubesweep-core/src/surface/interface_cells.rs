@@ -290,6 +290,14 @@ impl NodeSet {
         None
     }
 
+    /// [`face_neighbours`](Self::face_neighbours) when `wanted`, else nothing.
+    #[inline]
+    pub fn face_neighbours_if(&self, wanted: bool, node: (usize, usize, usize), visit: impl FnMut(usize)) {
+        if wanted {
+            self.face_neighbours(node, visit);
+        }
+    }
+
     /// The positions of the face neighbours of node `(i, j, k)` in the set, passed to `visit`.
     #[inline]
     pub fn face_neighbours(&self, (i, j, k): (usize, usize, usize), mut visit: impl FnMut(usize)) {

@@ -58,7 +58,19 @@ pub struct RedistancedBand {
     /// of the interface, such as a mask's voxel steps): their distance is that to the nearest
     /// point of the zero level set the iterations found.
     pub unsettled: usize,
+    /// Nodes of the band's inner half (the inner tube, with the default widths) with a face
+    /// neighbour whose closest point lies more than [`MEDIAL_GAP`]
+    /// spacings from theirs: near points equidistant from two parts of the zero level set, where
+    /// the tube is about as wide as the surface's radius of curvature, or two sheets face each
+    /// other within it (a grid too coarse for the surface).
+    pub medial: usize,
 }
+
+/// See [`RedistancedBand::medial`]: neighbouring nodes at distance `d` from a surface of radius of
+/// curvature `R` have closest points `Δx·R/(R − d)` apart on its concave side, 5Δx at `d = 4R/5`,
+/// and a mask's voxel steps move them by a spacing or two; across a point equidistant from two
+/// parts of the surface they jump from one to the other.
+pub const MEDIAL_GAP: f64 = 5.0;
 
 /// The options of [`redistanced_band_of_samples`].
 #[derive(Debug, Clone, Copy)]
@@ -195,7 +207,11 @@ fn refine<const D: usize>(
         // mask's voxel steps) instead of settling; where they settle they shrink by the ratio of
         // the node's distance to the radius of curvature per step
         let moved = sum_of_squares(&step).sqrt();
-        stalled = if moved > STALL_RATIO * last_move { stalled + 1 } else { 0 };
+        stalled = if moved > STALL_RATIO * last_move {
+            stalled + 1
+        } else {
+            0
+        };
         if stalled >= STALLED_STEPS {
             break;
         }
@@ -367,6 +383,21 @@ pub fn redistanced_band_of_samples<const D: usize>(
             out.direction.push(if good { (v / dist) as f32 } else { 0.0 });
         }
         out.unsettled += usize::from(!converged[p]);
+        // a face neighbour's closest point more than MEDIAL_GAP spacings away: the node is near
+        // points equidistant from two parts of the zero set (a focal point or two facing sheets)
+        let mut apart = false;
+        set.face_neighbours_if(
+            dist <= 0.5 * options.half_width,
+            lattice.split(linear[p] as usize),
+            |q| {
+                let mut s = 0.0;
+                for k in 0..D {
+                    s += (closest[q][k] - y[k]) * (closest[q][k] - y[k]);
+                }
+                apart |= s > (MEDIAL_GAP * h) * (MEDIAL_GAP * h);
+            },
+        );
+        out.medial += usize::from(apart);
     }
     Ok(out)
 }
