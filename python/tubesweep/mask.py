@@ -21,15 +21,16 @@ import numpy as np
 
 from ._validate import real_scalar
 from .grid import Grid
-from .surface import LevelSet
 
-__all__ = ["level_set_from_mask"]
+__all__ = ["level_set_function_of_mask"]
 
 
 def _checked_mask(mask: Any, grid: Grid) -> np.ndarray:
     """The mask as a boolean array of the grid's shape, or a ValueError naming what is wrong."""
     if not isinstance(grid, Grid):
-        raise TypeError(f"grid must be a ts.Grid (the grid whose nodes are the mask's voxels); got {type(grid).__name__}")
+        raise TypeError(
+            f"grid must be a ts.Grid (the grid whose nodes are the mask's voxels); got {type(grid).__name__}"
+        )
     arr = np.asarray(mask)
     if arr.shape != grid.shape:
         raise ValueError(
@@ -66,8 +67,9 @@ def _touching_the_box(inside: np.ndarray) -> Any:
     return None
 
 
-def level_set_from_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> LevelSet:
-    """:meth:`tubesweep.LevelSet.from_mask` (see there)."""
+def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np.ndarray:
+    """The φ of :meth:`tubesweep.LevelSet.from_mask` (see there): ``0.5 − mask``, smoothed, negative
+    inside, after the checks of the mask."""
     inside = _checked_mask(mask, grid)
     sigma = real_scalar(smooth, "smooth", "a width in voxels (0 for none)")
     if not (np.isfinite(sigma) and sigma >= 0):
@@ -98,4 +100,4 @@ def level_set_from_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> LevelSet:
             )
     else:
         phi = np.where(inside, -0.5, 0.5)
-    return LevelSet(phi, redistance=True)
+    return phi

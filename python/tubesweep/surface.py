@@ -292,9 +292,9 @@ class LevelSet(Surface):
         >>> ball = ts.LevelSet.from_mask(X**2 + Y**2 + Z**2 < 0.25, grid)
         >>> sol = ts.solve(ball, grid, [(-0.5, 0, 0)])
         """
-        from .mask import level_set_from_mask
+        from .mask import level_set_function_of_mask
 
-        return level_set_from_mask(mask, grid, smooth)
+        return LevelSet(level_set_function_of_mask(mask, grid, smooth), redistance=True)
 
     @property
     def is_dense(self) -> bool:
