@@ -158,12 +158,6 @@ impl<'a, const D: usize> SampledField<'a, D> {
         (value, grad)
     }
 
-    /// `y` moved onto the grid's box (see [`clamp_to_box`](Self::clamp_to_box)).
-    #[inline]
-    pub(crate) fn into_box(&self, y: &mut [f64; D]) {
-        self.clamp_to_box(y);
-    }
-
     /// φ at the node of D-index `node`.
     #[inline]
     pub(crate) fn sample(&self, node: [usize; D]) -> f64 {
@@ -215,7 +209,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
     /// face the interpolant is φ on the face, constant along the normal, whose gradient along
     /// that axis vanishes).
     #[inline]
-    fn clamp_to_box(&self, y: &mut [f64; D]) {
+    pub(crate) fn clamp_to_box(&self, y: &mut [f64; D]) {
         for k in 0..D {
             let upper = self.lower[k] + (self.shape[k] - 1) as f64 * self.spacing;
             y[k] = y[k].clamp(self.lower[k], upper);

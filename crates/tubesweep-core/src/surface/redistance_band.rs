@@ -112,7 +112,7 @@ const NEWTON_STEPS: usize = 4;
 /// along them) is that of the projection from the node.
 #[inline]
 fn onto_zero_set<const D: usize>(field: &SampledField<'_, D>, z: &mut [f64; D], on_zero_set: f64) -> bool {
-    field.into_box(z);
+    field.clamp_to_box(z);
     for _ in 0..NEWTON_STEPS {
         let (v, g) = field.value_and_gradient(z);
         if v.abs() <= on_zero_set {
@@ -126,7 +126,7 @@ fn onto_zero_set<const D: usize>(field: &SampledField<'_, D>, z: &mut [f64; D], 
         for k in 0..D {
             z[k] -= s * g[k];
         }
-        field.into_box(z);
+        field.clamp_to_box(z);
     }
     field.value(z).abs() <= on_zero_set
 }
