@@ -175,12 +175,15 @@ class LevelSet(Surface):
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
         default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
         is estimated from |∇φ| on a coarse lattice of the grid box for a callable and then from
-        |∇φ| at the band's candidates, and for an array bounded near each node from the
-        differences of the samples (a bound given here applies to the whole box instead).
+        |∇φ| at the band's candidates; an array needs none (it is not used: the band is found
+        from the cells the zero level set crosses).
     redistance : bool
         For φ that is *not* a distance function (e.g. ``x² + y² − r²``): in the band only, replace
-        φ by the signed distance to its zero level set — first ``φ/|∇φ|`` (a Newton step onto the
-        surface), then closest-point projection iterations (:mod:`tubesweep.redistance`). The tube
+        φ by the signed distance to its zero level set (:mod:`tubesweep.redistance`). An array may
+        be any φ whose sign changes across the surface (far from a distance, with plateaus, float32,
+        a 0/1 mask: see :meth:`from_mask`): the zero level set of its multilinear interpolant is
+        located cell by cell and the closest points on it refined from there. A callable is
+        projected from each node (Newton steps along ∇φ, then closest-point iterations). The tube
         widths are then true distances and the extension direction is ``(x − cp(x))/|x − cp(x)|``.
         Costs a few dozen φ evaluations per band node.
 
