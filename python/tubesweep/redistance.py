@@ -15,9 +15,11 @@ closest-point direction of Sect. 5.2). Gradients are central differences of φ w
 
 For a sampled φ (an array) the same iterations, with the same arithmetic and bits, run in Rust on
 all threads (``tubesweep_core::surface::redistance``), with the points kept in the grid's box, where φ is
-known (``box`` of :func:`project_to_level_set`), and the band's candidates come from two passes over
-the samples with a bound on |∇φ| near each node (``tubesweep_core::band::sampled``); this module's NumPy
-code runs them for a callable φ, which only Python can evaluate.
+known (``box`` of :func:`project_to_level_set`): they project given points (sources, paths). The band of
+a sampled φ does not start from its nodes but from the zero level set located cell by cell
+(:func:`_sampled_redistanced_band`, ``tubesweep_core::surface::redistance_band``), so it works from any
+φ with a sign change (masks, plateaus); this module's NumPy code runs the projection for a callable
+φ, which only Python can evaluate.
 """
 
 from __future__ import annotations
