@@ -41,6 +41,15 @@ def project_to_sampled_level_set(
     orthogonality_steps: int,
     tol: float,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+def redistanced_band_of_samples(
+    phi: npt.NDArray[np.float64],  # φ at every grid node, C-contiguous
+    lower: List[float],
+    spacing: float,
+    half_width: float,
+    eps: float,
+    max_steps: int,
+    tol: float,
+) -> Tuple[npt.NDArray[np.uint64], npt.NDArray[np.float64], npt.NDArray[np.float32], int, int, int]: ...
 def analytic_level_set_band(
     kind: str,  # "sphere", "torus", "ellipsoid", "star", "rounded-cube" or "double-torus"
     parameters: List[float],

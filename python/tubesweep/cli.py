@@ -25,6 +25,7 @@ EPILOG = """examples:
   tubesweep solve --mesh my-part.obj --source-vertex 0 --export out/part.ply
   tubesweep solve --surface star --n 401 --hamiltonian lxf --source 0.5 0 --out out/star
   tubesweep solve --phi phi.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0 --redistance
+  tubesweep solve --mask mask.npy --lower -1 -1 -1 --upper 1 1 1 --source 0.5 0 0 --smooth 1.5
   tubesweep travel-time --n 201 --dim 2 --source 0 0 --png
   tubesweep reproduce all --quick
 """
@@ -93,6 +94,12 @@ def build_parser() -> argparse.ArgumentParser:
         type=Path,
         help="a .npy (or one-array .npz) file with a level set function φ sampled on "
         "the grid given by --lower/--upper; add --redistance if φ is not a signed distance",
+    )
+    src.add_argument(
+        "--mask",
+        type=Path,
+        help="a .npy (or one-array .npz) file with a voxel mask (boolean, or 0 and 1; 1 inside) on the grid given "
+        "by --lower/--upper: the surface between inside and outside voxels (ts.LevelSet.from_mask); see --smooth",
     )
     src.add_argument(
         "--mesh",
@@ -183,6 +190,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--path-from) is asked for",
     )
     p.add_argument(
+        "--smooth",
+        type=float,
+        default=0.0,
+        help="--mask: smooth the mask with a Gaussian of this width in voxels first (default 0: none)",
+    )
+    p.add_argument(
         "--up",
         choices=["x", "y", "z"],
         help="the vertical axis of 3D pictures (default: y for --mesh, as in most mesh files, z otherwise)",
@@ -266,17 +279,17 @@ def _grid_for(surface, n: int, lower: Optional[Sequence[float]], upper: Optional
     return Grid(lower, upper, (n,) * len(lower))
 
 
-def _load_phi(path: Path) -> np.ndarray:
-    """φ sampled on the grid from a ``.npy`` file, or from a ``.npz`` holding one array (or one named
-    ``phi``)."""
+def _load_phi(path: Path, flag: str = "--phi") -> np.ndarray:
+    """φ (or a mask, ``flag``) sampled on the grid from a ``.npy`` file, or from a ``.npz`` holding one
+    array (or one named ``phi``)."""
     import zipfile
 
     try:
         data = np.load(path, allow_pickle=False)
     except (ValueError, EOFError, zipfile.BadZipFile):
         raise UsageError(
-            f"--phi {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
-            f"φ with numpy.save or numpy.savez"
+            f"{flag} {path}: not a NumPy .npy or .npz file of numbers (NumPy cannot read it as one); save "
+            f"it with numpy.save or numpy.savez"
         ) from None
     if isinstance(data, np.lib.npyio.NpzFile):
         with data:
@@ -285,7 +298,7 @@ def _load_phi(path: Path) -> np.ndarray:
                 return np.asarray(data["phi"])
             if len(names) == 1:
                 return np.asarray(data[names[0]])
-        raise UsageError(f"--phi {path}: an .npz file must hold one array or one named 'phi'; it holds {names}")
+        raise UsageError(f"{flag} {path}: an .npz file must hold one array or one named 'phi'; it holds {names}")
     return np.asarray(data)
 
 
@@ -372,6 +385,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
         surface = REGISTRY[args.surface]()  # type: ignore[assignment]
         grid = _grid_for(surface, 101 if args.n is None else args.n, args.lower, args.upper)
         name = args.surface
+    elif args.mask:
+        mask = _load_phi(args.mask, "--mask")
+        if args.lower is None or args.upper is None:
+            raise UsageError("--mask needs --lower and --upper (the grid's corners)")
+        grid = Grid(args.lower, args.upper, mask.shape)
+        surface = LevelSet.from_mask(mask, grid, smooth=args.smooth)  # type: ignore[assignment]
+        name = args.mask.stem
     else:
         phi = _load_phi(args.phi)
         if args.lower is None or args.upper is None:
@@ -379,6 +399,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
         grid = Grid(args.lower, args.upper, phi.shape)
         surface = LevelSet(phi, redistance=args.redistance)  # type: ignore[assignment]
         name = args.phi.stem
+    if args.smooth and not args.mask:
+        raise UsageError("--smooth applies to --mask only")
     if args.redistance and not args.phi:
         raise UsageError("--redistance applies to --phi only (library surfaces and meshes are distances already)")
     if args.padding is not None and not args.mesh:

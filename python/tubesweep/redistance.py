@@ -15,9 +15,11 @@ closest-point direction of Sect. 5.2). Gradients are central differences of φ w
 
 For a sampled φ (an array) the same iterations, with the same arithmetic and bits, run in Rust on
 all threads (``tubesweep_core::surface::redistance``), with the points kept in the grid's box, where φ is
-known (``box`` of :func:`project_to_level_set`), and the band's candidates come from two passes over
-the samples with a bound on |∇φ| near each node (``tubesweep_core::band::sampled``); this module's NumPy
-code runs them for a callable φ, which only Python can evaluate.
+known (``box`` of :func:`project_to_level_set`): they project given points (sources, paths). The band of
+a sampled φ does not start from its nodes but from the zero level set located cell by cell
+(:func:`_sampled_redistanced_band`, ``tubesweep_core::surface::redistance_band``), so it works from any
+φ with a sign change (masks, plateaus); this module's NumPy code runs the projection for a callable
+φ, which only Python can evaluate.
 """
 
 from __future__ import annotations
@@ -236,31 +238,24 @@ def _on_zero_set_within(surface, grid, x: np.ndarray, y: np.ndarray, reach: floa
 
 
 def redistanced_band(surface, grid, half_width: float):
-    """The band of ``LevelSet(phi, redistance=True)``: candidates ``|φ| ≤ L·half_width`` (L a bound
-    on |∇φ|, so every node within ``half_width`` of the surface is a candidate); then the exact
-    signed distance by :func:`project_to_level_set`; keep ``|d| ≤ half_width``.
+    """The band of ``LevelSet(phi, redistance=True)``.
 
-    For an array without a given ``lipschitz``, L is a bound on the gradient of φ's interpolant
-    near each node (per block of nodes, ``tubesweep_core::band::sampled::redistance_candidates_of_samples``):
-    a bound over the whole box would take φ's steepest part anywhere and make several times the
-    candidates. Otherwise L is the given bound or :func:`estimate_lipschitz`, and a callable's
-    candidates are found coarse-to-fine; without a given bound they are then narrowed by the
-    gradient at the candidates themselves (:func:`_narrowed_by_candidate_gradients`)."""
+    An array: :func:`_sampled_redistanced_band` (sub-cell interface points, from any φ with a sign
+    change). A callable: candidates ``|φ| ≤ L·half_width`` (L a bound on |∇φ|, so every node within
+    ``half_width`` of the surface is a candidate); then the exact signed distance by
+    :func:`project_to_level_set`; keep ``|d| ≤ half_width``. L is the given bound or
+    :func:`estimate_lipschitz`, and the candidates are found coarse-to-fine; without a given bound
+    they are then narrowed by the gradient at the candidates themselves
+    (:func:`_narrowed_by_candidate_gradients`)."""
     from .band import BandGeometry, discover_band
 
     d = grid.ndim
     if surface.is_dense:
-        from . import _native
-
-        if surface.lipschitz is None:
-            cand = _native.redistance_candidates_of_samples(surface._array, grid.spacing, half_width)[0].view(np.int64)
-        else:
-            cand = _native.band_of_samples(surface._array, surface.lipschitz * half_width)[0].view(np.int64)
-    else:
-        L = surface.lipschitz if surface.lipschitz is not None else estimate_lipschitz(surface, grid)
-        cand, values = discover_band(surface._fn, grid, L * half_width, L)
-        if surface.lipschitz is None:
-            cand = _narrowed_by_candidate_gradients(surface, grid, half_width, L, cand, values)
+        return _sampled_redistanced_band(surface, grid, half_width)
+    L = surface.lipschitz if surface.lipschitz is not None else estimate_lipschitz(surface, grid)
+    cand, values = discover_band(surface._fn, grid, L * half_width, L)
+    if surface.lipschitz is None:
+        cand = _narrowed_by_candidate_gradients(surface, grid, half_width, L, cand, values)
     if cand.size == 0:
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
     x = grid.node_points(cand)
@@ -280,6 +275,58 @@ def redistanced_band(surface, grid, half_width: float):
     direction = np.zeros((len(lin), d))
     direction[good] = diff[good] / norm[good, None]
     return BandGeometry(lin, norm, signed, direction.astype(np.float32), consumable=True)
+
+
+#: The most refinement iterations per node of a sampled φ's re-distanced band
+#: (``tubesweep_core::surface::redistance_band``): a node starts from a point of the zero level set
+#: next to its closest point (its neighbour's), so smooth φ settles in a few.
+REFINE_STEPS = 40
+
+#: A node's closest point has settled when a refinement moves it by at most this many grid spacings
+#: (its distance then within about ``(1e-6 Δx)² / d`` of the fixed point's; the projection's
+#: :data:`SETTLED` of 1e-12 took twice the time on a smoothed mask for no change in 3 digits).
+REFINE_SETTLED = 1e-6
+
+
+def _sampled_redistanced_band(surface, grid, half_width: float):
+    """The re-distanced band of a sampled φ, from any φ whose zero level set crosses the grid:
+    sub-cell interface points on the edges of the cells with a sign change, closest points carried
+    from them layer by layer through the band and refined on the multilinear interpolant, in Rust
+    (``tubesweep_core::surface::redistance_band``). Where φ is smooth the closest points are those of
+    :func:`project_to_level_set` from the node (the same iterations and fixed point, to the settling
+    tolerance); unlike it, no step reads ∇φ away from the zero level set, so masks, plateaus and φ
+    far from a distance work too."""
+    from . import _native
+    from .band import BandGeometry
+
+    linear, signed, direction, crossed, _, medial = _native.redistanced_band_of_samples(
+        surface._array,
+        [float(c) for c in grid.lower],
+        grid.spacing,
+        float(half_width),
+        SAMPLED_GRADIENT_STEP * grid.spacing,
+        REFINE_STEPS,
+        REFINE_SETTLED,
+    )
+    if crossed == 0:
+        raise ValueError(
+            "phi has no sign change on the grid (every sample is "
+            + ("> 0" if np.min(surface._array) > 0 else "≤ 0")
+            + "), so its zero level set does not cross the grid and there is no surface to re-distance: pass a φ that "
+            "is negative inside the surface and positive outside, on a grid that holds the surface"
+        )
+    if medial:
+        import warnings
+
+        warnings.warn(
+            f"{medial} nodes within {0.5 * half_width:.3g} of the zero level set lie near points "
+            "equidistant from two parts of it (their neighbours' closest points are more than 5 grid spacings apart): "
+            "the tube is about as wide as the surface's radius of curvature there, or two sheets of the surface face "
+            "each other within the tube; the travel times there may be wrong. Refine the grid",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+    return BandGeometry(linear.view(np.int64), None, signed, direction, consumable=True)
 
 
 def redistanced_project(surface, points: np.ndarray, grid):

@@ -176,12 +176,15 @@ class LevelSet(Surface):
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
         default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
         is estimated from |∇φ| on a coarse lattice of the grid box for a callable and then from
-        |∇φ| at the band's candidates, and for an array bounded near each node from the
-        differences of the samples (a bound given here applies to the whole box instead).
+        |∇φ| at the band's candidates; an array needs none (it is not used: the band is found
+        from the cells the zero level set crosses).
     redistance : bool
         For φ that is *not* a distance function (e.g. ``x² + y² − r²``): in the band only, replace
-        φ by the signed distance to its zero level set — first ``φ/|∇φ|`` (a Newton step onto the
-        surface), then closest-point projection iterations (:mod:`tubesweep.redistance`). The tube
+        φ by the signed distance to its zero level set (:mod:`tubesweep.redistance`). An array may
+        be any φ whose sign changes across the surface (far from a distance, with plateaus, float32,
+        a 0/1 mask: see :meth:`from_mask`): the zero level set of its multilinear interpolant is
+        located cell by cell and the closest points on it refined from there. A callable is
+        projected from each node (Newton steps along ∇φ, then closest-point iterations). The tube
         widths are then true distances and the extension direction is ``(x − cp(x))/|x − cp(x)|``.
         Costs a few dozen φ evaluations per band node.
 
@@ -254,6 +257,48 @@ class LevelSet(Surface):
             if not (np.isfinite(lipschitz) and lipschitz >= 1.0):
                 raise ValueError(f"lipschitz must be >= 1 (a distance function has |∇φ| = 1); got {lipschitz}")
             self.lipschitz = float(lipschitz)
+
+    @classmethod
+    def from_mask(cls, mask: Any, grid: Grid, *, smooth: float = 0.0) -> "LevelSet":
+        """The surface of a voxel mask (a segmentation) on the grid's nodes.
+
+        Parameters
+        ----------
+        mask : ndarray of ``grid.shape``, boolean or of 0 and 1
+            True (1) inside the object, False (0) outside. The object must not touch the grid's
+            boundary (pad the mask with outside voxels).
+        grid : Grid
+            The grid whose nodes are the mask's voxels.
+        smooth : float
+            The width σ, in voxels, of a Gaussian smoothing of the mask before its surface is taken
+            (0, the default: none). It removes the voxel steps and moves curved parts inward by
+            about σ²κ/2 (σ in length units, κ the sum of the principal curvatures). Needs scipy.
+
+        Returns
+        -------
+        LevelSet
+            The zero level set of ``0.5 − mask`` (smoothed), interpolated multilinearly between the
+            nodes (half-way between inside and outside nodes), re-distanced in the band
+            (``redistance=True``).
+
+        Raises
+        ------
+        ValueError
+            If the mask's shape is not the grid's, it holds values other than 0 and 1, it is all
+            inside or all outside, the object touches the grid's boundary, or ``smooth`` is negative
+            or erases the object.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+        >>> X, Y, Z = grid.meshgrid()
+        >>> ball = ts.LevelSet.from_mask(X**2 + Y**2 + Z**2 < 0.25, grid)
+        >>> sol = ts.solve(ball, grid, [(-0.5, 0, 0)])
+        """
+        from .mask import level_set_function_of_mask
+
+        return LevelSet(level_set_function_of_mask(mask, grid, smooth), redistance=True)
 
     @property
     def is_dense(self) -> bool:

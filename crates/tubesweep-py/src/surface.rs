@@ -437,10 +437,79 @@ pub(crate) fn project_to_sampled_level_set<'py>(
     ))
 }
 
+/// The re-distanced band of a φ sampled on the whole grid, from any φ whose zero level set
+/// crosses the grid (a mask, plateaus, φ far from a distance): sub-cell interface points on the
+/// crossed cells' edges, closest points carried layer by layer and refined on the multilinear
+/// interpolant (`tubesweep_core::surface::redistance_band`). Returns (linear indices (M,) uint64,
+/// signed distances (M,), directions (M, d) float32, crossed cells, unsettled nodes, medial nodes).
+#[pyfunction]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub(crate) fn redistanced_band_of_samples<'py>(
+    py: Python<'py>,
+    phi: PyReadonlyArrayDyn<'py, f64>,
+    lower: Vec<f64>,
+    spacing: f64,
+    half_width: f64,
+    eps: f64,
+    max_steps: usize,
+    tol: f64,
+) -> PyResult<(
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<f32>>,
+    usize,
+    usize,
+    usize,
+)> {
+    use tubesweep_core::surface::redistance::SampledField;
+    use tubesweep_core::surface::redistance_band::{
+        redistanced_band_of_samples as band_of, RedistanceOptions, RedistancedBand,
+    };
+    let shape = phi.shape().to_vec();
+    let d = shape.len();
+    let s = c_slice(&phi, "phi")?;
+    let options = RedistanceOptions {
+        half_width,
+        eps,
+        max_steps,
+        tol,
+    };
+    fn run<const D: usize>(
+        s: &[f64],
+        shape: &[usize],
+        lower: &[f64],
+        spacing: f64,
+        options: RedistanceOptions,
+    ) -> PyResult<RedistancedBand> {
+        let field = SampledField::<D>::new(s, shape_array::<D>(shape)?, coords_array::<D>(lower, "lower")?, spacing)
+            .map_err(to_pyerr)?;
+        band_of(&field, options).map_err(to_pyerr)
+    }
+    let out = py.detach(|| match d {
+        2 => run::<2>(s, &shape, &lower, spacing, options),
+        3 => run::<3>(s, &shape, &lower, spacing, options),
+        _ => Err(PyValueError::new_err(format!(
+            "only 2D and 3D grids are supported, got {d}D"
+        ))),
+    })?;
+    let m = out.linear.len();
+    let direction = numpy::ndarray::Array2::from_shape_vec((m, d), out.direction)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok((
+        out.linear.into_pyarray(py),
+        out.signed.into_pyarray(py),
+        direction.into_pyarray(py),
+        out.crossed_cells,
+        out.unsettled,
+        out.medial,
+    ))
+}
+
 /// Adds this file's classes and functions to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTriangleTree>()?;
     m.add_function(wrap_pyfunction!(project_to_sampled_level_set, m)?)?;
+    m.add_function(wrap_pyfunction!(redistanced_band_of_samples, m)?)?;
     m.add_function(wrap_pyfunction!(sphere_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(torus_signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(ellipsoid_signed_distance, m)?)?;

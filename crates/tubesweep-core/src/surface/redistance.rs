@@ -106,9 +106,95 @@ impl<'a, const D: usize> SampledField<'a, D> {
         out
     }
 
+    /// φ at `p` and its exact gradient there: the multilinear interpolant of the cell that holds
+    /// `p` and its derivatives (as [`value`](Self::value), the cell and the fractions clamped to
+    /// the grid; along an axis where `p` lies beyond the grid's face the derivative is zero, φ
+    /// being constant there). At a cell face it is the derivative of the cell `value` reads.
+    #[inline]
+    pub(crate) fn value_and_gradient(&self, p: &[f64; D]) -> (f64, [f64; D]) {
+        let mut base = [0usize; D];
+        let mut frac = [0.0f64; D];
+        let mut inside = [true; D];
+        for k in 0..D {
+            let t = (p[k] - self.lower[k]) / self.spacing;
+            let b = t.floor().clamp(0.0, (self.shape[k] - 2) as f64);
+            base[k] = b as usize;
+            let f = t - b;
+            inside[k] = (0.0..=1.0).contains(&f);
+            frac[k] = f.clamp(0.0, 1.0);
+        }
+        let origin: usize = (0..D).map(|k| base[k] * self.stride[k]).sum();
+        let mut value = 0.0;
+        let mut grad = [0.0; D];
+        for corner in 0..1usize << D {
+            let mut at = origin;
+            let mut factors = [0.0; D];
+            for k in 0..D {
+                factors[k] = if corner >> k & 1 == 1 {
+                    at += self.stride[k];
+                    frac[k]
+                } else {
+                    1.0 - frac[k]
+                };
+            }
+            let v = self.samples[at];
+            value += factors.iter().product::<f64>() * v;
+            for a in 0..D {
+                if !inside[a] {
+                    continue;
+                }
+                let mut w = if corner >> a & 1 == 1 { v } else { -v };
+                for (k, f) in factors.iter().enumerate() {
+                    if k != a {
+                        w *= f;
+                    }
+                }
+                grad[a] += w;
+            }
+        }
+        for g in grad.iter_mut() {
+            *g /= self.spacing;
+        }
+        (value, grad)
+    }
+
+    /// φ at the node of D-index `node`.
+    #[inline]
+    pub(crate) fn sample(&self, node: [usize; D]) -> f64 {
+        let mut at = 0;
+        for k in 0..D {
+            at += node[k] * self.stride[k];
+        }
+        self.samples[at]
+    }
+
+    /// The coordinate along `axis` of the nodes of index `index` on it.
+    #[inline]
+    pub(crate) fn coordinate(&self, axis: usize, index: usize) -> f64 {
+        self.lower[axis] + index as f64 * self.spacing
+    }
+
+    /// The grid spacing.
+    #[inline]
+    pub(crate) fn spacing(&self) -> f64 {
+        self.spacing
+    }
+
+    /// The samples, in C order.
+    #[inline]
+    pub(crate) fn samples(&self) -> &'a [f64] {
+        self.samples
+    }
+
+    /// The grid's shape.
+    #[inline]
+    pub(crate) fn shape(&self) -> [usize; D] {
+        self.shape
+    }
+
     /// Central differences of [`value`](Self::value) with step `eps` along each axis.
     #[inline]
-    fn gradient(&self, y: &[f64; D], eps: f64) -> [f64; D] {
+    pub(crate) fn gradient(&self, y: &[f64; D], eps: f64) -> [f64; D] {
         let mut g = [0.0; D];
         for k in 0..D {
             let (mut up, mut down) = (*y, *y);
@@ -123,7 +209,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
     /// face the interpolant is φ on the face, constant along the normal, whose gradient along
     /// that axis vanishes).
     #[inline]
-    fn clamp_to_box(&self, y: &mut [f64; D]) {
+    pub(crate) fn clamp_to_box(&self, y: &mut [f64; D]) {
         for k in 0..D {
             let upper = self.lower[k] + (self.shape[k] - 1) as f64 * self.spacing;
             y[k] = y[k].clamp(self.lower[k], upper);
@@ -141,7 +227,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
     /// gradient. The node was then dropped from the band, and the band nodes beyond it stayed
     /// unreached.
     #[inline]
-    fn newton(&self, y: &mut [f64; D], steps: usize, eps: f64) -> bool {
+    pub(crate) fn newton(&self, y: &mut [f64; D], steps: usize, eps: f64) -> bool {
         let mut good = true;
         self.clamp_to_box(y);
         for _ in 0..steps {
@@ -159,7 +245,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
 }
 
 #[inline]
-fn sum_of_squares<const D: usize>(v: &[f64; D]) -> f64 {
+pub(crate) fn sum_of_squares<const D: usize>(v: &[f64; D]) -> f64 {
     let mut s = v[0] * v[0];
     for x in &v[1..] {
         s += x * x;

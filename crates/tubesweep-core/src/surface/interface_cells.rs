@@ -1,0 +1,397 @@
+//! Where the zero level set of a sampled φ lies, cell by cell: the cells it crosses (a sign change
+//! among their corners), the points where it crosses their edges, and the nodes within a given
+//! number of cells of them, for the re-distancing of `LevelSet(phi_array, redistance=True)`
+//! ([`crate::surface::redistance_band`]).
+//!
+//! The interface is that of φ's multilinear interpolant (the [`SampledField`] the projection
+//! uses): on a cell edge the interpolant is linear, so where the edge's end values differ in sign
+//! (`φ > 0` against `φ ≤ 0`) it vanishes at the linear interpolation point, a point of the zero
+//! level set known exactly whatever φ is (a 0/1 mask, a plateau, a φ far from a distance), with no
+//! use of ∇φ. Every cell the interpolant's zero set passes through has such an edge.
+//!
+//! Only the crossed cells and the nodes near them are stored (the scan reads the samples once):
+//! the nodes are kept as intervals along the grid's last axis, row by row, so that memory scales
+//! with the band, plus one short list per row of the box's leading axes.
+
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+
+use super::redistance::SampledField;
+
+/// A 2D or 3D grid seen as 3D: a 2D grid `(n0, n1)` is the single slab `(1, n0, n1)`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Lattice {
+    /// Nodes per axis (the first is 1 for a 2D grid).
+    pub dims: [usize; 3],
+    /// A 2D grid: its cells span no first axis.
+    pub flat: bool,
+}
+
+impl Lattice {
+    pub fn new(shape: &[usize]) -> Result<Self> {
+        if !(shape.len() == 2 || shape.len() == 3) || shape.iter().any(|&n| n < 2) {
+            return Err(Error::invalid(
+                "phi",
+                format!("must be a 2D or 3D array with at least 2 nodes per axis, got shape {shape:?}"),
+            ));
+        }
+        let flat = shape.len() == 2;
+        let dims = if flat {
+            [1, shape[0], shape[1]]
+        } else {
+            [shape[0], shape[1], shape[2]]
+        };
+        Ok(Lattice { dims, flat })
+    }
+
+    /// The rows along the last axis: `dims[0] · dims[1]`.
+    pub fn rows(&self) -> usize {
+        self.dims[0] * self.dims[1]
+    }
+
+    /// `(i, j, k)` of a node's linear index.
+    #[inline]
+    pub fn split(&self, l: usize) -> (usize, usize, usize) {
+        let row = l / self.dims[2];
+        (row / self.dims[1], row % self.dims[1], l % self.dims[2])
+    }
+
+    /// The cells along the first axis whose lowest corner can be `i`: none beyond the first for
+    /// a 2D grid.
+    fn cell_slabs(&self) -> usize {
+        if self.flat {
+            1
+        } else {
+            self.dims[0] - 1
+        }
+    }
+
+    /// The linear offsets of a cell's corners from its lowest one, corner `c` having bit `a` set
+    /// for a step along axis `a` of the grid (`a = 0` the first), and their number (4 or 8).
+    pub fn corner_offsets(&self) -> ([usize; 8], usize) {
+        let strides = [self.dims[1] * self.dims[2], self.dims[2], 1];
+        let axes: &[usize] = if self.flat { &[1, 2] } else { &[0, 1, 2] };
+        let count = 1 << axes.len();
+        let mut out = [0usize; 8];
+        for (c, o) in out.iter_mut().enumerate().take(count) {
+            *o = axes
+                .iter()
+                .enumerate()
+                .filter(|(bit, _)| c >> bit & 1 == 1)
+                .map(|(_, &a)| strides[a])
+                .sum();
+        }
+        (out, count)
+    }
+}
+
+/// Whether the corner values of a cell differ in sign (`φ > 0` against `φ ≤ 0`).
+#[inline]
+pub(crate) fn crosses(corners: &[f64]) -> bool {
+    let positive = corners[0] > 0.0;
+    corners[1..].iter().any(|&v| (v > 0.0) != positive)
+}
+
+/// The sorted linear indices of the lowest corners of the cells the zero level set crosses (a
+/// sign change among the corners: [`crosses`]). One pass over the samples, on all threads.
+pub fn crossed_cells(shape: &[usize], samples: &[f64]) -> Result<Vec<u64>> {
+    let lattice = Lattice::new(shape)?;
+    if samples.len() != lattice.rows() * lattice.dims[2] {
+        return Err(Error::invalid(
+            "phi",
+            format!(
+                "expected {} samples for the shape {shape:?}, got {}",
+                lattice.rows() * lattice.dims[2],
+                samples.len()
+            ),
+        ));
+    }
+    let (offsets, count) = lattice.corner_offsets();
+    let [_, n1, n2] = lattice.dims;
+    let cell_rows = lattice.cell_slabs() * (n1 - 1);
+    let parts: Vec<Vec<u64>> = (0..cell_rows)
+        .into_par_iter()
+        .with_min_len(16)
+        .map(|r| {
+            let (i, j) = (r / (n1 - 1), r % (n1 - 1));
+            let row = (i * n1 + j) * n2;
+            let mut out = Vec::new();
+            let mut corners = [0.0f64; 8];
+            for k in 0..n2 - 1 {
+                let l = row + k;
+                for c in 0..count {
+                    corners[c] = samples[l + offsets[c]];
+                }
+                if crosses(&corners[..count]) {
+                    out.push(l as u64);
+                }
+            }
+            out
+        })
+        .collect();
+    Ok(parts.concat())
+}
+
+/// The points where the zero level set of `field`'s interpolant crosses the edges of the cell
+/// whose lowest corner is the node `lowest` (a D-index), passed to `visit`.
+#[inline]
+pub(crate) fn edge_crossings<const D: usize>(
+    field: &SampledField<'_, D>,
+    lowest: [usize; D],
+    mut visit: impl FnMut([f64; D]),
+) {
+    let mut values = [0.0f64; 8];
+    for (c, v) in values.iter_mut().enumerate().take(1 << D) {
+        let mut node = lowest;
+        for (a, n) in node.iter_mut().enumerate() {
+            *n += c >> (D - 1 - a) & 1;
+        }
+        *v = field.sample(node);
+    }
+    if !crosses(&values[..1 << D]) {
+        return;
+    }
+    for c in 0..1usize << D {
+        for a in 0..D {
+            let bit = 1 << (D - 1 - a);
+            if c & bit != 0 {
+                continue;
+            }
+            let (va, vb) = (values[c], values[c | bit]);
+            if (va > 0.0) == (vb > 0.0) {
+                continue;
+            }
+            let t = va / (va - vb);
+            let mut p = [0.0; D];
+            for (b, x) in p.iter_mut().enumerate() {
+                let index = lowest[b] + (c >> (D - 1 - b) & 1);
+                *x = field.coordinate(b, index);
+            }
+            p[a] += t * field.spacing();
+            visit(p);
+        }
+    }
+}
+
+/// The nodes within a number of cells of a set of cells, as intervals along the last axis.
+#[derive(Debug, Clone)]
+pub(crate) struct NodeSet {
+    pub lattice: Lattice,
+    /// Per row `(i, j)`, the nodes' inclusive intervals `[a, b]` of `k`, sorted and disjoint.
+    rows: Vec<Vec<(u32, u32)>>,
+    /// Per row, the position of its first node among all the set's nodes (C order); one more
+    /// entry at the end, the number of nodes.
+    row_start: Vec<usize>,
+}
+
+/// Sorted, merged inclusive intervals (adjacent ones joined).
+fn merged(mut v: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+    v.sort_unstable();
+    let mut out: Vec<(u32, u32)> = Vec::with_capacity(v.len());
+    for (a, b) in v {
+        match out.last_mut() {
+            Some(last) if a <= last.1.saturating_add(1) => last.1 = last.1.max(b),
+            _ => out.push((a, b)),
+        }
+    }
+    out
+}
+
+impl NodeSet {
+    /// The corners of the `cells` (sorted lowest-corner linear indices) and every node within
+    /// `reach` nodes of one along each axis (the cells dilated by a cube): the nodes whose
+    /// distance to the interface in these cells can be at most `reach · Δx`.
+    pub fn around_cells(lattice: Lattice, cells: &[u64], reach: usize) -> NodeSet {
+        let [n0, n1, n2] = lattice.dims;
+        let r = reach;
+        // along the last axis: the cell's two nodes and `reach` on each side
+        let mut rows0: Vec<Vec<(u32, u32)>> = vec![Vec::new(); lattice.rows()];
+        for &l in cells {
+            let (i, j, k) = lattice.split(l as usize);
+            let (a, b) = (k.saturating_sub(r), (k + 1 + r).min(n2 - 1));
+            let row = &mut rows0[i * n1 + j];
+            match row.last_mut() {
+                Some(last) if a as u32 <= last.1 + 1 => last.1 = last.1.max(b as u32),
+                _ => row.push((a as u32, b as u32)),
+            }
+        }
+        // along an axis of the rows: node `m` gets the rows of the cells `m − 1 − reach ..= m + reach`
+        let spread = |src: &Vec<Vec<(u32, u32)>>, axis: usize| -> Vec<Vec<(u32, u32)>> {
+            (0..lattice.rows())
+                .into_par_iter()
+                .with_min_len(64)
+                .map(|row| {
+                    let (i, j) = (row / n1, row % n1);
+                    let m = if axis == 0 { i } else { j };
+                    let n = if axis == 0 { n0 } else { n1 };
+                    let mut v = Vec::new();
+                    for c in m.saturating_sub(1 + r)..=(m + r).min(n - 1) {
+                        let from = if axis == 0 { c * n1 + j } else { i * n1 + c };
+                        v.extend_from_slice(&src[from]);
+                    }
+                    if v.is_empty() {
+                        v
+                    } else {
+                        merged(v)
+                    }
+                })
+                .collect()
+        };
+        let mut rows = spread(&rows0, 1);
+        drop(rows0);
+        if !lattice.flat {
+            rows = spread(&rows, 0);
+        }
+        let mut row_start = Vec::with_capacity(rows.len() + 1);
+        let mut total = 0usize;
+        for row in &rows {
+            row_start.push(total);
+            total += row.iter().map(|&(a, b)| (b - a) as usize + 1).sum::<usize>();
+        }
+        row_start.push(total);
+        NodeSet {
+            lattice,
+            rows,
+            row_start,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        *self.row_start.last().expect("one entry per row and one more")
+    }
+
+    /// The nodes' linear indices, sorted.
+    pub fn linear(&self) -> Vec<u64> {
+        let n2 = self.lattice.dims[2];
+        let mut out = Vec::with_capacity(self.len());
+        for (row, intervals) in self.rows.iter().enumerate() {
+            for &(a, b) in intervals {
+                out.extend((a as usize..=b as usize).map(|k| (row * n2 + k) as u64));
+            }
+        }
+        out
+    }
+
+    /// The position among the set's nodes of node `(i, j, k)`, if it is one.
+    #[inline]
+    pub fn position(&self, i: usize, j: usize, k: usize) -> Option<usize> {
+        let row = i * self.lattice.dims[1] + j;
+        let mut at = self.row_start[row];
+        let k = k as u32;
+        for &(a, b) in &self.rows[row] {
+            if k < a {
+                return None;
+            }
+            if k <= b {
+                return Some(at + (k - a) as usize);
+            }
+            at += (b - a) as usize + 1;
+        }
+        None
+    }
+
+    /// [`face_neighbours`](Self::face_neighbours) when `wanted`, else nothing.
+    #[inline]
+    pub fn face_neighbours_if(&self, wanted: bool, node: (usize, usize, usize), visit: impl FnMut(usize)) {
+        if wanted {
+            self.face_neighbours(node, visit);
+        }
+    }
+
+    /// The positions of the face neighbours of node `(i, j, k)` in the set, passed to `visit`.
+    #[inline]
+    pub fn face_neighbours(&self, (i, j, k): (usize, usize, usize), mut visit: impl FnMut(usize)) {
+        let [n0, n1, n2] = self.lattice.dims;
+        let mut try_node = |i: usize, j: usize, k: usize| {
+            if let Some(p) = self.position(i, j, k) {
+                visit(p);
+            }
+        };
+        if i > 0 {
+            try_node(i - 1, j, k);
+        }
+        if i + 1 < n0 {
+            try_node(i + 1, j, k);
+        }
+        if j > 0 {
+            try_node(i, j - 1, k);
+        }
+        if j + 1 < n1 {
+            try_node(i, j + 1, k);
+        }
+        if k > 0 {
+            try_node(i, j, k - 1);
+        }
+        if k + 1 < n2 {
+            try_node(i, j, k + 1);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crossed_cells_and_the_nodes_around_them_are_those_a_brute_force_finds() {
+        // a sphere's |x|² − r² on an uneven 3D grid and a circle's on a 2D one
+        for shape in [vec![13usize, 11, 9], vec![17, 14]] {
+            let d = shape.len();
+            let total: usize = shape.iter().product();
+            let idx = |mut l: usize| {
+                let mut m = vec![0usize; d];
+                for a in (0..d).rev() {
+                    m[a] = l % shape[a];
+                    l /= shape[a];
+                }
+                m
+            };
+            let samples: Vec<f64> = (0..total)
+                .map(|l| {
+                    idx(l)
+                        .iter()
+                        .zip(&shape)
+                        .map(|(&m, &n)| (m as f64 - 0.45 * n as f64).powi(2))
+                        .sum::<f64>()
+                        - 9.0
+                })
+                .collect();
+            let cells = crossed_cells(&shape, &samples).unwrap();
+            let lattice = Lattice::new(&shape).unwrap();
+            let (offsets, count) = lattice.corner_offsets();
+            let brute: Vec<u64> = (0..total)
+                .filter(|&l| {
+                    let m = idx(l);
+                    m.iter().zip(&shape).all(|(&m, &n)| m + 1 < n)
+                        && crosses(&offsets[..count].iter().map(|&o| samples[l + o]).collect::<Vec<_>>())
+                })
+                .map(|l| l as u64)
+                .collect();
+            assert!(!cells.is_empty());
+            assert_eq!(cells, brute);
+            for reach in [0usize, 2] {
+                let set = NodeSet::around_cells(lattice, &cells, reach);
+                let near: Vec<u64> = (0..total)
+                    .filter(|&l| {
+                        let m = idx(l);
+                        cells.iter().any(|&c| {
+                            let cm = idx(c as usize);
+                            m.iter().zip(&cm).all(|(&a, &b)| a + reach >= b && a <= b + 1 + reach)
+                        })
+                    })
+                    .map(|l| l as u64)
+                    .collect();
+                let linear = set.linear();
+                assert_eq!(linear, near, "reach {reach}");
+                for (p, &l) in linear.iter().enumerate() {
+                    let (i, j, k) = lattice.split(l as usize);
+                    assert_eq!(set.position(i, j, k), Some(p));
+                }
+                assert_eq!(set.len(), linear.len());
+            }
+        }
+        assert!(crossed_cells(&[4, 4, 4], &[1.0; 63]).is_err());
+        assert!(crossed_cells(&[4], &[1.0; 4]).is_err());
+        assert!(crossed_cells(&[4, 4], &[1.0; 16]).unwrap().is_empty());
+    }
+}
