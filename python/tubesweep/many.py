@@ -33,7 +33,7 @@ from ._validate import (
 )
 from ._prepare import ROLE_INNER
 from ._sources import SOURCE_RADIUS, _fix_sources
-from .solve import _check_source_init, _resolve_scheme
+from .solve import _check_order, _check_source_init, _resolve_scheme
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube
@@ -145,10 +145,12 @@ def solve_many(
     threads: int = 0,
     paper_sweeps: bool = False,
     return_stats: bool = False,
+    order: Any = "auto",
 ) -> Any:
     """See :meth:`tubesweep.Tube.solve_many` (the local run; a Dask client goes through
     :mod:`tubesweep.distributed`)."""
     t0 = time.perf_counter()
+    order = _check_order(order)
     tube._check_phi_unchanged()
     t = tube._tube
     grid = t.grid
@@ -169,6 +171,38 @@ def solve_many(
     nthreads = check_threads(threads)
     inf = check_infinity(infinity)
     points = None if at is None else as_points(at, grid.ndim, "at")
+    fallback: Optional[str] = None
+    if order != 1:
+        from . import second_order as so
+        from .many_order2 import solve_many_order2
+        from .solve import DEFAULT_TOL
+
+        try:
+            so.check_supported(t.surface, None, scheme, t.method, source_init, bool(paper_sweeps))
+            if tube._order2_refusal is not None:  # this band's geometry, refused before
+                raise so.Order2NotApplicable(tube._order2_refusal)
+            try:
+                out, st = solve_many_order2(
+                    tube,
+                    groups,
+                    points=points,
+                    speed=speed,
+                    tol=None if tol == DEFAULT_TOL else tol,
+                    max_iterations=max_iterations,
+                    progress=cb,
+                    threads=nthreads,
+                )
+            except so.Order2NotApplicable as e:
+                tube._order2_refusal = str(e)  # depends on the band only: not computed again
+                raise
+            if return_stats:
+                st.update(order=2, order_fallback=None, seconds_total=time.perf_counter() - t0)
+                return out, st
+            return out
+        except so.Order2NotApplicable as e:
+            if order == 2:
+                raise
+            fallback = str(e)  # order="auto": the first-order scheme, the reason in the stats
     linear = t.linear
     x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
@@ -218,5 +252,7 @@ def solve_many(
         st = dict(st)
         st["setup_seconds"] = setup  # type: ignore[assignment]
         st["seconds_total"] = time.perf_counter() - t0  # type: ignore[assignment]
+        st["order"] = 1  # type: ignore[assignment]
+        st["order_fallback"] = fallback  # type: ignore[assignment]
         return out, st
     return out
