@@ -129,7 +129,11 @@ def part_orders(quick: bool) -> None:
     for order in (1, "auto"):
         r[order] = rates(tube, pts, pts, 1 if quick else 3, order=order)
         print_rates(
-            f"sphere N = {n}, order={order!r}", tube.band_points, k, r[order], "; target >= 1.6x" if order == "auto" else ""
+            f"sphere N = {n}, order={order!r}",
+            tube.band_points,
+            k,
+            r[order],
+            "; target >= 1.6x" if order == "auto" else "",
         )
     for key, text in (("many1", "1 thread"), ("many2", "2 threads")):
         cost = (r["auto"][key + "_cores"] / r["auto"][key]) / (r[1][key + "_cores"] / r[1][key])
@@ -143,7 +147,8 @@ def part_orders(quick: bool) -> None:
         print(
             f"  distance_matrix order={order!r} (ran order {info['order']}): mean error {e.mean():.2e} "
             f"(target <= 2e-4 at the default), max {e.max():.2e}; symmetric {np.array_equal(d, d.T)}, zero diagonal "
-            f"{bool(np.all(np.diag(d) == 0))}; {k / sec:.1f} sources/s"
+            f"{bool(np.all(np.diag(d) == 0))}; asymmetry removed {info['asymmetry']:.2e}, largest one-way diagonal "
+            f"{info['diagonal']:.2e}; {k / sec:.1f} sources/s"
         )
 
 
@@ -176,17 +181,38 @@ def part_memory(quick: bool) -> None:
     import subprocess
 
     n, k = (41, 1000) if quick else (41, 10000)
-    base = int(subprocess.run([sys.executable, "-c", "import resource, tubesweep; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)"], capture_output=True, text=True, check=True).stdout)
-    print(f"peak RSS, sphere N = {n}, {k} sources (each run in its own process; importing tubesweep alone: {base / 1024:.0f} MB)")
-    for what, label in (("solve", f"ts.solve with {k} sources, read at 100 points"), ("many", f"solve_many of {k} sources at 100 points (2 threads)")):
+    base = int(
+        subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "import resource, tubesweep; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)",
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+    )
+    print(
+        f"peak RSS, sphere N = {n}, {k} sources (each run in its own process; importing tubesweep alone: {base / 1024:.0f} MB)"
+    )
+    for what, label in (
+        ("solve", f"ts.solve with {k} sources, read at 100 points"),
+        ("many", f"solve_many of {k} sources at 100 points (2 threads)"),
+    ):
         peak = {}
         for order in ("1", "auto"):
             t = time.perf_counter()
             out = subprocess.run(
-                [sys.executable, "-c", _MEMORY_CHILD, what, order, str(n), str(k)], capture_output=True, text=True, check=True
+                [sys.executable, "-c", _MEMORY_CHILD, what, order, str(n), str(k)],
+                capture_output=True,
+                text=True,
+                check=True,
             ).stdout.split()
             peak[order] = int(out[0])
-            print(f"  {label}, order={order} (ran {out[1]}): {peak[order] / 1024:.0f} MB ({time.perf_counter() - t:.1f} s)")
+            print(
+                f"  {label}, order={order} (ran {out[1]}): {peak[order] / 1024:.0f} MB ({time.perf_counter() - t:.1f} s)"
+            )
         print(f"  ratio default / order=1: {peak['auto'] / peak['1']:.2f} (target <= 3)")
 
 
@@ -275,7 +301,14 @@ def part_peers(quick: bool) -> None:
             t = time.perf_counter()
             ours = tube.solve_many(v[idx], at=v, threads=threads, order=order)
             rate = k / (time.perf_counter() - t)
-            rows.append((f"tubesweep solve_many order={order} ({threads} thread{'s' if threads > 1 else ''})", rate, ours, tube.setup_seconds))
+            rows.append(
+                (
+                    f"tubesweep solve_many order={order} ({threads} thread{'s' if threads > 1 else ''})",
+                    rate,
+                    ours,
+                    tube.setup_seconds,
+                )
+            )
     try:
         import potpourri3d as pp3d
 

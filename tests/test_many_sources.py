@@ -429,7 +429,9 @@ def test_order_fallback_follows_tube_solve(grid):
     # an option of the first-order scheme: the same rule as tube.solve
     sphere = ts.Tube(ts.surfaces.Sphere(R), grid)
     _, st = sphere.solve_many(sphere_points(2), at=sphere_points(2), hamiltonian="lxf", return_stats=True)
-    assert st["order"] == 1 and st["order_fallback"] == sphere.solve([[R, 0, 0]], hamiltonian="lxf").stats.order_fallback
+    assert (
+        st["order"] == 1 and st["order_fallback"] == sphere.solve([[R, 0, 0]], hamiltonian="lxf").stats.order_fallback
+    )
     with pytest.raises(ValueError, match="Godunov update only"):
         sphere.solve_many(sphere_points(2), hamiltonian="lxf", order=2)
 

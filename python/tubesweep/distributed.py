@@ -75,7 +75,12 @@ def _solve_chunk(spec: _TubeSpec, groups: List[np.ndarray], at: Optional[np.ndar
         warnings.simplefilter("always")
         values, stats = tube.solve_many(groups, at=at, threads=1, return_stats=True, **options)
     order = (stats.get("order", 1), stats.get("order_fallback"))
-    return values, {k: v for k, v in stats.items() if isinstance(v, np.ndarray)}, [str(w.message) for w in caught], order
+    return (
+        values,
+        {k: v for k, v in stats.items() if isinstance(v, np.ndarray)},
+        [str(w.message) for w in caught],
+        order,
+    )
 
 
 def _clear() -> int:

@@ -10,7 +10,6 @@ memory O(band · threads + K · M) instead of K band arrays.
 
 from __future__ import annotations
 
-import re
 import time
 import warnings
 from typing import TYPE_CHECKING, Any, Callable, List, Optional, Tuple
@@ -33,6 +32,7 @@ from ._validate import (
 )
 from ._prepare import ROLE_INNER
 from ._sources import SOURCE_RADIUS, _fix_sources
+from .many_order2 import renamed, solve_many_order2
 from .solve import _check_order, _check_source_init, _resolve_scheme
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -80,13 +80,6 @@ def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
     return at
 
 
-def _renamed(e: ValueError, k: int, group: bool) -> ValueError:
-    """A source error of ``_fix_sources`` (which numbers the points of one solve) renamed to the
-    source's place among the K: ``sources[k]`` or ``sources[k][j]``."""
-    text = re.sub(r"sources\[(\d+)\]", (lambda m: f"sources[{k}][{m.group(1)}]") if group else f"sources[{k}]", str(e))
-    return ValueError(text)
-
-
 def fixed_nodes(
     tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -105,7 +98,7 @@ def fixed_nodes(
                 surf, grid, t.band, t.linear, t.roles, src, slowness_at, source_init, inner_width
             )
         except ValueError as e:
-            raise _renamed(e, k, len(g) > 1) from None
+            raise renamed(e, k, len(g) > 1) from None
         if t.method != "naive" and len(src) == 1 and np.unique(pos).size >= n_inner:
             raise ValueError(
                 f"sources[{k}]: the grid is too coarse for this surface: every node of the inner tube lies within "
@@ -174,7 +167,6 @@ def solve_many(
     fallback: Optional[str] = None
     if order != 1:
         from . import second_order as so
-        from .many_order2 import solve_many_order2
         from .solve import DEFAULT_TOL
 
         try:
@@ -250,9 +242,9 @@ def solve_many(
         )
     if return_stats:
         st = dict(st)
-        st["setup_seconds"] = setup  # type: ignore[assignment]
-        st["seconds_total"] = time.perf_counter() - t0  # type: ignore[assignment]
-        st["order"] = 1  # type: ignore[assignment]
-        st["order_fallback"] = fallback  # type: ignore[assignment]
+        st["setup_seconds"] = setup
+        st["seconds_total"] = time.perf_counter() - t0
+        st["order"] = 1
+        st["order_fallback"] = fallback
         return out, st
     return out

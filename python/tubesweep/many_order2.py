@@ -13,6 +13,7 @@ with ``at``).
 
 from __future__ import annotations
 
+import re
 import warnings
 from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple
 
@@ -29,10 +30,11 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["solve_many_order2"]
 
 
-def _renamed(e: ValueError, k: int, group: bool) -> ValueError:
-    from .many import _renamed as renamed
-
-    return renamed(e, k, group)
+def renamed(e: ValueError, k: int, group: bool) -> ValueError:
+    """A source error of a single solve (which numbers the points of one solve) renamed to the
+    source's place among the K: ``sources[k]`` or ``sources[k][j]``."""
+    text = re.sub(r"sources\[(\d+)\]", (lambda m: f"sources[{k}][{m.group(1)}]") if group else f"sources[{k}]", str(e))
+    return ValueError(text)
 
 
 def solve_many_order2(
@@ -60,7 +62,7 @@ def solve_many_order2(
         try:
             srcs.append(as_sources(g, grid))
         except ValueError as e:
-            raise _renamed(e, k, len(g) > 1) from None
+            raise renamed(e, k, len(g) > 1) from None
         names.extend([f"sources[{k}]"] if len(g) == 1 else [f"sources[{k}][{j}]" for j in range(len(g))])
     every = np.ascontiguousarray(np.concatenate(srcs), dtype=float)
     offsets = np.concatenate([[0], np.cumsum([len(s) for s in srcs])]).astype(np.int64)
@@ -82,7 +84,7 @@ def solve_many_order2(
         values, st = _native.second_order_solve_many(
             t.band,
             np.ascontiguousarray(t.roles),
-            np.ascontiguousarray(t.geom.signed, dtype=np.float64),
+            np.ascontiguousarray(t.geom.signed, dtype=np.float64),  # type: ignore[union-attr]
             inputs.directions,
             [float(c) for c in grid.lower],
             h,
@@ -116,8 +118,14 @@ def solve_many_order2(
     st = dict(st)
     st["tol"] = inputs.tol
     for name, what in (
-        ("converged", "did not converge in max_iterations={m}: their rows are the last iterate. Increase max_iterations or tol"),
-        ("runaway_iteration", "ran away (a travel time fell below zero): their rows are the first-order factored solution (order 1); a finer grid or order=1 avoids it"),
+        (
+            "converged",
+            "did not converge in max_iterations={m}: their rows are the last iterate. Increase max_iterations or tol",
+        ),
+        (
+            "runaway_iteration",
+            "ran away (a travel time fell below zero): their rows are the first-order factored solution (order 1); a finer grid or order=1 avoids it",
+        ),
     ):
         bad = np.flatnonzero(~st["converged"]) if name == "converged" else np.flatnonzero(st[name] >= 0)
         if bad.size:

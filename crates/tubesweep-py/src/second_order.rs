@@ -278,7 +278,11 @@ fn feet_query<'py>(
             "feet (S, d) with S ≥ 1, slowness (S,) and points (M, d) must match",
         ));
     }
-    let (f, s, p) = (c_slice(feet, "feet")?, c_slice(slowness, "slowness")?, c_slice(points, "points")?);
+    let (f, s, p) = (
+        c_slice(feet, "feet")?,
+        c_slice(slowness, "slowness")?,
+        c_slice(points, "points")?,
+    );
     fn go<const D: usize>(f: &[f64], s: &[f64], p: &[f64], reach: Option<f64>) -> PyResult<(Vec<bool>, Vec<f64>)> {
         let feet = node_vectors::<f64, D>(f, f.len() / D, "feet")?;
         let pts = node_vectors::<f64, D>(p, p.len() / D, "points")?;
@@ -335,7 +339,9 @@ pub fn nearest_feet<'py>(
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let d = feet.shape()[1];
     if points.shape()[1] != d || feet.shape()[0] == 0 {
-        return Err(PyValueError::new_err("feet (S, d) with S ≥ 1 and points (M, d) must match"));
+        return Err(PyValueError::new_err(
+            "feet (S, d) with S ≥ 1 and points (M, d) must match",
+        ));
     }
     let (f, p) = (c_slice(&feet, "feet")?, c_slice(&points, "points")?);
     fn go<const D: usize>(f: &[f64], p: &[f64]) -> PyResult<Vec<i64>> {

@@ -114,7 +114,9 @@ mod tests {
         };
         let feet: Vec<[f64; 3]> = (0..300).map(|_| [rnd(), rnd(), rnd()]).collect();
         for uniform in [true, false] {
-            let slowness: Vec<f64> = (0..300).map(|_| if uniform { 1.5 } else { 1.0 + rnd().abs() }).collect();
+            let slowness: Vec<f64> = (0..300)
+                .map(|_| if uniform { 1.5 } else { 1.0 + rnd().abs() })
+                .collect();
             let tree = SourceFeet::new(&feet, &slowness);
             assert!(tree.tree.is_some());
             for _ in 0..500 {

@@ -285,7 +285,11 @@ where
     }
     results
         .into_iter()
-        .map(|r| r.into_inner().unwrap_or(None).ok_or(Error::Interrupted { iterations: 0 }))
+        .map(|r| {
+            r.into_inner()
+                .unwrap_or(None)
+                .ok_or(Error::Interrupted { iterations: 0 })
+        })
         .collect()
 }
 
