@@ -248,3 +248,152 @@ fn evaluate_at<const D: usize>(
         row[m] = wm + near.chord_min(&feet[m]);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::second_order::{check_geometry_of, tube_setup_of};
+
+    fn options() -> SecondOrderOptions {
+        SecondOrderOptions {
+            tol_first: f64::INFINITY,
+            tol: 1e-3 * 0.05 * 0.05,
+            max_iterations: 500,
+            stall_ratio: 0.9,
+            stall_window: 20,
+            own_first_phase: true,
+            window_first: 2.0,
+            window_second: 2.0,
+            extension_limit: 2.0,
+            threads: 2,
+            ramp_length: 1.0,
+        }
+    }
+
+    /// Each row is the single solve of its source (the set-up of `tube_setup_of` with that source,
+    /// its sweeps on two threads), bit for bit, on 1 and 2 threads, for a point source and a group;
+    /// the values at points are the interpolated u, and 0 at a source.
+    #[test]
+    fn rows_equal_single_second_order_solves_bit_for_bit() {
+        let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
+        let (phi, _) = crate::test_bands::sphere_phi_and_offsets(&band, h);
+        let surface = Implicit::LevelSet(&phi);
+        let (geometry, _) = tube_setup_of(&band, &roles, &surface, &dirs, [-1.0; 3], h, &[], &[], 2.0 * h, 1).unwrap();
+        check_geometry_of(&geometry.summary, 4.0 * h, h, false).unwrap();
+        let feet = [[-0.5, 0.0, 0.0], [0.0, 0.3, 0.4], [0.0, 0.0, -0.5]];
+        let slowness = [1.0, 1.0, 1.0];
+        let sources = [
+            BatchSource {
+                feet: &feet[..1],
+                slowness: &slowness[..1],
+            },
+            BatchSource {
+                feet: &feet[1..],
+                slowness: &slowness[1..],
+            },
+        ];
+        let tube = BatchTube {
+            band: &band,
+            roles: &roles,
+            surface: &surface,
+            directions: &dirs,
+            geometry: &geometry,
+            lower: [-1.0; 3],
+            spacing: h,
+            slowness: Slowness::Constant(1.0),
+            fix_radius: 2.0 * h,
+            options: options(),
+            front_window: 2.0,
+        };
+        let n = band.len();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let singles: Vec<Vec<f64>> = sources
+            .iter()
+            .map(|s| {
+                let (g, f) = tube_setup_of(
+                    &band,
+                    &roles,
+                    &surface,
+                    &dirs,
+                    [-1.0; 3],
+                    h,
+                    s.feet,
+                    s.slowness,
+                    2.0 * h,
+                    2,
+                )
+                .unwrap();
+                let f = f.unwrap();
+                let mut values = starting_values(&f);
+                sweep_second_order(
+                    &band,
+                    &g,
+                    &f,
+                    &dirs,
+                    Slowness::Constant(1.0),
+                    h,
+                    &mut values,
+                    &options(),
+                    &mut |_| Control::Continue,
+                )
+                .unwrap();
+                values.truncate(n);
+                values
+            })
+            .collect();
+        for threads in [1, 2] {
+            let mut out = vec![0.0; 2 * n];
+            let st = solve_many_second_order(&tube, &sources, threads, Order2Output::Band(&mut out), &mut |_| {
+                Control::Continue
+            })
+            .unwrap();
+            assert!(st.iter().all(|s| s.converged));
+            for (k, single) in singles.iter().enumerate() {
+                assert_eq!(
+                    bits(&out[k * n..(k + 1) * n]),
+                    bits(single),
+                    "source {k}, {threads} threads"
+                );
+            }
+            // at the sources and far from them: 0 at a source (its cell's nodes are fixed), the
+            // interpolated u beyond the reach
+            let points = [feet[0], feet[2], [0.5, 0.0, 0.0]];
+            let mut at = vec![0.0; 2 * 3];
+            solve_many_second_order(
+                &tube,
+                &sources,
+                threads,
+                Order2Output::AtPoints {
+                    lower: [-1.0; 3],
+                    points: &points,
+                    feet: &points,
+                    reach: 3.0 * h,
+                    values: &mut at,
+                },
+                &mut |_| Control::Continue,
+            )
+            .unwrap();
+            assert_eq!((at[0], at[4]), (0.0, 0.0));
+            let far = interpolate(&band, &singles[0], [-1.0; 3], h, &points[2]);
+            assert_eq!(at[2].to_bits(), far[0].to_bits());
+            assert!((at[2] - 0.5 * std::f64::consts::PI).abs() < 0.01, "{}", at[2]);
+        }
+        // a source with no inner-tube node near it: an error naming it, no rows
+        let off = [[0.0, 0.0, 0.0]];
+        let bad = [
+            sources[0],
+            BatchSource {
+                feet: &off,
+                slowness: &[1.0],
+            },
+        ];
+        let mut out = vec![0.0; 2 * n];
+        let err = solve_many_second_order(&tube, &bad, 2, Order2Output::Band(&mut out), &mut |_| Control::Continue)
+            .err()
+            .unwrap();
+        assert!(err.to_string().contains("source 1"), "{err}");
+        // stopped at once: Interrupted
+        let err = solve_many_second_order(&tube, &sources, 2, Order2Output::Band(&mut out), &mut |_| Control::Stop);
+        assert!(matches!(err, Err(Error::Interrupted { .. })));
+    }
+}
