@@ -150,6 +150,23 @@ def part_orders(quick: bool) -> None:
             f"{bool(np.all(np.diag(d) == 0))}; asymmetry removed {info['asymmetry']:.2e}, largest one-way diagonal "
             f"{info['diagonal']:.2e}; {k / sec:.1f} sources/s"
         )
+        if order == "auto":
+            default = d
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        print("  dask: skipped (pip install tubesweep[distributed])")
+        return
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=40
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        remote = ts.distance_matrix(tube, None, pts, client=client)
+    print(
+        f"  distance_matrix on a Dask LocalCluster (2 processes) equal to the local one bit for bit: {np.array_equal(remote, default)}"
+    )
 
 
 _MEMORY_CHILD = r"""
