@@ -22,6 +22,7 @@ import numpy as np
 
 from ._validate import as_points
 from ._prepare import ROLE_INNER
+from .solve import _check_order
 from .tube import Tube
 
 __all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]
@@ -238,8 +239,6 @@ def farthest_point_sampling(
     """
     if not (isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1):
         raise ValueError(f"k must be a positive whole number of points; got {k!r}")
-    from .solve import _check_order
-
     order = _check_order(order)
     tube = _as_tube(surface, grid, inner, outer)
     t = tube._tube

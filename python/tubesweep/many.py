@@ -33,7 +33,8 @@ from ._validate import (
 from ._prepare import ROLE_INNER
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .many_order2 import renamed, solve_many_order2
-from .solve import _check_order, _check_source_init, _resolve_scheme
+from . import second_order as so
+from .solve import DEFAULT_TOL, _check_order, _check_source_init, _resolve_scheme
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube
@@ -166,9 +167,6 @@ def solve_many(
     points = None if at is None else as_points(at, grid.ndim, "at")
     fallback: Optional[str] = None
     if order != 1:
-        from . import second_order as so
-        from .solve import DEFAULT_TOL
-
         try:
             so.check_supported(t.surface, None, scheme, t.method, source_init, bool(paper_sweeps))
             if tube._order2_refusal is not None:  # this band's geometry, refused before
