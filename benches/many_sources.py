@@ -4,7 +4,7 @@ Usage::
 
     .venv/bin/python benches/many_sources.py                # every part
     .venv/bin/python benches/many_sources.py --quick        # small sizes (a smoke run)
-    .venv/bin/python benches/many_sources.py --parts sphere,dask,peers,bunny,matrix
+    .venv/bin/python benches/many_sources.py --parts sphere,orders,memory,dask,peers,bunny,matrix
 
 Parts (all side by side in one run: read the ratios, the machine is shared):
 
@@ -12,6 +12,14 @@ Parts (all side by side in one run: read the ratios, the machine is shared):
   ``tube.solve(threads=1)`` against ``tube.solve_many(threads=1)`` and ``threads=2``, in
   alternating rounds; sources/s and the speed-up of ``solve_many`` on 2 threads over the loop
   (target ≥ 1.8×, ≥ 60 sources/s).
+* ``orders`` (issue 46): the sphere at N = 101 with 40 random surface points at the default order
+  (second order there) and at ``order=1``: the loop of ``tube.solve(threads=1)`` against
+  ``solve_many`` (rows equal bit for bit; target ≥ 1.6× on 2 cores), the CPU per source of the
+  default against ``order=1`` (target ≤ 2.5×), ``distance_matrix``'s mean error against the
+  great-circle distance (target ≤ 2e-4), its symmetry and zero diagonal.
+* ``memory`` (issue 46): peak RSS (``resource.getrusage``, each run in its own process) of
+  ``ts.solve`` with 10,000 sources and of a 10,000-source ``solve_many`` at N = 41, the default
+  order against ``order=1`` (target ≤ 3×).
 * ``bunny``: the same on the Stanford bunny at N = 161 (K = 20).
 * ``dask``: a Dask LocalCluster of 2 single-threaded worker processes against ``solve_many``
   (2 threads) on the same 200 sources with ``at=`` 200 points (target: within 1.3×); the
@@ -48,11 +56,12 @@ def sphere_tube(n: int) -> ts.Tube:
     return ts.Tube(ts.surfaces.Sphere(R), ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n)))
 
 
-def rates(tube: ts.Tube, sources: np.ndarray, at: np.ndarray, rounds: int) -> dict:
+def rates(tube: ts.Tube, sources: np.ndarray, at: np.ndarray, rounds: int, order: "int | str" = 1) -> dict:
     """Sources per second of: the loop of tube.solve(threads=1), solve_many on 1 and on 2 threads,
     in alternating rounds, the best round of each (the machine is shared); and the cores the
     process obtained in that round (its CPU time over the wall time: 2 for two busy threads on
-    an otherwise idle machine, less when other jobs hold the cores)."""
+    an otherwise idle machine, less when other jobs hold the cores). ``same``: the rows of
+    solve_many equal the loop's bit for bit."""
     k = len(sources)
     best = {"loop": (np.inf, 0.0), "many1": (np.inf, 0.0), "many2": (np.inf, 0.0)}
 
@@ -60,21 +69,23 @@ def rates(tube: ts.Tube, sources: np.ndarray, at: np.ndarray, rounds: int) -> di
         if wall < best[name][0]:
             best[name] = (wall, cpu / wall)
 
+    same = True
     for _ in range(rounds):
         t, c = time.perf_counter(), time.process_time()
-        for s in sources:
-            tube.solve([s], threads=1, order=1)(at)
+        loop = np.array([tube.solve([s], threads=1, order=order)(at) for s in sources])
         keep("loop", time.perf_counter() - t, time.process_time() - c)
         for name, threads in (("many1", 1), ("many2", 2)):
             t, c = time.perf_counter(), time.process_time()
-            tube.solve_many(sources, at=at, threads=threads)
+            many = tube.solve_many(sources, at=at, threads=threads, order=order)
             keep(name, time.perf_counter() - t, time.process_time() - c)
-    out = {name: k / wall for name, (wall, _) in best.items()}
+            same = same and np.array_equal(many.view(np.uint64), loop.view(np.uint64))
+    out: dict = {name: k / wall for name, (wall, _) in best.items()}
+    out["same"] = same
     out.update({name + "_cores": cores for name, (_, cores) in best.items()})
     return out
 
 
-def print_rates(label: str, band: int, k: int, r: dict) -> None:
+def print_rates(label: str, band: int, k: int, r: dict, target: str = "; target >= 1.8x") -> None:
     print(
         f"{label}: {band:,} band nodes, {k} sources (cores: the CPU time the process got per wall second; "
         "CPU ms/source: the work per source, which stays put when the threads do not slow each other)"
@@ -82,7 +93,7 @@ def print_rates(label: str, band: int, k: int, r: dict) -> None:
     rows = (
         ("loop of tube.solve(threads=1)", "loop", ""),
         ("solve_many(threads=1)", "many1", ""),
-        ("solve_many(threads=2)", "many2", "; target >= 1.8x"),
+        ("solve_many(threads=2)", "many2", target),
     )
     for text, key, target in rows:
         cpu_ms = 1000.0 * r[key + "_cores"] / r[key]
@@ -90,6 +101,7 @@ def print_rates(label: str, band: int, k: int, r: dict) -> None:
         print(
             f"  {text:30s} {r[key]:7.1f} sources/s  cores {r[key + '_cores']:.2f}  CPU {cpu_ms:6.1f} ms/source{ratio}"
         )
+    print(f"  rows of solve_many equal to the loop's bit for bit: {r['same']}")
 
 
 def part_sphere(quick: bool) -> None:
@@ -99,6 +111,126 @@ def part_sphere(quick: bool) -> None:
     r = rates(tube, src, src, 1 if quick else 3)
     print_rates(f"sphere N = {n}", tube.band_points, k, r)
     print(f"  target >= 60 sources/s on 2 cores: {'met' if r['many2'] >= 60 else 'NOT met'} ({r['many2']:.1f})")
+
+
+def random_sphere_points(m: int, seed: int) -> np.ndarray:
+    v = np.random.default_rng(seed).normal(size=(m, 3))
+    return R * v / np.linalg.norm(v, axis=1)[:, None]
+
+
+def part_orders(quick: bool) -> None:
+    """Issue 46's targets on the sphere at N = 101 with 40 random surface points: the default
+    order (second order here) against order=1, the loop of tube.solve(threads=1) against
+    solve_many, per-source cost, and distance_matrix's error against the great-circle distance."""
+    n, k = (41, 8) if quick else (101, 40)
+    tube = sphere_tube(n)
+    pts = random_sphere_points(k, seed=46)
+    r = {}
+    for order in (1, "auto"):
+        r[order] = rates(tube, pts, pts, 1 if quick else 3, order=order)
+        print_rates(
+            f"sphere N = {n}, order={order!r}",
+            tube.band_points,
+            k,
+            r[order],
+            "; target >= 1.6x" if order == "auto" else "",
+        )
+    for key, text in (("many1", "1 thread"), ("many2", "2 threads")):
+        cost = (r["auto"][key + "_cores"] / r["auto"][key]) / (r[1][key + "_cores"] / r[1][key])
+        print(f"  solve_many ({text}): CPU per source at the default order / order=1: {cost:.2f}x (target <= 2.5x)")
+    exact = great_circle(pts, pts)
+    for order in (1, "auto"):
+        t = time.perf_counter()
+        d, info = ts.distance_matrix(tube, None, pts, threads=2, info=True, order=order)
+        sec = time.perf_counter() - t
+        e = np.abs(d - exact)[~np.eye(k, dtype=bool)]
+        print(
+            f"  distance_matrix order={order!r} (ran order {info['order']}): mean error {e.mean():.2e} "
+            f"(target <= 2e-4 at the default), max {e.max():.2e}; symmetric {np.array_equal(d, d.T)}, zero diagonal "
+            f"{bool(np.all(np.diag(d) == 0))}; asymmetry removed {info['asymmetry']:.2e}, largest one-way diagonal "
+            f"{info['diagonal']:.2e}; {k / sec:.1f} sources/s"
+        )
+        if order == "auto":
+            default = d
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        print("  dask: skipped (pip install tubesweep[distributed])")
+        return
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=40
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        remote = ts.distance_matrix(tube, None, pts, client=client)
+    print(
+        f"  distance_matrix on a Dask LocalCluster (2 processes) equal to the local one bit for bit: {np.array_equal(remote, default)}"
+    )
+
+
+_MEMORY_CHILD = r"""
+import resource, sys
+import numpy as np
+import tubesweep as ts
+what, order, n, k = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+order = order if order == "auto" else int(order)
+v = np.random.default_rng(0).normal(size=(k, 3))
+src = 0.5 * v / np.linalg.norm(v, axis=1)[:, None]
+grid = ts.Grid((-1, -1, -1), (1, 1, 1), (n, n, n))
+at = src[:100]
+if what == "solve":
+    sol = ts.solve(ts.surfaces.Sphere(0.5), grid, src, order=order)
+    u = sol(at)
+    ran = sol.stats.order
+else:
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), grid)
+    u, st = tube.solve_many(src, at=at, threads=2, order=order, return_stats=True)
+    ran = st["order"]
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, ran)
+"""
+
+
+def part_memory(quick: bool) -> None:
+    """Peak resident memory (resource.getrusage, each run in its own process) of ts.solve with
+    10,000 sources and of a 10,000-source solve_many (at 100 points) on the sphere at N = 41, at
+    the default order against order=1."""
+    import subprocess
+
+    n, k = (41, 1000) if quick else (41, 10000)
+    base = int(
+        subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "import resource, tubesweep; print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)",
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+    )
+    print(
+        f"peak RSS, sphere N = {n}, {k} sources (each run in its own process; importing tubesweep alone: {base / 1024:.0f} MB)"
+    )
+    for what, label in (
+        ("solve", f"ts.solve with {k} sources, read at 100 points"),
+        ("many", f"solve_many of {k} sources at 100 points (2 threads)"),
+    ):
+        peak = {}
+        for order in ("1", "auto"):
+            t = time.perf_counter()
+            out = subprocess.run(
+                [sys.executable, "-c", _MEMORY_CHILD, what, order, str(n), str(k)],
+                capture_output=True,
+                text=True,
+                check=True,
+            ).stdout.split()
+            peak[order] = int(out[0])
+            print(
+                f"  {label}, order={order} (ran {out[1]}): {peak[order] / 1024:.0f} MB ({time.perf_counter() - t:.1f} s)"
+            )
+        print(f"  ratio default / order=1: {peak['auto'] / peak['1']:.2f} (target <= 3)")
 
 
 def bunny_tube(n: int) -> "tuple[ts.Tube, np.ndarray]":
@@ -181,12 +313,19 @@ def part_peers(quick: bool) -> None:
     exact = great_circle(v[idx], v)  # (k, V)
     rows = []
     tube = sphere_tube(n)
-    t = time.perf_counter()
-    ours = tube.solve_many(v[idx], at=v, threads=2)
-    rows.append(("tubesweep solve_many (2 threads)", k / (time.perf_counter() - t), ours, tube.setup_seconds))
-    t = time.perf_counter()
-    ours1 = tube.solve_many(v[idx], at=v, threads=1)
-    rows.append(("tubesweep solve_many (1 thread)", k / (time.perf_counter() - t), ours1, tube.setup_seconds))
+    for order in (1, 2):
+        for threads in (2, 1):
+            t = time.perf_counter()
+            ours = tube.solve_many(v[idx], at=v, threads=threads, order=order)
+            rate = k / (time.perf_counter() - t)
+            rows.append(
+                (
+                    f"tubesweep solve_many order={order} ({threads} thread{'s' if threads > 1 else ''})",
+                    rate,
+                    ours,
+                    tube.setup_seconds,
+                )
+            )
     try:
         import potpourri3d as pp3d
 
@@ -252,7 +391,15 @@ def part_matrix(quick: bool) -> None:
     )
 
 
-PARTS = {"sphere": part_sphere, "bunny": part_bunny, "dask": part_dask, "peers": part_peers, "matrix": part_matrix}
+PARTS = {
+    "sphere": part_sphere,
+    "orders": part_orders,
+    "memory": part_memory,
+    "bunny": part_bunny,
+    "dask": part_dask,
+    "peers": part_peers,
+    "matrix": part_matrix,
+}
 
 
 def main() -> int:
@@ -260,7 +407,7 @@ def main() -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--parts", default=",".join(PARTS))
     args = ap.parse_args()
-    print(f"== many sources (issue 33){' --quick' if args.quick else ''}: {os.cpu_count()} CPUs ==")
+    print(f"== many sources (issues 33, 46){' --quick' if args.quick else ''}: {os.cpu_count()} CPUs ==")
     for name in args.parts.split(","):
         t = time.perf_counter()
         PARTS[name](args.quick)

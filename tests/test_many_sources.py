@@ -42,7 +42,7 @@ def test_rows_equal_single_solves_bit_for_bit(tube, threads):
     pts = sphere_points(2)
     group = np.array([[R, 0, 0], [0, 0, -R]])
     sources = [p for p in pts] + [group]
-    many = tube.solve_many(sources, threads=threads)
+    many = tube.solve_many(sources, threads=threads, order=1)
     assert many.shape == (3, tube.band_points)
     for k, s in enumerate(sources):
         for single_threads in (1, 2):
@@ -50,7 +50,7 @@ def test_rows_equal_single_solves_bit_for_bit(tube, threads):
             assert np.array_equal(bits(many[k]), bits(single)), (k, single_threads)
     # at= gives the solutions read at the points, without the band rows
     at = np.vstack([pts, [[0, R, 0]]])
-    values = tube.solve_many(sources, at=at, threads=threads)
+    values = tube.solve_many(sources, at=at, threads=threads, order=1)
     assert values.shape == (3, 3)
     for k, s in enumerate(sources):
         assert np.array_equal(bits(values[k]), bits(tube.solve(np.atleast_2d(s), order=1)(at)))
@@ -59,7 +59,7 @@ def test_rows_equal_single_solves_bit_for_bit(tube, threads):
 def test_lxf_and_varying_speed_bit_for_bit(tube):
     pts = sphere_points(3, seed=1)
     speed = lambda p: 1.0 + 0.5 * p[:, 2]  # noqa: E731
-    many = tube.solve_many(pts, hamiltonian="lxf", speed=speed, threads=2)
+    many = tube.solve_many(pts, hamiltonian="lxf", speed=speed, threads=2)  # lxf: order "auto" falls back to 1
     for k, s in enumerate(pts):
         assert np.array_equal(bits(many[k]), bits(tube.solve([s], hamiltonian="lxf", speed=speed, order=1).values))
 
@@ -106,7 +106,7 @@ def test_distance_matrix_on_the_sphere(grid):
     pts = sphere_points(8, seed=2)
     # points slightly off the surface (within the inner tube) are snapped onto it
     off = pts * (1 + 0.02)
-    d, info = ts.distance_matrix(ts.surfaces.Sphere(R), grid, off, info=True)
+    d, info = ts.distance_matrix(ts.surfaces.Sphere(R), grid, off, info=True, order=1)
     exact = great_circle(pts, pts)
     assert d.shape == (8, 8)
     assert np.array_equal(d, d.T)  # symmetric bit for bit
@@ -119,7 +119,7 @@ def test_distance_matrix_on_the_sphere(grid):
     # what the average removed: the one-way estimates differ (0.021) and their diagonal is not 0 (0.033)
     assert 0 < info["asymmetry"] < 0.05 and 0 < info["diagonal"] < 0.05
     assert 0 < info["asymmetry_mean"] < info["asymmetry"]
-    fine = ts.distance_matrix(ts.surfaces.Sphere(R), ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81)), pts)
+    fine = ts.distance_matrix(ts.surfaces.Sphere(R), ts.Grid((-1, -1, -1), (1, 1, 1), (81, 81, 81)), pts, order=1)
     assert np.abs(fine - exact).max() < 0.5 * err.max()
     assert np.abs(fine - exact).mean() < 0.5 * err.mean()
 
@@ -143,7 +143,7 @@ def test_distance_matrix_bad_input(tube, grid):
 
 
 def test_farthest_point_sampling_on_the_sphere(tube):
-    pts, radii = ts.farthest_point_sampling(tube, None, 6, start=[0, 0, R])
+    pts, radii = ts.farthest_point_sampling(tube, None, 6, start=[0, 0, R], order=1)
     assert pts.shape == (6, 3) and radii.shape == (6,)
     assert np.allclose(np.linalg.norm(pts, axis=1), R, atol=1e-3)
     assert radii[0] == np.inf and np.all(np.diff(radii[1:]) <= 1e-12)
@@ -385,3 +385,153 @@ def test_bench_script_runs(tmp_path):
     ).stdout
     assert "solve_many(threads=2)" in out and "x the loop" in out
     assert "potpourri3d heat method" in out and "pygeodesic exact MMP" in out
+
+
+# ---------------------------------------------------------------------------------- order (issue 46)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_default_order_rows_equal_default_single_solves_bit_for_bit(tube, threads):
+    """The default order ("auto": second order on the sphere) of solve_many gives, row by row, the
+    default single solve bit for bit: the band values, and at= the values sol(at) reads (the
+    factored form near the source, exactly 0 at it); with a varying speed too."""
+    pts = sphere_points(3, seed=6)
+    sources = [p for p in pts] + [pts[:2]]
+    at = np.vstack([pts, sphere_points(5, seed=7)])
+    many, st = tube.solve_many(sources, threads=threads, return_stats=True)
+    values = tube.solve_many(sources, at=at, threads=threads)
+    assert st["order"] == 2 and st["order_fallback"] is None and st["converged"].all()
+    for k, s in enumerate(sources):
+        sol = tube.solve(np.atleast_2d(s), threads=2)
+        assert sol.stats.order == 2
+        assert np.array_equal(bits(many[k]), bits(sol.values)), k
+        assert np.array_equal(bits(values[k]), bits(sol(at))), k
+        assert st["iterations"][k] == sol.stats.iterations
+    assert np.all(values[np.arange(3), np.arange(3)] == 0.0)  # at the source: exactly 0
+    speed = lambda p: 1.0 + 0.5 * p[:, 2]  # noqa: E731
+    v = tube.solve_many(pts, at=at, speed=speed, threads=threads)
+    for k, s in enumerate(pts):
+        assert np.array_equal(bits(v[k]), bits(tube.solve([s], speed=speed)(at))), k
+
+
+def test_order_fallback_follows_tube_solve(grid):
+    """order="auto" falls back where tube.solve does, with its reason, and then equals order=1;
+    order=2 there is refused with the same message."""
+    ell = ts.Tube(ts.surfaces.Ellipsoid(0.6, 0.45, 0.3), grid)  # curvature not resolved at N = 41
+    pts = ell.surface.project(sphere_points(3, seed=8), grid)[1]
+    single = ell.solve([pts[0]])
+    assert single.stats.order == 1 and "outer·Δx·κ" in single.stats.order_fallback
+    auto, st = ell.solve_many(pts, at=pts, return_stats=True)
+    assert st["order"] == 1 and st["order_fallback"] == single.stats.order_fallback
+    assert np.array_equal(bits(auto), bits(ell.solve_many(pts, at=pts, order=1)))
+    with pytest.raises(ValueError, match="outer·Δx·κ"):
+        ell.solve_many(pts, order=2)
+    # an option of the first-order scheme: the same rule as tube.solve
+    sphere = ts.Tube(ts.surfaces.Sphere(R), grid)
+    _, st = sphere.solve_many(sphere_points(2), at=sphere_points(2), hamiltonian="lxf", return_stats=True)
+    assert (
+        st["order"] == 1 and st["order_fallback"] == sphere.solve([[R, 0, 0]], hamiltonian="lxf").stats.order_fallback
+    )
+    with pytest.raises(ValueError, match="Godunov update only"):
+        sphere.solve_many(sphere_points(2), hamiltonian="lxf", order=2)
+
+
+def test_order_bad_values(tube):
+    for bad in (0, 3, "2", "second", True, 1.5, None):
+        with pytest.raises(ValueError, match="order must be 1"):
+            tube.solve_many([[R, 0, 0]], order=bad)
+        with pytest.raises(ValueError, match="order must be 1"):
+            ts.distance_matrix(tube, None, [[R, 0, 0]], order=bad)
+        with pytest.raises(ValueError, match="order must be 1"):
+            ts.farthest_point_sampling(tube, None, 2, order=bad)
+    # a batch mixing sources on and off the surface is refused as a whole, naming the one off it
+    with pytest.raises(ValueError, match=r"sources\[2\].*farther than the inner tube"):
+        tube.solve_many([[R, 0, 0], [0, R, 0], [0, 0, 0.2]], order=2)
+
+
+def test_distance_matrix_second_order_and_duplicates(tube, grid):
+    """At the default order the matrix is second order (mean error 7e-4 at N = 41 against 5e-2 at
+    order=1); identical points, given several times, are exactly 0 apart with identical rows."""
+    pts = sphere_points(8, seed=2)
+    d, info = ts.distance_matrix(tube, None, pts, info=True)
+    assert info["order"] == 2 and info["order_fallback"] is None
+    err = np.abs(d - great_circle(pts, pts))
+    assert err.mean() < 2e-3 and err.max() < 1e-2, (err.mean(), err.max())
+    assert np.array_equal(d, d.T) and np.all(np.diag(d) == 0.0)
+    assert info["diagonal"] == 0.0  # the factored form reads exactly 0 at a source
+    for order in (1, 2):
+        twice = np.vstack([pts[:3], pts[:1], pts[1:2], pts[:1]])
+        dd = ts.distance_matrix(tube, None, twice, order=order)
+        for a, b in ((0, 3), (0, 5), (3, 5), (1, 4)):
+            assert dd[a, b] == 0.0 and np.array_equal(dd[a], dd[b]), (order, a, b)
+        assert np.array_equal(dd[:3, :3], ts.distance_matrix(tube, None, pts[:3], order=order))
+
+
+def test_factored_evaluation_with_many_sources_matches_the_plain_formula(tube):
+    """sol(points) of a solve with many sources finds the sources near each point with a kd-tree in
+    the core: the same values, bit for bit, as the plain formula over every source."""
+    from tubesweep._interpolation import interpolate_band
+
+    cloud = sphere_points(400, seed=9)
+    src = cloud[cloud[:, 2] > 0.35][:30]  # 30 sources in a cap: the points near the other pole are beyond reach
+    sol = tube.solve(src)
+    p = np.vstack([sphere_points(300, seed=10), src[:5]])
+    u0, feet, slowness, reach = sol._factoring
+    base = interpolate_band(sol._band, sol.values, sol.grid, p, "linear")
+    diff = p[:, None, :] - feet[None, :, :]
+    dist = np.sqrt((diff[..., 0] * diff[..., 0] + diff[..., 1] * diff[..., 1]) + diff[..., 2] * diff[..., 2])
+    close = (dist.min(axis=1) <= reach) & np.isfinite(base)
+    assert 0 < close.sum() < len(p)
+    dist_feet = sol.surface.project(p[close], sol.grid)
+    foot = np.where((dist_feet[0] <= 1e-9 * sol.grid.spacing)[:, None], p[close], dist_feet[1])
+    fd = foot[:, None, :] - feet[None, :, :]
+    chord = np.sqrt((fd[..., 0] * fd[..., 0] + fd[..., 1] * fd[..., 1]) + fd[..., 2] * fd[..., 2]) * slowness
+    expected = base.copy()
+    expected[close] = interpolate_band(sol._band, sol.values - u0, sol.grid, p[close], "linear") + chord.min(axis=1)
+    assert np.array_equal(bits(sol(p)), bits(expected))
+    assert np.all(sol(src[:5]) == 0.0)
+
+
+def test_disconnected_surface_no_warning(tmp_path):
+    """Two disjoint spheres: pairs on different spheres are inf apart, and neither distance_matrix
+    nor the command line lets NumPy's 'invalid value' RuntimeWarning out."""
+    import warnings
+
+    from tubesweep.cli import main
+
+    c = np.array([0.5, 0.0, 0.0])
+    g = ts.Grid((-1, -0.5, -0.5), (1, 0.5, 0.5), (41, 21, 21))
+
+    def phi(x):
+        return np.minimum(np.linalg.norm(x - c, axis=1), np.linalg.norm(x + c, axis=1)) - 0.3
+
+    pts = np.array([c + [0.3, 0, 0], c + [0, 0.3, 0], -c - [0.3, 0, 0], -c + [0, 0, 0.3]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for order in (1, "auto"):
+            d, info = ts.distance_matrix(ts.LevelSet(phi), g, pts, info=True, order=order)
+            assert np.all(np.isinf(d[:2, 2:])) and np.all(np.isfinite(d[:2, :2])) and np.all(np.isfinite(d[2:, 2:]))
+            assert np.array_equal(d, d.T) and np.isfinite(info["asymmetry"])
+        np.save(tmp_path / "phi.npy", phi(g.node_points(np.arange(np.prod(g.shape)))).reshape(g.shape))
+        np.save(tmp_path / "pts.npy", pts)
+        args = ["distances", "--phi", str(tmp_path / "phi.npy"), "--lower", "-1", "-0.5", "-0.5", "--upper", "1"]
+        args += ["0.5", "0.5", "--points", str(tmp_path / "pts.npy"), "--out", str(tmp_path / "D.npy"), "--quiet"]
+        assert main(args) == 0
+    assert np.all(np.isinf(np.load(tmp_path / "D.npy")[:2, 2:]))
+
+
+def test_dask_order2_equals_local_and_a_closed_client_is_refused(client, tube):
+    import distributed
+
+    pts = sphere_points(5, seed=11)
+    local, st = tube.solve_many(pts, at=pts, return_stats=True)
+    remote, rst = tube.solve_many(pts, at=pts, client=client, chunk_size=2, return_stats=True)
+    assert np.array_equal(bits(remote), bits(local)) and rst["order"] == st["order"] == 2
+    first = tube.solve_many(pts, at=pts, client=client, order=1)
+    assert np.array_equal(bits(first), bits(tube.solve_many(pts, at=pts, order=1)))
+    closed = distributed.Client(client.scheduler.address)
+    closed.close()
+    with pytest.raises(ValueError, match="client: this Dask client is closed"):
+        tube.solve_many(pts, at=pts, client=closed)
+    with pytest.raises(ValueError, match="order must be 1"):
+        tube.solve_many(pts, client=client, order=3)

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from . import _native
 from ._interpolation import interpolate_band
 
 #: ``sol(points)`` evaluates ``w + σ|cp(P) − x_s|`` (interpolated ``w = u − u₀``) at points within
@@ -39,25 +40,28 @@ def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: 
     interpolated plus ``σ_s |cp(P) − x_s|`` (``u₀`` at the point: the chord from the source to
     its closest point on the surface, the point itself when it is on the surface) at the points
     within :func:`factored_reach` of a source, so that the source's cone is not interpolated (the
-    value at a source is exactly 0)."""
+    value at a source is exactly 0). The sources near a point are found with a kd-tree in the
+    core (``tubesweep_core::solution::source_feet``): nothing of size points × sources, and the
+    same operations as ``Tube.solve_many``'s evaluation, bit for bit."""
     u0, feet, slowness, reach = sol._factoring
     grid = sol.grid
     h = grid.spacing
     if len(p) == 0:
         return values
-    dist = np.sqrt(((p[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2))
     # (points off the band read NaN as before: their closest points are not asked for, a map
     # may be undefined there)
-    close = (dist.min(axis=1) <= reach) & np.isfinite(values)
+    close = np.isfinite(values)
     if np.any(close):
-        q = p[close]
+        close[close] = _native.source_feet_within(feet, slowness, np.ascontiguousarray(p[close]), float(reach))
+    if np.any(close):
+        q = np.ascontiguousarray(p[close])
         foot = q
         if reach > FACTORED_RADIUS * h * (1 + 1e-9):
             # the points' closest points: the point itself when it is on the surface (to rounding)
             d_surface, foot = sol.surface.project(q, grid)
             foot = np.where((d_surface <= 1e-9 * h)[:, None], q, foot)
-        chord = np.sqrt(((foot[:, None, :] - feet[None, :, :]) ** 2).sum(axis=2)) * slowness[None, :]
+        chord = _native.source_feet_chords(feet, slowness, np.ascontiguousarray(foot, dtype=float))
         w = interpolate_band(sol._band, sol.values - u0, grid, q, interpolation)
         # never negative: w interpolated at a source rounds to ±1e-21 (the chord is 0 there)
-        values[close] = np.maximum(w + chord.min(axis=1), 0.0)
+        values[close] = np.maximum(w + chord, 0.0)
     return values

@@ -168,6 +168,47 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
     ramp_length: float = 1.0,  # ℓ: the limiter's ramp width is σΔx²/ℓ (second_order.ramp_length)
     extension_limit: float = ...,  # the extension's BDF2 correction limited beyond this many σΔx (default ∞)
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], Dict[str, Any]]: ...
+def second_order_solve_many(  # crates/tubesweep-py/src/many_sources.rs: K second-order solves, the geometry shared
+    band: "Band",
+    roles: npt.NDArray[np.uint8],
+    phi: npt.NDArray[np.float64],
+    directions: npt.NDArray[np.float32],
+    lower: List[float],
+    spacing: float,
+    feet: npt.NDArray[np.float64],  # (P, d) every source's foot points, concatenated
+    source_slowness: npt.NDArray[np.float64],  # (P,)
+    offsets: npt.NDArray[np.int64],  # (K + 1,) source k is feet[offsets[k]:offsets[k + 1]]
+    slowness: Union[float, npt.NDArray[np.float64]],
+    fix_radius: float,
+    outer_width: float,
+    tol_first: float,
+    tol: float,
+    max_iterations: int,
+    progress: Optional[Callable[[int, int], Any]] = None,  # (done, K)
+    threads: int = 0,
+    front_window: float = 2.0,
+    own_first_phase: bool = True,
+    cp_offsets: Optional[npt.NDArray[np.float64]] = None,
+    window_first: float = 0.0,
+    window_second: float = 0.0,
+    ramp_length: float = 1.0,
+    extension_limit: float = ...,
+    stall_ratio: float = 0.9,
+    stall_window: int = 20,
+    at: Optional[npt.NDArray[np.float64]] = None,  # (M, d)
+    at_feet: Optional[npt.NDArray[np.float64]] = None,  # (M, d) their feet on the surface
+    reach_spacings: float = 3.0,
+    reach_curvature_radii: float = 0.0,
+) -> Tuple[npt.NDArray[np.float64], Dict[str, Any]]: ...
+def source_feet_within(  # crates/tubesweep-py/src/second_order.rs: points within reach of a source (kd-tree)
+    feet: npt.NDArray[np.float64], slowness: npt.NDArray[np.float64], points: npt.NDArray[np.float64], reach: float
+) -> npt.NDArray[np.bool_]: ...
+def source_feet_chords(  # the smallest σ_s |p − x_s| per point
+    feet: npt.NDArray[np.float64], slowness: npt.NDArray[np.float64], points: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
+def nearest_feet(  # the nearest foot per point
+    feet: npt.NDArray[np.float64], points: npt.NDArray[np.float64]
+) -> npt.NDArray[np.int64]: ...
 def band_interpolate_cubic(  # crates/tubesweep-py/src/box_order2.rs: Catmull-Rom, multilinear where incomplete
     band: "Band", values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...

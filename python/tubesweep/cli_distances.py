@@ -74,6 +74,12 @@ def add_distances_parser(sub: Any) -> None:
         default=1e-10,
         help="stop when no value changes by more than this in an iteration (default 1e-10)",
     )
+    p.add_argument(
+        "--order",
+        choices=["1", "2", "auto"],
+        default="auto",
+        help="auto (default): second order where it applies, the paper's first-order scheme otherwise; 1 or 2",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -208,6 +214,7 @@ def cmd_distances(args: argparse.Namespace) -> int:
         raise ValueError(f"--sample {args.sample}: give a positive number of points")
     if args.chunk_size is not None and args.scheduler is None:
         raise ValueError("--chunk-size is for --scheduler (the sources per Dask task)")
+    order = args.order if args.order == "auto" else int(args.order)
     t0 = time.perf_counter()
     surface, grid = _surface_and_grid(args)
     client = _client(args.scheduler)  # connected first: a wrong address fails before any work
@@ -223,7 +230,7 @@ def cmd_distances(args: argparse.Namespace) -> int:
         bar = _SourcesBar("sampling", args.quiet)
         try:
             points, radii = farthest_point_sampling(
-                tube, None, args.sample, tol=args.tol, threads=args.threads, progress=bar
+                tube, None, args.sample, tol=args.tol, threads=args.threads, progress=bar, order=order
             )
         finally:
             bar.close()
@@ -241,6 +248,7 @@ def cmd_distances(args: argparse.Namespace) -> int:
             chunk_size=args.chunk_size,
             progress=bar,
             info=True,
+            order=order,
         )
     finally:
         bar.close()
@@ -255,7 +263,8 @@ def cmd_distances(args: argparse.Namespace) -> int:
         f"{m} x {m} distances in {seconds:.2f} s ({m / seconds:.1f} sources/s"
         f"{', on ' + args.scheduler if args.scheduler else ''}); largest {np.max(matrix[np.isfinite(matrix)]):.4g}; "
         f"asymmetry of the one-way estimates removed: {info['asymmetry']:.3g}, their largest diagonal "
-        f"{info['diagonal']:.3g}"
+        f"{info['diagonal']:.3g}; order {info['order']}"
+        + (f" (second order does not apply: {info['order_fallback']})" if info["order_fallback"] else "")
     )
     print(f"wrote {args.out} and {points_file} ({time.perf_counter() - t0:.2f} s in all)")
     return 0

@@ -22,6 +22,7 @@ import numpy as np
 
 from ._validate import as_points
 from ._prepare import ROLE_INNER
+from .solve import _check_order
 from .tube import Tube
 
 __all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]
@@ -79,6 +80,7 @@ def distance_matrix(
     chunk_size: Optional[int] = None,
     progress: Optional[Callable[[int, int], Any]] = None,
     info: bool = False,
+    order: Union[int, str] = "auto",
 ) -> Union[np.ndarray, Tuple[np.ndarray, dict]]:
     """Geodesic distances (M, M) between ``points`` on the surface.
 
@@ -91,17 +93,20 @@ def distance_matrix(
     client : dask.distributed.Client, optional — run the M solves on the cluster
         (``pip install tubesweep[distributed]``; see :meth:`Tube.solve_many`).
     threads : solves run at once locally (0: all cores), each on one thread.
-    progress : callable ``(done, M)``, optional.
+    progress : callable ``(done, M')``, optional (M' the distinct points).
+    order : ``"auto"`` (the default: second order where it applies, as :func:`tubesweep.solve`), 1 or 2.
     info : also return a dict: ``asymmetry`` (the largest ``|D[i, j] − D[j, i]|`` of the one-way
         estimates, removed by the average; ``asymmetry_mean`` its mean over the pairs),
         ``diagonal`` (the largest one-way ``u_i(x_i)``, set to 0), ``points`` (the snapped
-        points), ``seconds``.
+        points), ``seconds``, ``order`` and ``order_fallback`` (the order run, and why second order
+        did not apply).
 
     Returns
     -------
-    D : (M, M) float — symmetric bit for bit, zero diagonal; ``inf`` between points on parts of
-        the surface that no path joins. Accurate to the solver's order (first order in the grid
-        spacing with the default Godunov scheme: docs/many-sources.md).
+    D : (M, M) float — symmetric bit for bit, zero diagonal, and exactly 0 between points that
+        snap to the same surface point (one solve for them: their rows are identical); ``inf``
+        between points on parts of the surface that no path joins. Accurate to the solver's order
+        (second order in the grid spacing where it applies: docs/many-sources.md).
 
     Raises
     ------
@@ -120,9 +125,15 @@ def distance_matrix(
     t0 = time.perf_counter()
     tube = _as_tube(surface, grid, inner, outer)
     snapped = snap_to_surface(tube, points)
-    one_way = tube.solve_many(
-        snapped,
-        at=snapped,
+    # one solve per distinct point: points that snap to the same surface point get the same row
+    # and column, 0 apart
+    distinct, first, inverse = np.unique(snapped, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    distinct = snapped[np.sort(first)]  # in the order the points were given
+    inverse = np.argsort(np.argsort(first))[inverse]
+    one_way, stats = tube.solve_many(
+        distinct,
+        at=distinct,
         hamiltonian=hamiltonian,
         source_init=source_init,
         tol=tol,
@@ -131,21 +142,27 @@ def distance_matrix(
         client=client,
         chunk_size=chunk_size,
         progress=progress,
+        order=order,
+        return_stats=True,
     )
     if np.isnan(one_way).any():
         i, j = np.argwhere(np.isnan(one_way))[0]
+        i, j = int(np.flatnonzero(inverse == i)[0]), int(np.flatnonzero(inverse == j)[0])
         raise RuntimeError(
             f"the solution from points[{i}] could not be read at points[{j}] (its interpolation stencil "
             "leaves the band): increase outer"
         )
+    # pairs no path joins are inf both ways (inf − inf is not computed: no RuntimeWarning)
     both = np.isfinite(one_way) & np.isfinite(one_way.T)
-    diff = np.abs(one_way - one_way.T)
-    asymmetry = float(np.max(diff[both], initial=0.0))
+    diff = np.abs(np.where(both, one_way, 0.0) - np.where(both, one_way.T, 0.0))
+    asymmetry = float(np.max(diff, initial=0.0))
     off = both & ~np.eye(len(one_way), dtype=bool)
     asymmetry_mean = float(np.mean(diff[off])) if np.any(off) else 0.0
     diagonal = float(np.max(np.abs(np.diag(one_way)), initial=0.0))
     matrix = 0.5 * (one_way + one_way.T)
     np.fill_diagonal(matrix, 0.0)
+    if len(distinct) < len(snapped):
+        matrix = matrix[np.ix_(inverse, inverse)]
     if info:
         return matrix, {
             "asymmetry": asymmetry,
@@ -153,6 +170,8 @@ def distance_matrix(
             "diagonal": diagonal,
             "points": snapped,
             "seconds": time.perf_counter() - t0,
+            "order": stats.get("order", 1),
+            "order_fallback": stats.get("order_fallback"),
         }
     return matrix
 
@@ -173,6 +192,7 @@ def farthest_point_sampling(
     tol: float = 1e-10,
     threads: int = 0,
     progress: Optional[Callable[[int, int], Any]] = None,
+    order: Union[int, str] = "auto",
 ) -> Tuple[np.ndarray, np.ndarray]:
     """``k`` well-spread points on the surface by geodesic farthest-point sampling.
 
@@ -196,6 +216,9 @@ def farthest_point_sampling(
         As for :func:`tubesweep.solve`.
     progress : callable, optional
         Called as ``progress(done, k)``.
+    order : {"auto", 1, 2}
+        The order of each solve, as :func:`tubesweep.solve` (``"auto"``: second order where it
+        applies).
 
     Returns
     -------
@@ -223,6 +246,7 @@ def farthest_point_sampling(
     """
     if not (isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1):
         raise ValueError(f"k must be a positive whole number of points; got {k!r}")
+    order = _check_order(order)
     tube = _as_tube(surface, grid, inner, outer)
     t = tube._tube
     g = tube.grid
@@ -241,7 +265,7 @@ def farthest_point_sampling(
         )
 
     def distances_from(p: np.ndarray) -> np.ndarray:
-        return tube.solve([p], tol=tol, threads=threads, order=1).values[inner_pos]
+        return tube.solve([p], tol=tol, threads=threads, order=order).values[inner_pos]
 
     if start is None:
         seed = candidates[int(np.flatnonzero(usable)[0])]

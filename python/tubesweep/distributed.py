@@ -74,7 +74,13 @@ def _solve_chunk(spec: _TubeSpec, groups: List[np.ndarray], at: Optional[np.ndar
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         values, stats = tube.solve_many(groups, at=at, threads=1, return_stats=True, **options)
-    return values, {k: v for k, v in stats.items() if isinstance(v, np.ndarray)}, [str(w.message) for w in caught]
+    order = (stats.get("order", 1), stats.get("order_fallback"))
+    return (
+        values,
+        {k: v for k, v in stats.items() if isinstance(v, np.ndarray)},
+        [str(w.message) for w in caught],
+        order,
+    )
 
 
 def _clear() -> int:
@@ -137,6 +143,11 @@ def solve_many_on_client(
     points = None if at is None else as_points(at, tube.grid.ndim, "at")
     # every source checked here, before anything is sent: a bad one is refused with its index
     fixed_nodes(tube, groups, options.get("speed", 1.0), options.get("source_init", "exact"))
+    if getattr(client, "status", "running") in ("closed", "closing", "failed"):
+        raise ValueError(
+            f"client: this Dask client is {client.status}; connect a new one (Client(cluster) or "
+            "Client('tcp://scheduler:8786')) or leave client=None to solve on this machine"
+        )
     nthreads = sum(client.nthreads().values())
     if nthreads == 0:
         raise RuntimeError(
@@ -168,13 +179,14 @@ def solve_many_on_client(
     out = np.empty((k, width))
     stats: Dict[str, np.ndarray] = {}
     messages: List[str] = []
+    order: Any = None
     done = 0
     try:
         for fut in as_completed(futures):
             a = futures[fut]
             b = min(a + chunk_size, k)
             try:
-                values, st, caught = fut.result()
+                values, st, caught, chunk_order = fut.result()
             except (ValueError, TypeError, KeyboardInterrupt):
                 raise
             except Exception as e:  # a worker that died on every try (KilledWorker), a lost dependency...
@@ -184,6 +196,7 @@ def solve_many_on_client(
                     "(docs/many-sources.md, 'What to size')"
                 ) from e
             out[a:b] = values
+            order = chunk_order if order is None else order
             for name, v in st.items():
                 stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
             messages.extend(caught)
@@ -202,5 +215,7 @@ def solve_many_on_client(
             stacklevel=3,
         )
     if return_stats:
-        return out, stats
+        stats_out: Dict[str, Any] = dict(stats)
+        stats_out["order"], stats_out["order_fallback"] = order
+        return out, stats_out
     return out

@@ -10,7 +10,6 @@ memory O(band · threads + K · M) instead of K band arrays.
 
 from __future__ import annotations
 
-import re
 import time
 import warnings
 from typing import TYPE_CHECKING, Any, Callable, List, Optional, Tuple
@@ -33,7 +32,9 @@ from ._validate import (
 )
 from ._prepare import ROLE_INNER
 from ._sources import SOURCE_RADIUS, _fix_sources
-from .solve import _check_source_init, _resolve_scheme
+from .many_order2 import renamed, solve_many_order2
+from . import second_order as so
+from .solve import DEFAULT_TOL, _check_order, _check_source_init, _resolve_scheme
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube
@@ -80,13 +81,6 @@ def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
     return at
 
 
-def _renamed(e: ValueError, k: int, group: bool) -> ValueError:
-    """A source error of ``_fix_sources`` (which numbers the points of one solve) renamed to the
-    source's place among the K: ``sources[k]`` or ``sources[k][j]``."""
-    text = re.sub(r"sources\[(\d+)\]", (lambda m: f"sources[{k}][{m.group(1)}]") if group else f"sources[{k}]", str(e))
-    return ValueError(text)
-
-
 def fixed_nodes(
     tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -105,7 +99,7 @@ def fixed_nodes(
                 surf, grid, t.band, t.linear, t.roles, src, slowness_at, source_init, inner_width
             )
         except ValueError as e:
-            raise _renamed(e, k, len(g) > 1) from None
+            raise renamed(e, k, len(g) > 1) from None
         if t.method != "naive" and len(src) == 1 and np.unique(pos).size >= n_inner:
             raise ValueError(
                 f"sources[{k}]: the grid is too coarse for this surface: every node of the inner tube lies within "
@@ -145,10 +139,12 @@ def solve_many(
     threads: int = 0,
     paper_sweeps: bool = False,
     return_stats: bool = False,
+    order: Any = "auto",
 ) -> Any:
     """See :meth:`tubesweep.Tube.solve_many` (the local run; a Dask client goes through
     :mod:`tubesweep.distributed`)."""
     t0 = time.perf_counter()
+    order = _check_order(order)
     tube._check_phi_unchanged()
     t = tube._tube
     grid = t.grid
@@ -169,6 +165,34 @@ def solve_many(
     nthreads = check_threads(threads)
     inf = check_infinity(infinity)
     points = None if at is None else as_points(at, grid.ndim, "at")
+    fallback: Optional[str] = None
+    if order != 1:
+        try:
+            so.check_supported(t.surface, None, scheme, t.method, source_init, bool(paper_sweeps))
+            if tube._order2_refusal is not None:  # this band's geometry, refused before
+                raise so.Order2NotApplicable(tube._order2_refusal)
+            try:
+                out, st = solve_many_order2(
+                    tube,
+                    groups,
+                    points=points,
+                    speed=speed,
+                    tol=None if tol == DEFAULT_TOL else tol,
+                    max_iterations=max_iterations,
+                    progress=cb,
+                    threads=nthreads,
+                )
+            except so.Order2NotApplicable as e:
+                tube._order2_refusal = str(e)  # depends on the band only: not computed again
+                raise
+            if return_stats:
+                st.update(order=2, order_fallback=None, seconds_total=time.perf_counter() - t0)
+                return out, st
+            return out
+        except so.Order2NotApplicable as e:
+            if order == 2:
+                raise
+            fallback = str(e)  # order="auto": the first-order scheme, the reason in the stats
     linear = t.linear
     x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
@@ -216,7 +240,9 @@ def solve_many(
         )
     if return_stats:
         st = dict(st)
-        st["setup_seconds"] = setup  # type: ignore[assignment]
-        st["seconds_total"] = time.perf_counter() - t0  # type: ignore[assignment]
+        st["setup_seconds"] = setup
+        st["seconds_total"] = time.perf_counter() - t0
+        st["order"] = 1
+        st["order_fallback"] = fallback
         return out, st
     return out

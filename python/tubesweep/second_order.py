@@ -13,7 +13,7 @@ import dataclasses
 import math
 import time
 import warnings
-from typing import Any, Optional, Union
+from typing import Any, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -190,13 +190,26 @@ def _native_solve(*args: Any, **kwargs: Any) -> Any:
         raise
 
 
-def solve_on_tube(
-    tube: Any, src: np.ndarray, speed: Any, tol: Optional[float], max_iterations: int, cb: Any, threads: int, t0: float
-) -> Any:
-    """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept)."""
-    from ._prepare import ROLE_OUTER
+@dataclasses.dataclass
+class TubeInputs:
+    """What every second-order solve on a prepared tube reads besides its sources (computed once
+    for a batch: :mod:`tubesweep.many_order2`)."""
 
-    grid, surf, band, geom = tube.grid, tube.surface, tube.band, tube.geom
+    slowness: Any  # float, or one per band node
+    tol: float
+    tol_first: float
+    length: float
+    offsets: Optional[np.ndarray]  # x − cp(x) per band node for a closest-point surface
+    directions: np.ndarray
+    exact_feet: bool  # the surface gives closest points to rounding (sol(points)'s reach, _factoring)
+
+
+def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
+    """The checks and the per-node inputs of a second-order solve on ``tube`` (a
+    ``solve._PreparedTube`` with its geometry kept), independent of the sources."""
+    from .closest_point import ClosestPoint
+
+    grid, surf, geom = tube.grid, tube.surface, tube.geom
     h = grid.spacing
     d = grid.ndim
     if tube.outer_eff < tube.inner + 2.0 - 1e-9:
@@ -218,14 +231,42 @@ def solve_on_tube(
     # travel times too large or too small for the local updates' squares, a tol not small against
     # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
     check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
+    offsets = None
+    if isinstance(surf, ClosestPoint):
+        # x − cp(x) at the band nodes in float64 (the band keeps only float32 directions): n and
+        # D²φ come from its local signed distance (tubesweep_core::second_order::implicit)
+        nodes = grid.node_points(linear)
+        offsets = np.ascontiguousarray(nodes - surf.closest_point(nodes))
+        del nodes
+    directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
+    return TubeInputs(
+        slowness=float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
+        tol=float(tol),
+        tol_first=TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
+        length=length,
+        offsets=offsets,
+        directions=np.ascontiguousarray(directions),
+        # beyond 3Δx, sol(points) needs the points' closest points: only where the surface gives
+        # them to rounding (a closest-point map, a φ callable; not a sampled φ, whose multilinear
+        # interpolation errs by about Δx²κ/8 along the normal)
+        exact_feet=isinstance(surf, ClosestPoint) or (getattr(surf, "_fn", None) is not None and not surf.redistance),
+    )
+
+
+def source_feet(
+    surf: Any, grid: Any, src: np.ndarray, inner_width: float, speed: Any, names: Optional[List[str]] = None
+) -> Tuple[np.ndarray, np.ndarray]:
+    """The sources' foot points on the surface and the slowness at each; a source farther from
+    the surface than the inner tube is refused (``names[i]`` names source i in the message)."""
     dist, proj = surf.project(src, grid)
-    inner_width = tube.inner * h
     for i, (dd, s) in enumerate(zip(dist, src)):
         if not dd <= inner_width * (1 + 1e-6):
             raise ValueError(
-                f"sources[{i}] = {tuple(float(c) for c in s)} is {dd:.4g} from the surface, farther than the inner tube "
-                f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
+                f"{names[i] if names else f'sources[{i}]'} = {tuple(float(c) for c in s)} is {dd:.4g} from the surface, "
+                f"farther than the inner tube (inner·Δx = {inner_width:.4g}); put the source on the surface or increase "
+                "`inner`"
             )
+    h = grid.spacing
     # a source given on the surface is kept as given (its foot point differs by rounding only)
     on = np.linalg.norm(proj - src, axis=1) <= 1e-9 * h
     feet = np.where(on[:, None], src, proj)
@@ -241,42 +282,47 @@ def solve_on_tube(
             feet,
             "interpolated from the speed array at a source",
         )
-    offsets = None
-    from .closest_point import ClosestPoint
+    return np.ascontiguousarray(feet, dtype=float), np.ascontiguousarray(src_slowness, dtype=float)
 
-    if isinstance(surf, ClosestPoint):
-        # x − cp(x) at the band nodes in float64 (the band keeps only float32 directions): n and
-        # D²φ come from its local signed distance (tubesweep_core::second_order::implicit)
-        nodes = grid.node_points(linear)
-        offsets = np.ascontiguousarray(nodes - surf.closest_point(nodes))
-        del nodes
-    roles = tube.roles
-    directions = geom.direction if geom.direction.dtype == np.float32 else geom.direction.astype(np.float32)
+
+def solve_on_tube(
+    tube: Any, src: np.ndarray, speed: Any, tol: Optional[float], max_iterations: int, cb: Any, threads: int, t0: float
+) -> Any:
+    """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept)."""
+    from ._prepare import ROLE_OUTER
+
+    grid, surf, band = tube.grid, tube.surface, tube.band
+    h = grid.spacing
+    d = grid.ndim
+    inputs = tube_inputs(tube, speed, tol)
+    tol = inputs.tol
+    linear = tube.linear
+    feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
     setup = time.perf_counter() - t0
     try:
         values, u0, roles_out, st = _native_solve(
             band,
-            np.ascontiguousarray(roles),
-            np.ascontiguousarray(geom.signed, dtype=np.float64),
-            np.ascontiguousarray(directions),
+            np.ascontiguousarray(tube.roles),
+            np.ascontiguousarray(tube.geom.signed, dtype=np.float64),
+            inputs.directions,
             [float(c) for c in grid.lower],
             h,
-            np.ascontiguousarray(feet, dtype=float),
-            np.ascontiguousarray(src_slowness, dtype=float),
-            float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
+            feet,
+            src_slowness,
+            inputs.slowness,
             FIX_RADIUS * h,
             tube.outer_eff * h,
-            TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
+            inputs.tol_first,
             float(tol),
             int(max_iterations),
             cb,
             threads=_threads(threads),
             front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
             own_first_phase=_OWN_FIRST_PHASE,
-            offsets=offsets,
+            offsets=inputs.offsets,
             window_first=WINDOWS[0] if d == 3 else 0.0,
             window_second=WINDOWS[1] if d == 3 else 0.0,
-            ramp_length=length,
+            ramp_length=inputs.length,
             extension_limit=EXTENSION_LIMIT,
         )
     except Order2NotApplicable as e:
@@ -353,14 +399,13 @@ def solve_on_tube(
         order2=order2,
         box_cut=tube.box_cut,
     )
-    # the source of each fixed node: the nearest foot point
-    fixed_pts = grid.node_points(linear[positions])
+    # the source of each fixed node: the nearest foot point (a kd-tree in the core: nothing of size
+    # fixed nodes × sources)
     labels = (
-        np.argmin(np.linalg.norm(fixed_pts[:, None, :] - feet[None, :, :], axis=2), axis=1)
+        _native.nearest_feet(feet, np.ascontiguousarray(grid.node_points(linear[positions])))
         if len(positions)
         else np.empty(0, np.int64)
     )
-    del fixed_pts
     array = getattr(surf, "_array", None)
     phi_sample = None
     if array is not None:
@@ -389,13 +434,8 @@ def solve_on_tube(
     sol._factoring = (
         u0,
         feet,
-        np.asarray(src_slowness, dtype=float),
-        # beyond 3Δx, sol(points) needs the points' closest points: only where the surface gives
-        # them to rounding (a closest-point map, a φ callable; not a sampled φ, whose multilinear
-        # interpolation errs by about Δx²κ/8 along the normal)
-        factored_reach(h, float(st["max_curvature"]), d)
-        if isinstance(surf, ClosestPoint) or (getattr(surf, "_fn", None) is not None and not surf.redistance)
-        else FACTORED_RADIUS * h,
+        src_slowness,
+        factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
     sol.order = 2

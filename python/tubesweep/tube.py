@@ -271,10 +271,11 @@ class Tube:
         client: Any = None,
         chunk_size: Optional[int] = None,
         return_stats: bool = False,
+        order: Union[int, str] = "auto",
     ) -> Any:
         """K independent solves on this band, in parallel across the sources (docs/many-sources.md),
-        with the paper's first-order scheme (``order=1``; for second order, loop over
-        :meth:`solve` with ``order=2``).
+        each row the single :meth:`solve` of its source with the same ``order`` (default
+        ``"auto"``: second order where it applies, as :meth:`solve`).
 
         Parameters
         ----------
@@ -296,20 +297,26 @@ class Tube:
         chunk_size : int, optional
             Sources per cluster task.
         return_stats : bool
-            Also return per-source statistics.
+            Also return per-source statistics (and ``order``, ``order_fallback``: the order run and
+            why second order did not apply, as ``sol.stats``).
+        order : {"auto", 1, 2}
+            As for :meth:`solve`: ``"auto"`` (the default) runs second order where it applies (the
+            tube's geometry computed once for the batch) and the paper's first-order scheme
+            otherwise, with the same fallback rules and reasons.
 
         Returns
         -------
         values : numpy.ndarray
             ``(K, band_points)`` (or ``(K, M)`` with ``at``); row k equals
-            ``tube.solve(sources[k], order=1, ...).values`` (or its values at ``at``) bit for bit.
+            ``tube.solve(sources[k], order=order, ...).values`` (or ``sol(at)``) bit for bit.
         stats : dict
             Only with ``return_stats``: per-source arrays (iterations, converged, last_change, ...).
 
         Raises
         ------
         ValueError
-            For sources off the surface, an unsupported Hamiltonian, or as :meth:`solve`.
+            For sources off the surface, an unsupported Hamiltonian, an ``order`` other than 1, 2 or
+            ``"auto"``, ``order=2`` where it does not apply, or as :meth:`solve`.
         KeyboardInterrupt
             On Ctrl-C, which stops every solve (no partial result).
 
@@ -317,9 +324,9 @@ class Tube:
         -----
         ``sources`` is an array (K, d) of K point sources, or an array (K, P, d) / a list whose
         entries are points (d,) or groups (P, d) (a group is one multi-source solve). Returns a
-        (K, band_points) array whose row k equals ``tube.solve(sources[k], order=1, ...).values`` bit for
+        (K, band_points) array whose row k equals ``tube.solve(sources[k], order=order, ...).values`` bit for
         bit (``inf`` where never reached), or with ``at=points`` (M, d) the (K, M) values
-        ``tube.solve(sources[k], order=1, ...)(points)`` without keeping K band arrays (memory O(band ·
+        ``tube.solve(sources[k], order=order, ...)(points)`` without keeping K band arrays (memory O(band ·
         threads + K·M)). ``threads`` solves run at once, each on one thread (0: all cores), with
         the GIL released; ``progress(done, total)`` is called about every 50 ms, and Ctrl-C stops
         every solve with ``KeyboardInterrupt`` (no partial result). The other options are those of
@@ -357,6 +364,7 @@ class Tube:
                     max_iterations=max_iterations,
                     infinity=infinity,
                     paper_sweeps=paper_sweeps,
+                    order=_check_order(order),
                 ),
                 threads=threads,
                 return_stats=return_stats,
@@ -381,6 +389,7 @@ class Tube:
             threads=threads,
             paper_sweeps=paper_sweeps,
             return_stats=return_stats,
+            order=order,
         )
 
     @property

@@ -5,7 +5,9 @@ use crate::band::{AnyBand, PyBand};
 use crate::convert::{c_slice, node_roles};
 use crate::errors::to_pyerr;
 use crate::sweep::{extension_in_place, parse_missing, parse_scheme};
-use numpy::{IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray2};
+use numpy::{
+    IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -256,5 +258,305 @@ fn solve_many_on_band<'py>(
     match &band.band {
         AnyBand::D2(b) => run(py, b, common, &mut directions, &sources, at, progress),
         AnyBand::D3(b) => run(py, b, common, &mut directions, &sources, at, progress),
+    }
+}
+
+/// What the second-order batch reads, borrowed from NumPy.
+struct Order2Inputs<'s> {
+    roles: &'s [u8],
+    phi: &'s [f64],
+    cp_offsets: Option<&'s [f64]>,
+    directions: &'s [f32],
+    lower: Vec<f64>,
+    spacing: f64,
+    feet: &'s [f64],
+    source_slowness: &'s [f64],
+    offsets: &'s [i64],
+    slowness: Slowness<'s>,
+    fix_radius: f64,
+    outer_width: f64,
+    options: tubesweep_core::second_order::SecondOrderOptions,
+    threads: usize,
+    front_window: f64,
+    at: Option<(&'s [f64], &'s [f64])>,
+    reach_spacings: f64,
+    reach_curvature_radii: f64,
+}
+
+fn run_order2<'py, const D: usize>(
+    py: Python<'py>,
+    band: &NarrowBand<D>,
+    inp: &Order2Inputs<'_>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyDict>)> {
+    use crate::convert::node_vectors;
+    use tubesweep_core::second_order::many::{solve_many_second_order, BatchSource, BatchTube, Order2Output};
+    use tubesweep_core::second_order::{check_geometry_of, tube_setup_of, Implicit};
+    let n = band.len();
+    let roles = node_roles(inp.roles)?;
+    if roles.len() != n || inp.phi.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "roles and phi need one entry per band node ({n})"
+        )));
+    }
+    let directions = node_vectors::<f32, D>(inp.directions, n, "directions")?;
+    let surface = match inp.cp_offsets {
+        Some(o) => Implicit::ClosestPoint(node_vectors::<f64, D>(o, n, "offsets")?),
+        None => Implicit::LevelSet(inp.phi),
+    };
+    let feet = node_vectors::<f64, D>(inp.feet, inp.feet.len() / D, "feet")?;
+    if feet.len() * D != inp.feet.len() || inp.source_slowness.len() != feet.len() {
+        return Err(PyValueError::new_err("feet (P, d) and source_slowness (P,) must match"));
+    }
+    let offsets = inp.offsets;
+    if offsets.len() < 2
+        || offsets[0] != 0
+        || *offsets.last().unwrap_or(&0) as usize != feet.len()
+        || offsets.windows(2).any(|w| w[1] <= w[0])
+    {
+        return Err(PyValueError::new_err(
+            "offsets must rise strictly from 0 to the number of source points",
+        ));
+    }
+    let sources: Vec<BatchSource<'_, D>> = offsets
+        .windows(2)
+        .map(|w| BatchSource {
+            feet: &feet[w[0] as usize..w[1] as usize],
+            slowness: &inp.source_slowness[w[0] as usize..w[1] as usize],
+        })
+        .collect();
+    let lower: [f64; D] = inp
+        .lower
+        .as_slice()
+        .try_into()
+        .map_err(|_| PyValueError::new_err(format!("lower must have {D} entries")))?;
+    let at = match inp.at {
+        Some((p, f)) => {
+            let m = p.len() / D;
+            Some((
+                node_vectors::<f64, D>(p, m, "at")?,
+                node_vectors::<f64, D>(f, m, "at_feet")?,
+            ))
+        }
+        None => None,
+    };
+    let k = sources.len();
+    let width = at.map_or(n, |(p, _)| p.len());
+    let mut values = vec![0.0f64; k * width];
+    let mut py_error: Option<PyErr> = None;
+    let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
+    let result = py.detach(|| {
+        // the tube's geometry once for the batch (no sources: no factoring)
+        let (geometry, _) = tube_setup_of(
+            band,
+            roles,
+            &surface,
+            directions,
+            lower,
+            inp.spacing,
+            &[],
+            &[],
+            inp.fix_radius,
+            inp.threads,
+        )?;
+        check_geometry_of(
+            &geometry.summary,
+            inp.outer_width,
+            inp.spacing,
+            surface.is_closest_point(),
+        )?;
+        let kappa = geometry.summary.max_curvature;
+        // tubesweep._factoring.factored_reach, the same operations
+        let mut reach = inp.reach_spacings * inp.spacing;
+        if inp.reach_curvature_radii > 0.0 && D == 3 && kappa > 0.0 && kappa.is_finite() {
+            reach = reach.max(inp.reach_curvature_radii / kappa);
+        }
+        let tube = BatchTube {
+            band,
+            roles,
+            surface: &surface,
+            directions,
+            geometry: &geometry,
+            lower,
+            spacing: inp.spacing,
+            slowness: inp.slowness,
+            fix_radius: inp.fix_radius,
+            options: inp.options,
+            front_window: inp.front_window,
+        };
+        let output = match at {
+            Some((points, feet)) => Order2Output::AtPoints {
+                lower,
+                points,
+                // beyond a few grid spacings the points' own feet on the surface (as sol(points))
+                feet: if reach > inp.reach_spacings * inp.spacing * (1.0 + 1e-9) {
+                    feet
+                } else {
+                    points
+                },
+                reach,
+                values: &mut values,
+            },
+            None => Order2Output::Band(&mut values),
+        };
+        let mut report =
+            |done: usize| -> Control { crate::progress::check_in(&progress_ref, &mut py_error, (done, k)) };
+        let stats = solve_many_second_order(&tube, &sources, inp.threads, output, &mut report)?;
+        Ok::<_, tubesweep_core::Error>((stats, geometry.summary, reach))
+    });
+    if let Some(e) = py_error {
+        return Err(e);
+    }
+    let (stats, summary, reach) = result.map_err(to_pyerr)?;
+    let array = values.into_pyarray(py).reshape([k, width])?;
+    let d = PyDict::new(py);
+    let col = |f: &dyn Fn(&tubesweep_core::second_order::SecondOrderStats) -> i64| -> Vec<i64> {
+        stats.iter().map(f).collect()
+    };
+    d.set_item(
+        "iterations",
+        col(&|s| (s.first_order_iterations + s.second_order_iterations) as i64).into_pyarray(py),
+    )?;
+    d.set_item(
+        "second_order_iterations",
+        col(&|s| s.second_order_iterations as i64).into_pyarray(py),
+    )?;
+    d.set_item("updates", col(&|s| s.updates as i64).into_pyarray(py))?;
+    d.set_item(
+        "converged",
+        stats.iter().map(|s| s.converged).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "last_change",
+        stats.iter().map(|s| s.last_change).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "seconds",
+        stats.iter().map(|s| s.seconds).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item(
+        "fallback_iteration",
+        col(&|s| s.fallback_iteration.map_or(-1, |v| v as i64)).into_pyarray(py),
+    )?;
+    d.set_item(
+        "runaway_iteration",
+        col(&|s| s.runaway_iteration.map_or(-1, |v| v as i64)).into_pyarray(py),
+    )?;
+    d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
+    d.set_item("max_curvature", summary.max_curvature)?;
+    d.set_item("reach", reach)?;
+    Ok((array, d))
+}
+
+/// K second-order solves on `band` (`tubesweep_core::second_order::many`), the tube's geometry
+/// computed once: source `k` is the points `feet[offsets[k]:offsets[k+1]]` (on the surface) with
+/// their slownesses. The other arguments are `second_order_solve`'s; with `at` (M, d) points and
+/// their feet on the surface `at_feet`, the values there as `sol(points)` evaluates them (the
+/// factored form within `reach_spacings` grid spacings of a source, or `reach_curvature_radii`
+/// curvature radii when positive). Returns `(values, stats)`: values `(K, n)` or `(K, M)`, stats
+/// per-source arrays and the scalars `max_curvature` and `reach`. Refusals of the geometry are
+/// ValueErrors starting with `order=2`.
+#[pyfunction]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, feet, source_slowness, offsets, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, threads=0, front_window=2.0, own_first_phase=true, cp_offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, stall_ratio=0.9, stall_window=20, at=None, at_feet=None, reach_spacings=3.0, reach_curvature_radii=0.0))]
+#[allow(clippy::too_many_arguments)]
+pub fn second_order_solve_many<'py>(
+    py: Python<'py>,
+    band: PyRef<'py, PyBand>,
+    roles: PyReadonlyArray1<'py, u8>,
+    phi: PyReadonlyArray1<'py, f64>,
+    directions: PyReadonlyArray2<'py, f32>,
+    lower: Vec<f64>,
+    spacing: f64,
+    feet: PyReadonlyArray2<'py, f64>,
+    source_slowness: PyReadonlyArray1<'py, f64>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    slowness: Bound<'py, PyAny>,
+    fix_radius: f64,
+    outer_width: f64,
+    tol_first: f64,
+    tol: f64,
+    max_iterations: usize,
+    progress: Option<Bound<'py, PyAny>>,
+    threads: usize,
+    front_window: f64,
+    own_first_phase: bool,
+    cp_offsets: Option<PyReadonlyArray2<'py, f64>>,
+    window_first: f64,
+    window_second: f64,
+    ramp_length: f64,
+    extension_limit: f64,
+    stall_ratio: f64,
+    stall_window: usize,
+    at: Option<PyReadonlyArray2<'py, f64>>,
+    at_feet: Option<PyReadonlyArray2<'py, f64>>,
+    reach_spacings: f64,
+    reach_curvature_radii: f64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyDict>)> {
+    if !(tol > 0.0 && tol_first > 0.0) {
+        return Err(PyValueError::new_err("tol must be positive"));
+    }
+    let d = band.ndim();
+    if feet.shape()[1] != d {
+        return Err(PyValueError::new_err(format!("feet must have shape (P, {d})")));
+    }
+    let per_node: Option<PyReadonlyArray1<'py, f64>> = if slowness.is_instance_of::<pyo3::types::PyFloat>() {
+        None
+    } else {
+        Some(slowness.extract()?)
+    };
+    let constant: f64 = if per_node.is_none() { slowness.extract()? } else { 1.0 };
+    let at_pair = match (&at, &at_feet) {
+        (Some(p), Some(f)) => {
+            if p.shape() != f.shape() || p.shape()[1] != d {
+                return Err(PyValueError::new_err(format!(
+                    "at and at_feet must have the same shape (M, {d})"
+                )));
+            }
+            Some((c_slice(p, "at")?, c_slice(f, "at_feet")?))
+        }
+        (None, None) => None,
+        _ => return Err(PyValueError::new_err("at and at_feet go together")),
+    };
+    let inputs = Order2Inputs {
+        roles: c_slice(&roles, "roles")?,
+        phi: c_slice(&phi, "phi")?,
+        cp_offsets: match &cp_offsets {
+            Some(a) => Some(c_slice(a, "cp_offsets")?),
+            None => None,
+        },
+        directions: c_slice(&directions, "directions")?,
+        lower,
+        spacing,
+        feet: c_slice(&feet, "feet")?,
+        source_slowness: c_slice(&source_slowness, "source_slowness")?,
+        offsets: c_slice(&offsets, "offsets")?,
+        slowness: match &per_node {
+            Some(a) => Slowness::PerNode(c_slice(a, "slowness")?),
+            None => Slowness::Constant(constant),
+        },
+        fix_radius,
+        outer_width,
+        options: tubesweep_core::second_order::SecondOrderOptions {
+            tol_first,
+            tol,
+            max_iterations,
+            stall_ratio,
+            stall_window,
+            own_first_phase,
+            window_first,
+            window_second,
+            extension_limit,
+            threads: 1,
+            ramp_length,
+        },
+        threads,
+        front_window,
+        at: at_pair,
+        reach_spacings,
+        reach_curvature_radii,
+    };
+    match &band.band {
+        AnyBand::D2(b) => run_order2(py, b, &inputs, progress),
+        AnyBand::D3(b) => run_order2(py, b, &inputs, progress),
     }
 }

@@ -289,7 +289,107 @@ pub fn second_order_solve<'py>(
     }
 }
 
+fn feet_query<'py>(
+    py: Python<'py>,
+    feet: &PyReadonlyArray2<'py, f64>,
+    slowness: &PyReadonlyArray1<'py, f64>,
+    points: &PyReadonlyArray2<'py, f64>,
+    reach: Option<f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use tubesweep_core::solution::source_feet::SourceFeet;
+    let d = feet.shape()[1];
+    if points.shape()[1] != d || slowness.len() != feet.shape()[0] || feet.shape()[0] == 0 {
+        return Err(PyValueError::new_err(
+            "feet (S, d) with S ≥ 1, slowness (S,) and points (M, d) must match",
+        ));
+    }
+    let (f, s, p) = (
+        c_slice(feet, "feet")?,
+        c_slice(slowness, "slowness")?,
+        c_slice(points, "points")?,
+    );
+    fn go<const D: usize>(f: &[f64], s: &[f64], p: &[f64], reach: Option<f64>) -> PyResult<(Vec<bool>, Vec<f64>)> {
+        let feet = node_vectors::<f64, D>(f, f.len() / D, "feet")?;
+        let pts = node_vectors::<f64, D>(p, p.len() / D, "points")?;
+        let tree = SourceFeet::new(feet, s);
+        Ok(match reach {
+            Some(r) => (pts.iter().map(|x| tree.within(x, r)).collect(), Vec::new()),
+            None => (Vec::new(), pts.iter().map(|x| tree.chord_min(x)).collect()),
+        })
+    }
+    let (within, chords) = py.detach(|| match d {
+        2 => go::<2>(f, s, p, reach),
+        3 => go::<3>(f, s, p, reach),
+        _ => Err(PyValueError::new_err("points must be 2D or 3D")),
+    })?;
+    Ok(if reach.is_some() {
+        within.into_pyarray(py).into_any()
+    } else {
+        chords.into_pyarray(py).into_any()
+    })
+}
+
+/// Whether each of `points` (M, d) lies within `reach` of one of the sources' `feet` (S, d)
+/// (`tubesweep_core::solution::source_feet`, a kd-tree when S is large): bool (M,).
+#[pyfunction]
+pub fn source_feet_within<'py>(
+    py: Python<'py>,
+    feet: PyReadonlyArray2<'py, f64>,
+    slowness: PyReadonlyArray1<'py, f64>,
+    points: PyReadonlyArray2<'py, f64>,
+    reach: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    feet_query(py, &feet, &slowness, &points, Some(reach))
+}
+
+/// The smallest σ_s·|p − x_s| over the sources' `feet` (S, d) with their `slowness` (S,), for
+/// each of `points` (M, d): float (M,).
+#[pyfunction]
+pub fn source_feet_chords<'py>(
+    py: Python<'py>,
+    feet: PyReadonlyArray2<'py, f64>,
+    slowness: PyReadonlyArray1<'py, f64>,
+    points: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    feet_query(py, &feet, &slowness, &points, None)
+}
+
+/// The index of the nearest of `feet` (S, d) to each of `points` (M, d) (a kd-tree in the core):
+/// int64 (M,).
+#[pyfunction]
+pub fn nearest_feet<'py>(
+    py: Python<'py>,
+    feet: PyReadonlyArray2<'py, f64>,
+    points: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let d = feet.shape()[1];
+    if points.shape()[1] != d || feet.shape()[0] == 0 {
+        return Err(PyValueError::new_err(
+            "feet (S, d) with S ≥ 1 and points (M, d) must match",
+        ));
+    }
+    let (f, p) = (c_slice(&feet, "feet")?, c_slice(&points, "points")?);
+    fn go<const D: usize>(f: &[f64], p: &[f64]) -> PyResult<Vec<i64>> {
+        let feet = node_vectors::<f64, D>(f, f.len() / D, "feet")?;
+        let pts = node_vectors::<f64, D>(p, p.len() / D, "points")?;
+        Ok(tubesweep_core::solution::source_feet::nearest_feet(feet, pts)
+            .into_iter()
+            .map(|i| i as i64)
+            .collect())
+    }
+    let out = py.detach(|| match d {
+        2 => go::<2>(f, p),
+        3 => go::<3>(f, p),
+        _ => Err(PyValueError::new_err("points must be 2D or 3D")),
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
 /// Registers the functions of this file in the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(second_order_solve, m)?)
+    m.add_function(wrap_pyfunction!(second_order_solve, m)?)?;
+    m.add_function(wrap_pyfunction!(source_feet_within, m)?)?;
+    m.add_function(wrap_pyfunction!(source_feet_chords, m)?)?;
+    m.add_function(wrap_pyfunction!(nearest_feet, m)?)?;
+    m.add_function(wrap_pyfunction!(crate::many_sources::second_order_solve_many, m)?)
 }

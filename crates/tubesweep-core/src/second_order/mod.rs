@@ -10,6 +10,7 @@
 //! * [`factoring`]: u = u₀ + w with u₀ the chord distance to the nearest point source, the nodes
 //!   within a small ball of a source fixed at u₀;
 //! * [`setup`]: both in one parallel pass over the band;
+//! * [`many`]: many sources on one band, the geometry shared, in parallel across the sources;
 //! * [`local`]: the limited BDF2/BDF3 Godunov update (continuous ramps from first to second to third
 //!   order, Newton's method for the unequal steps) and the second-order extension update;
 //! * [`solver`]: phase 1 (first order, monotone) then phase 2 (second order, assignment), with
@@ -22,6 +23,7 @@ pub mod geometry;
 pub mod implicit;
 pub mod local;
 mod local_fit;
+pub mod many;
 mod pipeline;
 mod rows;
 pub mod setup;

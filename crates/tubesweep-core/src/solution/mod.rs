@@ -5,3 +5,4 @@
 pub mod interpolate;
 pub mod interpolate_cubic;
 pub mod nearest_source;
+pub mod source_feet;

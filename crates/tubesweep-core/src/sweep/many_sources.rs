@@ -125,7 +125,64 @@ pub fn solve_many<const D: usize>(
             m
         }
     };
-    let mut stats: Vec<Option<SolveStats>> = vec![None; k];
+    let one = SolveOptions { threads: 1, ..*options };
+    let (rows, at) = match &mut output {
+        Output::Band(v) => (&mut **v, None),
+        Output::AtPoints { lower, points, values } => (&mut **values, Some((*lower, *points))),
+    };
+    run_across_sources(
+        k,
+        width,
+        threads,
+        rows,
+        || template.roles.to_vec(),
+        |roles, i, stop, row| {
+            let (values, st) = solve_one(template, roles, sources[i], &one, stop)?;
+            match at {
+                None => row.copy_from_slice(&values),
+                Some((lower, points)) => {
+                    row.copy_from_slice(&interpolate(template.band, &values, lower, template.spacing, points))
+                }
+            }
+            Ok(st)
+        },
+        progress,
+    )
+}
+
+/// The scheduler of [`solve_many`], for any solver: `k` independent solves on `threads` worker
+/// threads (0: rayon's default number, at most `k`), each thread taking the next source when it
+/// finishes one. A thread starts with `scratch()` (its reusable working memory); `solve(scratch,
+/// i, stop, row)` solves source `i`, writes row `i` of `rows` (`k × width`, C order) and returns
+/// its statistics, stopping with [`Error::Interrupted`] when `stop` is set (another solve failed,
+/// or the caller asked to stop).
+///
+/// `progress(done)` runs on the calling thread about every 50 ms and once at the end;
+/// [`Control::Stop`] stops every solve and the call returns [`Error::Interrupted`]. On any error
+/// (the first failing source's, a real error before an interruption) no statistics are returned
+/// and `rows` are to be discarded (they may be partly written). A panic in `solve` (a bug) ends
+/// the call with an error, not a hang or an abort.
+#[allow(clippy::too_many_arguments)]
+pub fn run_across_sources<W, S, I, F>(
+    k: usize,
+    width: usize,
+    threads: usize,
+    rows: &mut [f64],
+    scratch: I,
+    solve: F,
+    progress: &mut dyn FnMut(usize) -> Control,
+) -> Result<Vec<S>>
+where
+    S: Send,
+    I: Fn() -> W + Sync,
+    F: Fn(&mut W, usize, &AtomicBool, &mut [f64]) -> Result<S> + Sync,
+{
+    if rows.len() != k * width {
+        return Err(Error::invalid(
+            "values",
+            format!("expected {k} × {width} values, got {}", rows.len()),
+        ));
+    }
     if k == 0 {
         progress(0);
         return Ok(Vec::new());
@@ -136,56 +193,36 @@ pub fn solve_many<const D: usize>(
         threads
     }
     .clamp(1, k);
-    let one = SolveOptions { threads: 1, ..*options };
-    let (rows, at) = match &mut output {
-        Output::Band(v) => (
-            v.chunks_mut(width.max(1))
-                .map(|r| Mutex::new(Some(r)))
-                .collect::<Vec<_>>(),
-            None,
-        ),
-        Output::AtPoints { lower, points, values } => (
-            values
-                .chunks_mut(width.max(1))
-                .map(|r| Mutex::new(Some(r)))
-                .collect::<Vec<_>>(),
-            Some((*lower, *points)),
-        ),
+    let rows: Vec<Mutex<Option<&mut [f64]>>> = if width == 0 {
+        (0..k).map(|_| Mutex::new(None)).collect()
+    } else {
+        rows.chunks_mut(width).map(|r| Mutex::new(Some(r))).collect()
     };
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
     let stop = AtomicBool::new(false);
     let first_error: Mutex<Option<(usize, Error)>> = Mutex::new(None);
-    let results: Vec<Mutex<Option<SolveStats>>> = (0..k).map(|_| Mutex::new(None)).collect();
+    let results: Vec<Mutex<Option<S>>> = (0..k).map(|_| Mutex::new(None)).collect();
     let mut interrupted = false;
     std::thread::scope(|scope| {
         for _ in 0..threads {
             scope.spawn(|| {
-                let mut roles = template.roles.to_vec();
+                let mut work = scratch();
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     if i >= k || stop.load(Ordering::Relaxed) {
                         break;
                     }
-                    let src = sources[i];
                     // a panic (a bug) ends this call with an error, not a hang or an abort
                     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                        let (values, st) = solve_one(template, &mut roles, src, &one, &stop)?;
-                        // the row is taken once, by the one thread that solved source i
-                        let row = rows.get(i).and_then(|r| r.lock().ok()?.take());
-                        if let Some(row) = row {
-                            match at {
-                                None => row.copy_from_slice(&values),
-                                Some((lower, points)) => row.copy_from_slice(&interpolate(
-                                    template.band,
-                                    &values,
-                                    lower,
-                                    template.spacing,
-                                    points,
-                                )),
-                            }
-                        }
-                        Ok(st)
+                        // the row is taken once, by the one thread that solves source i
+                        let mut row = rows.get(i).and_then(|r| r.lock().ok()?.take());
+                        let mut empty: [f64; 0] = [];
+                        let row: &mut [f64] = match row.as_mut() {
+                            Some(r) => r,
+                            None => &mut empty,
+                        };
+                        solve(&mut work, i, &stop, row)
                     }))
                     .unwrap_or_else(|_| {
                         Err(Error::BadBand {
@@ -246,12 +283,13 @@ pub fn solve_many<const D: usize>(
     if let Some((_, e)) = first_error.into_inner().unwrap_or(None) {
         return Err(e);
     }
-    for (slot, r) in stats.iter_mut().zip(results) {
-        *slot = r.into_inner().unwrap_or(None);
-    }
-    stats
+    results
         .into_iter()
-        .map(|s| s.ok_or(Error::Interrupted { iterations: 0 }))
+        .map(|r| {
+            r.into_inner()
+                .unwrap_or(None)
+                .ok_or(Error::Interrupted { iterations: 0 })
+        })
         .collect()
 }
 

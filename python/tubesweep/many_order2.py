@@ -1,0 +1,139 @@
+"""Many sources at second order: :meth:`tubesweep.Tube.solve_many` with ``order=2`` (or ``"auto"``
+where second order applies).
+
+The tube's geometry (n and B = (I − φD²φ)⁻¹ per node, ``tubesweep_core::second_order::geometry``)
+is computed once for the batch and shared by every solve; each source gets its own factoring
+(u = u₀ + w, the nodes near it fixed) and its own second-order sweeps on one thread, the sources on
+``threads`` threads at once with the GIL released (``tubesweep_core::second_order::many``). Each
+row is the single ``tube.solve([source], order=2)`` of that source bit for bit, read at ``at`` as
+``sol(at)`` reads it (the factored form near the source). Memory: one band's working arrays per
+thread, the tube's geometry once, and the K × M values (nothing of size sources × band nodes
+with ``at``).
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
+from ._validate import FRONT_WINDOW, as_sources
+from . import second_order as so
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .tube import Tube
+
+__all__ = ["solve_many_order2"]
+
+
+def renamed(e: ValueError, k: int, group: bool) -> ValueError:
+    """A source error of a single solve (which numbers the points of one solve) renamed to the
+    source's place among the K: ``sources[k]`` or ``sources[k][j]``."""
+    text = re.sub(r"sources\[(\d+)\]", (lambda m: f"sources[{k}][{m.group(1)}]") if group else f"sources[{k}]", str(e))
+    return ValueError(text)
+
+
+def solve_many_order2(
+    tube: "Tube",
+    groups: List[np.ndarray],
+    *,
+    points: Optional[np.ndarray],
+    speed: Any,
+    tol: Optional[float],
+    max_iterations: int,
+    progress: Optional[Callable[[int, int], Any]],
+    threads: int,
+) -> Tuple[np.ndarray, Dict[str, Any]]:
+    """The second-order batch (see the module's documentation): ``(values, stats)``, values
+    ``(K, band_points)`` or ``(K, M)`` at ``points``. Raises :class:`second_order.Order2NotApplicable`
+    where ``order=2`` does not apply to the tube (the caller falls back under ``order="auto"``)."""
+    t = tube._tube
+    grid, surf = t.grid, t.surface
+    h = grid.spacing
+    d = grid.ndim
+    inputs = so.tube_inputs(t, speed, tol)
+    srcs: List[np.ndarray] = []
+    names: List[str] = []
+    for k, g in enumerate(groups):
+        try:
+            srcs.append(as_sources(g, grid))
+        except ValueError as e:
+            raise renamed(e, k, len(g) > 1) from None
+        names.extend([f"sources[{k}]"] if len(g) == 1 else [f"sources[{k}][{j}]" for j in range(len(g))])
+    every = np.ascontiguousarray(np.concatenate(srcs), dtype=float)
+    offsets = np.concatenate([[0], np.cumsum([len(s) for s in srcs])]).astype(np.int64)
+    feet, src_slowness = so.source_feet(surf, grid, every, t.inner * h, speed, names)
+    at_feet = None
+    if points is not None:
+        points = np.ascontiguousarray(points, dtype=float)
+        at_feet = points
+        if inputs.exact_feet:
+            # the points' closest points (used within the reach of a source only, as sol(points));
+            # a point the surface cannot project is never within that reach
+            with np.errstate(invalid="ignore", over="ignore"):
+                d_surface, proj = surf.project(points, grid)
+            d_surface = np.asarray(d_surface, dtype=float)
+            proj = np.asarray(proj, dtype=float)
+            keep = (d_surface <= 1e-9 * h) | ~np.all(np.isfinite(proj), axis=1)
+            at_feet = np.ascontiguousarray(np.where(keep[:, None], points, proj))
+    try:
+        values, st = _native.second_order_solve_many(
+            t.band,
+            np.ascontiguousarray(t.roles),
+            np.ascontiguousarray(t.geom.signed, dtype=np.float64),  # type: ignore[union-attr]
+            inputs.directions,
+            [float(c) for c in grid.lower],
+            h,
+            feet,
+            src_slowness,
+            offsets,
+            inputs.slowness,
+            so.FIX_RADIUS * h,
+            t.outer_eff * h,
+            inputs.tol_first,
+            inputs.tol,
+            int(max_iterations),
+            progress,
+            threads=threads,
+            front_window=FRONT_WINDOW if d == 3 else 0.0,
+            own_first_phase=so._OWN_FIRST_PHASE,
+            cp_offsets=inputs.offsets,
+            window_first=so.WINDOWS[0] if d == 3 else 0.0,
+            window_second=so.WINDOWS[1] if d == 3 else 0.0,
+            ramp_length=inputs.length,
+            extension_limit=so.EXTENSION_LIMIT,
+            at=points,
+            at_feet=at_feet,
+            reach_spacings=FACTORED_RADIUS,
+            reach_curvature_radii=FACTORED_CURVATURE_RADII if inputs.exact_feet else 0.0,
+        )
+    except ValueError as e:
+        if "order=2" in str(e):
+            raise so.Order2NotApplicable(str(e)) from None
+        raise
+    st = dict(st)
+    st["tol"] = inputs.tol
+    for name, what in (
+        (
+            "converged",
+            "did not converge in max_iterations={m}: their rows are the last iterate. Increase max_iterations or tol",
+        ),
+        (
+            "runaway_iteration",
+            "ran away (a travel time fell below zero): their rows are the first-order factored solution (order 1); a finer grid or order=1 avoids it",
+        ),
+    ):
+        bad = np.flatnonzero(~st["converged"]) if name == "converged" else np.flatnonzero(st[name] >= 0)
+        if bad.size:
+            warnings.warn(
+                f"order=2: {bad.size} of {len(groups)} solves "
+                + what.format(m=max_iterations)
+                + f" (sources {bad[:5].tolist()}{'…' if bad.size > 5 else ''})",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+    return values, st
