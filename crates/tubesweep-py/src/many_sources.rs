@@ -354,6 +354,7 @@ fn run_order2<'py, const D: usize>(
             directions,
             lower,
             inp.spacing,
+            inp.outer_width,
             &[],
             &[],
             inp.fix_radius,
