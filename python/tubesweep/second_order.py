@@ -139,8 +139,9 @@ def check_supported(
         )
     kind = type(surf).__name__
     if isinstance(surf, ClosestPoint) and getattr(surf, "open_surface", False):
+        why = getattr(surf, "order2_refusal", None)
         raise Order2NotApplicable(
-            f"order=2 needs a closed surface: {kind} is open, and beyond its boundary rim the closest points lie on "
+            f"order=2 needs a closed surface: {kind} is open{f' ({why})' if why else ''}, and beyond its boundary rim the closest points lie on "
             "the boundary curve, where the corrected equation does not hold (the rim is not second order). "
             "Use order=1 for it"
         )

@@ -1,11 +1,12 @@
 //! Surfaces: how the solver evaluates Σ at grid nodes — exact signed distances of the analytic
 //! surfaces (level sets, paper Sect. 4), closest points on meshes and on the library's open
-//! surfaces (the closest-point representation, Sect. 5.2), and closest points on the zero level
-//! set of a sampled φ (re-distancing). A new kind of surface is one more file here, evaluated
-//! in bulk on the candidate nodes the band's search hands it (see [`crate::band`]).
+//! surfaces (the closest-point representation, Sect. 5.2), closest points on the zero level set
+//! of a sampled φ (re-distancing), and on point clouds (moving-least-squares projection,
+//! `point_cloud/`). A new kind of surface is one more file here, evaluated in bulk on the candidate nodes the band's search hands it (see [`crate::band`]).
 
 pub mod analytic;
 pub mod mesh;
 pub mod mobius;
 pub mod open_surfaces;
+pub mod point_cloud;
 pub mod redistance;
