@@ -3,7 +3,9 @@
 
 use crate::convert::*;
 use crate::errors::to_pyerr;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use tubesweep_core::surface::point_cloud::{PointCloud, SampleAnalysis};
@@ -43,7 +45,12 @@ impl PyPointCloud {
                 let r = rows::<3>(p);
                 Cloud::Three(py.detach(|| PointCloud::new(r, neighbours)).map_err(to_pyerr)?)
             }
-            _ => return Err(PyValueError::new_err(format!("points must have shape (M, 2) or (M, 3); got {:?}", points.shape()))),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "points must have shape (M, 2) or (M, 3); got {:?}",
+                    points.shape()
+                )))
+            }
         };
         Ok(PyPointCloud { cloud })
     }
@@ -109,21 +116,24 @@ impl PyPointCloud {
     }
 
     /// Closest points (M, d) of `points` and per point 0 (interior), 1 (moved to the rim) or 2
-    /// (no fit: NaN), in parallel.
+    /// (no fit: NaN), in parallel; `rho` is the smoothing radius (fits over at least the samples
+    /// within it).
+    #[pyo3(signature = (points, rho = 0.0))]
     fn closest<'py>(
         &self,
         py: Python<'py>,
         points: PyReadonlyArray2<'py, f64>,
+        rho: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
         let (cp, feet, d) = match &self.cloud {
             Cloud::Two(c) => {
                 let x = rows::<2>(points_slice(&points, 2)?);
-                let (cp, f) = py.detach(|| c.closest_points(&x));
+                let (cp, f) = py.detach(|| c.closest_points(&x, rho));
                 (flat(cp), f, 2)
             }
             Cloud::Three(c) => {
                 let x = rows::<3>(points_slice(&points, 3)?);
-                let (cp, f) = py.detach(|| c.closest_points(&x));
+                let (cp, f) = py.detach(|| c.closest_points(&x, rho));
                 (flat(cp), f, 3)
             }
         };
@@ -134,7 +144,11 @@ impl PyPointCloud {
     }
 
     /// Lower bounds of the distances from `points` to the surface (for the band search).
-    fn lower_bounds<'py>(&self, py: Python<'py>, points: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn lower_bounds<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let out = match &self.cloud {
             Cloud::Two(c) => {
                 let x = rows::<2>(points_slice(&points, 2)?);

@@ -41,6 +41,10 @@ DEFAULT_NEIGHBOURS = 20
 #: A sample whose residual against its neighbours' fit exceeds this fraction of the fit's radius is
 #: an outlier (``tubesweep_core::surface::point_cloud::OUTLIER_RATIO``).
 OUTLIER_RATIO = 0.5
+#: On a noisy cloud (noise above NOISY·Δx) the fits reach at least FIT_RADIUS grid spacings
+#: (docs/point-clouds.md).
+FIT_RADIUS = 3.0
+NOISY = 0.005
 #: More outliers than this share of the samples: refused (the cloud is not a surface's samples).
 MAX_OUTLIER_SHARE = 0.1
 #: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
@@ -242,7 +246,9 @@ class PointCloudSurface(ClosestPoint):
             raise TypeError(f"neighbours must be a whole number; got {neighbours!r}")
         low = 5 if d == 2 else 8
         if not low <= int(neighbours) <= 100:
-            raise ValueError(f"neighbours must be between {low} and 100 (the fit has {3 if d == 2 else 6} coefficients); got {neighbours}")
+            raise ValueError(
+                f"neighbours must be between {low} and 100 (the fit has {3 if d == 2 else 6} coefficients); got {neighbours}"
+            )
         if outliers not in ("remove", "raise"):
             raise ValueError(f"outliers must be 'remove' or 'raise'; got {outliers!r}")
         if normals is not None:
@@ -312,6 +318,8 @@ class PointCloudSurface(ClosestPoint):
         self.rim = np.flatnonzero(cloud.rim)
         self.open_surface = rim_count > 0
         self.spacing = float(np.median(spacing))
+        #: the samples' noise: 1.4826 × the median distance of a sample from its neighbours' fit
+        self.noise = 1.4826 * float(np.nanmedian(residual * radius))
         q05, q95 = np.quantile(radius, [0.05, 0.95])
         self.report: Dict[str, Any] = {
             "samples": given,
@@ -319,6 +327,7 @@ class PointCloudSurface(ClosestPoint):
             "outliers": len(self.outliers),
             "rim_samples": rim_count,
             "spacing": self.spacing,
+            "noise": self.noise,
             "density_ratio": float(q95 / q05) ** d if q05 > 0 else float("inf"),
         }
         #: why order=2 does not apply (second_order.check_supported), or None
@@ -329,10 +338,12 @@ class PointCloudSurface(ClosestPoint):
                 f"the point cloud has a rim (a hole or a boundary: {rim_count} samples, e.g. at {where}; "
                 "surface.rim lists them)"
             )
+        #: the smoothing radius ρ of the fits (set by the last band to FIT_RADIUS·Δx; 0 before)
+        self.smoothing = 0.0
         self._cp = self._closest
 
     def _closest(self, x: np.ndarray) -> np.ndarray:
-        cp, _ = self._tree.closest(np.ascontiguousarray(x, dtype=float))
+        cp, _ = self._tree.closest(np.ascontiguousarray(x, dtype=float), self.smoothing)
         return cp
 
     def __getstate__(self) -> dict:
@@ -349,7 +360,9 @@ class PointCloudSurface(ClosestPoint):
         self.__dict__.update(state)
         self._tree = _native.PointCloud(np.ascontiguousarray(self.points), self.neighbours)
         if len(self.rim):
-            self._tree.mark_rim(np.ascontiguousarray(np.where(np.isin(np.arange(len(self.points)), self.rim), 9.0, 0.0)))
+            self._tree.mark_rim(
+                np.ascontiguousarray(np.where(np.isin(np.arange(len(self.points)), self.rim), 9.0, 0.0))
+            )
         self._cp = self._closest
 
     def __repr__(self) -> str:
@@ -404,13 +417,17 @@ class PointCloudSurface(ClosestPoint):
                 f"Use a grid with spacing ≥ {self.spacing / SPARSE_FACTOR:.3g} (e.g. surface.grid(n) with a smaller n) "
                 "or denser samples"
             )
+        # on a noisy cloud the fits reach at least FIT_RADIUS·Δx: the noise is averaged over the
+        # samples within it (a fit over the k nearest alone has a curvature of noise/r², which
+        # makes the projection from the tube's far nodes unstable)
+        self.smoothing = FIT_RADIUS * h if self.noise > NOISY * h else 0.0
         candidates = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self._far_distance(p))
         parts: list = []
         undefined = []
         for s0 in range(0, len(candidates), CHUNK):
             lin = candidates[s0 : s0 + CHUNK]
             x = grid.node_points(lin)
-            cp, feet = self._tree.closest(np.ascontiguousarray(x))
+            cp, feet = self._tree.closest(np.ascontiguousarray(x), self.smoothing)
             norm = row_norms(x - cp)
             keep = norm <= half_width  # False where the fit failed (NaN)
             undefined.append(lin[~np.isfinite(norm)])
@@ -423,7 +440,7 @@ class PointCloudSurface(ClosestPoint):
         self.report["rim_nodes"] = int(np.count_nonzero(feet == 1))
         # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|
         pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)
-        again, _ = self._tree.closest(np.ascontiguousarray(cp[pick]))
+        again, _ = self._tree.closest(np.ascontiguousarray(cp[pick]), self.smoothing)
         self._noise = float(np.quantile(row_norms(again - cp[pick]), 0.9))
         self._band_cache = (x, cp)
         ok = norm > DIRECTION_EPS * h
@@ -461,7 +478,7 @@ class PointCloudSurface(ClosestPoint):
             return cache[1].copy()  # the band's nodes again (the second-order geometry)
         out = np.empty_like(p)
         for s0 in range(0, len(p), CHUNK):
-            out[s0 : s0 + CHUNK], _ = self._tree.closest(p[s0 : s0 + CHUNK])
+            out[s0 : s0 + CHUNK], _ = self._tree.closest(p[s0 : s0 + CHUNK], self.smoothing)
         return out
 
     # ------------------------------------------------------------------ conveniences

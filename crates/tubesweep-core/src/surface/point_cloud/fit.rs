@@ -4,9 +4,9 @@
 //! (a parabola for a curve); then the projection of a point onto the graph of that height function
 //! by Newton's method.
 //!
-//! Continuity: the support radius R is the distance from c to the (k+1)-th nearest sample, which
-//! gets weight 0, so the weights, the frame and the coefficients are continuous in c (a sample
-//! enters or leaves the neighbourhood with weight 0).
+//! Continuity: the support radius R is the larger of the distance from c to the (k+1)-th nearest
+//! sample (which gets weight 0) and a fixed smoothing radius ρ, so the weights, the frame and the
+//! coefficients are continuous in c (a sample enters or leaves the neighbourhood with weight 0).
 
 /// The number of basis functions of the height function: 1, a, a² (curves); 1, a, b, a², ab, b².
 pub(crate) const fn basis_len(d: usize) -> usize {
@@ -128,27 +128,25 @@ fn basis<const D: usize>(a: &[f64; 2]) -> [f64; 6] {
 }
 
 impl<const D: usize> Fit<D> {
-    /// The weighted fit to `neighbours` (sorted by distance to `centre`, the last one defining the
-    /// support radius and getting weight 0). `None` when the neighbourhood is degenerate (all its
-    /// weighted samples on a line in 3D, or coincident).
-    pub(crate) fn new(neighbours: &[[f64; D]], centre: &[f64; D]) -> Option<Self> {
+    /// The weighted fit to `neighbours` (the samples within `radius` of `centre`: weight
+    /// ψ(|p − c| / radius)). `None` when the neighbourhood is degenerate (all its weighted samples
+    /// on a line in 3D, or coincident).
+    pub(crate) fn new(neighbours: &[[f64; D]], centre: &[f64; D], radius: f64) -> Option<Self> {
         let n = neighbours.len();
         if n < basis_len(D) + 1 {
             return None;
         }
-        let radius = distance(&neighbours[n - 1], centre);
         if !(radius > 0.0 && radius.is_finite()) {
             return None;
         }
-        let mut w = [0.0; 128];
-        let n = n.min(128);
+        let weight = |i: usize| wendland(distance(&neighbours[i], centre) / radius);
         let mut wsum = 0.0;
         let mut mean = [0.0; D];
         for i in 0..n {
-            w[i] = wendland(distance(&neighbours[i], centre) / radius);
-            wsum += w[i];
+            let w = weight(i);
+            wsum += w;
             for k in 0..D {
-                mean[k] += w[i] * neighbours[i][k];
+                mean[k] += w * neighbours[i][k];
             }
         }
         if !(wsum > 0.0) {
@@ -159,10 +157,11 @@ impl<const D: usize> Fit<D> {
         }
         let mut cov = [[0.0; D]; D];
         for i in 0..n {
+            let w = weight(i);
             for p in 0..D {
                 let dp = neighbours[i][p] - mean[p];
                 for q in p..D {
-                    cov[p][q] += w[i] * dp * (neighbours[i][q] - mean[q]);
+                    cov[p][q] += w * dp * (neighbours[i][q] - mean[q]);
                 }
             }
         }
@@ -187,15 +186,16 @@ impl<const D: usize> Fit<D> {
         let mut ata = [[0.0; 6]; 6];
         let mut atb = [0.0; 6];
         for i in 0..n {
-            if w[i] == 0.0 {
+            let w = weight(i);
+            if w == 0.0 {
                 continue;
             }
             let (a, h) = local(&frame, &mean, radius, &neighbours[i]);
             let phi = basis::<D>(&a);
             for p in 0..nb {
-                atb[p] += w[i] * phi[p] * h;
+                atb[p] += w * phi[p] * h;
                 for q in p..nb {
-                    ata[p][q] += w[i] * phi[p] * phi[q];
+                    ata[p][q] += w * phi[p] * phi[q];
                 }
             }
         }
@@ -231,7 +231,10 @@ impl<const D: usize> Fit<D> {
             )
         } else {
             let g = c[0] + c[1] * a[0] + c[2] * a[1] + c[3] * a[0] * a[0] + c[4] * a[0] * a[1] + c[5] * a[1] * a[1];
-            let grad = [c[1] + 2.0 * c[3] * a[0] + c[4] * a[1], c[2] + c[4] * a[0] + 2.0 * c[5] * a[1]];
+            let grad = [
+                c[1] + 2.0 * c[3] * a[0] + c[4] * a[1],
+                c[2] + c[4] * a[0] + 2.0 * c[5] * a[1],
+            ];
             (g, grad, [[2.0 * c[3], c[4]], [c[4], 2.0 * c[5]]])
         }
     }
@@ -250,11 +253,22 @@ impl<const D: usize> Fit<D> {
     }
 
     /// The tangent coordinates of the point of the graph nearest to `x` (Newton's method on
-    /// ½|a − a₀|² + ½(g(a) − h₀)², Gauss–Newton where its Hessian is not positive).
+    /// f(a) = ½|a − a₀|² + ½(g(a) − h₀)², Gauss–Newton where its Hessian is not positive, each step
+    /// halved until f decreases), within the fit's support (|a| ≤ 1 in units of its radius: beyond,
+    /// the quadric means nothing, and the fixed point moves the centre there instead).
     pub(crate) fn project(&self, x: &[f64; D]) -> [f64; 2] {
         let (a0, h0) = self.local(x);
-        let mut a = a0;
         let m = D - 1;
+        let objective = |a: &[f64; 2]| {
+            let (g, _, _) = self.height(a);
+            let mut s = (g - h0) * (g - h0);
+            for p in 0..m {
+                s += (a[p] - a0[p]) * (a[p] - a0[p]);
+            }
+            0.5 * s
+        };
+        let mut a = inside_support(a0);
+        let mut fa = objective(&a);
         for _ in 0..NEWTON_STEPS {
             let (g, dg, hg) = self.height(&a);
             let r = g - h0;
@@ -276,12 +290,20 @@ impl<const D: usize> Fit<D> {
                 step = solve_small(&hess, &grad, m);
             }
             let Some(s) = step else { break };
-            let mut size = 0.0;
-            for p in 0..m {
-                a[p] -= s[p];
-                size += s[p] * s[p];
+            let mut t = 1.0;
+            let mut moved = false;
+            for _ in 0..30 {
+                let trial = inside_support([a[0] - t * s[0], if m == 2 { a[1] - t * s[1] } else { 0.0 }]);
+                let ft = objective(&trial);
+                if ft <= fa {
+                    moved = (trial[0] - a[0]).abs() + (trial[1] - a[1]).abs() > 1e-15;
+                    a = trial;
+                    fa = ft;
+                    break;
+                }
+                t *= 0.5;
             }
-            if size <= 1e-28 {
+            if !moved {
                 break;
             }
         }
@@ -289,8 +311,19 @@ impl<const D: usize> Fit<D> {
     }
 }
 
+/// `a` moved radially into the unit disc (the fit's support in scaled coordinates).
+#[inline]
+fn inside_support(a: [f64; 2]) -> [f64; 2] {
+    let r = (a[0] * a[0] + a[1] * a[1]).sqrt();
+    if r > 1.0 {
+        [a[0] / r, a[1] / r]
+    } else {
+        a
+    }
+}
+
 /// Newton steps of [`Fit::project`].
-const NEWTON_STEPS: usize = 8;
+const NEWTON_STEPS: usize = 12;
 
 #[inline]
 fn local<const D: usize>(frame: &[[f64; D]; D], origin: &[f64; D], radius: f64, x: &[f64; D]) -> ([f64; 2], f64) {
@@ -314,7 +347,10 @@ fn solve_small(h: &[[f64; 2]; 2], g: &[f64; 2], m: usize) -> Option<[f64; 2]> {
     if !(h[0][0] > 0.0 && det > 1e-14 * h[0][0] * h[1][1]) {
         return None;
     }
-    Some([(h[1][1] * g[0] - h[0][1] * g[1]) / det, (h[0][0] * g[1] - h[1][0] * g[0]) / det])
+    Some([
+        (h[1][1] * g[0] - h[0][1] * g[1]) / det,
+        (h[0][0] * g[1] - h[1][0] * g[0]) / det,
+    ])
 }
 
 /// Cholesky solve of the normal equations (n ≤ 6), a tiny ridge on the diagonal for
@@ -398,7 +434,8 @@ pub(crate) fn clamp_to_hull<const D: usize>(a: &[f64; 2], pts: &[[f64; 2]]) -> [
     if p.len() < 3 {
         return *a;
     }
-    let cross = |o: &[f64; 2], x: &[f64; 2], y: &[f64; 2]| (x[0] - o[0]) * (y[1] - o[1]) - (x[1] - o[1]) * (y[0] - o[0]);
+    let cross =
+        |o: &[f64; 2], x: &[f64; 2], y: &[f64; 2]| (x[0] - o[0]) * (y[1] - o[1]) - (x[1] - o[1]) * (y[0] - o[0]);
     let mut hull: Vec<[f64; 2]> = Vec::with_capacity(2 * p.len());
     for pass in 0..2 {
         let start = hull.len();

@@ -30,9 +30,9 @@ pub const DEFAULT_NEIGHBOURS: usize = 20;
 /// A sample whose leave-one-out residual exceeds this fraction of its fit's radius is an outlier.
 pub const OUTLIER_RATIO: f64 = 0.5;
 /// Angular gap (radians) among a sample's 2k nearest neighbours in its tangent plane above which
-/// the sample lies on a rim (160°; interior samples of a random cloud reach it with probability
-/// about 40·(1 − 160/360)³⁹ ≈ 1e-9).
-pub const RIM_GAP: f64 = 160.0 / 180.0 * std::f64::consts::PI;
+/// the sample lies on a rim (120°; an interior sample of a uniformly random cloud reaches it with
+/// probability about 40·(1 − 120/360)³⁹ ≈ 6e-6, and then rarely with two more beside it).
+pub const RIM_GAP: f64 = 120.0 / 180.0 * std::f64::consts::PI;
 /// A rim sample counts only with at least this many rim samples among its k nearest neighbours (a
 /// rim is a curve of samples; in 3D only).
 pub const RIM_CLUSTER: usize = 2;
@@ -72,7 +72,7 @@ pub struct SampleAnalysis {
 struct Candidates<const D: usize> {
     anchor: [f64; D],
     radius: f64,
-    points: Vec<(f64, [f64; D])>,
+    points: Vec<(f64, u32)>,
 }
 
 impl<const D: usize> Default for Candidates<D> {
@@ -91,6 +91,8 @@ pub struct PointCloud<const D: usize> {
     tree: ImmutableKdTree<f64, u32, D, 32>,
     neighbours: usize,
     rim: Vec<bool>,
+    /// The rim samples and their neighbours (where a foot may leave the samples' hull).
+    rim_zone: Vec<bool>,
     has_rim: bool,
     /// An upper bound of the distance from a point of the surface to its nearest sample.
     reach: f64,
@@ -103,7 +105,10 @@ impl<const D: usize> PointCloud<D> {
         if neighbours < need || neighbours > 100 {
             return Err(Error::invalid(
                 "neighbours",
-                format!("must be between {need} and 100 (the fit has {} coefficients); got {neighbours}", basis_len(D)),
+                format!(
+                    "must be between {need} and 100 (the fit has {} coefficients); got {neighbours}",
+                    basis_len(D)
+                ),
             ));
         }
         if points.len() < neighbours + 2 {
@@ -121,7 +126,10 @@ impl<const D: usize> PointCloud<D> {
             return Err(Error::invalid("points", "at most 2³² − 1 samples"));
         }
         if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(Error::invalid("points", format!("sample {i} is not finite: {:?}", points[i])));
+            return Err(Error::invalid(
+                "points",
+                format!("sample {i} is not finite: {:?}", points[i]),
+            ));
         }
         let tree = ImmutableKdTree::new_from_slice(&points);
         let rim = vec![false; points.len()];
@@ -129,6 +137,7 @@ impl<const D: usize> PointCloud<D> {
             points,
             tree,
             neighbours,
+            rim_zone: rim.clone(),
             rim,
             has_rim: false,
             reach: 0.0,
@@ -173,15 +182,6 @@ impl<const D: usize> PointCloud<D> {
         &self.rim
     }
 
-    /// The `count` nearest samples of `c`, nearest first.
-    fn nearest(&self, c: &[f64; D], count: usize) -> Vec<[f64; D]> {
-        self.tree
-            .nearest_n::<SquaredEuclidean>(c, NonZero::new(count).unwrap())
-            .iter()
-            .map(|n| self.points[n.item as usize])
-            .collect()
-    }
-
     /// The per-sample analysis (in parallel).
     pub fn analyse(&self) -> SampleAnalysis {
         let k = self.neighbours;
@@ -189,7 +189,9 @@ impl<const D: usize> PointCloud<D> {
             .into_par_iter()
             .map(|i| {
                 let p = &self.points[i];
-                let many = self.tree.nearest_n::<SquaredEuclidean>(p, NonZero::new(2 * k + 1).unwrap());
+                let many = self
+                    .tree
+                    .nearest_n::<SquaredEuclidean>(p, NonZero::new(2 * k + 1).unwrap());
                 let others: Vec<[f64; D]> = many
                     .iter()
                     .filter(|n| n.item as usize != i)
@@ -198,7 +200,7 @@ impl<const D: usize> PointCloud<D> {
                 let spacing = others.first().map_or(f64::NAN, |o| distance(o, p));
                 let own = &others[..(k + 1).min(others.len())];
                 let radius = own.last().map_or(f64::NAN, |o| distance(o, p));
-                match Fit::new(own, p) {
+                match Fit::new(own, p, radius) {
                     Some(fit) => {
                         let a = fit.project(p);
                         let residual = distance(&fit.lift(&a), p) / fit.radius;
@@ -243,92 +245,118 @@ impl<const D: usize> PointCloud<D> {
                 .collect()
         };
         let count = rim.iter().filter(|&&r| r).count();
+        // the rim's zone: the 2k + 1 nearest samples of every rim sample, where feet are clamped
+        let mut zone = rim.clone();
+        let kc = NonZero::new(2 * self.neighbours + 1).unwrap();
+        for (i, _) in rim.iter().enumerate().filter(|(_, &r)| r) {
+            for n in self.tree.nearest_n::<SquaredEuclidean>(&self.points[i], kc) {
+                zone[n.item as usize] = true;
+            }
+        }
+        self.rim_zone = zone;
         self.rim = rim;
         self.has_rim = count > 0;
         Ok(count)
     }
 
     /// The closest point of `x` on the cloud's surface and what was found.
-    pub fn closest_point(&self, x: &[f64; D]) -> ([f64; D], Foot) {
-        self.closest_point_from(x, *x, &mut Candidates::default())
+    /// `rho` is the smoothing radius ρ (0: the k nearest samples only).
+    pub fn closest_point(&self, x: &[f64; D], rho: f64) -> ([f64; D], Foot) {
+        self.closest_point_from(x, *x, rho, &mut Candidates::default())
     }
 
-    /// The k + 1 nearest samples of `c`, from `cache` (the 2k + 1 nearest samples of an anchor)
-    /// while they are provably the nearest: |c − anchor| + r_{k+1}(c) ≤ the cache's radius; else
-    /// the cache is queried again around `c`.
-    fn neighbourhood(&self, c: &[f64; D], cache: &mut Candidates<D>, out: &mut Vec<[f64; D]>) {
+    /// The neighbourhood of `c` (into `out`) and its radius R = max(r_{k+1}(c), ρ): the samples
+    /// within R. They come from `cache` (every sample within the cache's radius of an anchor: the
+    /// 2k + 1 nearest, or all within 2ρ when that is more) while |c − anchor| + R ≤ the cache's
+    /// radius, which proves it holds them all; else the cache is queried again around `c`.
+    fn neighbourhood(&self, c: &[f64; D], rho: f64, cache: &mut Candidates<D>, out: &mut Vec<[f64; D]>) -> (f64, bool) {
         let k1 = self.neighbours + 1;
         let kc = 2 * self.neighbours + 1;
+        let mut radius = 0.0;
         for attempt in 0..2 {
             if attempt == 1 || cache.points.is_empty() || distance(c, &cache.anchor) >= cache.radius {
                 cache.anchor = *c;
-                cache.points = self.nearest(c, kc).into_iter().map(|p| (0.0, p)).collect();
-                cache.radius = distance(c, &cache.points[kc - 1].1);
+                cache.points = self
+                    .tree
+                    .nearest_n::<SquaredEuclidean>(c, NonZero::new(kc).unwrap())
+                    .iter()
+                    .map(|n| (0.0, n.item))
+                    .collect();
+                cache.radius = distance(c, &self.points[cache.points[kc - 1].1 as usize]);
+                if cache.radius < 2.0 * rho {
+                    cache.radius = 2.0 * rho;
+                    cache.points = self
+                        .tree
+                        .within_unsorted::<SquaredEuclidean>(c, cache.radius * cache.radius)
+                        .iter()
+                        .map(|n| (0.0, n.item))
+                        .collect();
+                }
             }
             for e in cache.points.iter_mut() {
-                e.0 = distance(&e.1, c);
+                e.0 = distance(&self.points[e.1 as usize], c);
             }
             cache.points.select_nth_unstable_by(k1 - 1, |p, q| p.0.total_cmp(&q.0));
-            if distance(c, &cache.anchor) + cache.points[k1 - 1].0 <= cache.radius || attempt == 1 {
+            radius = cache.points[k1 - 1].0.max(rho);
+            if distance(c, &cache.anchor) + radius <= cache.radius || attempt == 1 {
                 break;
             }
         }
-        cache.points[..k1].sort_unstable_by(|p, q| p.0.total_cmp(&q.0));
         out.clear();
-        out.extend(cache.points[..k1].iter().map(|e| e.1));
+        let mut rim = false;
+        for e in cache.points.iter().filter(|e| e.0 < radius) {
+            out.push(self.points[e.1 as usize]);
+            rim |= self.rim_zone[e.1 as usize];
+        }
+        (radius, rim)
     }
 
     /// [`PointCloud::closest_point`] from the first centre `start` (x, or the foot of a nearby
     /// point), with a cache of candidate neighbours shared by nearby queries. The answer is the
     /// fixed point to [`TOLERANCE`], whatever the start near it.
-    fn closest_point_from(&self, x: &[f64; D], start: [f64; D], cache: &mut Candidates<D>) -> ([f64; D], Foot) {
+    fn closest_point_from(
+        &self,
+        x: &[f64; D],
+        start: [f64; D],
+        rho: f64,
+        cache: &mut Candidates<D>,
+    ) -> ([f64; D], Foot) {
         let mut c = start;
         let mut foot = [f64::NAN; D];
-        let mut a = [0.0; 2];
         let mut nb: Vec<[f64; D]> = Vec::with_capacity(self.neighbours + 1);
-        let mut fit = None;
+        let mut on_rim = false;
         for it in 0..MAX_ITERATIONS {
-            self.neighbourhood(&c, cache, &mut nb);
-            let Some(f) = Fit::new(&nb, &c) else {
+            let (radius, near_rim) = self.neighbourhood(&c, rho, cache, &mut nb);
+            let Some(f) = Fit::new(&nb, &c, radius) else {
                 return ([f64::NAN; D], Foot::Failed);
             };
-            a = f.project(x);
+            let mut a = f.project(x);
+            on_rim = false;
+            if near_rim {
+                // an open cloud: the foot stays within the hull of its neighbours in the tangent
+                // plane, so beyond the rim the closest point lies on it
+                let pts: Vec<[f64; 2]> = nb.iter().map(|p| f.local(p).0).collect();
+                let clamped = clamp_to_hull::<D>(&a, &pts);
+                on_rim = clamped != a;
+                a = clamped;
+            }
             foot = f.lift(&a);
             let moved = distance(&foot, &c);
-            fit = Some(f);
             c = foot;
             if it > 0 && moved <= TOLERANCE * f.radius {
                 break;
             }
         }
-        let Some(f) = fit else {
-            return ([f64::NAN; D], Foot::Failed);
-        };
         if !foot.iter().all(|v| v.is_finite()) {
             return ([f64::NAN; D], Foot::Failed);
         }
-        if self.has_rim {
-            let k1 = self.neighbours + 1;
-            let ids = self.tree.nearest_n::<SquaredEuclidean>(&c, NonZero::new(k1).unwrap());
-            if ids.iter().any(|n| self.rim[n.item as usize]) {
-                // the neighbours with positive weight (all but the farthest)
-                let pts: Vec<[f64; 2]> = ids[..ids.len() - 1]
-                    .iter()
-                    .map(|n| f.local(&self.points[n.item as usize]).0)
-                    .collect();
-                let clamped = clamp_to_hull::<D>(&a, &pts);
-                if clamped != a {
-                    return (f.lift(&clamped), Foot::Rim);
-                }
-            }
-        }
-        (foot, Foot::Interior)
+        (foot, if on_rim { Foot::Rim } else { Foot::Interior })
     }
 
     /// [`PointCloud::closest_point`] for many points, in parallel: in fixed blocks of
     /// [`BLOCK`] points (so the answer does not depend on the threads), each query starting from
     /// the previous point's foot when that point is near, sharing the candidate neighbours.
-    pub fn closest_points(&self, x: &[[f64; D]]) -> (Vec<[f64; D]>, Vec<Foot>) {
+    pub fn closest_points(&self, x: &[[f64; D]], rho: f64) -> (Vec<[f64; D]>, Vec<Foot>) {
         let per_block: Vec<Vec<([f64; D], Foot)>> = x
             .par_chunks(BLOCK)
             .map(|block| {
@@ -341,7 +369,7 @@ impl<const D: usize> PointCloud<D> {
                             Some((px, pf)) if pf[0].is_finite() && distance(&px, p) <= 2.0 * cache.radius => pf,
                             _ => *p,
                         };
-                        let r = self.closest_point_from(p, start, &mut cache);
+                        let r = self.closest_point_from(p, start, rho, &mut cache);
                         previous = Some((*p, r.0));
                         r
                     })
