@@ -139,7 +139,7 @@ def _read_text(path: Path, delimiter: Optional[str]) -> np.ndarray:
 
 def _read_ply(path: Path) -> np.ndarray:
     try:
-        from plyfile import PlyData  # type: ignore[import-not-found]
+        from plyfile import PlyData
 
         try:
             v = PlyData.read(str(path))["vertex"]
