@@ -317,8 +317,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
         surface = from_points(args.points)  # type: ignore[assignment]
         if args.lower is not None or args.upper is not None:
             raise UsageError("--points picks its grid from --n and --padding; do not give --lower/--upper")
-        grid = surface.grid(101 if args.n is None else args.n, padding=8.0 if args.padding is None else args.padding)  # type: ignore[attr-defined]
-        name = surface.name  # type: ignore[attr-defined]
+        grid = surface.grid(101 if args.n is None else args.n, padding=8.0 if args.padding is None else args.padding)
+        name = surface.name
         print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
     elif args.surface:
         from .surfaces import REGISTRY
