@@ -201,3 +201,18 @@ def test_pickled_cloud_gives_the_same_closest_points():
     again = pickle.loads(pickle.dumps(cloud))
     assert isinstance(again, PointCloudSurface)
     np.testing.assert_array_equal(again.closest_point(x), cloud.closest_point(x))
+
+
+def test_export_writes_the_samples_with_u(tmp_path):
+    cloud = from_points(sphere_cloud(3000))
+    sol = ts.solve(cloud, cube(31), sources=[cloud.points[0]])
+    text = ts.export(sol, tmp_path / "c.vtp").read_text()
+    assert 'NumberOfPoints="3000" NumberOfVerts="3000"' in text
+    pytest.importorskip("meshio")
+    import meshio
+
+    m = meshio.read(ts.export(sol, tmp_path / "c.ply"))
+    np.testing.assert_array_equal(m.points, cloud.points)
+    np.testing.assert_allclose(m.point_data["u"], sol(cloud.points), rtol=1e-12)
+    with pytest.raises(ValueError, match="written as .vtp or .ply"):
+        ts.export(sol, tmp_path / "c.vtu")
