@@ -115,6 +115,8 @@ bench: build
 	cargo run --release -q -p tubesweep-core --example upwind_sweep -- 161 1
 	# issue 35: the default thread count against threads=1 and all cores, quiet and with cores kept busy
 	$(PY) benches/under_load.py
+	# issue 45: point clouds against potpourri3d's PointCloudHeatSolver (docs/point-clouds.md)
+	$(PY) benches/point_clouds.py
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

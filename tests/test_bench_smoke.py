@@ -417,3 +417,19 @@ def test_under_load_bench_times_every_mode_on_the_same_values():
     times = under_load.rounds(21, 2, {"default": 0, "threads=1": 1})
     assert set(times) == {"default", "threads=1"}
     assert all(len(v) == 2 and all(t > 0 for t in v) for v in times.values())
+
+
+def test_point_clouds_bench_quick(capsys):
+    """benches/point_clouds.py --quick: the table's rows, tubesweep at order 2 on the closed clouds
+    and within a few times its measured errors."""
+    import point_clouds
+
+    rows = point_clouds.main(["--quick"])["rows"]
+    assert [r["cloud"] for r in rows] == ["sphere", "torus (outer equator)", "sphere, noise ±0.1Δx"]
+    sphere, torus, noisy = (r["tubesweep"] for r in rows)
+    assert sphere["order"] == 2 and sphere["mean"] < 2e-3
+    assert noisy["order"] == 2 and noisy["mean"] < 3e-3
+    assert torus["mean"] < 1e-2
+    if HAVE["potpourri3d"]:
+        assert all("heat" in r for r in rows)
+    assert "| sphere | 3,000 | 31 |" in capsys.readouterr().out

@@ -45,6 +45,7 @@ CASES = {
     "moving_medium": (41, ["moving_medium.png"]),
     "layered_travel_time": (101, ["layered_travel_time.png"]),
     "distance_matrix": (31, ["distance_matrix.png"]),
+    "point_cloud": (61, ["point_cloud.png"]),
 }
 
 
@@ -66,6 +67,8 @@ def test_example(name, tmp_path):
         assert abs(number(r"time to \(0, -1\): ([0-9.]+)", out) - 0.4) < 2 * h
     elif name == "distance_matrix":
         assert number(r"max error ([0-9.]+)", out) < 4 * h
+    elif name == "point_cloud":
+        assert "order 2" in out and number(r"outer equator: mean ([0-9.e-]+)", out) < 0.1 * h
     elif name == "torus_cells":
         shares = [float(x) for x in re.search(r"\[([0-9. ]+)\]", out).group(1).split()]
         assert abs(sum(shares) - 1) < 0.01 and min(shares) > 0.15

@@ -108,6 +108,12 @@ def build_parser() -> argparse.ArgumentParser:
         "for the bundled example meshes; used in the closest-point representation (Sect. 5.2): open and "
         "scanned meshes with holes are fine",
     )
+    src.add_argument(
+        "--points",
+        type=Path,
+        help="a point cloud file (.xyz .txt .csv .pts .npy .ply): closest points by moving least squares; "
+        "writes u at the samples to points.npz",
+    )
     p.add_argument(
         "--n",
         type=int,
@@ -376,6 +382,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
         grid = surface.grid(n, padding=8.0 if args.padding is None else args.padding)
         name = surface.name
         print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
+    elif args.points:
+        from .surfaces.points import from_points
+
+        surface = from_points(args.points)  # type: ignore[assignment]
+        if args.lower is not None or args.upper is not None:
+            raise UsageError("--points picks its grid from --n and --padding; do not give --lower/--upper")
+        grid = surface.grid(101 if args.n is None else args.n, padding=8.0 if args.padding is None else args.padding)
+        name = surface.name
+        print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
     elif args.surface:
         from .surfaces import REGISTRY
 
@@ -403,7 +418,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         raise UsageError("--smooth applies to --mask only")
     if args.redistance and not args.phi:
         raise UsageError("--redistance applies to --phi only (library surfaces and meshes are distances already)")
-    if args.padding is not None and not args.mesh:
+    if args.padding is not None and not (args.mesh or args.points):
         raise UsageError("--padding applies to --mesh only (a --surface or --phi grid is given by its box)")
     bad_arity = [len(p) for p in args.path_from or [] if len(p) != grid.ndim]
     if bad_arity:
@@ -484,6 +499,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
     if args.npz or not asked:
         _write_npz(out / "solution.npz", sol)
         print(f"wrote {out / 'solution.npz'}")
+    if args.points:
+        samples = surface.points  # type: ignore[attr-defined]
+        np.savez_compressed(out / "points.npz", points=samples, u=sol(samples))
+        print(f"wrote {out / 'points.npz'} (u at the {len(samples)} samples)")
     if args.dense:
         np.save(out / "solution_dense.npy", sol.to_dense())
         print(f"wrote {out / 'solution_dense.npy'}")

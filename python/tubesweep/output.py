@@ -34,9 +34,9 @@ EXPORT_FORMATS = (".vtu", ".vtp", ".vtk", ".ply", ".obj")
 # export
 # ---------------------------------------------------------------------------------------------
 def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Dict[str, np.ndarray]) -> None:
-    """VTK XML PolyData (ASCII): polygons for triangles, lines for segments."""
+    """VTK XML PolyData (ASCII): polygons for triangles, lines for segments, vertices for points."""
     n, m, k = len(points), len(cells), cells.shape[1]
-    kind = "Polys" if k >= 3 else "Lines"
+    kind = "Polys" if k >= 3 else "Lines" if k == 2 else "Verts"
 
     def arr(a: np.ndarray, fmt: str) -> str:
         return "\n".join(" ".join(fmt % x for x in row) for row in np.atleast_2d(a).reshape(len(a), -1))
@@ -67,7 +67,7 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
                 '<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n'
             )
             fh.write(
-                f'<Piece NumberOfPoints="{n}" NumberOfVerts="0" NumberOfLines="{m if kind == "Lines" else 0}" '
+                f'<Piece NumberOfPoints="{n}" NumberOfVerts="{m if kind == "Verts" else 0}" NumberOfLines="{m if kind == "Lines" else 0}" '
                 f'NumberOfStrips="0" NumberOfPolys="{m if kind == "Polys" else 0}">\n'
             )
             names = list(point_data)
@@ -230,8 +230,16 @@ def export(
     """
     path = Path(path)
     suffix = export_format(path)
-    v, cells = triangulate(sol, mesh=mesh)
-    u = sol.on_mesh(v)
+    cloud = mesh is None and hasattr(sol.surface, "rim") and hasattr(sol.surface, "points")
+    if cloud:
+        # a point cloud (surfaces.from_points): the samples, as vertices, with u at them
+        v = np.asarray(sol.surface.points, dtype=float)
+        cells = np.arange(len(v)).reshape(-1, 1)
+        if suffix not in (".vtp", ".ply"):
+            raise ValueError(f"a point cloud is written as .vtp or .ply; got {suffix}")
+    else:
+        v, cells = triangulate(sol, mesh=mesh)
+    u = sol.on_mesh(v) if not cloud else sol(v)
     u = np.where(np.isfinite(u), u, np.nan)
     data: Dict[str, np.ndarray] = {"u": u}
     if len(sol.sources) > 1 and sol._isotropic:
@@ -260,11 +268,11 @@ def export(
         _write_vtp(path, pts, cells, data)
         return path
     meshio = _need("meshio", "mesh", f"writing {suffix} files")
-    kind = {2: "line", 3: "triangle", 4: "quad"}[cells.shape[1]]
+    kind = {1: "vertex", 2: "line", 3: "triangle", 4: "quad"}[cells.shape[1]]
     export_format(path, curve=kind == "line")
     if suffix == ".ply" and len(pts) < 2**31:
         cells = cells.astype(np.int32)  # PLY has no 64-bit integers
-    m = meshio.Mesh(pts, [(kind, cells)], point_data={} if suffix == ".obj" else data)
+    m = meshio.Mesh(pts, [] if kind == "vertex" else [(kind, cells)], point_data={} if suffix == ".obj" else data)
     meshio.write(str(path), m, file_format={".vtk": "vtk", ".vtu": "vtu", ".ply": "ply", ".obj": "obj"}[suffix])
     return path
 

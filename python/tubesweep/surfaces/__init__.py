@@ -23,6 +23,9 @@ name (``REGISTRY``)       class              representation   exact geodesic dis
 ``mobius``                :class:`MobiusBand` cp (open, non-orientable)  none (tests use polyhedral geodesics)
 ========================  =================  ===============  =========================================
 
+Point clouds: :func:`from_points` (samples or a point file → :class:`PointCloudSurface`, closest
+points by moving least squares).
+
 ``REGISTRY`` maps the names used by the command line (``tubesweep solve --surface NAME``) to
 factories that build the default instance.
 """
@@ -35,6 +38,7 @@ from .closed import DoubleTorus, Ellipsoid, RoundedCube, Torus
 from .curves import Ellipse
 from .mesh import MeshSurface, from_mesh
 from .open import Disc, Hemisphere, MobiusBand, PlanePatch
+from .points import PointCloudSurface, from_points, read_points
 from ._repr import give_repr
 
 REGISTRY: Dict[str, Callable[[], Surface]] = {
@@ -71,5 +75,8 @@ __all__ = [
     "MobiusBand",
     "MeshSurface",
     "from_mesh",
+    "PointCloudSurface",
+    "from_points",
+    "read_points",
     "REGISTRY",
 ]

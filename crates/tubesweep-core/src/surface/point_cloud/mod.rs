@@ -1,0 +1,400 @@
+//! Point clouds as closest-point surfaces (paper Sect. 5.2): the closest point of x is its
+//! moving-least-squares projection onto local fits of the samples (`fit.rs`).
+//!
+//! The surface is the set of points y that lie on the fit centred at y itself (a weighted quadric
+//! height function over the k nearest samples of y, in their principal frame). The closest point of
+//! x is found by the fixed-point iteration c ← the projection of x onto the fit centred at c,
+//! starting from c = x; it stops when the foot moves by less than 1e-12 of the fit's radius (a few
+//! iterations in the tube). The weights are continuous in c, so the map is smooth at grid scale,
+//! which the second-order geometry needs (it differentiates x − cp(x) twice).
+//!
+//! Samples are analysed once (`analyse`): the distance to the nearest other sample (the spacing),
+//! the support radius, the leave-one-out residual of each sample against the fit of its neighbours
+//! (outliers), and the largest angular gap of its 2k nearest neighbours around it in the tangent
+//! plane (a gap wider than [`RIM_GAP`] marks a sample on a rim: a hole or the boundary of an open
+//! scan). On a cloud with a rim, a foot that leaves the convex hull of its neighbours in the
+//! tangent plane is moved back to the hull's boundary, so nodes beyond the rim get closest points
+//! on the rim, as for the library's open surfaces.
+
+mod fit;
+
+use crate::error::{Error, Result};
+use fit::{basis_len, clamp_to_hull, distance, largest_gap, Fit};
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
+use rayon::prelude::*;
+use std::num::NonZero;
+
+/// The default number of neighbours in a fit (measured in docs/point-clouds.md).
+pub const DEFAULT_NEIGHBOURS: usize = 20;
+/// A sample whose leave-one-out residual exceeds this fraction of its fit's radius is an outlier.
+pub const OUTLIER_RATIO: f64 = 0.5;
+/// Angular gap (radians) among a sample's 2k nearest neighbours in its tangent plane above which
+/// the sample lies on a rim (120°; an interior sample of a uniformly random cloud reaches it with
+/// probability about 40·(1 − 120/360)³⁹ ≈ 6e-6, and then rarely with two more beside it).
+pub const RIM_GAP: f64 = 120.0 / 180.0 * std::f64::consts::PI;
+/// A rim sample counts only with at least this many rim samples among its k nearest neighbours (a
+/// rim is a curve of samples; in 3D only).
+pub const RIM_CLUSTER: usize = 2;
+/// Queries per block of [`PointCloud::closest_points`].
+const BLOCK: usize = 256;
+/// Iterations of the fixed point c ← foot(x; fit at c).
+const MAX_ITERATIONS: usize = 12;
+/// The fixed point stops when the foot moves by less than this fraction of the fit's radius.
+const TOLERANCE: f64 = 1e-10;
+
+/// What a closest-point query found, per point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Foot {
+    /// On the surface, inside the samples.
+    Interior = 0,
+    /// Moved back to the rim of an open cloud.
+    Rim = 1,
+    /// No fit (a degenerate neighbourhood): the closest point is NaN.
+    Failed = 2,
+}
+
+/// Per-sample analysis of a cloud (see the module documentation).
+#[derive(Clone, Debug, Default)]
+pub struct SampleAnalysis {
+    /// Distance to the nearest other sample.
+    pub spacing: Vec<f64>,
+    /// The fit's support radius at the sample (distance to its (k+1)-th neighbour).
+    pub radius: Vec<f64>,
+    /// Leave-one-out residual over the radius; NaN where the neighbourhood is degenerate.
+    pub residual: Vec<f64>,
+    /// Largest angular gap (radians) of the 2k nearest neighbours around the sample.
+    pub gap: Vec<f64>,
+}
+
+/// The 2k + 1 nearest samples of an anchor (with their distances to the current centre).
+struct Candidates<const D: usize> {
+    anchor: [f64; D],
+    radius: f64,
+    points: Vec<(f64, u32)>,
+}
+
+impl<const D: usize> Default for Candidates<D> {
+    fn default() -> Self {
+        Candidates {
+            anchor: [f64::NAN; D],
+            radius: -1.0,
+            points: Vec::new(),
+        }
+    }
+}
+
+/// A point cloud with its kd-tree (kiddo) and its rim samples.
+pub struct PointCloud<const D: usize> {
+    points: Vec<[f64; D]>,
+    tree: ImmutableKdTree<f64, u32, D, 32>,
+    neighbours: usize,
+    rim: Vec<bool>,
+    /// The rim samples and their neighbours (where a foot may leave the samples' hull).
+    rim_zone: Vec<bool>,
+    has_rim: bool,
+    /// An upper bound of the distance from a point of the surface to its nearest sample.
+    reach: f64,
+}
+
+impl<const D: usize> PointCloud<D> {
+    /// The cloud of `points` (distinct, finite), fitted over `neighbours` samples.
+    pub fn new(points: Vec<[f64; D]>, neighbours: usize) -> Result<Self> {
+        let need = basis_len(D) + 2;
+        if neighbours < need || neighbours > 100 {
+            return Err(Error::invalid(
+                "neighbours",
+                format!(
+                    "must be between {need} and 100 (the fit has {} coefficients); got {neighbours}",
+                    basis_len(D)
+                ),
+            ));
+        }
+        if points.len() < neighbours + 2 {
+            return Err(Error::invalid(
+                "points",
+                format!(
+                    "the fit needs at least {} samples (neighbours + 2 = {}); got {}",
+                    neighbours + 2,
+                    neighbours + 2,
+                    points.len()
+                ),
+            ));
+        }
+        if points.len() >= u32::MAX as usize {
+            return Err(Error::invalid("points", "at most 2³² − 1 samples"));
+        }
+        if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(Error::invalid(
+                "points",
+                format!("sample {i} is not finite: {:?}", points[i]),
+            ));
+        }
+        let tree = ImmutableKdTree::new_from_slice(&points);
+        let rim = vec![false; points.len()];
+        let mut cloud = PointCloud {
+            points,
+            tree,
+            neighbours,
+            rim_zone: rim.clone(),
+            rim,
+            has_rim: false,
+            reach: 0.0,
+        };
+        let radius: Vec<f64> = (0..cloud.points.len())
+            .into_par_iter()
+            .map(|i| {
+                let nb = cloud.tree.nearest_n::<SquaredEuclidean>(&cloud.points[i], cloud.k1());
+                nb.last().map_or(0.0, |n| n.distance.sqrt())
+            })
+            .collect();
+        cloud.reach = radius.iter().copied().fold(0.0, f64::max);
+        Ok(cloud)
+    }
+
+    fn k1(&self) -> NonZero<usize> {
+        NonZero::new(self.neighbours + 1).unwrap()
+    }
+
+    /// The number of samples.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// True for a cloud of no samples (never: `new` refuses it).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// The samples.
+    pub fn points(&self) -> &[[f64; D]] {
+        &self.points
+    }
+
+    /// Whether any sample lies on a rim (after [`PointCloud::mark_rim`]).
+    pub fn has_rim(&self) -> bool {
+        self.has_rim
+    }
+
+    /// The rim flags per sample.
+    pub fn rim(&self) -> &[bool] {
+        &self.rim
+    }
+
+    /// The per-sample analysis (in parallel).
+    pub fn analyse(&self) -> SampleAnalysis {
+        let k = self.neighbours;
+        let rows: Vec<(f64, f64, f64, f64)> = (0..self.points.len())
+            .into_par_iter()
+            .map(|i| {
+                let p = &self.points[i];
+                let many = self
+                    .tree
+                    .nearest_n::<SquaredEuclidean>(p, NonZero::new(2 * k + 1).unwrap());
+                let others: Vec<[f64; D]> = many
+                    .iter()
+                    .filter(|n| n.item as usize != i)
+                    .map(|n| self.points[n.item as usize])
+                    .collect();
+                let spacing = others.first().map_or(f64::NAN, |o| distance(o, p));
+                let own = &others[..(k + 1).min(others.len())];
+                let radius = own.last().map_or(f64::NAN, |o| distance(o, p));
+                match Fit::new(own, p, radius) {
+                    Some(fit) => {
+                        let a = fit.project(p);
+                        let residual = distance(&fit.lift(&a), p) / fit.radius;
+                        let (ap, _) = fit.local(p);
+                        let around: Vec<[f64; 2]> = others.iter().map(|o| fit.local(o).0).collect();
+                        (spacing, radius, residual, largest_gap::<D>(&ap, &around))
+                    }
+                    None => (spacing, radius, f64::NAN, 0.0),
+                }
+            })
+            .collect();
+        SampleAnalysis {
+            spacing: rows.iter().map(|r| r.0).collect(),
+            radius: rows.iter().map(|r| r.1).collect(),
+            residual: rows.iter().map(|r| r.2).collect(),
+            gap: rows.iter().map(|r| r.3).collect(),
+        }
+    }
+
+    /// Marks the rim: samples whose gap exceeds [`RIM_GAP`] and (in 3D) with at least
+    /// [`RIM_CLUSTER`] such samples among their k nearest neighbours. Returns the rim's size.
+    pub fn mark_rim(&mut self, gap: &[f64]) -> Result<usize> {
+        if gap.len() != self.points.len() {
+            return Err(Error::invalid("gap", "one value per sample"));
+        }
+        let candidate: Vec<bool> = gap.iter().map(|&g| g > RIM_GAP).collect();
+        let rim: Vec<bool> = if D == 2 {
+            candidate
+        } else {
+            (0..self.points.len())
+                .into_par_iter()
+                .map(|i| {
+                    candidate[i]
+                        && self
+                            .tree
+                            .nearest_n::<SquaredEuclidean>(&self.points[i], self.k1())
+                            .iter()
+                            .filter(|n| n.item as usize != i && candidate[n.item as usize])
+                            .count()
+                            >= RIM_CLUSTER
+                })
+                .collect()
+        };
+        let count = rim.iter().filter(|&&r| r).count();
+        // the rim's zone: the 2k + 1 nearest samples of every rim sample, where feet are clamped
+        let mut zone = rim.clone();
+        let kc = NonZero::new(2 * self.neighbours + 1).unwrap();
+        for (i, _) in rim.iter().enumerate().filter(|(_, &r)| r) {
+            for n in self.tree.nearest_n::<SquaredEuclidean>(&self.points[i], kc) {
+                zone[n.item as usize] = true;
+            }
+        }
+        self.rim_zone = zone;
+        self.rim = rim;
+        self.has_rim = count > 0;
+        Ok(count)
+    }
+
+    /// The closest point of `x` on the cloud's surface and what was found.
+    /// `rho` is the smoothing radius ρ (0: the k nearest samples only).
+    pub fn closest_point(&self, x: &[f64; D], rho: f64) -> ([f64; D], Foot) {
+        self.closest_point_from(x, *x, rho, &mut Candidates::default())
+    }
+
+    /// The neighbourhood of `c` (into `out`) and its radius R = max(r_{k+1}(c), ρ): the samples
+    /// within R. They come from `cache` (every sample within the cache's radius of an anchor: the
+    /// 2k + 1 nearest, or all within 2ρ when that is more) while |c − anchor| + R ≤ the cache's
+    /// radius, which proves it holds them all; else the cache is queried again around `c`.
+    fn neighbourhood(&self, c: &[f64; D], rho: f64, cache: &mut Candidates<D>, out: &mut Vec<[f64; D]>) -> (f64, bool) {
+        let k1 = self.neighbours + 1;
+        let kc = 2 * self.neighbours + 1;
+        let mut radius = 0.0;
+        for attempt in 0..2 {
+            if attempt == 1 || cache.points.is_empty() || distance(c, &cache.anchor) >= cache.radius {
+                cache.anchor = *c;
+                cache.points = self
+                    .tree
+                    .nearest_n::<SquaredEuclidean>(c, NonZero::new(kc).unwrap())
+                    .iter()
+                    .map(|n| (0.0, n.item))
+                    .collect();
+                cache.radius = distance(c, &self.points[cache.points[kc - 1].1 as usize]);
+                if cache.radius < 2.0 * rho {
+                    cache.radius = 2.0 * rho;
+                    cache.points = self
+                        .tree
+                        .within_unsorted::<SquaredEuclidean>(c, cache.radius * cache.radius)
+                        .iter()
+                        .map(|n| (0.0, n.item))
+                        .collect();
+                }
+            }
+            for e in cache.points.iter_mut() {
+                e.0 = distance(&self.points[e.1 as usize], c);
+            }
+            cache.points.select_nth_unstable_by(k1 - 1, |p, q| p.0.total_cmp(&q.0));
+            radius = cache.points[k1 - 1].0.max(rho);
+            if distance(c, &cache.anchor) + radius <= cache.radius || attempt == 1 {
+                break;
+            }
+        }
+        out.clear();
+        let mut rim = false;
+        for e in cache.points.iter().filter(|e| e.0 < radius) {
+            out.push(self.points[e.1 as usize]);
+            rim |= self.rim_zone[e.1 as usize];
+        }
+        (radius, rim)
+    }
+
+    /// [`PointCloud::closest_point`] from the first centre `start` (x, or the foot of a nearby
+    /// point), with a cache of candidate neighbours shared by nearby queries. The answer is the
+    /// fixed point to [`TOLERANCE`], whatever the start near it.
+    fn closest_point_from(
+        &self,
+        x: &[f64; D],
+        start: [f64; D],
+        rho: f64,
+        cache: &mut Candidates<D>,
+    ) -> ([f64; D], Foot) {
+        let mut c = start;
+        let mut foot = [f64::NAN; D];
+        let mut nb: Vec<[f64; D]> = Vec::with_capacity(self.neighbours + 1);
+        let mut on_rim = false;
+        for it in 0..MAX_ITERATIONS {
+            let (radius, near_rim) = self.neighbourhood(&c, rho, cache, &mut nb);
+            let Some(f) = Fit::new(&nb, &c, radius) else {
+                return ([f64::NAN; D], Foot::Failed);
+            };
+            let mut a = f.project(x);
+            on_rim = false;
+            if near_rim {
+                // an open cloud: the foot stays within the hull of its neighbours in the tangent
+                // plane, so beyond the rim the closest point lies on it
+                let pts: Vec<[f64; 2]> = nb.iter().map(|p| f.local(p).0).collect();
+                let clamped = clamp_to_hull::<D>(&a, &pts);
+                on_rim = clamped != a;
+                a = clamped;
+            }
+            foot = f.lift(&a);
+            let moved = distance(&foot, &c);
+            c = foot;
+            if it > 0 && moved <= TOLERANCE * f.radius {
+                break;
+            }
+        }
+        if !foot.iter().all(|v| v.is_finite()) {
+            return ([f64::NAN; D], Foot::Failed);
+        }
+        (foot, if on_rim { Foot::Rim } else { Foot::Interior })
+    }
+
+    /// [`PointCloud::closest_point`] for many points, in parallel: in fixed blocks of
+    /// [`BLOCK`] points (so the answer does not depend on the threads), each query starting from
+    /// the previous point's foot when that point is near, sharing the candidate neighbours.
+    pub fn closest_points(&self, x: &[[f64; D]], rho: f64) -> (Vec<[f64; D]>, Vec<Foot>) {
+        let per_block: Vec<Vec<([f64; D], Foot)>> = x
+            .par_chunks(BLOCK)
+            .map(|block| {
+                let mut cache = Candidates::default();
+                let mut previous: Option<([f64; D], [f64; D])> = None;
+                block
+                    .iter()
+                    .map(|p| {
+                        let start = match previous {
+                            Some((px, pf)) if pf[0].is_finite() && distance(&px, p) <= 2.0 * cache.radius => pf,
+                            _ => *p,
+                        };
+                        let r = self.closest_point_from(p, start, rho, &mut cache);
+                        previous = Some((*p, r.0));
+                        r
+                    })
+                    .collect()
+            })
+            .collect();
+        per_block.into_iter().flatten().unzip()
+    }
+
+    /// A lower bound of the distance from each point to the surface: the distance to the nearest
+    /// sample less [`PointCloud::reach`] (for the coarse-to-fine band search).
+    pub fn distance_lower_bounds(&self, x: &[[f64; D]]) -> Vec<f64> {
+        x.par_iter()
+            .map(|p| {
+                let n = self.tree.nearest_one::<SquaredEuclidean>(p);
+                (n.distance.sqrt() - self.reach).max(0.0)
+            })
+            .collect()
+    }
+
+    /// An upper bound of the distance from a point of the surface to its nearest sample.
+    pub fn reach(&self) -> f64 {
+        self.reach
+    }
+}
+
+#[cfg(test)]
+mod tests;

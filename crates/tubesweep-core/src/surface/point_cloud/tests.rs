@@ -1,0 +1,93 @@
+use super::*;
+
+/// Deterministic points spread over the sphere of radius `r` (a Fibonacci lattice).
+fn sphere(n: usize, r: f64) -> Vec<[f64; 3]> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let s = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            [r * s * t.cos(), r * s * t.sin(), r * z]
+        })
+        .collect()
+}
+
+#[test]
+fn sphere_closest_points_are_accurate() {
+    let cloud = PointCloud::new(sphere(20_000, 0.5), DEFAULT_NEIGHBOURS).unwrap();
+    let queries: Vec<[f64; 3]> = sphere(500, 0.6).into_iter().chain(sphere(300, 0.42)).collect();
+    let (cp, feet) = cloud.closest_points(&queries, 0.0);
+    for (q, (c, f)) in queries.iter().zip(cp.iter().zip(&feet)) {
+        assert_eq!(*f, Foot::Interior);
+        let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+        let exact = [0.5 * q[0] / r, 0.5 * q[1] / r, 0.5 * q[2] / r];
+        assert!(distance(c, &exact) < 1e-6, "{:?} vs {:?}", c, exact);
+    }
+}
+
+#[test]
+fn a_closed_cloud_has_no_rim_and_no_outliers() {
+    let mut cloud = PointCloud::new(sphere(5_000, 0.5), DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    assert_eq!(cloud.mark_rim(&a.gap).unwrap(), 0);
+    assert!(a.residual.iter().all(|&r| r < 1e-3));
+}
+
+#[test]
+fn a_plane_patch_has_a_rim_and_clamps_to_it() {
+    let mut pts = Vec::new();
+    for i in 0..40 {
+        for j in 0..40 {
+            pts.push([i as f64 / 39.0, j as f64 / 39.0, 0.0]);
+        }
+    }
+    let mut cloud = PointCloud::new(pts, DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    assert!(cloud.mark_rim(&a.gap).unwrap() >= 4 * 38);
+    let (c, f) = cloud.closest_point(&[0.5, 0.5, 0.1], 0.0);
+    assert_eq!(f, Foot::Interior);
+    assert!(distance(&c, &[0.5, 0.5, 0.0]) < 1e-12);
+    let (c, f) = cloud.closest_point(&[1.1, 0.5, 0.05], 0.0);
+    assert_eq!(f, Foot::Rim);
+    assert!(distance(&c, &[1.0, 0.5, 0.0]) < 1e-9, "{c:?}");
+}
+
+#[test]
+fn an_outlier_has_a_large_residual() {
+    let mut pts = sphere(5_000, 0.5);
+    pts.push([0.0, 0.0, 0.56]);
+    let cloud = PointCloud::new(pts, DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    let last = *a.residual.last().unwrap();
+    assert!(last > OUTLIER_RATIO, "{last}");
+    let inliers = &a.residual[..a.residual.len() - 1];
+    assert!(inliers.iter().filter(|&&r| r > OUTLIER_RATIO).count() == 0);
+}
+
+#[test]
+fn a_circle_of_samples() {
+    let pts: Vec<[f64; 2]> = (0..400)
+        .map(|i| {
+            let t = i as f64 * std::f64::consts::TAU / 400.0;
+            [0.5 * t.cos(), 0.5 * t.sin()]
+        })
+        .collect();
+    let mut cloud = PointCloud::new(pts, 10).unwrap();
+    let a = cloud.analyse();
+    assert_eq!(cloud.mark_rim(&a.gap).unwrap(), 0);
+    let (c, f) = cloud.closest_point(&[0.3, 0.4], 0.0);
+    assert_eq!(f, Foot::Interior);
+    assert!(distance(&c, &[0.3, 0.4]) < 1e-5, "{c:?}");
+    let (c, _) = cloud.closest_point(&[0.6, 0.8], 0.0);
+    assert!(distance(&c, &[0.3, 0.4]) < 1e-5, "{c:?}");
+}
+
+#[test]
+fn bad_clouds_are_refused() {
+    assert!(PointCloud::<3>::new(vec![], DEFAULT_NEIGHBOURS).is_err());
+    assert!(PointCloud::new(sphere(10, 0.5), DEFAULT_NEIGHBOURS).is_err());
+    let mut p = sphere(100, 0.5);
+    p[3][1] = f64::NAN;
+    assert!(PointCloud::new(p, DEFAULT_NEIGHBOURS).is_err());
+}

@@ -1,0 +1,169 @@
+//! Point clouds as closest-point surfaces (`tubesweep_core::surface::point_cloud`): the kd-tree,
+//! the samples' analysis and the moving-least-squares closest points, the GIL released.
+
+use crate::convert::*;
+use crate::errors::to_pyerr;
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use tubesweep_core::surface::point_cloud::{PointCloud, SampleAnalysis};
+
+enum Cloud {
+    Two(PointCloud<2>),
+    Three(PointCloud<3>),
+}
+
+/// A point cloud with its kd-tree (see `tubesweep_core::surface::point_cloud`).
+#[pyclass(module = "tubesweep._native", name = "PointCloud")]
+pub(crate) struct PyPointCloud {
+    cloud: Cloud,
+}
+
+fn rows<const D: usize>(flat: &[f64]) -> Vec<[f64; D]> {
+    flat.chunks_exact(D).map(|c| std::array::from_fn(|k| c[k])).collect()
+}
+
+fn flat<const D: usize>(rows: Vec<[f64; D]>) -> Vec<f64> {
+    rows.into_iter().flatten().collect()
+}
+
+#[pymethods]
+impl PyPointCloud {
+    /// The cloud of `points` (M, 2) or (M, 3), distinct and finite, fitted over `neighbours`.
+    #[new]
+    fn new(py: Python<'_>, points: PyReadonlyArray2<'_, f64>, neighbours: usize) -> PyResult<Self> {
+        let d = points.shape()[1];
+        let p = c_slice(&points, "points")?;
+        let cloud = match d {
+            2 => {
+                let r = rows::<2>(p);
+                Cloud::Two(py.detach(|| PointCloud::new(r, neighbours)).map_err(to_pyerr)?)
+            }
+            3 => {
+                let r = rows::<3>(p);
+                Cloud::Three(py.detach(|| PointCloud::new(r, neighbours)).map_err(to_pyerr)?)
+            }
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "points must have shape (M, 2) or (M, 3); got {:?}",
+                    points.shape()
+                )))
+            }
+        };
+        Ok(PyPointCloud { cloud })
+    }
+
+    fn __len__(&self) -> usize {
+        match &self.cloud {
+            Cloud::Two(c) => c.len(),
+            Cloud::Three(c) => c.len(),
+        }
+    }
+
+    /// An upper bound of the distance from a point of the surface to its nearest sample.
+    #[getter]
+    fn reach(&self) -> f64 {
+        match &self.cloud {
+            Cloud::Two(c) => c.reach(),
+            Cloud::Three(c) => c.reach(),
+        }
+    }
+
+    /// The rim flags per sample (after `mark_rim`).
+    #[getter]
+    fn rim<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        match &self.cloud {
+            Cloud::Two(c) => c.rim().to_vec().into_pyarray(py),
+            Cloud::Three(c) => c.rim().to_vec().into_pyarray(py),
+        }
+    }
+
+    /// Per sample: spacing (distance to the nearest other sample), the fit's radius, the
+    /// leave-one-out residual over the radius, the largest angular gap of the neighbours.
+    #[allow(clippy::type_complexity)]
+    fn analyse<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+    ) {
+        let a: SampleAnalysis = py.detach(|| match &self.cloud {
+            Cloud::Two(c) => c.analyse(),
+            Cloud::Three(c) => c.analyse(),
+        });
+        (
+            a.spacing.into_pyarray(py),
+            a.radius.into_pyarray(py),
+            a.residual.into_pyarray(py),
+            a.gap.into_pyarray(py),
+        )
+    }
+
+    /// Marks the rim from the samples' gaps; returns how many samples lie on it.
+    fn mark_rim(&mut self, py: Python<'_>, gap: PyReadonlyArray1<'_, f64>) -> PyResult<usize> {
+        let g = c_slice(&gap, "gap")?;
+        let cloud = &mut self.cloud;
+        py.detach(|| match cloud {
+            Cloud::Two(c) => c.mark_rim(g),
+            Cloud::Three(c) => c.mark_rim(g),
+        })
+        .map_err(to_pyerr)
+    }
+
+    /// Closest points (M, d) of `points` and per point 0 (interior), 1 (moved to the rim) or 2
+    /// (no fit: NaN), in parallel; `rho` is the smoothing radius (fits over at least the samples
+    /// within it).
+    #[pyo3(signature = (points, rho = 0.0))]
+    fn closest<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+        rho: f64,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
+        let (cp, feet, d) = match &self.cloud {
+            Cloud::Two(c) => {
+                let x = rows::<2>(points_slice(&points, 2)?);
+                let (cp, f) = py.detach(|| c.closest_points(&x, rho));
+                (flat(cp), f, 2)
+            }
+            Cloud::Three(c) => {
+                let x = rows::<3>(points_slice(&points, 3)?);
+                let (cp, f) = py.detach(|| c.closest_points(&x, rho));
+                (flat(cp), f, 3)
+            }
+        };
+        let m = cp.len() / d;
+        let cp = cp.into_pyarray(py).reshape([m, d])?;
+        let feet: Vec<u8> = feet.into_iter().map(|f| f as u8).collect();
+        Ok((cp, feet.into_pyarray(py)))
+    }
+
+    /// Lower bounds of the distances from `points` to the surface (for the band search).
+    fn lower_bounds<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let out = match &self.cloud {
+            Cloud::Two(c) => {
+                let x = rows::<2>(points_slice(&points, 2)?);
+                py.detach(|| c.distance_lower_bounds(&x))
+            }
+            Cloud::Three(c) => {
+                let x = rows::<3>(points_slice(&points, 3)?);
+                py.detach(|| c.distance_lower_bounds(&x))
+            }
+        };
+        Ok(out.into_pyarray(py))
+    }
+}
+
+/// Adds this file's class to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyPointCloud>()
+}

@@ -1,0 +1,586 @@
+"""Point clouds as closest-point surfaces (paper Sect. 5.2).
+
+:func:`from_points` takes ``(M, 3)`` samples of a surface (``(M, 2)`` of a curve), or a file of
+them (:func:`read_points`), and returns a :class:`PointCloudSurface`. Its closest point of ``x`` is
+the moving-least-squares projection of ``x`` onto the samples, computed in the Rust core
+(``tubesweep_core::surface::point_cloud``) on all threads and only at the band's candidate nodes:
+
+* the k nearest samples (a kiddo kd-tree) of the current foot c, weighted by Wendland's function
+  of their distance to c (support: the (k+1)-th nearest, so the weights are continuous in c);
+* their weighted principal frame (the normal is the axis of least spread: no orientation needed)
+  and the weighted least-squares quadric height function over it (a parabola for curves);
+* Newton's method for the point of that graph nearest to x, and c ← that point, until it stops
+  moving. The map is smooth at grid scale, so ``order="auto"`` runs second order on a closed cloud.
+
+Before any solve the samples are analysed: repeated samples are kept once, samples far off the fit
+of their neighbours (outliers) are left out with a warning, and samples with an empty angular sector
+among their neighbours mark a rim (holes, the boundary of a scan). A cloud with a rim is an open
+surface: nodes beyond the rim get closest points on it (the open-surface treatment of Sect. 5.2) and
+``order="auto"`` runs the paper's first-order scheme. ``surface.report`` says what was found, and
+where.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any, Dict, Optional, Tuple, Union
+
+import numpy as np
+
+from ..closest_point import DIRECTION_EPS, ClosestPoint, _refuse_undefined_next_to
+from .._linalg import row_norms
+from ..grid import MAX_COORDINATE, Grid
+from ..band import BandGeometry, coarse_to_fine_candidates
+from .._warn import user_stacklevel
+
+__all__ = ["from_points", "read_points", "PointCloudSurface"]
+
+#: Neighbours of a fit (docs/point-clouds.md: 20 is the most accurate of 12–40 on the sphere).
+DEFAULT_NEIGHBOURS = 20
+#: A sample whose residual against its neighbours' fit exceeds this fraction of the fit's radius is
+#: an outlier (``tubesweep_core::surface::point_cloud::OUTLIER_RATIO``).
+OUTLIER_RATIO = 0.5
+#: On a noisy cloud (noise above NOISY·Δx) the fits reach at least FIT_RADIUS grid spacings
+#: (docs/point-clouds.md).
+FIT_RADIUS = 3.0
+NOISY = 0.005
+#: More outliers than this share of the samples: refused (the cloud is not a surface's samples).
+MAX_OUTLIER_SHARE = 0.1
+#: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
+SPARSE_FACTOR = 3.0
+#: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
+CHUNK = 1 << 20
+#: The file extensions :func:`read_points` reads.
+POINT_FILES = (".xyz", ".txt", ".csv", ".pts", ".npy", ".ply")
+
+
+def read_points(path: Union[str, Path]) -> np.ndarray:
+    """The points of a ``.xyz`` / ``.txt`` / ``.csv`` / ``.pts`` (numbers, one point a line), ``.npy``
+    or ``.ply`` file, as an ``(M, 3)`` (or ``(M, 2)``) float64 array.
+
+    Text files are read with numpy: whitespace- or comma-separated columns, ``#`` comments and one
+    header line allowed; the first three columns are the coordinates (two if there are only two).
+    ``.ply`` needs plyfile, trimesh or meshio (the ``mesh`` extra).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(M, 3)`` or ``(M, 2)`` float64.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    ValueError
+        If the file is not a point file (unknown extension, no numbers, the wrong number of columns).
+    ImportError
+        If a ``.ply`` file meets none of plyfile, trimesh, meshio.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, os
+    >>> from tubesweep.surfaces.points import read_points
+    >>> path = os.path.join(tempfile.mkdtemp(), "p.xyz")
+    >>> np.savetxt(path, np.eye(3))
+    >>> read_points(path).shape
+    (3, 3)
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"point file {str(path)!r} is a directory")
+    if not path.is_file():
+        raise FileNotFoundError(f"point file {str(path)!r} does not exist")
+    ext = path.suffix.lower()
+    if ext not in POINT_FILES:
+        raise ValueError(
+            f"{path.name!r} is not a point file tubesweep reads: use one of {', '.join(POINT_FILES)} "
+            "(a mesh file goes to from_mesh)"
+        )
+    if ext == ".npy":
+        try:
+            data = np.load(path, allow_pickle=False)
+        except (ValueError, OSError) as e:
+            raise ValueError(f"{path.name!r} is not a NumPy array file: {e}") from None
+    elif ext == ".ply":
+        data = _read_ply(path)
+    else:
+        data = _read_text(path, "," if ext == ".csv" else None)
+    data = np.asarray(data)
+    if data.dtype.kind not in "fiu" or data.ndim != 2 or data.shape[1] < 2:
+        raise ValueError(
+            f"{path.name!r} does not hold points: expected rows of 2 or 3 numbers, got an array of shape "
+            f"{data.shape} and type {data.dtype}"
+        )
+    if data.shape[0] == 0:
+        raise ValueError(f"{path.name!r} holds no points")
+    return np.ascontiguousarray(data[:, : min(3, data.shape[1])], dtype=float)
+
+
+def _read_text(path: Path, delimiter: Optional[str]) -> np.ndarray:
+    for skip in (0, 1):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # numpy's "empty input file"
+                data = np.loadtxt(path, delimiter=delimiter, skiprows=skip, ndmin=2, comments="#")
+            return data
+        except (ValueError, UnicodeDecodeError):
+            continue
+    raise ValueError(
+        f"{path.name!r} is not a point file: its lines are not rows of numbers (x y z per line, "
+        "whitespace- or comma-separated, one header line at most)"
+    )
+
+
+def _read_ply(path: Path) -> np.ndarray:
+    try:
+        from plyfile import PlyData
+
+        try:
+            v = PlyData.read(str(path))["vertex"]
+        except Exception as e:  # plyfile raises its own errors for a broken file
+            raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
+        return np.c_[v["x"], v["y"], v["z"]]
+    except ImportError:
+        pass
+    try:
+        import trimesh
+
+        try:
+            loaded = trimesh.load(str(path), process=False)
+        except Exception as e:  # trimesh raises many kinds for a broken file
+            raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
+        vertices = getattr(loaded, "vertices", None)
+        if vertices is None:
+            raise ValueError(f"{path.name!r} holds no vertices")
+        return np.asarray(vertices, dtype=float)
+    except ImportError:
+        pass
+    try:
+        import meshio
+
+        try:
+            return np.asarray(meshio.read(str(path)).points, dtype=float)
+        except Exception as e:  # meshio raises many kinds for a broken file
+            raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
+    except ImportError:
+        raise ImportError(
+            "reading .ply points needs plyfile, trimesh or meshio: pip install 'tubesweep[mesh]'"
+        ) from None
+
+
+def _checked_points(points: Any, name: str = "points") -> np.ndarray:
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of shape (M, 3) (or (M, 2) for a curve) of numbers") from None
+    if p.ndim != 2 or p.shape[1] not in (2, 3):
+        raise ValueError(f"{name} must have shape (M, 3) (or (M, 2) for a curve); got {p.shape}")
+    if p.shape[0] == 0:
+        raise ValueError(f"{name} is empty: a point cloud needs samples of the surface")
+    finite = np.isfinite(p).all(axis=1)
+    if not finite.all():
+        bad = np.flatnonzero(~finite)
+        raise ValueError(
+            f"{name} holds {bad.size} points with NaN or inf (the first, index {int(bad[0])}: "
+            f"{tuple(float(x) for x in p[bad[0]])}); drop them, e.g. {name}[np.isfinite({name}).all(axis=1)]"
+        )
+    big = float(np.max(np.abs(p)))
+    if big > MAX_COORDINATE:
+        raise ValueError(
+            f"{name} has coordinates up to {big:.3g}; they must lie within ±{MAX_COORDINATE:g} (the solver keeps "
+            "distances in single precision): rescale the cloud"
+        )
+    return np.ascontiguousarray(p)
+
+
+class PointCloudSurface(ClosestPoint):
+    """A point cloud as a closest-point surface (moving-least-squares projection, see the module).
+
+    Build it with :func:`from_points`.
+
+    Attributes
+    ----------
+    points : numpy.ndarray
+        The samples used (repeated samples once, outliers left out).
+    outliers : numpy.ndarray
+        The samples left out as outliers (coordinates, ``(K, d)``).
+    rim : numpy.ndarray
+        Indices into ``points`` of the samples on a rim (holes, the boundary of a scan).
+    open_surface : bool
+        True when the cloud has a rim (``order="auto"`` then runs first order).
+    report : dict
+        Samples given, repeated, outliers, rim samples, the spacing (median distance to the
+        nearest sample), the density's range (the ratio of the 95th to the 5th percentile of the
+        fit's radius) and, after a solve, the band nodes whose closest point lies on the rim.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> rng = np.random.default_rng(0)
+    >>> x = rng.normal(size=(5000, 3))
+    >>> cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+    >>> cloud.open_surface, len(cloud.rim)
+    (False, 0)
+    """
+
+    def __init__(
+        self,
+        points: Any,
+        *,
+        normals: Any = None,
+        neighbours: int = DEFAULT_NEIGHBOURS,
+        outliers: str = "remove",
+        name: str = "point cloud",
+    ):
+        from .. import _native
+
+        p = _checked_points(points)
+        d = p.shape[1]
+        if isinstance(neighbours, bool) or not isinstance(neighbours, (int, np.integer)):
+            raise TypeError(f"neighbours must be a whole number; got {neighbours!r}")
+        low = 5 if d == 2 else 8
+        if not low <= int(neighbours) <= 100:
+            raise ValueError(
+                f"neighbours must be between {low} and 100 (the fit has {3 if d == 2 else 6} coefficients); got {neighbours}"
+            )
+        if outliers not in ("remove", "raise"):
+            raise ValueError(f"outliers must be 'remove' or 'raise'; got {outliers!r}")
+        if normals is not None:
+            n = _checked_points(normals, "normals")
+            if n.shape != p.shape:
+                raise ValueError(f"normals must have the points' shape {p.shape}; got {n.shape}")
+        given = len(p)
+        unique, first = np.unique(p, axis=0, return_index=True)
+        keep = np.sort(first)
+        p = p[keep]
+        self.normals: Optional[np.ndarray] = None if normals is None else n[keep]
+        repeated = given - len(p)
+        need = int(neighbours) + 2
+        if len(p) < need:
+            raise ValueError(
+                f"the cloud has {len(p)} distinct points ({given} given); the fit needs at least {need} "
+                f"(neighbours + 2, neighbours = {neighbours}): give more samples"
+                + (" (all the points are the same)" if len(p) == 1 else "")
+            )
+        centred = p - p.mean(axis=0)
+        sv = np.linalg.svd(centred, compute_uv=False)
+        if d == 3 and sv[1] <= 1e-9 * sv[0]:
+            raise ValueError(
+                "the points all lie on one line: a cloud in 3D must sample a surface (for a curve give (M, 2) points)"
+            )
+        if d == 2 and sv[0] <= 0:
+            raise ValueError("the points all coincide")
+        self.ndim = d
+        self.lipschitz = 1.0
+        self._noise = 0.0
+        self.name = name
+        self.neighbours = int(neighbours)
+        cloud = _native.PointCloud(p, self.neighbours)
+        spacing, radius, residual, gap = cloud.analyse()
+        bad = ~(residual <= OUTLIER_RATIO)  # NaN: a degenerate neighbourhood, counted as an outlier
+        self.outliers = p[bad]
+        if bad.any():
+            where = tuple(round(float(c), 6) for c in p[np.flatnonzero(bad)[0]])
+            share = float(np.mean(bad))
+            if outliers == "raise" or share > MAX_OUTLIER_SHARE:
+                raise ValueError(
+                    f"{int(bad.sum())} of {len(p)} samples ({share:.1%}) lie off the surface their neighbours fit "
+                    f"(farther than {OUTLIER_RATIO} of the fit's radius; the first at {where})"
+                    + (
+                        f": more than {MAX_OUTLIER_SHARE:.0%}, so the cloud is not the samples of one smooth surface "
+                        "(too noisy, or too sparse for its curvature)"
+                        if share > MAX_OUTLIER_SHARE
+                        else "; pass outliers='remove' to leave them out"
+                    )
+                )
+            warnings.warn(
+                f"{int(bad.sum())} of {len(p)} samples lie off the surface their neighbours fit (the first at {where}); "
+                "they are left out (surface.outliers holds them)",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )
+            p = p[~bad]
+            if self.normals is not None:
+                self.normals = self.normals[~bad]
+            if len(p) < need:
+                raise ValueError(f"after leaving out the outliers {len(p)} samples remain; the fit needs {need}")
+            cloud = _native.PointCloud(np.ascontiguousarray(p), self.neighbours)
+            spacing, radius, residual, gap = cloud.analyse()
+        rim_count = cloud.mark_rim(np.ascontiguousarray(gap))
+        self.points = p
+        self._tree = cloud
+        self.rim = np.flatnonzero(cloud.rim)
+        self.open_surface = rim_count > 0
+        self.spacing = float(np.median(spacing))
+        #: the samples' noise: 1.4826 × the median distance of a sample from its neighbours' fit
+        self.noise = 1.4826 * float(np.nanmedian(residual * radius))
+        q05, q95 = np.quantile(radius, [0.05, 0.95])
+        self.report: Dict[str, Any] = {
+            "samples": given,
+            "repeated": repeated,
+            "outliers": len(self.outliers),
+            "rim_samples": rim_count,
+            "spacing": self.spacing,
+            "noise": self.noise,
+            "density_ratio": float(q95 / q05) ** d if q05 > 0 else float("inf"),
+        }
+        #: why order=2 does not apply (second_order.check_supported), or None
+        self.order2_refusal: Optional[str] = None
+        if self.open_surface:
+            where = tuple(round(float(c), 4) for c in p[self.rim[0]])
+            self.order2_refusal = (
+                f"the point cloud has a rim (a hole or a boundary: {rim_count} samples, e.g. at {where}; "
+                "surface.rim lists them)"
+            )
+        #: the smoothing radius ρ of the fits (set by the last band to FIT_RADIUS·Δx; 0 before)
+        self.smoothing = 0.0
+        self._cp = self._closest
+
+    def _closest(self, x: np.ndarray) -> np.ndarray:
+        cp, _ = self._tree.closest(np.ascontiguousarray(x, dtype=float), self.smoothing)
+        return cp
+
+    def __getstate__(self) -> dict:
+        # the native kd-tree does not pickle: a copy builds it again
+        state = self.__dict__.copy()
+        state["_tree"] = None
+        state["_cp"] = None
+        state["_band_cache"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        from .. import _native
+
+        self.__dict__.update(state)
+        self._tree = _native.PointCloud(np.ascontiguousarray(self.points), self.neighbours)
+        if len(self.rim):
+            self._tree.mark_rim(
+                np.ascontiguousarray(np.where(np.isin(np.arange(len(self.points)), self.rim), 9.0, 0.0))
+            )
+        self._cp = self._closest
+
+    def __repr__(self) -> str:
+        return (
+            f"PointCloudSurface({self.name!r}, {len(self.points)} samples, ndim={self.ndim}, "
+            f"spacing={self.spacing:.3g}, open={self.open_surface})"
+        )
+
+    def _far_distance(self, points: np.ndarray) -> np.ndarray:
+        # a lower bound (the nearest sample's distance less the reach): the search keeps more blocks,
+        # never fewer
+        return np.asarray(self._tree.lower_bounds(np.ascontiguousarray(points, dtype=float)))
+
+    def band(self, grid: Grid, half_width: float) -> BandGeometry:
+        """The band nodes within ``half_width`` of the cloud's surface, found coarse-to-fine (a lower
+        bound of the distance from the nearest sample), their closest points computed once, in Rust
+        on all threads, and kept for the second-order geometry.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance).
+
+        Returns
+        -------
+        BandGeometry
+
+        Raises
+        ------
+        ValueError
+            If the samples are much sparser than the grid (the message names the spacing needed),
+            or a fit fails next to the band.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+        >>> circle = ts.surfaces.from_points(0.5 * np.c_[np.cos(t), np.sin(t)])
+        >>> grid = circle.grid(61)
+        >>> len(circle.band(grid, 4 * grid.spacing).linear) > 0
+        True
+        """
+        self.check_grid(grid)
+        h = grid.spacing
+        d = grid.ndim
+        if self.spacing > SPARSE_FACTOR * h:
+            raise ValueError(
+                f"the samples are {self.spacing:.3g} apart (median distance to the nearest sample), "
+                f"{self.spacing / h:.1f} grid spacings: the grid resolves the surface finer than the samples do. "
+                f"Use a grid with spacing ≥ {self.spacing / SPARSE_FACTOR:.3g} (e.g. surface.grid(n) with a smaller n) "
+                "or denser samples"
+            )
+        # on a noisy cloud the fits reach at least FIT_RADIUS·Δx: the noise is averaged over the
+        # samples within it (a fit over the k nearest alone has a curvature of noise/r², which
+        # makes the projection from the tube's far nodes unstable)
+        self.smoothing = FIT_RADIUS * h if self.noise > NOISY * h else 0.0
+        candidates = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self._far_distance(p))
+        parts: list = []
+        undefined = []
+        for s0 in range(0, len(candidates), CHUNK):
+            lin = candidates[s0 : s0 + CHUNK]
+            x = grid.node_points(lin)
+            cp, feet = self._tree.closest(np.ascontiguousarray(x), self.smoothing)
+            norm = row_norms(x - cp)
+            keep = norm <= half_width  # False where the fit failed (NaN)
+            undefined.append(lin[~np.isfinite(norm)])
+            parts.append((lin[keep], norm[keep], x[keep], cp[keep], feet[keep]))
+        if not parts or sum(len(q[0]) for q in parts) == 0:
+            self._band_cache = None
+            return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
+        linear, norm, x, cp, feet = (np.concatenate([q[i] for q in parts]) for i in range(5))
+        _refuse_undefined_next_to(grid, np.concatenate(undefined), linear)
+        self.report["rim_nodes"] = int(np.count_nonzero(feet == 1))
+        # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|
+        pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)
+        again, _ = self._tree.closest(np.ascontiguousarray(cp[pick]), self.smoothing)
+        self._noise = float(np.quantile(row_norms(again - cp[pick]), 0.9))
+        self._band_cache = (x, cp)
+        ok = norm > DIRECTION_EPS * h
+        direction = np.zeros((len(linear), d))
+        direction[ok] = (x[ok] - cp[ok]) / norm[ok, None]
+        return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
+
+    def closest_point(self, points: np.ndarray) -> np.ndarray:
+        """The closest points on the cloud's surface (moving-least-squares projection; NaN where
+        no fit exists).
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, d)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, d)`` closest points.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+        >>> circle = ts.surfaces.from_points(0.5 * np.c_[np.cos(t), np.sin(t)])
+        >>> np.round(circle.closest_point(np.array([[1.0, 0.0]])), 6).tolist()
+        [[0.5, 0.0]]
+        """
+        p = np.ascontiguousarray(points, dtype=float)
+        if p.ndim != 2 or p.shape[1] != self.ndim:
+            raise ValueError(f"points must have shape (M, {self.ndim}); got {p.shape}")
+        cache = getattr(self, "_band_cache", None)
+        if cache is not None and cache[0].shape == p.shape and np.array_equal(cache[0], p):
+            return cache[1].copy()  # the band's nodes again (the second-order geometry)
+        out = np.empty_like(p)
+        for s0 in range(0, len(p), CHUNK):
+            out[s0 : s0 + CHUNK], _ = self._tree.closest(p[s0 : s0 + CHUNK], self.smoothing)
+        return out
+
+    # ------------------------------------------------------------------ conveniences
+    @property
+    def default_source(self) -> np.ndarray:
+        """The sample farthest from the samples' mean."""
+        p = self.points
+        return p[int(np.argmax(((p - p.mean(0)) ** 2).sum(1)))].copy()
+
+    @property
+    def bounds(self) -> Tuple[np.ndarray, np.ndarray]:
+        return self.points.min(0), self.points.max(0)
+
+    def grid(self, n: int = 101, padding: float = 8.0) -> Grid:
+        """A grid around the cloud with the same spacing in every axis: ``n`` nodes along the longest
+        side of the bounding box, ``padding`` empty spacings beyond it on every side.
+
+        Parameters
+        ----------
+        n : int
+            Nodes along the longest axis (at least ``2·padding + 3``).
+        padding : float
+            Spacings between the bounding box and the grid's faces.
+
+        Returns
+        -------
+        Grid
+
+        Raises
+        ------
+        ValueError
+            If ``n`` cannot hold the padding.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+        >>> ts.surfaces.from_points(np.c_[np.cos(t), np.sin(t)]).grid(61).shape
+        (61, 61)
+        """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+            raise TypeError(f"n must be a whole number of nodes along the longest axis; got {n!r}")
+        if not (np.isfinite(padding) and padding >= 0) or n < 2 * padding + 3:
+            raise ValueError(f"n = {n} nodes cannot hold {padding} spacings of padding on both sides")
+        lo, hi = self.bounds
+        ext = hi - lo
+        h = float(ext.max()) / (n - 1 - 2 * padding)
+        counts = np.maximum(3, np.ceil(ext / h - 1e-9).astype(int) + 1 + int(np.ceil(2 * padding)))
+        counts[int(np.argmax(ext))] = n
+        lower = 0.5 * (lo + hi) - 0.5 * h * (counts - 1)
+        return Grid(lower, lower + h * (counts - 1), counts)
+
+
+def from_points(
+    points: Union[str, Path, Any],
+    normals: Any = None,
+    *,
+    neighbours: int = DEFAULT_NEIGHBOURS,
+    outliers: str = "remove",
+) -> PointCloudSurface:
+    """A point cloud as a surface for :func:`tubesweep.solve` (closest points by moving least squares).
+
+    Parameters
+    ----------
+    points : array_like or str or pathlib.Path
+        ``(M, 3)`` samples of a surface (``(M, 2)`` of a curve), or a point file
+        (:func:`read_points`: ``.xyz``, ``.txt``, ``.csv``, ``.pts``, ``.npy``, ``.ply``).
+    normals : array_like, optional
+        ``(M, d)`` normals, kept for :func:`tubesweep.export`; not needed (the fits find the normals,
+        and no orientation is used).
+    neighbours : int
+        Samples in each local fit (default 20; more smooths more noise and blurs more curvature).
+    outliers : {"remove", "raise"}
+        Samples off the surface their neighbours fit: left out with a warning, or an error.
+
+    Returns
+    -------
+    PointCloudSurface
+
+    Raises
+    ------
+    ValueError
+        An empty cloud, NaN or inf samples, fewer distinct samples than the fit needs, samples all
+        on one line (3D), more than 10 % outliers (or any, with ``outliers="raise"``), a file that
+        is not a point file. At solve time: samples much sparser than the grid (the message names
+        the spacing needed).
+    TypeError
+        If ``points`` is not numbers.
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> rng = np.random.default_rng(1)
+    >>> x = rng.normal(size=(20000, 3))
+    >>> cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+    >>> sol = ts.solve(cloud, ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3), sources=[cloud.points[0]])
+    >>> sol.stats.order
+    2
+    """
+    name = "point cloud"
+    if isinstance(points, (str, Path)):
+        name = Path(points).stem
+        points = read_points(points)
+    surface = PointCloudSurface(points, normals=normals, neighbours=neighbours, outliers=outliers, name=name)
+    return surface

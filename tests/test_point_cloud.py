@@ -1,0 +1,218 @@
+"""Point clouds as closest-point surfaces (ts.surfaces.from_points): exact answers on the sphere,
+the torus's outer equator, a plane patch and a circle; second order and its convergence; noise;
+outliers and rims found and reported; a cloud and a mesh of the same surface agreeing; readers;
+bad input."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.surfaces.points import PointCloudSurface, from_points, read_points
+
+SRC = np.array([-0.5, 0.0, 0.0])
+
+
+def sphere_cloud(m: int, seed: int = 0, noise: float = 0.0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(m, 3))
+    p = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
+    if noise:
+        p = p * (1 + noise * rng.uniform(-1, 1, size=(m, 1)) / 0.5)
+    return p
+
+
+def great_circle(p: np.ndarray, src: np.ndarray = SRC) -> np.ndarray:
+    u = p / np.linalg.norm(p, axis=1, keepdims=True)
+    return 0.5 * np.arccos(np.clip(u @ (src / 0.5), -1, 1))
+
+
+def cube(n: int) -> ts.Grid:
+    return ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3)
+
+
+def sphere_error(n: int, m: int, noise: float = 0.0):
+    cloud = from_points(sphere_cloud(m, noise=noise))
+    sol = ts.solve(cloud, cube(n), sources=[SRC])
+    return sol, float(np.mean(np.abs(sol(cloud.points) - great_circle(cloud.points))))
+
+
+def test_sphere_second_order_and_its_convergence():
+    # samples growing with N² (docs/point-clouds.md has N = 41…121: order 2.1)
+    sol31, e31 = sphere_error(31, 5000)
+    sol41, e41 = sphere_error(41, 8889)
+    assert sol31.stats.order == 2 and sol41.stats.order == 2
+    assert e41 < 4.5e-4
+    order = np.log(e31 / e41) / np.log(40 / 30)
+    assert order > 1.8, (e31, e41, order)
+
+
+def test_noise_of_a_tenth_of_the_spacing_keeps_second_order():
+    h = 2 / 40
+    sol, e = sphere_error(41, 8889, noise=0.1 * h)
+    assert sol.stats.order == 2
+    assert e < 8e-4, e  # 3.9e-4 without noise
+
+
+def test_torus_outer_equator():
+    torus = ts.surfaces.Torus()  # R = 0.5, r = 0.2
+    rng = np.random.default_rng(3)
+    # area-uniform samples: θ, φ with density ∝ R + r cos φ (rejection)
+    th = rng.uniform(0, 2 * np.pi, 60000)
+    ph = rng.uniform(0, 2 * np.pi, 60000)
+    keep = rng.uniform(0, 0.7, 60000) < 0.5 + 0.2 * np.cos(ph)
+    th, ph = th[keep][:20000], ph[keep][:20000]
+    rho = 0.5 + 0.2 * np.cos(ph)
+    cloud = from_points(np.c_[rho * np.cos(th), rho * np.sin(th), 0.2 * np.sin(ph)])
+    assert not cloud.open_surface
+    src = torus.default_source
+    sol = ts.solve(cloud, cube(61), sources=[src])
+    assert sol.stats.order == 2
+    t = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    eq = np.c_[0.7 * np.cos(t), 0.7 * np.sin(t), 0 * t]
+    exact = torus.geodesic_distance(eq, src)
+    ok = np.isfinite(exact)
+    err = np.abs(sol(eq[ok]) - exact[ok])
+    assert ok.sum() > 50
+    assert err.mean() < 1.5e-3, err.mean()
+
+
+def test_plane_patch_is_open_and_exact():
+    rng = np.random.default_rng(4)
+    xy = rng.uniform(-0.6, 0.6, size=(8000, 2))
+    cloud = from_points(np.c_[xy, np.zeros(len(xy))])
+    assert cloud.open_surface and cloud.report["rim_samples"] > 50
+    # the rim samples lie near the square's sides
+    rim = cloud.points[cloud.rim]
+    assert np.all(np.max(np.abs(rim[:, :2]), axis=1) > 0.55)
+    sol = ts.solve(cloud, cube(51), sources=[(0.0, 0.0, 0.0)])
+    assert sol.stats.order == 1 and "rim" in sol.stats.order_fallback
+    assert cloud.report["rim_nodes"] > 0
+    q = cloud.points[np.max(np.abs(cloud.points[:, :2]), axis=1) < 0.4]
+    err = np.abs(sol(q) - np.linalg.norm(q, axis=1))
+    assert err.mean() < 0.02, err.mean()
+
+
+def test_circle_of_samples_is_a_curve():
+    t = np.random.default_rng(5).uniform(0, 2 * np.pi, 3000)
+    cloud = from_points(0.5 * np.c_[np.cos(t), np.sin(t)])
+    grid = ts.Grid((-1, -1), (1, 1), (161, 161))
+    sol = ts.solve(cloud, grid, sources=[(0.5, 0.0)])
+    assert sol.stats.order == 2
+    q = 0.5 * np.c_[np.cos(t), np.sin(t)]
+    exact = 0.5 * np.abs(np.angle(np.exp(1j * t)))
+    assert np.mean(np.abs(sol(q) - exact)) < 2e-4
+
+
+def test_cloud_and_mesh_of_the_same_sphere_agree():
+    pytest.importorskip("trimesh")
+    import trimesh
+
+    m = trimesh.creation.icosphere(subdivisions=4, radius=0.5)
+    v, f = np.asarray(m.vertices), np.asarray(m.faces)
+    grid = cube(61)
+    mesh_sol = ts.solve(ts.surfaces.from_mesh((v, f)), grid, sources=[v[0]])
+    cloud_sol = ts.solve(from_points(v), grid, sources=[v[0]])
+    exact = great_circle(v, v[0])
+    gap = np.abs(mesh_sol.on_mesh(v) - cloud_sol(v))
+    # both near the sphere's distances; the cloud (second order) closer than the mesh (first order)
+    assert gap.mean() < 0.03
+    assert np.mean(np.abs(cloud_sol(v) - exact)) < 0.3 * np.mean(np.abs(mesh_sol.on_mesh(v) - exact))
+
+
+def test_outliers_are_left_out_with_a_warning():
+    p = sphere_cloud(5000)
+    bad = np.array([[0.0, 0.0, 0.6], [0.3, 0.0, 0.0]])
+    with pytest.warns(RuntimeWarning, match="2 of 5002 samples lie off the surface"):
+        cloud = from_points(np.r_[p, bad])
+    assert cloud.report["outliers"] == 2 and len(cloud.points) == 5000
+    np.testing.assert_array_equal(np.sort(cloud.outliers, axis=0), np.sort(bad, axis=0))
+    with pytest.raises(ValueError, match="outliers='remove'"):
+        from_points(np.r_[p, bad], outliers="raise")
+
+
+def test_repeated_samples_are_kept_once():
+    p = sphere_cloud(3000)
+    cloud = from_points(np.r_[p, p[:100]])
+    assert cloud.report["repeated"] == 100 and len(cloud.points) == 3000
+
+
+def test_a_hole_is_a_rim():
+    p = sphere_cloud(20000)
+    cloud = from_points(p[p[:, 2] < 0.35])  # a cap cut off: a hole of radius ~0.36
+    assert cloud.open_surface
+    rim = cloud.points[cloud.rim]
+    assert np.all(rim[:, 2] > 0.3)
+    sol = ts.solve(cloud, cube(41), sources=[(0.0, 0.0, -0.5)])
+    assert sol.stats.order == 1 and "rim" in sol.stats.order_fallback
+
+
+@pytest.mark.parametrize(
+    "points, match",
+    [
+        (np.zeros((0, 3)), "empty"),
+        (np.full((30, 3), np.nan), "NaN or inf"),
+        (sphere_cloud(10), "the fit needs at least 22"),
+        (np.ones((50, 3)), "all the points are the same"),
+        (np.c_[np.linspace(0, 1, 50), np.zeros(50), np.zeros(50)], "one line"),
+        (np.zeros((5, 4)), r"shape \(M, 3\)"),
+    ],
+)
+def test_bad_clouds_are_refused(points, match):
+    with pytest.raises(ValueError, match=match):
+        from_points(points)
+
+
+def test_samples_much_sparser_than_the_grid_are_refused():
+    cloud = from_points(sphere_cloud(500))
+    with pytest.raises(ValueError, match="Use a grid with spacing ≥"):
+        ts.solve(cloud, cube(201), sources=[cloud.points[0]])
+
+
+def test_readers(tmp_path):
+    p = sphere_cloud(100)
+    np.savetxt(tmp_path / "a.xyz", p)
+    np.savetxt(tmp_path / "a.csv", p, delimiter=",", header="x,y,z", comments="")
+    np.save(tmp_path / "a.npy", p)
+    for name in ("a.xyz", "a.csv", "a.npy"):
+        np.testing.assert_allclose(read_points(tmp_path / name), p, rtol=1e-15, atol=0)
+    (tmp_path / "b.txt").write_text("this is not\na point file\n")
+    with pytest.raises(ValueError, match="not a point file"):
+        read_points(tmp_path / "b.txt")
+    (tmp_path / "c.obj").write_text("v 0 0 0\n")
+    with pytest.raises(ValueError, match="not a point file tubesweep reads"):
+        read_points(tmp_path / "c.obj")
+    with pytest.raises(FileNotFoundError):
+        read_points(tmp_path / "none.xyz")
+    np.save(tmp_path / "d.npy", np.zeros((4, 4, 4)))
+    with pytest.raises(ValueError, match="does not hold points"):
+        read_points(tmp_path / "d.npy")
+    pytest.importorskip("trimesh")
+    import trimesh
+
+    trimesh.PointCloud(p).export(tmp_path / "a.ply")
+    np.testing.assert_allclose(read_points(tmp_path / "a.ply"), p, rtol=1e-6)
+
+
+def test_pickled_cloud_gives_the_same_closest_points():
+    cloud = from_points(sphere_cloud(3000))
+    x = np.random.default_rng(2).uniform(-0.6, 0.6, (50, 3))
+    again = pickle.loads(pickle.dumps(cloud))
+    assert isinstance(again, PointCloudSurface)
+    np.testing.assert_array_equal(again.closest_point(x), cloud.closest_point(x))
+
+
+def test_export_writes_the_samples_with_u(tmp_path):
+    cloud = from_points(sphere_cloud(3000))
+    sol = ts.solve(cloud, cube(31), sources=[cloud.points[0]])
+    text = ts.export(sol, tmp_path / "c.vtp").read_text()
+    assert 'NumberOfPoints="3000" NumberOfVerts="3000"' in text
+    pytest.importorskip("meshio")
+    import meshio
+
+    m = meshio.read(ts.export(sol, tmp_path / "c.ply"))
+    np.testing.assert_array_equal(m.points, cloud.points)
+    np.testing.assert_allclose(m.point_data["u"], sol(cloud.points), rtol=1e-12)
+    with pytest.raises(ValueError, match="written as .vtp or .ply"):
+        ts.export(sol, tmp_path / "c.vtu")
