@@ -278,7 +278,20 @@ mod tests {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
         let (phi, _) = crate::test_bands::sphere_phi_and_offsets(&band, h);
         let surface = Implicit::LevelSet(&phi);
-        let (geometry, _) = tube_setup_of(&band, &roles, &surface, &dirs, [-1.0; 3], h, 4.0 * h, &[], &[], 2.0 * h, 1).unwrap();
+        let (geometry, _) = tube_setup_of(
+            &band,
+            &roles,
+            &surface,
+            &dirs,
+            [-1.0; 3],
+            h,
+            4.0 * h,
+            &[],
+            &[],
+            2.0 * h,
+            1,
+        )
+        .unwrap();
         check_geometry_of(&geometry.summary, 4.0 * h, h, false).unwrap();
         let feet = [[-0.5, 0.0, 0.0], [0.0, 0.3, 0.4], [0.0, 0.0, -0.5]];
         let slowness = [1.0, 1.0, 1.0];
