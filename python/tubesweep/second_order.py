@@ -35,8 +35,8 @@ __all__ = ["ORDERS", "Order2NotApplicable", "check_order", "FIX_RADIUS", "FACTOR
 
 #: A warning says how many inner-tube nodes ran the first-order update when they are more than
 #: this fraction of the tube (fewer are reported in ``sol.stats.order2`` only): the rims of the
-#: library's open surfaces and a crease take 4–21% at N = 41–161.
-FIRST_ORDER_WARNING = 0.25
+#: library's open surfaces and a crease take 4–26% at N = 41–161.
+FIRST_ORDER_WARNING = 0.4
 
 #: The values of ``order``: the paper's first-order scheme, second order, or ``"auto"`` (second
 #: order where it applies, first order otherwise, the reason in ``sol.stats.order_fallback``).
