@@ -87,7 +87,9 @@ def test_plane_patch_is_open_and_exact():
     rim = cloud.points[cloud.rim]
     assert np.all(np.max(np.abs(rim[:, :2]), axis=1) > 0.55)
     sol = ts.solve(cloud, cube(51), sources=[(0.0, 0.0, 0.0)])
-    assert sol.stats.order == 1 and "rim" in sol.stats.order_fallback
+    # second order inside, the paper's first-order update at the rim (node by node)
+    assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] > 0
+    assert np.all(np.max(np.abs(sol.first_order_points()[:, :2]), axis=1) > 0.5)
     assert cloud.report["rim_nodes"] > 0
     q = cloud.points[np.max(np.abs(cloud.points[:, :2]), axis=1) < 0.4]
     err = np.abs(sol(q) - np.linalg.norm(q, axis=1))
@@ -145,7 +147,8 @@ def test_a_hole_is_a_rim():
     rim = cloud.points[cloud.rim]
     assert np.all(rim[:, 2] > 0.3)
     sol = ts.solve(cloud, cube(41), sources=[(0.0, 0.0, -0.5)])
-    assert sol.stats.order == 1 and "rim" in sol.stats.order_fallback
+    assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] > 0
+    assert np.all(sol.first_order_points()[:, 2] > 0.2)
 
 
 @pytest.mark.parametrize(
