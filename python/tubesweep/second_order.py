@@ -44,9 +44,10 @@ ORDERS = (1, 2, "auto")
 
 
 class Order2NotApplicable(ValueError):
-    """``order=2`` does not apply to this surface, grid or these options (a mesh, an open surface,
-    a crease, a curvature the tube does not resolve, a φ that is not a distance, a Hamiltonian or
-    an option of the first-order scheme). The message says why and what to do; with
+    """``order=2`` does not apply to this surface, grid or these options (a mesh, a tube most of
+    which the grid does not resolve, convex creases or corners of a level set, a Hamiltonian or an
+    option of the first-order scheme; a rim, a concave crease or noise only turn it off node by
+    node). The message says why and what to do; with
     ``order="auto"`` the solve uses ``order=1`` instead and records the message in
     ``sol.stats.order_fallback``."""
 
