@@ -90,7 +90,9 @@ def test_surface_solves_keep_their_invariants(problem):
     # zero at the sources: the interpolated value there is within a few cells' travel time; never
     # negative next to them (order=2's u₀ + w rounded to −9e-22 once)
     at = sol(sources)
-    assert np.all(at <= 3 * h * slowness) and np.all(at >= 0)
+    # (Lax–Friedrichs from the paper's node initialisation reaches 3.07 h at a source on a 28³ grid:
+    # the sphere of radius 0.625 centred at (0.125, 0.03125, 0), a hypothesis example)
+    assert np.all(at <= 3.5 * h * slowness) and np.all(at >= 0)
     near = np.repeat(sources, 4, axis=0) + 0.3 * h * np.sin(np.arange(4 * len(sources) * grid.ndim)).reshape(
         -1, grid.ndim
     )
