@@ -84,10 +84,12 @@ def test_noise_is_read_through_local_fits():
     o2 = sol.stats.order2
     assert sol.stats.order == 2 and o2["geometry_fitted"]
     assert o2["first_order_nodes"] <= 0.05 * o2["inner_nodes"]
-    # the noisy zero level set is bumpy (its geodesics are longer): 1.6e-3 against 1.5e-2 at order 1
+    # the fits over three grid steps average the noise out of the surface: 7.3e-5 against 1.5e-2 at
+    # order 1 and 2.0e-5 without noise (1.6e-3 with the two-step fit, where the noisy zero level
+    # set's bumps made the geodesics longer)
     err = meridian_error(sol)
-    assert err < 2e-3
-    assert err < meridian_error(ts.solve(ts.LevelSet(phi), g, [(-0.5, 0.0, 0.0)], order=1)) / 5
+    assert err < 1.5e-4
+    assert err < meridian_error(ts.solve(ts.LevelSet(phi), g, [(-0.5, 0.0, 0.0)], order=1)) / 50
     # noise of 1e-4 is below the test: central differences
     quiet = sphere_phi(g) + 1e-4 * np.random.default_rng(0).standard_normal(g.shape)
     assert not ts.solve(ts.LevelSet(quiet), g, [(-0.5, 0.0, 0.0)]).stats.order2["geometry_fitted"]

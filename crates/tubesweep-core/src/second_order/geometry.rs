@@ -82,17 +82,26 @@ pub struct GeometrySummary {
 /// φ is taken as noisy, and the geometry computed again from the local fits at every node, when
 /// the central differences give |∇φ| off 1 by more than [`NOISY_GRADIENT`] at more than this
 /// fraction of the inner-tube nodes. Noise that makes some nodes fail the tests also spoils B at
-/// the others (the sphere with Gaussian noise of 1e-3 at N = 121: 43% of the inner tube off by
-/// more than 0.02; a mean error on a meridian of 2.6e-3 with the fit only where the tests failed,
-/// 1.6e-3 with it everywhere), while a rim, a crease or a box cut fails only where it is (the
+/// the others (the sphere with Gaussian noise of 1e-3 at N = 121: a mean error on a meridian of
+/// 2.6e-3 with the two-step fit only where the tests failed, 1.6e-3 with it everywhere, 7.3e-5
+/// with the three-step fit ([`WIDE_FIT`]) everywhere; noise of 3e-4: 7.6e-4 by central
+/// differences, 3.4e-5 fitted), while a rim, a crease or a box cut fails only where it is (the
 /// hemisphere's rim: 4–9% of the tube at N = 81–161), where the central differences are the
 /// more accurate ones (the hemisphere at N = 121: 6.3e-5 with the fit everywhere, against
 /// 1.6e-5 without).
 pub const NOISY_FRACTION: f64 = 0.25;
 
-/// See [`NOISY_FRACTION`]: far above the central differences' own error of |∇φ| on a resolved
-/// signed distance.
-pub const NOISY_GRADIENT: f64 = 0.02;
+/// See [`NOISY_FRACTION`]: above the central differences' own error of |∇φ| on a resolved
+/// signed distance ((Δx κ)²/3: no library surface reaches a quarter of its tube at any grid that
+/// `order=2` accepts), below what noise of 0.02Δx gives (Gaussian noise of 3e-4 at N = 121: 43%
+/// of the inner tube).
+pub const NOISY_GRADIENT: f64 = 0.01;
+
+/// When φ is noisy ([`NOISY_FRACTION`]), the fit is taken over the nodes within three grid steps
+/// (123 in 3D, 29 in 2D; at a node near the band's edge over those of them in the band), which
+/// averages the noise out of the surface's closest points (x − φ∇φ) as well as out of B: the
+/// sphere with noise of 1e-3 at N = 121, 7.3e-5 against 1.6e-3 with the two-step fit.
+pub const WIDE_FIT: bool = true;
 
 impl GeometrySummary {
     /// Nothing seen yet ([`Self::merge`]'s identity).
@@ -490,7 +499,7 @@ pub fn tube_geometry_of<const D: usize>(
                     &mut local,
                     outer_width,
                     &mut summary,
-                    || surface.local_fitted(band, i, spacing),
+                    || surface.local_fitted(band, i, spacing, WIDE_FIT && pass == 1),
                 ));
             }
         }

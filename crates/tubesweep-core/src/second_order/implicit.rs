@@ -72,8 +72,8 @@ impl<const D: usize> Implicit<'_, D> {
 
     /// As [`Self::local`], φ, ∇φ and D²φ from the least-squares quadratic over the nodes within
     /// two grid steps ([`super::local_fit`]): robust to noise in φ.
-    pub fn local_fitted(&self, band: &NarrowBand<D>, i: usize, h: f64) -> Option<LocalGeometry<D>> {
-        self.local_by(band, i, |phi| fitted_gradient_and_hessian_by(band, i, h, phi))
+    pub fn local_fitted(&self, band: &NarrowBand<D>, i: usize, h: f64, wide: bool) -> Option<LocalGeometry<D>> {
+        self.local_by(band, i, |phi| fitted_gradient_and_hessian_by(band, i, h, wide, phi))
     }
 
     /// φ, ∇φ and D²φ at node `i` as `differences` gives them from the (locally signed) φ.

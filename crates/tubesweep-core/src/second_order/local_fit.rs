@@ -10,17 +10,21 @@
 //! central differences only through noise passes with the fit, and a real crease, corner or rim
 //! (where no quadratic fits) still fails. The ball lies in the band at every inner-tube node
 //! (|φ| ≤ inner·Δx, the band reaching outer·Δx ≥ (inner + 2)Δx).
+//!
+//! When φ is noisy throughout ([`super::geometry::NOISY_FRACTION`]) the fit is over the ball of
+//! radius 3 (123 nodes in 3D), by its precomputed weights where the ball is in the band and by the
+//! normal equations over the nodes found where it is not (at least half of them).
 
 use std::sync::OnceLock;
 
 use crate::band::NarrowBand;
 
-/// The integer offsets within two grid steps (|o|² ≤ 4), the node itself first.
-fn ball<const D: usize>() -> Vec<[i32; D]> {
+/// The integer offsets within `radius` grid steps (|o|² ≤ radius²), the node itself first.
+fn ball<const D: usize>(radius: i32) -> Vec<[i32; D]> {
     let mut out = Vec::new();
-    let mut o = [-2i32; D];
+    let mut o = [-radius; D];
     loop {
-        if o.iter().map(|a| a * a).sum::<i32>() <= 4 {
+        if o.iter().map(|a| a * a).sum::<i32>() <= radius * radius {
             out.push(o);
         }
         let mut k = 0;
@@ -30,10 +34,10 @@ fn ball<const D: usize>() -> Vec<[i32; D]> {
                 return out;
             }
             o[k] += 1;
-            if o[k] <= 2 {
+            if o[k] <= radius {
                 break;
             }
-            o[k] = -2;
+            o[k] = -radius;
             k += 1;
         }
     }
@@ -55,12 +59,14 @@ fn monomials<const D: usize>(o: &[i32; D]) -> Vec<f64> {
 /// (rows of (AᵀA)⁻¹Aᵀ), computed once per dimension.
 struct Fit {
     offsets: Vec<Vec<i32>>,
+    /// `rows[j]`: the monomials at offset j (a row of the design matrix A).
+    rows: Vec<Vec<f64>>,
     /// `weights[c][j]`: coefficient c's weight on offset j.
     weights: Vec<Vec<f64>>,
 }
 
-fn fit_of<const D: usize>() -> Fit {
-    let offsets = ball::<D>();
+fn fit_of<const D: usize>(radius: i32) -> Fit {
+    let offsets = ball::<D>(radius);
     let rows: Vec<Vec<f64>> = offsets.iter().map(monomials::<D>).collect();
     let p = rows[0].len();
     // AᵀA and its inverse by Gauss–Jordan (symmetric positive definite, p ≤ 10)
@@ -100,16 +106,21 @@ fn fit_of<const D: usize>() -> Fit {
         .collect();
     Fit {
         offsets: offsets.iter().map(|o| o.to_vec()).collect(),
+        rows,
         weights,
     }
 }
 
-fn fit<const D: usize>() -> &'static Fit {
+fn fit<const D: usize>(wide: bool) -> &'static Fit {
     static FIT2: OnceLock<Fit> = OnceLock::new();
     static FIT3: OnceLock<Fit> = OnceLock::new();
-    match D {
-        2 => FIT2.get_or_init(fit_of::<2>),
-        _ => FIT3.get_or_init(fit_of::<3>),
+    static WIDE2: OnceLock<Fit> = OnceLock::new();
+    static WIDE3: OnceLock<Fit> = OnceLock::new();
+    match (D, wide) {
+        (2, false) => FIT2.get_or_init(|| fit_of::<2>(2)),
+        (_, false) => FIT3.get_or_init(|| fit_of::<3>(2)),
+        (2, true) => WIDE2.get_or_init(|| fit_of::<2>(3)),
+        (_, true) => WIDE3.get_or_init(|| fit_of::<3>(3)),
     }
 }
 
@@ -120,12 +131,27 @@ pub(crate) fn fitted_gradient_and_hessian_by<const D: usize>(
     band: &NarrowBand<D>,
     n: usize,
     h: f64,
+    wide: bool,
     phi: impl Fn(usize) -> f64,
 ) -> Option<(f64, [f64; D], [[f64; D]; D])> {
-    let fit = fit::<D>();
+    if wide {
+        return fit_by(band, n, h, fit::<D>(true), true, &phi);
+    }
+    fit_by(band, n, h, fit::<D>(false), false, &phi)
+}
+
+fn fit_by<const D: usize>(
+    band: &NarrowBand<D>,
+    n: usize,
+    h: f64,
+    fit: &Fit,
+    partial: bool,
+    phi: &impl Fn(usize) -> f64,
+) -> Option<(f64, [f64; D], [[f64; D]; D])> {
     let sentinel = band.sentinel();
     let mut coef = vec![0.0; fit.weights.len()];
-    for (j, o) in fit.offsets.iter().enumerate() {
+    let mut found: Vec<(usize, f64)> = Vec::with_capacity(fit.offsets.len());
+    'offsets: for (j, o) in fit.offsets.iter().enumerate() {
         // walk to the offset axis by axis through the neighbour table
         let mut at = n as u32;
         for (k, &steps) in o.iter().enumerate() {
@@ -133,14 +159,25 @@ pub(crate) fn fitted_gradient_and_hessian_by<const D: usize>(
             for _ in 0..steps.unsigned_abs() {
                 at = band.neighbours_of(at as usize)[k][side];
                 if at == sentinel {
+                    if partial {
+                        continue 'offsets;
+                    }
                     return None;
                 }
             }
         }
-        let v = phi(at as usize);
-        for (c, w) in coef.iter_mut().zip(&fit.weights) {
-            *c += w[j] * v;
+        found.push((j, phi(at as usize)));
+    }
+    if found.len() == fit.offsets.len() {
+        for &(j, v) in &found {
+            for (c, w) in coef.iter_mut().zip(&fit.weights) {
+                *c += w[j] * v;
+            }
         }
+    } else if found.len() >= fit.offsets.len() / 2 {
+        coef = solve_normal_equations(fit, &found)?;
+    } else {
+        return None;
     }
     let mut g = [0.0; D];
     let mut hess = [[0.0; D]; D];
@@ -159,22 +196,72 @@ pub(crate) fn fitted_gradient_and_hessian_by<const D: usize>(
     Some((coef[0], g, hess))
 }
 
+/// The least-squares quadratic through the values at the offsets found (`(offset, φ)`), by the
+/// normal equations AᵀA c = Aᵀφ and a Cholesky factorisation; None when AᵀA is singular (the
+/// nodes found do not determine a quadratic).
+fn solve_normal_equations(fit: &Fit, found: &[(usize, f64)]) -> Option<Vec<f64>> {
+    let p = fit.weights.len();
+    let mut m = vec![0.0; p * p];
+    let mut b = vec![0.0; p];
+    for &(j, v) in found {
+        let r = &fit.rows[j];
+        for a in 0..p {
+            b[a] += r[a] * v;
+            for c in 0..=a {
+                m[a * p + c] += r[a] * r[c];
+            }
+        }
+    }
+    // Cholesky, lower triangle in place
+    for a in 0..p {
+        for c in 0..=a {
+            let mut sum = m[a * p + c];
+            for k in 0..c {
+                sum -= m[a * p + k] * m[c * p + k];
+            }
+            if a == c {
+                if !(sum > 1e-9 * (1.0 + m[a * p + a].abs())) {
+                    return None;
+                }
+                m[a * p + a] = sum.sqrt();
+            } else {
+                m[a * p + c] = sum / m[c * p + c];
+            }
+        }
+    }
+    for a in 0..p {
+        let mut sum = b[a];
+        for k in 0..a {
+            sum -= m[a * p + k] * b[k];
+        }
+        b[a] = sum / m[a * p + a];
+    }
+    for a in (0..p).rev() {
+        let mut sum = b[a];
+        for k in a + 1..p {
+            sum -= m[k * p + a] * b[k];
+        }
+        b[a] = sum / m[a * p + a];
+    }
+    Some(b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn the_ball_has_33_nodes_in_3d_and_13_in_2d() {
-        assert_eq!(ball::<3>().len(), 33);
-        assert_eq!(ball::<2>().len(), 13);
-        assert_eq!(ball::<3>()[0], [0, 0, 0]);
+        assert_eq!(ball::<3>(2).len(), 33);
+        assert_eq!(ball::<2>(2).len(), 13);
+        assert_eq!(ball::<3>(2)[0], [0, 0, 0]);
     }
 
     /// The fit reproduces every quadratic exactly: its weights applied to a quadratic's values
     /// give back its coefficients.
     #[test]
     fn the_fit_is_exact_on_quadratics() {
-        let fit = fit::<3>();
+        let fit = fit::<3>(false);
         let q = [0.3, -1.2, 0.7, 2.5, 0.11, -0.4, 0.9, 1.3, -0.25, 0.6];
         for (c, w) in fit.weights.iter().enumerate() {
             let v: f64 = fit
@@ -189,5 +276,36 @@ mod tests {
                 .sum();
             assert!((v - q[c]).abs() < 1e-12, "coefficient {c}: {v} vs {}", q[c]);
         }
+    }
+
+    /// With nodes missing from the wide ball (a node near the edge of the band), the normal
+    /// equations over the nodes found still reproduce a quadratic exactly.
+    #[test]
+    fn the_partial_wide_fit_is_exact_on_quadratics() {
+        let fit = fit::<3>(true);
+        assert_eq!(fit.offsets.len(), 123);
+        let q = [0.3, -1.2, 0.7, 2.5, 0.11, -0.4, 0.9, 1.3, -0.25, 0.6];
+        // the half-ball o_z ≤ 1 (a node one step inside the band's edge)
+        let found: Vec<(usize, f64)> = fit
+            .rows
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| fit.offsets[*j][2] <= 1)
+            .map(|(j, r)| (j, r.iter().zip(&q).map(|(a, b)| a * b).sum()))
+            .collect();
+        assert!(found.len() < 123 && found.len() >= 123 / 2);
+        let c = solve_normal_equations(fit, &found).expect("a determined fit");
+        for (a, b) in c.iter().zip(&q) {
+            assert!((a - b).abs() < 1e-10, "{c:?} vs {q:?}");
+        }
+        // a plane of nodes does not determine the quadratic's z terms: refused, not guessed
+        let flat: Vec<(usize, f64)> = fit
+            .offsets
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o[2] == 0)
+            .map(|(j, _)| (j, 1.0))
+            .collect();
+        assert!(solve_normal_equations(fit, &flat).is_none());
     }
 }

@@ -14,7 +14,9 @@ use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
 use super::factoring::{check_source_arguments, check_sources_fixed, grad_u0_unit_of, node_factor, Factoring};
-use super::geometry::{abs_phi_of, check_tube_inputs, node_geometry, GeometrySummary, NodeGeometry, TubeGeometry};
+use super::geometry::{
+    abs_phi_of, check_tube_inputs, node_geometry, GeometrySummary, NodeGeometry, TubeGeometry, WIDE_FIT,
+};
 use super::implicit::Implicit;
 
 /// Nodes per chunk of the parallel pass.
@@ -85,7 +87,7 @@ pub fn tube_setup_of<const D: usize>(
                     &mut local,
                     outer_width,
                     &mut out.summary,
-                    || surface.local_fitted(band, i, spacing),
+                    || surface.local_fitted(band, i, spacing, WIDE_FIT && fitted),
                 ));
             }
             if !factor {
