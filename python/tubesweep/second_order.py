@@ -19,6 +19,7 @@ import numpy as np
 
 from . import _native
 from ._box_cut import box_reason
+from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._validate import (
     FRONT_WINDOW,
@@ -361,6 +362,7 @@ def solve_on_tube(
             RuntimeWarning,
             stacklevel=3,
         )
+    warn_creases(st.get("creases"), tube.inner, h)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
     order2 = {
@@ -377,6 +379,7 @@ def solve_on_tube(
             "first_order_reasons",
             "inner_nodes",
             "geometry_fitted",
+            "creases",
         )
     }
     order2["tol"] = float(tol)

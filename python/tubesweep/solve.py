@@ -258,8 +258,10 @@ def solve(
         source_radius=source_radius,
     )
     if fallback is not None:
+        from ._creases import warn_refused_creases
         from .second_order import with_fallback
 
+        warn_refused_creases(fallback, inner, grid.spacing)
         return with_fallback(sol, fallback)
     return sol
 

@@ -191,6 +191,11 @@ fn run<'py, const D: usize>(
     reasons.set_item("curvature", summary.unresolved_curvature)?;
     d.set_item("first_order_reasons", reasons)?;
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
+    let creases = PyDict::new(py);
+    creases.set_item("nodes", summary.creases.nodes)?;
+    creases.set_item("angle_degrees", summary.creases.angle)?;
+    creases.set_item("shortcut_per_inner_width", summary.creases.shortcut_per_inner_width())?;
+    d.set_item("creases", creases)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
     Ok((
         values.into_pyarray(py),

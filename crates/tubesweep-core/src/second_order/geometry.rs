@@ -13,6 +13,7 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
+use super::creases::{creases_of, Creases};
 use super::implicit::{Implicit, LocalGeometry};
 
 /// What the second-order sweeps read at one inner-tube node (the extension layer's nodes read
@@ -77,6 +78,9 @@ pub struct GeometrySummary {
     /// Whether every node's derivatives come from the local fit ([`super::local_fit`]): set
     /// before the pass when a first pass found φ noisy.
     pub fitted_everywhere: bool,
+    /// The creases and corners of a level set among the nodes of unresolved curvature
+    /// ([`super::creases`]), found after the pass.
+    pub creases: Creases,
 }
 
 /// φ is taken as noisy, and the geometry computed again from the local fits at every node, when
@@ -116,6 +120,7 @@ impl GeometrySummary {
             inner_nodes: 0,
             rough_gradients: 0,
             fitted_everywhere: false,
+            creases: Creases::default(),
         }
     }
 
@@ -131,6 +136,10 @@ impl GeometrySummary {
             inner_nodes: self.inner_nodes + other.inner_nodes,
             rough_gradients: self.rough_gradients + other.rough_gradients,
             fitted_everywhere: self.fitted_everywhere || other.fitted_everywhere,
+            creases: Creases {
+                nodes: self.creases.nodes + other.creases.nodes,
+                angle: self.creases.angle.max(other.creases.angle),
+            },
         }
     }
 
@@ -506,6 +515,9 @@ pub fn tube_geometry_of<const D: usize>(
     }
     nodes.shrink_to_fit();
     summary.finish();
+    if !surface.is_closest_point() {
+        summary.creases = creases_of(band, roles, surface, spacing, directions, &nodes);
+    }
     let abs_phi = abs_phi_of(surface, spacing);
     Ok(TubeGeometry {
         nodes,

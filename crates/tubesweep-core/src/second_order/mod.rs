@@ -10,6 +10,7 @@
 //! * [`factoring`]: u = u₀ + w with u₀ the chord distance to the nearest point source, the nodes
 //!   within a small ball of a source fixed at u₀;
 //! * [`setup`]: both in one parallel pass over the band;
+//! * [`creases`]: where φ's level sets have creases or corners, and the shortcut they cost;
 //! * [`many`]: many sources on one band, the geometry shared, in parallel across the sources;
 //! * [`local`]: the limited BDF2/BDF3 Godunov update (continuous ramps from first to second to third
 //!   order, Newton's method for the unequal steps) and the second-order extension update;
@@ -18,6 +19,7 @@
 //!
 //! The first-order solver ([`crate::sweep`]) is untouched: `order=1` is the paper's scheme.
 
+pub mod creases;
 pub mod factoring;
 pub mod geometry;
 pub mod implicit;
@@ -78,17 +80,32 @@ pub fn check_geometry_of(
     let unresolved = summary.first_order_nodes();
     if (unresolved as f64) <= MAX_FIRST_ORDER_FRACTION * total as f64 {
         if !closest_point && summary.unresolved_curvature as f64 > MAX_CREASE_FRACTION * total as f64 {
+            let share = 100.0 * summary.unresolved_curvature as f64 / total as f64;
+            if summary.creases.nodes == 0 {
+                return Err(Error::invalid(
+                    "grid",
+                    format!(
+                        "order=2: {} of the {} inner-tube nodes ({share:.0}%) have a principal curvature the tube does \
+                         not resolve (outer·Δx·κ ≥ 1; spacing {spacing:.4}, outer·Δx = {outer_width:.4}), where the \
+                         second-order update is no better than the first-order one. Refine the grid (or use order=1)",
+                        summary.unresolved_curvature, summary.inner_nodes,
+                    ),
+                ));
+            }
             return Err(Error::invalid(
                 "surface",
                 format!(
-                    "order=2: {} of the {} inner-tube nodes ({:.0}%) lie at convex creases or corners of φ's level sets \
-                     (a principal curvature with outer·Δx·κ ≥ 1), where the inner tube cuts the corner by about \
-                     2·inner·Δx per edge the front crosses whatever the order (the cube max|x| − 0.5 at N = 81: 1.77 \
-                     instead of 2.0), and the second-order update next to them came out no better. Round the edges over a \
-                     few grid spacings for second order; use order=1",
+                    "order=2: {} of the {} inner-tube nodes ({share:.0}%) lie at convex creases or corners of φ's level \
+                     sets or next to them (a principal curvature with outer·Δx·κ ≥ 1; {} crease nodes, the normal \
+                     turning by up to {:.0}°), where the inner tube lets the front cut the corner by about \
+                     {:.2}·inner·Δx per crease it crosses whatever the order (2·tan(θ/2); the cube max|x| − 0.5 at \
+                     N = 81: 1.78 instead of 2.0), and the second-order update next to them came out no better. Round \
+                     the edges over a few grid spacings for second order; use order=1",
                     summary.unresolved_curvature,
                     summary.inner_nodes,
-                    100.0 * summary.unresolved_curvature as f64 / total as f64
+                    summary.creases.nodes,
+                    summary.creases.angle,
+                    summary.creases.shortcut_per_inner_width(),
                 ),
             ));
         }

@@ -13,6 +13,7 @@ use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
+use super::creases::creases_of;
 use super::factoring::{check_source_arguments, check_sources_fixed, grad_u0_unit_of, node_factor, Factoring};
 use super::geometry::{
     abs_phi_of, check_tube_inputs, node_geometry, GeometrySummary, NodeGeometry, TubeGeometry, WIDE_FIT,
@@ -172,6 +173,9 @@ pub fn tube_setup_of<const D: usize>(
         }
     }
     summary.finish();
+    if !surface.is_closest_point() {
+        summary.creases = creases_of(band, roles, surface, spacing, directions, &nodes);
+    }
     let geometry = TubeGeometry {
         nodes,
         abs_phi,

@@ -1,0 +1,136 @@
+//! Creases and corners of φ's level sets: where they are, and how much they cost.
+//!
+//! Across a crease the normal n = ∇φ/|∇φ| jumps. In the tube the paper's equation (its Eq. (3),
+//! |P∇u| = 1/F with P = I − nnᵀ) lets the front move along n for free, so on the side of the crease
+//! where the tubes of the two faces overlap (inside a convex edge, outside a concave one) a path
+//! runs up one face's normal to the bisector and down the other's: the front arrives early by
+//! about 2·inner·Δx·tan(θ/2) per crease it crosses, θ the angle between the two faces' normals,
+//! whatever the order of the update (the cube max|x| − 0.5, θ = 90°, from the bottom centre to
+//! the top centre: 1.575 at N = 41 and 1.779 at N = 81 instead of 2.0, 4.25Δx and 4.42Δx per
+//! edge with inner = 2; 2.45Δx and 2.51Δx with inner = 1). That error is first order in Δx.
+//!
+//! The crease nodes are the inner-tube nodes within [`CREASE_REACH`] grid spacings of a level set
+//! whose geometry is unresolved by its curvature or its gradient ([`Unresolved::Curvature`]: a convex edge; [`Unresolved::Gradient`]:
+//! the central differences across a kink of φ = min(φ₁, φ₂) give |∇φ| < 1), whose normal turns
+//! by more than [`CREASE_ANGLE`] degrees to a neighbour's (noise, a φ that is not a distance and a
+//! curvature resolved by the grid turn it by much less) and where φ has a kink: |∇φ| by central
+//! differences off 1 by more than [`GRAD_NORM_TOLERANCE`] (across a kink they average the two
+//! faces' gradients, |∇φ| ≈ cos(θ/2), where a smooth surface that the grid barely resolves, such
+//! as the tip of the spheroid 0.25/0.25/0.5 at N = 41, keeps |∇φ| ≈ 1).
+//! Closest-point maps are left out (beyond the rim of an open surface the directions turn
+//! around the rim, which is not a crease).
+
+use crate::band::NarrowBand;
+use crate::sweep::NodeRole;
+
+use super::geometry::{NodeGeometry, Unresolved};
+use super::implicit::Implicit;
+use super::GRAD_NORM_TOLERANCE;
+
+/// The smallest turn of the normal between neighbouring nodes, in degrees, that marks a crease:
+/// above what a smooth surface gives where the grid barely resolves it (the torus 0.5/0.2 at
+/// N = 41, κΔx = 0.25: up to 28° between neighbours on the inner side of its tube), below the
+/// creases of the library and the tests (the double torus: 54–56°, two spheres joined by `min`
+/// and the cube: 90°).
+pub const CREASE_ANGLE: f64 = 40.0;
+
+/// Crease nodes lie within this many grid spacings of the surface (|φ| ≤ 1.5Δx): further in,
+/// the normals of a smooth surface the grid barely resolves turn fast near its focal points (the
+/// spheroid 0.25/0.25/0.5 at N = 41: up to 29° between neighbours within 1.5Δx, 39° beyond),
+/// while across a crease they turn by its angle at every distance (the cube: 55° by central
+/// differences of φ at every |φ| ≤ 2Δx).
+pub const CREASE_REACH: f64 = 1.5;
+
+/// The crease nodes of a tube and the largest turn of the normal there.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Creases {
+    /// Inner-tube nodes at a crease or corner (see the module documentation).
+    pub nodes: usize,
+    /// The largest angle, in degrees, between a crease node's normal and a neighbour's.
+    pub angle: f64,
+}
+
+impl Creases {
+    /// How early, in units of inner·Δx, a front arrives after crossing a crease whose faces'
+    /// normals differ by `self.angle`: 2·tan(θ/2) (capped at θ = 150°).
+    pub fn shortcut_per_inner_width(&self) -> f64 {
+        2.0 * (self.angle.min(150.0).to_radians() / 2.0).tan()
+    }
+}
+
+/// The creases among the inner-tube nodes of `band` (`nodes`: their geometry, in band order, one
+/// per node whose role is not [`NodeRole::Outer`]), from the given unit directions (away from the
+/// surface: sgn(φ)∇φ/|∇φ|, turned back into ∇φ/|∇φ| by φ's sign).
+pub fn creases_of<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    spacing: f64,
+    directions: &[[f32; D]],
+    nodes: &[NodeGeometry],
+) -> Creases {
+    let normal = |i: usize| {
+        let s = if surface.phi(i) < 0.0 { -1.0 } else { 1.0 };
+        let mut n = [0.0f64; D];
+        for c in 0..D {
+            n[c] = s * directions[i][c] as f64;
+        }
+        n
+    };
+    let threshold = CREASE_ANGLE.to_radians().cos();
+    let sentinel = band.sentinel();
+    let mut found = Creases::default();
+    let mut smallest = 1.0f64;
+    let mut k = 0usize;
+    for (i, role) in roles.iter().enumerate() {
+        if *role == NodeRole::Outer {
+            continue;
+        }
+        let geo = &nodes[k];
+        k += 1;
+        if geo.first_order != Unresolved::Curvature as u8 && geo.first_order != Unresolved::Gradient as u8
+            || surface.phi(i).abs() > CREASE_REACH * spacing
+        {
+            continue;
+        }
+        let mut cos_min = 1.0f64;
+        let ni = normal(i);
+        for axis in band.neighbours_of(i).iter() {
+            for &j in axis {
+                if j != sentinel {
+                    let nj = normal(j as usize);
+                    let dot: f64 = (0..D).map(|c| ni[c] * nj[c]).sum();
+                    cos_min = cos_min.min(dot);
+                }
+            }
+        }
+        // a kink of φ there: central differences across it average the two faces' gradients,
+        // |∇φ| ≈ cos(θ/2) (a smooth surface the grid barely resolves keeps |∇φ| ≈ 1)
+        let kink = || {
+            surface.local(band, i, spacing).is_none_or(|l| {
+                let norm = l.gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
+                (norm - 1.0).abs() > GRAD_NORM_TOLERANCE
+            })
+        };
+        if cos_min < threshold && kink() {
+            found.nodes += 1;
+            smallest = smallest.min(cos_min);
+        }
+    }
+    if found.nodes > 0 {
+        found.angle = smallest.clamp(-1.0, 1.0).acos().to_degrees();
+    }
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_right_angle_costs_two_inner_widths() {
+        let c = Creases { nodes: 1, angle: 90.0 };
+        assert!((c.shortcut_per_inner_width() - 2.0).abs() < 1e-12);
+        assert_eq!(Creases::default().shortcut_per_inner_width(), 0.0);
+    }
+}
