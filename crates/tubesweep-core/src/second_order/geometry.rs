@@ -515,7 +515,7 @@ pub fn tube_geometry_of<const D: usize>(
     }
     nodes.shrink_to_fit();
     summary.finish();
-    if !surface.is_closest_point() {
+    if !surface.is_closest_point() && !summary.fitted_everywhere {
         summary.creases = creases_of(band, roles, surface, spacing, directions, &nodes);
     }
     let abs_phi = abs_phi_of(surface, spacing);

@@ -173,7 +173,7 @@ pub fn tube_setup_of<const D: usize>(
         }
     }
     summary.finish();
-    if !surface.is_closest_point() {
+    if !surface.is_closest_point() && !summary.fitted_everywhere {
         summary.creases = creases_of(band, roles, surface, spacing, directions, &nodes);
     }
     let geometry = TubeGeometry {
