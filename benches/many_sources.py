@@ -126,12 +126,15 @@ def interleaved(tube: ts.Tube, pts: np.ndarray, rounds: int) -> dict:
     wall time and the process's CPU time per source; per round the ratios (the default order's
     CPU per source over order=1's, solve_many's speed over the loop's), so that a change of load
     between rounds cancels out of each ratio; the medians over the rounds. ``same``: the rows of
-    solve_many equal the loop's bit for bit in every run."""
+    solve_many equal the loop's bit for bit in every run. ``stats``: per order, from the first
+    round's solve_many(threads=1), the mean updates and iterations per source and the share of its
+    wall time spent in the sweeps (the solves' own timings)."""
     k = len(pts)
     runs = [("loop", 1), ("many1", 1), ("many0", 0)]
     out: dict = {o: {name: {"wall": [], "cpu": []} for name, _ in runs} for o in (1, "auto")}
     same = True
-    for _ in range(rounds):
+    out["stats"] = {}
+    for rnd in range(rounds):
         for order in (1, "auto"):
             loop = None
             for name, threads in runs:
@@ -139,8 +142,13 @@ def interleaved(tube: ts.Tube, pts: np.ndarray, rounds: int) -> dict:
                 if name == "loop":
                     loop = np.array([tube.solve([p], threads=1, order=order)(pts) for p in pts])
                     values = loop
+                elif rnd == 0 and name == "many1":
+                    values, st = tube.solve_many(pts, at=pts, threads=threads, order=order, return_stats=True)
+                    wall = time.perf_counter() - t
+                    out["stats"][order] = (np.mean(st["updates"]), np.mean(st["iterations"]), np.sum(st["seconds"]) / wall)
                 else:
                     values = tube.solve_many(pts, at=pts, threads=threads, order=order)
+                if name != "loop":
                     same = same and np.array_equal(values.view(np.uint64), loop.view(np.uint64))
                 out[order][name]["wall"].append((time.perf_counter() - t) / k)
                 out[order][name]["cpu"].append((time.process_time() - c) / k)
@@ -186,6 +194,15 @@ def part_orders(quick: bool) -> None:
             f"  solve_many ({text}): CPU per source at the default order / order=1: {med(a / b):.2f}x, per round "
             f"{np.round(a / b, 2).tolist()} (target <= 2.5x)"
         )
+    for order in (1, "auto"):
+        updates, iterations, share = r["stats"][order]
+        print(
+            f"  solve_many(threads=1, order={order!r}), per source: {updates / 1e6:.2f} million updates in "
+            f"{iterations:.1f} iterations; {100 * share:.0f}% of the wall time in the sweeps"
+        )
+    a, b = np.array(r["auto"]["many1"]["cpu"]), np.array(r[1]["many1"]["cpu"])
+    per_update = med(a / b) / (r["stats"]["auto"][0] / r["stats"][1][0])
+    print(f"  CPU per update at the default order / order=1 (solve_many, 1 thread): {per_update:.2f}x")
     print(f"  rows of solve_many equal to the loop's bit for bit at both orders: {r['same']}")
     exact = great_circle(pts, pts)
     for order in (1, "auto"):
