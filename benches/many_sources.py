@@ -145,7 +145,11 @@ def interleaved(tube: ts.Tube, pts: np.ndarray, rounds: int) -> dict:
                 elif rnd == 0 and name == "many1":
                     values, st = tube.solve_many(pts, at=pts, threads=threads, order=order, return_stats=True)
                     wall = time.perf_counter() - t
-                    out["stats"][order] = (np.mean(st["updates"]), np.mean(st["iterations"]), np.sum(st["seconds"]) / wall)
+                    out["stats"][order] = (
+                        np.mean(st["updates"]),
+                        np.mean(st["iterations"]),
+                        np.sum(st["seconds"]) / wall,
+                    )
                 else:
                     values = tube.solve_many(pts, at=pts, threads=threads, order=order)
                 if name != "loop":
