@@ -13,10 +13,11 @@ Parts (all side by side in one run: read the ratios, the machine is shared):
   alternating rounds; sources/s and the speed-up of ``solve_many`` on 2 threads over the loop
   (target ≥ 1.8×, ≥ 60 sources/s).
 * ``orders`` (issue 46): the sphere at N = 101 with 40 random surface points at the default order
-  (second order there) and at ``order=1``: the loop of ``tube.solve(threads=1)`` against
-  ``solve_many`` (rows equal bit for bit; target ≥ 1.6× on 2 cores), the CPU per source of the
-  default against ``order=1`` (target ≤ 2.5×), ``distance_matrix``'s mean error against the
-  great-circle distance (target ≤ 2e-4), its symmetry and zero diagonal.
+  (second order there) and at ``order=1``, in 7 interleaved rounds (medians of per-round ratios,
+  and the load average before and after): the loop of ``tube.solve(threads=1)`` against
+  ``solve_many`` on 1 thread and on all cores (rows equal bit for bit; target ≥ 1.6× on 2 cores),
+  the CPU per source of the default against ``order=1`` (target ≤ 2.5×), ``distance_matrix``'s
+  mean error against the great-circle distance (target ≤ 2e-4), its symmetry and zero diagonal.
 * ``memory`` (issue 46): peak RSS (``resource.getrusage``, each run in its own process) of
   ``ts.solve`` with 10,000 sources and of a 10,000-source ``solve_many`` at N = 41, the default
   order against ``order=1`` (target ≤ 3×).
@@ -118,26 +119,95 @@ def random_sphere_points(m: int, seed: int) -> np.ndarray:
     return R * v / np.linalg.norm(v, axis=1)[:, None]
 
 
+def interleaved(tube: ts.Tube, pts: np.ndarray, rounds: int) -> dict:
+    """Issue 46's cost and speed-up protocol: in every round, one after the other, at ``order=1``
+    and at the default order, the loop of ``tube.solve(threads=1)`` and ``solve_many`` on 1 thread
+    and on the default thread count (``threads=0``: all cores), each read at ``pts``. Per run the
+    wall time and the process's CPU time per source; per round the ratios (the default order's
+    CPU per source over order=1's, solve_many's speed over the loop's), so that a change of load
+    between rounds cancels out of each ratio; the medians over the rounds. ``same``: the rows of
+    solve_many equal the loop's bit for bit in every run. ``stats``: per order, from the first
+    round's solve_many(threads=1), the mean updates and iterations per source and the share of its
+    wall time spent in the sweeps (the solves' own timings)."""
+    k = len(pts)
+    runs = [("loop", 1), ("many1", 1), ("many0", 0)]
+    out: dict = {o: {name: {"wall": [], "cpu": []} for name, _ in runs} for o in (1, "auto")}
+    same = True
+    out["stats"] = {}
+    for rnd in range(rounds):
+        for order in (1, "auto"):
+            loop = None
+            for name, threads in runs:
+                t, c = time.perf_counter(), time.process_time()
+                if name == "loop":
+                    loop = np.array([tube.solve([p], threads=1, order=order)(pts) for p in pts])
+                    values = loop
+                elif rnd == 0 and name == "many1":
+                    values, st = tube.solve_many(pts, at=pts, threads=threads, order=order, return_stats=True)
+                    wall = time.perf_counter() - t
+                    out["stats"][order] = (
+                        np.mean(st["updates"]),
+                        np.mean(st["iterations"]),
+                        np.sum(st["seconds"]) / wall,
+                    )
+                else:
+                    values = tube.solve_many(pts, at=pts, threads=threads, order=order)
+                if name != "loop":
+                    same = same and np.array_equal(values.view(np.uint64), loop.view(np.uint64))
+                out[order][name]["wall"].append((time.perf_counter() - t) / k)
+                out[order][name]["cpu"].append((time.process_time() - c) / k)
+    out["same"] = same
+    return out
+
+
 def part_orders(quick: bool) -> None:
     """Issue 46's targets on the sphere at N = 101 with 40 random surface points: the default
     order (second order here) against order=1, the loop of tube.solve(threads=1) against
-    solve_many, per-source cost, and distance_matrix's error against the great-circle distance."""
+    solve_many (interleaved rounds, medians: :func:`interleaved`), and distance_matrix's error
+    against the great-circle distance."""
     n, k = (41, 8) if quick else (101, 40)
+    rounds = 2 if quick else 7
     tube = sphere_tube(n)
     pts = random_sphere_points(k, seed=46)
-    r = {}
+    load = os.getloadavg()
+    r = interleaved(tube, pts, rounds)
+    load_after = os.getloadavg()
+    med = np.median
+    print(
+        f"sphere N = {n} ({tube.band_points:,} band nodes), {k} random surface points, each solve read at them; "
+        f"{rounds} interleaved rounds, medians; load average (1 min) {load[0]:.1f} before, {load_after[0]:.1f} after, "
+        f"{os.cpu_count()} CPUs"
+    )
     for order in (1, "auto"):
-        r[order] = rates(tube, pts, pts, 1 if quick else 3, order=order)
-        print_rates(
-            f"sphere N = {n}, order={order!r}",
-            tube.band_points,
-            k,
-            r[order],
-            "; target >= 1.6x" if order == "auto" else "",
+        loop = np.array(r[order]["loop"]["wall"])
+        for name, text in (
+            ("loop", "loop of tube.solve(threads=1)"),
+            ("many1", "solve_many(threads=1)"),
+            ("many0", "solve_many() (all cores)"),
+        ):
+            wall, cpu = np.array(r[order][name]["wall"]), np.array(r[order][name]["cpu"])
+            speed = f"  {med(loop / wall):.2f}x the loop" if name != "loop" else ""
+            target = "  (target >= 1.6x)" if (order, name) == ("auto", "many0") else ""
+            print(
+                f"  order={order!r:6s} {text:32s} {1 / med(wall):6.1f} sources/s  CPU {1000 * med(cpu):6.1f} ms/source  "
+                f"cores {med(cpu / wall):.2f}{speed}{target}"
+            )
+    for name, text in (("many1", "1 thread"), ("many0", "all cores")):
+        a, b = np.array(r["auto"][name]["cpu"]), np.array(r[1][name]["cpu"])
+        print(
+            f"  solve_many ({text}): CPU per source at the default order / order=1: {med(a / b):.2f}x, per round "
+            f"{np.round(a / b, 2).tolist()} (target <= 2.5x)"
         )
-    for key, text in (("many1", "1 thread"), ("many2", "2 threads")):
-        cost = (r["auto"][key + "_cores"] / r["auto"][key]) / (r[1][key + "_cores"] / r[1][key])
-        print(f"  solve_many ({text}): CPU per source at the default order / order=1: {cost:.2f}x (target <= 2.5x)")
+    for order in (1, "auto"):
+        updates, iterations, share = r["stats"][order]
+        print(
+            f"  solve_many(threads=1, order={order!r}), per source: {updates / 1e6:.2f} million updates in "
+            f"{iterations:.1f} iterations; {100 * share:.0f}% of the wall time in the sweeps"
+        )
+    a, b = np.array(r["auto"]["many1"]["cpu"]), np.array(r[1]["many1"]["cpu"])
+    per_update = med(a / b) / (r["stats"]["auto"][0] / r["stats"][1][0])
+    print(f"  CPU per update at the default order / order=1 (solve_many, 1 thread): {per_update:.2f}x")
+    print(f"  rows of solve_many equal to the loop's bit for bit at both orders: {r['same']}")
     exact = great_circle(pts, pts)
     for order in (1, "auto"):
         t = time.perf_counter()

@@ -291,7 +291,7 @@ fn run_order2<'py, const D: usize>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyDict>)> {
     use crate::convert::node_vectors;
     use tubesweep_core::second_order::many::{solve_many_second_order, BatchSource, BatchTube, Order2Output};
-    use tubesweep_core::second_order::{check_geometry_of, tube_setup_of, Implicit};
+    use tubesweep_core::second_order::{check_geometry_of, setup::batch_setup_of, Implicit};
     let n = band.len();
     let roles = node_roles(inp.roles)?;
     if roles.len() != n || inp.phi.len() != n {
@@ -346,8 +346,8 @@ fn run_order2<'py, const D: usize>(
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
-        // the tube's geometry once for the batch (no sources: no factoring)
-        let (geometry, _) = tube_setup_of(
+        // the tube's geometry and the factoring's feet once for the batch
+        let (geometry, feet) = batch_setup_of(
             band,
             roles,
             &surface,
@@ -355,9 +355,6 @@ fn run_order2<'py, const D: usize>(
             lower,
             inp.spacing,
             inp.outer_width,
-            &[],
-            &[],
-            inp.fix_radius,
             inp.threads,
         )?;
         check_geometry_of(
@@ -375,9 +372,9 @@ fn run_order2<'py, const D: usize>(
         let tube = BatchTube {
             band,
             roles,
-            surface: &surface,
             directions,
             geometry: &geometry,
+            feet: &feet,
             lower,
             spacing: inp.spacing,
             slowness: inp.slowness,

@@ -157,25 +157,28 @@ pub(crate) struct NodeFactor<const D: usize> {
     pub(crate) fixed: bool,
 }
 
-/// u₀ and ∇u₀ at node `i` at `x`, with its outward direction sgn(φ) n, whether it is an
-/// inner-tube node, and φ's differences there (`local`, [`Implicit::local`]; None in the extension
-/// layer or for an incomplete stencil), ∇u₀ over `unit` ([`Factoring::grad_u0_unit`]); counts into
-/// `fixed_per_source` the sources it is within `fix_radius` of.
-#[allow(clippy::too_many_arguments)]
+/// What the factoring reads at a node besides the sources: its closest point, and at an
+/// inner-tube node the unit normal, φ and D²φ (in the orientation of the differences; no D²φ
+/// where the stencil is incomplete). The same for every source: a batch computes it once
+/// ([`TubeFeet`]).
+#[derive(Clone, Copy, Debug)]
+pub struct NodeFoot<const D: usize> {
+    pub normal: [f64; D],
+    pub phi: f64,
+    pub hessian: Option<[[f64; D]; D]>,
+}
+
+/// The closest point of node `i` at `x` and its [`NodeFoot`], from its outward direction sgn(φ) n
+/// and φ's differences there (`local`, [`Implicit::local`]; None in the extension layer or for an
+/// incomplete stencil).
 #[inline]
-pub(crate) fn node_factor<const D: usize>(
+pub(crate) fn node_foot<const D: usize>(
     surface: &Implicit<'_, D>,
     i: usize,
     x: &[f64; D],
     direction: &[f32; D],
-    inner: bool,
     local: Option<&LocalGeometry<D>>,
-    sources: &[[f64; D]],
-    source_slowness: &[f64],
-    unit: f64,
-    fix_radius: f64,
-    fixed_per_source: &mut [usize],
-) -> NodeFactor<D> {
+) -> ([f64; D], NodeFoot<D>) {
     // closest point: x − φ ∇φ/|∇φ|² from f64 differences where the stencil allows;
     // φ in the orientation of the differences, ∇φ/|∇φ| (the layer's geometry holds the
     // outward direction sgn(φ) n)
@@ -196,6 +199,59 @@ pub(crate) fn node_factor<const D: usize>(
         }
     }
     let cp = surface.closest_point(i, x, phi_i, &nrm);
+    (
+        cp,
+        NodeFoot {
+            normal: nrm,
+            phi: phi_i,
+            hessian: local.map(|l| l.hessian),
+        },
+    )
+}
+
+/// u₀ and ∇u₀ at node `i` at `x`, with its outward direction sgn(φ) n, whether it is an
+/// inner-tube node, and φ's differences there (`local`, [`Implicit::local`]; None in the extension
+/// layer or for an incomplete stencil), ∇u₀ over `unit` ([`Factoring::grad_u0_unit`]); counts into
+/// `fixed_per_source` the sources it is within `fix_radius` of.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn node_factor<const D: usize>(
+    surface: &Implicit<'_, D>,
+    i: usize,
+    x: &[f64; D],
+    direction: &[f32; D],
+    inner: bool,
+    local: Option<&LocalGeometry<D>>,
+    sources: &[[f64; D]],
+    source_slowness: &[f64],
+    unit: f64,
+    fix_radius: f64,
+    fixed_per_source: &mut [usize],
+) -> NodeFactor<D> {
+    let (cp, foot) = node_foot(surface, i, x, direction, local);
+    factor_at(
+        &cp,
+        inner.then_some(&foot),
+        sources,
+        source_slowness,
+        unit,
+        fix_radius,
+        fixed_per_source,
+    )
+}
+
+/// [`node_factor`] from the node's closest point `cp` and, at an inner-tube node, its
+/// [`NodeFoot`] (None in the extension layer).
+#[inline]
+pub(crate) fn factor_at<const D: usize>(
+    cp: &[f64; D],
+    inner: Option<&NodeFoot<D>>,
+    sources: &[[f64; D]],
+    source_slowness: &[f64],
+    unit: f64,
+    fix_radius: f64,
+    fixed_per_source: &mut [usize],
+) -> NodeFactor<D> {
     let mut best = (f64::INFINITY, 0usize, 0.0);
     for (s, (xs, &sl)) in sources.iter().zip(source_slowness).enumerate() {
         let c: f64 = (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt();
@@ -209,9 +265,9 @@ pub(crate) fn node_factor<const D: usize>(
         grad_u0: [0.0f32; D],
         fixed: false,
     };
-    if !inner {
+    let Some(foot) = inner else {
         return node;
-    }
+    };
     // the nodes within fix_radius of some source are fixed (the nearest's value)
     let near = sources
         .iter()
@@ -222,6 +278,7 @@ pub(crate) fn node_factor<const D: usize>(
         node.fixed = true;
     }
     if !node.fixed && chord > 0.0 {
+        let nrm = &foot.normal;
         let mut e = [0.0; D];
         for k in 0..D {
             e[k] = (cp[k] - sources[s][k]) / chord;
@@ -230,11 +287,85 @@ pub(crate) fn node_factor<const D: usize>(
         let ne: f64 = (0..D).map(|k| nrm[k] * e[k]).sum();
         for k in 0..D {
             let mut v = e[k] - nrm[k] * ne;
-            if let Some(l) = local {
-                v -= phi_i * (0..D).map(|m| l.hessian[k][m] * e[m]).sum::<f64>();
+            if let Some(hessian) = &foot.hessian {
+                v -= foot.phi * (0..D).map(|m| hessian[k][m] * e[m]).sum::<f64>();
             }
             node.grad_u0[k] = (source_slowness[s] * v / unit) as f32;
         }
     }
     node
+}
+
+/// The source-independent part of the factoring on a whole band ([`node_foot`] per node), for a
+/// batch of solves on it: computed once with the tube's geometry
+/// ([`super::setup::batch_setup_of`], from the same differences of φ as a single solve's set-up,
+/// refitted where that refits them), then each source's factoring is [`factor_sources_at`], the
+/// same values as [`super::tube_setup_of`]'s for that source, bit for bit, without φ's
+/// differences again (on the sphere at N = 101 they were most of a source's set-up).
+pub struct TubeFeet<const D: usize> {
+    /// The closest point of every band node.
+    pub closest_points: Vec<[f64; D]>,
+    /// One entry per node not in the extension layer, in band order.
+    pub inner: Vec<NodeFoot<D>>,
+}
+
+impl<const D: usize> TubeFeet<D> {
+    /// Bytes held.
+    pub fn nbytes(&self) -> usize {
+        self.closest_points.len() * std::mem::size_of::<[f64; D]>()
+            + self.inner.len() * std::mem::size_of::<NodeFoot<D>>()
+    }
+}
+
+/// One source's factoring from the band's [`TubeFeet`]: u₀, ∇u₀, the roles with the nodes near the
+/// sources fixed; the errors of [`factor_sources_of`].
+pub fn factor_sources_at<const D: usize>(
+    feet: &TubeFeet<D>,
+    roles: &[NodeRole],
+    sources: &[[f64; D]],
+    source_slowness: &[f64],
+    fix_radius: f64,
+) -> Result<Factoring<D>> {
+    let n = roles.len();
+    if feet.closest_points.len() != n || feet.inner.len() != roles.iter().filter(|&&r| r != NodeRole::Outer).count() {
+        return Err(Error::invalid("feet", format!("one closest point per band node ({n})")));
+    }
+    check_source_arguments(sources, source_slowness)?;
+    let unit = grad_u0_unit_of(source_slowness);
+    let mut u0 = Vec::with_capacity(n);
+    let mut grad_u0 = Vec::with_capacity(feet.inner.len());
+    let mut out_roles = roles.to_vec();
+    let mut fixed_per_source = vec![0usize; sources.len()];
+    let mut inner = feet.inner.iter();
+    for (i, cp) in feet.closest_points.iter().enumerate() {
+        let foot = if roles[i] != NodeRole::Outer {
+            inner.next()
+        } else {
+            None
+        };
+        let node = factor_at(
+            cp,
+            foot,
+            sources,
+            source_slowness,
+            unit,
+            fix_radius,
+            &mut fixed_per_source,
+        );
+        u0.push(node.u0);
+        if foot.is_some() {
+            grad_u0.push(node.grad_u0);
+        }
+        if node.fixed {
+            out_roles[i] = NodeRole::Fixed;
+        }
+    }
+    check_sources_fixed(&fixed_per_source, fix_radius)?;
+    Ok(Factoring {
+        u0,
+        grad_u0,
+        grad_u0_unit: unit,
+        roles: out_roles,
+        fixed_per_source,
+    })
 }

@@ -1,12 +1,15 @@
 //! Many second-order solves on one band (`Tube.solve_many(..., order=2)`), in parallel across the
-//! sources: the tube's geometry (n, B per node, [`super::geometry`]) computed once and shared by
-//! every solve of the batch, and per source its own factoring ([`super::factoring`]: u₀, ∇u₀, the
-//! fixed nodes) and sweeps ([`super::solver`]) on one thread. The scheduler is the first-order
+//! sources: the tube's geometry (n, B per node, [`super::geometry`]) and the source-independent
+//! part of the factoring (each node's closest point, normal, φ and D²φ: [`TubeFeet`]) computed
+//! once by [`super::setup::batch_setup_of`] and shared by every solve of the batch, and per source
+//! its own factoring ([`super::factoring::factor_sources_at`]: u₀, ∇u₀, the fixed nodes, from the
+//! shared feet) and sweeps ([`super::solver`]) on one thread. The scheduler is the first-order
 //! batch's ([`crate::sweep::many_sources::run_across_sources`]).
 //!
 //! Each source's values are those of a single second-order solve of it, bit for bit: the
-//! factoring of [`super::factor_sources_of`] is [`super::tube_setup_of`]'s, node by node, and the
-//! sweeps give the same values on any thread count. With [`Order2Output::AtPoints`] the values
+//! factoring from the shared feet is [`super::tube_setup_of`]'s, node by node (the same
+//! differences of φ, refitted where the geometry refits them), and the sweeps give the same
+//! values on any thread count. With [`Order2Output::AtPoints`] the values
 //! are evaluated as a second-order solution's `sol(points)` does (`python/tubesweep/_factoring.py`):
 //! multilinear interpolation of u, and within `reach` of a source w = u − u₀ interpolated plus the
 //! chord from the point's foot on the surface to the source
@@ -21,22 +24,21 @@ use crate::solution::source_feet::SourceFeet;
 use crate::sweep::many_sources::run_across_sources;
 use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 
-use super::factoring::factor_sources_of;
+use super::factoring::{factor_sources_at, TubeFeet};
 use super::geometry::TubeGeometry;
-use super::implicit::Implicit;
 use super::solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
 use super::start::first_order_start;
 use super::starting_values;
 
-/// What every solve of the batch shares: the band, its roles (no fixed node), the surface, the
-/// outward directions and the geometry computed once ([`super::tube_setup_of`] or
-/// [`super::tube_geometry_of`], checked by [`super::check_geometry_of`]).
+/// What every solve of the batch shares: the band, its roles (no fixed node), the outward
+/// directions, and the geometry and the feet computed once ([`super::setup::batch_setup_of`],
+/// the geometry checked by [`super::check_geometry_of`]).
 pub struct BatchTube<'a, const D: usize> {
     pub band: &'a NarrowBand<D>,
     pub roles: &'a [NodeRole],
-    pub surface: &'a Implicit<'a, D>,
     pub directions: &'a [[f32; D]],
     pub geometry: &'a TubeGeometry,
+    pub feet: &'a TubeFeet<D>,
     pub lower: [f64; D],
     pub spacing: f64,
     pub slowness: Slowness<'a>,
@@ -86,10 +88,10 @@ pub fn solve_many_second_order<const D: usize>(
 ) -> Result<Vec<SecondOrderStats>> {
     let n = tube.band.len();
     let k = sources.len();
-    if tube.roles.len() != n || tube.directions.len() != n || tube.surface.len() != n {
+    if tube.roles.len() != n || tube.directions.len() != n || tube.feet.closest_points.len() != n {
         return Err(Error::invalid(
             "roles",
-            format!("roles, directions and the surface need one entry per band node ({n})"),
+            format!("roles, directions and the feet need one entry per band node ({n})"),
         ));
     }
     if tube.roles.contains(&NodeRole::Fixed) {
@@ -163,17 +165,7 @@ fn solve_one<const D: usize>(
     src: BatchSource<'_, D>,
     stop: &AtomicBool,
 ) -> Result<(Vec<f64>, Vec<f64>, SecondOrderStats)> {
-    let factoring = factor_sources_of(
-        tube.band,
-        tube.roles,
-        tube.surface,
-        tube.directions,
-        tube.lower,
-        tube.spacing,
-        src.feet,
-        src.slowness,
-        tube.fix_radius,
-    )?;
+    let factoring = factor_sources_at(tube.feet, tube.roles, src.feet, src.slowness, tube.fix_radius)?;
     let mut values = starting_values(&factoring);
     let mut check = |_: &IterationReport| {
         if stop.load(Ordering::Relaxed) {
@@ -252,6 +244,8 @@ fn evaluate_at<const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::second_order::implicit::Implicit;
+    use crate::second_order::setup::batch_setup_of;
     use crate::second_order::{check_geometry_of, tube_setup_of};
 
     fn options() -> SecondOrderOptions {
@@ -278,20 +272,7 @@ mod tests {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
         let (phi, _) = crate::test_bands::sphere_phi_and_offsets(&band, h);
         let surface = Implicit::LevelSet(&phi);
-        let (geometry, _) = tube_setup_of(
-            &band,
-            &roles,
-            &surface,
-            &dirs,
-            [-1.0; 3],
-            h,
-            4.0 * h,
-            &[],
-            &[],
-            2.0 * h,
-            1,
-        )
-        .unwrap();
+        let (geometry, tube_feet) = batch_setup_of(&band, &roles, &surface, &dirs, [-1.0; 3], h, 4.0 * h, 1).unwrap();
         check_geometry_of(&geometry.summary, 4.0 * h, h, false).unwrap();
         let feet = [[-0.5, 0.0, 0.0], [0.0, 0.3, 0.4], [0.0, 0.0, -0.5]];
         let slowness = [1.0, 1.0, 1.0];
@@ -308,9 +289,9 @@ mod tests {
         let tube = BatchTube {
             band: &band,
             roles: &roles,
-            surface: &surface,
             directions: &dirs,
             geometry: &geometry,
+            feet: &tube_feet,
             lower: [-1.0; 3],
             spacing: h,
             slowness: Slowness::Constant(1.0),

@@ -14,7 +14,9 @@ use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
 
 use super::creases::creases_of;
-use super::factoring::{check_source_arguments, check_sources_fixed, grad_u0_unit_of, node_factor, Factoring};
+use super::factoring::{
+    check_source_arguments, check_sources_fixed, factor_at, grad_u0_unit_of, node_foot, Factoring, NodeFoot, TubeFeet,
+};
 use super::geometry::{
     abs_phi_of, check_tube_inputs, node_geometry, GeometrySummary, NodeGeometry, TubeGeometry, WIDE_FIT,
 };
@@ -32,6 +34,9 @@ struct Chunk<const D: usize> {
     fixed: Vec<u32>,
     fixed_per_source: Vec<usize>,
     summary: GeometrySummary,
+    /// [`TubeFeet`]'s parts for the chunk (when asked for).
+    closest_points: Vec<[f64; D]>,
+    feet: Vec<NodeFoot<D>>,
 }
 
 /// [`super::tube_geometry_of`] and [`super::factor_sources_of`] together, on `threads` threads
@@ -53,6 +58,71 @@ pub fn tube_setup_of<const D: usize>(
     fix_radius: f64,
     threads: usize,
 ) -> Result<(TubeGeometry, Result<Factoring<D>>)> {
+    let (geometry, factoring, _) = setup(
+        band,
+        roles,
+        surface,
+        directions,
+        lower,
+        spacing,
+        outer_width,
+        sources,
+        source_slowness,
+        fix_radius,
+        threads,
+        false,
+    )?;
+    Ok((geometry, factoring))
+}
+
+/// The set-up of a batch of solves on one band ([`super::many`]): the tube's geometry as
+/// [`tube_setup_of`] computes it, and the source-independent part of the factoring
+/// ([`TubeFeet`]) from the same differences of φ, so that each source's factoring
+/// ([`super::factoring::factor_sources_at`]) is the single solve's, bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn batch_setup_of<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    directions: &[[f32; D]],
+    lower: [f64; D],
+    spacing: f64,
+    outer_width: f64,
+    threads: usize,
+) -> Result<(TubeGeometry, TubeFeet<D>)> {
+    let (geometry, _, feet) = setup(
+        band,
+        roles,
+        surface,
+        directions,
+        lower,
+        spacing,
+        outer_width,
+        &[],
+        &[],
+        0.0,
+        threads,
+        true,
+    )?;
+    Ok((geometry, feet))
+}
+
+/// [`tube_setup_of`], and with `keep_feet` the [`TubeFeet`] (empty otherwise).
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn setup<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    directions: &[[f32; D]],
+    lower: [f64; D],
+    spacing: f64,
+    outer_width: f64,
+    sources: &[[f64; D]],
+    source_slowness: &[f64],
+    fix_radius: f64,
+    threads: usize,
+    keep_feet: bool,
+) -> Result<(TubeGeometry, Result<Factoring<D>>, TubeFeet<D>)> {
     let n = band.len();
     check_tube_inputs(n, roles, surface, directions, spacing, outer_width)?;
     let abs_phi = abs_phi_of(surface, spacing);
@@ -73,6 +143,8 @@ pub fn tube_setup_of<const D: usize>(
                 fitted_everywhere: fitted,
                 ..GeometrySummary::empty()
             },
+            closest_points: Vec::with_capacity(if keep_feet { e - s } else { 0 }),
+            feet: Vec::with_capacity(if keep_feet { inner } else { 0 }),
         };
         for i in s..e {
             let is_inner = roles[i] != NodeRole::Outer;
@@ -91,32 +163,38 @@ pub fn tube_setup_of<const D: usize>(
                     || surface.local_fitted(band, i, spacing, WIDE_FIT && fitted),
                 ));
             }
-            if !factor {
+            if !(factor || keep_feet) {
                 continue;
             }
             let mut x = [0.0; D];
             for k in 0..D {
                 x[k] = lower[k] + spacing * indices[i][k] as f64;
             }
-            let node = node_factor(
-                surface,
-                i,
-                &x,
-                &directions[i],
-                is_inner,
-                local.as_ref(),
-                sources,
-                source_slowness,
-                unit,
-                fix_radius,
-                &mut out.fixed_per_source,
-            );
-            out.u0.push(node.u0);
-            if is_inner {
-                out.grad_u0.push(node.grad_u0);
+            // (with a local that the geometry refitted, the refitted one, as the sweeps' B)
+            let (cp, foot) = node_foot(surface, i, &x, &directions[i], local.as_ref());
+            if factor {
+                let node = factor_at(
+                    &cp,
+                    is_inner.then_some(&foot),
+                    sources,
+                    source_slowness,
+                    unit,
+                    fix_radius,
+                    &mut out.fixed_per_source,
+                );
+                out.u0.push(node.u0);
+                if is_inner {
+                    out.grad_u0.push(node.grad_u0);
+                }
+                if node.fixed {
+                    out.fixed.push(i as u32);
+                }
             }
-            if node.fixed {
-                out.fixed.push(i as u32);
+            if keep_feet {
+                out.closest_points.push(cp);
+                if is_inner {
+                    out.feet.push(foot);
+                }
             }
         }
         out
@@ -160,7 +238,13 @@ pub fn tube_setup_of<const D: usize>(
     };
     let mut out_roles = roles.to_vec();
     let mut fixed_per_source = vec![0usize; sources.len()];
+    let mut feet = TubeFeet {
+        closest_points: Vec::with_capacity(if keep_feet { n } else { 0 }),
+        inner: Vec::with_capacity(if keep_feet { n_inner } else { 0 }),
+    };
     for part in parts {
+        feet.closest_points.extend_from_slice(&part.closest_points);
+        feet.inner.extend_from_slice(&part.feet);
         nodes.extend_from_slice(&part.nodes);
         summary = summary.merge(part.summary);
         u0.extend_from_slice(&part.u0);
@@ -191,7 +275,7 @@ pub fn tube_setup_of<const D: usize>(
             fixed_per_source,
         })
     });
-    Ok((geometry, factoring))
+    Ok((geometry, factoring, feet))
 }
 
 #[cfg(test)]
@@ -264,5 +348,91 @@ mod tests {
         )
         .unwrap();
         assert!(f.is_err());
+    }
+
+    /// A batch's factoring from the shared feet ([`batch_setup_of`], `factor_sources_at`) is the
+    /// one pass's bit for bit, on a level set, a closest-point map and a noisy φ whose
+    /// derivatives the geometry refits everywhere (there the factoring reads the refitted ones,
+    /// which `factor_sources_of` does not: its ∇u₀ differs).
+    #[test]
+    fn the_batch_factoring_is_the_one_pass_factoring() {
+        use crate::second_order::factoring::factor_sources_at;
+        let (band, roles, dirs, h) = crate::test_bands::shell_band(41, 0.5, &[0.0]);
+        let (phi, offsets) = crate::test_bands::sphere_phi_and_offsets(&band, h);
+        let mut next = crate::test_random::uniform(46);
+        let noisy: Vec<f64> = phi.iter().map(|p| p + 0.1 * h * (2.0 * next() - 1.0)).collect();
+        let sources = [[-0.5, 0.0, 0.0], [0.0, 0.3, 0.4]];
+        let slowness = [1.0, 1.5];
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (name, surface) in [
+            ("level set", Implicit::LevelSet(&phi)),
+            ("closest points", Implicit::ClosestPoint(&offsets)),
+            ("noisy level set", Implicit::LevelSet(&noisy)),
+        ] {
+            for threads in [1, 3] {
+                let (geo, feet) =
+                    batch_setup_of(&band, &roles, &surface, &dirs, [-1.0; 3], h, 4.0 * h, threads).unwrap();
+                for k in [1, 2] {
+                    let (g, f) = tube_setup_of(
+                        &band,
+                        &roles,
+                        &surface,
+                        &dirs,
+                        [-1.0; 3],
+                        h,
+                        4.0 * h,
+                        &sources[..k],
+                        &slowness[..k],
+                        2.0 * h,
+                        threads,
+                    )
+                    .unwrap();
+                    let f = f.unwrap();
+                    assert_eq!(g.nodes, geo.nodes, "{name}");
+                    assert_eq!(g.summary, geo.summary, "{name}");
+                    let b = factor_sources_at(&feet, &roles, &sources[..k], &slowness[..k], 2.0 * h).unwrap();
+                    assert_eq!(bits(&b.u0), bits(&f.u0), "{name}");
+                    assert_eq!(b.grad_u0, f.grad_u0, "{name}");
+                    assert_eq!(b.grad_u0_unit, f.grad_u0_unit, "{name}");
+                    assert_eq!(b.roles, f.roles, "{name}");
+                    assert_eq!(b.fixed_per_source, f.fixed_per_source, "{name}");
+                    if name == "noisy level set" {
+                        assert!(
+                            geo.summary.fitted_everywhere,
+                            "the noise is meant to make the geometry refit"
+                        );
+                        let plain = factor_sources_of(
+                            &band,
+                            &roles,
+                            &surface,
+                            &dirs,
+                            [-1.0; 3],
+                            h,
+                            &sources[..k],
+                            &slowness[..k],
+                            2.0 * h,
+                        )
+                        .unwrap();
+                        assert_ne!(plain.grad_u0, f.grad_u0);
+                    }
+                }
+            }
+        }
+        // a source with no inner-tube node near it: the single solve's error
+        let (_, feet) = batch_setup_of(
+            &band,
+            &roles,
+            &Implicit::LevelSet(&phi),
+            &dirs,
+            [-1.0; 3],
+            h,
+            4.0 * h,
+            1,
+        )
+        .unwrap();
+        let err = factor_sources_at(&feet, &roles, &[[0.0, 0.0, 0.0]], &[1.0], 2.0 * h)
+            .err()
+            .unwrap();
+        assert!(err.to_string().contains("sources[0]"), "{err}");
     }
 }
