@@ -31,7 +31,7 @@ from .tube import Tube
 from .distances import distance_matrix, farthest_point_sampling
 from .stats import SolveStats
 from .surface import LevelSet, Surface
-from . import data, surfaces
+from . import data, moving, surfaces
 
 __version__ = "0.1.0"
 
@@ -49,6 +49,7 @@ __all__ = [
     "export",
     "flows",
     "hamiltonians",
+    "moving",
     "plot",
     "solve",
     "surfaces",
