@@ -111,3 +111,69 @@ def test_a_refused_warm_start_solves_cold_when_asked(first):
     cold = ts.solve(ts.surfaces.Sphere(far), GRID, pole(far))
     assert np.array_equal(s.values, cold.values)
     assert "moved farther" in s.stats.order2["warm"]["refused"]
+
+
+# ---- ts.evolve: the level set moved by a law of its surface solution ----
+
+GRID31 = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
+
+
+def sphere_phi(grid: ts.Grid, r: float = 0.5) -> np.ndarray:
+    return np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1) - r
+
+
+def test_a_sphere_growing_at_constant_speed_keeps_its_shape_and_scales_its_distances(tmp_path):
+    ev = ts.evolve(sphere_phi(GRID31), GRID31, [(0, 0, 0.5)], lambda u: 0.3 + 0 * u, dt=0.05, steps=4, every=2,
+                   checkpoint=tmp_path / "run.npz")  # fmt: skip
+    assert ev.times == pytest.approx([0.0, 0.1, 0.2]) and ev.warm_starts == 4 and ev.cold_starts == 1
+    r = 0.5 + 0.3 * 0.2
+    sol = ev.solutions[-1]
+    # the pole followed the surface; the zero level set is the sphere of radius r to a tenth of a
+    # grid spacing (re-distancing and projection at N = 31, h = 0.067: measured 6.8e-3)
+    h = GRID31.spacing
+    assert sol.sources[0] == pytest.approx([0, 0, r], abs=0.15 * h)
+    feet = sol.surface.project(GRID31.node_points(sol.linear[np.abs(sol.phi) < h]), GRID31)[1]
+    assert np.max(np.abs(np.linalg.norm(feet, axis=1) - r)) < 0.15 * h
+    # u(r·d)/r the angle from the pole, as at the start (second order: 1.3e-2 at N = 31)
+    a = np.linspace(0.3, 2.6, 12)
+    d = np.stack([np.sin(a), 0 * a, np.cos(a)], 1)
+    first = ev.solutions[0](0.5 * d) / 0.5
+    last = sol(r * d) / r
+    assert np.max(np.abs(last - a)) < 2e-2 and np.max(np.abs(last - first)) < 1e-2
+    saved = np.load(tmp_path / "run.npz")
+    assert float(saved["t"]) == pytest.approx(0.2) and np.array_equal(saved["phi"], ev.phis[-1])
+    path = ev.export(tmp_path / "run.pvd")
+    text = path.read_text()
+    assert text.count("<DataSet") == 3 and (tmp_path / "run_0002.vtp").exists() and 'timestep="0.2' in text
+
+
+def test_the_axisymmetric_evolution_follows_the_front_tracked_meridian():
+    # the pear of benches/moving_axisymmetric.py at N = 31 against its reference (the bench fits
+    # order ≥ 1 over N = 41, 61, 81): shape and distances within a fraction of a grid spacing
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    import moving_axisymmetric as axi
+
+    r = axi.compare(31, axi.reference(axi.T, m=500))
+    h = GRID31.spacing  # measured: Hausdorff 1.2e-2, distances max 2.3e-2, mean 8.8e-3
+    assert r["hausdorff"] < 0.25 * h and r["max"] < 0.5 * h and r["mean"] < 0.2 * h
+
+
+def test_evolve_refuses_bad_input_with_the_cause_named():
+    phi = sphere_phi(GRID31)
+    with pytest.raises(ValueError, match="CFL condition fails at step 0.*take dt ≤"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 1.0 + 0 * u, dt=0.1, steps=2)
+    with pytest.raises(ValueError, match=r"speed\(u\) returned nan"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: np.where(u > 0.5, np.nan, 0.1), dt=0.05, steps=2)
+    with pytest.raises(ValueError, match="one normal speed per value"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: u[:3], dt=0.05, steps=2)
+    with pytest.raises(ValueError, match="cfl must be in"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=2, cfl=1.5)
+    with pytest.raises(ValueError, match="dt must be a positive"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=-1.0, steps=2)
+    with pytest.raises(ValueError, match="grid's shape"):
+        ts.evolve(phi[:-1], GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=2)
+    with pytest.raises(ValueError, match="must end in .pvd"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1).export("run.vtp")

@@ -24,6 +24,7 @@ from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .box_solution import BoxSolution
 from .euclidean import travel_time
+from .evolve import evolve
 from .grid import Grid
 from .output import export, plot, triangulate
 from .solve import Solution, solve
@@ -46,6 +47,7 @@ __all__ = [
     "SolveStats",
     "Surface",
     "data",
+    "evolve",
     "export",
     "flows",
     "hamiltonians",
