@@ -180,7 +180,7 @@ def evolve(
     >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
     >>> phi = np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1) - 0.5
     >>> ev = ts.evolve(phi, grid, [(0, 0, 0.5)], lambda u: 0.2 + 0 * u, dt=0.05, steps=2)
-    >>> round(float(-ev.phis[-1][15, 15, 15]), 3)  # the radius, 0.5 + 2 * 0.05 * 0.2
+    >>> round(float(ev.solutions[-1].sources[0][2]), 2)  # the pole, at 0.5 + 2 * 0.05 * 0.2
     0.52
     """
     grid = as_grid(grid)
