@@ -78,6 +78,23 @@ def test_distances_on_a_growing_sphere_scale_with_its_radius(first):
     assert worst_scaling <= worst_error
 
 
+def test_a_part_without_a_source_stays_unreached_in_a_warm_solve():
+    # two spheres far apart, the source on one: the other is +inf in the cold and the warm solve
+    X = np.stack(GRID.meshgrid(), axis=-1)
+
+    def two(r: float) -> np.ndarray:
+        return np.minimum(np.linalg.norm(X - (0.5, 0, 0), axis=-1), np.linalg.norm(X + (0.5, 0, 0), axis=-1)) - r
+
+    tube = ts.Tube(two(0.3), GRID)
+    sol = tube.solve([(0.5, 0.0, 0.3)])
+    r = 0.3 + 0.4 * H
+    warm = tube.moved(two(r)).solve([(0.5, 0.0, r)], warm=sol)
+    cold = ts.solve(two(r), GRID, [(0.5, 0.0, r)])
+    reached = np.isfinite(cold.values)
+    assert np.array_equal(reached, np.isfinite(warm.values)) and 0.3 < reached.mean() < 0.7
+    assert np.max(np.abs(warm.values[reached] - cold.values[reached])) <= 10 * cold.stats.order2["tol"]
+
+
 def test_refusals_name_the_cause(first):
     tube, sol = first
     r = 0.5 + 0.4 * H

@@ -119,13 +119,15 @@ def carried_values(warm: Any, tube: Any, feet: np.ndarray, inner_width: float) -
         carried[both] = 2.0 * carried[both] - before[both]
         extrapolated = int(np.count_nonzero(both))
     inner_new = tube.roles != ROLE_OUTER
-    missing = int(np.count_nonzero(inner_new & ~np.isfinite(carried)))
+    # nodes of the new inner tube outside the previous band (a node in it that the previous solve
+    # never reached, on a part without a source, stays unreached: the sweeps leave it at +∞)
+    at = np.minimum(np.searchsorted(old_linear, new_linear), len(old_linear) - 1)
+    missing = int(np.count_nonzero(inner_new & (old_linear[at] != new_linear)))
     if missing:
         raise WarmStartRefused(
-            f"warm: {missing} nodes of the new inner tube have no previous value (they lie outside the previous band, "
-            f"or the previous solve never reached them): the surface moved farther than outer − inner = {slack / h:g} "
-            "grid spacings since the previous solution, or a part of it without a source joined. Move in smaller steps "
-            "(at most outer − inner spacings per solve), widen the tube (outer=), or solve cold (leave out warm=)"
+            f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved farther than "
+            f"outer − inner = {slack / h:g} grid spacings since the previous solution. Move in smaller steps (at most "
+            "outer − inner spacings per solve), widen the tube (outer=), or solve cold (leave out warm=)"
         )
     old_inner = np.ascontiguousarray(warm.roles != ROLE_OUTER)
     n_old = _native.band_components(warm._band, old_inner)
