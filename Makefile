@@ -117,6 +117,10 @@ bench: build
 	$(PY) benches/under_load.py
 	# issue 45: point clouds against potpourri3d's PointCloudHeatSolver (docs/point-clouds.md)
 	$(PY) benches/point_clouds.py
+	# issue 47: warm re-solves on a moving surface, the growing sphere, ts.evolve against front tracking
+	$(PY) benches/moving_surfaces.py --n 121 --steps 20 --rounds 3
+	$(PY) benches/moving_surfaces.py --growth --n 121 --steps 20
+	$(PY) benches/moving_axisymmetric.py --sizes 41,61,81
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

@@ -46,6 +46,7 @@ CASES = {
     "layered_travel_time": (101, ["layered_travel_time.png"]),
     "distance_matrix": (31, ["distance_matrix.png"]),
     "point_cloud": (61, ["point_cloud.png"]),
+    "pear_growth": (41, ["pear_growth.png"]),
 }
 
 
@@ -72,6 +73,9 @@ def test_example(name, tmp_path):
     elif name == "torus_cells":
         shares = [float(x) for x in re.search(r"\[([0-9. ]+)\]", out).group(1).split()]
         assert abs(sum(shares) - 1) < 0.01 and min(shares) > 0.15
+    elif name == "pear_growth":
+        z, exact = number(r"z = ([0-9.]+)", out), number(r"exact ([0-9.]+)", out)
+        assert abs(z - exact) < 0.1 * h and "1 cold" in out
     elif name == "bunny_path":
         length = number(r"length ([0-9.]+)", out)
         assert abs(length - number(r"the distance there: ([0-9.]+)", out)) < 0.1 * length

@@ -24,6 +24,7 @@ from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .box_solution import BoxSolution
 from .euclidean import travel_time
+from .evolve import evolve
 from .grid import Grid
 from .output import export, plot, triangulate
 from .solve import Solution, solve
@@ -31,7 +32,7 @@ from .tube import Tube
 from .distances import distance_matrix, farthest_point_sampling
 from .stats import SolveStats
 from .surface import LevelSet, Surface
-from . import data, surfaces
+from . import data, moving, surfaces
 
 __version__ = "0.1.0"
 
@@ -46,9 +47,11 @@ __all__ = [
     "SolveStats",
     "Surface",
     "data",
+    "evolve",
     "export",
     "flows",
     "hamiltonians",
+    "moving",
     "plot",
     "solve",
     "surfaces",

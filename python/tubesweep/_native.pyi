@@ -167,7 +167,12 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
     window_second: float = 0.0,
     ramp_length: float = 1.0,  # ℓ: the limiter's ramp width is σΔx²/ℓ (second_order.ramp_length)
     extension_limit: float = ...,  # the extension's BDF2 correction limited beyond this many σΔx (default ∞)
+    warm: Optional[npt.NDArray[np.float64]] = None,  # a warm start: the previous values on this band (moving.rs)
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], Dict[str, Any]]: ...
+def carry_band_values(  # crates/tubesweep-py/src/moving.rs: previous values onto a new band (+inf where new)
+    old_linear: npt.NDArray[np.uint64], old_values: npt.NDArray[np.float64], new_linear: npt.NDArray[np.uint64]
+) -> npt.NDArray[np.float64]: ...
+def band_components(band: Band, select: npt.NDArray[np.bool_]) -> int: ...  # moving.rs: connected components
 def second_order_solve_many(  # crates/tubesweep-py/src/many_sources.rs: K second-order solves, the geometry shared
     band: "Band",
     roles: npt.NDArray[np.uint8],

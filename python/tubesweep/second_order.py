@@ -288,9 +288,19 @@ def source_feet(
 
 
 def solve_on_tube(
-    tube: Any, src: np.ndarray, speed: Any, tol: Optional[float], max_iterations: int, cb: Any, threads: int, t0: float
+    tube: Any,
+    src: np.ndarray,
+    speed: Any,
+    tol: Optional[float],
+    max_iterations: int,
+    cb: Any,
+    threads: int,
+    t0: float,
+    warm: Any = None,
+    warm_refused: str = "raise",
 ) -> Any:
-    """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept)."""
+    """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept);
+    ``warm``: a previous solution to start from (:mod:`tubesweep.moving`)."""
     from ._prepare import ROLE_OUTER
 
     grid, surf, band = tube.grid, tube.surface, tube.band
@@ -300,6 +310,16 @@ def solve_on_tube(
     tol = inputs.tol
     linear = tube.linear
     feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
+    warm_values, warm_info = None, None
+    if warm is not None:
+        from .moving import WarmStartRefused, carried_values
+
+        try:
+            warm_values, warm_info = carried_values(warm, tube, feet, tube.inner * h)
+        except WarmStartRefused as e:
+            if warm_refused != "cold":
+                raise
+            warm_info = {"refused": str(e)}
     setup = time.perf_counter() - t0
     try:
         values, u0, roles_out, st = _native_solve(
@@ -326,6 +346,7 @@ def solve_on_tube(
             window_second=WINDOWS[1] if d == 3 else 0.0,
             ramp_length=inputs.length,
             extension_limit=EXTENSION_LIMIT,
+            warm=warm_values,
         )
     except Order2NotApplicable as e:
         # a tube cut by the grid box: the reason names the box, not φ or the resolution
@@ -383,6 +404,10 @@ def solve_on_tube(
         )
     }
     order2["tol"] = float(tol)
+    if warm_info is not None:
+        if warm_values is not None:
+            warm_info["restarted"] = st["warm_restarted"]
+        order2["warm"] = warm_info
     order2["fix_radius"] = FIX_RADIUS * h
     stats = SolveStats(
         iterations=st["iterations"],

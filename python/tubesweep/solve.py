@@ -66,6 +66,8 @@ def solve(
     infinity: Optional[float] = None,
     threads: int = 0,
     paper_sweeps: bool = False,
+    warm: Any = None,
+    warm_refused: str = "raise",
 ) -> Solution:
     """First-arrival time (geodesic distance for ``speed=1``) on an implicit curve or surface.
 
@@ -168,6 +170,16 @@ def solve(
         smallest still-changing value are updated, and the band fills from the sources outwards):
         3× fewer local updates on the sphere at N=201, 5× at N=1001, and 2–4× less time
         (``benches/experiments/sweep_variants.py``).
+    warm : Solution or (Solution, Solution), optional
+        The solution of the previous step of a moving surface (docs/moving-surfaces.md): the
+        second-order sweeps start from its values carried onto this band instead of from the
+        sources alone, and end at the cold solve's values. A pair ``(older, previous)`` starts from
+        the values extrapolated in time. Refused (:class:`tubesweep.moving.WarmStartRefused`) for
+        another grid, first-order solves, other sources, a surface that moved farther than
+        ``outer − inner`` grid spacings or changed topology.
+    warm_refused : {"raise", "cold"}
+        What a refused warm start does: raise (the default), or solve cold and record why in
+        ``sol.stats.order2["warm"]``.
 
     Returns
     -------
@@ -212,6 +224,10 @@ def solve(
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)
+    if warm is not None:
+        from .moving import check_warm_refused
+
+        check_warm_refused(warm_refused)
     tube: Optional[_PreparedTube] = None
     fallback: Optional[str] = None
     if order != 1:
@@ -226,12 +242,25 @@ def solve(
             _so.check_widths(inner, outer)
             tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
             return _so.solve_on_tube(
-                tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
+                tube,
+                src,
+                speed,
+                None if tol == DEFAULT_TOL else tol,
+                max_iterations,
+                cb,
+                threads,
+                t0,
+                warm=warm,
+                warm_refused=warm_refused,
             )
         except _so.Order2NotApplicable as e:
             if order == 2:
                 raise
             fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
+    if warm is not None and warm_refused == "raise":
+        from .moving import refusal_for_order1
+
+        raise refusal_for_order1(fallback)
     _check_source_radius(source_radius, source_init, grid)
     # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
     # (unless a general Hamiltonian needs it) and the directions become the extension weights;

@@ -166,6 +166,8 @@ class Tube:
         paper_sweeps: bool = False,
         order: Union[int, str] = "auto",
         source_radius: Optional[float] = None,
+        warm: Any = None,
+        warm_refused: str = "raise",
     ) -> Solution:
         """First-arrival times from ``sources`` on this band, without building the band again.
 
@@ -176,7 +178,7 @@ class Tube:
         ----------
         sources : array_like
             ``(K, d)`` points on the surface.
-        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps, order, source_radius
+        hamiltonian, speed, flow, allow_supersonic, source_init, tol, max_iterations, progress, infinity, threads, paper_sweeps, order, source_radius, warm, warm_refused
             As for :func:`tubesweep.solve`.
 
         Returns
@@ -206,6 +208,10 @@ class Tube:
         check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
+        if warm is not None:
+            from .moving import check_warm_refused
+
+            check_warm_refused(warm_refused)
         fallback: Optional[str] = None
         if order != 1:
             from . import second_order as _so
@@ -221,7 +227,16 @@ class Tube:
                     raise _so.Order2NotApplicable(self._order2_refusal)
                 try:
                     return _so.solve_on_tube(
-                        self._tube, src, speed, None if tol == DEFAULT_TOL else tol, max_iterations, cb, threads, t0
+                        self._tube,
+                        src,
+                        speed,
+                        None if tol == DEFAULT_TOL else tol,
+                        max_iterations,
+                        cb,
+                        threads,
+                        t0,
+                        warm=warm,
+                        warm_refused=warm_refused,
                     )
                 except _so.Order2NotApplicable as e:
                     self._order2_refusal = str(e)  # depends on the band only: not computed again
@@ -230,6 +245,10 @@ class Tube:
                 if order == 2:
                     raise
                 fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
+        if warm is not None and warm_refused == "raise":
+            from .moving import refusal_for_order1
+
+            raise refusal_for_order1(fallback)
         _check_source_radius(source_radius, source_init, self.grid)
         sol = _solve_on_tube(
             self._tube,
@@ -253,6 +272,43 @@ class Tube:
 
             return with_fallback(sol, fallback)
         return sol
+
+    def moved(self, surface: Any) -> "Tube":
+        """The tube of this surface after it moved: the same grid, widths and method, the band of
+        ``surface`` (docs/moving-surfaces.md). Solve on it with ``warm=`` a solution on this tube
+        to start from the previous values instead of from the sources alone.
+
+        Parameters
+        ----------
+        surface : LevelSet, library surface, φ array of ``grid.shape`` or callable φ
+            The moved surface (φ at the new time).
+
+        Returns
+        -------
+        Tube
+            The new surface's tube (this one is left as it was).
+
+        Raises
+        ------
+        ValueError
+            If ``surface`` is a φ array of another shape than the grid, or as :class:`Tube`.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+        >>> tube = ts.Tube(ts.surfaces.Sphere(0.5), grid)
+        >>> sol = tube.solve([(0, 0, 0.5)])
+        >>> grown = tube.moved(ts.surfaces.Sphere(0.51))
+        >>> sol2 = grown.solve([(0, 0, 0.51)], warm=sol)
+        """
+        if isinstance(surface, np.ndarray) and tuple(surface.shape) != tuple(self.grid.shape):
+            raise ValueError(
+                f"moved: the φ array has shape {tuple(surface.shape)}, the tube's grid {tuple(self.grid.shape)}; a moved "
+                "surface is sampled on the same grid (build a new ts.Tube for another grid)"
+            )
+        inner, outer, method = self._args
+        return Tube(surface, self.grid, inner=inner, outer=outer, method=method)
 
     def solve_many(
         self,

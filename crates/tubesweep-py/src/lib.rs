@@ -14,6 +14,7 @@
 //! | `second_order.rs` | order=2 on surfaces (`tubesweep_core::second_order`) |
 //! | `point_cloud.rs` | point clouds' closest points (`tubesweep_core::surface::point_cloud`) |
 //! | `many_sources.rs` | many solves on one band (`tubesweep_core::sweep::many_sources`) |
+//! | `moving.rs` | warm starts on a moved surface (`tubesweep_core::second_order::warm`) |
 //! | `convert.rs` | NumPy arrays to and from slices |
 //! | `errors.rs` | the one place where core errors become Python exceptions |
 //!
@@ -25,6 +26,7 @@ mod box_order2;
 mod convert;
 mod errors;
 mod many_sources;
+mod moving;
 mod point_cloud;
 mod progress;
 mod second_order;
@@ -40,6 +42,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     band_search::register(m)?;
     box_order2::register(m)?;
     many_sources::register(m)?;
+    moving::register(m)?;
     point_cloud::register(m)?;
     second_order::register(m)?;
     surface::register(m)?;

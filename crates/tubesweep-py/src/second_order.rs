@@ -41,6 +41,8 @@ struct Inputs<'s> {
     options: SecondOrderOptions,
     threads: usize,
     front_window: f64,
+    /// the previous values carried onto this band (`moving.rs`): a warm start
+    warm: Option<&'s [f64]>,
 }
 
 fn run<'py, const D: usize>(
@@ -98,41 +100,61 @@ fn run<'py, const D: usize>(
         let mut callback = |r: &IterationReport| -> Control {
             crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))
         };
-        let mut first_seconds = 0.0;
-        let mut first_iterations = 0;
-        if !inp.options.own_first_phase {
-            let st = first_order_start(
+        let mut warm_report = None;
+        let stats = if let Some(carried) = inp.warm {
+            // a warm start (tubesweep_core::second_order::warm): phase 2 from the carried values
+            let w = tubesweep_core::second_order::warm::sweep_warm(
                 band,
-                &geometry.nodes,
+                &geometry,
                 &factoring,
                 directions,
                 slowness,
                 inp.spacing,
-                inp.options.tol_first,
-                inp.options.max_iterations,
-                inp.threads,
-                inp.front_window,
+                carried,
                 &mut values,
+                &inp.options,
                 &mut callback,
             )?;
-            first_seconds = st.seconds;
-            first_iterations = st.iterations;
-        }
-        let mut stats = sweep_second_order(
-            band,
-            &geometry,
-            &factoring,
-            directions,
-            slowness,
-            inp.spacing,
-            &mut values,
-            &inp.options,
-            &mut callback,
-        )?;
-        if !inp.options.own_first_phase {
-            stats.first_order_iterations = first_iterations;
-            stats.seconds += first_seconds;
-        }
+            warm_report = Some((w.carried, w.restarted));
+            w.stats
+        } else {
+            let mut first_seconds = 0.0;
+            let mut first_iterations = 0;
+            if !inp.options.own_first_phase {
+                let st = first_order_start(
+                    band,
+                    &geometry.nodes,
+                    &factoring,
+                    directions,
+                    slowness,
+                    inp.spacing,
+                    inp.options.tol_first,
+                    inp.options.max_iterations,
+                    inp.threads,
+                    inp.front_window,
+                    &mut values,
+                    &mut callback,
+                )?;
+                first_seconds = st.seconds;
+                first_iterations = st.iterations;
+            }
+            let mut stats = sweep_second_order(
+                band,
+                &geometry,
+                &factoring,
+                directions,
+                slowness,
+                inp.spacing,
+                &mut values,
+                &inp.options,
+                &mut callback,
+            )?;
+            if !inp.options.own_first_phase {
+                stats.first_order_iterations = first_iterations;
+                stats.seconds += first_seconds;
+            }
+            stats
+        };
         // what the solve holds besides the band and the arrays it borrows from the tube (φ,
         // the directions, the roles given): the inner nodes' geometry and ∂u₀, u₀, |φ|, the
         // roles with the fixed nodes, the values, the active flags, per row an offset
@@ -160,12 +182,13 @@ fn run<'py, const D: usize>(
             geometry.summary,
             bytes,
             first_order,
+            warm_report,
         ))
     });
     if let Some(e) = py_error {
         return Err(e);
     }
-    let (values, u0, roles_out, stats, summary, bytes, first_order) = result.map_err(to_pyerr)?;
+    let (values, u0, roles_out, stats, summary, bytes, first_order, warm_report) = result.map_err(to_pyerr)?;
     let d = PyDict::new(py);
     d.set_item(
         "iterations",
@@ -197,6 +220,10 @@ fn run<'py, const D: usize>(
     creases.set_item("shortcut_per_inner_width", summary.creases.shortcut_per_inner_width())?;
     d.set_item("creases", creases)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
+    if let Some((carried, restarted)) = warm_report {
+        d.set_item("warm_carried", carried)?;
+        d.set_item("warm_restarted", restarted.map(|r| format!("{r:?}").to_lowercase()))?;
+    }
     Ok((
         values.into_pyarray(py),
         u0.into_pyarray(py),
@@ -208,7 +235,7 @@ fn run<'py, const D: usize>(
 /// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
 /// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve<'py>(
     py: Python<'py>,
@@ -237,6 +264,7 @@ pub fn second_order_solve<'py>(
     window_second: f64,
     ramp_length: f64,
     extension_limit: f64,
+    warm: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Solved<'py>> {
     if !(tol > 0.0 && tol_first > 0.0) {
         return Err(PyValueError::new_err("tol must be positive"));
@@ -287,6 +315,10 @@ pub fn second_order_solve<'py>(
         },
         threads,
         front_window,
+        warm: match &warm {
+            Some(a) => Some(c_slice(a, "warm")?),
+            None => None,
+        },
     };
     match &band.band {
         AnyBand::D2(b) => run(py, b, &inputs, progress),

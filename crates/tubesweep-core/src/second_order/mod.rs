@@ -15,7 +15,8 @@
 //! * [`local`]: the limited BDF2/BDF3 Godunov update (continuous ramps from first to second to third
 //!   order, Newton's method for the unequal steps) and the second-order extension update;
 //! * [`solver`]: phase 1 (first order, monotone) then phase 2 (second order, assignment), with
-//!   the stagnation safeguard.
+//!   the stagnation safeguard;
+//! * [`warm`]: phase 2 from a moved surface's previous values (warm starts).
 //!
 //! The first-order solver ([`crate::sweep`]) is untouched: `order=1` is the paper's scheme.
 
@@ -31,6 +32,7 @@ mod rows;
 pub mod setup;
 pub mod solver;
 pub mod start;
+pub mod warm;
 
 pub use factoring::{factor_sources, factor_sources_of, Factoring};
 pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometry, TubeGeometry, Unresolved};

@@ -1,0 +1,155 @@
+"""Solving again on a surface that moved (docs/moving-surfaces.md): the warm start.
+
+``tube.moved(phi_new)`` gives the :class:`~tubesweep.Tube` of the moved surface on the same grid
+with the same widths, and ``tube.solve(sources, warm=previous)`` (or ``ts.solve(...,
+warm=previous)``) starts the second-order sweeps from ``previous``'s values carried onto the new
+band instead of from the sources alone. The result is the cold solve's fixed point: the sweeps
+from the carried values are phase 2 of the second-order solve (plain assignment, values may rise
+or fall), and a safeguard that would leave that path (the stagnation test, the runaway guard)
+makes the solve start again cold (``tubesweep_core::second_order::warm`` has the argument).
+
+A warm start is refused, with :class:`WarmStartRefused` naming the cause and the fix, when the
+previous solution cannot be carried: another grid, an ``order=1`` solution or a solve that runs
+first order, other sources (or sources that moved farther than the tube), a surface that moved
+farther than ``outer − inner`` grid spacings (nodes of the new inner tube outside the previous
+band), or a change of topology (the inner tube's connected components changed). With
+``warm_refused="cold"`` the solve runs cold instead and records why in
+``sol.stats.order2["warm"]``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Dict, Optional, Tuple
+
+import numpy as np
+
+from . import _native
+
+__all__ = ["WarmStartRefused", "WARM_REFUSED"]
+
+#: What a solve does when its warm start is refused: raise :class:`WarmStartRefused`, or solve cold.
+WARM_REFUSED = ("raise", "cold")
+
+
+class WarmStartRefused(ValueError):
+    """The previous solution given as ``warm=`` cannot start this solve; the message says why and
+    what to do (``warm_refused="cold"`` solves cold instead)."""
+
+
+def check_warm_refused(warm_refused: Any) -> str:
+    """``warm_refused`` as one of :data:`WARM_REFUSED`, or a ValueError naming the choices."""
+    if not isinstance(warm_refused, str) or warm_refused not in WARM_REFUSED:
+        raise ValueError(
+            f"warm_refused must be 'raise' (a refused warm start raises WarmStartRefused) or 'cold' (the solve runs "
+            f"cold instead, the reason in sol.stats.order2['warm']); got {warm_refused!r}"
+        )
+    return warm_refused
+
+
+def check_previous(warm: Any, grid: Any) -> Any:
+    """``warm`` as a second-order :class:`~tubesweep.Solution` on ``grid``, or the refusal."""
+    from .solution import Solution
+
+    if not isinstance(warm, Solution):
+        raise TypeError(
+            f"warm must be the Solution of a previous solve (ts.solve or Tube.solve); got {type(warm).__name__}"
+        )
+    if warm.grid != grid:
+        raise WarmStartRefused(
+            f"warm: the previous solution is on another grid ({warm.grid!r}, this solve's is {grid!r}); a warm start "
+            "carries values node by node, so both solves need the same grid. Solve cold (leave out warm=)"
+        )
+    if getattr(warm, "order", 1) != 2 or warm._factoring is None:
+        raise WarmStartRefused(
+            "warm: the previous solution was solved at first order (order=1, or order='auto' fell back to it); warm "
+            "starts run the second-order solve from a second-order solution. Solve the previous step with order=2 or "
+            "'auto' where second order applies, or solve cold (leave out warm=)"
+        )
+    return warm
+
+
+def refusal_for_order1(reason: Optional[str]) -> WarmStartRefused:
+    """The refusal of a warm start on a solve that runs first order (``reason``: why second order
+    did not apply, None for ``order=1`` asked for)."""
+    why = "order=1 was asked for" if reason is None else f"second order does not apply here ({reason})"
+    return WarmStartRefused(
+        f"warm: warm starts run the second-order solve, and {why}. Leave out warm= (or pass warm_refused='cold')"
+    )
+
+
+def _linear(sol_or_tube: Any) -> np.ndarray:
+    return np.ascontiguousarray(sol_or_tube.linear, dtype=np.int64).view(np.uint64)
+
+
+def carried_values(warm: Any, tube: Any, feet: np.ndarray, inner_width: float) -> Tuple[np.ndarray, Dict[str, Any]]:
+    """The previous solution ``warm`` carried onto ``tube`` (a ``_prepare._PreparedTube``) for a
+    solve from the sources' foot points ``feet``: a node in both bands keeps its value, a node new
+    to the band starts at +∞ (``tubesweep_core::second_order::warm::carry_values``). ``warm`` may
+    be a pair ``(older, previous)`` of the two previous steps' solutions: the start is then
+    extrapolated in time, ``2·previous − older``, where both have a value (error O(δ²) instead of
+    O(δ) for a surface moving smoothly by δ per step; about a quarter fewer updates). Raises
+    :class:`WarmStartRefused` when the previous solution does not fit (see the module)."""
+    from ._prepare import ROLE_OUTER
+
+    grid = tube.grid
+    older = None
+    if isinstance(warm, (tuple, list)):
+        if len(warm) != 2:
+            raise TypeError(
+                f"warm must be a Solution or a pair (older, previous) of the two previous steps' Solutions; got a "
+                f"sequence of {len(warm)}"
+            )
+        older, warm = warm
+        check_previous(older, grid)
+    check_previous(warm, grid)
+    h = grid.spacing
+    slack = tube.outer_eff * h - inner_width  # how far the surface may move: outer − inner spacings
+    old_feet = warm._factoring[1]
+    if len(old_feet) != len(feet):
+        raise WarmStartRefused(
+            f"warm: the previous solution has {len(old_feet)} source(s), this solve {len(feet)}; a warm start needs the "
+            "same sources, moved with the surface. Solve cold (leave out warm=)"
+        )
+    old_linear, new_linear = _linear(warm), _linear(tube)
+    carried = _native.carry_band_values(old_linear, np.ascontiguousarray(warm.values, dtype=float), new_linear)
+    extrapolated = 0
+    if older is not None:
+        before = _native.carry_band_values(_linear(older), np.ascontiguousarray(older.values, dtype=float), new_linear)
+        both = np.isfinite(before) & np.isfinite(carried)
+        carried[both] = 2.0 * carried[both] - before[both]
+        extrapolated = int(np.count_nonzero(both))
+    inner_new = tube.roles != ROLE_OUTER
+    # nodes of the new inner tube outside the previous band (a node in it that the previous solve
+    # never reached, on a part without a source, stays unreached: the sweeps leave it at +∞)
+    at = np.minimum(np.searchsorted(old_linear, new_linear), len(old_linear) - 1)
+    missing = int(np.count_nonzero(inner_new & (old_linear[at] != new_linear)))
+    if missing:
+        raise WarmStartRefused(
+            f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved farther than "
+            f"outer − inner = {slack / h:g} grid spacings since the previous solution. Move in smaller steps (at most "
+            "outer − inner spacings per solve), widen the tube (outer=), or solve cold (leave out warm=)"
+        )
+    old_inner = np.ascontiguousarray(warm.roles != ROLE_OUTER)
+    n_old = _native.band_components(warm._band, old_inner)
+    n_new = _native.band_components(tube.band, np.ascontiguousarray(inner_new))
+    if n_old != n_new:
+        raise WarmStartRefused(
+            f"warm: the topology changed: the inner tube has {n_new} connected component(s), the previous one had "
+            f"{n_old} (a part pinched off or two parts merged); carried values on a part that lost its source would never "
+            "settle. Solve cold (leave out warm=) across the change, then warm again"
+        )
+    moved = np.linalg.norm(np.asarray(old_feet) - feet, axis=1)
+    if moved.size and float(np.max(moved)) > slack * (1 + 1e-9):
+        i = int(np.argmax(moved))
+        raise WarmStartRefused(
+            f"warm: source {i} moved {moved[i]:.4g} from the previous solution's ({moved[i] / h:.2f} grid spacings), "
+            f"farther than the surface may move between warm solves (outer − inner = {slack / h:g} spacings); a source "
+            "that leaves the surface's path is another problem. Pass the previous sources moved with the surface, "
+            "move in smaller steps, or solve cold (leave out warm=)"
+        )
+    info = {
+        "carried": int(np.count_nonzero(np.isfinite(carried))),
+        "new_nodes": int(np.count_nonzero(~np.isfinite(carried))),
+        "extrapolated": extrapolated,
+    }
+    return np.ascontiguousarray(carried), info

@@ -1,0 +1,196 @@
+"""Warm re-solves on a moving surface (tubesweep.moving, docs/moving-surfaces.md): the warm start
+reaches the cold solve's values, refuses what it cannot carry with the cause named, and a sphere
+that grows keeps its distances proportional to its radius."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.moving import WarmStartRefused
+
+N = 41
+GRID = ts.Grid((-1, -1, -1), (1, 1, 1), (N, N, N))
+H = GRID.spacing
+
+
+def pole(r: float) -> list:
+    return [(0.0, 0.0, r)]
+
+
+@pytest.fixture(scope="module")
+def first():
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), GRID)
+    return tube, tube.solve(pole(0.5))
+
+
+def test_a_warm_solve_on_a_grown_sphere_equals_the_cold_solve(first):
+    tube, sol = first
+    r = 0.5 + 0.4 * H
+    moved = tube.moved(ts.surfaces.Sphere(r))
+    warm = moved.solve(pole(r), warm=sol)
+    cold = ts.solve(ts.surfaces.Sphere(r), GRID, pole(r))
+    assert warm.stats.order == 2 and np.array_equal(warm.linear, cold.linear)
+    info = warm.stats.order2["warm"]
+    assert info["restarted"] is None and info["carried"] > 0.8 * warm.stats.band_points
+    tol = cold.stats.order2["tol"]
+    assert np.max(np.abs(warm.values - cold.values)) <= 10 * tol
+    # ts.solve(..., warm=) runs the same solve as the tube's, bit for bit
+    again = ts.solve(ts.surfaces.Sphere(r), GRID, pole(r), warm=sol)
+    assert np.array_equal(again.values, warm.values)
+
+
+def test_a_start_extrapolated_from_two_steps_reaches_the_cold_values(first):
+    tube, s0 = first
+    r1, r2 = 0.5 + 0.4 * H, 0.5 + 0.8 * H
+    t1 = tube.moved(ts.surfaces.Sphere(r1))
+    s1 = t1.solve(pole(r1), warm=s0)
+    s2 = t1.moved(ts.surfaces.Sphere(r2)).solve(pole(r2), warm=(s0, s1))
+    cold = ts.solve(ts.surfaces.Sphere(r2), GRID, pole(r2))
+    assert s2.stats.order2["warm"]["extrapolated"] > 0.8 * s2.stats.band_points
+    assert np.max(np.abs(s2.values - cold.values)) <= 10 * cold.stats.order2["tol"]
+
+
+def test_distances_on_a_growing_sphere_scale_with_its_radius(first):
+    # warm steps of 0.4Δx from r = 0.5 to 0.5 + 2Δx: u(r·d)/r is the same function of the
+    # direction d at every radius, to the solver's accuracy (its error against rθ)
+    tube, sol = first
+    rng = np.random.default_rng(3)
+    d = rng.normal(size=(200, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    theta = np.arccos(np.clip(d[:, 2], -1, 1))
+    d, theta = d[(theta > 0.2) & (theta < np.pi - 0.3)], theta[(theta > 0.2) & (theta < np.pi - 0.3)]
+    base = sol(0.5 * d) / 0.5
+    worst_error = np.max(np.abs(base - theta))
+    worst_scaling = 0.0
+    r = 0.5
+    for _ in range(5):
+        r += 0.4 * H
+        tube = tube.moved(ts.surfaces.Sphere(r))
+        sol = tube.solve(pole(r), warm=sol)
+        assert sol.stats.order2["warm"]["restarted"] is None
+        scaled = sol(r * d) / r
+        worst_error = max(worst_error, np.max(np.abs(scaled - theta)))
+        worst_scaling = max(worst_scaling, np.max(np.abs(scaled - base)))
+    # measured at N = 41: 5.3e-3 against θ, 2.4e-3 between the radii
+    assert worst_error < 1e-2
+    assert worst_scaling <= worst_error
+
+
+def test_a_part_without_a_source_stays_unreached_in_a_warm_solve():
+    # two spheres far apart, the source on one: the other is +inf in the cold and the warm solve
+    X = np.stack(GRID.meshgrid(), axis=-1)
+
+    def two(r: float) -> np.ndarray:
+        return np.minimum(np.linalg.norm(X - (0.5, 0, 0), axis=-1), np.linalg.norm(X + (0.5, 0, 0), axis=-1)) - r
+
+    tube = ts.Tube(two(0.3), GRID)
+    sol = tube.solve([(0.5, 0.0, 0.3)])
+    r = 0.3 + 0.4 * H
+    warm = tube.moved(two(r)).solve([(0.5, 0.0, r)], warm=sol)
+    cold = ts.solve(two(r), GRID, [(0.5, 0.0, r)])
+    reached = np.isfinite(cold.values)
+    assert np.array_equal(reached, np.isfinite(warm.values)) and 0.3 < reached.mean() < 0.7
+    assert np.max(np.abs(warm.values[reached] - cold.values[reached])) <= 10 * cold.stats.order2["tol"]
+
+
+def test_refusals_name_the_cause(first):
+    tube, sol = first
+    r = 0.5 + 0.4 * H
+    moved = tube.moved(ts.surfaces.Sphere(r))
+    other = ts.Grid((-1, -1, -1), (1, 1, 1), (43, 43, 43))
+    with pytest.raises(WarmStartRefused, match="another grid"):
+        ts.solve(ts.surfaces.Sphere(r), other, pole(r), warm=sol)
+    with pytest.raises(WarmStartRefused, match="solved at first order"):
+        moved.solve(pole(r), warm=tube.solve(pole(0.5), order=1))
+    with pytest.raises(WarmStartRefused, match="order=1 was asked for"):
+        moved.solve(pole(r), warm=sol, order=1)
+    with pytest.raises(WarmStartRefused, match="source 0 moved"):
+        moved.solve([(r, 0.0, 0.0)], warm=sol)
+    with pytest.raises(WarmStartRefused, match="1 source"):
+        moved.solve([(0.0, 0.0, r), (r, 0.0, 0.0)], warm=sol)
+    far = 0.5 + 3.0 * H  # farther than outer − inner = 2 spacings
+    with pytest.raises(WarmStartRefused, match="moved farther than outer − inner = 2 grid spacings"):
+        tube.moved(ts.surfaces.Sphere(far)).solve(pole(far), warm=sol)
+    with pytest.raises(TypeError, match="warm must be the Solution"):
+        moved.solve(pole(r), warm=sol.values)
+    with pytest.raises(ValueError, match="warm_refused must be"):
+        moved.solve(pole(r), warm=sol, warm_refused="ignore")
+    with pytest.raises(ValueError, match="the φ array has shape"):
+        ts.Tube(np.linalg.norm(GRID.meshgrid(), axis=0) - 0.5, GRID).moved(np.zeros((5, 5, 5)))
+
+
+def test_a_refused_warm_start_solves_cold_when_asked(first):
+    tube, sol = first
+    far = 0.5 + 3.0 * H
+    s = tube.moved(ts.surfaces.Sphere(far)).solve(pole(far), warm=sol, warm_refused="cold")
+    cold = ts.solve(ts.surfaces.Sphere(far), GRID, pole(far))
+    assert np.array_equal(s.values, cold.values)
+    assert "moved farther" in s.stats.order2["warm"]["refused"]
+
+
+# ---- ts.evolve: the level set moved by a law of its surface solution ----
+
+GRID31 = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
+
+
+def sphere_phi(grid: ts.Grid, r: float = 0.5) -> np.ndarray:
+    return np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1) - r
+
+
+def test_a_sphere_growing_at_constant_speed_keeps_its_shape_and_scales_its_distances(tmp_path):
+    ev = ts.evolve(sphere_phi(GRID31), GRID31, [(0, 0, 0.5)], lambda u: 0.3 + 0 * u, dt=0.05, steps=4, every=2,
+                   checkpoint=tmp_path / "run.npz")  # fmt: skip
+    assert ev.times == pytest.approx([0.0, 0.1, 0.2]) and ev.warm_starts == 4 and ev.cold_starts == 1
+    r = 0.5 + 0.3 * 0.2
+    sol = ev.solutions[-1]
+    # the pole followed the surface; the zero level set is the sphere of radius r to a tenth of a
+    # grid spacing (re-distancing and projection at N = 31, h = 0.067: measured 6.8e-3)
+    h = GRID31.spacing
+    assert sol.sources[0] == pytest.approx([0, 0, r], abs=0.15 * h)
+    feet = sol.surface.project(GRID31.node_points(sol.linear[np.abs(sol.phi) < h]), GRID31)[1]
+    assert np.max(np.abs(np.linalg.norm(feet, axis=1) - r)) < 0.15 * h
+    # u(r·d)/r the angle from the pole, as at the start (second order: 1.3e-2 at N = 31)
+    a = np.linspace(0.3, 2.6, 12)
+    d = np.stack([np.sin(a), 0 * a, np.cos(a)], 1)
+    first = ev.solutions[0](0.5 * d) / 0.5
+    last = sol(r * d) / r
+    assert np.max(np.abs(last - a)) < 2e-2 and np.max(np.abs(last - first)) < 1e-2
+    saved = np.load(tmp_path / "run.npz")
+    assert float(saved["t"]) == pytest.approx(0.2) and np.array_equal(saved["phi"], ev.phis[-1])
+    path = ev.export(tmp_path / "run.pvd")
+    text = path.read_text()
+    assert text.count("<DataSet") == 3 and (tmp_path / "run_0002.vtp").exists() and 'timestep="0.2' in text
+
+
+def test_the_axisymmetric_evolution_follows_the_front_tracked_meridian():
+    # the pear of benches/moving_axisymmetric.py at N = 31 against its reference (the bench fits
+    # order ≥ 1 over N = 41, 61, 81): shape and distances within a fraction of a grid spacing
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    import moving_axisymmetric as axi
+
+    r = axi.compare(31, axi.reference(axi.T, m=500))
+    h = GRID31.spacing  # measured: Hausdorff 1.2e-2, distances max 2.3e-2, mean 8.8e-3
+    assert r["hausdorff"] < 0.25 * h and r["max"] < 0.5 * h and r["mean"] < 0.2 * h
+
+
+def test_evolve_refuses_bad_input_with_the_cause_named():
+    phi = sphere_phi(GRID31)
+    with pytest.raises(ValueError, match="CFL condition fails at step 0.*take dt ≤"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 1.0 + 0 * u, dt=0.1, steps=2)
+    with pytest.raises(ValueError, match=r"speed\(u\) returned nan"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: np.where(u > 0.5, np.nan, 0.1), dt=0.05, steps=2)
+    with pytest.raises(ValueError, match="one normal speed per value"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: u[:3], dt=0.05, steps=2)
+    with pytest.raises(ValueError, match="cfl must be in"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=2, cfl=1.5)
+    with pytest.raises(ValueError, match="dt must be a positive"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=-1.0, steps=2)
+    with pytest.raises(ValueError, match="grid's shape"):
+        ts.evolve(phi[:-1], GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=2)
+    with pytest.raises(ValueError, match="must end in .pvd"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1).export("run.vtp")
