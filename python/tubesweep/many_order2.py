@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple
 import numpy as np
 
 from . import _native
+from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
 from ._validate import FRONT_WINDOW, as_sources
 from . import second_order as so
@@ -117,6 +118,7 @@ def solve_many_order2(
         raise
     st = dict(st)
     st["tol"] = inputs.tol
+    warn_creases(st.get("creases"), t.inner, h)
     for name, what in (
         (
             "converged",
