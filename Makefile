@@ -117,6 +117,8 @@ bench: build
 	$(PY) benches/under_load.py
 	# issue 45: point clouds against potpourri3d's PointCloudHeatSolver (docs/point-clouds.md)
 	$(PY) benches/point_clouds.py
+	# issue 45 part 2: meshes at second order against the heat method and MMP
+	$(PY) benches/mesh_order2.py
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

@@ -29,6 +29,9 @@ MARGIN = 0.5
 #: against the grid: its band is the exact map's, and ``order="auto"`` runs first order on it (the
 #: fitted map of Spot at n = 200, 4.7 Δx, made the second-order sweeps run away; docs/point-clouds.md).
 COARSE = 3.0
+#: Triangles larger than this many grid spacings (longest edge) are fitted
+#: (``tubesweep_core::surface::mesh_smooth::FINE_LOW``).
+FINE = 2.0
 #: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
 CHUNK = 1 << 20
 
@@ -38,7 +41,10 @@ def closest(surface: Any, x: np.ndarray, h: Optional[float]) -> Tuple[np.ndarray
     closest points) and the map of each (codes of :data:`KINDS`)."""
     x = np.ascontiguousarray(np.asarray(x, dtype=float).reshape(-1, 3))
     # before any band, or on a mesh coarse against the grid: the exact closest points
-    mode = "auto" if h is not None and median_size(surface) <= COARSE * h else "exact"
+    if h is None or median_size(surface) > COARSE * h or "facing" in surface.report:
+        _, cp, _, _ = surface.closest(x)
+        return cp, np.full(len(x), 1, np.uint8)
+    mode = "auto"
     out = np.empty_like(x)
     kinds = np.empty(len(x), np.uint8)
     for s0 in range(0, len(x), CHUNK):
@@ -60,6 +66,15 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
         # coarse: today's band of the exact map, and first order (order2_obstacle)
         surface.report = {"coarse": size / h, "h": h}
         return exact_band()
+    if largest_size(surface) > FINE * h or not surface.closed:
+        # fits will be needed (large triangles, or a boundary's blend): first the exact map's band,
+        # and where the mesh faces itself across a gap narrower than its tubes that band and first
+        # order (order2_obstacle), without the fits' cost
+        exact = exact_band()
+        pairs = facing_pairs(grid, exact)
+        if pairs:
+            surface.report = {"facing": pairs, "h": h}
+            return exact
     reach = half_width + MARGIN * h
     candidates = surface.band_candidates(grid, reach)
     parts: list = []
@@ -100,7 +115,36 @@ def median_size(surface: Any) -> float:
     return float(surface._median_size)
 
 
-def order2_obstacle(surface: Any, facing_pairs: int) -> Optional[str]:
+def largest_size(surface: Any) -> float:
+    """The largest longest edge of the mesh's non-degenerate triangles."""
+    f = surface.faces[surface._good]
+    v = surface.vertices
+    edges = [np.linalg.norm(v[f[:, i]] - v[f[:, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))]
+    return float(np.max(np.maximum(np.maximum(edges[0], edges[1]), edges[2])))
+
+
+def facing_pairs(grid: Grid, geom: BandGeometry) -> int:
+    """Pairs of grid neighbours of the band, both more than 0.75 Δx from the mesh, whose extension
+    directions point more than 120° apart: the two sides of a gap narrower than the tubes (across a
+    single sheet two neighbours cannot both be that far from it)."""
+    h = grid.spacing
+    lin = geom.linear
+    if len(lin) == 0:
+        return 0
+    dist = geom.distance if geom.distance is not None else np.abs(geom.signed)
+    far = dist > 0.75 * h
+    count = 0
+    for k in range(grid.ndim):
+        stride = int(np.prod(grid.shape[k + 1 :]))
+        nxt = lin + stride
+        pos = np.minimum(np.searchsorted(lin, nxt), len(lin) - 1)
+        hit = (lin[pos] == nxt) & far & far[pos] & ((lin // stride) % grid.shape[k] < grid.shape[k] - 1)
+        dots = np.einsum("ij,ij->i", geom.direction[hit], geom.direction[pos[hit]])
+        count += int(np.count_nonzero(dots < -0.5))
+    return count
+
+
+def order2_obstacle(surface: Any, tube_pairs: int) -> Optional[str]:
     """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants)."""
     report = surface.report
     if "coarse" in report:
@@ -108,9 +152,10 @@ def order2_obstacle(surface: Any, facing_pairs: int) -> Optional[str]:
             f"the mesh is coarse against the grid: its triangles' median size is {report['coarse']:.1f} grid spacings "
             f"(second order on a mesh needs at most {COARSE:g}); subdivide the mesh, or use the grid it resolves"
         )
-    if facing_pairs:
+    pairs = report.get("facing", 0) or tube_pairs
+    if pairs:
         return (
-            f"the mesh faces itself across gaps narrower than its tubes ({facing_pairs} node pairs): the second-order "
+            f"the mesh faces itself across gaps narrower than its tubes ({pairs} node pairs): the second-order "
             "sweeps are not safe there on a mesh (they ran away on the bunny at n = 200); a finer grid resolves the gap"
         )
     return None
