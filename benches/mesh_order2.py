@@ -148,7 +148,9 @@ def main(argv: Optional[List[str]] = None) -> List[Dict]:
     rows += compare("icosphere (vs great circles)", v, f, src, box, great_circle(v, src), repeats)
     vs = v * np.array([1.0, 1.0, 0.7])
     top = int(np.argmax(vs[:, 2]))
-    rows += compare("spheroid 0.5/0.35 (vs geographiclib)", vs, f, top, box, spheroid_exact(vs, top, 0.5, 0.35), repeats)
+    rows += compare(
+        "spheroid 0.5/0.35 (vs geographiclib)", vs, f, top, box, spheroid_exact(vs, top, 0.5, 0.35), repeats
+    )
     for name in ("spot", "bunny"):
         base = ts.surfaces.from_mesh(ts.data.path(name), smooth=False)
         vv, ff = used_only(base.vertices, base.faces)

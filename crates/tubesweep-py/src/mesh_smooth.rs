@@ -27,7 +27,9 @@ impl PySmoothMesh {
         spacing: f64,
     ) -> PyResult<Self> {
         if vertices.shape()[1] != 3 || faces.shape()[1] != 3 {
-            return Err(PyValueError::new_err("vertices and faces must have shape (n, 3) and (m, 3)"));
+            return Err(PyValueError::new_err(
+                "vertices and faces must have shape (n, 3) and (m, 3)",
+            ));
         }
         let v: Vec<[f64; 3]> = c_slice(&vertices, "vertices")?
             .chunks_exact(3)
@@ -36,11 +38,16 @@ impl PySmoothMesh {
         let mut f = Vec::with_capacity(faces.shape()[0]);
         for t in c_slice(&faces, "faces")?.chunks_exact(3) {
             if t.iter().any(|&i| i < 0 || i as usize >= v.len()) {
-                return Err(PyValueError::new_err(format!("faces: a vertex index out of range 0..{}", v.len())));
+                return Err(PyValueError::new_err(format!(
+                    "faces: a vertex index out of range 0..{}",
+                    v.len()
+                )));
             }
             f.push([t[0] as u32, t[1] as u32, t[2] as u32]);
         }
-        let mesh = py.detach(|| SmoothMesh::new(&v, &f, neighbours, spacing)).map_err(to_pyerr)?;
+        let mesh = py
+            .detach(|| SmoothMesh::new(&v, &f, neighbours, spacing))
+            .map_err(to_pyerr)?;
         Ok(PySmoothMesh { mesh })
     }
 

@@ -41,7 +41,20 @@ from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_
 from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
 
-__all__ = ["from_mesh", "MeshSurface", "SmoothMeshSurface", "read_mesh", "closest_points_on_triangles"]
+__all__ = [
+    "from_mesh",
+    "MeshSurface",
+    "SmoothMeshSurface",
+    "read_mesh",
+    "closest_points_on_triangles",
+    "FACE",
+    "VERT_A",
+    "VERT_B",
+    "VERT_C",
+    "EDGE_AB",
+    "EDGE_AC",
+    "EDGE_BC",
+]
 
 _MESH_EXTRA = MESH_EXTRA
 
@@ -681,7 +694,27 @@ class SmoothMeshSurface(MeshSurface, ClosestPoint):
 
     def order2_obstacle(self, facing_pairs: int) -> Optional[str]:
         """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
-        or None; read by the second-order solve."""
+        or None; read by the second-order solve.
+
+        Parameters
+        ----------
+        facing_pairs : int
+            The node pairs of the tube whose sides face each other across a narrow gap (the
+            tube's own check, ``_prepare._warn_if_tubes_touch``).
+
+        Returns
+        -------
+        str or None
+            The reason, or None when second order may run.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> geometry = spot.band(spot.grid(200), 0.02)
+        >>> spot.order2_obstacle(0)[:36]
+        'the mesh is coarse against the grid:'
+        """
         return smooth_mesh.order2_obstacle(self, facing_pairs)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
