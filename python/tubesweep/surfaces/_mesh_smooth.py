@@ -1,4 +1,5 @@
-"""The band and closest points of :class:`~tubesweep.surfaces.mesh.SmoothMeshSurface`: the smooth
+"""The band, closest points and methods (:class:`SmoothMap`) of
+:class:`~tubesweep.surfaces.mesh.SmoothMeshSurface`: the smooth
 closest-point map of a triangle mesh, computed in the Rust core
 (``tubesweep_core::surface::mesh_smooth``) on all threads and only at the band's candidate nodes.
 """
@@ -159,3 +160,140 @@ def order2_obstacle(surface: Any, tube_pairs: int) -> Optional[str]:
             "sweeps are not safe there on a mesh (they ran away on the bunny at n = 200); a finer grid resolves the gap"
         )
     return None
+
+
+class SmoothMap:
+    """The methods of :class:`~tubesweep.surfaces.mesh.SmoothMeshSurface` that read and build the
+    smooth map (a mixin before ``MeshSurface`` in its bases: ``super()`` is the exact map's)."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    _good: np.ndarray
+    _h: Optional[float]
+    _smooth_map: Any
+    _band_cache: Optional[Tuple[np.ndarray, np.ndarray]]
+
+    @property
+    def smooth_map(self) -> Any:
+        """The native map for the grid spacing of the last band (built on first use)."""
+        spacing = SAMPLE_SPACING * (self._h or 0.0)
+        if self._smooth_map is None or self._smooth_map[0] != spacing:
+            from .. import _native
+
+            faces = np.ascontiguousarray(self.faces[self._good])
+            self._smooth_map = (spacing, _native.SmoothMesh(self.vertices, faces, NEIGHBOURS, spacing))
+        return self._smooth_map[1]
+
+    def __getstate__(self) -> dict:
+        state: dict = super().__getstate__()  # type: ignore[assignment]  # MeshSurface's
+        state["_smooth_map"] = None
+        state["_band_cache"] = None
+        return state
+
+    def _cp(self, x: np.ndarray) -> np.ndarray:
+        return closest(self, x, self._h)[0]
+
+    def order2_obstacle(self, facing_pairs: int) -> Optional[str]:
+        """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
+        or None; read by the second-order solve.
+
+        Parameters
+        ----------
+        facing_pairs : int
+            The node pairs of the tube whose sides face each other across a narrow gap (the
+            tube's own check, ``_prepare._warn_if_tubes_touch``).
+
+        Returns
+        -------
+        str or None
+            The reason, or None when second order may run.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> geometry = spot.band(spot.grid(200), 0.02)
+        >>> spot.order2_obstacle(0)[:36]
+        'the mesh is coarse against the grid:'
+        """
+        return order2_obstacle(self, facing_pairs)
+
+    def band(self, grid: Grid, half_width: float) -> BandGeometry:
+        """The band nodes within ``half_width`` of the smooth map's surface, their closest points
+        computed once in Rust (kept for the second-order geometry) and counted by map in
+        :attr:`report`. On a mesh coarse against the grid (median triangle above 3 Δx), the exact
+        map's band of :meth:`MeshSurface.band`.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance).
+
+        Returns
+        -------
+        BandGeometry
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> grid = spot.grid(40)
+        >>> len(spot.band(grid, 4 * grid.spacing).linear) > 0
+        True
+        """
+        return band(self, grid, half_width, lambda: super(SmoothMap, self).band(grid, half_width))  # type: ignore[misc]
+
+    def closest_point(self, points: np.ndarray) -> np.ndarray:
+        """The smooth map's closest points (for the grid of the last band; exact before any band).
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, 3)`` closest points.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> spot.closest_point(spot.vertices[:2] + 0.01).shape
+        (2, 3)
+        """
+        p = np.ascontiguousarray(points, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"points must have shape (M, 3); got {p.shape}")
+        cache = self._band_cache
+        if cache is not None and cache[0].shape == p.shape and np.array_equal(cache[0], p):
+            return cache[1].copy()  # the band's nodes again (the second-order geometry)
+        return closest(self, p, self._h)[0]
+
+    def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        """The smooth map's closest points for ``grid`` and the distances to them.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points.
+        grid : Grid
+            The grid (its spacing decides where the map is exact).
+
+        Returns
+        -------
+        distance, closest : numpy.ndarray
+            ``(M,)`` and ``(M, 3)``.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> d, cp = spot.project(spot.vertices[:2], spot.grid(100))
+        """
+        p = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 3))
+        cp = closest(self, p, grid.spacing)[0]
+        return np.linalg.norm(p - cp, axis=1), cp
