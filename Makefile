@@ -121,6 +121,8 @@ bench: build
 	$(PY) benches/moving_surfaces.py --n 121 --steps 20 --rounds 3
 	$(PY) benches/moving_surfaces.py --growth --n 121 --steps 20
 	$(PY) benches/moving_axisymmetric.py --sizes 41,61,81
+	# issue 45 part 2: meshes at second order against the heat method and MMP
+	$(PY) benches/mesh_order2.py
 
 reproduce: build
 	$(PY) -m tubesweep reproduce all --out out/reproduce

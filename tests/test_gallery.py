@@ -47,6 +47,7 @@ CASES = {
     "distance_matrix": (31, ["distance_matrix.png"]),
     "point_cloud": (61, ["point_cloud.png"]),
     "pear_growth": (41, ["pear_growth.png"]),
+    "mesh_order2": (61, ["mesh_order2.png"]),
 }
 
 
@@ -70,6 +71,9 @@ def test_example(name, tmp_path):
         assert number(r"max error ([0-9.]+)", out) < 4 * h
     elif name == "point_cloud":
         assert "order 2" in out and number(r"outer equator: mean ([0-9.e-]+)", out) < 0.1 * h
+    elif name == "mesh_order2":
+        smooth = number(r"smooth=True: order 2, mean error ([0-9.e-]+)", out)
+        assert smooth < 0.03 * h and number(r"smooth=False: order 1, mean error ([0-9.e-]+)", out) > 20 * smooth
     elif name == "torus_cells":
         shares = [float(x) for x in re.search(r"\[([0-9. ]+)\]", out).group(1).split()]
         assert abs(sum(shares) - 1) < 0.01 and min(shares) > 0.15

@@ -48,7 +48,7 @@ def test_auto_is_order_two_where_it_applies(surface, grid, src):
 
 
 def _cases():
-    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(16))
+    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(16), smooth=False)  # the exact map (smooth: test_mesh_order2.py)
     dt = ts.surfaces.DoubleTorus()
     g41 = box(41)
     return [
@@ -140,7 +140,7 @@ def test_the_default_is_auto():
     default, auto = ts.solve(SPHERE, g, [SRC]), ts.solve(SPHERE, g, [SRC], order="auto")
     assert default.stats.order == 2 and np.array_equal(default.values, auto.values)
     assert np.array_equal(ts.Tube(SPHERE, g).solve([SRC]).values, auto.values)
-    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(12))
+    mesh = ts.surfaces.from_mesh(SPHERE.triangulation(12), smooth=False)
     default = ts.solve(mesh, g, [SRC])
     assert default.stats.order == 1 and "piecewise flat" in default.stats.order_fallback
     assert np.array_equal(default.values, ts.solve(mesh, g, [SRC], order=1).values)

@@ -338,6 +338,20 @@ class PointCloud:
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
     def lower_bounds(self, points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
 
+class SmoothMesh:
+    """The smooth closest-point map of a triangle mesh (Rust core, surface/mesh_smooth.rs)."""
+
+    def __init__(
+        self, vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64], neighbours: int, spacing: float
+    ) -> None: ...
+    @property
+    def oriented(self) -> bool: ...
+    @property
+    def boundary_edges(self) -> int: ...
+    def closest(
+        self, points: npt.NDArray[np.float64], h: float, max_distance: float = ..., mode: str = "auto"
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+
 class TriangleTree:
     """Exact closest points on a triangle mesh (AABB tree of the Rust core)."""
 

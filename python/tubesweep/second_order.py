@@ -219,6 +219,10 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
             f"order=2 needs two band neighbours on each side of every inner-tube node: outer ≥ inner + 2 grid spacings "
             f"(got inner={tube.inner:g}, outer={tube.outer_eff:g}); the defaults are inner=2, outer=4"
         )
+    if getattr(surf, "smooth", False):  # a mesh through its smooth map (surfaces/_mesh_smooth.py)
+        obstacle = surf.order2_obstacle(int(tube.facing[0].size))
+        if obstacle is not None:
+            raise Order2NotApplicable(f"order=2 on this mesh: {obstacle}")
     linear = tube.linear
     x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
@@ -409,6 +413,8 @@ def solve_on_tube(
             warm_info["restarted"] = st["warm_restarted"]
         order2["warm"] = warm_info
     order2["fix_radius"] = FIX_RADIUS * h
+    if getattr(surf, "smooth", False):  # a mesh's smooth map: band nodes per map (surfaces/_mesh_smooth.py)
+        order2["mesh_map"] = dict(surf.report)
     stats = SolveStats(
         iterations=st["iterations"],
         sweeps=st["iterations"] * 2**d,

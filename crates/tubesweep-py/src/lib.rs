@@ -12,6 +12,7 @@
 //! | `sweep.rs` | solves (`tubesweep_core::sweep`), the GIL released, progress and Ctrl-C |
 //! | `box_order2.rs` | the second-order solve in the box (`tubesweep_core::sweep::factored_box`) |
 //! | `second_order.rs` | order=2 on surfaces (`tubesweep_core::second_order`) |
+//! | `mesh_smooth.rs` | the smooth closest-point map of a mesh (`tubesweep_core::surface::mesh_smooth`) |
 //! | `point_cloud.rs` | point clouds' closest points (`tubesweep_core::surface::point_cloud`) |
 //! | `many_sources.rs` | many solves on one band (`tubesweep_core::sweep::many_sources`) |
 //! | `moving.rs` | warm starts on a moved surface (`tubesweep_core::second_order::warm`) |
@@ -27,6 +28,7 @@ mod convert;
 mod errors;
 mod many_sources;
 mod moving;
+mod mesh_smooth;
 mod point_cloud;
 mod progress;
 mod second_order;
@@ -43,6 +45,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     box_order2::register(m)?;
     many_sources::register(m)?;
     moving::register(m)?;
+    mesh_smooth::register(m)?;
     point_cloud::register(m)?;
     second_order::register(m)?;
     surface::register(m)?;

@@ -36,7 +36,7 @@ from ..surface import Surface
 from .analytic import Circle, Sphere, Star
 from .closed import DoubleTorus, Ellipsoid, RoundedCube, Torus
 from .curves import Ellipse
-from .mesh import MeshSurface, from_mesh
+from .mesh import MeshSurface, SmoothMeshSurface, from_mesh
 from .open import Disc, Hemisphere, MobiusBand, PlanePatch
 from .points import PointCloudSurface, from_points, read_points
 from ._repr import give_repr
@@ -74,6 +74,7 @@ __all__ = [
     "PlanePatch",
     "MobiusBand",
     "MeshSurface",
+    "SmoothMeshSurface",
     "from_mesh",
     "PointCloudSurface",
     "from_points",

@@ -32,13 +32,29 @@ import numpy as np
 from ..grid import Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from ..surface import Surface
+from ..closest_point import ClosestPoint
 from .._validate import real_array, real_scalar, whole_indices
 from ..grid import MAX_COORDINATE
 from .._warn import user_stacklevel
 from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_library
+from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_B, VERT_C, closest_points_on_triangles
 from .analytic import finite_center, size_parameter
+from . import _mesh_smooth as smooth_mesh
 
-__all__ = ["from_mesh", "MeshSurface", "read_mesh", "closest_points_on_triangles"]
+__all__ = [
+    "from_mesh",
+    "MeshSurface",
+    "SmoothMeshSurface",
+    "read_mesh",
+    "closest_points_on_triangles",
+    "FACE",
+    "VERT_A",
+    "VERT_B",
+    "VERT_C",
+    "EDGE_AB",
+    "EDGE_AC",
+    "EDGE_BC",
+]
 
 _MESH_EXTRA = MESH_EXTRA
 
@@ -99,77 +115,6 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
 
 
 # ---------------------------------------------------------------------------------------------
-# exact point–triangle projection
-# ---------------------------------------------------------------------------------------------
-#: Feature codes returned by :func:`closest_points_on_triangles`.
-FACE, VERT_A, VERT_B, VERT_C, EDGE_AB, EDGE_AC, EDGE_BC = range(7)
-
-
-def closest_points_on_triangles(
-    p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray
-) -> Tuple[np.ndarray, np.ndarray]:
-    """Closest point on triangle (a_i, b_i, c_i) to p_i, for arrays of shape (n, 3).
-
-    The Voronoi-region test of the triangle (vertices, edges, interior), vectorised. Returns the
-    closest points (n, 3) and the feature code (n,) uint8: ``FACE``, ``VERT_A..C``,
-    ``EDGE_AB/AC/BC``. Triangles must be non-degenerate.
-    """
-    ab = b - a
-    ac = c - a
-    ap = p - a
-    d1 = np.einsum("ij,ij->i", ab, ap)
-    d2 = np.einsum("ij,ij->i", ac, ap)
-    bp = p - b
-    d3 = np.einsum("ij,ij->i", ab, bp)
-    d4 = np.einsum("ij,ij->i", ac, bp)
-    cq = p - c
-    d5 = np.einsum("ij,ij->i", ab, cq)
-    d6 = np.einsum("ij,ij->i", ac, cq)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-
-    code = np.full(len(p), FACE, dtype=np.uint8)
-    done = np.zeros(len(p), dtype=bool)
-
-    def claim(mask: np.ndarray, k: int) -> np.ndarray:
-        m = mask & ~done
-        code[m] = k
-        done[m] = True
-        return m
-
-    claim((d1 <= 0) & (d2 <= 0), VERT_A)
-    claim((d3 >= 0) & (d4 <= d3), VERT_B)
-    m_ab = claim((vc <= 0) & (d1 >= 0) & (d3 <= 0), EDGE_AB)
-    claim((d6 >= 0) & (d5 <= d6), VERT_C)
-    m_ac = claim((vb <= 0) & (d2 >= 0) & (d6 <= 0), EDGE_AC)
-    m_bc = claim((va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), EDGE_BC)
-
-    # barycentric weights (v on b, w on c) of the face region and of the three edges
-    denom = va + vb + vc
-    denom = np.where(denom != 0, denom, 1.0)
-    v = vb / denom
-    w = vc / denom
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t_ab = d1 / (d1 - d3)
-        t_ac = d2 / (d2 - d6)
-        t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-    v = np.where(m_ab, t_ab, v)
-    w = np.where(m_ab, 0.0, w)
-    v = np.where(m_ac, 0.0, v)
-    w = np.where(m_ac, t_ac, w)
-    v = np.where(m_bc, 1.0 - t_bc, v)
-    w = np.where(m_bc, t_bc, w)
-    for k, (vv, ww) in ((VERT_A, (0.0, 0.0)), (VERT_B, (1.0, 0.0)), (VERT_C, (0.0, 1.0))):
-        m = code == k
-        v = np.where(m, vv, v)
-        w = np.where(m, ww, w)
-    v = np.nan_to_num(v)
-    w = np.nan_to_num(w)
-    return a + v[:, None] * ab + w[:, None] * ac, code
-
-
-# ---------------------------------------------------------------------------------------------
 # the surface
 # ---------------------------------------------------------------------------------------------
 def _unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
@@ -224,6 +169,8 @@ class MeshSurface(Surface):
     """
 
     ndim = 3
+    #: False: exact closest points (see :class:`SmoothMeshSurface`)
+    smooth = False
 
     def __init__(
         self,
@@ -685,6 +632,50 @@ class MeshSurface(Surface):
         )
 
 
+class SmoothMeshSurface(smooth_mesh.SmoothMap, MeshSurface, ClosestPoint):
+    """A triangle mesh through a smooth closest-point map, for second order (the default of
+    :func:`from_mesh`).
+
+    The map (``tubesweep_core::surface::mesh_smooth``, docs/point-clouds.md) is the exact closest
+    point where the triangles are small against the grid spacing Δx, and elsewhere the
+    moving-least-squares projection onto a local quadric fitted to the mesh's vertices and face
+    centroids whose normals agree with the exact foot's triangle (so the two sheets of a thin part
+    never mix), with the exact closest point as fall-back where the fit disagrees with the mesh.
+    On an open mesh it is the exact map within a few Δx of the boundary, where the second-order
+    geometry runs first order. Everything else is :class:`MeshSurface`'s: ``closest`` and
+    ``signed_distance`` stay exact.
+
+    Attributes
+    ----------
+    report : dict
+        After a band: how many band nodes got each map (``fitted``, ``fine``, ``rim``,
+        ``fallback``), and ``h`` the grid spacing it was built for; ``sol.stats.order2["mesh_map"]``
+        holds a copy.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+    >>> type(spot).__name__, spot.smooth
+    ('SmoothMeshSurface', True)
+    """
+
+    smooth = True
+    open_surface = False  # order=2 runs; the geometry turns it off near the boundary
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, **kwargs: Any):
+        MeshSurface.__init__(self, vertices, faces, **kwargs)
+        self._noise = 0.0
+        self.lipschitz = 1.0
+        self._smooth_map: Any = None
+        self._h: Optional[float] = None
+        self._band_cache: Optional[Tuple[np.ndarray, np.ndarray]] = None
+        self.report: dict = {}
+
+    def __repr__(self) -> str:
+        return MeshSurface.__repr__(self)[:-1] + ", smooth=True)"
+
+
 def from_mesh(
     mesh: Union[str, Path, Tuple[Any, Any]],
     *,
@@ -692,6 +683,7 @@ def from_mesh(
     size: float = 1.0,
     center: Sequence[float] = (0.0, 0.0, 0.0),
     signed: Optional[bool] = None,
+    smooth: bool = True,
 ) -> MeshSurface:
     """A triangle mesh as a surface for :func:`tubesweep.solve` (closest-point representation).
 
@@ -711,11 +703,17 @@ def from_mesh(
         Report a signed distance as φ (needs a closed, consistently oriented mesh). Default: signed
         exactly when the mesh is closed. The solver itself only needs the unsigned distance and the
         extension direction ``(x − cp(x)) / |x − cp(x)|`` (Sect. 5.2), so open meshes with holes work.
+    smooth : bool
+        True (the default): a :class:`SmoothMeshSurface`, whose closest points follow the smooth
+        surface behind the mesh where the triangles are large against the grid spacing, so that
+        ``order="auto"`` runs second order on it (docs/point-clouds.md). False: the exact closest
+        points of the polyhedron and the paper's first-order scheme, as before.
 
     Returns
     -------
     MeshSurface
-        The mesh as a closest-point surface for :func:`tubesweep.solve`.
+        The mesh as a closest-point surface for :func:`tubesweep.solve` (a
+        :class:`SmoothMeshSurface` with ``smooth=True``).
 
     Raises
     ------
@@ -747,13 +745,16 @@ def from_mesh(
         v = real_array(v, "vertices")
         f = whole_indices(f, "faces")
         name = "mesh"
+    if not isinstance(smooth, (bool, np.bool_)):
+        raise TypeError(f"smooth must be True or False; got {smooth!r}")
+    kind = SmoothMeshSurface if smooth else MeshSurface
     offset = np.zeros(3)
     scale = 1.0
     if normalize:
         size = size_parameter("size", size)
         target = finite_center(center, 3)
         if f.size == 0 or f.min() < 0 or f.max() >= len(v) or v.ndim != 2 or v.shape[1] != 3:
-            return MeshSurface(v, f, signed=signed, name=name)  # raises with the mesh's own message
+            return kind(v, f, signed=signed, name=name)  # raises with the mesh's own message
         used = v[np.unique(f)]
         lo, hi = used.min(0), used.max(0)
         if not float((hi - lo).max()) > 0:
@@ -763,4 +764,4 @@ def from_mesh(
         scale = float(size) / float((hi - lo).max())
         offset = 0.5 * (lo + hi) - target / scale
         v = (v - offset) * scale
-    return MeshSurface(v, f, signed=signed, name=name, scale=scale, offset=offset)
+    return kind(v, f, signed=signed, name=name, scale=scale, offset=offset)

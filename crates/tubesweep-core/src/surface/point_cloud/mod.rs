@@ -16,7 +16,7 @@
 //! tangent plane is moved back to the hull's boundary, so nodes beyond the rim get closest points
 //! on the rim, as for the library's open surfaces.
 
-mod fit;
+pub(crate) mod fit;
 
 use crate::error::{Error, Result};
 use fit::{basis_len, clamp_to_hull, distance, largest_gap, Fit};

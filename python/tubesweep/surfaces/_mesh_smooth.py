@@ -1,0 +1,299 @@
+"""The band, closest points and methods (:class:`SmoothMap`) of
+:class:`~tubesweep.surfaces.mesh.SmoothMeshSurface`: the smooth
+closest-point map of a triangle mesh, computed in the Rust core
+(``tubesweep_core::surface::mesh_smooth``) on all threads and only at the band's candidate nodes.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Optional, Tuple
+
+import numpy as np
+
+from .._linalg import row_norms
+from ..band import BandGeometry
+from ..closest_point import DIRECTION_EPS
+from ..grid import Grid
+
+#: Samples in each local fit (as for point clouds, docs/point-clouds.md).
+NEIGHBOURS = 20
+#: Face samples about this many grid spacings apart (the fits then follow the polyhedron to a
+#: fraction of Δx and round its creases over a few Δx).
+SAMPLE_SPACING = 1.0
+#: The names of the maps, in the order of the core's ``MapKind`` codes.
+KINDS = ("fitted", "fine", "rim", "fallback", "far")
+#: Candidates are searched this many grid spacings beyond the band's half-width: the smooth map's
+#: distance differs from the exact one by at most a quarter of a triangle's size (the fits stay far closer: their samples lie on the mesh), and triangles
+#: larger than Δx are fitted (a node whose smooth distance is within the half-width is never lost).
+MARGIN = 0.5
+#: A mesh whose triangles' median size (longest edge) exceeds this many grid spacings is coarse
+#: against the grid: its band is the exact map's, and ``order="auto"`` runs first order on it (the
+#: fitted map of Spot at n = 200, 4.7 Δx, made the second-order sweeps run away; docs/point-clouds.md).
+COARSE = 3.0
+#: Triangles larger than this many grid spacings (longest edge) are fitted
+#: (``tubesweep_core::surface::mesh_smooth::FINE_LOW``).
+FINE = 2.0
+#: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
+CHUNK = 1 << 20
+
+
+def closest(surface: Any, x: np.ndarray, h: Optional[float]) -> Tuple[np.ndarray, np.ndarray]:
+    """The smooth map's closest points of ``x`` (M, 3) for grid spacing ``h`` (None: the exact
+    closest points) and the map of each (codes of :data:`KINDS`)."""
+    x = np.ascontiguousarray(np.asarray(x, dtype=float).reshape(-1, 3))
+    # before any band, or on a mesh coarse against the grid: the exact closest points
+    if h is None or median_size(surface) > COARSE * h or "facing" in surface.report:
+        _, cp, _, _ = surface.closest(x)
+        return cp, np.full(len(x), 1, np.uint8)
+    mode = "auto"
+    out = np.empty_like(x)
+    kinds = np.empty(len(x), np.uint8)
+    for s0 in range(0, len(x), CHUNK):
+        cp, kind = surface.smooth_map.closest(x[s0 : s0 + CHUNK], float(h or 1.0), np.inf, mode)
+        out[s0 : s0 + CHUNK] = cp
+        kinds[s0 : s0 + CHUNK] = kind
+    return out, kinds
+
+
+def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], BandGeometry]) -> BandGeometry:
+    """The band of the smooth map (see :meth:`SmoothMeshSurface.band`); ``exact_band()`` gives the
+    exact map's (:meth:`MeshSurface.band`), used on a coarse mesh."""
+    surface.check_grid(grid)
+    h = grid.spacing
+    surface._h = h
+    surface._band_cache = None
+    size = median_size(surface)
+    if size > COARSE * h:
+        # coarse: today's band of the exact map, and first order (order2_obstacle)
+        surface.report = {"coarse": size / h, "h": h}
+        return exact_band()
+    if largest_size(surface) > FINE * h or not surface.closed:
+        # fits will be needed (large triangles, or a boundary's blend): first the exact map's band,
+        # and where the mesh faces itself across a gap narrower than its tubes that band and first
+        # order (order2_obstacle), without the fits' cost
+        exact = exact_band()
+        pairs = facing_pairs(grid, exact)
+        if pairs:
+            surface.report = {"facing": pairs, "h": h}
+            return exact
+    reach = half_width + MARGIN * h
+    candidates = surface.band_candidates(grid, reach)
+    parts: list = []
+    counts = np.zeros(len(KINDS), np.int64)
+    for s0 in range(0, len(candidates), CHUNK):
+        lin = candidates[s0 : s0 + CHUNK]
+        x = grid.node_points(lin)
+        cp, kind = surface.smooth_map.closest(np.ascontiguousarray(x), h, reach, "auto")
+        norm = row_norms(x - cp)
+        keep = norm <= half_width  # False where nothing is within reach (NaN: beyond the band)
+        counts += np.bincount(kind[keep], minlength=len(KINDS))[: len(KINDS)]
+        parts.append((lin[keep], norm[keep], x[keep], cp[keep]))
+    surface.report = {name: int(c) for name, c in zip(KINDS[:4], counts[:4])}
+    surface.report["h"] = h
+    if not parts or sum(len(q[0]) for q in parts) == 0:
+        return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
+    linear, norm, x, cp = (np.concatenate([q[i] for q in parts]) for i in range(4))
+    # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|
+    pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)
+    again, _ = surface.smooth_map.closest(np.ascontiguousarray(cp[pick]), h, np.inf, "auto")
+    surface._noise = float(np.quantile(row_norms(again - cp[pick]), 0.9))
+    surface._band_cache = (x, cp)
+    ok = norm > DIRECTION_EPS * h
+    direction = np.zeros((len(linear), 3))
+    direction[ok] = (x[ok] - cp[ok]) / norm[ok, None]
+    return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
+
+
+def median_size(surface: Any) -> float:
+    """The median longest edge of the mesh's non-degenerate triangles (computed once)."""
+    known = getattr(surface, "_median_size", None)
+    if known is not None:
+        return float(known)
+    f = surface.faces[surface._good]
+    v = surface.vertices
+    edges = [np.linalg.norm(v[f[:, i]] - v[f[:, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))]
+    surface._median_size = float(np.median(np.maximum(np.maximum(edges[0], edges[1]), edges[2])))
+    return float(surface._median_size)
+
+
+def largest_size(surface: Any) -> float:
+    """The largest longest edge of the mesh's non-degenerate triangles."""
+    f = surface.faces[surface._good]
+    v = surface.vertices
+    edges = [np.linalg.norm(v[f[:, i]] - v[f[:, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))]
+    return float(np.max(np.maximum(np.maximum(edges[0], edges[1]), edges[2])))
+
+
+def facing_pairs(grid: Grid, geom: BandGeometry) -> int:
+    """Pairs of grid neighbours of the band, both more than 0.75 Δx from the mesh, whose extension
+    directions point more than 120° apart: the two sides of a gap narrower than the tubes (across a
+    single sheet two neighbours cannot both be that far from it)."""
+    h = grid.spacing
+    lin = geom.linear
+    if len(lin) == 0:
+        return 0
+    dist = geom.distance if geom.distance is not None else np.abs(geom.signed)
+    far = dist > 0.75 * h
+    count = 0
+    for k in range(grid.ndim):
+        stride = int(np.prod(grid.shape[k + 1 :]))
+        nxt = lin + stride
+        pos = np.minimum(np.searchsorted(lin, nxt), len(lin) - 1)
+        hit = (lin[pos] == nxt) & far & far[pos] & ((lin // stride) % grid.shape[k] < grid.shape[k] - 1)
+        dots = np.einsum("ij,ij->i", geom.direction[hit], geom.direction[pos[hit]])
+        count += int(np.count_nonzero(dots < -0.5))
+    return count
+
+
+def order2_obstacle(surface: Any, tube_pairs: int) -> Optional[str]:
+    """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants)."""
+    report = surface.report
+    if "coarse" in report:
+        return (
+            f"the mesh is coarse against the grid: its triangles' median size is {report['coarse']:.1f} grid spacings "
+            f"(second order on a mesh needs at most {COARSE:g}); subdivide the mesh, or use the grid it resolves"
+        )
+    pairs = report.get("facing", 0) or tube_pairs
+    if pairs:
+        return (
+            f"the mesh faces itself across gaps narrower than its tubes ({pairs} node pairs): the second-order "
+            "sweeps are not safe there on a mesh (they ran away on the bunny at n = 200); a finer grid resolves the gap"
+        )
+    return None
+
+
+class SmoothMap:
+    """The methods of :class:`~tubesweep.surfaces.mesh.SmoothMeshSurface` that read and build the
+    smooth map (a mixin before ``MeshSurface`` in its bases: ``super()`` is the exact map's)."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    _good: np.ndarray
+    _h: Optional[float]
+    _smooth_map: Any
+    _band_cache: Optional[Tuple[np.ndarray, np.ndarray]]
+
+    @property
+    def smooth_map(self) -> Any:
+        """The native map for the grid spacing of the last band (built on first use)."""
+        spacing = SAMPLE_SPACING * (self._h or 0.0)
+        if self._smooth_map is None or self._smooth_map[0] != spacing:
+            from .. import _native
+
+            faces = np.ascontiguousarray(self.faces[self._good])
+            self._smooth_map = (spacing, _native.SmoothMesh(self.vertices, faces, NEIGHBOURS, spacing))
+        return self._smooth_map[1]
+
+    def __getstate__(self) -> dict:
+        state: dict = super().__getstate__()  # type: ignore[assignment]  # MeshSurface's
+        state["_smooth_map"] = None
+        state["_band_cache"] = None
+        return state
+
+    def _cp(self, x: np.ndarray) -> np.ndarray:
+        return closest(self, x, self._h)[0]
+
+    def order2_obstacle(self, facing_pairs: int) -> Optional[str]:
+        """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
+        or None; read by the second-order solve.
+
+        Parameters
+        ----------
+        facing_pairs : int
+            The node pairs of the tube whose sides face each other across a narrow gap (the
+            tube's own check, ``_prepare._warn_if_tubes_touch``).
+
+        Returns
+        -------
+        str or None
+            The reason, or None when second order may run.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> geometry = spot.band(spot.grid(200), 0.02)
+        >>> spot.order2_obstacle(0)[:36]
+        'the mesh is coarse against the grid:'
+        """
+        return order2_obstacle(self, facing_pairs)
+
+    def band(self, grid: Grid, half_width: float) -> BandGeometry:
+        """The band nodes within ``half_width`` of the smooth map's surface, their closest points
+        computed once in Rust (kept for the second-order geometry) and counted by map in
+        :attr:`report`. On a mesh coarse against the grid (median triangle above 3 Δx), the exact
+        map's band of :meth:`MeshSurface.band`.
+
+        Parameters
+        ----------
+        grid : Grid
+            The grid.
+        half_width : float
+            The band's half-width (a distance).
+
+        Returns
+        -------
+        BandGeometry
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> grid = spot.grid(40)
+        >>> len(spot.band(grid, 4 * grid.spacing).linear) > 0
+        True
+        """
+        return band(self, grid, half_width, lambda: super(SmoothMap, self).band(grid, half_width))  # type: ignore[misc]
+
+    def closest_point(self, points: np.ndarray) -> np.ndarray:
+        """The smooth map's closest points (for the grid of the last band; exact before any band).
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(M, 3)`` closest points.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> spot.closest_point(spot.vertices[:2] + 0.01).shape
+        (2, 3)
+        """
+        p = np.ascontiguousarray(points, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"points must have shape (M, 3); got {p.shape}")
+        cache = self._band_cache
+        if cache is not None and cache[0].shape == p.shape and np.array_equal(cache[0], p):
+            return cache[1].copy()  # the band's nodes again (the second-order geometry)
+        return closest(self, p, self._h)[0]
+
+    def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        """The smooth map's closest points for ``grid`` and the distances to them.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points.
+        grid : Grid
+            The grid (its spacing decides where the map is exact).
+
+        Returns
+        -------
+        distance, closest : numpy.ndarray
+            ``(M,)`` and ``(M, 3)``.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> d, cp = spot.project(spot.vertices[:2], spot.grid(100))
+        """
+        p = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 3))
+        cp = closest(self, p, grid.spacing)[0]
+        return np.linalg.norm(p - cp, axis=1), cp
