@@ -282,9 +282,8 @@ def redistanced_band(surface, grid, half_width: float):
 #: next to its closest point (its neighbour's), so smooth φ settles in a few.
 REFINE_STEPS = 40
 
-#: A node's closest point has settled when a refinement moves it by at most this many grid spacings
-#: (its distance then within about ``(1e-6 Δx)² / d`` of the fixed point's; the projection's
-#: :data:`SETTLED` of 1e-12 took twice the time on a smoothed mask for no change in 3 digits).
+#: A node's closest point y has settled when |x − y| is within this many grid spacings of the
+#: distance from x to the tangent plane at y (``tubesweep_core::surface::redistance_band``).
 REFINE_SETTLED = 1e-6
 
 
@@ -293,9 +292,9 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     sub-cell interface points on the edges of the cells with a sign change, closest points carried
     from them layer by layer through the band and refined on the multilinear interpolant, in Rust
     (``tubesweep_core::surface::redistance_band``). Where φ is smooth the closest points are those of
-    :func:`project_to_level_set` from the node (the same iterations and fixed point, to the settling
-    tolerance); unlike it, no step reads ∇φ away from the zero level set, so masks, plateaus and φ
-    far from a distance work too."""
+    the interpolant's zero set (its own normal; :func:`project_to_level_set` from the node takes the
+    central differences' and lands within a few hundredths of a spacing of them); unlike it, no step
+    reads ∇φ away from the zero level set, so masks, plateaus and φ far from a distance work too."""
     from . import _native
     from .band import BandGeometry
 
