@@ -282,9 +282,13 @@ def redistanced_band(surface, grid, half_width: float):
 #: next to its closest point (its neighbour's), so smooth φ settles in a few.
 REFINE_STEPS = 40
 
-#: A node's closest point y has settled when |x − y| is within this many grid spacings of the
-#: distance from x to the tangent plane at y (``tubesweep_core::surface::redistance_band``).
-REFINE_SETTLED = 1e-6
+#: A node's closest point y has settled when the part of x − y along the zero level set at y, t,
+#: is small: ``|t|² ≤ 2 · REFINE_SETTLED · Δx · |x − y|`` (``tubesweep_core::surface::redistance_band``;
+#: then |x − y| is within REFINE_SETTLED · Δx of the distance to the tangent plane). The normal of the
+#: iterations is that of the central differences, not exactly the zero set's, so the distance errs
+#: linearly in |t|: 1e-12 keeps the band within 2e-7 Δx of the projection from the node (1e-9: 7e-6 Δx,
+#: on the skewed sphere quadric at N = 41, ``tests/test_surfaces.py``).
+REFINE_SETTLED = 1e-12
 
 
 def _sampled_redistanced_band(surface, grid, half_width: float):
@@ -292,9 +296,9 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     sub-cell interface points on the edges of the cells with a sign change, closest points carried
     from them layer by layer through the band and refined on the multilinear interpolant, in Rust
     (``tubesweep_core::surface::redistance_band``). Where φ is smooth the closest points are those of
-    the interpolant's zero set (its own normal; :func:`project_to_level_set` from the node takes the
-    central differences' and lands within a few hundredths of a spacing of them); unlike it, no step
-    reads ∇φ away from the zero level set, so masks, plateaus and φ far from a distance work too."""
+    :func:`project_to_level_set` from the node (the same iterations and fixed point, to the settling
+    tolerance); unlike it, no step reads ∇φ away from the zero level set, so masks, plateaus and φ
+    far from a distance work too."""
     from . import _native
     from .band import BandGeometry
 
