@@ -193,3 +193,50 @@ def test_mask_on_the_command_line(tmp_path, capsys):
     np.save(tmp_path / "bad.npy", np.full((31, 31, 31), 0.5))
     assert main(args[:1] + ["--mask", str(tmp_path / "bad.npy")] + args[3:] + ["--out", str(tmp_path / "o2")]) == 2
     assert "mask must hold only 0 and 1" in capsys.readouterr().err
+
+
+def _edge_crossings(phi, grid):
+    """The points where φ's multilinear interpolant vanishes on the grid's edges (a sign change,
+    φ > 0 against φ ≤ 0): points of its zero level set."""
+    pts = []
+    for axis in range(phi.ndim):
+        a = np.moveaxis(phi, axis, 0)
+        va, vb = a[:-1], a[1:]
+        cross = (va > 0) != (vb > 0)
+        idx = np.argwhere(cross)
+        t = va[cross] / (va[cross] - vb[cross])
+        idx = idx.astype(float)
+        idx[:, 0] += t
+        order = [axis] + [k for k in range(phi.ndim) if k != axis]  # the axes of the moved array
+        pts.append(np.asarray(grid.lower) + grid.spacing * idx[:, np.argsort(order)])
+    return np.concatenate(pts)
+
+
+@pytest.mark.parametrize(
+    "case, worst, mean", [("mask", 0.06, 0.01), ("smoothed mask", 0.01, 1e-3), ("gyroid-like", 0.25, 1e-3)]
+)
+def test_the_band_holds_the_nodes_near_an_edge_crossing_and_is_no_farther(case, worst, mean):
+    # the re-distancing refines only the nodes whose start point lies within a spacing of the band
+    # and carries closest points from the nodes around: checked against the edge crossings (points
+    # of the zero set) found by brute force (a k-d tree over all of them). Every node within the
+    # band's width less a quarter spacing of a crossing is in the band, and its distance exceeds
+    # its crossing's only where the refinement stopped at a kink (a voxel step, or where the
+    # gyroid's curvature makes the iterations stall): measured at N = 41, at most 0.050 Δx (mask),
+    # 0.0035 Δx (smoothed), 0.22 Δx (gyroid-like), on average 4e-3 Δx, 1e-4 Δx, 2e-4 Δx
+    from scipy.spatial import cKDTree
+
+    grid = _grid(41)
+    X, Y, Z = grid.meshgrid()
+    if case == "gyroid-like":
+        phi = np.sin(4 * X) * np.cos(4 * Y) + np.sin(4 * Y) * np.cos(4 * Z) + np.sin(4 * Z) * np.cos(4 * X)
+    else:
+        from tubesweep.mask import level_set_function_of_mask
+
+        phi = level_set_function_of_mask(X**2 + Y**2 + Z**2 < 0.25, grid, 1.5 if case == "smoothed mask" else 0.0)
+    h, w = grid.spacing, 4 * grid.spacing
+    geom = ts.LevelSet(phi, redistance=True).band(grid, w)
+    near, _ = cKDTree(_edge_crossings(phi, grid)).query(grid.node_points(np.arange(phi.size)))
+    assert np.all(np.isin(np.flatnonzero(near <= w - 0.25 * h), geom.linear))
+    within = np.intersect1d(np.flatnonzero(near <= w), geom.linear)
+    excess = (np.abs(geom.signed[np.searchsorted(geom.linear, within)]) - near[within]) / h
+    assert np.max(excess) <= worst and np.mean(np.maximum(excess, 0)) < mean, (np.max(excess), np.mean(excess))

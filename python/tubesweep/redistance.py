@@ -282,10 +282,13 @@ def redistanced_band(surface, grid, half_width: float):
 #: next to its closest point (its neighbour's), so smooth φ settles in a few.
 REFINE_STEPS = 40
 
-#: A node's closest point has settled when a refinement moves it by at most this many grid spacings
-#: (its distance then within about ``(1e-6 Δx)² / d`` of the fixed point's; the projection's
-#: :data:`SETTLED` of 1e-12 took twice the time on a smoothed mask for no change in 3 digits).
-REFINE_SETTLED = 1e-6
+#: A node's closest point y has settled when the part of x − y along the zero level set at y, t,
+#: is small: ``|t|² ≤ 2 · REFINE_SETTLED · Δx · |x − y|`` (``tubesweep_core::surface::redistance_band``;
+#: then |x − y| is within REFINE_SETTLED · Δx of the distance to the tangent plane). The normal of the
+#: iterations is that of the central differences, not exactly the zero set's, so the distance errs
+#: linearly in |t|: 1e-12 keeps the band within 2e-7 Δx of the projection from the node (1e-9: 7e-6 Δx,
+#: on the skewed sphere quadric at N = 41, ``tests/test_surfaces.py``).
+REFINE_SETTLED = 1e-12
 
 
 def _sampled_redistanced_band(surface, grid, half_width: float):

@@ -93,7 +93,11 @@ pub(crate) fn crosses(corners: &[f64]) -> bool {
 }
 
 /// The sorted linear indices of the lowest corners of the cells the zero level set crosses (a
-/// sign change among the corners: [`crosses`]). One pass over the samples, on all threads.
+/// sign change among the corners: [`crosses`]). One pass over the samples, on all threads: each
+/// row of the grid's last axis becomes a bit set of its positive samples (`φ > 0`), and a row of
+/// cells crosses where, over the 2 (2D) or 4 (3D) rows of its corners, its two columns of corners
+/// hold both a positive and a non-positive sample (word-wide operations on the bit sets, 64 cells
+/// at a time).
 pub fn crossed_cells(shape: &[usize], samples: &[f64]) -> Result<Vec<u64>> {
     let lattice = Lattice::new(shape)?;
     if samples.len() != lattice.rows() * lattice.dims[2] {
@@ -106,24 +110,81 @@ pub fn crossed_cells(shape: &[usize], samples: &[f64]) -> Result<Vec<u64>> {
             ),
         ));
     }
-    let (offsets, count) = lattice.corner_offsets();
     let [_, n1, n2] = lattice.dims;
+    let words = n2.div_ceil(64);
+    // the positive samples of each row, bit k of word k / 64
+    let mut positive = vec![0u64; lattice.rows() * words];
+    positive
+        .par_chunks_mut(words)
+        .zip(samples.par_chunks(n2))
+        .with_min_len(16)
+        .for_each(|(bits, row)| {
+            for (w, chunk) in bits.iter_mut().zip(row.chunks(64)) {
+                let mut b = 0u64;
+                for (k, &v) in chunk.iter().enumerate() {
+                    b |= u64::from(v > 0.0) << k;
+                }
+                *w = b;
+            }
+        });
+    // the cells along the last axis: k in 0..n2 − 1
+    let valid = |w: usize| -> u64 {
+        let cells = n2 - 1;
+        let from = w * 64;
+        if from + 64 <= cells {
+            u64::MAX
+        } else if from >= cells {
+            0
+        } else {
+            (1u64 << (cells - from)) - 1
+        }
+    };
+    let full = |w: usize| -> u64 {
+        let from = w * 64;
+        if from + 64 <= n2 {
+            u64::MAX
+        } else {
+            (1u64 << (n2 - from)) - 1
+        }
+    };
+    let corner_rows: &[(usize, usize)] = if lattice.flat {
+        &[(0, 0), (0, 1)]
+    } else {
+        &[(0, 0), (0, 1), (1, 0), (1, 1)]
+    };
     let cell_rows = lattice.cell_slabs() * (n1 - 1);
     let parts: Vec<Vec<u64>> = (0..cell_rows)
         .into_par_iter()
-        .with_min_len(16)
+        .with_min_len(64)
         .map(|r| {
             let (i, j) = (r / (n1 - 1), r % (n1 - 1));
-            let row = (i * n1 + j) * n2;
-            let mut out = Vec::new();
-            let mut corners = [0.0f64; 8];
-            for k in 0..n2 - 1 {
-                let l = row + k;
-                for c in 0..count {
-                    corners[c] = samples[l + offsets[c]];
+            let base = (i * n1 + j) * n2;
+            // per column k: a positive corner (any), a non-positive corner (any)
+            let column = |w: usize| -> (u64, u64) {
+                if w >= words {
+                    return (0, 0);
                 }
-                if crosses(&corners[..count]) {
-                    out.push(l as u64);
+                let (mut any_pos, mut all_pos) = (0u64, u64::MAX);
+                for &(di, dj) in corner_rows {
+                    let b = positive[((i + di) * n1 + j + dj) * words + w];
+                    any_pos |= b;
+                    all_pos &= b;
+                }
+                (any_pos, !all_pos & full(w))
+            };
+            let mut out = Vec::new();
+            let mut next = column(0);
+            for w in 0..words {
+                let (p, q) = next;
+                next = column(w + 1);
+                // column k + 1 of bit k: the word shifted, the next word's first bit on top
+                let p1 = (p >> 1) | (next.0 << 63);
+                let q1 = (q >> 1) | (next.1 << 63);
+                let mut crossing = (p | p1) & (q | q1) & valid(w);
+                while crossing != 0 {
+                    let k = w * 64 + crossing.trailing_zeros() as usize;
+                    out.push((base + k) as u64);
+                    crossing &= crossing - 1;
                 }
             }
             out
@@ -298,6 +359,50 @@ impl NodeSet {
         }
     }
 
+    /// The positions in the set of the nodes `k − 1`, `k`, `k + 1` of row `(i, j)` (None where a node
+    /// is not in the set or beyond the row's ends), in one pass over the row's intervals.
+    #[inline]
+    fn positions_around(&self, i: usize, j: usize, k: usize) -> [Option<usize>; 3] {
+        let row = i * self.lattice.dims[1] + j;
+        let mut out = [None; 3];
+        let mut at = self.row_start[row];
+        let (lo, hi) = (k.saturating_sub(1) as u32, (k + 1) as u32);
+        for &(a, b) in &self.rows[row] {
+            if a > hi {
+                break;
+            }
+            if b >= lo {
+                for m in a.max(lo)..=b.min(hi) {
+                    out[(m + 1 - k as u32) as usize] = Some(at + (m - a) as usize);
+                }
+            }
+            at += (b - a) as usize + 1;
+        }
+        if k == 0 {
+            out[0] = None;
+        }
+        out
+    }
+
+    /// The positions in the set of the nodes around node `(i, j, k)` (one step or none along each
+    /// axis, the node itself left out: 8 in 2D, 26 in 3D), passed to `visit`.
+    #[inline]
+    pub fn neighbours_around(&self, (i, j, k): (usize, usize, usize), mut visit: impl FnMut(usize)) {
+        let [n0, n1, _] = self.lattice.dims;
+        for a in i.saturating_sub(1)..=(i + 1).min(n0 - 1) {
+            for b in j.saturating_sub(1)..=(j + 1).min(n1 - 1) {
+                let centre_row = a == i && b == j;
+                for (c, p) in self.positions_around(a, b, k).into_iter().enumerate() {
+                    if let Some(p) = p {
+                        if !(centre_row && c == 1) {
+                            visit(p);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// The positions of the face neighbours of node `(i, j, k)` in the set, passed to `visit`.
     #[inline]
     pub fn face_neighbours(&self, (i, j, k): (usize, usize, usize), mut visit: impl FnMut(usize)) {
@@ -388,7 +493,52 @@ mod tests {
                     assert_eq!(set.position(i, j, k), Some(p));
                 }
                 assert_eq!(set.len(), linear.len());
+                // the nodes around each node, against position() one by one
+                for &l in linear.iter().step_by(7) {
+                    let (i, j, k) = lattice.split(l as usize);
+                    let mut got = Vec::new();
+                    set.neighbours_around((i, j, k), |p| got.push(p));
+                    let mut want = Vec::new();
+                    for a in i.saturating_sub(1)..=(i + 1).min(lattice.dims[0] - 1) {
+                        for b in j.saturating_sub(1)..=(j + 1).min(lattice.dims[1] - 1) {
+                            for c in k.saturating_sub(1)..=(k + 1).min(lattice.dims[2] - 1) {
+                                if (a, b, c) != (i, j, k) {
+                                    want.extend(set.position(a, b, c));
+                                }
+                            }
+                        }
+                    }
+                    got.sort_unstable();
+                    want.sort_unstable();
+                    assert_eq!(got, want);
+                }
             }
+        }
+        // rows longer than a word of the bit sets: an oscillating φ crosses at every word boundary
+        for shape in [vec![4usize, 5, 200], vec![6, 129], vec![3, 3, 65], vec![2, 64]] {
+            let total: usize = shape.iter().product();
+            let samples: Vec<f64> = (0..total)
+                .map(|l| {
+                    let k = l % shape[shape.len() - 1];
+                    let row = l / shape[shape.len() - 1];
+                    (0.37 * k as f64 + 1.3 * row as f64).sin() + if k % 7 == 0 { 0.0 } else { 0.1 }
+                })
+                .collect();
+            let lattice = Lattice::new(&shape).unwrap();
+            let (offsets, count) = lattice.corner_offsets();
+            let [_, n1, n2] = lattice.dims;
+            let brute: Vec<u64> = (0..total)
+                .filter(|&l| {
+                    let (i, j, k) = lattice.split(l);
+                    (lattice.flat || i + 1 < lattice.dims[0])
+                        && j + 1 < n1
+                        && k + 1 < n2
+                        && crosses(&offsets[..count].iter().map(|&o| samples[l + o]).collect::<Vec<_>>())
+                })
+                .map(|l| l as u64)
+                .collect();
+            assert!(brute.len() > 10);
+            assert_eq!(crossed_cells(&shape, &samples).unwrap(), brute, "{shape:?}");
         }
         assert!(crossed_cells(&[4, 4, 4], &[1.0; 63]).is_err());
         assert!(crossed_cells(&[4], &[1.0; 4]).is_err());

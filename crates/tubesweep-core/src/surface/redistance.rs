@@ -83,7 +83,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
         let mut frac = [0.0f64; D];
         for k in 0..D {
             let t = (p[k] - self.lower[k]) / self.spacing;
-            let b = t.floor().clamp(0.0, (self.shape[k] - 2) as f64);
+            let b = floor(t).clamp(0.0, (self.shape[k] - 2) as f64);
             base[k] = b as usize;
             frac[k] = (t - b).clamp(0.0, 1.0);
         }
@@ -117,39 +117,43 @@ impl<'a, const D: usize> SampledField<'a, D> {
         let mut inside = [true; D];
         for k in 0..D {
             let t = (p[k] - self.lower[k]) / self.spacing;
-            let b = t.floor().clamp(0.0, (self.shape[k] - 2) as f64);
+            let b = floor(t).clamp(0.0, (self.shape[k] - 2) as f64);
             base[k] = b as usize;
             let f = t - b;
             inside[k] = (0.0..=1.0).contains(&f);
             frac[k] = f.clamp(0.0, 1.0);
         }
         let origin: usize = (0..D).map(|k| base[k] * self.stride[k]).sum();
-        let mut value = 0.0;
-        let mut grad = [0.0; D];
-        for corner in 0..1usize << D {
+        // the corners (bit k of the corner: a step along axis k), reduced one axis at a time by
+        // linear interpolation, carrying the differences along the axes already reduced
+        let mut value = [0.0f64; 8];
+        let mut diff = [[0.0f64; D]; 8];
+        for (corner, v) in value.iter_mut().enumerate().take(1 << D) {
             let mut at = origin;
-            let mut factors = [0.0; D];
             for k in 0..D {
-                factors[k] = if corner >> k & 1 == 1 {
+                if corner >> k & 1 == 1 {
                     at += self.stride[k];
-                    frac[k]
-                } else {
-                    1.0 - frac[k]
-                };
+                }
             }
-            let v = self.samples[at];
-            value += factors.iter().product::<f64>() * v;
-            for a in 0..D {
-                if !inside[a] {
-                    continue;
+            *v = self.samples[at];
+        }
+        for a in 0..D {
+            let f = frac[a];
+            for c in 0..1usize << (D - 1 - a) {
+                let (lo, hi) = (2 * c, 2 * c + 1);
+                let mut d = [0.0f64; D];
+                for k in 0..a {
+                    d[k] = diff[lo][k] + f * (diff[hi][k] - diff[lo][k]);
                 }
-                let mut w = if corner >> a & 1 == 1 { v } else { -v };
-                for (k, f) in factors.iter().enumerate() {
-                    if k != a {
-                        w *= f;
-                    }
-                }
-                grad[a] += w;
+                d[a] = value[hi] - value[lo];
+                value[c] = value[lo] + f * d[a];
+                diff[c] = d;
+            }
+        }
+        let (value, mut grad) = (value[0], diff[0]);
+        for a in 0..D {
+            if !inside[a] {
+                grad[a] = 0.0;
             }
         }
         for g in grad.iter_mut() {
@@ -241,6 +245,19 @@ impl<'a, const D: usize> SampledField<'a, D> {
             self.clamp_to_box(y);
         }
         good
+    }
+}
+
+/// `t.floor()` after the clamps of [`SampledField::value`]: the same cell for every `t` (NaN
+/// and values beyond `i64` included, which the clamps bring into the grid), without the call to
+/// the C library's `floor` that `f64::floor` compiles to on the x86-64 baseline.
+#[inline(always)]
+fn floor(t: f64) -> f64 {
+    let i = t as i64 as f64; // towards zero, saturating; NaN → 0
+    if i > t {
+        i - 1.0
+    } else {
+        i
     }
 }
 
@@ -394,6 +411,12 @@ mod tests {
         let field = SampledField::new(&samples, [n, n], [-1.0, -1.0], h).unwrap();
         for p in [[-1.0, -1.0], [0.3, -0.7], [0.99, 1.0], [1.0, 1.0], [-0.125, 0.625]] {
             assert!((field.value(&p) - f(p[0], p[1])).abs() < 1e-14, "{p:?}");
+        }
+        // and the gradient of the interpolant, exact for a multilinear function
+        for p in [[0.3, -0.7], [-0.9, 0.95], [0.5, 0.25]] {
+            let (v, g) = field.value_and_gradient(&p);
+            assert!((v - f(p[0], p[1])).abs() < 1e-14, "{p:?}");
+            assert!((g[0] - (2.0 + 0.5 * p[1])).abs() < 1e-13 && (g[1] - (-1.0 + 0.5 * p[0])).abs() < 1e-13);
         }
         // beyond a face φ is the face's value
         assert!((field.value(&[1.5, 0.3]) - f(1.0, 0.3)).abs() < 1e-14);
