@@ -36,12 +36,15 @@ use super::GRAD_NORM_TOLERANCE;
 /// and the cube: 90°).
 pub const CREASE_ANGLE: f64 = 40.0;
 
-/// Crease nodes lie within this many grid spacings of the surface (|φ| ≤ 1.5Δx): further in,
-/// the normals of a smooth surface the grid barely resolves turn fast near its focal points (the
-/// spheroid 0.25/0.25/0.5 at N = 41: up to 29° between neighbours within 1.5Δx, 39° beyond),
-/// while across a crease they turn by its angle at every distance (the cube: 55° by central
-/// differences of φ at every |φ| ≤ 2Δx).
-pub const CREASE_REACH: f64 = 1.5;
+/// Crease nodes lie within this many grid spacings of the surface (|φ| ≤ 0.75Δx), where a
+/// crease's kink of φ meets the surface: further out, the normals of a smooth surface the grid
+/// barely resolves turn fast near its focal points (the spheroid 0.25/0.25/0.5 at N = 41: up to
+/// 29° between neighbours within 1.5Δx, 39° beyond), and a re-distanced φ has kinks midway
+/// across the narrow channels of a surface that faces itself (the gyroid-like φ of issue 43 at
+/// N = 41: 192 nodes turning by up to 66° within 1.5Δx, none within 0.75Δx), while across a
+/// crease the normals turn by its angle at every distance (the cube: 55° by central differences
+/// at every |φ| ≤ 2Δx; 236 crease nodes at N = 41, the double torus 30 at N = 81).
+pub const CREASE_REACH: f64 = 0.75;
 
 /// The crease nodes of a tube and the largest turn of the normal there.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
