@@ -442,11 +442,7 @@ fn run_order2<'py, const D: usize>(
     )?;
     d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
     d.set_item("max_curvature", summary.max_curvature)?;
-    let creases = PyDict::new(py);
-    creases.set_item("nodes", summary.creases.nodes)?;
-    creases.set_item("angle_degrees", summary.creases.angle)?;
-    creases.set_item("shortcut_per_inner_width", summary.creases.shortcut_per_inner_width())?;
-    d.set_item("creases", creases)?;
+    d.set_item("creases", crate::second_order::creases_dict(py, &summary.creases)?)?;
     d.set_item("reach", reach)?;
     Ok((array, d))
 }
