@@ -25,6 +25,7 @@ mod band;
 mod band_search;
 mod box_order2;
 mod convert;
+mod creases;
 mod errors;
 mod many_sources;
 mod mesh_smooth;

@@ -442,7 +442,7 @@ fn run_order2<'py, const D: usize>(
     )?;
     d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
     d.set_item("max_curvature", summary.max_curvature)?;
-    d.set_item("creases", crate::second_order::creases_dict(py, &summary.creases)?)?;
+    d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("reach", reach)?;
     Ok((array, d))
 }

@@ -214,7 +214,7 @@ fn run<'py, const D: usize>(
     reasons.set_item("curvature", summary.unresolved_curvature)?;
     d.set_item("first_order_reasons", reasons)?;
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
-    d.set_item("creases", creases_dict(py, &summary.creases)?)?;
+    d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
     if let Some((carried, restarted)) = warm_report {
         d.set_item("warm_carried", carried)?;
@@ -425,17 +425,4 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(source_feet_chords, m)?)?;
     m.add_function(wrap_pyfunction!(nearest_feet, m)?)?;
     m.add_function(wrap_pyfunction!(crate::many_sources::second_order_solve_many, m)?)
-}
-
-/// `sol.stats.order2["creases"]`: the crease nodes, the largest turn of the normal there (degrees)
-/// and the shortcut per crease crossed in units of inner·Δx (`second_order::creases`).
-pub(crate) fn creases_dict<'py>(
-    py: Python<'py>,
-    creases: &tubesweep_core::second_order::creases::Creases,
-) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("nodes", creases.nodes)?;
-    d.set_item("angle_degrees", creases.angle)?;
-    d.set_item("shortcut_per_inner_width", creases.shortcut_per_inner_width())?;
-    Ok(d)
 }
