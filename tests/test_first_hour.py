@@ -12,11 +12,25 @@ import tubesweep as ts
 from tubesweep.cli import build_parser, main
 
 
+def two_spheres_across_a_narrow_gap():
+    """Two spheres (φ = min of their distances) five spacings apart at grid 41: a level set, which
+    keeps the paper's scheme and warns where its tubes touch (a triangle mesh is cut there)."""
+    grid = ts.Grid([-1.2] * 3, [1.2] * 3, (41,) * 3)
+    h, r = grid.spacing, 0.45
+    axis = np.array([1.0, 1.0, 0.0]) / np.sqrt(2)
+    c1, c2 = -(r + 2.5 * h) * axis, (r + 2.5 * h) * axis
+
+    def phi(p):
+        return np.minimum(np.linalg.norm(p - c1, axis=1) - r, np.linalg.norm(p - c2, axis=1) - r)
+
+    return ts.LevelSet(phi, lipschitz=1.0), grid, c1 - r * axis
+
+
 def test_the_facing_gaps_warning_is_short_says_how_much_and_points_at_the_users_line():
-    spot = ts.surfaces.from_mesh(ts.data.spot())
+    surface, grid, source = two_spheres_across_a_narrow_gap()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        sol = ts.solve(spot, spot.grid(60), [spot.vertices[285]])
+        sol = ts.solve(surface, grid, [source])
     facing = [w for w in caught if "faces itself" in str(w.message)]
     assert len(facing) == 1
     w = facing[0]
@@ -30,14 +44,23 @@ def test_the_facing_gaps_warning_is_short_says_how_much_and_points_at_the_users_
 
 
 def test_a_repeated_solve_warns_once_with_the_default_filter():
-    spot = ts.surfaces.from_mesh(ts.data.spot())
-    grid = spot.grid(60)
+    surface, grid, source = two_spheres_across_a_narrow_gap()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         warnings.filterwarnings("default", category=RuntimeWarning)
         for _ in range(3):
-            ts.solve(spot, grid, [spot.vertices[285]])
+            ts.solve(surface, grid, [source])
     assert sum("faces itself" in str(w.message) for w in caught) == 1
+
+
+def test_a_mesh_is_cut_across_its_narrow_gaps_instead_of_warned_about():
+    # Spot at grid 60 faces itself across gaps narrower than the tubes (legs, ears): on a mesh the
+    # band is cut there (and above the concave edges), so nothing is warned and the stats say it
+    spot = ts.surfaces.from_mesh(ts.data.spot())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = ts.solve(spot, spot.grid(60), [spot.vertices[285]])
+    assert sol.stats.facing_pairs > 0 and sol.stats.cut_edges > sol.stats.facing_pairs
 
 
 def test_every_library_warning_names_a_line_outside_the_package():

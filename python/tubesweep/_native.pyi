@@ -266,6 +266,16 @@ class Band:
         direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
         spacing: float,
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+    def neighbours_of_nodes(self, positions: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
+    def medial_edges(
+        self,
+        inner: npt.NDArray[np.bool_],
+        phi: npt.NDArray[np.float32],
+        direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
+        spacing: float,
+        jump: float,
+    ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]: ...
+    def with_edges_cut(self, node: npt.NDArray[np.int64], neighbour: npt.NDArray[np.int64]) -> Tuple["Band", int]: ...
     def interpolate(
         self, values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
     ) -> npt.NDArray[np.float64]: ...

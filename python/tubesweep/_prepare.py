@@ -24,6 +24,7 @@ from .band import BandGeometry, band_neighbours
 from .surface import Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
+from ._shortcuts import cut_shortcuts, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -105,6 +106,9 @@ class _PreparedTube:
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray] = (np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0))
     #: where the grid box cuts the tube (``_box_cut.box_cut``), None where it does not
     box_cut: Optional[Dict[str, Any]] = None
+    #: the edges of the band's neighbour table removed across narrow gaps and medial edges
+    #: (``_shortcuts.cut_shortcuts``; triangle meshes only)
+    cut_edges: int = 0
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -192,12 +196,14 @@ def _warn_if_tubes_touch(
     inner: float,
     kink: Optional[np.ndarray] = None,
     noise: float = 0.0,
+    warn: bool = True,
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
     ``tubesweep_core::band::facing_sheets``): the eikonal equation crosses the gap there and the travel
     times beyond it come out too short, a shortcut the surface does not have. Returns the pairs'
-    band positions and their gaps."""
+    band positions and their gaps. ``warn=False`` where the band is cut across the pairs
+    (``_shortcuts``): the front does not cross them, and ``stats.facing_pairs`` reports them."""
     h = grid.spacing
     node, neighbour, gap = band.facing_sheet_pairs(
         roles == ROLE_INNER,
@@ -221,7 +227,7 @@ def _warn_if_tubes_touch(
         first = np.ones(node.size, bool)
         first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
         node, neighbour, gap = node[first], neighbour[first], gap[first]
-    if node.size == 0:
+    if node.size == 0 or not warn:
         return node, neighbour, gap
     narrowest = int(np.argmin(gap))
     where = ", ".join(f"{float(v):.4g}" for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
@@ -397,17 +403,14 @@ def _prepare_tube(
     # a surface that leaves the grid box: the distances are those of the part inside (warned)
     cut = box_cut(grid, linear, phi, inner_width)
     warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
+    directions = direction if direction is not None else geom.direction
+    cuts = cuts_shortcuts(surf)
     facing = _warn_if_tubes_touch(
-        grid,
-        band,
-        linear,
-        roles,
-        phi,
-        direction if direction is not None else geom.direction,
-        inner,
-        kink,
-        float(getattr(surf, "_noise", 0.0)),
+        grid, band, linear, roles, phi, directions, inner, kink, float(getattr(surf, "_noise", 0.0)), warn=not cuts
     )
+    cut_edges = 0
+    if cuts:
+        band, cut_edges = cut_shortcuts(band, roles == ROLE_INNER, phi, directions, h, facing)
     return _PreparedTube(
         grid,
         surf,
@@ -423,4 +426,5 @@ def _prepare_tube(
         time.perf_counter() - t0,
         facing,
         cut,
+        cut_edges,
     )

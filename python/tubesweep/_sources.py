@@ -36,10 +36,14 @@ def _fix_sources(
     source_init: str,
     inner_width: float,
     radius: float = SOURCE_RADIUS,
+    connected: bool = False,
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions in the band and values of the nodes fixed by the point sources, and the index of
     the source each node's value comes from (the nearest, where several sources fix one node).
-    ``radius``: the exact initialisation's reach in grid spacings."""
+    ``radius``: the exact initialisation's reach in grid spacings. ``connected`` (a band cut across
+    narrow gaps, ``_shortcuts``): only the nodes joined to the node nearest the source through the
+    band's edges within the ball are fixed, so that the chord does not reach across a gap to the
+    other side of a thin part."""
     h = grid.spacing
     d = grid.ndim
     dist, proj = surface.project(sources, grid)
@@ -89,6 +93,8 @@ def _fix_sources(
         near = geo <= radius * h
         if not np.any(near):
             near = geo <= geo.min()
+        if connected:
+            near = _joined_to_nearest(band, pos, geo, near)
         if radius > SOURCE_RADIUS:
             err = _chord_errors(surface, grid, sp, cp[near], geo[near])
             if err.size:
@@ -106,6 +112,29 @@ def _fix_sources(
     if radius > SOURCE_RADIUS:
         _check_source_balls(grid, proj, radius * h, chord_error, chord_fit)
     return positions, values, labels
+
+
+def _joined_to_nearest(band: Any, pos: np.ndarray, geo: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """``near`` without the nodes that the band's edges within it do not join to the node whose
+    closest point is nearest the source (a walk over the neighbour table of a cut band)."""
+    chosen = np.flatnonzero(near)
+    if chosen.size < 2:
+        return near
+    where = {int(p): j for j, p in enumerate(pos[chosen])}
+    table = band.neighbours_of_nodes(np.ascontiguousarray(pos[chosen], dtype=np.int64))
+    start = int(np.argmin(geo[chosen]))
+    seen = {start}
+    stack = [start]
+    while stack:
+        j = stack.pop()
+        for q in table[j].ravel():
+            k = where.get(int(q))
+            if k is not None and k not in seen:
+                seen.add(k)
+                stack.append(k)
+    out = np.zeros_like(near)
+    out[chosen[sorted(seen)]] = True
+    return out
 
 
 def _chord_errors(surface: Surface, grid: Grid, foot: np.ndarray, cp: np.ndarray, chord: np.ndarray) -> np.ndarray:

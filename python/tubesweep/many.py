@@ -96,7 +96,16 @@ def fixed_nodes(
         try:
             src = as_sources(g, grid)
             pos, val, _ = _fix_sources(
-                surf, grid, t.band, t.linear, t.roles, src, slowness_at, source_init, inner_width
+                surf,
+                grid,
+                t.band,
+                t.linear,
+                t.roles,
+                src,
+                slowness_at,
+                source_init,
+                inner_width,
+                connected=t.cut_edges > 0,
             )
         except ValueError as e:
             raise renamed(e, k, len(g) > 1) from None

@@ -430,6 +430,7 @@ def solve_on_tube(
         band_bytes=band.nbytes + st["solver_bytes"],
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
+        cut_edges=tube.cut_edges,
         order=2,
         order2=order2,
         box_cut=tube.box_cut,

@@ -15,6 +15,7 @@ from ._validate import (
 )
 from ._factoring import factored_values
 from ._interpolation import interpolate_band
+from ._sheet_readout import own_side_values
 from .grid import Grid
 from .stats import SolveStats
 from .surface import Surface
@@ -257,6 +258,9 @@ class Solution:
         out = interpolate_band(self._band, self.values, self.grid, p, interpolation)
         if self._factoring is not None:
             out = factored_values(self, p, out, interpolation)
+        elif self.stats.cut_edges and self._facing[0].size:
+            # a band cut across narrow gaps: each point read from its own side of the gap
+            out = own_side_values(self, p, out)
         return out
 
     def on_mesh(self, vertices: Any) -> np.ndarray:

@@ -386,7 +386,7 @@ def _solve_on_tube(
     # the exact initialisation's radius in grid spacings
     radius = SOURCE_RADIUS if source_radius is None else max(SOURCE_RADIUS, float(source_radius) / h)
     positions, fixed_vals, fixed_sources = _fix_sources(
-        surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width, radius
+        surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width, radius, tube.cut_edges > 0
     )
     roles[positions] = ROLE_FIXED
     if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER) and radius > SOURCE_RADIUS:
@@ -504,6 +504,7 @@ def _solve_on_tube(
         window_edge=st["window_edge"],
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
+        cut_edges=tube.cut_edges,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver=st.get("local_solver", scheme),

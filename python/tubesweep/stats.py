@@ -49,6 +49,12 @@ class SolveStats:
     narrowest_gap : float
         The narrowest such gap found, ``|cp(a) − cp(b)|`` over those pairs (``inf`` when there is
         none); the true gap can be narrower. Gaps under about one grid spacing are not found.
+    cut_edges : int
+        Edges between neighbouring band nodes that the solve removed so that the front cannot
+        take a shortcut the surface does not have (triangle meshes only): across the narrow gaps
+        of ``facing_pairs``, and above concave edges, where two neighbours' closest points lie
+        more than 1.5 grid spacings apart (docs/surfaces.md, "Parts of the surface that face
+        each other"). 0 on other surfaces, which keep the paper's scheme.
     thin_strip_iterations : tuple of two ints
         Parallel iterations (3D, more than one thread) whose sweeps ran strips thin across the
         first and across the second leading axis of the grid, where the iteration's work crossed
@@ -117,6 +123,7 @@ class SolveStats:
     window_edge: float = float("inf")
     facing_pairs: int = 0
     narrowest_gap: float = float("inf")
+    cut_edges: int = 0
     thin_strip_iterations: Tuple[int, int] = (0, 0)
     prefetch_iterations: int = 0
     local_solver: str = "godunov"

@@ -133,6 +133,37 @@ impl PyBand {
             .into_pyarray(py))
     }
 
+    /// The rows of the neighbour table ([`neighbours`](Self::neighbours)) of the band nodes at
+    /// `positions` only, shape (M, d, 2), K where a neighbour is not in the band (or its edge was
+    /// cut).
+    fn neighbours_of_nodes<'py>(
+        &self,
+        py: Python<'py>,
+        positions: PyReadonlyArray1<'py, i64>,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<i64>>> {
+        let pos = positions.as_slice()?;
+        let k = self.__len__();
+        if let Some(bad) = pos.iter().find(|&&p| p < 0 || p as usize >= k) {
+            return Err(PyValueError::new_err(format!(
+                "positions: {bad} is not a band position (the band has {k} nodes)"
+            )));
+        }
+        let d = self.ndim();
+        let flat: Vec<i64> = with_band!(
+            self,
+            b,
+            pos.iter()
+                .flat_map(|&n| b
+                    .neighbours_of(n as usize)
+                    .into_iter()
+                    .flat_map(|p| [p[0] as i64, p[1] as i64]))
+                .collect()
+        );
+        Ok(numpy::ndarray::Array3::from_shape_vec((pos.len(), d, 2), flat)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?
+            .into_pyarray(py))
+    }
+
     /// The places where central differences of φ at band nodes `start..stop` need φ off the
     /// band, as the module function `rim_nodes` gives them, read off this band's own neighbours
     /// (it must be the band of those linear indices). See
@@ -252,6 +283,72 @@ impl PyBand {
         let neighbour: Vec<i64> = pairs.iter().map(|p| p.neighbour as i64).collect();
         let gap: Vec<f64> = pairs.iter().map(|p| p.gap).collect();
         Ok((node.into_pyarray(py), neighbour.into_pyarray(py), gap.into_pyarray(py)))
+    }
+
+    /// The edges between neighbours whose closest points lie more than `jump` grid spacings
+    /// apart, one of them in the inner tube (`tubesweep_core::band::medial_edges`): `inner` per
+    /// node, `phi` its signed or unsigned distance, `direction` (K, d) its outward direction.
+    /// Returns the edges' band positions (node, its plus neighbour).
+    #[allow(clippy::type_complexity)]
+    fn medial_edges<'py>(
+        &self,
+        py: Python<'py>,
+        inner: PyReadonlyArray1<'py, bool>,
+        phi: PyReadonlyArray1<'py, f32>,
+        direction: PyReadonlyArray2<'py, f32>,
+        spacing: f64,
+        jump: f64,
+    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>)> {
+        let d = self.ndim();
+        if direction.shape()[1] != d {
+            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
+        }
+        let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
+        let edges = py
+            .detach(|| match &self.band {
+                AnyBand::D2(b) => tubesweep_core::band::medial_edges::medial_edges(b, inn, ph, dir, spacing, jump),
+                AnyBand::D3(b) => tubesweep_core::band::medial_edges::medial_edges(b, inn, ph, dir, spacing, jump),
+            })
+            .map_err(to_pyerr)?;
+        let node: Vec<i64> = edges.iter().map(|e| e.0 as i64).collect();
+        let neighbour: Vec<i64> = edges.iter().map(|e| e.1 as i64).collect();
+        Ok((node.into_pyarray(py), neighbour.into_pyarray(py)))
+    }
+
+    /// A copy of the band whose neighbour table no longer joins the pairs `(node[i],
+    /// neighbour[i])` (band positions of grid neighbours: the pairs across a narrow gap of
+    /// `facing_sheet_pairs`), so that the front cannot cross between them
+    /// (`tubesweep_core::band::NarrowBand::cut_edges`). Returns the band and the edges removed.
+    fn with_edges_cut(
+        &self,
+        py: Python<'_>,
+        node: PyReadonlyArray1<'_, i64>,
+        neighbour: PyReadonlyArray1<'_, i64>,
+    ) -> PyResult<(PyBand, usize)> {
+        let (a, b) = (node.as_slice()?, neighbour.as_slice()?);
+        if a.len() != b.len() {
+            return Err(PyValueError::new_err(format!(
+                "node and neighbour must have the same length, got {} and {}",
+                a.len(),
+                b.len()
+            )));
+        }
+        if a.iter().chain(b).any(|&p| p < 0) {
+            return Err(PyValueError::new_err("node and neighbour must be band positions (≥ 0)"));
+        }
+        let pairs: Vec<(usize, usize)> = a.iter().zip(b).map(|(&x, &y)| (x as usize, y as usize)).collect();
+        py.detach(|| match &self.band {
+            AnyBand::D2(band) => {
+                let mut cut = band.clone();
+                cut.cut_edges(&pairs).map(|n| (AnyBand::D2(cut), n))
+            }
+            AnyBand::D3(band) => {
+                let mut cut = band.clone();
+                cut.cut_edges(&pairs).map(|n| (AnyBand::D3(cut), n))
+            }
+        })
+        .map(|(band, n)| (PyBand { band }, n))
+        .map_err(to_pyerr)
     }
 
     /// Multilinear interpolation of `values` at `points` (M, d); NaN where the stencil leaves

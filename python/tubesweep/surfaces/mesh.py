@@ -171,6 +171,8 @@ class MeshSurface(Surface):
     ndim = 3
     #: False: exact closest points (see :class:`SmoothMeshSurface`)
     smooth = False
+    #: the band is cut across narrow gaps and above concave edges (``tubesweep._shortcuts``)
+    cuts_shortcuts = True
 
     def __init__(
         self,

@@ -3,8 +3,10 @@
 //! their extension directions (Eq. (8)), where the tubes of facing sheets touch, and the order in
 //! which the sweeps visit the band's rows (tiles and strips).
 
+mod cut_edges;
 pub mod discovery;
 pub mod facing_sheets;
+pub mod medial_edges;
 pub mod mesh_band;
 mod narrow_band;
 pub mod normals;

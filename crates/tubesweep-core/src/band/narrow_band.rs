@@ -32,10 +32,10 @@ pub struct NarrowBand<const D: usize> {
     row_start: Vec<u32>,
     last: Vec<u32>,
     /// Per node, `2 (D − 1)` entries: the minus and plus neighbours along each leading axis.
-    lead: Vec<u32>,
+    pub(super) lead: Vec<u32>,
     /// Per node: bit 0 set when the previous node of the row is its minus neighbour along the last
     /// axis, bit 1 when the next node is its plus neighbour.
-    along_row: Vec<u8>,
+    pub(super) along_row: Vec<u8>,
     schedule: SweepSchedule,
     /// 3D only: the parallel sweeps' schedules of rectangular tiles, strips thin along the first
     /// leading axis (`[0]`) and along the second (`[1]`) (see [`crate::band::schedule`]); built at the
