@@ -312,17 +312,19 @@ def test_an_unknown_experiment_is_an_error_line_with_exit_status_2(capsys):
 
 @pytest.mark.filterwarnings("default::RuntimeWarning")  # the CLI prints what a user sees: the default filter
 def test_warnings_are_one_line_each_without_the_library_source_line(tmp_path, capsys):
-    # a plate 0.08 thick meshed as 12 triangles, on a grid too coarse for it: the solve warns that
-    # the surface faces itself across a narrow gap
-    v = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.04, 0.04)])
-    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-    faces = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
-    mesh = tmp_path / "plate.obj"
-    mesh.write_text(
-        "".join(f"v {x} {y} {z}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces)
-    )
+    # two spheres five grid spacings apart, as a sampled φ = min(d₁, d₂): the solve warns that the
+    # surface faces itself across a narrow gap (a level set keeps the paper's scheme there)
+    n, r = 41, 0.45
+    x = np.linspace(-1.2, 1.2, n)
+    h = x[1] - x[0]
+    c = (r + 2.5 * h) * np.array([1.0, 1.0, 0.0]) / np.sqrt(2)
+    p = np.stack(np.meshgrid(x, x, x, indexing="ij"), -1)
+    phi = np.minimum(np.linalg.norm(p + c, axis=-1) - r, np.linalg.norm(p - c, axis=-1) - r)
+    np.save(tmp_path / "spheres.npy", phi)
+    source = [str(v) for v in -c - r * c / np.linalg.norm(c)]
+    box = ["--lower", "-1.2", "-1.2", "-1.2", "--upper", "1.2", "1.2", "1.2"]
     rc = main(
-        ["solve", "--mesh", str(mesh), "--n", "41", "--source", "0", "0", "0.04", "--out", str(tmp_path), "--quiet"]
+        ["solve", "--phi", str(tmp_path / "spheres.npy"), *box, "--source", *source, "--out", str(tmp_path), "--quiet"]
     )
     assert rc == 0
     err = capsys.readouterr().err
