@@ -201,10 +201,17 @@ def test_smooth_false_is_the_exact_map_bit_for_bit():
         warnings.simplefilter("error")  # Spot's narrow gaps at this grid are cut, not warned about
         sol = ts.solve(spot, spot.grid(50), [spot.vertices[0]])
     assert sol.stats.order == 1 and sol.stats.cut_edges > 0
-    # the sum of the band's values of the exact map's first-order solve (15314.712846845681
-    # before the band was cut across narrow gaps and above concave edges, ``_shortcuts``)
+    # the sum of the band's values of the exact map's first-order solve on the band cut across
+    # narrow gaps and above concave edges (``_shortcuts``)
     assert len(sol.values) == 16972
     assert float(np.sum(sol.values)) == 16368.24220129684
+    # without the cut: the values before smooth maps and cuts existed (the same solve on main then)
+    uncut = ts.surfaces.from_mesh(ts.data.spot(), smooth=False, cut_shortcuts=False)
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        old = ts.solve(uncut, uncut.grid(50), [uncut.vertices[0]])
+    assert old.stats.cut_edges == 0 and float(np.sum(old.values)) == 15314.712846845681
+    with pytest.raises(TypeError, match="cut_shortcuts must be True or False"):
+        ts.surfaces.from_mesh(ts.data.spot(), cut_shortcuts="no")
 
 
 def test_a_coarse_mesh_keeps_the_exact_map_and_first_order():

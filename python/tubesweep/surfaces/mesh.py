@@ -686,6 +686,7 @@ def from_mesh(
     center: Sequence[float] = (0.0, 0.0, 0.0),
     signed: Optional[bool] = None,
     smooth: bool = True,
+    cut_shortcuts: bool = True,
 ) -> MeshSurface:
     """A triangle mesh as a surface for :func:`tubesweep.solve` (closest-point representation).
 
@@ -709,7 +710,15 @@ def from_mesh(
         True (the default): a :class:`SmoothMeshSurface`, whose closest points follow the smooth
         surface behind the mesh where the triangles are large against the grid spacing, so that
         ``order="auto"`` runs second order on it (docs/point-clouds.md). False: the exact closest
-        points of the polyhedron and the paper's first-order scheme, as before.
+        points of the polyhedron and the first-order scheme.
+    cut_shortcuts : bool
+        True (the default): the band is cut where a step of one grid spacing in the tube would
+        stand for a much longer way along the surface, above the mesh's concave edges and across
+        gaps narrower than the tubes, so that the front does not cut across them
+        (docs/surfaces.md, "Parts of the surface that face each other"; about three times smaller
+        first-order errors on scanned meshes). False: the paper's two-layer method on the whole
+        band, which warns about narrow gaps instead (with ``smooth=False``, the values of earlier
+        versions bit for bit).
 
     Returns
     -------
@@ -747,8 +756,9 @@ def from_mesh(
         v = real_array(v, "vertices")
         f = whole_indices(f, "faces")
         name = "mesh"
-    if not isinstance(smooth, (bool, np.bool_)):
-        raise TypeError(f"smooth must be True or False; got {smooth!r}")
+    for flag, value in (("smooth", smooth), ("cut_shortcuts", cut_shortcuts)):
+        if not isinstance(value, (bool, np.bool_)):
+            raise TypeError(f"{flag} must be True or False; got {value!r}")
     kind = SmoothMeshSurface if smooth else MeshSurface
     offset = np.zeros(3)
     scale = 1.0
@@ -766,4 +776,6 @@ def from_mesh(
         scale = float(size) / float((hi - lo).max())
         offset = 0.5 * (lo + hi) - target / scale
         v = (v - offset) * scale
-    return kind(v, f, signed=signed, name=name, scale=scale, offset=offset)
+    surface = kind(v, f, signed=signed, name=name, scale=scale, offset=offset)
+    surface.cuts_shortcuts = bool(cut_shortcuts)
+    return surface
