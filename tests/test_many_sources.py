@@ -239,9 +239,10 @@ def test_dask_equals_local(client, tube):
     remote = tube.solve_many(sources, at=pts, client=client, chunk_size=3, progress=lambda d, t: done.append(d))
     assert np.array_equal(bits(remote), bits(local))
     assert done[-1] == 10
-    # each worker built the tube once and kept it (chunks reuse it)
+    # each worker that got a chunk built the tube once and kept it (chunks reuse it); under load
+    # the scheduler can give every chunk to one worker
     held = client.run(lambda: len(__import__("tubesweep.distributed").distributed._WORKER_TUBES))
-    assert set(held.values()) <= {1}
+    assert set(held.values()) <= {0, 1} and 1 in held.values()
     d_local = ts.distance_matrix(tube, None, pts)
     assert np.array_equal(ts.distance_matrix(tube, None, pts, client=client), d_local)
     # the options reach the workers (a callable speed through cloudpickle)
