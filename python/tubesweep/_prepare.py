@@ -109,6 +109,9 @@ class _PreparedTube:
     #: the edges of the band's neighbour table removed across narrow gaps and medial edges
     #: (``_shortcuts.cut_shortcuts``; triangle meshes only)
     cut_edges: int = 0
+    #: the band before the cut, for the Lax–Friedrichs scheme (which extrapolates a missing
+    #: neighbour, and does not settle beside edges cut inside the tube); None when nothing was cut
+    uncut_band: Any = None
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -227,8 +230,20 @@ def _warn_if_tubes_touch(
         first = np.ones(node.size, bool)
         first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
         node, neighbour, gap = node[first], neighbour[first], gap[first]
-    if node.size == 0 or not warn:
-        return node, neighbour, gap
+    if warn:
+        warn_facing_pairs(grid, linear, roles, (node, neighbour, gap), inner)
+    return node, neighbour, gap
+
+
+def warn_facing_pairs(
+    grid: Grid, linear: np.ndarray, roles: np.ndarray, facing: Tuple[np.ndarray, np.ndarray, np.ndarray], inner: float
+) -> None:
+    """The warning of :func:`_warn_if_tubes_touch` for the pairs ``facing`` (band positions of the
+    nodes and their neighbours, and the gaps), if there are any."""
+    node, neighbour, gap = facing
+    if node.size == 0:
+        return
+    h = grid.spacing
     narrowest = int(np.argmin(gap))
     where = ", ".join(f"{float(v):.4g}" for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
     needed = float(gap[narrowest]) / (2 * inner + 2)
@@ -245,7 +260,6 @@ def _warn_if_tubes_touch(
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
-    return node, neighbour, gap
 
 
 def _check_surface_spans_two_cells(
@@ -409,8 +423,12 @@ def _prepare_tube(
         grid, band, linear, roles, phi, directions, inner, kink, float(getattr(surf, "_noise", 0.0)), warn=not cuts
     )
     cut_edges = 0
+    uncut_band = None
     if cuts:
+        uncut_band = band
         band, cut_edges = cut_shortcuts(band, roles == ROLE_INNER, phi, directions, h, facing)
+        if cut_edges == 0:
+            uncut_band = None
     return _PreparedTube(
         grid,
         surf,
@@ -427,4 +445,5 @@ def _prepare_tube(
         facing,
         cut,
         cut_edges,
+        uncut_band,
     )

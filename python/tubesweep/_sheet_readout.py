@@ -14,54 +14,85 @@ A corner ``c`` lies on the side of the point's closest point ``p`` when its own 
 is no farther from ``p`` than ``c`` itself (up to a quarter spacing): projecting onto the sheet
 through ``p`` brings a node nearer to ``p``, while the closest point of a node of the other sheet
 lies across the gap, farther from ``p`` than the node, which lies between the two.
+
+The plan (which points, which corners, their weights) depends on the geometry only; the corner
+values are read by interpolation at the corners themselves, so that a single solve and a batch
+(``Tube.solve_many(at=...)``, which reads its rows in the core) give the same bits.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Optional, Tuple
 
 import numpy as np
+
+from .grid import Grid
 
 #: Slack of the side test, in grid spacings (curved sheets: the projection's shrinking is not exact).
 SIDE_SLACK = 0.25
 
 
-def own_side_values(sol: Any, points: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """``out`` (the multilinear values of ``sol`` at ``points``) with the points whose cell holds a
-    node of a pair across a narrow gap read from the corners of their own side only."""
-    node, neighbour, _ = sol._facing
+@dataclass
+class OwnSidePlan:
+    """The points to read from their own side: their rows among the points, their cells' corners
+    (R·2^d, d) and the corners' multilinear weights with the other side's set to 0 (R, 2^d)."""
+
+    rows: np.ndarray
+    corners: np.ndarray
+    weights: np.ndarray
+
+    def apply(self, out: np.ndarray, corner_values: np.ndarray) -> np.ndarray:
+        """``out`` (..., M) with its planned points read from ``corner_values`` (..., R·2^d), the
+        values at :attr:`corners` (unreached corners left out too); a point with no corner left
+        keeps its value."""
+        vals = corner_values.reshape(corner_values.shape[:-1] + self.weights.shape)
+        finite = np.isfinite(vals)
+        w = np.where(finite, self.weights, 0.0)
+        total = w.sum(axis=-1)
+        summed = (w * np.where(finite, vals, 0.0)).sum(axis=-1)
+        res = out.copy()
+        sub = res[..., self.rows]
+        ok = total > 0
+        sub[ok] = summed[ok] / total[ok]
+        res[..., self.rows] = sub
+        return res
+
+
+def own_side_plan(
+    grid: Grid,
+    surface: Any,
+    band: Any,
+    facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
+    n_nodes: int,
+    points: np.ndarray,
+) -> Optional[OwnSidePlan]:
+    """The :class:`OwnSidePlan` of ``points`` on a band of ``n_nodes`` nodes whose pairs across
+    narrow gaps are ``facing``; None when no point's cell holds a node of a pair."""
+    node, neighbour, _ = facing
     if node.size == 0 or len(points) == 0:
-        return out
-    grid = sol.grid
+        return None
     d, h = grid.ndim, grid.spacing
-    k_nodes = len(sol.values)
     shape = np.asarray(grid.shape)
     t = grid.continuous_index(points)
     base = np.clip(np.floor(t).astype(np.int64), 0, shape - 2)
     frac = np.clip(t - base, 0.0, 1.0)
     offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
     corners = base[:, None, :] + offsets[None, :, :]
-    pos = sol._band.find(np.ascontiguousarray(corners.reshape(-1, d))).reshape(len(points), -1)
-    paired = np.zeros(k_nodes + 1, bool)
+    pos = band.find(np.ascontiguousarray(corners.reshape(-1, d))).reshape(len(points), -1)
+    paired = np.zeros(n_nodes + 1, bool)
     paired[node] = True
     paired[neighbour] = True
-    rows = np.flatnonzero(np.any(paired[np.where(pos >= 0, pos, k_nodes)], axis=1))
+    rows = np.flatnonzero(np.any(paired[np.where(pos >= 0, pos, n_nodes)], axis=1))
     if rows.size == 0:
-        return out
+        return None
     corner_points = grid.points(corners[rows].reshape(-1, d))
-    _, corner_cp = sol.surface.project(corner_points, grid)
-    _, foot = sol.surface.project(points[rows], grid)
-    corner_points = corner_points.reshape(rows.size, -1, d)
+    _, corner_cp = surface.project(corner_points, grid)
+    _, foot = surface.project(points[rows], grid)
+    at = corner_points.reshape(rows.size, -1, d)
     corner_cp = np.asarray(corner_cp).reshape(rows.size, -1, d)
     foot = np.asarray(foot)[:, None, :]
-    own = np.linalg.norm(corner_cp - foot, axis=2) <= np.linalg.norm(corner_points - foot, axis=2) + SIDE_SLACK * h
-    sub = pos[rows]
-    vals = sol.values[np.maximum(sub, 0)]
-    own &= (sub >= 0) & np.isfinite(vals)
+    own = np.linalg.norm(corner_cp - foot, axis=2) <= np.linalg.norm(at - foot, axis=2) + SIDE_SLACK * h
+    own &= pos[rows] >= 0
     weight = np.prod(np.where(offsets[None, :, :] == 1, frac[rows, None, :], 1.0 - frac[rows, None, :]), axis=2)
-    weight = np.where(own, weight, 0.0)
-    total = weight.sum(axis=1)
-    ok = total > 0
-    res = out.copy()
-    res[rows[ok]] = (weight[ok] * np.where(own[ok], vals[ok], 0.0)).sum(axis=1) / total[ok]
-    return res
+    return OwnSidePlan(rows, np.ascontiguousarray(corner_points), np.where(own, weight, 0.0))

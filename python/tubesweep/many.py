@@ -30,7 +30,8 @@ from ._validate import (
     speed_at_points,
     speed_values,
 )
-from ._prepare import ROLE_INNER
+from ._prepare import ROLE_INNER, warn_facing_pairs
+from ._sheet_readout import own_side_plan
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .many_order2 import renamed, solve_many_order2
 from . import second_order as so
@@ -82,11 +83,13 @@ def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
 
 
 def fixed_nodes(
-    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str
+    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str, uncut: bool = False
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The band positions and values each source fixes, concatenated, and the offsets (K + 1,)
-    of each source's run: ``_fix_sources`` of a single solve, source by source."""
+    of each source's run: ``_fix_sources`` of a single solve, source by source. ``uncut``: on the
+    band before its cut (``_shortcuts``; the Lax–Friedrichs scheme)."""
     t = tube._tube
+    band, connected = (t.uncut_band, False) if uncut else (t.band, t.cut_edges > 0)
     grid, surf = t.grid, t.surface
     inner_width = t.inner * grid.spacing
     slowness_at = _slowness_at(speed, grid)
@@ -98,14 +101,14 @@ def fixed_nodes(
             pos, val, _ = _fix_sources(
                 surf,
                 grid,
-                t.band,
+                band,
                 t.linear,
                 t.roles,
                 src,
                 slowness_at,
                 source_init,
                 inner_width,
-                connected=t.cut_edges > 0,
+                connected=connected,
             )
         except ValueError as e:
             raise renamed(e, k, len(g) > 1) from None
@@ -209,12 +212,23 @@ def solve_many(
     slowness: Any = 1.0 / speed_nodes
     h = grid.spacing
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
-    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init)
+    # the Lax–Friedrichs scheme runs on the band before its cut (``_shortcuts``), with the warning
+    uncut = scheme == "lxf" and t.uncut_band is not None
+    band = t.uncut_band if uncut else t.band
+    if uncut:
+        warn_facing_pairs(grid, t.linear, t.roles, t.facing, t.inner)
+    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init, uncut)
+    # on a band cut across narrow gaps, points next to a gap read from their own side: the values
+    # at their cells' corners come back as extra points
+    plan = None
+    if points is not None and not uncut and t.cut_edges and t.facing[0].size:
+        plan = own_side_plan(grid, t.surface, band, t.facing, len(t.linear), points)
+    read_at = points if plan is None else np.ascontiguousarray(np.concatenate([points, plan.corners]))
     missing_policy = "infinity" if (t.method == "naive" and scheme == "godunov") else "extrapolate"
     directions = t.geom.directions_for_solver()  # type: ignore[union-attr]  # a copy: the tube's stay as they are
     setup = time.perf_counter() - t0
     out, st = _native.solve_many_on_band(
-        t.band,
+        band,
         t.roles,
         positions,
         values,
@@ -233,10 +247,13 @@ def solve_many(
         not paper_sweeps,
         not paper_sweeps,
         0.0 if paper_sweeps else FRONT_WINDOW,
-        points,
+        read_at,
         None if points is None else [float(v) for v in grid.lower],
     )
     del directions
+    if plan is not None:
+        m = len(points)  # type: ignore[arg-type]
+        out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])
     bad = np.flatnonzero(~st["converged"])
     if bad.size:
         warnings.warn(

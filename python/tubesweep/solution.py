@@ -15,7 +15,7 @@ from ._validate import (
 )
 from ._factoring import factored_values
 from ._interpolation import interpolate_band
-from ._sheet_readout import own_side_values
+from ._sheet_readout import own_side_plan
 from .grid import Grid
 from .stats import SolveStats
 from .surface import Surface
@@ -260,7 +260,10 @@ class Solution:
             out = factored_values(self, p, out, interpolation)
         elif self.stats.cut_edges and self._facing[0].size:
             # a band cut across narrow gaps: each point read from its own side of the gap
-            out = own_side_values(self, p, out)
+            plan = own_side_plan(self.grid, self.surface, self._band, self._facing, len(self.values), p)
+            if plan is not None:
+                corner_values = interpolate_band(self._band, self.values, self.grid, plan.corners, "linear")
+                out = plan.apply(out, corner_values)
         return out
 
     def on_mesh(self, vertices: Any) -> np.ndarray:

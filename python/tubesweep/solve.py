@@ -28,7 +28,16 @@ from ._result_check import check_values
 from .grid import Grid
 from .stats import SolveStats
 from .surface import as_surface
-from ._prepare import METHODS, ROLE_FIXED, ROLE_INNER, ROLE_OUTER, ROLE_RTOL, _PreparedTube, _prepare_tube
+from ._prepare import (
+    METHODS,
+    ROLE_FIXED,
+    ROLE_INNER,
+    ROLE_OUTER,
+    ROLE_RTOL,
+    _PreparedTube,
+    _prepare_tube,
+    warn_facing_pairs,
+)
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .solution import Solution
 
@@ -363,6 +372,13 @@ def _solve_on_tube(
     if not isinstance(paper_sweeps, (bool, np.bool_)):
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band
+    cut_edges = tube.cut_edges
+    if scheme == "lxf" and tube.uncut_band is not None:
+        # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
+        # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
+        # gaps the cut would have closed are warned about
+        band, cut_edges = tube.uncut_band, 0
+        warn_facing_pairs(grid, tube.linear, tube.roles, tube.facing, tube.inner)
     h = grid.spacing
     inner_width = tube.inner * h
     roles = tube.roles.copy() if reuse else tube.roles
@@ -386,7 +402,7 @@ def _solve_on_tube(
     # the exact initialisation's radius in grid spacings
     radius = SOURCE_RADIUS if source_radius is None else max(SOURCE_RADIUS, float(source_radius) / h)
     positions, fixed_vals, fixed_sources = _fix_sources(
-        surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width, radius, tube.cut_edges > 0
+        surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width, radius, cut_edges > 0
     )
     roles[positions] = ROLE_FIXED
     if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER) and radius > SOURCE_RADIUS:
@@ -504,7 +520,7 @@ def _solve_on_tube(
         window_edge=st["window_edge"],
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
-        cut_edges=tube.cut_edges,
+        cut_edges=cut_edges,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver=st.get("local_solver", scheme),
