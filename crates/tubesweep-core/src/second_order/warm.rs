@@ -23,6 +23,22 @@
 //! as the cold solve's (the window, not the start, sets the cost), and from a start extrapolated
 //! in time (two previous solutions, error O(δ²)) about three quarters of them.
 //!
+//! Tried and not kept: Gauss–Seidel passes in increasing order of the carried values before phase
+//! 2 (a counting sort by value in buckets of σ̄Δx/20, then the phase-2 update node by node, like
+//! fast marching with a known order), in the hope that one pass in a nearly causal order is
+//! nearly final. The scheme is not causal in value order: the extension update averages the
+//! neighbours of smaller |φ| whatever their values, the inner nodes at the tube's edge read
+//! those extension nodes, and along the normals the values tie (the solution is constant along
+//! them), so a stale neighbour across a tie feeds a node strongly. Even from the cold solution
+//! itself raised by 0.5Δx (an upper start, the exact order) one pass left the inner nodes' median
+//! error at 0.043Δx and the extension layer's largest at 0.81Δx (sphere → ellipsoid at N = 61).
+//! From the carried values (step 2 of 5) the median error went 0.23Δx → 0.092, 0.045, 0.015Δx
+//! after 1, 2, 3 passes — 2–2.5 times per pass, as per iteration of 2^D sweeps — and the largest
+//! 0.81Δx → 0.74, 0.97, 0.51Δx. Warm solves with 1 to 16 such passes before phase 2 took 1.2 to
+//! 1.8 times a cold solve (1.1 without them, same runs): the passes are sequential and walk the
+//! memory out of order, and phase 2 still needs several iterations after them. Refreshing the
+//! extension nodes right after each node they read, or ordering by u + c|φ|, did worse.
+//!
 //! Why the warm start reaches the cold solve's fixed point (to the path dependence that the
 //! second-order fixed point has anyway: the BDF3 kink test reads the node's own value, so two cold
 //! solves that differ only in their window differ by a few stopping tolerances, see
