@@ -243,7 +243,7 @@ def plan(
                 if prob == "bunny" and m == "mmp":
                     continue  # MMP on the input mesh is the bunny's exact reference
                 if prob == "bunny" and m == "tubesweep-godunov-order2":
-                    continue  # order=2 refuses meshes (their closest points are piecewise flat)
+                    continue  # order=2 refuses the bunny: a scanned mesh with gaps narrower than the tube
                 cap = caps.get(f"{m}@{prob}", caps.get(m))
                 if cap is not None and n > cap:
                     continue
@@ -252,8 +252,9 @@ def plan(
         notes.append("mmp is not listed on the bunny: MMP on the input mesh is the exact reference there")
     if "bunny" in sizes and "tubesweep-godunov-order2" in names:
         notes.append(
-            "tubesweep-godunov-order2 is not run on the bunny: order=2 refuses meshes (their closest points are "
-            "piecewise flat, with no curvature for the metric correction to use)"
+            "tubesweep-godunov-order2 is not run on the bunny: order=2 refuses it (a scanned mesh facing itself "
+            "across gaps narrower than the tube; the default runs order=1, on the band cut there and above the "
+            "mesh's concave edges)"
         )
     if any(PROBLEM_DIMS[p] == 2 for p in sizes):
         notes.append("heat and mmp need a triangle mesh of a surface: not run on the 2D star")
