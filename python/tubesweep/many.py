@@ -30,7 +30,7 @@ from ._validate import (
     speed_at_points,
     speed_values,
 )
-from ._prepare import ROLE_INNER, warn_facing_pairs
+from ._prepare import ROLE_INNER, uncut_band, warn_facing_pairs
 from ._sheet_readout import own_side_plan
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .many_order2 import renamed, solve_many_order2
@@ -83,13 +83,13 @@ def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
 
 
 def fixed_nodes(
-    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str, uncut: bool = False
+    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str, uncut: Any = None
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The band positions and values each source fixes, concatenated, and the offsets (K + 1,)
-    of each source's run: ``_fix_sources`` of a single solve, source by source. ``uncut``: on the
-    band before its cut (``_shortcuts``; the Lax–Friedrichs scheme)."""
+    of each source's run: ``_fix_sources`` of a single solve, source by source. ``uncut``: the
+    band before its cut (``_prepare.uncut_band``; the Lax–Friedrichs scheme), to fix them on."""
     t = tube._tube
-    band, connected = (t.uncut_band, False) if uncut else (t.band, t.cut_edges > 0)
+    band, connected = (uncut, False) if uncut is not None else (t.band, t.cut_edges > 0)
     grid, surf = t.grid, t.surface
     inner_width = t.inner * grid.spacing
     slowness_at = _slowness_at(speed, grid)
@@ -213,11 +213,11 @@ def solve_many(
     h = grid.spacing
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     # the Lax–Friedrichs scheme runs on the band before its cut (``_shortcuts``), with the warning
-    uncut = scheme == "lxf" and t.uncut_band is not None
-    band = t.uncut_band if uncut else t.band
+    uncut = scheme == "lxf" and t.cut_edges > 0
+    band = uncut_band(t) if uncut else t.band
     if uncut:
         warn_facing_pairs(grid, t.linear, t.roles, t.facing, t.inner)
-    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init, uncut)
+    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init, band if uncut else None)
     # on a band cut across narrow gaps, points next to a gap read from their own side: the values
     # at their cells' corners come back as extra points
     plan = None

@@ -36,6 +36,7 @@ from ._prepare import (
     ROLE_RTOL,
     _PreparedTube,
     _prepare_tube,
+    uncut_band,
     warn_facing_pairs,
 )
 from ._sources import SOURCE_RADIUS, _fix_sources
@@ -373,11 +374,11 @@ def _solve_on_tube(
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band
     cut_edges = tube.cut_edges
-    if scheme == "lxf" and tube.uncut_band is not None:
+    if scheme == "lxf" and cut_edges:
         # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
         # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
         # gaps the cut would have closed are warned about
-        band, cut_edges = tube.uncut_band, 0
+        band, cut_edges = uncut_band(tube), 0
         warn_facing_pairs(grid, tube.linear, tube.roles, tube.facing, tube.inner)
     h = grid.spacing
     inner_width = tube.inner * h
