@@ -165,7 +165,15 @@ fn refine<const D: usize>(
 ) -> Foot<D> {
     let h = field.spacing();
     let tol = options.tol * h;
-    let normal = |y: &[f64; D]| unit(field.gradient(y, options.eps));
+    // the central differences with step eps; in closed form for the default step, half a spacing
+    let half_step = options.eps == 0.5 * h;
+    let normal = |y: &[f64; D]| {
+        unit(if half_step {
+            field.half_step_gradient(y)
+        } else {
+            field.gradient(y, options.eps)
+        })
+    };
     let mut y = start;
     let Some(mut n) = start_normal.or_else(|| normal(&y)) else {
         return Foot {
@@ -302,6 +310,9 @@ pub fn redistanced_band_of_samples<const D: usize>(
     let mut layers: Vec<Vec<usize>> = Vec::new();
     while !frontier.is_empty() {
         let depth = layers.len() as u32 + 1;
+        // each layer in the nodes' order (C order): the nodes next to each other in the list read
+        // the same neighbours' closest points and the same samples
+        frontier.par_sort_unstable();
         let next: Vec<usize> = if depth > deepest {
             Vec::new()
         } else {
@@ -395,12 +406,12 @@ pub fn redistanced_band_of_samples<const D: usize>(
         }
     }
     drop(layer);
-    // the band: the nodes within the half-width
+    // the band: the nodes within the half-width, in the set's (C) order
     let keep = options.half_width * (1.0 + 1e-9); // ties on the band's edge: rounding
-    let kept: Vec<Option<(f64, [f64; D], bool, bool)>> = (0..m)
+    let kept: Vec<(u64, f64, [f32; D], bool, bool)> = (0..m)
         .into_par_iter()
         .with_min_len(1024)
-        .map(|p| {
+        .filter_map(|p| {
             let foot = feet[p].as_ref()?;
             let (idx, x) = node_of(p);
             let y = &foot.y;
@@ -429,24 +440,23 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     }
                 },
             );
-            Some((signed, diff, foot.settled, apart))
+            let good = dist > 1e-9 * h;
+            let direction = diff.map(|v| if good { (v / dist) as f32 } else { 0.0 });
+            Some((linear[p], signed, direction, foot.settled, apart))
         })
         .collect();
+    drop(feet);
     let mut out = RedistancedBand {
         crossed_cells: n_cells,
+        linear: Vec::with_capacity(kept.len()),
+        signed: Vec::with_capacity(kept.len()),
+        direction: Vec::with_capacity(D * kept.len()),
         ..Default::default()
     };
-    for (p, k) in kept.into_iter().enumerate() {
-        let Some((signed, diff, settled, apart)) = k else {
-            continue;
-        };
-        out.linear.push(linear[p]);
+    for (l, signed, direction, settled, apart) in kept {
+        out.linear.push(l);
         out.signed.push(signed);
-        let dist = signed.abs();
-        let good = dist > 1e-9 * h;
-        for v in diff {
-            out.direction.push(if good { (v / dist) as f32 } else { 0.0 });
-        }
+        out.direction.extend_from_slice(&direction);
         out.unsettled += usize::from(!settled);
         out.medial += usize::from(apart);
     }
