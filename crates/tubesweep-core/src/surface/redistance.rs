@@ -30,6 +30,10 @@ pub struct SampledField<'a, const D: usize> {
     shape: [usize; D],
     stride: [usize; D],
     lower: [f64; D],
+    /// The grid's upper corner, `lower + (shape − 1) · spacing`.
+    upper: [f64; D],
+    /// The lowest corner of the last cell along each axis, `shape − 2`.
+    last_cell: [f64; D],
     spacing: f64,
 }
 
@@ -64,11 +68,18 @@ impl<'a, const D: usize> SampledField<'a, D> {
         for k in (0..D - 1).rev() {
             stride[k] = stride[k + 1] * shape[k + 1];
         }
+        let (mut upper, mut last_cell) = (lower, [0.0; D]);
+        for k in 0..D {
+            upper[k] = lower[k] + (shape[k] - 1) as f64 * spacing;
+            last_cell[k] = (shape[k] - 2) as f64;
+        }
         Ok(SampledField {
             samples,
             shape,
             stride,
             lower,
+            upper,
+            last_cell,
             spacing,
         })
     }
@@ -92,7 +103,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
     #[inline(always)]
     fn locate(&self, axis: usize, c: f64) -> (usize, f64) {
         let t = (c - self.lower[axis]) / self.spacing;
-        let b = floor(t).clamp(0.0, (self.shape[axis] - 2) as f64);
+        let b = floor(t).clamp(0.0, self.last_cell[axis]);
         (b as usize, (t - b).clamp(0.0, 1.0))
     }
 
@@ -132,7 +143,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
         let mut inside = [true; D];
         for k in 0..D {
             let t = (p[k] - self.lower[k]) / self.spacing;
-            let b = floor(t).clamp(0.0, (self.shape[k] - 2) as f64);
+            let b = floor(t).clamp(0.0, self.last_cell[k]);
             base[k] = b as usize;
             let f = t - b;
             inside[k] = (0.0..=1.0).contains(&f);
@@ -306,8 +317,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
     #[inline]
     pub(crate) fn clamp_to_box(&self, y: &mut [f64; D]) {
         for k in 0..D {
-            let upper = self.lower[k] + (self.shape[k] - 1) as f64 * self.spacing;
-            y[k] = y[k].clamp(self.lower[k], upper);
+            y[k] = y[k].clamp(self.lower[k], self.upper[k]);
         }
     }
 

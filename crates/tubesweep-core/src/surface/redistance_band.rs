@@ -320,13 +320,15 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 .par_iter()
                 .with_min_len(256)
                 .flat_map_iter(|&p| {
-                    let mut found = Vec::new();
+                    // at most 2D face neighbours: no allocation per node
+                    let (mut found, mut count) = ([0usize; 6], 0);
                     set.face_neighbours(lattice.split(linear[p] as usize), |q| {
                         if layer[q].compare_exchange(UNSEEN, depth, Relaxed, Relaxed).is_ok() {
-                            found.push(q);
+                            found[count] = q;
+                            count += 1;
                         }
                     });
-                    found
+                    found.into_iter().take(count)
                 })
                 .collect()
         };
