@@ -22,7 +22,7 @@
 //!    tangent plane towards the foot of the node (the normal `n` from central differences of φ
 //!    with step `eps`, as the projection takes it: continuous across the cells' faces, so the
 //!    closest points vary smoothly from node to node, which the second-order solve's curvature
-//!    needs), then Newton steps `P` back onto the level set with the exact gradient of the cell's
+//!    needs; for the default step `Δx/2` in closed form, `SampledField::half_step_gradient`), then Newton steps `P` back onto the level set with the exact gradient of the cell's
 //!    interpolant (quadratic convergence), until `|x − y|` is within `tol · Δx` of the distance
 //!    to the tangent plane at `y` (`|t|² ≤ 2 tol Δx |x − y|`, `t` the tangential part of
 //!    `x − y`). Each step must land on the zero level set (within `1e-9 · Δx` of it,
