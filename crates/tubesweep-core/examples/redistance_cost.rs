@@ -19,7 +19,10 @@ fn cpu_seconds() -> f64 {
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).map(|a| a.parse().expect("N and repeats")).collect();
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("N and repeats"))
+        .collect();
     let n = args.first().copied().unwrap_or(201);
     let repeats = args.get(1).copied().unwrap_or(3).max(1);
     let h = 2.0 / (n - 1) as f64;
@@ -29,7 +32,10 @@ fn main() {
     };
     let cases: [(&str, Vec<f64>); 2] = [
         ("|x|²−R²", (0..n * n * n).map(|l| r2(l) - 0.25).collect()),
-        ("sphere mask", (0..n * n * n).map(|l| if r2(l) < 0.25 { -0.5 } else { 0.5 }).collect()),
+        (
+            "sphere mask",
+            (0..n * n * n).map(|l| if r2(l) < 0.25 { -0.5 } else { 0.5 }).collect(),
+        ),
     ];
     for (name, samples) in &cases {
         let field = SampledField::<3>::new(samples, [n; 3], [-1.0; 3], h).expect("a valid grid");

@@ -513,16 +513,28 @@ mod tests {
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
         let mut points: Vec<[f64; 3]> = (0..2000).map(|_| [next(), next(), next()]).collect();
-        points.extend([[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0], [0.0, 0.25, -0.75], [1.0, 0.1, -1.0], [-0.875, 0.5, 0.999]]);
+        points.extend([
+            [-1.0, -1.0, -1.0],
+            [1.0, 1.0, 1.0],
+            [0.0, 0.25, -0.75],
+            [1.0, 0.1, -1.0],
+            [-0.875, 0.5, 0.999],
+        ]);
         for p in &points {
             let (a, b) = (field.half_step_gradient(p), field.gradient(p, 0.5 * h));
             for k in 0..3 {
-                assert!((a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()), "{p:?}: {a:?} against {b:?}");
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()),
+                    "{p:?}: {a:?} against {b:?}"
+                );
             }
             let q = [p[0], p[2]];
             let (a, b) = (flat.half_step_gradient(&q), flat.gradient(&q, 0.5 * h));
             for k in 0..2 {
-                assert!((a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()), "{q:?}: {a:?} against {b:?}");
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-13 * (1.0 + b[k].abs()),
+                    "{q:?}: {a:?} against {b:?}"
+                );
             }
         }
     }
