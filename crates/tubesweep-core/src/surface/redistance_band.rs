@@ -22,7 +22,7 @@
 //!    tangent plane towards the foot of the node (the normal `n` from central differences of φ
 //!    with step `eps`, as the projection takes it: continuous across the cells' faces, so the
 //!    closest points vary smoothly from node to node, which the second-order solve's curvature
-//!    needs), then Newton steps `P` back onto the level set with the exact gradient of the cell's
+//!    needs; for the default step `Δx/2` in closed form, `SampledField::half_step_gradient`), then Newton steps `P` back onto the level set with the exact gradient of the cell's
 //!    interpolant (quadratic convergence), until `|x − y|` is within `tol · Δx` of the distance
 //!    to the tangent plane at `y` (`|t|² ≤ 2 tol Δx |x − y|`, `t` the tangential part of
 //!    `x − y`). Each step must land on the zero level set (within `1e-9 · Δx` of it,
@@ -165,7 +165,15 @@ fn refine<const D: usize>(
 ) -> Foot<D> {
     let h = field.spacing();
     let tol = options.tol * h;
-    let normal = |y: &[f64; D]| unit(field.gradient(y, options.eps));
+    // the central differences with step eps; in closed form for the default step, half a spacing
+    let half_step = options.eps == 0.5 * h;
+    let normal = |y: &[f64; D]| {
+        unit(if half_step {
+            field.half_step_gradient(y)
+        } else {
+            field.gradient(y, options.eps)
+        })
+    };
     let mut y = start;
     let Some(mut n) = start_normal.or_else(|| normal(&y)) else {
         return Foot {
@@ -302,6 +310,9 @@ pub fn redistanced_band_of_samples<const D: usize>(
     let mut layers: Vec<Vec<usize>> = Vec::new();
     while !frontier.is_empty() {
         let depth = layers.len() as u32 + 1;
+        // each layer in the nodes' order (C order): the nodes next to each other in the list read
+        // the same neighbours' closest points and the same samples
+        frontier.par_sort_unstable();
         let next: Vec<usize> = if depth > deepest {
             Vec::new()
         } else {
@@ -309,13 +320,15 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 .par_iter()
                 .with_min_len(256)
                 .flat_map_iter(|&p| {
-                    let mut found = Vec::new();
+                    // at most 2D face neighbours: no allocation per node
+                    let (mut found, mut count) = ([0usize; 6], 0);
                     set.face_neighbours(lattice.split(linear[p] as usize), |q| {
                         if layer[q].compare_exchange(UNSEEN, depth, Relaxed, Relaxed).is_ok() {
-                            found.push(q);
+                            found[count] = q;
+                            count += 1;
                         }
                     });
-                    found
+                    found.into_iter().take(count)
                 })
                 .collect()
         };
@@ -395,12 +408,12 @@ pub fn redistanced_band_of_samples<const D: usize>(
         }
     }
     drop(layer);
-    // the band: the nodes within the half-width
+    // the band: the nodes within the half-width, in the set's (C) order
     let keep = options.half_width * (1.0 + 1e-9); // ties on the band's edge: rounding
-    let kept: Vec<Option<(f64, [f64; D], bool, bool)>> = (0..m)
+    let kept: Vec<(u64, f64, [f32; D], bool, bool)> = (0..m)
         .into_par_iter()
         .with_min_len(1024)
-        .map(|p| {
+        .filter_map(|p| {
             let foot = feet[p].as_ref()?;
             let (idx, x) = node_of(p);
             let y = &foot.y;
@@ -429,24 +442,23 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     }
                 },
             );
-            Some((signed, diff, foot.settled, apart))
+            let good = dist > 1e-9 * h;
+            let direction = diff.map(|v| if good { (v / dist) as f32 } else { 0.0 });
+            Some((linear[p], signed, direction, foot.settled, apart))
         })
         .collect();
+    drop(feet);
     let mut out = RedistancedBand {
         crossed_cells: n_cells,
+        linear: Vec::with_capacity(kept.len()),
+        signed: Vec::with_capacity(kept.len()),
+        direction: Vec::with_capacity(D * kept.len()),
         ..Default::default()
     };
-    for (p, k) in kept.into_iter().enumerate() {
-        let Some((signed, diff, settled, apart)) = k else {
-            continue;
-        };
-        out.linear.push(linear[p]);
+    for (l, signed, direction, settled, apart) in kept {
+        out.linear.push(l);
         out.signed.push(signed);
-        let dist = signed.abs();
-        let good = dist > 1e-9 * h;
-        for v in diff {
-            out.direction.push(if good { (v / dist) as f32 } else { 0.0 });
-        }
+        out.direction.extend_from_slice(&direction);
         out.unsettled += usize::from(!settled);
         out.medial += usize::from(apart);
     }

@@ -1,0 +1,74 @@
+//! The cost of the sub-cell re-distancing alone (`tubesweep_core::surface::redistance_band`, what
+//! `LevelSet(phi_array, redistance=True).band(grid, 4Δx)` runs), for the sphere R = 0.5 in
+//! [−1, 1]³ sampled as `|x|² − R²` and as a voxel mask (`−0.5` inside, `0.5` outside): the CPU time
+//! of the process (all threads; medians of the repeats), the band's size and a hash of its linear
+//! indices, signed distances and directions (equal hashes: the same bits).
+//!
+//!     cargo run --release -p tubesweep-core --example redistance_cost -- [N] [repeats]   # 201 3
+//!
+//! For instruction counts, which a busy machine does not change:
+//! `RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no target/release/examples/redistance_cost 101 1`.
+use tubesweep_core::surface::redistance::SampledField;
+use tubesweep_core::surface::redistance_band::{redistanced_band_of_samples, RedistanceOptions};
+
+fn cpu_seconds() -> f64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: clock_gettime writes the timespec it is given
+    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("N and repeats"))
+        .collect();
+    let n = args.first().copied().unwrap_or(201);
+    let repeats = args.get(1).copied().unwrap_or(3).max(1);
+    let h = 2.0 / (n - 1) as f64;
+    let r2 = |l: usize| {
+        let (i, j, k) = (l / (n * n), l / n % n, l % n);
+        [i, j, k].iter().map(|&m| (-1.0 + h * m as f64).powi(2)).sum::<f64>()
+    };
+    let cases: [(&str, Vec<f64>); 2] = [
+        ("|x|²−R²", (0..n * n * n).map(|l| r2(l) - 0.25).collect()),
+        (
+            "sphere mask",
+            (0..n * n * n).map(|l| if r2(l) < 0.25 { -0.5 } else { 0.5 }).collect(),
+        ),
+    ];
+    for (name, samples) in &cases {
+        let field = SampledField::<3>::new(samples, [n; 3], [-1.0; 3], h).expect("a valid grid");
+        let options = RedistanceOptions {
+            half_width: 4.0 * h,
+            eps: 0.5 * h,
+            max_steps: 40,
+            tol: 1e-12,
+        };
+        let mut times = Vec::new();
+        let mut band = None;
+        for _ in 0..repeats {
+            let start = cpu_seconds();
+            band = Some(redistanced_band_of_samples(&field, options).expect("a sign change"));
+            times.push(cpu_seconds() - start);
+        }
+        times.sort_by(f64::total_cmp);
+        let band = band.expect("one repeat at least");
+        let mut hash = 0xcbf29ce484222325u64;
+        let mut mix = |v: u64| hash = (hash ^ v).wrapping_mul(0x100000001b3);
+        for (&l, &s) in band.linear.iter().zip(&band.signed) {
+            mix(l);
+            mix(s.to_bits());
+        }
+        for &d in &band.direction {
+            mix(u64::from(d.to_bits()));
+        }
+        println!(
+            "N={n} {name:12} band nodes {:8} (unsettled {:6}): CPU {:.3} s, {:.2} µs per band node; hash {hash:016x}",
+            band.linear.len(),
+            band.unsettled,
+            times[repeats / 2],
+            times[repeats / 2] * 1e6 / band.linear.len() as f64,
+        );
+    }
+}
