@@ -15,6 +15,8 @@ import re
 import warnings
 from typing import Any, Optional
 
+import numpy as np
+
 from ._warn import user_stacklevel
 
 _PER_INNER_WIDTH = re.compile(r"about ([0-9.]+)·inner·Δx per crease")
@@ -56,4 +58,19 @@ def warn_refused_creases(reason: str, inner: float, spacing: float) -> None:
         "second order and no shortcut",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
+    )
+
+
+def crease_nodes_to_extend(
+    band: Any, inner: np.ndarray, phi: np.ndarray, direction: np.ndarray, spacing: float
+) -> np.ndarray:
+    """The band positions of the inner-tube nodes (``inner``) on the overlap side of a crease,
+    farther than half a spacing from the surface (``tubesweep_core::band::crease_ridges``): as
+    extension nodes their values come from their closest points, and the front no longer cuts the
+    corner through them. A smooth surface has none."""
+    return band.crease_ridge_nodes(
+        np.ascontiguousarray(inner, dtype=bool),
+        np.ascontiguousarray(phi, dtype=np.float32),
+        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(inner), -1),
+        float(spacing),
     )

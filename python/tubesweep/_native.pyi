@@ -266,6 +266,13 @@ class Band:
         direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
         spacing: float,
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+    def crease_ridge_nodes(
+        self,
+        inner: npt.NDArray[np.bool_],
+        phi: npt.NDArray[np.float32],
+        direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
+        spacing: float,
+    ) -> npt.NDArray[np.int64]: ...
     def interpolate(
         self, values: npt.NDArray[np.float64], lower: List[float], spacing: float, points: npt.NDArray[np.float64]
     ) -> npt.NDArray[np.float64]: ...

@@ -21,9 +21,10 @@ from ._validate import (
 )
 from .grid import Grid
 from .band import BandGeometry, band_neighbours
-from .surface import Surface
+from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
+from ._creases import crease_nodes_to_extend
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -105,6 +106,8 @@ class _PreparedTube:
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray] = (np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0))
     #: where the grid box cuts the tube (``_box_cut.box_cut``), None where it does not
     box_cut: Optional[Dict[str, Any]] = None
+    #: inner-tube nodes at creases made extension nodes (``_creases.crease_nodes_to_extend``)
+    crease_extended: int = 0
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -278,11 +281,20 @@ def _check_surface_spans_two_cells(
 
 
 def _prepare_tube(
-    surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool, reusable: bool = False
+    surf: Surface,
+    grid: Grid,
+    inner: float,
+    outer: float,
+    method: str,
+    keep_geometry: bool,
+    reusable: bool = False,
+    creases: bool = False,
 ) -> _PreparedTube:
     """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
     single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
-    keeps the geometry unmodified for many solves (:class:`Tube`)."""
+    keeps the geometry unmodified for many solves (:class:`Tube`). ``creases`` (a level set, the
+    two-layer method): the inner-tube nodes on the overlap side of a crease become extension
+    nodes (``_creases.crease_nodes_to_extend``; ``order=2`` and ``"auto"``)."""
     t0 = time.perf_counter()
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
@@ -394,6 +406,12 @@ def _prepare_tube(
             _widening_message(missing, phi, h, inner, outer_eff), RuntimeWarning, stacklevel=user_stacklevel()
         )
         outer_eff += 1.0
+    extended = np.empty(0, np.int64)
+    if creases and method == "two-layer" and isinstance(surf, LevelSet):
+        extended = crease_nodes_to_extend(
+            band, roles == ROLE_INNER, phi, direction if direction is not None else geom.direction, h
+        )
+        roles[extended] = ROLE_OUTER
     # a surface that leaves the grid box: the distances are those of the part inside (warned)
     cut = box_cut(grid, linear, phi, inner_width)
     warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
@@ -423,4 +441,5 @@ def _prepare_tube(
         time.perf_counter() - t0,
         facing,
         cut,
+        int(extended.size),
     )

@@ -240,7 +240,7 @@ def solve(
                 )
             _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
             _so.check_widths(inner, outer)
-            tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
+            tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True, creases=True)
             return _so.solve_on_tube(
                 tube,
                 src,
