@@ -87,8 +87,18 @@ pub fn crease_ridge_nodes<const D: usize>(
     let mut marked = vec![false; k_nodes];
     for a in 0..k_nodes {
         let pa = phi[a] as f64;
+        let s = if pa < 0.0 { -1.0 } else { 1.0 };
         for (k, pair) in band.neighbours_of(a).iter().enumerate() {
             let (m, p) = (pair[0], pair[1]);
+            // two neighbours off the surface on one side whose normals turn and converge
+            if p != sentinel && (phi[p as usize] as f64) * pa > 0.0 {
+                let (na, np) = (normal(a), normal(p as usize));
+                let turn: f64 = (0..D).map(|c| na[c] * np[c]).sum();
+                if turn < cos_turn && s * (np[k] - na[k]) < 0.0 {
+                    marked[a] = true;
+                    marked[p as usize] = true;
+                }
+            }
             if m == sentinel || p == sentinel {
                 continue;
             }
@@ -102,7 +112,6 @@ pub fn crease_ridge_nodes<const D: usize>(
                 continue;
             }
             // away from the surface on a's side: sgn(φ(a))·n
-            let s = if pa < 0.0 { -1.0 } else { 1.0 };
             let (nm, np) = (normal_beyond(m, k, 0), normal_beyond(p, k, 1));
             let turn: f64 = (0..D).map(|c| nm[c] * np[c]).sum();
             if turn < cos_turn && s * (np[k] - nm[k]) < 0.0 {
@@ -111,7 +120,8 @@ pub fn crease_ridge_nodes<const D: usize>(
             }
         }
     }
-    let reach = RIDGE_REACH * spacing;
+    // (φ comes in single precision: a node at half a spacing stays)
+    let reach = RIDGE_REACH * spacing * (1.0 + 1e-5);
     let mut out = Vec::new();
     for b in 0..k_nodes {
         if !inner[b] || (phi[b] as f64).abs() <= reach {
