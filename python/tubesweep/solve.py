@@ -154,7 +154,8 @@ def solve(
         Lax–Friedrichs, flows and Hamiltonian objects, ``method="naive"``, ``paper_sweeps``,
         ``source_init="node"``, ``source_radius`` and ``outer < inner + 2`` are refused with a
         ``ValueError`` saying why. ``"auto"`` runs 2 where it applies (the same values) and where it
-        does not the first-order scheme (the same values as ``order=1``), with
+        does not the first-order scheme (the same values as ``order=1``, except that at a level
+        set's creases the inner tube is thinned, as for 2: docs/second-order.md), with
         ``sol.stats.order_fallback`` holding the text of the error ``order=2`` gives
         (``sol.stats.order`` says which ran).
     paper_sweeps : bool
