@@ -91,7 +91,9 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
         # the inner tube thinned at the creases (order=1 keeps the paper's): fewer inner nodes
         # (10,636 → 10,528 at N = 61), the front later on the whole by the shortcut they gave
         assert np.count_nonzero(auto.inner_mask) < np.count_nonzero(one.inner_mask)
-        change = auto.values - one.values
+        both = np.isfinite(auto.values) & np.isfinite(one.values)
+        assert np.array_equal(both, np.isfinite(one.values))
+        change = auto.values[both] - one.values[both]
         assert np.mean(change) > 0 and np.max(np.abs(change)) < 5 * grid.spacing
     else:
         assert np.array_equal(auto.values, one.values)
@@ -100,7 +102,9 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
         opts = {k: v for k, v in kw.items() if k not in ("inner", "outer", "method", "max_iterations")}
         for _ in range(2):  # the second time from the refusal the tube remembers
             t = tube.solve([src], order="auto", **opts)
-            assert t.stats.order_fallback == reason and np.array_equal(t.values, one.values)
+            # (a Tube's inner tube is the paper's at creases too: its refusal counts those nodes)
+            assert t.stats.order_fallback == reason or words == "crease" and words in t.stats.order_fallback
+            assert np.array_equal(t.values, one.values)
 
 
 def test_source_radius_is_first_order():
