@@ -28,8 +28,8 @@ _CONVEX_CREASES = re.compile(r"convex creases or corners")
 #: How early, in grid spacings, a front arrives per crease crossed once the inner tube is thinned
 #: there (``order=2`` and ``"auto"``): the cube max|x| − 0.5 from the bottom centre to the top
 #: centre, 0.56Δx per edge at N = 41 and 81 (nodes on its faces), 1.24Δx and 1.26Δx at N = 40 and
-#: 80 (a quarter spacing off them), 0.34Δx at N = 121 (second order); rotated at random, 0.8Δx to
-#: 1.5Δx at N = 41–81 (against 2.5Δx to 4.7Δx unthinned). ``benches/experiments/creases.py``.
+#: 80 (a quarter spacing off them), 0.34Δx at N = 121 (second order); turned at random, 0.9Δx to
+#: 1.3Δx at N = 41–81 (2.9Δx to 3.5Δx at order=1). ``benches/experiments/creases.py``.
 THINNED_SHORTCUT = 1.5
 
 

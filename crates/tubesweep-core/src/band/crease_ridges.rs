@@ -25,8 +25,12 @@
 //! where they lie farther than [`RIDGE_REACH`] grid spacings from the surface; the nodes nearer
 //! it stay in the inner tube and carry the front across the crease. On the cube max|x| − 0.5
 //! (bottom centre to top centre, exact 2.0) this takes the shortcut per edge from 4.25Δx and
-//! 4.42Δx (N = 41, 81) to 0.56Δx (`benches/experiments/creases.py`). A smooth surface has no
-//! ridge node within its inner tube, so its tube is unchanged.
+//! 4.42Δx (N = 41, 81) to 0.56Δx, and on the cube turned at random to 0.9–1.3Δx
+//! (`benches/experiments/creases.py`). A ridge counts only where it comes within
+//! [`RIDGE_SEED`] spacings of the surface, as a crease's does, and where the faces' normals
+//! persist a step beyond the pair (a spike of noise turns one node's): the medial surface of a
+//! smooth surface the grid barely resolves (the torus 0.5/0.2 at N = 41) lies deeper, so a smooth
+//! surface's tube is unchanged (none on the sphere, torus and ellipsoid at N = 41–121).
 
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
