@@ -81,7 +81,10 @@ def two_spheres(sizes: list) -> None:
     crease = np.c_[0.3 + 0 * ph, 0.4 * np.cos(ph), 0.4 * np.sin(ph)]
     to_crease = 0.5 * np.arccos(np.clip(-crease[:, 0] / 0.5, -1, 1))
     exact = np.array(
-        [np.min(to_crease + 0.5 * np.arccos(np.clip((crease - [0.6, 0, 0]) @ (p - [0.6, 0, 0]) / 0.25, -1, 1))) for p in pts]
+        [
+            np.min(to_crease + 0.5 * np.arccos(np.clip((crease - [0.6, 0, 0]) @ (p - [0.6, 0, 0]) / 0.25, -1, 1)))
+            for p in pts
+        ]
     )
     for n in sizes:
         g = _box(n, (1.6, 1.0, 1.0))

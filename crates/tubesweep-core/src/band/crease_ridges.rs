@@ -67,7 +67,10 @@ pub fn crease_ridge_nodes<const D: usize>(
     if inner.len() != k_nodes || phi.len() != k_nodes || direction.len() != D * k_nodes {
         return Err(Error::invalid(
             "inner, phi, direction",
-            format!("expected {k_nodes} entries each ({} directions), one per band node", D * k_nodes),
+            format!(
+                "expected {k_nodes} entries each ({} directions), one per band node",
+                D * k_nodes
+            ),
         ));
     }
     if !(spacing > 0.0 && spacing.is_finite()) {
@@ -141,7 +144,9 @@ pub fn crease_ridge_nodes<const D: usize>(
     // surface of a smooth surface the grid barely resolves, the torus 0.5/0.2 at N = 41) are left
     let seed = RIDGE_SEED * spacing * (1.0 + 1e-5);
     let mut kept = vec![false; k_nodes];
-    let mut stack: Vec<usize> = (0..k_nodes).filter(|&a| marked[a] && (phi[a] as f64).abs() <= seed).collect();
+    let mut stack: Vec<usize> = (0..k_nodes)
+        .filter(|&a| marked[a] && (phi[a] as f64).abs() <= seed)
+        .collect();
     for &a in &stack {
         kept[a] = true;
     }
@@ -162,9 +167,11 @@ pub fn crease_ridge_nodes<const D: usize>(
             continue;
         }
         let near = marked[b]
-            || band.neighbours_of(b).iter().flatten().any(|&a| {
-                a != sentinel && marked[a as usize] && phi[a as usize] as f64 * phi[b] as f64 > 0.0
-            });
+            || band
+                .neighbours_of(b)
+                .iter()
+                .flatten()
+                .any(|&a| a != sentinel && marked[a as usize] && phi[a as usize] as f64 * phi[b] as f64 > 0.0);
         if near {
             out.push(b);
         }
