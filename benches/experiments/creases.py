@@ -1,15 +1,16 @@
 """Creases: how early a front arrives after crossing one, with the inner tube thinned at creases
 (``order="auto"`` and 2: ``tubesweep_core::band::crease_ridges``) and without it (``order=1``, the
-paper's scheme). docs/second-order.md, "Creases and corners".
+paper's scheme). docs/second-order.md, "What order=2 needs".
 
 The cube max|x| − 0.5 on [−1, 1]³, source at the bottom centre: the top centre (exact 2.0, two
 edges crossed) and the centre of a side face (exact 1.0, one edge), the shortcut per edge in grid
-spacings; N odd puts nodes on the faces, N even a quarter spacing off them. Two spheres of radius
+spacings; N odd puts nodes on the faces, N even a quarter spacing off them. The cube of
+half-width 0.45 turned at random, the same path, against ``order=1``. Two spheres of radius
 0.5 joined by ``min`` (centres 0 and 0.6: a concave crease circle, its normals 74° apart), source
 (−0.5, 0, 0): the mean error on the far sphere's meridian up to 0.1 before the crease, against
 the great-circle distance through the crease circle::
 
-    .venv/bin/python benches/experiments/creases.py            # N = 40, 41, 80, 81, 121; about a minute
+    .venv/bin/python benches/experiments/creases.py            # N = 40–121; under a minute
     .venv/bin/python benches/experiments/creases.py --quick    # N = 41
 """
 

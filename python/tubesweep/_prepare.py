@@ -406,12 +406,6 @@ def _prepare_tube(
             _widening_message(missing, phi, h, inner, outer_eff), RuntimeWarning, stacklevel=user_stacklevel()
         )
         outer_eff += 1.0
-    extended = np.empty(0, np.int64)
-    if creases and method == "two-layer" and isinstance(surf, LevelSet):
-        extended = crease_nodes_to_extend(
-            band, roles == ROLE_INNER, phi, direction if direction is not None else geom.direction, h
-        )
-        roles[extended] = ROLE_OUTER
     # a surface that leaves the grid box: the distances are those of the part inside (warned)
     cut = box_cut(grid, linear, phi, inner_width)
     warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
@@ -426,6 +420,13 @@ def _prepare_tube(
         kink,
         float(getattr(surf, "_noise", 0.0)),
     )
+    # (after the facing test, which reads the paper's inner tube)
+    extended = np.empty(0, np.int64)
+    if creases and method == "two-layer" and isinstance(surf, LevelSet):
+        extended = crease_nodes_to_extend(
+            band, roles == ROLE_INNER, phi, direction if direction is not None else geom.direction, h
+        )
+        roles[extended] = ROLE_OUTER
     return _PreparedTube(
         grid,
         surf,
