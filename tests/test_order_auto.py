@@ -87,13 +87,27 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
     auto = ts.solve(surface, grid, [src], order="auto", **kw)
     assert auto.stats.order == 1 and one.stats.order == 1
     assert auto.stats.order_fallback == reason and one.stats.order_fallback is None
-    assert np.array_equal(auto.values, one.values)
+    if words == "crease":
+        # the inner tube thinned at the creases (order=1 keeps the paper's): fewer inner nodes
+        # (10,636 → 10,528 at N = 61), the front later on the whole by the shortcut they gave
+        assert np.count_nonzero(auto.inner_mask) < np.count_nonzero(one.inner_mask)
+        both = np.isfinite(auto.values) & np.isfinite(one.values)
+        assert np.array_equal(both, np.isfinite(one.values))
+        change = auto.values[both] - one.values[both]
+        assert np.mean(change) > 0 and np.max(np.abs(change)) < 5 * grid.spacing
+    else:
+        assert np.array_equal(auto.values, one.values)
     if kw.get("method") != "naive":
         tube = ts.Tube(surface, grid, **{k: v for k, v in kw.items() if k in ("inner", "outer")})
         opts = {k: v for k, v in kw.items() if k not in ("inner", "outer", "method", "max_iterations")}
         for _ in range(2):  # the second time from the refusal the tube remembers
             t = tube.solve([src], order="auto", **opts)
-            assert t.stats.order_fallback == reason and np.array_equal(t.values, one.values)
+            # a Tube's "auto" runs on the same tube as ts.solve's (thinned at creases): the same
+            # refusal and the same values
+            assert t.stats.order_fallback == auto.stats.order_fallback
+            assert np.array_equal(t.values, auto.values)
+        # order=1 on the Tube keeps the paper's tube
+        assert np.array_equal(tube.solve([src], order=1, **opts).values, one.values)
 
 
 def test_source_radius_is_first_order():

@@ -5,7 +5,8 @@ Noise: φ = |x| − 0.5 + noise·N(0, 1) on [−1, 1]³, source (−0.5, 0, 0), 
 meridian z = 0, y > 0 against the great-circle distance, at order 2 (the default) and 1, with
 ``order2["geometry_fitted"]`` (the fits over three grid steps at every node) and the first-order
 nodes. Creases: the cube max|x| − 0.5 from the bottom centre to the top centre (exact 2.0), the
-shortcut per edge measured against the one the warning says (2·tan(θ/2)·inner·Δx)::
+shortcut per edge measured against the one the warning says (up to 1.5Δx with the inner tube thinned at creases;
+benches/experiments/creases.py has the figures)::
 
     .venv/bin/python benches/experiments/noisy_level_sets.py            # N = 61 and 121, about a minute
     .venv/bin/python benches/experiments/noisy_level_sets.py --quick    # N = 61

@@ -1,12 +1,16 @@
 """Creases and corners of a level set: the shortcut the tube allows across them, said in a
-warning with its size (crates/tubesweep-core/src/second_order/creases.rs).
+warning with its size (crates/tubesweep-core/src/second_order/creases.rs), and the inner-tube
+nodes there that become extension nodes (crates/tubesweep-core/src/band/crease_ridges.rs).
 
 In the tube the paper's equation lets the front move along the normal for free, so where the
 tubes of a crease's two faces overlap a path runs up one face's normal and down the other's: the
 front arrives early by about ``2·inner·Δx·tan(θ/2)`` per crease it crosses (θ the angle between
-the faces' normals), whatever the order: the cube ``max|x| − 0.5`` at N = 81, bottom centre to top
-centre, 1.78 instead of 2.0. That error is first order in Δx; rounding the edges over a few grid
-spacings removes it.
+the faces' normals) in the paper's tube (``order=1``): the cube ``max|x| − 0.5`` at N = 81, bottom
+centre to top centre, 1.78 instead of 2.0. With ``order=2`` and ``"auto"`` the inner tube is
+thinned there (its nodes on the overlap side beyond half a spacing take their values from their
+closest points), which leaves about one spacing per crease crossed
+(:data:`THINNED_SHORTCUT`; ``benches/experiments/creases.py``). Either is first order in Δx;
+rounding the edges over a few grid spacings removes it.
 """
 
 from __future__ import annotations
@@ -15,9 +19,18 @@ import re
 import warnings
 from typing import Any, Optional
 
+import numpy as np
+
 from ._warn import user_stacklevel
 
-_PER_INNER_WIDTH = re.compile(r"about ([0-9.]+)·inner·Δx per crease")
+_CONVEX_CREASES = re.compile(r"convex creases or corners")
+
+#: How early, in grid spacings, a front arrives per crease crossed once the inner tube is thinned
+#: there (``order=2`` and ``"auto"``): the cube max|x| − 0.5 from the bottom centre to the top
+#: centre, 0.56Δx per edge at N = 41 and 81 (nodes on its faces), 1.24Δx and 1.26Δx at N = 40 and
+#: 80 (a quarter spacing off them), 0.34Δx at N = 121 (second order); turned at random, 0.9Δx to
+#: 1.3Δx at N = 41–81 (2.9Δx to 3.5Δx at order=1). ``benches/experiments/creases.py``.
+THINNED_SHORTCUT = 1.5
 
 
 def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
@@ -30,13 +43,13 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float) -> None:
     """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``)."""
     if not creases or not creases.get("nodes"):
         return
-    size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
+    size = THINNED_SHORTCUT * float(spacing)
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
         f"{creases['angle_degrees']:.0f}°): a front that crosses one arrives early by up to about {size:.3g} "
-        f"(2·tan(θ/2)·inner·Δx, first order in Δx), and the nodes there run the first-order update. "
-        "sol.first_order_points() shows where; rounding the edges over a few grid spacings, or a finer grid, "
-        "reduces it",
+        f"({THINNED_SHORTCUT:g}·Δx with the inner tube thinned there, first order in Δx), and the nodes there run the "
+        "first-order update. sol.first_order_points() shows where; rounding the edges over a few grid spacings, or a "
+        "finer grid, reduces it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
@@ -44,16 +57,30 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float) -> None:
 
 def warn_refused_creases(reason: str, inner: float, spacing: float) -> None:
     """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases
-    (the refusal's ``reason`` gives the shortcut in units of inner·Δx)."""
-    found: Any = _PER_INNER_WIDTH.search(reason)
-    if found is None:
+    (on the tube thinned at them: :data:`THINNED_SHORTCUT`)."""
+    if _CONVEX_CREASES.search(reason) is None:
         return
-    size = shortcut(float(found.group(1)), inner, spacing)
+    size = THINNED_SHORTCUT * float(spacing)
     warnings.warn(
         f"order=1 ran: φ's level sets have convex creases or corners over much of the tube, where a front cuts the "
-        f"corner and arrives early by about {size:.3g} per crease it crosses (2·tan(θ/2)·inner·Δx, first order in Δx, "
-        "whatever the order). sol.stats.order_fallback says more; round the edges over a few grid spacings for "
-        "second order and no shortcut",
+        f"corner and arrives early by up to about {size:.3g} per crease it crosses ({THINNED_SHORTCUT:g}·Δx with the "
+        f"inner tube thinned there, 2·tan(θ/2)·inner·Δx without: first order in Δx). sol.stats.order_fallback says "
+        "more; round the edges over a few grid spacings for second order and no shortcut",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
+    )
+
+
+def crease_nodes_to_extend(
+    band: Any, inner: np.ndarray, phi: np.ndarray, direction: np.ndarray, spacing: float
+) -> np.ndarray:
+    """The band positions of the inner-tube nodes (``inner``) on the overlap side of a crease,
+    farther than half a spacing from the surface (``tubesweep_core::band::crease_ridges``): as
+    extension nodes their values come from their closest points, and the front no longer cuts the
+    corner through them. A smooth surface has none."""
+    return band.crease_ridge_nodes(
+        np.ascontiguousarray(inner, dtype=bool),
+        np.ascontiguousarray(phi, dtype=np.float32),
+        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(inner), -1),
+        float(spacing),
     )

@@ -267,6 +267,13 @@ class Band:
         spacing: float,
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
     def neighbours_of_nodes(self, positions: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
+    def crease_ridge_nodes(
+        self,
+        inner: npt.NDArray[np.bool_],
+        phi: npt.NDArray[np.float32],
+        direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
+        spacing: float,
+    ) -> npt.NDArray[np.int64]: ...
     def medial_edges(
         self,
         inner: npt.NDArray[np.bool_],

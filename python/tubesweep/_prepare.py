@@ -21,9 +21,10 @@ from ._validate import (
 )
 from .grid import Grid
 from .band import BandGeometry, band_neighbours
-from .surface import Surface
+from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
+from ._creases import crease_nodes_to_extend
 from ._shortcuts import cut_shortcuts, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
@@ -109,6 +110,10 @@ class _PreparedTube:
     #: the edges of the band's neighbour table removed across narrow gaps and medial edges
     #: (``_shortcuts.cut_shortcuts``; triangle meshes only)
     cut_edges: int = 0
+    #: the inner-tube nodes at creases that second order (and ``order="auto"``) makes extension
+    #: nodes (``_creases.crease_nodes_to_extend``; band positions); their roles are changed only
+    #: by :func:`thinned_at_creases`, so that ``order=1`` keeps the paper's tube
+    crease_nodes: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0, np.int64))
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -117,6 +122,17 @@ class _PreparedTube:
 _BAND_BYTES_PER_NODE = 110
 # Points per axis (along the box's longest side) of the coarse sample that estimates the band.
 _BAND_ESTIMATE_POINTS = 17
+
+
+def thinned_at_creases(tube: _PreparedTube) -> _PreparedTube:
+    """``tube`` with its crease nodes (``_PreparedTube.crease_nodes``) made extension nodes: the
+    tube of ``order=2`` and of ``order="auto"`` on a level set with creases (docs/second-order.md).
+    ``tube`` itself when it has none; otherwise a copy sharing everything but the roles."""
+    if tube.crease_nodes.size == 0:
+        return tube
+    roles = tube.roles.copy()
+    roles[tube.crease_nodes] = ROLE_OUTER
+    return dataclasses.replace(tube, roles=roles)
 
 
 def uncut_band(tube: _PreparedTube) -> Any:
@@ -305,11 +321,21 @@ def _check_surface_spans_two_cells(
 
 
 def _prepare_tube(
-    surf: Surface, grid: Grid, inner: float, outer: float, method: str, keep_geometry: bool, reusable: bool = False
+    surf: Surface,
+    grid: Grid,
+    inner: float,
+    outer: float,
+    method: str,
+    keep_geometry: bool,
+    reusable: bool = False,
+    creases: bool = False,
 ) -> _PreparedTube:
     """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
     single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
-    keeps the geometry unmodified for many solves (:class:`Tube`)."""
+    keeps the geometry unmodified for many solves (:class:`Tube`). ``creases`` (a level set given
+    as a distance, the two-layer method): the inner-tube nodes on the overlap side of a crease are
+    found (``_creases.crease_nodes_to_extend``), for :func:`thinned_at_creases` to make them
+    extension nodes (``order=2`` and ``"auto"``); the roles themselves stay the paper's."""
     t0 = time.perf_counter()
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
@@ -432,6 +458,11 @@ def _prepare_tube(
     cut_edges = 0
     if cuts:
         band, cut_edges = cut_shortcuts(band, roles == ROLE_INNER, phi, directions, h, facing)
+    # (after the facing test, which reads the paper's inner tube); not on a re-distanced φ, whose
+    # kinks are those of its samples (a voxel mask's staircase), not creases of the surface
+    extended = np.empty(0, np.int64)
+    if creases and method == "two-layer" and isinstance(surf, LevelSet) and not getattr(surf, "redistance", False):
+        extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)
     return _PreparedTube(
         grid,
         surf,
@@ -448,4 +479,5 @@ def _prepare_tube(
         facing,
         cut,
         cut_edges,
+        extended,
     )

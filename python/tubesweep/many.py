@@ -32,6 +32,7 @@ from ._validate import (
 )
 from ._prepare import ROLE_INNER, uncut_band, warn_facing_pairs
 from ._sheet_readout import own_side_plan
+from ._creases import warn_refused_creases
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .many_order2 import renamed, solve_many_order2
 from . import second_order as so
@@ -83,12 +84,13 @@ def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
 
 
 def fixed_nodes(
-    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str, uncut: Any = None
+    tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str, uncut: Any = None, order: Any = 1
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The band positions and values each source fixes, concatenated, and the offsets (K + 1,)
     of each source's run: ``_fix_sources`` of a single solve, source by source. ``uncut``: the
-    band before its cut (``_prepare.uncut_band``; the Lax–Friedrichs scheme), to fix them on."""
-    t = tube._tube
+    band before its cut (``_prepare.uncut_band``; the Lax–Friedrichs scheme), to fix them on;
+    ``order`` other than 1: on the tube thinned at creases (``Tube._tube_order2``)."""
+    t = tube._tube if order == 1 else tube._tube_order2
     band, connected = (uncut, False) if uncut is not None else (t.band, t.cut_edges > 0)
     grid, surf = t.grid, t.surface
     inner_width = t.inner * grid.spacing
@@ -205,6 +207,8 @@ def solve_many(
             if order == 2:
                 raise
             fallback = str(e)  # order="auto": the first-order scheme, the reason in the stats
+    if order != 1:
+        t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
     linear = t.linear
     x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
@@ -217,7 +221,7 @@ def solve_many(
     band = uncut_band(t) if uncut else t.band
     if uncut:
         warn_facing_pairs(grid, t.linear, t.roles, t.facing, t.inner)
-    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init, band if uncut else None)
+    positions, values, offsets = fixed_nodes(tube, groups, speed, source_init, band if uncut else None, order)
     # on a band cut across narrow gaps, points next to a gap read from their own side: the values
     # at their cells' corners come back as extra points
     plan = None
@@ -251,6 +255,8 @@ def solve_many(
         None if points is None else [float(v) for v in grid.lower],
     )
     del directions
+    if fallback is not None:
+        warn_refused_creases(fallback, t.inner, h)
     if plan is not None:
         m = len(points)  # type: ignore[arg-type]
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])

@@ -52,7 +52,7 @@ def solve_many_order2(
     """The second-order batch (see the module's documentation): ``(values, stats)``, values
     ``(K, band_points)`` or ``(K, M)`` at ``points``. Raises :class:`second_order.Order2NotApplicable`
     where ``order=2`` does not apply to the tube (the caller falls back under ``order="auto"``)."""
-    t = tube._tube
+    t = tube._tube_order2  # thinned at a level set's creases, as ts.solve's
     grid, surf = t.grid, t.surface
     h = grid.spacing
     d = grid.ndim

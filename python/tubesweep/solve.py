@@ -36,6 +36,7 @@ from ._prepare import (
     ROLE_RTOL,
     _PreparedTube,
     _prepare_tube,
+    thinned_at_creases,
     uncut_band,
     warn_facing_pairs,
 )
@@ -164,7 +165,8 @@ def solve(
         Lax–Friedrichs, flows and Hamiltonian objects, ``method="naive"``, ``paper_sweeps``,
         ``source_init="node"``, ``source_radius`` and ``outer < inner + 2`` are refused with a
         ``ValueError`` saying why. ``"auto"`` runs 2 where it applies (the same values) and where it
-        does not the first-order scheme (the same values as ``order=1``), with
+        does not the first-order scheme (the same values as ``order=1``, except that at a level
+        set's creases the inner tube is thinned, as for 2: docs/second-order.md), with
         ``sol.stats.order_fallback`` holding the text of the error ``order=2`` gives
         (``sol.stats.order`` says which ran).
     paper_sweeps : bool
@@ -250,7 +252,7 @@ def solve(
                 )
             _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
             _so.check_widths(inner, outer)
-            tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=True)
+            tube = thinned_at_creases(_prepare_tube(surf, grid, inner, outer, method, keep_geometry=True, creases=True))
             return _so.solve_on_tube(
                 tube,
                 src,

@@ -29,7 +29,7 @@ import numpy as np
 
 from ._validate import as_grid, as_sources, check_tolerance, progress_callback
 from .grid import Grid
-from ._prepare import _prepare_tube
+from ._prepare import _prepare_tube, thinned_at_creases
 from .solution import Solution
 from .solve import DEFAULT_TOL, _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
@@ -92,7 +92,11 @@ class Tube:
         self.grid: Grid = as_grid(grid)
         self.surface: Surface = as_surface(surface)
         self.surface.check_grid(self.grid)
-        self._tube = _prepare_tube(self.surface, self.grid, inner, outer, method, keep_geometry=True, reusable=True)
+        self._tube = _prepare_tube(
+            self.surface, self.grid, inner, outer, method, keep_geometry=True, reusable=True, creases=True
+        )
+        # the tube of order=2 and "auto": at a level set's creases thinned (the same roles as ts.solve's)
+        self._tube_order2 = thinned_at_creases(self._tube)
         # a φ array is used in place, not copied: its values at the band's nodes, kept to notice
         # a change before a later solve projects sources on the changed array (O(band) per solve)
         array = getattr(self.surface, "_array", None)
@@ -227,7 +231,7 @@ class Tube:
                     raise _so.Order2NotApplicable(self._order2_refusal)
                 try:
                     return _so.solve_on_tube(
-                        self._tube,
+                        self._tube_order2,
                         src,
                         speed,
                         None if tol == DEFAULT_TOL else tol,
@@ -251,7 +255,7 @@ class Tube:
             raise refusal_for_order1(fallback)
         _check_source_radius(source_radius, source_init, self.grid)
         sol = _solve_on_tube(
-            self._tube,
+            self._tube if order == 1 else self._tube_order2,
             src,
             general,
             scheme,
@@ -268,8 +272,10 @@ class Tube:
             source_radius=source_radius,
         )
         if fallback is not None:
+            from ._creases import warn_refused_creases
             from .second_order import with_fallback
 
+            warn_refused_creases(fallback, self._tube.inner, self.grid.spacing)
             return with_fallback(sol, fallback)
         return sol
 

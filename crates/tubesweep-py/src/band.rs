@@ -285,6 +285,32 @@ impl PyBand {
         Ok((node.into_pyarray(py), neighbour.into_pyarray(py), gap.into_pyarray(py)))
     }
 
+    /// The inner-tube nodes on the overlap side of a crease that become extension nodes (see
+    /// `tubesweep_core::band::crease_ridges`): `inner` per node, `phi` φ (signed), `direction`
+    /// (K, d) the outward directions. Returns their band positions.
+    fn crease_ridge_nodes<'py>(
+        &self,
+        py: Python<'py>,
+        inner: PyReadonlyArray1<'py, bool>,
+        phi: PyReadonlyArray1<'py, f32>,
+        direction: PyReadonlyArray2<'py, f32>,
+        spacing: f64,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let d = self.ndim();
+        if direction.shape()[1] != d {
+            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
+        }
+        let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
+        let nodes = py
+            .detach(|| match &self.band {
+                AnyBand::D2(b) => tubesweep_core::band::crease_ridges::crease_ridge_nodes(b, inn, ph, dir, spacing),
+                AnyBand::D3(b) => tubesweep_core::band::crease_ridges::crease_ridge_nodes(b, inn, ph, dir, spacing),
+            })
+            .map_err(to_pyerr)?;
+        let out: Vec<i64> = nodes.iter().map(|&n| n as i64).collect();
+        Ok(out.into_pyarray(py))
+    }
+
     /// The edges between neighbours whose closest points lie more than `jump` grid spacings
     /// apart, one of them in the inner tube (`tubesweep_core::band::medial_edges`): `inner` per
     /// node, `phi` its signed or unsigned distance, `direction` (K, d) its outward direction.

@@ -100,9 +100,9 @@ pub fn check_geometry_of(
                     "order=2: {} of the {} inner-tube nodes ({share:.0}%) lie at convex creases or corners of φ's level \
                      sets or next to them (a principal curvature with outer·Δx·κ ≥ 1; {} crease nodes, the normal \
                      turning by up to {:.0}°), where the inner tube lets the front cut the corner by about \
-                     {:.2}·inner·Δx per crease it crosses whatever the order (2·tan(θ/2); the cube max|x| − 0.5 at \
-                     N = 81: 1.78 instead of 2.0), and the second-order update next to them came out no better. Round \
-                     the edges over a few grid spacings for second order; use order=1",
+                     {:.2}·inner·Δx per crease it crosses (2·tan(θ/2); about 1.5Δx where the inner tube is thinned \
+                     at them, order=\"auto\"), and the second-order update next to them came out no better. Round \
+                     the edges over a few grid spacings for second order; use order=1 (or \"auto\")",
                     summary.unresolved_curvature,
                     summary.inner_nodes,
                     summary.creases.nodes,
