@@ -268,11 +268,7 @@ impl PyBand {
         Bound<'py, PyArray1<i64>>,
         Bound<'py, PyArray1<f64>>,
     )> {
-        let d = self.ndim();
-        if direction.shape()[1] != d {
-            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
-        }
-        let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
+        let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
         let pairs = py
             .detach(|| match &self.band {
                 AnyBand::D2(b) => tubesweep_core::band::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
@@ -296,11 +292,7 @@ impl PyBand {
         direction: PyReadonlyArray2<'py, f32>,
         spacing: f64,
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let d = self.ndim();
-        if direction.shape()[1] != d {
-            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
-        }
-        let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
+        let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
         let nodes = py
             .detach(|| match &self.band {
                 AnyBand::D2(b) => tubesweep_core::band::crease_ridges::crease_ridge_nodes(b, inn, ph, dir, spacing),
@@ -325,11 +317,7 @@ impl PyBand {
         spacing: f64,
         jump: f64,
     ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>)> {
-        let d = self.ndim();
-        if direction.shape()[1] != d {
-            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
-        }
-        let (inn, ph, dir) = (inner.as_slice()?, phi.as_slice()?, c_slice(&direction, "direction")?);
+        let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
         let edges = py
             .detach(|| match &self.band {
                 AnyBand::D2(b) => tubesweep_core::band::medial_edges::medial_edges(b, inn, ph, dir, spacing, jump),
@@ -594,6 +582,24 @@ impl PyBand {
 }
 
 /// Adds this file's classes and functions to the module.
+impl PyBand {
+    /// The per-node fields of the band's surface tests (`facing_sheet_pairs`, `crease_ridge_nodes`,
+    /// `medial_edges`) as slices: `inner` and `phi` per node, `direction` (K, d) C-ordered. Their
+    /// lengths are checked against the band in the core (`check_node_fields`).
+    fn node_fields<'a>(
+        &self,
+        inner: &'a PyReadonlyArray1<'_, bool>,
+        phi: &'a PyReadonlyArray1<'_, f32>,
+        direction: &'a PyReadonlyArray2<'_, f32>,
+    ) -> PyResult<(&'a [bool], &'a [f32], &'a [f32])> {
+        let d = self.ndim();
+        if direction.shape()[1] != d {
+            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
+        }
+        Ok((inner.as_slice()?, phi.as_slice()?, c_slice(direction, "direction")?))
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBand>()?;
     Ok(())

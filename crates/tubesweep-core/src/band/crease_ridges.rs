@@ -32,8 +32,9 @@
 //! smooth surface the grid barely resolves (the torus 0.5/0.2 at N = 41) lies deeper, so a smooth
 //! surface's tube is unchanged (none on the sphere, torus and ellipsoid at N = 41–121).
 
+use crate::band::facing_sheets::check_node_fields;
 use crate::band::NarrowBand;
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// The second difference of |φ| across a ridge node, in grid spacings (see the module docs).
 pub const RIDGE_SECOND_DIFFERENCE: f64 = 0.75;
@@ -63,19 +64,8 @@ pub fn crease_ridge_nodes<const D: usize>(
     direction: &[f32],
     spacing: f64,
 ) -> Result<Vec<usize>> {
+    check_node_fields(band, inner, phi, direction, spacing)?;
     let k_nodes = band.len();
-    if inner.len() != k_nodes || phi.len() != k_nodes || direction.len() != D * k_nodes {
-        return Err(Error::invalid(
-            "inner, phi, direction",
-            format!(
-                "expected {k_nodes} entries each ({} directions), one per band node",
-                D * k_nodes
-            ),
-        ));
-    }
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(Error::invalid("spacing", "must be a positive finite number"));
-    }
     let sentinel = band.sentinel();
     let cos_turn = RIDGE_ANGLE.to_radians().cos();
     // the normal ∇φ/|∇φ| (the directions are sgn(φ)∇φ/|∇φ|, ∇φ/|∇φ| on the surface)

@@ -62,6 +62,32 @@ pub const MIN_ACROSS: f64 = 1.0;
 /// the two sheets (30°).
 pub const ACROSS_COSINE: f64 = 0.866;
 
+/// Checks the per-node fields that the band's tests of the surface read (facing sheets, medial
+/// edges, crease ridges): one `inner` flag, one `phi` and `D` direction components per node of
+/// `band`, and a positive finite `spacing`.
+pub(crate) fn check_node_fields<const D: usize>(
+    band: &NarrowBand<D>,
+    inner: &[bool],
+    phi: &[f32],
+    direction: &[f32],
+    spacing: f64,
+) -> Result<()> {
+    let k_nodes = band.len();
+    if inner.len() != k_nodes || phi.len() != k_nodes || direction.len() != D * k_nodes {
+        return Err(Error::invalid(
+            "inner, phi, direction",
+            format!(
+                "expected {k_nodes} entries each ({} directions), one per band node",
+                D * k_nodes
+            ),
+        ));
+    }
+    if !(spacing > 0.0 && spacing.is_finite()) {
+        return Err(Error::invalid("spacing", "must be a positive finite number"));
+    }
+    Ok(())
+}
+
 /// A pair of neighbouring band nodes whose closest points lie on two parts of the surface that
 /// face each other across a gap.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,19 +111,8 @@ pub fn facing_sheet_pairs<const D: usize>(
     direction: &[f32],
     spacing: f64,
 ) -> Result<Vec<FacingPair>> {
+    check_node_fields(band, inner, phi, direction, spacing)?;
     let k_nodes = band.len();
-    if inner.len() != k_nodes || phi.len() != k_nodes || direction.len() != D * k_nodes {
-        return Err(Error::invalid(
-            "inner, phi, direction",
-            format!(
-                "expected {k_nodes} entries each ({} directions), one per band node",
-                D * k_nodes
-            ),
-        ));
-    }
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(Error::invalid("spacing", "must be a positive finite number"));
-    }
     let sentinel = band.sentinel();
     let dir = |n: usize| -> [f64; D] { std::array::from_fn(|k| direction[D * n + k] as f64) };
     let dot = |u: &[f64; D], v: &[f64; D]| -> f64 { (0..D).map(|j| u[j] * v[j]).sum() };

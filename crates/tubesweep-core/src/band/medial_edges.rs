@@ -18,6 +18,7 @@
 //! ([`NarrowBand::cut_edges`]) leaves the front the paths along which closest points move
 //! continuously, near the surface.
 
+use crate::band::facing_sheets::check_node_fields;
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
@@ -41,19 +42,8 @@ pub fn medial_edges<const D: usize>(
     spacing: f64,
     jump: f64,
 ) -> Result<Vec<(usize, usize)>> {
+    check_node_fields(band, inner, phi, direction, spacing)?;
     let k_nodes = band.len();
-    if inner.len() != k_nodes || phi.len() != k_nodes || direction.len() != D * k_nodes {
-        return Err(Error::invalid(
-            "inner, phi, direction",
-            format!(
-                "expected {k_nodes} entries each ({} directions), one per band node",
-                D * k_nodes
-            ),
-        ));
-    }
-    if !(spacing > 0.0 && spacing.is_finite()) {
-        return Err(Error::invalid("spacing", "must be a positive finite number"));
-    }
     if !(jump >= 1.0 && jump.is_finite()) {
         return Err(Error::invalid(
             "jump",
