@@ -4,7 +4,7 @@
 //! of the process (all threads; medians of the repeats), the band's size and a hash of its linear
 //! indices, signed distances and directions (equal hashes: the same bits).
 //!
-//!     cargo run --release -p tubesweep-core --example redistance_cost -- [N] [repeats]   # 201 3
+//!     cargo run --release -p tubesweep-core --example redistance_cost -- [N] [repeats] [tol]   # 201 3 1e-12
 //!
 //! For instruction counts, which a busy machine does not change:
 //! `RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no target/release/examples/redistance_cost 101 1`.
@@ -19,12 +19,13 @@ fn cpu_seconds() -> f64 {
 }
 
 fn main() {
-    let args: Vec<usize> = std::env::args()
+    let args: Vec<f64> = std::env::args()
         .skip(1)
-        .map(|a| a.parse().expect("N and repeats"))
+        .map(|a| a.parse().expect("N, repeats and tol"))
         .collect();
-    let n = args.first().copied().unwrap_or(201);
-    let repeats = args.get(1).copied().unwrap_or(3).max(1);
+    let n = args.first().map_or(201, |&v| v as usize);
+    let repeats = args.get(1).map_or(3, |&v| v as usize).max(1);
+    let tol = args.get(2).copied().unwrap_or(1e-12);
     let h = 2.0 / (n - 1) as f64;
     let r2 = |l: usize| {
         let (i, j, k) = (l / (n * n), l / n % n, l % n);
@@ -43,7 +44,7 @@ fn main() {
             half_width: 4.0 * h,
             eps: 0.5 * h,
             max_steps: 40,
-            tol: 1e-12,
+            tol,
         };
         let mut times = Vec::new();
         let mut band = None;
@@ -54,6 +55,13 @@ fn main() {
         }
         times.sort_by(f64::total_cmp);
         let band = band.expect("one repeat at least");
+        // the largest error against the sphere's exact signed distance |x| − R
+        let worst = band
+            .linear
+            .iter()
+            .zip(&band.signed)
+            .map(|(&l, &s)| (s - (r2(l as usize).sqrt() - 0.5)).abs())
+            .fold(0.0f64, f64::max);
         let mut hash = 0xcbf29ce484222325u64;
         let mut mix = |v: u64| hash = (hash ^ v).wrapping_mul(0x100000001b3);
         for (&l, &s) in band.linear.iter().zip(&band.signed) {
@@ -64,11 +72,12 @@ fn main() {
             mix(u64::from(d.to_bits()));
         }
         println!(
-            "N={n} {name:12} band nodes {:8} (unsettled {:6}): CPU {:.3} s, {:.2} µs per band node; hash {hash:016x}",
+            "N={n} {name:12} band nodes {:8} (unsettled {:6}): CPU {:.3} s, {:.2} µs per band node; largest error {:.3e} Δx; hash {hash:016x}",
             band.linear.len(),
             band.unsettled,
             times[repeats / 2],
             times[repeats / 2] * 1e6 / band.linear.len() as f64,
+            worst / h,
         );
     }
 }

@@ -238,11 +238,14 @@ pub(crate) fn edge_crossings<const D: usize>(
 #[derive(Debug, Clone)]
 pub(crate) struct NodeSet {
     pub lattice: Lattice,
-    /// Per row `(i, j)`, the nodes' inclusive intervals `[a, b]` of `k`, sorted and disjoint.
-    rows: Vec<Vec<(u32, u32)>>,
-    /// Per row, the position of its first node among all the set's nodes (C order); one more
-    /// entry at the end, the number of nodes.
-    row_start: Vec<usize>,
+    /// The nodes' inclusive intervals `[a, b]` of `k`, row `(i, j)` after row, sorted and
+    /// disjoint within a row, with the position of each interval's first node among all the set's
+    /// nodes (C order): `(a, b, position)`.
+    intervals: Vec<(u32, u32, usize)>,
+    /// Per row, the index of its first interval in `intervals`; one more entry at the end.
+    row_first: Vec<u32>,
+    /// The number of nodes.
+    count: usize,
 }
 
 /// Sorted, merged inclusive intervals (adjacent ones joined).
@@ -303,31 +306,56 @@ impl NodeSet {
         if !lattice.flat {
             rows = spread(&rows, 0);
         }
-        let mut row_start = Vec::with_capacity(rows.len() + 1);
-        let mut total = 0usize;
+        let mut intervals = Vec::with_capacity(rows.iter().map(Vec::len).sum());
+        let mut row_first = Vec::with_capacity(rows.len() + 1);
+        let mut count = 0usize;
         for row in &rows {
-            row_start.push(total);
-            total += row.iter().map(|&(a, b)| (b - a) as usize + 1).sum::<usize>();
+            row_first.push(u32::try_from(intervals.len()).expect("fewer intervals than 2³²"));
+            for &(a, b) in row {
+                intervals.push((a, b, count));
+                count += (b - a) as usize + 1;
+            }
         }
-        row_start.push(total);
+        row_first.push(u32::try_from(intervals.len()).expect("fewer intervals than 2³²"));
         NodeSet {
             lattice,
-            rows,
-            row_start,
+            intervals,
+            row_first,
+            count,
         }
     }
 
+    /// The intervals of row `row`.
+    #[inline(always)]
+    fn row(&self, row: usize) -> &[(u32, u32, usize)] {
+        &self.intervals[self.row_first[row] as usize..self.row_first[row + 1] as usize]
+    }
+
     pub fn len(&self) -> usize {
-        *self.row_start.last().expect("one entry per row and one more")
+        self.count
     }
 
     /// The nodes' linear indices, sorted.
     pub fn linear(&self) -> Vec<u64> {
         let n2 = self.lattice.dims[2];
         let mut out = Vec::with_capacity(self.len());
-        for (row, intervals) in self.rows.iter().enumerate() {
-            for &(a, b) in intervals {
+        for row in 0..self.row_first.len() - 1 {
+            for &(a, b, _) in self.row(row) {
                 out.extend((a as usize..=b as usize).map(|k| (row * n2 + k) as u64));
+            }
+        }
+        out
+    }
+
+    /// The nodes' `(i, j, k)`, in the set's order (their positions): what [`Lattice::split`] gives
+    /// of [`linear`](Self::linear)'s entries, without a division per node.
+    pub fn coordinates(&self) -> Vec<[u32; 3]> {
+        let n1 = self.lattice.dims[1];
+        let mut out = Vec::with_capacity(self.len());
+        for row in 0..self.row_first.len() - 1 {
+            let (i, j) = ((row / n1) as u32, (row % n1) as u32);
+            for &(a, b, _) in self.row(row) {
+                out.extend((a..=b).map(|k| [i, j, k]));
             }
         }
         out
@@ -336,17 +364,14 @@ impl NodeSet {
     /// The position among the set's nodes of node `(i, j, k)`, if it is one.
     #[inline]
     pub fn position(&self, i: usize, j: usize, k: usize) -> Option<usize> {
-        let row = i * self.lattice.dims[1] + j;
-        let mut at = self.row_start[row];
         let k = k as u32;
-        for &(a, b) in &self.rows[row] {
+        for &(a, b, at) in self.row(i * self.lattice.dims[1] + j) {
             if k < a {
                 return None;
             }
             if k <= b {
                 return Some(at + (k - a) as usize);
             }
-            at += (b - a) as usize + 1;
         }
         None
     }
@@ -363,11 +388,9 @@ impl NodeSet {
     /// is not in the set or beyond the row's ends), in one pass over the row's intervals.
     #[inline]
     fn positions_around(&self, i: usize, j: usize, k: usize) -> [Option<usize>; 3] {
-        let row = i * self.lattice.dims[1] + j;
         let mut out = [None; 3];
-        let mut at = self.row_start[row];
         let (lo, hi) = (k.saturating_sub(1) as u32, (k + 1) as u32);
-        for &(a, b) in &self.rows[row] {
+        for &(a, b, at) in self.row(i * self.lattice.dims[1] + j) {
             if a > hi {
                 break;
             }
@@ -376,7 +399,6 @@ impl NodeSet {
                     out[(m + 1 - k as u32) as usize] = Some(at + (m - a) as usize);
                 }
             }
-            at += (b - a) as usize + 1;
         }
         if k == 0 {
             out[0] = None;

@@ -138,6 +138,30 @@ impl<'a, const D: usize> SampledField<'a, D> {
     /// being constant there). At a cell face it is the derivative of the cell `value` reads.
     #[inline]
     pub(crate) fn value_and_gradient(&self, p: &[f64; D]) -> (f64, [f64; D]) {
+        let (base, frac, inside) = self.cell_of(p);
+        self.value_and_gradient_in(&base, &frac, &inside)
+    }
+
+    /// φ at `p` and its exact gradient ([`value_and_gradient`](Self::value_and_gradient)) and,
+    /// when `wanted(φ, ∇φ)`, the [`half_step_gradient`](Self::half_step_gradient) there, in one
+    /// location of `p` (the same bits as the separate calls).
+    #[inline]
+    pub(crate) fn value_gradient_and_half_step_if(
+        &self,
+        p: &[f64; D],
+        wanted: impl FnOnce(f64, &[f64; D]) -> bool,
+    ) -> (f64, [f64; D], Option<[f64; D]>) {
+        let (base, frac, inside) = self.cell_of(p);
+        let (v, g) = self.value_and_gradient_in(&base, &frac, &inside);
+        let half_step = wanted(v, &g).then(|| self.half_step_gradient_in(&base, &frac));
+        (v, g, half_step)
+    }
+
+    /// The cell that holds `p` (clamped to the grid), the fractions of `p` in it (clamped to
+    /// [0, 1]) and, per axis, whether `p` lies within the grid along it (the location of
+    /// [`locate`](Self::locate)).
+    #[inline(always)]
+    fn cell_of(&self, p: &[f64; D]) -> ([usize; D], [f64; D], [bool; D]) {
         let mut base = [0usize; D];
         let mut frac = [0.0f64; D];
         let mut inside = [true; D];
@@ -149,6 +173,13 @@ impl<'a, const D: usize> SampledField<'a, D> {
             inside[k] = (0.0..=1.0).contains(&f);
             frac[k] = f.clamp(0.0, 1.0);
         }
+        (base, frac, inside)
+    }
+
+    /// The value and exact gradient of the cell `base`'s interpolant at the fractions `frac`
+    /// ([`value_and_gradient`](Self::value_and_gradient)).
+    #[inline(always)]
+    fn value_and_gradient_in(&self, base: &[usize; D], frac: &[f64; D], inside: &[bool; D]) -> (f64, [f64; D]) {
         let origin: usize = (0..D).map(|k| base[k] * self.stride[k]).sum();
         // the corners (bit k of the corner: a step along axis k), reduced one axis at a time by
         // linear interpolation, carrying the differences along the axes already reduced
@@ -253,11 +284,19 @@ impl<'a, const D: usize> SampledField<'a, D> {
     #[inline]
     pub(crate) fn half_step_gradient(&self, y: &[f64; D]) -> [f64; D] {
         let mut base = [0usize; D];
+        let mut frac = [0.0f64; D];
+        for k in 0..D {
+            (base[k], frac[k]) = self.locate(k, y[k]);
+        }
+        self.half_step_gradient_in(&base, &frac)
+    }
+
+    /// [`half_step_gradient`](Self::half_step_gradient) at the fractions `frac` of the cell `base`.
+    #[inline(always)]
+    fn half_step_gradient_in(&self, base: &[usize; D], frac: &[f64; D]) -> [f64; D] {
         let mut factor = [[0.0f64; 2]; D]; // 1 − frac and frac per axis
         for k in 0..D {
-            let (b, f) = self.locate(k, y[k]);
-            base[k] = b;
-            factor[k] = [1.0 - f, f];
+            factor[k] = [1.0 - frac[k], frac[k]];
         }
         let origin: usize = (0..D).map(|k| base[k] * self.stride[k]).sum();
         let mut g = [0.0; D];
