@@ -94,8 +94,13 @@ def test_convex_creases_are_said_with_the_shortcut_they_cost(n, fewer):
     assert said == pytest.approx(1.5 * g.spacing, rel=1e-3)
     measured = (2.0 - sol([(0.0, 0.0, 0.5)])[0]) / 2  # two edges crossed
     assert sol.stats.order == 1 and 0 < measured <= said
-    paper = (2.0 - ts.solve(ts.LevelSet(phi), g, [(0.0, 0.0, -0.5)], order=1)([(0.0, 0.0, 0.5)])[0]) / 2
+    paper_sol = ts.solve(ts.LevelSet(phi), g, [(0.0, 0.0, -0.5)], order=1)
+    paper = (2.0 - paper_sol([(0.0, 0.0, 0.5)])[0]) / 2
     assert measured < paper / fewer
+    # the stats count the inner-tube nodes that the thinning made extension nodes: those the
+    # paper's tube has in its inner tube and this one has not
+    assert paper_sol.stats.crease_thinned == 0
+    assert sol.stats.crease_thinned == paper_sol.stats.inner_points - sol.stats.inner_points > 0
     # a smooth surface the grid barely resolves is not taken for a crease
     s = ts.surfaces.Ellipsoid(0.25, 0.25, 0.5)
     with pytest.raises(ts.second_order.Order2NotApplicable, match="Refine the grid"):
@@ -118,6 +123,7 @@ def test_a_tube_and_a_batch_thin_the_cube_as_ts_solve_does():
         rows = tube.solve_many([src[0]], at=at)
     assert np.array_equal(again.values, single.values)
     assert np.array_equal(rows[0], single(at))
+    assert again.stats.crease_thinned == single.stats.crease_thinned > 0
     paper = ts.solve(cube, g, src, order=1)
     assert np.array_equal(tube.solve(src, order=1).values, paper.values)
     assert np.array_equal(tube.solve_many([src[0]], at=at, order=1)[0], paper(at))
@@ -138,6 +144,7 @@ def test_a_rotated_cube_crosses_its_edges_with_about_a_spacing_lost():
     per_edge = (1.8 - sol([rot.T @ np.array([0, 0, 0.45])])[0]) / 2 / g.spacing
     assert sol.stats.order == 2 and sol.stats.converged
     assert 0 < per_edge < 1.5
+    assert sol.stats.crease_thinned > 0 and sol.stats.order2["creases"]["nodes"] > 0
 
 
 def test_noise_is_read_through_local_fits():

@@ -135,6 +135,15 @@ def thinned_at_creases(tube: _PreparedTube) -> _PreparedTube:
     return dataclasses.replace(tube, roles=roles)
 
 
+def thinned_count(tube: _PreparedTube) -> int:
+    """How many of ``tube``'s crease nodes :func:`thinned_at_creases` made extension nodes: all of
+    them in the thinned tube, 0 in the paper's (``sol.stats.crease_thinned``)."""
+    nodes = tube.crease_nodes
+    if nodes.size == 0 or not np.all(tube.roles[nodes] == ROLE_OUTER):
+        return 0
+    return int(nodes.size)
+
+
 def uncut_band(tube: _PreparedTube) -> Any:
     """The band of ``tube`` without its cut (``_shortcuts``), built again from its nodes, for the
     Lax–Friedrichs scheme: it extrapolates a missing neighbour and does not settle beside edges cut

@@ -305,9 +305,10 @@ def solve_on_tube(
 ) -> Any:
     """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept);
     ``warm``: a previous solution to start from (:mod:`tubesweep.moving`)."""
-    from ._prepare import ROLE_OUTER
+    from ._prepare import ROLE_OUTER, thinned_count
 
     grid, surf, band = tube.grid, tube.surface, tube.band
+    crease_thinned = thinned_count(tube)
     h = grid.spacing
     d = grid.ndim
     inputs = tube_inputs(tube, speed, tol)
@@ -431,6 +432,7 @@ def solve_on_tube(
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         cut_edges=tube.cut_edges,
+        crease_thinned=crease_thinned,
         order=2,
         order2=order2,
         box_cut=tube.box_cut,

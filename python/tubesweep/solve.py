@@ -37,6 +37,7 @@ from ._prepare import (
     _PreparedTube,
     _prepare_tube,
     thinned_at_creases,
+    thinned_count,
     uncut_band,
     warn_facing_pairs,
 )
@@ -376,6 +377,7 @@ def _solve_on_tube(
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band
     cut_edges = tube.cut_edges
+    crease_thinned = thinned_count(tube)
     if scheme == "lxf" and cut_edges:
         # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
         # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
@@ -524,6 +526,7 @@ def _solve_on_tube(
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         cut_edges=cut_edges,
+        crease_thinned=crease_thinned,
         thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver=st.get("local_solver", scheme),

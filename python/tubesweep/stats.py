@@ -55,6 +55,11 @@ class SolveStats:
         of ``facing_pairs``, and above concave edges, where two neighbours' closest points lie
         more than 1.5 grid spacings apart (docs/surfaces.md, "Parts of the surface that face
         each other"). 0 on other surfaces, which keep the paper's scheme.
+    crease_thinned : int
+        Inner-tube nodes at a level set's creases or corners that ran as extension nodes (their
+        values read at their closest points) so that the front cannot cut the corner there:
+        ``order=2`` and ``order="auto"`` on level sets given as distances (docs/second-order.md,
+        the cube's edges). 0 for ``order=1``, smooth surfaces, meshes and re-distanced φ.
     thin_strip_iterations : tuple of two ints
         Parallel iterations (3D, more than one thread) whose sweeps ran strips thin across the
         first and across the second leading axis of the grid, where the iteration's work crossed
@@ -124,6 +129,7 @@ class SolveStats:
     facing_pairs: int = 0
     narrowest_gap: float = float("inf")
     cut_edges: int = 0
+    crease_thinned: int = 0
     thin_strip_iterations: Tuple[int, int] = (0, 0)
     prefetch_iterations: int = 0
     local_solver: str = "godunov"
