@@ -17,6 +17,9 @@
 //!    the normal there): next to its own
 //!    closest point, so the refinement is short, and a node whose start lies more than a spacing
 //!    beyond the half-width is left out (its distance exceeds the half-width) without refinement.
+//!    The layers grow as they are refined, each from the nodes of the one before that were not
+//!    left out (a band node has a path of face steps to the surface along which its distance
+//!    falls): on the sphere at N = 201, 367k nodes searched instead of 492k, the same bits.
 //! 3. **Refinement on the interpolant.** From that point on the zero level set, the
 //!    orthogonality iterations of the projection: `y ← P(y + (I − n nᵀ)(x − y))`, a move in the
 //!    tangent plane towards the foot of the node (the normal `n` from central differences of φ
@@ -51,7 +54,7 @@
 
 use crate::error::{Error, Result};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 
 use super::interface_cells::{crossed_cells, edge_crossings, Lattice, NodeSet};
 use super::redistance::{sum_of_squares, SampledField};
@@ -375,51 +378,22 @@ pub fn redistanced_band_of_samples<const D: usize>(
     // the half-width can be: its closest point lies in a crossed cell, within √D/2 spacings of a
     // corner, so at most √D (half_width/Δx + √D/2) face steps from it
     let deepest = ((D as f64).sqrt() * (options.half_width / h) + D as f64 / 2.0 + 1e-9).floor() as u32;
-    const UNSEEN: u32 = u32::MAX;
-    let layer: Vec<AtomicU32> = (0..m).map(|_| AtomicU32::new(UNSEEN)).collect();
+    let seen: Vec<AtomicBool> = (0..m).map(|_| AtomicBool::new(false)).collect();
     let (offsets, count) = lattice.corner_offsets();
     let mut frontier: Vec<usize> = cells
         .par_iter()
         .with_min_len(256)
         .flat_map_iter(|&c| {
-            let (set, layer) = (&set, &layer);
+            let (set, seen) = (&set, &seen);
             offsets[..count].iter().filter_map(move |&o| {
                 let (i, j, k) = lattice.split(c as usize + o);
                 let p = set.position(i, j, k).expect("a crossed cell's corners are in the set");
-                (layer[p].compare_exchange(UNSEEN, 0, Relaxed, Relaxed).is_ok()).then_some(p)
+                (!seen[p].swap(true, Relaxed)).then_some(p)
             })
         })
         .collect();
     let n_cells = cells.len();
     drop(cells);
-    let mut layers: Vec<Vec<usize>> = Vec::new();
-    while !frontier.is_empty() {
-        let depth = layers.len() as u32 + 1;
-        // each layer in the nodes' order (C order): the nodes next to each other in the list read
-        // the same neighbours' closest points and the same samples
-        frontier.par_sort_unstable();
-        let next: Vec<usize> = if depth > deepest {
-            Vec::new()
-        } else {
-            frontier
-                .par_iter()
-                .with_min_len(256)
-                .flat_map_iter(|&p| {
-                    // at most 2D face neighbours: no allocation per node
-                    let (mut found, mut count) = ([0usize; 6], 0);
-                    set.face_neighbours(split(p), |q| {
-                        if layer[q].compare_exchange(UNSEEN, depth, Relaxed, Relaxed).is_ok() {
-                            found[count] = q;
-                            count += 1;
-                        }
-                    });
-                    found.into_iter().take(count)
-                })
-                .collect()
-        };
-        layers.push(std::mem::replace(&mut frontier, next));
-    }
-    let layer: Vec<u32> = layer.into_iter().map(AtomicU32::into_inner).collect();
     let node_of = |p: usize| -> ([usize; D], [f64; D]) {
         let mut idx = [0usize; D];
         let mut x = [0.0; D];
@@ -433,10 +407,15 @@ pub fn redistanced_band_of_samples<const D: usize>(
     // the half-width: the start is a neighbour's closest point, within about a spacing of its own)
     let prune = options.half_width + PRUNE_MARGIN * h;
     let mut feet: Vec<Option<Foot<D>>> = vec![None; m];
-    // the feet's points alone (NaN: none), which the search for the nearest start reads
+    // the feet's points alone (NaN: none yet), which the search for the nearest start reads: the
+    // nodes of the layers before have them, those of this layer and after not yet
     let mut feet_y: Vec<[f64; D]> = vec![[f64::NAN; D]; m];
-    for (depth, nodes) in layers.iter().enumerate() {
-        let found: Vec<Option<Foot<D>>> = nodes
+    let mut depth = 0u32;
+    while !frontier.is_empty() {
+        // each layer in the nodes' order (C order): the nodes next to each other in the list read
+        // the same neighbours' closest points and the same samples
+        frontier.par_sort_unstable();
+        let found: Vec<Option<Foot<D>>> = frontier
             .par_iter()
             .with_min_len(64)
             .map(|&p| {
@@ -474,10 +453,9 @@ pub fn redistanced_band_of_samples<const D: usize>(
                         }
                     }
                 } else {
+                    // only the points are read here; the normal and curvature of the nearest below
                     set.neighbours_around(split(p), |q| {
-                        // only the points are read here (the nodes before this layer that have
-                        // one); the normal and curvature of the nearest below
-                        if layer[q] < depth as u32 && !feet_y[q][0].is_nan() {
+                        if !feet_y[q][0].is_nan() {
                             consider(feet_y[q], q);
                         }
                     });
@@ -490,14 +468,38 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 Some(refine(field, &x, start, normal, &options))
             })
             .collect();
-        for (&p, f) in nodes.iter().zip(found) {
+        for (&p, f) in frontier.iter().zip(found) {
             if let Some(f) = &f {
                 feet_y[p] = f.y;
             }
             feet[p] = f;
         }
+        if depth == deepest {
+            break;
+        }
+        // the next layer: the face neighbours not yet reached of the nodes that got a closest
+        // point (a band node has a path of face steps to the surface along which the distance
+        // falls, so it is reached from refined nodes; the pruned ones lead only farther out)
+        let feet = &feet;
+        frontier = frontier
+            .par_iter()
+            .with_min_len(256)
+            .filter(|&&p| feet[p].is_some())
+            .flat_map_iter(|&p| {
+                // at most 2D face neighbours: no allocation per node
+                let (mut found, mut count) = ([0usize; 6], 0);
+                set.face_neighbours(split(p), |q| {
+                    if !seen[q].swap(true, Relaxed) {
+                        found[count] = q;
+                        count += 1;
+                    }
+                });
+                found.into_iter().take(count)
+            })
+            .collect();
+        depth += 1;
     }
-    drop(layer);
+    drop(seen);
     // the band: the nodes within the half-width, in the set's (C) order
     let keep = options.half_width * (1.0 + 1e-9); // ties on the band's edge: rounding
     let kept: Vec<(u64, f64, [f32; D], bool, bool)> = (0..m)
