@@ -244,8 +244,6 @@ pub(crate) struct NodeSet {
     intervals: Vec<(u32, u32, usize)>,
     /// Per row, the index of its first interval in `intervals`; one more entry at the end.
     row_first: Vec<u32>,
-    /// The number of nodes.
-    count: usize,
 }
 
 /// Sorted, merged inclusive intervals (adjacent ones joined).
@@ -321,8 +319,13 @@ impl NodeSet {
             lattice,
             intervals,
             row_first,
-            count,
         }
+    }
+
+    /// The number of nodes.
+    #[cfg(test)]
+    pub fn len(&self) -> usize {
+        self.intervals.last().map_or(0, |&(a, b, at)| at + (b - a) as usize + 1)
     }
 
     /// The intervals of row `row`.
@@ -331,34 +334,34 @@ impl NodeSet {
         &self.intervals[self.row_first[row] as usize..self.row_first[row + 1] as usize]
     }
 
-    pub fn len(&self) -> usize {
-        self.count
-    }
-
     /// The nodes' linear indices, sorted.
     pub fn linear(&self) -> Vec<u64> {
         let n2 = self.lattice.dims[2];
-        let mut out = Vec::with_capacity(self.len());
-        for row in 0..self.row_first.len() - 1 {
-            for &(a, b, _) in self.row(row) {
-                out.extend((a as usize..=b as usize).map(|k| (row * n2 + k) as u64));
-            }
-        }
-        out
+        (0..self.row_first.len() - 1)
+            .into_par_iter()
+            .with_min_len(64)
+            .flat_map_iter(|row| {
+                self.row(row)
+                    .iter()
+                    .flat_map(move |&(a, b, _)| (a as usize..=b as usize).map(move |k| (row * n2 + k) as u64))
+            })
+            .collect()
     }
 
     /// The nodes' `(i, j, k)`, in the set's order (their positions): what [`Lattice::split`] gives
     /// of [`linear`](Self::linear)'s entries, without a division per node.
     pub fn coordinates(&self) -> Vec<[u32; 3]> {
         let n1 = self.lattice.dims[1];
-        let mut out = Vec::with_capacity(self.len());
-        for row in 0..self.row_first.len() - 1 {
-            let (i, j) = ((row / n1) as u32, (row % n1) as u32);
-            for &(a, b, _) in self.row(row) {
-                out.extend((a..=b).map(|k| [i, j, k]));
-            }
-        }
-        out
+        (0..self.row_first.len() - 1)
+            .into_par_iter()
+            .with_min_len(64)
+            .flat_map_iter(|row| {
+                let (i, j) = ((row / n1) as u32, (row % n1) as u32);
+                self.row(row)
+                    .iter()
+                    .flat_map(move |&(a, b, _)| (a..=b).map(move |k| [i, j, k]))
+            })
+            .collect()
     }
 
     /// The position among the set's nodes of node `(i, j, k)`, if it is one.

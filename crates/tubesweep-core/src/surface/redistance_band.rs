@@ -54,7 +54,7 @@
 
 use crate::error::{Error, Result};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 use super::interface_cells::{crossed_cells, edge_crossings, Lattice, NodeSet};
 use super::redistance::{sum_of_squares, SampledField};
@@ -378,20 +378,42 @@ pub fn redistanced_band_of_samples<const D: usize>(
     // the half-width can be: its closest point lies in a crossed cell, within √D/2 spacings of a
     // corner, so at most √D (half_width/Δx + √D/2) face steps from it
     let deepest = ((D as f64).sqrt() * (options.half_width / h) + D as f64 / 2.0 + 1e-9).floor() as u32;
-    let seen: Vec<AtomicBool> = (0..m).map(|_| AtomicBool::new(false)).collect();
-    let (offsets, count) = lattice.corner_offsets();
-    let mut frontier: Vec<usize> = cells
-        .par_iter()
-        .with_min_len(256)
-        .flat_map_iter(|&c| {
-            let (set, seen) = (&set, &seen);
-            offsets[..count].iter().filter_map(move |&o| {
-                let (i, j, k) = lattice.split(c as usize + o);
-                let p = set.position(i, j, k).expect("a crossed cell's corners are in the set");
-                (!seen[p].swap(true, Relaxed)).then_some(p)
+    // the nodes reached (bit p: node p), and those reached for the next layer: read off in the
+    // nodes' order (C order), so the layers need no sorting
+    let words = m.div_ceil(64);
+    let seen: Vec<AtomicU64> = (0..words).map(|_| AtomicU64::new(0)).collect();
+    let fresh: Vec<AtomicU64> = (0..words).map(|_| AtomicU64::new(0)).collect();
+    let reach_node = |p: usize| {
+        let bit = 1u64 << (p % 64);
+        if seen[p / 64].fetch_or(bit, Relaxed) & bit == 0 {
+            fresh[p / 64].fetch_or(bit, Relaxed);
+        }
+    };
+    let take_fresh = || -> Vec<usize> {
+        fresh
+            .par_iter()
+            .enumerate()
+            .with_min_len(256)
+            .flat_map_iter(|(w, word)| {
+                let mut bits = word.swap(0, Relaxed);
+                std::iter::from_fn(move || {
+                    (bits != 0).then(|| {
+                        let b = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        64 * w + b
+                    })
+                })
             })
-        })
-        .collect();
+            .collect()
+    };
+    let (offsets, count) = lattice.corner_offsets();
+    cells.par_iter().with_min_len(256).for_each(|&c| {
+        for &o in &offsets[..count] {
+            let (i, j, k) = lattice.split(c as usize + o);
+            reach_node(set.position(i, j, k).expect("a crossed cell's corners are in the set"));
+        }
+    });
+    let mut frontier = take_fresh();
     let n_cells = cells.len();
     drop(cells);
     let node_of = |p: usize| -> ([usize; D], [f64; D]) {
@@ -414,7 +436,6 @@ pub fn redistanced_band_of_samples<const D: usize>(
     while !frontier.is_empty() {
         // each layer in the nodes' order (C order): the nodes next to each other in the list read
         // the same neighbours' closest points and the same samples
-        frontier.par_sort_unstable();
         let found: Vec<Option<Foot<D>>> = frontier
             .par_iter()
             .with_min_len(64)
@@ -481,25 +502,15 @@ pub fn redistanced_band_of_samples<const D: usize>(
         // point (a band node has a path of face steps to the surface along which the distance
         // falls, so it is reached from refined nodes; the pruned ones lead only farther out)
         let feet = &feet;
-        frontier = frontier
-            .par_iter()
-            .with_min_len(256)
-            .filter(|&&p| feet[p].is_some())
-            .flat_map_iter(|&p| {
-                // at most 2D face neighbours: no allocation per node
-                let (mut found, mut count) = ([0usize; 6], 0);
-                set.face_neighbours(split(p), |q| {
-                    if !seen[q].swap(true, Relaxed) {
-                        found[count] = q;
-                        count += 1;
-                    }
-                });
-                found.into_iter().take(count)
-            })
-            .collect();
+        frontier.par_iter().with_min_len(256).for_each(|&p| {
+            if feet[p].is_some() {
+                set.face_neighbours(split(p), reach_node);
+            }
+        });
+        frontier = take_fresh();
         depth += 1;
     }
-    drop(seen);
+    drop((seen, fresh));
     // the band: the nodes within the half-width, in the set's (C) order
     let keep = options.half_width * (1.0 + 1e-9); // ties on the band's edge: rounding
     let kept: Vec<(u64, f64, [f32; D], bool, bool)> = (0..m)
