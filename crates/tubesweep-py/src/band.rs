@@ -270,9 +270,12 @@ impl PyBand {
     )> {
         let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
         let pairs = py
-            .detach(|| match &self.band {
-                AnyBand::D2(b) => tubesweep_core::band::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
-                AnyBand::D3(b) => tubesweep_core::band::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing),
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::band::facing_sheets::facing_sheet_pairs(b, inn, ph, dir, spacing)
+                )
             })
             .map_err(to_pyerr)?;
         let node: Vec<i64> = pairs.iter().map(|p| p.node as i64).collect();
@@ -294,9 +297,12 @@ impl PyBand {
     ) -> PyResult<Bound<'py, PyArray1<i64>>> {
         let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
         let nodes = py
-            .detach(|| match &self.band {
-                AnyBand::D2(b) => tubesweep_core::band::crease_ridges::crease_ridge_nodes(b, inn, ph, dir, spacing),
-                AnyBand::D3(b) => tubesweep_core::band::crease_ridges::crease_ridge_nodes(b, inn, ph, dir, spacing),
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::band::crease_ridges::crease_ridge_nodes(b, inn, ph, dir, spacing)
+                )
             })
             .map_err(to_pyerr)?;
         let out: Vec<i64> = nodes.iter().map(|&n| n as i64).collect();
@@ -319,9 +325,12 @@ impl PyBand {
     ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>)> {
         let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
         let edges = py
-            .detach(|| match &self.band {
-                AnyBand::D2(b) => tubesweep_core::band::medial_edges::medial_edges(b, inn, ph, dir, spacing, jump),
-                AnyBand::D3(b) => tubesweep_core::band::medial_edges::medial_edges(b, inn, ph, dir, spacing, jump),
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::band::medial_edges::medial_edges(b, inn, ph, dir, spacing, jump)
+                )
             })
             .map_err(to_pyerr)?;
         let node: Vec<i64> = edges.iter().map(|e| e.0 as i64).collect();

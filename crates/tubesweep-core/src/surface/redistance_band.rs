@@ -135,13 +135,6 @@ fn onto_zero_set<const D: usize>(
     eps: f64,
 ) -> Option<[f64; D]> {
     let half_step = eps == 0.5 * field.spacing();
-    let normal_field = |z: &[f64; D]| {
-        if half_step {
-            field.half_step_gradient(z)
-        } else {
-            field.gradient(z, eps)
-        }
-    };
     field.clamp_to_box(z);
     for step in 0..=NEWTON_STEPS {
         // after a step the point is most likely on the zero level set: its normal in the same call
@@ -154,7 +147,7 @@ fn onto_zero_set<const D: usize>(
         };
         let n2 = sum_of_squares(&g);
         if landed(v, &g) {
-            return Some(normal.unwrap_or_else(|| normal_field(z)));
+            return Some(normal.unwrap_or_else(|| normal_gradient(field, z, eps)));
         }
         if step == NEWTON_STEPS || !(n2 > 1e-300) {
             return None;
@@ -166,6 +159,17 @@ fn onto_zero_set<const D: usize>(
         field.clamp_to_box(z);
     }
     None
+}
+
+/// The gradient that gives the iterations' normal at `y`: the central differences of φ with step
+/// `eps`, in closed form for the default step, half a spacing ([`SampledField::half_step_gradient`]).
+#[inline]
+fn normal_gradient<const D: usize>(field: &SampledField<'_, D>, y: &[f64; D], eps: f64) -> [f64; D] {
+    if eps == 0.5 * field.spacing() {
+        field.half_step_gradient(y)
+    } else {
+        field.gradient(y, eps)
+    }
 }
 
 /// `g / |g|`, or None where `g` vanishes.
@@ -202,15 +206,7 @@ fn refine<const D: usize>(
 ) -> Foot<D> {
     let h = field.spacing();
     let tol = options.tol * h;
-    // the central differences with step eps; in closed form for the default step, half a spacing
-    let half_step = options.eps == 0.5 * h;
-    let normal = |y: &[f64; D]| {
-        unit(if half_step {
-            field.half_step_gradient(y)
-        } else {
-            field.gradient(y, options.eps)
-        })
-    };
+    let normal = |y: &[f64; D]| unit(normal_gradient(field, y, options.eps));
     let mut y = start;
     let (start_normal, start_kappa) = match start_normal {
         Some((n, kappa)) => (Some(n), kappa),
