@@ -1,12 +1,14 @@
 //! The cost of the sub-cell re-distancing alone (`tubesweep_core::surface::redistance_band`, what
 //! `LevelSet(phi_array, redistance=True).band(grid, 4Δx)` runs), for the sphere R = 0.5 in
-//! [−1, 1]³ sampled as `|x|² − R²` and as a voxel mask (`−0.5` inside, `0.5` outside): the CPU time
+//! [−1, 1]³ sampled as `|x|² − R²`, as a voxel mask (`−0.5` inside, `0.5` outside) and as that mask
+//! smoothed (σ = 1.5 voxels, as `LevelSet.from_mask(mask, smooth=1.5)`): the CPU time
 //! of the process (all threads; medians of the repeats), the band's size and a hash of its linear
 //! indices, signed distances and directions (equal hashes: the same bits).
 //!
 //!     cargo run --release -p tubesweep-core --example redistance_cost -- [N] [repeats] [tol]   # 201 3 1e-12
 //!
-//! For instruction counts, which a busy machine does not change:
+//! `CASE=<start of a case's name>` runs that case alone. For instruction counts, which a busy
+//! machine does not change:
 //! `RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no target/release/examples/redistance_cost 101 1`.
 use tubesweep_core::surface::redistance::SampledField;
 use tubesweep_core::surface::redistance_band::{redistanced_band_of_samples, RedistanceOptions};
@@ -31,14 +33,16 @@ fn main() {
         let (i, j, k) = (l / (n * n), l / n % n, l % n);
         [i, j, k].iter().map(|&m| (-1.0 + h * m as f64).powi(2)).sum::<f64>()
     };
-    let cases: [(&str, Vec<f64>); 2] = [
+    let mask: Vec<f64> = (0..n * n * n).map(|l| if r2(l) < 0.25 { -0.5 } else { 0.5 }).collect();
+    let cases: [(&str, Vec<f64>); 3] = [
         ("|x|²−R²", (0..n * n * n).map(|l| r2(l) - 0.25).collect()),
-        (
-            "sphere mask",
-            (0..n * n * n).map(|l| if r2(l) < 0.25 { -0.5 } else { 0.5 }).collect(),
-        ),
+        ("sphere mask σ=1.5", smoothed(&mask, n, 1.5)),
+        ("sphere mask", mask),
     ];
     for (name, samples) in &cases {
+        if std::env::var("CASE").is_ok_and(|c| !name.starts_with(&c)) {
+            continue;
+        }
         let field = SampledField::<3>::new(samples, [n; 3], [-1.0; 3], h).expect("a valid grid");
         let options = RedistanceOptions {
             half_width: 4.0 * h,
@@ -72,7 +76,7 @@ fn main() {
             mix(u64::from(d.to_bits()));
         }
         println!(
-            "N={n} {name:12} band nodes {:8} (unsettled {:6}): CPU {:.3} s, {:.2} µs per band node; largest error {:.3e} Δx; hash {hash:016x}",
+            "N={n} {name:18} band nodes {:8} (unsettled {:6}): CPU {:.3} s, {:.2} µs per band node; largest error {:.3e} Δx; hash {hash:016x}",
             band.linear.len(),
             band.unsettled,
             times[repeats / 2],
@@ -80,4 +84,29 @@ fn main() {
             worst / h,
         );
     }
+}
+
+/// The mask smoothed as `LevelSet.from_mask(mask, smooth=sigma)` does (`scipy.ndimage.gaussian_filter`
+/// with `mode="nearest"`, truncated at 4σ), along each axis in turn: the mask's −0.5/0.5 here, so
+/// 0.5 − the smoothed 0/1 mask.
+fn smoothed(mask: &[f64], n: usize, sigma: f64) -> Vec<f64> {
+    let radius = (4.0 * sigma + 0.5) as isize;
+    let weights: Vec<f64> = (-radius..=radius)
+        .map(|m| (-0.5 * (m as f64 / sigma).powi(2)).exp())
+        .collect();
+    let total: f64 = weights.iter().sum();
+    let mut out = mask.to_vec();
+    for stride in [n * n, n, 1] {
+        let src = out.clone();
+        for (l, v) in out.iter_mut().enumerate() {
+            let at = (l / stride % n) as isize;
+            let mut sum = 0.0;
+            for (w, m) in weights.iter().zip(-radius..=radius) {
+                let c = (at + m).clamp(0, n as isize - 1);
+                sum += w * src[(l as isize + (c - at) * stride as isize) as usize];
+            }
+            *v = sum / total;
+        }
+    }
+    out
 }

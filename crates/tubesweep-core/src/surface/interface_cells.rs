@@ -335,6 +335,7 @@ impl NodeSet {
     }
 
     /// The nodes' linear indices, sorted.
+    #[cfg(test)]
     pub fn linear(&self) -> Vec<u64> {
         let n2 = self.lattice.dims[2];
         (0..self.row_first.len() - 1)
@@ -394,6 +395,14 @@ impl NodeSet {
         let mut out = [None; 3];
         let (lo, hi) = (k.saturating_sub(1) as u32, (k + 1) as u32);
         for &(a, b, at) in self.row(i * self.lattice.dims[1] + j) {
+            if b < lo {
+                continue;
+            }
+            if a <= lo && hi <= b && k > 0 {
+                // the three in one interval (most rows)
+                let first = at + (lo - a) as usize;
+                return [Some(first), Some(first + 1), Some(first + 2)];
+            }
             if a > hi {
                 break;
             }
