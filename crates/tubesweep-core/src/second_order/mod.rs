@@ -31,6 +31,7 @@ mod pipeline;
 mod rows;
 pub mod setup;
 pub mod solver;
+mod stagnation;
 pub mod start;
 pub mod warm;
 
