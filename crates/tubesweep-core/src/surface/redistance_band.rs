@@ -586,7 +586,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 let normal = (from != usize::MAX)
                     .then(|| foot_of(from))
                     .flatten()
-                    .map(|f| (f.n, f.kappa));
+                    .map(|f| (f.n, if f.settled { f.kappa } else { 0.0 }));
                 if nearest.sqrt() > prune {
                     return None;
                 }
