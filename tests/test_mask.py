@@ -221,8 +221,8 @@ def test_the_band_holds_the_nodes_near_an_edge_crossing_and_is_no_farther(case, 
     # of the zero set) found by brute force (a k-d tree over all of them). Every node within the
     # band's width less a quarter spacing of a crossing is in the band, and its distance exceeds
     # its crossing's only where the refinement stopped at a kink (a voxel step, or where the
-    # gyroid's curvature makes the iterations stall): measured at N = 41, at most 0.050 Δx (mask),
-    # 0.0035 Δx (smoothed), 0.22 Δx (gyroid-like), on average 4e-3 Δx, 1e-4 Δx, 2e-4 Δx
+    # gyroid's curvature makes the iterations stall): measured at N = 41, at most 0.047 Δx (mask),
+    # 0.0036 Δx (smoothed), 0.22 Δx (gyroid-like), on average 4e-3 Δx, 1e-4 Δx, 3e-4 Δx
     from scipy.spatial import cKDTree
 
     grid = _grid(41)
