@@ -190,7 +190,7 @@ def test_sampled_redistance_is_the_numpy_projection_bit_for_bit(d, n):
     assert 0 < ok1.sum() < len(x)  # both outcomes were compared
     # and the surface's band (sub-cell interface points refined by the same iterations,
     # tubesweep_core::surface::redistance_band) has the projection's distances at its nodes, to the
-    # band's settling tolerance (1e-6 Δx on the closest point; the largest difference is 2e-8 Δx)
+    # band's settling tolerance (1e-6 Δx on the closest point; the largest difference is 2.5e-7 Δx)
     geom = surface.band(grid, 4 * h)
     xb = grid.points(grid.unravel(geom.linear))
     _, sb, okb = project_to_level_set(lambda p: _interp_dense(phi, grid, p), xb, SAMPLED_GRADIENT_STEP * h, box=box)
