@@ -698,7 +698,8 @@ fn run_phase<const D: usize>(
     let rows_state = RowsState::new(band, values, sw.u0);
     let isa = Isa::for_this_solve();
     let shared = SharedValues::new(values);
-    let mut history: Vec<f64> = Vec::new();
+    // the largest change of each iteration since the window opened (the stagnation test's and the
+    // limit cycles', `in_a_limit_cycle`)
     let mut changes: Vec<f64> = Vec::new();
     let mut unmoved = 0usize;
     while *iteration < options.max_iterations {
@@ -733,7 +734,6 @@ fn run_phase<const D: usize>(
             stats.runaway_iteration = Some(*iteration - stats.first_order_iterations);
             return Ok(false);
         }
-        // a limit cycle: the largest change of an iteration repeats (see `in_a_limit_cycle`)
         changes.push(change.max_change);
         let cycling = lim.second && !lim.decreases_only && in_a_limit_cycle(&changes);
         if lim.window == f64::INFINITY {
@@ -741,11 +741,10 @@ fn run_phase<const D: usize>(
                 return Ok(true);
             }
             if lim.second && !lim.decreases_only {
-                history.push(change.max_change);
-                let m = history.len();
+                let m = changes.len();
                 if cycling
                     || (m > options.stall_window
-                        && change.max_change > options.stall_ratio * history[m - 1 - options.stall_window])
+                        && change.max_change > options.stall_ratio * changes[m - 1 - options.stall_window])
                 {
                     lim.decreases_only = true;
                     stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
@@ -769,6 +768,9 @@ fn run_phase<const D: usize>(
             } else {
                 edge
             };
+            if lim.window == f64::INFINITY {
+                changes.clear();
+            }
         }
     }
     Ok(false)

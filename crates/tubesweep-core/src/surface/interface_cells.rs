@@ -193,14 +193,70 @@ pub fn crossed_cells(shape: &[usize], samples: &[f64]) -> Result<Vec<u64>> {
     Ok(parts.concat())
 }
 
+/// The points where the zero level set of `field`'s interpolant crosses the edges at the node
+/// `node` (a D-index), a corner of a crossed cell, passed to `visit`: those on the node's own
+/// edges (one step along an axis), or, where none of them crosses, those on the edges of the
+/// crossed cells the node is a corner of ([`edge_crossings`]).
+#[inline]
+pub(crate) fn crossings_at_corner<const D: usize>(
+    field: &SampledField<'_, D>,
+    node: [usize; D],
+    mut visit: impl FnMut([f64; D]),
+) {
+    let shape = field.shape();
+    let h = field.spacing();
+    let here = field.sample(node);
+    let mut own = false;
+    for a in 0..D {
+        for up in [false, true] {
+            let mut other = node;
+            if up {
+                if node[a] + 1 >= shape[a] {
+                    continue;
+                }
+                other[a] += 1;
+            } else {
+                if node[a] == 0 {
+                    continue;
+                }
+                other[a] -= 1;
+            }
+            let there = field.sample(other);
+            if (here > 0.0) != (there > 0.0) {
+                let t = here / (here - there);
+                let mut q: [f64; D] = std::array::from_fn(|b| field.coordinate(b, node[b]));
+                q[a] += if up { t * h } else { -t * h };
+                visit(q);
+                own = true;
+            }
+        }
+    }
+    if own {
+        return;
+    }
+    for around in 0..1usize << D {
+        let mut lowest = node;
+        let mut inside = true;
+        for a in 0..D {
+            if around >> a & 1 == 1 {
+                if lowest[a] == 0 {
+                    inside = false;
+                }
+                lowest[a] = lowest[a].wrapping_sub(1);
+            } else if lowest[a] + 1 >= shape[a] {
+                inside = false;
+            }
+        }
+        if inside {
+            edge_crossings(field, lowest, &mut visit);
+        }
+    }
+}
+
 /// The points where the zero level set of `field`'s interpolant crosses the edges of the cell
 /// whose lowest corner is the node `lowest` (a D-index), passed to `visit`.
 #[inline]
-pub(crate) fn edge_crossings<const D: usize>(
-    field: &SampledField<'_, D>,
-    lowest: [usize; D],
-    mut visit: impl FnMut([f64; D]),
-) {
+fn edge_crossings<const D: usize>(field: &SampledField<'_, D>, lowest: [usize; D], mut visit: impl FnMut([f64; D])) {
     let mut values = [0.0f64; 8];
     for (c, v) in values.iter_mut().enumerate().take(1 << D) {
         let mut node = lowest;

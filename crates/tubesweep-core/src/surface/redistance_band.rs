@@ -8,7 +8,7 @@
 //!
 //! 1. **Sub-cell interface location.** The cells with a sign change among their corners
 //!    ([`crossed_cells`]) hold the zero level set; on their edges it is known exactly, at the
-//!    linear interpolation of the two end values ([`edge_crossings`]), with no use of ∇φ.
+//!    linear interpolation of the two end values ([`crossings_at_corner`]), with no use of ∇φ.
 //! 2. **Closest points, layer by layer.** The nodes within `reach` cells of a crossed cell
 //!    ([`NodeSet`]) are ordered by their number of face steps from a crossed cell's corner (as
 //!    many as a node within the half-width can be away). A corner takes the nearest crossing on
@@ -65,7 +65,7 @@ use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
-use super::interface_cells::{crossed_cells, edge_crossings, Lattice, NodeSet};
+use super::interface_cells::{crossed_cells, crossings_at_corner, Lattice, NodeSet};
 use super::redistance::{sum_of_squares, SampledField};
 
 /// The re-distanced band.
@@ -499,9 +499,10 @@ pub fn redistanced_band_of_samples<const D: usize>(
         }
         s.sqrt()
     };
-    let keep = options.half_width * (1.0 + 1e-9); // ties on the band's edge: rounding
-                                                  // the closest points found, layer after layer (each in C order), and each node's among them
-                                                  // (NONE: none yet): the nodes of the layers before have one, those of this layer and after not
+    // (ties on the band's edge: rounding)
+    let keep = options.half_width * (1.0 + 1e-9);
+    // the closest points found, layer after layer (each in C order), and each node's among them
+    // (NONE: none yet): the nodes of the layers before have one, those of this layer and after not
     let mut feet: Vec<Foot<D>> = Vec::new();
     let slot: Vec<AtomicU32> = (0..m).map(|_| AtomicU32::new(NONE)).collect();
     let mut depth = 0u32;
@@ -529,51 +530,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     }
                 };
                 if depth == 0 {
-                    // the crossings on the node's own edges, or failing them those of the
-                    // crossed cells the node is a corner of
-                    let here = field.sample(idx);
-                    let mut own = false;
-                    for a in 0..D {
-                        for up in [false, true] {
-                            let mut other = idx;
-                            if up {
-                                if idx[a] + 1 >= shape[a] {
-                                    continue;
-                                }
-                                other[a] += 1;
-                            } else {
-                                if idx[a] == 0 {
-                                    continue;
-                                }
-                                other[a] -= 1;
-                            }
-                            let there = field.sample(other);
-                            if (here > 0.0) != (there > 0.0) {
-                                let t = here / (here - there);
-                                let mut q = x;
-                                q[a] += if up { t * h } else { -t * h };
-                                consider(q, usize::MAX);
-                                own = true;
-                            }
-                        }
-                    }
-                    for around in 0..if own { 0 } else { 1usize << D } {
-                        let mut lowest = idx;
-                        let mut inside = true;
-                        for a in 0..D {
-                            if around >> a & 1 == 1 {
-                                if lowest[a] == 0 {
-                                    inside = false;
-                                }
-                                lowest[a] = lowest[a].wrapping_sub(1);
-                            } else if lowest[a] + 1 >= shape[a] {
-                                inside = false;
-                            }
-                        }
-                        if inside {
-                            edge_crossings(field, lowest, |q| consider(q, usize::MAX));
-                        }
-                    }
+                    crossings_at_corner(field, idx, |q| consider(q, usize::MAX));
                 } else {
                     // only the points are read here; the normal and curvature of the nearest below
                     set.neighbours_around(split(p), |q| {
