@@ -13,10 +13,10 @@ const CYCLE_PERIOD: usize = 8;
 /// See [`CYCLE_PERIOD`].
 const CYCLE_MATCHES: usize = 2;
 
-/// See [`CYCLE_PERIOD`]: the smoothed sphere mask at N = 191 cycles with periods of 1 and 5
-/// iterations whose changes repeat to 8 digits (5.5876847e-7, and 6.0038e-7, 9.3578e-7, 6.5323e-7,
-/// 6.0029e-7, 9.3609e-7); where the second-order sweeps converge slowly (the six-fold star at
-/// N = 1601), successive changes differ in the third digit or before.
+/// See [`CYCLE_PERIOD`]: the smoothed sphere mask at N = 191 cycles with a period of 1 iteration
+/// whose change repeats to 8 digits (5.5876847e-7; `benches/experiments/limit_cycles.py 191
+/// --changes`); where the second-order sweeps converge slowly (the six-fold star at N = 1601),
+/// successive changes differ in the third digit or before.
 const CYCLE_SPREAD: f64 = 1e-6;
 
 /// Whether the largest changes of the iterations so far, `changes` (the newest last), end in a
@@ -41,7 +41,7 @@ mod tests {
 
     #[test]
     fn cycles_of_one_to_eight_iterations_are_recognised_and_slow_convergence_is_not() {
-        // the smoothed sphere mask at N = 191: period 1, then period 5
+        // the smoothed sphere mask at N = 191: period 1; then a cycle of period 5
         let one: Vec<f64> = [7.7930146, 3.366462, 6.65504, 1.415579, 5.154589]
             .iter()
             .map(|d| 5.5876847e-7 + d * 1e-16)
