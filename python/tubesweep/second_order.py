@@ -222,7 +222,7 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
     if getattr(surf, "smooth", False):  # a mesh through its smooth map (surfaces/_mesh_smooth.py)
         obstacle = surf.order2_obstacle(int(tube.facing[0].size))
         if obstacle is not None:
-            raise Order2NotApplicable(f"order=2 on this mesh: {obstacle}")
+            raise Order2NotApplicable(obstacle)
     linear = tube.linear
     x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)

@@ -157,7 +157,7 @@ def order2_obstacle(surface: Any, tube_pairs: int) -> Optional[str]:
     if pairs:
         return (
             f"the mesh faces itself across gaps narrower than its tubes ({pairs} node pairs): the second-order "
-            "sweeps are not safe there on a mesh (they ran away on the bunny at n = 200); a finer grid resolves the gap"
+            "sweeps can run away across such a gap on a mesh; a finer grid resolves the gap"
         )
     return None
 
