@@ -5,8 +5,10 @@ and the six-fold star (2D, ``order=2``) as a surface whose second-order sweeps c
 without cycling. Printed per solve: the iterations, the phase-2 iteration at which the sweeps fell
 back to decreases only (None: they did not), and with ``--changes`` the largest change of each
 iteration (a cycle repeats them to many digits). ``--perturb E`` solves the mask's φ multiplied by
-1 + E·(standard normal noise, seed 0) as well, from the same source (at N = 191, E = 1e-12: another
-period-1 cycle, of 6.0078673e-7).
+1 + E·(standard normal noise, seed 0) as well, from the same source. Before the inner update's side
+rule had its margin (``second_order/solver.rs``, ``UPWIND_MARGIN``) the mask cycled at N = 191 and
+201 (period 1, changes of 5.5876847e-7; perturbed by 1e-12, of 6.0078673e-7) and the test ended
+those solves at 38 and 40 iterations; now they converge in 29 and 30.
 
     .venv/bin/python benches/experiments/limit_cycles.py [N ...] [--star N] [--perturb E] [--changes]
     # default 191 201, star 801, no perturbation

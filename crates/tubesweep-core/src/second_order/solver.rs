@@ -10,8 +10,9 @@
 //! iteration above `stall_ratio` times that `stall_window` iterations earlier), they fall back
 //! to accepting decreases only, which ends any limit cycle; a limit cycle whose changes repeat
 //! exactly (period of up to 8 iterations, [`super::stagnation`]) is recognised within a few
-//! periods instead (the smoothed sphere mask at N = 191: 38 iterations instead of 70), and behind
-//! the window opens it at once (a cycle holds the window's edge).
+//! periods instead (the smoothed sphere mask at N = 191 cycled before the margin of
+//! `Sweeper::inner`'s side rule: 38 iterations instead of 70), and behind the window opens it at
+//! once (a cycle holds the window's edge).
 //!
 //! In 3D both phases run behind a front window like the first-order driver's
 //! ([`crate::sweep::DEFAULT_FRONT_WINDOW`]; see [`run_phase`]): the sweeps leave out the nodes
@@ -166,6 +167,12 @@ pub(super) struct Sweeper<'a, const D: usize> {
     extension_limit: f64,
 }
 
+/// A side of the inner update whose first neighbour lies this many ramp scales ε (σΔx²/ℓ) or
+/// more above the node is reconstructed at first order only (see `Sweeper::inner`): more than
+/// the O(Δx²∂²u₀) by which a side's first-order value on w differs from u1 where the chord u₀
+/// curves by up to about 10/ℓ along an axis.
+const UPWIND_MARGIN: f64 = 10.0;
+
 impl<const D: usize> Sweeper<'_, D> {
     #[inline(always)]
     fn sigma(&self, i: usize) -> f64 {
@@ -179,13 +186,20 @@ impl<const D: usize> Sweeper<'_, D> {
     /// hold w = u − u₀ (see [`sweep_second_order`]); u = w + u₀ at a neighbour feeds the ramps
     /// and the metric's direction.
     ///
-    /// A side is reconstructed at second order ([`reconstruct`]) only where it is upwind of the
-    /// node's current value (u1 < uᵢ, or the node not reached): a side with u1 ≥ uᵢ is not taken
-    /// by the Godunov update at a root ≤ uᵢ at first order nor at second (its BDF2 difference
-    /// (3/2)(u − u1) − (1/2)(u1 − u2) is then below its first-order one u − u1 ≤ 0; BDF3 is off
-    /// there), so the fixed points are the same; only a value on its way up takes such a side at
-    /// first order for one update. On the sphere at N = 201 that leaves out the second and third
-    /// neighbours of about a third of the sides, with the same errors to three digits.
+    /// A side is reconstructed at second order ([`reconstruct`]) unless its first neighbour lies
+    /// [`UPWIND_MARGIN`] ramp scales ε or more above the node's current value (u1 ≥ uᵢ + 10ε):
+    /// such a side is not taken by the Godunov update at a root ≤ uᵢ at first order nor at second,
+    /// so skipping its second and third neighbours' reads (about a third of the sides on the
+    /// sphere at N = 201) leaves the fixed points alone; only a value on its way up takes it at
+    /// first order for one update. The margin is needed because the sweeps hold w = u − u₀: a
+    /// side's first-order value is w1 ± Δx∂u₀, which differs from u1 by O(Δx²∂²u₀), so the
+    /// update can take a side with u1 slightly above uᵢ. Without it (u1 < uᵢ as the test) the
+    /// update jumped with the sign of uᵢ − u1 at a node whose neighbour along an axis nearly
+    /// tangent to the front lay within 1e-8 of it: on a smoothed sphere mask at N = 191 and 201
+    /// that held a node in a two-state cycle of 5e-7 until the limit-cycle test ended the solve
+    /// at 38 and 40 iterations; with it, 29 and 30, and the sphere's, circle's and star's errors
+    /// the same to four digits (`benches/experiments/limit_cycles.py`,
+    /// `tubesweep reproduce second-order`).
     #[inline(always)]
     fn inner(&self, w: &SharedValues<'_>, i: usize, k_inner: usize, second: bool) -> Option<f64> {
         let table = self.table;
@@ -203,6 +217,8 @@ impl<const D: usize> Sweeper<'_, D> {
             Slowness::Constant(_) => (self.ramp_constant, self.inv_sigma_constant),
             Slowness::PerNode(_) => (self.ramp_scale / sigma, 1.0 / sigma),
         };
+        // the sides whose first neighbour lies this high or higher are taken at first order
+        let skip_from = ui + UPWIND_MARGIN / inv_eps;
         // SAFETY: `k_inner` counts the nodes before `i` not in the extension layer, fewer than
         // the inner geometries and ∇u₀'s (checked equal to that count)
         let (geometry, grad_u0) = unsafe {
@@ -246,7 +262,7 @@ impl<const D: usize> Sweeper<'_, D> {
                     d1: f64::NAN,
                     d2: f64::NAN,
                 };
-                let upwind = second && u1 < ui;
+                let upwind = second && u1 < skip_from;
                 if upwind {
                     let j2 = unsafe { table.neighbour_unchecked(j1, k, side) };
                     if j2 != sentinel {

@@ -13,10 +13,10 @@ const CYCLE_PERIOD: usize = 8;
 /// See [`CYCLE_PERIOD`].
 const CYCLE_MATCHES: usize = 2;
 
-/// See [`CYCLE_PERIOD`]: the smoothed sphere mask at N = 191 cycles with a period of 1 iteration
-/// whose change repeats to 8 digits (5.5876847e-7; `benches/experiments/limit_cycles.py 191
-/// --changes`); where the second-order sweeps converge slowly (the six-fold star at N = 1601),
-/// successive changes differ in the third digit or before.
+/// See [`CYCLE_PERIOD`]: the smoothed sphere mask at N = 191 cycled (before the margin of the
+/// inner update's side rule, `solver.rs`) with a period of 1 iteration whose change repeated to 8
+/// digits (5.5876847e-7); where the second-order sweeps converge slowly (the six-fold star at
+/// N = 1601), successive changes differ in the third digit or before.
 const CYCLE_SPREAD: f64 = 1e-6;
 
 /// Whether the largest changes of the iterations so far, `changes` (the newest last), end in a
