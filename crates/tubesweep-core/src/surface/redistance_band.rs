@@ -115,7 +115,7 @@ pub struct RedistanceOptions {
 /// A point is on the zero level set when `|φ| ≤ ON_ZERO_SET · Δx · |∇φ|` there (about that many
 /// grid spacings from it along the normal): every iterate is. Far below the interpolant's own
 /// error (`Δx²|D²φ|/(8|∇φ|)`, 7.5e-3 Δx on `|x|² − R²` at N = 201) and near the directions' f32
-/// rounding; 1e-9 instead took a third Newton step at about one landing in six on the smoothed
+/// rounding; 1e-9 instead took a third Newton step at about one landing in three on the smoothed
 /// mask (8.1 evaluations per node instead of 6.7), for the same errors.
 const ON_ZERO_SET: f64 = 1e-7;
 
@@ -144,10 +144,9 @@ const PRUNE_MARGIN: f64 = 1.0;
 /// unrefined: a surface whose radii of curvature are a spacing or more bends towards the node by
 /// at most `t²/(2Δx)` over `t`. At N = 201 that leaves out 42k of the 52k nodes that the
 /// refinement found beyond the band on the sphere's quadric (of 305k; its mask: 19k), with the
-/// same band, bit for bit, on the
-/// sphere's quadric, its mask and smoothed mask, the gyroid-like φ, a noisy sphere, a `min` union,
-/// a torus, a cube and a float32 φ at N = 81 and 121 (without the margin, one node of the noisy
-/// sphere 0.001–0.013 Δx inside the band's edge was lost).
+/// same band, bit for bit, on the sphere's quadric, its mask and smoothed mask, the gyroid-like φ,
+/// a noisy sphere, a `min` union, a torus, a cube and a float32 φ at N = 81 and 121 (without the
+/// margin, one node of the noisy sphere 0.001–0.013 Δx inside the band's edge was lost).
 const BEND_ALLOWANCE: f64 = 0.5;
 
 /// See [`BEND_ALLOWANCE`].
