@@ -164,6 +164,8 @@ pub(super) struct Sweeper<'a, const D: usize> {
     ramp_constant: f64,
     /// 1/σ for a constant slowness.
     inv_sigma_constant: f64,
+    /// [`UPWIND_MARGIN`]·ε for a constant slowness.
+    margin_constant: f64,
     extension_limit: f64,
 }
 
@@ -213,12 +215,15 @@ impl<const D: usize> Sweeper<'_, D> {
         let u0 = |j: usize| unsafe { *self.u0.get_unchecked(j) };
         let ui = wi + u0(i);
         let sigma = self.sigma(i);
-        let (inv_eps, inv_sigma) = match self.slowness {
-            Slowness::Constant(_) => (self.ramp_constant, self.inv_sigma_constant),
-            Slowness::PerNode(_) => (self.ramp_scale / sigma, 1.0 / sigma),
+        let (inv_eps, inv_sigma, margin) = match self.slowness {
+            Slowness::Constant(_) => (self.ramp_constant, self.inv_sigma_constant, self.margin_constant),
+            Slowness::PerNode(_) => {
+                let inv_eps = self.ramp_scale / sigma;
+                (inv_eps, 1.0 / sigma, UPWIND_MARGIN / inv_eps)
+            }
         };
         // the sides whose first neighbour lies this high or higher are taken at first order
-        let skip_from = ui + UPWIND_MARGIN / inv_eps;
+        let skip_from = ui + margin;
         // SAFETY: `k_inner` counts the nodes before `i` not in the extension layer, fewer than
         // the inner geometries and ∇u₀'s (checked equal to that count)
         let (geometry, grad_u0) = unsafe {
@@ -537,6 +542,10 @@ pub fn sweep_second_order<const D: usize>(
             ));
         }
     }
+    let ramp_constant = match slowness {
+        Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
+        Slowness::PerNode(_) => f64::NAN,
+    };
     let sw = Sweeper {
         table: band.neighbour_table(),
         roles: &factoring.roles,
@@ -548,14 +557,12 @@ pub fn sweep_second_order<const D: usize>(
         slowness,
         spacing,
         ramp_scale: options.ramp_length / (spacing * spacing),
-        ramp_constant: match slowness {
-            Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
-            Slowness::PerNode(_) => f64::NAN,
-        },
+        ramp_constant,
         inv_sigma_constant: match slowness {
             Slowness::Constant(s) => 1.0 / s,
             Slowness::PerNode(_) => f64::NAN,
         },
+        margin_constant: UPWIND_MARGIN / ramp_constant,
         abs_phi,
         extension_limit: options.extension_limit,
     };

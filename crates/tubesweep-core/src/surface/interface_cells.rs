@@ -204,7 +204,6 @@ pub(crate) fn crossings_at_corner<const D: usize>(
     mut visit: impl FnMut([f64; D]),
 ) {
     let shape = field.shape();
-    let h = field.spacing();
     let here = field.sample(node);
     let mut own = false;
     for a in 0..D {
@@ -221,11 +220,8 @@ pub(crate) fn crossings_at_corner<const D: usize>(
                 }
                 other[a] -= 1;
             }
-            let there = field.sample(other);
-            if (here > 0.0) != (there > 0.0) {
-                let t = here / (here - there);
-                let mut q: [f64; D] = std::array::from_fn(|b| field.coordinate(b, node[b]));
-                q[a] += if up { t * h } else { -t * h };
+            let sign = if up { 1.0 } else { -1.0 };
+            if let Some(q) = crossing_on_edge(field, node, here, field.sample(other), a, sign) {
                 visit(q);
                 own = true;
             }
@@ -253,6 +249,27 @@ pub(crate) fn crossings_at_corner<const D: usize>(
     }
 }
 
+/// Where the interpolant's zero level set crosses the grid edge from `node` (φ = `value` there)
+/// along `axis` in the direction `sign` (±1) to its neighbour (φ = `other`): the linear
+/// interpolation of the two values, with no use of ∇φ; None where they have the same sign.
+#[inline]
+fn crossing_on_edge<const D: usize>(
+    field: &SampledField<'_, D>,
+    node: [usize; D],
+    value: f64,
+    other: f64,
+    axis: usize,
+    sign: f64,
+) -> Option<[f64; D]> {
+    if (value > 0.0) == (other > 0.0) {
+        return None;
+    }
+    let t = value / (value - other);
+    let mut q: [f64; D] = std::array::from_fn(|b| field.coordinate(b, node[b]));
+    q[axis] += sign * t * field.spacing();
+    Some(q)
+}
+
 /// The points where the zero level set of `field`'s interpolant crosses the edges of the cell
 /// whose lowest corner is the node `lowest` (a D-index), passed to `visit`.
 #[inline]
@@ -274,18 +291,10 @@ fn edge_crossings<const D: usize>(field: &SampledField<'_, D>, lowest: [usize; D
             if c & bit != 0 {
                 continue;
             }
-            let (va, vb) = (values[c], values[c | bit]);
-            if (va > 0.0) == (vb > 0.0) {
-                continue;
+            let corner: [usize; D] = std::array::from_fn(|b| lowest[b] + (c >> (D - 1 - b) & 1));
+            if let Some(p) = crossing_on_edge(field, corner, values[c], values[c | bit], a, 1.0) {
+                visit(p);
             }
-            let t = va / (va - vb);
-            let mut p = [0.0; D];
-            for (b, x) in p.iter_mut().enumerate() {
-                let index = lowest[b] + (c >> (D - 1 - b) & 1);
-                *x = field.coordinate(b, index);
-            }
-            p[a] += t * field.spacing();
-            visit(p);
         }
     }
 }

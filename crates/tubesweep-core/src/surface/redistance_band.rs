@@ -561,13 +561,13 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     });
                 }
                 let (start, from) = start?;
+                if nearest.sqrt() > prune {
+                    return None;
+                }
                 let normal = (from != usize::MAX)
                     .then(|| foot_of(from))
                     .flatten()
                     .map(|f| (f.n, if f.settled { f.kappa } else { 0.0 }));
-                if nearest.sqrt() > prune {
-                    return None;
-                }
                 // far above the start's tangent plane: beyond the band, left out unrefined
                 if let Some((n, _)) = normal {
                     let mut along = 0.0;
