@@ -2,7 +2,7 @@
 the smoothed sphere mask (R = 0.5 in [−1, 1]³, ``LevelSet.from_mask(mask, grid, smooth=1.5)``)
 solved by default from the band node nearest (−0.5, 0, 0) (as ``redistance_cost.py`` picks it),
 and the six-fold star (2D, ``order=2``) as a surface whose second-order sweeps converge slowly
-without cycling. Printed per solve: the iterations, the phase-2 iteration at which the sweeps fell
+without cycling. Printed per solve: the iterations and local updates, the phase-2 iteration at which the sweeps fell
 back to decreases only (None: they did not), and with ``--changes`` the largest change of each
 iteration (a cycle repeats them to many digits). ``--perturb E`` solves the mask's φ multiplied by
 1 + E·(standard normal noise, seed 0) as well, from the same source. Before the inner update's side
@@ -28,7 +28,8 @@ from tubesweep.surfaces import Star
 
 def _report(name: str, sol, changes, show: bool) -> None:
     print(
-        f"{name}: {sol.stats.iterations} iterations, fallback at {sol.stats.order2['fallback_iteration']}",
+        f"{name}: {sol.stats.iterations} iterations, {sol.stats.updates:,} updates, "
+        f"fallback at {sol.stats.order2['fallback_iteration']}",
         flush=True,
     )
     if show:

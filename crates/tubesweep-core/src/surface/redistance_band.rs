@@ -115,8 +115,9 @@ pub struct RedistanceOptions {
 /// A point is on the zero level set when `|φ| ≤ ON_ZERO_SET · Δx · |∇φ|` there (about that many
 /// grid spacings from it along the normal): every iterate is. Far below the interpolant's own
 /// error (`Δx²|D²φ|/(8|∇φ|)`, 7.5e-3 Δx on `|x|² − R²` at N = 201) and near the directions' f32
-/// rounding; 1e-9 instead took a third Newton step at about one landing in three on the smoothed
-/// mask (8.1 evaluations per node instead of 6.7), for the same errors.
+/// rounding; 1e-9 instead took a third Newton step at many of the smoothed mask's landings. A node whose iterations stall at kinks (a
+/// mask's voxel steps, the gyroid-like φ's tight folds) may stop at another point with either:
+/// up to 0.12 and 0.22 Δx apart there (`benches/experiments/band_fingerprints.py`).
 const ON_ZERO_SET: f64 = 1e-7;
 
 /// The refinement stops when a move is more than [`STALL_RATIO`] times the one before.
@@ -142,11 +143,12 @@ const PRUNE_MARGIN: f64 = 1.0;
 /// closest point, with its normal) exceeds the half-width by more than `BEND_ALLOWANCE · t²/Δx +
 /// BEYOND_MARGIN · Δx` (`t` the start's offset along the plane) is beyond the band and left out
 /// unrefined: a surface whose radii of curvature are a spacing or more bends towards the node by
-/// at most `t²/(2Δx)` over `t`. At N = 201 that leaves out 42k of the 52k nodes that the
-/// refinement found beyond the band on the sphere's quadric (of 305k; its mask: 19k), with the
-/// same band, bit for bit, on the sphere's quadric, its mask and smoothed mask, the gyroid-like φ,
-/// a noisy sphere, a `min` union, a torus, a cube and a float32 φ at N = 81 and 121 (without the
-/// margin, one node of the noisy sphere 0.001–0.013 Δx inside the band's edge was lost).
+/// at most `t²/(2Δx)` over `t`. Most of the nodes that the refinement used to take only to find
+/// them beyond the band are left out so (`BEYOND_MARGIN` keeps those just past the edge: without
+/// it a node of a noisy sphere 0.001–0.013 Δx inside the edge was lost). With the looser landing
+/// of [`ON_ZERO_SET`], which came with it, the bands of the nine φ of
+/// `benches/experiments/band_fingerprints.py` kept their nodes (the gyroid-like φ gained 6 at
+/// N = 121) and their settled distances to 1e-7 Δx.
 const BEND_ALLOWANCE: f64 = 0.5;
 
 /// See [`BEND_ALLOWANCE`].
