@@ -33,7 +33,7 @@ pub struct SampledField<'a, const D: usize> {
     /// The grid's upper corner, `lower + (shape − 1) · spacing`.
     upper: [f64; D],
     /// The lowest corner of the last cell along each axis, `shape − 2`.
-    last_cell: [f64; D],
+    last_cell: [i64; D],
     spacing: f64,
 }
 
@@ -68,10 +68,10 @@ impl<'a, const D: usize> SampledField<'a, D> {
         for k in (0..D - 1).rev() {
             stride[k] = stride[k + 1] * shape[k + 1];
         }
-        let (mut upper, mut last_cell) = (lower, [0.0; D]);
+        let (mut upper, mut last_cell) = (lower, [0i64; D]);
         for k in 0..D {
             upper[k] = lower[k] + (shape[k] - 1) as f64 * spacing;
-            last_cell[k] = (shape[k] - 2) as f64;
+            last_cell[k] = (shape[k] - 2) as i64;
         }
         Ok(SampledField {
             samples,
@@ -103,8 +103,18 @@ impl<'a, const D: usize> SampledField<'a, D> {
     #[inline(always)]
     fn locate(&self, axis: usize, c: f64) -> (usize, f64) {
         let t = (c - self.lower[axis]) / self.spacing;
-        let b = floor(t).clamp(0.0, self.last_cell[axis]);
-        (b as usize, (t - b).clamp(0.0, 1.0))
+        let b = self.cell_index(axis, t);
+        (b, (t - b as f64).clamp(0.0, 1.0))
+    }
+
+    /// `⌊t⌋` clamped to the cells along `axis`, `0 ..= shape − 2`: the same cell for every `t`
+    /// (NaN and values beyond `i64` included, which the clamp brings into the grid), in integers,
+    /// without the call to the C library's `floor` that `f64::floor` compiles to on the x86-64
+    /// baseline or a second conversion from a float.
+    #[inline(always)]
+    fn cell_index(&self, axis: usize, t: f64) -> usize {
+        let i = t as i64; // towards zero, saturating; NaN → 0
+        i.saturating_sub(i64::from(i as f64 > t)).clamp(0, self.last_cell[axis]) as usize
     }
 
     /// The multilinear interpolant of the cell with lowest corner `base` at the fractions `frac`:
@@ -167,9 +177,8 @@ impl<'a, const D: usize> SampledField<'a, D> {
         let mut inside = [true; D];
         for k in 0..D {
             let t = (p[k] - self.lower[k]) / self.spacing;
-            let b = floor(t).clamp(0.0, self.last_cell[k]);
-            base[k] = b as usize;
-            let f = t - b;
+            base[k] = self.cell_index(k, t);
+            let f = t - base[k] as f64;
             inside[k] = (0.0..=1.0).contains(&f);
             frac[k] = f.clamp(0.0, 1.0);
         }
@@ -388,18 +397,6 @@ impl<'a, const D: usize> SampledField<'a, D> {
     }
 }
 
-/// `t.floor()` after the clamps of [`SampledField::value`]: the same cell for every `t` (NaN
-/// and values beyond `i64` included, which the clamps bring into the grid), without the call to
-/// the C library's `floor` that `f64::floor` compiles to on the x86-64 baseline.
-#[inline(always)]
-fn floor(t: f64) -> f64 {
-    let i = t as i64 as f64; // towards zero, saturating; NaN → 0
-    if i > t {
-        i - 1.0
-    } else {
-        i
-    }
-}
 
 #[inline]
 pub(crate) fn sum_of_squares<const D: usize>(v: &[f64; D]) -> f64 {
