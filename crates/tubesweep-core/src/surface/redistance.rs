@@ -201,7 +201,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
                     at += self.stride[k];
                 }
             }
-            *v = self.samples[at];
+            *v = self.corner(at);
         }
         for a in 0..D {
             let f = frac[a];
@@ -226,6 +226,18 @@ impl<'a, const D: usize> SampledField<'a, D> {
             *g /= self.spacing;
         }
         (value, grad)
+    }
+
+    /// The sample at linear index `at` of a corner of a cell of the grid (a cell index within
+    /// `0 ..= shape − 2` along each axis, as [`cell_index`](Self::cell_index) gives, plus 0 or 1
+    /// along each, or the window of [`half_step_gradient_in`](Self::half_step_gradient_in) checked
+    /// to lie in the grid): in the grid by construction, so read without a bounds check, the
+    /// innermost load of the re-distancing's evaluations.
+    #[inline(always)]
+    fn corner(&self, at: usize) -> f64 {
+        debug_assert!(at < self.samples.len());
+        // SAFETY: `new` checked `samples.len()` = ∏ shape; the callers' cells lie in the grid
+        unsafe { *self.samples.get_unchecked(at) }
     }
 
     /// φ at the node of D-index `node`.
@@ -339,7 +351,7 @@ impl<'a, const D: usize> SampledField<'a, D> {
                 let n0 = row + first as usize * step;
                 for c in 0..1usize << (D - 1) {
                     let at = n0 + offset[c];
-                    let (v0, v1, v2) = (self.samples[at], self.samples[at + step], self.samples[at + 2 * step]);
+                    let (v0, v1, v2) = (self.corner(at), self.corner(at + step), self.corner(at + 2 * step));
                     sum += weight[c] * (lower_len * (v1 - v0) + upper_len * (v2 - v1));
                 }
             } else {
