@@ -409,7 +409,6 @@ impl<'a, const D: usize> SampledField<'a, D> {
     }
 }
 
-
 #[inline]
 pub(crate) fn sum_of_squares<const D: usize>(v: &[f64; D]) -> f64 {
     let mut s = v[0] * v[0];
