@@ -23,6 +23,17 @@
 //! as the cold solve's (the window, not the start, sets the cost), and from a start extrapolated
 //! in time (two previous solutions, error O(δ²)) about three quarters of them.
 //!
+//! How close could a start be? `benches/experiments/warm_predictors.py` predicts each cold solution
+//! of that sequence from the *cold* solutions of the steps before (the best a warm start could
+//! have): carried, 44k tolerances off at the worst node (median 14k); extrapolated linearly, 5.6k–12k
+//! (median 220); quadratically (three steps), 1.3k–6.5k (median 12–25), the worst at the
+//! antipode, where the geodesics meet, and 60–75 % of the nodes common to the bands still more
+//! than 10 tolerances off. So even that start needs about 8 iterations over the whole band (cold:
+//! 19, 18 updates per band node): the sweeps alone would still cost about half of a cold solve.
+//! Updating only the nodes whose stencil changed in the last sweep (an active set, not built)
+//! would be the next thing to try; the errors are spread over the band, so its gain is bounded
+//! by the 60–75 % still off after the quadratic start.
+//!
 //! Tried and not kept: Gauss–Seidel passes in increasing order of the carried values before phase
 //! 2 (a counting sort by value in buckets of σ̄Δx/20, then the phase-2 update node by node, like
 //! fast marching with a known order), in the hope that one pass in a nearly causal order is
