@@ -61,7 +61,7 @@ def travel_time_general(
     t0: float,
 ) -> Any:
     """The box solve of :func:`tubesweep.travel_time` for a general Hamiltonian ``ham``."""
-    from .hamiltonians import _mean_cell_time, _coefficient_bytes
+    from ._hamiltonian_solve import _mean_cell_time, _coefficient_bytes
 
     linear = np.arange(grid.size, dtype=np.int64)
     x = np.stack([c.reshape(-1) for c in grid.meshgrid()], axis=1)

@@ -25,12 +25,12 @@ from __future__ import annotations
 import copy
 import warnings
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Optional
+from typing import Any, Dict, Optional
 
 import numpy as np
 
 from .grid import Grid
-from ._validate import call_on_points, check_tolerance_scale, real_array
+from ._validate import call_on_points, real_array
 from ._warn import user_stacklevel
 
 __all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
@@ -710,106 +710,3 @@ def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Ham
     if allow_supersonic:
         raise ValueError("allow_supersonic=True needs a flow (the moving-medium equation); pass flow=v")
     return None
-
-
-def _coefficient_bytes(prep: _Prepared, n_nodes: int, d: int) -> int:
-    """The bytes of the flow or metric the native solver holds for ``n_nodes`` nodes: the flow
-    ``8 d`` per node; the metric ``8 d²`` per node with the Lax–Friedrichs update (M as given), and
-    with the upwind solver its symmetric part packed, ``8 d(d+1)/2`` per matrix stored (one for a
-    constant M)."""
-    if prep.metric is None:
-        return 8 * d * n_nodes
-    if prep.scheme == "lxf":
-        return 8 * d * d * n_nodes
-    return 8 * (d * (d + 1) // 2) * len(prep.metric)
-
-
-def _mean_cell_time(ham: Hamiltonian, prep: _Prepared, n_nodes: int, grid: Grid) -> float:
-    """The mean travel time of one grid step along ±each axis under ``ham``'s local (constant)
-    Hamiltonian, over up to 4,096 nodes spread through the band: the scale of the values that
-    ``tol`` is compared with. A metric or a flow changes it from spacing × slowness (a metric
-    ``M = 1e30·I`` makes it 1e-15 times smaller)."""
-    nodes = np.unique(np.linspace(0, n_nodes - 1, min(n_nodes, 4096)).astype(np.int64))
-    d, h = grid.ndim, grid.spacing
-    times = [
-        ham.local_time(prep, nodes, np.broadcast_to(sign * h * np.eye(d)[k], (len(nodes), d)))
-        for k in range(d)
-        for sign in (1.0, -1.0)
-    ]
-    return float(np.mean(times))
-
-
-def solve_band(
-    ham: Hamiltonian,
-    surface: Any,
-    grid: Grid,
-    geom: Any,
-    band: Any,
-    roles: np.ndarray,
-    positions: np.ndarray,
-    fixed_values: np.ndarray,
-    sources: np.ndarray,
-    speed_nodes: Any,
-    exact_sources: bool,
-    source_radius: float,
-    tol: float,
-    max_iterations: int,
-    infinity: Optional[float],
-    progress: Optional[Callable[[int, float, int], None]],
-    threads: int = 0,
-    activation_threshold: float = 0.0,
-    defer_outer_rim: bool = True,
-) -> tuple:
-    """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
-    travel time (for ``exact_sources``), and runs the sweeps with the upwind local solver or the
-    general Lax–Friedrichs update (Sect. 5.1), as ``prep.scheme`` says."""
-    x = grid.node_points(geom.linear)
-    slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
-    prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
-    check_tolerance_scale(
-        tol,
-        grid.spacing,
-        _mean_cell_time(ham, prep, len(roles), grid) / grid.spacing,
-        max(grid.shape),
-        "the Hamiltonian's travel time along the axes, averaged over the band",
-        "the Hamiltonian's coefficients",
-    )
-    fixed = np.array(fixed_values, dtype=float)
-    if exact_sources and positions.size:
-        _, cp = surface.project(x[positions], grid)
-        _, sp = surface.project(sources, grid)
-        best = np.full(len(positions), np.inf)
-        reach = (source_radius + 4.0) * grid.spacing
-        for s in sp:
-            disp = cp - s
-            near = np.linalg.norm(disp, axis=1) <= reach
-            t = ham.local_time(prep, positions, disp)
-            best = np.where(near, np.minimum(best, t), best)
-        fixed = np.where(np.isfinite(best), best, fixed)
-    values, st = band.solve_general(
-        roles,
-        positions,
-        fixed,
-        grid.spacing,
-        prep.kind,
-        prep.slowness,
-        geom.directions_for_solver(),
-        "extrapolate",
-        float(tol),
-        int(max_iterations),
-        None if infinity is None else float(infinity),
-        flow=prep.flow,
-        metric=prep.metric,
-        sigma=prep.sigma,
-        progress=progress,
-        threads=int(threads),
-        skip_inactive=True,
-        activation_threshold=float(activation_threshold),
-        defer_outer_rim=bool(defer_outer_rim),
-        scheme=prep.scheme,
-    )
-    st = dict(st)
-    # "upwind" for the moving medium and metrics, Eq. (3) itself for the isotropic Hamiltonian
-    st["local_solver"] = "lxf" if prep.scheme == "lxf" else ("godunov" if prep.kind == "isotropic" else "upwind")
-    st.update(prep.extra if "inverse" not in prep.extra else {})
-    return values, st

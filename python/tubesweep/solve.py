@@ -42,6 +42,7 @@ from ._prepare import (
     warn_facing_pairs,
 )
 from ._sources import SOURCE_RADIUS, _fix_sources
+from . import _hamiltonian_solve
 from .solution import Solution
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
@@ -371,8 +372,6 @@ def _solve_on_tube(
     """Fixes the sources on the prepared tube and sweeps. With ``reuse`` the tube is left as it
     was (its roles and directions are copied); without, its arrays are consumed and dropped
     before the sweeps."""
-    from . import hamiltonians as _hams
-
     if not isinstance(paper_sweeps, (bool, np.bool_)):
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band
@@ -467,7 +466,7 @@ def _solve_on_tube(
         del directions
     else:
         setup = time.perf_counter() - t0
-        values, st = _hams.solve_band(
+        values, st = _hamiltonian_solve.solve_band(
             general,
             surf,
             grid,
