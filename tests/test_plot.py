@@ -133,7 +133,7 @@ def test_the_default_views_look_at_the_source_and_at_the_far_side(sphere_sol):
 
 def test_a_spheroid_with_the_source_at_the_pole_is_seen_whole():
     # both former fixed views looked at it from 20° above the equator: the far half never shown
-    from tubesweep._plot import _default_views
+    from tubesweep._plot_surface import _default_views
     from tubesweep._triangulate import triangulate
 
     s = ts.surfaces.Ellipsoid(0.25, 0.25, 0.5)
