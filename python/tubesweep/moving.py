@@ -81,14 +81,19 @@ def _linear(sol_or_tube: Any) -> np.ndarray:
     return np.ascontiguousarray(sol_or_tube.linear, dtype=np.int64).view(np.uint64)
 
 
-def carried_values(warm: Any, tube: Any, feet: np.ndarray, inner_width: float) -> Tuple[np.ndarray, Dict[str, Any]]:
+def carried_values(
+    warm: Any, tube: Any, feet: np.ndarray, inner_width: float
+) -> Tuple[np.ndarray, Dict[str, Any], Dict[str, Any]]:
     """The previous solution ``warm`` carried onto ``tube`` (a ``_prepare._PreparedTube``) for a
     solve from the sources' foot points ``feet``: a node in both bands keeps its value, a node new
     to the band starts at +∞ (``tubesweep_core::second_order::warm::carry_values``). ``warm`` may
     be a pair ``(older, previous)`` of the two previous steps' solutions: the start is then
-    extrapolated in time, ``2·previous − older``, where both have a value (error O(δ²) instead of
-    O(δ) for a surface moving smoothly by δ per step; about a quarter fewer updates). Raises
-    :class:`WarmStartRefused` when the previous solution does not fit (see the module)."""
+    extrapolated in time, ``2·previous − older``, where both have a value and the node's update
+    changed (error O(δ²) instead of O(δ) for a surface moving smoothly by δ per step; about a
+    quarter fewer updates). Returns the carried values, the other warm arguments of the native
+    solve (the older values, the previous band's positions and digests: the sweeps start from
+    the nodes whose update changed) and the report. Raises :class:`WarmStartRefused` when the
+    previous solution does not fit (see the module)."""
     from ._prepare import ROLE_OUTER
 
     grid = tube.grid
@@ -112,12 +117,15 @@ def carried_values(warm: Any, tube: Any, feet: np.ndarray, inner_width: float) -
         )
     old_linear, new_linear = _linear(warm), _linear(tube)
     carried = _native.carry_band_values(old_linear, np.ascontiguousarray(warm.values, dtype=float), new_linear)
-    extrapolated = 0
+    more: Dict[str, Any] = {}
     if older is not None:
-        before = _native.carry_band_values(_linear(older), np.ascontiguousarray(older.values, dtype=float), new_linear)
-        both = np.isfinite(before) & np.isfinite(carried)
-        carried[both] = 2.0 * carried[both] - before[both]
-        extrapolated = int(np.count_nonzero(both))
+        more["warm_older"] = _native.carry_band_values(
+            _linear(older), np.ascontiguousarray(older.values, dtype=float), new_linear
+        )
+    digests = getattr(warm, "_digests", None)
+    if digests is not None:
+        more["warm_previous_linear"] = old_linear
+        more["warm_previous_digests"] = np.ascontiguousarray(digests, dtype=np.uint64)
     inner_new = tube.roles != ROLE_OUTER
     # nodes of the new inner tube outside the previous band (a node in it that the previous solve
     # never reached, on a part without a source, stays unreached: the sweeps leave it at +∞)
@@ -150,6 +158,5 @@ def carried_values(warm: Any, tube: Any, feet: np.ndarray, inner_width: float) -
     info = {
         "carried": int(np.count_nonzero(np.isfinite(carried))),
         "new_nodes": int(np.count_nonzero(~np.isfinite(carried))),
-        "extrapolated": extrapolated,
     }
-    return np.ascontiguousarray(carried), info
+    return np.ascontiguousarray(carried), more, info

@@ -13,7 +13,7 @@ import dataclasses
 import math
 import time
 import warnings
-from typing import Any, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -316,11 +316,12 @@ def solve_on_tube(
     linear = tube.linear
     feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
     warm_values, warm_info = None, None
+    warm_more: Dict[str, Any] = {}
     if warm is not None:
         from .moving import WarmStartRefused, carried_values
 
         try:
-            warm_values, warm_info = carried_values(warm, tube, feet, tube.inner * h)
+            warm_values, warm_more, warm_info = carried_values(warm, tube, feet, tube.inner * h)
         except WarmStartRefused as e:
             if warm_refused != "cold":
                 raise
@@ -352,6 +353,7 @@ def solve_on_tube(
             ramp_length=inputs.length,
             extension_limit=EXTENSION_LIMIT,
             warm=warm_values,
+            **warm_more,
         )
     except Order2NotApplicable as e:
         # a tube cut by the grid box: the reason names the box, not φ or the resolution
@@ -412,6 +414,8 @@ def solve_on_tube(
     if warm_info is not None:
         if warm_values is not None:
             warm_info["restarted"] = st["warm_restarted"]
+            warm_info["changed"] = st["warm_changed"]
+            warm_info["extrapolated"] = st["warm_extrapolated"]
         order2["warm"] = warm_info
     order2["fix_radius"] = FIX_RADIUS * h
     if getattr(surf, "smooth", False):  # a mesh's smooth map: band nodes per map (surfaces/_mesh_smooth.py)
@@ -476,5 +480,6 @@ def solve_on_tube(
         factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
+    sol._digests = st["digests"]
     sol.order = 2
     return sol

@@ -108,6 +108,9 @@ class Solution:
         # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
         self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray, float]] = None
         self._first_order_positions: Optional[np.ndarray] = None
+        # order=2: per band node a digest of what its update reads (a warm start from this
+        # solution starts the sweeps where they changed: tubesweep_core::second_order::fingerprint)
+        self._digests: Optional[np.ndarray] = None
         self.order = 1
 
     def __getstate__(self) -> dict:

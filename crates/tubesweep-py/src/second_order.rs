@@ -5,6 +5,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tubesweep_core::band::NarrowBand;
+use tubesweep_core::second_order::fingerprint::node_fingerprints;
+use tubesweep_core::second_order::warm::WarmStart;
 use tubesweep_core::second_order::{
     check_geometry_of, first_order_start, starting_values, sweep_second_order, tube_setup_of, Implicit,
     SecondOrderOptions,
@@ -43,6 +45,11 @@ struct Inputs<'s> {
     front_window: f64,
     /// the previous values carried onto this band (`moving.rs`): a warm start
     warm: Option<&'s [f64]>,
+    /// the values of the solve before the previous one on this band (a start extrapolated in time)
+    warm_older: Option<&'s [f64]>,
+    /// the previous band's grid positions and its nodes' digests (the sweeps start from the nodes
+    /// whose update changed)
+    warm_previous: Option<(&'s [u64], &'s [u64])>,
 }
 
 fn run<'py, const D: usize>(
@@ -101,8 +108,15 @@ fn run<'py, const D: usize>(
             crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))
         };
         let mut warm_report = None;
+        // what each node's update reads of its own, for a warm start from this solve
+        let digests = node_fingerprints(band, &geometry, &factoring, directions, slowness)?;
         let stats = if let Some(carried) = inp.warm {
             // a warm start (tubesweep_core::second_order::warm): phase 2 from the carried values
+            let start = WarmStart {
+                carried,
+                older: inp.warm_older,
+                previous: inp.warm_previous.map(|(l, d)| (l, d, &digests[..])),
+            };
             let w = tubesweep_core::second_order::warm::sweep_warm(
                 band,
                 &geometry,
@@ -110,12 +124,12 @@ fn run<'py, const D: usize>(
                 directions,
                 slowness,
                 inp.spacing,
-                carried,
+                &start,
                 &mut values,
                 &inp.options,
                 &mut callback,
             )?;
-            warm_report = Some((w.carried, w.restarted));
+            warm_report = Some(w);
             w.stats
         } else {
             let mut first_seconds = 0.0;
@@ -165,7 +179,8 @@ fn run<'py, const D: usize>(
             + factoring.roles.capacity()
             + values.capacity() * 8
             + n
-            + 4 * (band.n_rows() + 1);
+            + 4 * (band.n_rows() + 1)
+            + digests.capacity() * 8;
         let roles_out: Vec<u8> = factoring.roles.iter().map(|&r| r as u8).collect();
         // where the update ran first order (band positions), node by node
         let first_order: Vec<u32> = (0..n)
@@ -183,12 +198,13 @@ fn run<'py, const D: usize>(
             bytes,
             first_order,
             warm_report,
+            digests,
         ))
     });
     if let Some(e) = py_error {
         return Err(e);
     }
-    let (values, u0, roles_out, stats, summary, bytes, first_order, warm_report) = result.map_err(to_pyerr)?;
+    let (values, u0, roles_out, stats, summary, bytes, first_order, warm_report, digests) = result.map_err(to_pyerr)?;
     let d = PyDict::new(py);
     d.set_item(
         "iterations",
@@ -216,9 +232,12 @@ fn run<'py, const D: usize>(
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
     d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
-    if let Some((carried, restarted)) = warm_report {
-        d.set_item("warm_carried", carried)?;
-        d.set_item("warm_restarted", restarted.map(|r| format!("{r:?}").to_lowercase()))?;
+    d.set_item("digests", digests.into_pyarray(py))?;
+    if let Some(w) = warm_report {
+        d.set_item("warm_carried", w.carried)?;
+        d.set_item("warm_restarted", w.restarted.map(|r| format!("{r:?}").to_lowercase()))?;
+        d.set_item("warm_changed", w.changed)?;
+        d.set_item("warm_extrapolated", w.extrapolated)?;
     }
     Ok((
         values.into_pyarray(py),
@@ -231,7 +250,7 @@ fn run<'py, const D: usize>(
 /// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
 /// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None, warm_older=None, warm_previous_linear=None, warm_previous_digests=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve<'py>(
     py: Python<'py>,
@@ -261,6 +280,9 @@ pub fn second_order_solve<'py>(
     ramp_length: f64,
     extension_limit: f64,
     warm: Option<PyReadonlyArray1<'py, f64>>,
+    warm_older: Option<PyReadonlyArray1<'py, f64>>,
+    warm_previous_linear: Option<PyReadonlyArray1<'py, u64>>,
+    warm_previous_digests: Option<PyReadonlyArray1<'py, u64>>,
 ) -> PyResult<Solved<'py>> {
     if !(tol > 0.0 && tol_first > 0.0) {
         return Err(PyValueError::new_err("tol must be positive"));
@@ -314,6 +336,22 @@ pub fn second_order_solve<'py>(
         warm: match &warm {
             Some(a) => Some(c_slice(a, "warm")?),
             None => None,
+        },
+        warm_older: match &warm_older {
+            Some(a) => Some(c_slice(a, "warm_older")?),
+            None => None,
+        },
+        warm_previous: match (&warm_previous_linear, &warm_previous_digests) {
+            (Some(l), Some(d)) => Some((
+                c_slice(l, "warm_previous_linear")?,
+                c_slice(d, "warm_previous_digests")?,
+            )),
+            (None, None) => None,
+            _ => {
+                return Err(PyValueError::new_err(
+                    "warm_previous_linear and warm_previous_digests go together",
+                ))
+            }
         },
     };
     match &band.band {

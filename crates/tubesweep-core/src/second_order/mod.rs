@@ -20,8 +20,10 @@
 //!
 //! The first-order solver ([`crate::sweep`]) is untouched: `order=1` is the paper's scheme.
 
+mod active;
 pub mod creases;
 pub mod factoring;
+pub mod fingerprint;
 pub mod geometry;
 pub mod implicit;
 pub mod local;

@@ -145,13 +145,13 @@ impl Limits {
 }
 
 pub(super) struct Sweeper<'a, const D: usize> {
-    table: NeighbourTable<'a, D>,
+    pub(super) table: NeighbourTable<'a, D>,
     pub(super) roles: &'a [NodeRole],
     /// Per node not in the extension layer, in band order (`k` below).
     geometry: &'a [NodeGeometry],
     /// The outward unit directions sgn(φ) n per node, which the extension update follows.
     directions: &'a [[f32; D]],
-    u0: &'a [f64],
+    pub(super) u0: &'a [f64],
     grad_u0: &'a [[f32; D]],
     /// ∇u₀ = `grad_u0` × this ([`Factoring::grad_u0_unit`]).
     grad_u0_unit: f64,
@@ -448,58 +448,6 @@ impl<const D: usize> Sweeper<'_, D> {
         }
         0
     }
-
-    /// The active flags at the start of a phase: the nodes that are not fixed and have a value,
-    /// and those that read a node with a value ([`Self::activate`]). Any other node would be
-    /// visited only to find no neighbour reached (`inner` and `outer` give None) and be set
-    /// inactive until a neighbour wakes it: the same values without those visits (from the fixed
-    /// nodes alone, on the sphere at N = 201, 0.25 million of the 5.6 million updates).
-    fn start_flags(&self, active: &[AtomicU8], values: &[f64]) {
-        #[cfg(test)]
-        if ALL_ACTIVE_START.with(|a| a.get()) {
-            for (a, &r) in active.iter().zip(self.roles) {
-                a.store((r != NodeRole::Fixed) as u8, Ordering::Relaxed);
-            }
-            return;
-        }
-        for a in active {
-            a.store(0, Ordering::Relaxed);
-        }
-        for (i, v) in values.iter().enumerate() {
-            if v.is_finite() {
-                self.activate(active, i);
-            }
-        }
-        for ((a, v), &r) in active.iter().zip(values).zip(self.roles) {
-            if r == NodeRole::Fixed {
-                a.store(0, Ordering::Relaxed);
-            } else if v.is_finite() {
-                a.store(1, Ordering::Relaxed);
-            }
-        }
-    }
-
-    /// Marks the nodes that read node `i`: its neighbours at distance 1 and 2 along each axis.
-    /// Without branches: a missing neighbour is the sentinel, whose flag is the sink at the end
-    /// of `active`, and a missing first neighbour's own neighbour is taken from `i` (the same
-    /// sentinel), so that the twelve stores cost no mispredicted jumps.
-    #[inline(always)]
-    fn activate(&self, active: &[AtomicU8], i: usize) {
-        let table = self.table;
-        let sentinel = table.sentinel();
-        debug_assert_eq!(active.len(), sentinel as usize + 1);
-        for k in 0..D {
-            for side in 0..2 {
-                // SAFETY: `i` and `from` are band nodes; `active` has one flag per band node and
-                // one for the sentinel
-                let j = unsafe { table.neighbour_unchecked(i, k, side) };
-                let from = if j == sentinel { i } else { j as usize };
-                let j2 = unsafe { table.neighbour_unchecked(from, k, side) };
-                unsafe { active.get_unchecked(j as usize) }.store(1, Ordering::Relaxed);
-                unsafe { active.get_unchecked(j2 as usize) }.store(1, Ordering::Relaxed);
-            }
-        }
-    }
 }
 
 /// Runs both phases on `values` (fixed nodes hold their values, the others +∞ or a start).
@@ -513,6 +461,23 @@ pub fn sweep_second_order<const D: usize>(
     spacing: f64,
     values: &mut [f64],
     options: &SecondOrderOptions,
+    control: &mut dyn FnMut(&IterationReport) -> Control,
+) -> Result<SecondOrderStats> {
+    let sw = (geometry, factoring, directions, slowness);
+    sweep_second_order_from(band, sw, spacing, values, options, None, control)
+}
+
+/// [`sweep_second_order`] whose first phase starts from the nodes `changed` marks and the nodes
+/// that read them (a warm start on a surface that moved in part, [`super::warm::sweep_warm`]):
+/// the others hold a fixed point of their unchanged update, and the window starts at the
+/// smallest value among the active nodes instead of at the fixed nodes.
+pub(super) fn sweep_second_order_from<const D: usize>(
+    band: &NarrowBand<D>,
+    (geometry, factoring, directions, slowness): (&TubeGeometry, &Factoring<D>, &[[f32; D]], Slowness<'_>),
+    spacing: f64,
+    values: &mut [f64],
+    options: &SecondOrderOptions,
+    mut changed: Option<&[bool]>,
     control: &mut dyn FnMut(&IterationReport) -> Control,
 ) -> Result<SecondOrderStats> {
     let start = Instant::now();
@@ -541,6 +506,12 @@ pub fn sweep_second_order<const D: usize>(
                 format!("one slowness per band node ({n}) is needed"),
             ));
         }
+    }
+    if changed.is_some_and(|c| c.len() != n) {
+        return Err(Error::invalid(
+            "changed",
+            format!("one flag per band node ({n}) is needed"),
+        ));
     }
     let ramp_constant = match slowness {
         Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
@@ -618,21 +589,24 @@ pub fn sweep_second_order<const D: usize>(
             if *iteration > 0 {
                 pipeline.new_phase();
             }
-            sw.start_flags(&active, values);
-            run_phase(
-                &sw,
-                band,
-                values,
-                &active,
-                &row_inner,
+            let first = match changed.take() {
+                Some(c) => Some(sw.start_flags_changed(&active, values, c)),
+                None => {
+                    sw.start_flags(&active, values);
+                    None
+                }
+            };
+            let (run, state) = (
+                RunPhase {
+                    sw: &sw,
+                    band,
+                    active: &active,
+                    row_inner: &row_inner,
+                    options,
+                },
                 &mut pipeline,
-                lim,
-                width,
-                options,
-                iteration,
-                stats,
-                control,
-            )
+            );
+            run_phase(&run, values, state, lim, width, first, iteration, stats, control)
         };
     // the phases; w back to u whatever their outcome (an interrupted solve's values included)
     let mut phases = || -> Result<()> {
@@ -692,30 +666,47 @@ pub fn sweep_second_order<const D: usize>(
 /// left out when nothing in the window moved; it opens fully when no node was left out, or when
 /// the edge has not moved for [`WINDOW_PATIENCE`] iterations. Once it is open, the stagnation test
 /// of the second-order phase applies (see the module documentation).
+/// What a phase's iterations read besides the values.
+struct RunPhase<'r, 'a, const D: usize> {
+    sw: &'r Sweeper<'a, D>,
+    band: &'r NarrowBand<D>,
+    active: &'r [AtomicU8],
+    row_inner: &'r [u32],
+    options: &'r SecondOrderOptions,
+}
+
+/// `first`: where the window starts (the smallest value among the active nodes of a warm start
+/// on a surface that moved in part); None: at the smallest fixed value.
 #[allow(clippy::too_many_arguments)]
 fn run_phase<const D: usize>(
-    sw: &Sweeper<'_, D>,
-    band: &NarrowBand<D>,
+    run: &RunPhase<'_, '_, D>,
     values: &mut [f64],
-    active: &[AtomicU8],
-    row_inner: &[u32],
     pipeline: &mut Pipeline,
     mut lim: Limits,
     window_width: f64,
-    options: &SecondOrderOptions,
+    first: Option<f64>,
     iteration: &mut usize,
     stats: &mut SecondOrderStats,
     control: &mut dyn FnMut(&IterationReport) -> Control,
 ) -> Result<bool> {
+    let RunPhase {
+        sw,
+        band,
+        active,
+        row_inner,
+        options,
+    } = *run;
     let tol = lim.settled;
     if window_width > 0.0 {
-        let first = values
-            .iter()
-            .zip(sw.u0)
-            .zip(sw.roles)
-            .filter(|(_, &r)| r == NodeRole::Fixed)
-            .map(|((&w, &u0), _)| w + u0)
-            .fold(f64::INFINITY, f64::min);
+        let first = first.unwrap_or_else(|| {
+            values
+                .iter()
+                .zip(sw.u0)
+                .zip(sw.roles)
+                .filter(|(_, &r)| r == NodeRole::Fixed)
+                .map(|((&w, &u0), _)| w + u0)
+                .fold(f64::INFINITY, f64::min)
+        });
         lim.window = first + window_width;
     }
     let rows_state = RowsState::new(band, values, sw.u0);
