@@ -233,3 +233,22 @@ def test_a_warm_solve_on_an_unchanged_surface_keeps_the_previous_values_bit_for_
     info = again.stats.order2["warm"]
     assert info["changed"] == 0 and info["extrapolated"] == 0 and again.stats.updates == 0
     assert np.array_equal(again.values, sol.values)
+
+
+def test_the_local_moves_bench_runs_at_a_small_size(capsys):
+    # benches/moving_surfaces.py --local at N = 41, one round: a row per bump, each warm solve
+    # with a share of the band changed and fewer updates than the cold solve's
+    import re
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    import moving_surfaces
+
+    moving_surfaces.local(41, 1)
+    rows = [line for line in capsys.readouterr().out.splitlines() if "changed" in line]
+    assert len(rows) == 3
+    for row in rows:
+        share = float(re.search(r"cold [\d,]+ \(([\d.]+)\)", row).group(1))
+        tols = float(re.search(r"max\|warm − cold\|/tol ([\d.]+)", row).group(1))
+        assert share < 0.5 and tols <= 15, row
