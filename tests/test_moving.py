@@ -194,6 +194,20 @@ def test_evolve_refuses_bad_input_with_the_cause_named():
         ts.evolve(phi[:-1], GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=2)
     with pytest.raises(ValueError, match="must end in .pvd"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1).export("run.vtp")
+    with pytest.raises(TypeError, match="dt must be a positive time step; got True"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=True, steps=1)
+
+
+def test_a_speed_law_that_writes_to_u_leaves_the_solutions_alone():
+    phi = sphere_phi(GRID31)
+
+    def law(u: np.ndarray) -> np.ndarray:
+        u[:] = -7.0  # a careless law: it gets a copy of the values
+        return 0.1 + 0 * u
+
+    ev = ts.evolve(phi, GRID31, [(0, 0, 0.5)], law, dt=0.02, steps=1)
+    clean = ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0.1 + 0 * u, dt=0.02, steps=1)
+    assert all(np.array_equal(a.values, b.values) for a, b in zip(ev.solutions, clean.solutions))
 
 
 def bumped_sphere(grid: ts.Grid, centre: tuple, amplitude: float, width: float = 0.15) -> tuple:

@@ -415,3 +415,20 @@ def test_a_solution_refuses_paths_after_its_phi_array_changed():
 def test_more_bad_arguments_name_themselves(call, error, match):
     with pytest.raises(error, match=match):
         call()
+
+
+@pytest.mark.parametrize("bad", [True, "2", [2.0], 2 + 0j, -1.0])
+def test_infinity_is_checked_whichever_order_runs(bad):
+    # the default order="auto" runs second order, which has no use for infinity: a bad value is
+    # still refused, by ts.solve and Tube.solve alike
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (21, 21, 21))
+    with pytest.raises((TypeError, ValueError), match="infinity must be"):
+        ts.solve(ts.surfaces.Sphere(0.5), grid, [(0, 0, 0.5)], infinity=bad)
+    with pytest.raises((TypeError, ValueError), match="infinity must be"):
+        ts.Tube(ts.surfaces.Sphere(0.5), grid).solve([(0, 0, 0.5)], infinity=bad)
+
+
+def test_warm_refused_is_checked_without_warm():
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (21, 21, 21))
+    with pytest.raises(ValueError, match="warm_refused must be 'raise'"):
+        ts.solve(ts.surfaces.Sphere(0.5), grid, [(0, 0, 0.5)], warm_refused="ignore")

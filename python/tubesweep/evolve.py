@@ -21,7 +21,7 @@ from typing import Any, Callable, List, Optional, Union
 
 import numpy as np
 
-from ._validate import as_grid, as_sources
+from ._validate import as_grid, as_sources, real_scalar
 from .solution import Solution
 from .solve import DEFAULT_TOL
 from .output import export
@@ -99,7 +99,7 @@ class Evolution:
 
 
 def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) -> np.ndarray:
-    v = np.asarray(speed(u), dtype=float)
+    v = np.asarray(speed(u.copy()), dtype=float)  # a copy: a law that writes to u leaves the solution alone
     if v.ndim == 0:
         v = np.full(u.shape, float(v))
     if v.shape != u.shape:
@@ -188,11 +188,13 @@ def evolve(
     if arr.shape != tuple(grid.shape):
         raise ValueError(f"evolve: phi must be an array of the grid's shape {tuple(grid.shape)}; got {arr.shape}")
     src = as_sources(sources, grid)
-    if not (isinstance(dt, (int, float, np.floating)) and np.isfinite(dt) and dt > 0):
+    dt = real_scalar(dt, "evolve: dt", "a positive time step")
+    if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"evolve: dt must be a positive time step; got {dt!r}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
         raise ValueError(f"evolve: steps must be a positive integer; got {steps!r}")
-    if not (isinstance(cfl, (int, float, np.floating)) and 0 < cfl <= 1):
+    cfl = real_scalar(cfl, "evolve: cfl", "a number in (0, 1]")
+    if not 0 < cfl <= 1:
         raise ValueError(
             f"evolve: cfl must be in (0, 1] (the surface moves at most cfl grid spacings per step); got {cfl!r}"
         )

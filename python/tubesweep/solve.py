@@ -26,6 +26,7 @@ from ._validate import (
 )
 from ._result_check import check_values
 from .grid import Grid
+from .moving import check_warm_refused
 from .stats import SolveStats
 from .surface import as_surface
 from ._prepare import (
@@ -238,10 +239,8 @@ def solve(
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)
-    if warm is not None:
-        from .moving import check_warm_refused
-
-        check_warm_refused(warm_refused)
+    _infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
+    check_warm_refused(warm_refused)
     tube: Optional[_PreparedTube] = None
     fallback: Optional[str] = None
     if order != 1:

@@ -27,8 +27,9 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._validate import as_grid, as_sources, check_tolerance, progress_callback
+from ._validate import as_grid, as_sources, check_infinity, check_tolerance, progress_callback
 from .grid import Grid
+from .moving import check_warm_refused
 from ._prepare import _prepare_tube, thinned_at_creases
 from .solution import Solution
 from .solve import DEFAULT_TOL, _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
@@ -212,10 +213,8 @@ class Tube:
         check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
-        if warm is not None:
-            from .moving import check_warm_refused
-
-            check_warm_refused(warm_refused)
+        check_infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
+        check_warm_refused(warm_refused)
         fallback: Optional[str] = None
         if order != 1:
             from . import second_order as _so
