@@ -160,6 +160,10 @@ def test_from_mask_refuses_bad_masks_with_the_cause_and_the_fix():
         ts.LevelSet.from_mask(ball, grid, smooth=-1)
     with pytest.raises(ValueError, match=r"smooth = 30 voxels erases the object"):
         ts.LevelSet.from_mask(X**2 + Y**2 + Z**2 < 0.01, grid, smooth=30)
+    # a width beyond the object's thinnest extent is refused before the filter runs (1e6 voxels
+    # took minutes of filtering before)
+    with pytest.raises(ValueError, match=r"smooth = 1e\+06 voxels erases the object: it is only \d+ voxels across"):
+        ts.LevelSet.from_mask(ball, grid, smooth=1e6)
     with pytest.raises(TypeError, match=r"grid must be a ts.Grid"):
         ts.LevelSet.from_mask(ball, ball.shape)
     # 0/1 integers and floats are masks too, and give the boolean mask's surface
@@ -263,3 +267,16 @@ def test_a_smoothed_mask_s_second_order_sweeps_settle_without_a_limit_cycle():
     # 0.5 − σ²κ/2 = 0.4988 here) to within a grid spacing
     antipode = -0.4988 * source / np.linalg.norm(source)
     assert abs(sol([antipode])[0] - np.pi * 0.4988) < grid.spacing
+
+
+def test_re_distancing_does_not_depend_on_the_scale_of_phi():
+    # only φ's zero level set matters: |x|² − R² scaled by 1e-200 or 1e200 (where squared
+    # differences under- or overflow; before, the band moved 2.5e-2 or the solve was refused) gives
+    # the unscaled solve's values to the rounding of the scaled samples (measured 1.6e-14)
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    x, y, z = np.meshgrid(*(np.linspace(-1, 1, 41),) * 3, indexing="ij")
+    quadric = x**2 + y**2 + z**2 - 0.25
+    base = ts.solve(ts.LevelSet(quadric, redistance=True), grid, [(0, 0, 0.5)])
+    for scale in (1e-200, 1e200):
+        scaled = ts.solve(ts.LevelSet(scale * quadric, redistance=True), grid, [(0, 0, 0.5)])
+        assert np.max(np.abs(scaled.values - base.values)) < 1e-12

@@ -87,6 +87,17 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
             "is cut open by the box there. Pad the mask with outside voxels, e.g. np.pad(mask, 6), and widen the grid "
             "by as many spacings on each side"
         )
+    extent = min(
+        int(np.ptp(np.flatnonzero(np.any(inside, axis=tuple(j for j in range(inside.ndim) if j != k))))) + 1
+        for k in range(inside.ndim)
+    )
+    if sigma > extent:
+        # the smoothed mask is at most erf(t/(2√2σ)) < 1/2 for an object t voxels thick once
+        # σ > 0.75t: refused before a filter that wide runs (its cost grows with σ)
+        raise ValueError(
+            f"smooth = {sigma:g} voxels erases the object: it is only {extent} voxels across along its thinnest "
+            "axis, and a Gaussian wider than that leaves no voxel above one half. Use a smooth of a few voxels"
+        )
     if sigma > 0:
         try:
             from scipy.ndimage import gaussian_filter

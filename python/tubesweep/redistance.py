@@ -291,6 +291,21 @@ REFINE_STEPS = 40
 REFINE_SETTLED = 1e-12
 
 
+#: Re-distancing rescales a φ whose largest |value| lies outside [2⁻ᴿ, 2ᴿ] (only the zero level
+#: set matters): squares of differences of φ ≈ 1e±200 under- or overflow.
+RESCALE_BEYOND = 60
+
+
+def _in_range(array: np.ndarray) -> np.ndarray:
+    """``array`` scaled by a power of two (exactly: only the zero level set matters to the
+    re-distancing) when its largest finite |value| lies outside [2⁻⁶⁰, 2⁶⁰]; else itself."""
+    finite = np.abs(array[np.isfinite(array)])
+    top = float(finite.max()) if finite.size else 0.0
+    if top == 0.0 or 2.0**-RESCALE_BEYOND <= top <= 2.0**RESCALE_BEYOND:
+        return array
+    return np.ldexp(array, -int(np.frexp(top)[1]))
+
+
 def _sampled_redistanced_band(surface, grid, half_width: float):
     """The re-distanced band of a sampled φ, from any φ whose zero level set crosses the grid:
     sub-cell interface points on the edges of the cells with a sign change, closest points carried
@@ -303,7 +318,7 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     from .band import BandGeometry
 
     linear, signed, direction, crossed, _, medial = _native.redistanced_band_of_samples(
-        surface._array,
+        _in_range(surface._array),
         [float(c) for c in grid.lower],
         grid.spacing,
         float(half_width),
