@@ -351,7 +351,13 @@ class PointCloud:
     def rim(self) -> npt.NDArray[np.bool_]: ...
     def analyse(
         self,
-    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    ) -> Tuple[
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.uint32],
+    ]: ...
     def mark_rim(self, gap: npt.NDArray[np.float64]) -> int: ...
     def closest(
         self, points: npt.NDArray[np.float64], rho: float = 0.0

@@ -81,7 +81,8 @@ impl PyPointCloud {
     }
 
     /// Per sample: spacing (distance to the nearest other sample), the fit's radius, the
-    /// leave-one-out residual over the radius, the largest angular gap of the neighbours.
+    /// leave-one-out residual over the radius, the largest angular gap of the neighbours, the
+    /// index of the nearest other sample (2³² − 1 for none).
     #[allow(clippy::type_complexity)]
     fn analyse<'py>(
         &self,
@@ -91,6 +92,7 @@ impl PyPointCloud {
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<u32>>,
     ) {
         let a: SampleAnalysis = py.detach(|| match &self.cloud {
             Cloud::Two(c) => c.analyse(),
@@ -101,6 +103,7 @@ impl PyPointCloud {
             a.radius.into_pyarray(py),
             a.residual.into_pyarray(py),
             a.gap.into_pyarray(py),
+            a.nearest.into_pyarray(py),
         )
     }
 

@@ -12,7 +12,8 @@ the moving-least-squares projection of ``x`` onto the samples, computed in the R
 * Newton's method for the point of that graph nearest to x, and c ← that point, until it stops
   moving. The map is smooth at grid scale, so ``order="auto"`` runs second order on a closed cloud.
 
-Before any solve the samples are analysed: repeated samples are kept once, samples far off the fit
+Before any solve the samples are analysed: repeated samples (and samples within a thousandth of
+the fits' median radius of another) are kept once, samples far off the fit
 of their neighbours (outliers) are left out with a warning, and samples with an empty angular sector
 among their neighbours mark a rim (holes, the boundary of a scan). A cloud with a rim is an open
 surface: nodes beyond the rim get closest points on it (the open-surface treatment of Sect. 5.2) and
@@ -30,6 +31,7 @@ import numpy as np
 
 from ..closest_point import DIRECTION_EPS, ClosestPoint, _refuse_undefined_next_to
 from .._linalg import row_norms
+from .._validate import real_array
 from ..grid import MAX_COORDINATE, Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
@@ -47,6 +49,10 @@ FIT_RADIUS = 3.0
 NOISY = 0.005
 #: More outliers than this share of the samples: refused (the cloud is not a surface's samples).
 MAX_OUTLIER_SHARE = 0.1
+#: Samples closer to another than this fraction of the fits' median radius (the distance to the
+#: (k+1)-th neighbour, which repeats do not shrink much, unlike the nearest-sample distance) are
+#: near repeats: kept once (a fit over such pairs sees half as many distinct samples, and fails).
+NEAR_REPEAT = 1e-3
 #: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
 SPARSE_FACTOR = 3.0
 #: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
@@ -175,10 +181,19 @@ def _read_ply(path: Path) -> np.ndarray:
 
 
 def _checked_points(points: Any, name: str = "points") -> np.ndarray:
+    what = f"{name} must be an array of shape (M, 3) (or (M, 2) for a curve) of numbers"
     try:
-        p = np.asarray(points, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be an array of shape (M, 3) (or (M, 2) for a curve) of numbers") from None
+        a = np.asarray(points)
+    except ValueError:  # ragged nesting
+        raise TypeError(f"{what}; got {type(points).__name__}") from None
+    not_numbers = (str, bytes, bool, np.bool_)
+    if a.dtype.kind in "USb" or (a.dtype == object and any(isinstance(x, not_numbers) for x in a.reshape(-1))):
+        # strings (even of digits), bytes and booleans are not coordinates
+        raise TypeError(f"{what}; got dtype {a.dtype}")
+    try:
+        p = real_array(a, name)
+    except TypeError as e:
+        raise TypeError(f"{what}: {e}") from None
     if p.ndim != 2 or p.shape[1] not in (2, 3):
         raise ValueError(f"{name} must have shape (M, 3) (or (M, 2) for a curve); got {p.shape}")
     if p.shape[0] == 0:
@@ -207,7 +222,7 @@ class PointCloudSurface(ClosestPoint):
     Attributes
     ----------
     points : numpy.ndarray
-        The samples used (repeated samples once, outliers left out).
+        The samples used (repeated and nearly repeated samples once, outliers left out).
     outliers : numpy.ndarray
         The samples left out as outliers (coordinates, ``(K, d)``).
     rim : numpy.ndarray
@@ -215,7 +230,8 @@ class PointCloudSurface(ClosestPoint):
     open_surface : bool
         True when the cloud has a rim (``order="auto"`` then runs first order).
     report : dict
-        Samples given, repeated, outliers, rim samples, the spacing (median distance to the
+        Samples given, repeated (or within ``NEAR_REPEAT`` of the fits' median radius of another),
+        outliers, rim samples, the spacing (median distance to the
         nearest sample), the density's range (the ratio of the 95th to the 5th percentile of the
         fit's radius) and, after a solve, the band nodes whose closest point lies on the rim.
 
@@ -282,7 +298,24 @@ class PointCloudSurface(ClosestPoint):
         self.name = name
         self.neighbours = int(neighbours)
         cloud = _native.PointCloud(p, self.neighbours)
-        spacing, radius, residual, gap = cloud.analyse()
+        spacing, radius, residual, gap, nearest = cloud.analyse()
+        for _ in range(8):  # chains of near repeats: each round keeps one of each nearest pair
+            near = spacing < NEAR_REPEAT * np.median(radius)
+            if not near.any():
+                break
+            # a near repeat goes when its nearest sample comes first: the first of a cluster stays
+            drop = near & (nearest.astype(np.int64) < np.arange(len(p)))
+            p = p[~drop]
+            if self.normals is not None:
+                self.normals = self.normals[~drop]
+            repeated += int(drop.sum())
+            if len(p) < need:
+                raise ValueError(
+                    f"the cloud has {len(p)} distinct points ({given} given, {repeated} of them repeated or nearly: "
+                    f"closer than {NEAR_REPEAT:g} of the fits' median radius to another); the fit needs at least {need}"
+                )
+            cloud = _native.PointCloud(np.ascontiguousarray(p), self.neighbours)
+            spacing, radius, residual, gap, nearest = cloud.analyse()
         bad = ~(residual <= OUTLIER_RATIO)  # NaN: a degenerate neighbourhood, counted as an outlier
         self.outliers = p[bad]
         if bad.any():
@@ -311,7 +344,7 @@ class PointCloudSurface(ClosestPoint):
             if len(p) < need:
                 raise ValueError(f"after leaving out the outliers {len(p)} samples remain; the fit needs {need}")
             cloud = _native.PointCloud(np.ascontiguousarray(p), self.neighbours)
-            spacing, radius, residual, gap = cloud.analyse()
+            spacing, radius, residual, gap, _ = cloud.analyse()
         rim_count = cloud.mark_rim(np.ascontiguousarray(gap))
         self.points = p
         self._tree = cloud

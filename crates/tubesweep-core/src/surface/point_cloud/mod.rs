@@ -66,6 +66,8 @@ pub struct SampleAnalysis {
     pub residual: Vec<f64>,
     /// Largest angular gap (radians) of the 2k nearest neighbours around the sample.
     pub gap: Vec<f64>,
+    /// The nearest other sample (`u32::MAX` for a lone sample).
+    pub nearest: Vec<u32>,
 }
 
 /// The 2k + 1 nearest samples of an anchor (with their distances to the current centre).
@@ -185,13 +187,14 @@ impl<const D: usize> PointCloud<D> {
     /// The per-sample analysis (in parallel).
     pub fn analyse(&self) -> SampleAnalysis {
         let k = self.neighbours;
-        let rows: Vec<(f64, f64, f64, f64)> = (0..self.points.len())
+        let rows: Vec<(f64, f64, f64, f64, u32)> = (0..self.points.len())
             .into_par_iter()
             .map(|i| {
                 let p = &self.points[i];
                 let many = self
                     .tree
                     .nearest_n::<SquaredEuclidean>(p, NonZero::new(2 * k + 1).unwrap());
+                let nearest = many.iter().find(|n| n.item as usize != i).map_or(u32::MAX, |n| n.item);
                 let others: Vec<[f64; D]> = many
                     .iter()
                     .filter(|n| n.item as usize != i)
@@ -206,9 +209,9 @@ impl<const D: usize> PointCloud<D> {
                         let residual = distance(&fit.lift(&a), p) / fit.radius;
                         let (ap, _) = fit.local(p);
                         let around: Vec<[f64; 2]> = others.iter().map(|o| fit.local(o).0).collect();
-                        (spacing, radius, residual, largest_gap::<D>(&ap, &around))
+                        (spacing, radius, residual, largest_gap::<D>(&ap, &around), nearest)
                     }
-                    None => (spacing, radius, f64::NAN, 0.0),
+                    None => (spacing, radius, f64::NAN, 0.0, nearest),
                 }
             })
             .collect();
@@ -217,6 +220,7 @@ impl<const D: usize> PointCloud<D> {
             radius: rows.iter().map(|r| r.1).collect(),
             residual: rows.iter().map(|r| r.2).collect(),
             gap: rows.iter().map(|r| r.3).collect(),
+            nearest: rows.iter().map(|r| r.4).collect(),
         }
     }
 
