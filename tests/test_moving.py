@@ -198,6 +198,21 @@ def test_evolve_refuses_bad_input_with_the_cause_named():
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=True, steps=1)
 
 
+def test_a_zero_speed_leaves_the_surface_and_its_distances_as_they_were():
+    # φ is advanced as it is: re-distanced values in its place at every step moved the distances by
+    # 0.45Δx in one step (the distances to the multilinear interpolant's zero set are not smooth at
+    # grid scale, and 54 nodes' curvatures tripped)
+    phi = sphere_phi(GRID31)
+    ev = ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=3)
+    assert all(np.array_equal(p, phi) for p in ev.phis)
+    # the source, projected onto the surface again at each step, moves by rounding at most: the
+    # warm solves start from the few nodes that changed (measured: 0, 0, 1) and the values agree
+    # to rounding
+    for s in ev.solutions[1:]:
+        assert s.stats.order2["warm"]["changed"] <= 10 and s.stats.order2["first_order_nodes"] == 0
+        assert np.max(np.abs(s.values - ev.solutions[0].values)) <= 1e-15
+
+
 def test_a_speed_law_that_writes_to_u_leaves_the_solutions_alone():
     phi = sphere_phi(GRID31)
 
