@@ -272,9 +272,10 @@ def test_a_smoothed_mask_s_second_order_sweeps_settle_without_a_limit_cycle():
 def test_re_distancing_does_not_depend_on_the_scale_of_phi():
     # only φ's zero level set matters: |x|² − R² scaled by 1e-200 or 1e200 (where squared
     # differences under- or overflow; before, the band moved 2.5e-2 or the solve was refused) gives
-    # the unscaled solve's values to the rounding of the scaled samples (measured 1.6e-14)
-    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
-    x, y, z = np.meshgrid(*(np.linspace(-1, 1, 41),) * 3, indexing="ij")
+    # the unscaled solve's values to the rounding of the scaled samples (measured 1.6e-14; the
+    # source's projection had an absolute floor on |∇φ|² too, which left it 1.1e-3 off the surface)
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
+    x, y, z = np.meshgrid(*(np.linspace(-1, 1, 31),) * 3, indexing="ij")
     quadric = x**2 + y**2 + z**2 - 0.25
     base = ts.solve(ts.LevelSet(quadric, redistance=True), grid, [(0, 0, 0.5)])
     for scale in (1e-200, 1e200):

@@ -132,7 +132,7 @@ def _project(
         from . import _native
 
         return _native.project_to_sampled_level_set(
-            surface._array,
+            _scaled_samples(surface),
             [float(c) for c in grid.lower],
             grid.spacing,
             np.ascontiguousarray(x, dtype=float),
@@ -306,6 +306,17 @@ def _in_range(array: np.ndarray) -> np.ndarray:
     return np.ldexp(array, -int(np.frexp(top)[1]))
 
 
+def _scaled_samples(surface) -> np.ndarray:
+    """The surface's samples :func:`_in_range`, kept on the surface for the projections that follow
+    (keyed by the array, which a solve checks has not changed)."""
+    array = surface._array
+    kept = getattr(surface, "_in_range_samples", None)
+    if kept is None or kept[0] is not array:
+        kept = (array, _in_range(array))
+        surface._in_range_samples = kept
+    return kept[1]
+
+
 def _sampled_redistanced_band(surface, grid, half_width: float):
     """The re-distanced band of a sampled φ, from any φ whose zero level set crosses the grid:
     sub-cell interface points on the edges of the cells with a sign change, closest points carried
@@ -318,7 +329,7 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     from .band import BandGeometry
 
     linear, signed, direction, crossed, _, medial = _native.redistanced_band_of_samples(
-        _in_range(surface._array),
+        _scaled_samples(surface),
         [float(c) for c in grid.lower],
         grid.spacing,
         float(half_width),
