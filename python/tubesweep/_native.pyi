@@ -171,6 +171,7 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
     warm_older: Optional[npt.NDArray[np.float64]] = None,  # the values before those (a start extrapolated in time)
     warm_previous_linear: Optional[npt.NDArray[np.uint64]] = None,  # the previous band's grid positions
     warm_previous_digests: Optional[npt.NDArray[np.uint64]] = None,  # and its nodes' digests (st["digests"])
+    keep_digests: bool = False,  # return this solve's digests in st["digests"] (8 bytes per node)
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.uint8], Dict[str, Any]]: ...
 def carry_band_values(  # crates/tubesweep-py/src/moving.rs: previous values onto a new band (+inf where new)
     old_linear: npt.NDArray[np.uint64], old_values: npt.NDArray[np.float64], new_linear: npt.NDArray[np.uint64]

@@ -302,9 +302,12 @@ def solve_on_tube(
     t0: float,
     warm: Any = None,
     warm_refused: str = "raise",
+    keep_digests: bool = False,
 ) -> Any:
     """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept);
-    ``warm``: a previous solution to start from (:mod:`tubesweep.moving`)."""
+    ``warm``: a previous solution to start from (:mod:`tubesweep.moving`); ``keep_digests``: the
+    solution keeps its nodes' digests, for a warm start from it to sweep only where the update
+    changed (8 bytes per node; a ``ts.Tube``'s solves and warm solves keep them)."""
     from ._prepare import ROLE_OUTER, thinned_count
 
     grid, surf, band = tube.grid, tube.surface, tube.band
@@ -353,6 +356,7 @@ def solve_on_tube(
             ramp_length=inputs.length,
             extension_limit=EXTENSION_LIMIT,
             warm=warm_values,
+            keep_digests=keep_digests or warm is not None,
             **warm_more,
         )
     except Order2NotApplicable as e:
@@ -480,6 +484,6 @@ def solve_on_tube(
         factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
-    sol._digests = st["digests"]
+    sol._digests = st.get("digests")
     sol.order = 2
     return sol

@@ -240,6 +240,7 @@ class Tube:
                         t0,
                         warm=warm,
                         warm_refused=warm_refused,
+                        keep_digests=True,  # a tube's solutions start warm solves on its moved tubes
                     )
                 except _so.Order2NotApplicable as e:
                     self._order2_refusal = str(e)  # depends on the band only: not computed again

@@ -50,6 +50,8 @@ struct Inputs<'s> {
     /// the previous band's grid positions and its nodes' digests (the sweeps start from the nodes
     /// whose update changed)
     warm_previous: Option<(&'s [u64], &'s [u64])>,
+    /// return this solve's digests (for a warm start from it; 8 bytes per node)
+    keep_digests: bool,
 }
 
 fn run<'py, const D: usize>(
@@ -108,8 +110,13 @@ fn run<'py, const D: usize>(
             crate::progress::check_in(&progress_ref, &mut py_error, (r.iteration, r.max_change, r.updates))
         };
         let mut warm_report = None;
-        // what each node's update reads of its own, for a warm start from this solve
-        let digests = node_fingerprints(band, &geometry, &factoring, directions, slowness)?;
+        // what each node's update reads of its own, for a warm start from this solve (or this one's
+        // from the previous solve's)
+        let digests = if inp.keep_digests || inp.warm_previous.is_some() {
+            node_fingerprints(band, &geometry, &factoring, directions, slowness)?
+        } else {
+            Vec::new()
+        };
         let stats = if let Some(carried) = inp.warm {
             // a warm start (tubesweep_core::second_order::warm): phase 2 from the carried values
             let start = WarmStart {
@@ -180,7 +187,7 @@ fn run<'py, const D: usize>(
             + values.capacity() * 8
             + n
             + 4 * (band.n_rows() + 1)
-            + digests.capacity() * 8;
+            + if inp.keep_digests { digests.capacity() * 8 } else { 0 };
         let roles_out: Vec<u8> = factoring.roles.iter().map(|&r| r as u8).collect();
         // where the update ran first order (band positions), node by node
         let first_order: Vec<u32> = (0..n)
@@ -204,6 +211,7 @@ fn run<'py, const D: usize>(
     if let Some(e) = py_error {
         return Err(e);
     }
+    let inp_keep_digests = inp.keep_digests;
     let (values, u0, roles_out, stats, summary, bytes, first_order, warm_report, digests) = result.map_err(to_pyerr)?;
     let d = PyDict::new(py);
     d.set_item(
@@ -232,7 +240,9 @@ fn run<'py, const D: usize>(
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
     d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
-    d.set_item("digests", digests.into_pyarray(py))?;
+    if inp_keep_digests {
+        d.set_item("digests", digests.into_pyarray(py))?;
+    }
     if let Some(w) = warm_report {
         d.set_item("warm_carried", w.carried)?;
         d.set_item("warm_restarted", w.restarted.map(|r| format!("{r:?}").to_lowercase()))?;
@@ -250,7 +260,7 @@ fn run<'py, const D: usize>(
 /// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
 /// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None, warm_older=None, warm_previous_linear=None, warm_previous_digests=None))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None, warm_older=None, warm_previous_linear=None, warm_previous_digests=None, keep_digests=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve<'py>(
     py: Python<'py>,
@@ -283,6 +293,7 @@ pub fn second_order_solve<'py>(
     warm_older: Option<PyReadonlyArray1<'py, f64>>,
     warm_previous_linear: Option<PyReadonlyArray1<'py, u64>>,
     warm_previous_digests: Option<PyReadonlyArray1<'py, u64>>,
+    keep_digests: bool,
 ) -> PyResult<Solved<'py>> {
     if !(tol > 0.0 && tol_first > 0.0) {
         return Err(PyValueError::new_err("tol must be positive"));
@@ -353,6 +364,7 @@ pub fn second_order_solve<'py>(
                 ))
             }
         },
+        keep_digests,
     };
     match &band.band {
         AnyBand::D2(b) => run(py, b, &inputs, progress),

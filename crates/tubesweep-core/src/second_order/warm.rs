@@ -43,9 +43,9 @@
 //! pole): at the antipode 0.02 of the cold solve's updates, at the equator 0.06, next to the
 //! source 0.20; `moved` and the solve together 0.27, 0.32 and 0.48 of a cold solve's time (the
 //! rest is the tube and its geometry, built anew), the values within 2.1, 3.1 and 11.2
-//! tolerances of the cold solve's. Every second-order solve computes the digests: 5–6 ms of a
-//! one-thread solve of the sphere at N = 201 (0.67 s; 22 ns per node); whole solves timed against
-//! the build before them came out 1–3 % slower, within this machine's noise.
+//! tolerances of the cold solve's. The solves of a `ts.Tube` and warm solves compute and keep the
+//! digests (a one-off `ts.solve` does not: 8 bytes per node would break issue 31's memory target):
+//! 5–6 ms of a one-thread solve of the sphere at N = 201 (0.67 s; 22 ns per node).
 //!
 //! Tried and not kept: Gauss–Seidel passes in increasing order of the carried values before phase
 //! 2 (a counting sort by value in buckets of σ̄Δx/20, then the phase-2 update node by node, like
