@@ -67,6 +67,16 @@ def _touching_the_box(inside: np.ndarray) -> Any:
     return None
 
 
+def _thinnest_extent(inside: np.ndarray) -> int:
+    """Voxels across the object's bounding box along its thinnest axis."""
+    spans = []
+    for axis in range(inside.ndim):
+        others = tuple(k for k in range(inside.ndim) if k != axis)
+        occupied = np.flatnonzero(inside.any(axis=others))
+        spans.append(int(occupied[-1] - occupied[0]) + 1)
+    return min(spans)
+
+
 def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np.ndarray:
     """The φ of :meth:`tubesweep.LevelSet.from_mask` (see there): ``0.5 − mask``, smoothed, negative
     inside, after the checks of the mask."""
@@ -87,10 +97,7 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
             "is cut open by the box there. Pad the mask with outside voxels, e.g. np.pad(mask, 6), and widen the grid "
             "by as many spacings on each side"
         )
-    extent = min(
-        int(np.ptp(np.flatnonzero(np.any(inside, axis=tuple(j for j in range(inside.ndim) if j != k))))) + 1
-        for k in range(inside.ndim)
-    )
+    extent = _thinnest_extent(inside)
     if sigma > extent:
         # the smoothed mask is at most erf(t/(2√2σ)) < 1/2 for an object t voxels thick once
         # σ > 0.75t: refused before a filter that wide runs (its cost grows with σ)

@@ -211,7 +211,6 @@ fn run<'py, const D: usize>(
     if let Some(e) = py_error {
         return Err(e);
     }
-    let inp_keep_digests = inp.keep_digests;
     let (values, u0, roles_out, stats, summary, bytes, first_order, warm_report, digests) = result.map_err(to_pyerr)?;
     let d = PyDict::new(py);
     d.set_item(
@@ -240,7 +239,7 @@ fn run<'py, const D: usize>(
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
     d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
-    if inp_keep_digests {
+    if inp.keep_digests {
         d.set_item("digests", digests.into_pyarray(py))?;
     }
     if let Some(w) = warm_report {
