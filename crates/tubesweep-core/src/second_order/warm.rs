@@ -45,7 +45,7 @@
 //! rest is the tube and its geometry, built anew), the values within 2.1, 3.1 and 11.2
 //! tolerances of the cold solve's. The solves of a `ts.Tube` and warm solves compute and keep the
 //! digests (a one-off `ts.solve` does not: 8 bytes per node would break issue 31's memory target):
-//! 5–6 ms of a one-thread solve of the sphere at N = 201 (0.67 s; 22 ns per node).
+//! one pass over the band, O(band).
 //!
 //! Tried and not kept: Gauss–Seidel passes in increasing order of the carried values before phase
 //! 2 (a counting sort by value in buckets of σ̄Δx/20, then the phase-2 update node by node, like
