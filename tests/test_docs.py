@@ -107,9 +107,11 @@ SETUP_PREFIXES = ("make ", "pip install ", ".venv/bin/pip install ", "cargo ", "
 SNIPPET = re.compile(r'^--8<-- "(examples/\w+\.py)"$')
 #: what stands in for a cluster this test cannot reach: the same calls on an in-process LocalCluster
 CLUSTER_STAND_INS = {
-    'Client("tcp://10.0.0.5:8786")': "Client(LocalCluster(n_workers=1, processes=False))",
-    "from dask_jobqueue import SLURMCluster": "SLURMCluster = lambda **kw: LocalCluster(n_workers=1, processes=False)",
+    'Client("tcp://10.0.0.5:8786")': "Client(LocalCluster(n_workers=1, processes=False, dashboard_address=None))",
+    "from dask_jobqueue import SLURMCluster": "SLURMCluster = lambda **kw: LocalCluster(n_workers=1, processes=False, dashboard_address=None)",
     "cluster.scale(jobs=4)": "cluster.scale(1)",
+    # a dashboard on its default port warns when another process holds the port: the test log stays quiet
+    "LocalCluster(n_workers=2, threads_per_worker=1)": "LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None)",
 }
 
 
@@ -262,7 +264,7 @@ def test_the_shell_blocks_of_a_user_page_run_as_printed(page, tmp_path, monkeypa
         if "--scheduler" in argv:  # CLUSTER_STAND_INS: an in-process cluster for the page's address
             from distributed import LocalCluster
 
-            cluster = cluster or LocalCluster(n_workers=1, threads_per_worker=1, processes=False)
+            cluster = cluster or LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
             argv[argv.index("--scheduler") + 1] = cluster.scheduler_address
         if "--help" in argv:
             with pytest.raises(SystemExit) as e:
