@@ -106,8 +106,10 @@ def test_refusals_name_the_cause(first):
         moved.solve(pole(r), warm=tube.solve(pole(0.5), order=1))
     with pytest.raises(WarmStartRefused, match="order=1 was asked for"):
         moved.solve(pole(r), warm=sol, order=1)
-    with pytest.raises(WarmStartRefused, match="source 0 moved"):
+    with pytest.raises(WarmStartRefused, match="source 0 lies 0.7.* from the nearest of the previous solution's"):
         moved.solve([(r, 0.0, 0.0)], warm=sol)
+    with pytest.raises(WarmStartRefused, match="the older solution has 2 source"):
+        moved.solve(pole(r), warm=(tube.solve([(0.0, 0.0, 0.5), (0.5, 0.0, 0.0)]), sol))
     with pytest.raises(WarmStartRefused, match="1 source"):
         moved.solve([(0.0, 0.0, r), (r, 0.0, 0.0)], warm=sol)
     far = 0.5 + 3.0 * H  # farther than outer − inner = 2 spacings
@@ -262,6 +264,57 @@ def test_a_warm_solve_on_an_unchanged_surface_keeps_the_previous_values_bit_for_
     info = again.stats.order2["warm"]
     assert info["changed"] == 0 and info["extrapolated"] == 0 and again.stats.updates == 0
     assert np.array_equal(again.values, sol.values)
+
+
+def _stale_previous(kind: str, tube: ts.Tube) -> ts.Solution:
+    if kind == "unconverged":
+        with pytest.warns(RuntimeWarning, match="did not converge in max_iterations=4"):
+            return tube.solve(pole(0.5), max_iterations=4)
+    if kind == "looser tol":
+        return tube.solve(pole(0.5), tol=1e-3)
+    sol = tube.solve(pole(0.5))
+    sol.values[:] *= 1.05  # edited after the solve
+    return sol
+
+
+@pytest.mark.parametrize(
+    "kind, why",
+    [("unconverged", "did not converge"), ("looser tol", "tolerance 0.001 is looser"), ("edited", "values were changed")],
+)
+def test_a_warm_start_from_values_that_are_not_the_fixed_point_sweeps_every_node(kind, why):
+    # a node whose update did not change keeps its previous value only if that value is the
+    # converged one at this tolerance: from an unconverged solve (60 % of the band still +inf at
+    # max_iterations=4), a looser tolerance or edited values, the digests were trusted before and
+    # the warm solve returned those values (up to 62,000 tolerances off, with converged=True)
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    phi, bumped = bumped_sphere(grid, (0.0, 0.0, -0.5), 0.3 * grid.spacing)
+    tube = ts.Tube(phi, grid)
+    previous = _stale_previous(kind, tube)
+    for target in (phi, bumped):  # unchanged, and moved at the antipode only
+        warm = tube.moved(target).solve(pole(0.5), warm=previous)
+        cold = ts.solve(target, grid, pole(0.5))
+        info = warm.stats.order2["warm"]
+        assert why in info["all_started"] and info["changed"] is None and warm.stats.converged
+        assert np.array_equal(np.isfinite(warm.values), np.isfinite(cold.values))
+        assert np.max(np.abs(warm.values - cold.values)) <= 10 * cold.stats.order2["tol"]
+    assert kind != "unconverged" or info["unreached_before"] > 0.3 * warm.stats.band_points
+    fresh = tube.solve(pole(0.5))
+    assert tube.moved(bumped).solve(pole(0.5), warm=fresh).stats.order2["warm"]["all_started"] is None
+
+
+def test_sources_are_matched_as_a_set():
+    # the same two sources in the other order start warm (they were refused: "source 0 moved 0.71")
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), GRID)
+    two = [(0.0, 0.0, 0.5), (0.5, 0.0, 0.0)]
+    sol = tube.solve(two)
+    r = 0.5 + 0.4 * H
+    moved = tube.moved(ts.surfaces.Sphere(r))
+    warm = moved.solve([(r, 0.0, 0.0), (0.0, 0.0, r)], warm=sol)
+    cold = ts.solve(ts.surfaces.Sphere(r), GRID, [(0.0, 0.0, r), (r, 0.0, 0.0)])
+    assert warm.stats.order2["warm"]["new_nodes"] == np.count_nonzero(~np.isin(warm.linear, sol.linear))
+    assert np.max(np.abs(warm.values - cold.values)) <= 10 * cold.stats.order2["tol"]
+    with pytest.raises(WarmStartRefused, match="the previous solution's source 1 lies"):
+        moved.solve([(0.0, 0.0, r), (0.0, 0.0, r)], warm=sol)
 
 
 def test_the_local_moves_bench_runs_at_a_small_size(capsys):

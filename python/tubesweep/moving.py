@@ -14,11 +14,13 @@ first order, other sources (or sources that moved farther than the tube), a surf
 farther than ``outer − inner`` grid spacings (nodes of the new inner tube outside the previous
 band), or a change of topology (the inner tube's connected components changed). With
 ``warm_refused="cold"`` the solve runs cold instead and records why in
-``sol.stats.order2["warm"]``.
+``sol.stats.order2["warm"]`` (a solve that runs first order has no ``order2`` report:
+``sol.stats.order == 1`` says the warm start was not used).
 """
 
 from __future__ import annotations
 
+import zlib
 from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
@@ -77,12 +79,38 @@ def refusal_for_order1(reason: Optional[str]) -> WarmStartRefused:
     )
 
 
+def values_checksum(values: np.ndarray) -> int:
+    """A CRC-32 of a solution's values, kept with its digests: values edited after the solve
+    (``sol.values`` is a plain array) no longer match it, and a warm start then sweeps every node."""
+    return zlib.crc32(np.ascontiguousarray(values, dtype=np.float64))
+
+
+def _digests_to_trust(warm: Any, tol: float) -> Tuple[Optional[np.ndarray], Optional[str]]:
+    """The previous solution's digests, when its values are the fixed point of the updates they
+    describe at this solve's tolerance; else None and why every node starts active. A node whose
+    digest is unchanged is not visited until a node it reads moves, so its previous value must be
+    converged, at a tolerance no looser than this solve's, and as the solve left it."""
+    digests, digested = getattr(warm, "_digests", None), getattr(warm, "_digested", None)
+    if isinstance(digested, str):
+        return None, f"{digested}: every node started"
+    if digests is None or digested is None:
+        return None, "the previous solution kept no digests (a one-off ts.solve): every node started"
+    prev_tol, checksum = digested
+    if prev_tol > tol * (1 + 1e-12):
+        return None, (
+            f"the previous solve's tolerance {prev_tol:.3g} is looser than this one's {tol:.3g}: every node started"
+        )
+    if values_checksum(warm.values) != checksum:
+        return None, "the previous solution's values were changed after its solve: every node started"
+    return digests, None
+
+
 def _linear(sol_or_tube: Any) -> np.ndarray:
     return np.ascontiguousarray(sol_or_tube.linear, dtype=np.int64).view(np.uint64)
 
 
 def carried_values(
-    warm: Any, tube: Any, feet: np.ndarray, inner_width: float
+    warm: Any, tube: Any, feet: np.ndarray, inner_width: float, tol: float
 ) -> Tuple[np.ndarray, Dict[str, Any], Dict[str, Any]]:
     """The previous solution ``warm`` carried onto ``tube`` (a ``_prepare._PreparedTube``) for a
     solve from the sources' foot points ``feet``: a node in both bands keeps its value, a node new
@@ -92,7 +120,8 @@ def carried_values(
     changed (error O(δ²) instead of O(δ) for a surface moving smoothly by δ per step; about a
     quarter fewer updates). Returns the carried values, the other warm arguments of the native
     solve (the older values, the previous band's positions and digests: the sweeps start from
-    the nodes whose update changed) and the report. Raises :class:`WarmStartRefused` when the
+    the nodes whose update changed, when the previous values are the converged, unedited values of
+    a solve at a tolerance no looser than ``tol``) and the report. Raises :class:`WarmStartRefused` when the
     previous solution does not fit (see the module)."""
     from ._prepare import ROLE_OUTER
 
@@ -107,6 +136,11 @@ def carried_values(
         older, warm = warm
         check_previous(older, grid)
     check_previous(warm, grid)
+    if older is not None and len(older._factoring[1]) != len(warm._factoring[1]):
+        raise WarmStartRefused(
+            f"warm: the older solution has {len(older._factoring[1])} source(s), the previous one "
+            f"{len(warm._factoring[1])}; warm=(older, previous) takes the two previous steps of the same problem"
+        )
     h = grid.spacing
     slack = tube.outer_eff * h - inner_width  # how far the surface may move: outer − inner spacings
     old_feet = warm._factoring[1]
@@ -122,7 +156,7 @@ def carried_values(
         more["warm_older"] = _native.carry_band_values(
             _linear(older), np.ascontiguousarray(older.values, dtype=float), new_linear
         )
-    digests = getattr(warm, "_digests", None)
+    digests, all_started = _digests_to_trust(warm, tol)
     if digests is not None:
         more["warm_previous_linear"] = old_linear
         more["warm_previous_digests"] = np.ascontiguousarray(digests, dtype=np.uint64)
@@ -146,17 +180,28 @@ def carried_values(
             f"{n_old} (a part pinched off or two parts merged); carried values on a part that lost its source would never "
             "settle. Solve cold (leave out warm=) across the change, then warm again"
         )
-    moved = np.linalg.norm(np.asarray(old_feet) - feet, axis=1)
-    if moved.size and float(np.max(moved)) > slack * (1 + 1e-9):
-        i = int(np.argmax(moved))
+    # the sources as a set, in any order: each one's nearest previous source, and the other way
+    old_feet = np.ascontiguousarray(old_feet, dtype=float)
+    moved = np.linalg.norm(old_feet[_native.nearest_feet(old_feet, feet)] - feet, axis=1)
+    back = np.linalg.norm(feet[_native.nearest_feet(feet, old_feet)] - old_feet, axis=1)
+    if moved.size and max(float(np.max(moved)), float(np.max(back))) > slack * (1 + 1e-9):
+        new_side = float(np.max(moved)) >= float(np.max(back))
+        i = int(np.argmax(moved if new_side else back))
+        far = float((moved if new_side else back)[i])
+        which = f"source {i} lies" if new_side else f"the previous solution's source {i} lies"
+        other = "the previous solution's sources" if new_side else "this solve's sources"
         raise WarmStartRefused(
-            f"warm: source {i} moved {moved[i]:.4g} from the previous solution's ({moved[i] / h:.2f} grid spacings), "
-            f"farther than the surface may move between warm solves (outer − inner = {slack / h:g} spacings); a source "
-            "that leaves the surface's path is another problem. Pass the previous sources moved with the surface, "
-            "move in smaller steps, or solve cold (leave out warm=)"
+            f"warm: {which} {far:.4g} from the nearest of {other} ({far / h:.2f} grid spacings), farther than the "
+            f"surface may move between warm solves (outer − inner = {slack / h:g} spacings); a source that leaves the "
+            "surface's path is another problem. Pass the previous sources moved with the surface, move in smaller "
+            "steps, or solve cold (leave out warm=)"
         )
+    in_both = old_linear[at] == new_linear
     info = {
         "carried": int(np.count_nonzero(np.isfinite(carried))),
-        "new_nodes": int(np.count_nonzero(~np.isfinite(carried))),
+        # nodes new to the band, and nodes of both that the previous solve left unreached: both start at +∞
+        "new_nodes": int(np.count_nonzero(~in_both)),
+        "unreached_before": int(np.count_nonzero(in_both & ~np.isfinite(carried))),
+        "all_started": all_started,
     }
     return np.ascontiguousarray(carried), more, info

@@ -21,6 +21,7 @@ from . import _native
 from ._box_cut import box_reason
 from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
+from .moving import values_checksum
 from ._validate import (
     FRONT_WINDOW,
     check_threads as _threads,
@@ -324,7 +325,7 @@ def solve_on_tube(
         from .moving import WarmStartRefused, carried_values
 
         try:
-            warm_values, warm_more, warm_info = carried_values(warm, tube, feet, tube.inner * h)
+            warm_values, warm_more, warm_info = carried_values(warm, tube, feet, tube.inner * h, float(tol))
         except WarmStartRefused as e:
             if warm_refused != "cold":
                 raise
@@ -484,6 +485,15 @@ def solve_on_tube(
         factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
-    sol._digests = st.get("digests")
+    # digests stand for the fixed point of each node's update: kept only for a solve that reached it
+    # (not one stopped at max_iterations, nor one whose second-order sweeps ran away)
+    if st.get("digests") is not None:
+        if not st["converged"]:
+            sol._digested = "the previous solve did not converge"
+        elif st["runaway_iteration"] is not None:
+            sol._digested = "the previous solve's second-order sweeps ran away (its values are first order)"
+        else:
+            sol._digests = st["digests"]
+            sol._digested = (float(tol), values_checksum(values))
     sol.order = 2
     return sol

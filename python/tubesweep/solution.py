@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from typing import Any, List, Optional, Tuple
+from typing import Any, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -111,6 +111,10 @@ class Solution:
         # order=2: per band node a digest of what its update reads (a warm start from this
         # solution starts the sweeps where they changed: tubesweep_core::second_order::fingerprint)
         self._digests: Optional[np.ndarray] = None
+        # with the digests: the solve's tolerance and a checksum of its values (a warm start uses
+        # the digests only for the converged values of a solve at least as tight, unedited); or
+        # why a solve that would have kept them did not
+        self._digested: Optional[Union[Tuple[float, int], str]] = None
         self.order = 1
 
     def __getstate__(self) -> dict:

@@ -194,7 +194,8 @@ def solve(
         ``outer − inner`` grid spacings or changed topology.
     warm_refused : {"raise", "cold"}
         What a refused warm start does: raise (the default), or solve cold and record why in
-        ``sol.stats.order2["warm"]``.
+        ``sol.stats.order2["warm"]`` (a solve that runs first order has no such report:
+        ``sol.stats.order == 1``).
 
     Returns
     -------
