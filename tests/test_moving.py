@@ -176,8 +176,11 @@ def test_the_axisymmetric_evolution_follows_the_front_tracked_meridian():
     import moving_axisymmetric as axi
 
     r = axi.compare(31, axi.reference(axi.T, m=500))
-    h = GRID31.spacing  # measured: Hausdorff 1.2e-2, distances max 2.3e-2, mean 8.8e-3
-    assert r["hausdorff"] < 0.25 * h and r["max"] < 0.5 * h and r["mean"] < 0.2 * h
+    # measured: Hausdorff 4.9e-3, distances max 7.7e-3, mean 2.4e-3 (h = 0.067); 1.2e-2, 2.3e-2 and
+    # 8.8e-3 while the band's edge, central differences reading the bound beyond it, sent the whole
+    # band to its re-distanced values from the second step on
+    h = GRID31.spacing
+    assert r["hausdorff"] < 0.1 * h and r["max"] < 0.15 * h and r["mean"] < 0.05 * h
 
 
 def test_evolve_refuses_bad_input_with_the_cause_named():
@@ -198,6 +201,26 @@ def test_evolve_refuses_bad_input_with_the_cause_named():
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1).export("run.vtp")
     with pytest.raises(TypeError, match="dt must be a positive time step; got True"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=True, steps=1)
+    with pytest.raises(ValueError, match="checkpoint is written with numpy.savez and must end in .npz"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint="run.ckpt")
+    with pytest.raises(ValueError, match="t0 must be a finite time"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, t0=float("nan"))
+
+
+def test_an_evolution_continues_from_its_checkpoint(tmp_path):
+    # the checkpoint is written whole under its own name (none beside it), and t0 carries its time
+    law = lambda u: 0.1 + 0.2 * u  # noqa: E731
+    ev = ts.evolve(sphere_phi(GRID31), GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=2, checkpoint=tmp_path / "run.npz")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz"]
+    c = np.load(tmp_path / "run.npz")
+    assert int(c["step"]) == 2 and np.array_equal(c["phi"], ev.phis[-1])
+    more = ts.evolve(c["phi"], GRID31, c["sources"], law, dt=0.05, steps=2, t0=float(c["t"]))
+    assert more.times == pytest.approx([0.1, 0.15, 0.2])
+    assert np.array_equal(more.phis[0], ev.phis[-1])
+    # the same run in one go, to the warm and cold solves' difference (a resumed run starts cold)
+    whole = ts.evolve(sphere_phi(GRID31), GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=4)
+    h = GRID31.spacing
+    assert np.max(np.abs(more.phis[-1] - whole.phis[-1])[np.abs(whole.phis[-1]) < 2 * h]) < 1e-6
 
 
 def test_a_zero_speed_leaves_the_surface_and_its_distances_as_they_were():

@@ -8,7 +8,7 @@ onto the surface, the surface solve on the moved tube started warm from the prev
 solution there: V is constant along the normals, which keeps φ close to a signed distance), and one
 forward Euler step φ ← φ − Δt·V|∇φ| (φ_t + V|∇φ| = 0, |∇φ| by central differences) on φ itself,
 or on the band's re-distanced values where |∇φ| strays beyond a factor 1.25 of 1 (a mask, or a φ far
-from a distance). First order in time, second order in
+from a distance) and at the band's edge (whose neighbours beyond it hold only a bound). First order in time, second order in
 space where the surface solve is; the CFL condition Δt·max|V| ≤ cfl·Δx (cfl ≤ 1, default 0.5) is
 checked at every step. Beyond the band φ is only a bound: its magnitude is lowered by Δt·max|V| per
 step, so that it never overstates the distance to the moved surface and the next band holds every
@@ -18,6 +18,7 @@ node it should (work O(N^d) per step there, a few array operations).
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 from typing import Any, Callable, List, Optional, Union
 
@@ -105,25 +106,50 @@ class Evolution:
 GRADIENT_DRIFT = 1.25
 
 
-def _advanced(arr: np.ndarray, linear: np.ndarray, signed: np.ndarray, move: np.ndarray, h: float) -> np.ndarray:
+def _advanced(
+    arr: np.ndarray, linear: np.ndarray, signed: np.ndarray, move: np.ndarray, h: float
+) -> np.ndarray:
     """φ − Δt·V|∇φ| at the band's nodes (``move`` = Δt·V): from φ itself, whose samples are smooth
     where φ is, with |∇φ| by central differences; from the re-distanced values (|∇φ| = 1) where φ is
     far from a distance. Advancing the re-distanced values at every step would replace φ by the
     distances to its multilinear interpolant's zero set at each step: an O(Δx²) change that is not
     smooth at grid scale, which the next step's curvatures see as noise (V = 0 moved distances by
-    0.45Δx in one step at N = 31)."""
+    0.45Δx in one step at N = 31).
+
+    Beyond the band φ is only a bound (:func:`evolve` puts values in the band's nodes that held
+    one). A node with a neighbour outside the band or the box takes its re-distanced value:
+    central differences across the edge would read the bound as a distance (on a sphere moved by a
+    V that varies, they strayed beyond the drift test's factor at the band's edge and sent the
+    whole band to the re-distanced values from the second step on). Such nodes lie about ``outer``
+    spacings from the surface."""
     shape = arr.shape
     idx = np.unravel_index(linear, shape)
+    in_band = np.zeros(arr.size, dtype=bool)
+    in_band[linear] = True
+    in_band = in_band.reshape(shape)
     grad2 = np.zeros(len(linear))
+    interior = np.ones(len(linear), dtype=bool)
     for k in range(arr.ndim):
-        lo = [np.maximum(i - 1, 0) if j == k else i for j, i in enumerate(idx)]
-        hi = [np.minimum(i + 1, shape[k] - 1) if j == k else i for j, i in enumerate(idx)]
-        span = (hi[k] - lo[k]) * h
-        grad2 += ((arr[tuple(hi)] - arr[tuple(lo)]) / np.maximum(span, h)) ** 2
+        lo = tuple(np.maximum(i - 1, 0) if j == k else i for j, i in enumerate(idx))
+        hi = tuple(np.minimum(i + 1, shape[k] - 1) if j == k else i for j, i in enumerate(idx))
+        interior &= (idx[k] > 0) & (idx[k] < shape[k] - 1) & in_band[lo] & in_band[hi]
+        grad2 += ((arr[hi] - arr[lo]) / (2 * h)) ** 2
     grad = np.sqrt(grad2)
-    if not np.all((grad >= 1 / GRADIENT_DRIFT) & (grad <= GRADIENT_DRIFT)):
+    drift = interior & ((grad < 1 / GRADIENT_DRIFT) | (grad > GRADIENT_DRIFT))
+    if np.any(drift):
         return signed - move
-    return arr.reshape(-1)[linear] - move * grad
+    edge = ~interior & (move != 0)  # unmoved, a node keeps its value (V = 0 leaves φ as it was)
+    out = arr.reshape(-1)[linear] - move * grad
+    out[edge] = signed[edge] - move[edge]
+    return out
+
+
+def _write_checkpoint(path: Path, **arrays: Any) -> None:
+    """``numpy.savez`` to a file beside ``path``, then renamed onto it: a write interrupted by a
+    crash or a kill leaves the previous checkpoint whole."""
+    partial = path.with_name(path.name + ".partial.npz")
+    np.savez(partial, **arrays)
+    os.replace(partial, path)
 
 
 def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) -> np.ndarray:
@@ -158,6 +184,7 @@ def evolve(
     progress: Optional[Callable[[int, int, float], Any]] = None,
     checkpoint: Optional[Union[str, Path]] = None,
     tol: Optional[float] = None,
+    t0: float = 0.0,
 ) -> Evolution:
     """Moves the zero level set of ``phi`` with the normal speed ``speed(u)``, u the surface
     solution (the geodesic distance) from ``sources`` (docs/moving-surfaces.md).
@@ -186,9 +213,13 @@ def evolve(
         Called as ``progress(step, steps, t)`` after each step.
     checkpoint : str or Path, optional
         A ``.npz`` file rewritten at each kept frame with ``phi``, ``t``, ``step`` and
-        ``sources``: call ``evolve`` again from them to continue.
+        ``sources`` (written beside it and renamed, so that an interrupted write leaves the last
+        one whole): ``evolve(c["phi"], grid, c["sources"], speed, ..., t0=float(c["t"]))``
+        continues from it.
     tol : float, optional
         The surface solves' tolerance (the default of :func:`tubesweep.solve`).
+    t0 : float
+        The time of ``phi`` (default 0): the frames' times start there.
 
     Returns
     -------
@@ -228,6 +259,13 @@ def evolve(
         )
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
         raise ValueError(f"evolve: every must be a positive integer; got {every!r}")
+    t0 = real_scalar(t0, "evolve: t0", "the time of phi")
+    if not np.isfinite(t0):
+        raise ValueError(f"evolve: t0 must be a finite time; got {t0!r}")
+    if checkpoint is not None and Path(checkpoint).suffix.lower() != ".npz":
+        raise ValueError(
+            f"evolve: checkpoint is written with numpy.savez and must end in .npz; got {str(checkpoint)!r}"
+        )
     if not callable(speed):
         raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
     h = grid.spacing
@@ -235,13 +273,23 @@ def evolve(
     tube: Optional[Any] = None
     older: Optional[Solution] = None
     prev: Optional[Solution] = None
-    t = 0.0
+    previous_band: Optional[np.ndarray] = None
+    t = t0
     for step in range(steps + 1):
         surf = LevelSet(arr, redistance=True)
         tube = Tube(surf, grid) if tube is None else tube.moved(surf)
         src = np.ascontiguousarray(surf.project(src, grid)[1])
         warm: Any = None if prev is None else (prev if older is None else (older, prev))
         sol = tube.solve(src, warm=warm, warm_refused="cold", tol=DEFAULT_TOL if tol is None else tol)
+        # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
+        # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
+        linear = tube._tube.linear
+        if previous_band is not None:
+            fresh = ~np.isin(linear, previous_band)
+            if np.any(fresh):
+                arr = arr.copy()
+                arr.reshape(-1)[linear[fresh]] = np.asarray(tube._tube.geom.signed, dtype=float)[fresh]  # type: ignore[union-attr]
+        previous_band = linear
         info = (sol.stats.order2 or {}).get("warm")
         if info is not None and "refused" not in info:
             out.warm_starts += 1
@@ -252,7 +300,7 @@ def evolve(
             out.phis.append(arr)
             out.solutions.append(sol)
             if checkpoint is not None:
-                np.savez(checkpoint, phi=arr, t=t, step=step, sources=src)
+                _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=src)
         if step == steps:
             break
         u = sol.values
@@ -263,7 +311,6 @@ def evolve(
                 f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
                 f"cfl·Δx = {cfl * h:.4g} (max|V| = {vmax:.4g}); take dt ≤ {cfl * h / vmax:.4g}"
             )
-        linear = tube._tube.linear
         geom = tube._tube.geom
         assert geom is not None  # a Tube keeps its geometry
         signed = np.asarray(geom.signed, dtype=float)
