@@ -411,3 +411,13 @@ def test_distances_reads_points_from_numpy_and_text_files(tmp_path, capsys):
     (tmp_path / "words.txt").write_text("a b c\n")
     assert main([*base, "--points", str(tmp_path / "words.txt"), "--out", str(tmp_path / "D.npy")]) == 2
     assert "not a text file of numbers with 3 per line" in capsys.readouterr().err
+    # an empty .npy and one that starts like a zip archive: numpy raises EOFError and BadZipFile,
+    # which went out as tracebacks (for --points and for --phi)
+    (tmp_path / "empty.npy").write_bytes(b"")
+    (tmp_path / "zip.npy").write_bytes(b"PK\x03\x04 not a zip archive")
+    for name in ("empty.npy", "zip.npy"):
+        assert main([*base, "--points", str(tmp_path / name), "--out", str(tmp_path / "D.npy")]) == 2
+        assert "not a NumPy .npy file of numbers" in capsys.readouterr().err
+        argv = ["distances", "--phi", str(tmp_path / name), "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]
+        assert main([*argv, "--sample", "3", "--out", str(tmp_path / "D.npy"), "--quiet"]) == 2
+        assert "not a NumPy .npy file of numbers" in capsys.readouterr().err

@@ -81,6 +81,8 @@ def test_solve_many_bad_input(tube):
         tube.solve_many(np.empty((0, 3)))
     with pytest.raises(ValueError, match="sources is empty"):
         tube.solve_many([])
+    with pytest.raises(ValueError, match=r"sources\[1\] is an empty group"):
+        tube.solve_many([[R, 0, 0], np.empty((0, 3))])
     with pytest.raises(ValueError, match=r"sources\[1\].*farther than the inner tube"):
         tube.solve_many([[R, 0, 0], [0.9, 0, 0]])
     with pytest.raises(ValueError, match=r"sources\[1\]\[1\].*farther than the inner tube"):

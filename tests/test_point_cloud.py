@@ -238,3 +238,16 @@ def test_export_writes_the_samples_with_u(tmp_path):
     np.testing.assert_allclose(m.point_data["u"], sol(cloud.points), rtol=1e-12)
     with pytest.raises(ValueError, match="written as .vtp or .ply"):
         ts.export(sol, tmp_path / "c.vtu")
+
+
+def test_a_cloud_s_vtp_reads_back_with_its_normals(tmp_path):
+    # read_vtp knew polygons and lines only ("no Lines connectivity"); the normals given to
+    # from_points, "kept for export", were not written
+    p = sphere_cloud(3000)
+    cloud = from_points(p, normals=2 * p)
+    sol = ts.solve(cloud, cube(31), sources=[cloud.points[0]])
+    points, cells, data = ts.output.read_vtp(ts.export(sol, tmp_path / "c.vtp"))
+    assert np.array_equal(cells[:, 0], np.arange(3000)) and cells.shape == (3000, 1)
+    np.testing.assert_allclose(points, cloud.points, rtol=1e-15)
+    np.testing.assert_allclose(data["normals"], cloud.normals, rtol=1e-15)
+    np.testing.assert_allclose(data["u"], sol(cloud.points), rtol=1e-15)

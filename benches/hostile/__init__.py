@@ -17,6 +17,7 @@ GROUPS = (
     "messages_and_types",  # 5, 5b: messages on valid input, argument types
     "native",  # 7: the private native module
     "any_phi_and_motion",  # 8: masks, re-distanced φ, point clouds, warm starts, ts.evolve
+    "api_reach",  # 9: many sources, Solution methods, export, anisotropic Hamiltonians, the CLI, awkward meshes
 )
 
 

@@ -668,9 +668,11 @@ def _run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print("\ninterrupted", file=sys.stderr)
         return 130
-    except (ValueError, TypeError, MemoryError, ImportError, OSError, NotImplementedError, Warning) as e:
+    except (ValueError, TypeError, MemoryError, ImportError, OSError, NotImplementedError, Warning, EOFError) as e:
         # OSError: files (missing, a directory, no permission); NotImplementedError: a mesh format
-        # that trimesh/meshio cannot read; Warning: a warning turned into an error (-W error)
+        # that trimesh/meshio cannot read; Warning: a warning turned into an error (-W error);
+        # EOFError: a file that ends early (numpy.load of an empty file; zipfile.BadZipFile is an
+        # Exception, caught where files are read)
         print(f"error: {e}", file=sys.stderr)
         return 2
     parser.print_help()

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import zipfile
 from pathlib import Path
 from typing import Any, Optional
 
@@ -142,7 +143,7 @@ def _surface_and_grid(args: argparse.Namespace) -> Any:
         raise ValueError("--phi needs --lower and --upper (the grid's corners)")
     try:
         phi = np.load(args.phi, allow_pickle=False)
-    except ValueError:
+    except (ValueError, EOFError, zipfile.BadZipFile):  # an empty file; a zip header without an archive
         raise ValueError(f"--phi {args.phi}: not a NumPy .npy file of numbers") from None
     if not isinstance(phi, np.ndarray):
         raise ValueError(f"--phi {args.phi}: give a .npy file (numpy.save), not an archive")
@@ -159,7 +160,7 @@ def load_points(path: Path, ndim: int) -> np.ndarray:
     if suffix == ".npy":
         try:
             points = np.load(path, allow_pickle=False)
-        except ValueError:
+        except (ValueError, EOFError, zipfile.BadZipFile):
             raise ValueError(
                 f"--points {path}: not a NumPy .npy file of numbers; save the points with numpy.save, or give a "
                 f"text file ({' '.join(TEXT_SUFFIXES)}) with one point per line"

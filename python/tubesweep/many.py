@@ -54,7 +54,7 @@ def source_groups(sources: Any, ndim: int) -> List[np.ndarray]:
             p = as_points(sources, ndim, "sources")
             return [p[i : i + 1] for i in range(len(p))]
         if sources.ndim == 3:
-            return [as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)]
+            return _non_empty([as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)])
         raise ValueError(
             f"sources must have shape (K, {ndim}) (K point sources), (K, P, {ndim}) (K groups of P points) "
             f"or be a list of points and groups; got shape {sources.shape}"
@@ -64,7 +64,16 @@ def source_groups(sources: Any, ndim: int) -> List[np.ndarray]:
             f"sources must be an array (K, {ndim}) or a list of points ({ndim},) and groups (P, {ndim}); "
             f"got {type(sources).__name__}"
         )
-    return [as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)]
+    return _non_empty([as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)])
+
+
+def _non_empty(groups: List[np.ndarray]) -> List[np.ndarray]:
+    for k, g in enumerate(groups):
+        if len(g) == 0:
+            raise ValueError(
+                f"sources[{k}] is an empty group: give each group at least one point (or leave the entry out)"
+            )
+    return groups
 
 
 def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:

@@ -122,7 +122,7 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
     points : numpy.ndarray
         ``(n, 3)`` vertices.
     cells : numpy.ndarray
-        ``(m, k)`` polygons or lines.
+        ``(m, k)`` polygons, lines, or ``(m, 1)`` vertices (a point cloud).
     point_data : dict
         Name → per-vertex array.
 
@@ -148,7 +148,8 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
         return np.array((el.text or "").split(), dtype=dtype)
 
     points = values(piece.find("Points/DataArray"), float).reshape(-1, 3)
-    kind = "Polys" if int(piece.get("NumberOfPolys", "0")) > 0 else "Lines"
+    # the cells' section: polygons (a surface), lines (a curve) or vertices (a point cloud)
+    kind = next((k for k in ("Polys", "Lines", "Verts") if int(piece.get(f"NumberOf{k}", "0")) > 0), "Polys")
     conn = offs = None
     for el in piece.findall(f"{kind}/DataArray"):
         if el.get("Name") == "connectivity":
@@ -191,7 +192,9 @@ def export(
     ``u`` is :meth:`Solution.on_mesh` at the vertices (``inf`` where never reached becomes NaN).
     With several sources and an isotropic Hamiltonian, ``nearest_source`` (the label of
     :meth:`Solution.nearest_source`, -1 where no front arrives) is written too. 2D curves are
-    written as line cells with z = 0.
+    written as line cells with z = 0. A point cloud (:func:`tubesweep.surfaces.from_points`) is
+    written as its samples (vertex cells, ``.vtp`` or ``.ply``), with the ``normals`` given to
+    ``from_points`` if any.
 
     Parameters
     ----------
@@ -242,6 +245,8 @@ def export(
     u = sol.on_mesh(v) if not cloud else sol(v)
     u = np.where(np.isfinite(u), u, np.nan)
     data: Dict[str, np.ndarray] = {"u": u}
+    if cloud and getattr(sol.surface, "normals", None) is not None:
+        data["normals"] = np.asarray(sol.surface.normals, dtype=float)  # given to from_points: kept for this
     if len(sol.sources) > 1 and sol._isotropic:
         data["nearest_source"] = sol.nearest_source(v).astype(float)
     if point_data is not None and not isinstance(point_data, dict):
