@@ -17,7 +17,8 @@ GROUPS = (
     "messages_and_types",  # 5, 5b: messages on valid input, argument types
     "native",  # 7: the private native module
     "any_phi_and_motion",  # 8: masks, re-distanced φ, point clouds, warm starts, ts.evolve
-    "api_reach",  # 9: many sources, Solution methods, export, anisotropic Hamiltonians, the CLI, awkward meshes
+    "api_reach",  # 9a-d: many sources, Solution methods, export and evolve's files
+    "api_reach_more",  # 9e-g: anisotropic Hamiltonians, the command line, awkward meshes and clouds
 )
 
 
