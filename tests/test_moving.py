@@ -235,7 +235,7 @@ def test_a_zero_speed_leaves_the_surface_and_its_distances_as_they_were():
     # to rounding
     for s in ev.solutions[1:]:
         assert s.stats.order2["warm"]["changed"] <= 10 and s.stats.order2["first_order_nodes"] == 0
-        assert np.max(np.abs(s.values - ev.solutions[0].values)) <= 1e-15
+        assert np.max(np.abs(s.values - ev.solutions[0].values)) <= 1e-14  # a few ulps of values up to 1.6
 
 
 def test_a_speed_law_that_writes_to_u_leaves_the_solutions_alone():

@@ -64,8 +64,8 @@ impl<const D: usize> Sweeper<'_, D> {
 
     /// The active flags at the start of a warm phase on a surface that moved in part: the nodes
     /// not fixed whose update reads something else than in the previous solve (`changed`, from
-    /// [`super::fingerprint::changed_nodes`]) and the nodes that read them (their values, |φ| or
-    /// u₀ may have changed). Every other node holds the previous solve's fixed point of an
+    /// [`super::fingerprint::changed_nodes`]) and the nodes that read them, up to distance 3
+    /// along the axes (their values, |φ| or u₀ may have changed). Every other node holds the previous solve's fixed point of an
     /// unchanged update and is visited again only once a node it reads changes by more than the
     /// tolerance, as in any iteration. Returns where the front window starts: the smallest value
     /// among the active nodes and the changed fixed nodes (+∞ when nothing changed).
@@ -73,10 +73,30 @@ impl<const D: usize> Sweeper<'_, D> {
         for a in active {
             a.store(0, Ordering::Relaxed);
         }
+        let table = self.table;
+        let sentinel = table.sentinel();
         for (i, &c) in changed.iter().enumerate() {
             if c {
                 active[i].store(1, Ordering::Relaxed);
                 self.activate(active, i);
+                // and the readers at distance 3 (the BDF3 ramp's third neighbour): during the
+                // sweeps a change reaches them through the nodes between, but a changed input
+                // there (u₀, a node entering the band) need not move those nodes
+                for k in 0..D {
+                    for side in 0..2 {
+                        let mut j = i as u32;
+                        for _ in 0..3 {
+                            if j == sentinel {
+                                break;
+                            }
+                            // SAFETY: `j` is a band node (not the sentinel), k < D, side < 2
+                            j = unsafe { table.neighbour_unchecked(j as usize, k, side) };
+                        }
+                        if j != sentinel {
+                            active[j as usize].store(1, Ordering::Relaxed);
+                        }
+                    }
+                }
             }
         }
         let mut first = f64::INFINITY;

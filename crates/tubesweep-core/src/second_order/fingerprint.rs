@@ -6,11 +6,12 @@
 //! factored u₀ of [`super`], or the extension update along the normal) reads: the node's role,
 //! u₀, |φ| and outward direction, its slowness, at a node not in the extension layer its
 //! geometry ([`NodeGeometry`]: the normal, B and whether it runs first order) and ∂u₀, and the
-//! values, |φ| and u₀ of the band nodes at distance 1 and 2 along the axes. [`node_fingerprints`]
+//! values, |φ| and u₀ of the band nodes at distance 1 and 2 along the axes (and at distance 3,
+//! the value and u₀ of the BDF3 ramp's third neighbour). [`node_fingerprints`]
 //! digests the node's own part and which of its neighbours along the axes are in the band (a
 //! neighbour entering or leaving the band changes it; one at distance 2 changes the neighbour
 //! between); a node whose digest is unchanged but one of whose read nodes changed is woken by
-//! [`super::active`] (the readers of every changed node start active). Where neither happened, the node's update is the previous solve's, and the previous
+//! [`super::active`] (the readers of every changed node, up to distance 3, start active). Where neither happened, the node's update is the previous solve's, and the previous
 //! value, a fixed point of it to the tolerance, can stay until a neighbour moves.
 //!
 //! Two digests that agree by chance where the inputs differ: about 2⁻⁶⁴ per node.
