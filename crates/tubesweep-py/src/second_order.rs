@@ -193,7 +193,7 @@ fn run<'py, const D: usize>(
         let first_order: Vec<u32> = (0..n)
             .filter(|&i| roles[i] != NodeRole::Outer)
             .zip(&geometry.nodes)
-            .filter(|(_, g)| g.first_order != 0)
+            .filter(|(_, g)| g.first_order() != 0)
             .map(|(i, _)| i as u32)
             .collect();
         Ok::<_, tubesweep_core::Error>((

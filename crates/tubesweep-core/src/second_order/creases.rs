@@ -93,7 +93,7 @@ pub fn creases_of<const D: usize>(
         }
         let geo = &nodes[k];
         k += 1;
-        if geo.first_order != Unresolved::Curvature as u8 && geo.first_order != Unresolved::Gradient as u8
+        if geo.first_order() != Unresolved::Curvature as u8 && geo.first_order() != Unresolved::Gradient as u8
             || surface.phi(i).abs() > CREASE_REACH * spacing
         {
             continue;

@@ -48,10 +48,11 @@ impl Digest {
         z ^ (z >> 31)
     }
     fn add_geometry(mut self, g: &NodeGeometry) -> Self {
-        for &c in g.normal.iter().chain(&g.b) {
+        // the packed B holds the first-order reason too
+        for &c in g.normal.iter().chain(g.packed()) {
             self = self.add(c.to_bits() as u64);
         }
-        self.add(g.first_order as u64)
+        self
     }
 }
 

@@ -24,14 +24,51 @@ pub struct NodeGeometry {
     /// sgn(φ) where the stencil is incomplete).
     pub normal: [f32; 3],
     /// B = (I − φ D²φ)⁻¹, symmetric, packed as (00, 01, 02, 11, 12, 22) (2D: 00, 01, 11 in the
-    /// places 0, 1, 3); I at a first-order node.
-    pub b: [f32; 6],
+    /// places 0, 1, 3); I at a first-order node, whose B₀₀ place holds minus the reason instead
+    /// (B is positive definite, so B₀₀ > 0 at every other node): read B through [`Self::b`].
+    packed_b: [f32; 6],
+}
+
+impl NodeGeometry {
+    /// A first-order node's geometry: B = `identity` (packed), `reason` kept in B₀₀'s place.
+    fn first_order_node(normal: [f32; 3], identity: [f32; 6], reason: Unresolved) -> Self {
+        let mut packed_b = identity;
+        packed_b[0] = -(reason as u8 as f32);
+        NodeGeometry { normal, packed_b }
+    }
+
+    /// The entry `s` of the packed B ([`sym`]'s places): 1 in B₀₀'s place at a first-order node.
+    #[inline(always)]
+    pub fn b(&self, s: usize) -> f32 {
+        let v = self.packed_b[s];
+        if s == 0 && v < 0.0 {
+            1.0
+        } else {
+            v
+        }
+    }
+
     /// Why the node runs the paper's first-order update (Eq. (3), B = I) instead of the
     /// second-order one: 0 where the local geometry is resolved, else one of the
     /// [`Unresolved`] reasons. Decided node by node ([`node_geometry`]): a crease, a corner, a
     /// noise spike, an unresolved curvature, a stencil cut by the box or the band's edge, or the
-    /// rim of an open surface turns off second order only where it is.
-    pub first_order: u8,
+    /// rim of an open surface turns off second order only where it is. Kept in the sign of B₀₀'s
+    /// place, so that a node's geometry is 36 bytes (a byte of its own would pad it to 40: 2 more
+    /// bytes per band node, a rounded cube's order=2 memory 1.55× order=1's against 1.50).
+    #[inline(always)]
+    pub fn first_order(&self) -> u8 {
+        if self.packed_b[0] < 0.0 {
+            -self.packed_b[0] as u8
+        } else {
+            0
+        }
+    }
+
+    /// The packed entries as stored (the digest reads them, the first-order reason included).
+    #[inline(always)]
+    pub fn packed(&self) -> &[f32; 6] {
+        &self.packed_b
+    }
 }
 
 /// Why a node's geometry is not resolved (the values of [`NodeGeometry::first_order`]).
@@ -184,19 +221,14 @@ pub(crate) fn node_geometry<const D: usize>(
         identity[sym(k, k)] = 1.0;
     }
     let sign = if phi < 0.0 { -1.0f32 } else { 1.0 };
-    let mut geo = NodeGeometry {
-        normal: [0.0; 3],
-        b: identity,
-        first_order: 0,
-    };
+    let mut normal = [0.0f32; 3];
     for k in 0..D {
-        geo.normal[k] = sign * direction[k];
+        normal[k] = sign * direction[k];
     }
     summary.inner_nodes += 1;
     let Some(found) = local.as_ref() else {
         summary.incomplete_stencils += 1;
-        geo.first_order = Unresolved::Stencil as u8;
-        return geo;
+        return NodeGeometry::first_order_node(normal, identity, Unresolved::Stencil);
     };
     let first = if summary.fitted_everywhere {
         Err(Unresolved::Curvature)
@@ -221,17 +253,19 @@ pub(crate) fn node_geometry<const D: usize>(
                     Unresolved::Gradient => summary.off_distance += 1,
                     _ => summary.unresolved_curvature += 1,
                 }
-                geo.first_order = reason as u8;
-                return geo;
+                return NodeGeometry::first_order_node(normal, identity, reason);
             }
         },
     };
     summary.max_curvature = summary.max_curvature.max(resolved.kappa);
     summary.grad_norm_min = summary.grad_norm_min.min(resolved.norm);
     summary.grad_norm_max = summary.grad_norm_max.max(resolved.norm);
-    geo.normal[..D].copy_from_slice(&resolved.normal);
-    geo.b = resolved.b;
-    geo
+    normal[..D].copy_from_slice(&resolved.normal);
+    debug_assert!(resolved.b[0] > 0.0, "B is positive definite at a resolved node");
+    NodeGeometry {
+        normal,
+        packed_b: resolved.b,
+    }
 }
 
 /// What [`resolve`] finds at a resolved node.
@@ -577,6 +611,28 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_node_s_geometry_is_36_bytes_and_keeps_its_first_order_reason_in_b() {
+        // 2 bytes per band node more with a byte of its own (issue 31's memory target)
+        assert_eq!(std::mem::size_of::<NodeGeometry>(), 36);
+        let mut identity = [0.0f32; 6];
+        for k in 0..3 {
+            identity[sym(k, k)] = 1.0;
+        }
+        for reason in [Unresolved::Stencil, Unresolved::Gradient, Unresolved::Curvature] {
+            let g = NodeGeometry::first_order_node([0.0, 0.0, 1.0], identity, reason);
+            assert_eq!(g.first_order(), reason as u8);
+            assert_eq!((0..6).map(|s| g.b(s)).collect::<Vec<_>>(), identity.to_vec());
+        }
+        let b = [1.25f32, 0.1, 0.0, 0.75, 0.0, 1.0];
+        let g = NodeGeometry {
+            normal: [1.0, 0.0, 0.0],
+            packed_b: b,
+        };
+        assert_eq!(g.first_order(), 0);
+        assert_eq!((0..6).map(|s| g.b(s)).collect::<Vec<_>>(), b.to_vec());
+    }
+
+    #[test]
     fn the_curvature_test_never_skips_a_node_that_could_raise_the_bound() {
         let mut next = crate::test_random::uniform(7);
         let (mut skipped, mut computed_below) = (0, 0);
@@ -700,7 +756,7 @@ mod tests {
             let mut m = [[0.0; 3]; 3];
             for k in 0..3 {
                 for l in 0..3 {
-                    m[k][l] = g.b[sym(k, l)] as f64;
+                    m[k][l] = g.b(sym(k, l)) as f64;
                 }
             }
             let mut e = symmetric_eigenvalues(&m);

@@ -173,7 +173,7 @@ mod tests {
             for k in 0..3 {
                 for l in k..3 {
                     let s = sym(k, l);
-                    worst_b = worst_b.max((ga.b[s] - gb.b[s]).abs() as f64);
+                    worst_b = worst_b.max((ga.b(s) - gb.b(s)).abs() as f64);
                 }
             }
             // the normals agree up to sign (a closest-point map's orientation is local)

@@ -138,7 +138,7 @@ pub fn corrected_slowness_squared<const D: usize>(
         e[k] = g[k] - gn * n[k] as f64;
         e2 += e[k] * e[k];
     }
-    let b = |k: usize, l: usize| geo.b[sym(k.min(l), k.max(l))] as f64;
+    let b = |k: usize, l: usize| geo.b(sym(k.min(l), k.max(l))) as f64;
     // q = 1 without its square root and division where |e|/σ clearly exceeds DIRECTION_FULL (a
     // relative margin of 1e-9, far above the rounding of q's operations)
     let q = if e2 > DIRECTION_FULL * DIRECTION_FULL * (1.0 + 1e-9) {

@@ -236,7 +236,7 @@ impl<const D: usize> Sweeper<'_, D> {
         // there), on u itself: its ∂u₀ came from differences of φ across the crease, the corner
         // or the rim that made it unresolved (O(1/Δx) there: on two spheres joined by `min` the
         // factored update fell by 1.6Δx every sweep), so the sides read u₀ at the neighbours
-        let resolved = geometry.first_order == 0;
+        let resolved = geometry.first_order() == 0;
         let second = second && resolved;
         for k in 0..D {
             let du0 = if resolved {

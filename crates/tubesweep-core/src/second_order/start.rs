@@ -35,7 +35,7 @@ fn isotropic_slowness<const D: usize>(
                 return sigma;
             }
             let Some(g) = inner.next() else { return sigma };
-            let b = |k: usize, l: usize| g.b[sym(k.min(l), k.max(l))] as f64;
+            let b = |k: usize, l: usize| g.b(sym(k.min(l), k.max(l))) as f64;
             let (mut tr, mut bn2) = (0.0, 0.0);
             for k in 0..D {
                 let mut bn = 0.0;
