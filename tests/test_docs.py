@@ -264,7 +264,9 @@ def test_the_shell_blocks_of_a_user_page_run_as_printed(page, tmp_path, monkeypa
         if "--scheduler" in argv:  # CLUSTER_STAND_INS: an in-process cluster for the page's address
             from distributed import LocalCluster
 
-            cluster = cluster or LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+            cluster = cluster or LocalCluster(
+                n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+            )
             argv[argv.index("--scheduler") + 1] = cluster.scheduler_address
         if "--help" in argv:
             with pytest.raises(SystemExit) as e:

@@ -302,7 +302,11 @@ def _stale_previous(kind: str, tube: ts.Tube) -> ts.Solution:
 
 @pytest.mark.parametrize(
     "kind, why",
-    [("unconverged", "did not converge"), ("looser tol", "tolerance 0.001 is looser"), ("edited", "values were changed")],
+    [
+        ("unconverged", "did not converge"),
+        ("looser tol", "tolerance 0.001 is looser"),
+        ("edited", "values were changed"),
+    ],
 )
 def test_a_warm_start_from_values_that_are_not_the_fixed_point_sweeps_every_node(kind, why):
     # a node whose update did not change keeps its previous value only if that value is the

@@ -106,9 +106,7 @@ class Evolution:
 GRADIENT_DRIFT = 1.25
 
 
-def _advanced(
-    arr: np.ndarray, linear: np.ndarray, signed: np.ndarray, move: np.ndarray, h: float
-) -> np.ndarray:
+def _advanced(arr: np.ndarray, linear: np.ndarray, signed: np.ndarray, move: np.ndarray, h: float) -> np.ndarray:
     """φ − Δt·V|∇φ| at the band's nodes (``move`` = Δt·V): from φ itself, whose samples are smooth
     where φ is, with |∇φ| by central differences; from the re-distanced values (|∇φ| = 1) where φ is
     far from a distance. Advancing the re-distanced values at every step would replace φ by the
@@ -124,9 +122,9 @@ def _advanced(
     spacings from the surface."""
     shape = arr.shape
     idx = np.unravel_index(linear, shape)
-    in_band = np.zeros(arr.size, dtype=bool)
-    in_band[linear] = True
-    in_band = in_band.reshape(shape)
+    flags = np.zeros(arr.size, dtype=bool)
+    flags[linear] = True
+    in_band = flags.reshape(shape)
     grad2 = np.zeros(len(linear))
     interior = np.ones(len(linear), dtype=bool)
     for k in range(arr.ndim):

@@ -82,7 +82,7 @@ def refusal_for_order1(reason: Optional[str]) -> WarmStartRefused:
 def values_checksum(values: np.ndarray) -> int:
     """A CRC-32 of a solution's values, kept with its digests: values edited after the solve
     (``sol.values`` is a plain array) no longer match it, and a warm start then sweeps every node."""
-    return zlib.crc32(np.ascontiguousarray(values, dtype=np.float64))
+    return zlib.crc32(np.ascontiguousarray(values, dtype=np.float64).data)
 
 
 def _digests_to_trust(warm: Any, tol: float) -> Tuple[Optional[np.ndarray], Optional[str]]:
