@@ -134,6 +134,21 @@ def test_outliers_are_left_out_with_a_warning():
         from_points(np.r_[p, bad], outliers="raise")
 
 
+def test_a_small_group_of_stray_samples_is_left_out_and_the_sphere_stays_closed():
+    # three samples 0.1 apart, far away: they fit one another, passed the residual test, were taken
+    # for a rim (the sphere "open") and stretched cloud.grid() to spacing 0.233, where the solve failed
+    p = sphere_cloud(3000)
+    strays = np.array([[5.0, 5.0, 5.0], [5.1, 5.0, 5.0], [5.0, 5.1, 5.0]])
+    with pytest.warns(RuntimeWarning, match="3 of them in groups of fewer than 22 samples apart from the rest"):
+        cloud = from_points(np.r_[p, strays])
+    assert cloud.report["outliers"] == 3 and not cloud.open_surface
+    np.testing.assert_array_equal(np.sort(cloud.outliers, axis=0), np.sort(strays, axis=0))
+    grid = cloud.grid(41)
+    assert grid.spacing < 0.05  # the sphere's box (0.042), not the strays'
+    clean = from_points(p)
+    assert np.array_equal(ts.solve(cloud, grid, sources=[SRC]).values, ts.solve(clean, grid, sources=[SRC]).values)
+
+
 def test_repeated_samples_are_kept_once():
     p = sphere_cloud(3000)
     cloud = from_points(np.r_[p, p[:100]])

@@ -118,6 +118,25 @@ impl PyPointCloud {
         .map_err(to_pyerr)
     }
 
+    /// Per sample, whether it lies in a group of fewer than `min_size` samples apart from the rest
+    /// (`tubesweep_core::surface::point_cloud::isolated`); `spacing` from `analyse`.
+    fn isolated<'py>(
+        &self,
+        py: Python<'py>,
+        spacing: PyReadonlyArray1<'py, f64>,
+        median_radius: f64,
+        min_size: usize,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        let s = c_slice(&spacing, "spacing")?;
+        let flags = py
+            .detach(|| match &self.cloud {
+                Cloud::Two(c) => c.isolated(s, median_radius, min_size),
+                Cloud::Three(c) => c.isolated(s, median_radius, min_size),
+            })
+            .map_err(to_pyerr)?;
+        Ok(flags.into_pyarray(py))
+    }
+
     /// Closest points (M, d) of `points` and per point 0 (interior), 1 (moved to the rim) or 2
     /// (no fit: NaN), in parallel; `rho` is the smoothing radius (fits over at least the samples
     /// within it).

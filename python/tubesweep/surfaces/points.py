@@ -316,15 +316,20 @@ class PointCloudSurface(ClosestPoint):
                 )
             cloud = _native.PointCloud(np.ascontiguousarray(p), self.neighbours)
             spacing, radius, residual, gap, nearest = cloud.analyse()
-        bad = ~(residual <= OUTLIER_RATIO)  # NaN: a degenerate neighbourhood, counted as an outlier
+        # a few samples apart from the rest fit one another and pass the residual test; a group
+        # smaller than one fit cannot be a piece of surface (tubesweep_core's point_cloud::isolated)
+        isolated = cloud.isolated(spacing, float(np.nanmedian(radius)), need)
+        bad = ~(residual <= OUTLIER_RATIO) | isolated  # NaN: a degenerate neighbourhood, an outlier
         self.outliers = p[bad]
         if bad.any():
             where = tuple(round(float(c), 6) for c in p[np.flatnonzero(bad)[0]])
             share = float(np.mean(bad))
+            n_iso = int(isolated.sum())
+            apart = f"; {n_iso} of them in groups of fewer than {need} samples apart from the rest" if n_iso else ""
             if outliers == "raise" or share > MAX_OUTLIER_SHARE:
                 raise ValueError(
                     f"{int(bad.sum())} of {len(p)} samples ({share:.1%}) lie off the surface their neighbours fit "
-                    f"(farther than {OUTLIER_RATIO} of the fit's radius; the first at {where})"
+                    f"(farther than {OUTLIER_RATIO} of the fit's radius{apart}; the first at {where})"
                     + (
                         f": more than {MAX_OUTLIER_SHARE:.0%}, so the cloud is not the samples of one smooth surface "
                         "(too noisy, or too sparse for its curvature)"
@@ -333,8 +338,8 @@ class PointCloudSurface(ClosestPoint):
                     )
                 )
             warnings.warn(
-                f"{int(bad.sum())} of {len(p)} samples lie off the surface their neighbours fit (the first at {where}); "
-                "they are left out (surface.outliers holds them)",
+                f"{int(bad.sum())} of {len(p)} samples lie off the surface their neighbours fit{apart} (the first at "
+                f"{where}); they are left out (surface.outliers holds them)",
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )

@@ -17,6 +17,9 @@
 //! on the rim, as for the library's open surfaces.
 
 pub(crate) mod fit;
+mod isolated;
+
+pub use isolated::LINK;
 
 use crate::error::{Error, Result};
 use fit::{basis_len, clamp_to_hull, distance, largest_gap, Fit};

@@ -91,3 +91,26 @@ fn bad_clouds_are_refused() {
     p[3][1] = f64::NAN;
     assert!(PointCloud::new(p, DEFAULT_NEIGHBOURS).is_err());
 }
+
+#[test]
+fn a_small_group_of_stray_samples_is_isolated_and_the_surface_is_not() {
+    // three samples 0.1 apart, far from a sampled sphere: their own fit passes the residual test
+    let mut p = sphere(3000, 0.5);
+    p.extend([[5.0, 5.0, 5.0], [5.1, 5.0, 5.0], [5.0, 5.1, 5.0]]);
+    let cloud = PointCloud::new(p.clone(), DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    let mut r = a.radius.clone();
+    r.sort_by(f64::total_cmp);
+    let flags = cloud
+        .isolated(&a.spacing, r[r.len() / 2], DEFAULT_NEIGHBOURS + 2)
+        .unwrap();
+    assert_eq!(flags.iter().filter(|&&f| f).count(), 3);
+    assert!(flags[3000..].iter().all(|&f| f));
+    // two spheres far apart (two parts, each a surface): none isolated
+    let mut two = sphere(2000, 0.5);
+    two.extend(sphere(2000, 0.5).iter().map(|q| [q[0] + 3.0, q[1], q[2]]));
+    let cloud = PointCloud::new(two, DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    let flags = cloud.isolated(&a.spacing, 0.0, DEFAULT_NEIGHBOURS + 2).unwrap();
+    assert!(flags.iter().all(|&f| !f));
+}
