@@ -46,8 +46,8 @@ class Evolution:
     solutions : list of Solution
         The surface solution at each kept time (on that time's surface).
     warm_starts, cold_starts : int
-        Steps whose surface solve started warm, and cold (the first, and any whose warm start was
-        refused).
+        Steps whose surface solve ran warm, and cold (the first, any whose warm start was refused,
+        and any that started again cold when a safeguard fired: ``order2["warm"]["restarted"]``).
     """
 
     times: List[float]
@@ -289,7 +289,7 @@ def evolve(
                 arr.reshape(-1)[linear[fresh]] = np.asarray(tube._tube.geom.signed, dtype=float)[fresh]  # type: ignore[union-attr]
         previous_band = linear
         info = (sol.stats.order2 or {}).get("warm")
-        if info is not None and "refused" not in info:
+        if info is not None and "refused" not in info and info.get("restarted") is None:
             out.warm_starts += 1
         else:
             out.cold_starts += 1
