@@ -8,9 +8,9 @@ onto the surface, the surface solve on the moved tube started warm from the prev
 solution there: V is constant along the normals, which keeps φ close to a signed distance), and one
 forward Euler step φ ← φ − Δt·V|∇φ| (φ_t + V|∇φ| = 0, |∇φ| by central differences) on φ itself,
 or on the band's re-distanced values where |∇φ| strays beyond a factor 1.25 of 1 (a mask, or a φ far
-from a distance) and at the band's edge (whose neighbours beyond it hold only a bound). First order in time, second order in
-space where the surface solve is; the CFL condition Δt·max|V| ≤ cfl·Δx (cfl ≤ 1, default 0.5) is
-checked at every step. Beyond the band φ is only a bound: its magnitude is lowered by Δt·max|V| per
+from a distance) and at the band's edge (whose neighbours beyond it hold only a bound). First order
+in time, second order in space where the surface solve is; the CFL condition Δt·max|V| ≤ cfl·Δx
+(cfl ≤ 1, default 0.5) is checked at every step. Beyond the band φ is only a bound: its magnitude is lowered by Δt·max|V| per
 step, so that it never overstates the distance to the moved surface and the next band holds every
 node it should (work O(N^d) per step there, a few array operations).
 """
@@ -282,11 +282,14 @@ def evolve(
         # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
         # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
         linear = tube._tube.linear
+        geom = tube._tube.geom
+        assert geom is not None  # a Tube keeps its geometry
+        signed = np.asarray(geom.signed, dtype=float)  # the band's re-distanced φ
         if previous_band is not None:
             fresh = ~np.isin(linear, previous_band)
             if np.any(fresh):
                 arr = arr.copy()
-                arr.reshape(-1)[linear[fresh]] = np.asarray(tube._tube.geom.signed, dtype=float)[fresh]  # type: ignore[union-attr]
+                arr.reshape(-1)[linear[fresh]] = signed[fresh]
         previous_band = linear
         info = (sol.stats.order2 or {}).get("warm")
         if info is not None and "refused" not in info and info.get("restarted") is None:
@@ -309,9 +312,6 @@ def evolve(
                 f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
                 f"cfl·Δx = {cfl * h:.4g} (max|V| = {vmax:.4g}); take dt ≤ {cfl * h / vmax:.4g}"
             )
-        geom = tube._tube.geom
-        assert geom is not None  # a Tube keeps its geometry
-        signed = np.asarray(geom.signed, dtype=float)
         new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
         new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
         arr = new
