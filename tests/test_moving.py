@@ -95,6 +95,24 @@ def test_a_part_without_a_source_stays_unreached_in_a_warm_solve():
     assert np.max(np.abs(warm.values[reached] - cold.values[reached])) <= 10 * cold.stats.order2["tol"]
 
 
+def test_a_change_of_topology_is_refused_also_after_a_warm_step():
+    # two spheres, then one of them gone: the inner tube's components go from 2 to 1; the previous
+    # solution is itself warm, so its count was kept from its own start (and is the one read)
+    X = np.stack(GRID.meshgrid(), axis=-1)
+    a, b = np.linalg.norm(X - (0.5, 0, 0), axis=-1), np.linalg.norm(X + (0.5, 0, 0), axis=-1)
+    tube = ts.Tube(np.minimum(a, b) - 0.3, GRID)
+    sol = tube.solve([(0.8, 0.0, 0.0)])
+    r = 0.3 + 0.4 * H
+    grown = tube.moved(np.minimum(a, b) - r)
+    step = grown.solve([(0.5 + r, 0.0, 0.0)], warm=sol)
+    assert step._inner_components is not None and step._inner_components[0] == 2
+    with pytest.raises(WarmStartRefused, match="the inner tube has 1 connected component.*the previous one had 2"):
+        grown.moved(a - r).solve([(0.5 + r, 0.0, 0.0)], warm=step)
+    # the same counts from a cold previous solution, which kept none
+    with pytest.raises(WarmStartRefused, match="the inner tube has 1 connected component.*the previous one had 2"):
+        tube.moved(a - r).solve([(0.5 + r, 0.0, 0.0)], warm=sol)
+
+
 def test_refusals_name_the_cause(first):
     tube, sol = first
     r = 0.5 + 0.4 * H

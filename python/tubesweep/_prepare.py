@@ -114,6 +114,9 @@ class _PreparedTube:
     #: nodes (``_creases.crease_nodes_to_extend``; band positions); their roles are changed only
     #: by :func:`thinned_at_creases`, so that ``order=1`` keeps the paper's tube
     crease_nodes: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0, np.int64))
+    #: the inner tube's connected components and the checksum of its flags, once a warm start
+    #: counted them (``moving.inner_components``)
+    inner_components: Optional[Tuple[int, int]] = None
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at

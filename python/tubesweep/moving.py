@@ -109,6 +109,20 @@ def _linear(sol_or_tube: Any) -> np.ndarray:
     return np.ascontiguousarray(sol_or_tube.linear, dtype=np.int64).view(np.uint64)
 
 
+def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[int, int]]) -> Tuple[int, int]:
+    """The number of connected components of the inner tube (the nodes of ``roles`` other than
+    the extension layer's) on ``band``, as ``(count, checksum of the inner flags)``: ``known``, a
+    pair kept from an earlier call, is used when the flags' checksum matches (a warm solve's tube
+    is the next step's previous tube: its components are counted once)."""
+    from ._prepare import ROLE_OUTER
+
+    inner = np.ascontiguousarray(roles != ROLE_OUTER)
+    crc = zlib.crc32(inner.view(np.uint8).data)
+    if known is not None and known[1] == crc:
+        return known
+    return int(_native.band_components(band, inner)), crc
+
+
 def carried_values(
     warm: Any, tube: Any, feet: np.ndarray, inner_width: float, tol: float
 ) -> Tuple[np.ndarray, Dict[str, Any], Dict[str, Any]]:
@@ -161,19 +175,21 @@ def carried_values(
         more["warm_previous_linear"] = old_linear
         more["warm_previous_digests"] = np.ascontiguousarray(digests, dtype=np.uint64)
     inner_new = tube.roles != ROLE_OUTER
+    # whether each node of the new band was in the previous one: the same merge as the values,
+    # carrying the previous positions (+∞ for a node new to the band)
+    in_both = np.isfinite(_native.carry_band_values(old_linear, np.arange(len(old_linear), dtype=float), new_linear))
     # nodes of the new inner tube outside the previous band (a node in it that the previous solve
     # never reached, on a part without a source, stays unreached: the sweeps leave it at +∞)
-    at = np.minimum(np.searchsorted(old_linear, new_linear), len(old_linear) - 1)
-    missing = int(np.count_nonzero(inner_new & (old_linear[at] != new_linear)))
+    missing = int(np.count_nonzero(inner_new & ~in_both))
     if missing:
         raise WarmStartRefused(
             f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved farther than "
             f"outer − inner = {slack / h:g} grid spacings since the previous solution. Move in smaller steps (at most "
             "outer − inner spacings per solve), widen the tube (outer=), or solve cold (leave out warm=)"
         )
-    old_inner = np.ascontiguousarray(warm.roles != ROLE_OUTER)
-    n_old = _native.band_components(warm._band, old_inner)
-    n_new = _native.band_components(tube.band, np.ascontiguousarray(inner_new))
+    n_old, _ = inner_components(warm._band, warm.roles, getattr(warm, "_inner_components", None))
+    tube.inner_components = inner_components(tube.band, tube.roles, tube.inner_components)
+    n_new = tube.inner_components[0]  # (kept: the next step's warm start from this solve reads it)
     if n_old != n_new:
         raise WarmStartRefused(
             f"warm: the topology changed: the inner tube has {n_new} connected component(s), the previous one had "
@@ -196,7 +212,6 @@ def carried_values(
             "surface's path is another problem. Pass the previous sources moved with the surface, move in smaller "
             "steps, or solve cold (leave out warm=)"
         )
-    in_both = old_linear[at] == new_linear
     info = {
         "carried": int(np.count_nonzero(np.isfinite(carried))),
         # nodes new to the band, and nodes of both that the previous solve left unreached: both start at +∞

@@ -485,6 +485,8 @@ def solve_on_tube(
         factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
+    # the inner tube's components, when a warm start counted them (the next warm start reads them)
+    sol._inner_components = tube.inner_components
     # digests stand for the fixed point of each node's update: kept only for a solve that reached it
     # (not one stopped at max_iterations, nor one whose second-order sweeps ran away)
     if st.get("digests") is not None:

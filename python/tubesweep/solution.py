@@ -115,6 +115,9 @@ class Solution:
         # the digests only for the converged values of a solve at least as tight, unedited); or
         # why a solve that would have kept them did not
         self._digested: Optional[Union[Tuple[float, int], str]] = None
+        # the inner tube's connected components and a checksum of its flags, once a warm start
+        # counted them (tubesweep.moving.inner_components)
+        self._inner_components: Optional[Tuple[int, int]] = None
         self.order = 1
 
     def __getstate__(self) -> dict:

@@ -519,14 +519,20 @@ class LevelSet(Surface):
             from .redistance import redistanced_project
 
             return redistanced_project(self, points, grid)
-        phi = self.phi(points, grid)
         h = grid.spacing
-        d = points.shape[1]
-        g = np.empty_like(points)
+        m, d = points.shape
+        # φ at the points and a spacing either side along each axis, in one evaluation (the same
+        # values as one call per set: φ is evaluated point by point)
+        shifted = [points]
         for k in range(d):
             e = np.zeros(d)
             e[k] = h
-            g[:, k] = (self.phi(points + e, grid) - self.phi(points - e, grid)) / (2 * h)
+            shifted += [points + e, points - e]
+        values = self.phi(np.concatenate(shifted), grid)
+        phi = values[:m]
+        g = np.empty_like(points)
+        for k in range(d):
+            g[:, k] = (values[(2 * k + 1) * m : (2 * k + 2) * m] - values[(2 * k + 2) * m : (2 * k + 3) * m]) / (2 * h)
         n2 = np.maximum(np.sum(g * g, axis=1), 1e-24)
         closest = points - (phi / n2)[:, None] * g
         return np.abs(phi), closest

@@ -35,6 +35,7 @@
 use crate::band::facing_sheets::check_node_fields;
 use crate::band::NarrowBand;
 use crate::error::Result;
+use rayon::prelude::*;
 
 /// The second difference of |φ| across a ridge node, in grid spacings (see the module docs).
 pub const RIDGE_SECOND_DIFFERENCE: f64 = 0.75;
@@ -94,8 +95,11 @@ pub fn crease_ridge_nodes<const D: usize>(
         (Some(m), Some(p)) => turns(&normal_beyond(m, k, 0), &normal_beyond(p, k, 1)),
         _ => true,
     };
-    let mut marked = vec![false; k_nodes];
-    for a in 0..k_nodes {
+    // what node `a`'s tests mark, as bits: 1 for `a` itself, 2 << k for its plus neighbour
+    // along axis k (the pair test); the tests read only, so the nodes run on all threads and the
+    // marks are gathered after (the same marks as one pass in band order)
+    let marks_of = |a: usize| -> u8 {
+        let mut bits = 0u8;
         let pa = phi[a] as f64;
         let s = if pa < 0.0 { -1.0 } else { 1.0 };
         for (k, pair) in band.neighbours_of(a).iter().enumerate() {
@@ -105,8 +109,7 @@ pub fn crease_ridge_nodes<const D: usize>(
                 let (na, np) = (normal(a), normal(p as usize));
                 let turn: f64 = (0..D).map(|c| na[c] * np[c]).sum();
                 if turn < cos_turn && s * (np[k] - na[k]) < 0.0 && persists(step(a, k, 0), step(p as usize, k, 1), k) {
-                    marked[a] = true;
-                    marked[p as usize] = true;
+                    bits |= 1 | (2 << k);
                 }
             }
             if m == sentinel || p == sentinel {
@@ -125,8 +128,23 @@ pub fn crease_ridge_nodes<const D: usize>(
             let (nm, np) = (normal_beyond(m, k, 0), normal_beyond(p, k, 1));
             let turn: f64 = (0..D).map(|c| nm[c] * np[c]).sum();
             if turn < cos_turn && s * (np[k] - nm[k]) < 0.0 && persists(step(m, k, 0), step(p, k, 1), k) {
-                marked[a] = true;
+                bits |= 1;
                 break;
+            }
+        }
+        bits
+    };
+    let bits: Vec<u8> = (0..k_nodes).into_par_iter().with_min_len(4096).map(marks_of).collect();
+    let mut marked = vec![false; k_nodes];
+    for (a, &b) in bits.iter().enumerate() {
+        if b == 0 {
+            continue;
+        }
+        marked[a] |= b & 1 != 0;
+        let nb = band.neighbours_of(a);
+        for (k, pair) in nb.iter().enumerate() {
+            if b & (2 << k) != 0 {
+                marked[pair[1] as usize] = true;
             }
         }
     }
