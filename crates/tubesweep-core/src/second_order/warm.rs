@@ -41,9 +41,10 @@
 //! the change is swept. Measured (`benches/moving_surfaces.py --local`, the sphere at N = 121, a
 //! bump of 0.3Δx and radius 0.15 changing 2.6 % of the band's updates, the source at the north
 //! pole): at the antipode 0.02 of the cold solve's updates, at the equator 0.06, next to the
-//! source 0.20; `moved` and the solve together 0.27, 0.32 and 0.48 of a cold solve's time (the
-//! rest is the tube and its geometry, built anew), the values within 2.1, 3.1 and 11.2
-//! tolerances of the cold solve's. The solves of a `ts.Tube` and warm solves compute and keep the
+//! source 0.20; `moved` and the solve together 0.23, 0.28 and 0.43 of a cold solve's time (the
+//! rest is the tube and its geometry, built anew: some ten O(band) passes of 1–4 ms each at
+//! N = 121, where reading a node's old and new φ to see whether it changed costs over half of
+//! computing its direction), the values within 2.1, 3.0 and 11.0 tolerances of the cold solve's. The solves of a `ts.Tube` and warm solves compute and keep the
 //! digests (a one-off `ts.solve` does not: 8 bytes per node would break issue 31's memory target):
 //! one pass over the band, O(band).
 //!
