@@ -22,6 +22,7 @@ from ._box_cut import box_reason
 from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from .moving import values_checksum
+from ._warn import user_stacklevel
 from ._validate import (
     FRONT_WINDOW,
     check_threads as _threads,
@@ -292,6 +293,170 @@ def source_feet(
     return np.ascontiguousarray(feet, dtype=float), np.ascontiguousarray(src_slowness, dtype=float)
 
 
+def warm_start(
+    warm: Any, tube: Any, feet: np.ndarray, tol: float, warm_refused: str
+) -> Tuple[Optional[np.ndarray], Dict[str, Any], Optional[Dict[str, Any]]]:
+    """The warm start of a solve on ``tube`` from ``warm`` (:mod:`tubesweep.moving`): the carried
+    values (None to start cold), the native solve's other warm arguments, and the report for
+    ``sol.stats.order2["warm"]`` (None without ``warm``). A refused start raises
+    :class:`~tubesweep.moving.WarmStartRefused`, or with ``warm_refused="cold"`` starts cold and
+    says why in the report."""
+    if warm is None:
+        return None, {}, None
+    from .moving import WarmStartRefused, carried_values
+
+    try:
+        return carried_values(warm, tube, feet, tube.inner * tube.grid.spacing, float(tol))
+    except WarmStartRefused as e:
+        if warm_refused != "cold":
+            raise
+        return None, {}, {"refused": str(e)}
+
+
+def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float) -> None:
+    """The warnings of a second-order solve from its native report ``st``: not converged, the
+    sweeps ran away, many first-order nodes, convex creases."""
+    if not st["converged"]:
+        warnings.warn(
+            f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
+            f"iteration was {st['last_change']:.3g} (tol={tol:g}). Increase max_iterations or tol; the values returned "
+            "are the last iterate",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+    if st["runaway_iteration"] is not None:
+        warnings.warn(
+            f"order=2: the second-order sweeps ran away at their iteration {st['runaway_iteration']} (a travel time "
+            "fell below zero) and were abandoned: the values returned are the first-order factored solution (order 1). "
+            "sol.stats.order2['runaway_iteration'] records it; a finer grid or order=1 avoids it",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+    first_order = int(st["first_order_nodes"])
+    if first_order > FIRST_ORDER_WARNING * st["inner_nodes"]:
+        r = st["first_order_reasons"]
+        warnings.warn(
+            f"order=2: {first_order} of the {st['inner_nodes']} inner-tube nodes "
+            f"({100 * first_order / st['inner_nodes']:.0f}%) ran the first-order update, where the grid does not "
+            f"resolve the surface ({r['curvature']} unresolved curvature: creases, corners, rims, noise; "
+            f"{r['gradient']} φ not a distance; {r['stencil']} stencils cut by the box or the band). Errors near them "
+            "and beyond them are first order; sol.first_order_points() shows where. A finer grid resolves more of it",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+    warn_creases(st.get("creases"), tube.inner, tube.grid.spacing)
+
+
+#: The native report's entries that ``sol.stats.order2`` keeps as they are.
+_REPORTED = (
+    "first_order_iterations",
+    "second_order_iterations",
+    "fallback_iteration",
+    "runaway_iteration",
+    "unreached",
+    "max_curvature",
+    "grad_norm_range",
+    "first_order_nodes",
+    "first_order_reasons",
+    "inner_nodes",
+    "geometry_fitted",
+    "creases",
+)
+
+
+def order2_report(
+    st: Dict[str, Any], tol: float, surf: Any, spacing: float, warm_info: Optional[Dict[str, Any]], started_warm: bool
+) -> Dict[str, Any]:
+    """``sol.stats.order2`` from the native report ``st`` (the warm start's report completed with
+    what the sweeps did, when it ran)."""
+    order2 = {k: st[k] for k in _REPORTED}
+    order2["tol"] = float(tol)
+    if warm_info is not None:
+        if started_warm:
+            warm_info["restarted"] = st["warm_restarted"]
+            warm_info["changed"] = st["warm_changed"]
+            warm_info["extrapolated"] = st["warm_extrapolated"]
+        order2["warm"] = warm_info
+    order2["fix_radius"] = FIX_RADIUS * spacing
+    if getattr(surf, "smooth", False):  # a mesh's smooth map: band nodes per map (surfaces/_mesh_smooth.py)
+        order2["mesh_map"] = dict(surf.report)
+    return order2
+
+
+def keep_for_warm_starts(sol: Any, st: Dict[str, Any], tube: Any, tol: float) -> None:
+    """What a later warm start from ``sol`` reads: the inner tube's components when counted, and
+    the nodes' digests with the solve's tolerance and a checksum of its values, or why none were
+    kept."""
+    # the inner tube's components, when a warm start counted them (the next warm start reads them)
+    sol._inner_components = tube.inner_components
+    # digests stand for the fixed point of each node's update: kept only for a solve that reached it
+    # (not one stopped at max_iterations, nor one whose second-order sweeps ran away)
+    if st.get("digests") is None:
+        return
+    if not st["converged"]:
+        sol._digested = "the previous solve did not converge"
+    elif st["runaway_iteration"] is not None:
+        sol._digested = "the previous solve's second-order sweeps ran away (its values are first order)"
+    else:
+        sol._digests = st["digests"]
+        sol._digested = (float(tol), values_checksum(sol.values))
+
+
+def run_native(
+    tube: Any,
+    inputs: TubeInputs,
+    feet: np.ndarray,
+    src_slowness: np.ndarray,
+    max_iterations: int,
+    cb: Any,
+    threads: int,
+    warm_values: Optional[np.ndarray],
+    warm_more: Dict[str, Any],
+    keep_digests: bool,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray, Dict[str, Any]]:
+    """The native second-order solve (``tubesweep_core::second_order``) on ``tube``: the values
+    (clamped at 0), u₀, the roles after the sources were fixed, and the native report."""
+    grid = tube.grid
+    h, d = grid.spacing, grid.ndim
+    try:
+        values, u0, roles_out, st = _native_solve(
+            tube.band,
+            np.ascontiguousarray(tube.roles),
+            np.ascontiguousarray(tube.geom.signed, dtype=np.float64),
+            inputs.directions,
+            [float(c) for c in grid.lower],
+            h,
+            feet,
+            src_slowness,
+            inputs.slowness,
+            FIX_RADIUS * h,
+            tube.outer_eff * h,
+            inputs.tol_first,
+            float(inputs.tol),
+            int(max_iterations),
+            cb,
+            threads=_threads(threads),
+            front_window=FRONT_WINDOW if d == 3 else 0.0,
+            own_first_phase=_OWN_FIRST_PHASE,
+            offsets=inputs.offsets,
+            window_first=WINDOWS[0] if d == 3 else 0.0,
+            window_second=WINDOWS[1] if d == 3 else 0.0,
+            ramp_length=inputs.length,
+            extension_limit=EXTENSION_LIMIT,
+            warm=warm_values,
+            keep_digests=keep_digests,
+            **warm_more,
+        )
+    except Order2NotApplicable as e:
+        # a tube cut by the grid box: the reason names the box, not φ or the resolution
+        raise Order2NotApplicable(box_reason(tube.box_cut, str(e), tube.outer_eff * h)) from None
+    # u = u₀ + w rounds to just below 0 next to a source (−9e-22 on a circle of radius 4Δx): a
+    # travel time is never negative. Clamped here, not in the sweeps, whose runaway guard reads the
+    # sign (a value below −Δx times the mean slowness)
+    np.maximum(values, 0.0, out=values)
+    return values, u0, roles_out, st
+
+
 def solve_on_tube(
     tube: Any,
     src: np.ndarray,
@@ -308,123 +473,33 @@ def solve_on_tube(
     """The second-order solve on a prepared tube (``solve._PreparedTube``, its geometry kept);
     ``warm``: a previous solution to start from (:mod:`tubesweep.moving`); ``keep_digests``: the
     solution keeps its nodes' digests, for a warm start from it to sweep only where the update
-    changed (8 bytes per node; a ``ts.Tube``'s solves and warm solves keep them)."""
+    changed (8 bytes per node; a ``ts.Tube``'s solves and warm solves keep them). The stages:
+    the per-node inputs, the sources' feet, the warm start, the native solve, the warnings, the
+    report and the :class:`~tubesweep.Solution`."""
     from ._prepare import ROLE_OUTER, thinned_count
 
     grid, surf, band = tube.grid, tube.surface, tube.band
-    crease_thinned = thinned_count(tube)
-    h = grid.spacing
-    d = grid.ndim
+    h, d = grid.spacing, grid.ndim
     inputs = tube_inputs(tube, speed, tol)
     tol = inputs.tol
-    linear = tube.linear
     feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
-    warm_values, warm_info = None, None
-    warm_more: Dict[str, Any] = {}
-    if warm is not None:
-        from .moving import WarmStartRefused, carried_values
-
-        try:
-            warm_values, warm_more, warm_info = carried_values(warm, tube, feet, tube.inner * h, float(tol))
-        except WarmStartRefused as e:
-            if warm_refused != "cold":
-                raise
-            warm_info = {"refused": str(e)}
+    warm_values, warm_more, warm_info = warm_start(warm, tube, feet, tol, warm_refused)
     setup = time.perf_counter() - t0
-    try:
-        values, u0, roles_out, st = _native_solve(
-            band,
-            np.ascontiguousarray(tube.roles),
-            np.ascontiguousarray(tube.geom.signed, dtype=np.float64),
-            inputs.directions,
-            [float(c) for c in grid.lower],
-            h,
-            feet,
-            src_slowness,
-            inputs.slowness,
-            FIX_RADIUS * h,
-            tube.outer_eff * h,
-            inputs.tol_first,
-            float(tol),
-            int(max_iterations),
-            cb,
-            threads=_threads(threads),
-            front_window=FRONT_WINDOW if grid.ndim == 3 else 0.0,
-            own_first_phase=_OWN_FIRST_PHASE,
-            offsets=inputs.offsets,
-            window_first=WINDOWS[0] if d == 3 else 0.0,
-            window_second=WINDOWS[1] if d == 3 else 0.0,
-            ramp_length=inputs.length,
-            extension_limit=EXTENSION_LIMIT,
-            warm=warm_values,
-            keep_digests=keep_digests or warm is not None,
-            **warm_more,
-        )
-    except Order2NotApplicable as e:
-        # a tube cut by the grid box: the reason names the box, not φ or the resolution
-        raise Order2NotApplicable(box_reason(tube.box_cut, str(e), tube.outer_eff * h)) from None
-    # u = u₀ + w rounds to just below 0 next to a source (−9e-22 on a circle of radius 4Δx): a
-    # travel time is never negative. Clamped here, not in the sweeps, whose runaway guard reads the
-    # sign (a value below −Δx times the mean slowness)
-    np.maximum(values, 0.0, out=values)
-    if not st["converged"]:
-        warnings.warn(
-            f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
-            f"iteration was {st['last_change']:.3g} (tol={tol:g}). Increase max_iterations or tol; the values returned "
-            "are the last iterate",
-            RuntimeWarning,
-            stacklevel=3,
-        )
-    if st["runaway_iteration"] is not None:
-        warnings.warn(
-            f"order=2: the second-order sweeps ran away at their iteration {st['runaway_iteration']} (a travel time "
-            "fell below zero) and were abandoned: the values returned are the first-order factored solution (order 1). "
-            "sol.stats.order2['runaway_iteration'] records it; a finer grid or order=1 avoids it",
-            RuntimeWarning,
-            stacklevel=3,
-        )
-    first_order = int(st["first_order_nodes"])
-    if first_order > FIRST_ORDER_WARNING * st["inner_nodes"]:
-        r = st["first_order_reasons"]
-        warnings.warn(
-            f"order=2: {first_order} of the {st['inner_nodes']} inner-tube nodes "
-            f"({100 * first_order / st['inner_nodes']:.0f}%) ran the first-order update, where the grid does not "
-            f"resolve the surface ({r['curvature']} unresolved curvature: creases, corners, rims, noise; "
-            f"{r['gradient']} φ not a distance; {r['stencil']} stencils cut by the box or the band). Errors near them "
-            "and beyond them are first order; sol.first_order_points() shows where. A finer grid resolves more of it",
-            RuntimeWarning,
-            stacklevel=3,
-        )
-    warn_creases(st.get("creases"), tube.inner, h)
+    values, u0, roles_out, st = run_native(
+        tube,
+        inputs,
+        feet,
+        src_slowness,
+        max_iterations,
+        cb,
+        threads,
+        warm_values,
+        warm_more,
+        keep_digests or warm is not None,
+    )
+    warn_about(st, tube, max_iterations, tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
-    order2 = {
-        k: st[k]
-        for k in (
-            "first_order_iterations",
-            "second_order_iterations",
-            "fallback_iteration",
-            "runaway_iteration",
-            "unreached",
-            "max_curvature",
-            "grad_norm_range",
-            "first_order_nodes",
-            "first_order_reasons",
-            "inner_nodes",
-            "geometry_fitted",
-            "creases",
-        )
-    }
-    order2["tol"] = float(tol)
-    if warm_info is not None:
-        if warm_values is not None:
-            warm_info["restarted"] = st["warm_restarted"]
-            warm_info["changed"] = st["warm_changed"]
-            warm_info["extrapolated"] = st["warm_extrapolated"]
-        order2["warm"] = warm_info
-    order2["fix_radius"] = FIX_RADIUS * h
-    if getattr(surf, "smooth", False):  # a mesh's smooth map: band nodes per map (surfaces/_mesh_smooth.py)
-        order2["mesh_map"] = dict(surf.report)
     stats = SolveStats(
         iterations=st["iterations"],
         sweeps=st["iterations"] * 2**d,
@@ -441,22 +516,22 @@ def solve_on_tube(
         facing_pairs=int(tube.facing[0].size),
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         cut_edges=tube.cut_edges,
-        crease_thinned=crease_thinned,
+        crease_thinned=thinned_count(tube),
         order=2,
-        order2=order2,
+        order2=order2_report(st, tol, surf, h, warm_info, warm_values is not None),
         box_cut=tube.box_cut,
     )
     # the source of each fixed node: the nearest foot point (a kd-tree in the core: nothing of size
     # fixed nodes × sources)
     labels = (
-        _native.nearest_feet(feet, np.ascontiguousarray(grid.node_points(linear[positions])))
+        _native.nearest_feet(feet, np.ascontiguousarray(grid.node_points(tube.linear[positions])))
         if len(positions)
         else np.empty(0, np.int64)
     )
     array = getattr(surf, "_array", None)
     phi_sample = None
     if array is not None:
-        pick = linear[:: max(1, len(linear) // 4096)].copy()
+        pick = tube.linear[:: max(1, len(tube.linear) // 4096)].copy()
         phi_sample = (pick, array.reshape(-1)[pick].copy())
     from .solution import Solution
 
@@ -485,17 +560,6 @@ def solve_on_tube(
         factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
-    # the inner tube's components, when a warm start counted them (the next warm start reads them)
-    sol._inner_components = tube.inner_components
-    # digests stand for the fixed point of each node's update: kept only for a solve that reached it
-    # (not one stopped at max_iterations, nor one whose second-order sweeps ran away)
-    if st.get("digests") is not None:
-        if not st["converged"]:
-            sol._digested = "the previous solve did not converge"
-        elif st["runaway_iteration"] is not None:
-            sol._digested = "the previous solve's second-order sweeps ran away (its values are first order)"
-        else:
-            sol._digests = st["digests"]
-            sol._digested = (float(tol), values_checksum(values))
+    keep_for_warm_starts(sol, st, tube, float(tol))
     sol.order = 2
     return sol
