@@ -286,8 +286,9 @@ class Tube:
 
         Parameters
         ----------
-        surface : LevelSet, library surface, φ array of ``grid.shape`` or callable φ
-            The moved surface (φ at the new time).
+        surface : LevelSet, library surface, φ array of ``grid.shape``, callable φ, mesh or point cloud
+            The moved surface (φ at the new time, or the surface built from the moved vertices or
+            points).
 
         Returns
         -------
