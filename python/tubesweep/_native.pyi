@@ -157,7 +157,7 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
     tol: float,
     max_iterations: int,
     progress: Optional[Callable[[int, float, int], Any]] = None,
-    stall_ratio: float = 0.9,
+    stall_ratio: float = 0.98,
     stall_window: int = 10,
     threads: int = 0,
     front_window: float = 2.0,
@@ -202,7 +202,7 @@ def second_order_solve_many(  # crates/tubesweep-py/src/many_sources.rs: K secon
     window_second: float = 0.0,
     ramp_length: float = 1.0,
     extension_limit: float = ...,
-    stall_ratio: float = 0.9,
+    stall_ratio: float = 0.98,
     stall_window: int = 20,
     at: Optional[npt.NDArray[np.float64]] = None,  # (M, d)
     at_feet: Optional[npt.NDArray[np.float64]] = None,  # (M, d) their feet on the surface

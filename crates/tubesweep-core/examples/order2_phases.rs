@@ -114,7 +114,7 @@ fn main() {
         tol,
         // MAX_ITERATIONS=20 on the sphere at N = 201: phase 1 alone (for profiling it)
         max_iterations: std::env::var("MAX_ITERATIONS").map_or(10000, |v| v.parse().expect("a count")),
-        stall_ratio: 0.9,
+        stall_ratio: tubesweep_core::second_order::STALL_RATIO,
         stall_window: 20,
         own_first_phase: true,
         window_first,

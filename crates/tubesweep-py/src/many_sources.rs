@@ -456,7 +456,7 @@ fn run_order2<'py, const D: usize>(
 /// per-source arrays and the scalars `max_curvature` and `reach`. Refusals of the geometry are
 /// ValueErrors starting with `order=2`.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, feet, source_slowness, offsets, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, threads=0, front_window=2.0, own_first_phase=true, cp_offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, stall_ratio=0.9, stall_window=20, at=None, at_feet=None, reach_spacings=3.0, reach_curvature_radii=0.0))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, feet, source_slowness, offsets, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, threads=0, front_window=2.0, own_first_phase=true, cp_offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, stall_ratio=tubesweep_core::second_order::STALL_RATIO, stall_window=20, at=None, at_feet=None, reach_spacings=3.0, reach_curvature_radii=0.0))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve_many<'py>(
     py: Python<'py>,

@@ -259,7 +259,7 @@ fn run<'py, const D: usize>(
 /// The second-order solve on `band` (see `tubesweep_core::second_order`): returns the values u,
 /// the factored part u₀, the roles with the fixed nodes marked (0) and a statistics dict.
 #[pyfunction]
-#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=0.9, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None, warm_older=None, warm_previous_linear=None, warm_previous_digests=None, keep_digests=false))]
+#[pyo3(signature = (band, roles, phi, directions, lower, spacing, sources, source_slowness, slowness, fix_radius, outer_width, tol_first, tol, max_iterations, progress=None, stall_ratio=tubesweep_core::second_order::STALL_RATIO, stall_window=20, threads=0, front_window=2.0, own_first_phase=false, offsets=None, window_first=0.0, window_second=0.0, ramp_length=1.0, extension_limit=f64::INFINITY, warm=None, warm_older=None, warm_previous_linear=None, warm_previous_digests=None, keep_digests=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn second_order_solve<'py>(
     py: Python<'py>,

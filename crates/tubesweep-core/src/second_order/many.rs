@@ -253,7 +253,7 @@ mod tests {
             tol_first: f64::INFINITY,
             tol: 1e-3 * 0.05 * 0.05,
             max_iterations: 500,
-            stall_ratio: 0.9,
+            stall_ratio: crate::second_order::STALL_RATIO,
             stall_window: 20,
             own_first_phase: true,
             window_first: 2.0,

@@ -42,6 +42,7 @@ pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometr
 pub use implicit::Implicit;
 pub use setup::tube_setup_of;
 pub use solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
+pub use stagnation::STALL_RATIO;
 pub use start::first_order_start;
 
 /// |∇φ| at an inner node must be within this of 1 for its second-order update (B uses D²φ,
@@ -226,7 +227,7 @@ mod tests {
             tol_first: first_tol * h * h,
             tol: 1e-3 * h * h,
             max_iterations: 500,
-            stall_ratio: 0.9,
+            stall_ratio: STALL_RATIO,
             stall_window: 20,
             own_first_phase: true,
             window_first: window,

@@ -6,9 +6,10 @@
 //! assignment, from phase 1's values (or from the fixed nodes alone when `tol_first` is +∞, the
 //! Python package's choice in 3D: the window reaches every node anyway, in 20–30% fewer updates),
 //! until the largest change of an iteration is below `tol` (≪ Δx²). The
-//! second-order sweeps are not monotone: when the change stops shrinking (the change of an
-//! iteration above `stall_ratio` times that `stall_window` iterations earlier), they fall back
-//! to accepting decreases only, which ends any limit cycle; a limit cycle whose changes repeat
+//! second-order sweeps are not monotone: when the change stops shrinking (no change of the last
+//! `stall_window` iterations below `stall_ratio` times the smallest before them:
+//! [`super::stagnation::stalled`]), they fall back to accepting decreases only, which ends any
+//! limit cycle; a limit cycle whose changes repeat
 //! exactly (period of up to 8 iterations, [`super::stagnation`]) is recognised within a few
 //! periods instead (the smoothed sphere mask at N = 191 cycled before the margin of
 //! `Sweeper::inner`'s side rule: 38 iterations instead of 70), and behind the window opens it at
@@ -39,7 +40,7 @@ use super::geometry::{NodeGeometry, TubeGeometry};
 use super::local::{corrected_slowness_squared, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
 use super::pipeline::Pipeline;
 use super::rows::{Isa, RowWalk, RowsState};
-use super::stagnation::in_a_limit_cycle;
+use super::stagnation::{in_a_limit_cycle, stalled};
 
 /// Stopping rules of the two phases.
 #[derive(Debug, Clone, Copy)]
@@ -756,10 +757,7 @@ fn run_phase<const D: usize>(
             }
             if lim.second && !lim.decreases_only {
                 let m = changes.len();
-                if cycling
-                    || (m > options.stall_window
-                        && change.max_change > options.stall_ratio * changes[m - 1 - options.stall_window])
-                {
+                if cycling || stalled(&changes, options.stall_window, options.stall_ratio) {
                     lim.decreases_only = true;
                     stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
                 }
