@@ -756,7 +756,6 @@ fn run_phase<const D: usize>(
                 return Ok(true);
             }
             if lim.second && !lim.decreases_only {
-                let m = changes.len();
                 if cycling || stalled(&changes, options.stall_window, options.stall_ratio) {
                     lim.decreases_only = true;
                     stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
