@@ -755,11 +755,12 @@ fn run_phase<const D: usize>(
             if change.max_change < tol {
                 return Ok(true);
             }
-            if lim.second && !lim.decreases_only {
-                if cycling || stalled(&changes, options.stall_window, options.stall_ratio) {
-                    lim.decreases_only = true;
-                    stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
-                }
+            if lim.second
+                && !lim.decreases_only
+                && (cycling || stalled(&changes, options.stall_window, options.stall_ratio))
+            {
+                lim.decreases_only = true;
+                stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
             }
         } else if cycling {
             // the window cannot move past a cycle: open it, for the cycle to be ended there
