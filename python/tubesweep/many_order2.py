@@ -101,7 +101,7 @@ def solve_many_order2(
             progress,
             threads=threads,
             front_window=FRONT_WINDOW if d == 3 else 0.0,
-            own_first_phase=so._OWN_FIRST_PHASE,
+            own_first_phase=so._OWN_FIRST_PHASE[grid.ndim],
             cp_offsets=inputs.offsets,
             window_first=so.WINDOWS[0] if d == 3 else 0.0,
             window_second=so.WINDOWS[1] if d == 3 else 0.0,

@@ -81,9 +81,16 @@ TOL_FACTOR = {2: 1e-3, 3: 5e-4}
 #: poor start (``tubesweep_core::second_order::solver``, ``Sweeper::outer``).
 EXTENSION_LIMIT = 2.0
 
-# phase 1 by the second-order module's own sweeps (the factored scheme with the full anisotropic
-# correction) instead of the first-order driver (for measurements)
-_OWN_FIRST_PHASE = True
+#: Phase 1 (2D: 3D has none) on the first-order driver (``False``: the paper's first-order tube
+#: scheme with the isotropic part of the metric correction, exact on a curve, from the fixed
+#: nodes: ``tubesweep_core::second_order::start``) or on the second-order module's own sweeps
+#: (``True``: the factored scheme, whose changes fall by only a few percent per iteration on a
+#: fine curve). The driver's start halves the 2D solve's updates (0.46–0.61 on the circle, the
+#: star, an ellipse, three sources, a speed field, a smoothed mask and a closest-point circle at
+#: N = 201–1601) and 2D order=2 takes 0.6–0.7 of the time, with errors as small against the exact
+#: distances (far max and mean within 4% on the star at N = 201–1601 and the circle at 101–801;
+#: the circle's far max at N = 1601 4.3e-7 instead of 5.3e-7).
+_OWN_FIRST_PHASE = {2: False, 3: True}
 
 # the front windows of the two phases in 3D (factors of the first-order driver's width; 0: none):
 # on the sphere at N = 201, 30 million updates without them, 10 million with them (7 million
@@ -437,7 +444,7 @@ def run_native(
             cb,
             threads=_threads(threads),
             front_window=FRONT_WINDOW if d == 3 else 0.0,
-            own_first_phase=_OWN_FIRST_PHASE,
+            own_first_phase=_OWN_FIRST_PHASE[d],
             offsets=inputs.offsets,
             window_first=WINDOWS[0] if d == 3 else 0.0,
             window_second=WINDOWS[1] if d == 3 else 0.0,
