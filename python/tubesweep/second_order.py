@@ -89,7 +89,7 @@ EXTENSION_LIMIT = 2.0
 #: star, an ellipse, three sources, a speed field, a smoothed mask and a closest-point circle at
 #: N = 201–1601) and 2D order=2 takes 0.6–0.7 of the time, with errors as small against the exact
 #: distances (far max and mean within 4% on the star at N = 201–1601 and the circle at 101–801;
-#: the circle's far max at N = 1601 4.3e-7 instead of 5.3e-7).
+#: the circle's far max at N = 1601 4.3e-7 instead of 5.3e-7: ``benches/experiments/first_phase_2d.py``).
 _OWN_FIRST_PHASE = {2: False, 3: True}
 
 # the front windows of the two phases in 3D (factors of the first-order driver's width; 0: none):
