@@ -3,7 +3,8 @@
 antipode (the ``--local`` case of ``benches/moving_surfaces.py``): the time to gather the new φ at
 each band node and its six axis neighbours (what a check that a node's direction is unchanged must
 read) against the time to compute the directions outright, and the band search and band
-structure for scale. Best of 30 calls each.
+structure for scale (best of 30 calls each); then where the time of ``tube.moved`` and of the warm
+solve goes (cProfile, 20 calls each, the calls above 0.5 ms per call).
 
     .venv/bin/python benches/experiments/moved_reuse_check.py [--n 121]
 """
@@ -11,6 +12,8 @@ structure for scale. Best of 30 calls each.
 from __future__ import annotations
 
 import argparse
+import cProfile
+import pstats
 import time
 
 import numpy as np
@@ -51,6 +54,18 @@ def main() -> None:
     )
     print(f"band search: {best(lambda: _native.band_of_samples(bumped, 4 * h)):.2f}")
     print(f"band structure: {best(lambda: _native.Band.from_linear([n] * 3, lin.view(np.uint64))):.2f}")
+    src = [(0.0, 0.0, 0.5)]
+    sol = tube.solve(src)
+    moved = tube.moved(bumped)
+    for what, call in (("tube.moved", lambda: tube.moved(bumped)), ("warm solve", lambda: moved.solve(src, warm=sol))):
+        profile = cProfile.Profile()
+        profile.enable()
+        for _ in range(20):
+            call()
+        profile.disable()
+        stats = pstats.Stats(profile).stats  # type: ignore[attr-defined]
+        rows = sorted(((tt / 20 * 1e3, f[2]) for f, (_, _, tt, _, _) in stats.items()), reverse=True)
+        print(f"{what}: " + ", ".join(f"{name} {ms:.1f}" for ms, name in rows if ms > 0.5) + " (ms per call)")
 
 
 if __name__ == "__main__":
