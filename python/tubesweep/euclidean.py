@@ -28,6 +28,7 @@ from ._validate import (
     warn_unconverged,
 )
 from ._result_check import check_values
+from ._stagnation import fallback_message, largest_finite
 from ._warn import user_stacklevel
 from .box_order2 import NOT_GODUNOV, check_order, order2_tol, solve_order2
 from .box_solution import BoxSolution
@@ -434,6 +435,16 @@ def _order2(
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
+    if st["converged"] and st["safeguard_iteration"] is not None:
+        fallback = fallback_message(
+            st["safeguard_iteration"] - st["first_order_iterations"],
+            st["safeguard_change"],
+            tol,
+            largest_finite(values),
+            recorded="stats.order2['fallback_iteration'] and ['fallback_change']",
+        )
+        if fallback is not None:
+            warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
     if st["runaway_iteration"] is not None:
         warnings.warn(
             f"order=2: the factored sweeps ran away at iteration {st['runaway_iteration']} (travel times falling without "
@@ -472,6 +483,7 @@ def _order2(
             "fallback_iteration": (
                 None if st["safeguard_iteration"] is None else st["safeguard_iteration"] - st["first_order_iterations"]
             ),
+            "fallback_change": st["safeguard_change"],
             "runaway_iteration": st["runaway_iteration"],
             "plain_iterations": st["plain_iterations"],
             "unreached": int(np.count_nonzero(~np.isfinite(values))),

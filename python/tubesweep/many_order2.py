@@ -22,6 +22,7 @@ import numpy as np
 from . import _native
 from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
+from ._stagnation import FALLBACK_WARNING, fallback_message, largest_finite
 from ._validate import FRONT_WINDOW, as_sources
 from . import second_order as so
 
@@ -138,4 +139,21 @@ def solve_many_order2(
                 RuntimeWarning,
                 stacklevel=4,
             )
+    # the stagnation fallbacks large enough to warn of (``_stagnation``), as the single solve does
+    large = np.flatnonzero((st["fallback_iteration"] >= 0) & (st["fallback_change"] > FALLBACK_WARNING * inputs.tol))
+    if large.size:
+        worst = int(large[np.argmax(st["fallback_change"][large])])
+        text = fallback_message(
+            int(st["fallback_iteration"][worst]),
+            float(st["fallback_change"][worst]),
+            inputs.tol,
+            largest_finite(values[worst]),
+            recorded="the stats' 'fallback_iteration' and 'fallback_change' (return_stats=True)",
+        )
+        warnings.warn(
+            f"order=2: {large.size} of {len(groups)} solves (sources {large[:5].tolist()}"
+            f"{'…' if large.size > 5 else ''}) fell back to decreases only; in solve {worst}, the largest: {text}",
+            RuntimeWarning,
+            stacklevel=4,
+        )
     return values, st

@@ -22,6 +22,7 @@ from ._box_cut import box_reason
 from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from .moving import values_checksum
+from ._stagnation import fallback_message, largest_finite
 from ._warn import user_stacklevel
 from ._validate import (
     FRONT_WINDOW,
@@ -40,6 +41,7 @@ __all__ = ["ORDERS", "Order2NotApplicable", "check_order", "FIX_RADIUS", "FACTOR
 #: this fraction of the tube (fewer are reported in ``sol.stats.order2`` only): the rims of the
 #: library's open surfaces and a crease take 4–26% at N = 41–161.
 FIRST_ORDER_WARNING = 0.4
+
 
 #: The values of ``order``: the paper's first-order scheme, second order, or ``"auto"`` (second
 #: order where it applies, first order otherwise, the reason in ``sol.stats.order_fallback``).
@@ -320,9 +322,9 @@ def warm_start(
         return None, {}, {"refused": str(e)}
 
 
-def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float) -> None:
+def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float, values: np.ndarray) -> None:
     """The warnings of a second-order solve from its native report ``st``: not converged, the
-    sweeps ran away, many first-order nodes, convex creases."""
+    sweeps ran away, a large stagnation fallback, many first-order nodes, convex creases."""
     if not st["converged"]:
         warnings.warn(
             f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
@@ -339,6 +341,11 @@ def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float) -
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
+    fallback = None
+    if st["fallback_iteration"] is not None:
+        fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, largest_finite(values))
+    if fallback is not None:
+        warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
     first_order = int(st["first_order_nodes"])
     if first_order > FIRST_ORDER_WARNING * st["inner_nodes"]:
         r = st["first_order_reasons"]
@@ -359,6 +366,7 @@ _REPORTED = (
     "first_order_iterations",
     "second_order_iterations",
     "fallback_iteration",
+    "fallback_change",
     "runaway_iteration",
     "unreached",
     "max_curvature",
@@ -504,7 +512,7 @@ def solve_on_tube(
         warm_more,
         keep_digests or warm is not None,
     )
-    warn_about(st, tube, max_iterations, tol)
+    warn_about(st, tube, max_iterations, tol, values)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
     stats = SolveStats(

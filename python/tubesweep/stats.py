@@ -87,7 +87,9 @@ class SolveStats:
     order2 : dict or None
         For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
         phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
-        switched to accepting decreases only, None when it did not fire), ``runaway_iteration``
+        switched to accepting decreases only, None when it did not fire), ``fallback_change``
+        (the largest change of the iterations before it: about how far from settled the values were,
+        with a warning above 100 tolerances; None when it did not fire), ``runaway_iteration``
         (on surfaces the phase-2 iteration at which a value fell below zero and the second-order sweeps were
         abandoned for the first phase's values; in the box the iteration, both phases counted, at which the
         factored sweeps fell without bound and were abandoned for the plain first-order scheme, whose

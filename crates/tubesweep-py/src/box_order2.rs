@@ -22,6 +22,7 @@ fn stats_dict<'py>(py: Python<'py>, s: &FactoredStats) -> PyResult<Bound<'py, Py
     d.set_item("converged", s.converged)?;
     d.set_item("last_change", s.last_change)?;
     d.set_item("safeguard_iteration", s.safeguard_iteration)?;
+    d.set_item("safeguard_change", s.safeguard_change)?;
     d.set_item("runaway_iteration", s.runaway_iteration)?;
     d.set_item("plain_iterations", s.plain_iterations)?;
     d.set_item("seconds", s.seconds)?;

@@ -437,6 +437,14 @@ fn run_order2<'py, const D: usize>(
         col(&|s| s.fallback_iteration.map_or(-1, |v| v as i64)).into_pyarray(py),
     )?;
     d.set_item(
+        "fallback_change",
+        stats
+            .iter()
+            .map(|s| s.fallback_change.unwrap_or(f64::NAN))
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    d.set_item(
         "runaway_iteration",
         col(&|s| s.runaway_iteration.map_or(-1, |v| v as i64)).into_pyarray(py),
     )?;

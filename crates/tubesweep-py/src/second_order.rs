@@ -224,6 +224,7 @@ fn run<'py, const D: usize>(
     d.set_item("last_change", stats.last_change)?;
     d.set_item("seconds", stats.seconds)?;
     d.set_item("fallback_iteration", stats.fallback_iteration)?;
+    d.set_item("fallback_change", stats.fallback_change)?;
     d.set_item("runaway_iteration", stats.runaway_iteration)?;
     d.set_item("unreached", stats.unreached)?;
     d.set_item("max_curvature", summary.max_curvature)?;

@@ -29,6 +29,7 @@ pub mod implicit;
 pub mod local;
 mod local_fit;
 pub mod many;
+mod phase;
 mod pipeline;
 mod rows;
 pub mod setup;
@@ -199,6 +200,18 @@ mod tests {
         first_tol: f64,
         extension_limit: f64,
     ) -> (f64, f64, SecondOrderStats, Vec<f64>) {
+        sphere_solve_tuned(n, window, threads, first_tol, extension_limit, &|_| {})
+    }
+
+    /// The same, the options changed by `tune` before the solve.
+    fn sphere_solve_tuned(
+        n: usize,
+        window: f64,
+        threads: usize,
+        first_tol: f64,
+        extension_limit: f64,
+        tune: &dyn Fn(&mut SecondOrderOptions),
+    ) -> (f64, f64, SecondOrderStats, Vec<f64>) {
         let (band, roles, dirs, h) = crate::test_bands::shell_band(n, 0.5, &[0.0]);
         let idx = band.indices();
         let pts: Vec<[f64; 3]> = idx
@@ -223,7 +236,7 @@ mod tests {
         )
         .unwrap();
         let mut values = starting_values(&fac);
-        let options = SecondOrderOptions {
+        let mut options = SecondOrderOptions {
             tol_first: first_tol * h * h,
             tol: 1e-3 * h * h,
             max_iterations: 500,
@@ -236,6 +249,7 @@ mod tests {
             threads,
             ramp_length: 1.0,
         };
+        tune(&mut options);
         let stats = sweep_second_order(
             &band,
             &geo,
@@ -276,6 +290,28 @@ mod tests {
             order > 1.5 && mean_order > 1.75 && m2 < 1e-4,
             "max errors {e1:.3e} {e2:.3e}, order {order:.2}; mean {m1:.3e} {m2:.3e}, order {mean_order:.2}"
         );
+    }
+
+    #[test]
+    fn a_fallback_reports_how_far_from_settled_the_values_were() {
+        // without the window, a stall test that fires as soon as it can (phase 2's second iteration)
+        let (e, _, st, _) = sphere_solve_tuned(41, 0.0, 1, 1e-3, 2.0, &|o| {
+            o.stall_window = 1;
+            o.stall_ratio = 1e-300;
+        });
+        let h = 2.0 / 40.0;
+        let (fired, change) = (
+            st.fallback_iteration.expect("it fires"),
+            st.fallback_change.expect("its size"),
+        );
+        assert!(st.converged && fired >= 2, "{st:?}");
+        // the change of the iteration before it fired (phase 1's first-order values corrected to
+        // second order): above the tolerance, else it had stopped, and below a spacing; accepting
+        // decreases only from there still ends near the second-order values on the sphere
+        assert!(change > 1e-3 * h * h && change < h, "{change:e}");
+        let (e_plain, _, plain) = sphere_error(41, 0.0);
+        assert!(plain.fallback_iteration.is_none() && plain.fallback_change.is_none());
+        assert!(e < 2.0 * e_plain, "{e:e} against {e_plain:e}, {st:?}");
     }
 
     #[test]

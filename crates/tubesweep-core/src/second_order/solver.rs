@@ -38,9 +38,8 @@ use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 use super::factoring::Factoring;
 use super::geometry::{NodeGeometry, TubeGeometry};
 use super::local::{corrected_slowness_squared, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
+use super::phase::{run_phase, RunPhase};
 use super::pipeline::Pipeline;
-use super::rows::{Isa, RowWalk, RowsState};
-use super::stagnation::{in_a_limit_cycle, stalled};
 
 /// Stopping rules of the two phases.
 #[derive(Debug, Clone, Copy)]
@@ -90,6 +89,9 @@ pub struct SecondOrderStats {
     /// The phase-2 iteration at which the stagnation safeguard switched to accepting decreases
     /// only (None when it did not fire).
     pub fallback_iteration: Option<usize>,
+    /// The largest change of the last `stall_window` iterations before that fallback (of the
+    /// cycle, for a limit cycle): about how far from settled the values were when it fired.
+    pub fallback_change: Option<f64>,
     /// Non-fixed nodes never reached (another component of the surface, or an extension-layer
     /// node with no upwind neighbour of smaller |φ|).
     pub unreached: usize,
@@ -103,9 +105,6 @@ pub struct SecondOrderStats {
 /// A phase-2 value below `-RUNAWAY_FLOOR·σ̄·Δx` is a runaway: the solution is non-negative and
 /// the nodes next to a source are fixed, so no converging iterate comes near it.
 pub const RUNAWAY_FLOOR: f64 = 1.0;
-
-/// The front window opens fully when its edge has not moved for this many iterations.
-const WINDOW_PATIENCE: usize = 10;
 
 #[cfg(test)]
 thread_local! {
@@ -122,13 +121,13 @@ pub(super) const WOKE: u8 = 2;
 /// What one iteration's visits compare against.
 #[derive(Clone, Copy)]
 pub(super) struct Limits {
-    second: bool,
-    decreases_only: bool,
-    threshold: f64,
+    pub(super) second: bool,
+    pub(super) decreases_only: bool,
+    pub(super) threshold: f64,
     pub(super) window: f64,
-    settled: f64,
+    pub(super) settled: f64,
     /// A value changed to below this ends the phase as a runaway (phase 2 only; −∞ otherwise).
-    floor: f64,
+    pub(super) floor: f64,
 }
 
 impl Limits {
@@ -657,133 +656,4 @@ pub(super) fn sweep_second_order_from<const D: usize>(
         .count();
     stats.seconds = start.elapsed().as_secs_f64();
     Ok(stats)
-}
-
-/// One phase's iterations (each the 2^D sweeps) until the largest change of an iteration with the
-/// window fully open is below `lim.settled`; returns whether it got there. With a positive
-/// `window_width` the sweeps leave out the nodes whose value lies beyond an edge that starts at
-/// the smallest fixed value plus the width and moves on to the iteration's front (the smallest value that
-/// still changed by more than `settled`) plus the width, or on by a width to the nearest node
-/// left out when nothing in the window moved; it opens fully when no node was left out, or when
-/// the edge has not moved for [`WINDOW_PATIENCE`] iterations. Once it is open, the stagnation test
-/// of the second-order phase applies (see the module documentation).
-/// What a phase's iterations read besides the values.
-struct RunPhase<'r, 'a, const D: usize> {
-    sw: &'r Sweeper<'a, D>,
-    band: &'r NarrowBand<D>,
-    active: &'r [AtomicU8],
-    row_inner: &'r [u32],
-    options: &'r SecondOrderOptions,
-}
-
-/// `first`: where the window starts (the smallest value among the active nodes of a warm start
-/// on a surface that moved in part); None: at the smallest fixed value.
-#[allow(clippy::too_many_arguments)]
-fn run_phase<const D: usize>(
-    run: &RunPhase<'_, '_, D>,
-    values: &mut [f64],
-    pipeline: &mut Pipeline,
-    mut lim: Limits,
-    window_width: f64,
-    first: Option<f64>,
-    iteration: &mut usize,
-    stats: &mut SecondOrderStats,
-    control: &mut dyn FnMut(&IterationReport) -> Control,
-) -> Result<bool> {
-    let RunPhase {
-        sw,
-        band,
-        active,
-        row_inner,
-        options,
-    } = *run;
-    let tol = lim.settled;
-    if window_width > 0.0 {
-        let first = first.unwrap_or_else(|| {
-            values
-                .iter()
-                .zip(sw.u0)
-                .zip(sw.roles)
-                .filter(|(_, &r)| r == NodeRole::Fixed)
-                .map(|((&w, &u0), _)| w + u0)
-                .fold(f64::INFINITY, f64::min)
-        });
-        lim.window = first + window_width;
-    }
-    let rows_state = RowsState::new(band, values, sw.u0);
-    let isa = Isa::for_this_solve();
-    let shared = SharedValues::new(values);
-    // the largest change of each iteration since the window opened (the stagnation test's and the
-    // limit cycles', `in_a_limit_cycle`)
-    let mut changes: Vec<f64> = Vec::new();
-    let mut unmoved = 0usize;
-    while *iteration < options.max_iterations {
-        *iteration += 1;
-        let lim_now = lim;
-        let run_rows = |rows: &[u32], backwards: bool| -> Accumulator {
-            let walk = RowWalk {
-                sw,
-                band,
-                rows_state: &rows_state,
-                shared: &shared,
-                active,
-                row_inner,
-                lim: lim_now,
-            };
-            walk.run(isa, rows, backwards)
-        };
-        let change = pipeline.iteration(band, &run_rows);
-        stats.updates += change.updates;
-        stats.last_change = change.max_change;
-        if control(&IterationReport {
-            iteration: *iteration,
-            max_change: change.max_change,
-            updates: change.updates,
-        }) == Control::Stop
-        {
-            return Err(Error::Interrupted { iterations: *iteration });
-        }
-        // `front` is the smallest value that changed by more than `settled`: a runaway's values
-        // fall by ever larger steps, so it is among them
-        if change.front < lim.floor {
-            stats.runaway_iteration = Some(*iteration - stats.first_order_iterations);
-            return Ok(false);
-        }
-        changes.push(change.max_change);
-        let cycling = lim.second && !lim.decreases_only && in_a_limit_cycle(&changes);
-        if lim.window == f64::INFINITY {
-            if change.max_change < tol {
-                return Ok(true);
-            }
-            if lim.second
-                && !lim.decreases_only
-                && (cycling || stalled(&changes, options.stall_window, options.stall_ratio))
-            {
-                lim.decreases_only = true;
-                stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
-            }
-        } else if cycling {
-            // the window cannot move past a cycle: open it, for the cycle to be ended there
-            lim.window = f64::INFINITY;
-            changes.clear();
-        } else {
-            let edge = if change.waiting == f64::INFINITY {
-                f64::INFINITY
-            } else if change.front < f64::INFINITY {
-                lim.window.max(change.front + window_width)
-            } else {
-                (lim.window + window_width).max(change.waiting + window_width)
-            };
-            unmoved = if edge > lim.window { 0 } else { unmoved + 1 };
-            lim.window = if unmoved >= WINDOW_PATIENCE {
-                f64::INFINITY
-            } else {
-                edge
-            };
-            if lim.window == f64::INFINITY {
-                changes.clear();
-            }
-        }
-    }
-    Ok(false)
 }

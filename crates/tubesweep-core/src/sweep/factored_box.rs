@@ -112,6 +112,9 @@ pub struct FactoredStats {
     /// The iteration after which phase 2 fell back to accepting decreases only (the stagnation
     /// safeguard), if it did.
     pub safeguard_iteration: Option<usize>,
+    /// The largest change of the `stagnation_window` + 1 iterations that made it fire: about how
+    /// far from settled the values were.
+    pub safeguard_change: Option<f64>,
     /// The iteration (phases 1 and 2 counted together) after which a value fell below
     /// [`RUNAWAY_FLOOR`]`·s_min·Δx`, or the monotone sweeps drifted ([`DRIFT_WINDOW`]), and the
     /// factored sweeps were abandoned for the plain first-order ones (the module's note); None
@@ -482,6 +485,7 @@ impl<'a, const D: usize> FactoredBox<'a, D> {
                 drift.clear();
                 phase_start = stats.sweeps as u32 + 1;
                 stats.safeguard_iteration = Some(stats.iterations);
+                stats.safeguard_change = Some(history[history.len() - 1 - w..].iter().copied().fold(0.0, f64::max));
             }
         }
         stats.seconds = start.elapsed().as_secs_f64();

@@ -141,6 +141,9 @@ fn the_stagnation_safeguard_switches_to_decreases_only_and_is_reported() {
     let (u, exact, st) = constant_speed_3d(&[[0.33, 0.71, 0.52], [1.2, 0.9, 1.37]], &opts);
     let fired = st.safeguard_iteration.expect("the safeguard fires");
     assert_eq!(fired, st.first_order_iterations + 2);
+    // the two changes that made it fire, the larger one reported
+    let change = st.safeguard_change.expect("its change is reported");
+    assert!(change.is_finite() && change > opts.tol, "{change:e}");
     assert!(st.converged);
     let err = u.iter().zip(&exact).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     assert!(err < 0.2 * 0.1 * 2.5, "{err:e}");

@@ -1,0 +1,54 @@
+"""The stagnation safeguard of the second-order sweeps, as the user hears of it: when the sweeps
+stop converging they accept decreases only from then on (``second_order/stagnation.rs`` and
+``sweep/factored_box.rs`` in the core), and the report says how far from settled the values were."""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+#: When the stagnation safeguard of the second-order sweeps fires (they stopped converging and
+#: accept decreases only from then on), a warning says so if the largest change of the iterations
+#: before it was above this many stopping tolerances (``sol.stats.order2["fallback_change"]``):
+#: about how far from settled the values were. Below it, the stats alone record it (two solves that
+#: differ only in their path differ by up to 20 tolerances: docs/moving-surfaces.md).
+FALLBACK_WARNING = 100.0
+
+
+#: A stall at changes below this many machine epsilons times the largest travel time is the
+#: round-off of the values (a ``tol`` below it cannot be met), not a limit cycle of the scheme:
+#: the sphere at N = 41 with ``tol=1e-16`` stalls at 1.9e-14, about 100 of them.
+ROUND_OFF = 1e4
+
+
+def fallback_message(
+    iteration: Any,
+    change: Any,
+    tol: float,
+    scale: float,
+    recorded: str = "sol.stats.order2['fallback_iteration'] and ['fallback_change']",
+) -> Optional[str]:
+    """The warning's text for a stagnation fallback at phase-2 ``iteration`` after changes of up
+    to ``change`` (None when it did not fire or was small); ``scale``: the largest finite travel
+    time; ``recorded``: where the stats keep it."""
+    if iteration is None or change is None or not change > FALLBACK_WARNING * tol:
+        return None
+    if change <= ROUND_OFF * np.finfo(np.float64).eps * scale:
+        return (
+            f"the second-order sweeps' changes stopped falling at {change:.3g} (their iteration {iteration}), the "
+            f"round-off of travel times up to {scale:.3g}: tol={tol:g} is below what float64 resolves for them. The "
+            f"values are as settled as they can be; a tol of {change:.0e} or more stops there without this warning"
+        )
+    return (
+        f"the second-order sweeps stopped converging at their iteration {iteration} (the largest change of the "
+        f"iterations before was {change:.3g}, {change / tol:.0f} times tol={tol:g}) and accepted decreases only "
+        "from then on: the values may be off the second-order solution by up to about that much. "
+        f"{recorded} record it; a finer grid or a smoother surface usually avoids it"
+    )
+
+
+def largest_finite(values: np.ndarray) -> float:
+    """The largest finite value (0 when there is none): the scale of :func:`fallback_message`."""
+    finite = values[np.isfinite(values)]
+    return float(np.max(np.abs(finite))) if finite.size else 0.0
