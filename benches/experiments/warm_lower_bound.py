@@ -36,9 +36,7 @@ def main(n: int, k: int) -> None:
     moved = tube.moved(phis[1])
     runs: dict = {"cold": [], "warm": []}
     cold = moved.solve(poles[1], progress=lambda it, change, updates: runs["cold"].append((change, updates)))
-    warm = moved.solve(
-        poles[1], warm=prev, progress=lambda it, change, updates: runs["warm"].append((change, updates))
-    )
+    warm = moved.solve(poles[1], warm=prev, progress=lambda it, change, updates: runs["warm"].append((change, updates)))
     nodes = cold.values.size
     tol = cold.stats.order2["tol"]
     print(f"N = {n}, step {k} of {STEPS}: {nodes:,} band nodes, tolerance {tol:.2e}")
@@ -46,8 +44,7 @@ def main(n: int, k: int) -> None:
         per = [u / nodes for _, u in runs[name]]
         print(
             f"{name}: {len(per)} iterations, {sol.stats.updates / nodes:.1f} updates per node "
-            f"({sol.stats.updates / nodes / 8:.2f} full iterations); per iteration "
-            + " ".join(f"{p:.1f}" for p in per)
+            f"({sol.stats.updates / nodes / 8:.2f} full iterations); per iteration " + " ".join(f"{p:.1f}" for p in per)
         )
     print(f"max |warm − cold| = {float(np.max(np.abs(warm.values - cold.values))) / tol:.1f} tolerances")
 
