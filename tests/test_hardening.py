@@ -291,11 +291,15 @@ _TAKE_ARRAYS = [
 ]
 
 
+def _with_tol(v):
+    return ts.solve(SPHERE, G3, [(0.5, 0, 0)], tol=v)
+
+
 @pytest.mark.parametrize("bad", [True, np.True_, "2", b"2", None, [[2.0]], 2 + 0j])
 @pytest.mark.parametrize(
     "call",
     [
-        lambda v: ts.solve(SPHERE, G3, [(0.5, 0, 0)], tol=v),
+        _with_tol,
         lambda v: ts.solve(SPHERE, G3, [(0.5, 0, 0)], max_iterations=v),
         lambda v: ts.solve(SPHERE, G3, [(0.5, 0, 0)], inner=v),
         lambda v: ts.solve(SPHERE, G3, [(0.5, 0, 0)], threads=v),
@@ -309,14 +313,18 @@ def test_bools_strings_and_sequences_are_refused_alike_as_numbers(call, bad):
     # a TypeError: now one ArgumentTypeError (a TypeError and a ValueError) everywhere
     if isinstance(bad, list) and call in _TAKE_ARRAYS:
         return  # an array is a speed too (refused for its shape)
+    if bad is None and call is _with_tol:
+        return  # tol=None is the default (the order's own tolerance)
     with pytest.raises(ArgumentTypeError):
         call(bad)
 
 
 def test_numpy_scalars_and_zero_dimensional_arrays_are_numbers_everywhere():
     ref = ts.solve(SPHERE, G3, [(0.5, 0, 0)]).values
+    # an explicit tol is used as given (the default, None, is the order's own)
+    tight = ts.solve(SPHERE, G3, [(0.5, 0, 0)], tol=1e-10).values
+    assert np.array_equal(ts.solve(SPHERE, G3, [(0.5, 0, 0)], tol=np.array(1e-10)).values, tight)
     for kw in (
-        dict(tol=np.array(1e-10)),
         dict(inner=np.array(2.0)),
         dict(infinity=np.array(100.0)),
         dict(threads=np.array(1)),

@@ -394,3 +394,19 @@ def test_the_limited_extension_converges_from_a_poor_start(monkeypatch, first):
     # second order: 1.3e-3 / 1.07e-4 at N = 101 (first order: 3.8e-2 / 1.2e-2)
     assert far < 1.5e-3 and mean < 1.2e-4, (far, mean)
     assert abs(far - far0) < 0.01 * far0 and abs(mean - mean0) < 0.01 * mean0, (far, far0, mean, mean0)
+
+
+def test_an_explicit_tol_is_used_also_when_it_equals_the_first_order_default():
+    # tol=1e-10 stood for "the default" and gave order=2 its own default (1.25e-6 here) silently
+    grid = box(41)
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), grid)
+    src = [(0.5, 0.0, 0.0)]
+    for tol, expected in ((None, 5e-4 * (2 / 40) ** 2), (1e-10, 1e-10)):
+        kw = {} if tol is None else {"tol": tol}
+        sols = [ts.solve(ts.surfaces.Sphere(0.5), grid, src, **kw), tube.solve(src, **kw)]
+        _, st = tube.solve_many(src, return_stats=True, **kw)
+        assert [s.stats.order2["tol"] for s in sols] + [st["tol"]] == pytest.approx([expected] * 3, rel=1e-12)
+    # order=1 keeps 1e-10 as its default: the same values with tol=None and tol=1e-10
+    a = ts.solve(ts.surfaces.Sphere(0.5), grid, src, order=1)
+    b = ts.solve(ts.surfaces.Sphere(0.5), grid, src, order=1, tol=1e-10)
+    assert np.array_equal(a.values, b.values) and a.stats.iterations == b.stats.iterations

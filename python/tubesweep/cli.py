@@ -47,9 +47,10 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--tol",
         type=float,
-        default=1e-10,
-        help="stop when no value changes by more than this in an iteration (default: 1e-10; about "
-        "1e-3 × the grid spacing is as accurate and faster)",
+        default=None,
+        help="stop when no value changes by more than this in an iteration (default: 1e-10 at first order, "
+        "about 5e-4 spacing² at second order; at first order about 1e-3 × the grid spacing is as accurate "
+        "and faster)",
     )
     p.add_argument(
         "--max-iterations",
@@ -162,9 +163,10 @@ def build_parser() -> argparse.ArgumentParser:
         "--order",
         choices=["1", "2", "auto"],
         default="auto",
-        help="1 = the paper's first-order scheme; 2 = second order on smooth closed level sets and closest-point "
-        "surfaces (refuses meshes, open surfaces, creases, Lax-Friedrichs); auto = 2 where it applies, 1 otherwise, "
-        "with the reason printed (default: auto)",
+        help="1 = the paper's first-order scheme; 2 = second order, decided node by node (first order at rims, "
+        "creases and unresolved curvature; refuses a grid that does not resolve most of the tube, a cube's edges, "
+        "coarse or self-facing meshes, Lax-Friedrichs); auto = 2 where it applies, 1 otherwise, with the reason "
+        "printed (default: auto)",
     )
     p.add_argument("--inner", type=float, default=2.0, help="inner tube half-width in grid spacings (default 2)")
     p.add_argument(

@@ -26,7 +26,6 @@ import numpy as np
 
 from ._validate import as_grid, as_sources, real_scalar
 from .solution import Solution
-from .solve import DEFAULT_TOL
 from .output import export
 from .surface import LevelSet
 from .tube import Tube
@@ -278,7 +277,7 @@ def evolve(
         tube = Tube(surf, grid) if tube is None else tube.moved(surf)
         src = np.ascontiguousarray(surf.project(src, grid)[1])
         warm: Any = None if prev is None else (prev if older is None else (older, prev))
-        sol = tube.solve(src, warm=warm, warm_refused="cold", tol=DEFAULT_TOL if tol is None else tol)
+        sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
         # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
         # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
         linear = tube._tube.linear

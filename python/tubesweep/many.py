@@ -155,7 +155,7 @@ def solve_many(
     hamiltonian: Any = "godunov",
     speed: Any = 1.0,
     source_init: str = "exact",
-    tol: float = 1e-10,
+    tol: Optional[float] = None,
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, int], Any]] = None,
     infinity: Optional[float] = None,
@@ -180,7 +180,7 @@ def solve_many(
             "solve_many takes hamiltonian='godunov' or 'lxf'; for a ts.hamiltonians object solve each "
             "source with tube.solve"
         )
-    check_tolerance(tol, max_iterations)
+    check_tolerance(DEFAULT_TOL if tol is None else tol, max_iterations)
     cb = check_many_progress(progress)
     _check_source_init(source_init)
     if not isinstance(paper_sweeps, (bool, np.bool_)):
@@ -200,7 +200,7 @@ def solve_many(
                     groups,
                     points=points,
                     speed=speed,
-                    tol=None if tol == DEFAULT_TOL else tol,
+                    tol=tol,
                     max_iterations=max_iterations,
                     progress=cb,
                     threads=nthreads,
@@ -216,6 +216,7 @@ def solve_many(
             if order == 2:
                 raise
             fallback = str(e)  # order="auto": the first-order scheme, the reason in the stats
+    tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if order != 1:
         t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
     linear = t.linear

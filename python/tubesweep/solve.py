@@ -48,8 +48,8 @@ from .solution import Solution
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
 
-#: The default stopping tolerance of the first-order sweeps (with ``order=2`` it stands for the
-#: second-order default, ``second_order.default_tol``).
+#: The default stopping tolerance of the first-order sweeps (``tol=None``; ``order=2`` has its
+#: own, ``second_order.default_tol``).
 DEFAULT_TOL = 1e-10
 
 SOURCE_INITS = ("exact", "node")
@@ -73,7 +73,7 @@ def solve(
     method: str = "two-layer",
     source_init: str = "exact",
     source_radius: Optional[float] = None,
-    tol: float = DEFAULT_TOL,
+    tol: Optional[float] = None,
     order: Union[int, str] = "auto",
     max_iterations: int = 10000,
     progress: Optional[Callable[[int, float, int], None]] = None,
@@ -139,10 +139,10 @@ def solve(
         0.6 on a plane, docs/hamiltonians.md). The local value is the straight (chord) distance
         times the slowness, or the Hamiltonian's travel time along it, so the surface should be
         flat and the speed, flow or metric constant within the radius.
-    tol, max_iterations : float, int
+    tol, max_iterations : float or None, int
         Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
-        ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol`` defaults
-        to 1e-10 for ``order=1`` and for ``order=2`` to ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
+        ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol=None`` (the
+        default) stands for 1e-10 with ``order=1`` and with ``order=2`` for ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
         times the mean slowness (at most twice its lower quartile, so that an obstacle does not
         loosen it), ℓ half the grid's longest side.
     progress : callable, optional
@@ -161,13 +161,17 @@ def solve(
         ``"auto"`` (the default): second order where it applies, the paper's first-order scheme
         where it does not (below). 1: the paper's first-order scheme. 2: second order (docs/second-order.md):
         the metric-corrected tube equation with limited BDF2–BDF3 differences and factored point
-        sources, for level sets (arrays, callables, library surfaces) and closed smooth
-        closest-point surfaces with the Godunov update; ``sol.stats.order2`` reports its phases.
-        A surface whose curvature the tube does not resolve (``outer·Δx·κ ≥ 1``), a φ that is
-        not a signed distance (without ``redistance=True``), a crease, meshes, open surfaces,
+        sources, for level sets (arrays, callables, library surfaces), closest-point surfaces,
+        point clouds and meshes (through their smooth map) with the Godunov update;
+        ``sol.stats.order2`` reports its phases. It is decided node by node: where the local
+        geometry is not resolved (an open surface's rim, a crease, noise, a curvature the tube
+        does not resolve, φ not a distance there) a node runs the first-order update
+        (``sol.stats.order2["first_order_nodes"]``, ``sol.first_order_points()``). Refused with a
+        ``ValueError`` saying why: a tube more than half unresolved (the grid does not resolve the
+        surface), a level set's convex creases or corners (the cube), a mesh with ``smooth=False``,
+        coarse against the grid or facing itself across gaps narrower than its tubes,
         Lax–Friedrichs, flows and Hamiltonian objects, ``method="naive"``, ``paper_sweeps``,
-        ``source_init="node"``, ``source_radius`` and ``outer < inner + 2`` are refused with a
-        ``ValueError`` saying why. ``"auto"`` runs 2 where it applies (the same values) and where it
+        ``source_init="node"``, ``source_radius`` and ``outer < inner + 2``. ``"auto"`` runs 2 where it applies (the same values) and where it
         does not the first-order scheme (the same values as ``order=1``, except that at a level
         set's creases the inner tube is thinned, as for 2: docs/second-order.md), with
         ``sol.stats.order_fallback`` holding the text of the error ``order=2`` gives
@@ -237,7 +241,7 @@ def solve(
     surf.check_grid(grid)
     src = as_sources(sources, grid)
     general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-    check_tolerance(tol, max_iterations)
+    check_tolerance(DEFAULT_TOL if tol is None else tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)
     _infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
@@ -259,7 +263,7 @@ def solve(
                 tube,
                 src,
                 speed,
-                None if tol == DEFAULT_TOL else tol,
+                tol,
                 max_iterations,
                 cb,
                 threads,
@@ -290,7 +294,7 @@ def solve(
         scheme,
         speed,
         source_init,
-        tol,
+        DEFAULT_TOL if tol is None else tol,
         max_iterations,
         cb,
         infinity,
