@@ -78,6 +78,21 @@ def test_a_mask_solves_by_default_and_converges():
     assert errors[0] / errors[1] > 1.3, errors
 
 
+def test_a_raw_mask_s_first_order_fallback_says_to_smooth_it():
+    grid = _grid(41)
+    X, Y, Z = grid.meshgrid()
+    mask = X**2 + Y**2 + Z**2 < 0.25
+    sol = ts.solve(ts.LevelSet.from_mask(mask, grid), grid, [(-0.5, 0.0, 0.0)])
+    assert sol.stats.order == 1 and "from_mask(mask, grid, smooth=1)" in sol.stats.order_fallback
+    with pytest.raises(ValueError, match=r"raw voxel mask.*smooth=1"):
+        ts.solve(ts.LevelSet.from_mask(mask, grid), grid, [(-0.5, 0.0, 0.0)], order=2)
+    # the advice holds: smoothed, the same mask runs second order; a φ array gets no such advice
+    assert ts.solve(ts.LevelSet.from_mask(mask, grid, smooth=1), grid, [(-0.5, 0.0, 0.0)]).stats.order == 2
+    staircase = ts.LevelSet(np.where(mask, -1.0, 1.0) * grid.spacing / 2, redistance=True)
+    fallback = ts.solve(staircase, grid, [(-0.5, 0.0, 0.0)]).stats.order_fallback
+    assert fallback is not None and "raw voxel mask" not in fallback
+
+
 def test_a_smoothed_mask_moves_the_sphere_inward_by_about_half_sigma_squared_kappa():
     grid = _grid(61)
     X, Y, Z = grid.meshgrid()

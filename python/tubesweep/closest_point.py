@@ -127,9 +127,9 @@ class ClosestPoint(Surface):
     >>> surf = ts.ClosestPoint(cp)
     """
 
-    #: True for the library's open surfaces (``order=2`` refuses them: their rim is not second
-    #: order); a user's map is taken as closed, and ``order=2`` refuses it when its closest points
-    #: show a rim or an edge (docs/second-order.md)
+    #: True for the library's open surfaces (``order=2`` runs the first-order update at the nodes
+    #: next to their rim); a user's map is taken as closed, and the nodes where its closest points
+    #: show a rim or an edge run the first-order update too (docs/second-order.md)
     open_surface: bool = False
 
     def __init__(self, cp: Callable[[np.ndarray], np.ndarray], *, ndim: Optional[int] = None, lipschitz: float = 1.0):

@@ -22,6 +22,7 @@ import numpy as np
 from . import _native
 from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
+from .mask import mask_advice
 from ._stagnation import FALLBACK_WARNING, fallback_message, largest_finite
 from ._validate import FRONT_WINDOW, as_sources
 from . import second_order as so
@@ -115,7 +116,7 @@ def solve_many_order2(
         )
     except ValueError as e:
         if "order=2" in str(e):
-            raise so.Order2NotApplicable(str(e)) from None
+            raise so.Order2NotApplicable(mask_advice(t.surface, str(e))) from None
         raise
     st = dict(st)
     st["tol"] = inputs.tol

@@ -119,3 +119,15 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
     else:
         phi = np.where(inside, -0.5, 0.5)
     return phi
+
+
+def mask_advice(surface: Any, reason: str) -> str:
+    """``reason`` (why ``order=2`` does not apply) with the advice for a raw voxel mask: its
+    staircase is the unresolved curvature, and smoothing it (``smooth=1``) is the fix, not a finer
+    grid (docs/surfaces.md, "From a voxel mask")."""
+    if getattr(surface, "_mask_smoothing", None) != 0.0 or "curvature the tube does not resolve" not in reason:
+        return reason
+    return (
+        reason + ". This surface is a raw voxel mask, whose staircase is that curvature at any grid: "
+        "LevelSet.from_mask(mask, grid, smooth=1) smooths it over a voxel and runs second order"
+    )

@@ -21,6 +21,7 @@ from . import _native
 from ._box_cut import box_reason
 from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
+from .mask import mask_advice
 from .moving import values_checksum
 from ._stagnation import fallback_message, largest_finite
 from ._warn import user_stacklevel
@@ -464,7 +465,8 @@ def run_native(
         )
     except Order2NotApplicable as e:
         # a tube cut by the grid box: the reason names the box, not φ or the resolution
-        raise Order2NotApplicable(box_reason(tube.box_cut, str(e), tube.outer_eff * h)) from None
+        reason = box_reason(tube.box_cut, str(e), tube.outer_eff * h)
+        raise Order2NotApplicable(mask_advice(tube.surface, reason)) from None
     # u = u₀ + w rounds to just below 0 next to a source (−9e-22 on a circle of radius 4Δx): a
     # travel time is never negative. Clamped here, not in the sweeps, whose runaway guard reads the
     # sign (a value below −Δx times the mean slowness)

@@ -81,9 +81,10 @@ class SolveStats:
         where it applies and 1 where it does not (then ``order_fallback`` says why).
     order_fallback : str or None
         With ``order="auto"``, when second order did not apply and the solve ran ``order=1``: the
-        reason, the text of the ``ValueError`` an explicit ``order=2`` raises (a mesh, an open
-        surface, a crease, a curvature the tube does not resolve, a Hamiltonian or option of the
-        first-order scheme, ...). None otherwise.
+        reason, the text of the ``ValueError`` an explicit ``order=2`` raises (a tube more than
+        half unresolved, a cube's convex edges, a mesh coarse against the grid or facing itself
+        across narrow gaps, a Hamiltonian or option of the first-order scheme, ...). None
+        otherwise.
     order2 : dict or None
         For ``order=2``: ``first_order_iterations`` and ``second_order_iterations`` (the two
         phases), ``fallback_iteration`` (the phase-2 iteration at which the stagnation safeguard
@@ -97,7 +98,19 @@ class SolveStats:
         ``unreached`` (nodes
         never reached), ``tol`` (the phases' stopping tolerance) and ``fix_radius`` (the ball of
         nodes fixed around each source); on surfaces also ``max_curvature`` (the largest principal
-        curvature found in the tube) and ``grad_norm_range`` (|∇φ| in the inner tube).
+        curvature found in the tube), ``grad_norm_range`` (|∇φ| in the inner tube),
+        ``inner_nodes``, ``first_order_nodes`` (the inner-tube nodes that ran the first-order update:
+        second order is decided node by node) and ``first_order_reasons`` (how many for each
+        reason: ``curvature``, ``gradient``, ``stencil``; ``sol.first_order_points()`` shows where),
+        ``geometry_fitted`` (whether the derivatives of a noisy φ came from least-squares fits),
+        ``creases`` (the crease nodes found, the largest turn of the normal and the shortcut per
+        crease), on a mesh ``mesh_map`` (the mesh's smooth map: how it was fitted), and with
+        ``warm=`` a ``warm`` dict: ``carried`` (nodes started from the previous values),
+        ``new_nodes`` (nodes new to the band), ``unreached_before``, ``all_started``,
+        ``restarted`` (why the warm sweeps started again cold, None when they did not), ``changed``
+        (the nodes whose update changed, where the sweeps started), ``extrapolated`` (whether
+        two previous solutions gave the start) or, for a start refused with
+        ``warm_refused="cold"``, ``refused`` (why): docs/moving-surfaces.md.
     box_cut : dict or None
         On surfaces, where the grid box cuts the tube (None where the band stays inside it):
         ``surface_cut`` (the surface itself crosses the box's boundary, with a ``RuntimeWarning``:

@@ -138,7 +138,11 @@ class Surface:
         >>> ts.LevelSet(np.zeros((5, 5))).check_grid(ts.Grid((-1, -1), (1, 1), (5, 5)))
         """
         if self.ndim is not None and self.ndim != grid.ndim:
-            raise ValueError(f"surface is {self.ndim}D but the grid is {grid.ndim}D")
+            raise ValueError(
+                f"surface is {self.ndim}D but the grid is {grid.ndim}D: a φ array needs one axis per grid axis "
+                f"(grid.shape = {tuple(grid.shape)}), a curve a 2D grid and a surface a 3D grid; build the grid with "
+                f"as many axes as the surface has coordinates"
+            )
 
 
 def _norm_bounds(values: np.ndarray, norm: np.ndarray, half_width: float) -> Tuple[float, float, bool]:
@@ -210,6 +214,9 @@ class LevelSet(Surface):
     >>> squashed = ts.LevelSet(X**2 + Y**2 - 0.25, redistance=True)   # not a distance: re-distanced
     >>> sol = ts.solve(squashed, grid, [(0.5, 0.0)])
     """
+
+    #: The smoothing width of :meth:`from_mask` (in voxels) for a mask's surface, None otherwise.
+    _mask_smoothing: Optional[float] = None
 
     def __init__(
         self,
@@ -298,7 +305,9 @@ class LevelSet(Surface):
         """
         from .mask import level_set_function_of_mask
 
-        return LevelSet(level_set_function_of_mask(mask, grid, smooth), redistance=True)
+        surface = LevelSet(level_set_function_of_mask(mask, grid, smooth), redistance=True)
+        surface._mask_smoothing = float(smooth)  # for the advice of a refusal (mask.mask_advice)
+        return surface
 
     @property
     def is_dense(self) -> bool:

@@ -157,7 +157,9 @@ def order2_obstacle(surface: Any, tube_pairs: int) -> Optional[str]:
     if pairs:
         return (
             f"the mesh faces itself across gaps narrower than its tubes ({pairs} node pairs): the second-order "
-            "sweeps can run away across such a gap on a mesh; a finer grid resolves the gap"
+            "sweeps can run away across such a gap on a mesh. A gap of a few grid spacings closes with a finer grid; "
+            "where the surface nearly touches itself (the bundled bunny and Spot), no grid of practical size resolves "
+            "it, and order=1 (the band cut across the gap) is the answer"
         )
     return None
 
