@@ -77,7 +77,7 @@ def main() -> None:
     cores = os.cpu_count() or 1
     modes = {"default": 0, "threads=1": 1, "all cores": cores}
     print(f"sphere N = {args.n}, {cores} cores, {args.rounds} alternating rounds (round 0 discarded)")
-    report("quiet (other helpers' jobs aside)", rounds(args.n, args.rounds, modes))
+    report("quiet", rounds(args.n, args.rounds, modes))
     busy = [subprocess.Popen([sys.executable, "-c", BUSY]) for _ in range(max(1, cores - 1))]
     try:
         time.sleep(0.5)
