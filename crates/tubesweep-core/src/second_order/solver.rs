@@ -204,6 +204,27 @@ impl<const D: usize> Sweeper<'_, D> {
     /// `tubesweep reproduce second-order`).
     #[inline(always)]
     fn inner(&self, w: &SharedValues<'_>, i: usize, k_inner: usize, second: bool) -> Option<f64> {
+        // SAFETY: `k_inner` counts the nodes before `i` not in the extension layer, fewer than
+        // the inner geometries (checked equal to that count)
+        let resolved = unsafe { self.geometry.get_unchecked(k_inner) }.first_order() == 0;
+        // compiled apart for the two kinds of node, so that a resolved node's update carries no
+        // test of the kind (the same arithmetic either way)
+        if resolved {
+            self.inner_of::<true>(w, i, k_inner, second)
+        } else {
+            self.inner_of::<false>(w, i, k_inner, false)
+        }
+    }
+
+    /// [`Self::inner`] for a node whose geometry is resolved (`RESOLVED`) or not.
+    #[inline(always)]
+    fn inner_of<const RESOLVED: bool>(
+        &self,
+        w: &SharedValues<'_>,
+        i: usize,
+        k_inner: usize,
+        second: bool,
+    ) -> Option<f64> {
         let table = self.table;
         let sentinel = table.sentinel();
         let h = self.spacing;
@@ -236,8 +257,7 @@ impl<const D: usize> Sweeper<'_, D> {
         // there), on u itself: its ∂u₀ came from differences of φ across the crease, the corner
         // or the rim that made it unresolved (O(1/Δx) there: on two spheres joined by `min` the
         // factored update fell by 1.6Δx every sweep), so the sides read u₀ at the neighbours
-        let resolved = geometry.first_order() == 0;
-        let second = second && resolved;
+        let resolved = RESOLVED;
         for k in 0..D {
             let du0 = if resolved {
                 grad_u0[k] as f64 * self.grad_u0_unit
