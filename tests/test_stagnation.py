@@ -50,12 +50,12 @@ def test_a_tol_below_the_round_off_warns_that_it_cannot_be_met():
 
 
 def test_a_large_fallback_says_how_large():
-    text = fallback_message(12, 3e-5, 1e-7, 1.5)
+    text = fallback_message(12, 3e-5, 1e-7, np.array([1.5]))
     assert "iteration 12" in text and "3e-05, 300 times tol=1e-07" in text and "off the second-order" in text
-    assert fallback_message(12, 0.9 * FALLBACK_WARNING * 1e-7, 1e-7, 1.5) is None
-    assert fallback_message(None, None, 1e-7, 1.5) is None
+    assert fallback_message(12, 0.9 * FALLBACK_WARNING * 1e-7, 1e-7, np.array([1.5])) is None
+    assert fallback_message(None, None, 1e-7, np.array([1.5])) is None
     # the same change against travel times of 1e9 is their round-off
-    assert "round-off" in fallback_message(12, 3e-5, 1e-7, 1e9)
+    assert "round-off" in fallback_message(12, 3e-5, 1e-7, np.array([1e9, np.inf]))
 
 
 def test_many_sources_report_their_fallbacks_per_source():

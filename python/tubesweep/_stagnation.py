@@ -26,14 +26,16 @@ def fallback_message(
     iteration: Any,
     change: Any,
     tol: float,
-    scale: float,
+    values: np.ndarray,
     recorded: str = "sol.stats.order2['fallback_iteration'] and ['fallback_change']",
 ) -> Optional[str]:
     """The warning's text for a stagnation fallback at phase-2 ``iteration`` after changes of up
-    to ``change`` (None when it did not fire or was small); ``scale``: the largest finite travel
-    time; ``recorded``: where the stats keep it."""
+    to ``change`` (None when it did not fire or was small); ``values``: the solve's travel times,
+    whose largest finite one sets the round-off; ``recorded``: where the stats keep it."""
     if iteration is None or change is None or not change > FALLBACK_WARNING * tol:
         return None
+    finite = values[np.isfinite(values)]
+    scale = float(np.max(np.abs(finite))) if finite.size else 0.0
     if change <= ROUND_OFF * np.finfo(np.float64).eps * scale:
         return (
             f"the second-order sweeps' changes stopped falling at {change:.3g} (their iteration {iteration}), the "
@@ -46,9 +48,3 @@ def fallback_message(
         "from then on: the values may be off the second-order solution by up to about that much. "
         f"{recorded} record it; a finer grid or a smoother surface usually avoids it"
     )
-
-
-def largest_finite(values: np.ndarray) -> float:
-    """The largest finite value (0 when there is none): the scale of :func:`fallback_message`."""
-    finite = values[np.isfinite(values)]
-    return float(np.max(np.abs(finite))) if finite.size else 0.0

@@ -147,11 +147,14 @@ def check_hamiltonian(hamiltonian: str) -> str:
 MAX_ITERATIONS_LIMIT = 10**9
 
 
-def check_tolerance(tol: float, max_iterations: int) -> None:
+def check_tolerance(tol: Optional[float], max_iterations: int) -> None:
+    """Refuses a ``tol`` that is not a positive finite number (None stands for the scheme's own
+    default) and a ``max_iterations`` out of range."""
     what = "a positive finite number (the sweeps stop once no value changes by more in an iteration)"
-    t = real_scalar(tol, "tol", what)
-    if not (np.isfinite(t) and t > 0):
-        raise ValueError(f"tol must be {what}; got {tol!r}")
+    if tol is not None:
+        t = real_scalar(tol, "tol", what)
+        if not (np.isfinite(t) and t > 0):
+            raise ValueError(f"tol must be {what}; got {tol!r}")
     m = whole_number(max_iterations, "max_iterations", f"an integer from 1 to {MAX_ITERATIONS_LIMIT:,}")
     if not 1 <= m <= MAX_ITERATIONS_LIMIT:
         raise ValueError(

@@ -28,7 +28,7 @@ from ._validate import (
     warn_unconverged,
 )
 from ._result_check import check_values
-from ._stagnation import fallback_message, largest_finite
+from ._stagnation import fallback_message
 from ._warn import user_stacklevel
 from .box_order2 import NOT_GODUNOV, check_order, order2_tol, solve_order2
 from .box_solution import BoxSolution
@@ -268,7 +268,7 @@ def travel_time(
         )
     if tol is None and (order == 1 or general is not None):
         tol = 1e-10
-    check_tolerance(1.0 if tol is None else tol, max_iterations)
+    check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     # before anything of the box's size is allocated (a callable speed also takes the nodes'
     # coordinates, twice: the meshgrid and the stacked points)
@@ -440,7 +440,7 @@ def _order2(
             st["safeguard_iteration"] - st["first_order_iterations"],
             st["safeguard_change"],
             tol,
-            largest_finite(values),
+            values,
             recorded="stats.order2['fallback_iteration'] and ['fallback_change']",
         )
         if fallback is not None:

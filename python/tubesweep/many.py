@@ -180,7 +180,7 @@ def solve_many(
             "solve_many takes hamiltonian='godunov' or 'lxf'; for a ts.hamiltonians object solve each "
             "source with tube.solve"
         )
-    check_tolerance(DEFAULT_TOL if tol is None else tol, max_iterations)
+    check_tolerance(tol, max_iterations)
     cb = check_many_progress(progress)
     _check_source_init(source_init)
     if not isinstance(paper_sweeps, (bool, np.bool_)):

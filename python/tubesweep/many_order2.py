@@ -23,7 +23,7 @@ from . import _native
 from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
 from .mask import mask_advice
-from ._stagnation import FALLBACK_WARNING, fallback_message, largest_finite
+from ._stagnation import FALLBACK_WARNING, fallback_message
 from ._validate import FRONT_WINDOW, as_sources
 from . import second_order as so
 
@@ -148,7 +148,7 @@ def solve_many_order2(
             int(st["fallback_iteration"][worst]),
             float(st["fallback_change"][worst]),
             inputs.tol,
-            largest_finite(values[worst]),
+            values[worst],
             recorded="the stats' 'fallback_iteration' and 'fallback_change' (return_stats=True)",
         )
         warnings.warn(

@@ -23,7 +23,7 @@ from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from .mask import mask_advice
 from .moving import values_checksum
-from ._stagnation import fallback_message, largest_finite
+from ._stagnation import fallback_message
 from ._warn import user_stacklevel
 from ._validate import (
     FRONT_WINDOW,
@@ -42,7 +42,6 @@ __all__ = ["ORDERS", "Order2NotApplicable", "check_order", "FIX_RADIUS", "FACTOR
 #: this fraction of the tube (fewer are reported in ``sol.stats.order2`` only): the rims of the
 #: library's open surfaces and a crease take 4–26% at N = 41–161.
 FIRST_ORDER_WARNING = 0.4
-
 
 #: The values of ``order``: the paper's first-order scheme, second order, or ``"auto"`` (second
 #: order where it applies, first order otherwise, the reason in ``sol.stats.order_fallback``).
@@ -342,9 +341,7 @@ def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float, v
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
-    fallback = None
-    if st["fallback_iteration"] is not None:
-        fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, largest_finite(values))
+    fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, values)
     if fallback is not None:
         warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
     first_order = int(st["first_order_nodes"])

@@ -241,7 +241,7 @@ def solve(
     surf.check_grid(grid)
     src = as_sources(sources, grid)
     general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-    check_tolerance(DEFAULT_TOL if tol is None else tol, max_iterations)
+    check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     _check_source_init(source_init)
     _infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
@@ -294,7 +294,7 @@ def solve(
         scheme,
         speed,
         source_init,
-        DEFAULT_TOL if tol is None else tol,
+        tol,
         max_iterations,
         cb,
         infinity,
@@ -363,7 +363,7 @@ def _solve_on_tube(
     scheme: str,
     speed: Any,
     source_init: str,
-    tol: float,
+    tol: Optional[float],
     max_iterations: int,
     cb: Any,
     infinity: Any,
@@ -376,6 +376,7 @@ def _solve_on_tube(
     """Fixes the sources on the prepared tube and sweeps. With ``reuse`` the tube is left as it
     was (its roles and directions are copied); without, its arrays are consumed and dropped
     before the sweeps."""
+    tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if not isinstance(paper_sweeps, (bool, np.bool_)):
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band

@@ -32,7 +32,7 @@ from .grid import Grid
 from .moving import check_warm_refused
 from ._prepare import _prepare_tube, thinned_at_creases
 from .solution import Solution
-from .solve import DEFAULT_TOL, _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
+from .solve import _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
 
 __all__ = ["Tube"]
@@ -210,7 +210,7 @@ class Tube:
         order = _check_order(order)
         src = as_sources(sources, self.grid)
         general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-        check_tolerance(DEFAULT_TOL if tol is None else tol, max_iterations)
+        check_tolerance(tol, max_iterations)
         cb = progress_callback(progress)
         _check_source_init(source_init)
         check_infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
@@ -261,7 +261,7 @@ class Tube:
             scheme,
             speed,
             source_init,
-            DEFAULT_TOL if tol is None else tol,
+            tol,
             max_iterations,
             cb,
             infinity,

@@ -123,7 +123,7 @@ pub(super) const WOKE: u8 = 2;
 pub(super) struct Limits {
     pub(super) second: bool,
     pub(super) decreases_only: bool,
-    pub(super) threshold: f64,
+    threshold: f64,
     pub(super) window: f64,
     pub(super) settled: f64,
     /// A value changed to below this ends the phase as a runaway (phase 2 only; −∞ otherwise).
