@@ -74,3 +74,28 @@ def test_the_box_reports_the_same_entries():
     grid = ts.Grid((-1, -1), (1, 1), (101, 101))
     _, st = ts.travel_time(grid, [(0.1, 0.2)], order=2, return_stats=True)
     assert st.order2["fallback_iteration"] is None and st.order2["fallback_change"] is None
+
+
+def test_a_tol_far_below_the_default_is_named_in_the_advice():
+    # the six-fold star at N = 801 with 1e-5 of the default tol: the changes stop falling at about
+    # 8e-12 (130 tolerances), above the round-off test; the advice is about tol, not the grid
+    grid = ts.Grid((-1.0, -1.0), (1.0, 1.0), (801, 801))
+    star = ts.surfaces.Star()
+    default = ts.solve(star, grid, [(0.5, 0.0)])
+    tol = 1e-5 * default.stats.order2["tol"]
+    with pytest.warns(RuntimeWarning, match=r"tol=6\.25e-14 is 100000 times below the default \(6\.25e-09\)") as rec:
+        sol = ts.solve(star, grid, [(0.5, 0.0)], tol=tol)
+    assert "finer grid" not in str(rec[0].message)
+    o = sol.stats.order2
+    assert sol.stats.converged and o["fallback_iteration"] is not None and o["fallback_change"] > FALLBACK_WARNING * tol
+    # the values are the default solve's to within the default's creep at this N (docs/development)
+    assert np.max(np.abs(sol.values - default.values)) < 100 * default.stats.order2["tol"]
+    # at the default the same stall is below it: no fallback
+    assert default.stats.order2["fallback_iteration"] is None
+
+
+def test_the_advice_names_the_grid_at_the_default_tol():
+    text = fallback_message(12, 3e-5, 1e-7, np.array([1.5]), default_tol=1e-7)
+    assert "finer grid" in text and "below the default" not in text
+    text = fallback_message(12, 3e-5, 1e-9, np.array([1.5]), default_tol=1e-7)
+    assert "tol=1e-09 is 100 times below the default (1e-07)" in text and "a tol of 3e-05 or more" in text

@@ -21,6 +21,11 @@ FALLBACK_WARNING = 100.0
 #: the sphere at N = 41 with ``tol=1e-16`` stalls at 1.9e-14, about 100 of them.
 ROUND_OFF = 1e4
 
+#: A ``tol`` this many times below the solve's default is the user's own, tighter than the scheme
+#: settles to on some surfaces: the warning then names ``tol`` rather than the grid (the six-fold
+#: star at N = 1601 with 1e-4 of the default stalls at 130 tolerances, 2.0e-11).
+TIGHT_TOL = 10.0
+
 
 def fallback_message(
     iteration: Any,
@@ -28,10 +33,13 @@ def fallback_message(
     tol: float,
     values: np.ndarray,
     recorded: str = "sol.stats.order2['fallback_iteration'] and ['fallback_change']",
+    default_tol: Optional[float] = None,
 ) -> Optional[str]:
     """The warning's text for a stagnation fallback at phase-2 ``iteration`` after changes of up
     to ``change`` (None when it did not fire or was small); ``values``: the solve's travel times,
-    whose largest finite one sets the round-off; ``recorded``: where the stats keep it."""
+    whose largest finite one sets the round-off; ``recorded``: where the stats keep it;
+    ``default_tol``: the solve's default ``tol`` (the advice names ``tol`` when it is
+    :data:`TIGHT_TOL` times below it)."""
     if iteration is None or change is None or not change > FALLBACK_WARNING * tol:
         return None
     finite = values[np.isfinite(values)]
@@ -42,9 +50,16 @@ def fallback_message(
             f"round-off of travel times up to {scale:.3g}: tol={tol:g} is below what float64 resolves for them. The "
             f"values are as settled as they can be; a tol of {change:.0e} or more stops there without this warning"
         )
+    if default_tol is not None and tol * TIGHT_TOL < default_tol:
+        advice = (
+            f"tol={tol:g} is {default_tol / tol:.0f} times below the default ({default_tol:.3g}) and tighter than the "
+            f"sweeps settle to here: a tol of {change:.0e} or more, or the default, stops before this"
+        )
+    else:
+        advice = "a finer grid or a smoother surface usually avoids it"
     return (
         f"the second-order sweeps stopped converging at their iteration {iteration} (the largest change of the "
         f"iterations before was {change:.3g}, {change / tol:.0f} times tol={tol:g}) and accepted decreases only "
         "from then on: the values may be off the second-order solution by up to about that much. "
-        f"{recorded} record it; a finer grid or a smoother surface usually avoids it"
+        f"{recorded} record it; {advice}"
     )

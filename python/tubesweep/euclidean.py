@@ -442,6 +442,7 @@ def _order2(
             tol,
             values,
             recorded="stats.order2['fallback_iteration'] and ['fallback_change']",
+            default_tol=order2_tol(grid, tolerance_slowness(slowness)),
         )
         if fallback is not None:
             warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())

@@ -150,6 +150,7 @@ def solve_many_order2(
             inputs.tol,
             values[worst],
             recorded="the stats' 'fallback_iteration' and 'fallback_change' (return_stats=True)",
+            default_tol=inputs.default_tol,
         )
         warnings.warn(
             f"order=2: {large.size} of {len(groups)} solves (sources {large[:5].tolist()}"

@@ -210,6 +210,7 @@ class TubeInputs:
 
     slowness: Any  # float, or one per band node
     tol: float
+    default_tol: float  # what tol is when the user gives none (the warnings compare against it)
     tol_first: float
     length: float
     offsets: Optional[np.ndarray]  # x − cp(x) per band node for a closest-point surface
@@ -243,8 +244,9 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
     # the tolerances' slowness: the mean unless an obstacle pulls it up (_validate.tolerance_slowness)
     tol_slowness = tolerance_slowness(slowness)
     length = ramp_length(grid)
+    default = default_tol(h, tol_slowness, length, d)
     if tol is None:
-        tol = default_tol(h, tol_slowness, length, d)
+        tol = default
     # travel times too large or too small for the local updates' squares, a tol not small against
     # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
     check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
@@ -259,6 +261,7 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
     return TubeInputs(
         slowness=float(slowness) if np.ndim(slowness) == 0 else np.ascontiguousarray(slowness, dtype=float),
         tol=float(tol),
+        default_tol=default,
         tol_first=TOL_FIRST_FACTOR[d] * h * h * tol_slowness / length,
         length=length,
         offsets=offsets,
@@ -322,9 +325,12 @@ def warm_start(
         return None, {}, {"refused": str(e)}
 
 
-def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float, values: np.ndarray) -> None:
+def warn_about(
+    st: Dict[str, Any], tube: Any, max_iterations: int, tol: float, values: np.ndarray, default: Optional[float] = None
+) -> None:
     """The warnings of a second-order solve from its native report ``st``: not converged, the
-    sweeps ran away, a large stagnation fallback, many first-order nodes, convex creases."""
+    sweeps ran away, a large stagnation fallback, many first-order nodes, convex creases;
+    ``default``: the solve's default ``tol`` (:func:`~tubesweep._stagnation.fallback_message`)."""
     if not st["converged"]:
         warnings.warn(
             f"order=2: the sweeps did not converge in max_iterations={max_iterations}: the largest change in the last "
@@ -341,7 +347,7 @@ def warn_about(st: Dict[str, Any], tube: Any, max_iterations: int, tol: float, v
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
-    fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, values)
+    fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, values, default_tol=default)
     if fallback is not None:
         warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
     first_order = int(st["first_order_nodes"])
@@ -511,7 +517,7 @@ def solve_on_tube(
         warm_more,
         keep_digests or warm is not None,
     )
-    warn_about(st, tube, max_iterations, tol, values)
+    warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
     stats = SolveStats(
