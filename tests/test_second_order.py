@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import tubesweep as ts
+import tubesweep.second_order as so
 from conftest import fit_order
 
 
@@ -218,6 +219,28 @@ def test_a_slow_descent_on_a_fine_circle_is_not_taken_for_a_stall():
     assert np.abs(sol(pts) - exact)[far].max() < 4e-7
 
 
+def test_the_2d_default_tol_follows_the_fine_curve_creep():
+    # phase 2's changes fall ever more slowly on a fine curve: stopping at a change of 1e-3 Δx²
+    # left the circle at N = 1601 1.8e-7 from the fixed point and its mean error 15% above the
+    # converged one; the default falls as Δx³ beyond N = 401 (second_order.FINE_CURVE_SPACINGS)
+    assert so.default_tol(2 / 400, 1.0, 1.0, 2) == 1e-3 * (2 / 400) ** 2
+    assert so.default_tol(2 / 1600, 1.0, 1.0, 2) == pytest.approx(0.25 * 1e-3 * (2 / 1600) ** 2, rel=1e-12)
+    assert so.default_tol(2 / 1600, 1.0, 1.0, 3) == 5e-4 * (2 / 1600) ** 2
+    circle = ts.surfaces.Circle(0.5)
+    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
+    src = np.array([0.5, 0.0])
+    exact = circle.geodesic_distance(pts, src)
+    g = box(1601, 2)
+    mean = {}
+    for name, tol in (("default", None), ("dx2 rule", 1e-3 * g.spacing**2), ("converged", 1e-5 * g.spacing**2)):
+        sol = ts.solve(circle, g, [src], **({} if tol is None else {"tol": tol}))
+        assert sol.stats.converged and sol.stats.order2["fallback_iteration"] is None
+        mean[name] = float(np.mean(np.abs(sol(pts) - exact)))
+    assert abs(mean["default"] / mean["converged"] - 1) < 0.03
+    assert mean["dx2 rule"] / mean["converged"] > 1.1
+
+
 def test_speed_scales_and_several_sources():
     g = box(41)
     one = ts.solve(SPHERE, g, [SRC], order=2)
@@ -359,7 +382,6 @@ def test_a_runaway_second_phase_falls_back_to_first_order(monkeypatch):
     # from that start the second-order sweeps run away (values to −1e6 and beyond, for minutes
     # until max_iterations); they are abandoned at the first value below −σ̄Δx, with a warning,
     # and the first phase's values are returned
-    import tubesweep.second_order as so
 
     monkeypatch.setitem(so.TOL_FIRST_FACTOR, 3, 64.0)
     monkeypatch.setattr(so, "EXTENSION_LIMIT", np.inf)
@@ -380,7 +402,6 @@ def test_a_runaway_second_phase_falls_back_to_first_order(monkeypatch):
 def test_the_limited_extension_converges_from_a_poor_start(monkeypatch, first):
     # the same start with the extension's correction limited (the default) converges at second
     # order, like the default solve (which has no first phase in 3D) and one from a full first phase
-    import tubesweep.second_order as so
 
     far0, mean0, sol0 = sphere_errors(101)
     assert sol0.stats.order2["first_order_iterations"] == 0

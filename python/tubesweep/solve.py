@@ -142,8 +142,8 @@ def solve(
     tol, max_iterations : float or None, int
         Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
         ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol=None`` (the
-        default) stands for 1e-10 with ``order=1`` and with ``order=2`` for ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D)
-        times the mean slowness (at most twice its lower quartile, so that an obstacle does not
+        default) stands for 1e-10 with ``order=1`` and with ``order=2`` for ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D; times
+        ``200 Δx/ℓ`` where that is below 1) times the mean slowness (at most twice its lower quartile, so that an obstacle does not
         loosen it), ℓ half the grid's longest side.
     progress : callable, optional
         Called after every iteration as ``progress(iteration, max_change, updates)``.
