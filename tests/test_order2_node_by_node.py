@@ -211,3 +211,21 @@ def test_most_of_the_tube_unresolved_falls_back_with_the_counts():
     with pytest.warns(RuntimeWarning, match="faces itself"):
         auto = ts.solve(small, box(51), [(-0.12, 0, 0)])
     assert auto.stats.order == 1 and "refine the grid" in auto.stats.order_fallback
+
+
+@pytest.mark.parametrize(("kind", "bound"), [("cube", 0.02), ("tanh", 0.035)])
+def test_unresolved_nodes_off_the_surface_open_no_shortcut(kind, bound):
+    # φ = (r − 0.5)³ or a sharp tanh, re-distanced at N = 41: 150–190 inner nodes at |φ| = 1–2Δx on
+    # the concave side are flagged for their curvature. Solving |∇u| = σ there (B = I, a parallel
+    # surface 10–20% shorter) let the front cut through them: max error 0.16, every distance short,
+    # reported as second order. They take the extension update now (solver.rs,
+    # UNRESOLVED_EXTENSION_FROM): 0.0105 and 0.0243, against 0.0134 for the exact signed distance
+    g = box(41)
+    r = sphere_phi(g) + 0.5
+    phi = (r - 0.5) ** 3 if kind == "cube" else np.tanh((r - 0.5) / 0.01)
+    sol = ts.solve(ts.LevelSet(phi, redistance=True), g, [(-0.5, 0, 0)])
+    assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] > 100
+    q = np.random.default_rng(1).normal(size=(400, 3))
+    q = 0.5 * q / np.linalg.norm(q, axis=1, keepdims=True)
+    exact = 0.5 * np.arccos(np.clip(-2.0 * q[:, 0], -1.0, 1.0))
+    assert np.max(np.abs(sol(q) - exact)) < bound

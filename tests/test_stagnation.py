@@ -78,12 +78,12 @@ def test_the_box_reports_the_same_entries():
 
 def test_a_tol_far_below_the_default_is_named_in_the_advice():
     # the six-fold star at N = 801 with 1e-5 of the default tol: the changes stop falling at about
-    # 8e-12 (130 tolerances), above the round-off test; the advice is about tol, not the grid
+    # 6e-12 (200 tolerances), above the round-off test; the advice is about tol, not the grid
     grid = ts.Grid((-1.0, -1.0), (1.0, 1.0), (801, 801))
     star = ts.surfaces.Star()
     default = ts.solve(star, grid, [(0.5, 0.0)])
     tol = 1e-5 * default.stats.order2["tol"]
-    with pytest.warns(RuntimeWarning, match=r"tol=6\.25e-14 is 100000 times below the default \(6\.25e-09\)") as rec:
+    with pytest.warns(RuntimeWarning, match=r"tol=3\.125e-14 is 100000 times below the default \(3\.13e-09\)") as rec:
         sol = ts.solve(star, grid, [(0.5, 0.0)], tol=tol)
     assert "finer grid" not in str(rec[0].message)
     o = sol.stats.order2

@@ -205,6 +205,8 @@ def solve_many(
                     progress=cb,
                     threads=nthreads,
                 )
+            except so.Order2RanAway:
+                raise  # depends on the speed and the sources: not kept as the band's refusal
             except so.Order2NotApplicable as e:
                 tube._order2_refusal = str(e)  # depends on the band only: not computed again
                 raise
@@ -215,6 +217,7 @@ def solve_many(
         except so.Order2NotApplicable as e:
             if order == 2:
                 raise
+            so.warn_fallback(e, order)
             fallback = str(e)  # order="auto": the first-order scheme, the reason in the stats
     tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if order != 1:

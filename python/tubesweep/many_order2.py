@@ -119,6 +119,13 @@ def solve_many_order2(
             raise so.Order2NotApplicable(mask_advice(t.surface, str(e))) from None
         raise
     st = dict(st)
+    failed = np.flatnonzero(st["restart_failed"])
+    if failed.size:
+        # values falling without bound for these sources: no factored solution (second_order.Order2RanAway)
+        raise so.Order2RanAway(
+            so.ran_away_message(int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness)
+            + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}{'…' if failed.size > 5 else ''})"
+        )
     st["tol"] = inputs.tol
     warn_creases(st.get("creases"), t.inner, h)
     for name, what in (

@@ -57,6 +57,41 @@ class Order2NotApplicable(ValueError):
     ``sol.stats.order_fallback``."""
 
 
+class Order2RanAway(Order2NotApplicable):
+    """The second-order sweeps ran away (travel times falling below zero) and so did their
+    first-order factored restart: the factored update ``u = u₀ + w`` is not causal where the speed
+    is far higher than at the sources (a region 70–1000 times faster), and no factored solution
+    exists there. It depends on the speed and the sources, not on the band: a :class:`~tubesweep.Tube`
+    does not keep it as a refusal. With ``order="auto"`` the solve warns and returns the paper's
+    first-order scheme, which is not factored."""
+
+
+def ran_away_message(iteration: Any, slowness: Any, src_slowness: np.ndarray) -> str:
+    """:class:`Order2RanAway`'s text: where it ran away, and how much faster than the sources the
+    fastest part of the band is."""
+    fastest = float(np.min(slowness))
+    contrast = float(np.max(src_slowness)) / fastest if fastest > 0 else float("inf")
+    if contrast >= RAN_AWAY_CONTRAST:
+        cause = f"where the speed is much higher than at the sources (here up to {contrast:.3g} times)"
+    else:
+        speed = "a constant speed" if contrast <= 1.0 + 1e-9 else f"a speed at most {contrast:.3g} times the sources'"
+        cause = (
+            f"on this band, with {speed}: the surface is the likely "
+            "cause (a dent, bump or noise that the grid does not resolve: a finer grid or a smoother φ may avoid it)"
+        )
+    return (
+        f"order=2: the second-order sweeps ran away at their iteration {iteration} (travel times fell below zero) and "
+        f"the first-order factored restart did too: the factored update is not causal {cause}. order=1, the paper's "
+        "scheme, which is not factored, solves it"
+    )
+
+
+#: :func:`ran_away_message` names the speed as the cause of a runaway from this ratio of the
+#: sources' slowness to the smallest in the band on (a fast region of 70–1000 times ran away on
+#: the sphere at N = 41; 3–50 did not).
+RAN_AWAY_CONTRAST = 10.0
+
+
 #: Inner-tube nodes whose closest point is within this many grid spacings of a source are fixed
 #: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there).
 FIX_RADIUS = 2.0
@@ -339,6 +374,25 @@ def warm_start(
         return None, {}, {"refused": str(e)}
 
 
+#: ``sol.stats.order_fallback`` of a solve whose second-order sweeps ran away and whose first-order
+#: factored restart converged (its values are returned).
+RAN_AWAY_RESTARTED = (
+    "the second-order sweeps ran away (a travel time fell below zero): the values are the first-order factored "
+    "solution from the sources (order 1); sol.stats.order2['runaway_iteration'] says when"
+)
+
+
+def warn_fallback(e: Order2NotApplicable, order: Any) -> None:
+    """With ``order="auto"``, a warning for a fallback to the first-order scheme that the solve
+    found only by running (:class:`Order2RanAway`); the refusals known before are in the stats."""
+    if order == "auto" and isinstance(e, Order2RanAway):
+        warnings.warn(
+            f"{e}; the first-order solution is returned (sol.stats.order_fallback keeps this)",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+
+
 def warn_about(
     st: Dict[str, Any], tube: Any, max_iterations: int, tol: float, values: np.ndarray, default: Optional[float] = None
 ) -> None:
@@ -386,6 +440,7 @@ _REPORTED = (
     "fallback_iteration",
     "fallback_change",
     "runaway_iteration",
+    "restart_failed",
     "unreached",
     "max_curvature",
     "grad_norm_range",
@@ -531,6 +586,8 @@ def solve_on_tube(
         warm_more,
         keep_digests or warm is not None,
     )
+    if st["restart_failed"]:
+        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness))
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
@@ -551,7 +608,9 @@ def solve_on_tube(
         narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
         cut_edges=tube.cut_edges,
         crease_thinned=thinned_count(tube),
-        order=2,
+        # a runaway's values are the first-order factored restart's (warn_about says so)
+        order=2 if st["runaway_iteration"] is None else 1,
+        order_fallback=None if st["runaway_iteration"] is None else RAN_AWAY_RESTARTED,
         order2=order2_report(st, tol, surf, h, warm_info, warm_values is not None),
         box_cut=tube.box_cut,
     )

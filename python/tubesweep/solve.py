@@ -274,6 +274,7 @@ def solve(
         except _so.Order2NotApplicable as e:
             if order == 2:
                 raise
+            _so.warn_fallback(e, order)
             fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
     if warm is not None and warm_refused == "raise":
         from .moving import refusal_for_order1

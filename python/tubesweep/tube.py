@@ -242,12 +242,15 @@ class Tube:
                         warm_refused=warm_refused,
                         keep_digests=True,  # a tube's solutions start warm solves on its moved tubes
                     )
+                except _so.Order2RanAway:
+                    raise  # depends on the speed and the sources: not kept as the band's refusal
                 except _so.Order2NotApplicable as e:
                     self._order2_refusal = str(e)  # depends on the band only: not computed again
                     raise
             except _so.Order2NotApplicable as e:
                 if order == 2:
                     raise
+                _so.warn_fallback(e, order)
                 fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
         if warm is not None and warm_refused == "raise":
             from .moving import refusal_for_order1

@@ -448,6 +448,14 @@ fn run_order2<'py, const D: usize>(
         "runaway_iteration",
         col(&|s| s.runaway_iteration.map_or(-1, |v| v as i64)).into_pyarray(py),
     )?;
+    d.set_item(
+        "restart_failed",
+        stats
+            .iter()
+            .map(|s| s.restart_failed)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
     d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
     d.set_item("max_curvature", summary.max_curvature)?;
     d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;

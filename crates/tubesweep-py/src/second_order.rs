@@ -171,7 +171,7 @@ fn run<'py, const D: usize>(
                 &mut callback,
             )?;
             if !inp.options.own_first_phase {
-                stats.first_order_iterations = first_iterations;
+                stats.first_order_iterations += first_iterations;
                 stats.seconds += first_seconds;
             }
             stats
@@ -226,6 +226,7 @@ fn run<'py, const D: usize>(
     d.set_item("fallback_iteration", stats.fallback_iteration)?;
     d.set_item("fallback_change", stats.fallback_change)?;
     d.set_item("runaway_iteration", stats.runaway_iteration)?;
+    d.set_item("restart_failed", stats.restart_failed)?;
     d.set_item("unreached", stats.unreached)?;
     d.set_item("max_curvature", summary.max_curvature)?;
     d.set_item("grad_norm_range", (summary.grad_norm_min, summary.grad_norm_max))?;
