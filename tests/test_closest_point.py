@@ -181,10 +181,12 @@ def test_mobius_converges_to_polyhedral_geodesics(mobius_reference):
             u = sol(V)
             assert not np.any(np.isnan(u))
             err[ham, n] = float(np.max(np.abs(u - ref)))
-    # measured: Godunov 0.113, 0.041, 0.011; LxF 0.078, 0.064
-    assert _order(err["godunov", 41], err["godunov", 81]) > 1.0
+    # measured: Godunov (order=2 node by node; first order at the rim, where the errors start)
+    # 0.0157, 0.0080, 0.0035 (0.082, 0.029, 0.0072 before the rim's nodes off the surface took the
+    # extension update); LxF 0.078, 0.064
+    assert _order(err["godunov", 41], err["godunov", 81]) > 0.9
     assert _order(err["godunov", 81], err["godunov", 161]) > 1.0
-    assert err["godunov", 161] < 0.015
+    assert err["godunov", 161] < 0.005
     assert err["lxf", 81] < err["lxf", 41] < 0.1
 
 

@@ -382,15 +382,25 @@ RAN_AWAY_RESTARTED = (
 )
 
 
+#: The refusal of a tube whose φ is mostly not a signed distance says this
+#: (``tubesweep_core::second_order::check_geometry_of``): its cure is in the user's hands.
+NOT_A_DISTANCE = "redistance=True) re-distances φ"
+
+
 def warn_fallback(e: Order2NotApplicable, order: Any) -> None:
     """With ``order="auto"``, a warning for a fallback to the first-order scheme that the solve
-    found only by running (:class:`Order2RanAway`); the refusals known before are in the stats."""
-    if order == "auto" and isinstance(e, Order2RanAway):
-        warnings.warn(
-            f"{e}; the first-order solution is returned (sol.stats.order_fallback keeps this)",
-            RuntimeWarning,
-            stacklevel=user_stacklevel(),
-        )
+    found only by running (:class:`Order2RanAway`), or that a φ which is not a signed distance
+    caused (errors of order Δx instead of Δx², cured by ``redistance=True``); the other refusals
+    (a mesh, an option of the first-order scheme, ...) are in ``sol.stats.order_fallback`` alone."""
+    if order != "auto":
+        return
+    if isinstance(e, Order2RanAway):
+        text = f"{e}; the first-order solution is returned"
+    elif NOT_A_DISTANCE in str(e):
+        text = f"order='auto' ran the first-order scheme (errors of order Δx, not Δx²): {e}"
+    else:
+        return
+    warnings.warn(f"{text} (sol.stats.order_fallback keeps this)", RuntimeWarning, stacklevel=user_stacklevel())
 
 
 def warn_about(

@@ -112,6 +112,8 @@ pub struct GeometrySummary {
     /// Inner-tube nodes whose central differences give |∇φ| off 1 by more than
     /// [`NOISY_GRADIENT`] (the measure of noise, [`Self::noisy`]).
     pub rough_gradients: usize,
+    /// The count, sum and sum of squares of those |∇φ| (their spread, [`Self::noisy`]).
+    pub gradient_moments: (usize, f64, f64),
     /// Whether every node's derivatives come from the local fit ([`super::local_fit`]): set
     /// before the pass when a first pass found φ noisy.
     pub fitted_everywhere: bool,
@@ -138,6 +140,15 @@ pub const NOISY_FRACTION: f64 = 0.25;
 /// of the inner tube).
 pub const NOISY_GRADIENT: f64 = 0.01;
 
+/// See [`NOISY_FRACTION`]: noise also spreads |∇φ| (its standard deviation over the inner tube:
+/// 0.0127 with Gaussian noise of 3e-4 at N = 121, 0.042 with 1e-3), while a signed distance
+/// scaled by a constant, c·d, moves it as a whole (0.0010 at N = 41 and 0.0001 at N = 121 for
+/// c = 0.97 or 0.9, every node off 1 by more than [`NOISY_GRADIENT`]). Such a φ is not noise, and
+/// the fit everywhere only hid its real reason: it runs second order where |∇φ| is within
+/// [`super::GRAD_NORM_TOLERANCE`] of 1 and is refused for its gradient elsewhere, which
+/// `redistance=True` or dividing φ by c cures.
+pub const NOISY_SPREAD: f64 = 0.5 * NOISY_GRADIENT;
+
 /// When φ is noisy ([`NOISY_FRACTION`]), the fit is taken over the nodes within three grid steps
 /// (123 in 3D, 29 in 2D; at a node near the band's edge over those of them in the band), which
 /// averages the noise out of the surface's closest points (x − φ∇φ) as well as out of B: the
@@ -156,6 +167,7 @@ impl GeometrySummary {
             unresolved_curvature: 0,
             inner_nodes: 0,
             rough_gradients: 0,
+            gradient_moments: (0, 0.0, 0.0),
             fitted_everywhere: false,
             creases: Creases::default(),
         }
@@ -172,6 +184,11 @@ impl GeometrySummary {
             unresolved_curvature: self.unresolved_curvature + other.unresolved_curvature,
             inner_nodes: self.inner_nodes + other.inner_nodes,
             rough_gradients: self.rough_gradients + other.rough_gradients,
+            gradient_moments: (
+                self.gradient_moments.0 + other.gradient_moments.0,
+                self.gradient_moments.1 + other.gradient_moments.1,
+                self.gradient_moments.2 + other.gradient_moments.2,
+            ),
             fitted_everywhere: self.fitted_everywhere || other.fitted_everywhere,
             creases: Creases {
                 nodes: self.creases.nodes + other.creases.nodes,
@@ -182,7 +199,12 @@ impl GeometrySummary {
 
     /// Whether a pass with these counts found φ noisy ([`NOISY_FRACTION`]).
     pub fn noisy(&self) -> bool {
-        !self.fitted_everywhere && self.rough_gradients as f64 > NOISY_FRACTION * self.inner_nodes as f64
+        let (count, sum, squares) = self.gradient_moments;
+        let mean = sum / count.max(1) as f64;
+        let spread = (squares / count.max(1) as f64 - mean * mean).max(0.0).sqrt();
+        !self.fitted_everywhere
+            && self.rough_gradients as f64 > NOISY_FRACTION * self.inner_nodes as f64
+            && spread > NOISY_SPREAD
     }
 
     /// The inner-tube nodes that run the first-order update (every [`Unresolved`] reason).
@@ -239,6 +261,10 @@ pub(crate) fn node_geometry<const D: usize>(
         let norm = found.gradient.iter().map(|v| v * v).sum::<f64>().sqrt();
         if !((norm - 1.0).abs() <= NOISY_GRADIENT) {
             summary.rough_gradients += 1;
+        }
+        if norm.is_finite() {
+            let m = &mut summary.gradient_moments;
+            *m = (m.0 + 1, m.1 + norm, m.2 + norm * norm);
         }
     }
     let resolved = match first {

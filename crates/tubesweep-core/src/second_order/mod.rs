@@ -145,12 +145,27 @@ pub fn check_geometry_of(
             if closest_point { "an open surface's rim, " } else { "" }
         ));
     }
+    let (count, sum, _) = summary.gradient_moments;
+    let gradient = !closest_point && 2 * summary.off_distance > unresolved;
+    let advice = if gradient {
+        // mostly φ's gradient: a finer grid does not change that
+        if count > 0 {
+            let mean = sum / count as f64;
+            format!(
+                "|∇φ| is {mean:.3} on average near the surface: ts.LevelSet(phi, redistance=True) re-distances φ (or \
+                 divide φ by {mean:.3} if it is a scaled distance), or use order=1"
+            )
+        } else {
+            "ts.LevelSet(phi, redistance=True) re-distances φ, or use order=1".to_string()
+        }
+    } else {
+        "refine the grid, or use order=1".to_string()
+    };
     Err(Error::invalid(
-        "grid",
+        if gradient { "surface" } else { "grid" },
         format!(
             "order=2: {unresolved} of the {} inner-tube nodes ({:.0}%) cannot run the second-order update: {}. Second \
-             order runs node by node where the geometry is resolved, but here most of the tube is not: refine the grid, \
-             or use order=1",
+             order runs node by node where the geometry is resolved, but here most of the tube is not: {advice}",
             summary.inner_nodes,
             100.0 * unresolved as f64 / total as f64,
             reasons.join("; ")
