@@ -149,8 +149,13 @@ def test_refusals_name_the_cause(first):
     with pytest.raises(WarmStartRefused, match="1 source"):
         moved.solve([(0.0, 0.0, r), (r, 0.0, 0.0)], warm=sol)
     far = 0.5 + 3.0 * H  # farther than outer − inner = 2 spacings
-    with pytest.raises(WarmStartRefused, match="moved farther than outer − inner = 2 grid spacings"):
+    with pytest.raises(
+        WarmStartRefused, match="moved farther than the previous solution.s outer − inner = 2 grid spacings"
+    ):
         tube.moved(ts.surfaces.Sphere(far)).solve(pole(far), warm=sol)
+    # a wider new tube does not widen the previous band: the limit given is the previous one's
+    with pytest.raises(WarmStartRefused, match="previous solution.s outer − inner = 2 grid spacings.*outer=6"):
+        ts.Tube(ts.surfaces.Sphere(far), GRID, outer=6).solve(pole(far), warm=sol)
     with pytest.raises(TypeError, match="warm must be the Solution"):
         moved.solve(pole(r), warm=sol.values)
     with pytest.raises(ValueError, match="warm_refused must be"):
@@ -241,6 +246,43 @@ def test_evolve_refuses_bad_input_with_the_cause_named():
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint="run.ckpt")
     with pytest.raises(ValueError, match="t0 must be a finite time"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, t0=float("nan"))
+
+
+def test_evolve_refuses_more_bad_input_up_front(tmp_path):
+    phi = sphere_phi(GRID31)
+    # a source 4.5 grid spacings off the initial surface: refused as ts.solve refuses it (it was
+    # projected onto the surface without a word)
+    with pytest.raises(ValueError, match=r"sources\[0\] = \(0\.0, 0\.0, 0\.8\) is 0\.3 from the surface"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.8)], lambda u: 0.1 + 0 * u, dt=0.05, steps=1)
+    with pytest.raises(TypeError, match=r"speed\(u\) returned None"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: None, dt=0.05, steps=1)
+    with pytest.raises(TypeError, match="must return real numbers"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: (0.1 + 0j) * u, dt=0.05, steps=1)
+    # a checkpoint's folder is checked before the first solve, under the name given
+    with pytest.raises(ValueError, match="the folder of checkpoint=.*nodir.*does not exist"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=tmp_path / "nodir/a.npz")
+    # a .pvd beside frames whose names need escaping is well-formed XML
+    import xml.etree.ElementTree as ET
+
+    ev = ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1)
+    path = ev.export(tmp_path / 'a&b"<c.pvd')
+    files = [d.get("file") for d in ET.parse(path).getroot().iter("DataSet")]
+    assert files == ['a&b"<c_0000.vtp', 'a&b"<c_0001.vtp'] and all((tmp_path / f).exists() for f in files)
+
+
+def test_a_vanishing_surface_stops_the_evolution_with_its_frames():
+    # a sphere of radius 0.3 shrinking at speed 1 on N = 31 falls below two grid spacings at step 8
+    phi = sphere_phi(GRID31, 0.3)
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):  # across its centre, on the way
+        with pytest.raises(ts.EvolutionStopped, match=r"step 8 \(t = 0\.24\): the surface.*vanished") as info:
+            ts.evolve(phi, GRID31, [(0, 0, 0.3)], lambda u: -1 + 0 * u, dt=0.03, steps=20)
+    e = info.value
+    assert isinstance(e, ValueError) and e.step == 8 and e.time == pytest.approx(0.24)
+    assert len(e.evolution.times) == 8 and e.evolution.times[-1] == pytest.approx(0.21)
+    assert "too coarse" in str(e.__cause__)
+    # the last frame's sphere: radius 0.3 − 0.21 = 0.09 to a tenth of a grid spacing
+    last = e.evolution.solutions[-1]
+    assert abs(float(np.linalg.norm(last.sources[0])) - 0.09) < 0.1 * GRID31.spacing
 
 
 def test_an_evolution_continues_from_its_checkpoint(tmp_path):

@@ -229,3 +229,23 @@ def test_unresolved_nodes_off_the_surface_open_no_shortcut(kind, bound):
     q = 0.5 * q / np.linalg.norm(q, axis=1, keepdims=True)
     exact = 0.5 * np.arccos(np.clip(-2.0 * q[:, 0], -1.0, 1.0))
     assert np.max(np.abs(sol(q) - exact)) < bound
+
+
+def test_a_scaled_distance_is_not_taken_for_noise():
+    # φ = c·d moves |∇φ| off 1 at every node but spreads it by 0.001 only: not noise (geometry.rs,
+    # NOISY_SPREAD). Within GRAD_NORM_TOLERANCE it runs second order; beyond, it is refused for its
+    # gradient, with the cure (it was refused for an unresolved curvature, with a finer grid as
+    # the advice, and order="auto" said nothing)
+    g = box(41)
+    d = sphere_phi(g)
+    q = np.random.default_rng(1).normal(size=(400, 3))
+    q = 0.5 * q / np.linalg.norm(q, axis=1, keepdims=True)
+    exact = 0.5 * np.arccos(np.clip(-2.0 * q[:, 0], -1.0, 1.0))
+    sol = ts.solve(ts.LevelSet(0.97 * d), g, [(-0.5, 0, 0)])
+    assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] == 0
+    assert np.max(np.abs(sol(q) - exact)) < 0.016  # 0.0147; the exact distance 0.0134
+    with pytest.raises(ValueError, match=r"\|∇φ\| is 0\.898 on average .*divide φ by 0\.898"):
+        ts.solve(ts.LevelSet(0.9 * d), g, [(-0.5, 0, 0)], order=2)
+    with pytest.warns(RuntimeWarning, match=r"order='auto' ran the first-order scheme \(errors of order Δx"):
+        sol = ts.solve(ts.LevelSet(0.9 * d), g, [(-0.5, 0, 0)])
+    assert sol.stats.order == 1 and "redistance=True" in sol.stats.order_fallback

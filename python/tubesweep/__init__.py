@@ -24,7 +24,7 @@ from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .box_solution import BoxSolution
 from .euclidean import travel_time
-from .evolve import evolve
+from .evolve import Evolution, EvolutionStopped, evolve
 from .grid import Grid
 from .output import export, plot, triangulate
 from .solve import Solution, solve
@@ -48,6 +48,8 @@ __all__ = [
     "Surface",
     "data",
     "evolve",
+    "Evolution",
+    "EvolutionStopped",
     "export",
     "flows",
     "hamiltonians",

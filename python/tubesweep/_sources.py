@@ -25,6 +25,17 @@ SOURCE_RADIUS = 2.0
 CHORD_TOLERANCE = 0.1
 
 
+def check_on_surface(sources: np.ndarray, dist: np.ndarray, inner_width: float) -> None:
+    """Refuses a source farther from the surface than the inner tube (``dist``: the sources'
+    distances to their closest points, ``inner_width``: inner·Δx)."""
+    for i, (dd, s) in enumerate(zip(dist, sources)):
+        if dd > inner_width * (1 + 1e-6):
+            raise ValueError(
+                f"sources[{i}] = {tuple(float(x) for x in s)} is {dd:.4g} from the surface, farther than the inner tube "
+                f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
+            )
+
+
 def _fix_sources(
     surface: Surface,
     grid: Grid,
@@ -47,12 +58,7 @@ def _fix_sources(
     h = grid.spacing
     d = grid.ndim
     dist, proj = surface.project(sources, grid)
-    for i, (dd, s) in enumerate(zip(dist, sources)):
-        if dd > inner_width * (1 + 1e-6):
-            raise ValueError(
-                f"sources[{i}] = {tuple(float(x) for x in s)} is {dd:.4g} from the surface, farther than the inner tube "
-                f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
-            )
+    check_on_surface(sources, dist, inner_width)
     best: dict = {}
     r = int(np.ceil(radius + inner_width / h)) + 1
     # the nodes around a source: a box of (2r + 1)^d offsets, or for a box larger than the band

@@ -23,14 +23,16 @@ from pathlib import Path
 from typing import Any, Callable, List, Optional, Union
 
 import numpy as np
+from xml.sax.saxutils import quoteattr
 
 from ._validate import as_grid, as_sources, real_scalar
+from ._sources import check_on_surface
 from .solution import Solution
 from .output import export
 from .surface import LevelSet
 from .tube import Tube
 
-__all__ = ["evolve", "Evolution"]
+__all__ = ["evolve", "Evolution", "EvolutionStopped"]
 
 
 @dataclasses.dataclass
@@ -47,6 +49,15 @@ class Evolution:
     warm_starts, cold_starts : int
         Steps whose surface solve ran warm, and cold (the first, any whose warm start was refused,
         and any that started again cold when a safeguard fired: ``order2["warm"]["restarted"]``).
+
+    Examples
+    --------
+    >>> import numpy as np, tubesweep as ts
+    >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
+    >>> phi = np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1) - 0.5
+    >>> ev = ts.evolve(phi, grid, [(0, 0, 0.5)], lambda u: 0.2 + 0 * u, dt=0.05, steps=2)
+    >>> [round(t, 2) for t in ev.times], ev.warm_starts + ev.cold_starts
+    ([0.0, 0.05, 0.1], 3)
     """
 
     times: List[float]
@@ -92,12 +103,52 @@ class Evolution:
         for k, (t, sol) in enumerate(zip(self.times, self.solutions)):
             frame = path.with_name(f"{path.stem}_{k:04d}.vtp")
             export(sol, frame)
-            rows.append(f'    <DataSet timestep="{t:.17g}" group="" part="0" file="{frame.name}"/>')
+            # the name as an XML attribute: '&', '<' and quotes escaped
+            rows.append(f'    <DataSet timestep="{t:.17g}" group="" part="0" file={quoteattr(frame.name)}/>')
         path.write_text(
             '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
             "  <Collection>\n" + "\n".join(rows) + "\n  </Collection>\n</VTKFile>\n"
         )
         return path
+
+
+class EvolutionStopped(ValueError):
+    """:func:`evolve` could not go on: the surface vanished or shrank below the grid, the part
+    that carries a source did, a step broke the CFL condition or the speed law's values, or a
+    surface solve failed to converge. The message names the step, the time and the cause (the
+    exception it came from is chained as ``__cause__``).
+
+    Attributes
+    ----------
+    evolution : Evolution
+        The frames computed before it stopped.
+    step : int
+        The step at which it stopped.
+    time : float
+        The time of that step.
+
+    Examples
+    --------
+    A sphere of radius 0.3 shrinking at speed 1 falls below the grid at t = 0.24 (N = 31):
+
+    >>> import warnings
+    >>> import numpy as np, tubesweep as ts
+    >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
+    >>> phi = np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1) - 0.3
+    >>> try:
+    ...     with warnings.catch_warnings():
+    ...         warnings.simplefilter("ignore")  # the narrow gaps across its centre, on the way
+    ...         ts.evolve(phi, grid, [(0, 0, 0.3)], lambda u: -1 + 0 * u, dt=0.03, steps=20)
+    ... except ts.EvolutionStopped as e:
+    ...     print(e.step, len(e.evolution.times), round(e.time, 2))
+    8 8 0.24
+    """
+
+    def __init__(self, message: str, evolution: "Evolution", step: int, time: float) -> None:
+        super().__init__(message)
+        self.evolution = evolution
+        self.step = step
+        self.time = time
 
 
 #: φ is advanced as it is (φ ← φ − Δt·V|∇φ|) while |∇φ| stays within this factor of 1 over the
@@ -150,7 +201,15 @@ def _write_checkpoint(path: Path, **arrays: Any) -> None:
 
 
 def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) -> np.ndarray:
-    v = np.asarray(speed(u.copy()), dtype=float)  # a copy: a law that writes to u leaves the solution alone
+    raw = speed(u.copy())  # a copy: a law that writes to u leaves the solution alone
+    if raw is None:
+        raise TypeError(
+            "evolve: speed(u) returned None; it must return the normal speed V: an array like u, or a number"
+        )
+    a = np.asarray(raw)
+    if np.iscomplexobj(a) or not (np.issubdtype(a.dtype, np.number) or a.dtype == np.bool_):
+        raise TypeError(f"evolve: speed(u) must return real numbers (the normal speed V); got dtype {a.dtype}")
+    v = a.astype(float)
     if v.ndim == 0:
         v = np.full(u.shape, float(v))
     if v.shape != u.shape:
@@ -226,9 +285,17 @@ def evolve(
     Raises
     ------
     ValueError
-        If ``dt``, ``steps``, ``cfl`` or ``every`` is not valid, the speed law returns NaN or inf
-        or the wrong shape, or a step violates the CFL condition (the message gives the largest Δt
-        allowed); or as :func:`tubesweep.solve`.
+        If ``dt``, ``steps``, ``cfl``, ``every`` or the checkpoint's folder is not valid, or, at
+        the first step, the speed law returns NaN or inf or the wrong shape, the CFL condition
+        fails (the message gives the largest Δt allowed) or :func:`tubesweep.solve` refuses the
+        surface or the sources (they must lie on it).
+    EvolutionStopped
+        A ``ValueError`` raised at a later step: the surface or the part that carries a source
+        vanished or shrank below the grid, the speed law or the CFL condition failed, or a surface
+        solve did not converge. It names the step and the time, and its ``evolution`` holds the
+        frames computed before.
+    TypeError
+        If ``speed`` is not callable or returns None or values that are not real numbers.
 
     Examples
     --------
@@ -263,6 +330,11 @@ def evolve(
         raise ValueError(
             f"evolve: checkpoint is written with numpy.savez and must end in .npz; got {str(checkpoint)!r}"
         )
+    if checkpoint is not None and not Path(checkpoint).resolve().parent.is_dir():
+        raise ValueError(
+            f"evolve: the folder of checkpoint={str(checkpoint)!r} does not exist; create it first (the checkpoint is "
+            "written after the first step's solve)"
+        )
     if not callable(speed):
         raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
     h = grid.spacing
@@ -273,11 +345,38 @@ def evolve(
     previous_band: Optional[np.ndarray] = None
     t = t0
     for step in range(steps + 1):
-        surf = LevelSet(arr, redistance=True)
-        tube = Tube(surf, grid) if tube is None else tube.moved(surf)
-        src = np.ascontiguousarray(surf.project(src, grid)[1])
-        warm: Any = None if prev is None else (prev if older is None else (older, prev))
-        sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
+        try:
+            surf = LevelSet(arr, redistance=True)
+            tube = Tube(surf, grid) if tube is None else tube.moved(surf)
+            # onto the surface: at step 0 the caller's sources, refused as ts.solve refuses them
+            # when off it by more than the inner tube; later, carried onto the moved surface
+            dist, feet = surf.project(src, grid)
+            if step == 0:
+                check_on_surface(src, dist, tube.inner * grid.spacing)
+            src = np.ascontiguousarray(feet)
+            warm: Any = None if prev is None else (prev if older is None else (older, prev))
+            sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
+        except ValueError as e:
+            if step == 0:
+                raise  # the caller's surface or sources, refused as by ts.solve
+            raise EvolutionStopped(
+                f"evolve stopped at step {step} (t = {t:.6g}): the surface, or the part of it that carries a source, "
+                f"vanished or shrank below a few grid spacings: {e}. The frames so far are in this exception's "
+                "evolution attribute",
+                out,
+                step,
+                t,
+            ) from e
+        if not sol.stats.converged:
+            raise EvolutionStopped(
+                f"evolve stopped at step {step} (t = {t:.6g}): the surface solve did not converge (its last change "
+                f"{sol.stats.last_change:.3g}); advancing φ with its values would move the surface by a wrong law. A "
+                "finer grid, a looser tol or a smaller dt may help; the frames so far are in this exception's "
+                "evolution attribute",
+                out,
+                step,
+                t,
+            )
         # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
         # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
         linear = tube._tube.linear
@@ -304,12 +403,24 @@ def evolve(
         if step == steps:
             break
         u = sol.values
-        v = _speed_values(speed, u, step)
+        try:
+            v = _speed_values(speed, u, step)
+        except ValueError as e:
+            if step == 0:
+                raise
+            raise EvolutionStopped(
+                f"{e}. The frames so far are in this exception's evolution attribute", out, step, t
+            ) from e
         vmax = float(np.max(np.abs(v)))
         if dt * vmax > cfl * h:
-            raise ValueError(
+            message = (
                 f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
                 f"cfl·Δx = {cfl * h:.4g} (max|V| = {vmax:.4g}); take dt ≤ {cfl * h / vmax:.4g}"
+            )
+            if step == 0:
+                raise ValueError(message)
+            raise EvolutionStopped(
+                message + ". The frames so far are in this exception's evolution attribute", out, step, t
             )
         new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
         new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)

@@ -182,10 +182,13 @@ def carried_values(
     # never reached, on a part without a source, stays unreached: the sweeps leave it at +∞)
     missing = int(np.count_nonzero(inner_new & ~in_both))
     if missing:
+        # the previous band's width is the limit (the new tube's may be wider)
+        prev_outer = float(getattr(warm, "outer", tube.outer_eff))
         raise WarmStartRefused(
             f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved farther than "
-            f"outer − inner = {slack / h:g} grid spacings since the previous solution. Move in smaller steps (at most "
-            "outer − inner spacings per solve), widen the tube (outer=), or solve cold (leave out warm=)"
+            f"the previous solution's outer − inner = {prev_outer - inner_width / h:g} grid spacings since it. Move in "
+            "smaller steps (at most outer − inner spacings per solve), build the tubes of both steps wider "
+            "(ts.Tube(..., outer=6); tube.moved keeps the widths), or solve cold (leave out warm=)"
         )
     n_old, _ = inner_components(warm._band, warm.roles, getattr(warm, "_inner_components", None))
     tube.inner_components = inner_components(tube.band, tube.roles, tube.inner_components)
