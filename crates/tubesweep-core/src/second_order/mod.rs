@@ -159,7 +159,9 @@ pub fn check_geometry_of(
             "ts.LevelSet(phi, redistance=True) re-distances φ, or use order=1".to_string()
         }
     } else {
-        "refine the grid, or use order=1".to_string()
+        "the grid does not resolve the surface (curvature radii below the tube's width, or noise at the grid's \
+         scale): refine the grid or smooth φ, or use order=1"
+            .to_string()
     };
     Err(Error::invalid(
         if gradient { "surface" } else { "grid" },
