@@ -240,4 +240,3 @@ def test_a_plane_or_a_sampled_phi_crossing_the_box_is_recorded_without_a_warning
     grid = ts.Grid((-1, -1, -1), (0.3, 1, 1), (66, 101, 101))
     with pytest.warns(RuntimeWarning, match="grid box cuts the surface"):
         ts.solve(torus, grid, [(-0.85, 0, 0)], order=1)
-

@@ -112,8 +112,9 @@ pub struct GeometrySummary {
     /// Inner-tube nodes whose central differences give |∇φ| off 1 by more than
     /// [`NOISY_GRADIENT`] (the measure of noise, [`Self::noisy`]).
     pub rough_gradients: usize,
-    /// The count, sum and sum of squares of those |∇φ| (their spread, [`Self::noisy`]).
-    pub gradient_moments: (usize, f64, f64),
+    /// The count, sum and sum of squares of those |∇φ| (their spread, [`Self::noisy`]), in fixed
+    /// point ([`MOMENT_SCALE`]): integers, so that the sums are the same whatever the split.
+    pub gradient_moments: (usize, u128, u128),
     /// Whether every node's derivatives come from the local fit ([`super::local_fit`]): set
     /// before the pass when a first pass found φ noisy.
     pub fitted_everywhere: bool,
@@ -149,6 +150,11 @@ pub const NOISY_GRADIENT: f64 = 0.01;
 /// `redistance=True` or dividing φ by c cures.
 pub const NOISY_SPREAD: f64 = 0.5 * NOISY_GRADIENT;
 
+/// [`GeometrySummary::gradient_moments`]' fixed point: |∇φ| in units of 2⁻²⁴, capped at
+/// [`MOMENT_CAP`] (a sum of squares of 2⁴⁸·10⁸ per node stays far inside u128 for any band).
+const MOMENT_SCALE: f64 = 16_777_216.0;
+const MOMENT_CAP: f64 = 1e4;
+
 /// When φ is noisy ([`NOISY_FRACTION`]), the fit is taken over the nodes within three grid steps
 /// (123 in 3D, 29 in 2D; at a node near the band's edge over those of them in the band), which
 /// averages the noise out of the surface's closest points (x − φ∇φ) as well as out of B: the
@@ -167,7 +173,7 @@ impl GeometrySummary {
             unresolved_curvature: 0,
             inner_nodes: 0,
             rough_gradients: 0,
-            gradient_moments: (0, 0.0, 0.0),
+            gradient_moments: (0, 0, 0),
             fitted_everywhere: false,
             creases: Creases::default(),
         }
@@ -199,12 +205,22 @@ impl GeometrySummary {
 
     /// Whether a pass with these counts found φ noisy ([`NOISY_FRACTION`]).
     pub fn noisy(&self) -> bool {
-        let (count, sum, squares) = self.gradient_moments;
-        let mean = sum / count.max(1) as f64;
-        let spread = (squares / count.max(1) as f64 - mean * mean).max(0.0).sqrt();
+        let spread = self.gradient_mean_spread().1;
         !self.fitted_everywhere
             && self.rough_gradients as f64 > NOISY_FRACTION * self.inner_nodes as f64
             && spread > NOISY_SPREAD
+    }
+
+    /// The mean and standard deviation of |∇φ| by central differences over the inner tube (0
+    /// and 0 when none was measured).
+    pub fn gradient_mean_spread(&self) -> (f64, f64) {
+        let (count, sum, squares) = self.gradient_moments;
+        let n = count.max(1) as f64;
+        let mean = sum as f64 / MOMENT_SCALE / n;
+        let spread = (squares as f64 / (MOMENT_SCALE * MOMENT_SCALE) / n - mean * mean)
+            .max(0.0)
+            .sqrt();
+        (mean, spread)
     }
 
     /// The inner-tube nodes that run the first-order update (every [`Unresolved`] reason).
@@ -263,8 +279,9 @@ pub(crate) fn node_geometry<const D: usize>(
             summary.rough_gradients += 1;
         }
         if norm.is_finite() {
+            let q = (norm.min(MOMENT_CAP) * MOMENT_SCALE).round() as u128;
             let m = &mut summary.gradient_moments;
-            *m = (m.0 + 1, m.1 + norm, m.2 + norm * norm);
+            *m = (m.0 + 1, m.1 + q, m.2 + q * q);
         }
     }
     let resolved = match first {

@@ -145,12 +145,12 @@ pub fn check_geometry_of(
             if closest_point { "an open surface's rim, " } else { "" }
         ));
     }
-    let (count, sum, _) = summary.gradient_moments;
+    let (count, _, _) = summary.gradient_moments;
     let gradient = !closest_point && 2 * summary.off_distance > unresolved;
     let advice = if gradient {
         // mostly φ's gradient: a finer grid does not change that
         if count > 0 {
-            let mean = sum / count as f64;
+            let mean = summary.gradient_mean_spread().0;
             format!(
                 "|∇φ| is {mean:.3} on average near the surface: ts.LevelSet(phi, redistance=True) re-distances φ (or \
                  divide φ by {mean:.3} if it is a scaled distance), or use order=1"
