@@ -266,3 +266,17 @@ def test_a_cloud_s_vtp_reads_back_with_its_normals(tmp_path):
     np.testing.assert_allclose(points, cloud.points, rtol=1e-15)
     np.testing.assert_allclose(data["normals"], cloud.normals, rtol=1e-15)
     np.testing.assert_allclose(data["u"], sol(cloud.points), rtol=1e-15)
+
+
+def test_a_sample_half_a_cell_off_its_neighbours_surface_gets_a_cloud_s_message():
+    # one sample of 5000 moved 0.5Δx off the sphere: not an outlier, not smoothed out, it folds the
+    # closest points and the band cannot close; the message spoke of a level set's φ and LevelSet
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    x = np.random.default_rng(0).normal(size=(5000, 3))
+    p = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
+    p[0] *= 1.05
+    cloud = ts.surfaces.from_points(np.r_[p, [[-0.5, 0, 0]]])
+    with pytest.warns(RuntimeWarning, match="Widening the extension layer"):
+        with pytest.raises(ValueError, match=r"lack a neighbour \(the first near .*Some samples lie off") as info:
+            ts.solve(cloud, g, [(-0.5, 0, 0)])
+    assert "LevelSet" not in str(info.value) and "neighbours=" in str(info.value)

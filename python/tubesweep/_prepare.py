@@ -59,6 +59,11 @@ def _widening_message(missing: np.ndarray, phi: np.ndarray, h: float, inner: flo
     )
 
 
+def _where(grid: Grid, node: Any) -> str:
+    """A grid node's position, for a message: ``(x, y, z)`` to four digits."""
+    return "(" + ", ".join(f"{float(v):.4g}" for v in grid.node_points(np.array([int(node)]))[0]) + ")"
+
+
 def _percent(share: float) -> str:
     """A share as a short percentage: '0.1%', '12%', or '< 0.01%'."""
     if share < 1e-4:
@@ -381,8 +386,9 @@ def _prepare_tube(
         # (catch_warnings only where needed: entering and leaving it resets Python's record of the
         # warnings already shown, and a solve repeated in a loop would then repeat its warnings)
         with warnings.catch_warnings() if attempt > 0 else contextlib.nullcontext():
-            if attempt > 0:  # a warning about the band's nodes was given at the first attempt
+            if attempt > 0:  # warnings about the band's nodes and φ's gradient were given at the first attempt
                 warnings.filterwarnings("ignore", message=".*could not be projected onto it", category=RuntimeWarning)
+                warnings.filterwarnings("ignore", message="φ is only roughly a distance", category=RuntimeWarning)
             geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
             raise ValueError(
@@ -438,11 +444,14 @@ def _prepare_tube(
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
+            advice = getattr(surf, "band_advice", None)  # a surface kind's own cause (a point cloud's)
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
-                "inner nodes lack a neighbour. "
+                f"inner nodes lack a neighbour (the first near {_where(grid, linear[missing[0]])}). "
                 + (
-                    ""
+                    advice + ", or "
+                    if advice
+                    else ""
                     if redistanced
                     else "φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or "
                 )

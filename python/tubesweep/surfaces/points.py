@@ -245,6 +245,13 @@ class PointCloudSurface(ClosestPoint):
     (False, 0)
     """
 
+    #: Why the band of a cloud's closest points may not close, for the band's error (``_prepare``).
+    band_advice = (
+        "Some samples lie off their neighbours' surface by about half a grid spacing (too little for the outlier "
+        "test, too much for the local fits to smooth out), which folds the closest points there: leave such samples "
+        "out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid"
+    )
+
     def __init__(
         self,
         points: Any,
