@@ -285,7 +285,7 @@ def warn_facing_pairs(
         return
     h = grid.spacing
     narrowest = int(np.argmin(gap))
-    where = ", ".join(f"{float(v):.4g}" for v in grid.node_points(linear[node[narrowest : narrowest + 1]])[0])
+    where = _where(grid, linear[node[narrowest]])
     needed = float(gap[narrowest]) / (2 * inner + 2)
     # how much of the surface: the inner-tube nodes of the pairs among all inner-tube nodes
     inner_nodes = roles == ROLE_INNER
@@ -293,7 +293,7 @@ def warn_facing_pairs(
     share = np.count_nonzero(inner_nodes[touched]) / max(int(np.count_nonzero(inner_nodes)), 1)
     warnings.warn(
         f"the surface faces itself across gaps narrower than its tubes at {node.size} node pair(s), about "
-        f"{_percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near ({where})). Distances "
+        f"{_percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near {where}). Distances "
         "reached across such a gap can come out too short; elsewhere the result holds. sol.narrow_gaps() shows where; "
         f"a grid spacing below {needed:.3g} (now {h:.3g}) resolves a real gap, while a crease or scan artefact stays "
         "narrower than any grid",
@@ -444,17 +444,14 @@ def _prepare_tube(
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
-            advice = getattr(surf, "band_advice", None)  # a surface kind's own cause (a point cloud's)
+            # a surface kind's own cause (a point cloud's), or φ's for a level set not re-distanced
+            cause = getattr(surf, "band_advice", None)
+            if cause is None and not redistanced:
+                cause = "φ is far from a distance function (use ts.LevelSet(phi, redistance=True))"
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
                 f"inner nodes lack a neighbour (the first near {_where(grid, linear[missing[0]])}). "
-                + (
-                    advice + ", or "
-                    if advice
-                    else ""
-                    if redistanced
-                    else "φ is far from a distance function (use ts.LevelSet(phi, redistance=True)), or "
-                )
+                + (f"{cause}, or " if cause else "")
                 + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
                 "than the tube: refine the grid)"
                 + (

@@ -145,7 +145,7 @@ class EvolutionStopped(ValueError):
     """
 
     def __init__(self, message: str, evolution: "Evolution", step: int, time: float) -> None:
-        super().__init__(message)
+        super().__init__(f"{message}. The frames so far are in this exception's evolution attribute")
         self.evolution = evolution
         self.step = step
         self.time = time
@@ -361,8 +361,7 @@ def evolve(
                 raise  # the caller's surface or sources, refused as by ts.solve
             raise EvolutionStopped(
                 f"evolve stopped at step {step} (t = {t:.6g}): the surface, or the part of it that carries a source, "
-                f"vanished or shrank below a few grid spacings: {e}. The frames so far are in this exception's "
-                "evolution attribute",
+                f"vanished or shrank below a few grid spacings: {e}",
                 out,
                 step,
                 t,
@@ -371,8 +370,7 @@ def evolve(
             raise EvolutionStopped(
                 f"evolve stopped at step {step} (t = {t:.6g}): the surface solve did not converge (its last change "
                 f"{sol.stats.last_change:.3g}); advancing φ with its values would move the surface by a wrong law. A "
-                "finer grid, a looser tol or a smaller dt may help; the frames so far are in this exception's "
-                "evolution attribute",
+                "finer grid, a looser tol or a smaller dt may help",
                 out,
                 step,
                 t,
@@ -408,9 +406,7 @@ def evolve(
         except ValueError as e:
             if step == 0:
                 raise
-            raise EvolutionStopped(
-                f"{e}. The frames so far are in this exception's evolution attribute", out, step, t
-            ) from e
+            raise EvolutionStopped(str(e), out, step, t) from e
         vmax = float(np.max(np.abs(v)))
         if dt * vmax > cfl * h:
             message = (
@@ -419,9 +415,7 @@ def evolve(
             )
             if step == 0:
                 raise ValueError(message)
-            raise EvolutionStopped(
-                message + ". The frames so far are in this exception's evolution attribute", out, step, t
-            )
+            raise EvolutionStopped(message, out, step, t)
         new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
         new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
         arr = new

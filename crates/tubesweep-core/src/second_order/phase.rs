@@ -11,7 +11,7 @@ use crate::sweep::{Control, IterationReport, NodeRole};
 use super::pipeline::Pipeline;
 use super::rows::{Isa, RowWalk, RowsState};
 use super::solver::{Limits, SecondOrderOptions, SecondOrderStats, Sweeper};
-use super::stagnation::{in_a_limit_cycle, stalled};
+use super::stagnation::{creeping, in_a_limit_cycle, stalled};
 
 /// The front window opens fully when its edge has not moved for this many iterations.
 const WINDOW_PATIENCE: usize = 10;
@@ -127,12 +127,8 @@ pub(super) fn run_phase<const D: usize>(
             }
             if lim.decreases_only {
                 decreases.push(change.max_change);
-                let w = options.stall_window.max(decreases.len() / 2).min(decreases.len());
-                let least = decreases[decreases.len() - w..]
-                    .iter()
-                    .copied()
-                    .fold(f64::INFINITY, f64::min);
-                if least > CREEP_TOLERANCES * tol && stalled(&decreases, options.stall_window, options.stall_ratio) {
+                let floor = CREEP_TOLERANCES * tol;
+                if creeping(&decreases, options.stall_window, options.stall_ratio, floor) {
                     stats.runaway_iteration = Some(*iteration - stats.first_order_iterations);
                     return Ok(false);
                 }

@@ -61,6 +61,14 @@ pub(super) fn stalled(changes: &[f64], window: usize, ratio: f64) -> bool {
     recent > ratio * before
 }
 
+/// The creep of iterations that accept decreases only ([`super::phase`]'s runaway test): the
+/// largest changes `changes` stalled ([`stalled`]) with every change of the stretch above `floor`.
+pub(super) fn creeping(changes: &[f64], window: usize, ratio: f64, floor: f64) -> bool {
+    let m = changes.len();
+    let w = window.max(m / 2).min(m);
+    changes[m - w..].iter().all(|&c| c > floor) && stalled(changes, window, ratio)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
