@@ -10,3 +10,29 @@ def fit_order(hs, errs):
 @pytest.fixture
 def order():
     return fit_order
+
+
+#: The start of the warning of ``order="auto"``'s first-order fallback on a grid that does not
+#: resolve the surface (``tubesweep._fallback_size``).
+FIRST_ORDER_SIZE = "order='auto' ran the paper's first-order scheme, whose errors are about Δx·κ"
+
+
+@pytest.fixture
+def first_order_size():
+    """``first_order_size(expected)``: a context in which the solves raise no warning but the
+    first-order fallback's size warning, asserted to fire ``expected`` times (``True``: once;
+    ``None``: any number)."""
+    import contextlib
+    import warnings
+
+    @contextlib.contextmanager
+    def context(expected: "int | None" = 1):
+        with warnings.catch_warnings(record=True) as record:
+            warnings.simplefilter("always")
+            yield record
+        messages = [str(w.message) for w in record]
+        sized = [m for m in messages if m.startswith(FIRST_ORDER_SIZE)]
+        assert expected is None or len(sized) == int(expected), messages
+        assert len(messages) == len(sized), messages
+
+    return context

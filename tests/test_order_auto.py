@@ -2,10 +2,14 @@
 bit the explicit order=2; the first-order scheme where it does not, bit for bit the explicit
 order=1, with the reason an explicit order=2 gives recorded in sol.stats.order_fallback."""
 
+import contextlib
+import re
+
 import numpy as np
 import pytest
 
 import tubesweep as ts
+from conftest import FIRST_ORDER_SIZE
 
 SPHERE = ts.surfaces.Sphere(0.5)
 SRC = (-0.5, 0.0, 0.0)
@@ -18,6 +22,11 @@ def box(n, d=3):
 def _sphere_cp(x):
     r = np.linalg.norm(x, axis=1, keepdims=True)
     return 0.5 * x / np.where(r > 0, r, 1.0)
+
+
+def sized_if(expected):
+    """The first-order fallback's size warning, asserted when ``expected`` (``_fallback_size``)."""
+    return pytest.warns(RuntimeWarning, match=re.escape(FIRST_ORDER_SIZE)) if expected else contextlib.nullcontext()
 
 
 def _refusal(surface, grid, sources, **kw):
@@ -84,7 +93,8 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
     reason = _refusal(surface, grid, [src], **kw)
     assert words in reason
     one = ts.solve(surface, grid, [src], order=1, **kw)
-    auto = ts.solve(surface, grid, [src], order="auto", **kw)
+    with sized_if(words == "refine the grid"):  # first order on a sphere 7.5 spacings across: 22%
+        auto = ts.solve(surface, grid, [src], order="auto", **kw)
     assert auto.stats.order == 1 and one.stats.order == 1
     assert auto.stats.order_fallback == reason and one.stats.order_fallback is None
     if words == "crease":
@@ -101,7 +111,8 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
         tube = ts.Tube(surface, grid, **{k: v for k, v in kw.items() if k in ("inner", "outer")})
         opts = {k: v for k, v in kw.items() if k not in ("inner", "outer", "method", "max_iterations")}
         for _ in range(2):  # the second time from the refusal the tube remembers
-            t = tube.solve([src], order="auto", **opts)
+            with sized_if(words == "refine the grid"):
+                t = tube.solve([src], order="auto", **opts)
             # a Tube's "auto" runs on the same tube as ts.solve's (thinned at creases): the same
             # refusal and the same values
             assert t.stats.order_fallback == auto.stats.order_fallback
@@ -155,6 +166,7 @@ def test_the_default_is_auto():
     assert default.stats.order == 2 and np.array_equal(default.values, auto.values)
     assert np.array_equal(ts.Tube(SPHERE, g).solve([SRC]).values, auto.values)
     mesh = ts.surfaces.from_mesh(SPHERE.triangulation(12), smooth=False)
-    default = ts.solve(mesh, g, [SRC])
+    with sized_if(True):  # the mesh at N = 31, first order: 13% of the distances
+        default = ts.solve(mesh, g, [SRC])
     assert default.stats.order == 1 and "piecewise flat" in default.stats.order_fallback
     assert np.array_equal(default.values, ts.solve(mesh, g, [SRC], order=1).values)

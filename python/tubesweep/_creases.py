@@ -55,11 +55,11 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float) -> None:
     )
 
 
-def warn_refused_creases(reason: str, inner: float, spacing: float) -> None:
+def warn_refused_creases(reason: str, inner: float, spacing: float) -> bool:
     """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases
-    (on the tube thinned at them: :data:`THINNED_SHORTCUT`)."""
+    (on the tube thinned at them: :data:`THINNED_SHORTCUT`); whether it warned."""
     if _CONVEX_CREASES.search(reason) is None:
-        return
+        return False
     size = THINNED_SHORTCUT * float(spacing)
     warnings.warn(
         f"order=1 ran: φ's level sets have convex creases or corners over much of the tube, where a front cuts the "
@@ -69,6 +69,7 @@ def warn_refused_creases(reason: str, inner: float, spacing: float) -> None:
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
+    return True
 
 
 def crease_nodes_to_extend(

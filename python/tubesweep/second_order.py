@@ -57,6 +57,13 @@ class Order2NotApplicable(ValueError):
     ``sol.stats.order_fallback``."""
 
 
+class OptionOfOrder1(Order2NotApplicable):
+    """An option the caller chose that only the first-order scheme has (a Hamiltonian, a flow, the
+    naive tube, the paper's sweeps, ``source_init="node"``, ``source_radius``, narrow widths):
+    ``order="auto"`` runs it without a warning of its errors' size (the caller chose that scheme),
+    as it does not for a fallback the surface or the grid caused (:mod:`tubesweep._fallback_size`)."""
+
+
 class Order2RanAway(Order2NotApplicable):
     """The second-order sweeps ran away (travel times falling below zero) and so did their
     first-order factored restart: the factored update ``u = u₀ + w`` is not causal where the speed
@@ -191,20 +198,20 @@ def check_supported(
     from .surface import LevelSet
 
     if general is not None or scheme != "godunov":
-        raise Order2NotApplicable(
+        raise OptionOfOrder1(
             "order=2 solves the isotropic eikonal equation with the Godunov update only "
             f"(hamiltonian={scheme!r} given); use order=1 for Lax–Friedrichs, flows and general Hamiltonians"
         )
     if method != "two-layer":
-        raise Order2NotApplicable(
+        raise OptionOfOrder1(
             f"order=2 needs method='two-layer' (got {method!r}); the naive tube is the paper's baseline"
         )
     if paper_sweeps:
-        raise Order2NotApplicable(
+        raise OptionOfOrder1(
             "paper_sweeps=True runs the paper's first-order sweeps; it cannot be combined with order=2"
         )
     if source_init_given == "node":
-        raise Order2NotApplicable(
+        raise OptionOfOrder1(
             "order=2 factors the point sources (u = u₀ + w); source_init='node' is the paper's first-order "
             "initialisation: use order=1 for it"
         )
@@ -233,7 +240,7 @@ def check_widths(inner: Any, outer: Any) -> None:
         for w in (inner, outer)
     )
     if numbers and float(outer) < float(inner) + 2.0 - 1e-9:
-        raise Order2NotApplicable(
+        raise OptionOfOrder1(
             f"order=2 needs two band neighbours on each side of every inner-tube node: outer ≥ inner + 2 grid spacings "
             f"(got inner={float(inner):g}, outer={float(outer):g}); pass outer={float(inner) + 2.0:g} or more (the "
             "defaults are inner=2, outer=4), or order=1"
@@ -387,20 +394,26 @@ RAN_AWAY_RESTARTED = (
 NOT_A_DISTANCE = "redistance=True) re-distances φ"
 
 
-def warn_fallback(e: Order2NotApplicable, order: Any) -> None:
+def warn_fallback(e: Order2NotApplicable, order: Any) -> bool:
     """With ``order="auto"``, a warning for a fallback to the first-order scheme that the solve
     found only by running (:class:`Order2RanAway`), or that a φ which is not a signed distance
     caused (errors of order Δx instead of Δx², cured by ``redistance=True``); the other refusals
-    (a mesh, an option of the first-order scheme, ...) are in ``sol.stats.order_fallback`` alone."""
+    (a mesh, a grid that does not resolve the surface, ...) are in ``sol.stats.order_fallback``,
+    and in a warning after the solve when its errors are large (:mod:`tubesweep._fallback_size`).
+    Whether the fallback needs no word after the solve: warned here, or an option the caller chose
+    (:class:`OptionOfOrder1`)."""
     if order != "auto":
-        return
+        return False
+    if isinstance(e, OptionOfOrder1):
+        return True
     if isinstance(e, Order2RanAway):
         text = f"{e}; the first-order solution is returned"
     elif NOT_A_DISTANCE in str(e):
         text = f"order='auto' ran the first-order scheme (errors of order Δx, not Δx²): {e}"
     else:
-        return
+        return False
     warnings.warn(f"{text} (sol.stats.order_fallback keeps this)", RuntimeWarning, stacklevel=user_stacklevel())
+    return True
 
 
 def warn_about(

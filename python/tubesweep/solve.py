@@ -24,6 +24,7 @@ from ._validate import (
     speed_values,
     warn_unconverged,
 )
+from ._fallback_size import curvature_to_size, warn_first_order
 from ._result_check import check_values
 from .grid import Grid
 from .moving import check_warm_refused
@@ -248,12 +249,13 @@ def solve(
     check_warm_refused(warm_refused)
     tube: Optional[_PreparedTube] = None
     fallback: Optional[str] = None
+    said = False  # the fallback warned about before the solve, or an option the caller chose
     if order != 1:
         from . import second_order as _so
 
         try:
             if source_radius is not None:
-                raise _so.Order2NotApplicable(
+                raise _so.OptionOfOrder1(
                     "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
                 )
             _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
@@ -274,7 +276,7 @@ def solve(
         except _so.Order2NotApplicable as e:
             if order == 2:
                 raise
-            _so.warn_fallback(e, order)
+            said = _so.warn_fallback(e, order)
             fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
     if warm is not None and warm_refused == "raise":
         from .moving import refusal_for_order1
@@ -288,6 +290,7 @@ def solve(
     reuse = tube is not None
     if tube is None:
         tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
+    kappa = curvature_to_size(tube, fallback, said)
     sol = _solve_on_tube(
         tube,
         src,
@@ -306,10 +309,9 @@ def solve(
         source_radius=source_radius,
     )
     if fallback is not None:
-        from ._creases import warn_refused_creases
         from .second_order import with_fallback
 
-        warn_refused_creases(fallback, inner, grid.spacing)
+        warn_first_order(fallback, sol.values, tube, kappa, said=said)
         return with_fallback(sol, fallback)
     return sol
 

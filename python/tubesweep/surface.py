@@ -300,8 +300,10 @@ class LevelSet(Surface):
         >>> import numpy as np, tubesweep as ts
         >>> grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
         >>> X, Y, Z = grid.meshgrid()
-        >>> ball = ts.LevelSet.from_mask(X**2 + Y**2 + Z**2 < 0.25, grid)
+        >>> ball = ts.LevelSet.from_mask(X**2 + Y**2 + Z**2 < 0.25, grid, smooth=1)
         >>> sol = ts.solve(ball, grid, [(-0.5, 0, 0)])
+        >>> sol.stats.order  # smoothed over a voxel: second order (a raw mask runs first order)
+        2
         """
         from .mask import level_set_function_of_mask
 

@@ -30,6 +30,7 @@ import numpy as np
 from ._validate import as_grid, as_sources, check_infinity, check_tolerance, progress_callback
 from .grid import Grid
 from .moving import check_warm_refused
+from ._fallback_size import curvature_to_size, warn_first_order
 from ._prepare import _prepare_tube, thinned_at_creases
 from .solution import Solution
 from .solve import _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
@@ -216,12 +217,13 @@ class Tube:
         check_infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
         check_warm_refused(warm_refused)
         fallback: Optional[str] = None
+        said = False  # the fallback warned about before the solve, or an option the caller chose
         if order != 1:
             from . import second_order as _so
 
             try:
                 if source_radius is not None:
-                    raise _so.Order2NotApplicable(
+                    raise _so.OptionOfOrder1(
                         "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
                     )
                 _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
@@ -250,13 +252,14 @@ class Tube:
             except _so.Order2NotApplicable as e:
                 if order == 2:
                     raise
-                _so.warn_fallback(e, order)
+                said = _so.warn_fallback(e, order)
                 fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
         if warm is not None and warm_refused == "raise":
             from .moving import refusal_for_order1
 
             raise refusal_for_order1(fallback)
         _check_source_radius(source_radius, source_init, self.grid)
+        kappa = curvature_to_size(self._tube_order2, fallback, said)  # a Tube keeps its linear indices
         sol = _solve_on_tube(
             self._tube if order == 1 else self._tube_order2,
             src,
@@ -275,10 +278,9 @@ class Tube:
             source_radius=source_radius,
         )
         if fallback is not None:
-            from ._creases import warn_refused_creases
             from .second_order import with_fallback
 
-            warn_refused_creases(fallback, self._tube.inner, self.grid.spacing)
+            warn_first_order(fallback, sol.values, self._tube_order2, kappa, said=said)
             return with_fallback(sol, fallback)
         return sol
 
