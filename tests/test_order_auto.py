@@ -25,7 +25,7 @@ def _sphere_cp(x):
 
 
 def sized_if(expected):
-    """The first-order fallback's size warning, asserted when ``expected`` (``_fallback_size``)."""
+    """The first-order fallback's size warning, asserted when ``expected`` (``_fallback``)."""
     return pytest.warns(RuntimeWarning, match=re.escape(FIRST_ORDER_SIZE)) if expected else contextlib.nullcontext()
 
 

@@ -32,7 +32,7 @@ from ._validate import (
 )
 from ._prepare import ROLE_INNER, uncut_band, warn_facing_pairs
 from ._sheet_readout import own_side_plan
-from ._fallback_size import curvature_to_size, warn_first_order
+from ._fallback import Fallback
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .many_order2 import renamed, solve_many_order2
 from . import second_order as so
@@ -188,8 +188,7 @@ def solve_many(
     nthreads = check_threads(threads)
     inf = check_infinity(infinity)
     points = None if at is None else as_points(at, grid.ndim, "at")
-    fallback: Optional[str] = None
-    said = False  # the fallback warned about before the solve, or an option the caller chose
+    fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
     if order != 1:
         try:
             so.check_supported(t.surface, None, scheme, t.method, source_init, bool(paper_sweeps))
@@ -218,12 +217,12 @@ def solve_many(
         except so.Order2NotApplicable as e:
             if order == 2:
                 raise
-            said = so.warn_fallback(e, order)
-            fallback = str(e)  # order="auto": the first-order scheme, the reason in the stats
+            fallback = Fallback.of(e, order)
     tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if order != 1:
         t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
-    kappa = curvature_to_size(t, fallback, said)
+    if fallback is not None:
+        fallback.measure(t)
     linear = t.linear
     x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
     speed_nodes = speed_values(speed, grid, x, linear)
@@ -271,7 +270,7 @@ def solve_many(
     )
     del directions
     if fallback is not None:
-        warn_first_order(fallback, out, t, kappa, said=said)
+        fallback.warn(out, t)
     if plan is not None:
         m = len(points)  # type: ignore[arg-type]
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])
@@ -290,6 +289,6 @@ def solve_many(
         st["setup_seconds"] = setup
         st["seconds_total"] = time.perf_counter() - t0
         st["order"] = 1
-        st["order_fallback"] = fallback
+        st["order_fallback"] = None if fallback is None else fallback.reason
         return out, st
     return out

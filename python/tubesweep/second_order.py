@@ -61,7 +61,7 @@ class OptionOfOrder1(Order2NotApplicable):
     """An option the caller chose that only the first-order scheme has (a Hamiltonian, a flow, the
     naive tube, the paper's sweeps, ``source_init="node"``, ``source_radius``, narrow widths):
     ``order="auto"`` runs it without a warning of its errors' size (the caller chose that scheme),
-    as it does not for a fallback the surface or the grid caused (:mod:`tubesweep._fallback_size`)."""
+    as it does not for a fallback the surface or the grid caused (:mod:`tubesweep._fallback`)."""
 
 
 class Order2RanAway(Order2NotApplicable):
@@ -399,7 +399,7 @@ def warn_fallback(e: Order2NotApplicable, order: Any) -> bool:
     found only by running (:class:`Order2RanAway`), or that a φ which is not a signed distance
     caused (errors of order Δx instead of Δx², cured by ``redistance=True``); the other refusals
     (a mesh, a grid that does not resolve the surface, ...) are in ``sol.stats.order_fallback``,
-    and in a warning after the solve when its errors are large (:mod:`tubesweep._fallback_size`).
+    and in a warning after the solve when its errors are large (:mod:`tubesweep._fallback`).
     Whether the fallback needs no word after the solve: warned here, or an option the caller chose
     (:class:`OptionOfOrder1`)."""
     if order != "auto":

@@ -24,7 +24,7 @@ from ._validate import (
     speed_values,
     warn_unconverged,
 )
-from ._fallback_size import curvature_to_size, warn_first_order
+from ._fallback import Fallback
 from ._result_check import check_values
 from .grid import Grid
 from .moving import check_warm_refused
@@ -248,8 +248,7 @@ def solve(
     _infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
     check_warm_refused(warm_refused)
     tube: Optional[_PreparedTube] = None
-    fallback: Optional[str] = None
-    said = False  # the fallback warned about before the solve, or an option the caller chose
+    fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
     if order != 1:
         from . import second_order as _so
 
@@ -276,12 +275,11 @@ def solve(
         except _so.Order2NotApplicable as e:
             if order == 2:
                 raise
-            said = _so.warn_fallback(e, order)
-            fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
+            fallback = Fallback.of(e, order)
     if warm is not None and warm_refused == "raise":
         from .moving import refusal_for_order1
 
-        raise refusal_for_order1(fallback)
+        raise refusal_for_order1(None if fallback is None else fallback.reason)
     _check_source_radius(source_radius, source_init, grid)
     # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
     # (unless a general Hamiltonian needs it) and the directions become the extension weights;
@@ -290,7 +288,8 @@ def solve(
     reuse = tube is not None
     if tube is None:
         tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
-    kappa = curvature_to_size(tube, fallback, said)
+    if fallback is not None:
+        fallback.measure(tube)
     sol = _solve_on_tube(
         tube,
         src,
@@ -311,8 +310,8 @@ def solve(
     if fallback is not None:
         from .second_order import with_fallback
 
-        warn_first_order(fallback, sol.values, tube, kappa, said=said)
-        return with_fallback(sol, fallback)
+        fallback.warn(sol.values, tube)
+        return with_fallback(sol, fallback.reason)
     return sol
 
 

@@ -30,7 +30,7 @@ import numpy as np
 from ._validate import as_grid, as_sources, check_infinity, check_tolerance, progress_callback
 from .grid import Grid
 from .moving import check_warm_refused
-from ._fallback_size import curvature_to_size, warn_first_order
+from ._fallback import Fallback
 from ._prepare import _prepare_tube, thinned_at_creases
 from .solution import Solution
 from .solve import _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
@@ -216,8 +216,7 @@ class Tube:
         _check_source_init(source_init)
         check_infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
         check_warm_refused(warm_refused)
-        fallback: Optional[str] = None
-        said = False  # the fallback warned about before the solve, or an option the caller chose
+        fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
         if order != 1:
             from . import second_order as _so
 
@@ -252,14 +251,14 @@ class Tube:
             except _so.Order2NotApplicable as e:
                 if order == 2:
                     raise
-                said = _so.warn_fallback(e, order)
-                fallback = str(e)  # order="auto": the first-order scheme, the reason kept in the stats
+                fallback = Fallback.of(e, order)
         if warm is not None and warm_refused == "raise":
             from .moving import refusal_for_order1
 
-            raise refusal_for_order1(fallback)
+            raise refusal_for_order1(None if fallback is None else fallback.reason)
         _check_source_radius(source_radius, source_init, self.grid)
-        kappa = curvature_to_size(self._tube_order2, fallback, said)  # a Tube keeps its linear indices
+        if fallback is not None:
+            fallback.measure(self._tube_order2)
         sol = _solve_on_tube(
             self._tube if order == 1 else self._tube_order2,
             src,
@@ -280,8 +279,8 @@ class Tube:
         if fallback is not None:
             from .second_order import with_fallback
 
-            warn_first_order(fallback, sol.values, self._tube_order2, kappa, said=said)
-            return with_fallback(sol, fallback)
+            fallback.warn(sol.values, self._tube_order2)
+            return with_fallback(sol, fallback.reason)
         return sol
 
     def moved(self, surface: Any) -> "Tube":

@@ -1,5 +1,5 @@
 """order="auto"'s first-order fallback on a grid that does not resolve the surface: a warning that
-says how large its errors are (python/tubesweep/_fallback_size.py)."""
+says how large its errors are (python/tubesweep/_fallback.py)."""
 
 import re
 import warnings
@@ -9,7 +9,7 @@ import pytest
 
 import tubesweep as ts
 from conftest import FIRST_ORDER_SIZE
-from tubesweep._fallback_size import FIRST_ORDER_SPACINGS, SIZE_WARNING, first_order_share
+from tubesweep._fallback import FIRST_ORDER_SPACINGS, SIZE_WARNING, first_order_share
 
 R = 0.5
 SIZE = r"errors up to about (\d+)% of the distances"
@@ -94,7 +94,7 @@ def test_the_share_is_the_smaller_estimate_over_the_finite_values():
 
 
 def test_the_tube_sees_the_sphere_s_curvature_and_a_flat_plane_s():
-    from tubesweep._fallback_size import mean_curvature
+    from tubesweep._fallback import mean_curvature
     from tubesweep._prepare import _prepare_tube
     from tubesweep.surface import as_surface
 

@@ -1,4 +1,5 @@
-"""How large the errors of ``order="auto"``'s first-order fallback are, said in a warning.
+"""``order="auto"``'s fallback to the first-order scheme (:class:`Fallback`): why, kept in
+``sol.stats.order_fallback``, and how large its errors are, said in a warning.
 
 Where the surface or the grid rules out the second-order scheme (a grid that does not resolve
 the surface, a mesh given as it is), ``order="auto"`` runs the paper's first-order scheme. On a
@@ -10,7 +11,7 @@ the torus (0.6, 0.25) at N = 16–31 (11–19% of its distances at N = 21–31, 
 says 10–16%), 0.6–2.4Δx on the ellipsoid (0.8, 0.5, 0.3) at N = 16–41 (2–4.5%, where it says
 11–20%: its geodesics turn less than its curvature), against second-order solves at N = 201.
 The warning takes the smaller of the two estimates (:func:`first_order_share`), so that a flat
-part does not warn for the spacings alone (``tests/test_fallback_size.py``).
+part does not warn for the spacings alone (``tests/test_fallback.py``).
 
 Not warned about: an option the caller chose that only the first-order scheme has
 (``second_order.OptionOfOrder1``: the caller chose that scheme), and open surfaces, whose
@@ -20,6 +21,7 @@ read as a curvature of 10).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from typing import Any, Tuple
 
@@ -27,6 +29,7 @@ import numpy as np
 
 from ._creases import warn_refused_creases
 from ._warn import user_stacklevel
+from .second_order import Order2NotApplicable, warn_fallback
 
 #: The first-order scheme's error where fronts meet, in grid spacings (the sphere's antipode:
 #: 3.2Δx at every N from 12 to 81).
@@ -78,20 +81,10 @@ def first_order_share(values: Any, spacing: float, curvature: float) -> Tuple[fl
     return min(FIRST_ORDER_SPACINGS * float(spacing) / largest, float(spacing) * float(curvature)), largest
 
 
-def curvature_to_size(tube: Any, fallback: Any, said: bool) -> float:
-    """:func:`mean_curvature` of ``tube`` when :func:`warn_first_order` will need it: before the
-    solve, which drops the band's linear indices (0 without a fallback, when ``said``, on an open
-    surface)."""
-    surface = tube.surface
-    if fallback is None or said or getattr(surface, "open_surface", False) or getattr(surface, "closed", True) is False:
-        return 0.0
-    return mean_curvature(tube)
-
-
 def warn_first_order(reason: str, values: Any, tube: Any, kappa: float, *, said: bool) -> None:
     """After ``order="auto"`` ran the first-order scheme on ``tube`` for ``reason``: the crease
     warning when creases caused it, else a RuntimeWarning when its errors are a large share of
-    the distances (:data:`SIZE_WARNING`; ``kappa`` from :func:`curvature_to_size`). Nothing when
+    the distances (:data:`SIZE_WARNING`; ``kappa`` from :meth:`Fallback.measure`). Nothing when
     ``said`` (the fallback was warned about already, a runaway or a φ that is not a distance, or
     the caller chose an option of the first-order scheme: ``second_order.warn_fallback``), nor on
     an open surface (``kappa`` 0)."""
@@ -110,3 +103,33 @@ def warn_first_order(reason: str, values: Any, tube: Any, kappa: float, *, said:
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
+
+
+@dataclasses.dataclass
+class Fallback:
+    """``order="auto"`` running the first-order scheme: ``reason``, the refusal's text (kept in
+    ``sol.stats.order_fallback``); ``said``, whether nothing more is to be said after the solve
+    (warned already, or an option the caller chose: ``second_order.warn_fallback``); ``kappa``,
+    the tube's :func:`mean_curvature` for the size warning (:meth:`measure`)."""
+
+    reason: str
+    said: bool
+    kappa: float = 0.0
+
+    @classmethod
+    def of(cls, refusal: Order2NotApplicable, order: Any) -> "Fallback":
+        """The fallback for ``refusal``, warned about now when the refusal's kind asks for it."""
+        return cls(str(refusal), warn_fallback(refusal, order))
+
+    def measure(self, tube: Any) -> None:
+        """Reads the curvature that :meth:`warn` needs from ``tube`` before the solve, which
+        drops the band's linear indices (none when nothing is to be said, or on an open surface)."""
+        surface = tube.surface
+        if self.said or getattr(surface, "open_surface", False) or getattr(surface, "closed", True) is False:
+            return
+        self.kappa = mean_curvature(tube)
+
+    def warn(self, values: Any, tube: Any) -> None:
+        """After the solve on ``tube``: the crease or size warning for its ``values``
+        (:func:`warn_first_order`)."""
+        warn_first_order(self.reason, values, tube, self.kappa, said=self.said)
