@@ -11,7 +11,8 @@ the torus (0.6, 0.25) at N = 16–31 (11–19% of its distances at N = 21–31, 
 says 10–16%), 0.6–2.4Δx on the ellipsoid (0.8, 0.5, 0.3) at N = 16–41 (2–4.5%, where it says
 11–20%: its geodesics turn less than its curvature), against second-order solves at N = 201.
 The warning takes the smaller of the two estimates (:func:`first_order_share`), so that a flat
-part does not warn for the spacings alone (``tests/test_fallback.py``).
+part does not warn for the spacings alone (``tests/test_fallback.py``; the table:
+``benches/experiments/fallback_size.py``).
 
 Not warned about: an option the caller chose that only the first-order scheme has
 (``second_order.OptionOfOrder1``: the caller chose that scheme), and open surfaces, whose

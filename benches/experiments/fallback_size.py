@@ -1,0 +1,76 @@
+"""How large ``order="auto"``'s first-order fallback's errors are, against what its warning says
+(``python/tubesweep/_fallback.py``, docs/second-order.md, "order='auto'").
+
+On coarse grids where second order does not apply, per surface and N: the order that ran, the
+largest error over points of the surface as a share of the largest distance, and the share the
+warning states (— where it did not warn). The sphere of radius 0.5 against the great circles
+from (−0.5, 0, 0); the torus (0.6, 0.25) from (0.85, 0, 0) and the ellipsoid (0.8, 0.5, 0.3)
+from (0.8, 0, 0) against second-order solves at N = 201 (a minute or two each)::
+
+    .venv/bin/python benches/experiments/fallback_size.py            # N = 12–41
+    .venv/bin/python benches/experiments/fallback_size.py --quick    # the sphere only
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import warnings
+
+import numpy as np
+
+import tubesweep as ts
+
+R = 0.5
+
+
+def stated(caught) -> str:
+    for w in caught:
+        m = re.search(r"errors up to about (\d+)% of the distances", str(w.message))
+        if m:
+            return m.group(1) + "%"
+    return "—"
+
+
+def surface_points(name: str) -> np.ndarray:
+    if name == "torus":
+        t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+        a, b = np.meshgrid(t, t)
+        rho = 0.6 + 0.25 * np.cos(b)
+        return np.c_[(rho * np.cos(a)).ravel(), (rho * np.sin(a)).ravel(), (0.25 * np.sin(b)).ravel()]
+    th, ph = np.meshgrid(np.linspace(0.05, np.pi - 0.05, 40), np.linspace(0, 2 * np.pi, 60, endpoint=False))
+    if name == "ellipsoid":
+        return np.c_[
+            (0.8 * np.sin(th) * np.cos(ph)).ravel(), (0.5 * np.sin(th) * np.sin(ph)).ravel(), (0.3 * np.cos(th)).ravel()
+        ]
+    return R * np.c_[(np.sin(th) * np.cos(ph)).ravel(), (np.sin(th) * np.sin(ph)).ravel(), np.cos(th).ravel()]
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args(argv)
+    cases = [("sphere", ts.surfaces.Sphere(R), (-R, 0.0, 0.0), (12, 16, 20, 25))]
+    if not args.quick:
+        cases += [
+            ("torus", ts.surfaces.Torus(0.6, 0.25), (0.85, 0.0, 0.0), (16, 21, 26, 31, 41)),
+            ("ellipsoid", ts.surfaces.Ellipsoid(0.8, 0.5, 0.3), (0.8, 0.0, 0.0), (16, 21, 26, 31, 41)),
+        ]
+    print("| surface | N | order | largest error / largest distance | the warning says |")
+    print("|---|---|---|---|---|")
+    for name, surface, src, ns in cases:
+        pts = surface_points(name)
+        if name == "sphere":
+            exact = R * np.arccos(np.clip(pts @ np.asarray(src) / R**2, -1, 1))
+        else:
+            exact = ts.solve(surface, ts.Grid((-1,) * 3, (1,) * 3, (201,) * 3), [src], order=2)(pts)
+        for n in ns:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                sol = ts.solve(surface, ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3), [src])
+            share = np.max(np.abs(sol(pts) - exact)) / np.max(exact)
+            print(f"| {name} | {n} | {sol.stats.order} | {100 * share:.1f}% | {stated(caught)} |")
+
+
+if __name__ == "__main__":
+    main()
