@@ -14,7 +14,7 @@ def order():
 
 #: The start of the warning of ``order="auto"``'s first-order fallback on a grid that does not
 #: resolve the surface (``tubesweep._fallback``).
-FIRST_ORDER_SIZE = "order='auto' ran the paper's first-order scheme, whose errors are about Δx·κ"
+FIRST_ORDER_SIZE = "order='auto' ran the paper's first-order scheme, whose errors are a few grid spacings"
 
 
 @pytest.fixture

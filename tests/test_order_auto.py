@@ -93,7 +93,8 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
     reason = _refusal(surface, grid, [src], **kw)
     assert words in reason
     one = ts.solve(surface, grid, [src], order=1, **kw)
-    with sized_if(words == "refine the grid"):  # first order on a sphere 7.5 spacings across: 22%
+    # first order on a sphere 7.5 spacings across (22%), and the mesh at N = 41 (3Δx: 10%)
+    with sized_if(words in ("refine the grid", "piecewise flat")):
         auto = ts.solve(surface, grid, [src], order="auto", **kw)
     assert auto.stats.order == 1 and one.stats.order == 1
     assert auto.stats.order_fallback == reason and one.stats.order_fallback is None
@@ -111,7 +112,7 @@ def test_auto_falls_back_to_order_one_with_the_reason(case):
         tube = ts.Tube(surface, grid, **{k: v for k, v in kw.items() if k in ("inner", "outer")})
         opts = {k: v for k, v in kw.items() if k not in ("inner", "outer", "method", "max_iterations")}
         for _ in range(2):  # the second time from the refusal the tube remembers
-            with sized_if(words == "refine the grid"):
+            with sized_if(words in ("refine the grid", "piecewise flat")):
                 t = tube.solve([src], order="auto", **opts)
             # a Tube's "auto" runs on the same tube as ts.solve's (thinned at creases): the same
             # refusal and the same values

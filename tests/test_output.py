@@ -128,7 +128,7 @@ class _CpSphere(Surface):
 
 def test_triangulate_needs_a_mesh_for_bare_closest_point_surfaces(tmp_path):
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (25, 25, 25))
-    with pytest.warns(RuntimeWarning, match="whose errors are about Δx·κ"):  # first order at N = 25
+    with pytest.warns(RuntimeWarning, match="whose errors are a few grid spacings"):  # first order at N = 25
         sol = ts.solve(_CpSphere(), grid, [(-0.5, 0, 0)])
     with pytest.raises(ValueError, match="mesh=\\(vertices, faces\\)"):
         ts.triangulate(sol)

@@ -97,7 +97,7 @@ def test_a_closest_point_surface_without_a_mesh_is_drawn_as_its_points():
 def test_nearest_source_cells_are_coloured_per_source_with_a_legend():
     torus = ts.surfaces.Torus(0.5, 0.2)
     sources = np.array([[0.7, 0.0, 0.0], [-0.7, 0.0, 0.0], [0.0, 0.7, 0.0]])
-    with pytest.warns(RuntimeWarning, match="whose errors are about Δx·κ"):  # r = 4 spacings: first order
+    with pytest.warns(RuntimeWarning, match="whose errors are a few grid spacings"):  # r = 4 spacings: first order
         sol = ts.solve(torus, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), sources)
     fig = ts.plot(sol, color="nearest_source", views=((30, -60),))
     assert [t.get_text() for t in fig.legends[0].get_texts()] == [f"nearest to source {k}" for k in range(3)]
@@ -138,7 +138,9 @@ def test_a_spheroid_with_the_source_at_the_pole_is_seen_whole():
     from tubesweep._triangulate import triangulate
 
     s = ts.surfaces.Ellipsoid(0.25, 0.25, 0.5)
-    with pytest.warns(RuntimeWarning, match="whose errors are about Δx·κ"):  # first order at its tips' curvature
+    with pytest.warns(
+        RuntimeWarning, match="whose errors are a few grid spacings"
+    ):  # first order at its tips' curvature
         sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3), [(0, 0, 0.5)])
     v, f = triangulate(sol)
     views = _default_views(sol, v, [0, 1, 2])

@@ -10,7 +10,8 @@ centre to top centre, 1.78 instead of 2.0. With ``order=2`` and ``"auto"`` the i
 thinned there (its nodes on the overlap side beyond half a spacing take their values from their
 closest points), which leaves about one spacing per crease crossed
 (:data:`THINNED_SHORTCUT`; ``benches/experiments/creases.py``). Either is first order in Δx;
-rounding the edges over a few grid spacings removes it.
+rounding the edges over more than the tube's width (outer·Δx) removes it; rounded over less, they
+act as creases (``_fallback.UNRESOLVED_SHORTCUT``).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import numpy as np
 from ._warn import user_stacklevel
 
 _CONVEX_CREASES = re.compile(r"convex creases or corners")
+_PER_INNER_WIDTH = re.compile(r"cut the corner by about ([0-9.]+)·inner·Δx")
 
 #: How early, in grid spacings, a front arrives per crease crossed once the inner tube is thinned
 #: there (``order=2`` and ``"auto"``): the cube max|x| − 0.5 from the bottom centre to the top
@@ -39,33 +41,50 @@ def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
     return float(per_inner_width) * float(inner) * float(spacing)
 
 
-def warn_creases(creases: Optional[dict], inner: float, spacing: float) -> None:
-    """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``)."""
+def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: bool) -> None:
+    """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``):
+    the shortcut per crease, :data:`THINNED_SHORTCUT` spacings where the inner tube was thinned
+    there (``thinned``), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle."""
     if not creases or not creases.get("nodes"):
         return
-    size = THINNED_SHORTCUT * float(spacing)
+    angle = float(creases["angle_degrees"])
+    size = THINNED_SHORTCUT * float(spacing) if thinned else shortcut(2 * np.tan(np.radians(angle) / 2), inner, spacing)
+    how = (
+        f"{THINNED_SHORTCUT:g}·Δx with the inner tube thinned there"
+        if thinned
+        else "2·tan(θ/2)·inner·Δx: the inner tube is not thinned there"
+    )
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
-        f"{creases['angle_degrees']:.0f}°): a front that crosses one arrives early by up to about {size:.3g} "
-        f"({THINNED_SHORTCUT:g}·Δx with the inner tube thinned there, first order in Δx), and the nodes there run the "
-        "first-order update. sol.first_order_points() shows where; rounding the edges over a few grid spacings, or a "
-        "finer grid, reduces it",
+        f"{angle:.0f}°): a front that crosses one arrives early by up to about {size:.3g} ({how}, first order in Δx), "
+        "and the nodes there run the first-order update. sol.first_order_points() shows where; rounding the edges "
+        "over a few grid spacings, or a finer grid, reduces it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
 
 
-def warn_refused_creases(reason: str, inner: float, spacing: float) -> bool:
-    """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases
-    (on the tube thinned at them: :data:`THINNED_SHORTCUT`); whether it warned."""
+def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: bool) -> bool:
+    """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases:
+    the shortcut per crease, :data:`THINNED_SHORTCUT` spacings on the tube thinned at them
+    (``thinned``), else ``2·tan(θ/2)·inner·Δx`` at the largest turn θ that the refusal names (the
+    paper's tube, which a re-distanced φ keeps: the box max|x| − 0.5 re-distanced at N = 41, 4.8Δx
+    per edge, where the warning says 4Δx; a voxel mask's cube 3.75–3.94Δx); whether it warned."""
     if _CONVEX_CREASES.search(reason) is None:
         return False
-    size = THINNED_SHORTCUT * float(spacing)
+    given = _PER_INNER_WIDTH.search(reason)  # 2·tan(θ/2) at the largest turn θ, as the refusal gives it
+    per_width = float(given.group(1)) if given else 2.0
+    size = THINNED_SHORTCUT * float(spacing) if thinned else shortcut(per_width, inner, spacing)
+    how = (
+        f"{THINNED_SHORTCUT:g}·Δx with the inner tube thinned there"
+        if thinned
+        else f"2·tan(θ/2)·inner·Δx = {per_width:.3g}·inner·Δx at the largest turn θ, the inner tube not thinned there"
+    )
     warnings.warn(
         f"order=1 ran: φ's level sets have convex creases or corners over much of the tube, where a front cuts the "
-        f"corner and arrives early by up to about {size:.3g} per crease it crosses ({THINNED_SHORTCUT:g}·Δx with the "
-        f"inner tube thinned there, 2·tan(θ/2)·inner·Δx without: first order in Δx). sol.stats.order_fallback says "
-        "more; round the edges over a few grid spacings for second order and no shortcut",
+        f"corner and arrives early by up to about {size:.3g} per crease it crosses ({how}: first order in Δx). "
+        "sol.stats.order_fallback says more; round the edges over more than the tube's width (outer·Δx) for second "
+        "order and no shortcut",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )

@@ -440,7 +440,7 @@ def _prepare_tube(
                 f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
                 "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
                 "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
-                "there (round the edges over a few grid spacings), pass a signed distance function, or refine the grid"
+                "there (round the edges over more than the tube's width), pass a signed distance function, or refine the grid"
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:

@@ -28,6 +28,7 @@ from xml.sax.saxutils import quoteattr
 from ._validate import as_grid, as_sources, real_scalar
 from ._sources import check_on_surface
 from .solution import Solution
+from ._step_warnings import StepWarnings
 from .output import export
 from .surface import LevelSet
 from .tube import Tube
@@ -344,83 +345,88 @@ def evolve(
     prev: Optional[Solution] = None
     previous_band: Optional[np.ndarray] = None
     t = t0
-    for step in range(steps + 1):
-        try:
-            surf = LevelSet(arr, redistance=True)
-            tube = Tube(surf, grid) if tube is None else tube.moved(surf)
-            # onto the surface: at step 0 the caller's sources, refused as ts.solve refuses them
-            # when off it by more than the inner tube; later, carried onto the moved surface
-            dist, feet = surf.project(src, grid)
-            if step == 0:
-                check_on_surface(src, dist, tube.inner * grid.spacing)
-            src = np.ascontiguousarray(feet)
-            warm: Any = None if prev is None else (prev if older is None else (older, prev))
-            sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
-        except ValueError as e:
-            if step == 0:
-                raise  # the caller's surface or sources, refused as by ts.solve
-            raise EvolutionStopped(
-                f"evolve stopped at step {step} (t = {t:.6g}): the surface, or the part of it that carries a source, "
-                f"vanished or shrank below a few grid spacings: {e}",
-                out,
-                step,
-                t,
-            ) from e
-        if not sol.stats.converged:
-            raise EvolutionStopped(
-                f"evolve stopped at step {step} (t = {t:.6g}): the surface solve did not converge (its last change "
-                f"{sol.stats.last_change:.3g}); advancing φ with its values would move the surface by a wrong law. A "
-                "finer grid, a looser tol or a smaller dt may help",
-                out,
-                step,
-                t,
-            )
-        # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
-        # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
-        linear = tube._tube.linear
-        geom = tube._tube.geom
-        assert geom is not None  # a Tube keeps its geometry
-        signed = np.asarray(geom.signed, dtype=float)  # the band's re-distanced φ
-        if previous_band is not None:
-            fresh = ~np.isin(linear, previous_band)
-            if np.any(fresh):
-                arr = arr.copy()
-                arr.reshape(-1)[linear[fresh]] = signed[fresh]
-        previous_band = linear
-        info = (sol.stats.order2 or {}).get("warm")
-        if info is not None and "refused" not in info and info.get("restarted") is None:
-            out.warm_starts += 1
-        else:
-            out.cold_starts += 1
-        if step % every == 0 or step == steps:
-            out.times.append(t)
-            out.phis.append(arr)
-            out.solutions.append(sol)
-            if checkpoint is not None:
-                _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=src)
-        if step == steps:
-            break
-        u = sol.values
-        try:
-            v = _speed_values(speed, u, step)
-        except ValueError as e:
-            if step == 0:
-                raise
-            raise EvolutionStopped(str(e), out, step, t) from e
-        vmax = float(np.max(np.abs(v)))
-        if dt * vmax > cfl * h:
-            message = (
-                f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
-                f"cfl·Δx = {cfl * h:.4g} (max|V| = {vmax:.4g}); take dt ≤ {cfl * h / vmax:.4g}"
-            )
-            if step == 0:
-                raise ValueError(message)
-            raise EvolutionStopped(message, out, step, t)
-        new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
-        new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
-        arr = new
-        older, prev = prev, sol
-        t += dt
-        if progress is not None:
-            progress(step + 1, steps, t)
-    return out
+    said = StepWarnings()  # the steps' warnings, once per kind when the evolution ends
+    try:
+        for step in range(steps + 1):
+            try:
+                with said.step(step):
+                    surf = LevelSet(arr, redistance=True)
+                    tube = Tube(surf, grid) if tube is None else tube.moved(surf)
+                    # onto the surface: at step 0 the caller's sources, refused as ts.solve refuses
+                    # them when off it by more than the inner tube; later, carried onto the moved surface
+                    dist, feet = surf.project(src, grid)
+                    if step == 0:
+                        check_on_surface(src, dist, tube.inner * grid.spacing)
+                    src = np.ascontiguousarray(feet)
+                    warm: Any = None if prev is None else (prev if older is None else (older, prev))
+                    sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
+            except ValueError as e:
+                if step == 0:
+                    raise  # the caller's surface or sources, refused as by ts.solve
+                raise EvolutionStopped(
+                    f"evolve stopped at step {step} (t = {t:.6g}): the surface, or the part of it that carries a source, "
+                    f"vanished or shrank below a few grid spacings: {e}",
+                    out,
+                    step,
+                    t,
+                ) from e
+            if not sol.stats.converged:
+                raise EvolutionStopped(
+                    f"evolve stopped at step {step} (t = {t:.6g}): the surface solve did not converge (its last change "
+                    f"{sol.stats.last_change:.3g}); advancing φ with its values would move the surface by a wrong law. A "
+                    "finer grid, a looser tol or a smaller dt may help",
+                    out,
+                    step,
+                    t,
+                )
+            # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
+            # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
+            linear = tube._tube.linear
+            geom = tube._tube.geom
+            assert geom is not None  # a Tube keeps its geometry
+            signed = np.asarray(geom.signed, dtype=float)  # the band's re-distanced φ
+            if previous_band is not None:
+                fresh = ~np.isin(linear, previous_band)
+                if np.any(fresh):
+                    arr = arr.copy()
+                    arr.reshape(-1)[linear[fresh]] = signed[fresh]
+            previous_band = linear
+            info = (sol.stats.order2 or {}).get("warm")
+            if info is not None and "refused" not in info and info.get("restarted") is None:
+                out.warm_starts += 1
+            else:
+                out.cold_starts += 1
+            if step % every == 0 or step == steps:
+                out.times.append(t)
+                out.phis.append(arr)
+                out.solutions.append(sol)
+                if checkpoint is not None:
+                    _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=src)
+            if step == steps:
+                break
+            u = sol.values
+            try:
+                v = _speed_values(speed, u, step)
+            except ValueError as e:
+                if step == 0:
+                    raise
+                raise EvolutionStopped(str(e), out, step, t) from e
+            vmax = float(np.max(np.abs(v)))
+            if dt * vmax > cfl * h:
+                message = (
+                    f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
+                    f"cfl·Δx = {cfl * h:.4g} (max|V| = {vmax:.4g}); take dt ≤ {cfl * h / vmax:.4g}"
+                )
+                if step == 0:
+                    raise ValueError(message)
+                raise EvolutionStopped(message, out, step, t)
+            new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
+            new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
+            arr = new
+            older, prev = prev, sol
+            t += dt
+            if progress is not None:
+                progress(step + 1, steps, t)
+        return out
+    finally:
+        said.say()

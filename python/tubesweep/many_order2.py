@@ -22,6 +22,7 @@ import numpy as np
 from . import _native
 from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
+from ._prepare import thinned_count
 from .mask import mask_advice
 from ._stagnation import FALLBACK_WARNING, fallback_message
 from ._validate import FRONT_WINDOW, as_sources
@@ -127,7 +128,7 @@ def solve_many_order2(
             + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}{'…' if failed.size > 5 else ''})"
         )
     st["tol"] = inputs.tol
-    warn_creases(st.get("creases"), t.inner, h)
+    warn_creases(st.get("creases"), t.inner, h, thinned=thinned_count(t) > 0)
     for name, what in (
         (
             "converged",

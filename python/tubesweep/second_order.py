@@ -21,6 +21,7 @@ from . import _native
 from ._box_cut import box_reason
 from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
+from ._prepare import ROLE_OUTER, thinned_count
 from .mask import mask_advice
 from .moving import values_checksum
 from ._stagnation import fallback_message
@@ -396,22 +397,19 @@ NOT_A_DISTANCE = "redistance=True) re-distances φ"
 
 def warn_fallback(e: Order2NotApplicable, order: Any) -> bool:
     """With ``order="auto"``, a warning for a fallback to the first-order scheme that the solve
-    found only by running (:class:`Order2RanAway`), or that a φ which is not a signed distance
-    caused (errors of order Δx instead of Δx², cured by ``redistance=True``); the other refusals
-    (a mesh, a grid that does not resolve the surface, ...) are in ``sol.stats.order_fallback``,
-    and in a warning after the solve when its errors are large (:mod:`tubesweep._fallback`).
+    found only by running (:class:`Order2RanAway`); the other refusals (a mesh, a grid that does
+    not resolve the surface, a φ that is not a signed distance, ...) are in
+    ``sol.stats.order_fallback``, and in a warning after the solve that sizes the errors when
+    they are large or φ is not a distance (:mod:`tubesweep._fallback`).
     Whether the fallback needs no word after the solve: warned here, or an option the caller chose
     (:class:`OptionOfOrder1`)."""
     if order != "auto":
         return False
     if isinstance(e, OptionOfOrder1):
         return True
-    if isinstance(e, Order2RanAway):
-        text = f"{e}; the first-order solution is returned"
-    elif NOT_A_DISTANCE in str(e):
-        text = f"order='auto' ran the first-order scheme (errors of order Δx, not Δx²): {e}"
-    else:
-        return False
+    if not isinstance(e, Order2RanAway):
+        return False  # a φ that is not a distance: said with its errors' size after the solve
+    text = f"{e}; the first-order solution is returned"
     warnings.warn(f"{text} (sol.stats.order_fallback keeps this)", RuntimeWarning, stacklevel=user_stacklevel())
     return True
 
@@ -453,7 +451,7 @@ def warn_about(
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
-    warn_creases(st.get("creases"), tube.inner, tube.grid.spacing)
+    warn_creases(st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_count(tube) > 0)
 
 
 #: The native report's entries that ``sol.stats.order2`` keeps as they are.
@@ -588,8 +586,6 @@ def solve_on_tube(
     changed (8 bytes per node; a ``ts.Tube``'s solves and warm solves keep them). The stages:
     the per-node inputs, the sources' feet, the warm start, the native solve, the warnings, the
     report and the :class:`~tubesweep.Solution`."""
-    from ._prepare import ROLE_OUTER, thinned_count
-
     grid, surf, band = tube.grid, tube.surface, tube.band
     h, d = grid.spacing, grid.ndim
     inputs = tube_inputs(tube, speed, tol)

@@ -107,7 +107,8 @@ pub fn check_geometry_of(
                      turning by up to {:.0}°), where the inner tube lets the front cut the corner by about \
                      {:.2}·inner·Δx per crease it crosses (2·tan(θ/2); about 1.5Δx where the inner tube is thinned \
                      at them, order=\"auto\"), and the second-order update next to them came out no better. Round \
-                     the edges over a few grid spacings for second order; use order=1 (or \"auto\")",
+                     the edges over more than the tube's width (outer·Δx = {outer_width:.4}) for second order; use \
+                     order=1 (or \"auto\")",
                     summary.unresolved_curvature,
                     summary.inner_nodes,
                     summary.creases.nodes,
