@@ -122,3 +122,21 @@ def test_a_rounded_cube_s_edges_are_sized_as_creases():
     assert sol.stats.order == 1
     exact = 4 * 0.4 + 2 * (np.pi / 2) * 0.1  # along the faces and round two quarter circles: 1.9142
     assert 1 - sol([(0, 0, 0.5)])[0] / exact == pytest.approx(0.177, abs=0.005)
+
+
+def test_a_phi_whose_gradient_spreads_is_named_as_not_a_distance_with_the_cure():
+    # |x|² − R²: |∇φ| = 2|x|, 0.87-1.12 in the tube at N = 61; its mean is 1, so it passed for a
+    # distance and the fallback blamed the grid ("refine"), which does not cure it
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # 6.6% short: below the size warning's 10%
+        sol = ts.solve(lambda p: (p**2).sum(axis=1) - R**2, g, [(-R, 0, 0)])
+    assert sol.stats.order == 1
+    assert re.search(r"\|∇φ\| ranges over \[0\.8\d+, 1\.1\d+\] in the tube.*redistance=True", sol.stats.order_fallback)
+    assert 1 - sol([(R, 0, 0)])[0] / (np.pi * R) == pytest.approx(0.066, abs=0.003)
+    cured = ts.solve(ts.LevelSet(lambda p: (p**2).sum(axis=1) - R**2, redistance=True), g, [(-R, 0, 0)])
+    assert cured.stats.order == 2 and abs(1 - cured([(R, 0, 0)])[0] / (np.pi * R)) < 0.01
+    # a signed distance on a coarse grid gets no such note
+    with pytest.warns(RuntimeWarning, match=SIZE):
+        coarse = ts.solve(ts.surfaces.Sphere(R), ts.Grid((-1, -1, -1), (1, 1, 1), (20, 20, 20)), [(-R, 0, 0)])
+    assert "ranges over" not in coarse.stats.order_fallback

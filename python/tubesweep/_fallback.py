@@ -33,6 +33,7 @@ import numpy as np
 
 from ._creases import warn_refused_creases
 from ._prepare import thinned_count
+from .surface import LevelSet
 from ._warn import user_stacklevel
 from .second_order import NOT_A_DISTANCE, Order2NotApplicable, warn_fallback
 
@@ -55,6 +56,12 @@ SIZE_WARNING = 0.1
 #: φ is taken for a distance
 GRADIENT_READ = 0.05
 
+#: A φ given as it is whose |∇φ| spreads by more than this factor over the tube (95th against 5th
+#: percentile) is not a distance, which the second-order geometry reads as unresolved curvature:
+#: the fallback's reason says so (φ = |x|² − 0.25: 0.81–1.19, refused for "a curvature the tube
+#: does not resolve"; a signed distance reads 0.9–1.0 at N = 12)
+GRADIENT_SPREAD = 1.2
+
 #: A fallback for curvatures the tube does not resolve (the second-order geometry's refusal,
 #: with the share of the inner tube: "(22%) have a principal curvature the tube does not resolve")
 _UNRESOLVED = re.compile(r"\((\d+)%\)[^()]*curvature the tube does not resolve")
@@ -66,18 +73,19 @@ _UNRESOLVED = re.compile(r"\((\d+)%\)[^()]*curvature the tube does not resolve")
 EDGES_SHARE = 0.35
 
 
-def mean_gradient(tube: Any) -> float:
-    """The mean ``|∇φ|`` (central differences) over the band nodes 1–2 spacings off the surface
-    whose 2d neighbours are in the band: 1 for a signed distance, the scale of a scaled one (1
-    without such nodes). ``tube``: a prepared tube (``_prepare._PreparedTube``), whose ``phi`` is
-    the signed or unsigned distance, or the given φ, at its band nodes."""
+def gradient_range(tube: Any) -> Tuple[float, float, float]:
+    """The mean, 5th and 95th percentiles of ``|∇φ|`` (central differences) over the band nodes
+    1–2 spacings off the surface whose 2d neighbours are in the band: 1 for a signed distance, the
+    scale of a scaled one (1, 1, 1 without such nodes). ``tube``: a prepared tube
+    (``_prepare._PreparedTube``), whose ``phi`` is the signed or unsigned distance, or the given
+    φ, at its band nodes."""
     grid, linear = tube.grid, tube.linear
     h, d = grid.spacing, grid.ndim
     phi = np.asarray(tube.phi, dtype=float)
     away = np.abs(phi)
     at = np.flatnonzero((away >= h * (1 - 1e-6)) & (away <= 2 * h))
     if at.size == 0:
-        return 1.0
+        return 1.0, 1.0, 1.0
     nodes = grid.unravel(linear[at])
     strides = [int(np.prod(grid.shape[k + 1 :])) for k in range(d)]
     gradient = np.zeros((at.size, d))
@@ -89,8 +97,11 @@ def mean_gradient(tube: Any) -> float:
             found = (nodes[:, k] + step >= 0) & (nodes[:, k] + step < grid.shape[k]) & (linear[j] == target)
             whole &= found
             gradient[:, k] += step * np.where(found, phi[j], 0.0)
-    g = float(np.mean(np.linalg.norm(gradient[whole], axis=1))) / (2 * h) if whole.any() else 1.0
-    return g if g > 0 else 1.0
+    norms = np.linalg.norm(gradient[whole], axis=1) / (2 * h)
+    if norms.size == 0 or not np.mean(norms) > 0:
+        return 1.0, 1.0, 1.0
+    low, high = np.percentile(norms, [5, 95])
+    return float(np.mean(norms)), float(low), float(high)
 
 
 def first_order_share(values: Any, spacing: float, gradient: float = 1.0) -> Tuple[float, float]:
@@ -176,7 +187,13 @@ class Fallback:
         surface = tube.surface
         if self.said or getattr(surface, "open_surface", False) or getattr(surface, "closed", True) is False:
             return
-        self.gradient = mean_gradient(tube)
+        self.gradient, low, high = gradient_range(tube)
+        given = isinstance(surface, LevelSet) and not surface.redistance
+        if given and high > GRADIENT_SPREAD * low and NOT_A_DISTANCE not in self.reason:
+            self.reason += (
+                f"; |∇φ| ranges over [{low:.3g}, {high:.3g}] in the tube, so φ is not a distance, which reads as "
+                "curvature: LevelSet(φ, redistance=True) re-distances it and may run second order"
+            )
 
     def warn(self, values: Any, tube: Any) -> None:
         """After the solve on ``tube``: the crease or size warning for its ``values``
