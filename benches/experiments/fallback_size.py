@@ -5,7 +5,8 @@ On coarse grids where second order does not apply, per surface and N: the order 
 largest error over points of the surface as a share of the largest distance, and the share the
 warning states (— where it did not warn; + the edges' term when it adds one per edge crossed).
 The sphere of radius 0.5 against the great circles from (−0.5, 0, 0), also with φ scaled by
-0.5; the torus (0.6, 0.25) from (0.85, 0, 0), the ellipsoid (0.8, 0.5, 0.3) from (0.8, 0, 0) and
+0.5 and as |x|² − 0.25 (not a distance: given as it is and re-distanced); the circle of radius
+0.5 from (−0.5, 0); the hemisphere from its pole (an open surface: never warned about); the torus (0.6, 0.25) from (0.85, 0, 0), the ellipsoid (0.8, 0.5, 0.3) from (0.8, 0, 0) and
 ``RoundedCube()`` from its bottom face's centre against second-order solves at N = 201 (a minute
 or two each)::
 
@@ -36,6 +37,9 @@ def stated(caught) -> str:
 
 
 def surface_points(name: str) -> np.ndarray:
+    if name == "circle":
+        t = np.linspace(0, 2 * np.pi, 240, endpoint=False)
+        return R * np.c_[np.cos(t), np.sin(t)]
     if name == "torus":
         t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
         a, b = np.meshgrid(t, t)
@@ -49,16 +53,22 @@ def surface_points(name: str) -> np.ndarray:
         return np.c_[
             (0.8 * np.sin(th) * np.cos(ph)).ravel(), (0.5 * np.sin(th) * np.sin(ph)).ravel(), (0.3 * np.cos(th)).ravel()
         ]
-    return R * np.c_[(np.sin(th) * np.cos(ph)).ravel(), (np.sin(th) * np.sin(ph)).ravel(), np.cos(th).ravel()]
+    on = R * np.c_[(np.sin(th) * np.cos(ph)).ravel(), (np.sin(th) * np.sin(ph)).ravel(), np.cos(th).ravel()]
+    return on[on[:, 2] > 0.02] if name == "hemisphere" else on
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
+    square = lambda p: (p**2).sum(axis=1) - R**2  # noqa: E731  # |∇φ| = 2|x|: not a distance
     cases = [
         ("sphere", ts.surfaces.Sphere(R), (-R, 0.0, 0.0), (12, 16, 20, 25)),
         ("sphere, φ·0.5", lambda p: 0.5 * (np.linalg.norm(p, axis=1) - R), (-R, 0.0, 0.0), (31, 41)),
+        ("sphere, |x|² − R²", square, (-R, 0.0, 0.0), (41, 61)),
+        ("sphere, |x|² − R² re-distanced", ts.LevelSet(square, redistance=True), (-R, 0.0, 0.0), (61,)),
+        ("circle", ts.surfaces.Circle(R), (-R, 0.0), (12, 16, 21, 31, 61)),
+        ("hemisphere (open)", ts.surfaces.Hemisphere(R), (0.0, 0.0, R), (16, 21)),
     ]
     if not args.quick:
         cases += [
@@ -66,11 +76,15 @@ def main(argv=None) -> None:
             ("torus", ts.surfaces.Torus(0.6, 0.25), (0.85, 0.0, 0.0), (16, 21, 26, 31, 41)),
             ("ellipsoid", ts.surfaces.Ellipsoid(0.8, 0.5, 0.3), (0.8, 0.0, 0.0), (16, 21, 26, 31, 41)),
         ]
-    print("| surface | N | order | largest error / largest distance | the warning says |")
-    print("|---|---|---|---|---|")
+    print("| surface | N | order | largest error / largest distance | largest error / Δx | the warning says |")
+    print("|---|---|---|---|---|---|")
     for name, surface, src, ns in cases:
-        pts = surface_points(name.split(",")[0])
-        if name.startswith("sphere"):
+        d = len(src)
+        key = next(
+            k for k in ("rounded cube", "sphere", "circle", "hemisphere", "torus", "ellipsoid") if name.startswith(k)
+        )
+        pts = surface_points(key)
+        if key in ("sphere", "circle", "hemisphere"):
             exact = R * np.arccos(np.clip(pts @ np.asarray(src) / R**2, -1, 1))
         else:
             exact = ts.solve(surface, ts.Grid((-1,) * 3, (1,) * 3, (201,) * 3), [src], order=2)(pts)
@@ -78,9 +92,13 @@ def main(argv=None) -> None:
         for n in ns:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
-                sol = ts.solve(surface, ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3), [src])
-            share = np.max(np.abs(sol(pts) - exact)) / np.max(exact)
-            print(f"| {name} | {n} | {sol.stats.order} | {100 * share:.1f}% | {stated(caught)} |")
+                grid = ts.Grid((-1,) * d, (1,) * d, (n,) * d)
+                sol = ts.solve(surface, grid, [src])
+            error = np.max(np.abs(sol(pts) - exact))
+            print(
+                f"| {name} | {n} | {sol.stats.order} | {100 * error / np.max(exact):.1f}% | "
+                f"{error / grid.spacing:.1f} | {stated(caught)} |"
+            )
 
 
 if __name__ == "__main__":

@@ -4,13 +4,13 @@
 Where the surface or the grid rules out the second-order scheme (a grid that does not resolve
 the surface, a mesh given as it is, a φ that is not a distance), ``order="auto"`` runs the
 paper's first-order scheme. Its errors are a few grid spacings where fronts meet, whatever the
-grid: 3.2Δx at the antipode of the sphere of radius 0.5 at N = 12–81, 2.5–3.1Δx at the
-circle's at N = 12–61, up to 2–4.3Δx on the torus (0.6, 0.25) at N = 16–31 and 0.6–2.4Δx on
-the ellipsoid (0.8, 0.5, 0.3) at N = 16–41, against second-order solves at N = 201. On a
+grid: the largest errors are 2.7–3.1Δx on the sphere of radius 0.5 at N = 12–20, 2.5–2.8Δx on
+the circle at N = 12–16, 2.0–4.3Δx on the torus (0.6, 0.25) at N = 16–31 and 0.6–2.4Δx on the
+ellipsoid (0.8, 0.5, 0.3) at N = 16–41, against second-order solves at N = 201. On a
 surface a few tens of spacings across that is a large share of the distances: the warning
 states :data:`FIRST_ORDER_SPACINGS` spacings against the largest distance, divided by the mean
 |∇φ| where φ is not a distance (the tube is that much wider: φ = 0.5·(|x| − 0.5) at N = 41 is
-25% short at the antipode, and the warning says 23%), and adds about
+24% off, and the warning says 23%), and adds about
 :data:`UNRESOLVED_SHORTCUT` spacings for each edge or tip whose curvature radius is below the
 tube's width that a path crosses (``RoundedCube()`` at N = 41–61 is 10–18% short across two
 edges). ``benches/experiments/fallback_size.py`` prints the errors against what the warning
@@ -18,8 +18,8 @@ says; ``tests/test_fallback.py``.
 
 Not warned about: an option the caller chose that only the first-order scheme has
 (``second_order.OptionOfOrder1``: the caller chose that scheme), and open surfaces, where the
-first-order errors are smaller (no fronts meet around them; the hemisphere at N = 16–21, 6–9%
-at its rim).
+first-order errors are smaller (no fronts meet around them; the hemisphere at N = 16–21, 7.6–9.5%
+at most).
 """
 
 from __future__ import annotations
@@ -33,22 +33,23 @@ import numpy as np
 
 from ._creases import warn_refused_creases
 from ._prepare import thinned_count
+from .band import band_neighbours
 from .surface import LevelSet
 from ._warn import user_stacklevel
 from .second_order import NOT_A_DISTANCE, Order2NotApplicable, warn_fallback
 
 #: The first-order scheme's error where fronts meet, in grid spacings (the sphere's antipode:
-#: 3.2Δx at every N from 12 to 81).
+#: 2.7–3.1Δx at N = 12–20).
 FIRST_ORDER_SPACINGS = 3.0
 
 #: How early a front arrives, in grid spacings, after crossing an edge, a tip or a corner whose
 #: curvature radius is below the tube's width (as at a crease): ``RoundedCube()`` (radius 0.1) from
-#: a face's centre to the opposite one's, two edges crossed, 2.3–3.4Δx per edge at N = 41–61
-#: (``benches/experiments/fallback_size.py``).
+#: its bottom face's centre, largest errors 4.6–6.8Δx at N = 41–61 where two edges were crossed,
+#: 2.3–3.4Δx per edge (``benches/experiments/fallback_size.py``).
 UNRESOLVED_SHORTCUT = 3.5
 
-#: The warning fires when the estimated error is at least this share of the distances (the
-#: sphere of radius 0.5 at N = 41, 3.2Δx short at its antipode, is just below: 9.9%).
+#: The warning fires when the estimated error is at least this share of the distances: a surface
+#: whose farthest path is 30 grid spacings long or more is not warned about for the 3Δx alone.
 SIZE_WARNING = 0.1
 
 #: How far from 1 the mean |∇φ| of a signed distance reads through central differences where the
@@ -58,8 +59,8 @@ GRADIENT_READ = 0.05
 
 #: A φ given as it is whose |∇φ| spreads by more than this factor over the tube (95th against 5th
 #: percentile) is not a distance, which the second-order geometry reads as unresolved curvature:
-#: the fallback's reason says so (φ = |x|² − 0.25: 0.81–1.19, refused for "a curvature the tube
-#: does not resolve"; a signed distance reads 0.9–1.0 at N = 12)
+#: the fallback's reason says so (φ = |x|² − 0.25 at N = 61: 0.8–1.2, refused for "a curvature the
+#: tube does not resolve"; a signed distance at N = 20 gets no note: ``tests/test_fallback.py``)
 GRADIENT_SPREAD = 1.2
 
 #: A fallback for curvatures the tube does not resolve (the second-order geometry's refusal,
@@ -80,23 +81,18 @@ def gradient_range(tube: Any) -> Tuple[float, float, float]:
     (``_prepare._PreparedTube``), whose ``phi`` is the signed or unsigned distance, or the given
     φ, at its band nodes."""
     grid, linear = tube.grid, tube.linear
-    h, d = grid.spacing, grid.ndim
+    h = grid.spacing
     phi = np.asarray(tube.phi, dtype=float)
     away = np.abs(phi)
     at = np.flatnonzero((away >= h * (1 - 1e-6)) & (away <= 2 * h))
     if at.size == 0:
         return 1.0, 1.0, 1.0
-    nodes = grid.unravel(linear[at])
-    strides = [int(np.prod(grid.shape[k + 1 :])) for k in range(d)]
-    gradient = np.zeros((at.size, d))
+    gradient = np.zeros((at.size, grid.ndim))
     whole = np.ones(at.size, dtype=bool)
-    for k, stride in enumerate(strides):
-        for step in (1, -1):
-            target = linear[at] + step * stride
-            j = np.minimum(np.searchsorted(linear, target), len(linear) - 1)
-            found = (nodes[:, k] + step >= 0) & (nodes[:, k] + step < grid.shape[k]) & (linear[j] == target)
-            whole &= found
-            gradient[:, k] += step * np.where(found, phi[j], 0.0)
+    for i, (_, _, pos) in enumerate(band_neighbours(grid, tube.band, linear, at)):
+        k, side = divmod(i, 2)  # axis k, the + side then the − side
+        whole &= pos >= 0
+        gradient[:, k] += (1 if side == 0 else -1) * np.where(pos >= 0, phi[pos], 0.0)
     norms = np.linalg.norm(gradient[whole], axis=1) / (2 * h)
     if norms.size == 0 or not np.mean(norms) > 0:
         return 1.0, 1.0, 1.0

@@ -1,7 +1,7 @@
 """The warnings of an evolution's surface solves (``ts.evolve``), said once per kind at the end
 with the steps that gave them, instead of once per step: a coarse grid's first-order fallback or
-a narrow gap on the way to a merge warned at every step (12 warnings in 8 steps of a shrinking
-sphere at N = 31, ``tests/test_moving.py``)."""
+a narrow gap on the way to a merge warned at every step (a shrinking sphere at N = 31: three
+kinds over its 8 steps, ``tests/test_step_warnings.py``)."""
 
 from __future__ import annotations
 
