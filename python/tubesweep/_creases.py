@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import re
 import warnings
-from typing import Any, Optional
+from typing import Any, Optional, Tuple
 
 import numpy as np
 
@@ -41,6 +41,18 @@ def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
     return float(per_inner_width) * float(inner) * float(spacing)
 
 
+def _per_crease(per_inner_width: float, inner: float, spacing: float, thinned: bool) -> Tuple[float, str]:
+    """How early a front arrives per crease crossed, and how that was reckoned: :data:`THINNED_SHORTCUT`
+    spacings on the tube thinned at the creases, else :func:`shortcut` (``per_inner_width``:
+    2·tan(θ/2) at the largest turn θ of the normal)."""
+    if thinned:
+        return THINNED_SHORTCUT * float(spacing), f"{THINNED_SHORTCUT:g}·Δx with the inner tube thinned there"
+    return (
+        shortcut(per_inner_width, inner, spacing),
+        f"2·tan(θ/2)·inner·Δx = {per_inner_width:.3g}·inner·Δx at the largest turn θ, the inner tube not thinned there",
+    )
+
+
 def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: bool) -> None:
     """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``):
     the shortcut per crease, :data:`THINNED_SHORTCUT` spacings where the inner tube was thinned
@@ -48,17 +60,12 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
     if not creases or not creases.get("nodes"):
         return
     angle = float(creases["angle_degrees"])
-    size = THINNED_SHORTCUT * float(spacing) if thinned else shortcut(2 * np.tan(np.radians(angle) / 2), inner, spacing)
-    how = (
-        f"{THINNED_SHORTCUT:g}·Δx with the inner tube thinned there"
-        if thinned
-        else "2·tan(θ/2)·inner·Δx: the inner tube is not thinned there"
-    )
+    size, how = _per_crease(2 * np.tan(np.radians(angle) / 2), inner, spacing, thinned)
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
         f"{angle:.0f}°): a front that crosses one arrives early by up to about {size:.3g} ({how}, first order in Δx), "
         "and the nodes there run the first-order update. sol.first_order_points() shows where; rounding the edges "
-        "over a few grid spacings, or a finer grid, reduces it",
+        "over more than the tube's width (outer·Δx), or a finer grid, reduces it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
@@ -73,13 +80,7 @@ def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: 
     if _CONVEX_CREASES.search(reason) is None:
         return False
     given = _PER_INNER_WIDTH.search(reason)  # 2·tan(θ/2) at the largest turn θ, as the refusal gives it
-    per_width = float(given.group(1)) if given else 2.0
-    size = THINNED_SHORTCUT * float(spacing) if thinned else shortcut(per_width, inner, spacing)
-    how = (
-        f"{THINNED_SHORTCUT:g}·Δx with the inner tube thinned there"
-        if thinned
-        else f"2·tan(θ/2)·inner·Δx = {per_width:.3g}·inner·Δx at the largest turn θ, the inner tube not thinned there"
-    )
+    size, how = _per_crease(float(given.group(1)) if given else 2.0, inner, spacing, thinned)
     warnings.warn(
         f"order=1 ran: φ's level sets have convex creases or corners over much of the tube, where a front cuts the "
         f"corner and arrives early by up to about {size:.3g} per crease it crosses ({how}: first order in Δx). "
