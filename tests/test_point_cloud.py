@@ -185,6 +185,36 @@ def test_a_hole_is_a_rim():
     assert np.all(sol.first_order_points()[:, 2] > 0.2)
 
 
+def test_where_the_sampling_thins_is_no_rim():
+    # 30 times denser above the equator: the last dense samples see their 40 nearest on one side
+    # (a gap of ~180°), but samples farther out fill it; it was taken for a rim, the feet there
+    # were clamped to it, and the solve came back 5.7 % short at order 2, converged, unwarned
+    p = sphere_cloud(8000, seed=1)
+    q = sphere_cloud(300, seed=2)
+    cloud = from_points(np.vstack([p[p[:, 2] > 0], q[q[:, 2] <= 0]]))
+    assert not cloud.open_surface and cloud.report["rim_samples"] == 0
+    sol = ts.solve(cloud, cube(61), sources=[(0.0, 0.0, 0.5)])
+    assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] == 0
+    probe = sphere_cloud(2000, seed=3)
+    exact = 0.5 * np.arccos(np.clip(probe[:, 2] / 0.5, -1, 1))
+    assert np.max(np.abs(sol(probe) - exact)) < 0.012  # was 0.090
+
+
+@pytest.mark.parametrize("dense, sparse", [(4000, 40), (400, 100)])
+def test_a_circle_sampled_densely_on_one_half(dense, sparse):
+    # 4000/40: the last dense samples were taken for the ends of an open curve. 400/100: the band
+    # lost the column of nodes through the centre above it (each started from the foot of the
+    # node before, on the far side, and stayed there) and the solve raised
+    t = np.r_[np.linspace(0, np.pi, dense, endpoint=False), np.linspace(np.pi, 2 * np.pi, sparse, endpoint=False)]
+    cloud = from_points(0.5 * np.c_[np.cos(t), np.sin(t)])
+    assert not cloud.open_surface
+    sol = ts.solve(cloud, ts.Grid((-1, -1), (1, 1), (81, 81)), sources=[(0.5, 0.0)])
+    assert sol.stats.order == 2
+    p = cloud.points
+    err = np.abs(sol(p) - 0.5 * np.abs(np.arctan2(p[:, 1], p[:, 0])))
+    assert np.max(err) < 1e-3  # 6.2e-4 and 1.7e-4
+
+
 @pytest.mark.parametrize(
     "points, match",
     [

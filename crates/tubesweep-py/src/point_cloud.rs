@@ -139,23 +139,25 @@ impl PyPointCloud {
 
     /// Closest points (M, d) of `points` and per point 0 (interior), 1 (moved to the rim) or 2
     /// (no fit: NaN), in parallel; `rho` is the smoothing radius (fits over at least the samples
-    /// within it).
-    #[pyo3(signature = (points, rho = 0.0))]
+    /// within it); feet found from a neighbour's foot and farther than `trust` from their point are
+    /// checked against its nearest sample (0: all of them).
+    #[pyo3(signature = (points, rho = 0.0, trust = 0.0))]
     fn closest<'py>(
         &self,
         py: Python<'py>,
         points: PyReadonlyArray2<'py, f64>,
         rho: f64,
+        trust: f64,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
         let (cp, feet, d) = match &self.cloud {
             Cloud::Two(c) => {
                 let x = rows::<2>(points_slice(&points, 2)?);
-                let (cp, f) = py.detach(|| c.closest_points(&x, rho));
+                let (cp, f) = py.detach(|| c.closest_points(&x, rho, trust));
                 (flat(cp), f, 2)
             }
             Cloud::Three(c) => {
                 let x = rows::<3>(points_slice(&points, 3)?);
-                let (cp, f) = py.detach(|| c.closest_points(&x, rho));
+                let (cp, f) = py.detach(|| c.closest_points(&x, rho, trust));
                 (flat(cp), f, 3)
             }
         };

@@ -472,7 +472,7 @@ class PointCloudSurface(ClosestPoint):
         for s0 in range(0, len(candidates), CHUNK):
             lin = candidates[s0 : s0 + CHUNK]
             x = grid.node_points(lin)
-            cp, feet = self._tree.closest(np.ascontiguousarray(x), self.smoothing)
+            cp, feet = self._tree.closest(np.ascontiguousarray(x), self.smoothing, half_width)
             norm = row_norms(x - cp)
             keep = norm <= half_width  # False where the fit failed (NaN)
             undefined.append(lin[~np.isfinite(norm)])

@@ -396,12 +396,15 @@ fn solve_spd(mut a: [[f64; 6]; 6], mut b: [f64; 6], n: usize) -> Option<[f64; 6]
 }
 
 /// The largest angular gap (radians) between the directions from `a` to `others` in the tangent
-/// plane; for a curve (D = 2), 0 when the others lie on both sides of `a`, 2π when on one side.
-pub(crate) fn largest_gap<const D: usize>(a: &[f64; 2], others: &[[f64; 2]]) -> f64 {
+/// plane (for a curve, D = 2: 0 when the others lie on both sides of `a`, 2π when on one side),
+/// and the unit direction (tangent coordinates) that bisects it: where the samples around `a`
+/// stop (for a curve, the side with no others).
+pub(crate) fn gap_and_bisector<const D: usize>(a: &[f64; 2], others: &[[f64; 2]]) -> (f64, [f64; 2]) {
     if D == 2 {
         let below = others.iter().any(|o| o[0] < a[0]);
         let above = others.iter().any(|o| o[0] > a[0]);
-        return if below && above { 0.0 } else { std::f64::consts::TAU };
+        let side = if below { 1.0 } else { -1.0 };
+        return (if below && above { 0.0 } else { std::f64::consts::TAU }, [side, 0.0]);
     }
     let mut angles: Vec<f64> = others
         .iter()
@@ -409,14 +412,18 @@ pub(crate) fn largest_gap<const D: usize>(a: &[f64; 2], others: &[[f64; 2]]) -> 
         .map(|o| (o[1] - a[1]).atan2(o[0] - a[0]))
         .collect();
     if angles.is_empty() {
-        return std::f64::consts::TAU;
+        return (std::f64::consts::TAU, [1.0, 0.0]);
     }
     angles.sort_by(f64::total_cmp);
-    let mut gap = angles[0] + std::f64::consts::TAU - angles[angles.len() - 1];
+    let last = angles[angles.len() - 1];
+    let (mut gap, mut from) = (angles[0] + std::f64::consts::TAU - last, last);
     for w in angles.windows(2) {
-        gap = gap.max(w[1] - w[0]);
+        if w[1] - w[0] > gap {
+            (gap, from) = (w[1] - w[0], w[0]);
+        }
     }
-    gap
+    let mid = from + 0.5 * gap;
+    (gap, [mid.cos(), mid.sin()])
 }
 
 /// The point of the convex hull of `pts` (2D, or an interval for a curve) nearest to `a`: `a`

@@ -12,7 +12,8 @@
 //! the support radius, the leave-one-out residual of each sample against the fit of its neighbours
 //! (outliers), and the largest angular gap of its 2k nearest neighbours around it in the tangent
 //! plane (a gap wider than [`RIM_GAP`] marks a sample on a rim: a hole or the boundary of an open
-//! scan). On a cloud with a rim, a foot that leaves the convex hull of its neighbours in the
+//! scan), unless samples farther out fill it ([`PointCloud::bridged_gap`]: where the sampling
+//! only thins, the last dense samples see all their 2k neighbours on one side). On a cloud with a rim, a foot that leaves the convex hull of its neighbours in the
 //! tangent plane is moved back to the hull's boundary, so nodes beyond the rim get closest points
 //! on the rim, as for the library's open surfaces.
 
@@ -22,7 +23,7 @@ mod isolated;
 pub use isolated::LINK;
 
 use crate::error::{Error, Result};
-use fit::{basis_len, clamp_to_hull, distance, largest_gap, Fit};
+use fit::{basis_len, clamp_to_hull, distance, dot, gap_and_bisector, Fit};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
@@ -39,6 +40,10 @@ pub const RIM_GAP: f64 = 120.0 / 180.0 * std::f64::consts::PI;
 /// A rim sample counts only with at least this many rim samples among its k nearest neighbours (a
 /// rim is a curve of samples; in 3D only).
 pub const RIM_CLUSTER: usize = 2;
+/// A foot found from a neighbour's foot farther from the query than twice its nearest sample plus
+/// this fraction of the neighbourhood's radius is found again from the query itself
+/// ([`PointCloud::closest_points`]).
+const STALE_START: f64 = 0.1;
 /// Queries per block of [`PointCloud::closest_points`].
 const BLOCK: usize = 256;
 /// Iterations of the fixed point c ← foot(x; fit at c).
@@ -212,7 +217,13 @@ impl<const D: usize> PointCloud<D> {
                         let residual = distance(&fit.lift(&a), p) / fit.radius;
                         let (ap, _) = fit.local(p);
                         let around: Vec<[f64; 2]> = others.iter().map(|o| fit.local(o).0).collect();
-                        (spacing, radius, residual, largest_gap::<D>(&ap, &around), nearest)
+                        (
+                            spacing,
+                            radius,
+                            residual,
+                            self.bridged_gap(p, &fit, &ap, around),
+                            nearest,
+                        )
                     }
                     None => (spacing, radius, f64::NAN, 0.0, nearest),
                 }
@@ -225,6 +236,51 @@ impl<const D: usize> PointCloud<D> {
             gap: rows.iter().map(|r| r.3).collect(),
             nearest: rows.iter().map(|r| r.4).collect(),
         }
+    }
+
+    /// The largest angular gap around sample `p` among `around` (its 2k nearest neighbours in the
+    /// fit's tangent coordinates, `ap` its own), once the samples farther out in the gap's
+    /// direction are counted: while the gap exceeds [`RIM_GAP`], probe points go out along its
+    /// bisector t at distances s = r, 2r, 4r, ... (r the fit's radius) up to 2·[`PointCloud::reach`]
+    /// (the sparsest fit's radius: a gap no wider than that is spanned by the fits anyway), and the
+    /// first sample within s/2 of a probe and near the tangent plane (its offset along the normal
+    /// under half its distance) joins the neighbours. Where the sampling only thins (a scan denser
+    /// on one side) the gap closes; beyond a true rim the nearest sample to every probe is the rim
+    /// itself, about s away, and the gap stays.
+    fn bridged_gap(&self, p: &[f64; D], fit: &Fit<D>, ap: &[f64; 2], mut around: Vec<[f64; 2]>) -> f64 {
+        let (mut gap, mut dir) = gap_and_bisector::<D>(ap, &around);
+        let mut closed = 0;
+        while gap > RIM_GAP && closed < 4 {
+            let mut t = [0.0; D];
+            for k in 0..D {
+                for j in 0..D - 1 {
+                    t[k] += dir[j] * fit.frame[j][k];
+                }
+            }
+            let normal = &fit.frame[D - 1];
+            let mut s = fit.radius;
+            let mut found = None;
+            while s <= 2.0 * self.reach && found.is_none() {
+                let mut probe = *p;
+                for k in 0..D {
+                    probe[k] += s * t[k];
+                }
+                let q = &self.points[self.tree.nearest_one::<SquaredEuclidean>(&probe).item as usize];
+                let mut off = [0.0; D];
+                for k in 0..D {
+                    off[k] = q[k] - p[k];
+                }
+                if distance(q, &probe) <= 0.5 * s && dot(&off, normal).abs() <= 0.5 * distance(q, p) {
+                    found = Some(*q);
+                }
+                s *= 2.0;
+            }
+            let Some(q) = found else { break };
+            around.push(fit.local(&q).0);
+            (gap, dir) = gap_and_bisector::<D>(ap, &around);
+            closed += 1;
+        }
+        gap
     }
 
     /// Marks the rim: samples whose gap exceeds [`RIM_GAP`] and (in 3D) with at least
@@ -362,8 +418,12 @@ impl<const D: usize> PointCloud<D> {
 
     /// [`PointCloud::closest_point`] for many points, in parallel: in fixed blocks of
     /// [`BLOCK`] points (so the answer does not depend on the threads), each query starting from
-    /// the previous point's foot when that point is near, sharing the candidate neighbours.
-    pub fn closest_points(&self, x: &[[f64; D]], rho: f64) -> (Vec<[f64; D]>, Vec<Foot>) {
+    /// the previous point's foot when that point is near, sharing the candidate neighbours. A foot
+    /// found from such a start that lies farther than `trust` from its point is checked against the
+    /// point's nearest sample, and found again from the point itself when that sample is much
+    /// nearer (0: every such foot is checked; a band search passes its half-width, beyond which
+    /// it drops the nodes, so that only the feet it would drop are checked).
+    pub fn closest_points(&self, x: &[[f64; D]], rho: f64, trust: f64) -> (Vec<[f64; D]>, Vec<Foot>) {
         let per_block: Vec<Vec<([f64; D], Foot)>> = x
             .par_chunks(BLOCK)
             .map(|block| {
@@ -372,11 +432,22 @@ impl<const D: usize> PointCloud<D> {
                 block
                     .iter()
                     .map(|p| {
-                        let start = match previous {
-                            Some((px, pf)) if pf[0].is_finite() && distance(&px, p) <= 2.0 * cache.radius => pf,
-                            _ => *p,
+                        let reused = match previous {
+                            Some((px, pf)) if pf[0].is_finite() && distance(&px, p) <= 2.0 * cache.radius => Some(pf),
+                            _ => None,
                         };
-                        let r = self.closest_point_from(p, start, rho, &mut cache);
+                        let mut r = self.closest_point_from(p, reused.unwrap_or(*p), rho, &mut cache);
+                        if reused.is_some() && !(distance(&r.0, p) <= trust) {
+                            // a start on another part of the surface can hold the fixed point at a
+                            // foot that is only locally nearest: up a column of nodes through a
+                            // circle's centre the feet stayed on the far side, and the band lost
+                            // the column beyond it. A closest point is never much farther than the
+                            // nearest sample, so such a foot is found again from the point itself
+                            let nearest = self.tree.nearest_one::<SquaredEuclidean>(p).distance.sqrt();
+                            if !(distance(&r.0, p) <= 2.0 * nearest + STALE_START * cache.radius) {
+                                r = self.closest_point_from(p, *p, rho, &mut cache);
+                            }
+                        }
                         previous = Some((*p, r.0));
                         r
                     })

@@ -17,7 +17,7 @@ fn sphere(n: usize, r: f64) -> Vec<[f64; 3]> {
 fn sphere_closest_points_are_accurate() {
     let cloud = PointCloud::new(sphere(20_000, 0.5), DEFAULT_NEIGHBOURS).unwrap();
     let queries: Vec<[f64; 3]> = sphere(500, 0.6).into_iter().chain(sphere(300, 0.42)).collect();
-    let (cp, feet) = cloud.closest_points(&queries, 0.0);
+    let (cp, feet) = cloud.closest_points(&queries, 0.0, 0.0);
     for (q, (c, f)) in queries.iter().zip(cp.iter().zip(&feet)) {
         assert_eq!(*f, Foot::Interior);
         let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
