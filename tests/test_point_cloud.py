@@ -200,6 +200,20 @@ def test_where_the_sampling_thins_is_no_rim():
     assert np.max(np.abs(sol(probe) - exact)) < 0.012  # was 0.090
 
 
+def test_a_part_sampled_too_sparsely_for_its_curvature_is_named_when_the_tube_folds():
+    # 50 samples on the lower hemisphere, 4000 on the upper: the fits below span 0.54, more than
+    # the sphere's radius; the error blamed samples off the surface by half a grid spacing only
+    rng = np.random.default_rng(1)
+    a, b = (0.5 * x / np.linalg.norm(x, axis=1, keepdims=True) for x in (rng.normal(size=(m, 3)) for m in (8000, 100)))
+    with pytest.warns(RuntimeWarning, match="lie off the surface their neighbours fit"):
+        cloud = from_points(np.vstack([a[a[:, 2] > 0], b[b[:, 2] <= 0]]))
+    with pytest.warns(RuntimeWarning, match="Widening the extension layer"):
+        with pytest.raises(
+            ValueError, match=r"sampled too sparsely for their curvature: the widest fit spans 0\.544, 10 times"
+        ):
+            ts.solve(cloud, cube(61), sources=[(0.0, 0.0, 0.5)])
+
+
 @pytest.mark.parametrize("dense, sparse", [(4000, 40), (400, 100)])
 def test_a_circle_sampled_densely_on_one_half(dense, sparse):
     # 4000/40: the last dense samples were taken for the ends of an open curve. 400/100: the band

@@ -55,6 +55,9 @@ MAX_OUTLIER_SHARE = 0.1
 NEAR_REPEAT = 1e-3
 #: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
 SPARSE_FACTOR = 3.0
+#: A widest fit more than this many times the median one: the sampling is uneven enough that a
+#: fold of the closest points may come from parts sampled too sparsely for their curvature.
+UNEVEN_FITS = 4.0
 #: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
 CHUNK = 1 << 20
 #: The file extensions :func:`read_points` reads.
@@ -246,11 +249,23 @@ class PointCloudSurface(ClosestPoint):
     """
 
     #: Why the band of a cloud's closest points may not close, for the band's error (``_prepare``).
-    band_advice = (
-        "Some samples lie off their neighbours' surface by about half a grid spacing (too little for the outlier "
-        "test, too much for the local fits to smooth out), which folds the closest points there: leave such samples "
-        "out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid"
-    )
+    @property
+    def band_advice(self) -> str:
+        """What folds a cloud's closest points so that the tube is not enclosed (for the error of
+        ``_prepare._prepare_tube``): samples a little off the surface, or, where the sampling is
+        uneven, parts sampled too sparsely for their curvature."""
+        advice = (
+            "Some samples lie off their neighbours' surface by about half a grid spacing (too little for the outlier "
+            "test, too much for the local fits to smooth out), which folds the closest points there: leave such "
+            "samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid"
+        )
+        if self._sparsest_fit > UNEVEN_FITS * self._median_fit:
+            advice += (
+                f". Or parts of the cloud are sampled too sparsely for their curvature: the widest fit spans "
+                f"{self._sparsest_fit:.3g}, {self._sparsest_fit / self._median_fit:.0f} times the median fit "
+                "(sample those parts more densely, or pass a smaller neighbours=)"
+            )
+        return advice
 
     def __init__(
         self,
@@ -363,6 +378,9 @@ class PointCloudSurface(ClosestPoint):
         self.rim = np.flatnonzero(cloud.rim)
         self.open_surface = rim_count > 0
         self.spacing = float(np.median(spacing))
+        # the fits' radii: the median and the widest (the band's error names uneven sampling)
+        self._median_fit = float(np.nanmedian(radius))
+        self._sparsest_fit = float(np.nanmax(radius))
         #: the samples' noise: 1.4826 × the median distance of a sample from its neighbours' fit
         self.noise = 1.4826 * float(np.nanmedian(residual * radius))
         q05, q95 = np.quantile(radius, [0.05, 0.95])
