@@ -224,15 +224,36 @@ def test_smooth_false_is_the_exact_map_bit_for_bit():
         ts.surfaces.from_mesh(ts.data.spot(), cut_shortcuts="no")
 
 
-def test_a_coarse_mesh_keeps_the_exact_map_and_first_order():
-    v, f = icosphere(2)  # 162 vertices, triangles of about 7 Δx at N = 101
+def test_a_coarse_polyhedron_keeps_the_exact_map_and_first_order():
+    # triangles of about 8.5 Δx at N = 61, edges turning by 90° (each face has its own vertices:
+    # the edges pair up by position)
+    v, f = cube_mesh(4)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        smooth = ts.solve(ts.surfaces.from_mesh((v, f)), box(101), [v[0]])
-        exact = ts.solve(ts.surfaces.from_mesh((v, f), smooth=False), box(101), [v[0]])
+        smooth = ts.solve(ts.surfaces.from_mesh((v, f)), box(61), [v[0]])
+        exact = ts.solve(ts.surfaces.from_mesh((v, f), smooth=False), box(61), [v[0]])
     assert smooth.stats.order == 1
     assert "coarse against the grid" in smooth.stats.order_fallback
+    assert "turns by more than 35°, up to 90°" in smooth.stats.order_fallback
     np.testing.assert_array_equal(smooth.values, exact.values)
+
+
+def test_a_coarse_triangulation_of_a_smooth_surface_runs_second_order_and_refining_helps():
+    # 320 triangles of a sphere (edges turning by about 12°): at N = 41 and 81 the triangles are
+    # about 3.2 and 6.4 Δx. They used to run first order on the exact map, 10.6 % and 4.6 % off the
+    # exact polyhedral geodesics at the worst vertex (mean 2.5 % and 0.96 %); the map is now built
+    # for the spacing that resolves them and second order runs on the finer grid
+    pygeodesic = pytest.importorskip("pygeodesic.geodesic")
+    v, f = icosphere(2)
+    exact, _ = pygeodesic.PyGeodesicAlgorithmExact(v, f).geodesicDistances(np.array([0]), None)
+    errors = []
+    for n in (41, 81):
+        surf = ts.surfaces.from_mesh((v, f))
+        sol = ts.solve(surf, box(n), [v[0]])
+        assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] == 0
+        assert surf.report["map_spacing"] > box(n).spacing
+        errors.append(np.max(np.abs(sol.on_mesh(v) - exact)) / exact.max())
+    assert errors[0] < 0.02 and errors[1] < 0.011 and errors[1] < errors[0]  # 1.6 % and 0.87 %
 
 
 def test_bad_input():

@@ -170,7 +170,7 @@ def solve(
         (``sol.stats.order2["first_order_nodes"]``, ``sol.first_order_points()``). Refused with a
         ``ValueError`` saying why: a tube more than half unresolved (the grid does not resolve the
         surface), a level set's convex creases or corners (the cube), a mesh with ``smooth=False``,
-        coarse against the grid or facing itself across gaps narrower than its tubes,
+        with creases of its own and coarse against the grid, or facing itself across gaps narrower than its tubes,
         Lax–Friedrichs, flows and Hamiltonian objects, ``method="naive"``, ``paper_sweeps``,
         ``source_init="node"``, ``source_radius`` and ``outer < inner + 2``. ``"auto"`` runs 2 where it applies (the same values) and where it
         does not the first-order scheme (the same values as ``order=1``, except that at a level

@@ -82,7 +82,7 @@ class SolveStats:
     order_fallback : str or None
         With ``order="auto"``, when second order did not apply and the solve ran ``order=1``: the
         reason, the text of the ``ValueError`` an explicit ``order=2`` raises (a tube more than
-        half unresolved, a cube's convex edges, a mesh coarse against the grid or facing itself
+        half unresolved, a cube's convex edges, a mesh with creases coarse against the grid or facing itself
         across narrow gaps, a Hamiltonian or option of the first-order scheme, ...). None
         otherwise.
     order2 : dict or None

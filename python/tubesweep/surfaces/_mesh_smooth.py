@@ -27,9 +27,21 @@ KINDS = ("fitted", "fine", "rim", "fallback", "far")
 #: larger than Δx are fitted (a node whose smooth distance is within the half-width is never lost).
 MARGIN = 0.5
 #: A mesh whose triangles' median size (longest edge) exceeds this many grid spacings is coarse
-#: against the grid: its band is the exact map's, and ``order="auto"`` runs first order on it (the
-#: fitted map of Spot at n = 200, 4.7 Δx, made the second-order sweeps run away; docs/point-clouds.md).
+#: against the grid. If it has creases of its own (:data:`SHARP_TURN`), its band is the exact
+#: map's and ``order="auto"`` runs first order on it (the fitted map of Spot at n = 200, 4.7 Δx,
+#: made the second-order sweeps run away; docs/point-clouds.md). If not, its triangles sample a
+#: smooth surface: the map is built for the spacing that resolves them (median size / COARSE),
+#: smooth at that scale on the finer grid, and second order runs (an icosphere of 320 triangles
+#: against its exact polyhedral geodesics at N = 41–121: 0.59–0.21 %, where first order gave
+#: 8.9–2.2 %, worse than at N = 31; ``benches/experiments/coarse_meshes.py``).
 COARSE = 3.0
+#: An edge whose two triangles' normals turn by more than this many degrees is a crease of the
+#: mesh itself (a cube's 90°, an icosahedron's 41.8°), not the facet of a smooth surface's
+#: triangulation (an icosphere of 80 triangles turns by 22.5°, a torus of 576 by 30°)...
+SHARP_TURN = 35.0
+#: ... and a mesh with more than this share of its edges' length at such creases is a polyhedron
+#: (Spot: 1.4 %, its ears and horns; the bunny: 0.8 %).
+SHARP_SHARE = 0.01
 #: Triangles larger than this many grid spacings (longest edge) are fitted
 #: (``tubesweep_core::surface::mesh_smooth::FINE_LOW``).
 FINE = 2.0
@@ -42,7 +54,7 @@ def closest(surface: Any, x: np.ndarray, h: Optional[float]) -> Tuple[np.ndarray
     closest points) and the map of each (codes of :data:`KINDS`)."""
     x = np.ascontiguousarray(np.asarray(x, dtype=float).reshape(-1, 3))
     # before any band, or on a mesh coarse against the grid: the exact closest points
-    if h is None or median_size(surface) > COARSE * h or "facing" in surface.report:
+    if h is None or "coarse" in surface.report or "facing" in surface.report:
         _, cp, _, _ = surface.closest(x)
         return cp, np.full(len(x), 1, np.uint8)
     mode = "auto"
@@ -59,14 +71,21 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
     """The band of the smooth map (see :meth:`SmoothMeshSurface.band`); ``exact_band()`` gives the
     exact map's (:meth:`MeshSurface.band`), used on a coarse mesh."""
     surface.check_grid(grid)
-    h = grid.spacing
-    surface._h = h
+    grid_h = grid.spacing
     surface._band_cache = None
     size = median_size(surface)
-    if size > COARSE * h:
-        # coarse: today's band of the exact map, and first order (order2_obstacle)
-        surface.report = {"coarse": size / h, "h": h}
-        return exact_band()
+    # the map's length scale: the grid's spacing, or on a coarse mesh without creases of its own
+    # the spacing that resolves its triangles
+    h = grid_h
+    if size > COARSE * grid_h:
+        share, turn = sharp_edges(surface)
+        if share > SHARP_SHARE:
+            # a coarse polyhedron: the exact map's band, and first order (order2_obstacle)
+            surface._h = grid_h
+            surface.report = {"coarse": size / grid_h, "h": grid_h, "sharp_share": share, "sharp_turn": turn}
+            return exact_band()
+        h = size / COARSE
+    surface._h = h
     if largest_size(surface) > FINE * h or not surface.closed:
         # fits will be needed (large triangles, or a boundary's blend): first the exact map's band,
         # and where the mesh faces itself across a gap narrower than its tubes that band and first
@@ -74,7 +93,7 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
         exact = exact_band()
         pairs = facing_pairs(grid, exact)
         if pairs:
-            surface.report = {"facing": pairs, "h": h}
+            surface.report = {"facing": pairs, "h": grid_h}
             return exact
     reach = half_width + MARGIN * h
     candidates = surface.band_candidates(grid, reach)
@@ -89,7 +108,9 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
         counts += np.bincount(kind[keep], minlength=len(KINDS))[: len(KINDS)]
         parts.append((lin[keep], norm[keep], x[keep], cp[keep]))
     surface.report = {name: int(c) for name, c in zip(KINDS[:4], counts[:4])}
-    surface.report["h"] = h
+    surface.report["h"] = grid_h
+    if h > grid_h:
+        surface.report["map_spacing"] = h
     if not parts or sum(len(q[0]) for q in parts) == 0:
         return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, 3), np.float32))
     linear, norm, x, cp = (np.concatenate([q[i] for q in parts]) for i in range(4))
@@ -98,7 +119,7 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
     again, _ = surface.smooth_map.closest(np.ascontiguousarray(cp[pick]), h, np.inf, "auto")
     surface._noise = float(np.quantile(row_norms(again - cp[pick]), 0.9))
     surface._band_cache = (x, cp)
-    ok = norm > DIRECTION_EPS * h
+    ok = norm > DIRECTION_EPS * grid_h
     direction = np.zeros((len(linear), 3))
     direction[ok] = (x[ok] - cp[ok]) / norm[ok, None]
     return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
@@ -114,6 +135,41 @@ def median_size(surface: Any) -> float:
     edges = [np.linalg.norm(v[f[:, i]] - v[f[:, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))]
     surface._median_size = float(np.median(np.maximum(np.maximum(edges[0], edges[1]), edges[2])))
     return float(surface._median_size)
+
+
+def sharp_edges(surface: Any) -> Tuple[float, float]:
+    """The share of the mesh's edge length (edges between two triangles) whose triangles' normals
+    turn by more than :data:`SHARP_TURN`, and the largest turn in degrees (computed once). On a
+    mesh that is not consistently oriented the flipped neighbours turn by about 180°: it counts
+    as having creases."""
+    known = getattr(surface, "_sharp_edges", None)
+    if known is not None:
+        return known
+    f = surface.faces[surface._good]
+    v = surface.vertices
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    n /= row_norms(n)[:, None]
+    # vertices at the same position are one (an STL's triangles each have their own)
+    _, same = np.unique(v, axis=0, return_inverse=True)
+    g = same.reshape(-1)[f]
+    edges = np.concatenate([np.sort(g[:, [i, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))])
+    ends = np.concatenate([f[:, [i, j]] for i, j in ((0, 1), (1, 2), (2, 0))])
+    face = np.tile(np.arange(len(f)), 3)
+    all_length = row_norms(v[ends[:, 0]] - v[ends[:, 1]])
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    edges, face, ends = edges[order], face[order], ends[order]
+    pair = np.all(edges[1:] == edges[:-1], axis=1)
+    length = row_norms(v[ends[:-1][pair, 0]] - v[ends[:-1][pair, 1]])
+    if 4.0 * length.sum() < all_length.sum():
+        # under half of the edges (by length) shared by two triangles: nothing to tell smooth
+        # facets from creases with; taken as creases (the exact map and first order, as before)
+        surface._sharp_edges = (1.0, float("nan"))
+        return surface._sharp_edges
+    a, b = face[:-1][pair], face[1:][pair]
+    turn = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", n[a], n[b]), -1.0, 1.0)))
+    sharp = turn > SHARP_TURN
+    surface._sharp_edges = (float(length[sharp].sum() / length.sum()), float(turn.max()))
+    return surface._sharp_edges
 
 
 def largest_size(surface: Any) -> float:
@@ -149,9 +205,16 @@ def order2_obstacle(surface: Any, tube_pairs: int) -> Optional[str]:
     """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants)."""
     report = surface.report
     if "coarse" in report:
+        turn = report["sharp_turn"]
+        creases = (
+            "its triangles share under half their edges, so its creases cannot be told from its facets"
+            if np.isnan(turn)
+            else f"{report['sharp_share']:.1%} of its edge length turns by more than {SHARP_TURN:g}°, up to {turn:.0f}°"
+        )
         return (
             f"the mesh is coarse against the grid: its triangles' median size is {report['coarse']:.1f} grid spacings "
-            f"(second order on a mesh needs at most {COARSE:g}); subdivide the mesh, or use the grid it resolves"
+            f"(second order on a mesh needs at most {COARSE:g} where it has creases of its own; here {creases}); "
+            "use the grid it resolves, or a mesh whose triangles sample a smooth surface"
         )
     pairs = report.get("facing", 0) or tube_pairs
     if pairs:
@@ -223,8 +286,9 @@ class SmoothMap:
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """The band nodes within ``half_width`` of the smooth map's surface, their closest points
         computed once in Rust (kept for the second-order geometry) and counted by map in
-        :attr:`report`. On a mesh coarse against the grid (median triangle above 3 Δx), the exact
-        map's band of :meth:`MeshSurface.band`.
+        :attr:`report`. On a mesh coarse against the grid (median triangle above 3 Δx) with creases
+        of its own (:data:`SHARP_TURN`), the exact map's band of :meth:`MeshSurface.band`; without
+        them, the map built for the spacing that resolves the triangles (``report["map_spacing"]``).
 
         Parameters
         ----------
