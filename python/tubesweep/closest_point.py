@@ -60,10 +60,11 @@ def _evaluate_cp(cp: Callable[[np.ndarray], np.ndarray], points: np.ndarray, fin
     return out
 
 
-def _refuse_undefined_next_to(grid: Grid, undefined: np.ndarray, linear: np.ndarray) -> None:
+def _refuse_undefined_next_to(grid: Grid, undefined: np.ndarray, linear: np.ndarray, advice: str = "") -> None:
     """Refuses candidate nodes where cp is not finite (``undefined``, linear indices) that are
     grid neighbours of band nodes (``linear``, sorted): cp may be undefined far from the surface,
-    but such a node next to the band may be a band node lost."""
+    but such a node next to the band may be a band node lost. ``advice``: a surface kind's own
+    cause and cure, which replaces the generic one."""
     if undefined.size == 0 or linear.size == 0:
         return
     idx = grid.unravel(undefined)
@@ -78,8 +79,8 @@ def _refuse_undefined_next_to(grid: Grid, undefined: np.ndarray, linear: np.ndar
             if np.any(hit):
                 p = grid.points(idx[inside][hit][:1])[0]
                 raise ValueError(
-                    f"cp returned NaN or inf at {tuple(float(c) for c in p)}, next to the band; it must be "
-                    "finite at every point near the surface (it may be undefined far from it)"
+                    f"cp returned NaN or inf at {tuple(float(c) for c in p)}, next to the band; "
+                    + (advice or "it must be finite at every point near the surface (it may be undefined far from it)")
                 )
 
 

@@ -499,7 +499,20 @@ class PointCloudSurface(ClosestPoint):
             self._band_cache = None
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
         linear, norm, x, cp, feet = (np.concatenate([q[i] for q in parts]) for i in range(5))
-        _refuse_undefined_next_to(grid, np.concatenate(undefined), linear)
+        _refuse_undefined_next_to(
+            grid,
+            np.concatenate(undefined),
+            linear,
+            "the cloud's local fits find no surface there (their feet wander off the samples). Some samples lie off "
+            "their neighbours' surface by about half a grid spacing (too little for the outlier test, too much for "
+            "the local fits to smooth out)"
+            + (
+                f", or the samples are noisy (noise ≈ {self.noise:.3g}, {self.noise / h:.2f} grid spacings)"
+                if self.noise > NOISY * h
+                else ""
+            )
+            + ": leave such samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid",
+        )
         self.report["rim_nodes"] = int(np.count_nonzero(feet == 1))
         # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|
         pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)

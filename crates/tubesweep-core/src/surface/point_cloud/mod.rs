@@ -384,6 +384,18 @@ impl<const D: usize> PointCloud<D> {
         rho: f64,
         cache: &mut Candidates<D>,
     ) -> ([f64; D], Foot) {
+        self.closest_point_from_at(x, start, rho, cache, 0)
+    }
+
+    /// [`PointCloud::closest_point_from`], `depth` 1 when started again from x's nearest sample.
+    fn closest_point_from_at(
+        &self,
+        x: &[f64; D],
+        start: [f64; D],
+        rho: f64,
+        cache: &mut Candidates<D>,
+        depth: u8,
+    ) -> ([f64; D], Foot) {
         let mut c = start;
         let mut foot = [f64::NAN; D];
         let mut nb: Vec<[f64; D]> = Vec::with_capacity(self.neighbours + 1);
@@ -412,6 +424,24 @@ impl<const D: usize> PointCloud<D> {
         }
         if !foot.iter().all(|v| v.is_finite()) {
             return ([f64::NAN; D], Foot::Failed);
+        }
+        // Every point of the surface lies within `reach` of a sample. Far from the samples the fit
+        // around c spans a wide cap and can hold a fixed point of its own off the samples (a noisy
+        // sphere's: feet 0.12–0.23 off it, a quarter of the radius, three times the reach, which
+        // put nodes far outside into the inner tube and ended the solve after a minute of widened
+        // layers). The last neighbourhood bounds the nearest sample's distance from above; only
+        // when that bound exceeds the reach is the tree asked, and such a foot is found again
+        // from x's nearest sample, on the surface (or fails).
+        let bound = nb.iter().map(|s| distance(s, &foot)).fold(f64::INFINITY, f64::min);
+        if bound > self.reach {
+            let nearest = self.tree.nearest_one::<SquaredEuclidean>(&foot);
+            if nearest.distance.sqrt() > self.reach {
+                let on_surface = self.points[self.tree.nearest_one::<SquaredEuclidean>(x).item as usize];
+                if depth == 0 && on_surface != start {
+                    return self.closest_point_from_at(x, on_surface, rho, cache, 1);
+                }
+                return ([f64::NAN; D], Foot::Failed);
+            }
         }
         (foot, if on_rim { Foot::Rim } else { Foot::Interior })
     }
