@@ -125,14 +125,14 @@ def test_a_rounded_cube_s_edges_are_sized_as_creases():
 
 
 def test_a_phi_whose_gradient_spreads_is_named_as_not_a_distance_with_the_cure():
-    # |x|² − R²: |∇φ| = 2|x|, 0.87-1.12 in the tube at N = 61; its mean is 1, so it passed for a
+    # |x|² − R²: |∇φ| = 2|x|, 0.76-1.17 over the tube at N = 61; its mean is 1, so it passed for a
     # distance and the fallback blamed the grid ("refine"), which does not cure it
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61))
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # 6.6% short: below the size warning's 10%
         sol = ts.solve(lambda p: (p**2).sum(axis=1) - R**2, g, [(-R, 0, 0)])
     assert sol.stats.order == 1
-    assert re.search(r"\|∇φ\| ranges over \[0\.8\d+, 1\.1\d+\] in the tube.*redistance=True", sol.stats.order_fallback)
+    assert re.search(r"\|∇φ\| ranges over \[0\.7\d+, 1\.1\d+\] in the tube.*redistance=True", sol.stats.order_fallback)
     assert 1 - sol([(R, 0, 0)])[0] / (np.pi * R) == pytest.approx(0.066, abs=0.003)
     cured = ts.solve(ts.LevelSet(lambda p: (p**2).sum(axis=1) - R**2, redistance=True), g, [(-R, 0, 0)])
     assert cured.stats.order == 2 and abs(1 - cured([(R, 0, 0)])[0] / (np.pi * R)) < 0.01
@@ -140,3 +140,16 @@ def test_a_phi_whose_gradient_spreads_is_named_as_not_a_distance_with_the_cure()
     with pytest.warns(RuntimeWarning, match=SIZE):
         coarse = ts.solve(ts.surfaces.Sphere(R), ts.Grid((-1, -1, -1), (1, 1, 1), (20, 20, 20)), [(-R, 0, 0)])
     assert "ranges over" not in coarse.stats.order_fallback
+
+
+def test_a_phi_that_flattens_away_from_the_surface_is_named_as_not_a_distance():
+    # 0.2·tanh(d/0.2) at N = 41: |∇φ| = 0.94 and 0.79 one and two spacings off, 0.42 at the tube's
+    # edge; read 1–2 spacings off only, it passed for a distance and the fallback (10.9 % short)
+    # blamed the curvature and the grid
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    with pytest.warns(RuntimeWarning, match=SIZE):
+        sol = ts.solve(lambda p: 0.2 * np.tanh((np.linalg.norm(p, axis=1) - R) / 0.2), g, [(-R, 0, 0)])
+    assert sol.stats.order == 1
+    assert re.search(
+        r"ranges over \[0\.\d+, 0\.\d+\] in the tube, so φ is not a distance.*redistance=True", sol.stats.order_fallback
+    )
