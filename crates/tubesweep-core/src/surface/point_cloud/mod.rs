@@ -13,9 +13,10 @@
 //! (outliers), and the largest angular gap of its 2k nearest neighbours around it in the tangent
 //! plane (a gap wider than [`RIM_GAP`] marks a sample on a rim: a hole or the boundary of an open
 //! scan), unless samples farther out fill it ([`PointCloud::bridged_gap`]: where the sampling
-//! only thins, the last dense samples see all their 2k neighbours on one side). On a cloud with a rim, a foot that leaves the convex hull of its neighbours in the
-//! tangent plane is moved back to the hull's boundary, so nodes beyond the rim get closest points
-//! on the rim, as for the library's open surfaces.
+//! only thins, the last dense samples see all their 2k neighbours on one side). On a cloud with a
+//! rim, a foot that leaves the convex hull of its neighbours in the tangent plane is moved back to
+//! the hull's boundary, so nodes beyond the rim get closest points on the rim, as for the
+//! library's open surfaces.
 
 pub(crate) mod fit;
 mod isolated;
@@ -377,6 +378,12 @@ impl<const D: usize> PointCloud<D> {
     /// [`PointCloud::closest_point`] from the first centre `start` (x, or the foot of a nearby
     /// point), with a cache of candidate neighbours shared by nearby queries. The answer is the
     /// fixed point to [`TOLERANCE`], whatever the start near it.
+    ///
+    /// Every point of the surface lies within `reach` of a sample. Far from the samples the fit
+    /// around c spans a wide cap and can hold a fixed point of its own off the samples (a noisy
+    /// sphere's: feet 0.12–0.23 off it, a quarter of the radius, three times the reach, which put
+    /// nodes far outside into the inner tube and ended the solve after a minute of widened
+    /// layers); such a foot is found again from x's nearest sample, on the surface, or fails.
     fn closest_point_from(
         &self,
         x: &[f64; D],
@@ -384,18 +391,29 @@ impl<const D: usize> PointCloud<D> {
         rho: f64,
         cache: &mut Candidates<D>,
     ) -> ([f64; D], Foot) {
-        self.closest_point_from_at(x, start, rho, cache, 0)
+        let (foot, kind, off_samples) = self.fixed_point(x, start, rho, cache);
+        if !off_samples {
+            return (foot, kind);
+        }
+        let on_surface = self.points[self.tree.nearest_one::<SquaredEuclidean>(x).item as usize];
+        if on_surface != start {
+            if let (foot, kind, false) = self.fixed_point(x, on_surface, rho, cache) {
+                return (foot, kind);
+            }
+        }
+        ([f64::NAN; D], Foot::Failed)
     }
 
-    /// [`PointCloud::closest_point_from`], `depth` 1 when started again from x's nearest sample.
-    fn closest_point_from_at(
+    /// The fixed point c ← the projection of `x` onto the fit centred at c, from `start`, and
+    /// whether its foot lies farther than `reach` from every sample (the last neighbourhood bounds
+    /// that distance from above; only past the bound is the tree asked).
+    fn fixed_point(
         &self,
         x: &[f64; D],
         start: [f64; D],
         rho: f64,
         cache: &mut Candidates<D>,
-        depth: u8,
-    ) -> ([f64; D], Foot) {
+    ) -> ([f64; D], Foot, bool) {
         let mut c = start;
         let mut foot = [f64::NAN; D];
         let mut nb: Vec<[f64; D]> = Vec::with_capacity(self.neighbours + 1);
@@ -403,7 +421,7 @@ impl<const D: usize> PointCloud<D> {
         for it in 0..MAX_ITERATIONS {
             let (radius, near_rim) = self.neighbourhood(&c, rho, cache, &mut nb);
             let Some(f) = Fit::new(&nb, &c, radius) else {
-                return ([f64::NAN; D], Foot::Failed);
+                return ([f64::NAN; D], Foot::Failed, false);
             };
             let mut a = f.project(x);
             on_rim = false;
@@ -423,27 +441,12 @@ impl<const D: usize> PointCloud<D> {
             }
         }
         if !foot.iter().all(|v| v.is_finite()) {
-            return ([f64::NAN; D], Foot::Failed);
+            return ([f64::NAN; D], Foot::Failed, false);
         }
-        // Every point of the surface lies within `reach` of a sample. Far from the samples the fit
-        // around c spans a wide cap and can hold a fixed point of its own off the samples (a noisy
-        // sphere's: feet 0.12–0.23 off it, a quarter of the radius, three times the reach, which
-        // put nodes far outside into the inner tube and ended the solve after a minute of widened
-        // layers). The last neighbourhood bounds the nearest sample's distance from above; only
-        // when that bound exceeds the reach is the tree asked, and such a foot is found again
-        // from x's nearest sample, on the surface (or fails).
         let bound = nb.iter().map(|s| distance(s, &foot)).fold(f64::INFINITY, f64::min);
-        if bound > self.reach {
-            let nearest = self.tree.nearest_one::<SquaredEuclidean>(&foot);
-            if nearest.distance.sqrt() > self.reach {
-                let on_surface = self.points[self.tree.nearest_one::<SquaredEuclidean>(x).item as usize];
-                if depth == 0 && on_surface != start {
-                    return self.closest_point_from_at(x, on_surface, rho, cache, 1);
-                }
-                return ([f64::NAN; D], Foot::Failed);
-            }
-        }
-        (foot, if on_rim { Foot::Rim } else { Foot::Interior })
+        let off_samples =
+            bound > self.reach && self.tree.nearest_one::<SquaredEuclidean>(&foot).distance.sqrt() > self.reach;
+        (foot, if on_rim { Foot::Rim } else { Foot::Interior }, off_samples)
     }
 
     /// [`PointCloud::closest_point`] for many points, in parallel: in fixed blocks of
