@@ -225,7 +225,11 @@ fn setup<const D: usize>(
     // φ noisy: every node's derivatives again, from the local fits (geometry::NOISY_FRACTION)
     let first = parts.iter().fold(GeometrySummary::empty(), |a, p| a.merge(p.summary));
     if first.noisy() {
-        parts = pass(true);
+        let fitted = pass(true);
+        let second = fitted.iter().fold(GeometrySummary::empty(), |a, p| a.merge(p.summary));
+        if first.fit_is_kept(&second, outer_width, spacing, surface.is_closest_point()) {
+            parts = fitted;
+        }
     }
     drop(indices);
     let n_inner: usize = parts.iter().map(|p| p.nodes.len()).sum();
