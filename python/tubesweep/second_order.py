@@ -289,7 +289,9 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
             f"(got inner={tube.inner:g}, outer={tube.outer_eff:g}); the defaults are inner=2, outer=4"
         )
     if getattr(surf, "smooth", False):  # a mesh through its smooth map (surfaces/_mesh_smooth.py)
-        obstacle = surf.order2_obstacle(int(tube.facing[0].size))
+        node, neighbour, _ = tube.facing
+        depth = np.median(np.maximum(np.abs(tube.phi[node]), np.abs(tube.phi[neighbour]))) / h if node.size else np.inf
+        obstacle = surf.order2_obstacle(int(node.size), float(depth))
         if obstacle is not None:
             raise Order2NotApplicable(obstacle)
     linear = tube.linear
