@@ -4,6 +4,7 @@ outliers and rims found and reported; a cloud and a mesh of the same surface agr
 bad input."""
 
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -339,3 +340,37 @@ def test_feet_never_wander_off_the_samples():
     # the smoothing radius of a solve on this cloud at N = 61 (3 Δx)
     cp, _ = cloud._tree.closest(np.outer(np.linspace(0.45, 0.9, 19), ray), 0.1)
     assert np.all(np.abs(np.linalg.norm(cp, axis=1) - 0.5) < 0.005)  # were 0.652 and 0.751 at 0.65, 0.75
+
+
+def test_a_part_sampled_too_sparsely_is_named_in_the_warnings():
+    # 4000 samples on the northern hemisphere, 75 on the southern (8 times the median fit's
+    # radius): at N = 61 the band widened twice "as φ is not close to a distance function" and
+    # the runaway blamed "a smoother φ"; the warnings now name the sparse part and its cure
+    rng = np.random.default_rng(0)
+
+    def sphere_samples(k):
+        x = rng.normal(size=(k, 3))
+        return 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
+
+    north = sphere_samples(8000)
+    north = north[north[:, 2] > 0][:4000]
+    south = sphere_samples(600)
+    south = south[south[:, 2] < 0]
+    g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    with pytest.warns(RuntimeWarning, match="lie off the surface their neighbours fit"):  # one lone southern sample
+        sparse = ts.surfaces.from_points(np.r_[north, south[:75]])
+    with pytest.warns(
+        RuntimeWarning, match=r"ran away.*the surface is the likely cause \(parts of the cloud sampled too sparsely"
+    ):
+        with pytest.warns(
+            RuntimeWarning, match=r"the closest points fold there .*: parts of the cloud sampled too sparsely"
+        ):
+            sol = ts.solve(sparse, g, [(0, 0, 0.5)])
+    assert sol.stats.order == 1 and "sampled too sparsely" in sol.stats.order_fallback
+    # twice as many samples there: second order, 0.4% of the largest distance at the worst point
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        denser = ts.solve(ts.surfaces.from_points(np.r_[north, south[:150]]), g, [(0, 0, 0.5)])
+    q = sphere_samples(2000)
+    exact = 0.5 * np.arccos(np.clip(q[:, 2] / 0.5, -1, 1))
+    assert denser.stats.order == 2 and np.max(np.abs(denser(q) - exact)) < 0.01 * np.pi * 0.5

@@ -36,13 +36,16 @@ ROLE_RTOL = 1e-9
 ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
 
 
-def _widening_message(missing: np.ndarray, phi: np.ndarray, h: float, inner: float, outer: float) -> str:
+def _widening_message(
+    missing: np.ndarray, phi: np.ndarray, h: float, inner: float, outer: float, surface: Any = None
+) -> str:
     """Why inner-tube nodes (band positions ``missing``) lack a neighbour in the band of half-width
     ``outer`` spacings. For a distance function a neighbour lies at most one spacing farther from
     the surface, so an inner node within ``outer − 1`` spacings of it whose neighbour falls
     outside says φ is not a distance function there; when every such node lies beyond that (only
     possible when ``outer − inner`` is about 1) the extension layer is merely too thin to hold the
-    neighbours, rounding included, and φ is not to blame."""
+    neighbours, rounding included, and φ is not to blame. A surface with its own
+    ``unresolved_advice`` (a point cloud) has it named instead of φ."""
     far = np.abs(phi[missing].astype(float)) > (outer - 1.0) * h * (1 - 1e-6)
     widen = f"Widening the extension layer to outer = {outer + 1}"
     if np.all(far):
@@ -52,11 +55,13 @@ def _widening_message(missing: np.ndarray, phi: np.ndarray, h: float, inner: flo
             f"tube (a neighbour can lie a full spacing farther out, and rounding puts some just beyond). {widen}; "
             "pass outer ≥ inner + 2 to avoid this"
         )
-    return (
-        f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: φ is not close to a "
-        f"distance function there (at {int(np.count_nonzero(~far))} of them the neighbour is more than one spacing "
-        f"farther out in φ). {widen}"
+    advice = getattr(surface, "unresolved_advice", None)
+    cause = "φ is not close to a distance function there" if advice is None else "the closest points fold there"
+    text = (
+        f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: {cause} (at "
+        f"{int(np.count_nonzero(~far))} of them the neighbour is more than one spacing farther out)"
     )
+    return f"{text}. {widen}" if advice is None else f"{text}: {advice}. {widen}"
 
 
 def _where(grid: Grid, node: Any) -> str:
@@ -462,7 +467,7 @@ def _prepare_tube(
                 )
             )
         warnings.warn(
-            _widening_message(missing, phi, h, inner, outer_eff), RuntimeWarning, stacklevel=user_stacklevel()
+            _widening_message(missing, phi, h, inner, outer_eff, surf), RuntimeWarning, stacklevel=user_stacklevel()
         )
         outer_eff += 1.0
     # a surface that leaves the grid box: the distances are those of the part inside (warned)

@@ -124,7 +124,7 @@ def solve_many_order2(
     if failed.size:
         # values falling without bound for these sources: no factored solution (second_order.Order2RanAway)
         raise so.Order2RanAway(
-            so.ran_away_message(int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness)
+            so.ran_away_message(int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness, t.surface)
             + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}{'…' if failed.size > 5 else ''})"
         )
     st["tol"] = inputs.tol

@@ -74,19 +74,20 @@ class Order2RanAway(Order2NotApplicable):
     first-order scheme, which is not factored."""
 
 
-def ran_away_message(iteration: Any, slowness: Any, src_slowness: np.ndarray) -> str:
+def ran_away_message(iteration: Any, slowness: Any, src_slowness: np.ndarray, surface: Any = None) -> str:
     """:class:`Order2RanAway`'s text: where it ran away, and how much faster than the sources the
-    fastest part of the band is."""
+    fastest part of the band is; at a constant speed, what of the ``surface`` the grid may not
+    resolve (its ``unresolved_advice`` where it has one: a point cloud's sampling)."""
     fastest = float(np.min(slowness))
     contrast = float(np.max(src_slowness)) / fastest if fastest > 0 else float("inf")
     if contrast >= RAN_AWAY_CONTRAST:
         cause = f"where the speed is much higher than at the sources (here up to {contrast:.3g} times)"
     else:
         speed = "a constant speed" if contrast <= 1.0 + 1e-9 else f"a speed at most {contrast:.3g} times the sources'"
-        cause = (
-            f"on this band, with {speed}: the surface is the likely "
-            "cause (a dent, bump or noise that the grid does not resolve: a finer grid or a smoother φ may avoid it)"
+        what = getattr(surface, "unresolved_advice", None) or (
+            "a dent, bump or noise that the grid does not resolve: a finer grid or a smoother φ may avoid it"
         )
+        cause = f"on this band, with {speed}: the surface is the likely cause ({what})"
     return (
         f"order=2: the second-order sweeps ran away at their iteration {iteration} (travel times fell below zero) and "
         f"the first-order factored restart did too: the factored update is not causal {cause}. order=1, the paper's "
@@ -608,7 +609,7 @@ def solve_on_tube(
         keep_digests or warm is not None,
     )
     if st["restart_failed"]:
-        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness))
+        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf))
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)

@@ -267,6 +267,21 @@ class PointCloudSurface(ClosestPoint):
             )
         return advice
 
+    #: What of a cloud the grid may not resolve, for the message of a second-order runaway
+    #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
+    @property
+    def unresolved_advice(self) -> str:
+        """Where a cloud's closest points fold or bend more than the grid resolves: samples a little
+        off their neighbours' surface, or, where the sampling is uneven, parts sampled too sparsely."""
+        advice = "samples a little off their neighbours' surface, which a larger neighbours= smooths out"
+        if self._sparsest_fit > UNEVEN_FITS * self._median_fit:
+            advice = (
+                f"parts of the cloud sampled too sparsely for the grid, where a fit spans up to {self._sparsest_fit:.3g}, "
+                f"{self._sparsest_fit / self._median_fit:.0f} times the median fit, and denser samples cure it; or "
+                + advice
+            )
+        return advice
+
     def __init__(
         self,
         points: Any,
