@@ -308,3 +308,17 @@ def test_re_distancing_does_not_depend_on_the_scale_of_phi():
     for scale in (1e-200, 1e200):
         scaled = ts.solve(ts.LevelSet(scale * quadric, redistance=True), grid, [(0, 0, 0.5)])
         assert np.max(np.abs(scaled.values - base.values)) < 1e-12
+
+
+def test_a_source_given_on_the_mask_s_surface_reads_zero_there():
+    # the ball r < 0.5 at N = 61: the smoothed mask's surface lies half a voxel inside the node
+    # (−0.5, 0, 0), which was both the source and the query; sol(points) near a source evaluated
+    # the chord from the query point itself, not from its closest point, and read Δx/2 there
+    g = _grid(61)
+    h = g.spacing
+    X, Y, Z = g.meshgrid()
+    sol = ts.solve(ts.LevelSet.from_mask(np.sqrt(X**2 + Y**2 + Z**2) < 0.5, g, smooth=1), g, [(-0.5, 0, 0)])
+    assert sol.stats.order == 2
+    # constant along the normal through the source: 0 at the source and up to half a voxel inside
+    along = sol([(-0.5 + k * h / 4, 0, 0) for k in range(3)])
+    assert np.max(along) < 1e-12

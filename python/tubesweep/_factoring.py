@@ -55,11 +55,11 @@ def factored_values(sol: Any, p: np.ndarray, values: np.ndarray, interpolation: 
         close[close] = _native.source_feet_within(feet, slowness, np.ascontiguousarray(p[close]), float(reach))
     if np.any(close):
         q = np.ascontiguousarray(p[close])
-        foot = q
-        if reach > FACTORED_RADIUS * h * (1 + 1e-9):
-            # the points' closest points: the point itself when it is on the surface (to rounding)
-            d_surface, foot = sol.surface.project(q, grid)
-            foot = np.where((d_surface <= 1e-9 * h)[:, None], q, foot)
+        # the points' closest points: the point itself when it is on the surface (to rounding). A
+        # point off the surface read the chord from itself: a source given on a voxel mask's
+        # surface, which its smoothed φ places half a voxel away, read Δx/2 at the source
+        d_surface, foot = sol.surface.project(q, grid)
+        foot = np.where((d_surface <= 1e-9 * h)[:, None], q, foot)
         chord = _native.source_feet_chords(feet, slowness, np.ascontiguousarray(foot, dtype=float))
         w = interpolate_band(sol._band, sol.values - u0, grid, q, interpolation)
         # never negative: w interpolated at a source rounds to ±1e-21 (the chord is 0 there)
