@@ -140,8 +140,11 @@ pub(super) fn run_phase<const D: usize>(
                 lim.decreases_only = true;
                 stats.fallback_iteration = Some(*iteration - stats.first_order_iterations);
                 // how far from settled the iterate was: the largest change of the stall's window
+                // (the finite ones: a node first reached in it changed from +∞, which says
+                // nothing of how far the values were from settled — a coarse torus mesh at
+                // N = 81 warned "up to inf")
                 let w = options.stall_window.min(changes.len());
-                stats.fallback_change = Some(changes[changes.len() - w..].iter().copied().fold(0.0, f64::max));
+                stats.fallback_change = Some(settled_distance(&changes[changes.len() - w..]));
             }
         } else if cycling {
             // the window cannot move past a cycle: open it, for the cycle to be ended there
@@ -167,4 +170,24 @@ pub(super) fn run_phase<const D: usize>(
         }
     }
     Ok(false)
+}
+
+/// The largest finite change of `window` (a stall's iterations), +∞ when none is finite.
+fn settled_distance(window: &[f64]) -> f64 {
+    let finite = window.iter().copied().filter(|c| c.is_finite());
+    finite
+        .fold(None, |m: Option<f64>, c| Some(m.map_or(c, |m| m.max(c))))
+        .unwrap_or(f64::INFINITY)
+}
+
+#[cfg(test)]
+mod settled_tests {
+    use super::settled_distance;
+
+    #[test]
+    fn a_first_reached_node_does_not_make_the_distance_infinite() {
+        assert_eq!(settled_distance(&[1e-6, f64::INFINITY, 3e-6, 2e-6]), 3e-6);
+        assert_eq!(settled_distance(&[f64::INFINITY]), f64::INFINITY);
+        assert_eq!(settled_distance(&[0.0, 0.0]), 0.0);
+    }
 }
