@@ -301,3 +301,18 @@ def test_a_rough_mesh_is_named_as_rough_not_as_facing_itself(ico5):
     spot = ts.surfaces.from_mesh(ts.data.spot())
     sol = ts.solve(spot, spot.grid(100), [spot.default_source])
     assert sol.stats.order == 1 and sol.stats.order_fallback.startswith("the mesh faces itself across gaps")
+
+
+def test_a_capsule_of_long_thin_triangles_runs_second_order():
+    # trimesh's capsule: its cylinder is one ring of 0.80 × 0.059 triangles. The fits' samples lay
+    # in rows a spacing apart along them but 0.004 apart across, feet came out up to 4Δx off the
+    # surface, and the band did not close at N = 61 (at N = 41: order 1, 8-10% short, "faces
+    # itself"); now the thin faces are sampled a spacing apart both ways
+    trimesh = pytest.importorskip("trimesh")
+    m = trimesh.creation.capsule(height=0.8, radius=0.3, count=[32, 32])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = ts.solve(ts.surfaces.from_mesh((np.asarray(m.vertices), np.asarray(m.faces))), box(61), [(0, 0, 0.7)])
+    exact = np.array([np.pi / 2 * 0.3 + 0.4, np.pi * 0.3 + 0.8])  # the cylinder's equator, the other pole
+    assert sol.stats.order == 2
+    assert np.max(np.abs(sol([(0.3, 0, 0), (0, 0, -0.7)]) / exact - 1)) < 0.008  # 0.17%, 0.61%
