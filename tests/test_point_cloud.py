@@ -374,3 +374,20 @@ def test_a_part_sampled_too_sparsely_is_named_in_the_warnings():
     q = sphere_samples(2000)
     exact = 0.5 * np.arccos(np.clip(q[:, 2] / 0.5, -1, 1))
     assert denser.stats.order == 2 and np.max(np.abs(denser(q) - exact)) < 0.01 * np.pi * 0.5
+
+
+def test_the_sharp_edges_of_a_box_are_named_in_the_error():
+    # noise-free samples of a 0.8³ box: the fits cannot follow its 90° edges, feet bounce between
+    # the faces and fail; the error blamed samples off the surface (the cloud has none)
+    rng = np.random.default_rng(0)
+    u = rng.uniform(-0.4, 0.4, size=(30000, 3))
+    face = rng.integers(0, 6, size=30000)
+    u[np.arange(30000), face % 3] = np.where(face < 3, -0.4, 0.4)
+    with pytest.warns(RuntimeWarning, match="1 of 29999 samples lie off the surface"):  # one next to an edge
+        box = ts.surfaces.from_points(u)
+    assert box.noise < 1e-6 and box.report["crease_samples"] > 0.005 * 30000
+    g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    with pytest.raises(ValueError, match=r"sharp edges or corners \(\d+ samples .* as a mesh \(from_mesh"):
+        ts.solve(box, g, [(0, 0, 0.4)])
+    # a sphere has none
+    assert ts.surfaces.from_points(sphere_cloud(8000)).report["crease_samples"] < 0.005 * 8000
