@@ -131,13 +131,18 @@ def test_a_rounded_cube_s_edges_are_sized_as_creases():
 
 def test_a_phi_whose_gradient_spreads_is_named_as_not_a_distance_with_the_cure():
     # |x|² − R²: |∇φ| = 2|x|, 0.76-1.17 over the tube at N = 61; its mean is 1, so it passed for a
-    # distance and the fallback blamed the grid ("refine"), which does not cure it
+    # distance and the fallback blamed the grid ("refine"), which does not cure it. The central
+    # differences fail almost only for |∇φ|: that reason leads, and the solve warns as for any φ
+    # that is not a distance (6.6% short)
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (61, 61, 61))
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")  # 6.6% short: below the size warning's 10%
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"φ is not a distance \(its \|∇φ\| is 1 on average but spreads.*"
+        r"errors up to about 7% .*redistance=True\) cures it",
+    ):
         sol = ts.solve(lambda p: (p**2).sum(axis=1) - R**2, g, [(-R, 0, 0)])
     assert sol.stats.order == 1
-    assert re.search(r"\|∇φ\| ranges over \[0\.7\d+, 1\.1\d+\] in the tube.*redistance=True", sol.stats.order_fallback)
+    assert re.search(r"^surface: order=2: \d+ of .* have \|∇φ\| off 1 .*redistance=True", sol.stats.order_fallback)
     assert 1 - sol([(R, 0, 0)])[0] / (np.pi * R) == pytest.approx(0.066, abs=0.003)
     cured = ts.solve(ts.LevelSet(lambda p: (p**2).sum(axis=1) - R**2, redistance=True), g, [(-R, 0, 0)])
     assert cured.stats.order == 2 and abs(1 - cured([(R, 0, 0)])[0] / (np.pi * R)) < 0.01
@@ -150,14 +155,12 @@ def test_a_phi_whose_gradient_spreads_is_named_as_not_a_distance_with_the_cure()
 def test_a_phi_that_flattens_away_from_the_surface_is_named_as_not_a_distance():
     # 0.2·tanh(d/0.2) at N = 41: |∇φ| = 0.94 and 0.79 one and two spacings off, 0.42 at the tube's
     # edge; read 1–2 spacings off only, it passed for a distance and the fallback (10.9 % short)
-    # blamed the curvature and the grid
+    # blamed the curvature and the grid; the central differences' |∇φ| leads the reason now
     g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
     with pytest.warns(RuntimeWarning, match=SIZE):
         sol = ts.solve(lambda p: 0.2 * np.tanh((np.linalg.norm(p, axis=1) - R) / 0.2), g, [(-R, 0, 0)])
     assert sol.stats.order == 1
-    assert re.search(
-        r"ranges over \[0\.\d+, 0\.\d+\] in the tube, so φ is not a distance.*redistance=True", sol.stats.order_fallback
-    )
+    assert re.search(r"^surface: order=2: \d+ of .* have \|∇φ\| off 1 .*redistance=True", sol.stats.order_fallback)
 
 
 def test_a_smooth_phi_that_only_looks_noisy_keeps_second_order_where_it_is_a_distance():
@@ -173,3 +176,17 @@ def test_a_smooth_phi_that_only_looks_noisy_keeps_second_order_where_it_is_a_dis
     assert sol.stats.order == 2 and o2["first_order_reasons"]["curvature"] == 0
     assert 0.1 < o2["first_order_reasons"]["gradient"] / o2["inner_nodes"] < 0.2
     assert abs(1 - sol([(R, 0, 0)])[0] / (np.pi * R)) < 0.012
+
+
+def test_an_ellipsoid_s_algebraic_distance_is_named_as_not_a_distance_with_the_error_size():
+    # c·(|(x/a, y/b, z/c)| − 1), |∇φ| from 0.36 to 1 near the surface: the fit everywhere read it
+    # as curvature ("grid: ... refine the grid", 94% of the tube) and no size warning came, 12% short
+    a, b, c = 0.7, 0.5, 0.25
+    g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    X, Y, Z = g.meshgrid()
+    phi = c * (np.sqrt((X / a) ** 2 + (Y / b) ** 2 + (Z / c) ** 2) - 1)
+    with pytest.warns(RuntimeWarning, match=r"φ is not a distance \(mean \|∇φ\| = 0\.6\d+\), which widens"):
+        with pytest.warns(RuntimeWarning, match="φ is only roughly a distance function"):
+            sol = ts.solve(ts.LevelSet(phi), g, [(a, 0, 0)])
+    assert sol.stats.order == 1
+    assert re.search(r"^surface: order=2: \d+ of .* \(9\d%\) .* have \|∇φ\| off 1", sol.stats.order_fallback)

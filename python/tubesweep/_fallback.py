@@ -138,22 +138,30 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     if share < SIZE_WARNING and 2 * crossing < SIZE_WARNING * largest and not not_a_distance:
         return
     size = f"up to about {100 * share:.0f}% of the distances" if share < 1 else "as large as the distances"
-    scaled = (
-        f"; φ is not a distance (mean |∇φ| = {gradient:.3g}), which widens the tube and the errors by 1/|∇φ|"
-        if not_a_distance
-        else ""
-    )
+    if not not_a_distance:
+        scaled = ""
+    elif gradient == 1.0:
+        scaled = "; φ is not a distance (its |∇φ| is 1 on average but spreads over the tube)"
+    else:
+        scaled = f"; φ is not a distance (mean |∇φ| = {gradient:.3g}), which widens the tube and the errors by 1/|∇φ|"
     edges = (
         f", and up to about {crossing:.3g} more ({100 * crossing / largest:.0f}% of the largest) for each edge, tip "
         "or corner with a curvature radius below the tube's width that a path crosses (as at a crease)"
         if crossing
         else ""
     )
-    cure = "redistance=True removes the widening" if not_a_distance else "a finer grid lowers them in proportion"
+    if not_a_distance:
+        cure = (
+            "LevelSet(φ, redistance=True) removes the widening"
+            if gradient != 1.0
+            else "LevelSet(φ, redistance=True) cures it"
+        )
+    else:
+        cure = "a finer grid lowers them in proportion"
     warnings.warn(
         f"order='auto' ran the paper's first-order scheme, whose errors are a few grid spacings where fronts meet "
         f"(about {FIRST_ORDER_SPACINGS:g}·Δx on a sphere){scaled}: here Δx = {spacing:.3g} and distances up to "
-        f"{largest:.3g}, so errors {size}{edges}. {cure.capitalize()} (why order 2 did not apply, kept in "
+        f"{largest:.3g}, so errors {size}{edges}. {cure[0].upper()}{cure[1:]} (why order 2 did not apply, kept in "
         f"sol.stats.order_fallback: {reason})",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
@@ -193,7 +201,7 @@ class Fallback:
         if given and high > GRADIENT_SPREAD * low and NOT_A_DISTANCE not in self.reason:
             self.reason += (
                 f"; |∇φ| ranges over [{low:.3g}, {high:.3g}] in the tube, so φ is not a distance, which reads as "
-                "curvature: LevelSet(φ, redistance=True) re-distances it and may run second order"
+                "curvature: LevelSet(φ, redistance=True) re-distances φ and may run second order"
             )
 
     def warn(self, values: Any, tube: Any) -> None:
