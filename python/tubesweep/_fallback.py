@@ -12,8 +12,9 @@ states :data:`FIRST_ORDER_SPACINGS` spacings against the largest distance, divid
 |∇φ| where φ is not a distance (the tube is that much wider: φ = 0.5·(|x| − 0.5) at N = 41 is
 24% off, and the warning says 23%), and adds about
 :data:`UNRESOLVED_SHORTCUT` spacings for each edge or tip whose curvature radius is below the
-tube's width that a path crosses (``RoundedCube()`` at N = 41–61 is 10–18% short across two
-edges). ``benches/experiments/fallback_size.py`` prints the errors against what the warning
+tube's width that a path crosses and where the tube is not thinned (``RoundedCube()`` at N = 71,
+5.9% short across two edges; inside edges rounded tighter than three spacings the inner tube is
+thinned as at a crease, ``band::crease_ridges``, and N = 41–61 come out 2.7–5.9% short). ``benches/experiments/fallback_size.py`` prints the errors against what the warning
 says; ``tests/test_fallback.py``.
 
 Not warned about: an option the caller chose that only the first-order scheme has
@@ -31,7 +32,7 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
-from ._creases import warn_refused_creases
+from ._creases import THINNED_SHORTCUT, warn_refused_creases
 from ._prepare import thinned_count
 from .band import band_neighbours
 from .surface import LevelSet
@@ -43,9 +44,10 @@ from .second_order import NOT_A_DISTANCE, Order2NotApplicable, warn_fallback
 FIRST_ORDER_SPACINGS = 3.0
 
 #: How early a front arrives, in grid spacings, after crossing an edge, a tip or a corner whose
-#: curvature radius is below the tube's width (as at a crease): ``RoundedCube()`` (radius 0.1) from
-#: its bottom face's centre, largest errors 4.6–6.8Δx at N = 41–61 where two edges were crossed,
-#: 2.3–3.4Δx per edge (``benches/experiments/fallback_size.py``).
+#: curvature radius is below the tube's width (as at a crease), where the inner tube is not thinned
+#: there: ``RoundedCube()`` (radius 0.1) from its bottom face's centre on the paper's tube, largest
+#: errors 4.6–6.8Δx at N = 41–61 where two edges were crossed, 2.3–3.4Δx per edge; thinned (edges
+#: rounded over less than three spacings) :data:`~tubesweep._creases.THINNED_SHORTCUT` instead.
 UNRESOLVED_SHORTCUT = 3.5
 
 #: The warning fires when the estimated error is at least this share of the distances: a surface
@@ -122,7 +124,8 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     first-order scheme: ``second_order.warn_fallback``), nor on an open surface (``gradient`` None:
     near a rim the distance curves whatever the surface does)."""
     spacing = tube.grid.spacing
-    if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned_count(tube) > 0):
+    thinned = thinned_count(tube) > 0
+    if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned):
         return
     if gradient is None:
         return
@@ -133,7 +136,9 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
         return
     unresolved = _UNRESOLVED.search(reason)
     edges_only = unresolved is not None and int(unresolved.group(1)) < 100 * EDGES_SHARE
-    crossing = UNRESOLVED_SHORTCUT * spacing / gradient if edges_only else 0.0
+    # (the inner tube thinned at the edges: THINNED_SHORTCUT spacings per edge, as at a crease)
+    per_edge = THINNED_SHORTCUT if thinned else UNRESOLVED_SHORTCUT
+    crossing = per_edge * spacing / gradient if edges_only else 0.0
     not_a_distance = NOT_A_DISTANCE in reason
     if share < SIZE_WARNING and 2 * crossing < SIZE_WARNING * largest and not not_a_distance:
         return
@@ -198,10 +203,13 @@ class Fallback:
             # ε = 4Δx at N = 41: |∇φ| 0.94 and 0.79 at 1 and 2 spacings, 0.42 at 4) is blamed on
             # the grid when read 1–2 spacings off only
             _, low, high = gradient_range(tube, far=np.inf)
+        # (a note, not the reason: a library surface's edges on a coarse grid spread |∇φ| read
+        # through central differences too, and are no φ to re-distance; NOT_A_DISTANCE, which
+        # the size warning reads as the cause, comes only from the geometry's own refusal)
         if given and high > GRADIENT_SPREAD * low and NOT_A_DISTANCE not in self.reason:
             self.reason += (
                 f"; |∇φ| ranges over [{low:.3g}, {high:.3g}] in the tube, so φ is not a distance, which reads as "
-                "curvature: LevelSet(φ, redistance=True) re-distances φ and may run second order"
+                "curvature: LevelSet(φ, redistance=True) re-distances it and may run second order"
             )
 
     def warn(self, values: Any, tube: Any) -> None:

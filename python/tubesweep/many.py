@@ -218,6 +218,8 @@ def solve_many(
             if order == 2:
                 raise
             fallback = Fallback.of(e, order)
+            if isinstance(e, so.OptionOfOrder1):
+                order = 1  # an option of the first-order scheme: its tube, as ts.solve's and tube.solve's
     tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if order != 1:
         t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's

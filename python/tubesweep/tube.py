@@ -217,6 +217,7 @@ class Tube:
         check_infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
         check_warm_refused(warm_refused)
         fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
+        paper_tube = order == 1  # the paper's tube, not thinned at creases: the first-order scheme chosen
         if order != 1:
             from . import second_order as _so
 
@@ -252,6 +253,9 @@ class Tube:
                 if order == 2:
                     raise
                 fallback = Fallback.of(e, order)
+                # an option of the first-order scheme: its tube, as ts.solve's (which refuses such
+                # an option before it builds the thinned one)
+                paper_tube = isinstance(e, _so.OptionOfOrder1)
         if warm is not None and warm_refused == "raise":
             from .moving import refusal_for_order1
 
@@ -260,7 +264,7 @@ class Tube:
         if fallback is not None:
             fallback.measure(self._tube_order2)
         sol = _solve_on_tube(
-            self._tube if order == 1 else self._tube_order2,
+            self._tube if paper_tube else self._tube_order2,
             src,
             general,
             scheme,

@@ -27,10 +27,10 @@
 //! (bottom centre to top centre, exact 2.0) this takes the shortcut per edge from 4.25Δx and
 //! 4.42Δx (N = 41, 81) to 0.56Δx, and on the cube turned at random to 0.9–1.3Δx
 //! (`benches/experiments/creases.py`). A ridge counts only where it comes within
-//! [`RIDGE_SEED`] spacings of the surface, as a crease's does, and where the faces' normals
-//! persist a step beyond the pair (a spike of noise turns one node's): the medial surface of a
-//! smooth surface the grid barely resolves (the torus 0.5/0.2 at N = 41) lies deeper, so a smooth
-//! surface's tube is unchanged (none on the sphere, torus and ellipsoid at N = 41–121).
+//! [`RIDGE_SEED`] spacings of the surface, as a crease's and a tightly rounded edge's do, and
+//! where the faces' normals persist a step beyond the pair (a spike of noise turns one node's):
+//! the medial surface of a smooth surface the tube resolves lies deeper, so its tube is unchanged
+//! (none on the sphere, torus and ellipsoid at N = 41–121).
 
 use crate::band::facing_sheets::check_node_fields;
 use crate::band::NarrowBand;
@@ -45,8 +45,15 @@ pub const RIDGE_SECOND_DIFFERENCE: f64 = 0.75;
 /// directions two spacings apart turn by 55° to 90°).
 pub const RIDGE_ANGLE: f64 = 40.0;
 
-/// A ridge is a crease's when it comes this near the surface (in grid spacings).
-pub const RIDGE_SEED: f64 = 1.0;
+/// A ridge is a crease's when it comes this near the surface (in grid spacings). Inside a rounded
+/// edge of radius r the ridge lies r deep, and where r is below the tube's width the tube cuts the
+/// edge's corner as at a crease: `RoundedCube(0.4, 0.05)` from a face's centre to the opposite
+/// one's, 11.3% short at N = 81 (r = 2Δx) and 8.6% at N = 101 when only ridges within one
+/// spacing counted, 0.6% and 5.2% now; `RoundedCube()` (r = 0.1) 1.0% at N = 41 (17.7%). A
+/// smooth surface that the tube resolves (κ·outer·Δx < 1) has its medial surface deeper than
+/// outer = 4 spacings; where two sides' tubes meet inside a sphere of radius 2.75–3.75Δx (N = 12–31)
+/// its centre's ridge counts too, as the crossing it is (the antipode 1.0Δx short instead of 2.7Δx).
+pub const RIDGE_SEED: f64 = 3.0;
 
 /// Nodes within this many grid spacings of the surface stay in the inner tube at a crease: the
 /// front crosses the crease through them. Nodes on the surface of the cube (N = 41, 81) and a
