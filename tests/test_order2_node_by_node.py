@@ -253,3 +253,17 @@ def test_a_scaled_distance_is_not_taken_for_noise():
     ):
         sol = ts.solve(ts.LevelSet(0.9 * d), g, [(-0.5, 0, 0)])
     assert sol.stats.order == 1 and "redistance=True" in sol.stats.order_fallback
+
+
+def test_a_crease_whose_normal_reverses_is_not_given_a_bound_of_1e15():
+    # two spheres of radius 0.3 a 0.02 gap apart, φ = min of their distances re-distanced: the
+    # normal turns by 180° across the gap, and 2·tan(θ/2)·inner·Δx said "up to about 3.27e+15"
+    g = box(41)
+    x = np.stack(g.meshgrid(), axis=-1)
+    c = 0.31
+    phi = np.minimum(np.linalg.norm(x - [c, 0, 0], axis=-1), np.linalg.norm(x + [c, 0, 0], axis=-1)) - 0.3
+    with pytest.warns(RuntimeWarning) as caught:
+        ts.Tube(ts.LevelSet(phi, redistance=True), g).solve([(0.61, 0, 0)])
+    (crease,) = [str(w.message) for w in caught if "creases or corners" in str(w.message)]
+    assert "turning by up to 180°" in crease and "e+" not in crease
+    assert re.search(r"arrives early by 0\.746 or more: the normal reverses there", crease)

@@ -35,6 +35,11 @@ _PER_INNER_WIDTH = re.compile(r"cut the corner by about ([0-9.]+)·inner·Δx")
 THINNED_SHORTCUT = 1.5
 
 
+#: Beyond this turn of the normal (degrees) a crease's shortcut is not bounded by 2·tan(θ/2)·inner·Δx
+#: (the core's ``Creases::shortcut_per_inner_width`` caps θ there too).
+REVERSED = 150.0
+
+
 def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
     """How early a front arrives after crossing one crease: ``per_inner_width`` (2·tan(θ/2))
     times the inner tube's half-width ``inner·Δx``."""
@@ -60,10 +65,19 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
     if not creases or not creases.get("nodes"):
         return
     angle = float(creases["angle_degrees"])
-    size, how = _per_crease(2 * np.tan(np.radians(angle) / 2), inner, spacing, thinned)
+    # 2·tan(θ/2) capped at θ = 150° as the core's (Creases::shortcut_per_inner_width): at 180° the
+    # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
+    # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
+    size, how = _per_crease(2 * np.tan(np.radians(min(angle, REVERSED)) / 2), inner, spacing, thinned)
+    early = (
+        f"arrives early by up to about {size:.3g} ({how}, first order in Δx)"
+        if angle <= REVERSED
+        else f"arrives early by {size:.3g} or more: the normal reverses there, two sheets face each other across a "
+        "gap narrower than the tube, and a front can cross over"
+    )
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
-        f"{angle:.0f}°): a front that crosses one arrives early by up to about {size:.3g} ({how}, first order in Δx), "
+        f"{angle:.0f}°): a front that crosses one {early}, "
         "and the nodes there run the first-order update. sol.first_order_points() shows where; rounding the edges "
         "over more than the tube's width (outer·Δx), or a finer grid, reduces it",
         RuntimeWarning,
