@@ -453,3 +453,28 @@ def test_a_tube_s_solutions_keep_digests_and_a_one_off_solve_does_not():
     assert one_off._digests is None and len(kept._digests) == kept.stats.band_points
     assert kept.stats.band_bytes - one_off.stats.band_bytes == 8 * kept.stats.band_points
     assert np.array_equal(kept.values, one_off.values)
+
+
+def test_a_warm_start_leaves_unreached_what_a_cold_solve_leaves_unreached():
+    # two spheres of radius 0.25 moving apart (gap 0.30 → 0.33 at N = 41), the source on one: the
+    # extension nodes on the midplane between them now extend the other sphere, which no source
+    # reaches; they kept their carried values (24 nodes, 0.62–0.77) where a cold solve leaves +∞
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    x = np.stack(g.meshgrid(), axis=-1)
+
+    def two(gap):
+        c = 0.25 + gap / 2
+        d = np.minimum(np.linalg.norm(x - [c, 0, 0], axis=-1), np.linalg.norm(x + [c, 0, 0], axis=-1)) - 0.25
+        return ts.LevelSet(d, redistance=True)
+
+    with pytest.warns(RuntimeWarning):  # the spheres' tubes face each other across the gap
+        tube = ts.Tube(two(0.30), g)
+        previous = tube.solve([(0.65, 0, 0)])
+        moved = tube.moved(two(0.33))
+        warm = moved.solve([(0.665, 0, 0)], warm=previous)
+        cold = moved.solve([(0.665, 0, 0)])
+    assert warm.stats.order2["warm"]["restarted"] is None
+    assert np.array_equal(np.isfinite(warm.values), np.isfinite(cold.values))
+    assert np.isinf(cold.values).sum() > 2000  # the other sphere
+    both = np.isfinite(cold.values)
+    assert np.max(np.abs(warm.values[both] - cold.values[both])) <= 10 * cold.stats.order2["tol"]

@@ -353,7 +353,7 @@ impl<const D: usize> Sweeper<'_, D> {
     /// sgn(φ) n has a component, the neighbour towards the surface, used only if it is in the band
     /// and has strictly smaller |φ| (so that no two layer nodes wait on each other); BDF2
     /// (weight 1.5|n_k|) when the next one along is there too, else first order (|n_k|).
-    /// None while a used neighbour is not reached, or when no neighbour qualifies. Like
+    /// +∞ while a used neighbour is not reached, None when no neighbour qualifies. Like
     /// [`Self::inner`], on w and returning the new w.
     ///
     /// The BDF2 correction is limited like the inner sides' (`reconstruct`): with δ = w₁ − w₂ and
@@ -392,7 +392,8 @@ impl<const D: usize> Sweeper<'_, D> {
             }
             let w1 = w.get(j1);
             if !w1.is_finite() {
-                return None;
+                // not reached: nor is this node (+∞, which a start's carried value gives way to)
+                return Some(f64::INFINITY);
             }
             let weight = nk.abs() as f64;
             if second {
@@ -467,8 +468,18 @@ impl<const D: usize> Sweeper<'_, D> {
         };
         change.updates += 1;
         let Some(new) = new else { return 0 };
-        if new == old || (lim.decreases_only && !(new < old)) || !new.is_finite() {
+        if new == old || (lim.decreases_only && !(new < old)) || new.is_nan() {
             return 0;
+        }
+        if new == f64::INFINITY {
+            // an extension node whose upwind neighbour is not reached holds +∞ in a cold solve
+            // (its values only fall); a warm start's carried value there goes back to +∞ too, or
+            // it stayed finite where nothing supports it (two spheres moving apart: 24 nodes
+            // between them kept 0.62–0.77 where a cold solve leaves them unreached)
+            w.set(i, new);
+            change.max_change = f64::INFINITY;
+            self.activate(active, i);
+            return WOKE;
         }
         if new + u0 > lim.window && !old.is_finite() {
             // reached, but beyond the window: not taken yet
