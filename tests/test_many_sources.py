@@ -543,3 +543,15 @@ def test_dask_order2_equals_local_and_a_closed_client_is_refused(client, tube):
         tube.solve_many(pts, at=pts, client=closed)
     with pytest.raises(ValueError, match="order must be 1"):
         tube.solve_many(pts, client=client, order=3)
+
+
+def test_points_of_at_off_the_band_are_named_in_a_warning():
+    # their columns are NaN (as sol(points) reads off the band); a matrix fed on to clustering
+    # carried them silently, while ts.distance_matrix refuses such points
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3))
+    at = [(0, 0, -0.5), (0, 0, 0.0), (0, 0, 0.2)]
+    with pytest.warns(
+        RuntimeWarning, match=r"2 of the 3 points of at lie off the band \(e\.g\. at\[1\] = \(0\.0, 0\.0, 0\.0\)\)"
+    ):
+        U = tube.solve_many([(0, 0, 0.5)], at=at)
+    assert np.all(np.isnan(U[:, 1:])) and abs(U[0, 0] - np.pi * 0.5) < 0.02

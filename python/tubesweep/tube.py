@@ -35,6 +35,7 @@ from ._prepare import _prepare_tube, thinned_at_creases
 from .solution import Solution
 from .solve import _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
+from ._warn import user_stacklevel
 
 __all__ = ["Tube"]
 
@@ -421,7 +422,7 @@ class Tube:
         if client is not None:
             from .distributed import solve_many_on_client
 
-            return solve_many_on_client(
+            out = solve_many_on_client(
                 self,
                 sources,
                 client=client,
@@ -441,13 +442,14 @@ class Tube:
                 threads=threads,
                 return_stats=return_stats,
             )
+            return _warn_nan_columns(out, at, return_stats)
         if chunk_size is not None:
             raise ValueError(
                 "chunk_size is for a Dask client (client=...): a local solve_many runs every source at once"
             )
         from .many import solve_many
 
-        return solve_many(
+        out = solve_many(
             self,
             sources,
             at=at,
@@ -463,6 +465,7 @@ class Tube:
             return_stats=return_stats,
             order=order,
         )
+        return _warn_nan_columns(out, at, return_stats)
 
     @property
     def nbytes(self) -> int:
@@ -471,3 +474,27 @@ class Tube:
         g = t.geom
         arrays = [t.linear, t.roles, t.phi, g.signed, g.direction] + ([g.distance] if g.distance is not None else [])  # type: ignore[union-attr]
         return int(sum(np.asarray(a).nbytes for a in arrays) + t.band.nbytes)
+
+
+def _warn_nan_columns(out: Any, at: Any, return_stats: bool) -> Any:
+    """``out`` of :meth:`Tube.solve_many`, after a RuntimeWarning naming the points of ``at``
+    whose column is NaN in every row: they lie off the band (``sol(points)`` reads NaN there too),
+    which a matrix fed on to clustering or MDS would otherwise carry silently."""
+    if at is None:
+        return out
+    values = out[0] if return_stats else out
+    v = np.asarray(values)
+    if v.ndim != 2 or v.shape[0] == 0:
+        return out
+    off = np.flatnonzero(np.all(np.isnan(v), axis=0))
+    if off.size:
+        p = np.asarray(at, dtype=float).reshape(v.shape[1], -1)
+        i = int(off[0])
+        warnings.warn(
+            f"{off.size} of the {v.shape[1]} points of at lie off the band (e.g. at[{i}] = "
+            f"{tuple(float(c) for c in p[i])}): their columns are NaN, as sol(points) reads there. Move them onto "
+            "the surface (ts.distance_matrix snaps points within the inner tube onto it)",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+    return out
