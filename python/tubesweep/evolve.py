@@ -44,7 +44,9 @@ class Evolution:
     ----------
     times : list of float
     phis : list of numpy.ndarray
-        φ on the grid at each kept time (the band re-distanced; a bound beyond it).
+        φ on the grid at each kept time (the band re-distanced; a bound beyond it). To solve on a
+        frame again, pass it as ``ts.LevelSet(phi, redistance=True)``: beyond the band the bound
+        falls towards one grid spacing, which ``ts.Tube(phi, grid)`` refuses as not a distance.
     solutions : list of Solution
         The surface solution at each kept time (on that time's surface).
     warm_starts, cold_starts : int
