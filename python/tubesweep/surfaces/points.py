@@ -256,6 +256,12 @@ class PointCloudSurface(ClosestPoint):
     (False, 0)
     """
 
+    def _uneven(self) -> Optional[float]:
+        """How many times the median fit the widest one spans, when above :data:`UNEVEN_FITS`
+        (parts may be sampled too sparsely), else None."""
+        ratio = self._sparsest_fit / self._median_fit
+        return ratio if ratio > UNEVEN_FITS else None
+
     def _crease_advice(self) -> str:
         """The cloud's sharp edges and their cure, or "" when it has none (:data:`CREASE_SHARE`)."""
         count, where = self._creases
@@ -281,14 +287,15 @@ class PointCloudSurface(ClosestPoint):
             "test, too much for the local fits to smooth out), which folds the closest points there: leave such "
             "samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid"
         )
-        if self._sparsest_fit > UNEVEN_FITS * self._median_fit:
+        uneven = self._uneven()
+        if uneven is not None:
             advice += (
                 f". Or parts of the cloud are sampled too sparsely for their curvature: the widest fit spans "
-                f"{self._sparsest_fit:.3g}, {self._sparsest_fit / self._median_fit:.0f} times the median fit "
+                f"{self._sparsest_fit:.3g}, {uneven:.0f} times the median fit "
                 "(sample those parts more densely, or pass a smaller neighbours=)"
             )
         crease = self._crease_advice()
-        return f"{crease[0].upper()}{crease[1:]}. Or: {advice}" if crease else advice
+        return f"{_sentence(crease)}. Or: {advice}" if crease else advice
 
     #: What of a cloud the grid may not resolve, for the message of a second-order runaway
     #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
@@ -297,11 +304,11 @@ class PointCloudSurface(ClosestPoint):
         """Where a cloud's closest points fold or bend more than the grid resolves: samples a little
         off their neighbours' surface, or, where the sampling is uneven, parts sampled too sparsely."""
         advice = "samples a little off their neighbours' surface, which a larger neighbours= smooths out"
-        if self._sparsest_fit > UNEVEN_FITS * self._median_fit:
+        uneven = self._uneven()
+        if uneven is not None:
             advice = (
                 f"parts of the cloud sampled too sparsely for the grid, where a fit spans up to {self._sparsest_fit:.3g}, "
-                f"{self._sparsest_fit / self._median_fit:.0f} times the median fit, and denser samples cure it; or "
-                + advice
+                f"{uneven:.0f} times the median fit, and denser samples cure it; or " + advice
             )
         crease = self._crease_advice()
         return f"{crease}; or {advice}" if crease else advice
@@ -548,7 +555,7 @@ class PointCloudSurface(ClosestPoint):
             np.concatenate(undefined),
             linear,
             "the cloud's local fits find no surface there (their feet wander off the samples). "
-            + (f"{crease[0].upper()}{crease[1:]}. Or: some" if crease else "Some")
+            + (f"{_sentence(crease)}. Or: some" if crease else "Some")
             + " samples lie off "
             "their neighbours' surface by about half a grid spacing (too little for the outlier test, too much for "
             "the local fits to smooth out)"
@@ -706,3 +713,8 @@ def from_points(
         points = read_points(points)
     surface = PointCloudSurface(points, normals=normals, neighbours=neighbours, outliers=outliers, name=name)
     return surface
+
+
+def _sentence(text: str) -> str:
+    """``text`` with its first letter capitalised (the rest as it is: names such as ``neighbours=``)."""
+    return text[:1].upper() + text[1:]

@@ -174,9 +174,11 @@ pub(super) fn run_phase<const D: usize>(
 
 /// The largest finite change of `window` (a stall's iterations), +∞ when none is finite.
 fn settled_distance(window: &[f64]) -> f64 {
-    let finite = window.iter().copied().filter(|c| c.is_finite());
-    finite
-        .fold(None, |m: Option<f64>, c| Some(m.map_or(c, |m| m.max(c))))
+    window
+        .iter()
+        .copied()
+        .filter(|c| c.is_finite())
+        .reduce(f64::max)
         .unwrap_or(f64::INFINITY)
 }
 
