@@ -431,7 +431,10 @@ def test_order_fallback_follows_tube_solve(grid):
     assert st["order"] == 1 and st["order_fallback"] == single.stats.order_fallback
     # the first order of "auto" runs on the tube thinned at the creases, as tube.solve's
     assert np.array_equal(bits(auto[0]), bits(single(pts)))
-    assert not np.array_equal(bits(auto), bits(ell.solve_many(pts, at=pts, order=1)))
+    # order=1 keeps the paper's tube, whose creases' corners are cut: said with their size
+    with pytest.warns(RuntimeWarning, match=r"in the paper's tube \(order=1\).*early by up to about 0\.[2-3]"):
+        paper = ell.solve_many(pts, at=pts, order=1)
+    assert not np.array_equal(bits(auto), bits(paper))
     with pytest.raises(ValueError, match="outer·Δx·κ"):
         ell.solve_many(pts, order=2)
     # an option of the first-order scheme: the same rule as tube.solve

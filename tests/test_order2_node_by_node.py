@@ -94,8 +94,14 @@ def test_convex_creases_are_said_with_the_shortcut_they_cost(n, fewer):
     assert said == pytest.approx(1.5 * g.spacing, rel=1e-3)
     measured = (2.0 - sol([(0.0, 0.0, 0.5)])[0]) / 2  # two edges crossed
     assert sol.stats.order == 1 and 0 < measured <= said
-    paper_sol = ts.solve(ts.LevelSet(phi), g, [(0.0, 0.0, -0.5)], order=1)
+    # order=1 keeps the paper's tube and says what it costs there: 2·tan(45°)·inner·Δx = 4Δx
+    with pytest.warns(RuntimeWarning, match=r"in the paper's tube \(order=1\).*about ([0-9.]+) per crease") as rec:
+        paper_sol = ts.solve(ts.LevelSet(phi), g, [(0.0, 0.0, -0.5)], order=1)
+    said_paper = float(re.search(r"about ([0-9.]+) per crease", str(rec[0].message)).group(1))
+    assert said_paper == pytest.approx(4 * g.spacing, rel=0.02)
     paper = (2.0 - paper_sol([(0.0, 0.0, 0.5)])[0]) / 2
+    assert 0.7 * said_paper < paper < 1.2 * said_paper
+    assert paper_sol.stats.creases["nodes"] > 0 and paper_sol.stats.creases["angle_degrees"] == pytest.approx(90, abs=1)
     assert measured < paper / fewer
     # the stats count the inner-tube nodes that the thinning made extension nodes: those the
     # paper's tube has in its inner tube and this one has not
@@ -124,9 +130,12 @@ def test_a_tube_and_a_batch_thin_the_cube_as_ts_solve_does():
     assert np.array_equal(again.values, single.values)
     assert np.array_equal(rows[0], single(at))
     assert again.stats.crease_thinned == single.stats.crease_thinned > 0
-    paper = ts.solve(cube, g, src, order=1)
-    assert np.array_equal(tube.solve(src, order=1).values, paper.values)
-    assert np.array_equal(tube.solve_many([src[0]], at=at, order=1)[0], paper(at))
+    with pytest.warns(RuntimeWarning, match=r"in the paper's tube \(order=1\)"):
+        paper = ts.solve(cube, g, src, order=1)
+    with pytest.warns(RuntimeWarning, match=r"in the paper's tube \(order=1\)"):
+        assert np.array_equal(tube.solve(src, order=1).values, paper.values)
+    with pytest.warns(RuntimeWarning, match=r"in the paper's tube \(order=1\)"):
+        assert np.array_equal(tube.solve_many([src[0]], at=at, order=1)[0], paper(at))
     assert not np.array_equal(single.values, paper.values)
 
 

@@ -171,11 +171,12 @@ def test_order2_refuses_outer_below_inner_plus_2_as_given_widened_or_not(outer):
     with pytest.raises(ts.second_order.Order2NotApplicable, match=r"outer ≥ inner \+ 2 .*pass outer=4 or more"):
         ts.solve(SPHERE, G41, [(-0.5, 0, 0)], order=2, outer=outer)
     for make in (lambda: ts.solve(SPHERE, G41, [(-0.5, 0, 0)], outer=outer), lambda: ts.Tube(SPHERE, G41, outer=outer)):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)  # the widening of outer=3
+        with pytest.warns(RuntimeWarning) as seen:  # (and the widening of outer=3)
             made = make()
-        sol = made if isinstance(made, ts.Solution) else made.solve([(-0.5, 0, 0)])
+            sol = made if isinstance(made, ts.Solution) else made.solve([(-0.5, 0, 0)])
         assert sol.stats.order == 1 and "outer ≥ inner + 2" in sol.stats.order_fallback
+        # said: the widths chose the first-order scheme, which a caller may not know
+        assert any("order='auto' ran the first-order scheme" in str(w.message) for w in seen)
 
 
 # ------------------------------------------------------------------ 4. distances never negative

@@ -37,7 +37,7 @@ from ._prepare import thinned_count
 from .band import band_neighbours
 from .surface import LevelSet
 from ._warn import user_stacklevel
-from .second_order import NOT_A_DISTANCE, Order2NotApplicable, warn_fallback
+from .second_order import NOT_A_DISTANCE, NarrowExtension, Order2NotApplicable, warn_fallback
 
 #: The first-order scheme's error where fronts meet, in grid spacings (the sphere's antipode:
 #: 2.7–3.1Δx at N = 12–20).
@@ -148,7 +148,7 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     elif gradient == 1.0:
         scaled = "; φ is not a distance (its |∇φ| is 1 on average but spreads over the tube)"
     else:
-        scaled = f"; φ is not a distance (mean |∇φ| = {gradient:.3g}), which widens the tube and the errors by 1/|∇φ|"
+        scaled = f"; φ is not a distance (mean |∇φ| = {gradient:.3g}), which scales the tube and the errors by 1/|∇φ|"
     edges = (
         f", and up to about {crossing:.3g} more ({100 * crossing / largest:.0f}% of the largest) for each edge, tip "
         "or corner with a curvature radius below the tube's width that a path crosses (as at a crease)"
@@ -157,7 +157,7 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     )
     if not_a_distance:
         cure = (
-            "LevelSet(φ, redistance=True) removes the widening"
+            "LevelSet(φ, redistance=True) removes that scaling"
             if gradient != 1.0
             else "LevelSet(φ, redistance=True) cures it"
         )
@@ -184,11 +184,13 @@ class Fallback:
     reason: str
     said: bool
     gradient: Optional[float] = None
+    #: widths that leave second order no room (``second_order.NarrowExtension``), said after the solve
+    narrow: bool = False
 
     @classmethod
     def of(cls, refusal: Order2NotApplicable, order: Any) -> "Fallback":
         """The fallback for ``refusal``, warned about now when the refusal's kind asks for it."""
-        return cls(str(refusal), warn_fallback(refusal, order))
+        return cls(str(refusal), warn_fallback(refusal, order), narrow=isinstance(refusal, NarrowExtension))
 
     def measure(self, tube: Any) -> None:
         """Reads the mean ``|∇φ|`` that :meth:`warn` needs from ``tube`` before the solve, which
@@ -214,5 +216,13 @@ class Fallback:
 
     def warn(self, values: Any, tube: Any) -> None:
         """After the solve on ``tube``: the crease or size warning for its ``values``
-        (:func:`warn_first_order`)."""
+        (:func:`warn_first_order`), or that the widths chose the first-order scheme."""
+        if self.narrow:
+            warnings.warn(
+                f"order='auto' ran the first-order scheme, whose errors are a few grid spacings where fronts meet: "
+                f"{self.reason}",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )
+            return
         warn_first_order(self.reason, values, tube, self.gradient, said=self.said)

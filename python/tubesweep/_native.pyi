@@ -278,6 +278,13 @@ class Band:
         direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
         spacing: float,
     ) -> npt.NDArray[np.int64]: ...
+    def creases_of_level_set(
+        self,
+        inner: npt.NDArray[np.bool_],
+        phi: npt.NDArray[np.float32],
+        direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
+        spacing: float,
+    ) -> Tuple[int, float]: ...
     def medial_edges(
         self,
         inner: npt.NDArray[np.bool_],

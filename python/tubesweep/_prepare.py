@@ -24,7 +24,7 @@ from .band import BandGeometry, band_neighbours
 from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
-from ._creases import crease_nodes_to_extend
+from ._creases import crease_nodes_to_extend, creases_in_paper_tube
 from ._shortcuts import cut_shortcuts, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
@@ -124,6 +124,10 @@ class _PreparedTube:
     #: nodes (``_creases.crease_nodes_to_extend``; band positions); their roles are changed only
     #: by :func:`thinned_at_creases`, so that ``order=1`` keeps the paper's tube
     crease_nodes: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0, np.int64))
+    #: the creases of a level set given as a distance in the paper's tube, where ``order=1`` cuts
+    #: their corners (``_creases.creases_in_paper_tube``): a dict as ``order2["creases"]``, None
+    #: for other surfaces
+    paper_creases: Optional[Dict[str, Any]] = None
     #: the inner tube's connected components and the checksum of its flags, once a warm start
     #: counted them (``moving.inner_components``)
     inner_components: Optional[Tuple[int, int]] = None
@@ -484,8 +488,11 @@ def _prepare_tube(
     # (after the facing test, which reads the paper's inner tube); not on a re-distanced φ, whose
     # kinks are those of its samples (a voxel mask's staircase), not creases of the surface
     extended = np.empty(0, np.int64)
-    if creases and method == "two-layer" and isinstance(surf, LevelSet) and not getattr(surf, "redistance", False):
-        extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)
+    paper_creases = None
+    if method == "two-layer" and isinstance(surf, LevelSet) and not getattr(surf, "redistance", False):
+        paper_creases = creases_in_paper_tube(band, roles == ROLE_INNER, phi, directions, h)
+        if creases:
+            extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)
     return _PreparedTube(
         grid,
         surf,
@@ -503,4 +510,5 @@ def _prepare_tube(
         cut,
         cut_edges,
         extended,
+        paper_creases=paper_creases,
     )

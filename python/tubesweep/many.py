@@ -30,7 +30,8 @@ from ._validate import (
     speed_at_points,
     speed_values,
 )
-from ._prepare import ROLE_INNER, uncut_band, warn_facing_pairs
+from ._creases import warn_paper_tube_creases
+from ._prepare import ROLE_INNER, thinned_count, uncut_band, warn_facing_pairs
 from ._sheet_readout import own_side_plan
 from ._fallback import Fallback
 from ._sources import SOURCE_RADIUS, _fix_sources
@@ -273,6 +274,8 @@ def solve_many(
     del directions
     if fallback is not None:
         fallback.warn(out, t)
+    if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut
+        warn_paper_tube_creases(t.paper_creases, t.inner, h)
     if plan is not None:
         m = len(points)  # type: ignore[arg-type]
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])
@@ -292,5 +295,6 @@ def solve_many(
         st["seconds_total"] = time.perf_counter() - t0
         st["order"] = 1
         st["order_fallback"] = None if fallback is None else fallback.reason
+        st["creases"] = t.paper_creases
         return out, st
     return out

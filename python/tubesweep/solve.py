@@ -30,6 +30,7 @@ from .grid import Grid
 from .moving import check_warm_refused
 from .stats import SolveStats
 from .surface import as_surface
+from ._creases import warn_paper_tube_creases
 from ._prepare import (
     METHODS,
     ROLE_FIXED,
@@ -384,6 +385,8 @@ def _solve_on_tube(
     grid, surf, band = tube.grid, tube.surface, tube.band
     cut_edges = tube.cut_edges
     crease_thinned = thinned_count(tube)
+    if crease_thinned == 0:  # the paper's tube: its creases' corners are cut
+        warn_paper_tube_creases(tube.paper_creases, tube.inner, grid.spacing)
     if scheme == "lxf" and cut_edges:
         # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
         # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
@@ -537,6 +540,7 @@ def _solve_on_tube(
         prefetch_iterations=int(st["prefetch_iterations"]),
         local_solver=st.get("local_solver", scheme),
         box_cut=tube.box_cut,
+        creases=tube.paper_creases,
     )
     return Solution(
         grid,

@@ -309,6 +309,31 @@ impl PyBand {
         Ok(out.into_pyarray(py))
     }
 
+    /// The creases of a level set in the paper's tube (`order=1`, see
+    /// `tubesweep_core::second_order::creases::creases_of_level_set`): `inner` per node, `phi` φ
+    /// (signed), `direction` (K, d) the outward directions. Returns the crease nodes' count and the
+    /// largest turn of the normal there, in degrees.
+    fn creases_of_level_set(
+        &self,
+        py: Python<'_>,
+        inner: PyReadonlyArray1<'_, bool>,
+        phi: PyReadonlyArray1<'_, f32>,
+        direction: PyReadonlyArray2<'_, f32>,
+        spacing: f64,
+    ) -> PyResult<(usize, f64)> {
+        let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
+        let c = py
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::second_order::creases::creases_of_level_set(b, inn, ph, dir, spacing)
+                )
+            })
+            .map_err(to_pyerr)?;
+        Ok((c.nodes, c.angle))
+    }
+
     /// The edges between neighbours whose closest points lie more than `jump` grid spacings
     /// apart, one of them in the inner tube (`tubesweep_core::band::medial_edges`): `inner` per
     /// node, `phi` its signed or unsigned distance, `direction` (K, d) its outward direction.
@@ -593,7 +618,7 @@ impl PyBand {
 /// Adds this file's classes and functions to the module.
 impl PyBand {
     /// The per-node fields of the band's surface tests (`facing_sheet_pairs`, `crease_ridge_nodes`,
-    /// `medial_edges`) as slices: `inner` and `phi` per node, `direction` (K, d) C-ordered. Their
+    /// `creases_of_level_set`, `medial_edges`) as slices: `inner` and `phi` per node, `direction` (K, d) C-ordered. Their
     /// lengths are checked against the band in the core (`check_node_fields`).
     fn node_fields<'a>(
         &self,

@@ -199,12 +199,16 @@ pub fn crease_ridge_nodes<const D: usize>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    /// The cube max|x| − 0.5 on [−1, 1]³ at N = 21 (Δx = 0.1): ridge nodes inside along its
-    /// edges and corners, none farther than the inner tube or on the surface; a sphere: none.
-    fn band_of(n: usize, phi: impl Fn([f64; 3]) -> f64) -> (NarrowBand<3>, Vec<f32>, Vec<f32>, Vec<bool>, f64) {
+    /// The band of |φ| ≤ 4Δx on [−1, 1]³ at `n` nodes per axis with φ (f32), the outward
+    /// directions by central differences and the inner tube |φ| ≤ 2Δx (also the crease tests'
+    /// of `second_order::creases`).
+    pub(crate) fn band_of(
+        n: usize,
+        phi: impl Fn([f64; 3]) -> f64,
+    ) -> (NarrowBand<3>, Vec<f32>, Vec<f32>, Vec<bool>, f64) {
         let h = 2.0 / (n - 1) as f64;
         let at = |i: usize| -1.0 + h * i as f64;
         let mut linear = Vec::new();
@@ -239,6 +243,8 @@ mod tests {
         (band, ph, dir, inner, h)
     }
 
+    /// The cube max|x| − 0.5 at N = 21 (Δx = 0.1): ridge nodes inside along its edges and
+    /// corners, none farther than the inner tube or on the surface; a sphere: none.
     #[test]
     fn the_cube_has_ridge_nodes_inside_its_edges_and_a_sphere_none() {
         let cube = |x: [f64; 3]| x[0].abs().max(x[1].abs()).max(x[2].abs()) - 0.5;

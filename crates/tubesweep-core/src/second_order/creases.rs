@@ -22,7 +22,11 @@
 //! turn by tens of degrees between neighbours where the noise spikes; the sphere with noise of
 //! 3e-3 at N = 121 re-distanced showed six such nodes).
 
+use rayon::prelude::*;
+
+use crate::band::facing_sheets::check_node_fields;
 use crate::band::NarrowBand;
+use crate::error::Result;
 use crate::sweep::NodeRole;
 
 use super::geometry::{NodeGeometry, Unresolved};
@@ -83,7 +87,6 @@ pub fn creases_of<const D: usize>(
         n
     };
     let threshold = CREASE_ANGLE.to_radians().cos();
-    let sentinel = band.sentinel();
     let mut found = Creases::default();
     let mut smallest = 1.0f64;
     let mut k = 0usize;
@@ -98,17 +101,7 @@ pub fn creases_of<const D: usize>(
         {
             continue;
         }
-        let mut cos_min = 1.0f64;
-        let ni = normal(i);
-        for axis in band.neighbours_of(i).iter() {
-            for &j in axis {
-                if j != sentinel {
-                    let nj = normal(j as usize);
-                    let dot: f64 = (0..D).map(|c| ni[c] * nj[c]).sum();
-                    cos_min = cos_min.min(dot);
-                }
-            }
-        }
+        let cos_min = smallest_turn(band, i, |j| Some(normal(j)));
         // a kink of φ there: central differences across it average the two faces' gradients,
         // |∇φ| ≈ cos(θ/2) (a smooth surface the grid barely resolves keeps |∇φ| ≈ 1)
         let kink = || {
@@ -128,6 +121,117 @@ pub fn creases_of<const D: usize>(
     found
 }
 
+/// The cosine of the largest turn of the normal from node `i` to its axis neighbours in the band
+/// (1 when none turns); `normal(j)` is None where node `j` has no direction (a node on the surface).
+fn smallest_turn<const D: usize>(band: &NarrowBand<D>, i: usize, normal: impl Fn(usize) -> Option<[f64; D]>) -> f64 {
+    let sentinel = band.sentinel();
+    let Some(ni) = normal(i) else { return 1.0 };
+    let mut cos_min = 1.0f64;
+    for axis in band.neighbours_of(i).iter() {
+        for &j in axis {
+            if j != sentinel {
+                if let Some(nj) = normal(j as usize) {
+                    let dot: f64 = (0..D).map(|c| ni[c] * nj[c]).sum();
+                    cos_min = cos_min.min(dot);
+                }
+            }
+        }
+    }
+    cos_min
+}
+
+/// The creases of a level set in the paper's tube, for the first-order scheme (Algorithm 3 on
+/// Eq. (3)), which computes no curvatures: the test of [`creases_of`] without its first gate — an
+/// inner-tube node (`inner`) within [`CREASE_REACH`] spacings of the surface whose normal turns by
+/// more than [`CREASE_ANGLE`] degrees to a neighbour's and where φ has a kink (|∇φ| by central
+/// differences of `phi` off 1 by more than [`GRAD_NORM_TOLERANCE`]). The angle reported is the
+/// widest turn at a crease node, also from its neighbour on one side to the one on the other
+/// (the cube's edges: 90°, where neighbours turn by 55°). `direction`: the unit
+/// outward directions sgn(φ)∇φ/|∇φ|, D per node (zero on the surface, where the central
+/// differences' normal stands in). The turn and the kink are each far beyond what a smooth surface that the tube
+/// resolves gives so near it (the torus (0.5, 0.2) at N = 41: up to 28° between neighbours), so
+/// only creases count, not where two sides' tubes meet deeper inside a small sphere.
+pub fn creases_of_level_set<const D: usize>(
+    band: &NarrowBand<D>,
+    inner: &[bool],
+    phi: &[f32],
+    direction: &[f32],
+    spacing: f64,
+) -> Result<Creases> {
+    check_node_fields(band, inner, phi, direction, spacing)?;
+    let sentinel = band.sentinel();
+    // ∇φ by central differences (None where a neighbour is outside the band)
+    let gradient = |n: usize| -> Option<[f64; D]> {
+        let nb = band.neighbours_of(n);
+        let mut g = [0.0f64; D];
+        for (k, pair) in nb.iter().enumerate() {
+            if pair[0] == sentinel || pair[1] == sentinel {
+                return None;
+            }
+            g[k] = (phi[pair[1] as usize] as f64 - phi[pair[0] as usize] as f64) / (2.0 * spacing);
+        }
+        Some(g)
+    };
+    // ∇φ/|∇φ|: the direction turned back by φ's sign, or on the surface (no direction there; the
+    // cube's faces at N = 41 lie on nodes) the central differences'
+    let normal = |n: usize| -> Option<[f64; D]> {
+        let s = if phi[n] < 0.0 { -1.0 } else { 1.0 };
+        let v: [f64; D] = std::array::from_fn(|k| s * direction[D * n + k] as f64);
+        if v.iter().any(|&c| c != 0.0) {
+            return Some(v);
+        }
+        let g = gradient(n)?;
+        let norm = g.iter().map(|c| c * c).sum::<f64>().sqrt();
+        (norm > 0.0).then(|| g.map(|c| c / norm))
+    };
+    let threshold = CREASE_ANGLE.to_radians().cos();
+    // the smallest cosine at a crease node, per node (2: not one)
+    let turn_at = |i: usize| -> f64 {
+        if !inner[i] || (phi[i] as f64).abs() > CREASE_REACH * spacing {
+            return 2.0;
+        }
+        let cos_min = smallest_turn(band, i, normal);
+        if cos_min >= threshold {
+            return 2.0;
+        }
+        // the faces' angle: the widest turn from one side of the node to the other (across a
+        // crease the central differences average the faces' normals at the nodes next to it, so
+        // neighbours turn by less: the cube's 90° edges by 55°, the bound 2·tan(θ/2) halved)
+        let mut widest = cos_min;
+        for pair in band.neighbours_of(i).iter() {
+            if pair[0] != sentinel && pair[1] != sentinel {
+                if let (Some(nm), Some(np)) = (normal(pair[0] as usize), normal(pair[1] as usize)) {
+                    widest = widest.min((0..D).map(|c| nm[c] * np[c]).sum());
+                }
+            }
+        }
+        // a stencil node outside the band counts as a kink, as in creases_of
+        let kink =
+            gradient(i).is_none_or(|g| (g.iter().map(|c| c * c).sum::<f64>().sqrt() - 1.0).abs() > GRAD_NORM_TOLERANCE);
+        if kink {
+            widest
+        } else {
+            2.0
+        }
+    };
+    let (nodes, smallest) = (0..band.len())
+        .into_par_iter()
+        .map(|i| {
+            let c = turn_at(i);
+            if c <= 1.0 {
+                (1usize, c)
+            } else {
+                (0, 1.0)
+            }
+        })
+        .reduce(|| (0, 1.0), |a, b| (a.0 + b.0, a.1.min(b.1)));
+    let mut found = Creases { nodes, angle: 0.0 };
+    if nodes > 0 {
+        found.angle = smallest.clamp(-1.0, 1.0).acos().to_degrees();
+    }
+    Ok(found)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,5 +241,49 @@ mod tests {
         let c = Creases { nodes: 1, angle: 90.0 };
         assert!((c.shortcut_per_inner_width() - 2.0).abs() < 1e-12);
         assert_eq!(Creases::default().shortcut_per_inner_width(), 0.0);
+    }
+
+    /// The paper's tube of the cube max|x| − 0.5 at N = 21 and 41 has crease nodes along its
+    /// edges (116 at N = 21) and its faces' angle, 90° (from one side of a node to the other:
+    /// neighbours turn by 55° by central differences); a sphere, a torus the grid barely resolves (the inner
+    /// side of Torus(0.5, 0.2) at N = 41, κΔx = 0.25) and a small sphere whose two sides' tubes
+    /// meet at its centre (radius 3Δx) have none.
+    #[test]
+    fn the_paper_tube_of_a_cube_has_creases_and_smooth_surfaces_none() {
+        use crate::band::crease_ridges::tests::band_of;
+        let cube = |x: [f64; 3]| x[0].abs().max(x[1].abs()).max(x[2].abs()) - 0.5;
+        for n in [21, 41] {
+            let (band, phi, dir, inner, h) = band_of(n, cube);
+            let c = creases_of_level_set(&band, &inner, &phi, &dir, h).unwrap();
+            assert!(c.nodes >= 10 * (n / 2), "{n}: {c:?}");
+            assert!((c.angle - 90.0).abs() < 1.0, "{n}: {c:?}");
+            // the tube's directions are zero on the surface (its faces lie on nodes here): the
+            // central differences' normals stand in, and the same nodes are found
+            let mut zeroed = dir.clone();
+            for (i, v) in phi.iter().enumerate() {
+                if *v == 0.0 {
+                    zeroed[3 * i..3 * i + 3].fill(0.0);
+                }
+            }
+            assert!(zeroed != dir);
+            assert_eq!(creases_of_level_set(&band, &inner, &phi, &zeroed, h).unwrap(), c, "{n}");
+        }
+        let sphere = |r: f64| move |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - r;
+        let torus = |x: [f64; 3]| ((x[0] * x[0] + x[1] * x[1]).sqrt() - 0.5).hypot(x[2]) - 0.2;
+        for (n, c) in [
+            (41, creases_of_level_set_of(41, sphere(0.5))),
+            (41, creases_of_level_set_of(41, torus)),
+            (21, creases_of_level_set_of(21, sphere(0.3))),
+        ] {
+            assert_eq!(c, Creases::default(), "{n}");
+        }
+        // the fields are checked
+        let (band, phi, dir, inner, h) = band_of(21, cube);
+        assert!(creases_of_level_set(&band, &inner[1..], &phi, &dir, h).is_err());
+    }
+
+    fn creases_of_level_set_of(n: usize, phi: impl Fn([f64; 3]) -> f64) -> Creases {
+        let (band, phi, dir, inner, h) = crate::band::crease_ridges::tests::band_of(n, phi);
+        creases_of_level_set(&band, &inner, &phi, &dir, h).unwrap()
     }
 }
