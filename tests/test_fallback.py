@@ -203,7 +203,7 @@ def test_an_ellipsoid_s_algebraic_distance_is_named_as_not_a_distance_with_the_e
     g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
     X, Y, Z = g.meshgrid()
     phi = c * (np.sqrt((X / a) ** 2 + (Y / b) ** 2 + (Z / c) ** 2) - 1)
-    with pytest.warns(RuntimeWarning, match=r"φ is not a distance \(mean \|∇φ\| = 0\.6\d+\), which widens"):
+    with pytest.warns(RuntimeWarning, match=r"φ is not a distance \(mean \|∇φ\| = 0\.6\d+\), which scales the tube"):
         with pytest.warns(RuntimeWarning, match="φ is only roughly a distance function"):
             sol = ts.solve(ts.LevelSet(phi), g, [(a, 0, 0)])
     assert sol.stats.order == 1

@@ -322,3 +322,20 @@ def test_a_source_given_on_the_mask_s_surface_reads_zero_there():
     # constant along the normal through the source: 0 at the source and up to half a voxel inside
     along = sol([(-0.5 + k * h / 4, 0, 0) for k in range(3)])
     assert np.max(along) < 1e-12
+
+
+@pytest.mark.parametrize("order", [1, "auto"])
+def test_a_source_deep_inside_a_mask_or_at_a_ball_s_centre_is_refused(order):
+    # the projection onto a re-distanced φ stops where its slope vanishes (a mask's plateau, the
+    # centre of a ball): the source was taken for one on the surface, 0 from it, and solved
+    # (u at the pole 0.25 for a source 0.25 below it, no warning)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    X, Y, Z = g.meshgrid()
+    phi = np.sqrt(X**2 + Y**2 + Z**2) - 0.5
+    surfaces = [ts.LevelSet(phi, redistance=True), ts.LevelSet.from_mask(phi < 0, g)]
+    for surface, inside in zip(surfaces, [(0.0, 0.0, 0.0), (0.0, 0.0, 0.25)]):
+        with pytest.raises(ValueError, match=r"sources\[0\] = .* is not near the surface \(φ there does not lead"):
+            ts.solve(surface, g, [inside], order=order)
+        # a source on the surface is still taken (the projection converges there)
+        sol = ts.solve(surface, g, [(0.0, 0.0, 0.5)], order=1)
+        assert sol([(0.0, 0.0, 0.5)])[0] < g.spacing

@@ -25,13 +25,24 @@ SOURCE_RADIUS = 2.0
 CHORD_TOLERANCE = 0.1
 
 
+def how_far(distance: float) -> str:
+    """How far a point is from the surface, for the messages that refuse it: +∞ is a projection
+    that did not reach the zero level set (``redistance.redistanced_project``)."""
+    if distance == np.inf:
+        return (
+            "is not near the surface (φ there does not lead to its zero level set: its slope vanishes, as deep inside a "
+            "voxel mask or at a ball's centre, where a re-distanced φ is only known within its band)"
+        )
+    return f"is {distance:.4g} from the surface"
+
+
 def check_on_surface(sources: np.ndarray, dist: np.ndarray, inner_width: float) -> None:
     """Refuses a source farther from the surface than the inner tube (``dist``: the sources'
     distances to their closest points, ``inner_width``: inner·Δx)."""
     for i, (dd, s) in enumerate(zip(dist, sources)):
         if dd > inner_width * (1 + 1e-6):
             raise ValueError(
-                f"sources[{i}] = {tuple(float(x) for x in s)} is {dd:.4g} from the surface, farther than the inner tube "
+                f"sources[{i}] = {tuple(float(x) for x in s)} {how_far(dd)}, farther than the inner tube "
                 f"(inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
             )
 

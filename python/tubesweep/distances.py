@@ -20,6 +20,7 @@ from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
 
+from ._sources import how_far
 from ._validate import as_points
 from ._prepare import ROLE_INNER
 from .solve import _check_order
@@ -57,7 +58,7 @@ def snap_to_surface(tube: Tube, points: Any, name: str = "points") -> np.ndarray
     if bad.size:
         i = int(bad[0])
         raise ValueError(
-            f"{name}[{i}] = {tuple(float(x) for x in p[i])} is {float(dist[i]):.4g} from the surface, farther than the "
+            f"{name}[{i}] = {tuple(float(x) for x in p[i])} {how_far(float(dist[i]))}, farther than the "
             f"inner tube (inner·Δx = {limit:.4g}){f' ({bad.size} points in all)' if bad.size > 1 else ''}: points must "
             "lie on the surface (they are snapped to it from within the inner tube); move them onto it"
         )

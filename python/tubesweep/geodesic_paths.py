@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any, List, Optional, Tuple
 import numpy as np
 
 from ._validate import as_points
-from ._sources import SOURCE_RADIUS
+from ._sources import SOURCE_RADIUS, how_far
 from ._warn import user_stacklevel
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -261,7 +261,7 @@ def trace_paths(
     if far.size:
         i = int(far[0])
         raise ValueError(
-            f"starts[{i}] = {tuple(float(v) for v in p[i])} is {float(dist[i]):.4g} from the surface, farther than the "
+            f"starts[{i}] = {tuple(float(v) for v in p[i])} {how_far(float(dist[i]))}, farther than the "
             f"inner tube ({sol.inner:g} grid spacings = {sol.inner * h:.4g}); start the path on the surface"
         )
     u = sol(x)

@@ -129,5 +129,6 @@ def mask_advice(surface: Any, reason: str) -> str:
         return reason
     return (
         reason + ". This surface is a raw voxel mask, whose staircase is that curvature at any grid: "
-        "LevelSet.from_mask(mask, grid, smooth=1) smooths it over a voxel and runs second order"
+        "LevelSet.from_mask(mask, grid, smooth=1) smooths it over a voxel and runs second order on objects many voxels "
+        "across (a ball 10 voxels in radius; not one of 5, whose curvature the grid barely resolves)"
     )

@@ -359,6 +359,9 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
 
 
 def redistanced_project(surface, points: np.ndarray, grid):
-    """Unsigned distance and closest points of ``points`` on the zero level set of φ."""
-    cp, signed, _ = _project(surface, grid, np.asarray(points, dtype=float))
-    return np.abs(signed), cp
+    """Unsigned distance and closest points of ``points`` on the zero level set of φ: +∞ (and the
+    point itself) where the projection did not reach it — ∇φ vanished on the way or the iterations
+    did not settle, as on a voxel mask's plateau or at a ball's centre, far from the surface
+    compared with its reach (a source there was taken for one on the surface, 0 from it)."""
+    cp, signed, converged = _project(surface, grid, np.asarray(points, dtype=float))
+    return np.where(converged, np.abs(signed), np.inf), cp

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, List, Optional, Tuple, Union
 
 import numpy as np
@@ -20,6 +21,7 @@ from .grid import Grid
 from .stats import SolveStats
 from .surface import Surface
 from ._prepare import ROLE_OUTER
+from ._warn import user_stacklevel
 
 
 class Solution:
@@ -312,7 +314,32 @@ class Solution:
         if bad.size:
             pos = self._nearest_reached(p[bad])
             out[bad] = np.where(pos >= 0, self.values[np.maximum(pos, 0)], np.nan)
+            self._warn_off_band(p[bad[pos < 0]], len(p))
         return out
+
+    def _warn_off_band(self, p: np.ndarray, total: int) -> None:
+        """A RuntimeWarning when points that :meth:`on_mesh` leaves NaN are off the band (their
+        nearest grid node is not in it, or they lie outside the box), not merely on a part of the
+        surface no source reaches: they are not on this surface (a mesh's own vertices after
+        ``from_mesh(..., normalize=True)`` moved it, a mesh on another scale)."""
+        if p.size == 0:
+            return
+        g = self.grid
+        ci = g.continuous_index(p)
+        inside = np.all((ci > -0.5) & (ci < np.asarray(g.shape) - 0.5), axis=1)
+        off = ~inside
+        if np.any(inside):
+            idx = np.rint(ci[inside]).astype(np.int64)
+            off[inside] = self._band.find(np.ascontiguousarray(idx)) < 0
+        n = int(np.count_nonzero(off))
+        if n:
+            warnings.warn(
+                f"on_mesh: {n} of {total} vertices lie off the band (farther from the surface than the tube, or outside "
+                "the grid box): NaN there. Are they this surface's vertices? from_mesh(..., normalize=True) moves the "
+                "mesh: pass surface.vertices",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )
 
     def _nearest_reached(self, p: np.ndarray) -> np.ndarray:
         """Band position (M,) of the band node nearest to each point within ``outer + 1`` grid
