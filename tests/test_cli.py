@@ -301,6 +301,11 @@ def test_a_curve_cannot_be_exported_to_ply_and_a_directory_is_not_a_mesh(tmp_pat
         main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "c.ply"), "--out", str(out)]) == 2
     )
     assert ".ply holds surfaces only" in capsys.readouterr().err and not out.exists()
+    # nor to .obj (meshio's own error, and a traceback, before)
+    assert (
+        main(["solve", "--surface", "circle", "--n", "41", "--export", str(tmp_path / "c.obj"), "--out", str(out)]) == 2
+    )
+    assert ".obj holds surfaces only" in capsys.readouterr().err and not out.exists()
     assert main(["solve", "--mesh", str(tmp_path), "--out", str(out)]) == 2
     assert "is a directory" in capsys.readouterr().err
 

@@ -4,6 +4,8 @@ that grows keeps its distances proportional to its radius."""
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 
@@ -478,3 +480,44 @@ def test_a_warm_start_leaves_unreached_what_a_cold_solve_leaves_unreached():
     assert np.isinf(cold.values).sum() > 2000  # the other sphere
     both = np.isfinite(cold.values)
     assert np.max(np.abs(warm.values[both] - cold.values[both])) <= 10 * cold.stats.order2["tol"]
+
+
+def test_a_fortran_ordered_phi_evolves_as_its_c_ordered_copy():
+    # φ read from NIfTI or MATLAB files comes in Fortran order: the band's nodes were written
+    # through a copy and the step's motion lost (the pole 0.51 instead of 0.52, converged)
+    phi = sphere_phi(GRID31)
+    law = lambda u: 0.2 + 0 * u  # noqa: E731
+    c = ts.evolve(phi, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=2)
+    f = ts.evolve(np.asfortranarray(phi), GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=2)
+    assert np.array_equal(f.phis[-1], c.phis[-1]) and np.array_equal(f.solutions[-1].values, c.solutions[-1].values)
+    assert float(c.solutions[-1].sources[0][2]) == pytest.approx(0.52, abs=0.1 * GRID31.spacing)
+    # the frames' times are t0 + k·dt, not a running sum
+    assert c.times == [0.0, 0.05, 0.1]
+
+
+def test_evolve_names_phi_progress_and_checkpoint_faults(tmp_path):
+    phi = sphere_phi(GRID31)
+    law = lambda u: 0 * u  # noqa: E731
+    for surface in (ts.LevelSet(phi), ts.surfaces.Sphere(0.5), lambda p: np.linalg.norm(p, axis=1) - 0.5):
+        with pytest.raises(TypeError, match=r"evolve: phi must be an array of φ at the grid's nodes"):
+            ts.evolve(surface, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    with pytest.raises(TypeError, match=r"evolve: progress must be None or a callable"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=1, progress=3)
+    (tmp_path / "run.npz").mkdir()
+    with pytest.raises(ValueError, match=r"checkpoint=.*run\.npz' is a folder"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=1, checkpoint=tmp_path / "run.npz")
+    # a checkpoint that cannot be written mid-run (its folder removed) stops the run with its frames
+    folder = tmp_path / "gone"
+    folder.mkdir()
+    calls = []
+
+    def remove_folder(step, steps, t):
+        calls.append(step)
+        shutil.rmtree(folder)  # with the checkpoint of step 0
+
+    with pytest.raises(ts.EvolutionStopped, match=r"step 1 .*the checkpoint .* could not be written") as info:
+        ts.evolve(
+            phi, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=2, checkpoint=folder / "a.npz", progress=remove_folder
+        )
+    # (the frame of step 1 is kept; only its checkpoint is missing)
+    assert calls == [1] and info.value.evolution.times == [0.0, 0.05] and isinstance(info.value.__cause__, OSError)

@@ -30,7 +30,7 @@ from ._sources import check_on_surface
 from .solution import Solution
 from ._step_warnings import StepWarnings
 from .output import export
-from .surface import LevelSet
+from .surface import LevelSet, Surface
 from .tube import Tube
 
 __all__ = ["evolve", "Evolution", "EvolutionStopped"]
@@ -294,11 +294,13 @@ def evolve(
         surface or the sources (they must lie on it).
     EvolutionStopped
         A ``ValueError`` raised at a later step: the surface or the part that carries a source
-        vanished or shrank below the grid, the speed law or the CFL condition failed, or a surface
-        solve did not converge. It names the step and the time, and its ``evolution`` holds the
+        vanished, shrank below the grid or left its box, the speed law or the CFL condition failed,
+        a surface solve did not converge, or the checkpoint could not be written. It names the step and the time, and its ``evolution`` holds the
         frames computed before.
     TypeError
-        If ``speed`` is not callable or returns None or values that are not real numbers.
+        If ``phi`` is not an array (a surface or a function: pass its values at the nodes),
+        ``speed`` or ``progress`` is not callable, or ``speed`` returns None or values that are not
+        real numbers.
 
     Examples
     --------
@@ -310,7 +312,15 @@ def evolve(
     0.52
     """
     grid = as_grid(grid)
-    arr = np.array(phi, dtype=float)  # a copy: the caller's array is left alone
+    if isinstance(phi, Surface) or callable(phi):
+        raise TypeError(
+            f"evolve: phi must be an array of φ at the grid's nodes, which evolve advances; got {type(phi).__name__}. "
+            "For a surface or a φ function pass its values, e.g. surface.signed_distance(grid.node_points("
+            "np.arange(grid.size))).reshape(grid.shape)"
+        )
+    # a copy in C order: the caller's array is left alone, and the band's nodes are written
+    # through its flat view (of a Fortran-ordered array, a copy that dropped the step's motion)
+    arr = np.array(phi, dtype=float, order="C")
     if arr.shape != tuple(grid.shape):
         raise ValueError(f"evolve: phi must be an array of the grid's shape {tuple(grid.shape)}; got {arr.shape}")
     src = as_sources(sources, grid)
@@ -333,6 +343,8 @@ def evolve(
         raise ValueError(
             f"evolve: checkpoint is written with numpy.savez and must end in .npz; got {str(checkpoint)!r}"
         )
+    if checkpoint is not None and Path(checkpoint).is_dir():
+        raise ValueError(f"evolve: checkpoint={str(checkpoint)!r} is a folder; give a file name ending in .npz")
     if checkpoint is not None and not Path(checkpoint).resolve().parent.is_dir():
         raise ValueError(
             f"evolve: the folder of checkpoint={str(checkpoint)!r} does not exist; create it first (the checkpoint is "
@@ -340,6 +352,10 @@ def evolve(
         )
     if not callable(speed):
         raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(
+            f"evolve: progress must be None or a callable progress(step, steps, t); got {type(progress).__name__}"
+        )
     h = grid.spacing
     out = Evolution([], [], [])
     tube: Optional[Any] = None
@@ -367,7 +383,7 @@ def evolve(
                     raise  # the caller's surface or sources, refused as by ts.solve
                 raise EvolutionStopped(
                     f"evolve stopped at step {step} (t = {t:.6g}): the surface, or the part of it that carries a source, "
-                    f"vanished or shrank below a few grid spacings: {e}",
+                    f"vanished, shrank below a few grid spacings or left the grid box: {e}",
                     out,
                     step,
                     t,
@@ -403,7 +419,16 @@ def evolve(
                 out.phis.append(arr)
                 out.solutions.append(sol)
                 if checkpoint is not None:
-                    _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=src)
+                    try:
+                        _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=src)
+                    except OSError as e:
+                        raise EvolutionStopped(
+                            f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "
+                            f"be written ({e}); the frames computed so far are in this error's evolution",
+                            out,
+                            step,
+                            t,
+                        ) from e
             if step == steps:
                 break
             u = sol.values
@@ -426,7 +451,7 @@ def evolve(
             new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
             arr = new
             older, prev = prev, sol
-            t += dt
+            t = t0 + (step + 1) * dt  # not a running sum: no rounding carried from step to step
             if progress is not None:
                 progress(step + 1, steps, t)
         return out

@@ -168,15 +168,15 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
 
 def export_format(path: Union[str, Path], curve: bool = False) -> str:
     """The format of an export path (its suffix, lower case), or a ValueError naming the ones known;
-    ``curve``: the mesh is of line cells (a 2D curve), which ``.ply`` cannot hold."""
+    ``curve``: the mesh is of line cells (a 2D curve), which ``.ply`` and ``.obj`` cannot hold."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in EXPORT_FORMATS:
         raise ValueError(
             f"export: unknown format {path.suffix!r} of {str(path)!r}; use one of {', '.join(EXPORT_FORMATS)}"
         )
-    if curve and suffix == ".ply":
-        raise ValueError("export: .ply holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
+    if curve and suffix in (".ply", ".obj"):
+        raise ValueError(f"export: {suffix} holds surfaces only; write a 2D curve as .vtu, .vtp or .vtk")
     return suffix
 
 
