@@ -426,3 +426,16 @@ def test_distances_reads_points_from_numpy_and_text_files(tmp_path, capsys):
         argv = ["distances", "--phi", str(tmp_path / name), "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]
         assert main([*argv, "--sample", "3", "--out", str(tmp_path / "D.npy"), "--quiet"]) == 2
         assert "not a NumPy .npy file of numbers" in capsys.readouterr().err
+
+
+def test_output_paths_that_cannot_be_written_are_refused_before_the_solve(tmp_path, capsys):
+    # (a bare OSError after the solve before, naming no option: the solve's work lost)
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    assert main(["solve", "--surface", "sphere", "--n", "21", "--out", str(afile / "o")]) == 2
+    assert f"--out {afile / 'o'}: {afile} is a file, not a folder" in capsys.readouterr().err
+    out = tmp_path / "o"
+    assert main(["solve", "--surface", "sphere", "--n", "21", "--export", str(afile / "x.vtp"), "--out", str(out)]) == 2
+    assert "--export" in capsys.readouterr().err and not out.exists()
+    assert main(["distances", "--surface", "sphere", "--n", "21", "--sample", "3", "--out", str(afile / "D.npy")]) == 2
+    assert "--out" in capsys.readouterr().err

@@ -521,3 +521,16 @@ def test_evolve_names_phi_progress_and_checkpoint_faults(tmp_path):
         )
     # (the frame of step 1 is kept; only its checkpoint is missing)
     assert calls == [1] and info.value.evolution.times == [0.0, 0.05] and isinstance(info.value.__cause__, OSError)
+
+
+def test_a_surface_growing_out_of_the_box_is_said_once():
+    # a sampled φ says nothing beyond the box, so a solve cannot tell a cut surface from one meant
+    # to go on; the evolution knows the box held it at the start
+    h = GRID31.spacing
+    x = np.stack(GRID31.meshgrid(), -1)
+    phi = np.linalg.norm(x - np.array([0.3, 0.0, 0.0]), axis=-1) - 0.5
+    with pytest.warns(RuntimeWarning, match=r"evolve: the surface grew out of the grid box \(it crosses x = 1") as rec:
+        ev = ts.evolve(phi, GRID31, [(-0.2, 0, 0)], lambda u: 1 + 0 * u, dt=0.5 * h, steps=8, every=4)
+    assert sum("grew out of the grid box" in str(w.message) for w in rec) == 1
+    assert ev.solutions[0].stats.box_cut is None or not ev.solutions[0].stats.box_cut["surface_cut"]
+    assert ev.solutions[-1].stats.box_cut["surface_cut"]

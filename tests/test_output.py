@@ -1,6 +1,8 @@
 """Results out: Solution.on_mesh, triangulate (marching cubes / squares, a surface's own mesh),
 export (meshio round trips, VTK XML PolyData) and plot (matplotlib figures, 2D and 3D)."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -242,3 +244,13 @@ def test_vtp_export_keeps_the_target_s_mode_and_writes_through_symlinks(circle_s
     with pytest.raises(IsADirectoryError):
         ts.export(circle_sol, tmp_path / "d.vtp")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.vtp", "d.vtp", "l.vtp"]
+
+
+def test_an_export_that_cannot_be_written_names_the_path_given(sphere_sol, tmp_path):
+    # a missing folder is made; a file where a folder should be is named with the path given
+    # (the error named only the file)
+    assert ts.export(sphere_sol, tmp_path / "missing" / "x.vtp").exists()
+    (tmp_path / "afile").write_text("")
+    target = tmp_path / "afile" / "x.vtp"
+    with pytest.raises(FileExistsError, match=rf"cannot write {re.escape(str(target))}: its folder"):
+        ts.export(sphere_sol, target)

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import __version__
 from ._progress import make_progress
-from .cli_distances import add_distances_parser, cmd_distances
+from .cli_distances import add_distances_parser, cmd_distances, writable
 
 EPILOG = """examples:
   tubesweep solve --surface sphere --n 101 --png
@@ -446,8 +446,13 @@ def cmd_solve(args: argparse.Namespace) -> int:
     for path in args.export or []:
         try:
             export_format(path, curve=grid.ndim == 2)
+            writable(Path(path), "--export")
         except ValueError as e:
-            raise UsageError(f"--export {path}: {e}") from None
+            raise UsageError(f"--export {path}: {e}" if not str(e).startswith("--export") else str(e)) from None
+    try:
+        writable(args.out, "--out", folder=True)
+    except ValueError as e:
+        raise UsageError(str(e)) from None
     if args.source_vertex:
         nv = len(surface.vertices)
         bad = [i for i in args.source_vertex if not 0 <= i < nv]

@@ -203,6 +203,25 @@ def _client(address: Optional[str]) -> Any:
     return Client(address)
 
 
+def writable(path: Path, option: str, folder: bool = False) -> None:
+    """A ValueError naming ``option`` unless a file can be created in the folder of ``path`` (in
+    ``path`` itself with ``folder``; where that does not exist yet, in its nearest existing
+    ancestor): checked before the solve, whose result would otherwise be lost to a bare OSError
+    after it."""
+    import tempfile
+
+    folder_ = path.resolve() if folder else path.resolve().parent
+    while not folder_.exists() and folder_ != folder_.parent:
+        folder_ = folder_.parent
+    if not folder_.is_dir():
+        raise ValueError(f"{option} {path}: {folder_} is a file, not a folder")
+    try:
+        with tempfile.TemporaryFile(dir=folder_):
+            pass
+    except OSError as e:
+        raise ValueError(f"{option} {path}: cannot write in {folder_} ({e.strerror})") from None
+
+
 def cmd_distances(args: argparse.Namespace) -> int:
     """Runs ``tubesweep distances``; bad input raises ValueError/TypeError/OSError (exit status 2)."""
     from .distances import distance_matrix, farthest_point_sampling
@@ -212,6 +231,7 @@ def cmd_distances(args: argparse.Namespace) -> int:
         raise ValueError(f"--out {args.out}: the matrix is written as a .npy file; give a name ending in .npy")
     if args.out.parent and not args.out.parent.exists():
         raise ValueError(f"--out {args.out}: the folder {args.out.parent} does not exist")
+    writable(args.out, "--out")
     if args.sample is not None and args.sample < 1:
         raise ValueError(f"--sample {args.sample}: give a positive number of points")
     if args.chunk_size is not None and args.scheduler is None:

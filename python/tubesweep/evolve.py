@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import warnings
 from pathlib import Path
 from typing import Any, Callable, List, Optional, Union
 
@@ -29,6 +30,7 @@ from ._validate import as_grid, as_sources, real_scalar
 from ._sources import check_on_surface
 from .solution import Solution
 from ._step_warnings import StepWarnings
+from ._warn import user_stacklevel
 from .output import export
 from .surface import LevelSet, Surface
 from .tube import Tube
@@ -193,6 +195,20 @@ def _advanced(arr: np.ndarray, linear: np.ndarray, signed: np.ndarray, move: np.
     out = arr.reshape(-1)[linear] - move * grad
     out[edge] = signed[edge] - move[edge]
     return out
+
+
+def _warn_left_box(cut: dict) -> None:
+    """The warning for a surface that grew out of the grid box during the evolution (the box held
+    it at the start): a sampled φ says nothing beyond the box, so the solve itself cannot tell a
+    bounded surface cut by it from one meant to go on beyond (``_box_cut.looks_bounded``)."""
+    size = f"a curve about {cut['cut_length']:.3g} long" if "cut_length" in cut else f"{cut['cut_points']} points"
+    warnings.warn(
+        f"evolve: the surface grew out of the grid box (it crosses {', '.join(cut['faces'])} along {size}): from then "
+        "on the distances are those of the part inside the box and paths through the part outside are not found. "
+        "Enlarge the box to hold the surface's whole motion with a margin of outer·Δx",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )
 
 
 def _write_checkpoint(path: Path, **arrays: Any) -> None:
@@ -363,6 +379,7 @@ def evolve(
     prev: Optional[Solution] = None
     previous_band: Optional[np.ndarray] = None
     t = t0
+    cut_at_start = False  # whether the grid box cut the surface at step 0 (then nothing new to say)
     said = StepWarnings()  # the steps' warnings, once per kind when the evolution ends
     try:
         for step in range(steps + 1):
@@ -378,6 +395,11 @@ def evolve(
                     src = np.ascontiguousarray(feet)
                     warm: Any = None if prev is None else (prev if older is None else (older, prev))
                     sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
+                    cut = sol.stats.box_cut
+                    if step == 0:
+                        cut_at_start = bool(cut and cut["surface_cut"])
+                    elif cut and cut["surface_cut"] and not cut_at_start:
+                        _warn_left_box(cut)
             except ValueError as e:
                 if step == 0:
                     raise  # the caller's surface or sources, refused as by ts.solve

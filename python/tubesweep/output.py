@@ -58,6 +58,8 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
         fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
     except PermissionError:
         fd, name = -1, ""
+    except OSError as e:  # named by the path given, not by the temporary file's name
+        raise OSError(e.errno, f"cannot write {path} ({e.strerror})") from None
     part = Path(name) if name else target
     if fd >= 0:
         os.close(fd)
@@ -268,7 +270,10 @@ def export(
             raise ValueError(f"point_data[{name!r}] has {a.shape[0]} entries but the mesh has {len(v)} vertices")
         data[name] = a
     pts = v if v.shape[1] == 3 else np.column_stack([v, np.zeros(len(v))])
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:  # a file where a folder of the path should be: named by the path given
+        raise OSError(e.errno, f"cannot write {path}: its folder {path.parent} cannot be made ({e.strerror})") from None
     if suffix == ".vtp":
         _write_vtp(path, pts, cells, data)
         return path
