@@ -76,6 +76,12 @@ def test_every_library_warning_names_a_line_outside_the_package():
 def test_a_library_surface_on_a_too_coarse_grid_is_told_so_first():
     with pytest.raises(ValueError, match=r"^the grid is too coarse for this surface"):
         ts.solve(ts.surfaces.Sphere(0.2), ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), [(0.2, 0, 0)])
+    # a user's φ that is a distance (|∇φ| ≈ 1 but at the centre the tube reaches) is told of the
+    # grid first, not to re-distance
+    with pytest.raises(
+        ValueError, match=r"falls to .* though it is ≈ 1 elsewhere .*If φ is a distance, the grid is too"
+    ):
+        ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.2, ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), [(0.2, 0, 0)])
     # a user's φ that is not a distance is still pointed to re-distancing, CLI option included
     X, Y = np.meshgrid(np.linspace(-1, 1, 41), np.linspace(-1, 1, 41), indexing="ij")
     with pytest.raises(ValueError, match=r"redistance=True\) \(on the command line: --redistance\)"):

@@ -315,7 +315,8 @@ class Grid:
         [[2.5, 0.0]]
         """
         p = np.asarray(points, dtype=float)
-        return (p - self._lower) / self._spacing
+        with np.errstate(over="ignore", invalid="ignore"):  # points near ±1e308: ±inf, far off the grid
+            return (p - self._lower) / self._spacing
 
     def nearest_index(self, points: "np.ndarray | Sequence[Sequence[float]]") -> np.ndarray:
         """Index of the node nearest to each point.

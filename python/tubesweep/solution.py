@@ -454,7 +454,8 @@ class Solution:
         step : float
             Step length in grid spacings (default 0.5, at least 0.01).
         max_steps : int, optional
-            The most steps to take (default: enough for a path four times the largest value).
+            The most steps to take (default: 8·(the grid's points per axis, summed)/step, more than any
+            path within the grid needs).
 
         Returns
         -------

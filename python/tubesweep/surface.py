@@ -506,6 +506,19 @@ class LevelSet(Surface):
                 "such as the centre of a sphere not much larger than the tube or the core of a thin torus: refine the "
                 "grid, or make the surface larger than a few grid spacings"
             )
+        if lo < GRAD_ERROR_LOW and abs(hi - 1.0) <= 0.1:
+            # as steep as a distance at most and at best, but flat somewhere: most likely a distance whose tube
+            # reaches where its gradient vanishes (two spheres min(d1, d2) 4.5 spacings apart at N = 41
+            # were first told to re-distance)
+            raise ValueError(
+                f"surface: |∇φ| falls to {lo:.3g} near the surface, though it is ≈ 1 elsewhere (up to {hi:.3g}). If φ is "
+                "a distance, "
+                "the grid is too coarse for the surface: the tube (outer × grid spacing on each side) reaches a point "
+                "where ∇φ vanishes, such as the middle of a gap between two parts of the surface that face each other, "
+                "the centre of a sphere not much larger than the tube or the core of a thin tube; refine the grid. "
+                "Otherwise use ts.LevelSet(phi, redistance=True) (on the command line: --redistance), which "
+                "re-distances φ in the band"
+            )
         if lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH:
             raise ValueError(
                 f"surface: φ is not close to a signed distance function: |∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the "
