@@ -391,3 +391,20 @@ def test_the_sharp_edges_of_a_box_are_named_in_the_error():
         ts.solve(box, g, [(0, 0, 0.4)])
     # a sphere has none
     assert ts.surfaces.from_points(sphere_cloud(8000)).report["crease_samples"] < 0.005 * 8000
+
+
+def test_a_gap_in_a_sparse_cloud_is_not_cured_by_a_finer_grid_and_the_warning_says_so():
+    # 150 samples of a sphere, 2.7 grid spacings apart at N = 81: a fold of the fits between them
+    # faces itself across a spacing; the warning told only to refine the grid, which the
+    # sparse-sample check then refuses
+    x = np.random.default_rng(0).normal(size=(150, 3))
+    cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+    g = ts.Grid((-1,) * 3, (1,) * 3, (81,) * 3)
+    with pytest.warns(RuntimeWarning, match=r"samples lie 2\.7 grid spacings apart, so such a gap may be a fold"):
+        sol = ts.solve(cloud, g, [cloud.points[0]])
+    assert sol.stats.facing_pairs > 0 and sol.stats.order == 2
+    # the exact geodesic distance over the sphere, to a third of a percent of its largest value
+    y = np.random.default_rng(1).normal(size=(2000, 3))
+    probe = 0.5 * y / np.linalg.norm(y, axis=1, keepdims=True)
+    exact = ts.surfaces.Sphere(0.5).geodesic_distance(probe, cloud.points[0])
+    assert np.max(np.abs(sol(probe) - exact)) < 0.005 * exact.max()

@@ -249,6 +249,7 @@ def _warn_if_tubes_touch(
     kink: Optional[np.ndarray] = None,
     noise: float = 0.0,
     warn: bool = True,
+    note: str = "",
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Warns where two parts of the surface face each other across a gap so narrow that the inner
     tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
@@ -280,15 +281,21 @@ def _warn_if_tubes_touch(
         first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
         node, neighbour, gap = node[first], neighbour[first], gap[first]
     if warn:
-        warn_facing_pairs(grid, linear, roles, (node, neighbour, gap), inner)
+        warn_facing_pairs(grid, linear, roles, (node, neighbour, gap), inner, note)
     return node, neighbour, gap
 
 
 def warn_facing_pairs(
-    grid: Grid, linear: np.ndarray, roles: np.ndarray, facing: Tuple[np.ndarray, np.ndarray, np.ndarray], inner: float
+    grid: Grid,
+    linear: np.ndarray,
+    roles: np.ndarray,
+    facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
+    inner: float,
+    note: str = "",
 ) -> None:
     """The warning of :func:`_warn_if_tubes_touch` for the pairs ``facing`` (band positions of the
-    nodes and their neighbours, and the gaps), if there are any."""
+    nodes and their neighbours, and the gaps), if there are any; ``note`` ends it (a sparse point
+    cloud's, ``PointCloudSurface.gap_note``)."""
     node, neighbour, gap = facing
     if node.size == 0:
         return
@@ -305,7 +312,7 @@ def warn_facing_pairs(
         f"{_percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near {where}). Distances "
         "reached across such a gap can come out too short; elsewhere the result holds. sol.narrow_gaps() shows where; "
         f"a grid spacing below {needed:.3g} (now {h:.3g}) resolves a real gap, while a crease or scan artefact stays "
-        "narrower than any grid",
+        f"narrower than any grid{note}",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
@@ -479,8 +486,19 @@ def _prepare_tube(
     warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
     directions = direction if direction is not None else geom.direction
     cuts = cuts_shortcuts(surf)
+    gap_note = getattr(surf, "gap_note", None)
     facing = _warn_if_tubes_touch(
-        grid, band, linear, roles, phi, directions, inner, kink, float(getattr(surf, "_noise", 0.0)), warn=not cuts
+        grid,
+        band,
+        linear,
+        roles,
+        phi,
+        directions,
+        inner,
+        kink,
+        float(getattr(surf, "_noise", 0.0)),
+        warn=not cuts,
+        note=gap_note(h) if gap_note is not None else "",
     )
     cut_edges = 0
     if cuts:

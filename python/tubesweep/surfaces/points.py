@@ -299,6 +299,20 @@ class PointCloudSurface(ClosestPoint):
 
     #: What of a cloud the grid may not resolve, for the message of a second-order runaway
     #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
+    def gap_note(self, h: float) -> str:
+        """For the warning of parts that face each other across narrow gaps (``_prepare.warn_facing_pairs``)
+        on a grid of spacing ``h``: where the samples lie more than a grid spacing apart, such a gap
+        can be a fold of the fits between them, and a finer grid only makes the samples sparser
+        against it (150 samples of a sphere 2.7 spacings apart at N = 81: 5 pairs, 0.05% of the
+        surface, and the advice to refine the grid ran into the sparse-sample refusal)."""
+        if not self.spacing > h:
+            return ""
+        return (
+            f"; here the cloud's samples lie {self.spacing / h:.1f} grid spacings apart, so such a gap may be a fold of "
+            f"its fits between them, which a finer grid does not cure (it is refused below a spacing of "
+            f"{self.spacing / SPARSE_FACTOR:.3g}): more samples there do"
+        )
+
     @property
     def unresolved_advice(self) -> str:
         """Where a cloud's closest points fold or bend more than the grid resolves: samples a little
