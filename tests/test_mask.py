@@ -339,3 +339,16 @@ def test_a_source_deep_inside_a_mask_or_at_a_ball_s_centre_is_refused(order):
         # a source on the surface is still taken (the projection converges there)
         sol = ts.solve(surface, g, [(0.0, 0.0, 0.5)], order=1)
         assert sol([(0.0, 0.0, 0.5)])[0] < g.spacing
+
+
+def test_a_mask_passed_as_phi_is_refused_with_from_mask_named():
+    # 0 inside, 1 outside: no negative sample, and the zero level set a whole ball; it ran first
+    # order 12% off, the warning advising the redistance=True given already
+    g = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+    r = np.linalg.norm(np.stack(g.meshgrid(), -1), axis=-1)
+    for phi in ((r > 0.5).astype(float), -(r > 0.5).astype(float)):
+        with pytest.raises(ValueError, match=r"exactly 0 on a whole region .*ts\.LevelSet\.from_mask\(mask, grid\)"):
+            ts.solve(ts.LevelSet(phi, redistance=True), g, [(0, 0, 0.5)])
+    # a φ of one sign without such a region keeps its own refusal
+    with pytest.raises(ValueError, match=r"phi has no sign change on the grid"):
+        ts.solve(ts.LevelSet(r + 0.1, redistance=True), g, [(0, 0, 0.5)])
