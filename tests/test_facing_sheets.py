@@ -266,3 +266,26 @@ def test_lax_friedrichs_runs_on_the_whole_band_of_a_mesh_and_warns_about_its_gap
     with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
         rows = ts.Tube(plate, grid).solve_many([[0.0, 0.0, PLATE / 2]], hamiltonian="lxf")
     assert np.array_equal(rows[0], ref.values)
+
+
+@pytest.mark.parametrize("gap", [2.5, 5.0])
+def test_a_mesh_part_a_few_spacings_from_the_source_s_part_stays_unreached(gap):
+    # two mesh spheres `gap` spacings apart, the source on the left one: the right one is another
+    # component, unreached (inf). The front crossed through the extension nodes between them (their
+    # closest points on the two spheres) and reached every vertex of it, without a word
+    import trimesh
+
+    a = trimesh.creation.icosphere(4, radius=0.35)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (81,) * 3)
+    d = 0.35 + gap * g.spacing / 2
+    left, right = a.vertices - [d, 0, 0], a.vertices + [d, 0, 0]
+    mesh = ts.surfaces.from_mesh((np.r_[left, right], np.r_[a.faces, a.faces + len(a.vertices)]))
+    src = left[np.argmin(left[:, 0])]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the gap is cut, not warned about; no stranded node either
+        sol = ts.solve(mesh, g, [src])
+    assert sol.stats.converged and sol.stats.cut_edges > sol.stats.facing_pairs
+    assert np.all(np.isinf(sol(right))) and np.all(np.isfinite(sol(left)))
+    # the left sphere as a sphere alone would give it, to first order (r·angle)
+    exact = ts.surfaces.Sphere(0.35).geodesic_distance(left + [d, 0, 0], src + [d, 0, 0])
+    assert np.max(np.abs(sol(left) - exact)) < 3 * g.spacing

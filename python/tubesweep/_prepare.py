@@ -295,7 +295,7 @@ def warn_facing_pairs(
 ) -> None:
     """The warning of :func:`_warn_if_tubes_touch` for the pairs ``facing`` (band positions of the
     nodes and their neighbours, and the gaps), if there are any; ``note`` ends it (a sparse point
-    cloud's, ``PointCloudSurface.gap_note``)."""
+    cloud's, ``PointCloudSurface._gap_note``)."""
     node, neighbour, gap = facing
     if node.size == 0:
         return
@@ -486,7 +486,7 @@ def _prepare_tube(
     warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
     directions = direction if direction is not None else geom.direction
     cuts = cuts_shortcuts(surf)
-    gap_note = getattr(surf, "gap_note", None)
+    gap_note = getattr(surf, "_gap_note", None)
     facing = _warn_if_tubes_touch(
         grid,
         band,

@@ -26,10 +26,9 @@ def _first_point(grid: Grid, band: Any, positions: np.ndarray) -> tuple:
 
 def stranded_nodes(grid: Grid, band: Any, values: np.ndarray, inner: Optional[np.ndarray]) -> np.ndarray:
     """Band positions of the inner-tube nodes at ``inf`` with an inner-tube neighbour that the
-    front reached (finite). Costs nothing when every node was reached; otherwise O(unreached)
-    neighbour look-ups and the band's linear indices (8 bytes per node, for the look-ups)."""
-    from .band import band_neighbours
-
+    front reached (finite), neighbours in the band's own table: an edge cut across a narrow gap
+    (``_shortcuts``) joins nothing, and a part of a mesh that faces a reached one across such a gap
+    is unreached, not stranded. Costs nothing when every node was reached; otherwise O(unreached)."""
     unreached = np.flatnonzero(~np.isfinite(values))
     if inner is not None:
         unreached = unreached[inner[unreached]]
@@ -37,13 +36,10 @@ def stranded_nodes(grid: Grid, band: Any, values: np.ndarray, inner: Optional[np
         return unreached
     if inner is None:
         inner = np.ones(len(values), bool)
-    linear = band.linear()
-    stranded = np.zeros(unreached.size, bool)
-    for _, _, pos in band_neighbours(grid, band, linear, unreached):
-        found = pos >= 0
-        near = np.zeros(unreached.size, bool)
-        near[found] = np.isfinite(values[pos[found]]) & inner[pos[found]]
-        stranded |= near
+    nb = band.neighbours_of_nodes(np.ascontiguousarray(unreached, dtype=np.int64)).reshape(unreached.size, -1)
+    found = nb < len(values)
+    at = np.where(found, nb, 0)
+    stranded = np.any(found & np.isfinite(values[at]) & inner[at], axis=1)
     return unreached[stranded]
 
 

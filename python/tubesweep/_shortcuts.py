@@ -45,8 +45,10 @@ def cut_shortcuts(
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> Tuple[Any, int]:
     """The band without the edges across narrow gaps (``facing``'s pairs) and the medial edges
-    (closest points more than :data:`MEDIAL_JUMP` spacings apart, one node in the inner tube),
-    and the number of edges removed. The band itself when there is none."""
+    (closest points more than :data:`MEDIAL_JUMP` spacings apart where one node is in the inner
+    tube, more than a resolved sheet's jump at their |φ| between two extension nodes: two parts of
+    a mesh 4–8 spacings apart), and the number of edges removed. The band itself when there is
+    none."""
     phi32 = np.ascontiguousarray(phi, dtype=np.float32)
     dir32 = np.ascontiguousarray(direction, dtype=np.float32).reshape(len(phi32), -1)
     node, neighbour = band.medial_edges(inner, phi32, dir32, spacing, MEDIAL_JUMP)

@@ -52,9 +52,10 @@ class SolveStats:
     cut_edges : int
         Edges between neighbouring band nodes that the solve removed so that the front cannot
         take a shortcut the surface does not have (triangle meshes only): across the narrow gaps
-        of ``facing_pairs``, and above concave edges, where two neighbours' closest points lie
-        more than 1.5 grid spacings apart (docs/surfaces.md, "Parts of the surface that face
-        each other"). 0 on other surfaces, which keep the paper's scheme.
+        of ``facing_pairs``, and above concave edges and between parts a few spacings apart,
+        where two neighbours' closest points lie more than 1.5 grid spacings apart (more, between
+        two extension nodes: docs/surfaces.md, "Parts of the surface that face each other"). 0 on
+        other surfaces, which keep the paper's scheme.
     crease_thinned : int
         Inner-tube nodes at a level set's creases or corners that ran as extension nodes (their
         values read at their closest points) so that the front cannot cut the corner there:

@@ -299,7 +299,7 @@ class PointCloudSurface(ClosestPoint):
 
     #: What of a cloud the grid may not resolve, for the message of a second-order runaway
     #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
-    def gap_note(self, h: float) -> str:
+    def _gap_note(self, h: float) -> str:
         """For the warning of parts that face each other across narrow gaps (``_prepare.warn_facing_pairs``)
         on a grid of spacing ``h``: where the samples lie more than a grid spacing apart, such a gap
         can be a fold of the fits between them, and a finer grid only makes the samples sparser

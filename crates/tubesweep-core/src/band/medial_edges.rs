@@ -31,9 +31,20 @@ use rayon::prelude::*;
 /// the bunny 0.87 %, 0.73 %, 0.41 %.
 pub const MEDIAL_JUMP: f64 = 1.5;
 
+/// The largest jump, in grid spacings, that the threshold between two extension nodes allows for
+/// (a resolved sheet's steps grow as 1/(1 − |φ|/R) away from its concave side; capped here).
+pub const EXTENSION_JUMP_CAP: f64 = 4.0;
+
 /// The medial edges of `band` (see the module's documentation): pairs `(a, b)` of band positions,
-/// `b` the plus neighbour of `a` along some axis, at least one in the inner tube (`inner[n]`),
-/// whose closest points `x − |φ[n]| direction[n]` lie more than `jump · spacing` apart.
+/// `b` the plus neighbour of `a` along some axis, whose closest points `x − |φ[n]| direction[n]`
+/// lie more than `jump · spacing` apart where one is in the inner tube (`inner[n]`), and more than
+/// the jump of a sheet with the smallest radius of curvature that `jump` allows, R = 2/(1 − 1/jump)
+/// spacings (6 at 1.5), at the larger |φ| of the two, 1/(1 − |φ|/R) (at most
+/// [`EXTENSION_JUMP_CAP`]) spacings, between two extension nodes. Those matter too: between
+/// two parts of a mesh 4–8 spacings apart the nodes near the middle are all extension nodes, each
+/// extended from its own part's side, and an edge between two of them whose closest points lie on
+/// the two parts carried the front across (two spheres 5 spacings apart at N = 81: the second,
+/// which no source reaches, reached everywhere without a word).
 pub fn medial_edges<const D: usize>(
     band: &NarrowBand<D>,
     inner: &[bool],
@@ -52,6 +63,9 @@ pub fn medial_edges<const D: usize>(
     }
     let sentinel = band.sentinel();
     let limit2 = jump * jump;
+    // the smallest radius of curvature, in spacings, whose inner-tube steps (|φ| ≤ 2) jump by
+    // less than `jump`: 1/(1 − 2/R) = jump
+    let resolved = 2.0 / (1.0 - 1.0 / jump);
     // |φ| n in grid spacings
     let offset = |n: usize| -> [f64; D] {
         let t = (phi[n] as f64).abs() / spacing;
@@ -66,9 +80,17 @@ pub fn medial_edges<const D: usize>(
                 let oa = offset(a);
                 for (k, pair) in band.neighbours_of(a).iter().enumerate() {
                     let b = pair[1];
-                    if b == sentinel || !(inner[a] || inner[b as usize]) {
+                    if b == sentinel {
                         continue;
                     }
+                    let limit2 = if inner[a] || inner[b as usize] {
+                        limit2
+                    } else {
+                        // two extension nodes: the jump a resolved sheet gives that far out
+                        let t = (phi[a] as f64).abs().max((phi[b as usize] as f64).abs()) / spacing;
+                        let lim = 1.0 / (1.0 - t / resolved).max(1.0 / EXTENSION_JUMP_CAP);
+                        lim * lim
+                    };
                     let ob = offset(b as usize);
                     // cp(a) − cp(b) = (a − b) − |φ_a| n_a + |φ_b| n_b, a − b = −e_k
                     let jump2: f64 = (0..D)
@@ -118,6 +140,39 @@ mod tests {
             dir.push((sg * best.1[1]) as f32);
         }
         (band, phi, dir)
+    }
+
+    /// Two parallel lines y = ±3.5h: the nodes near the middle are all extension nodes, and the
+    /// edges between those whose closest points lie on the two lines (7 spacings apart) are
+    /// medial edges, while the edges along each line's own side are not.
+    #[test]
+    fn two_sheets_a_few_spacings_apart_are_cut_between_their_extension_nodes() {
+        let (n, h, a) = (21usize, 0.1, 0.35);
+        let band = NarrowBand::<2>::full_box([n, n]).unwrap();
+        let c = (n / 2) as f64;
+        let (mut phi, mut dir, mut inner) = (Vec::new(), Vec::new(), Vec::new());
+        for idx in band.indices() {
+            let y = (idx[0] as f64 - c) * h;
+            // the nearer line (+a at a tie): unsigned distance, direction away from it (y, x)
+            let (d, s) = if (y - a).abs() <= (y + a).abs() {
+                (y - a, 1.0)
+            } else {
+                (y + a, -1.0)
+            };
+            phi.push(d.abs() as f32);
+            dir.push(if d == 0.0 { s } else { d.signum() } as f32);
+            dir.push(0.0);
+            inner.push(d.abs() <= 2.0 * h + 1e-9);
+        }
+        let edges = medial_edges(&band, &inner, &phi, &dir, h, MEDIAL_JUMP).unwrap();
+        assert!(!edges.is_empty());
+        for &(p, q) in &edges {
+            let (ip, iq) = (band.index_of(p), band.index_of(q));
+            // across the middle row only (y = −h → 0), between two extension nodes
+            assert_eq!((ip[0], iq[0]), (c as usize - 1, c as usize), "{ip:?} {iq:?}");
+            assert!(!inner[p] && !inner[q]);
+        }
+        assert_eq!(edges.len(), n);
     }
 
     #[test]
