@@ -218,6 +218,13 @@ def test_read_formats_and_normalise(tmp_path):
         tri_in = np.sort(np.round(v[f].reshape(-1, 9), 5), axis=0)
         tri_out = np.sort(np.round(m.vertices[m.faces].reshape(-1, 9), 5), axis=0)
         assert np.allclose(tri_in, tri_out, atol=1e-5), suffix
+        # an STL file is a triangle soup: read merged, it is closed like the others (it had 240
+        # boundary edges, and the exact map instead of the smooth one)
+        assert m.closed and m.boundary_edges == 0 and len(m.vertices) == len(v), suffix
+    # the same soup given as arrays: said, with the fix
+    soup = v[f].reshape(-1, 3)
+    with pytest.warns(RuntimeWarning, match=r"repeat another's coordinates .*reads as open \(240 boundary edges\)"):
+        assert not from_mesh((soup, np.arange(len(soup)).reshape(-1, 3))).closed
     m = from_mesh((v * 3 + 7, f), normalize=True, size=2.0)
     lo, hi = m.bounds
     assert np.isclose((hi - lo).max(), 2.0) and np.allclose(0.5 * (lo + hi), 0.0, atol=1e-12)

@@ -249,4 +249,14 @@ def read_with_library(path: Path) -> Tuple[np.ndarray, np.ndarray]:
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
+        v, f = welded(v, f)
     return _checked(path, v, f)
+
+
+def welded(v: np.ndarray, f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """An STL file's triangle soup (three vertices of its own per triangle) with the vertices of
+    equal coordinates made one, in the order of their coordinates: the triangles' shared edges are
+    what makes a mesh closed and its smooth map possible (read as it was, a closed icosphere had
+    960 boundary edges and the exact map's errors, 2–3 times the merged mesh's)."""
+    uniq, inverse = np.unique(v, axis=0, return_inverse=True)
+    return np.ascontiguousarray(uniq), np.ascontiguousarray(inverse.reshape(-1)[f], dtype=f.dtype)

@@ -117,6 +117,23 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
 # ---------------------------------------------------------------------------------------------
 # the surface
 # ---------------------------------------------------------------------------------------------
+def _warn_repeated_vertices(v: np.ndarray, f: np.ndarray, boundary_edges: int) -> None:
+    """A RuntimeWarning for an open-looking mesh whose triangles do not share their vertices but
+    repeat them (equal coordinates under other indices, a triangle soup as STL writes it): read as
+    given, its shared edges are boundaries, and a closed surface loses its smooth map (a closed
+    icosphere's errors 2–3 times the merged mesh's)."""
+    used = np.unique(f)
+    repeated = len(used) - len(np.unique(v[used], axis=0))
+    if repeated > 0.1 * len(used):
+        warnings.warn(
+            f"{repeated} of the mesh's {len(used)} vertices repeat another's coordinates under another index, so the "
+            f"triangles do not share them and the mesh reads as open ({boundary_edges} boundary edges). Merge them "
+            "first, e.g. trimesh.Trimesh(vertices, faces).merge_vertices() (from_mesh reads .stl files merged)",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+
+
 def _unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """Undirected edges of the triangles: per-face ids of edges (AB, AC, BC) and use counts."""
     e = np.concatenate([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]])
@@ -249,6 +266,8 @@ class MeshSurface(Surface):
         directed_unique = len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1])) == len(e_dir)
         self.closed = bool(np.all(counts == 2) and directed_unique)
         self.boundary_edges = int(np.count_nonzero(counts == 1))
+        if self.boundary_edges:
+            _warn_repeated_vertices(v, f, self.boundary_edges)
         if signed is None:
             signed = self.closed
         if signed and not self.closed:
