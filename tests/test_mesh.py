@@ -167,8 +167,14 @@ def test_signed_distance_of_closed_mesh_and_open_mesh_has_none():
     keep = v[f].mean(1)[:, 2] > 0
     half = MeshSurface(v, f[keep])
     assert not half.closed and not half.signed and half.boundary_edges > 0
-    with pytest.raises(ValueError, match="signed=True needs a closed"):
+    with pytest.raises(ValueError, match=r"signed=True needs a closed.*has \d+ boundary edges\. Use signed=False"):
         MeshSurface(v, f[keep], signed=True)
+    # faces flipped against their neighbours: counted, with the fix (it said "0 boundary edges or
+    # inconsistent orientation")
+    some = f.copy()
+    some[:3] = some[:3, ::-1]
+    with pytest.raises(ValueError, match=r"has \d+ edges that two faces run the same way .*fix_normals"):
+        MeshSurface(v, some, signed=True)
     geom = half.band(ts.Grid((-1, -1, -1), (1, 1, 1), (21, 21, 21)), 0.3)
     assert np.array_equal(geom.signed, geom.distance)
 

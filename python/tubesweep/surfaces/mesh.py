@@ -263,7 +263,9 @@ class MeshSurface(Surface):
 
         edge_ids, counts = _unique_edges(f)
         e_dir = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
-        directed_unique = len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1])) == len(e_dir)
+        #: edges two faces run the same way (faces flipped against their neighbours)
+        flipped = len(e_dir) - len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1]))
+        directed_unique = flipped == 0
         self.closed = bool(np.all(counts == 2) and directed_unique)
         self.boundary_edges = int(np.count_nonzero(counts == 1))
         if self.boundary_edges:
@@ -271,10 +273,12 @@ class MeshSurface(Surface):
         if signed is None:
             signed = self.closed
         if signed and not self.closed:
+            what = [f"{self.boundary_edges} boundary edges"] if self.boundary_edges else []
+            what += [f"{flipped} edges that two faces run the same way (faces flipped)"] if flipped else []
             raise ValueError(
-                f"signed=True needs a closed, consistently oriented mesh; this one has {self.boundary_edges} boundary "
-                "edges or inconsistent orientation. Use signed=False (the closest-point representation needs no "
-                "inside/outside)"
+                f"signed=True needs a closed, consistently oriented mesh; this one has {' and '.join(what)}. Use "
+                "signed=False (the closest-point representation needs no inside/outside)"
+                + (", or orient the faces consistently (trimesh: mesh.fix_normals())" if flipped else "")
             )
         self.signed = bool(signed)
         if self.signed:
