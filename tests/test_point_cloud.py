@@ -386,8 +386,15 @@ def test_the_sharp_edges_of_a_box_are_named_in_the_error():
     with pytest.warns(RuntimeWarning, match="1 of 29999 samples lie off the surface"):  # one next to an edge
         box = ts.surfaces.from_points(u)
     assert box.noise < 1e-6 and box.report["crease_samples"] > 0.005 * 30000
+    # listed, and on the box's edges (two coordinates at ±0.4 to within the fits' reach)
+    assert len(box.crease_samples) == box.report["crease_samples"]
+    at_edges = np.sum(np.abs(np.abs(box.points[box.crease_samples]) - 0.4) < 0.05, axis=1) >= 2
+    assert np.mean(at_edges) > 0.9
     g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
-    with pytest.raises(ValueError, match=r"sharp edges or corners \(\d+ samples .* as a mesh \(from_mesh"):
+    # (and, should the surface be smooth there, what to do with such samples)
+    with pytest.raises(
+        ValueError, match=r"sharp edges or corners \(\d+ samples .* as a mesh \(from_mesh.*crease_samples"
+    ):
         ts.solve(box, g, [(0, 0, 0.4)])
     # a sphere has none
     assert ts.surfaces.from_points(sphere_cloud(8000)).report["crease_samples"] < 0.005 * 8000

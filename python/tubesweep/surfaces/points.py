@@ -238,6 +238,10 @@ class PointCloudSurface(ClosestPoint):
         The samples left out as outliers (coordinates, ``(K, d)``).
     rim : numpy.ndarray
         Indices into ``points`` of the samples on a rim (holes, the boundary of a scan).
+    crease_samples : numpy.ndarray
+        Indices into ``points`` of the samples their neighbours' fits miss by far more than the
+        noise: at sharp edges or corners, or samples off a smooth surface that the outlier test
+        kept (``report["crease_samples"]`` counts them).
     open_surface : bool
         True when the cloud has a rim (``order="auto"`` then runs first order).
     report : dict
@@ -273,7 +277,8 @@ class PointCloudSurface(ClosestPoint):
             f"local fits (about {self._median_fit:.2g} across) cannot follow: the closest points bounce between the "
             "faces there. Give the surface as a mesh (from_mesh: meshes keep their creases and run first order "
             "there); a larger neighbours= rounds the edges over more samples, which helps only where the fits then "
-            "span several grid spacings"
+            "span several grid spacings. If the surface is smooth there, those samples lie off it (scan outliers "
+            "too close to their neighbours for the outlier test): leave them out (cloud.crease_samples lists them)"
         )
 
     #: Why the band of a cloud's closest points may not close, for the band's error (``_prepare``).
@@ -446,6 +451,8 @@ class PointCloudSurface(ClosestPoint):
         # sharp edges and corners: samples their fit misses by far more than the noise
         crease = residual > max(CREASE_RESIDUAL, 4.0 * float(np.nanmedian(residual)))
         self._creases = (int(np.count_nonzero(crease)), p[int(np.argmax(crease))] if np.any(crease) else None)
+        #: the samples their fits miss (indices into ``points``): at sharp edges, or off the surface
+        self.crease_samples = np.flatnonzero(crease)
         q05, q95 = np.quantile(radius, [0.05, 0.95])
         self.report: Dict[str, Any] = {
             "samples": given,
