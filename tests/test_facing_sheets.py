@@ -289,3 +289,22 @@ def test_a_mesh_part_a_few_spacings_from_the_source_s_part_stays_unreached(gap):
     # the left sphere as a sphere alone would give it, to first order (r·angle)
     exact = ts.surfaces.Sphere(0.35).geodesic_distance(left + [d, 0, 0], src + [d, 0, 0])
     assert np.max(np.abs(sol(left) - exact)) < 3 * g.spacing
+
+
+def test_parts_of_a_mesh_closer_than_a_spacing_are_said():
+    # a flat ellipsoid 0.5 × 0.5 × 0.025: near its rim the two sides lie within a spacing, no
+    # facing pair is found there and the front crosses between them (its bottom centre 9 spacings
+    # short at N = 61, without a word); the box plate 0.08 thick of the tests above is not warned
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(5, radius=1.0)
+    v = sphere.vertices * [0.5, 0.5, 0.025]
+    mesh = ts.surfaces.from_mesh((v, sphere.faces))
+    g = ts.Grid((-0.6,) * 3, (0.6,) * 3, (61,) * 3)
+    with pytest.warns(RuntimeWarning, match=r"about 14% of the mesh's area lies within a grid spacing of another part"):
+        sol = ts.solve(mesh, g, [v[np.argmax(v[:, 2])]])
+    # what it warns of: the bottom centre (exact polyhedral geodesic 1.005) several spacings short
+    assert 1.005 - sol.on_mesh(v[[np.argmin(v[:, 2])]])[0] > 5 * g.spacing
+    # and a Tube says it once, at construction (kept per spacing on the surface)
+    with pytest.warns(RuntimeWarning, match="within a grid spacing of another part"):
+        ts.Tube(mesh, g)

@@ -2,12 +2,11 @@
 its top face, against exact polyhedral geodesics (pygeodesic, MMP) on the same mesh
 (``docs/surfaces.md``, "Parts of the surface that face each other"). Its two faces lie within each
 other's tubes over much of the surface: the band is cut between them (``sol.stats.cut_edges``), but
-a path round the rim, a fold much sharper than the grid, cuts the corner in the tube, and no
-warning says so yet (a box plate of the same thickness, whose rim is two 90° edges, comes out about
-a spacing short: ``tests/test_facing_sheets.py``, so the share of facing pairs alone cannot tell
-them apart). Prints per thickness and grid the share of the inner tube in facing pairs, the
-shortfall at the bottom face's centre in grid spacings, and the largest and mean error over the
-vertices relative to the largest distance::
+the two sides lie within a grid spacing of each other near the rim, where no tube keeps them apart
+and the front crosses between them. Prints per thickness and grid the share of the inner tube in
+facing pairs, the share of the mesh's area within a spacing of a part facing it (the warning's
+trigger, ``surfaces._mesh_checks.THIN_SHARE``), the shortfall at the bottom face's centre in grid
+spacings, and the largest and mean error over the vertices relative to the largest distance::
 
     .venv/bin/python benches/experiments/thin_parts_meshes.py      # about a minute
 """
@@ -20,6 +19,7 @@ import numpy as np
 import trimesh
 
 import tubesweep as ts
+from tubesweep.surfaces._mesh_checks import thin_parts
 
 
 def main() -> None:
@@ -27,8 +27,8 @@ def main() -> None:
 
     warnings.simplefilter("ignore")  # the warning under study
     sphere = trimesh.creation.icosphere(5, radius=1.0)
-    print("| c | N | facing share | bottom centre short (Δx) | largest / mean error |")
-    print("|---|---|---|---|---|")
+    print("| c | N | facing share | thin share | bottom centre short (Δx) | largest / mean error |")
+    print("|---|---|---|---|---|---|")
     for c in (0.025, 0.05, 0.1):
         v = sphere.vertices * [0.5, 0.5, c]
         top, bottom = int(np.argmax(v[:, 2])), int(np.argmin(v[:, 2]))
@@ -41,7 +41,8 @@ def main() -> None:
             e = np.abs(u - exact) / exact.max()
             short = (exact[bottom] - u[bottom]) / grid.spacing
             share = sol.stats.facing_pairs / max(sol.stats.inner_points, 1)
-            print(f"| {c} | {n} | {share:.1%} | {short:.1f} | {e.max():.1%} / {e.mean():.2%} |")
+            thin, _ = thin_parts(mesh, grid.spacing)
+            print(f"| {c} | {n} | {share:.1%} | {thin:.1%} | {short:.1f} | {e.max():.1%} / {e.mean():.2%} |")
 
 
 if __name__ == "__main__":

@@ -503,6 +503,9 @@ def _prepare_tube(
     cut_edges = 0
     if cuts:
         band, cut_edges = cut_shortcuts(band, roles == ROLE_INNER, phi, directions, h, facing)
+    thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
+    if thin_parts is not None:
+        thin_parts(h, inner)
     # (after the facing test, which reads the paper's inner tube); not on a re-distanced φ, whose
     # kinks are those of its samples (a voxel mask's staircase), not creases of the surface
     extended = np.empty(0, np.int64)

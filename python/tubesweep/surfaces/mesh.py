@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Any, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -40,6 +40,7 @@ from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_lib
 from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_B, VERT_C, closest_points_on_triangles
 from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
+from ._mesh_checks import thin_parts, warn_repeated_vertices, warn_thin_parts
 
 __all__ = [
     "from_mesh",
@@ -117,23 +118,6 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
 # ---------------------------------------------------------------------------------------------
 # the surface
 # ---------------------------------------------------------------------------------------------
-def _warn_repeated_vertices(v: np.ndarray, f: np.ndarray, boundary_edges: int) -> None:
-    """A RuntimeWarning for an open-looking mesh whose triangles do not share their vertices but
-    repeat them (equal coordinates under other indices, a triangle soup as STL writes it): read as
-    given, its shared edges are boundaries, and a closed surface loses its smooth map (a closed
-    icosphere's errors 2–3 times the merged mesh's)."""
-    used = np.unique(f)
-    repeated = len(used) - len(np.unique(v[used], axis=0))
-    if repeated > 0.1 * len(used):
-        warnings.warn(
-            f"{repeated} of the mesh's {len(used)} vertices repeat another's coordinates under another index, so the "
-            f"triangles do not share them and the mesh reads as open ({boundary_edges} boundary edges). Merge them "
-            "first, e.g. trimesh.Trimesh(vertices, faces).merge_vertices() (from_mesh reads .stl files merged)",
-            RuntimeWarning,
-            stacklevel=user_stacklevel(),
-        )
-
-
 def _unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """Undirected edges of the triangles: per-face ids of edges (AB, AC, BC) and use counts."""
     e = np.concatenate([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]])
@@ -269,7 +253,7 @@ class MeshSurface(Surface):
         self.closed = bool(np.all(counts == 2) and directed_unique)
         self.boundary_edges = int(np.count_nonzero(counts == 1))
         if self.boundary_edges:
-            _warn_repeated_vertices(v, f, self.boundary_edges)
+            warn_repeated_vertices(v, f, self.boundary_edges)
         if signed is None:
             signed = self.closed
         if signed and not self.closed:
@@ -383,6 +367,15 @@ class MeshSurface(Surface):
         d, cp, t, code = self.tree.closest(x, float(max_distance))
         face = np.where(t >= 0, self._good[np.maximum(t, 0)], -1)
         return d, cp, face, code
+
+    def _warn_thin_parts(self, h: float, inner: float) -> None:
+        """The warning of parts of the mesh closer to each other than a grid spacing ``h``
+        (``_mesh_checks.thin_parts``, kept per spacing), for the tube of a solve."""
+        cache: Dict[float, Tuple[float, Optional[np.ndarray]]] = self.__dict__.setdefault("_thin_cache", {})
+        if h not in cache:
+            cache[h] = thin_parts(self, h)
+        share, where = cache[h]
+        warn_thin_parts(share, where, h, inner)
 
     def signed_distance(self, points: Any) -> np.ndarray:
         """Signed distance to a closed mesh (negative inside), from the angle-weighted pseudo-normal of
