@@ -213,8 +213,8 @@ def test_smooth_false_is_the_exact_map_bit_for_bit():
         sol = ts.solve(spot, spot.grid(50), [spot.vertices[0]])
     assert sol.stats.order == 1 and sol.stats.cut_edges > 0
     # the sum of the band's values of the exact map's first-order solve on the band cut across
-    # narrow gaps and above concave edges (``_shortcuts``; also between extension nodes, since
-    # 16368.24220129684)
+    # narrow gaps and above concave edges (``_shortcuts``; 16368.24220129684 before edges between
+    # two extension nodes were cut too)
     assert len(sol.values) == 16972
     assert float(np.sum(sol.values)) == 16373.563279929505
     # without the cut: the values before smooth maps and cuts existed (the same solve on main then)

@@ -491,8 +491,10 @@ def test_a_fortran_ordered_phi_evolves_as_its_c_ordered_copy():
     f = ts.evolve(np.asfortranarray(phi), GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=2)
     assert np.array_equal(f.phis[-1], c.phis[-1]) and np.array_equal(f.solutions[-1].values, c.solutions[-1].values)
     assert float(c.solutions[-1].sources[0][2]) == pytest.approx(0.52, abs=0.1 * GRID31.spacing)
-    # the frames' times are t0 + k·dt, not a running sum
-    assert c.times == [0.0, 0.05, 0.1]
+    # the frames' times are t0 + k·dt, not a running sum (0.1 added six times is 0.6, 6·0.1 is
+    # 0.6000000000000001)
+    still = ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.1, steps=8)
+    assert still.times == [k * 0.1 for k in range(9)]
 
 
 def test_evolve_names_phi_progress_and_checkpoint_faults(tmp_path):

@@ -159,9 +159,9 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the faces turning by up to "
         f"{angle:.0f}°): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "
-        f"order='auto' (the default) and order=2 thin the tube there, which leaves about {THINNED_SHORTCUT:g}Δx per "
-        "crease; rounding the edges over more than the tube's width (outer·Δx) leaves none. sol.stats.creases has "
-        "the figures",
+        f"Second order's tube (order='auto', the default, or order=2, with outer ≥ inner + 2) is thinned there, which "
+        f"leaves about {THINNED_SHORTCUT:g}Δx per crease; rounding the edges over more than the tube's width "
+        "(outer·Δx) leaves none. sol.stats.creases has the figures",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )

@@ -218,9 +218,12 @@ class Fallback:
         """After the solve on ``tube``: the crease or size warning for its ``values``
         (:func:`warn_first_order`), or that the widths chose the first-order scheme."""
         if self.narrow:
+            share, largest = first_order_share(values, tube.grid.spacing)
+            size = f" (here {share:.0%} of the largest distance, {largest:.3g}, or more: the error grows with inner)"
             warnings.warn(
-                f"order='auto' ran the first-order scheme, whose errors are a few grid spacings where fronts meet: "
-                f"{self.reason}",
+                f"order='auto' ran the first-order scheme, whose errors are {FIRST_ORDER_SPACINGS:g} grid spacings or "
+                f"more where fronts meet{size if largest > 0 else ''}: {self.reason}. A widening of the extension "
+                "layer during the solve does not change this: the widths given decide",
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )

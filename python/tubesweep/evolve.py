@@ -201,9 +201,11 @@ def _warn_left_box(cut: dict) -> None:
     """The warning for a surface that grew out of the grid box during the evolution (the box held
     it at the start): a sampled φ says nothing beyond the box, so the solve itself cannot tell a
     bounded surface cut by it from one meant to go on beyond (``_box_cut.looks_bounded``)."""
-    size = f"a curve about {cut['cut_length']:.3g} long" if "cut_length" in cut else f"{cut['cut_points']} points"
+    size = (
+        f"along a curve about {cut['cut_length']:.3g} long" if "cut_length" in cut else f"at {cut['cut_points']} points"
+    )
     warnings.warn(
-        f"evolve: the surface grew out of the grid box (it crosses {', '.join(cut['faces'])} along {size}): from then "
+        f"evolve: the surface grew out of the grid box (it crosses {', '.join(cut['faces'])} {size}): from then "
         "on the distances are those of the part inside the box and paths through the part outside are not found. "
         "Enlarge the box to hold the surface's whole motion with a margin of outer·Δx",
         RuntimeWarning,

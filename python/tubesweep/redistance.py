@@ -322,7 +322,7 @@ def _refuse_zero_region(array: np.ndarray) -> None:
     axis are 0 too): its zero level set is that region, not a surface — a 0/1 mask passed as φ
     (``(r > 0.5).astype(float)`` ran first order, 12% off, and the warning advised the
     ``redistance=True`` given already)."""
-    if np.any(array < 0) and np.any(array > 0):
+    if array.size and array.min() < 0 < array.max():  # (NaN fails both: checked below)
         return
     zero = array == 0
     interior = zero.copy()
@@ -379,10 +379,63 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     return BandGeometry(linear.view(np.int64), None, signed, direction, consumable=True)
 
 
+#: A projection that did not settle still reached the zero level set when it moved and φ at its
+#: end is below this share of φ at its start (near a crease only the orthogonality iterations fail
+#: to settle: the cube's re-distanced φ within half a spacing of its surface, at most 0.24).
+REACHED = 0.5
+
+#: Where the projection stalls on a sampled φ (its slope zero: a voxel mask's plateau more than a
+#: voxel from its edge), the zero level set is looked for among the sign changes within this many
+#: cells of the point.
+CROSSING_REACH = 4
+
+
 def redistanced_project(surface, points: np.ndarray, grid):
-    """Unsigned distance and closest points of ``points`` on the zero level set of φ: +∞ (and the
-    point itself) where the projection did not reach it — ∇φ vanished on the way or the iterations
-    did not settle, as on a voxel mask's plateau or at a ball's centre, far from the surface
-    compared with its reach (a source there was taken for one on the surface, 0 from it)."""
-    cp, signed, converged = _project(surface, grid, np.asarray(points, dtype=float))
-    return np.where(converged, np.abs(signed), np.inf), cp
+    """Unsigned distance and closest points of ``points`` on the zero level set of φ. Where the
+    projection did not reach it — ∇φ vanished on the way, as on a voxel mask's plateau or at a
+    ball's centre — the distance is that of the nearest of a sampled φ's sign changes within
+    :data:`CROSSING_REACH` cells (:func:`_nearest_crossing`), +∞ beyond them or for a callable φ
+    (a source there was taken for one on the surface, 0 from it); the closest point stays where
+    the projection ended. Where only the orthogonality
+    iterations did not settle (next to a crease) but Newton's step reached φ = 0
+    (:data:`REACHED`), the projection's distance is kept."""
+    x = np.asarray(points, dtype=float)
+    cp, signed, converged = _project(surface, grid, x)
+    distance = np.abs(signed)
+    unsettled = np.flatnonzero(~np.asarray(converged, dtype=bool))
+    if unsettled.size:
+        start = np.abs(surface.phi(x[unsettled], grid))
+        end = np.abs(surface.phi(cp[unsettled], grid))
+        moved = np.any(cp[unsettled] != x[unsettled], axis=1)
+        lost = unsettled[~(moved & (end <= REACHED * start))]
+        for i in lost:
+            distance[i] = _nearest_crossing(surface, grid, x[i]) if surface.is_dense else np.inf
+    return distance, cp
+
+
+def _nearest_crossing(surface, grid, x: np.ndarray) -> float:
+    """The distance from ``x`` to the nearest point of the zero level set on a sampled φ's edges
+    within :data:`CROSSING_REACH` cells (linear along each grid edge whose ends differ in sign);
+    +∞ when there is none."""
+    array = surface._array
+    h = grid.spacing
+    centre = np.rint(grid.continuous_index(x[None])[0]).astype(np.int64)
+    lo = np.maximum(centre - CROSSING_REACH, 0)
+    hi = np.minimum(centre + CROSSING_REACH + 1, np.asarray(array.shape))
+    if np.any(hi <= lo):
+        return np.inf
+    block = array[tuple(slice(a, b) for a, b in zip(lo, hi))]
+    origin = np.asarray(grid.lower, dtype=float) + lo * h
+    best = np.inf
+    for k in range(block.ndim):
+        a = np.take(block, np.arange(block.shape[k] - 1), axis=k)
+        b = np.take(block, np.arange(1, block.shape[k]), axis=k)
+        crossing = (a < 0) != (b < 0)
+        if not np.any(crossing):
+            continue
+        idx = np.argwhere(crossing)
+        t = a[crossing] / (a[crossing] - b[crossing])
+        pts = origin + idx * h
+        pts[:, k] += t * h
+        best = min(best, float(np.min(np.linalg.norm(pts - x, axis=1))))
+    return best

@@ -46,7 +46,7 @@ def thin_parts(mesh: Any, h: float) -> Tuple[float, Optional[np.ndarray]]:
     whose normal is opposite to its own (a plate thinner than a spacing, two sheets closer than
     one). There the tube's two sides are one and the front crosses between them; the narrow gaps
     that the band is cut across (``_shortcuts``) are only found from about a spacing up."""
-    good = mesh._good[:: max(1, len(mesh._good) // THIN_FACES)]
+    good = mesh._good[:: max(1, -(-len(mesh._good) // THIN_FACES))]
     v, f = mesh.vertices, mesh.faces[good]
     a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)

@@ -249,7 +249,7 @@ def read_with_library(path: Path) -> Tuple[np.ndarray, np.ndarray]:
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
-        v, f = welded(v, f)
+        return welded(*_checked(path, v, f))
     return _checked(path, v, f)
 
 

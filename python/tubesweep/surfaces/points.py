@@ -302,8 +302,6 @@ class PointCloudSurface(ClosestPoint):
         crease = self._crease_advice()
         return f"{_sentence(crease)}. Or: {advice}" if crease else advice
 
-    #: What of a cloud the grid may not resolve, for the message of a second-order runaway
-    #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
     def _gap_note(self, h: float) -> str:
         """For the warning of parts that face each other across narrow gaps (``_prepare.warn_facing_pairs``)
         on a grid of spacing ``h``: where the samples lie more than a grid spacing apart, such a gap
@@ -318,6 +316,8 @@ class PointCloudSurface(ClosestPoint):
             f"{self.spacing / SPARSE_FACTOR:.3g}): more samples there do"
         )
 
+    #: What of a cloud the grid may not resolve, for the message of a second-order runaway
+    #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
     @property
     def unresolved_advice(self) -> str:
         """Where a cloud's closest points fold or bend more than the grid resolves: samples a little

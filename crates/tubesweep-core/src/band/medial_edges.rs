@@ -63,8 +63,9 @@ pub fn medial_edges<const D: usize>(
     }
     let sentinel = band.sentinel();
     let limit2 = jump * jump;
-    // the smallest radius of curvature, in spacings, whose inner-tube steps (|φ| ≤ 2) jump by
-    // less than `jump`: 1/(1 − 2/R) = jump
+    // the smallest radius of curvature, in spacings, whose inner-tube steps (|φ| ≤ 2, the default
+    // inner width; the callers pass MEDIAL_JUMP for that width) jump by less than `jump`:
+    // 1/(1 − 2/R) = jump
     let resolved = 2.0 / (1.0 - 1.0 / jump);
     // |φ| n in grid spacings
     let offset = |n: usize| -> [f64; D] {

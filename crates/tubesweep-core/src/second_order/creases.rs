@@ -55,7 +55,9 @@ pub const CREASE_REACH: f64 = 0.75;
 pub struct Creases {
     /// Inner-tube nodes at a crease or corner (see the module documentation).
     pub nodes: usize,
-    /// The largest angle, in degrees, between a crease node's normal and a neighbour's.
+    /// The largest angle, in degrees, between a crease node's normal and a neighbour's
+    /// ([`creases_of`]); [`creases_of_level_set`] also reads it from the neighbour on one side to
+    /// the one on the other (the faces' angle: 90° on the cube, where neighbours turn by 55°).
     pub angle: f64,
 }
 
