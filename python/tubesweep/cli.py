@@ -17,7 +17,8 @@ import numpy as np
 
 from . import __version__
 from ._progress import make_progress
-from .cli_distances import add_distances_parser, cmd_distances, writable
+from .cli_distances import add_distances_parser, cmd_distances
+from ._paths import writable
 
 EPILOG = """examples:
   tubesweep solve --surface sphere --n 101 --png

@@ -12,6 +12,8 @@ from typing import Any, Optional
 
 import numpy as np
 
+from ._paths import writable
+
 EXAMPLES = """examples:
   tubesweep distances --surface sphere --n 101 --sample 200 --out D.npy
   tubesweep distances --mesh bunny --n 161 --points pts.npy --out D.npy
@@ -201,25 +203,6 @@ def _client(address: Optional[str]) -> Any:
             "--scheduler needs Dask's distributed scheduler: pip install tubesweep[distributed]"
         ) from None
     return Client(address)
-
-
-def writable(path: Path, option: str, folder: bool = False) -> None:
-    """A ValueError naming ``option`` unless a file can be created in the folder of ``path`` (in
-    ``path`` itself with ``folder``; where that does not exist yet, in its nearest existing
-    ancestor): checked before the solve, whose result would otherwise be lost to a bare OSError
-    after it."""
-    import tempfile
-
-    folder_ = path.resolve() if folder else path.resolve().parent
-    while not folder_.exists() and folder_ != folder_.parent:
-        folder_ = folder_.parent
-    if not folder_.is_dir():
-        raise ValueError(f"{option} {path}: {folder_} is a file, not a folder")
-    try:
-        with tempfile.TemporaryFile(dir=folder_):
-            pass
-    except OSError as e:
-        raise ValueError(f"{option} {path}: cannot write in {folder_} ({e.strerror})") from None
 
 
 def cmd_distances(args: argparse.Namespace) -> int:
