@@ -170,7 +170,8 @@ def test_from_mask_refuses_bad_masks_with_the_cause_and_the_fix():
     with pytest.raises(ValueError, match=r"mask is all False"):
         ts.LevelSet.from_mask(np.zeros(grid.shape, np.uint8), grid)
     with pytest.raises(
-        ValueError, match=r"mask has shape \(20, 21, 21\) but the grid has shape \(21, 21, 21\).*ts.Grid"
+        ValueError,
+        match=r"mask has shape \(20, 21, 21\) but the grid has shape \(21, 21, 21\).*ts.Grid.*keeping the voxel size",
     ):
         ts.LevelSet.from_mask(ball[1:], grid)
     with pytest.raises(ValueError, match=r"mask must hold only 0 and 1.*got 0.5 at index.*labels == k"):

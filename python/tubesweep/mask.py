@@ -35,7 +35,8 @@ def _checked_mask(mask: Any, grid: Grid) -> np.ndarray:
     if arr.shape != grid.shape:
         raise ValueError(
             f"mask has shape {arr.shape} but the grid has shape {grid.shape}: the mask's voxels are the grid's nodes; "
-            f"build the grid with ts.Grid(lower, upper, mask.shape)"
+            "build the grid with ts.Grid(lower, upper, mask.shape) where upper = lower + (mask.shape − 1)·voxel size "
+            "(a padded mask moves lower and upper out by the padding, keeping the voxel size)"
         )
     if arr.dtype == bool:
         return arr
