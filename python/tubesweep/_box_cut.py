@@ -157,16 +157,20 @@ def looks_bounded(surface: Any, grid: Grid) -> bool:
     return False
 
 
+def cut_extent(cut: Dict[str, Any]) -> str:
+    """Where the surface crosses the box's boundary, for a message: along a curve of its length
+    (3D) or at its points (2D)."""
+    if "cut_length" in cut:
+        return f"along a curve about {cut['cut_length']:.3g} long"
+    return f"at {cut['cut_points']} point{'s' if cut['cut_points'] != 1 else ''}"
+
+
 def warn_box_cut(cut: Optional[Dict[str, Any]], inner_points: int, surface: Any, grid: Grid) -> None:
     """The warning for a bounded surface that leaves the grid box, with how much is cut."""
     if cut is None or not cut["surface_cut"] or not looks_bounded(surface, grid):
         return
     where = ", ".join(cut["faces"])
-    size = (
-        f"along a curve about {cut['cut_length']:.3g} long"
-        if "cut_length" in cut
-        else f"at {cut['cut_points']} point{'s' if cut['cut_points'] != 1 else ''}"
-    )
+    size = cut_extent(cut)
     share = cut["inner_on_boundary"] / max(inner_points, 1)
     warnings.warn(
         f"the grid box cuts the surface: it crosses the box's boundary {where} {size} ({share:.1%} of the inner "

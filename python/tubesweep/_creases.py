@@ -58,6 +58,18 @@ def _per_crease(per_inner_width: float, inner: float, spacing: float, thinned: b
     )
 
 
+def _early(angle: float, size: float, reckoned: str) -> str:
+    """How early a front arrives after a crease whose normal turns by ``angle`` degrees: up to
+    ``size`` (``reckoned`` says how), or, beyond :data:`REVERSED`, that much or more as it can
+    cross over between two sheets facing each other."""
+    if angle <= REVERSED:
+        return f"arrives early by up to about {size:.3g} {reckoned}"
+    return (
+        f"arrives early by {size:.3g} or more: the normal reverses there, two sheets face each other across a gap "
+        "narrower than the tube, and a front can cross over"
+    )
+
+
 def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: bool) -> None:
     """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``):
     the shortcut per crease, :data:`THINNED_SHORTCUT` spacings where the inner tube was thinned
@@ -69,12 +81,7 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
     # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
     # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
     size, how = _per_crease(2 * np.tan(np.radians(min(angle, REVERSED)) / 2), inner, spacing, thinned)
-    early = (
-        f"arrives early by up to about {size:.3g} ({how}, first order in Δx)"
-        if angle <= REVERSED
-        else f"arrives early by {size:.3g} or more: the normal reverses there, two sheets face each other across a "
-        "gap narrower than the tube, and a front can cross over"
-    )
+    early = _early(angle, size, f"({how}, first order in Δx)")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
         f"{angle:.0f}°): a front that crosses one {early}, "
@@ -150,12 +157,7 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
         return
     angle = float(creases["angle_degrees"])
     size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
-    early = (
-        f"arrives early by up to about {size:.3g} per crease it crosses (2·tan(θ/2)·inner·Δx, first order in Δx)"
-        if angle <= REVERSED
-        else f"arrives early by {size:.3g} or more: the normal reverses there, two sheets face each other across a "
-        "gap narrower than the tube, and a front can cross over"
-    )
+    early = _early(angle, size, "per crease it crosses (2·tan(θ/2)·inner·Δx, first order in Δx)")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the faces turning by up to "
         f"{angle:.0f}°): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "

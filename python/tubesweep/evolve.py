@@ -27,6 +27,7 @@ import numpy as np
 from xml.sax.saxutils import quoteattr
 
 from ._validate import as_grid, as_sources, real_scalar
+from ._box_cut import cut_extent
 from ._sources import check_on_surface
 from .solution import Solution
 from ._step_warnings import StepWarnings
@@ -201,9 +202,7 @@ def _warn_left_box(cut: dict) -> None:
     """The warning for a surface that grew out of the grid box during the evolution (the box held
     it at the start): a sampled φ says nothing beyond the box, so the solve itself cannot tell a
     bounded surface cut by it from one meant to go on beyond (``_box_cut.looks_bounded``)."""
-    size = (
-        f"along a curve about {cut['cut_length']:.3g} long" if "cut_length" in cut else f"at {cut['cut_points']} points"
-    )
+    size = cut_extent(cut)
     warnings.warn(
         f"evolve: the surface grew out of the grid box (it crosses {', '.join(cut['faces'])} {size}): from then "
         "on the distances are those of the part inside the box and paths through the part outside are not found. "
