@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -440,3 +441,23 @@ def test_output_paths_that_cannot_be_written_are_refused_before_the_solve(tmp_pa
     assert not out.exists()
     assert main(["distances", "--surface", "sphere", "--n", "21", "--sample", "3", "--out", str(afile / "D.npy")]) == 2
     assert f"--out {afile / 'D.npy'}: {afile} is a file, not a folder" in capsys.readouterr().err
+
+
+def test_a_solve_that_stops_at_max_iterations_writes_its_files_and_exits_3(tmp_path, capsys):
+    # a script must not take the last iterate for the answer: status 3 (2 is refused input); the
+    # warning is a line on stderr, as on a user's command line (not an error as in the tests)
+    argv = ["--out", str(tmp_path), "--quiet", "--max-iterations", "1"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", RuntimeWarning)
+        assert main(["solve", "--surface", "sphere", "--n", "41", "--order", "1", *argv]) == 3
+        assert (tmp_path / "solution.npz").exists()
+        err = capsys.readouterr().err
+        assert "warning: the sweeps did not converge in max_iterations=1" in err
+        assert "error: the solve stopped at --max-iterations 1 without converging" in err
+        assert main(["travel-time", "--n", "41", "--dim", "2", "--source", "0.1", "0", *argv]) == 3
+        assert np.isfinite(np.load(tmp_path / "travel_time.npy")).any()
+        err = capsys.readouterr().err
+        assert "warning: the sweeps did not converge" in err and "error: the solve stopped at --max-iterations 1" in err
+    # converged: 0, and no error line
+    assert main(["travel-time", "--n", "41", "--dim", "2", "--out", str(tmp_path), "--quiet"]) == 0
+    assert "error" not in capsys.readouterr().err

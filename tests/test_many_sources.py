@@ -118,6 +118,10 @@ def test_distance_matrix_on_the_sphere(grid):
     # where the fronts meet), the mean 0.053; at h = 0.025 0.066 and 0.021
     err = np.abs(d - exact)
     assert err.max() < 0.2 and err.mean() < 0.06, (err.max(), err.mean())
+    assert info["unconverged"] == 0
+    with pytest.warns(RuntimeWarning, match="8 of 8 solves did not converge"):
+        _, stopped = ts.distance_matrix(ts.surfaces.Sphere(R), grid, off, info=True, order=1, max_iterations=1)
+    assert stopped["unconverged"] == 8
     # what the average removed: the one-way estimates differ (0.021) and their diagonal is not 0 (0.033)
     assert 0 < info["asymmetry"] < 0.05 and 0 < info["diagonal"] < 0.05
     assert 0 < info["asymmetry_mean"] < info["asymmetry"]

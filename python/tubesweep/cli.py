@@ -18,6 +18,7 @@ import numpy as np
 from . import __version__
 from ._progress import make_progress
 from .cli_distances import add_distances_parser, cmd_distances
+from ._cli_exit import exit_status
 from ._paths import writable
 
 EPILOG = """examples:
@@ -57,8 +58,8 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
         "--max-iterations",
         type=int,
         default=10000,
-        help="stop after this many iterations (2^d sweeps each) even if not converged; the result then "
-        "reports converged=False (default: 10000)",
+        help="stop after this many iterations (2^d sweeps each) even if not converged; the files are then "
+        "written with the last iterate and the command exits with status 3 (default: 10000)",
     )
     p.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: ./out)")
     p.add_argument("--png", action="store_true", help="write a picture into --out (needs matplotlib)")
@@ -532,7 +533,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         )
         fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
         print(f"wrote {out / 'solution.png'}")
-    return 0
+    return exit_status(s.converged, f"the solve stopped at --max-iterations {args.max_iterations}")
 
 
 def _write_npz(path: Path, sol: Any) -> None:
@@ -615,7 +616,7 @@ def cmd_travel_time(args: argparse.Namespace) -> int:
             args.out / "travel_time.png", dpi=110, bbox_inches="tight"
         )
         print(f"wrote {args.out / 'travel_time.png'}")
-    return 0
+    return exit_status(s.converged, f"the solve stopped at --max-iterations {args.max_iterations}")
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:

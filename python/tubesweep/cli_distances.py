@@ -12,6 +12,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from ._cli_exit import exit_status
 from ._paths import writable
 
 EXAMPLES = """examples:
@@ -272,4 +273,5 @@ def cmd_distances(args: argparse.Namespace) -> int:
         + (f" (second order does not apply: {info['order_fallback']})" if info["order_fallback"] else "")
     )
     print(f"wrote {args.out} and {points_file} ({time.perf_counter() - t0:.2f} s in all)")
-    return 0
+    bad = info["unconverged"]
+    return exit_status(bad == 0, f"{bad} of the {m} solves stopped at their iteration limit", "pass a larger --tol")

@@ -100,7 +100,8 @@ def distance_matrix(
         estimates, removed by the average; ``asymmetry_mean`` its mean over the pairs),
         ``diagonal`` (the largest one-way ``u_i(x_i)``, set to 0), ``points`` (the snapped
         points), ``seconds``, ``order`` and ``order_fallback`` (the order run, and why second order
-        did not apply).
+        did not apply), ``unconverged`` (how many of the solves stopped at ``max_iterations``:
+        their rows are the last iterate, and a warning says so).
 
     Returns
     -------
@@ -173,6 +174,7 @@ def distance_matrix(
             "seconds": time.perf_counter() - t0,
             "order": stats.get("order", 1),
             "order_fallback": stats.get("order_fallback"),
+            "unconverged": int(np.count_nonzero(~np.asarray(stats["converged"], dtype=bool))),
         }
     return matrix
 
