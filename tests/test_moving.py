@@ -536,3 +536,45 @@ def test_a_surface_growing_out_of_the_box_is_said_once():
     assert sum("grew out of the grid box" in str(w.message) for w in rec) == 1
     assert ev.solutions[0].stats.box_cut is None or not ev.solutions[0].stats.box_cut["surface_cut"]
     assert ev.solutions[-1].stats.box_cut["surface_cut"]
+
+
+def test_errors_of_the_speed_law_and_of_progress_keep_the_frames():
+    # a law or a progress callback that raises mid-run lost every frame computed before it
+    phi = sphere_phi(GRID31)
+
+    def failing_law(u):
+        failing_law.calls += 1
+        if failing_law.calls == 3:
+            raise RuntimeError("the model diverged")
+        return 0.1 + 0 * u
+
+    failing_law.calls = 0
+    with pytest.raises(
+        ts.EvolutionStopped, match=r"step 2 .*speed\(u\) raised RuntimeError: the model diverged"
+    ) as info:
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], failing_law, dt=0.05, steps=4)
+    assert info.value.evolution.times == [0.0, 0.05, 0.1] and isinstance(info.value.__cause__, RuntimeError)
+    assert info.value.step == 2 and str(info.value).count("evolution attribute") == 1
+
+    def failing_progress(step, steps, t):
+        if step == 2:
+            raise KeyError("no such bar")
+
+    with pytest.raises(ts.EvolutionStopped, match=r"at step 2 .*progress raised KeyError") as info:
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=4, progress=failing_progress)
+    assert info.value.evolution.times == [0.0, 0.05]  # (called when φ has moved to step 2, before its solve)
+    # a masked array's values under the mask are not speeds
+    masked = lambda u: np.ma.masked_where(u > 0.5, 0.1 + 0 * u)  # noqa: E731
+    with pytest.raises(ValueError, match=r"masked array with \d+ masked values"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], masked, dt=0.05, steps=2)
+
+
+def test_an_older_solution_at_first_order_is_named_and_evolve_starts_from_the_previous_alone(first):
+    tube, sol = first
+    r = 0.5 + 0.4 * H
+    moved = tube.moved(ts.surfaces.Sphere(r))
+    order1 = tube.solve(pole(0.5), order=1)
+    with pytest.raises(WarmStartRefused, match=r"the older solution was solved at first order.*warm=previous alone"):
+        moved.solve(pole(r), warm=(order1, sol))
+    with pytest.raises(WarmStartRefused, match=r"the previous solution was solved at first order"):
+        moved.solve(pole(r), warm=(sol, order1))

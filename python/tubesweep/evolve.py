@@ -121,8 +121,9 @@ class Evolution:
 class EvolutionStopped(ValueError):
     """:func:`evolve` could not go on: the surface vanished or shrank below the grid, the part
     that carries a source did, a step broke the CFL condition or the speed law's values, or a
-    surface solve failed to converge. The message names the step, the time and the cause (the
-    exception it came from is chained as ``__cause__``).
+    surface solve failed to converge, the speed law or ``progress`` raised, or a checkpoint could
+    not be written. The message names the step, the time and the cause (the exception it came from
+    is chained as ``__cause__``).
 
     Attributes
     ----------
@@ -225,6 +226,11 @@ def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) 
     if raw is None:
         raise TypeError(
             "evolve: speed(u) returned None; it must return the normal speed V: an array like u, or a number"
+        )
+    if np.ma.isMaskedArray(raw) and np.ma.count_masked(raw):
+        raise ValueError(
+            f"evolve: at step {step} speed(u) returned a masked array with {np.ma.count_masked(raw)} masked values, "
+            "whose values would be taken as speeds; fill them (V.filled(value)) or return a plain array"
         )
     a = np.asarray(raw)
     if np.iscomplexobj(a) or not (np.issubdtype(a.dtype, np.number) or a.dtype == np.bool_):
@@ -394,7 +400,10 @@ def evolve(
                     if step == 0:
                         check_on_surface(src, dist, tube.inner * grid.spacing)
                     src = np.ascontiguousarray(feet)
-                    warm: Any = None if prev is None else (prev if older is None else (older, prev))
+                    # extrapolated from the two previous steps where both ran second order; a step that
+                    # fell back to first order starts the next one cold and the one after from it alone
+                    pair = older is not None and getattr(older, "order", 1) == 2
+                    warm: Any = None if prev is None else ((older, prev) if pair else prev)
                     sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
                     cut = sol.stats.box_cut
                     if step == 0:
@@ -447,7 +456,7 @@ def evolve(
                     except OSError as e:
                         raise EvolutionStopped(
                             f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "
-                            f"be written ({e}); the frames computed so far are in this error's evolution",
+                            f"be written ({e})",
                             out,
                             step,
                             t,
@@ -457,10 +466,17 @@ def evolve(
             u = sol.values
             try:
                 v = _speed_values(speed, u, step)
-            except ValueError as e:
+            except Exception as e:  # the law's own errors too: the frames so far are kept
                 if step == 0:
                     raise
-                raise EvolutionStopped(str(e), out, step, t) from e
+                if isinstance(e, (ValueError, TypeError)) and str(e).startswith("evolve:"):
+                    raise EvolutionStopped(str(e), out, step, t) from e
+                raise EvolutionStopped(
+                    f"evolve stopped at step {step} (t = {t:.6g}): speed(u) raised {type(e).__name__}: {e}",
+                    out,
+                    step,
+                    t,
+                ) from e
             vmax = float(np.max(np.abs(v)))
             if dt * vmax > cfl * h:
                 message = (
@@ -476,7 +492,15 @@ def evolve(
             older, prev = prev, sol
             t = t0 + (step + 1) * dt  # not a running sum: no rounding carried from step to step
             if progress is not None:
-                progress(step + 1, steps, t)
+                try:
+                    progress(step + 1, steps, t)
+                except Exception as e:  # the frames so far are kept
+                    raise EvolutionStopped(
+                        f"evolve stopped at step {step + 1} (t = {t:.6g}): progress raised {type(e).__name__}: {e}",
+                        out,
+                        step + 1,
+                        t,
+                    ) from e
         return out
     finally:
         said.say()

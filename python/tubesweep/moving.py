@@ -48,24 +48,30 @@ def check_warm_refused(warm_refused: Any) -> str:
     return warm_refused
 
 
-def check_previous(warm: Any, grid: Any) -> Any:
-    """``warm`` as a second-order :class:`~tubesweep.Solution` on ``grid``, or the refusal."""
+def check_previous(warm: Any, grid: Any, which: str = "previous") -> Any:
+    """``warm`` as a second-order :class:`~tubesweep.Solution` on ``grid``, or the refusal;
+    ``which`` names it ("previous", or "older" of a pair ``(older, previous)``)."""
     from .solution import Solution
 
+    what = "warm" if which == "previous" else "warm=(older, previous): older"
     if not isinstance(warm, Solution):
         raise TypeError(
-            f"warm must be the Solution of a previous solve (ts.solve or Tube.solve); got {type(warm).__name__}"
+            f"{what} must be the Solution of a previous solve (ts.solve or Tube.solve); got {type(warm).__name__}"
         )
     if warm.grid != grid:
         raise WarmStartRefused(
-            f"warm: the previous solution is on another grid ({warm.grid!r}, this solve's is {grid!r}); a warm start "
+            f"warm: the {which} solution is on another grid ({warm.grid!r}, this solve's is {grid!r}); a warm start "
             "carries values node by node, so both solves need the same grid. Solve cold (leave out warm=)"
         )
     if getattr(warm, "order", 1) != 2 or warm._factoring is None:
+        cure = (
+            "Solve the previous step with order=2 or 'auto' where second order applies, or solve cold (leave out warm=)"
+            if which == "previous"
+            else "Pass warm=previous alone (a start carried from one step, not extrapolated from two)"
+        )
         raise WarmStartRefused(
-            "warm: the previous solution was solved at first order (order=1, or order='auto' fell back to it); warm "
-            "starts run the second-order solve from a second-order solution. Solve the previous step with order=2 or "
-            "'auto' where second order applies, or solve cold (leave out warm=)"
+            f"warm: the {which} solution was solved at first order (order=1, or order='auto' fell back to it); warm "
+            f"starts run the second-order solve from second-order solutions. {cure}"
         )
     return warm
 
@@ -148,7 +154,8 @@ def carried_values(
                 f"sequence of {len(warm)}"
             )
         older, warm = warm
-        check_previous(older, grid)
+        check_previous(warm, grid)
+        check_previous(older, grid, "older")
     check_previous(warm, grid)
     if older is not None and len(older._factoring[1]) != len(warm._factoring[1]):
         raise WarmStartRefused(
