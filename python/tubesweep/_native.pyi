@@ -177,6 +177,9 @@ def carry_band_values(  # crates/tubesweep-py/src/moving.rs: previous values ont
     old_linear: npt.NDArray[np.uint64], old_values: npt.NDArray[np.float64], new_linear: npt.NDArray[np.uint64]
 ) -> npt.NDArray[np.float64]: ...
 def band_components(band: Band, select: npt.NDArray[np.bool_]) -> int: ...  # moving.rs: connected components
+def band_component_labels(
+    band: Band, select: npt.NDArray[np.bool_]
+) -> npt.NDArray[np.uint32]: ...  # moving.rs: each node's component
 def second_order_solve_many(  # crates/tubesweep-py/src/many_sources.rs: K second-order solves, the geometry shared
     band: "Band",
     roles: npt.NDArray[np.uint8],

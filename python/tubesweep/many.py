@@ -32,6 +32,7 @@ from ._validate import (
 )
 from ._creases import warn_paper_tube_creases
 from ._prepare import ROLE_INNER, thinned_count, uncut_band, warn_facing_pairs
+from ._parts import drop_unsourced_rows
 from ._sheet_readout import own_side_plan
 from ._fallback import Fallback
 from ._sources import SOURCE_RADIUS, _fix_sources
@@ -211,6 +212,7 @@ def solve_many(
             except so.Order2NotApplicable as e:
                 tube._order2_refusal = str(e)  # depends on the band only: not computed again
                 raise
+            out = drop_unsourced_rows(out, tube._tube_order2, groups, points)  # (``_parts``)
             if return_stats:
                 st.update(order=2, order_fallback=None, seconds_total=time.perf_counter() - t0)
                 return out, st
@@ -279,6 +281,7 @@ def solve_many(
     if plan is not None:
         m = len(points)  # type: ignore[arg-type]
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])
+    out = drop_unsourced_rows(out, t, groups, points)  # a part without a source keeps inf (``_parts``)
     bad = np.flatnonzero(~st["converged"])
     if bad.size:
         warnings.warn(

@@ -21,6 +21,7 @@ from . import _native
 from ._box_cut import box_reason
 from ._creases import warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
+from ._parts import drop_unsourced, part_labels, source_parts
 from ._prepare import ROLE_OUTER, thinned_count
 from .mask import mask_advice
 from .moving import values_checksum
@@ -603,6 +604,8 @@ def solve_on_tube(
     tol = inputs.tol
     feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
     warm_values, warm_more, warm_info = warm_start(warm, tube, feet, tol, warm_refused)
+    parts = part_labels(tube)  # a part without a source keeps inf (``_parts``)
+    sourced = None if parts is None else source_parts(grid, band, parts, feet)
     setup = time.perf_counter() - t0
     values, u0, roles_out, st = run_native(
         tube,
@@ -618,6 +621,8 @@ def solve_on_tube(
     )
     if st["restart_failed"]:
         raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf))
+    if parts is not None:
+        drop_unsourced(values, parts, sourced)
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)

@@ -31,6 +31,7 @@ from .moving import check_warm_refused
 from .stats import SolveStats
 from .surface import as_surface
 from ._creases import warn_paper_tube_creases
+from ._parts import drop_unsourced, part_labels, source_parts
 from ._prepare import (
     METHODS,
     ROLE_FIXED,
@@ -393,6 +394,10 @@ def _solve_on_tube(
         # gaps the cut would have closed are warned about
         band, cut_edges = uncut_band(tube), 0
         warn_facing_pairs(grid, tube.linear, tube.roles, tube.facing, tube.inner)
+    # the parts of the surface (before the sweeps consume the tube): a part without a source
+    # keeps inf whatever reached it across a narrow gap (``_parts``)
+    parts = part_labels(tube)
+    sourced = None if parts is None else source_parts(grid, tube.band, parts, src)
     h = grid.spacing
     inner_width = tube.inner * h
     roles = tube.roles.copy() if reuse else tube.roles
@@ -499,6 +504,8 @@ def _solve_on_tube(
         )
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
+    if parts is not None:
+        drop_unsourced(values, parts, sourced)
     # no NaN, and no inf next to a reached node in a solve reported converged
     check_values(
         grid,

@@ -3,7 +3,7 @@
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use tubesweep_core::second_order::warm::{carry_values, inner_components};
+use tubesweep_core::second_order::warm::{carry_values, component_labels, inner_components};
 
 use crate::band::{AnyBand, PyBand};
 use crate::convert::c_slice;
@@ -39,8 +39,28 @@ pub fn band_components(py: Python<'_>, band: PyRef<'_, PyBand>, select: PyReadon
     .map_err(to_pyerr)
 }
 
+/// The connected component (along the axes) of each band node flagged in `select`: the smallest
+/// band position in it, `u32::MAX` for the nodes not flagged.
+#[pyfunction]
+pub fn band_component_labels<'py>(
+    py: Python<'py>,
+    band: PyRef<'py, PyBand>,
+    select: PyReadonlyArray1<'py, bool>,
+) -> PyResult<Bound<'py, PyArray1<u32>>> {
+    let s = c_slice(&select, "select")?;
+    let b = &band.band;
+    let out = py
+        .detach(|| match b {
+            AnyBand::D2(b) => component_labels(b, s),
+            AnyBand::D3(b) => component_labels(b, s),
+        })
+        .map_err(to_pyerr)?;
+    Ok(out.into_pyarray(py))
+}
+
 /// Registers the functions of this file in the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(carry_band_values, m)?)?;
-    m.add_function(wrap_pyfunction!(band_components, m)?)
+    m.add_function(wrap_pyfunction!(band_components, m)?)?;
+    m.add_function(wrap_pyfunction!(band_component_labels, m)?)
 }

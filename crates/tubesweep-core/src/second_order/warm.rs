@@ -127,6 +127,16 @@ pub fn carry_values(old_linear: &[u64], old_values: &[f64], new_linear: &[u64]) 
 /// The number of connected components of the nodes with `select` (neighbours along the axes), by
 /// union–find over the band's neighbour table: O(band).
 pub fn inner_components<const D: usize>(band: &NarrowBand<D>, select: &[bool]) -> Result<usize> {
+    let labels = component_labels(band, select)?;
+    Ok((0..labels.len())
+        .filter(|&i| select[i] && labels[i] == i as u32)
+        .count())
+}
+
+/// The connected component of each node with `select` (neighbours along the axes): the smallest
+/// band position in it, `u32::MAX` for the nodes not selected. Union–find over the band's
+/// neighbour table, O(band); a cut edge (`crate::band::cut_edges`) joins nothing.
+pub fn component_labels<const D: usize>(band: &NarrowBand<D>, select: &[bool]) -> Result<Vec<u32>> {
     let n = band.len();
     if select.len() != n {
         return Err(Error::invalid(
@@ -156,11 +166,20 @@ pub fn inner_components<const D: usize>(band: &NarrowBand<D>, select: &[bool]) -
             }
             let (a, b) = (root(&mut parent, i as u32), root(&mut parent, j));
             if a != b {
+                // the smaller root stays: a component's root is its smallest position
                 parent[a.max(b) as usize] = a.min(b);
             }
         }
     }
-    Ok((0..n).filter(|&i| select[i] && parent[i] == i as u32).count())
+    Ok((0..n)
+        .map(|i| {
+            if select[i] {
+                root(&mut parent, i as u32)
+            } else {
+                u32::MAX
+            }
+        })
+        .collect())
 }
 
 /// Why a warm solve was solved again cold.
@@ -358,6 +377,14 @@ mod tests {
             .map(|(&s, i)| s && (i[2] as i64 - 20).abs() > 1)
             .collect();
         assert_eq!(inner_components(&band, &cut).unwrap(), 2);
+        // each node's label is the smallest position of its component, u32::MAX off the selection
+        let labels = component_labels(&band, &cut).unwrap();
+        let north: Vec<usize> = (0..idx.len()).filter(|&i| cut[i] && idx[i][2] > 20).collect();
+        let south: Vec<usize> = (0..idx.len()).filter(|&i| cut[i] && idx[i][2] < 20).collect();
+        assert!(south.iter().all(|&i| labels[i] == south[0] as u32));
+        assert!(north.iter().all(|&i| labels[i] == north[0] as u32));
+        assert!((0..idx.len()).all(|i| cut[i] || labels[i] == u32::MAX));
+        assert!(component_labels(&band, &cut[1..]).is_err());
     }
 
     /// A cold solve on the sphere of radius `r` (n³ nodes over [−1, 1]³, source on the −x axis):

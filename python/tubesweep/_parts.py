@@ -1,0 +1,138 @@
+"""Parts of the surface that no path joins: a value only from a source on the node's own part.
+
+Where two parts of the surface face each other across a gap narrower than the tubes
+(``_prepare._warn_if_tubes_touch``), the two-layer method (Algorithm 3) lets a node read a
+neighbour whose closest point lies on the other part, so the front can cross the gap. Where the
+band is cut there (``_shortcuts``, triangle meshes) it cannot; elsewhere a part that carries no
+source was given finite, too short travel times: two spheres 6 grid spacings apart as a
+re-distanced φ (``ts.LevelSet(phi, redistance=True)``, and so every step of ``ts.evolve``), the
+far one reached at 1.27 with ``converged=True`` and a warning of "1 node pair, 0.027 % of the
+surface".
+
+A connected surface has a connected inner tube: its nodes lie within ``inner``·Δx of the surface,
+and the balls of that radius around the surface's points overlap along it, so its nodes are
+joined along the axes. An inner-tube component (a *part*) that holds no source is therefore one
+that no path on the surface reaches, and its nodes keep ``inf`` whatever reached them across a
+gap. The inner tube here is the paper's: the nodes that second order moves to the extension
+layer at creases (``_creases``) count as inner (a cube's thinned inner tube stays connected
+around its edges at N = 41 and 81, but a sharper crease could split it). An
+extension node belongs to the part of its neighbour nearest the surface (its closest point's
+side), followed down to an inner node.
+
+Only tubes with facing pairs are labelled (elsewhere no front crosses between parts): O(band)
+union–find in the core (``second_order::warm::component_labels``) and a few passes over the
+extension layer.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _native
+from .grid import Grid
+
+#: The label of a node of no part (an extension node whose neighbours lead to no inner node).
+NO_PART = np.iinfo(np.uint32).max
+
+
+def part_labels(tube: Any) -> Optional[np.ndarray]:
+    """Per band node of ``tube`` (a ``_prepare._PreparedTube``) its part of the surface (uint32:
+    the smallest band position of its inner-tube component; :data:`NO_PART` where none is
+    found), or None when no two parts face each other across a gap (nothing can cross) or the
+    band is cut between them (``_shortcuts``: a mesh, whose inner tube the cuts above concave
+    edges could split, so its parts are left to the cuts)."""
+    from ._prepare import ROLE_OUTER
+
+    if tube.facing[0].size == 0 or tube.cut_edges:
+        return None  # no front crosses between parts; a mesh's band is cut between them already
+    inner = tube.roles != ROLE_OUTER
+    if len(tube.crease_nodes):
+        inner = inner.copy()
+        inner[tube.crease_nodes] = True  # the paper's inner tube (see the module)
+    labels = _native.band_component_labels(tube.band, np.ascontiguousarray(inner))
+    ext = np.flatnonzero(~inner)
+    if ext.size == 0:
+        return labels
+    n = len(labels)
+    nb = tube.band.neighbours_of_nodes(np.ascontiguousarray(ext, dtype=np.int64)).reshape(ext.size, -1)
+    nb = np.where(nb < n, nb, n)
+    depth = np.append(np.abs(np.asarray(tube.phi, dtype=float)), np.inf)
+    toward = nb[np.arange(ext.size), np.argmin(depth[nb], axis=1)]
+    # each node's step toward the surface: itself for inner nodes, none (n) where no neighbour is
+    # nearer the surface; then pointer jumping down to the inner tube (|φ| falls along each chain)
+    step = np.arange(n + 1)
+    step[ext] = np.where(depth[toward] < depth[ext], toward, n)
+    for _ in range(64):
+        nxt = step[step]
+        if np.array_equal(nxt, step):
+            break
+        step = nxt
+    # (an extension node's own label is NO_PART: a chain that ends on none stays without a part)
+    return np.append(labels, np.uint32(NO_PART))[step[:n]]
+
+
+def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The parts of the band nodes at the corners of each point's cell, ``(M, 2^d)`` (NO_PART
+    where a corner is not in the band)."""
+    d = grid.ndim
+    shape = np.asarray(grid.shape)
+    base = np.clip(np.floor(grid.continuous_index(points)).astype(np.int64), 0, shape - 2)
+    offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
+    corners = (base[:, None, :] + offsets[None, :, :]).reshape(-1, d)
+    pos = band.find(np.ascontiguousarray(corners)).reshape(len(points), -1)
+    lab = np.append(labels, np.uint32(NO_PART))
+    return lab[np.where(pos >= 0, pos, len(labels))]
+
+
+def source_parts(grid: Grid, band: Any, labels: np.ndarray, sources: np.ndarray) -> Optional[np.ndarray]:
+    """The parts that hold the sources (those of the corners of each source's cell), or None
+    when a source's cell has no labelled corner (then nothing is dropped)."""
+    at = parts_at(grid, band, labels, np.asarray(sources, dtype=float).reshape(-1, grid.ndim))
+    found = at != NO_PART
+    if not np.all(np.any(found, axis=1)):
+        return None
+    return np.unique(at[found])
+
+
+def drop_unsourced(values: np.ndarray, labels: np.ndarray, sourced: Optional[np.ndarray]) -> int:
+    """Sets to inf (in place) the finite values of nodes on parts other than ``sourced``; returns
+    how many there were."""
+    if sourced is None:
+        return 0
+    off = np.isfinite(values) & (labels != NO_PART) & ~np.isin(labels, sourced)
+    values[off] = np.inf
+    return int(np.count_nonzero(off))
+
+
+def drop_unsourced_points(values: np.ndarray, corner_parts: np.ndarray, sourced: Optional[np.ndarray]) -> np.ndarray:
+    """``values`` at points (M,) with inf where no corner of a point's cell lies on a part of
+    ``sourced`` but some corner lies on a part (the batch's reading of :func:`drop_unsourced`)."""
+    if sourced is None:
+        return values
+    labelled = corner_parts != NO_PART
+    off = np.any(labelled, axis=1) & ~np.any(labelled & np.isin(corner_parts, sourced), axis=1)
+    if not np.any(off & np.isfinite(values)):
+        return values
+    out = values.copy()
+    out[off] = np.inf
+    return out
+
+
+def drop_unsourced_rows(rows: np.ndarray, tube: Any, groups: Any, points: Optional[np.ndarray]) -> np.ndarray:
+    """The rows of ``Tube.solve_many`` (one per source group: band values, or values at ``points``)
+    with inf on the parts of the surface other than their sources' (as each single solve's)."""
+    parts = part_labels(tube)
+    if parts is None:
+        return rows
+    grid, band = tube.grid, tube.band
+    corners = None if points is None else parts_at(grid, band, parts, points)
+    out = np.array(rows, dtype=float, copy=True)
+    for k, group in enumerate(groups):
+        sourced = source_parts(grid, band, parts, group)
+        if corners is None:
+            drop_unsourced(out[k], parts, sourced)
+        else:
+            out[k] = drop_unsourced_points(out[k], corners, sourced)
+    return out

@@ -1,0 +1,94 @@
+"""Parts of the surface that no path joins (tubesweep._parts): a part without a source stays
+unreached even where the front crosses a gap narrower than the tubes to it."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep._parts import NO_PART, part_labels
+
+GRID = ts.Grid((-1.2, -1, -1), (1.2, 1, 1), (49, 41, 41))  # h = 0.05
+R, C = 0.3, 0.45  # two spheres 0.3 = 6 spacings apart
+
+
+def two_spheres() -> np.ndarray:
+    x = np.stack(GRID.meshgrid(), -1)
+    return np.minimum(np.linalg.norm(x - [-C, 0, 0], axis=-1), np.linalg.norm(x - [C, 0, 0], axis=-1)) - R
+
+
+def quiet(f, *args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the narrow gap between the spheres, said elsewhere
+        return f(*args, **kwargs)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_a_sphere_without_a_source_six_spacings_away_stays_unreached(order):
+    # re-distanced (as every step of ts.evolve is), the front crossed the gap: the far sphere read
+    # 1.27 at its far pole with converged=True, shorter than any path across the gap (≥ 1.40)
+    surface = ts.LevelSet(two_spheres(), redistance=True)
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        with pytest.warns(RuntimeWarning, match="equidistant from two parts"):
+            sol = ts.solve(surface, GRID, [(-C, 0, R)], order=order)
+    assert sol.stats.order == order and sol.stats.converged and sol.stats.facing_pairs > 0
+    far = np.array([(C, 0, R), (C + R, 0, 0), (C, 0, -R)])
+    assert np.all(np.isinf(sol(far)))
+    # the source's sphere is solved as alone: the great-circle distances, to the scheme's accuracy
+    near = np.array([(-C, 0, -R), (-C - R, 0, 0), (-C, R, 0)])
+    exact = R * np.array([np.pi, np.pi / 2, np.pi / 2])
+    assert np.max(np.abs(sol(near) - exact)) < (0.2 if order == 1 else 0.02)
+    # the parts: one per sphere's inner tube, the extension layer with its sphere
+    labels = part_labels(sol_tube(surface))
+    assert labels is not None and len(np.unique(labels[labels != NO_PART])) == 2
+
+
+def sol_tube(surface):
+    return quiet(ts.Tube, surface, GRID)._tube
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_a_batch_drops_the_other_parts_as_the_single_solves_do(order):
+    tube = quiet(ts.Tube, ts.LevelSet(two_spheres(), redistance=True), GRID)
+    sources = [(-C, 0, R), (C, 0, -R)]
+    at = np.array([(C, 0, R), (C + R, 0, 0), (-C, 0, -R), (-C - R, 0, 0)])
+    rows = quiet(tube.solve_many, sources, at=at, order=order)
+    full = quiet(tube.solve_many, sources, order=order)
+    for k, source in enumerate(sources):
+        single = quiet(tube.solve, [source], order=order)
+        assert np.array_equal(rows[k], single(at)) and np.array_equal(full[k], single.values)
+    assert np.all(np.isinf(rows[0, :2])) and np.all(np.isfinite(rows[0, 2:]))
+    assert np.all(np.isinf(rows[1, 2:])) and np.all(np.isfinite(rows[1, :2]))
+    d = quiet(ts.distance_matrix, tube, None, at, order=order)
+    assert np.all(np.isinf(d[:2, 2:])) and np.all(np.isfinite(d[:2, :2])) and np.all(np.isfinite(d[2:, 2:]))
+
+
+def test_an_evolving_droplet_does_not_reach_the_sphere_beneath_it():
+    # a droplet carrying the source 6 spacings above a larger sphere: every frame of ts.evolve
+    # gave the sphere finite distances, and its speed law V = g(u) moved it by them
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    x = np.stack(grid.meshgrid(), -1)
+    top, bottom = np.array([0.0, 0.0, 0.75]), np.array([0.0, 0.0, -0.25])
+    phi = np.minimum(np.linalg.norm(x - top, axis=-1) - 0.2, np.linalg.norm(x - bottom, axis=-1) - 0.5)
+    ev = quiet(ts.evolve, phi, grid, [top + [0, 0.2, 0]], lambda u: 0.1 / (1 + u), dt=0.01, steps=1)
+    sphere = np.array([bottom + [0, 0, -0.5], bottom + [0.5, 0, 0]])
+    for sol in ev.solutions:
+        assert np.all(np.isinf(sol(sphere)))
+
+
+def test_the_faces_of_a_cube_next_to_a_sphere_stay_one_part():
+    # second order moves the nodes at a cube's creases to the extension layer; its faces stay one
+    # part (the paper's inner tube is labelled) and all six are reached, the sphere is not
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))  # h = 0.05
+    x = np.stack(grid.meshgrid(), -1)
+    q = np.abs(x - [-0.4, 0, 0]) - 0.3
+    cube = np.linalg.norm(np.maximum(q, 0), axis=-1) + np.minimum(q.max(axis=-1), 0)
+    sphere = np.linalg.norm(x - [0.45, 0, 0], axis=-1) - 0.3  # 0.25 = 5 spacings from the cube
+    sol = quiet(ts.solve, np.minimum(cube, sphere), grid, [(-0.4, 0, 0.3)])
+    assert sol.stats.facing_pairs > 0 and sol.stats.crease_thinned > 0
+    faces = np.array([(-0.4, 0, -0.3), (-0.7, 0, 0), (-0.1, 0, 0), (-0.4, 0.3, 0), (-0.4, -0.3, 0)])
+    assert np.all(np.isfinite(sol(faces)))
+    assert np.all(np.isinf(sol(np.array([(0.75, 0, 0), (0.45, 0, 0.3)]))))
