@@ -374,3 +374,13 @@ def test_a_mask_passed_as_phi_is_refused_with_from_mask_named():
     # a φ of one sign without such a region keeps its own refusal
     with pytest.raises(ValueError, match=r"phi has no sign change on the grid"):
         ts.solve(ts.LevelSet(r + 0.1, redistance=True), g, [(0, 0, 0.5)])
+    # φ rounded to a few values is 0 on a shell two spacings thick: in ts.evolve the surface
+    # jumped by 9 times its law per step
+    quantized = np.round((r - 0.5) * 10)
+    with pytest.raises(ValueError, match=r"exactly 0 on a whole region between its negative and positive values"):
+        ts.solve(ts.LevelSet(quantized, redistance=True), g, [(0, 0, 0.5)])
+    with pytest.raises(ValueError, match=r"exactly 0 on a whole region"):
+        ts.evolve(quantized, g, [(0, 0, 0.5)], lambda u: 0.1 + 0 * u, dt=0.02, steps=2)
+    # a plane of zeros (φ = z with z = 0 nodes) is a surface
+    z = np.stack(g.meshgrid(), -1)[..., 2]
+    assert ts.solve(ts.LevelSet(z, redistance=True), g, [(0, 0, 0)]).stats.converged

@@ -282,7 +282,9 @@ def evolve(
         current surface.
     speed : callable
         ``speed(u)`` → the outward normal speed V at each value of u (an array of the band's
-        values; a scalar for a constant speed). Positive V grows the surface.
+        values; a scalar for a constant speed). Positive V grows the surface. It takes u alone: a
+        law that also depends on time or on the step can count its calls or read a variable of
+        yours (one call per step, in order).
     dt : float
         The time step.
     steps : int

@@ -318,23 +318,30 @@ def _scaled_samples(surface) -> np.ndarray:
 
 
 def _refuse_zero_region(array: np.ndarray) -> None:
-    """Refuses a φ of one sign that is 0 on a whole region (a sample whose neighbours along every
-    axis are 0 too): its zero level set is that region, not a surface — a 0/1 mask passed as φ
+    """Refuses a φ that is 0 on a whole region (a sample whose neighbours along every axis are 0
+    too): its zero level set is that region, not a surface. Of one sign, a 0/1 mask passed as φ
     (``(r > 0.5).astype(float)`` ran first order, 12% off, and the warning advised the
-    ``redistance=True`` given already)."""
-    if array.size and array.min() < 0 < array.max():  # (NaN fails both: checked below)
-        return
+    ``redistance=True`` given already); changing sign, a φ rounded to a few values (``round(10·d)``
+    is 0 on a shell two spacings thick: in ``ts.evolve`` the surface jumped by 9 times its law).
+    A plane of zeros, φ = z on a grid with z = 0 nodes, has no such sample."""
     zero = array == 0
     interior = zero.copy()
     for axis in range(array.ndim):
         interior &= np.roll(zero, 1, axis) & np.roll(zero, -1, axis)
     count = int(np.count_nonzero(interior))
-    if count:
+    if not count:
+        return
+    if array.min() < 0 < array.max():  # (NaN fails both: checked elsewhere)
         raise ValueError(
-            f"phi is {'≥' if not np.any(array < 0) else '≤'} 0 everywhere and exactly 0 on a whole region ({count} samples "
-            "inside it): its zero level set is that region, not a surface. A 0/1 mask is given as "
-            "ts.LevelSet.from_mask(mask, grid) (mask True inside); else pass φ < 0 inside and > 0 outside"
+            f"phi is exactly 0 on a whole region between its negative and positive values ({count} samples inside it): "
+            "its zero level set is that region, not a surface, as when φ is rounded to a few values. Pass φ at full "
+            "precision (a signed distance or any function whose zero level set is the surface)"
         )
+    raise ValueError(
+        f"phi is {'≥' if not np.any(array < 0) else '≤'} 0 everywhere and exactly 0 on a whole region ({count} samples "
+        "inside it): its zero level set is that region, not a surface. A 0/1 mask is given as "
+        "ts.LevelSet.from_mask(mask, grid) (mask True inside); else pass φ < 0 inside and > 0 outside"
+    )
 
 
 def _sampled_redistanced_band(surface, grid, half_width: float):
