@@ -32,6 +32,7 @@ import numpy as np
 
 from . import _native
 from .grid import Grid
+from ._shortcuts import cuts_medial_edges
 
 #: The label of a node of no part (an extension node whose neighbours lead to no inner node).
 NO_PART = np.iinfo(np.uint32).max
@@ -41,11 +42,12 @@ def part_labels(tube: Any) -> Optional[np.ndarray]:
     """Per band node of ``tube`` (a ``_prepare._PreparedTube``) its part of the surface (uint32:
     the smallest band position of its inner-tube component; :data:`NO_PART` where none is
     found), or None when no two parts face each other across a gap (nothing can cross) or the
-    band is cut between them (``_shortcuts``: a mesh, whose inner tube the cuts above concave
-    edges could split, so its parts are left to the cuts)."""
+    band is cut at medial edges too (``_shortcuts``: a mesh, whose inner tube the cuts above
+    concave edges could split, so its parts are left to the cuts; a point cloud's band is cut
+    only between facing sheets, which leaves each sheet's inner tube whole)."""
     from ._prepare import ROLE_OUTER
 
-    if tube.facing[0].size == 0 or tube.cut_edges:
+    if tube.facing[0].size == 0 or (tube.cut_edges and cuts_medial_edges(tube.surface)):
         return None  # no front crosses between parts; a mesh's band is cut between them already
     inner = tube.roles != ROLE_OUTER
     if len(tube.crease_nodes):
@@ -81,7 +83,7 @@ def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray) -> n
     base = np.clip(np.floor(grid.continuous_index(points)).astype(np.int64), 0, shape - 2)
     offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
     corners = (base[:, None, :] + offsets[None, :, :]).reshape(-1, d)
-    pos = band.find(np.ascontiguousarray(corners)).reshape(len(points), -1)
+    pos = band.find(np.ascontiguousarray(corners)).reshape(len(points), 1 << d)
     lab = np.append(labels, np.uint32(NO_PART))
     return lab[np.where(pos >= 0, pos, len(labels))]
 

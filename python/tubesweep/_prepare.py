@@ -25,7 +25,7 @@ from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
-from ._shortcuts import cut_shortcuts, cuts_shortcuts
+from ._shortcuts import cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -118,7 +118,7 @@ class _PreparedTube:
     #: where the grid box cuts the tube (``_box_cut.box_cut``), None where it does not
     box_cut: Optional[Dict[str, Any]] = None
     #: the edges of the band's neighbour table removed across narrow gaps and medial edges
-    #: (``_shortcuts.cut_shortcuts``; triangle meshes only)
+    #: (``_shortcuts.cut_shortcuts``; triangle meshes, and point clouds across resolved gaps)
     cut_edges: int = 0
     #: the inner-tube nodes at creases that second order (and ``order="auto"``) makes extension
     #: nodes (``_creases.crease_nodes_to_extend``; band positions); their roles are changed only
@@ -292,17 +292,19 @@ def warn_facing_pairs(
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
     inner: float,
     note: str = "",
+    resolving: Optional[float] = None,
 ) -> None:
     """The warning of :func:`_warn_if_tubes_touch` for the pairs ``facing`` (band positions of the
-    nodes and their neighbours, and the gaps), if there are any; ``note`` ends it (a sparse point
-    cloud's, ``PointCloudSurface._gap_note``)."""
+    nodes and their neighbours, and the gaps), if there are any; ``note`` ends it (a point
+    cloud's, ``PointCloudSurface._gap_note`` and ``_unresolved_gap_note``). A gap ``resolving`` grid
+    spacings wide is resolved (default ``2·inner + 2``: the tubes of the two sides apart)."""
     node, neighbour, gap = facing
     if node.size == 0:
         return
     h = grid.spacing
     narrowest = int(np.argmin(gap))
     where = _where(grid, linear[node[narrowest]])
-    needed = float(gap[narrowest]) / (2 * inner + 2)
+    needed = float(gap[narrowest]) / (2 * inner + 2 if resolving is None else resolving)
     # how much of the surface: the inner-tube nodes of the pairs among all inner-tube nodes
     inner_nodes = roles == ROLE_INNER
     touched = np.unique(np.concatenate([node, neighbour]))
@@ -501,8 +503,25 @@ def _prepare_tube(
         note=gap_note(h) if gap_note is not None else "",
     )
     cut_edges = 0
+    cut_facing = facing
+    resolved = getattr(surf, "resolved_gap", None)  # a cloud: the gaps its fits keep apart
+    if cuts and resolved is not None:
+        node, neighbour, gap = facing
+        narrow = gap < resolved(h)
+        cut_facing = (node[~narrow], neighbour[~narrow], gap[~narrow])
+        warn_facing_pairs(
+            grid,
+            linear,
+            roles,
+            (node[narrow], neighbour[narrow], gap[narrow]),
+            inner,
+            getattr(surf, "_unresolved_gap_note")(h) + (gap_note(h) if gap_note is not None else ""),
+            resolving=float(getattr(surf, "resolving_spacings")),
+        )
     if cuts:
-        band, cut_edges = cut_shortcuts(band, roles == ROLE_INNER, phi, directions, h, facing)
+        band, cut_edges = cut_shortcuts(
+            band, roles == ROLE_INNER, phi, directions, h, cut_facing, medial=cuts_medial_edges(surf)
+        )
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)

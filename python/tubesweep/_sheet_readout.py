@@ -45,16 +45,20 @@ class OwnSidePlan:
     def apply(self, out: np.ndarray, corner_values: np.ndarray) -> np.ndarray:
         """``out`` (..., M) with its planned points read from ``corner_values`` (..., R·2^d), the
         values at :attr:`corners` (unreached corners left out too); a point with no corner left
-        keeps its value."""
+        keeps its value, and one whose own side is mostly unreached (less than half its corners'
+        weight reached) reads inf: its side of the gap is a part no source reaches, the few
+        reached corners lie across it (a point cloud's closest points near a gap)."""
         vals = corner_values.reshape(corner_values.shape[:-1] + self.weights.shape)
         finite = np.isfinite(vals)
         w = np.where(finite, self.weights, 0.0)
         total = w.sum(axis=-1)
+        own = self.weights.sum(axis=-1)
         summed = (w * np.where(finite, vals, 0.0)).sum(axis=-1)
         res = out.copy()
         sub = res[..., self.rows]
-        ok = total > 0
-        sub[ok] = summed[ok] / total[ok]
+        ok = total >= 0.5 * own
+        sub[ok & (total > 0)] = summed[ok & (total > 0)] / total[ok & (total > 0)]
+        sub[~ok] = np.inf
         res[..., self.rows] = sub
         return res
 

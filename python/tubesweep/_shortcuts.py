@@ -13,7 +13,11 @@ surface. Two kinds of edges break that:
   across the valley.
 
 On a triangle mesh both are removed, so that the front travels only where closest points move
-continuously along the surface. On Spot and the Stanford bunny at n = 200 the first-order mean
+continuously along the surface. On a point cloud only the first: its closest points come from
+local fits, which fold where the samples are sparse or off the surface, and cutting there left
+parts of a connected cloud unreached (a hemisphere sampled 50 times more sparsely than the
+other: 387 edges cut, 5 of 2000 points at inf); across narrow gaps the cut keeps a thin shell's
+two sheets apart (``benches/experiments/cloud_gaps.py``). On Spot and the Stanford bunny at n = 200 the first-order mean
 error against exact polyhedral geodesics falls from 0.83 % and 0.87 % of the largest distance to
 0.29 % and 0.41 % (the heat method: 0.59 % and 0.44 %; ``benches/mesh_order2.py``). Other surfaces
 keep the paper's scheme bit for bit (their narrow gaps are warned about instead).
@@ -31,9 +35,15 @@ MEDIAL_JUMP = 1.5
 
 
 def cuts_shortcuts(surf: Any) -> bool:
-    """Whether the band of ``surf`` is cut across narrow gaps and medial edges (triangle meshes,
-    whose closest-point map is that of a polyhedron: see the module's documentation)."""
+    """Whether the band of ``surf`` is cut across narrow gaps (triangle meshes and point clouds:
+    see the module's documentation)."""
     return bool(getattr(surf, "cuts_shortcuts", False))
+
+
+def cuts_medial_edges(surf: Any) -> bool:
+    """Whether the band of ``surf`` is cut at its medial edges too (triangle meshes, whose
+    closest-point map is that of a polyhedron)."""
+    return cuts_shortcuts(surf) and bool(getattr(surf, "cuts_medial_edges", True))
 
 
 def cut_shortcuts(
@@ -43,17 +53,21 @@ def cut_shortcuts(
     direction: np.ndarray,
     spacing: float,
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
+    medial: bool = True,
 ) -> Tuple[Any, int]:
-    """The band without the edges across narrow gaps (``facing``'s pairs) and the medial edges
-    (closest points more than :data:`MEDIAL_JUMP` spacings apart where one node is in the inner
-    tube, more than a resolved sheet's jump at their |φ| between two extension nodes: two parts of
-    a mesh 4–8 spacings apart), and the number of edges removed. The band itself when there is
-    none."""
-    phi32 = np.ascontiguousarray(phi, dtype=np.float32)
-    dir32 = np.ascontiguousarray(direction, dtype=np.float32).reshape(len(phi32), -1)
-    node, neighbour = band.medial_edges(inner, phi32, dir32, spacing, MEDIAL_JUMP)
-    node = np.concatenate([facing[0].astype(np.int64), node])
-    neighbour = np.concatenate([facing[1].astype(np.int64), neighbour])
+    """The band without the edges across narrow gaps (``facing``'s pairs) and, with ``medial``,
+    the medial edges (closest points more than :data:`MEDIAL_JUMP` spacings apart where one node
+    is in the inner tube, more than a resolved sheet's jump at their |φ| between two extension
+    nodes: two parts of a mesh 4–8 spacings apart), and the number of edges removed. The band
+    itself when there is none."""
+    node = facing[0].astype(np.int64)
+    neighbour = facing[1].astype(np.int64)
+    if medial:
+        phi32 = np.ascontiguousarray(phi, dtype=np.float32)
+        dir32 = np.ascontiguousarray(direction, dtype=np.float32).reshape(len(phi32), -1)
+        medial_node, medial_neighbour = band.medial_edges(inner, phi32, dir32, spacing, MEDIAL_JUMP)
+        node = np.concatenate([node, medial_node])
+        neighbour = np.concatenate([neighbour, medial_neighbour])
     if node.size == 0:
         return band, 0
     return band.with_edges_cut(node, neighbour)

@@ -23,6 +23,7 @@ from . import _native
 from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
 from ._prepare import thinned_count
+from ._sheet_readout import own_side_plan
 from .mask import mask_advice
 from ._stagnation import FALLBACK_WARNING, fallback_message
 from ._validate import FRONT_WINDOW, as_sources
@@ -72,8 +73,15 @@ def solve_many_order2(
     offsets = np.concatenate([[0], np.cumsum([len(s) for s in srcs])]).astype(np.int64)
     feet, src_slowness = so.source_feet(surf, grid, every, t.inner * h, speed, names)
     at_feet = None
+    plan = None
     if points is not None:
         points = np.ascontiguousarray(points, dtype=float)
+        if t.cut_edges and t.facing[0].size:
+            # on a band cut across narrow gaps, points next to a gap read from their own side (as
+            # sol(points)): their cells' corners are read as extra points
+            plan = own_side_plan(grid, surf, t.band, t.facing, len(t.linear), points)
+            if plan is not None:
+                points = np.ascontiguousarray(np.concatenate([points, plan.corners]))
         at_feet = points
         if inputs.exact_feet:
             # the points' closest points (used within the reach of a source only, as sol(points));
@@ -120,6 +128,9 @@ def solve_many_order2(
             raise so.Order2NotApplicable(mask_advice(t.surface, str(e))) from None
         raise
     st = dict(st)
+    if plan is not None:
+        m = len(points) - len(plan.corners)  # type: ignore[arg-type]
+        values = plan.apply(np.ascontiguousarray(values[:, :m]), values[:, m:])
     failed = np.flatnonzero(st["restart_failed"])
     if failed.size:
         # values falling without bound for these sources: no factored solution (second_order.Order2RanAway)

@@ -267,15 +267,21 @@ class Solution:
         >>> v = sol([(0.0, 0.5, 0.0)], interpolation="cubic")
         """
         p = as_points(points, self.grid.ndim, "points")
+        out = self._read(p, interpolation)
+        if self.stats.cut_edges and self._facing[0].size:
+            # a band cut across narrow gaps: each point read from its own side of the gap (at
+            # second order its cell's corners read as any point: the factored form near a source)
+            plan = own_side_plan(self.grid, self.surface, self._band, self._facing, len(self.values), p)
+            if plan is not None:
+                out = plan.apply(out, self._read(plan.corners, "linear"))
+        return out
+
+    def _read(self, p: np.ndarray, interpolation: str) -> np.ndarray:
+        """The values interpolated at ``p``, in the factored form near a second-order solution's
+        point sources (:func:`~tubesweep._factoring.factored_values`)."""
         out = interpolate_band(self._band, self.values, self.grid, p, interpolation)
         if self._factoring is not None:
             out = factored_values(self, p, out, interpolation)
-        elif self.stats.cut_edges and self._facing[0].size:
-            # a band cut across narrow gaps: each point read from its own side of the gap
-            plan = own_side_plan(self.grid, self.surface, self._band, self._facing, len(self.values), p)
-            if plan is not None:
-                corner_values = interpolate_band(self._band, self.values, self.grid, plan.corners, "linear")
-                out = plan.apply(out, corner_values)
         return out
 
     def on_mesh(self, vertices: Any) -> np.ndarray:

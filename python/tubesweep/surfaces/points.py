@@ -260,6 +260,54 @@ class PointCloudSurface(ClosestPoint):
     (False, 0)
     """
 
+    #: The band is cut across the narrow gaps that the fits resolve (``tubesweep._shortcuts``,
+    #: :meth:`resolved_gap`): two sheets a few spacings apart (a thin shell, the two sides of a thin
+    #: part) are kept apart. Not at medial edges, as a mesh's is, nor across narrower gaps: the
+    #: fits fold where the samples are sparse, and cuts there strand parts of the cloud or bend
+    #: its distances (``benches/experiments/cloud_gaps.py``).
+    cuts_shortcuts = True
+    cuts_medial_edges = False
+    #: A gap this many grid spacings wide is resolved where the samples are dense (the fits'
+    #: radius FIT_RADIUS·Δx): the grid spacing the narrow-gap warning advises is the gap over it.
+    resolving_spacings = 1.5 * FIT_RADIUS
+
+    def resolved_gap(self, h: float) -> float:
+        """The narrowest gap between two parts of the cloud that a solve on a grid of spacing
+        ``h`` keeps apart (the band is cut across it; narrower gaps are warned about).
+
+        It is 1.5 times the fits' support radius, the larger of ``FIT_RADIUS``·Δx and the fits'
+        median radius: across a narrower gap a fit centred on one side reaches the other's
+        samples. Two sphere clouds 4 and 5 spacings apart at N = 61 (support 3 spacings): cut at
+        5, the outer sphere's mean error 0.12 → 6.5e-4 of a largest distance of 1.57; at 4,
+        0.07, not cut (``benches/experiments/cloud_gaps.py``).
+
+        Parameters
+        ----------
+        h : float
+            The grid spacing.
+
+        Returns
+        -------
+        float
+            The gap, in the cloud's units.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> x = np.random.default_rng(0).normal(size=(5000, 3))
+        >>> cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+        >>> round(cloud.resolved_gap(0.05), 3)  # 4.5 spacings
+        0.225
+        """
+        return 1.5 * max(FIT_RADIUS * h, self._median_fit)
+
+    def _unresolved_gap_note(self, h: float) -> str:
+        """Ends the warning of the gaps narrower than :meth:`resolved_gap` (``_prepare``)."""
+        return (
+            f"; the cloud's fits (radius {self.resolved_gap(h) / 1.5:.3g}) blend the two sides of a gap narrower than "
+            f"{self.resolved_gap(h):.3g}, so the band is not cut there (it is across wider gaps)"
+        )
+
     def _uneven(self) -> Optional[float]:
         """How many times the median fit the widest one spans, when above :data:`UNEVEN_FITS`
         (parts may be sampled too sparsely), else None."""
