@@ -461,3 +461,8 @@ def test_a_solve_that_stops_at_max_iterations_writes_its_files_and_exits_3(tmp_p
     # converged: 0, and no error line
     assert main(["travel-time", "--n", "41", "--dim", "2", "--out", str(tmp_path), "--quiet"]) == 0
     assert "error" not in capsys.readouterr().err
+    # reported not converged before the limit (values the solve could not settle): the warning
+    # says why, not --max-iterations
+    from tubesweep.cli import _unconverged
+
+    assert _unconverged(24, 10000) == ("the solve ended", "see the warning above for why")

@@ -54,14 +54,18 @@ def sol_tube(surface):
 def test_a_batch_drops_the_other_parts_as_the_single_solves_do(order):
     tube = quiet(ts.Tube, ts.LevelSet(two_spheres(), redistance=True), GRID)
     sources = [(-C, 0, R), (C, 0, -R)]
-    at = np.array([(C, 0, R), (C + R, 0, 0), (-C, 0, -R), (-C - R, 0, 0)])
+    # on both spheres, and across the gap between them (cells with corners on both parts)
+    gap = np.stack([np.arange(-0.15, 0.151, 0.025), 0 * np.arange(13), 0 * np.arange(13)], 1)
+    at = np.concatenate([[(C, 0, R), (C + R, 0, 0), (-C, 0, -R), (-C - R, 0, 0)], gap])
     rows = quiet(tube.solve_many, sources, at=at, order=order)
     full = quiet(tube.solve_many, sources, order=order)
     for k, source in enumerate(sources):
         single = quiet(tube.solve, [source], order=order)
         assert np.array_equal(rows[k], single(at)) and np.array_equal(full[k], single.values)
-    assert np.all(np.isinf(rows[0, :2])) and np.all(np.isfinite(rows[0, 2:]))
-    assert np.all(np.isinf(rows[1, 2:])) and np.all(np.isfinite(rows[1, :2]))
+    assert np.all(np.isinf(rows[0, :2])) and np.all(np.isfinite(rows[0, 2:4]))
+    assert np.all(np.isinf(rows[1, 2:4])) and np.all(np.isfinite(rows[1, :2]))
+    assert np.isfinite(rows[0, 4]) and np.isinf(rows[0, -1])  # the gap's ends, on each side
+    at = at[:4]
     d = quiet(ts.distance_matrix, tube, None, at, order=order)
     assert np.all(np.isinf(d[:2, 2:])) and np.all(np.isfinite(d[:2, :2])) and np.all(np.isfinite(d[2:, 2:]))
 

@@ -1,7 +1,7 @@
 """Two sheets of a point cloud a few grid spacings apart: two concentric spheres sampled (radii 0.5
 and 0.5 − gap, 40,000 samples on the outer one, as many per area on the inner one), the source on
 the outer one, at N = 61 in [-1, 1]³ (h = 1/30). The band is cut across the narrow gaps that the
-fits resolve (``PointCloudSurface.resolved_gap``: 1.5 times their radius, 4.5 spacings here;
+fits resolve (``PointCloudSurface.resolved_gap``: 5/3 of their radius, 5 spacings here;
 ``tubesweep._shortcuts``); before, the front crossed to the inner sphere and back, and the outer
 sphere's distances came out short. Prints per gap, with the cut and without it (the class
 attribute ``cuts_shortcuts`` switched off): the order run, the edges cut, the outer sphere's mean
@@ -38,7 +38,7 @@ def main() -> None:
     h = 2.0 / (args.n - 1)
     grid = ts.Grid((-1.0,) * 3, (1.0,) * 3, (args.n,) * 3)
     source = np.array([0.0, 0.0, -0.5])
-    print(f"N = {args.n}, h = {h:.4g}: gaps from {1.5 * 3.0:g} spacings are cut (1.5 times the fits' radius 3h)")
+    print(f"N = {args.n}, h = {h:.4g}: gaps from 5 spacings are cut (5/3 of the fits' radius 3h)")
     print(
         "| gap (Δx) | cut | order | edges cut | outer mean / largest error | outer unreached | inner reached | warned |"
     )

@@ -1,6 +1,7 @@
-"""The command line's exit status for a solve that stopped at its iteration limit before it
-converged (``tubesweep solve``, ``travel-time``, ``distances``): its files are written, but a
-script must not take them for the answer, so the command says so on stderr and exits non-zero."""
+"""The command line's exit status for a solve reported not converged (``tubesweep solve``,
+``travel-time``, ``distances``): stopped at its iteration limit, or with values it could not
+settle (a warning says which). Its files are written, but a script must not take them for the
+answer, so the command says so on stderr and exits non-zero."""
 
 from __future__ import annotations
 

@@ -38,27 +38,30 @@ from ._shortcuts import cuts_medial_edges
 NO_PART = np.iinfo(np.uint32).max
 
 
-def part_labels(tube: Any) -> Optional[np.ndarray]:
+def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
     """Per band node of ``tube`` (a ``_prepare._PreparedTube``) its part of the surface (uint32:
-    the smallest band position of its inner-tube component; :data:`NO_PART` where none is
-    found), or None when no two parts face each other across a gap (nothing can cross) or the
-    band is cut at medial edges too (``_shortcuts``: a mesh, whose inner tube the cuts above
-    concave edges could split, so its parts are left to the cuts; a point cloud's band is cut
-    only between facing sheets, which leaves each sheet's inner tube whole)."""
+    the smallest band position of its inner-tube component on ``band``, the band the sweeps run
+    on, default the tube's; :data:`NO_PART` where none is found), or None when no two parts face
+    each other across a gap (nothing can cross) or ``band`` is cut at medial edges (``_shortcuts``:
+    a mesh, whose inner tube the cuts above concave edges could split, so its parts are left to
+    the cuts; a point cloud's band is cut only between facing sheets, which leaves each sheet's
+    inner tube whole, and the Lax–Friedrichs scheme runs on the uncut band)."""
     from ._prepare import ROLE_OUTER
 
-    if tube.facing[0].size == 0 or (tube.cut_edges and cuts_medial_edges(tube.surface)):
+    band = tube.band if band is None else band
+    cut = band is tube.band and tube.cut_edges > 0
+    if tube.facing[0].size == 0 or (cut and cuts_medial_edges(tube.surface)):
         return None  # no front crosses between parts; a mesh's band is cut between them already
     inner = tube.roles != ROLE_OUTER
     if len(tube.crease_nodes):
         inner = inner.copy()
         inner[tube.crease_nodes] = True  # the paper's inner tube (see the module)
-    labels = _native.band_component_labels(tube.band, np.ascontiguousarray(inner))
+    labels = _native.band_component_labels(band, np.ascontiguousarray(inner))
     ext = np.flatnonzero(~inner)
     if ext.size == 0:
         return labels
     n = len(labels)
-    nb = tube.band.neighbours_of_nodes(np.ascontiguousarray(ext, dtype=np.int64)).reshape(ext.size, -1)
+    nb = band.neighbours_of_nodes(np.ascontiguousarray(ext, dtype=np.int64)).reshape(ext.size, -1)
     nb = np.where(nb < n, nb, n)
     depth = np.append(np.abs(np.asarray(tube.phi, dtype=float)), np.inf)
     toward = nb[np.arange(ext.size), np.argmin(depth[nb], axis=1)]
@@ -75,17 +78,25 @@ def part_labels(tube: Any) -> Optional[np.ndarray]:
     return np.append(labels, np.uint32(NO_PART))[step[:n]]
 
 
-def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray) -> np.ndarray:
+def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray, weighted: bool = False) -> np.ndarray:
     """The parts of the band nodes at the corners of each point's cell, ``(M, 2^d)`` (NO_PART
-    where a corner is not in the band)."""
+    where a corner is not in the band; with ``weighted``, also where its multilinear weight is 0,
+    computed as the core's interpolation computes it, ``tubesweep_core::solution::interpolate``)."""
     d = grid.ndim
     shape = np.asarray(grid.shape)
-    base = np.clip(np.floor(grid.continuous_index(points)).astype(np.int64), 0, shape - 2)
+    p = np.asarray(points, dtype=float).reshape(-1, d)
+    t = (p - np.asarray(grid.lower, dtype=float)) / grid.spacing
+    base = np.clip(np.floor(t).astype(np.int64), 0, shape - 2)
+    frac = np.clip(t - base, 0.0, 1.0)
     offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
     corners = (base[:, None, :] + offsets[None, :, :]).reshape(-1, d)
-    pos = band.find(np.ascontiguousarray(corners)).reshape(len(points), 1 << d)
+    pos = band.find(np.ascontiguousarray(corners)).reshape(len(p), 1 << d)
     lab = np.append(labels, np.uint32(NO_PART))
-    return lab[np.where(pos >= 0, pos, len(labels))]
+    out = lab[np.where(pos >= 0, pos, len(labels))]
+    if weighted:
+        weight = np.prod(np.where(offsets[None, :, :] == 1, frac[:, None, :], 1.0 - frac[:, None, :]), axis=2)
+        out[weight == 0.0] = NO_PART
+    return out
 
 
 def source_parts(grid: Grid, band: Any, labels: np.ndarray, sources: np.ndarray) -> Optional[np.ndarray]:
@@ -109,12 +120,13 @@ def drop_unsourced(values: np.ndarray, labels: np.ndarray, sourced: Optional[np.
 
 
 def drop_unsourced_points(values: np.ndarray, corner_parts: np.ndarray, sourced: Optional[np.ndarray]) -> np.ndarray:
-    """``values`` at points (M,) with inf where no corner of a point's cell lies on a part of
-    ``sourced`` but some corner lies on a part (the batch's reading of :func:`drop_unsourced`)."""
+    """``values`` read at points (M,) as a solve whose band values :func:`drop_unsourced` set
+    reads them: inf where a corner of nonzero weight (``corner_parts`` from :func:`parts_at` with
+    ``weighted``) lies on a part other than ``sourced`` (NaN, a corner off the band, stays)."""
     if sourced is None:
         return values
-    labelled = corner_parts != NO_PART
-    off = np.any(labelled, axis=1) & ~np.any(labelled & np.isin(corner_parts, sourced), axis=1)
+    off = np.any((corner_parts != NO_PART) & ~np.isin(corner_parts, sourced), axis=1)
+    off &= ~np.isnan(values)
     if not np.any(off & np.isfinite(values)):
         return values
     out = values.copy()
@@ -122,14 +134,17 @@ def drop_unsourced_points(values: np.ndarray, corner_parts: np.ndarray, sourced:
     return out
 
 
-def drop_unsourced_rows(rows: np.ndarray, tube: Any, groups: Any, points: Optional[np.ndarray]) -> np.ndarray:
-    """The rows of ``Tube.solve_many`` (one per source group: band values, or values at ``points``)
-    with inf on the parts of the surface other than their sources' (as each single solve's)."""
-    parts = part_labels(tube)
+def drop_unsourced_rows(
+    rows: np.ndarray, tube: Any, groups: Any, points: Optional[np.ndarray], band: Any = None
+) -> np.ndarray:
+    """The rows of ``Tube.solve_many`` (one per source group: band values, or the values read at
+    ``points``, before any own-side reading of them) with inf on the parts of the surface other
+    than their sources', as each single solve's; ``band`` the band the sweeps ran on."""
+    parts = part_labels(tube, band)
     if parts is None:
         return rows
-    grid, band = tube.grid, tube.band
-    corners = None if points is None else parts_at(grid, band, parts, points)
+    grid, band = tube.grid, tube.band if band is None else band
+    corners = None if points is None else parts_at(grid, band, parts, points, weighted=True)
     out = np.array(rows, dtype=float, copy=True)
     for k, group in enumerate(groups):
         sourced = source_parts(grid, band, parts, group)

@@ -533,7 +533,15 @@ def cmd_solve(args: argparse.Namespace) -> int:
         )
         fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
         print(f"wrote {out / 'solution.png'}")
-    return exit_status(s.converged, f"the solve stopped at --max-iterations {args.max_iterations}")
+    return exit_status(s.converged, *_unconverged(s.iterations, args.max_iterations))
+
+
+def _unconverged(iterations: int, max_iterations: int) -> tuple:
+    """What stopped a solve reported not converged, and its cure, for :func:`exit_status`: the
+    iteration limit, or values the solve could not settle (the warning above says which)."""
+    if iterations >= max_iterations:
+        return f"the solve stopped at --max-iterations {max_iterations}", "pass a larger --max-iterations or --tol"
+    return "the solve ended", "see the warning above for why"
 
 
 def _write_npz(path: Path, sol: Any) -> None:
@@ -616,7 +624,7 @@ def cmd_travel_time(args: argparse.Namespace) -> int:
             args.out / "travel_time.png", dpi=110, bbox_inches="tight"
         )
         print(f"wrote {args.out / 'travel_time.png'}")
-    return exit_status(s.converged, f"the solve stopped at --max-iterations {args.max_iterations}")
+    return exit_status(s.converged, *_unconverged(s.iterations, args.max_iterations))
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:

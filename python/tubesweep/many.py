@@ -212,7 +212,6 @@ def solve_many(
             except so.Order2NotApplicable as e:
                 tube._order2_refusal = str(e)  # depends on the band only: not computed again
                 raise
-            out = drop_unsourced_rows(out, tube._tube_order2, groups, points)  # (``_parts``)
             if return_stats:
                 st.update(order=2, order_fallback=None, seconds_total=time.perf_counter() - t0)
                 return out, st
@@ -278,10 +277,11 @@ def solve_many(
         fallback.warn(out, t)
     if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut
         warn_paper_tube_creases(t.paper_creases, t.inner, h)
+    # a part without a source keeps inf (``_parts``), read as the single solve reads it
+    out = drop_unsourced_rows(out, t, groups, None if points is None else read_at, band)
     if plan is not None:
         m = len(points)  # type: ignore[arg-type]
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])
-    out = drop_unsourced_rows(out, t, groups, points)  # a part without a source keeps inf (``_parts``)
     bad = np.flatnonzero(~st["converged"])
     if bad.size:
         warnings.warn(

@@ -22,6 +22,7 @@ import numpy as np
 from . import _native
 from ._creases import warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
+from ._parts import drop_unsourced_rows
 from ._prepare import thinned_count
 from ._sheet_readout import own_side_plan
 from .mask import mask_advice
@@ -128,6 +129,8 @@ def solve_many_order2(
             raise so.Order2NotApplicable(mask_advice(t.surface, str(e))) from None
         raise
     st = dict(st)
+    # a part without a source keeps inf (``_parts``), read as the single solve reads it
+    values = drop_unsourced_rows(values, t, groups, points)
     if plan is not None:
         m = len(points) - len(plan.corners)  # type: ignore[arg-type]
         values = plan.apply(np.ascontiguousarray(values[:, :m]), values[:, m:])

@@ -154,9 +154,9 @@ def carried_values(
                 f"sequence of {len(warm)}"
             )
         older, warm = warm
-        check_previous(warm, grid)
-        check_previous(older, grid, "older")
     check_previous(warm, grid)
+    if older is not None:
+        check_previous(older, grid, "older")
     if older is not None and len(older._factoring[1]) != len(warm._factoring[1]):
         raise WarmStartRefused(
             f"warm: the older solution has {len(older._factoring[1])} source(s), the previous one "

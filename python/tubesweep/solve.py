@@ -396,8 +396,8 @@ def _solve_on_tube(
         warn_facing_pairs(grid, tube.linear, tube.roles, tube.facing, tube.inner)
     # the parts of the surface (before the sweeps consume the tube): a part without a source
     # keeps inf whatever reached it across a narrow gap (``_parts``)
-    parts = part_labels(tube)
-    sourced = None if parts is None else source_parts(grid, tube.band, parts, src)
+    parts = part_labels(tube, band)
+    sourced = None if parts is None else source_parts(grid, band, parts, src)
     h = grid.spacing
     inner_width = tube.inner * h
     roles = tube.roles.copy() if reuse else tube.roles

@@ -68,6 +68,10 @@ CREASE_SHARE = 0.005
 UNEVEN_FITS = 4.0
 #: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
 CHUNK = 1 << 20
+#: A gap between two parts of a cloud wider than this many fit radii is kept apart (the band cut
+#: across it): two sphere clouds 5 spacings apart at N = 61 (fits of 3 spacings) are, 4.6 and 4.8
+#: apart still crossed (``benches/experiments/cloud_gaps.py``)
+RESOLVED_GAP = 5.0 / 3.0
 #: The file extensions :func:`read_points` reads.
 POINT_FILES = (".xyz", ".txt", ".csv", ".pts", ".npy", ".ply")
 
@@ -269,17 +273,17 @@ class PointCloudSurface(ClosestPoint):
     cuts_medial_edges = False
     #: A gap this many grid spacings wide is resolved where the samples are dense (the fits'
     #: radius FIT_RADIUS·Δx): the grid spacing the narrow-gap warning advises is the gap over it.
-    resolving_spacings = 1.5 * FIT_RADIUS
+    resolving_spacings = RESOLVED_GAP * FIT_RADIUS
 
     def resolved_gap(self, h: float) -> float:
         """The narrowest gap between two parts of the cloud that a solve on a grid of spacing
         ``h`` keeps apart (the band is cut across it; narrower gaps are warned about).
 
-        It is 1.5 times the fits' support radius, the larger of ``FIT_RADIUS``·Δx and the fits'
-        median radius: across a narrower gap a fit centred on one side reaches the other's
-        samples. Two sphere clouds 4 and 5 spacings apart at N = 61 (support 3 spacings): cut at
-        5, the outer sphere's mean error 0.12 → 6.5e-4 of a largest distance of 1.57; at 4,
-        0.07, not cut (``benches/experiments/cloud_gaps.py``).
+        It is :data:`RESOLVED_GAP` (5/3) times the fits' support radius, the larger of
+        ``FIT_RADIUS``·Δx and the fits' median radius: across a narrower gap a fit centred on one
+        side reaches the other's samples. Two sphere clouds 6 spacings apart at N = 61 (support 3
+        spacings): cut, the outer sphere's mean error 0.13 → 4.9e-4 of a largest distance of
+        1.57; 4 apart, 0.07, not cut and warned (``benches/experiments/cloud_gaps.py``).
 
         Parameters
         ----------
@@ -296,15 +300,15 @@ class PointCloudSurface(ClosestPoint):
         >>> import numpy as np, tubesweep as ts
         >>> x = np.random.default_rng(0).normal(size=(5000, 3))
         >>> cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
-        >>> round(cloud.resolved_gap(0.05), 3)  # 4.5 spacings
-        0.225
+        >>> round(cloud.resolved_gap(0.05), 3)  # 5 spacings
+        0.25
         """
-        return 1.5 * max(FIT_RADIUS * h, self._median_fit)
+        return RESOLVED_GAP * max(FIT_RADIUS * h, self._median_fit)
 
     def _unresolved_gap_note(self, h: float) -> str:
         """Ends the warning of the gaps narrower than :meth:`resolved_gap` (``_prepare``)."""
         return (
-            f"; the cloud's fits (radius {self.resolved_gap(h) / 1.5:.3g}) blend the two sides of a gap narrower than "
+            f"; the cloud's fits (radius {self.resolved_gap(h) / RESOLVED_GAP:.3g}) blend the two sides of a gap narrower than "
             f"{self.resolved_gap(h):.3g}, so the band is not cut there (it is across wider gaps)"
         )
 
