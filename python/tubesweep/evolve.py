@@ -222,7 +222,15 @@ def _write_checkpoint(path: Path, **arrays: Any) -> None:
 
 
 def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) -> np.ndarray:
-    raw = speed(u.copy())  # a copy: a law that writes to u leaves the solution alone
+    try:
+        raw = speed(u.copy())  # a copy: a law that writes to u leaves the solution alone
+    except TypeError as e:
+        if "positional argument" not in str(e):
+            raise
+        raise TypeError(
+            f"evolve: speed is called as speed(u), with the band's values alone ({e}); a law that depends on time "
+            "or on the step can read a variable of yours or count its calls (one per step, in order)"
+        ) from e
     if raw is None:
         raise TypeError(
             "evolve: speed(u) returned None; it must return the normal speed V: an array like u, or a number"
