@@ -115,7 +115,8 @@ def test_two_spheres_as_min_of_distances_five_spacings_apart_warn(as_array):
         # the paper's scheme (order=2 runs node by node here, and its front does not cross)
         sol = ts.solve(surface, grid, [c1 - r * axis], order=1)
     assert np.isinf(sol(np.array([c2 + r * axis]))[0])  # the spheres do not touch
-    assert np.isinf(sol.values).sum() > 0.4 * sol.stats.band_points
+    inner = sol.roles != 2  # the inner tube (role 2: the extension layer, which keeps its values)
+    assert np.isinf(sol.values[inner]).sum() > 0.4 * inner.sum()
     assert len(facing_warnings(caught)) == 1 and sol.stats.facing_pairs > 0
     assert 3 * h < sol.stats.narrowest_gap < 7 * h
 

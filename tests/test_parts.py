@@ -41,7 +41,7 @@ def test_a_sphere_without_a_source_six_spacings_away_stays_unreached(order):
     near = np.array([(-C, 0, -R), (-C - R, 0, 0), (-C, R, 0)])
     exact = R * np.array([np.pi, np.pi / 2, np.pi / 2])
     assert np.max(np.abs(sol(near) - exact)) < (0.2 if order == 1 else 0.02)
-    # the parts: one per sphere's inner tube, the extension layer with its sphere
+    # the parts: one per sphere's inner tube (the extension layer belongs to none)
     labels = part_labels(sol_tube(surface))
     assert labels is not None and len(np.unique(labels[labels != NO_PART])) == 2
 
@@ -96,3 +96,35 @@ def test_the_faces_of_a_cube_next_to_a_sphere_stay_one_part():
     faces = np.array([(-0.4, 0, -0.3), (-0.7, 0, 0), (-0.1, 0, 0), (-0.4, 0.3, 0), (-0.4, -0.3, 0)])
     assert np.all(np.isfinite(sol(faces)))
     assert np.all(np.isinf(sol(np.array([(0.75, 0, 0), (0.45, 0, 0.3)]))))
+
+
+def test_a_thin_inner_tube_or_a_corner_across_a_narrow_gap_drops_nothing_reachable():
+    # (a review) φ = 2·distance with inner=1: an inner tube half a spacing thick broke the source's
+    # sphere into nine parts, eight set to inf; now a tube that thin is not labelled
+    g = ts.Grid((-1,) * 3, (1,) * 3, (60,) * 3)
+    h, r = g.spacing, 0.45
+    top = np.array([0, 0, r + 3 * h + 0.2])
+
+    def phi(x):
+        return 2.0 * np.minimum(np.linalg.norm(x, axis=-1) - r, np.linalg.norm(x - top, axis=-1) - 0.2)
+
+    sol = quiet(ts.solve, phi, g, [(r, 0, 0)], inner=1, outer=3)
+    assert sol.stats.facing_pairs > 0
+    d = np.random.default_rng(0).normal(size=(2000, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    assert np.all(np.isfinite(sol(r * d)))
+    # two concentric spheres 3.2 spacings apart, inner=1: a point on the source's sphere had a
+    # corner of weight 6e-6 in the other sphere's extension layer, set to inf; only inner-tube
+    # nodes are dropped now, and the other sphere still reads inf
+    g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    outer_r = 0.8
+    inner_r = outer_r - 3.2 * g.spacing
+    shell = ts.LevelSet(
+        lambda x: np.maximum(inner_r - np.linalg.norm(x, axis=-1), np.linalg.norm(x, axis=-1) - outer_r),
+        redistance=True,
+    )
+    point = np.array([-0.26594992, 0.49978387, -0.56523156])
+    point *= outer_r / np.linalg.norm(point)
+    sol = quiet(ts.solve, shell, g, [(outer_r, 0, 0)], inner=1, outer=3, order=1)
+    assert sol.stats.facing_pairs > 0
+    assert np.isfinite(sol([point])[0]) and np.isinf(sol([inner_r * point / outer_r])[0])

@@ -15,9 +15,12 @@ joined along the axes. An inner-tube component (a *part*) that holds no source i
 that no path on the surface reaches, and its nodes keep ``inf`` whatever reached them across a
 gap. The inner tube here is the paper's: the nodes that second order moves to the extension
 layer at creases (``_creases``) count as inner (a cube's thinned inner tube stays connected
-around its edges at N = 41 and 81, but a sharper crease could split it). An
-extension node belongs to the part of its neighbour nearest the surface (its closest point's
-side), followed down to an inner node.
+around its edges at N = 41 and 81, but a sharper crease could split it). Only inner-tube nodes are
+set to inf: a point on the surface reads at least one of them (the nearest corner of its cell lies
+within √3/2 spacings), while an extension node can lie as close to the other part as to its own
+(with ``inner=1`` a point on the sourced part read inf through such a corner of weight 6e-6). And
+only where the inner tube is thick enough to be connected (:func:`_thick_enough`: a φ far from a
+distance makes it thinner).
 
 Only tubes with facing pairs are labelled (elsewhere no front crosses between parts): O(band)
 union–find in the core (``second_order::warm::component_labels``) and a few passes over the
@@ -34,15 +37,16 @@ from . import _native
 from .grid import Grid
 from ._shortcuts import cuts_medial_edges
 
-#: The label of a node of no part (an extension node whose neighbours lead to no inner node).
+#: The label of a node of no part (an extension node).
 NO_PART = np.iinfo(np.uint32).max
 
 
 def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
     """Per band node of ``tube`` (a ``_prepare._PreparedTube``) its part of the surface (uint32:
     the smallest band position of its inner-tube component on ``band``, the band the sweeps run
-    on, default the tube's; :data:`NO_PART` where none is found), or None when no two parts face
-    each other across a gap (nothing can cross) or ``band`` is cut at medial edges (``_shortcuts``:
+    on, default the tube's; :data:`NO_PART` for extension nodes), or None when no two parts face
+    each other across a gap (nothing can cross), the inner tube is too thin to be connected
+    (:func:`_thick_enough`), or ``band`` is cut at medial edges (``_shortcuts``:
     a mesh, whose inner tube the cuts above concave edges could split, so its parts are left to
     the cuts; a point cloud's band is cut only between facing sheets, which leaves each sheet's
     inner tube whole, and the Lax–Friedrichs scheme runs on the uncut band)."""
@@ -56,26 +60,40 @@ def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
     if len(tube.crease_nodes):
         inner = inner.copy()
         inner[tube.crease_nodes] = True  # the paper's inner tube (see the module)
-    labels = _native.band_component_labels(band, np.ascontiguousarray(inner))
-    ext = np.flatnonzero(~inner)
-    if ext.size == 0:
-        return labels
-    n = len(labels)
-    nb = band.neighbours_of_nodes(np.ascontiguousarray(ext, dtype=np.int64)).reshape(ext.size, -1)
-    nb = np.where(nb < n, nb, n)
-    depth = np.append(np.abs(np.asarray(tube.phi, dtype=float)), np.inf)
-    toward = nb[np.arange(ext.size), np.argmin(depth[nb], axis=1)]
-    # each node's step toward the surface: itself for inner nodes, none (n) where no neighbour is
-    # nearer the surface; then pointer jumping down to the inner tube (|φ| falls along each chain)
-    step = np.arange(n + 1)
-    step[ext] = np.where(depth[toward] < depth[ext], toward, n)
-    for _ in range(64):
-        nxt = step[step]
-        if np.array_equal(nxt, step):
-            break
-        step = nxt
-    # (an extension node's own label is NO_PART: a chain that ends on none stays without a part)
-    return np.append(labels, np.uint32(NO_PART))[step[:n]]
+    if not _thick_enough(tube, band, inner):
+        return None
+    # extension nodes keep NO_PART: only the inner tube is dropped, so that a point read next to a
+    # narrow gap keeps the values of its own side (with inner = 1 a point on the sourced part had
+    # a corner of weight 6e-6 on the other part's extension layer)
+    return _native.band_component_labels(band, np.ascontiguousarray(inner))
+
+
+#: The inner tube is labelled only where it is at least this many grid spacings thick on either
+#: side of the surface: the nodes within w of a plane are joined along the axes when 2w ≥ √3·Δx
+#: (the largest L1 norm of a unit normal).
+THICK_ENOUGH = 0.5 * np.sqrt(3.0)
+
+
+def _thick_enough(tube: Any, band: Any, inner: np.ndarray) -> bool:
+    """Whether the inner tube of a connected surface is connected: its half-width in distance,
+    ``inner``·Δx over |∇φ| (central differences of the band's φ at its inner nodes, the 95th
+    percentile), is at least :data:`THICK_ENOUGH` spacings. φ = 2·d with ``inner=1`` is half a spacing thick and
+    broke a sphere's inner tube into nine parts, eight of them set to inf."""
+    h = tube.grid.spacing
+    # (not at the facing pairs: across the ridge between two sheets φ jumps, a sheet's sign to the
+    # other's; and a high percentile, not the largest, for the kinks elsewhere)
+    away = inner.copy()
+    away[tube.facing[0]] = False
+    away[tube.facing[1]] = False
+    nodes = np.flatnonzero(away)
+    nb = band.neighbours_of_nodes(np.ascontiguousarray(nodes, dtype=np.int64)).reshape(nodes.size, -1, 2)
+    n = len(inner)
+    phi = np.append(np.asarray(tube.phi, dtype=float), np.nan)
+    ends = np.where(nb < n, nb, n)
+    slope = (phi[ends[:, :, 1]] - phi[ends[:, :, 0]]) / (2.0 * h)
+    grad = np.sqrt(np.sum(slope**2, axis=1))
+    grad = grad[np.isfinite(grad)]
+    return grad.size == 0 or tube.inner / float(np.quantile(grad, 0.95)) >= THICK_ENOUGH
 
 
 def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray, weighted: bool = False) -> np.ndarray:
