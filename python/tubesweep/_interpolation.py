@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Optional, Tuple
 
 import numpy as np
 
@@ -29,6 +29,21 @@ def interpolate_band(band: Any, values: np.ndarray, grid: Grid, points: np.ndarr
         return band.interpolate(values, list(grid.lower), grid.spacing, points)
     out, _ = _native.band_interpolate_cubic(band, values, list(grid.lower), grid.spacing, points)
     return out
+
+
+def cell_corners(grid: Grid, band: Any, points: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The 2^d corners of each point's cell as the core's multilinear interpolation takes them
+    (``tubesweep_core::solution::interpolate``): their grid indices ``(M, 2^d, d)``, band
+    positions ``(M, 2^d)`` (−1 off the band) and weights ``(M, 2^d)``."""
+    d = grid.ndim
+    t = grid.continuous_index(np.asarray(points, dtype=float).reshape(-1, d))
+    base = np.clip(np.floor(t).astype(np.int64), 0, np.asarray(grid.shape) - 2)
+    frac = np.clip(t - base, 0.0, 1.0)
+    offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
+    corners = base[:, None, :] + offsets[None, :, :]
+    pos = band.find(np.ascontiguousarray(corners.reshape(-1, d))).reshape(len(t), 1 << d)
+    weight = np.prod(np.where(offsets[None, :, :] == 1, frac[:, None, :], 1.0 - frac[:, None, :]), axis=2)
+    return corners, pos, weight
 
 
 def catmull_rom_weights(f: np.ndarray) -> np.ndarray:

@@ -176,7 +176,6 @@ def second_order_solve(  # crates/tubesweep-py/src/second_order.rs: solve(..., o
 def carry_band_values(  # crates/tubesweep-py/src/moving.rs: previous values onto a new band (+inf where new)
     old_linear: npt.NDArray[np.uint64], old_values: npt.NDArray[np.float64], new_linear: npt.NDArray[np.uint64]
 ) -> npt.NDArray[np.float64]: ...
-def band_components(band: Band, select: npt.NDArray[np.bool_]) -> int: ...  # moving.rs: connected components
 def band_component_labels(
     band: Band, select: npt.NDArray[np.bool_]
 ) -> npt.NDArray[np.uint32]: ...  # moving.rs: each node's component

@@ -23,8 +23,8 @@ only where the inner tube is thick enough to be connected (:func:`_thick_enough`
 distance makes it thinner).
 
 Only tubes with facing pairs are labelled (elsewhere no front crosses between parts): O(band)
-union–find in the core (``second_order::warm::component_labels``) and a few passes over the
-extension layer.
+union–find in the core (``second_order::warm::component_labels``) and one pass over the inner
+tube's neighbours (:func:`_thick_enough`).
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import _native
+from ._interpolation import cell_corners
 from .grid import Grid
 from ._shortcuts import cuts_medial_edges
 
@@ -99,20 +100,10 @@ def _thick_enough(tube: Any, band: Any, inner: np.ndarray) -> bool:
 def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray, weighted: bool = False) -> np.ndarray:
     """The parts of the band nodes at the corners of each point's cell, ``(M, 2^d)`` (NO_PART
     where a corner is not in the band; with ``weighted``, also where its multilinear weight is 0,
-    computed as the core's interpolation computes it, ``tubesweep_core::solution::interpolate``)."""
-    d = grid.ndim
-    shape = np.asarray(grid.shape)
-    p = np.asarray(points, dtype=float).reshape(-1, d)
-    t = (p - np.asarray(grid.lower, dtype=float)) / grid.spacing
-    base = np.clip(np.floor(t).astype(np.int64), 0, shape - 2)
-    frac = np.clip(t - base, 0.0, 1.0)
-    offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
-    corners = (base[:, None, :] + offsets[None, :, :]).reshape(-1, d)
-    pos = band.find(np.ascontiguousarray(corners)).reshape(len(p), 1 << d)
-    lab = np.append(labels, np.uint32(NO_PART))
-    out = lab[np.where(pos >= 0, pos, len(labels))]
+    computed as the core's interpolation computes it: :func:`~tubesweep._interpolation.cell_corners`)."""
+    _, pos, weight = cell_corners(grid, band, points)
+    out = np.append(labels, np.uint32(NO_PART))[np.where(pos >= 0, pos, len(labels))]
     if weighted:
-        weight = np.prod(np.where(offsets[None, :, :] == 1, frac[:, None, :], 1.0 - frac[:, None, :]), axis=2)
         out[weight == 0.0] = NO_PART
     return out
 

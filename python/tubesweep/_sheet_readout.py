@@ -27,6 +27,7 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
+from ._interpolation import cell_corners
 from .grid import Grid
 
 #: Slack of the side test, in grid spacings (curved sheets: the projection's shrinking is not exact).
@@ -77,13 +78,7 @@ def own_side_plan(
     if node.size == 0 or len(points) == 0:
         return None
     d, h = grid.ndim, grid.spacing
-    shape = np.asarray(grid.shape)
-    t = grid.continuous_index(points)
-    base = np.clip(np.floor(t).astype(np.int64), 0, shape - 2)
-    frac = np.clip(t - base, 0.0, 1.0)
-    offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)
-    corners = base[:, None, :] + offsets[None, :, :]
-    pos = band.find(np.ascontiguousarray(corners.reshape(-1, d))).reshape(len(points), -1)
+    corners, pos, weight = cell_corners(grid, band, points)
     paired = np.zeros(n_nodes + 1, bool)
     paired[node] = True
     paired[neighbour] = True
@@ -98,5 +93,4 @@ def own_side_plan(
     foot = np.asarray(foot)[:, None, :]
     own = np.linalg.norm(corner_cp - foot, axis=2) <= np.linalg.norm(at - foot, axis=2) + SIDE_SLACK * h
     own &= pos[rows] >= 0
-    weight = np.prod(np.where(offsets[None, :, :] == 1, frac[rows, None, :], 1.0 - frac[rows, None, :]), axis=2)
-    return OwnSidePlan(rows, np.ascontiguousarray(corner_points), np.where(own, weight, 0.0))
+    return OwnSidePlan(rows, np.ascontiguousarray(corner_points), np.where(own, weight[rows], 0.0))

@@ -126,7 +126,8 @@ def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[int, in
     crc = zlib.crc32(inner.view(np.uint8).data)
     if known is not None and known[1] == crc:
         return known
-    return int(_native.band_components(band, inner)), crc
+    labels = _native.band_component_labels(band, inner)  # a component's label: its smallest position
+    return int(np.count_nonzero(labels == np.arange(len(labels), dtype=np.uint32))), crc
 
 
 def carried_values(

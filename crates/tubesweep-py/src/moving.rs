@@ -3,7 +3,7 @@
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
-use tubesweep_core::second_order::warm::{carry_values, component_labels, inner_components};
+use tubesweep_core::second_order::warm::{carry_values, component_labels};
 
 use crate::band::{AnyBand, PyBand};
 use crate::convert::c_slice;
@@ -25,18 +25,6 @@ pub fn carry_band_values<'py>(
     );
     let out = py.detach(|| carry_values(a, v, b)).map_err(to_pyerr)?;
     Ok(out.into_pyarray(py))
-}
-
-/// The number of connected components (along the axes) of the band nodes flagged in `select`.
-#[pyfunction]
-pub fn band_components(py: Python<'_>, band: PyRef<'_, PyBand>, select: PyReadonlyArray1<'_, bool>) -> PyResult<usize> {
-    let s = c_slice(&select, "select")?;
-    let b = &band.band;
-    py.detach(|| match b {
-        AnyBand::D2(b) => inner_components(b, s),
-        AnyBand::D3(b) => inner_components(b, s),
-    })
-    .map_err(to_pyerr)
 }
 
 /// The connected component (along the axes) of each band node flagged in `select`: the smallest
@@ -61,6 +49,5 @@ pub fn band_component_labels<'py>(
 /// Registers the functions of this file in the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(carry_band_values, m)?)?;
-    m.add_function(wrap_pyfunction!(band_components, m)?)?;
     m.add_function(wrap_pyfunction!(band_component_labels, m)?)
 }
