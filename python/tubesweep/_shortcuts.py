@@ -16,7 +16,8 @@ On a triangle mesh both are removed, so that the front travels only where closes
 continuously along the surface. On a point cloud only the first: its closest points come from
 local fits, which fold where the samples are sparse or off the surface, and cutting there left
 parts of a connected cloud unreached (a hemisphere sampled 50 times more sparsely than the
-other: 387 edges cut, 5 of 2000 points at inf); across narrow gaps the cut keeps a thin shell's
+other, in a scratch run of ``tests/test_point_cloud.py``'s sparse hemisphere with them cut: 387
+edges cut, 5 of 2000 points at inf); across narrow gaps the cut keeps a thin shell's
 two sheets apart (``benches/experiments/cloud_gaps.py``). On Spot and the Stanford bunny at n = 200 the first-order mean
 error against exact polyhedral geodesics falls from 0.83 % and 0.87 % of the largest distance to
 0.29 % and 0.41 % (the heat method: 0.59 % and 0.44 %; ``benches/mesh_order2.py``). Other surfaces
