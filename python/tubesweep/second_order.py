@@ -504,10 +504,19 @@ def order2_report(
     return order2
 
 
-def keep_for_warm_starts(sol: Any, st: Dict[str, Any], tube: Any, tol: float) -> None:
+def keep_for_warm_starts(
+    sol: Any,
+    st: Dict[str, Any],
+    tube: Any,
+    tol: float,
+    anchors: Optional[np.ndarray] = None,
+    started: Optional[np.ndarray] = None,
+) -> None:
     """What a later warm start from ``sol`` reads: the inner tube's components when counted, and
     the nodes' digests with the solve's tolerance and a checksum of its values, or why none were
-    kept."""
+    kept; with the digests the nodes' anchors (``moving._unpropagated_drift``): a warm solve's
+    carried ``anchors`` (NaN: renewed) where its node moved by no more than the tolerance from
+    its start ``started``, else the new value (its readers were woken)."""
     # the inner tube's components, when a warm start counted them (the next warm start reads them)
     sol._inner_components = tube.inner_components
     # digests stand for the fixed point of each node's update: kept only for a solve that reached it
@@ -521,6 +530,13 @@ def keep_for_warm_starts(sol: Any, st: Dict[str, Any], tube: Any, tol: float) ->
     else:
         sol._digests = st["digests"]
         sol._digested = (float(tol), values_checksum(sol.values))
+        values = np.asarray(sol.values, dtype=float)
+        if anchors is None or started is None or len(anchors) != len(values):
+            sol._anchor = values.copy()
+        else:
+            with np.errstate(invalid="ignore"):
+                quiet = (np.abs(values - started) <= tol) | (np.isinf(values) & (values == started))
+            sol._anchor = np.where(quiet & ~np.isnan(anchors), anchors, values)
 
 
 def run_native(
@@ -604,6 +620,7 @@ def solve_on_tube(
     tol = inputs.tol
     feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
     warm_values, warm_more, warm_info = warm_start(warm, tube, feet, tol, warm_refused)
+    anchors = warm_more.pop("_anchors", None)  # (moving._ANCHOR)
     parts = part_labels(tube)  # a part without a source keeps inf (``_parts``)
     sourced = None if parts is None else source_parts(grid, band, parts, feet)
     setup = time.perf_counter() - t0
@@ -688,6 +705,6 @@ def solve_on_tube(
         factored_reach(h, float(st["max_curvature"]), d) if inputs.exact_feet else FACTORED_RADIUS * h,
     )
     sol._first_order_positions = st["first_order_positions"]
-    keep_for_warm_starts(sol, st, tube, float(tol))
+    keep_for_warm_starts(sol, st, tube, float(tol), anchors, warm_values)
     sol.order = 2
     return sol

@@ -117,6 +117,9 @@ class Solution:
         # the digests only for the converged values of a solve at least as tight, unedited); or
         # why a solve that would have kept them did not
         self._digested: Optional[Union[Tuple[float, int], str]] = None
+        # with the digests: per node its value when its readers were last brought up to date (a
+        # warm start wakes the readers of a node that drifted from it: moving._unpropagated_drift)
+        self._anchor: Optional[np.ndarray] = None
         # the inner tube's connected components and a checksum of its flags, once a warm start
         # counted them (tubesweep.moving.inner_components)
         self._inner_components: Optional[Tuple[int, int]] = None

@@ -107,6 +107,15 @@ impl PyPointCloud {
         )
     }
 
+    /// Sets the samples' noise (`tubesweep_core::surface::point_cloud::PointCloud::set_noise`).
+    fn set_noise(&mut self, noise: f64) -> PyResult<()> {
+        match &mut self.cloud {
+            Cloud::Two(c) => c.set_noise(noise),
+            Cloud::Three(c) => c.set_noise(noise),
+        }
+        .map_err(to_pyerr)
+    }
+
     /// Marks the rim from the samples' gaps; returns how many samples lie on it.
     fn mark_rim(&mut self, py: Python<'_>, gap: PyReadonlyArray1<'_, f64>) -> PyResult<usize> {
         let g = c_slice(&gap, "gap")?;

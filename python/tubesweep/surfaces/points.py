@@ -500,6 +500,7 @@ class PointCloudSurface(ClosestPoint):
         self._sparsest_fit = float(np.nanmax(radius))
         #: the samples' noise: 1.4826 × the median distance of a sample from its neighbours' fit
         self.noise = 1.4826 * float(np.nanmedian(residual * radius))
+        cloud.set_noise(self.noise)
         # sharp edges and corners: samples their fit misses by far more than the noise
         crease = residual > max(CREASE_RESIDUAL, 4.0 * float(np.nanmedian(residual)))
         self._creases = (int(np.count_nonzero(crease)), p[int(np.argmax(crease))] if np.any(crease) else None)
@@ -545,6 +546,7 @@ class PointCloudSurface(ClosestPoint):
 
         self.__dict__.update(state)
         self._tree = _native.PointCloud(np.ascontiguousarray(self.points), self.neighbours)
+        self._tree.set_noise(self.noise)
         if len(self.rim):
             self._tree.mark_rim(
                 np.ascontiguousarray(np.where(np.isin(np.arange(len(self.points)), self.rim), 9.0, 0.0))

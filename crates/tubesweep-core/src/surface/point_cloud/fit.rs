@@ -213,6 +213,24 @@ impl<const D: usize> Fit<D> {
         })
     }
 
+    /// The weighted root-mean-square distance of `neighbours` (those it was fitted to, centred at
+    /// `centre` within `radius`) from the fitted graph: about the samples' noise on one sheet.
+    pub(crate) fn misfit(&self, neighbours: &[[f64; D]], centre: &[f64; D], radius: f64) -> f64 {
+        let (mut sum, mut wsum) = (0.0, 0.0);
+        for p in neighbours {
+            let w = wendland(distance(p, centre) / radius);
+            let (a, h) = self.local(p);
+            let off = (h - self.height(&a).0) * self.radius;
+            sum += w * off * off;
+            wsum += w;
+        }
+        if wsum > 0.0 {
+            (sum / wsum).sqrt()
+        } else {
+            0.0
+        }
+    }
+
     /// Tangent coordinates and height of `x` in the fit's scaled frame.
     #[inline]
     pub(crate) fn local(&self, x: &[f64; D]) -> ([f64; 2], f64) {

@@ -24,7 +24,7 @@ mod isolated;
 pub use isolated::LINK;
 
 use crate::error::{Error, Result};
-use fit::{basis_len, clamp_to_hull, distance, dot, gap_and_bisector, Fit};
+use fit::{basis_len, clamp_to_hull, distance, gap_and_bisector, Fit};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
@@ -45,6 +45,26 @@ pub const RIM_CLUSTER: usize = 2;
 /// this fraction of the neighbourhood's radius is found again from the query itself
 /// ([`PointCloud::closest_points`]).
 const STALE_START: f64 = 0.1;
+/// A foot farther than this fraction of its neighbourhood's radius from every sample lies between
+/// two sheets that the neighbourhood blends (on one sheet a foot lies within about a sample
+/// spacing of a sample: 0.1 of the radius on a curve, 0.3 on a surface, with k = 20).
+const BLENDED_HOLE: f64 = 0.6;
+/// A sample beyond a fit's own neighbours farther from its graph than this fraction of its
+/// distance lies on another sheet and fills no gap around the sample (the next turn of a spiral
+/// near its end: 0.9 and more; a noisy sheet's samples, noise 0.75 of their spacing, reach it
+/// now and then).
+const ANOTHER_SHEET: f64 = 0.85;
+/// ... or farther than this many times the fit's misfit (its samples' noise): on a noisy sphere
+/// (noise 0.75 of the spacing) the samples beyond the fit's own stay within it.
+const NOISE_MARGIN: f64 = 4.0;
+/// A foot farther from its query than the query's nearest sample by more than this fraction of
+/// the neighbourhood's radius plus [`NOISY_FOOT`] times the samples' noise is found again from that
+/// sample, and the nearer foot kept ([`PointCloud::closest_points`]; between the turns of a spiral
+/// 8 spacings apart, a node 3.8 spacings from one turn had its foot on the other, 4.2 away).
+const FARTHER_FOOT: f64 = 0.02;
+/// ... (without the noise a scan's noise of 0.3Δx set the check off at most nodes of a sphere, for
+/// 1.7 times the band's set-up time).
+const NOISY_FOOT: f64 = 3.0;
 /// Queries per block of [`PointCloud::closest_points`].
 const BLOCK: usize = 256;
 /// Iterations of the fixed point c ← foot(x; fit at c).
@@ -107,6 +127,8 @@ pub struct PointCloud<const D: usize> {
     has_rim: bool,
     /// An upper bound of the distance from a point of the surface to its nearest sample.
     reach: f64,
+    /// The samples' noise (a robust spread of their distances from their fits; 0 until set).
+    noise: f64,
 }
 
 impl<const D: usize> PointCloud<D> {
@@ -151,6 +173,7 @@ impl<const D: usize> PointCloud<D> {
             rim_zone: rim.clone(),
             rim,
             has_rim: false,
+            noise: 0.0,
             reach: 0.0,
         };
         let radius: Vec<f64> = (0..cloud.points.len())
@@ -181,6 +204,16 @@ impl<const D: usize> PointCloud<D> {
     /// The samples.
     pub fn points(&self) -> &[[f64; D]] {
         &self.points
+    }
+
+    /// Sets the samples' noise (from [`PointCloud::analyse`]'s residuals): a foot that lies farther
+    /// than the nearest sample by more than the noise allows is found again ([`FARTHER_FOOT`]).
+    pub fn set_noise(&mut self, noise: f64) -> Result<()> {
+        if !(noise >= 0.0 && noise.is_finite()) {
+            return Err(Error::invalid("noise", "a finite value ≥ 0"));
+        }
+        self.noise = noise;
+        Ok(())
     }
 
     /// Whether any sample lies on a rim (after [`PointCloud::mark_rim`]).
@@ -217,7 +250,18 @@ impl<const D: usize> PointCloud<D> {
                         let a = fit.project(p);
                         let residual = distance(&fit.lift(&a), p) / fit.radius;
                         let (ap, _) = fit.local(p);
-                        let around: Vec<[f64; 2]> = others.iter().map(|o| fit.local(o).0).collect();
+                        // the fit's own neighbours, and those beyond near its graph: samples of
+                        // another sheet close by (the next turn past a spiral's end) fill no gap
+                        let noise = NOISE_MARGIN * fit.misfit(own, p, radius);
+                        let around: Vec<[f64; 2]> = others
+                            .iter()
+                            .enumerate()
+                            .filter_map(|(j, o)| {
+                                let (a, w) = fit.local(o);
+                                (j < own.len() || on_graph(&fit, &a, w, (ANOTHER_SHEET * distance(o, p)).max(noise)))
+                                    .then_some(a)
+                            })
+                            .collect();
                         (
                             spacing,
                             radius,
@@ -244,7 +288,7 @@ impl<const D: usize> PointCloud<D> {
     /// direction are counted: while the gap exceeds [`RIM_GAP`], probe points go out along its
     /// bisector t at distances s = r, 2r, 4r, ... (r the fit's radius) up to 2·[`PointCloud::reach`]
     /// (the sparsest fit's radius: a gap no wider than that is spanned by the fits anyway), and the
-    /// first sample within s/2 of a probe and near the tangent plane (its offset along the normal
+    /// first sample within s/2 of a probe and near the fitted graph (its offset from the graph
     /// under half its distance) joins the neighbours. Where the sampling only thins (a scan denser
     /// on one side) the gap closes; beyond a true rim the nearest sample to every probe is the rim
     /// itself, about s away, and the gap stays.
@@ -258,7 +302,6 @@ impl<const D: usize> PointCloud<D> {
                     t[k] += dir[j] * fit.frame[j][k];
                 }
             }
-            let normal = &fit.frame[D - 1];
             let mut s = fit.radius;
             let mut found = None;
             while s <= 2.0 * self.reach && found.is_none() {
@@ -267,11 +310,11 @@ impl<const D: usize> PointCloud<D> {
                     probe[k] += s * t[k];
                 }
                 let q = &self.points[self.tree.nearest_one::<SquaredEuclidean>(&probe).item as usize];
-                let mut off = [0.0; D];
-                for k in 0..D {
-                    off[k] = q[k] - p[k];
-                }
-                if distance(q, &probe) <= 0.5 * s && dot(&off, normal).abs() <= 0.5 * distance(q, p) {
+                // the offset from the fitted graph, not from the tangent plane: the surface's own
+                // continuation follows the graph's curvature, another sheet curving beside it (the
+                // next turn of a spiral past its end) does not
+                let (aq, wq) = fit.local(q);
+                if distance(q, &probe) <= 0.5 * s && on_graph(fit, &aq, wq, 0.5 * distance(q, p)) {
                     found = Some(*q);
                 }
                 s *= 2.0;
@@ -391,37 +434,59 @@ impl<const D: usize> PointCloud<D> {
         rho: f64,
         cache: &mut Candidates<D>,
     ) -> ([f64; D], Foot) {
-        let (foot, kind, off_samples) = self.fixed_point(x, start, rho, cache);
-        if !off_samples {
+        let (foot, kind, off_samples, blended, radius) = self.fixed_point(x, start, rho, cache);
+        let nearest = self.tree.nearest_one::<SquaredEuclidean>(x);
+        let on_surface = self.points[nearest.item as usize];
+        if !off_samples && !blended {
+            // A closest point is never much farther than the nearest sample. Past an open cloud's
+            // rim the fixed point can settle on another sheet (the next turn beyond a spiral's
+            // end, 7.1 spacings off where the end lay 4.0 away; between a spiral's turns, on the
+            // farther turn): it is found again from that sample, and the nearer foot kept
+            let far = distance(&foot, x);
+            if far > nearest.distance.sqrt() + FARTHER_FOOT * radius + NOISY_FOOT * self.noise && on_surface != start {
+                if let (again, k, false, false, _) = self.fixed_point(x, on_surface, rho, cache) {
+                    if distance(&again, x) < far {
+                        return (again, k);
+                    }
+                }
+            }
             return (foot, kind);
         }
-        let on_surface = self.points[self.tree.nearest_one::<SquaredEuclidean>(x).item as usize];
         if on_surface != start {
-            if let (foot, kind, false) = self.fixed_point(x, on_surface, rho, cache) {
-                return (foot, kind);
+            if let (again, k, false, false, _) = self.fixed_point(x, on_surface, rho, cache) {
+                return (again, k);
             }
+        }
+        if !off_samples {
+            // every fit near x blends the sheets (a gap the fits do not resolve, which the band
+            // search warns of): the blended foot, as before this check
+            return (foot, kind);
         }
         ([f64::NAN; D], Foot::Failed)
     }
 
     /// The fixed point c ← the projection of `x` onto the fit centred at c, from `start`, and
     /// whether its foot lies farther than `reach` from every sample (the last neighbourhood bounds
-    /// that distance from above; only past the bound is the tree asked).
+    /// that distance from above; only past the bound is the tree asked), and whether its fit
+    /// blends two sheets (a foot in a hole of its samples, [`BLENDED_HOLE`]: midway between the turns of a
+    /// spiral 8 spacings apart, the graph through both turns' samples held a node 4 spacings from
+    /// either at 0.15 spacings from its "surface"), and the last neighbourhood's radius.
     fn fixed_point(
         &self,
         x: &[f64; D],
         start: [f64; D],
         rho: f64,
         cache: &mut Candidates<D>,
-    ) -> ([f64; D], Foot, bool) {
+    ) -> ([f64; D], Foot, bool, bool, f64) {
         let mut c = start;
         let mut foot = [f64::NAN; D];
         let mut nb: Vec<[f64; D]> = Vec::with_capacity(self.neighbours + 1);
         let mut on_rim = false;
+        let mut last_radius = 0.0;
         for it in 0..MAX_ITERATIONS {
             let (radius, near_rim) = self.neighbourhood(&c, rho, cache, &mut nb);
             let Some(f) = Fit::new(&nb, &c, radius) else {
-                return ([f64::NAN; D], Foot::Failed, false);
+                return ([f64::NAN; D], Foot::Failed, false, false, 0.0);
             };
             let mut a = f.project(x);
             on_rim = false;
@@ -436,17 +501,25 @@ impl<const D: usize> PointCloud<D> {
             foot = f.lift(&a);
             let moved = distance(&foot, &c);
             c = foot;
+            last_radius = radius;
             if it > 0 && moved <= TOLERANCE * f.radius {
                 break;
             }
         }
         if !foot.iter().all(|v| v.is_finite()) {
-            return ([f64::NAN; D], Foot::Failed, false);
+            return ([f64::NAN; D], Foot::Failed, false, false, 0.0);
         }
         let bound = nb.iter().map(|s| distance(s, &foot)).fold(f64::INFINITY, f64::min);
-        let off_samples =
-            bound > self.reach && self.tree.nearest_one::<SquaredEuclidean>(&foot).distance.sqrt() > self.reach;
-        (foot, if on_rim { Foot::Rim } else { Foot::Interior }, off_samples)
+        let nearest = || self.tree.nearest_one::<SquaredEuclidean>(&foot).distance.sqrt();
+        let off_samples = bound > self.reach && nearest() > self.reach;
+        let blended = !off_samples && bound > BLENDED_HOLE * last_radius && nearest() > BLENDED_HOLE * last_radius;
+        (
+            foot,
+            if on_rim { Foot::Rim } else { Foot::Interior },
+            off_samples,
+            blended,
+            last_radius,
+        )
     }
 
     /// [`PointCloud::closest_point`] for many points, in parallel: in fixed blocks of
@@ -505,6 +578,13 @@ impl<const D: usize> PointCloud<D> {
     pub fn reach(&self) -> f64 {
         self.reach
     }
+}
+
+/// Whether a sample at tangent coordinates `a` and height `w` (scaled, as [`Fit::local`] gives
+/// them) lies within `within` of the fitted graph or of the tangent plane (whichever is nearer: a
+/// noisy fit's curvature, extrapolated past its radius, may miss its own sheet).
+fn on_graph<const D: usize>(fit: &Fit<D>, a: &[f64; 2], w: f64, within: f64) -> bool {
+    w.abs().min((w - fit.height(a).0).abs()) * fit.radius <= within
 }
 
 #[cfg(test)]

@@ -114,3 +114,22 @@ fn a_small_group_of_stray_samples_is_isolated_and_the_surface_is_not() {
     let flags = cloud.isolated(&a.spacing, 0.0, DEFAULT_NEIGHBOURS + 2).unwrap();
     assert!(flags.iter().all(|&f| !f));
 }
+
+#[test]
+fn the_ends_of_a_spiral_are_its_rim_though_the_next_turn_lies_beyond_them() {
+    // an Archimedean spiral r = 0.15 + b θ, turns 0.12 apart, sampled every 0.0033: past its inner
+    // end the tangent points at the next turn, which curves the other way and must not fill the gap
+    let b = 0.12 / std::f64::consts::TAU;
+    let mut pts: Vec<[f64; 2]> = Vec::new();
+    let mut t: f64 = 0.0;
+    while 0.15 + b * t < 0.8 {
+        let r = 0.15 + b * t;
+        pts.push([r * t.cos(), r * t.sin()]);
+        t += 0.0033 / (r * r + b * b).sqrt();
+    }
+    let n = pts.len();
+    let mut cloud = PointCloud::new(pts, DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    assert_eq!(cloud.mark_rim(&a.gap).unwrap(), 2);
+    assert!(cloud.rim[0] && cloud.rim[n - 1]);
+}
