@@ -34,3 +34,14 @@ def test_bad_dimensions_and_bounds():
         ts.Grid((0, 1), (1, 1), (5, 5))
     with pytest.raises(ValueError, match="same length"):
         ts.Grid((0, 0), (1, 1, 1), (5, 5))
+
+
+def test_grids_are_equal_up_to_rounding_in_units_of_their_spacing():
+    # numpy's relative tolerance let two boxes near x = 1000, 0.18 spacings apart, compare equal
+    # (and a warm start from the one grid was taken on the other)
+    a = ts.Grid((1000.0,) * 3, (1002.0,) * 3, (41,) * 3)
+    assert a != ts.Grid((1000.009,) * 3, (1002.009,) * 3, (41,) * 3)
+    assert a == ts.Grid((1000.0 + 1e-12,) * 3, (1002.0,) * 3, (41,) * 3)
+    b = ts.Grid((0.1 + 0.2, 0.0), (1.3, 1.0), (11, 11))
+    assert b == ts.Grid((0.3, 0.0), (1.3, 1.0), (11, 11)) and hash(b) == hash(ts.Grid((0.3, 0.0), (1.3, 1.0), (11, 11)))
+    assert b != ts.Grid((0.3, 0.0), (1.3 + 1e-4, 1.0 + 1e-4), (11, 11))

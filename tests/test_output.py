@@ -1,6 +1,7 @@
 """Results out: Solution.on_mesh, triangulate (marching cubes / squares, a surface's own mesh),
 export (meshio round trips, VTK XML PolyData) and plot (matplotlib figures, 2D and 3D)."""
 
+import base64
 import re
 
 import numpy as np
@@ -96,6 +97,22 @@ def test_export_vtp_and_curves(sphere_sol, circle_sol, tmp_path):
         ts.export(circle_sol, tmp_path / "c.ply")
     with pytest.raises(ValueError, match="point_data"):
         ts.export(sphere_sol, tmp_path / "s.vtu", point_data={"bad": np.zeros(3)})
+
+
+def test_a_vtp_export_holds_unreached_values_as_binary_nan_bit_for_bit(sphere_sol, tmp_path):
+    # VTK's ASCII reader stops at "nan" (ParaView then fails to read the file): the arrays are
+    # inline base64 binary, the byte count first, and read back bit for bit
+    v, _ = ts.triangulate(sphere_sol)
+    x = np.where(v[:, 2] > 0.2, np.nan, v[:, 0] / 3)
+    path = ts.export(sphere_sol, tmp_path / "s.vtp", point_data={"x": x})
+    text = path.read_text()
+    assert not re.search(r"(^|\s)nan(\s|$)", text, re.IGNORECASE) and 'format="ascii"' not in text
+    assert text.count('format="binary"') == 5  # u, x, the points, connectivity, offsets
+    p, _, data = read_vtp(path)
+    assert np.array_equal(p, v) and np.array_equal(data["x"], x, equal_nan=True)
+    assert np.isnan(data["x"]).sum() == np.count_nonzero(v[:, 2] > 0.2) > 0
+    block = text.split('Name="x" format="binary">\n')[1].split("\n")[0]
+    assert int(np.frombuffer(base64.b64decode(block[:8]), "<u4")[0]) == 8 * len(v)
 
 
 def test_export_uses_the_meshs_own_triangulation(tmp_path):

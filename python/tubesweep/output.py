@@ -14,10 +14,11 @@ scikit-image) and ``pip install 'tubesweep[plot]'`` (matplotlib).
 
 from __future__ import annotations
 
+import base64
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 from typing import Any, Dict, Optional, Tuple, Union
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -34,12 +35,17 @@ EXPORT_FORMATS = (".vtu", ".vtp", ".vtk", ".ply", ".obj")
 # export
 # ---------------------------------------------------------------------------------------------
 def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Dict[str, np.ndarray]) -> None:
-    """VTK XML PolyData (ASCII): polygons for triangles, lines for segments, vertices for points."""
+    """VTK XML PolyData (inline base64 binary): polygons for triangles, lines for segments, vertices
+    for points."""
     n, m, k = len(points), len(cells), cells.shape[1]
     kind = "Polys" if k >= 3 else "Lines" if k == 2 else "Verts"
 
-    def arr(a: np.ndarray, fmt: str) -> str:
-        return "\n".join(" ".join(fmt % x for x in row) for row in np.atleast_2d(a).reshape(len(a), -1))
+    def arr(a: np.ndarray, dtype: str) -> str:
+        # VTK's inline binary: the byte count (UInt32) and the little-endian values, each in base64.
+        # Binary, not ASCII: VTK's ASCII reader stops at a NaN (an unreached node), which ParaView
+        # then fails to read
+        data = np.ascontiguousarray(a, dtype=dtype).tobytes()
+        return (base64.b64encode(np.uint32(len(data)).tobytes()) + base64.b64encode(data)).decode("ascii")
 
     # written to a temporary file next to the target (through symlinks) and renamed over it when
     # complete, with the target's mode: an error half-way leaves no truncated file behind. A
@@ -77,17 +83,19 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
             for name, a in point_data.items():
                 comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""
                 fh.write(
-                    f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="ascii">\n'
-                    f"{arr(a, '%.17g')}\n</DataArray>\n"
+                    f'<DataArray type="Float64" Name={quoteattr(str(name))}{comps} format="binary">\n'
+                    f"{arr(a, '<f8')}\n</DataArray>\n"
                 )
             fh.write("</PointData>\n<Points>\n")
             fh.write(
-                f'<DataArray type="Float64" NumberOfComponents="3" format="ascii">\n{arr(points, "%.17g")}\n</DataArray>\n'
+                f'<DataArray type="Float64" NumberOfComponents="3" format="binary">\n{arr(points, "<f8")}\n</DataArray>\n'
             )
             fh.write(f"</Points>\n<{kind}>\n")
-            fh.write(f'<DataArray type="Int64" Name="connectivity" format="ascii">\n{arr(cells, "%d")}\n</DataArray>\n')
             fh.write(
-                f'<DataArray type="Int64" Name="offsets" format="ascii">\n{arr(np.arange(1, m + 1) * k, "%d")}\n</DataArray>\n'
+                f'<DataArray type="Int64" Name="connectivity" format="binary">\n{arr(cells, "<i8")}\n</DataArray>\n'
+            )
+            fh.write(
+                f'<DataArray type="Int64" Name="offsets" format="binary">\n{arr(np.arange(1, m + 1) * k, "<i8")}\n</DataArray>\n'
             )
             fh.write(f"</{kind}>\n</Piece>\n</PolyData>\n</VTKFile>\n")
         if part != target:
@@ -112,7 +120,7 @@ def _umask() -> int:
 
 
 def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, np.ndarray]]:
-    """Reads an ASCII ``.vtp`` file written by :func:`export`.
+    """Reads a ``.vtp`` file written by :func:`export` (inline binary or ASCII data arrays).
 
     Parameters
     ----------
@@ -147,7 +155,15 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
         raise ValueError(f"{path}: not a VTK PolyData file")
 
     def values(el: Any, dtype: Any) -> np.ndarray:
-        return np.array((el.text or "").split(), dtype=dtype)
+        text = (el.text or "").strip()
+        if el.get("format", "ascii") != "binary":
+            return np.array(text.split(), dtype=dtype)
+        # the byte count (UInt32: 8 base64 characters), then the values
+        size = int(np.frombuffer(base64.b64decode(text[:8]), "<u4")[0])
+        raw = base64.b64decode(text[8:])
+        if len(raw) != size:
+            raise ValueError(f"{path}: a DataArray holds {len(raw)} bytes where its header says {size}")
+        return np.frombuffer(raw, "<f8" if dtype is float else "<i8").astype(dtype)
 
     points = values(piece.find("Points/DataArray"), float).reshape(-1, 3)
     # the cells' section: polygons (a surface), lines (a curve) or vertices (a point cloud)
