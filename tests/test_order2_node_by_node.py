@@ -2,6 +2,7 @@
 ``node_geometry``): where the local geometry is not resolved (a rim, a crease, noise, a stencil
 cut by the box) the update is the paper's first-order one, elsewhere second order."""
 
+import contextlib
 import math
 import re
 
@@ -233,7 +234,9 @@ def test_unresolved_nodes_off_the_surface_open_no_shortcut(kind, bound):
     g = box(41)
     r = sphere_phi(g) + 0.5
     phi = (r - 0.5) ** 3 if kind == "cube" else np.tanh((r - 0.5) / 0.01)
-    sol = ts.solve(ts.LevelSet(phi, redistance=True), g, [(-0.5, 0, 0)])
+    # (the cube's slope vanishes on the surface, which places it only to first order: said)
+    with pytest.warns(RuntimeWarning, match="slope nearly vanishes") if kind == "cube" else contextlib.nullcontext():
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), g, [(-0.5, 0, 0)])
     assert sol.stats.order == 2 and sol.stats.order2["first_order_nodes"] > 100
     q = np.random.default_rng(1).normal(size=(400, 3))
     q = 0.5 * q / np.linalg.norm(q, axis=1, keepdims=True)
@@ -275,4 +278,5 @@ def test_a_crease_whose_normal_reverses_is_not_given_a_bound_of_1e15():
         ts.Tube(ts.LevelSet(phi, redistance=True), g).solve([(0.61, 0, 0)])
     (crease,) = [str(w.message) for w in caught if "creases or corners" in str(w.message)]
     assert "turning by up to 180°" in crease and "e+" not in crease
-    assert re.search(r"arrives early by 0\.746 or more: the normal reverses there", crease)
+    # (the inner tube thinned at the crease, as for any level set: 1.5Δx; 0.746 in the paper's tube)
+    assert re.search(r"arrives early by 0\.075 or more: the normal reverses there", crease)

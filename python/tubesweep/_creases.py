@@ -96,8 +96,9 @@ def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: 
     """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases:
     the shortcut per crease, :data:`THINNED_SHORTCUT` spacings on the tube thinned at them
     (``thinned``), else ``2·tan(θ/2)·inner·Δx`` at the largest turn θ that the refusal names (the
-    paper's tube, which a re-distanced φ keeps: the box max|x| − 0.5 re-distanced at N = 41, 4.8Δx
-    per edge, where the warning says 4Δx; a voxel mask's cube 3.75–3.94Δx); whether it warned."""
+    paper's tube; a re-distanced φ kept it until its crease nodes were thinned too: the box
+    max|x| − 0.5 re-distanced at N = 41 came out 4.8Δx short per edge there, 1.16Δx thinned);
+    whether it warned."""
     if _CONVEX_CREASES.search(reason) is None:
         return False
     given = _PER_INNER_WIDTH.search(reason)  # 2·tan(θ/2) at the largest turn θ, as the refusal gives it
