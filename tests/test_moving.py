@@ -599,3 +599,35 @@ def test_an_older_solution_at_first_order_is_named_and_evolve_starts_from_the_pr
         moved.solve(pole(r), warm=(order1, sol))
     with pytest.raises(WarmStartRefused, match=r"the previous solution was solved at first order"):
         moved.solve(pole(r), warm=(sol, order1))
+
+
+def test_a_part_pinching_off_while_two_others_merge_is_refused():
+    # a dumbbell curve, the source on its left lobe, pinches off while two circles close by merge
+    # (their inner tubes join): 4 components before and after, which the count alone let through,
+    # and the right lobe kept finite carried values it had lost the source of
+    grid = ts.Grid((-1, -1), (1, 1), (201, 201))
+    x, y = grid.meshgrid()
+
+    def smin(a, b, k=0.03):
+        w = np.maximum(k - np.abs(a - b), 0) / k
+        return np.minimum(a, b) - w * w * k / 4
+
+    left, right = np.hypot(x + 0.45, y + 0.4) - 0.28, np.hypot(x - 0.45, y + 0.4) - 0.28
+    neck = np.maximum(np.abs(y + 0.4) - 0.014, np.abs(x) - 0.3)
+
+    def pair(gap):
+        return np.minimum(np.hypot(x + 0.25 + gap / 2, y - 0.5) - 0.25, np.hypot(x - 0.25 - gap / 2, y - 0.5) - 0.25)
+
+    before = ts.LevelSet(np.minimum(smin(smin(left, neck), right), pair(0.04)), redistance=True)
+    after = ts.LevelSet(np.minimum(np.minimum(left, right), pair(0.02)), redistance=True)
+    source = [(-0.45, -0.12)]
+    # (the neck, and the merging circles, face across narrow gaps: said, with the medial nodes)
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        with pytest.warns(RuntimeWarning, match="equidistant from two parts"):
+            tube = ts.Tube(before, grid, outer=6)
+    sol = tube.solve(source)
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        with pytest.warns(RuntimeWarning, match="equidistant from two parts"):
+            tube = tube.moved(after)
+    with pytest.raises(WarmStartRefused, match=r"4 connected component\(s\) do not match the previous ones one to one"):
+        tube.solve(source, warm=sol)

@@ -130,7 +130,7 @@ class _PreparedTube:
     paper_creases: Optional[Dict[str, Any]] = None
     #: the inner tube's connected components and the checksum of its flags, once a warm start
     #: counted them (``moving.inner_components``)
-    inner_components: Optional[Tuple[int, int]] = None
+    inner_components: Optional[Tuple[int, int, np.ndarray]] = None
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at

@@ -115,19 +115,50 @@ def _linear(sol_or_tube: Any) -> np.ndarray:
     return np.ascontiguousarray(sol_or_tube.linear, dtype=np.int64).view(np.uint64)
 
 
-def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[int, int]]) -> Tuple[int, int]:
-    """The number of connected components of the inner tube (the nodes of ``roles`` other than
-    the extension layer's) on ``band``, as ``(count, checksum of the inner flags)``: ``known``, a
-    pair kept from an earlier call, is used when the flags' checksum matches (a warm solve's tube
-    is the next step's previous tube: its components are counted once)."""
+def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[Any, ...]]) -> Tuple[int, int, np.ndarray]:
+    """The connected components of the inner tube (the nodes of ``roles`` other than the
+    extension layer's) on ``band``, as ``(count, checksum of the inner flags, each node's
+    component label)``: ``known``, kept from an earlier call, is used when the flags' checksum
+    matches (a warm solve's tube is the next step's previous tube: its components are labelled
+    once)."""
     from ._prepare import ROLE_OUTER
 
     inner = np.ascontiguousarray(roles != ROLE_OUTER)
     crc = zlib.crc32(inner.view(np.uint8).data)
-    if known is not None and known[1] == crc:
-        return known
+    if known is not None and len(known) == 3 and known[1] == crc:
+        return known  # type: ignore[return-value]
     labels = _native.band_component_labels(band, inner)  # a component's label: its smallest position
-    return int(np.count_nonzero(labels == np.arange(len(labels), dtype=np.uint32))), crc
+    return int(np.count_nonzero(labels == np.arange(len(labels), dtype=np.uint32))), crc, labels
+
+
+def _topology_change(
+    warm: Any, old: Tuple[int, int, np.ndarray], tube: Any, new: Tuple[int, int, np.ndarray]
+) -> Optional[str]:
+    """Why the inner tube's topology changed from ``warm``'s to ``tube``'s, or None. The
+    components must correspond one to one through the nodes in both inner tubes: a count alone
+    let a part pinch off while two others merged (3 components before and after), and the part
+    that lost its source kept finite carried values."""
+    from ._prepare import ROLE_OUTER
+
+    if old[0] != new[0]:
+        return (
+            f"the inner tube has {new[0]} connected component(s), the previous one had {old[0]} (a part pinched off "
+            "or two parts merged)"
+        )
+    _, at_old, at_new = np.intersect1d(
+        np.asarray(warm.linear), np.asarray(tube.linear), assume_unique=True, return_indices=True
+    )
+    both = (np.asarray(warm.roles)[at_old] != ROLE_OUTER) & (np.asarray(tube.roles)[at_new] != ROLE_OUTER)
+    pairs = np.unique(np.stack([old[2][at_old[both]], new[2][at_new[both]]], axis=1), axis=0)
+    before, after = np.unique(pairs[:, 0]), np.unique(pairs[:, 1])
+    if len(pairs) == len(before) == len(after) == old[0]:
+        return None
+    split = before[np.flatnonzero(np.bincount(np.searchsorted(before, pairs[:, 0])) > 1)]
+    how = "a part pinched off" if split.size else "two parts merged"
+    return (
+        f"the inner tube's {new[0]} connected component(s) do not match the previous ones one to one ({how} while "
+        "others merged or split, keeping the count)"
+    )
 
 
 def carried_values(
@@ -200,13 +231,13 @@ def carried_values(
             "smaller steps (at most outer − inner spacings per solve), build the tubes of both steps wider "
             "(ts.Tube(..., outer=6); tube.moved keeps the widths), or solve cold (leave out warm=)"
         )
-    n_old, _ = inner_components(warm._band, warm.roles, getattr(warm, "_inner_components", None))
+    old = inner_components(warm._band, warm.roles, getattr(warm, "_inner_components", None))
+    # (kept: the next step's warm start from this solve reads it)
     tube.inner_components = inner_components(tube.band, tube.roles, tube.inner_components)
-    n_new = tube.inner_components[0]  # (kept: the next step's warm start from this solve reads it)
-    if n_old != n_new:
+    changed = _topology_change(warm, old, tube, tube.inner_components)
+    if changed is not None:
         raise WarmStartRefused(
-            f"warm: the topology changed: the inner tube has {n_new} connected component(s), the previous one had "
-            f"{n_old} (a part pinched off or two parts merged); carried values on a part that lost its source would never "
+            f"warm: the topology changed: {changed}; carried values on a part that lost its source would never "
             "settle. Solve cold (leave out warm=) across the change, then warm again"
         )
     # the sources as a set, in any order: each one's nearest previous source, and the other way

@@ -122,7 +122,7 @@ class Solution:
         self._anchor: Optional[np.ndarray] = None
         # the inner tube's connected components and a checksum of its flags, once a warm start
         # counted them (tubesweep.moving.inner_components)
-        self._inner_components: Optional[Tuple[int, int]] = None
+        self._inner_components: Optional[Tuple[int, int, np.ndarray]] = None
         self.order = 1
 
     def __getstate__(self) -> dict:
