@@ -126,7 +126,7 @@ def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[Any, ..
     inner = np.ascontiguousarray(roles != ROLE_OUTER)
     crc = zlib.crc32(inner.view(np.uint8).data)
     if known is not None and len(known) == 3 and known[1] == crc:
-        return known  # type: ignore[return-value]
+        return known
     labels = _native.band_component_labels(band, inner)  # a component's label: its smallest position
     return int(np.count_nonzero(labels == np.arange(len(labels), dtype=np.uint32))), crc, labels
 
