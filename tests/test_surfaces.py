@@ -761,3 +761,24 @@ def test_native_ellipsoid_and_star_distances_match_their_numpy_formulations():
     a, b = s.signed_distance(p2), s._signed_distance_numpy(p2)
     assert np.max(np.abs(a - b)) < 1e-14
     assert np.array_equal(np.sign(a), np.sign(b))
+
+
+def test_a_callable_phi_refused_at_its_edges_is_told_to_pass_its_samples():
+    # a cube's exact distance as a callable, re-distanced: the projections from the nodes outside
+    # its edges do not settle and the solve is refused (N = 31 to 61); the same φ sampled on the
+    # grid solves, which the error now says
+    a = 0.413
+
+    def cube(p):
+        q = np.abs(p) - a
+        return np.linalg.norm(np.maximum(q, 0), axis=1) + np.minimum(q.max(axis=1), 0)
+
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+    with pytest.raises(ValueError, match=r"could not be projected.*sample the callable φ on the grid"):
+        with pytest.warns(RuntimeWarning, match="nodes within the tube .* could not be projected"):
+            with pytest.warns(RuntimeWarning, match="had a neighbour outside the band"):
+                ts.solve(ts.LevelSet(cube, redistance=True), grid, [(0, 0, a)])
+    samples = cube(grid.node_points(np.arange(grid.size))).reshape(grid.shape)
+    with pytest.warns(RuntimeWarning, match="convex creases or corners"):
+        sol = ts.solve(ts.LevelSet(samples, redistance=True), grid, [(0, 0, a)])
+    assert 4 * a - 4 * 1.5 * grid.spacing < sol([(0, 0, -a)])[0] < 4 * a

@@ -460,6 +460,13 @@ def _prepare_tube(
                 "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
                 "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
                 "there (round the edges over more than the tube's width), pass a signed distance function, or refine the grid"
+                + (
+                    "; or sample the callable φ on the grid and pass the array (LevelSet(phi_array, redistance=True) "
+                    "locates the zero level set cell by cell, edges and corners included: a cube's distance at N = 61, "
+                    "refused as a callable, solves as an array)"
+                    if getattr(surf, "_array", True) is None
+                    else ""
+                )
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
