@@ -34,6 +34,21 @@ _PER_INNER_WIDTH = re.compile(r"cut the corner by about ([0-9.]+)·inner·Δx")
 #: 1.3Δx at N = 41–81 (2.9Δx to 3.5Δx at order=1). ``benches/experiments/creases.py``.
 THINNED_SHORTCUT = 1.5
 
+#: The same for a re-distanced φ (a voxel mask, ``redistance=True``), whose zero level set between
+#: the nodes adds its own error at the edge: a closed cylinder's two rims 1.2–1.75Δx each
+#: re-distanced, 2.05–2.1Δx as a voxel mask, N = 41–81; a cube with a = 0.413 re-distanced at
+#: N = 61, 1.9Δx per edge (review scratch ``/tmp/reviewA``).
+THINNED_SHORTCUT_REDISTANCED = 2.5
+
+
+def thinned_spacings(tube: Any, thinned: bool) -> float:
+    """How many spacings a front gains per crease on ``tube`` (a prepared tube) thinned there
+    (``thinned``): :data:`THINNED_SHORTCUT`, or :data:`THINNED_SHORTCUT_REDISTANCED` for a
+    re-distanced φ; 0 when not thinned."""
+    if not thinned:
+        return 0.0
+    return THINNED_SHORTCUT_REDISTANCED if getattr(tube.surface, "redistance", False) else THINNED_SHORTCUT
+
 
 #: Beyond this turn of the normal (degrees) a crease's shortcut is not bounded by 2·tan(θ/2)·inner·Δx
 #: (the core's ``Creases::shortcut_per_inner_width`` caps θ there too).
@@ -46,12 +61,12 @@ def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
     return float(per_inner_width) * float(inner) * float(spacing)
 
 
-def _per_crease(per_inner_width: float, inner: float, spacing: float, thinned: bool) -> Tuple[float, str]:
-    """How early a front arrives per crease crossed, and how that was reckoned: :data:`THINNED_SHORTCUT`
-    spacings on the tube thinned at the creases, else :func:`shortcut` (``per_inner_width``:
-    2·tan(θ/2) at the largest turn θ of the normal)."""
+def _per_crease(per_inner_width: float, inner: float, spacing: float, thinned: float) -> Tuple[float, str]:
+    """How early a front arrives per crease crossed, and how that was reckoned: ``thinned``
+    spacings on the tube thinned at the creases (:func:`thinned_spacings`; 0: not thinned), else
+    :func:`shortcut` (``per_inner_width``: 2·tan(θ/2) at the largest turn θ of the normal)."""
     if thinned:
-        return THINNED_SHORTCUT * float(spacing), f"{THINNED_SHORTCUT:g}·Δx with the inner tube thinned there"
+        return thinned * float(spacing), f"{thinned:g}·Δx with the inner tube thinned there"
     return (
         shortcut(per_inner_width, inner, spacing),
         f"2·tan(θ/2)·inner·Δx = {per_inner_width:.3g}·inner·Δx at the largest turn θ, the inner tube not thinned there",
@@ -70,7 +85,7 @@ def _early(angle: float, size: float, reckoned: str) -> str:
     )
 
 
-def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: bool) -> None:
+def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: float) -> None:
     """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``):
     the shortcut per crease, :data:`THINNED_SHORTCUT` spacings where the inner tube was thinned
     there (``thinned``), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle."""
@@ -92,7 +107,7 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
     )
 
 
-def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: bool) -> bool:
+def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: float) -> bool:
     """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases:
     the shortcut per crease, :data:`THINNED_SHORTCUT` spacings on the tube thinned at them
     (``thinned``), else ``2·tan(θ/2)·inner·Δx`` at the largest turn θ that the refusal names (the

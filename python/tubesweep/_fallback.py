@@ -32,7 +32,7 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
-from ._creases import THINNED_SHORTCUT, warn_refused_creases
+from ._creases import thinned_spacings, warn_refused_creases
 from ._prepare import thinned_count
 from .band import band_neighbours
 from .surface import LevelSet
@@ -125,7 +125,7 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     near a rim the distance curves whatever the surface does)."""
     spacing = tube.grid.spacing
     thinned = thinned_count(tube) > 0
-    if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned):
+    if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned_spacings(tube, thinned)):
         return
     if gradient is None:
         return
@@ -137,7 +137,7 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     unresolved = _UNRESOLVED.search(reason)
     edges_only = unresolved is not None and int(unresolved.group(1)) < 100 * EDGES_SHARE
     # (the inner tube thinned at the edges: THINNED_SHORTCUT spacings per edge, as at a crease)
-    per_edge = THINNED_SHORTCUT if thinned else UNRESOLVED_SHORTCUT
+    per_edge = thinned_spacings(tube, True) if thinned else UNRESOLVED_SHORTCUT
     crossing = per_edge * spacing / gradient if edges_only else 0.0
     not_a_distance = NOT_A_DISTANCE in reason
     if share < SIZE_WARNING and 2 * crossing < SIZE_WARNING * largest and not not_a_distance:

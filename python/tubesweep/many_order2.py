@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple
 import numpy as np
 
 from . import _native
-from ._creases import warn_creases
+from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
 from ._parts import drop_unsourced_rows
 from ._prepare import thinned_count
@@ -142,7 +142,7 @@ def solve_many_order2(
             + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}{'…' if failed.size > 5 else ''})"
         )
     st["tol"] = inputs.tol
-    warn_creases(st.get("creases"), t.inner, h, thinned=thinned_count(t) > 0)
+    warn_creases(st.get("creases"), t.inner, h, thinned=thinned_spacings(t, thinned_count(t) > 0))
     for name, what in (
         (
             "converged",

@@ -19,7 +19,7 @@ import numpy as np
 
 from . import _native
 from ._box_cut import box_reason
-from ._creases import warn_creases
+from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._parts import drop_unsourced, part_labels, source_parts
 from ._prepare import ROLE_OUTER, thinned_count
@@ -463,7 +463,9 @@ def warn_about(
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
-    warn_creases(st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_count(tube) > 0)
+    warn_creases(
+        st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_spacings(tube, thinned_count(tube) > 0)
+    )
 
 
 #: The native report's entries that ``sol.stats.order2`` keeps as they are.
