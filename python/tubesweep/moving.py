@@ -149,7 +149,9 @@ def _topology_change(
         np.asarray(warm.linear), np.asarray(tube.linear), assume_unique=True, return_indices=True
     )
     both = (np.asarray(warm.roles)[at_old] != ROLE_OUTER) & (np.asarray(tube.roles)[at_new] != ROLE_OUTER)
-    pairs = np.unique(np.stack([old[2][at_old[both]], new[2][at_new[both]]], axis=1), axis=0)
+    # the (previous, new) label pairs, as one 64-bit key each (np.unique over rows is slow)
+    keys = np.unique((old[2][at_old[both]].astype(np.uint64) << np.uint64(32)) | new[2][at_new[both]].astype(np.uint64))
+    pairs = np.stack([keys >> np.uint64(32), keys & np.uint64(0xFFFFFFFF)], axis=1)
     before, after = np.unique(pairs[:, 0]), np.unique(pairs[:, 1])
     if len(pairs) == len(before) == len(after) == old[0]:
         return None
