@@ -307,7 +307,9 @@ def evolve(
         A ``.npz`` file rewritten at each kept frame with ``phi``, ``t``, ``step`` and
         ``sources`` (written beside it and renamed, so that an interrupted write leaves the last
         one whole): ``evolve(c["phi"], grid, c["sources"], speed, ..., t0=float(c["t"]))``
-        continues from it.
+        continues from it, bit for bit as the uninterrupted run with the same ``dt``, ``every``
+        and a ``checkpoint`` (a step that writes one solves cold; the sources are kept as they
+        were before that step projected them).
     tol : float, optional
         The surface solves' tolerance (the default of :func:`tubesweep.solve`).
     t0 : float
@@ -409,11 +411,20 @@ def evolve(
                     dist, feet = surf.project(src, grid)
                     if step == 0:
                         check_on_surface(src, dist, tube.inner * grid.spacing)
-                    src = np.ascontiguousarray(feet)
+                    # (the checkpoint keeps the sources before this projection: a continued run
+                    # projects them again, onto the same surface, to the same bits)
+                    unprojected, src = src, np.ascontiguousarray(feet)
                     # extrapolated from the two previous steps where both ran second order; a step that
                     # fell back to first order starts the next one cold and the one after from it alone
                     pair = older is not None and getattr(older, "order", 1) == 2
                     warm: Any = None if prev is None else ((older, prev) if pair else prev)
+                    # a step that writes a checkpoint solves cold, and the next one starts from it
+                    # alone: a run continued from the checkpoint (cold, with no older step) then
+                    # repeats the uninterrupted one bit for bit (warm, its first solve differed by
+                    # 2.9 tolerances, its φ by 5e-8 after four more steps); a warm solve costs as
+                    # much as a cold one here (docs/moving-surfaces.md)
+                    if checkpoint is not None and step % every == 0:
+                        warm = None
                     sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
                     cut = sol.stats.box_cut
                     if step == 0:
@@ -462,7 +473,7 @@ def evolve(
                 out.solutions.append(sol)
                 if checkpoint is not None:
                     try:
-                        _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=src)
+                        _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=unprojected)
                     except OSError as e:
                         raise EvolutionStopped(
                             f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "
@@ -499,7 +510,7 @@ def evolve(
             new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
             new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
             arr = new
-            older, prev = prev, sol
+            older, prev = (None if checkpoint is not None and step % every == 0 else prev), sol
             t = t0 + (step + 1) * dt  # not a running sum: no rounding carried from step to step
             if progress is not None:
                 try:
