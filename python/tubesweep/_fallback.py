@@ -121,8 +121,8 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     the distances (:data:`SIZE_WARNING`; ``gradient`` from :meth:`Fallback.measure`), or φ is not a
     distance (whose cure, ``redistance=True``, the reason names). Nothing when ``said`` (the
     fallback was warned about already, a runaway, or the caller chose an option of the
-    first-order scheme: ``second_order.warn_fallback``), nor without a ``gradient`` (none
-    measured; an open surface is taken at 1)."""
+    first-order scheme: ``second_order.warn_fallback``), nor on an open surface (``gradient`` None:
+    near a rim the distance curves whatever the surface does)."""
     spacing = tube.grid.spacing
     thinned = thinned_count(tube) > 0
     if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned_spacings(tube, thinned)):
@@ -196,13 +196,7 @@ class Fallback:
         """Reads the mean ``|∇φ|`` that :meth:`warn` needs from ``tube`` before the solve, which
         drops the band's linear indices (none when nothing is to be said, or on an open surface)."""
         surface = tube.surface
-        if self.said:
-            return
-        if getattr(surface, "open_surface", False) or getattr(surface, "closed", True) is False:
-            # near a rim the distance curves whatever the surface does, so |∇φ| is not read; the
-            # size of the first-order error is said all the same (the Stanford bunny's vertices, a
-            # cloud with holes, on a grid 8 spacings across it: 11 % off on average, unsaid)
-            self.gradient = 1.0
+        if self.said or getattr(surface, "open_surface", False) or getattr(surface, "closed", True) is False:
             return
         self.gradient, low, high = gradient_range(tube)
         given = isinstance(surface, LevelSet) and not surface.redistance
