@@ -650,3 +650,16 @@ def test_a_part_pinching_off_while_two_others_merge_is_refused():
             tube = tube.moved(after)
     with pytest.raises(WarmStartRefused, match=r"4 connected component\(s\) do not match the previous ones one to one"):
         tube.solve(source, warm=sol)
+
+
+def test_a_component_that_moved_past_its_inner_tube_is_not_taken_for_a_change_of_topology():
+    # a sphere grown by 3.2 spacings with inner = 1.5 and outer = 6: no node lies in both inner
+    # tubes, which the one-to-one match took for "two parts merged" though the move is within
+    # outer − inner (a review's scratch); only a component meeting two of the other's is refused
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    r = np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1)
+    tube = ts.Tube(ts.LevelSet(r - 0.4), grid, inner=1.5, outer=6)
+    sol = tube.solve([(0.4, 0.0, 0.0)])
+    grown = 0.4 + 3.2 * grid.spacing
+    warm = tube.moved(ts.LevelSet(r - grown)).solve([(grown, 0.0, 0.0)], warm=sol)
+    assert warm.stats.converged and "refused" not in warm.stats.order2["warm"]

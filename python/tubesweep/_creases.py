@@ -87,8 +87,8 @@ def _early(angle: float, size: float, reckoned: str) -> str:
 
 def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: float) -> None:
     """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``):
-    the shortcut per crease, :data:`THINNED_SHORTCUT` spacings where the inner tube was thinned
-    there (``thinned``), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle."""
+    the shortcut per crease, ``thinned`` spacings where the inner tube was thinned there
+    (:func:`thinned_spacings`), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle."""
     if not creases or not creases.get("nodes"):
         return
     angle = float(creases["angle_degrees"])
@@ -109,8 +109,8 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
 
 def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: float) -> bool:
     """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases:
-    the shortcut per crease, :data:`THINNED_SHORTCUT` spacings on the tube thinned at them
-    (``thinned``), else ``2·tan(θ/2)·inner·Δx`` at the largest turn θ that the refusal names (the
+    the shortcut per crease, ``thinned`` spacings on the tube thinned at them
+    (:func:`thinned_spacings`), else ``2·tan(θ/2)·inner·Δx`` at the largest turn θ that the refusal names (the
     paper's tube; a re-distanced φ kept it until its crease nodes were thinned too: the box
     max|x| − 0.5 re-distanced at N = 41 came out 4.8Δx short per edge there, 1.16Δx thinned);
     whether it warned."""

@@ -136,7 +136,7 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
         return
     unresolved = _UNRESOLVED.search(reason)
     edges_only = unresolved is not None and int(unresolved.group(1)) < 100 * EDGES_SHARE
-    # (the inner tube thinned at the edges: THINNED_SHORTCUT spacings per edge, as at a crease)
+    # (the inner tube thinned at the edges: _creases.thinned_spacings per edge, as at a crease)
     per_edge = thinned_spacings(tube, True) if thinned else UNRESOLVED_SHORTCUT
     crossing = per_edge * spacing / gradient if edges_only else 0.0
     not_a_distance = NOT_A_DISTANCE in reason

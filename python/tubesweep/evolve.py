@@ -307,9 +307,11 @@ def evolve(
         A ``.npz`` file rewritten at each kept frame with ``phi``, ``t``, ``step`` and
         ``sources`` (written beside it and renamed, so that an interrupted write leaves the last
         one whole): ``evolve(c["phi"], grid, c["sources"], speed, ..., t0=float(c["t"]))``
-        continues from it, bit for bit as the uninterrupted run with the same ``dt``, ``every``
-        and a ``checkpoint`` (a step that writes one solves cold; the sources are kept as they
-        were before that step projected them).
+        continues from it. From a checkpoint written at a multiple of ``every`` steps, a run
+        continued with the same ``dt``, ``every`` and a ``checkpoint`` repeats the uninterrupted
+        one bit for bit (such a step solves cold; the sources are kept as they were before that
+        step projected them); from the last step's, when ``steps`` is not such a multiple, to a
+        few times the solver's tolerance.
     tol : float, optional
         The surface solves' tolerance (the default of :func:`tubesweep.solve`).
     t0 : float

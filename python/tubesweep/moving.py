@@ -134,10 +134,12 @@ def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[Any, ..
 def _topology_change(
     warm: Any, old: Tuple[int, int, np.ndarray], tube: Any, new: Tuple[int, int, np.ndarray]
 ) -> Optional[str]:
-    """Why the inner tube's topology changed from ``warm``'s to ``tube``'s, or None. The
-    components must correspond one to one through the nodes in both inner tubes: a count alone
-    let a part pinch off while two others merged (3 components before and after), and the part
-    that lost its source kept finite carried values."""
+    """Why the inner tube's topology changed from ``warm``'s to ``tube``'s, or None: another
+    number of connected components, or, with the same number, a component that meets two of the
+    other's through the nodes in both inner tubes (a count alone let a part pinch off while two
+    others merged, and the part that lost its source kept finite carried values). A component
+    that shares no inner node with the other tube (moved farther than the inner tube is wide,
+    within outer − inner) is not held against it."""
     from ._prepare import ROLE_OUTER
 
     if old[0] != new[0]:
@@ -151,15 +153,21 @@ def _topology_change(
     both = (np.asarray(warm.roles)[at_old] != ROLE_OUTER) & (np.asarray(tube.roles)[at_new] != ROLE_OUTER)
     # the (previous, new) label pairs, as one 64-bit key each (np.unique over rows is slow)
     keys = np.unique((old[2][at_old[both]].astype(np.uint64) << np.uint64(32)) | new[2][at_new[both]].astype(np.uint64))
-    pairs = np.stack([keys >> np.uint64(32), keys & np.uint64(0xFFFFFFFF)], axis=1)
-    before, after = np.unique(pairs[:, 0]), np.unique(pairs[:, 1])
-    if len(pairs) == len(before) == len(after) == old[0]:
+    before, after = keys >> np.uint64(32), keys & np.uint64(0xFFFFFFFF)
+    split = np.unique(before).size < before.size  # a previous component meets two new ones
+    merged = np.unique(after).size < after.size  # a new component meets two previous ones
+    if not (split or merged):
         return None
-    split = before[np.flatnonzero(np.bincount(np.searchsorted(before, pairs[:, 0])) > 1)]
-    how = "a part pinched off" if split.size else "two parts merged"
+    how = (
+        "a part pinched off while two others merged"
+        if split and merged
+        else "a part pinched off while another appeared"
+        if split
+        else "two parts merged while another vanished"
+    )
     return (
-        f"the inner tube's {new[0]} connected component(s) do not match the previous ones one to one ({how} while "
-        "others merged or split, keeping the count)"
+        f"the inner tube's {new[0]} connected component(s) do not match the previous ones one to one ({how}, keeping "
+        "the count)"
     )
 
 

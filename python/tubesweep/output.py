@@ -41,11 +41,12 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
     kind = "Polys" if k >= 3 else "Lines" if k == 2 else "Verts"
 
     def arr(a: np.ndarray, dtype: str) -> str:
-        # VTK's inline binary: the byte count (UInt32) and the little-endian values, each in base64.
+        # VTK's inline binary: the byte count (UInt64, header_type; UInt32 overflows past 4 GiB) and
+        # the little-endian values, each in base64.
         # Binary, not ASCII: VTK's ASCII reader stops at a NaN (an unreached node), which ParaView
         # then fails to read
         data = np.ascontiguousarray(a, dtype=dtype).tobytes()
-        return (base64.b64encode(np.uint32(len(data)).tobytes()) + base64.b64encode(data)).decode("ascii")
+        return (base64.b64encode(np.uint64(len(data)).tobytes()) + base64.b64encode(data)).decode("ascii")
 
     # written to a temporary file next to the target (through symlinks) and renamed over it when
     # complete, with the target's mode: an error half-way leaves no truncated file behind. A
@@ -72,7 +73,8 @@ def _write_vtp(path: Path, points: np.ndarray, cells: np.ndarray, point_data: Di
     try:
         with open(part, "w") as fh:
             fh.write(
-                '<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n<PolyData>\n'
+                '<?xml version="1.0"?>\n<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" header_type="UInt64">\n'
+                "<PolyData>\n"
             )
             fh.write(
                 f'<Piece NumberOfPoints="{n}" NumberOfVerts="{m if kind == "Verts" else 0}" NumberOfLines="{m if kind == "Lines" else 0}" '
@@ -158,9 +160,12 @@ def read_vtp(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray, Dict[str, 
         text = (el.text or "").strip()
         if el.get("format", "ascii") != "binary":
             return np.array(text.split(), dtype=dtype)
-        # the byte count (UInt32: 8 base64 characters), then the values
-        size = int(np.frombuffer(base64.b64decode(text[:8]), "<u4")[0])
-        raw = base64.b64decode(text[8:])
+        # the byte count (UInt32 or UInt64, the file's header_type: 8 or 12 base64 characters), then
+        # the values
+        wide = root.get("header_type", "UInt32") == "UInt64"
+        head = 12 if wide else 8
+        size = int(np.frombuffer(base64.b64decode(text[:head]), "<u8" if wide else "<u4")[0])
+        raw = base64.b64decode(text[head:])
         if len(raw) != size:
             raise ValueError(f"{path}: a DataArray holds {len(raw)} bytes where its header says {size}")
         return np.frombuffer(raw, "<f8" if dtype is float else "<i8").astype(dtype)

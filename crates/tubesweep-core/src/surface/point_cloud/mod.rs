@@ -288,8 +288,9 @@ impl<const D: usize> PointCloud<D> {
     /// direction are counted: while the gap exceeds [`RIM_GAP`], probe points go out along its
     /// bisector t at distances s = r, 2r, 4r, ... (r the fit's radius) up to 2·[`PointCloud::reach`]
     /// (the sparsest fit's radius: a gap no wider than that is spanned by the fits anyway), and the
-    /// first sample within s/2 of a probe and near the fitted graph (its offset from the graph
-    /// under half its distance) joins the neighbours. Where the sampling only thins (a scan denser
+    /// first sample within s/2 of a probe and near the fit (its offset from the fitted graph or
+    /// from the tangent plane, the smaller, under half its distance: [`on_graph`]) joins the
+    /// neighbours. Where the sampling only thins (a scan denser
     /// on one side) the gap closes; beyond a true rim the nearest sample to every probe is the rim
     /// itself, about s away, and the gap stays.
     fn bridged_gap(&self, p: &[f64; D], fit: &Fit<D>, ap: &[f64; 2], mut around: Vec<[f64; 2]>) -> f64 {
@@ -310,7 +311,7 @@ impl<const D: usize> PointCloud<D> {
                     probe[k] += s * t[k];
                 }
                 let q = &self.points[self.tree.nearest_one::<SquaredEuclidean>(&probe).item as usize];
-                // the offset from the fitted graph, not from the tangent plane: the surface's own
+                // the offset from the fitted graph (or the tangent plane, the smaller): the surface's own
                 // continuation follows the graph's curvature, another sheet curving beside it (the
                 // next turn of a spiral past its end) does not
                 let (aq, wq) = fit.local(q);
@@ -444,7 +445,9 @@ impl<const D: usize> PointCloud<D> {
             // farther turn): it is found again from that sample, and the nearer foot kept
             let far = distance(&foot, x);
             if far > nearest.distance.sqrt() + FARTHER_FOOT * radius + NOISY_FOOT * self.noise && on_surface != start {
-                if let (again, k, false, false, _) = self.fixed_point(x, on_surface, rho, cache) {
+                if let (again, k @ (Foot::Interior | Foot::Rim), false, false, _) =
+                    self.fixed_point(x, on_surface, rho, cache)
+                {
                     if distance(&again, x) < far {
                         return (again, k);
                     }
@@ -453,7 +456,9 @@ impl<const D: usize> PointCloud<D> {
             return (foot, kind);
         }
         if on_surface != start {
-            if let (again, k, false, false, _) = self.fixed_point(x, on_surface, rho, cache) {
+            if let (again, k @ (Foot::Interior | Foot::Rim), false, false, _) =
+                self.fixed_point(x, on_surface, rho, cache)
+            {
                 return (again, k);
             }
         }
