@@ -397,6 +397,11 @@ def evolve(
     out = Evolution([], [], [])
     tube: Optional[Any] = None
     older: Optional[Solution] = None
+
+    def checkpointed(step: int) -> bool:
+        # a step that writes a checkpoint at a multiple of every: solved cold, the next from it alone
+        return checkpoint is not None and step % every == 0
+
     prev: Optional[Solution] = None
     previous_band: Optional[np.ndarray] = None
     t = t0
@@ -425,7 +430,7 @@ def evolve(
                     # repeats the uninterrupted one bit for bit (warm, its first solve differed by
                     # 2.9 tolerances, its φ by 5e-8 after four more steps); a warm solve costs as
                     # much as a cold one here (docs/moving-surfaces.md)
-                    if checkpoint is not None and step % every == 0:
+                    if checkpointed(step):
                         warm = None
                     sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
                     cut = sol.stats.box_cut
@@ -512,7 +517,7 @@ def evolve(
             new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
             new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
             arr = new
-            older, prev = (None if checkpoint is not None and step % every == 0 else prev), sol
+            older, prev = (None if checkpointed(step) else prev), sol
             t = t0 + (step + 1) * dt  # not a running sum: no rounding carried from step to step
             if progress is not None:
                 try:

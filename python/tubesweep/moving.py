@@ -125,21 +125,26 @@ def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[Any, ..
 
     inner = np.ascontiguousarray(roles != ROLE_OUTER)
     crc = zlib.crc32(inner.view(np.uint8).data)
-    if known is not None and len(known) == 3 and known[1] == crc:
+    if known is not None and known[1] == crc:
         return known
     labels = _native.band_component_labels(band, inner)  # a component's label: its smallest position
     return int(np.count_nonzero(labels == np.arange(len(labels), dtype=np.uint32))), crc, labels
 
 
 def _topology_change(
-    warm: Any, old: Tuple[int, int, np.ndarray], tube: Any, new: Tuple[int, int, np.ndarray]
+    warm: Any,
+    old: Tuple[int, int, np.ndarray],
+    tube: Any,
+    new: Tuple[int, int, np.ndarray],
+    old_position: np.ndarray,
 ) -> Optional[str]:
     """Why the inner tube's topology changed from ``warm``'s to ``tube``'s, or None: another
     number of connected components, or, with the same number, a component that meets two of the
     other's through the nodes in both inner tubes (a count alone let a part pinch off while two
     others merged, and the part that lost its source kept finite carried values). A component
     that shares no inner node with the other tube (moved farther than the inner tube is wide,
-    within outer − inner) is not held against it."""
+    within outer − inner) is not held against it. ``old_position``: each of ``tube``'s band nodes'
+    position in ``warm``'s band (+∞ when new to it), as ``carried_values`` merged them."""
     from ._prepare import ROLE_OUTER
 
     if old[0] != new[0]:
@@ -147,9 +152,8 @@ def _topology_change(
             f"the inner tube has {new[0]} connected component(s), the previous one had {old[0]} (a part pinched off "
             "or two parts merged)"
         )
-    _, at_old, at_new = np.intersect1d(
-        np.asarray(warm.linear), np.asarray(tube.linear), assume_unique=True, return_indices=True
-    )
+    at_new = np.flatnonzero(np.isfinite(old_position))
+    at_old = old_position[at_new].astype(np.int64)
     both = (np.asarray(warm.roles)[at_old] != ROLE_OUTER) & (np.asarray(tube.roles)[at_new] != ROLE_OUTER)
     # the (previous, new) label pairs, as one 64-bit key each (np.unique over rows is slow)
     keys = np.unique((old[2][at_old[both]].astype(np.uint64) << np.uint64(32)) | new[2][at_new[both]].astype(np.uint64))
@@ -228,7 +232,8 @@ def carried_values(
     inner_new = tube.roles != ROLE_OUTER
     # whether each node of the new band was in the previous one: the same merge as the values,
     # carrying the previous positions (+∞ for a node new to the band)
-    in_both = np.isfinite(_native.carry_band_values(old_linear, np.arange(len(old_linear), dtype=float), new_linear))
+    old_position = _native.carry_band_values(old_linear, np.arange(len(old_linear), dtype=float), new_linear)
+    in_both = np.isfinite(old_position)
     # nodes of the new inner tube outside the previous band (a node in it that the previous solve
     # never reached, on a part without a source, stays unreached: the sweeps leave it at +∞)
     missing = int(np.count_nonzero(inner_new & ~in_both))
@@ -244,7 +249,7 @@ def carried_values(
     old = inner_components(warm._band, warm.roles, getattr(warm, "_inner_components", None))
     # (kept: the next step's warm start from this solve reads it)
     tube.inner_components = inner_components(tube.band, tube.roles, tube.inner_components)
-    changed = _topology_change(warm, old, tube, tube.inner_components)
+    changed = _topology_change(warm, old, tube, tube.inner_components, old_position)
     if changed is not None:
         raise WarmStartRefused(
             f"warm: the topology changed: {changed}; carried values on a part that lost its source would never "

@@ -24,9 +24,12 @@ a sampled φ does not start from its nodes but from the zero level set located c
 
 from __future__ import annotations
 
+import warnings
 from typing import Callable, Optional, Tuple
 
 import numpy as np
+
+from . import _native
 from ._warn import user_stacklevel
 
 __all__ = ["project_to_level_set", "GRADIENT_STEP", "SAMPLED_GRADIENT_STEP"]
@@ -129,8 +132,6 @@ def _project(
     """:func:`project_to_level_set` of the points ``x`` (M, d) for the surface's φ: in Rust for a
     sampled φ (the same iterations and bits), in NumPy for a callable."""
     if surface.is_dense:
-        from . import _native
-
         return _native.project_to_sampled_level_set(
             _scaled_samples(surface),
             [float(c) for c in grid.lower],
@@ -152,8 +153,6 @@ def estimate_lipschitz(surface, grid, n: int = 17) -> float:
     of a re-distanced callable φ (an array's candidates use a bound near each node instead, see
     :func:`redistanced_band`)."""
     if surface.is_dense:
-        from . import _native
-
         # the largest |∇φ| of numpy.gradient over every node, in one pass with nothing stored
         return max(1.25 * _native.max_gradient_norm_of_samples(surface._array, grid.spacing), 1e-12)
     axes = [np.linspace(lo, hi, n) for lo, hi in zip(grid.lower, grid.upper)]
@@ -211,8 +210,6 @@ def _warn_if_band_nodes_unprojected(
         return
     within = _on_zero_set_within(surface, grid, x[failed], cp[failed], half_width)
     if np.any(within):
-        import warnings
-
         warnings.warn(
             f"{int(np.count_nonzero(within))} nodes within the tube (at most {half_width:.3g} from the zero level set) "
             "could not be projected onto it (the closest-point iterations did not settle): they are left out of the "
@@ -352,7 +349,6 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
     :func:`project_to_level_set` from the node (the same iterations and fixed point, to the settling
     tolerance); unlike it, no step reads ∇φ away from the zero level set, so masks, plateaus and φ
     far from a distance work too."""
-    from . import _native
     from .band import BandGeometry
 
     _refuse_zero_region(surface._array)
@@ -374,8 +370,6 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
             "is negative inside the surface and positive outside, on a grid that holds the surface"
         )
     if medial:
-        import warnings
-
         warnings.warn(
             f"{medial} nodes within {0.5 * half_width:.3g} of the zero level set lie near points "
             "equidistant from two parts of it (their neighbours' closest points are more than 5 grid spacings apart): "
@@ -384,7 +378,7 @@ def _sampled_redistanced_band(surface, grid, half_width: float):
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
-    _warn_if_flat_at_surface(samples, grid, linear.view(np.int64), signed)
+    _warn_if_flat_at_surface(samples, grid, np.ascontiguousarray(linear.view(np.int64)), signed)
     return BandGeometry(linear.view(np.int64), None, signed, direction, consumable=True)
 
 
@@ -396,7 +390,7 @@ FLAT_AT_SURFACE = 0.5
 
 
 def _warn_if_flat_at_surface(array: np.ndarray, grid, linear: np.ndarray, signed: np.ndarray) -> None:
-    """A RuntimeWarning when φ's slope (central differences of the samples) at the band nodes
+    """A RuntimeWarning when φ's slope (central differences of the samples ``array``) at the band nodes
     within half a spacing of its zero level set is under :data:`FLAT_AT_SURFACE` of its slope at
     those 1.5 to 2.5 spacings away (medians): the multilinear interpolant then places the zero
     level set between the nodes only to first order."""
@@ -405,22 +399,16 @@ def _warn_if_flat_at_surface(array: np.ndarray, grid, linear: np.ndarray, signed
     near, far = linear[away <= 0.5 * h], linear[(away >= 1.5 * h) & (away <= 2.5 * h)]
     if near.size < 8 or far.size < 8:
         return
-    values = np.asarray(array, dtype=float)
 
     def slope(at: np.ndarray) -> float:
-        idx = np.unravel_index(at, values.shape)
-        squares = np.zeros(at.size)
-        for k, n in enumerate(values.shape):
-            up, down = list(idx), list(idx)
-            up[k], down[k] = np.minimum(idx[k] + 1, n - 1), np.maximum(idx[k] - 1, 0)
-            squares += ((values[tuple(up)] - values[tuple(down)]) / (2 * h)) ** 2
-        return float(np.median(np.sqrt(squares)))
+        # central differences of the samples, as the band's own directions take them
+        # (one-sided at the grid's faces)
+        scratch = np.empty((at.size, grid.ndim), np.float32)
+        return float(np.median(_native.outward_directions_of_samples(array, h, at.view(np.uint64), scratch)))
 
     at_surface, beyond = slope(near), slope(far)
     if not (beyond > 0 and at_surface < FLAT_AT_SURFACE * beyond):
         return
-    import warnings
-
     warnings.warn(
         f"φ's slope nearly vanishes on its zero level set (|∇φ| there is {at_surface / beyond:.2f} of its value two "
         "spacings away, as for φ = d·|d| or d³): interpolated between the nodes, the surface lies a fraction of a grid "
