@@ -66,6 +66,11 @@ CREASE_SHARE = 0.005
 #: A widest fit more than this many times the median one: the sampling is uneven enough that a
 #: fold of the closest points may come from parts sampled too sparsely for their curvature.
 UNEVEN_FITS = 4.0
+#: Band nodes whose closest points come from their nearest sample's fit alone (``Foot::NearestFit``
+#: of the Rust core: the fixed point wandered off the samples) are warned of above this share of
+#: the band (a noise-free box's edges at N = 61: 71 of some 30k nodes; one sample 0.5Δx off a
+#: sphere of 5000: one node, not warned of)
+NEAREST_FIT_SHARE = 1e-3
 #: Nodes per call of the native closest points (bounds the memory of a band's evaluation).
 CHUNK = 1 << 20
 #: A gap between two parts of a cloud wider than this many fit radii is kept apart (the band cut
@@ -642,6 +647,20 @@ class PointCloudSurface(ClosestPoint):
             + ": leave such samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid",
         )
         self.report["rim_nodes"] = int(np.count_nonzero(feet == 1))
+        # feet whose fixed point wandered off the samples, from the query and from its nearest
+        # sample: projected onto that sample's own fit instead (Foot::NearestFit)
+        self.report["nearest_fit_nodes"] = nearest = int(np.count_nonzero(feet == 3))
+        if nearest > NEAREST_FIT_SHARE * len(linear) and getattr(self, "_nearest_fit_warned", None) != grid:
+            self._nearest_fit_warned = grid  # (once per grid: a widened layer searches the band again)
+            warnings.warn(
+                f"{nearest} of the {len(linear)} band nodes ({100 * nearest / len(linear):.2g}%) have closest points "
+                "that the cloud's local fits do not find (their fixed point wanders off the samples): each was "
+                "projected onto its nearest sample's own fit instead, which keeps it among the samples but is not "
+                f"smooth, so the distances there are first order at best (cloud.report['nearest_fit_nodes']). The cause: "
+                f"{self.unresolved_advice}",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )
         # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|
         pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)
         again, _ = self._tree.closest(np.ascontiguousarray(cp[pick]), self.smoothing)

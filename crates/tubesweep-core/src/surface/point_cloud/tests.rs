@@ -133,3 +133,15 @@ fn the_ends_of_a_spiral_are_its_rim_though_the_next_turn_lies_beyond_them() {
     assert_eq!(cloud.mark_rim(&a.gap).unwrap(), 2);
     assert!(cloud.rim[0] && cloud.rim[n - 1]);
 }
+
+#[test]
+fn a_cloud_of_fewer_than_twice_the_neighbours_answers_without_panicking() {
+    // the candidates' cache took the 2k + 1 nearest samples and read the last of them: a cloud of
+    // k + 2 to 2k samples (which a fit allows) panicked with an index out of bounds
+    for n in [DEFAULT_NEIGHBOURS + 2, 30, 2 * DEFAULT_NEIGHBOURS] {
+        let cloud = PointCloud::new(sphere(n, 0.5), DEFAULT_NEIGHBOURS).unwrap();
+        let (c, _) = cloud.closest_point(&[0.0, 0.0, 0.7], 0.0);
+        let r = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        assert!((r - 0.5).abs() < 0.05, "{n} samples: |foot| = {r}");
+    }
+}
