@@ -25,7 +25,7 @@ from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
-from ._shortcuts import cut_shortcuts, cuts_medial_edges, cuts_shortcuts
+from ._shortcuts import cut_between_parts, cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -530,6 +530,8 @@ def _prepare_tube(
         band, cut_edges = cut_shortcuts(
             band, roles == ROLE_INNER, phi, directions, h, cut_facing, medial=cuts_medial_edges(surf)
         )
+        band, parted = cut_between_parts(surf, grid, band, linear)
+        cut_edges += parted
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)

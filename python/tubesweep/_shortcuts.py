@@ -3,16 +3,19 @@ have (``tubesweep_core::band::cut_edges``).
 
 The two-layer method (Algorithm 3) lets a node's update read every band neighbour, taking a step
 of one grid spacing in the tube for the step between the two nodes' closest points on the
-surface. Two kinds of edges break that:
+surface. Three kinds of edges break that:
 
 * across a gap narrower than the tubes, between two parts of the surface that face each other
   (``_prepare._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``): the front would
   cross the gap;
 * on a triangle mesh, above each concave edge, where the exact closest points of two neighbours
   lie on the two faces far apart (``tubesweep_core::band::medial_edges``): the front would cut
-  across the valley.
+  across the valley;
+* on a triangle mesh of separate pieces, between nodes whose nearest triangles lie on two of them
+  (``surfaces._mesh_parts``): the facing test reads the band's closest points, which the smooth
+  map can blend across a gap narrower than its fits.
 
-On a triangle mesh both are removed, so that the front travels only where closest points move
+On a triangle mesh all three are removed, so that the front travels only where closest points move
 continuously along the surface. On a point cloud only the first: its closest points come from
 local fits, which fold where the samples are sparse or off the surface, and cutting there left
 parts of a connected cloud unreached (a hemisphere sampled 50 times more sparsely than the
@@ -69,6 +72,19 @@ def cut_shortcuts(
         medial_node, medial_neighbour = band.medial_edges(inner, phi32, dir32, spacing, MEDIAL_JUMP)
         node = np.concatenate([node, medial_node])
         neighbour = np.concatenate([neighbour, medial_neighbour])
+    if node.size == 0:
+        return band, 0
+    return band.with_edges_cut(node, neighbour)
+
+
+def cut_between_parts(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
+    """The band without its edges between two separate parts of ``surf`` (a triangle mesh's
+    ``part_cut_pairs``: ``surfaces._mesh_parts``), and the number of edges removed; the band
+    itself on other surfaces and on a mesh of one part."""
+    pairs = getattr(surf, "part_cut_pairs", None)
+    if pairs is None:
+        return band, 0
+    node, neighbour = pairs(grid, band, linear)
     if node.size == 0:
         return band, 0
     return band.with_edges_cut(node, neighbour)

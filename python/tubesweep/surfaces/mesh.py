@@ -41,6 +41,7 @@ from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_
 from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
 from ._mesh_checks import thin_parts, warn_repeated_vertices, warn_thin_parts
+from ._mesh_parts import part_cut_pairs
 
 __all__ = [
     "from_mesh",
@@ -174,6 +175,7 @@ class MeshSurface(Surface):
     smooth = False
     #: the band is cut across narrow gaps and above concave edges (``tubesweep._shortcuts``)
     cuts_shortcuts = True
+    part_cut_pairs = part_cut_pairs  # the band's edges between separate parts (cut: _shortcuts)
 
     def __init__(
         self,
