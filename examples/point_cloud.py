@@ -19,7 +19,7 @@ import tubesweep as ts  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--n", type=int, default=81, help="grid nodes per axis on [-1, 1]^3")
-parser.add_argument("--out", type=Path, default=Path("."), help="folder for the picture")
+parser.add_argument("--out", type=Path, default=Path("out/gallery"), help="folder for the picture")
 args = parser.parse_args()
 
 # area-uniform random samples of the torus R = 0.5, r = 0.2

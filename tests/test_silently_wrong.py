@@ -247,3 +247,42 @@ def test_a_plane_or_a_sampled_phi_crossing_the_box_is_recorded_without_a_warning
     grid = ts.Grid((-1, -1, -1), (0.3, 1, 1), (66, 101, 101))
     with pytest.warns(RuntimeWarning, match="grid box cuts the surface"):
         ts.solve(torus, grid, [(-0.85, 0, 0)], order=1)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda speed, g: ts.solve(SPHERE, g, [(-0.5, 0, 0)], order=1, speed=speed).values,
+        lambda speed, g: ts.solve(SPHERE, g, [(-0.5, 0, 0)], hamiltonian="lxf", speed=speed).values,
+        lambda speed, g: ts.Tube(SPHERE, g).solve_many([(-0.5, 0, 0)], order=1, speed=speed)[0],
+        lambda speed, g: ts.travel_time(g, [(0.0, 0.0, 0.0)], speed=speed).ravel(),
+    ],
+)
+def test_first_order_results_scale_with_the_speed_under_the_default_tolerance(call):
+    # the first-order default tol was an absolute 1e-10: at speed 1e8 the sweeps stopped early,
+    # 1.9e-4 off in relative terms (Lax–Friedrichs 3.5e-3), with converged=True and no warning
+    g = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+    unit = call(1.0, g)
+    fast = call(1e8, g) * 1e8
+    finite = np.isfinite(unit)
+    assert np.array_equal(finite, np.isfinite(fast))
+    np.testing.assert_allclose(fast[finite], unit[finite], rtol=1e-9)
+
+
+def test_the_closest_pair_of_sources_is_found_without_a_table_of_all_gaps():
+    # source_radius's overlap check built the K × K table of the sources' gaps (1 GB at K = 4000)
+    from tubesweep._sources import closest_pair
+
+    rng = np.random.default_rng(0)
+    for m, d in ((2, 3), (50, 3), (400, 2), (300, 3)):
+        p = rng.uniform(-1, 1, (m, d))
+        p[:, 0] *= 1e-3 if m == 300 else 1.0  # crowded along one axis: sorted along another
+        full = np.linalg.norm(p[:, None] - p[None], axis=2) + np.diag(np.full(m, np.inf))
+        gap, i, j = closest_pair(p, np.inf)
+        assert gap == full.min() and full[i, j] == gap
+        assert closest_pair(p, 0.999 * full.min()) == (np.inf, -1, -1)
+    # many sources on a sphere, each ball apart: no table, and the nearest two named
+    x = rng.normal(size=(20000, 3))
+    feet = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
+    gap, i, j = closest_pair(feet, 0.02)
+    assert gap < 0.02 and np.isclose(np.linalg.norm(feet[i] - feet[j]), gap)

@@ -112,48 +112,58 @@ def test_tol_must_be_positive_and_max_iterations_bounded():
 
 
 @pytest.mark.parametrize("speed", [1e15, 1e9])
-def test_a_tol_not_small_against_a_cell_s_travel_time_is_refused(speed):
-    # at speed 1e15 the default tol 1e-10 exceeds every travel time: the sweeps stopped at once,
-    # half the band at the numerical infinity, reported converged
+def test_a_tol_not_small_against_a_cell_s_travel_time_is_refused_and_the_default_scales(speed):
+    # at speed 1e15 a tol of 1e-10 exceeds every travel time: the sweeps stopped at once, half the
+    # band at the numerical infinity, reported converged. Given, it is refused; the default (an
+    # absolute 1e-10 that was refused too, though the caller never gave it) is now 1e-10 of the
+    # travel time across the grid
     with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel times of this problem"):
-        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, order=1)
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, order=1, tol=1e-10)
     with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel times"):
-        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, hamiltonian=ts.hamiltonians.Isotropic(), order=1)
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, hamiltonian=ts.hamiltonians.Isotropic(), order=1, tol=1e-10)
     with pytest.raises(ValueError, match="travel times"):
-        ts.travel_time(G2, [(0, 0)], speed=speed)
-    # the fix the message names works, and gives the speed-1 answer scaled
+        ts.travel_time(G2, [(0, 0)], speed=speed, tol=1e-10)
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], order=1)([(0.5, 0, 0)])[0]
+    # the fix the message names works, and gives the speed-1 answer scaled; so does the default
     cell = G3.spacing / speed
     u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, tol=1e-10 * cell, order=1)([(0.5, 0, 0)])[0]
-    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], order=1)([(0.5, 0, 0)])[0]
     assert abs(u * speed - u1) < 1e-6 * u1
+    for kw in (dict(), dict(hamiltonian=ts.hamiltonians.Isotropic())):
+        unit = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], order=1, **kw)([(0.5, 0, 0)])[0]
+        u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed, order=1, **kw)([(0.5, 0, 0)])[0]
+        assert abs(u * speed - unit) < 1e-9 * unit
+    box = ts.travel_time(G2, [(0, 0)], speed=speed, order=1) * speed
+    np.testing.assert_allclose(box, ts.travel_time(G2, [(0, 0)], order=1), rtol=1e-9)
 
 
-def test_a_metric_that_shrinks_the_travel_times_needs_a_tol_on_their_scale():
-    # M = 1e30·I makes every travel time 1e-15 of the isotropic one: the default tol stopped the
-    # sweeps after two iterations with 87% of the band at infinity, reported converged
+def test_a_metric_that_shrinks_the_travel_times_sets_the_default_tol_on_their_scale():
+    # M = 1e30·I makes every travel time 1e-15 of the isotropic one: a tol of 1e-10 stopped the
+    # sweeps after two iterations with 87% of the band at infinity, reported converged; given, it
+    # is refused, and the default is 1e-10 of the metric's travel time across the grid
     big = ts.hamiltonians.Metric(1e30 * np.eye(3))
     with pytest.raises(ValueError, match=r"tol=1e-10 is not small against the travel times.*Hamiltonian"):
-        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=big)
-    # the tol it names works, and gives the identity metric's answer scaled by 1e-15
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=big, tol=1e-10)
+    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(3)))([(0.5, 0, 0)])[0]
+    # the tol it names works, and gives the identity metric's answer scaled by 1e-15; so does the default
     cell = 1e-15 * G3.spacing
     u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=big, tol=1e-10 * cell)([(0.5, 0, 0)])[0]
-    u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(3)))([(0.5, 0, 0)])[0]
     assert abs(u * 1e15 - u1) < 1e-6 * u1
+    u = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=big)([(0.5, 0, 0)])[0]
+    assert abs(u * 1e15 - u1) < 1e-9 * u1
     # a metric that lengthens the travel times is no reason to refuse the default tol
     slow = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(1e-30 * np.eye(3)))([(0.5, 0, 0)])[0]
     assert abs(slow * 1e-15 - u1) < 1e-6 * u1
 
 
-def test_a_small_grid_in_small_units_needs_a_tol_in_those_units():
+def test_a_small_grid_in_small_units_needs_a_tol_in_those_units_and_the_default_has_it():
     s = 1e-12
     grid = ts.Grid((-s,) * 3, (s,) * 3, (31,) * 3)
     with pytest.raises(ValueError, match="tol"):
-        ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], order=1)
-    u = ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], tol=1e-10 * grid.spacing, order=1)(
-        [(0.5 * s, 0, 0)]
-    )[0]
+        ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], order=1, tol=1e-10)
     u1 = ts.solve(SPHERE, G3, [(-0.5, 0, 0)], order=1)([(0.5, 0, 0)])[0]
-    assert abs(u / s - u1) < 1e-6
+    for tol in (1e-10 * grid.spacing, None):
+        u = ts.solve(ts.surfaces.Sphere(0.5 * s), grid, [(-0.5 * s, 0, 0)], tol=tol, order=1)([(0.5 * s, 0, 0)])[0]
+        assert abs(u / s - u1) < 1e-6
 
 
 @pytest.mark.parametrize("value, match", [(np.nan, "speed is nan"), (-1.0, "speed is -1.0"), (0.0, "speed is 0.0")])
@@ -432,3 +442,42 @@ def test_warm_refused_is_checked_without_warm():
     grid = ts.Grid((-1, -1, -1), (1, 1, 1), (21, 21, 21))
     with pytest.raises(ValueError, match="warm_refused must be 'raise'"):
         ts.solve(ts.surfaces.Sphere(0.5), grid, [(0, 0, 0.5)], warm_refused="ignore")
+
+
+@pytest.mark.parametrize(
+    "name, call",
+    [
+        ("signed", lambda v: ts.surfaces.from_mesh(_tetra(), signed=v)),
+        ("normalize", lambda v: ts.surfaces.from_mesh(_tetra(), normalize=v)),
+        ("redistance", lambda v: ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5, redistance=v)),
+        ("allow_supersonic", lambda v: ts.solve(ts.surfaces.Circle(0.5), _G2, [(0.5, 0)], allow_supersonic=v)),
+        ("return_stats", lambda v: ts.travel_time(_G2, [(0, 0)], return_stats=v)),
+        ("return_solution", lambda v: ts.travel_time(_G2, [(0, 0)], return_solution=v)),
+        ("return_stats", lambda v: ts.Tube(ts.surfaces.Circle(0.5), _G2).solve_many([(0.5, 0)], return_stats=v)),
+        ("info", lambda v: ts.distance_matrix(ts.surfaces.Circle(0.5), _G2, [(0.5, 0), (-0.5, 0)], info=v)),
+    ],
+)
+def test_yes_no_options_refuse_other_values_by_name(name, call):
+    # a truthy string was taken for True: from_mesh(signed='no') signed the mesh, LevelSet(φ,
+    # redistance='no') re-distanced, travel_time(return_stats='no') returned a tuple
+    for bad in ("no", 1, None):
+        if bad is None and name == "signed":
+            continue  # signed=None: as the mesh is (closed or not)
+        with pytest.raises(TypeError, match=rf"{name} must be True or False"):
+            call(bad)
+
+
+_G2 = ts.Grid((-1, -1), (1, 1), (41, 41))
+
+
+def _tetra():
+    v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    return v, np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+
+
+def test_a_vertex_index_as_a_source_points_to_the_vertex_s_coordinates():
+    g = ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3)
+    with pytest.raises(ValueError, match=r"got shape \(1,\) \(to start at vertex i of a mesh .*surface\.vertices\[i\]"):
+        ts.solve(ts.surfaces.Sphere(0.5), g, [4])
+    with pytest.raises(ValueError, match=r"got shape \(2,\)$"):  # not whole numbers: no such note
+        ts.solve(ts.surfaces.Sphere(0.5), g, [0.5, 0.1])

@@ -148,7 +148,10 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     elif gradient == 1.0:
         scaled = "; φ is not a distance (its |∇φ| is 1 on average but spreads over the tube)"
     else:
-        scaled = f"; φ is not a distance (mean |∇φ| = {gradient:.3g}), which scales the tube and the errors by 1/|∇φ|"
+        scaled = (
+            f"; φ is not a distance (mean |∇φ| = {gradient:.3g}), which scales the tube and the errors by 1/|∇φ| (a "
+            "distance sampled on another box or spacing than the grid's reads so too: sample it at grid.meshgrid())"
+        )
     edges = (
         f", and up to about {crossing:.3g} more ({100 * crossing / largest:.0f}% of the largest) for each edge, tip "
         "or corner with a curvature radius below the tube's width that a path crosses (as at a crease)"

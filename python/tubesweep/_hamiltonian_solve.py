@@ -11,7 +11,7 @@ import numpy as np
 
 from .grid import Grid
 from .hamiltonians import Hamiltonian, _Prepared
-from ._validate import check_tolerance_scale
+from ._validate import check_tolerance_scale, first_order_tol
 
 
 def _coefficient_bytes(prep: _Prepared, n_nodes: int, d: int) -> int:
@@ -54,24 +54,30 @@ def solve_band(
     speed_nodes: Any,
     exact_sources: bool,
     source_radius: float,
-    tol: float,
+    tol: Optional[float],
     max_iterations: int,
     infinity: Optional[float],
     progress: Optional[Callable[[int, float, int], None]],
     threads: int = 0,
-    activation_threshold: float = 0.0,
+    activation_fraction: float = 0.0,
     defer_outer_rim: bool = True,
 ) -> tuple:
     """Prepares the per-node data of ``ham``, re-initialises the source nodes with its local
     travel time (for ``exact_sources``), and runs the sweeps with the upwind local solver or the
-    general Lax–Friedrichs update (Sect. 5.1), as ``prep.scheme`` says."""
+    general Lax–Friedrichs update (Sect. 5.1), as ``prep.scheme`` says. ``tol`` None: 1e-10 of
+    the Hamiltonian's travel time across the grid, at most 1e-10 (``_validate.first_order_tol``);
+    the sweeps skip changes below ``activation_fraction`` of it. Returns the values, the native
+    report and the ``tol`` used."""
     x = grid.node_points(geom.linear)
     slow = np.ascontiguousarray(np.broadcast_to(1.0 / np.asarray(speed_nodes, dtype=float), (len(roles),)))
     prep = ham.prepare(surface, grid, geom.linear, x, geom.direction, slow, roles)
+    cell_slowness = _mean_cell_time(ham, prep, len(roles), grid) / grid.spacing
+    tol = first_order_tol(tol, grid.spacing, cell_slowness, max(grid.shape))
+    activation_threshold = activation_fraction * tol
     check_tolerance_scale(
         tol,
         grid.spacing,
-        _mean_cell_time(ham, prep, len(roles), grid) / grid.spacing,
+        cell_slowness,
         max(grid.shape),
         "the Hamiltonian's travel time along the axes, averaged over the band",
         "the Hamiltonian's coefficients",
@@ -114,4 +120,4 @@ def solve_band(
     # "upwind" for the moving medium and metrics, Eq. (3) itself for the isotropic Hamiltonian
     st["local_solver"] = "lxf" if prep.scheme == "lxf" else ("godunov" if prep.kind == "isotropic" else "upwind")
     st.update(prep.extra if "inverse" not in prep.extra else {})
-    return values, st
+    return values, st, tol

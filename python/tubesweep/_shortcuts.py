@@ -79,9 +79,9 @@ def cut_shortcuts(
 
 def cut_between_parts(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
     """The band without its edges between two separate parts of ``surf`` (a triangle mesh's
-    ``part_cut_pairs``: ``surfaces._mesh_parts``), and the number of edges removed; the band
+    ``_part_cut_pairs``: ``surfaces._mesh_parts``), and the number of edges removed; the band
     itself on other surfaces and on a mesh of one part."""
-    pairs = getattr(surf, "part_cut_pairs", None)
+    pairs = getattr(surf, "_part_cut_pairs", None)
     if pairs is None:
         return band, 0
     node, neighbour = pairs(grid, band, linear)

@@ -33,6 +33,10 @@ def how_far(distance: float) -> str:
             "is not near the surface (φ there does not lead to its zero level set: its slope vanishes, as deep inside a "
             "voxel mask or at a ball's centre, where a re-distanced φ is only known within its band)"
         )
+    if np.isnan(distance):
+        # a closest point that the surface could not give (a point cloud's fits find no surface
+        # so far from the samples, at the centre of a sphere of them)
+        return "is far from the surface (its closest point there is not defined: NaN)"
     return f"is {distance:.4g} from the surface"
 
 
@@ -167,6 +171,27 @@ def _chord_errors(surface: Surface, grid: Grid, foot: np.ndarray, cp: np.ndarray
     return np.where(np.isfinite(err), err, 0.0)
 
 
+def closest_pair(points: np.ndarray, within: float) -> Tuple[float, int, int]:
+    """The distance between the two nearest of ``points`` (M ≥ 2) and their indices, when it is
+    below ``within``; else ``(inf, -1, -1)``. Sorted along the axis of widest spread and swept:
+    O(M) memory, and O(M log M) time unless many points crowd within ``within`` of one another
+    along that axis (the K × K table of all the gaps took 1 GB at K = 4000 sources)."""
+    axis = int(np.argmax(np.ptp(points, axis=0)))
+    order = np.argsort(points[:, axis], kind="stable")
+    p = points[order]
+    best, bi, bj = np.inf, -1, -1
+    for k in range(1, len(p)):
+        limit = min(best, within)
+        near = np.flatnonzero(p[k:, axis] - p[:-k, axis] < limit)
+        if near.size == 0:
+            break  # farther offsets only spread more along the sorted axis
+        gaps = np.linalg.norm(p[near + k] - p[near], axis=1)
+        m = int(np.argmin(gaps))
+        if gaps[m] < limit:
+            best, bi, bj = float(gaps[m]), int(order[near[m]]), int(order[near[m] + k])
+    return best, bi, bj
+
+
 def _check_source_balls(grid: Grid, feet: np.ndarray, reach: float, chord_error: float, chord_fit: float) -> None:
     """With a ``source_radius`` beyond the default: refuses a radius within which the chord is not
     the distance along the surface (the surface curves), and warns when the balls of two sources
@@ -183,15 +208,13 @@ def _check_source_balls(grid: Grid, feet: np.ndarray, reach: float, chord_error:
             f"{fit:.3g}, or leave it out (the default, {SOURCE_RADIUS:g} grid spacings)"
         )
     if len(feet) > 1:
-        gaps = np.linalg.norm(feet[:, None, :] - feet[None, :, :], axis=2)
-        gaps[np.diag_indices(len(feet))] = np.inf
-        i, j = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
-        if gaps[i, j] < 2.0 * reach:
+        gap, i, j = closest_pair(feet, 2.0 * reach)
+        if gap < 2.0 * reach:
             warnings.warn(
                 f"source_radius = {reach:.4g}: the balls of exact values around sources[{min(i, j)}] and "
-                f"sources[{max(i, j)}] overlap (they are {gaps[i, j]:.4g} apart, less than twice the radius): the nodes "
+                f"sources[{max(i, j)}] overlap (they are {gap:.4g} apart, less than twice the radius): the nodes "
                 f"in both are fixed to the nearer chord and where the two fronts meet is not solved for. Use "
-                f"source_radius < {0.5 * gaps[i, j]:.4g} to keep the sources' balls apart",
+                f"source_radius < {0.5 * gap:.4g} to keep the sources' balls apart",
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )

@@ -117,7 +117,17 @@ def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
     if p.ndim == 1 and p.size == ndim:
         p = p.reshape(1, ndim)
     if p.ndim != 2 or p.shape[1] != ndim:
-        raise ValueError(f"{name} must have shape (M, {ndim}) for a {ndim}D grid; got shape {p.shape}")
+        # (whole numbers alone: indices, as a mesh's vertex or a cloud's sample, which are points there)
+        index = p.ndim <= 1 and p.size > 0 and bool(np.all(p == np.round(p)))
+        raise ValueError(
+            f"{name} must have shape (M, {ndim}) for a {ndim}D grid; got shape {p.shape}"
+            + (
+                " (to start at vertex i of a mesh or sample i of a point cloud, pass its point: "
+                "surface.vertices[i] or surface.points[i])"
+                if index
+                else ""
+            )
+        )
     if not np.all(np.isfinite(p)):
         bad = np.flatnonzero(~np.all(np.isfinite(p), axis=1))
         raise ValueError(f"{name} contains NaN or inf (row {bad[0]}); every coordinate must be finite")
@@ -147,6 +157,14 @@ def check_hamiltonian(hamiltonian: str) -> str:
 MAX_ITERATIONS_LIMIT = 10**9
 
 
+def check_flag(value: Any, name: str, none: bool = False) -> Any:
+    """``value`` when it is True or False (or None, with ``none``), else a TypeError naming
+    ``name``: a truthy string such as ``'no'`` read as True (``signed='no'`` signed a mesh)."""
+    if isinstance(value, (bool, np.bool_)) or (none and value is None):
+        return value if value is None else bool(value)
+    raise TypeError(f"{name} must be True or False{' or None' if none else ''}; got {value!r}")
+
+
 def check_tolerance(tol: Optional[float], max_iterations: int) -> None:
     """Refuses a ``tol`` that is not a positive finite number (None stands for the scheme's own
     default) and a ``max_iterations`` out of range."""
@@ -160,6 +178,23 @@ def check_tolerance(tol: Optional[float], max_iterations: int) -> None:
         raise ValueError(
             f"max_iterations must be an integer from 1 to {MAX_ITERATIONS_LIMIT:,}; got {max_iterations!r}"
         )
+
+
+#: The first-order sweeps' default ``tol`` (``tol=None``) at travel times across the grid of 1 or
+#: more; below, that share of them (:func:`first_order_tol`).
+FIRST_ORDER_TOL = 1e-10
+
+
+def first_order_tol(tol: Optional[float], spacing: float, mean_slowness: float, cells: int) -> float:
+    """``tol``, or when None the first-order sweeps' default: :data:`FIRST_ORDER_TOL` times the
+    travel time across the grid's longest side (``spacing`` × ``mean_slowness`` × ``cells``), at
+    most :data:`FIRST_ORDER_TOL`. An absolute 1e-10 stopped the sweeps early where travel times
+    are small (a speed of 1e8 on the unit sphere: 1.9e-4 off in relative terms, ``converged=True``;
+    a grid in units of 1e-9: 9.7e-4), and refused a grid in units of 1e-10 for a ``tol`` the
+    caller never gave; now the result scales with the units."""
+    if tol is not None:
+        return tol
+    return FIRST_ORDER_TOL * min(1.0, spacing * mean_slowness * cells)
 
 
 def check_tolerance_scale(

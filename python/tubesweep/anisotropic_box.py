@@ -12,7 +12,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ._result_check import check_values
-from ._validate import ACTIVATION_FRACTION, check_tolerance_scale, warn_unconverged
+from ._validate import ACTIVATION_FRACTION, check_tolerance_scale, first_order_tol, warn_unconverged
 from .grid import Grid
 from .stats import SolveStats
 
@@ -50,7 +50,7 @@ def travel_time_general(
     sources: np.ndarray,
     ham: Any,
     slowness: Any,
-    tol: float,
+    tol: Optional[float],
     max_iterations: int,
     return_stats: bool,
     cb: Optional[Callable],
@@ -69,10 +69,13 @@ def travel_time_general(
     roles = np.ones(grid.size, dtype=np.uint8)
     prep = ham.prepare(None, grid, linear, x, None, slow, roles)
     del x
+    cell_slowness = _mean_cell_time(ham, prep, grid.size, grid) / grid.spacing
+    # (tol None: 1e-10 of the Hamiltonian's travel time across the box, at most 1e-10)
+    tol = first_order_tol(tol, grid.spacing, cell_slowness, max(grid.shape))
     check_tolerance_scale(
         tol,
         grid.spacing,
-        _mean_cell_time(ham, prep, grid.size, grid) / grid.spacing,
+        cell_slowness,
         max(grid.shape),
         "the Hamiltonian's travel time along the axes, averaged over the box",
         "the Hamiltonian's coefficients",

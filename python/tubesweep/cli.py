@@ -50,8 +50,8 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
         "--tol",
         type=float,
         default=None,
-        help="stop when no value changes by more than this in an iteration (default: 1e-10 at first order, "
-        "about 5e-4 spacing² at second order; at first order about 1e-3 × the grid spacing is as accurate "
+        help="stop when no value changes by more than this in an iteration (default: 1e-10 of the travel time across the grid, at most 1e-10, "
+        "at first order, about 5e-4 spacing² at second order; at first order about 1e-3 × the grid spacing is as accurate "
         "and faster)",
     )
     p.add_argument(

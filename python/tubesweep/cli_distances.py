@@ -76,8 +76,8 @@ def add_distances_parser(sub: Any) -> None:
         "--tol",
         type=float,
         default=None,
-        help="stop when no value changes by more than this in an iteration (default: 1e-10 at first order, "
-        "about 5e-4 spacing² at second order)",
+        help="stop when no value changes by more than this in an iteration (default: 1e-10 of the travel time across the grid, at most 1e-10, "
+        "at first order, about 5e-4 spacing² at second order)",
     )
     p.add_argument(
         "--order",

@@ -21,7 +21,7 @@ from typing import Any, Callable, Optional, Tuple, Union
 import numpy as np
 
 from ._sources import how_far
-from ._validate import as_points
+from ._validate import as_points, check_flag
 from ._prepare import ROLE_INNER
 from .solve import _check_order
 from .tube import Tube
@@ -124,6 +124,7 @@ def distance_matrix(
     >>> D.shape, bool(np.all(D == D.T))
     ((3, 3), True)
     """
+    check_flag(info, "info")
     t0 = time.perf_counter()
     tube = _as_tube(surface, grid, inner, outer)
     snapped = snap_to_surface(tube, points)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional
 
 import numpy as np
 
-from ._validate import as_points
+from ._validate import as_points, check_flag
 from .many import check_many_progress, fixed_nodes, source_groups
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -137,6 +137,7 @@ def solve_many_on_client(
     tube._check_phi_unchanged()
     groups = source_groups(sources, tube.grid.ndim)
     k = len(groups)
+    check_flag(return_stats, "return_stats")
     if k == 0:
         raise ValueError("sources is empty: give at least one source (a point, or a group of points)")
     cb = check_many_progress(progress)

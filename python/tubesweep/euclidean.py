@@ -12,6 +12,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_flag,
     ACTIVATION_FRACTION,
     check_threads as _threads,
     check_infinity as _infinity,
@@ -21,6 +22,7 @@ from ._validate import (
     check_memory,
     check_tolerance,
     check_tolerance_scale,
+    first_order_tol,
     tolerance_slowness,
     speed_at_points,
     progress_callback,
@@ -181,7 +183,7 @@ def travel_time(
         Solve a flow with ``|v| ≥ F`` somewhere anyway (Lax–Friedrichs, with a ``RuntimeWarning``).
     tol : float, optional
         Stop when the largest change in one iteration (2^d sweeps) is below ``tol``. Default
-        1e-10 with ``order=1``; with ``order=2`` each phase stops below
+        with ``order=1`` 1e-10 of the travel time across the box (its longest side), at most 1e-10; with ``order=2`` each phase stops below
         ``1e-3 · s̄ · Δx² / L`` (``s̄`` the mean slowness, at most twice its lower quartile so that an
         obstacle does not loosen it; ``L`` the box's longest side), far below its O(Δx²) error.
     max_iterations : int
@@ -248,6 +250,8 @@ def travel_time(
     0.0
     """
     t0 = time.perf_counter()
+    check_flag(return_stats, "return_stats")
+    check_flag(return_solution, "return_solution")
     grid = as_grid(grid)
     src = as_sources(sources, grid)
     from . import hamiltonians as _hams
@@ -266,8 +270,6 @@ def travel_time(
             "return_solution=True is for the eikonal equation; with flow= or a Hamiltonian object "
             "travel_time returns the array (pass return_solution=False)"
         )
-    if tol is None and (order == 1 or general is not None):
-        tol = 1e-10
     check_tolerance(tol, max_iterations)
     cb = progress_callback(progress)
     # before anything of the box's size is allocated (a callable speed also takes the nodes'
@@ -295,7 +297,7 @@ def travel_time(
             src,
             general,
             slowness,
-            tol,  # type: ignore[arg-type]
+            tol,
             max_iterations,
             return_stats,
             cb,
@@ -308,7 +310,10 @@ def travel_time(
         if return_stats and fallback is not None:
             result = (result[0], dataclasses.replace(result[1], order_fallback=fallback))
         return result
-    if tol is None:
+    if tol is None and order == 1:
+        # 1e-10 of the travel time across the box, at most 1e-10
+        tol = first_order_tol(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))
+    elif tol is None:
         # the mean slowness, capped where an obstacle pulls it up (_validate.tolerance_slowness)
         tol = order2_tol(grid, tolerance_slowness(slowness))
     check_tolerance_scale(tol, grid.spacing, float(np.mean(slowness)), max(grid.shape))

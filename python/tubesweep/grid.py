@@ -135,9 +135,9 @@ class Grid:
             if abs(steps[k] - h) > _SPACING_RTOL * h:
                 fix_n = (hi[k] - lo[k]) / h + 1
                 raise ValueError(
-                    f"non-uniform spacing: axis {k} has spacing {steps[k]:.6g} but axis 0 has {h:.6g}. "
-                    f"tubesweep needs equal spacing in every axis: use upper[{k}] = {lo[k] + h * (shp[k] - 1):.6g} "
-                    f"or shape[{k}] ≈ {fix_n:.6g} (must be an integer)"
+                    f"non-uniform spacing: axis {k} has spacing {steps[k]:.10g} but axis 0 has {h:.10g} (they differ by "
+                    f"{abs(steps[k] - h) / h:.2g} of it). tubesweep needs equal spacing in every axis: use upper[{k}] = "
+                    f"{lo[k] + h * (shp[k] - 1):.10g} or shape[{k}] ≈ {fix_n:.6g} (must be an integer)"
                 )
         self._lower = lo
         self._upper = lo + h * (np.asarray(shp) - 1)

@@ -30,7 +30,7 @@ from typing import Any, Dict, Optional
 import numpy as np
 
 from .grid import Grid
-from ._validate import call_on_points, real_array
+from ._validate import call_on_points, check_flag, real_array
 from ._warn import user_stacklevel
 
 __all__ = ["Hamiltonian", "Isotropic", "MovingMedium", "Metric", "NORMAL_FLOW_RTOL"]
@@ -409,7 +409,7 @@ class MovingMedium(Hamiltonian):
                 "MovingMedium needs a flow: a callable v(points) -> (M, d), an array of grid.shape + (d,) or a vector"
             )
         self.flow = flow
-        self.allow_supersonic = bool(allow_supersonic)
+        self.allow_supersonic = bool(check_flag(allow_supersonic, "allow_supersonic"))
 
     def __repr__(self) -> str:
         return (
@@ -691,6 +691,7 @@ class Metric(Hamiltonian):
 def resolve(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Optional[Hamiltonian]:
     """The general Hamiltonian a ``solve`` call asks for, or None for the eikonal schemes
     (``"godunov"``, ``"lxf"``). ``flow`` selects :class:`MovingMedium`."""
+    check_flag(allow_supersonic, "allow_supersonic")
     if isinstance(hamiltonian, Hamiltonian):
         if flow is not None:
             raise ValueError(

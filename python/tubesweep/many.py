@@ -18,6 +18,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_flag,
     ACTIVATION_FRACTION,
     FRONT_WINDOW,
     as_points,
@@ -26,6 +27,7 @@ from ._validate import (
     check_threads,
     check_tolerance,
     check_tolerance_scale,
+    first_order_tol,
     checked_point_speeds,
     speed_at_points,
     speed_values,
@@ -38,7 +40,7 @@ from ._fallback import Fallback
 from ._sources import SOURCE_RADIUS, _fix_sources
 from .many_order2 import renamed, solve_many_order2
 from . import second_order as so
-from .solve import DEFAULT_TOL, _check_order, _check_source_init, _resolve_scheme
+from .solve import _check_order, _check_source_init, _resolve_scheme
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube
@@ -169,6 +171,7 @@ def solve_many(
     """See :meth:`tubesweep.Tube.solve_many` (the local run; a Dask client goes through
     :mod:`tubesweep.distributed`)."""
     t0 = time.perf_counter()
+    check_flag(return_stats, "return_stats")
     order = _check_order(order)
     tube._check_phi_unchanged()
     t = tube._tube
@@ -222,7 +225,6 @@ def solve_many(
             fallback = Fallback.of(e, order)
             if isinstance(e, so.OptionOfOrder1):
                 order = 1  # an option of the first-order scheme: its tube, as ts.solve's and tube.solve's
-    tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if order != 1:
         t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
     if fallback is not None:
@@ -233,6 +235,7 @@ def solve_many(
     del x
     slowness: Any = 1.0 / speed_nodes
     h = grid.spacing
+    tol = first_order_tol(tol, h, float(np.mean(slowness)), max(grid.shape))  # the first-order scheme's default
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     # the Lax–Friedrichs scheme runs on the band before its cut (``_shortcuts``), with the warning
     uncut = scheme == "lxf" and t.cut_edges > 0

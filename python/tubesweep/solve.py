@@ -18,6 +18,8 @@ from ._validate import (
     check_hamiltonian,
     check_tolerance,
     check_tolerance_scale,
+    FIRST_ORDER_TOL,
+    first_order_tol,
     checked_point_speeds,
     speed_at_points,
     progress_callback,
@@ -51,9 +53,10 @@ from .solution import Solution
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
 
-#: The default stopping tolerance of the first-order sweeps (``tol=None``; ``order=2`` has its
-#: own, ``second_order.default_tol``).
-DEFAULT_TOL = 1e-10
+#: The default stopping tolerance of the first-order sweeps (``tol=None``) at travel times across
+#: the grid of 1 or more (below, that share of them: ``_validate.first_order_tol``; ``order=2``
+#: has its own, ``second_order.default_tol``).
+DEFAULT_TOL = FIRST_ORDER_TOL
 
 SOURCE_INITS = ("exact", "node")
 
@@ -145,7 +148,7 @@ def solve(
     tol, max_iterations : float or None, int
         Stop when no value changes by more than ``tol`` in an iteration of 2^d sweeps, or after
         ``max_iterations`` (then ``stats.converged`` is False, with a warning). ``tol=None`` (the
-        default) stands for 1e-10 with ``order=1`` and with ``order=2`` for ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D; times
+        default) stands with ``order=1`` for 1e-10 of the travel time across the grid (its longest side at the mean slowness), at most 1e-10, and with ``order=2`` for ``5e-4 Δx²/ℓ`` (3D) or ``1e-3 Δx²/ℓ`` (2D; times
         ``200 Δx/ℓ`` where that is below 1) times the mean slowness (at most twice its lower quartile, so that an obstacle does not
         loosen it), ℓ half the grid's longest side.
     progress : callable, optional
@@ -380,7 +383,6 @@ def _solve_on_tube(
     """Fixes the sources on the prepared tube and sweeps. With ``reuse`` the tube is left as it
     was (its roles and directions are copied); without, its arrays are consumed and dropped
     before the sweeps."""
-    tol = DEFAULT_TOL if tol is None else tol  # the first-order scheme's default
     if not isinstance(paper_sweeps, (bool, np.bool_)):
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     grid, surf, band = tube.grid, tube.surface, tube.band
@@ -417,7 +419,12 @@ def _solve_on_tube(
         f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
         return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
 
-    check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
+    # (the default: 1e-10 of the travel time across the grid, at most 1e-10; a Hamiltonian's own
+    # travel times set it in _hamiltonian_solve)
+    given_tol = tol
+    tol = first_order_tol(tol, h, float(np.mean(slowness)), max(grid.shape))
+    if general is None:
+        check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     # the exact initialisation's radius in grid spacings
     radius = SOURCE_RADIUS if source_radius is None else max(SOURCE_RADIUS, float(source_radius) / h)
     positions, fixed_vals, fixed_sources = _fix_sources(
@@ -481,7 +488,7 @@ def _solve_on_tube(
         del directions
     else:
         setup = time.perf_counter() - t0
-        values, st = _hamiltonian_solve.solve_band(
+        values, st, tol = _hamiltonian_solve.solve_band(
             general,
             surf,
             grid,
@@ -494,12 +501,12 @@ def _solve_on_tube(
             speed_nodes,
             source_init == "exact",
             radius,
-            tol,
+            given_tol,
             max_iterations,
             _infinity(infinity),
             cb,
             _threads(threads),
-            ACTIVATION_FRACTION * float(tol),
+            ACTIVATION_FRACTION,
             not paper_sweeps,
         )
     warn_unconverged(st, tol, max_iterations)

@@ -22,7 +22,7 @@ import numpy as np
 
 from .band import EVAL_CHUNK, BandGeometry, _evaluate, _kinks, discover_band
 from .grid import Grid
-from ._validate import real_array, real_scalar
+from ._validate import check_flag, real_array, real_scalar
 from ._warn import user_stacklevel
 
 __all__ = ["Surface", "LevelSet", "BandGeometry", "as_surface"]
@@ -251,7 +251,7 @@ class LevelSet(Surface):
             self._fn = None
             self._array = arr
             self.ndim = arr.ndim
-        self.redistance = bool(redistance)
+        self.redistance = bool(check_flag(redistance, "redistance"))
         if lipschitz is not None:
             lipschitz = real_scalar(lipschitz, "lipschitz", "a real number (a bound on |∇φ|)")
         if lipschitz is None:

@@ -33,7 +33,7 @@ from ..grid import Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from ..surface import Surface
 from ..closest_point import ClosestPoint
-from .._validate import real_array, real_scalar, whole_indices
+from .._validate import check_flag, real_array, real_scalar, whole_indices
 from ..grid import MAX_COORDINATE
 from .._warn import user_stacklevel
 from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_library
@@ -175,7 +175,7 @@ class MeshSurface(Surface):
     smooth = False
     #: the band is cut across narrow gaps and above concave edges (``tubesweep._shortcuts``)
     cuts_shortcuts = True
-    part_cut_pairs = part_cut_pairs  # the band's edges between separate parts (cut: _shortcuts)
+    _part_cut_pairs = part_cut_pairs  # the band's edges between separate parts (cut: _shortcuts)
 
     def __init__(
         self,
@@ -774,9 +774,9 @@ def from_mesh(
         v = real_array(v, "vertices")
         f = whole_indices(f, "faces")
         name = "mesh"
-    for flag, value in (("smooth", smooth), ("cut_shortcuts", cut_shortcuts)):
-        if not isinstance(value, (bool, np.bool_)):
-            raise TypeError(f"{flag} must be True or False; got {value!r}")
+    for flag, value in (("smooth", smooth), ("cut_shortcuts", cut_shortcuts), ("normalize", normalize)):
+        check_flag(value, flag)
+    check_flag(signed, "signed", none=True)
     kind = SmoothMeshSurface if smooth else MeshSurface
     offset = np.zeros(3)
     scale = 1.0
