@@ -74,7 +74,6 @@ def _fix_sources(
     d = grid.ndim
     dist, proj = surface.project(sources, grid)
     check_on_surface(sources, dist, inner_width)
-    best: dict = {}
     r = int(np.ceil(radius + inner_width / h)) + 1
     # the nodes around a source: a box of (2r + 1)^d offsets, or for a box larger than the band
     # (a large source_radius) the band's nodes within it: memory of the band's size, not the box's
@@ -133,12 +132,15 @@ def _fix_sources(
     return positions, values, labels
 
 
+#: The nodes fixed by the sources: their band positions, values and sources' indices.
+Fixed = Tuple[np.ndarray, np.ndarray, np.ndarray]
+
 #: Sources per batch of :func:`_fixed_in_batches` (bounds the memory: a batch looks up
 #: ``BATCH`` × (2r + 1)^d nodes, 1331 per source in 3D with the default widths).
 BATCH = 512
 
 
-def _nearest_per_node(pos: np.ndarray, val: np.ndarray, src: np.ndarray) -> Tuple[np.ndarray, ...]:
+def _nearest_per_node(pos: np.ndarray, val: np.ndarray, src: np.ndarray) -> Fixed:
     """Per band position its smallest value and that value's source (the first source among
     equal values, as a loop over the sources in order that keeps a strictly smaller one)."""
     order = np.lexsort((src, val, pos))
@@ -148,7 +150,7 @@ def _nearest_per_node(pos: np.ndarray, val: np.ndarray, src: np.ndarray) -> Tupl
     return pos[first], val[first], src[first]
 
 
-def _fixed_at_nearest_nodes(grid: Grid, band: Any, roles: np.ndarray, sources: np.ndarray) -> Tuple[np.ndarray, ...]:
+def _fixed_at_nearest_nodes(grid: Grid, band: Any, roles: np.ndarray, sources: np.ndarray) -> Fixed:
     """``source_init="node"``: the inner-tube node nearest each source, fixed to 0 (the first
     source of each node labels it)."""
     pos = np.asarray(band.find(np.ascontiguousarray(grid.nearest_index(sources))), dtype=np.int64)
@@ -173,7 +175,7 @@ def _fixed_in_batches(
     radius: float,
     offsets: np.ndarray,
     connected: bool,
-) -> Tuple[np.ndarray, ...]:
+) -> Fixed:
     """:func:`_fix_sources` with the default radius, :data:`BATCH` sources at a time: the
     inner-tube nodes in each source's box of ``offsets``, their closest points projected once per
     batch, the nodes within ``radius`` spacings of the source's foot ``proj`` (or the nearest,
@@ -186,7 +188,7 @@ def _fixed_in_batches(
     # foot's cell, within √d spacings of it (58% of the box in 3D)
     reach = float(np.max(np.abs(offsets))) - 1 + np.sqrt(d)
     offsets = offsets[np.sum(offsets.astype(float) ** 2, axis=1) <= reach**2 + 1e-9]
-    best = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64))
+    best: Fixed = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64))
     for s0 in range(0, len(sources), BATCH):
         chunk = np.arange(s0, min(s0 + BATCH, len(sources)), dtype=np.int64)
         corner = np.floor(grid.continuous_index(proj[chunk])).astype(np.int64)
