@@ -360,3 +360,13 @@ def test_a_cube_mesh_is_cut_inside_its_edges_and_converges_across_them():
         assert 2.0 - 3.2 * grid.spacing < top < 2.0 and 1.0 - 1.5 * grid.spacing < side < 1.0
         errors.append(2.0 - top)
     assert errors[0] / errors[1] > 1.8
+
+
+def test_a_triangle_naming_a_vertex_twice_leaves_a_closed_mesh_closed():
+    # [0, 0, 1] and [2, 2, 2] added to a closed sphere mesh counted edge (0, 1) three times: the
+    # mesh read as open, unsigned, without a word
+    v, f = icosphere(2)
+    mesh = from_mesh((v, np.r_[f, [[0, 0, 1], [2, 2, 2]]]))
+    assert mesh.closed and mesh.signed and mesh.boundary_edges == 0
+    # a real hole still opens it
+    assert not from_mesh((v, f[1:])).closed

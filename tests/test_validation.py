@@ -481,3 +481,13 @@ def test_a_vertex_index_as_a_source_points_to_the_vertex_s_coordinates():
         ts.solve(ts.surfaces.Sphere(0.5), g, [4])
     with pytest.raises(ValueError, match=r"got shape \(2,\)$"):  # not whole numbers: no such note
         ts.solve(ts.surfaces.Sphere(0.5), g, [0.5, 0.1])
+
+
+def test_a_callable_phi_undefined_over_a_region_that_reaches_the_surface_is_named():
+    # NaN for x > 0.3: four widenings of the extension layer, then "φ is far from a distance
+    # function", NaN never mentioned
+    def phi(p):
+        return np.where(p[:, 0] > 0.3, np.nan, np.linalg.norm(p, axis=1) - 0.5)
+
+    with pytest.raises(ValueError, match=r"phi callable returned NaN or inf at \(0\.3"):
+        ts.solve(phi, G3, [(-0.5, 0, 0)])

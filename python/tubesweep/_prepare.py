@@ -20,7 +20,7 @@ from ._validate import (
     real_scalar,
 )
 from .grid import Grid
-from .band import BandGeometry, band_neighbours
+from .band import BandGeometry, _evaluate, band_neighbours
 from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
@@ -441,6 +441,11 @@ def _prepare_tube(
         if missing.size == 0:
             break
         lacking = _lacking_neighbours(grid, band, linear, missing)
+        # a callable φ that is NaN or inf next to the inner tube (undefined over a region that
+        # reaches the surface): said as such, not as a φ far from a distance after widenings
+        fn = getattr(surf, "_fn", None) if isinstance(surf, LevelSet) and not redistanced else None
+        if fn is not None and lacking.size:
+            _evaluate(fn, grid.node_points(lacking), "phi callable")
         if (
             redistanced
             and given_bound is None

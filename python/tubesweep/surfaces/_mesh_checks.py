@@ -22,6 +22,15 @@ THIN_SHARE = 0.02
 THIN_FACES = 20000
 
 
+def unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Undirected edges of the triangles: per-face ids of edges (AB, AC, BC) and use counts."""
+    e = np.concatenate([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]])
+    e.sort(axis=1)
+    n = int(f.max()) + 1
+    _, inv, counts = np.unique(e[:, 0] * n + e[:, 1], return_inverse=True, return_counts=True)
+    return inv.reshape(3, -1).T, counts
+
+
 def warn_repeated_vertices(v: np.ndarray, f: np.ndarray, boundary_edges: int) -> None:
     """A RuntimeWarning for an open-looking mesh whose triangles do not share their vertices but
     repeat them (equal coordinates under other indices, a triangle soup as STL writes it): read as

@@ -40,7 +40,7 @@ from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_lib
 from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_B, VERT_C, closest_points_on_triangles
 from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
-from ._mesh_checks import thin_parts, warn_repeated_vertices, warn_thin_parts
+from ._mesh_checks import thin_parts, unique_edges, warn_repeated_vertices, warn_thin_parts
 from ._mesh_parts import part_cut_pairs
 
 __all__ = [
@@ -119,13 +119,6 @@ def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
 # ---------------------------------------------------------------------------------------------
 # the surface
 # ---------------------------------------------------------------------------------------------
-def _unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-    """Undirected edges of the triangles: per-face ids of edges (AB, AC, BC) and use counts."""
-    e = np.concatenate([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]])
-    e.sort(axis=1)
-    n = int(f.max()) + 1
-    _, inv, counts = np.unique(e[:, 0] * n + e[:, 1], return_inverse=True, return_counts=True)
-    return inv.reshape(3, -1).T, counts
 
 
 class MeshSurface(Surface):
@@ -247,12 +240,17 @@ class MeshSurface(Surface):
         self.face_normals = np.zeros_like(cross)
         self.face_normals[good] = cross[good] / area2[good, None]
 
-        edge_ids, counts = _unique_edges(f)
-        e_dir = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+        edge_ids, counts = unique_edges(f)
+        # a triangle naming a vertex twice has no edges of its own: not counted ([0, 0, 1] made a
+        # closed sphere mesh open, unsigned)
+        proper = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+        counts = np.bincount(edge_ids[proper].ravel(), minlength=len(counts))
+        fp = f[proper]
+        e_dir = np.concatenate([fp[:, [0, 1]], fp[:, [1, 2]], fp[:, [2, 0]]])
         #: edges two faces run the same way (faces flipped against their neighbours)
         flipped = len(e_dir) - len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1]))
         directed_unique = flipped == 0
-        self.closed = bool(np.all(counts == 2) and directed_unique)
+        self.closed = bool(np.all(counts[counts > 0] == 2) and directed_unique)
         self.boundary_edges = int(np.count_nonzero(counts == 1))
         if self.boundary_edges:
             warn_repeated_vertices(v, f, self.boundary_edges)
