@@ -50,3 +50,43 @@ def test_a_mesh_of_one_part_is_not_cut_between_parts():
     v, f = icosphere(3, 0.4)
     mesh = ts.surfaces.from_mesh((v, f))
     assert face_parts(mesh) is None
+
+
+def test_the_lax_friedrichs_scheme_on_its_uncut_band_leaves_the_piece_without_a_source_unreached():
+    # the Lax–Friedrichs scheme runs on the band before its cut (warned of the narrow gap): the
+    # right sphere was reached across it (1.34 at its far pole); now its inner tube is labelled by
+    # the mesh's pieces and dropped, and the solve is still converged
+    g = ts.Grid((-1,) * 3, (1,) * 3, (51,) * 3)
+    v, f, _ = two_spheres(1.2, g.spacing)
+    mesh = ts.surfaces.from_mesh((v, f))
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        sol = ts.solve(mesh, g, [v[0]], hamiltonian="lxf")
+    assert sol.stats.converged and np.all(np.isinf(sol(v[len(v) // 2 :])))
+    assert np.all(np.isfinite(sol(v[: len(v) // 2])))
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        rows = ts.Tube(mesh, g).solve_many([v[0], v[len(v) // 2]], hamiltonian="lxf", at=v)
+    half = len(v) // 2
+    assert np.all(np.isinf(rows[0, half:])) and np.all(np.isinf(rows[1, :half]))
+    assert np.all(np.isfinite(rows[0, :half])) and np.all(np.isfinite(rows[1, half:]))
+
+
+@pytest.mark.parametrize("hamiltonian", ["godunov", "lxf"])
+def test_points_next_to_the_gap_read_their_own_piece(hamiltonian):
+    # the right sphere's vertices next to the gap, the source on it: their cells hold nodes of the
+    # left piece, unreached, and 12 (Lax–Friedrichs: 19) read inf; each now reads its own piece
+    g = ts.Grid((-1,) * 3, (1,) * 3, (51,) * 3)
+    v, f, d = two_spheres(1.2, g.spacing)
+    half = len(v) // 2
+    mesh = ts.surfaces.from_mesh((v, f))
+    with pytest.warns(RuntimeWarning):  # the first-order fallback's size, or the gap (Lax–Friedrichs)
+        sol = ts.solve(mesh, g, [v[half]], hamiltonian=hamiltonian)
+    right = v[half:]
+    centre = np.array([d / 2, 0, 0])
+    exact = 0.3 * np.arccos(np.clip(np.sum((right - centre) * (v[half] - centre), axis=1) / 0.09, -1, 1))
+    u = sol(right)
+    assert np.all(np.isfinite(u)) and np.all(np.isinf(sol(v[:half])))
+    near_gap = right[:, 0] < d / 2 - 0.2
+    assert near_gap.sum() > 20 and np.max(np.abs(u - exact)[near_gap]) < 3.5 * g.spacing
+    with pytest.warns(RuntimeWarning):
+        rows = ts.Tube(mesh, g).solve_many([v[half]], hamiltonian=hamiltonian, at=right)
+    np.testing.assert_array_equal(rows[0], u)

@@ -50,11 +50,21 @@ def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
     (:func:`_thick_enough`), or ``band`` is cut at medial edges (``_shortcuts``:
     a mesh, whose inner tube the cuts above concave edges could split, so its parts are left to
     the cuts; a point cloud's band is cut only between facing sheets, which leaves each sheet's
-    inner tube whole, and the Lax–Friedrichs scheme runs on the uncut band)."""
+    inner tube whole, and the Lax–Friedrichs scheme runs on the uncut band, where a mesh's
+    separate pieces label its inner tube: ``surfaces._mesh_parts``)."""
     from ._prepare import ROLE_OUTER
 
     band = tube.band if band is None else band
     cut = band is tube.band and tube.cut_edges > 0
+    pieces = getattr(tube.surface, "_node_parts", None)
+    if pieces is not None and band is not tube.band and tube.linear is not None:
+        # a mesh's band left uncut (the Lax–Friedrichs scheme): its separate pieces, from each
+        # node's nearest face (surfaces._mesh_parts), label the inner tube
+        part = pieces(tube.grid, tube.linear)
+        if part is not None:
+            labels = np.where(part >= 0, part, NO_PART).astype(np.uint32)
+            labels[tube.roles == ROLE_OUTER] = NO_PART
+            return labels
     if tube.facing[0].size == 0 or (cut and cuts_medial_edges(tube.surface)):
         return None  # no front crosses between parts; a mesh's band is cut between them already
     inner = tube.roles != ROLE_OUTER
@@ -116,6 +126,14 @@ def source_parts(grid: Grid, band: Any, labels: np.ndarray, sources: np.ndarray)
     if not np.all(np.any(found, axis=1)):
         return None
     return np.unique(at[found])
+
+
+def on_sourced_parts(labels: Optional[np.ndarray], sourced: Optional[np.ndarray]) -> Optional[np.ndarray]:
+    """Per band node whether it may be reached: False on the inner tube of a part without a
+    source (None when nothing is dropped: every node may)."""
+    if labels is None or sourced is None:
+        return None
+    return (labels == NO_PART) | np.isin(labels, sourced)
 
 
 def drop_unsourced(values: np.ndarray, labels: np.ndarray, sourced: Optional[np.ndarray]) -> int:

@@ -29,6 +29,7 @@ import numpy as np
 
 from ._interpolation import cell_corners
 from .grid import Grid
+from .surfaces._mesh_parts import face_parts, point_parts
 
 #: Slack of the side test, in grid spacings (curved sheets: the projection's shrinking is not exact).
 SIDE_SLACK = 0.25
@@ -71,26 +72,48 @@ def own_side_plan(
     facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
     n_nodes: int,
     points: np.ndarray,
+    cut: bool = True,
 ) -> Optional[OwnSidePlan]:
     """The :class:`OwnSidePlan` of ``points`` on a band of ``n_nodes`` nodes whose pairs across
-    narrow gaps are ``facing``; None when no point's cell holds a node of a pair."""
+    narrow gaps are ``facing`` (when the band is ``cut`` across them), and on a triangle mesh of
+    separate pieces (``surfaces._mesh_parts``, cut band or not) with the corners on another
+    piece than the point's nearest face left out; None when no point's cell holds a node of a
+    pair or spans two pieces."""
     node, neighbour, _ = facing
-    if node.size == 0 or len(points) == 0:
+    use_facing = cut and node.size > 0
+    node_parts = getattr(surface, "_node_parts", None)
+    pieces = node_parts is not None and face_parts(surface) is not None
+    if not (use_facing or pieces) or len(points) == 0:
         return None
     d, h = grid.ndim, grid.spacing
     corners, pos, weight = cell_corners(grid, band, points)
-    paired = np.zeros(n_nodes + 1, bool)
-    paired[node] = True
-    paired[neighbour] = True
-    rows = np.flatnonzero(np.any(paired[np.where(pos >= 0, pos, n_nodes)], axis=1))
+    chosen = np.zeros(len(points), bool)
+    if use_facing:
+        paired = np.zeros(n_nodes + 1, bool)
+        paired[node] = True
+        paired[neighbour] = True
+        chosen |= np.any(paired[np.where(pos >= 0, pos, n_nodes)], axis=1)
+    if pieces:
+        # each corner's piece against the point's (its nearest face's): a cell across the gap
+        # between two pieces reads only its own piece's corners
+        inside = np.all((corners >= 0) & (corners < np.asarray(grid.shape)), axis=2)
+        lin = grid.linear_index(np.clip(corners, 0, np.asarray(grid.shape) - 1).reshape(-1, d))
+        corner_piece = np.where(inside, node_parts(grid, lin).reshape(pos.shape), -1)
+        point_piece = point_parts(surface, points)
+        same_piece = corner_piece == point_piece[:, None]
+        chosen |= np.any(~same_piece & (pos >= 0), axis=1)
+    rows = np.flatnonzero(chosen)
     if rows.size == 0:
         return None
     corner_points = grid.points(corners[rows].reshape(-1, d))
-    _, corner_cp = surface.project(corner_points, grid)
-    _, foot = surface.project(points[rows], grid)
-    at = corner_points.reshape(rows.size, -1, d)
-    corner_cp = np.asarray(corner_cp).reshape(rows.size, -1, d)
-    foot = np.asarray(foot)[:, None, :]
-    own = np.linalg.norm(corner_cp - foot, axis=2) <= np.linalg.norm(at - foot, axis=2) + SIDE_SLACK * h
-    own &= pos[rows] >= 0
+    own = pos[rows] >= 0
+    if use_facing:
+        _, corner_cp = surface.project(corner_points, grid)
+        _, foot = surface.project(points[rows], grid)
+        at = corner_points.reshape(rows.size, -1, d)
+        corner_cp = np.asarray(corner_cp).reshape(rows.size, -1, d)
+        foot = np.asarray(foot)[:, None, :]
+        own &= np.linalg.norm(corner_cp - foot, axis=2) <= np.linalg.norm(at - foot, axis=2) + SIDE_SLACK * h
+    if pieces:
+        own &= same_piece[rows]
     return OwnSidePlan(rows, np.ascontiguousarray(corner_points), np.where(own, weight[rows], 0.0))

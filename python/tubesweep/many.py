@@ -246,8 +246,10 @@ def solve_many(
     # on a band cut across narrow gaps, points next to a gap read from their own side: the values
     # at their cells' corners come back as extra points
     plan = None
-    if points is not None and not uncut and t.cut_edges and t.facing[0].size:
-        plan = own_side_plan(grid, t.surface, band, t.facing, len(t.linear), points)
+    if points is not None:
+        plan = own_side_plan(
+            grid, t.surface, band, t.facing, len(t.linear), points, cut=bool(t.cut_edges) and not uncut
+        )
     read_at = points if plan is None else np.ascontiguousarray(np.concatenate([points, plan.corners]))
     missing_policy = "infinity" if (t.method == "naive" and scheme == "godunov") else "extrapolate"
     directions = t.geom.directions_for_solver()  # type: ignore[union-attr]  # a copy: the tube's stay as they are

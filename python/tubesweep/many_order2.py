@@ -77,12 +77,11 @@ def solve_many_order2(
     plan = None
     if points is not None:
         points = np.ascontiguousarray(points, dtype=float)
-        if t.cut_edges and t.facing[0].size:
-            # on a band cut across narrow gaps, points next to a gap read from their own side (as
-            # sol(points)): their cells' corners are read as extra points
-            plan = own_side_plan(grid, surf, t.band, t.facing, len(t.linear), points)
-            if plan is not None:
-                points = np.ascontiguousarray(np.concatenate([points, plan.corners]))
+        # on a band cut across narrow gaps (or a mesh of separate pieces), points next to a gap
+        # read from their own side (as sol(points)): their cells' corners are read as extra points
+        plan = own_side_plan(grid, surf, t.band, t.facing, len(t.linear), points, cut=bool(t.cut_edges))
+        if plan is not None:
+            points = np.ascontiguousarray(np.concatenate([points, plan.corners]))
         at_feet = points
         if inputs.exact_feet:
             # the points' closest points (used within the reach of a source only, as sol(points));

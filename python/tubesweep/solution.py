@@ -271,12 +271,14 @@ class Solution:
         """
         p = as_points(points, self.grid.ndim, "points")
         out = self._read(p, interpolation)
-        if self.stats.cut_edges and self._facing[0].size:
-            # a band cut across narrow gaps: each point read from its own side of the gap (at
-            # second order its cell's corners read as any point: the factored form near a source)
-            plan = own_side_plan(self.grid, self.surface, self._band, self._facing, len(self.values), p)
-            if plan is not None:
-                out = plan.apply(out, self._read(plan.corners, "linear"))
+        # a band cut across narrow gaps, or a mesh of separate pieces: each point read from its own
+        # side of the gap (at second order its cell's corners read as any point: the factored form
+        # near a source)
+        plan = own_side_plan(
+            self.grid, self.surface, self._band, self._facing, len(self.values), p, cut=bool(self.stats.cut_edges)
+        )
+        if plan is not None:
+            out = plan.apply(out, self._read(plan.corners, "linear"))
         return out
 
     def _read(self, p: np.ndarray, interpolation: str) -> np.ndarray:

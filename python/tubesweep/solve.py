@@ -33,7 +33,7 @@ from .moving import check_warm_refused
 from .stats import SolveStats
 from .surface import as_surface
 from ._creases import warn_paper_tube_creases
-from ._parts import drop_unsourced, part_labels, source_parts
+from ._parts import drop_unsourced, on_sourced_parts, part_labels, source_parts
 from ._prepare import (
     METHODS,
     ROLE_FIXED,
@@ -513,12 +513,14 @@ def _solve_on_tube(
     values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
     if parts is not None:
         drop_unsourced(values, parts, sourced)
-    # no NaN, and no inf next to a reached node in a solve reported converged
+    # no NaN, and no inf next to a reached node in a solve reported converged (the inner tube of a
+    # part without a source is unreachable: next to a reached part across a narrow gap, not stranded)
+    reachable = on_sourced_parts(parts, sourced)
     check_values(
         grid,
         band,
         values,
-        roles != ROLE_OUTER,
+        (roles != ROLE_OUTER) if reachable is None else (roles != ROLE_OUTER) & reachable,
         st,
         _infinity(infinity),
         reachability=general is None or general.label == "isotropic",

@@ -59,18 +59,41 @@ def face_parts(surface: Any) -> Optional[np.ndarray]:
     return surface._face_parts
 
 
-def part_cut_pairs(surface: Any, grid: Grid, band: Any, linear: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-    """The band edges (``node``, ``neighbour``: band positions, ``node < neighbour``) between nodes
-    whose nearest faces lie on two parts of the mesh ``surface``; empty on a mesh of one part."""
+def node_parts(surface: Any, grid: Grid, linear: np.ndarray) -> Optional[np.ndarray]:
+    """Per grid node of ``linear`` (linear indices) the part of the mesh ``surface`` its nearest
+    face lies on, or None on a mesh of one part."""
     parts = face_parts(surface)
-    empty = np.zeros(0, np.int64)
-    if parts is None or len(linear) == 0:
-        return empty, empty
+    if parts is None:
+        return None
     n = len(linear)
     part = np.empty(n, np.int64)
     for s in range(0, n, CHUNK):
         _, _, face, _ = surface.closest(grid.node_points(linear[s : s + CHUNK]))
         part[s : s + CHUNK] = np.where(face >= 0, parts[np.maximum(face, 0)], -1)
+    return part
+
+
+def point_parts(surface: Any, points: np.ndarray) -> np.ndarray:
+    """Per point the part of the mesh ``surface`` its nearest face lies on (-1 where none is;
+    all 0 on a mesh of one part)."""
+    parts = face_parts(surface)
+    if parts is None:
+        return np.zeros(len(points), np.int64)
+    out = np.empty(len(points), np.int64)
+    for s in range(0, len(points), CHUNK):
+        _, _, face, _ = surface.closest(points[s : s + CHUNK])
+        out[s : s + CHUNK] = np.where(face >= 0, parts[np.maximum(face, 0)], -1)
+    return out
+
+
+def part_cut_pairs(surface: Any, grid: Grid, band: Any, linear: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """The band edges (``node``, ``neighbour``: band positions, ``node < neighbour``) between nodes
+    whose nearest faces lie on two parts of the mesh ``surface``; empty on a mesh of one part."""
+    empty = np.zeros(0, np.int64)
+    part = node_parts(surface, grid, linear) if len(linear) else None
+    if part is None:
+        return empty, empty
+    n = len(linear)
     nodes, neighbours = [], []
     for s in range(0, n, CHUNK):
         at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)

@@ -41,7 +41,7 @@ from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_
 from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
 from ._mesh_checks import thin_parts, unique_edges, warn_repeated_vertices, warn_thin_parts
-from ._mesh_parts import part_cut_pairs
+from ._mesh_parts import node_parts, part_cut_pairs
 
 __all__ = [
     "from_mesh",
@@ -169,6 +169,7 @@ class MeshSurface(Surface):
     #: the band is cut across narrow gaps and above concave edges (``tubesweep._shortcuts``)
     cuts_shortcuts = True
     _part_cut_pairs = part_cut_pairs  # the band's edges between separate parts (cut: _shortcuts)
+    _node_parts = node_parts  # each node's part, for a band left uncut (_parts)
 
     def __init__(
         self,
