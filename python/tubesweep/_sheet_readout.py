@@ -93,7 +93,7 @@ def own_side_plan(
         paired[node] = True
         paired[neighbour] = True
         chosen |= np.any(paired[np.where(pos >= 0, pos, n_nodes)], axis=1)
-    if pieces:
+    if pieces and node_parts is not None:
         # each corner's piece against the point's (its nearest face's): a cell across the gap
         # between two pieces reads only its own piece's corners
         inside = np.all((corners >= 0) & (corners < np.asarray(grid.shape)), axis=2)
