@@ -56,8 +56,10 @@ x = np.linspace(-1, 1, args.n)
 for k, (t, p) in enumerate(zip(ev.times, ev.phis)):
     ax.contour(x, x, p[:, args.n // 2, :].T, levels=[0], colors=[plt.cm.plasma(k / frames)])
     ax.plot([], [], color=plt.cm.plasma(k / frames), label=f"t = {t:.2f}")
-ax.set(aspect="equal", xlim=(-0.85, 0.85), ylim=(-0.85, 0.85), xlabel="x", ylabel="z", title="cross-sections y = 0")
-ax.legend(fontsize=7, loc="upper right")
+ax.set(aspect="equal", xlim=(-0.85, 0.85), ylim=(-0.85, 0.85), xlabel="x", title="cross-sections y = 0")
+ax.set_ylabel("z", labelpad=-2)
+ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.02, 0.5), frameon=False)  # beside the curves
+fig.subplots_adjust(wspace=0.3)
 fig.colorbar(
     surf, ax=fig.axes[:frames], location="bottom", shrink=0.4, pad=0.02, label="geodesic distance u from the north pole"
 )

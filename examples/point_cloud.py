@@ -43,10 +43,10 @@ error = np.abs(sol(equator) - 0.7 * np.abs(t))
 print(f"error along the outer equator: mean {error.mean():.2e}, max {error.max():.2e}")
 
 fig = plt.figure(figsize=(8, 5))
-ax = fig.add_subplot(projection="3d")
-art = ax.scatter(*samples.T, c=sol(samples), s=1.0, cmap="viridis")
-ax.scatter(*source, color="red", marker="*", s=250, depthshade=False)
-ax.view_init(elev=35, azim=-60)
+ax = fig.add_subplot(projection="3d", computed_zorder=False)  # the star drawn over the samples
+art = ax.scatter(*samples.T, c=sol(samples), s=2.5, cmap="viridis", depthshade=False)
+ax.scatter(*source, color="red", marker="*", s=250, depthshade=False, zorder=3)
+ax.view_init(elev=35, azim=-25)  # the source in front, the far side of the ring behind
 ax.set_box_aspect((1.4, 1.4, 0.4))
 ax.set_axis_off()
 fig.colorbar(art, ax=ax, shrink=0.6, label="geodesic distance")
