@@ -90,3 +90,28 @@ def test_points_next_to_the_gap_read_their_own_piece(hamiltonian):
     with pytest.warns(RuntimeWarning):
         rows = ts.Tube(mesh, g).solve_many([v[half]], hamiltonian=hamiltonian, at=right)
     np.testing.assert_array_equal(rows[0], u)
+
+
+def test_pieces_are_joined_at_repeated_coordinates_and_where_they_cross():
+    # pieces by vertex index alone: a seam (the southern faces on copies of the vertices, as an
+    # export writes at a UV seam), a triangle soup and two crossing shells each read as separate
+    # pieces, and the cut left the source's far side at inf, converged and unwarned
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    v, f = icosphere(3, 0.5)
+    south = v[f].mean(axis=1)[:, 2] < 0
+    seam = (np.r_[v, v], np.where(south[:, None], f + len(v), f))
+    soup = (v[f].reshape(-1, 3), np.arange(3 * len(f)).reshape(-1, 3))
+    crossing = (np.r_[v * 0.7 - [0.2, 0, 0], v * 0.7 + [0.2, 0, 0]], np.r_[f, f + len(v)])
+    for mesh, warns in ((seam, None), (soup, "repeat another's coordinates"), (crossing, None)):
+        with pytest.warns(RuntimeWarning) if warns else _quiet():
+            surface = ts.surfaces.from_mesh(mesh, smooth=False)
+        assert face_parts(surface) is None
+    v2, f2 = seam
+    sol = ts.solve(ts.surfaces.from_mesh((v2, f2), smooth=False), g, [(0, 0, 0.5)])
+    assert abs(sol([(0, 0, -0.5)])[0] - 0.5 * np.pi) < 3.5 * g.spacing  # inf before (first order: 3.3 spacings)
+
+
+def _quiet():
+    import contextlib
+
+    return contextlib.nullcontext()

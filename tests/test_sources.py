@@ -52,3 +52,20 @@ def test_the_sources_batched_fix_the_nodes_a_loop_over_them_fixes(speed):
     assert np.array_equal(got[0][order], want[0])
     np.testing.assert_allclose(got[1][order], want[1], rtol=1e-15, atol=0)
     assert np.array_equal(got[2][order], want[2])
+
+
+def test_a_source_whose_closest_point_is_not_defined_is_refused_by_name():
+    # a sphere of samples, the source at its centre: the fits find no surface there; the message
+    # said "is nan from the surface" (and a surface whose projection gave NaN passed the check)
+    x = np.random.default_rng(0).normal(size=(3000, 3))
+    cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+    with pytest.raises(ValueError, match=r"sources\[0\] = \(0\.0, 0\.0, 0\.0\) is far from the surface \(its closest"):
+        ts.solve(cloud, ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3), [(0.0, 0.0, 0.0)])
+
+    class Undefined(ts.surfaces.Sphere):
+        def project(self, points, grid):
+            d, cp = super().project(points, grid)
+            return np.where(np.linalg.norm(points, axis=1) < 1e-9, np.nan, d), cp
+
+    with pytest.raises(ValueError, match=r"is far from the surface \(its closest point there is not defined"):
+        ts.solve(Undefined(0.5), ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3), [(0.0, 0.0, 0.0)], order=1)

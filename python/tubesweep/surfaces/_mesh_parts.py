@@ -11,7 +11,12 @@ belongs to needs no such test on a mesh: it is the part of the face nearest to t
 exact closest point, ``MeshSurface.closest``), and every band edge between nodes of two parts is
 cut. A part that holds no source then stays unreached (``inf``), as with ``smooth=False``.
 
-One part (most meshes): nothing is computed beyond the parts themselves, once per mesh.
+A piece is what the triangles join through shared vertices, vertices at the same coordinates
+counting as one (an export's seam, a triangle soup); pieces that may touch or cross (a union of
+shells never booleaned) count as one, so that only pieces provably apart are cut
+(:func:`apart`).
+
+One piece (most meshes): nothing is computed beyond the pieces themselves, once per mesh.
 """
 
 from __future__ import annotations
@@ -49,14 +54,63 @@ def vertex_parts(n_vertices: int, faces: np.ndarray) -> np.ndarray:
 
 
 def face_parts(surface: Any) -> Optional[np.ndarray]:
-    """Per face of ``surface`` (a ``MeshSurface``) its connected part, numbered 0, 1, ..., or
-    None when the mesh is one part; computed once and kept."""
+    """Per face of ``surface`` (a ``MeshSurface``) its separate piece, numbered 0, 1, ..., or
+    None when the mesh is one piece; computed once and kept. Triangles are joined through shared
+    vertices, vertices at the same coordinates counting as one (a seam of an export, a triangle
+    soup), and two pieces whose surfaces may touch or cross (:func:`apart`) count as one."""
     if "_face_parts" not in surface.__dict__:
         faces = surface.faces
-        label = vertex_parts(len(surface.vertices), faces)[faces[:, 0]]
+        _, same = np.unique(surface.vertices, axis=0, return_inverse=True)
+        merged = same.ravel()[faces]
+        label = vertex_parts(int(merged.max()) + 1, merged)[merged[:, 0]]
         _, parts = np.unique(label, return_inverse=True)
-        surface._face_parts = parts.astype(np.int64) if parts.max(initial=0) > 0 else None
+        parts = parts.ravel().astype(np.int64)
+        if parts.max(initial=0) > 0:
+            parts = _joined_where_touching(surface, parts)
+        surface._face_parts = parts if parts.max(initial=0) > 0 else None
     return surface._face_parts
+
+
+def _joined_where_touching(surface: Any, parts: np.ndarray) -> np.ndarray:
+    """``parts`` (per face) with the pieces that are not :func:`apart` merged, renumbered."""
+    count = int(parts.max()) + 1
+    v, f = surface.vertices, surface.faces
+    longest = np.zeros(count)
+    edge = np.max(np.linalg.norm(v[f] - v[np.roll(f, 1, axis=1)], axis=2), axis=1)
+    np.maximum.at(longest, parts, edge)
+    lo = np.full((count, 3), np.inf)
+    hi = np.full((count, 3), -np.inf)
+    np.minimum.at(lo, parts, v[f].min(axis=1))
+    np.maximum.at(hi, parts, v[f].max(axis=1))
+    # candidate pairs: boxes within the longer piece's longest edge of each other (farther, apart)
+    reach = np.maximum(longest[:, None], longest[None, :])
+    gap = np.max(np.maximum(lo[:, None, :] - hi[None, :, :], lo[None, :, :] - hi[:, None, :]), axis=2)
+    a, b = np.nonzero(np.triu(gap <= reach, k=1))
+    label = np.arange(count)
+    for i, j in zip(a, b):
+        if not apart(surface, parts, int(i), int(j), longest) and label[i] != label[j]:
+            label[label == label[j]] = label[i]
+    _, joined = np.unique(label[parts], return_inverse=True)
+    return joined.ravel().astype(np.int64)
+
+
+def apart(surface: Any, parts: np.ndarray, i: int, j: int, longest: np.ndarray) -> bool:
+    """Whether pieces ``i`` and ``j`` of ``surface`` are provably apart: every vertex of each lies
+    farther from the other than its own piece's longest edge over √3, so no point of its
+    triangles reaches the other (every point of a triangle lies within its longest edge over √3
+    of a vertex: the circumradius of an acute triangle, half the longest edge of an obtuse one).
+    Two shells that cross or touch, or whose gap is narrower, are one piece (their front may pass
+    between them as before)."""
+    from .. import _native
+
+    for p, q in ((i, j), (j, i)):
+        verts = np.unique(surface.faces[parts == p])
+        reach = float(longest[p]) / np.sqrt(3.0)
+        tree = _native.TriangleTree(surface.vertices, np.ascontiguousarray(surface.faces[parts == q]))
+        d, _, _, _ = tree.closest(np.ascontiguousarray(surface.vertices[verts]), reach)
+        if not np.all(d > reach):
+            return False
+    return True
 
 
 def node_parts(surface: Any, grid: Grid, linear: np.ndarray) -> Optional[np.ndarray]:
