@@ -115,3 +115,73 @@ def _quiet():
     import contextlib
 
     return contextlib.nullcontext()
+
+
+def _sphere(level, r, centre=(0.0, 0.0, 0.0)):
+    v, f = icosphere(level, r)
+    return v + np.asarray(centre), f
+
+
+def _disc(z, r=0.4, rings=12):
+    """A flat disc of ``rings`` rings of 6k points each, triangulated (scipy's Delaunay)."""
+    from scipy.spatial import Delaunay
+
+    pts = [np.zeros((1, 2))]
+    for k in range(1, rings + 1):
+        t = np.linspace(0, 2 * np.pi, 6 * k, endpoint=False)
+        pts.append(r * k / rings * np.c_[np.cos(t), np.sin(t)])
+    p = np.concatenate(pts)
+    return np.c_[p, np.full(len(p), z)], Delaunay(p).simplices
+
+
+def test_no_path_or_reading_crosses_to_a_piece_without_a_source():
+    # (a multi-piece review) second order's exact start (two discs 2 spacings apart: the upper
+    # one reached in full) and the Lax–Friedrichs parts, taken from the source cell's corners (a
+    # source on the pole facing the gap) reached the other piece; on_mesh read a point of it from
+    # the nearest reached node, the other piece's
+    g = ts.Grid((-1,) * 3, (1,) * 3, (51,) * 3)
+    lower, upper = _disc(-g.spacing), _disc(g.spacing)
+    discs = ts.surfaces.from_mesh((np.r_[lower[0], upper[0]], np.r_[lower[1], upper[1] + len(lower[0])]))
+    with pytest.warns(RuntimeWarning, match="ran the first-order update"):
+        sol = ts.solve(discs, g, [lower[0][0]])
+    assert sol.stats.order == 2 and sol.stats.converged
+    assert np.all(np.isinf(sol(upper[0]))) and np.all(np.isfinite(sol(lower[0])))
+    v, f, d = two_spheres(1.2, g.spacing)
+    half = len(v) // 2
+    facing = np.array([-d / 2 + 0.3, 0.0, 0.0])
+    mesh = ts.surfaces.from_mesh((v, f))
+    for kw in (dict(), dict(hamiltonian="lxf")):
+        with pytest.warns(RuntimeWarning):
+            sol = ts.solve(mesh, g, [facing], **kw)
+        assert sol.stats.converged and np.all(np.isinf(sol(v[half:]))), kw
+        assert np.all(np.isnan(sol.on_mesh(v[half:]))) and np.all(np.isfinite(sol.on_mesh(v[:half])))
+
+
+def test_a_shell_a_spacing_inside_another_reads_its_own_piece_and_stays_unreached():
+    # an outer sphere with the source and a separate one a spacing inside it: 225 of the outer
+    # sphere's 2562 vertices read inf, their cells' corners read back at their own coordinates
+    # (lower + i·h) through a weight of 1e-16 on an unreached node of the inner sphere
+    g = ts.Grid((-1,) * 3, (1,) * 3, (51,) * 3)
+    outer = _sphere(4, 0.6)
+    inner = _sphere(3, 0.6 - g.spacing)
+    v = np.r_[outer[0], inner[0]]
+    f = np.r_[outer[1], inner[1] + len(outer[0])]
+    mesh = ts.surfaces.from_mesh((v, f))
+    assert face_parts(mesh).max() == 1
+    sol = ts.solve(mesh, g, [outer[0][0]], order=1)
+    u = sol(outer[0])
+    assert np.all(np.isfinite(u)) and np.all(np.isinf(sol(inner[0])))
+    # (first order, its inner side's stencils cut by the other piece: 3.7 spacings at most)
+    exact = 0.6 * np.arccos(np.clip(outer[0] @ outer[0][0] / 0.36, -1, 1))
+    assert np.max(np.abs(u - exact)) < 4 * g.spacing
+
+
+def test_pieces_closer_than_their_triangles_but_apart_stay_apart():
+    # a coarse sphere (edges 0.049) 0.98 spacings (0.039) inside another: "every vertex farther
+    # than the longest edge over √3" merged them, and the inner one was reached; its triangles
+    # sampled near the other piece show the gap
+    g = ts.Grid((-1,) * 3, (1,) * 3, (51,) * 3)
+    outer = _sphere(3, 0.6)
+    inner = _sphere(3, 0.6 - 0.98 * g.spacing)
+    mesh = ts.surfaces.from_mesh((np.r_[outer[0], inner[0]], np.r_[outer[1], inner[1] + len(outer[0])]))
+    assert face_parts(mesh).max() == 1

@@ -37,6 +37,8 @@ def cell_corners(grid: Grid, band: Any, points: np.ndarray) -> Tuple[np.ndarray,
     positions ``(M, 2^d)`` (−1 off the band) and weights ``(M, 2^d)``."""
     d = grid.ndim
     t = grid.continuous_index(np.asarray(points, dtype=float).reshape(-1, d))
+    # (a point on a grid plane to rounding is on it, as in the core)
+    t = np.where(np.abs(t - np.round(t)) <= 1e-9, np.round(t), t)
     base = np.clip(np.floor(t).astype(np.int64), 0, np.asarray(grid.shape) - 2)
     frac = np.clip(t - base, 0.0, 1.0)
     offsets = np.array([[(c >> k) & 1 for k in range(d)] for c in range(1 << d)], dtype=np.int64)

@@ -57,9 +57,10 @@ def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
     band = tube.band if band is None else band
     cut = band is tube.band and tube.cut_edges > 0
     pieces = getattr(tube.surface, "_node_parts", None)
-    if pieces is not None and band is not tube.band and tube.linear is not None:
-        # a mesh's band left uncut (the Lax–Friedrichs scheme): its separate pieces, from each
-        # node's nearest face (surfaces._mesh_parts), label the inner tube
+    if pieces is not None and tube.linear is not None:
+        # a mesh's separate pieces, from each node's nearest face (surfaces._mesh_parts), label
+        # the inner tube, cut or not: second order's exact start reaches across a narrow gap
+        # (FIX_RADIUS), as the Lax–Friedrichs scheme on its uncut band does
         part = pieces(tube.grid, tube.linear)
         if part is not None:
             labels = np.where(part >= 0, part, NO_PART).astype(np.uint32)
@@ -118,9 +119,20 @@ def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray, weig
     return out
 
 
-def source_parts(grid: Grid, band: Any, labels: np.ndarray, sources: np.ndarray) -> Optional[np.ndarray]:
-    """The parts that hold the sources (those of the corners of each source's cell), or None
-    when a source's cell has no labelled corner (then nothing is dropped)."""
+def source_parts(
+    grid: Grid, band: Any, labels: np.ndarray, sources: np.ndarray, surface: Any = None
+) -> Optional[np.ndarray]:
+    """The parts that hold the sources (those of the corners of each source's cell; on a mesh of
+    separate pieces, ``surface``, the pieces of the sources' nearest faces: a cell next to the
+    gap has corners on both), or None when a source's cell has no labelled corner (then nothing
+    is dropped)."""
+    if surface is not None and getattr(surface, "_node_parts", None) is not None:
+        from .surfaces._mesh_parts import face_parts, point_parts
+
+        if face_parts(surface) is not None:  # (the labels are the pieces: part_labels)
+            own = point_parts(surface, np.asarray(sources, dtype=float).reshape(-1, grid.ndim))
+            if np.all(own >= 0):
+                return np.unique(own).astype(np.uint32)
     at = parts_at(grid, band, labels, np.asarray(sources, dtype=float).reshape(-1, grid.ndim))
     found = at != NO_PART
     if not np.all(np.any(found, axis=1)):
@@ -174,7 +186,7 @@ def drop_unsourced_rows(
     corners = None if points is None else parts_at(grid, band, parts, points, weighted=True)
     out = np.array(rows, dtype=float, copy=True)
     for k, group in enumerate(groups):
-        sourced = source_parts(grid, band, parts, group)
+        sourced = source_parts(grid, band, parts, group, tube.surface)
         if corners is None:
             drop_unsourced(out[k], parts, sourced)
         else:

@@ -624,7 +624,7 @@ def solve_on_tube(
     warm_values, warm_more, warm_info = warm_start(warm, tube, feet, tol, warm_refused)
     anchors = warm_more.pop("_anchors", None)  # (moving._ANCHOR)
     parts = part_labels(tube)  # a part without a source keeps inf (``_parts``)
-    sourced = None if parts is None else source_parts(grid, band, parts, feet)
+    sourced = None if parts is None else source_parts(grid, band, parts, feet, tube.surface)
     setup = time.perf_counter() - t0
     values, u0, roles_out, st = run_native(
         tube,

@@ -392,6 +392,17 @@ class Solution:
             bd[open_[take]] = dist[take]
         found = bp >= 0
         bp[found & ~np.isfinite(self.values[np.maximum(bp, 0)])] = -1
+        node_parts = getattr(self.surface, "_node_parts", None)
+        if node_parts is not None and np.any(bp >= 0):
+            # a mesh of separate pieces: the nearest node must lie on the point's own piece (across
+            # a gap narrower than the tube it is the other piece's, and a piece no source reaches
+            # read its neighbour's values)
+            from .surfaces._mesh_parts import point_parts
+
+            at = np.flatnonzero(bp >= 0)
+            piece = node_parts(self.grid, self.linear[bp[at]])
+            if piece is not None:
+                bp[at[piece != point_parts(self.surface, p[near[at]])]] = -1
         best[near] = bp
         return best
 

@@ -399,7 +399,7 @@ def _solve_on_tube(
     # the parts of the surface (before the sweeps consume the tube): a part without a source
     # keeps inf whatever reached it across a narrow gap (``_parts``)
     parts = part_labels(tube, band)
-    sourced = None if parts is None else source_parts(grid, band, parts, src)
+    sourced = None if parts is None else source_parts(grid, band, parts, src, surf)
     h = grid.spacing
     inner_width = tube.inner * h
     roles = tube.roles.copy() if reuse else tube.roles

@@ -72,45 +72,98 @@ def face_parts(surface: Any) -> Optional[np.ndarray]:
 
 
 def _joined_where_touching(surface: Any, parts: np.ndarray) -> np.ndarray:
-    """``parts`` (per face) with the pieces that are not :func:`apart` merged, renumbered."""
+    """``parts`` (per face) with the pieces that are not :func:`apart` merged, renumbered. Only
+    pieces whose boxes come within an edge of each other are compared (sorted along x and swept),
+    each piece's faces grouped once and its tree built once: linear in the pieces, not quadratic."""
     count = int(parts.max()) + 1
-    v, f = surface.vertices, surface.faces
+    tri = surface.vertices[surface.faces]
+    edge = np.max(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2), axis=1)
     longest = np.zeros(count)
-    edge = np.max(np.linalg.norm(v[f] - v[np.roll(f, 1, axis=1)], axis=2), axis=1)
     np.maximum.at(longest, parts, edge)
     lo = np.full((count, 3), np.inf)
     hi = np.full((count, 3), -np.inf)
-    np.minimum.at(lo, parts, v[f].min(axis=1))
-    np.maximum.at(hi, parts, v[f].max(axis=1))
-    # candidate pairs: boxes within the longer piece's longest edge of each other (farther, apart)
-    reach = np.maximum(longest[:, None], longest[None, :])
-    gap = np.max(np.maximum(lo[:, None, :] - hi[None, :, :], lo[None, :, :] - hi[:, None, :]), axis=2)
-    a, b = np.nonzero(np.triu(gap <= reach, k=1))
-    label = np.arange(count)
-    for i, j in zip(a, b):
-        if not apart(surface, parts, int(i), int(j), longest) and label[i] != label[j]:
-            label[label == label[j]] = label[i]
+    np.minimum.at(lo, parts, tri.min(axis=1))
+    np.maximum.at(hi, parts, tri.max(axis=1))
+    order = np.argsort(parts, kind="stable")
+    starts = np.searchsorted(parts[order], np.arange(count + 1))
+    root = np.arange(count)
+
+    def find(k: int) -> int:
+        while root[k] != k:
+            root[k] = root[root[k]]
+            k = int(root[k])
+        return k
+
+    trees: dict = {}
+    for i, j in _box_pairs(lo, hi, longest):
+        ri, rj = find(i), find(j)
+        if ri == rj:
+            continue
+        # the smaller piece sampled against the larger one's tree
+        a, b = (i, j) if starts[i + 1] - starts[i] <= starts[j + 1] - starts[j] else (j, i)
+        if b not in trees:
+            trees[b] = _piece_tree(surface, order[starts[b] : starts[b + 1]])
+        if not apart(tri[order[starts[a] : starts[a + 1]]], trees[b], lo[b], hi[b]):
+            root[ri] = rj
+    label = np.array([find(k) for k in range(count)])
     _, joined = np.unique(label[parts], return_inverse=True)
     return joined.ravel().astype(np.int64)
 
 
-def apart(surface: Any, parts: np.ndarray, i: int, j: int, longest: np.ndarray) -> bool:
-    """Whether pieces ``i`` and ``j`` of ``surface`` are provably apart: every vertex of each lies
-    farther from the other than its own piece's longest edge over √3, so no point of its
-    triangles reaches the other (every point of a triangle lies within its longest edge over √3
-    of a vertex: the circumradius of an acute triangle, half the longest edge of an obtuse one).
-    Two shells that cross or touch, or whose gap is narrower, are one piece (their front may pass
-    between them as before)."""
+def _box_pairs(lo: np.ndarray, hi: np.ndarray, longest: np.ndarray) -> list:
+    """The pairs of pieces whose boxes come within the longer one's longest edge of each other."""
+    reach = float(longest.max())
+    by_x = np.argsort(lo[:, 0], kind="stable")
+    ends = np.searchsorted(lo[by_x, 0], hi[by_x, 0] + reach, side="right")
+    out: list = []
+    for k, i in enumerate(by_x):
+        others = by_x[k + 1 : ends[k]]
+        if others.size == 0:
+            continue
+        near = np.maximum(longest[i], longest[others])
+        gap = np.max(np.maximum(lo[others] - hi[i], lo[i] - hi[others]), axis=1)
+        out.extend((int(i), int(j)) for j in others[gap <= near])
+    return out
+
+
+def _piece_tree(surface: Any, faces: np.ndarray) -> Any:
     from .. import _native
 
-    for p, q in ((i, j), (j, i)):
-        verts = np.unique(surface.faces[parts == p])
-        reach = float(longest[p]) / np.sqrt(3.0)
-        tree = _native.TriangleTree(surface.vertices, np.ascontiguousarray(surface.faces[parts == q]))
-        d, _, _, _ = tree.closest(np.ascontiguousarray(surface.vertices[verts]), reach)
-        if not np.all(d > reach):
-            return False
-    return True
+    return _native.TriangleTree(surface.vertices, np.ascontiguousarray(surface.faces[faces]))
+
+
+#: Subdivisions per edge of a triangle sampled near another piece (:func:`apart`): pieces closer
+#: than 1/(8√3) of their triangles' longest edge, 7 %, count as touching.
+SAMPLES_PER_EDGE = 8
+
+
+def apart(tri: np.ndarray, tree: Any, lo: np.ndarray, hi: np.ndarray) -> bool:
+    """Whether the triangles ``tri`` (T, 3, 3) of one piece are provably apart from the piece
+    whose ``tree`` and box (``lo``, ``hi``) are given: every point of a triangle lies within its
+    longest edge over √3 of one of its vertices (the circumradius of an acute triangle, half the
+    longest edge of an obtuse one), so a triangle whose vertices are all farther than that from
+    the other piece is apart; a nearer one is sampled at :data:`SAMPLES_PER_EDGE` subdivisions
+    per edge, each sample standing for the points within its sub-triangles' bound. Two shells
+    that cross or touch (a union never booleaned) are one piece, and their front passes between
+    them."""
+    edge = np.max(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2), axis=1)
+    bound = edge / np.sqrt(3.0)
+    # triangles whose box comes within their bound of the other piece's box
+    gap = np.max(np.maximum(tri.min(axis=1) - hi, lo - tri.max(axis=1)), axis=1)
+    tri, bound = tri[gap <= bound], bound[gap <= bound]
+    if len(tri) == 0:
+        return True
+    d, _, _, _ = tree.closest(np.ascontiguousarray(tri.reshape(-1, 3)), float(bound.max()))
+    near = d.reshape(-1, 3).min(axis=1) <= bound
+    if not np.any(near):
+        return True
+    m = SAMPLES_PER_EDGE
+    i, j = np.meshgrid(np.arange(m + 1), np.arange(m + 1), indexing="ij")
+    keep = i + j <= m
+    w = np.stack([i[keep], j[keep], m - i[keep] - j[keep]], axis=1) / m  # barycentric samples
+    samples = np.einsum("sk,tkc->tsc", w, tri[near])
+    d, _, _, _ = tree.closest(np.ascontiguousarray(samples.reshape(-1, 3)), float(bound[near].max()))
+    return bool(np.all(d.reshape(len(samples), -1).min(axis=1) > bound[near] / m))
 
 
 def node_parts(surface: Any, grid: Grid, linear: np.ndarray) -> Optional[np.ndarray]:

@@ -21,10 +21,16 @@ pub fn interpolate<const D: usize>(
             let mut base = [0i64; D];
             let mut frac = [0.0f64; D];
             for k in 0..D {
-                let t = (p[k] - lower[k]) / h;
+                let mut t = (p[k] - lower[k]) / h;
                 let tol = 1e-9;
                 if !(t >= -tol && t <= (shape[k] - 1) as f64 + tol) {
                     return f64::NAN;
+                }
+                // a point on a grid plane to rounding (a node's own coordinates, lower + i·h,
+                // read back) takes no weight from the next plane: an unreached node there gave
+                // a reached node's own point inf through a weight of 1e-16
+                if (t - t.round()).abs() <= tol {
+                    t = t.round();
                 }
                 let i = (t.floor() as i64).clamp(0, shape[k] as i64 - 2);
                 base[k] = i;
@@ -82,5 +88,20 @@ mod tests {
         let out = interpolate(&sparse, &[0.0, 1.0, 2.0], [0.0, 0.0], 1.0, &[0.0, 0.5, 0.5, 0.5]);
         assert!((out[0] - 0.5).abs() < 1e-12);
         assert!(out[1].is_nan());
+    }
+
+    #[test]
+    fn a_node_read_back_at_its_own_coordinates_takes_no_weight_from_its_neighbours() {
+        // lower + i·h read back is i to rounding, not i: a weight of 1e-16 on an unreached
+        // neighbour made a reached node's own point inf
+        let band = NarrowBand::<2>::full_box([4, 4]).unwrap();
+        let (lower, h) = ([-1.0, -1.0], 0.04); // (-1 + 0.04 + 1) / 0.04 = 1.0000000000000009
+        let mut vals = vec![1.0; band.len()];
+        let far = band.find([2, 1]).unwrap();
+        vals[far] = f64::INFINITY;
+        let node = [lower[0] + h * 1.0, lower[1] + h * 1.0];
+        assert_eq!(interpolate(&band, &vals, lower, h, &node), vec![1.0]);
+        // a point off the plane by more than the rounding still reads its neighbours
+        assert!(interpolate(&band, &vals, lower, h, &[node[0] + 1e-6, node[1]])[0].is_infinite());
     }
 }
