@@ -9,7 +9,10 @@ two icospheres of radius 0.3 1.2 spacings apart at N = 51, a source on one, gave
 finite distances (1.42 at its far pole) with ``converged=True`` and no warning. Which part a node
 belongs to needs no such test on a mesh: it is the part of the face nearest to the node (the
 exact closest point, ``MeshSurface.closest``), and every band edge between nodes of two parts is
-cut. A part that holds no source then stays unreached (``inf``), as with ``smooth=False``.
+cut. A part that holds no source then stays unreached (``inf``), as with ``smooth=False``; every
+solve also labels the inner tube by piece and drops the pieces without a source (``_parts``:
+second order's exact start reaches a few spacings across a gap), and a point is read from the
+nodes of its own piece (``_sheet_readout``, ``Solution.on_mesh``).
 
 A piece is what the triangles join through shared vertices, vertices at the same coordinates
 counting as one (an export's seam, a triangle soup); pieces that may touch or cross (a union of
