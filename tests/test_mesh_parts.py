@@ -185,3 +185,17 @@ def test_pieces_closer_than_their_triangles_but_apart_stay_apart():
     inner = _sphere(3, 0.6 - 0.98 * g.spacing)
     mesh = ts.surfaces.from_mesh((np.r_[outer[0], inner[0]], np.r_[outer[1], inner[1] + len(outer[0])]))
     assert face_parts(mesh).max() == 1
+
+
+def test_each_point_beside_a_very_narrow_gap_is_labelled_by_its_own_piece():
+    # two spheres 0.5 spacings apart, a source on each: 33 vertices beside the gap were labelled
+    # -1 (their nearest band node was the other piece's, and no node of their own was looked for)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (51,) * 3)
+    v, f, d = two_spheres(0.5, g.spacing)
+    half = len(v) // 2
+    mesh = ts.surfaces.from_mesh((v, f))
+    assert face_parts(mesh) is not None
+    with pytest.warns(RuntimeWarning):
+        sol = ts.solve(mesh, g, [v[0], v[half]])
+    labels = sol.nearest_source(v)
+    assert np.array_equal(labels, np.repeat([0, 1], half))

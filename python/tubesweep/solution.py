@@ -377,6 +377,14 @@ class Solution:
         open_ = np.arange(len(near))
         bd = np.full(len(near), np.inf)
         bp = np.full(len(near), -1, dtype=np.int64)
+        # a mesh of separate pieces: only nodes of the point's own piece (across a gap narrower
+        # than the tube the nearest node is the other piece's, and a piece no source reaches
+        # read its neighbour's values)
+        own = self._band_pieces()
+        if own is not None:
+            from .surfaces._mesh_parts import point_parts
+
+            point_piece = point_parts(self.surface, p[near])
         for o, length in zip(offs[order], lengths[order]):
             open_ = open_[bd[open_] > length - slack]
             if open_.size == 0:
@@ -384,6 +392,8 @@ class Solution:
             idx = base[open_] + o
             pos = self._band.find(np.ascontiguousarray(idx))
             ok = pos >= 0
+            if own is not None:
+                ok &= own[np.maximum(pos, 0)] == point_piece[open_]
             if not np.any(ok):
                 continue
             dist = np.linalg.norm(idx - ci[open_], axis=1)
@@ -392,19 +402,18 @@ class Solution:
             bd[open_[take]] = dist[take]
         found = bp >= 0
         bp[found & ~np.isfinite(self.values[np.maximum(bp, 0)])] = -1
-        node_parts = getattr(self.surface, "_node_parts", None)
-        if node_parts is not None and np.any(bp >= 0):
-            # a mesh of separate pieces: the nearest node must lie on the point's own piece (across
-            # a gap narrower than the tube it is the other piece's, and a piece no source reaches
-            # read its neighbour's values)
-            from .surfaces._mesh_parts import point_parts
-
-            at = np.flatnonzero(bp >= 0)
-            piece = node_parts(self.grid, self.linear[bp[at]])
-            if piece is not None:
-                bp[at[piece != point_parts(self.surface, p[near[at]])]] = -1
         best[near] = bp
         return best
+
+    def _band_pieces(self) -> Optional[np.ndarray]:
+        """Per band node the piece of a mesh of separate pieces its nearest face lies on (kept
+        after the first call), or None on other surfaces."""
+        node_parts = getattr(self.surface, "_node_parts", None)
+        if node_parts is None:
+            return None
+        if "_pieces" not in self.__dict__:
+            self._pieces = node_parts(self.grid, self.linear)
+        return self._pieces
 
     def nearest_source(self, points: Any = None) -> np.ndarray:
         """Which source reaches each place first: indices into :attr:`sources`.

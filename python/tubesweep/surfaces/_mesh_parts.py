@@ -114,16 +114,20 @@ def _joined_where_touching(surface: Any, parts: np.ndarray) -> np.ndarray:
 
 
 def _box_pairs(lo: np.ndarray, hi: np.ndarray, longest: np.ndarray) -> list:
-    """The pairs of pieces whose boxes come within the longer one's longest edge of each other."""
-    reach = float(longest.max())
-    by_x = np.argsort(lo[:, 0], kind="stable")
-    ends = np.searchsorted(lo[by_x, 0], hi[by_x, 0] + reach, side="right")
+    """The pairs of pieces whose boxes come within the distance at which :func:`apart` can find
+    them touching (the longer one's longest edge over 8√3) of each other: sorted along the axis
+    on which the boxes spread most and swept."""
+    within = longest / (SAMPLES_PER_EDGE * np.sqrt(3.0))
+    reach = float(within.max())
+    axis = int(np.argmax(np.ptp(0.5 * (lo + hi), axis=0)))
+    by_x = np.argsort(lo[:, axis], kind="stable")
+    ends = np.searchsorted(lo[by_x, axis], hi[by_x, axis] + reach, side="right")
     out: list = []
     for k, i in enumerate(by_x):
         others = by_x[k + 1 : ends[k]]
         if others.size == 0:
             continue
-        near = np.maximum(longest[i], longest[others])
+        near = np.maximum(within[i], within[others])
         gap = np.max(np.maximum(lo[others] - hi[i], lo[i] - hi[others]), axis=1)
         out.extend((int(i), int(j)) for j in others[gap <= near])
     return out
