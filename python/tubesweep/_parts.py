@@ -56,16 +56,17 @@ def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
 
     band = tube.band if band is None else band
     cut = band is tube.band and tube.cut_edges > 0
-    pieces = getattr(tube.surface, "_node_parts", None)
-    if pieces is not None and tube.linear is not None:
+    part = tube.pieces
+    node_parts = getattr(tube.surface, "_node_parts", None)
+    if part is None and node_parts is not None and tube.linear is not None:
+        part = node_parts(tube.grid, tube.linear)  # (a tube prepared without the cut)
+    if part is not None:
         # a mesh's separate pieces, from each node's nearest face (surfaces._mesh_parts), label
         # the inner tube, cut or not: second order's exact start reaches across a narrow gap
         # (FIX_RADIUS), as the Lax–Friedrichs scheme on its uncut band does
-        part = pieces(tube.grid, tube.linear)
-        if part is not None:
-            labels = np.where(part >= 0, part, NO_PART).astype(np.uint32)
-            labels[tube.roles == ROLE_OUTER] = NO_PART
-            return labels
+        labels = np.where(part >= 0, part, NO_PART).astype(np.uint32)
+        labels[tube.roles == ROLE_OUTER] = NO_PART
+        return labels
     if tube.facing[0].size == 0 or (cut and cuts_medial_edges(tube.surface)):
         return None  # no front crosses between parts; a mesh's band is cut between them already
     inner = tube.roles != ROLE_OUTER

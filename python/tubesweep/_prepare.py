@@ -131,6 +131,9 @@ class _PreparedTube:
     #: the inner tube's connected components and the checksum of its flags, once a warm start
     #: counted them (``moving.inner_components``)
     inner_components: Optional[Tuple[int, int, np.ndarray]] = None
+    #: each band node's piece of a triangle mesh of separate pieces (``surfaces._mesh_parts``, from
+    #: the band's cut), None on other surfaces
+    pieces: Optional[np.ndarray] = None
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -516,6 +519,7 @@ def _prepare_tube(
         note=gap_note(h) if gap_note is not None else "",
     )
     cut_edges = 0
+    pieces = None
     cut_facing = facing
     resolved = getattr(surf, "resolved_gap", None)  # a cloud: the gaps its fits keep apart
     if cuts and resolved is not None:
@@ -535,7 +539,7 @@ def _prepare_tube(
         band, cut_edges = cut_shortcuts(
             band, roles == ROLE_INNER, phi, directions, h, cut_facing, medial=cuts_medial_edges(surf)
         )
-        band, parted = cut_between_parts(surf, grid, band, linear)
+        band, parted, pieces = cut_between_parts(surf, grid, band, linear)
         cut_edges += parted
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
@@ -572,4 +576,5 @@ def _prepare_tube(
         cut_edges,
         extended,
         paper_creases=paper_creases,
+        pieces=pieces,
     )

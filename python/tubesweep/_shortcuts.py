@@ -29,7 +29,7 @@ keep the paper's scheme bit for bit (their narrow gaps are warned about instead)
 
 from __future__ import annotations
 
-from typing import Any, Tuple
+from typing import Any, Optional, Tuple
 
 import numpy as np
 
@@ -77,14 +77,15 @@ def cut_shortcuts(
     return band.with_edges_cut(node, neighbour)
 
 
-def cut_between_parts(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
+def cut_between_parts(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int, Optional[np.ndarray]]:
     """The band without its edges between two separate parts of ``surf`` (a triangle mesh's
-    ``_part_cut_pairs``: ``surfaces._mesh_parts``), and the number of edges removed; the band
-    itself on other surfaces and on a mesh of one part."""
+    ``_part_cut_pairs``: ``surfaces._mesh_parts``), the number of edges removed, and each band
+    node's part; the band itself, 0 and None on other surfaces and on a mesh of one part."""
     pairs = getattr(surf, "_part_cut_pairs", None)
     if pairs is None:
-        return band, 0
-    node, neighbour = pairs(grid, band, linear)
+        return band, 0, None
+    node, neighbour, pieces = pairs(grid, band, linear)
     if node.size == 0:
-        return band, 0
-    return band.with_edges_cut(node, neighbour)
+        return band, 0, pieces
+    band, cut = band.with_edges_cut(node, neighbour)
+    return band, cut, pieces

@@ -76,6 +76,8 @@ def _fix_sources(
     d = grid.ndim
     dist, proj = surface.project(sources, grid)
     check_on_surface(sources, dist, inner_width)
+    if source_init == "node":
+        return _fixed_at_nearest_nodes(grid, band, roles, sources)
     r = int(np.ceil(radius + inner_width / h)) + 1
     # the nodes around a source: a box of (2r + 1)^d offsets, or for a box larger than the band
     # (a large source_radius) the band's nodes within it: memory of the band's size, not the box's
@@ -85,8 +87,6 @@ def _fix_sources(
         if band_index is None
         else None
     )
-    if source_init == "node":
-        return _fixed_at_nearest_nodes(grid, band, roles, sources)
     if offsets is not None and radius <= SOURCE_RADIUS:
         # the default: the sources in batches (one per source took 0.24 ms of Python, 61 s for
         # 200,000 sources against 8 s for the second-order solve)
@@ -209,7 +209,8 @@ def _fixed_in_batches(
             raise ValueError(
                 f"sources[{int(chunk[empty[0]])}] has no inner-tube node near it; refine the grid or increase `inner`"
             )
-        which = np.repeat(chunk, inner.sum(axis=1))  # each found node's source, in the sources' order
+        per = inner.sum(axis=1)
+        which = np.repeat(chunk, per)  # each found node's source, in the sources' order
         pos = found[inner]
         # each node's closest point once (sources near one another share their nodes)
         unique, back = np.unique(pos, return_inverse=True)
@@ -218,14 +219,13 @@ def _fixed_in_batches(
         geo = np.linalg.norm(cp - proj[which], axis=1)
         near = geo <= radius * h
         # a source none of whose nodes is within the radius: its nearest ones
-        per = inner.sum(axis=1)
         starts = np.concatenate([[0], np.cumsum(per)[:-1]])
         nearest = np.minimum.reduceat(geo, starts)
         without = ~np.logical_or.reduceat(near, starts)
         if np.any(without):
             near |= without[which - s0] & (geo <= nearest[which - s0])
         if connected:
-            for k, (a, n) in enumerate(zip(starts, per)):
+            for a, n in zip(starts, per):
                 near[a : a + n] = _joined_to_nearest(band, pos[a : a + n], geo[a : a + n], near[a : a + n])
         source_slowness = slowness_at(proj[chunk])
         slow = 0.5 * (slowness_at(cp[near]) + source_slowness[which[near] - s0])

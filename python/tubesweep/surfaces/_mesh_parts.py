@@ -173,18 +173,23 @@ def apart(tri: np.ndarray, tree: Any, lo: np.ndarray, hi: np.ndarray) -> bool:
     return bool(np.all(d.reshape(len(samples), -1).min(axis=1) > bound[near] / m))
 
 
+def _nearest_pieces(surface: Any, parts: np.ndarray, count: int, points_of: Any) -> np.ndarray:
+    """Per point the piece (of ``parts``, per face) of its nearest face, -1 where none is; the
+    ``count`` points come ``CHUNK`` at a time from ``points_of(start, stop)``."""
+    out = np.empty(count, np.int64)
+    for s in range(0, count, CHUNK):
+        _, _, face, _ = surface.closest(points_of(s, min(s + CHUNK, count)))
+        out[s : s + CHUNK] = np.where(face >= 0, parts[np.maximum(face, 0)], -1)
+    return out
+
+
 def node_parts(surface: Any, grid: Grid, linear: np.ndarray) -> Optional[np.ndarray]:
     """Per grid node of ``linear`` (linear indices) the part of the mesh ``surface`` its nearest
     face lies on, or None on a mesh of one part."""
     parts = face_parts(surface)
     if parts is None:
         return None
-    n = len(linear)
-    part = np.empty(n, np.int64)
-    for s in range(0, n, CHUNK):
-        _, _, face, _ = surface.closest(grid.node_points(linear[s : s + CHUNK]))
-        part[s : s + CHUNK] = np.where(face >= 0, parts[np.maximum(face, 0)], -1)
-    return part
+    return _nearest_pieces(surface, parts, len(linear), lambda a, b: grid.node_points(linear[a:b]))
 
 
 def point_parts(surface: Any, points: np.ndarray) -> np.ndarray:
@@ -193,20 +198,19 @@ def point_parts(surface: Any, points: np.ndarray) -> np.ndarray:
     parts = face_parts(surface)
     if parts is None:
         return np.zeros(len(points), np.int64)
-    out = np.empty(len(points), np.int64)
-    for s in range(0, len(points), CHUNK):
-        _, _, face, _ = surface.closest(points[s : s + CHUNK])
-        out[s : s + CHUNK] = np.where(face >= 0, parts[np.maximum(face, 0)], -1)
-    return out
+    return _nearest_pieces(surface, parts, len(points), lambda a, b: points[a:b])
 
 
-def part_cut_pairs(surface: Any, grid: Grid, band: Any, linear: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+def part_cut_pairs(
+    surface: Any, grid: Grid, band: Any, linear: np.ndarray
+) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
     """The band edges (``node``, ``neighbour``: band positions, ``node < neighbour``) between nodes
-    whose nearest faces lie on two parts of the mesh ``surface``; empty on a mesh of one part."""
+    whose nearest faces lie on two parts of the mesh ``surface``, and each band node's part
+    (:func:`node_parts`); empty and None on a mesh of one part."""
     empty = np.zeros(0, np.int64)
     part = node_parts(surface, grid, linear) if len(linear) else None
     if part is None:
-        return empty, empty
+        return empty, empty, None
     n = len(linear)
     nodes, neighbours = [], []
     for s in range(0, n, CHUNK):
@@ -219,4 +223,4 @@ def part_cut_pairs(surface: Any, grid: Grid, band: Any, linear: np.ndarray) -> T
         crossing = part[node] != part[other]
         nodes.append(node[crossing])
         neighbours.append(other[crossing])
-    return np.concatenate(nodes), np.concatenate(neighbours)
+    return np.concatenate(nodes), np.concatenate(neighbours), part
