@@ -12,10 +12,13 @@ the moving-least-squares projection of ``x`` onto the samples, computed in the R
 * Newton's method for the point of that graph nearest to x, and c ← that point, until it stops
   moving. The map is smooth at grid scale, so ``order="auto"`` runs second order on a closed cloud.
 
-Before any solve the samples are analysed: repeated samples (and samples within a thousandth of
-the fits' median radius of another) are kept once, samples far off the fit
-of their neighbours (outliers) are left out with a warning, and samples with an empty angular sector
-among their neighbours mark a rim (holes, the boundary of a scan). A cloud with a rim is an open
+Before any solve the samples are analysed (``_cloud_analysis``): repeated samples (and samples
+within a thousandth of the fits' median radius of another) are kept once, samples far off the fit
+of their neighbours (outliers: beyond half the fit's radius and six times the samples' noise) are
+left out with a warning, and samples with an empty angular sector among their neighbours mark a
+rim (holes, the boundary of a scan). On a noisy cloud (a scan) the analysis takes wider
+neighbourhoods, and the fits of the closest points reach at least 11 times the noise
+(:meth:`PointCloudSurface.smoothing_radius`). A cloud with a rim is an open
 surface: nodes beyond the rim get closest points on it (the open-surface treatment of Sect. 5.2) and
 ``order="auto"`` runs the paper's first-order scheme. ``surface.report`` says what was found, and
 where.
@@ -35,6 +38,8 @@ from .._validate import real_array
 from ..grid import MAX_COORDINATE, Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
+from ._cloud_analysis import analyse
+from ._cloud_files import read_points
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
 
@@ -47,6 +52,20 @@ OUTLIER_RATIO = 0.5
 #: (docs/point-clouds.md).
 FIT_RADIUS = 3.0
 NOISY = 0.005
+#: ... and at least this many times the noise, so that a fit sees the noise as a thin layer
+#: about the surface. Spheres with Gaussian noise of 0.5Δx (noise measured 0.45Δx): 20000 samples
+#: at N = 61 folded with fits of 3Δx (second order ran away, first order off by 2.4Δx), not with
+#: 5Δx; 50000 at N = 41 folded with 3.3Δx, not with 4.1Δx; noise Δx needed more than 6.5Δx (the
+#: extension layer did not close) (``benches/experiments/noisy_clouds.py``)
+NOISE_SPAN = 11.0
+#: ... and wide enough that the noise averaged over the samples within the fit (noise/√samples)
+#: stays under this fraction of Δx, which matters where the samples are sparse against the grid:
+#: 5000 samples with noise 0.25Δx at N = 81 (0.7 samples per Δx²) did not close their extension
+#: layer with fits of 3Δx
+NOISE_AVERAGED = 0.03
+#: ... but at most this many grid spacings (a wider fit flattens the surface's curvature): beyond
+#: it the grid resolves the surface finer than its noise allows, which is warned of
+MAX_SMOOTHING = 8.0
 #: More outliers than this share of the samples: refused (the cloud is not a surface's samples).
 MAX_OUTLIER_SHARE = 0.1
 #: Samples closer to another than this fraction of the fits' median radius (the distance to the
@@ -55,8 +74,8 @@ MAX_OUTLIER_SHARE = 0.1
 NEAR_REPEAT = 1e-3
 #: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
 SPARSE_FACTOR = 3.0
-#: A sample whose residual against its fit exceeds this fraction of the fit's radius, and four
-#: times the median residual (noise raises them all alike), lies where the fits cannot follow the
+#: A sample whose residual against its fit exceeds this fraction of the fit's radius, and six
+#: times the samples' noise (``_cloud_analysis``), lies where the fits cannot follow the
 #: surface: a sharp edge or corner. Noise-free samples of a 0.8³ box: 2.9% of them, of a cylinder
 #: with flat caps 1.5%; of a sphere or a torus none; a sphere with noise of 1-2% of its radius
 #: none (median residual 0.14-0.18).
@@ -77,127 +96,6 @@ CHUNK = 1 << 20
 #: across it): two sphere clouds 5 spacings apart at N = 61 (fits of 3 spacings) are, 4.6 and 4.8
 #: apart still crossed (``benches/experiments/cloud_gaps.py``)
 RESOLVED_GAP = 5.0 / 3.0
-#: The file extensions :func:`read_points` reads.
-POINT_FILES = (".xyz", ".txt", ".csv", ".pts", ".npy", ".ply")
-
-
-def read_points(path: Union[str, Path]) -> np.ndarray:
-    """The points of a ``.xyz`` / ``.txt`` / ``.csv`` / ``.pts`` (numbers, one point a line), ``.npy``
-    or ``.ply`` file, as an ``(M, 3)`` (or ``(M, 2)``) float64 array.
-
-    Text files are read with numpy: whitespace- or comma-separated columns, ``#`` comments and one
-    header line allowed; the first three columns are the coordinates (two if there are only two).
-    ``.ply`` needs plyfile, trimesh or meshio (the ``mesh`` extra).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The file.
-
-    Returns
-    -------
-    numpy.ndarray
-        ``(M, 3)`` or ``(M, 2)`` float64.
-
-    Raises
-    ------
-    FileNotFoundError
-        If the file does not exist.
-    ValueError
-        If the file is not a point file (unknown extension, no numbers, the wrong number of columns).
-    ImportError
-        If a ``.ply`` file meets none of plyfile, trimesh, meshio.
-
-    Examples
-    --------
-    >>> import numpy as np, tempfile, os
-    >>> from tubesweep.surfaces.points import read_points
-    >>> path = os.path.join(tempfile.mkdtemp(), "p.xyz")
-    >>> np.savetxt(path, np.eye(3))
-    >>> read_points(path).shape
-    (3, 3)
-    """
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(f"point file {str(path)!r} is a directory")
-    if not path.is_file():
-        raise FileNotFoundError(f"point file {str(path)!r} does not exist")
-    ext = path.suffix.lower()
-    if ext not in POINT_FILES:
-        raise ValueError(
-            f"{path.name!r} is not a point file tubesweep reads: use one of {', '.join(POINT_FILES)} "
-            "(a mesh file goes to from_mesh)"
-        )
-    if ext == ".npy":
-        try:
-            data = np.load(path, allow_pickle=False)
-        except (ValueError, OSError) as e:
-            raise ValueError(f"{path.name!r} is not a NumPy array file: {e}") from None
-    elif ext == ".ply":
-        data = _read_ply(path)
-    else:
-        data = _read_text(path, "," if ext == ".csv" else None)
-    data = np.asarray(data)
-    if data.dtype.kind not in "fiu" or data.ndim != 2 or data.shape[1] < 2:
-        raise ValueError(
-            f"{path.name!r} does not hold points: expected rows of 2 or 3 numbers, got an array of shape "
-            f"{data.shape} and type {data.dtype}"
-        )
-    if data.shape[0] == 0:
-        raise ValueError(f"{path.name!r} holds no points")
-    return np.ascontiguousarray(data[:, : min(3, data.shape[1])], dtype=float)
-
-
-def _read_text(path: Path, delimiter: Optional[str]) -> np.ndarray:
-    for skip in (0, 1):
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # numpy's "empty input file"
-                data = np.loadtxt(path, delimiter=delimiter, skiprows=skip, ndmin=2, comments="#")
-            return data
-        except (ValueError, UnicodeDecodeError):
-            continue
-    raise ValueError(
-        f"{path.name!r} is not a point file: its lines are not rows of numbers (x y z per line, "
-        "whitespace- or comma-separated, one header line at most)"
-    )
-
-
-def _read_ply(path: Path) -> np.ndarray:
-    try:
-        from plyfile import PlyData
-
-        try:
-            v = PlyData.read(str(path))["vertex"]
-        except Exception as e:  # plyfile raises its own errors for a broken file
-            raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
-        return np.c_[v["x"], v["y"], v["z"]]
-    except ImportError:
-        pass
-    try:
-        import trimesh
-
-        try:
-            loaded = trimesh.load(str(path), process=False)
-        except Exception as e:  # trimesh raises many kinds for a broken file
-            raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
-        vertices = getattr(loaded, "vertices", None)
-        if vertices is None:
-            raise ValueError(f"{path.name!r} holds no vertices")
-        return np.asarray(vertices, dtype=float)
-    except ImportError:
-        pass
-    try:
-        import meshio
-
-        try:
-            return np.asarray(meshio.read(str(path)).points, dtype=float)
-        except Exception as e:  # meshio raises many kinds for a broken file
-            raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
-    except ImportError:
-        raise ImportError(
-            "reading .ply points needs plyfile, trimesh or meshio: pip install 'tubesweep[mesh]'"
-        ) from None
 
 
 def _checked_points(points: Any, name: str = "points") -> np.ndarray:
@@ -360,6 +258,12 @@ class PointCloudSurface(ClosestPoint):
                 "(sample those parts more densely, or pass a smaller neighbours=)"
             )
         crease = self._crease_advice()
+        if self.smoothing > 0:  # the last band's fits were widened for the noise
+            advice = (
+                f"The samples are noisy (noise ≈ {self.noise:.3g}; the fits reached {self.smoothing:.3g} to smooth it "
+                "out, and the grid resolves the surface finer than that): use a coarser grid, or denser or less noisy "
+                f"samples. Or: {advice[0].lower()}{advice[1:]}"
+            )
         return f"{_sentence(crease)}. Or: {advice}" if crease else advice
 
     def _gap_note(self, h: float) -> str:
@@ -401,8 +305,6 @@ class PointCloudSurface(ClosestPoint):
         outliers: str = "remove",
         name: str = "point cloud",
     ):
-        from .. import _native
-
         p = _checked_points(points)
         d = p.shape[1]
         if isinstance(neighbours, bool) or not isinstance(neighbours, (int, np.integer)):
@@ -444,14 +346,13 @@ class PointCloudSurface(ClosestPoint):
         self._noise = 0.0
         self.name = name
         self.neighbours = int(neighbours)
-        cloud = _native.PointCloud(p, self.neighbours)
-        spacing, radius, residual, gap, nearest = cloud.analyse()
+        a = analyse(p, self.neighbours)
         for _ in range(8):  # chains of near repeats: each round keeps one of each nearest pair
-            near = spacing < NEAR_REPEAT * np.median(radius)
+            near = a.spacing < NEAR_REPEAT * np.median(a.radius)
             if not near.any():
                 break
             # a near repeat goes when its nearest sample comes first: the first of a cluster stays
-            drop = near & (nearest.astype(np.int64) < np.arange(len(p)))
+            drop = near & (a.nearest.astype(np.int64) < np.arange(len(p)))
             p = p[~drop]
             if self.normals is not None:
                 self.normals = self.normals[~drop]
@@ -461,12 +362,11 @@ class PointCloudSurface(ClosestPoint):
                     f"the cloud has {len(p)} distinct points ({given} given, {repeated} of them repeated or nearly: "
                     f"closer than {NEAR_REPEAT:g} of the fits' median radius to another); the fit needs at least {need}"
                 )
-            cloud = _native.PointCloud(np.ascontiguousarray(p), self.neighbours)
-            spacing, radius, residual, gap, nearest = cloud.analyse()
+            a = analyse(p, self.neighbours)
         # a few samples apart from the rest fit one another and pass the residual test; a group
         # smaller than one fit cannot be a piece of surface (tubesweep_core's point_cloud::isolated)
-        isolated = cloud.isolated(spacing, float(np.nanmedian(radius)), need)
-        bad = ~(residual <= OUTLIER_RATIO) | isolated  # NaN: a degenerate neighbourhood, an outlier
+        isolated = a.cloud.isolated(a.spacing, float(np.nanmedian(a.radius)), need)
+        bad = a.outliers(OUTLIER_RATIO) | isolated
         self.outliers = p[bad]
         if bad.any():
             where = tuple(round(float(c), 6) for c in p[np.flatnonzero(bad)[0]])
@@ -495,26 +395,27 @@ class PointCloudSurface(ClosestPoint):
                 self.normals = self.normals[~bad]
             if len(p) < need:
                 raise ValueError(f"after leaving out the outliers {len(p)} samples remain; the fit needs {need}")
-            cloud = _native.PointCloud(np.ascontiguousarray(p), self.neighbours)
-            spacing, radius, residual, gap, _ = cloud.analyse()
-        rim_count = cloud.mark_rim(np.ascontiguousarray(gap))
+            a = analyse(p, self.neighbours)
+        cloud = a.cloud
+        rim_count = cloud.mark_rim(np.ascontiguousarray(a.gap))
         self.points = p
         self._tree = cloud
         self.rim = np.flatnonzero(cloud.rim)
         self.open_surface = rim_count > 0
-        self.spacing = float(np.median(spacing))
+        self.spacing = float(np.median(a.spacing))
         # the fits' radii: the median and the widest (the band's error names uneven sampling)
-        self._median_fit = float(np.nanmedian(radius))
-        self._sparsest_fit = float(np.nanmax(radius))
+        self._median_fit = float(np.nanmedian(a.radius))
+        self._sparsest_fit = float(np.nanmax(a.radius))
         #: the samples' noise: 1.4826 × the median distance of a sample from its neighbours' fit
-        self.noise = 1.4826 * float(np.nanmedian(residual * radius))
+        #: (over wider neighbourhoods on a noisy cloud, ``_cloud_analysis``)
+        self.noise = a.noise
         cloud.set_noise(self.noise)
         # sharp edges and corners: samples their fit misses by far more than the noise
-        crease = residual > max(CREASE_RESIDUAL, 4.0 * float(np.nanmedian(residual)))
+        crease = a.creases(CREASE_RESIDUAL)
         self._creases = (int(np.count_nonzero(crease)), p[int(np.argmax(crease))] if np.any(crease) else None)
         #: the samples their fits miss (indices into ``points``): at sharp edges, or off the surface
         self.crease_samples = np.flatnonzero(crease)
-        q05, q95 = np.quantile(radius, [0.05, 0.95])
+        q05, q95 = np.quantile(a.radius, [0.05, 0.95])
         self.report: Dict[str, Any] = {
             "samples": given,
             "repeated": repeated,
@@ -572,6 +473,63 @@ class PointCloudSurface(ClosestPoint):
         # never fewer
         return np.asarray(self._tree.lower_bounds(np.ascontiguousarray(points, dtype=float)))
 
+    def smoothing_radius(self, h: float) -> float:
+        """The radius ρ over which the fits average the samples on a grid of spacing ``h``: 0 (the
+        k nearest samples alone) on a clean cloud; on a noisy one (noise above 0.005·h) at least
+        3·h (a fit over the k nearest alone has a curvature of noise/r², which makes the
+        projection from the tube's far nodes unstable), 11 times the noise (:data:`NOISE_SPAN`:
+        a fit then sees the noise as a thin layer about the surface) and wide enough to hold the
+        samples that average the noise to 0.03·h (:data:`NOISE_AVERAGED`), up to 8·h (a wider fit
+        flattens the surface's curvature; beyond it a warning names the spacing that resolves
+        the noise).
+
+        Parameters
+        ----------
+        h : float
+            The grid spacing.
+
+        Returns
+        -------
+        float
+            ρ, in the cloud's units.
+
+        Examples
+        --------
+        >>> import numpy as np, tubesweep as ts
+        >>> x = np.random.default_rng(0).normal(size=(5000, 3))
+        >>> cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
+        >>> cloud.smoothing_radius(0.05)  # noise-free
+        0.0
+        """
+        if not self.noise > NOISY * h:
+            return 0.0
+        return float(np.clip(self._noise_reach(h), FIT_RADIUS * h, MAX_SMOOTHING * h))
+
+    def _noise_reach(self, h: float) -> float:
+        """The fits' reach that the noise asks for: NOISE_SPAN noises, and the radius within which
+        (k + 1)·(ρ / r)² samples (r the fits' median radius) average the noise to NOISE_AVERAGED·h."""
+        return max(NOISE_SPAN * self.noise, self._averaging() / h)
+
+    def _averaging(self) -> float:
+        """ρ·h of the averaging reach (:meth:`_noise_reach`)."""
+        return self._median_fit * self.noise / NOISE_AVERAGED / float(np.sqrt(self.neighbours + 1))
+
+    def _warn_noise_unresolved(self, h: float) -> None:
+        """Warns when the noise needs fits wider than MAX_SMOOTHING·h (once per grid spacing)."""
+        if not self._noise_reach(h) > MAX_SMOOTHING * h or getattr(self, "_noise_warned", None) == h:
+            return
+        self._noise_warned = h
+        coarser = max(NOISE_SPAN * self.noise / MAX_SMOOTHING, float(np.sqrt(self._averaging() / MAX_SMOOTHING)))
+        warnings.warn(
+            f"the samples are noisy for this grid: they lie off their neighbours' fits by about {self.noise:.3g} "
+            f"({self.noise / h:.2g} grid spacings; noise, or samples too sparse for the surface's curvature), and fits "
+            f"of {MAX_SMOOTHING:g} grid spacings (the widest, not to flatten the surface) leave part of it in the "
+            "closest points, which may fold; the distances are uncertain by about as much. A grid spacing ≥ "
+            f"{coarser:.3g} (now {h:.3g}) lets the fits smooth it out, or denser samples do",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
+
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """The band nodes within ``half_width`` of the cloud's surface, found coarse-to-fine (a lower
         bound of the distance from the nearest sample), their closest points computed once, in Rust
@@ -613,10 +571,9 @@ class PointCloudSurface(ClosestPoint):
                 f"Use a grid with spacing ≥ {self.spacing / SPARSE_FACTOR:.3g} (e.g. surface.grid(n) with a smaller n) "
                 "or denser samples"
             )
-        # on a noisy cloud the fits reach at least FIT_RADIUS·Δx: the noise is averaged over the
-        # samples within it (a fit over the k nearest alone has a curvature of noise/r², which
-        # makes the projection from the tube's far nodes unstable)
-        self.smoothing = FIT_RADIUS * h if self.noise > NOISY * h else 0.0
+        self.smoothing = self.smoothing_radius(h)
+        if self.smoothing:
+            self._warn_noise_unresolved(h)
         candidates = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self._far_distance(p))
         parts: list = []
         undefined = []
@@ -664,10 +621,15 @@ class PointCloudSurface(ClosestPoint):
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
-        # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|
+        # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|, and
+        # the fitted surface's own wiggle, the samples' noise averaged over a fit's samples (their
+        # count within ρ, over the Wendland weights' and the quadric's share: 1/18; at noise
+        # 0.25Δx, ρ = 3Δx, the surface of 20000 sphere samples wiggles by ±0.1Δx, and nodes
+        # 0.02–0.1Δx off it on either side looked like sheets facing each other)
         pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)
         again, _ = self._tree.closest(np.ascontiguousarray(cp[pick]), self.smoothing)
-        self._noise = float(np.quantile(row_norms(again - cp[pick]), 0.9))
+        samples = (self.neighbours + 1) * max(self.smoothing / self._median_fit, 1.0) ** 2
+        self._noise = max(float(np.quantile(row_norms(again - cp[pick]), 0.9)), self.noise * np.sqrt(18.0 / samples))
         self._band_cache = (x, cp)
         ok = norm > DIRECTION_EPS * h
         direction = np.zeros((len(linear), d))

@@ -1,0 +1,92 @@
+"""Noisy point clouds (scans): Gaussian noise is measured, not taken for outliers, rims or creases;
+real outliers and real rims are still found; the fits widen with the noise so that second order
+runs; noise too large for the grid is warned of with the spacing that resolves it
+(``surfaces/_cloud_analysis.py``, ``PointCloudSurface.smoothing_radius``)."""
+
+import re
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.surfaces._cloud_analysis import analyse
+from tubesweep.surfaces.points import FIT_RADIUS, MAX_SMOOTHING
+
+
+def noisy_sphere(m: int, sigma: float, seed: int = 1, radius: float = 0.6, upper_half: bool = False) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(m, 3))
+    if upper_half:
+        p[:, 2] = np.abs(p[:, 2])
+    p = radius * p / np.linalg.norm(p, axis=1, keepdims=True)
+    return p + sigma * rng.normal(size=p.shape)
+
+
+def cube(n: int) -> ts.Grid:
+    return ts.Grid((-1,) * 3, (1,) * 3, (n,) * 3)
+
+
+def test_gaussian_noise_is_measured_and_not_taken_for_outliers_rims_or_creases():
+    # 20000 samples of a sphere of radius 0.6, Gaussian noise 0.0167 (half a spacing at N = 61, 1.2
+    # times the samples' spacing): over 20 neighbours, 580 samples were left out as outliers, 92
+    # marked a rim (a closed scan made open: first order) and the noise read as 0.0115
+    sigma = 0.5 * 2 / 60
+    cloud = ts.surfaces.from_points(noisy_sphere(20000, sigma))
+    r = cloud.report
+    assert (r["outliers"], r["rim_samples"], r["crease_samples"]) == (0, 0, 0) and not cloud.open_surface
+    assert abs(cloud.noise / sigma - 1) < 0.15, cloud.noise / sigma  # 0.90
+    # a dense scan whose noise is ten of its spacings: measured on thinned subsets
+    a = analyse(noisy_sphere(50000, 0.025), 20)
+    assert a.thinned_noise is not None and abs(a.noise / 0.025 - 1) < 0.2, a.noise  # 0.88; 0.0074 unthinned
+
+
+def test_a_real_outlier_on_a_noisy_cloud_is_still_left_out():
+    sigma = 0.01
+    p = noisy_sphere(20000, sigma)
+    strays = np.array([[0.0, 0.0, 0.72], [0.72, 0.0, 0.0], [0.0, -0.5, 0.0]])  # 12 and 10 noises off
+    with pytest.warns(RuntimeWarning, match="3 of 20003 samples lie off the surface their neighbours fit"):
+        cloud = ts.surfaces.from_points(np.r_[p, strays])
+    np.testing.assert_array_equal(np.sort(cloud.outliers, axis=0), np.sort(strays, axis=0))
+
+
+def test_a_noisy_open_scan_keeps_its_rim():
+    # the upper half of the sphere, noise 0.01 (0.3 spacings at N = 61): its rim is the equator
+    cloud = ts.surfaces.from_points(noisy_sphere(10000, 0.01, upper_half=True))
+    assert cloud.open_surface and cloud.report["rim_samples"] > 50
+    assert np.all(np.abs(cloud.points[cloud.rim, 2]) < 0.08)
+
+
+def test_fits_widen_with_the_noise_and_a_noisy_sphere_runs_second_order():
+    # 5000 samples, Gaussian noise of half a spacing at N = 41 (4 % of the radius): fits of
+    # 4.6 spacings; second order, within 0.36Δx of the exact distance on the sphere
+    g = cube(41)
+    h = g.spacing
+    cloud = ts.surfaces.from_points(noisy_sphere(5000, 0.5 * h))
+    rho = cloud.smoothing_radius(h)
+    assert FIT_RADIUS * h < rho < MAX_SMOOTHING * h
+    # the clean cloud keeps its own fits; the noise-wide ones grow as the grid refines
+    assert ts.surfaces.from_points(noisy_sphere(5000, 0.0)).smoothing_radius(h) == 0.0
+    assert cloud.smoothing_radius(h / 2) / (h / 2) > rho / h
+    source = np.array([0.0, 0.0, 0.6])
+    sol = ts.solve(cloud, g, [source])
+    assert sol.stats.order == 2 and sol.stats.converged
+    q = noisy_sphere(3000, 0.0, seed=5)
+    exact = ts.surfaces.Sphere(0.6).geodesic_distance(q, source)
+    e = np.abs(sol(q) - exact) / h
+    assert np.max(e) < 0.45 and np.median(e) < 0.06, (np.max(e), np.median(e))
+
+
+def test_noise_too_large_for_the_grid_is_warned_with_the_spacing_that_resolves_it():
+    # 5000 samples with noise 0.02 (3 % of the radius, 0.8 spacings at N = 81): fits of 8 spacings
+    # (the widest) leave a curvature of noise the tube does not resolve
+    g = cube(81)
+    h = g.spacing
+    cloud = ts.surfaces.from_points(noisy_sphere(5000, 0.02))
+    assert cloud.smoothing_radius(h) == MAX_SMOOTHING * h
+    with pytest.warns(
+        RuntimeWarning, match=r"the samples are noisy for this grid: they lie off .* A grid spacing ≥ \S+ \(now 0.025\)"
+    ) as said:
+        cloud.band(g, 2 * h)
+    # at the advised spacing the fits need no more than the widest
+    coarse = float(re.search(r"spacing ≥ (\S+) ", str(said[0].message)).group(1))
+    assert coarse > h and cloud.smoothing_radius(1.001 * coarse) < MAX_SMOOTHING * 1.001 * coarse
