@@ -112,3 +112,19 @@ def test_a_dense_noisy_cloud_fits_a_random_share_of_its_samples_the_same_after_p
     # the share's samples are drawn the same way again: a copy gives the same closest points
     x = 0.65 * q[:200]
     np.testing.assert_array_equal(pickle.loads(pickle.dumps(cloud)).closest_point(x), cloud.closest_point(x))
+
+
+def test_a_noisy_curve_cloud_keeps_second_order():
+    # 4000 samples of a circle of radius 0.6 with noise of half a spacing at N = 101: no outlier,
+    # no rim (a closed curve), second order within half a spacing of the arclength
+    rng = np.random.default_rng(1)
+    t = rng.uniform(0, 2 * np.pi, 4000)
+    g = ts.Grid((-1, -1), (1, 1), (101, 101))
+    h = g.spacing
+    cloud = ts.surfaces.from_points(0.6 * np.c_[np.cos(t), np.sin(t)] + 0.5 * h * rng.normal(size=(4000, 2)))
+    assert (cloud.report["outliers"], cloud.report["rim_samples"]) == (0, 0)
+    assert FIT_RADIUS * h < cloud.smoothing_radius(h) < MAX_SMOOTHING * h
+    sol = ts.solve(cloud, g, [(0.6, 0.0)])
+    q = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    e = np.abs(sol(0.6 * np.c_[np.cos(q), np.sin(q)]) - 0.6 * np.minimum(q, 2 * np.pi - q)) / h
+    assert sol.stats.order == 2 and np.max(e) < 0.5 and np.median(e) < 0.1, (np.max(e), np.median(e))  # 0.42, 0.07

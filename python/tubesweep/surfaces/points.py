@@ -454,7 +454,7 @@ class PointCloudSurface(ClosestPoint):
         rho = self.smoothing_radius(h)
         if not rho or self.open_surface:
             return 1.0
-        within = (self.neighbours + 1) * (rho / self._median_fit) ** 2
+        within = self._within(rho)
         need = max(FIT_SAMPLES, (self.noise / (NOISE_AVERAGED * h)) ** 2)
         return 1.0 if within < 2 * need else need / within
 
@@ -541,19 +541,28 @@ class PointCloudSurface(ClosestPoint):
 
     def _noise_reach(self, h: float) -> float:
         """The fits' reach that the noise asks for: NOISE_SPAN noises, and the radius within which
-        (k + 1)·(ρ / r)² samples (r the fits' median radius) average the noise to NOISE_AVERAGED·h."""
-        return max(NOISE_SPAN * self.noise, self._averaging() / h)
+        the samples (:meth:`_within`) average the noise to NOISE_AVERAGED·h."""
+        return max(NOISE_SPAN * self.noise, self._median_fit * self._averaging() * h ** (-2 / (self.ndim - 1)))
 
     def _averaging(self) -> float:
-        """ρ·h of the averaging reach (:meth:`_noise_reach`)."""
-        return self._median_fit * self.noise / NOISE_AVERAGED / float(np.sqrt(self.neighbours + 1))
+        """The averaging reach over the fits' median radius, times h^(2/(d − 1)): the samples
+        within ρ, (k + 1)·(ρ / r)^(d − 1), reach (noise / (NOISE_AVERAGED·h))²."""
+        return float(((self.noise / NOISE_AVERAGED) ** 2 / (self.neighbours + 1)) ** (1 / (self.ndim - 1)))
+
+    def _within(self, rho: float) -> float:
+        """About how many samples lie within ``rho`` of a point of the surface: (k + 1)·(ρ / r)^(d − 1),
+        r the fits' median radius (the (k + 1)-th nearest sample's distance)."""
+        return (self.neighbours + 1) * (rho / self._median_fit) ** (self.ndim - 1)
 
     def _warn_noise_unresolved(self, h: float) -> None:
         """Warns when the noise needs fits wider than MAX_SMOOTHING·h (once per grid spacing)."""
         if not self._noise_reach(h) > MAX_SMOOTHING * h or getattr(self, "_noise_warned", None) == h:
             return
         self._noise_warned = h
-        coarser = max(NOISE_SPAN * self.noise / MAX_SMOOTHING, float(np.sqrt(self._averaging() / MAX_SMOOTHING)))
+        # the averaging reach r·c·h^(−2/e) (e = d − 1) is MAX_SMOOTHING·h at h = (r·c / MAX_SMOOTHING)^(e/(e+2))
+        e = self.ndim - 1
+        averaged = (self._median_fit * self._averaging() / MAX_SMOOTHING) ** (e / (e + 2))
+        coarser = max(NOISE_SPAN * self.noise / MAX_SMOOTHING, averaged)
         warnings.warn(
             f"the samples are noisy for this grid: they lie off their neighbours' fits by about {self.noise:.3g} "
             f"({self.noise / h:.2g} grid spacings; noise, or samples too sparse for the surface's curvature), and fits "
@@ -664,7 +673,7 @@ class PointCloudSurface(ClosestPoint):
         # 0.02–0.1Δx off it on either side looked like sheets facing each other)
         pick = np.linspace(0, len(linear) - 1, min(len(linear), 512)).astype(np.int64)
         again, _ = fits.closest(np.ascontiguousarray(cp[pick]), self.smoothing)
-        samples = (self.neighbours + 1) * max(self.smoothing / self._median_fit, 1.0) ** 2 * self._share
+        samples = self._within(max(self.smoothing, self._median_fit)) * self._share
         self._noise = max(float(np.quantile(row_norms(again - cp[pick]), 0.9)), self.noise * np.sqrt(18.0 / samples))
         self._band_cache = (x, cp)
         ok = norm > DIRECTION_EPS * h
