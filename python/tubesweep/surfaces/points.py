@@ -542,17 +542,19 @@ class PointCloudSurface(ClosestPoint):
     def _noise_reach(self, h: float) -> float:
         """The fits' reach that the noise asks for: NOISE_SPAN noises, and the radius within which
         the samples (:meth:`_within`) average the noise to NOISE_AVERAGED·h."""
-        return max(NOISE_SPAN * self.noise, self._median_fit * self._averaging() * h ** (-2 / (self.ndim - 1)))
+        return max(
+            NOISE_SPAN * self.noise, self._median_fit * self._averaging() * h ** (-2 / (self.points.shape[1] - 1))
+        )
 
     def _averaging(self) -> float:
         """The averaging reach over the fits' median radius, times h^(2/(d − 1)): the samples
         within ρ, (k + 1)·(ρ / r)^(d − 1), reach (noise / (NOISE_AVERAGED·h))²."""
-        return float(((self.noise / NOISE_AVERAGED) ** 2 / (self.neighbours + 1)) ** (1 / (self.ndim - 1)))
+        return float(((self.noise / NOISE_AVERAGED) ** 2 / (self.neighbours + 1)) ** (1 / (self.points.shape[1] - 1)))
 
     def _within(self, rho: float) -> float:
         """About how many samples lie within ``rho`` of a point of the surface: (k + 1)·(ρ / r)^(d − 1),
         r the fits' median radius (the (k + 1)-th nearest sample's distance)."""
-        return (self.neighbours + 1) * (rho / self._median_fit) ** (self.ndim - 1)
+        return (self.neighbours + 1) * (rho / self._median_fit) ** (self.points.shape[1] - 1)
 
     def _warn_noise_unresolved(self, h: float) -> None:
         """Warns when the noise needs fits wider than MAX_SMOOTHING·h (once per grid spacing)."""
@@ -560,7 +562,7 @@ class PointCloudSurface(ClosestPoint):
             return
         self._noise_warned = h
         # the averaging reach r·c·h^(−2/e) (e = d − 1) is MAX_SMOOTHING·h at h = (r·c / MAX_SMOOTHING)^(e/(e+2))
-        e = self.ndim - 1
+        e = self.points.shape[1] - 1
         averaged = (self._median_fit * self._averaging() / MAX_SMOOTHING) ** (e / (e + 2))
         coarser = max(NOISE_SPAN * self.noise / MAX_SMOOTHING, averaged)
         warnings.warn(
