@@ -21,7 +21,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-__all__ = ["SampleAnalysis", "analyse", "NOISY_FIT", "NOISE_SCALE", "OUTLIER_NOISE", "WIDEST"]
+__all__ = ["SampleAnalysis", "analyse", "analyse_own", "widen", "NOISY_FIT", "NOISE_SCALE", "OUTLIER_NOISE", "WIDEST"]
 
 #: A cloud whose noise exceeds this fraction of its fits' median radius is analysed over wider
 #: neighbourhoods: over 20 neighbours, 20000 samples of a sphere with noise of 0.25–1 grid
@@ -95,12 +95,26 @@ class SampleAnalysis:
 def analyse(points: np.ndarray, neighbours: int) -> SampleAnalysis:
     """The cloud of ``points`` fitted over ``neighbours`` and its samples' analysis, over wider
     neighbourhoods where the noise is a sizeable part of the fits (:data:`NOISY_FIT`)."""
+    return widen(analyse_own(points, neighbours), points)
+
+
+def analyse_own(points: np.ndarray, neighbours: int) -> SampleAnalysis:
+    """The analysis over the cloud's own ``neighbours`` alone (what the near repeats need)."""
     from .. import _native
 
     p = np.ascontiguousarray(points)
     cloud = _native.PointCloud(p, neighbours)
     spacing, radius, residual, gap, nearest = cloud.analyse()
-    analysis = SampleAnalysis(cloud, spacing, radius, nearest, residual, radius, gap, neighbours)
+    return SampleAnalysis(cloud, spacing, radius, nearest, residual, radius, gap, neighbours)
+
+
+def widen(analysis: SampleAnalysis, points: np.ndarray) -> SampleAnalysis:
+    """``analysis`` (of ``points``, over their own neighbours) with the residuals, gaps and noise
+    taken over wider neighbourhoods where the noise is a sizeable part of the fits."""
+    from .. import _native
+
+    p = np.ascontiguousarray(points)
+    neighbours = analysis.analysis_neighbours
     share = analysis._share()
     if not share > NOISY_FIT:
         return analysis

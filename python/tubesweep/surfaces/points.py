@@ -38,7 +38,7 @@ from .._validate import real_array
 from ..grid import MAX_COORDINATE, Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
-from ._cloud_analysis import analyse
+from ._cloud_analysis import analyse, analyse_own, widen
 from ._cloud_files import read_points
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
@@ -351,7 +351,7 @@ class PointCloudSurface(ClosestPoint):
         self._noise = 0.0
         self.name = name
         self.neighbours = int(neighbours)
-        a = analyse(p, self.neighbours)
+        a = analyse_own(p, self.neighbours)
         for _ in range(8):  # chains of near repeats: each round keeps one of each nearest pair
             near = a.spacing < NEAR_REPEAT * np.median(a.radius)
             if not near.any():
@@ -367,7 +367,8 @@ class PointCloudSurface(ClosestPoint):
                     f"the cloud has {len(p)} distinct points ({given} given, {repeated} of them repeated or nearly: "
                     f"closer than {NEAR_REPEAT:g} of the fits' median radius to another); the fit needs at least {need}"
                 )
-            a = analyse(p, self.neighbours)
+            a = analyse_own(p, self.neighbours)
+        a = widen(a, p)
         # a few samples apart from the rest fit one another and pass the residual test; a group
         # smaller than one fit cannot be a piece of surface (tubesweep_core's point_cloud::isolated)
         isolated = a.cloud.isolated(a.spacing, float(np.nanmedian(a.radius)), need)
