@@ -361,6 +361,7 @@ class PointCloud:
     def rim(self) -> npt.NDArray[np.bool_]: ...
     def analyse(
         self,
+        bridge: Optional[float] = None,
     ) -> Tuple[
         npt.NDArray[np.float64],
         npt.NDArray[np.float64],

@@ -82,29 +82,39 @@ impl PyPointCloud {
 
     /// Per sample: spacing (distance to the nearest other sample), the fit's radius, the
     /// leave-one-out residual over the radius, the largest angular gap of the neighbours, the
-    /// index of the nearest other sample (2³² − 1 for none).
+    /// index of the nearest other sample (2³² − 1 for none). The gaps are bridged by samples up
+    /// to `bridge` away (default: twice the sparsest fit's radius; `PointCloud::analyse_bridging`).
     #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (bridge=None))]
     fn analyse<'py>(
         &self,
         py: Python<'py>,
-    ) -> (
+        bridge: Option<f64>,
+    ) -> PyResult<(
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<u32>>,
-    ) {
+    )> {
+        if let Some(b) = bridge {
+            if !(b >= 0.0 && b.is_finite()) {
+                return Err(PyValueError::new_err(format!(
+                    "bridge must be a finite distance ≥ 0; got {b}"
+                )));
+            }
+        }
         let a: SampleAnalysis = py.detach(|| match &self.cloud {
-            Cloud::Two(c) => c.analyse(),
-            Cloud::Three(c) => c.analyse(),
+            Cloud::Two(c) => c.analyse_bridging(bridge.unwrap_or(2.0 * c.reach())),
+            Cloud::Three(c) => c.analyse_bridging(bridge.unwrap_or(2.0 * c.reach())),
         });
-        (
+        Ok((
             a.spacing.into_pyarray(py),
             a.radius.into_pyarray(py),
             a.residual.into_pyarray(py),
             a.gap.into_pyarray(py),
             a.nearest.into_pyarray(py),
-        )
+        ))
     }
 
     /// Sets the samples' noise (`tubesweep_core::surface::point_cloud::PointCloud::set_noise`).

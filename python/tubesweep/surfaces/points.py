@@ -17,8 +17,8 @@ within a thousandth of the fits' median radius of another) are kept once, sample
 of their neighbours (outliers: beyond half the fit's radius and six times the samples' noise) are
 left out with a warning, and samples with an empty angular sector among their neighbours mark a
 rim (holes, the boundary of a scan). On a noisy cloud (a scan) the analysis takes wider
-neighbourhoods, and the fits of the closest points reach at least 11 times the noise
-(:meth:`PointCloudSurface.smoothing_radius`). A cloud with a rim is an open
+neighbourhoods, and the fits of the closest points reach 11 times the noise, up to 8 grid
+spacings (:meth:`PointCloudSurface.smoothing_radius`). A cloud with a rim is an open
 surface: nodes beyond the rim get closest points on it (the open-surface treatment of Sect. 5.2) and
 ``order="auto"`` runs the paper's first-order scheme. ``surface.report`` says what was found, and
 where.
@@ -265,9 +265,10 @@ class PointCloudSurface(ClosestPoint):
         crease = self._crease_advice()
         if self.smoothing > 0:  # the last band's fits were widened for the noise
             advice = (
-                f"The samples are noisy (noise ≈ {self.noise:.3g}; the fits reached {self.smoothing:.3g} to smooth it "
-                "out, and the grid resolves the surface finer than that): use a coarser grid, or denser or less noisy "
-                f"samples. Or: {advice[0].lower()}{advice[1:]}"
+                f"The samples lie off their neighbours' fits by about {self.noise:.3g} (noise, or samples too sparse for "
+                f"the surface's curvature; the fits reached {self.smoothing:.3g} to smooth it out, and the grid resolves "
+                "the surface finer than that): use a coarser grid, or denser or less noisy samples. "
+                f"Or: {advice[0].lower()}{advice[1:]}"
             )
         return f"{_sentence(crease)}. Or: {advice}" if crease else advice
 
@@ -440,7 +441,7 @@ class PointCloudSurface(ClosestPoint):
                 f"the point cloud has a rim (a hole or a boundary: {rim_count} samples, e.g. at {where}; "
                 "surface.rim lists them)"
             )
-        #: the smoothing radius ρ of the fits (set by the last band to FIT_RADIUS·Δx; 0 before)
+        #: the smoothing radius ρ of the fits (set by the last band: smoothing_radius(Δx); 0 before)
         self.smoothing = 0.0
         self._cp = self._closest
 
@@ -542,10 +543,12 @@ class PointCloudSurface(ClosestPoint):
 
     def _noise_reach(self, h: float) -> float:
         """The fits' reach that the noise asks for: NOISE_SPAN noises, and the radius within which
-        the samples (:meth:`_within`) average the noise to NOISE_AVERAGED·h."""
-        return max(
-            NOISE_SPAN * self.noise, self._median_fit * self._averaging() * h ** (-2 / (self.points.shape[1] - 1))
-        )
+        the samples (:meth:`_within`) average the noise to NOISE_AVERAGED·h (on a surface; a
+        curve's fits of NOISE_SPAN noises, with as few samples as a curve holds, stay within
+        0.06Δx: 4000 samples of a circle with noise 0.5Δx at N = 101, ``tests/test_point_cloud_noise.py``)."""
+        if self.points.shape[1] == 2:
+            return NOISE_SPAN * self.noise
+        return max(NOISE_SPAN * self.noise, self._median_fit * self._averaging() / h)
 
     def _averaging(self) -> float:
         """The averaging reach over the fits' median radius, times h^(2/(d − 1)): the samples
@@ -564,8 +567,9 @@ class PointCloudSurface(ClosestPoint):
         self._noise_warned = h
         # the averaging reach r·c·h^(−2/e) (e = d − 1) is MAX_SMOOTHING·h at h = (r·c / MAX_SMOOTHING)^(e/(e+2))
         e = self.points.shape[1] - 1
-        averaged = (self._median_fit * self._averaging() / MAX_SMOOTHING) ** (e / (e + 2))
+        averaged = (self._median_fit * self._averaging() / MAX_SMOOTHING) ** (e / (e + 2)) if e == 2 else 0.0
         coarser = max(NOISE_SPAN * self.noise / MAX_SMOOTHING, averaged)
+        coarser = _round_up(coarser * (1 + 1e-9))  # (printed rounded to the nearest, it can fall short)
         warnings.warn(
             f"the samples are noisy for this grid: they lie off their neighbours' fits by about {self.noise:.3g} "
             f"({self.noise / h:.2g} grid spacings; noise, or samples too sparse for the surface's curvature), and fits "
@@ -820,6 +824,12 @@ def from_points(
         points = read_points(points)
     surface = PointCloudSurface(points, normals=normals, neighbours=neighbours, outliers=outliers, name=name)
     return surface
+
+
+def _round_up(x: float, digits: int = 3) -> float:
+    """``x`` rounded up to ``digits`` significant digits."""
+    unit = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
+    return float(np.ceil(x / unit) * unit)
 
 
 def _sentence(text: str) -> str:

@@ -232,6 +232,14 @@ impl<const D: usize> PointCloud<D> {
 
     /// The per-sample analysis (in parallel).
     pub fn analyse(&self) -> SampleAnalysis {
+        self.analyse_bridging(2.0 * self.reach)
+    }
+
+    /// [`PointCloud::analyse`] with the gaps bridged by samples found up to `bridge` away
+    /// ([`PointCloud::bridged_gap`]; `analyse` bridges up to twice the sparsest fit's radius). A
+    /// noisy cloud's analysis over wide neighbourhoods bridges only as far as its own fits reach:
+    /// a hole narrower than twice the wide fits' radius would otherwise pass for thinner sampling.
+    pub fn analyse_bridging(&self, bridge: f64) -> SampleAnalysis {
         let k = self.neighbours;
         let rows: Vec<(f64, f64, f64, f64, u32)> = (0..self.points.len())
             .into_par_iter()
@@ -270,7 +278,7 @@ impl<const D: usize> PointCloud<D> {
                             spacing,
                             radius,
                             residual,
-                            self.bridged_gap(p, &fit, &ap, around),
+                            self.bridged_gap(p, &fit, &ap, around, bridge),
                             nearest,
                         )
                     }
@@ -290,14 +298,15 @@ impl<const D: usize> PointCloud<D> {
     /// The largest angular gap around sample `p` among `around` (its 2k nearest neighbours in the
     /// fit's tangent coordinates, `ap` its own), once the samples farther out in the gap's
     /// direction are counted: while the gap exceeds [`RIM_GAP`], probe points go out along its
-    /// bisector t at distances s = r, 2r, 4r, ... (r the fit's radius) up to 2·[`PointCloud::reach`]
-    /// (the sparsest fit's radius: a gap no wider than that is spanned by the fits anyway), and the
+    /// bisector t at distances s = r, 2r, 4r, ... (r the fit's radius) up to `bridge` (by default
+    /// 2·[`PointCloud::reach`], the sparsest fit's radius: a gap no wider than that is spanned by
+    /// the fits anyway), and the
     /// first sample within s/2 of a probe and near the fit (its offset from the fitted graph or
     /// from the tangent plane, the smaller, under half its distance: [`on_graph`]) joins the
     /// neighbours. Where the sampling only thins (a scan denser
     /// on one side) the gap closes; beyond a true rim the nearest sample to every probe is the rim
     /// itself, about s away, and the gap stays.
-    fn bridged_gap(&self, p: &[f64; D], fit: &Fit<D>, ap: &[f64; 2], mut around: Vec<[f64; 2]>) -> f64 {
+    fn bridged_gap(&self, p: &[f64; D], fit: &Fit<D>, ap: &[f64; 2], mut around: Vec<[f64; 2]>, bridge: f64) -> f64 {
         let (mut gap, mut dir) = gap_and_bisector::<D>(ap, &around);
         let mut closed = 0;
         while gap > RIM_GAP && closed < 4 {
@@ -309,7 +318,7 @@ impl<const D: usize> PointCloud<D> {
             }
             let mut s = fit.radius;
             let mut found = None;
-            while s <= 2.0 * self.reach && found.is_none() {
+            while s <= bridge && found.is_none() {
                 let mut probe = *p;
                 for k in 0..D {
                     probe[k] += s * t[k];
