@@ -37,8 +37,8 @@ __all__ = [
 
 #: A cloud whose noise exceeds this fraction of its fits' median radius is analysed over wider
 #: neighbourhoods: over 20 neighbours, 20000 samples of a sphere with noise of 0.25–1 grid
-#: spacings at N = 61 (noise/radius 0.22–0.28) showed 16–84 false rim samples
-#: (``tests/test_point_cloud_noise.py``).
+#: spacings at N = 61 (noise/radius 0.22–0.28) showed 16–84 false rim samples (single runs;
+#: ``tests/test_point_cloud_noise.py`` checks that such a cloud now shows none).
 NOISY_FIT = 0.1
 #: ... wide enough to reach this many times the noise: those clouds show no rim over 60–100
 #: neighbours.
@@ -51,7 +51,7 @@ WIDE_RIM_GAP = np.pi / 2
 WIDEST = 100
 #: An outlier lies farther off its fit than half the fit's radius (``points.OUTLIER_RATIO``) and
 #: than this many times the samples' noise: the Gaussian noise of those clouds put 0.8–3 % of the
-#: samples beyond half a fit's radius.
+#: samples beyond half a fit's radius (single runs; the test above checks that none is left out).
 OUTLIER_NOISE = 6.0
 #: Rounds of thinning, and the fewest samples a thinned cloud keeps.
 THINNING_ROUNDS = 4
