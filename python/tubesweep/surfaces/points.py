@@ -418,7 +418,7 @@ class PointCloudSurface(ClosestPoint):
         self.noise = a.noise
         cloud.set_noise(self.noise)
         # sharp edges and corners: samples their fit misses by far more than the noise
-        crease = a.creases(CREASE_RESIDUAL)
+        crease = a.creases(CREASE_RESIDUAL, p)
         self._creases = (int(np.count_nonzero(crease)), p[int(np.argmax(crease))] if np.any(crease) else None)
         #: the samples their fits miss (indices into ``points``): at sharp edges, or off the surface
         self.crease_samples = np.flatnonzero(crease)
