@@ -174,3 +174,14 @@ def test_a_dense_noisy_curve_cloud_reads_its_noise():
     q = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
     e = np.abs(sol(0.6 * np.c_[np.cos(q), np.sin(q)]) - 0.6 * np.minimum(q, 2 * np.pi - q)) / g.spacing
     assert sol.stats.order == 2 and np.max(e) < 0.2, np.max(e)  # 0.053
+
+
+def test_a_noisy_cloud_sampled_unevenly_stays_closed():
+    # a sphere with noise 0.006, sampled 15 times more densely above its equator: one sample at
+    # the density step passed for a rim, which made it open (first order there)
+    x = np.random.default_rng(2).normal(size=(40000, 3))
+    p = 0.6 * x / np.linalg.norm(x, axis=1, keepdims=True)
+    rng = np.random.default_rng(2)
+    p = p[rng.uniform(size=len(p)) < np.where(p[:, 2] > 0, 1.0, 1 / 15)]
+    cloud = ts.surfaces.from_points(p + 0.006 * rng.normal(size=p.shape))
+    assert cloud.report["rim_samples"] == 0 and not cloud.open_surface and cloud.order2_refusal is None
