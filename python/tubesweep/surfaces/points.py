@@ -83,8 +83,8 @@ MAX_OUTLIER_SHARE = 0.1
 NEAR_REPEAT = 1e-3
 #: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
 SPARSE_FACTOR = 3.0
-#: A sample whose residual against its fit exceeds this fraction of the fit's radius, and six
-#: times the samples' noise (``_cloud_analysis``), lies where the fits cannot follow the
+#: A sample whose residual against its fit exceeds this fraction of the fit's radius (and the
+#: noise's share, ``_cloud_analysis.SampleAnalysis.creases``) lies where the fits cannot follow the
 #: surface: a sharp edge or corner. Noise-free samples of a 0.8³ box: 2.9% of them, of a cylinder
 #: with flat caps 1.5%; of a sphere or a torus none; a sphere with noise of 1-2% of its radius
 #: none (median residual 0.14-0.18).
