@@ -568,3 +568,27 @@ def test_points_of_at_off_the_band_are_named_in_a_warning():
     ):
         U = tube.solve_many([(0, 0, 0.5)], at=at)
     assert np.all(np.isnan(U[:, 1:])) and abs(U[0, 0] - np.pi * 0.5) < 0.02
+
+
+def test_dask_checks_as_locally_and_a_runaway_row_falls_back_alone(client):
+    # threads and a speed array of the wrong shape were not checked on the client (an IndexError
+    # on the workers); each chunk chose its own order and stats["order"] was the first chunk's
+    tube = ts.Tube(ts.surfaces.Sphere(R), ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3))
+    src = [(0.5, 0, 0), (-0.5, 0, 0), (0, 0, 0.5)]
+    with pytest.raises(ValueError, match="threads must be a non-negative integer"):
+        tube.solve_many(src, client=client, threads=-1)
+    with pytest.raises(ValueError, match=r"speed array must have the grid's shape \(41, 41, 41\); got \(3, 3\)"):
+        tube.solve_many(src, client=client, speed=np.ones((3, 3)))
+    x = np.stack(np.meshgrid(*[np.linspace(-1, 1, 41)] * 3, indexing="ij"), -1)
+    speed = np.where(np.linalg.norm(x - [0.5, 0, 0], axis=-1) < 0.15, 1e-2, 1.0)
+    at = sphere_points(5, seed=1)
+    with pytest.warns(RuntimeWarning, match="ran away"):
+        local, st = tube.solve_many(src, at=at, speed=speed, return_stats=True)
+    with pytest.warns(RuntimeWarning, match="on the workers: .*ran away"):
+        remote, rst = tube.solve_many(src, at=at, speed=speed, client=client, chunk_size=1, return_stats=True)
+    assert np.array_equal(bits(remote), bits(local))
+    assert rst["orders"].tolist() == st["orders"].tolist() == [1, 2, 2] and rst["order"] == st["order"] == 1
+    # a point of at off the band is named once (not again from the workers)
+    with pytest.warns(RuntimeWarning, match="points of at lie off the band") as caught:
+        tube.solve_many(src[1:], at=[(0, 0, 0)], client=client)
+    assert len(caught) == 1

@@ -116,6 +116,8 @@ def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be an array-like of shape (M, {ndim}) of numbers") from None
     if p.ndim == 1 and p.size == ndim:
         p = p.reshape(1, ndim)
+    if p.size == 0 and p.ndim <= 1:
+        raise ValueError(f"{name} is empty: give at least one point, as an array of shape (M, {ndim})")
     if p.ndim != 2 or p.shape[1] != ndim:
         # (whole numbers alone: indices, as a mesh's vertex or a cloud's sample, which are points there)
         index = p.ndim <= 1 and p.size > 0 and bool(np.all(p == np.round(p)))

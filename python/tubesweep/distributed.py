@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional
 
 import numpy as np
 
-from ._validate import as_points, check_flag
-from .many import check_many_progress, fixed_nodes, source_groups
+from ._validate import as_points, check_flag, check_threads, speed_values
+from .many import check_many_progress, fixed_nodes, solve_many, source_groups
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube
@@ -73,13 +73,13 @@ def _solve_chunk(spec: _TubeSpec, groups: List[np.ndarray], at: Optional[np.ndar
     tube = _worker_tube(spec)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        values, stats = tube.solve_many(groups, at=at, threads=1, return_stats=True, **options)
-    order = (stats.get("order", 1), stats.get("order_fallback"))
+        # (the local solve_many: the client's Tube.solve_many names the points of at off the band, once)
+        values, stats = solve_many(tube, groups, at=at, threads=1, return_stats=True, **options)
     return (
         values,
         {k: v for k, v in stats.items() if isinstance(v, np.ndarray)},
         [str(w.message) for w in caught],
-        order,
+        stats.get("order_fallback"),
     )
 
 
@@ -141,6 +141,11 @@ def solve_many_on_client(
     if k == 0:
         raise ValueError("sources is empty: give at least one source (a point, or a group of points)")
     cb = check_many_progress(progress)
+    check_threads(threads)  # (not used: checked as a local solve_many checks it)
+    speed = options.get("speed", 1.0)
+    if not callable(speed):  # a number or an array of grid.shape, checked as locally (a callable runs on the workers)
+        linear = tube._tube.linear
+        speed_values(speed, tube.grid, np.empty((len(linear), 0)), linear)
     points = None if at is None else as_points(at, tube.grid.ndim, "at")
     # every source checked here, before anything is sent: a bad one is refused with its index
     fixed_nodes(tube, groups, options.get("speed", 1.0), options.get("source_init", "exact"))
@@ -180,14 +185,14 @@ def solve_many_on_client(
     out = np.empty((k, width))
     stats: Dict[str, np.ndarray] = {}
     messages: List[str] = []
-    order: Any = None
+    reason: Any = None  # why some rows ran the first-order scheme (order="auto")
     done = 0
     try:
         for fut in as_completed(futures):
             a = futures[fut]
             b = min(a + chunk_size, k)
             try:
-                values, st, caught, chunk_order = fut.result()
+                values, st, caught, chunk_reason = fut.result()
             except (ValueError, TypeError, KeyboardInterrupt):
                 raise
             except Exception as e:  # a worker that died on every try (KilledWorker), a lost dependency...
@@ -197,7 +202,7 @@ def solve_many_on_client(
                     "(docs/many-sources.md, 'What to size')"
                 ) from e
             out[a:b] = values
-            order = chunk_order if order is None else order
+            reason = chunk_reason if reason is None else reason
             for name, v in st.items():
                 stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
             messages.extend(caught)
@@ -217,6 +222,8 @@ def solve_many_on_client(
         )
     if return_stats:
         stats_out: Dict[str, Any] = dict(stats)
-        stats_out["order"], stats_out["order_fallback"] = order
+        # each row's order; "order" the lowest, as locally (chunks may differ where a source ran away)
+        stats_out["order"] = int(np.min(stats["orders"]))
+        stats_out["order_fallback"] = reason
         return out, stats_out
     return out

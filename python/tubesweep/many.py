@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from typing import TYPE_CHECKING, Any, Callable, List, Optional, Tuple
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -33,6 +33,7 @@ from ._validate import (
     speed_values,
 )
 from ._creases import warn_paper_tube_creases
+from ._warn import user_stacklevel
 from ._prepare import ROLE_INNER, thinned_count, uncut_band, warn_facing_pairs
 from ._parts import drop_unsourced_rows
 from ._sheet_readout import own_side_plan
@@ -193,10 +194,23 @@ def solve_many(
     nthreads = check_threads(threads)
     inf = check_infinity(infinity)
     points = None if at is None else as_points(at, grid.ndim, "at")
+    first = dict(
+        points=points,
+        scheme=scheme,
+        speed=speed,
+        source_init=source_init,
+        tol=tol,
+        max_iterations=max_iterations,
+        cb=cb,
+        inf=inf,
+        nthreads=nthreads,
+        paper_sweeps=bool(paper_sweeps),
+    )
     fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
     if order != 1:
         try:
             so.check_supported(t.surface, None, scheme, t.method, source_init, bool(paper_sweeps))
+            so.check_widths(tube._args[0], tube._args[1])  # the widths given decide, as tube.solve's
             if tube._order2_refusal is not None:  # this band's geometry, refused before
                 raise so.Order2NotApplicable(tube._order2_refusal)
             try:
@@ -210,21 +224,81 @@ def solve_many(
                     progress=cb,
                     threads=nthreads,
                 )
-            except so.Order2RanAway:
-                raise  # depends on the speed and the sources: not kept as the band's refusal
             except so.Order2NotApplicable as e:
                 tube._order2_refusal = str(e)  # depends on the band only: not computed again
                 raise
-            if return_stats:
-                st.update(order=2, order_fallback=None, seconds_total=time.perf_counter() - t0)
-                return out, st
-            return out
         except so.Order2NotApplicable as e:
             if order == 2:
                 raise
             fallback = Fallback.of(e, order)
             if isinstance(e, so.OptionOfOrder1):
                 order = 1  # an option of the first-order scheme: its tube, as ts.solve's and tube.solve's
+        else:
+            orders = np.full(len(groups), 2, dtype=np.int8)
+            reason = None
+            failed = np.flatnonzero(st["restart_failed"])
+            if failed.size:
+                # values falling without bound for these sources: no factored solution. tube.solve
+                # raises for each under order=2 and runs the first-order scheme under "auto": so do
+                # their rows (the others keep second order)
+                ran_away = so.Order2RanAway(
+                    st.pop("ran_away") + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}"
+                    f"{'…' if failed.size > 5 else ''})"
+                )
+                if order == 2:
+                    raise ran_away
+                lower = Fallback.of(ran_away, order)  # (warned now)
+                reason = lower.reason
+                rows, _ = _first_order_batch(
+                    tube, [groups[i] for i in failed], "auto", lower, **{**first, "cb": None}, numbers=failed
+                )
+                out[failed] = rows
+                orders[failed] = 1
+            else:
+                st.pop("ran_away", None)
+            if return_stats:
+                # the lowest order of any row ("orders": each row's)
+                st.update(
+                    order=int(orders.min()),
+                    orders=orders,
+                    order_fallback=reason,
+                    seconds_total=time.perf_counter() - t0,
+                )
+                return out, st
+            return out
+    out, st = _first_order_batch(tube, groups, order, fallback, **first)
+    if return_stats:
+        st["seconds_total"] = time.perf_counter() - t0
+        st["orders"] = np.ones(len(groups), dtype=np.int8)
+        return out, st
+    return out
+
+
+def _first_order_batch(
+    tube: "Tube",
+    groups: List[np.ndarray],
+    order: Any,
+    fallback: Optional[Fallback],
+    *,
+    points: Optional[np.ndarray],
+    scheme: str,
+    speed: Any,
+    source_init: str,
+    tol: Optional[float],
+    max_iterations: int,
+    cb: Optional[Callable[[int, int], Any]],
+    inf: float,
+    nthreads: int,
+    paper_sweeps: bool,
+    numbers: Optional[np.ndarray] = None,
+) -> Tuple[np.ndarray, Dict[str, Any]]:
+    """The paper's first-order scheme for every group (``_native.solve_many_on_band``): on the
+    paper's tube for ``order=1``, on the tube thinned at creases for ``"auto"``'s fallback (as
+    ``tube.solve``), ``fallback`` then saying why; ``numbers``: the groups' places among the
+    sources (the rows of those that ran away at second order). Returns the rows and the stats."""
+    t0 = time.perf_counter()
+    t = tube._tube
+    grid = t.grid
     if order != 1:
         t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
     if fallback is not None:
@@ -289,20 +363,18 @@ def solve_many(
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])
     bad = np.flatnonzero(~st["converged"])
     if bad.size:
+        ids = bad if numbers is None else numbers[bad]
         warnings.warn(
             f"{bad.size} of {len(groups)} solves did not converge in max_iterations={max_iterations} (sources "
-            f"{bad[:5].tolist()}{'…' if bad.size > 5 else ''}; the largest change in the last iteration "
+            f"{ids[:5].tolist()}{'…' if bad.size > 5 else ''}; the largest change in the last iteration "
             f"{float(np.max(st['last_change'][bad])):.3g}, tol={tol:g}): their rows are the last iterate. Increase "
             "max_iterations or tol",
             RuntimeWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
-    if return_stats:
-        st = dict(st)
-        st["setup_seconds"] = setup
-        st["seconds_total"] = time.perf_counter() - t0
-        st["order"] = 1
-        st["order_fallback"] = None if fallback is None else fallback.reason
-        st["creases"] = t.paper_creases
-        return out, st
-    return out
+    stats: Dict[str, Any] = dict(st)
+    stats["setup_seconds"] = setup
+    stats["order"] = 1
+    stats["order_fallback"] = None if fallback is None else fallback.reason
+    stats["creases"] = t.paper_creases
+    return out, stats

@@ -28,6 +28,7 @@ from ._sheet_readout import own_side_plan
 from .mask import mask_advice
 from ._stagnation import FALLBACK_WARNING, fallback_message
 from ._validate import FRONT_WINDOW, as_sources
+from ._warn import user_stacklevel
 from . import second_order as so
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -56,7 +57,9 @@ def solve_many_order2(
 ) -> Tuple[np.ndarray, Dict[str, Any]]:
     """The second-order batch (see the module's documentation): ``(values, stats)``, values
     ``(K, band_points)`` or ``(K, M)`` at ``points``. Raises :class:`second_order.Order2NotApplicable`
-    where ``order=2`` does not apply to the tube (the caller falls back under ``order="auto"``)."""
+    where ``order=2`` does not apply to the tube (the caller falls back under ``order="auto"``).
+    Sources whose sweeps ran away are flagged in the stats' ``restart_failed``, ``ran_away`` saying
+    why; their rows are to be replaced."""
     t = tube._tube_order2  # thinned at a level set's creases, as ts.solve's
     grid, surf = t.grid, t.surface
     h = grid.spacing
@@ -135,12 +138,13 @@ def solve_many_order2(
         values = plan.apply(np.ascontiguousarray(values[:, :m]), values[:, m:])
     failed = np.flatnonzero(st["restart_failed"])
     if failed.size:
-        # values falling without bound for these sources: no factored solution (second_order.Order2RanAway)
-        raise so.Order2RanAway(
-            so.ran_away_message(int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness, t.surface)
-            + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}{'…' if failed.size > 5 else ''})"
+        # values falling without bound for these sources: no factored solution; the caller raises
+        # (order=2) or solves them at first order ("auto"), with this text (second_order.Order2RanAway)
+        st["ran_away"] = so.ran_away_message(
+            int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness, t.surface
         )
     st["tol"] = inputs.tol
+    so.warn_first_order_nodes(st, "tube.solve(source).first_order_points() shows where")
     warn_creases(st.get("creases"), t.inner, h, thinned=thinned_spacings(t, thinned_count(t) > 0))
     for name, what in (
         (
@@ -153,16 +157,21 @@ def solve_many_order2(
         ),
     ):
         bad = np.flatnonzero(~st["converged"]) if name == "converged" else np.flatnonzero(st[name] >= 0)
+        bad = np.setdiff1d(bad, failed)  # (those rows are replaced: said by the caller)
         if bad.size:
             warnings.warn(
                 f"order=2: {bad.size} of {len(groups)} solves "
                 + what.format(m=max_iterations)
                 + f" (sources {bad[:5].tolist()}{'…' if bad.size > 5 else ''})",
                 RuntimeWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
     # the stagnation fallbacks large enough to warn of (``_stagnation``), as the single solve does
-    large = np.flatnonzero((st["fallback_iteration"] >= 0) & (st["fallback_change"] > FALLBACK_WARNING * inputs.tol))
+    large = np.flatnonzero(
+        (st["fallback_iteration"] >= 0)
+        & (st["fallback_change"] > FALLBACK_WARNING * inputs.tol)
+        & ~st["restart_failed"]
+    )
     if large.size:
         worst = int(large[np.argmax(st["fallback_change"][large])])
         text = fallback_message(
@@ -177,6 +186,6 @@ def solve_many_order2(
             f"order=2: {large.size} of {len(groups)} solves (sources {large[:5].tolist()}"
             f"{'…' if large.size > 5 else ''}) fell back to decreases only; in solve {worst}, the largest: {text}",
             RuntimeWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
     return values, st

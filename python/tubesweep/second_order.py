@@ -451,6 +451,16 @@ def warn_about(
     fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, values, default_tol=default)
     if fallback is not None:
         warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
+    warn_first_order_nodes(st)
+    warn_creases(
+        st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_spacings(tube, thinned_count(tube) > 0)
+    )
+
+
+def warn_first_order_nodes(st: Dict[str, Any], where: str = "sol.first_order_points() shows where") -> None:
+    """The warning that more than :data:`FIRST_ORDER_WARNING` of the inner tube ran the
+    first-order update (the native report's ``first_order_nodes``, ``inner_nodes`` and
+    ``first_order_reasons``: the tube's geometry, the same for every source of a batch)."""
     first_order = int(st["first_order_nodes"])
     if first_order > FIRST_ORDER_WARNING * st["inner_nodes"]:
         r = st["first_order_reasons"]
@@ -459,13 +469,10 @@ def warn_about(
             f"({100 * first_order / st['inner_nodes']:.0f}%) ran the first-order update, where the grid does not "
             f"resolve the surface ({r['curvature']} unresolved curvature: creases, corners, rims, noise; "
             f"{r['gradient']} φ not a distance; {r['stencil']} stencils cut by the box or the band). Errors near them "
-            "and beyond them are first order; sol.first_order_points() shows where. A finer grid resolves more of it",
+            f"and beyond them are first order; {where}. A finer grid resolves more of it",
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
-    warn_creases(
-        st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_spacings(tube, thinned_count(tube) > 0)
-    )
 
 
 #: The native report's entries that ``sol.stats.order2`` keeps as they are.

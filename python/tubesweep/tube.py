@@ -370,8 +370,10 @@ class Tube:
         chunk_size : int, optional
             Sources per cluster task.
         return_stats : bool
-            Also return per-source statistics (and ``order``, ``order_fallback``: the order run and
-            why second order did not apply, as ``sol.stats``).
+            Also return per-source statistics (and ``order``, ``order_fallback``: the order run, the
+            lowest of any row, and why second order did not apply, as ``sol.stats``; ``orders``, each
+            row's: a source whose second-order sweeps run away runs first order, as its
+            :meth:`solve` does; at second order ``first_order_nodes`` and ``inner_nodes``).
         order : {"auto", 1, 2}
             As for :meth:`solve`: ``"auto"`` (the default) runs second order where it applies (the
             tube's geometry computed once for the batch) and the paper's first-order scheme

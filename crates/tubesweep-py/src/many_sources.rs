@@ -16,6 +16,9 @@ use tubesweep_core::sweep::many_sources::{solve_many, FixedSet, Output};
 use tubesweep_core::sweep::{default_row_prefetch_above, MissingNeighbour, Slowness};
 use tubesweep_core::{Control, InnerScheme, SolveOptions, SolveStats, SweepProblem};
 
+/// What a batch too large for memory says (the K × n values of a batch without `at`, or K × M).
+const ROWS_FIX: &str = "pass at= (the values at the points you need: sources × points) or solve fewer sources per call";
+
 /// Registers the functions of this file in the native module (called from `lib.rs`).
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve_many_on_band, m)?)
@@ -114,7 +117,7 @@ fn run<'py, const D: usize>(
             .map_err(|_| PyValueError::new_err(format!("lower must have {D} entries")))?,
         None => [0.0; D],
     };
-    let mut values = vec![0.0f64; k * width];
+    let mut values = tubesweep_core::error::batch_rows(k, width, ROWS_FIX).map_err(to_pyerr)?;
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
@@ -342,7 +345,7 @@ fn run_order2<'py, const D: usize>(
     };
     let k = sources.len();
     let width = at.map_or(n, |(p, _)| p.len());
-    let mut values = vec![0.0f64; k * width];
+    let mut values = tubesweep_core::error::batch_rows(k, width, ROWS_FIX).map_err(to_pyerr)?;
     let mut py_error: Option<PyErr> = None;
     let progress_ref = progress.as_ref().map(|p| p.clone().unbind());
     let result = py.detach(|| {
@@ -458,6 +461,15 @@ fn run_order2<'py, const D: usize>(
     )?;
     d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
     d.set_item("max_curvature", summary.max_curvature)?;
+    d.set_item("grad_norm_range", (summary.grad_norm_min, summary.grad_norm_max))?;
+    // the tube's geometry, shared by every source: the inner nodes that run the first-order update
+    d.set_item("first_order_nodes", summary.first_order_nodes())?;
+    d.set_item("inner_nodes", summary.inner_nodes)?;
+    let reasons = PyDict::new(py);
+    reasons.set_item("stencil", summary.incomplete_stencils)?;
+    reasons.set_item("gradient", summary.off_distance)?;
+    reasons.set_item("curvature", summary.unresolved_curvature)?;
+    d.set_item("first_order_reasons", reasons)?;
     d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("reach", reach)?;
     Ok((array, d))

@@ -207,6 +207,14 @@ fn solve_one<const D: usize>(
         stats.seconds += st.seconds;
     }
     values.truncate(tube.band.len());
+    // a travel time is never negative: u = u₀ + w rounds to just below 0 next to a source, and
+    // the single solve clamps its values at 0 after its sweeps (whose runaway guard reads the
+    // sign), so the batch's rows and their read-outs do too (NaN stays NaN, as numpy's maximum)
+    for v in values.iter_mut() {
+        if *v < 0.0 {
+            *v = 0.0;
+        }
+    }
     Ok((values, factoring.u0, stats))
 }
 
