@@ -26,7 +26,7 @@ from typing import Any, Callable, List, Optional, Union
 import numpy as np
 from xml.sax.saxutils import quoteattr
 
-from ._validate import as_grid, as_sources, real_scalar
+from ._validate import as_grid, as_sources, real_array, real_scalar
 from ._box_cut import cut_extent
 from ._sources import check_on_surface
 from .solution import Solution
@@ -357,9 +357,18 @@ def evolve(
         )
     # a copy in C order: the caller's array is left alone, and the band's nodes are written
     # through its flat view (of a Fortran-ordered array, a copy that dropped the step's motion)
-    arr = np.array(phi, dtype=float, order="C")
+    arr = np.array(real_array(phi, "evolve: phi"), dtype=float, order="C")
     if arr.shape != tuple(grid.shape):
         raise ValueError(f"evolve: phi must be an array of the grid's shape {tuple(grid.shape)}; got {arr.shape}")
+    unfinite = np.flatnonzero(~np.isfinite(arr.reshape(-1)))
+    if unfinite.size:
+        # (each step re-distances φ, LevelSet(phi, redistance=True), which reads it at every node)
+        where = tuple(round(float(c), 6) for c in grid.node_points(unfinite[:1])[0])
+        raise ValueError(
+            f"evolve: phi is NaN or inf at {unfinite.size} of {arr.size} nodes (the first at {where}); evolve "
+            "re-distances φ at every step, which reads every node. Replace them by a value of their side's sign "
+            "farther from the surface than the band (e.g. np.where(np.isfinite(phi), phi, ±1))"
+        )
     src = as_sources(sources, grid)
     dt = real_scalar(dt, "evolve: dt", "a positive time step")
     if not (np.isfinite(dt) and dt > 0):

@@ -91,6 +91,11 @@ def values_checksum(values: np.ndarray) -> int:
     return zlib.crc32(np.ascontiguousarray(values, dtype=np.float64).data)
 
 
+#: How much looser than a warm solve's tolerance the previous solve's may be for its digests to
+#: be trusted (:func:`_digests_to_trust`).
+TOL_SLACK = 1.1
+
+
 def _digests_to_trust(warm: Any, tol: float) -> Tuple[Optional[np.ndarray], Optional[str]]:
     """The previous solution's digests, when its values are the fixed point of the updates they
     describe at this solve's tolerance; else None and why every node starts active. A node whose
@@ -102,9 +107,13 @@ def _digests_to_trust(warm: Any, tol: float) -> Tuple[Optional[np.ndarray], Opti
     if digests is None or digested is None:
         return None, "the previous solution kept no digests (a one-off ts.solve): every node started"
     prev_tol, checksum = digested
-    if prev_tol > tol * (1 + 1e-12):
+    # (a tenth looser is kept: its values are then within 1.1 of this solve's tolerance of their fixed
+    # point, and a speed changed by 1e-6 moves the default tolerance, which scales with the slowness)
+    if prev_tol > tol * TOL_SLACK:
         return None, (
-            f"the previous solve's tolerance {prev_tol:.3g} is looser than this one's {tol:.3g}: every node started"
+            f"the previous solve's tolerance {prev_tol:.6g} is looser than this one's {tol:.6g} by more than "
+            f"{TOL_SLACK - 1:.0%}: every node started (the default tolerance scales with the mean slowness: pass the "
+            "same tol= to both solves to keep the local start)"
         )
     if values_checksum(warm.values) != checksum:
         return None, "the previous solution's values were changed after its solve: every node started"
@@ -240,6 +249,13 @@ def carried_values(
     if missing:
         # the previous band's width is the limit (the new tube's may be wider)
         prev_outer = float(getattr(warm, "outer", tube.outer_eff))
+        if prev_outer <= inner_width / h + 1e-9:
+            raise WarmStartRefused(
+                f"warm: {missing} nodes of the new inner tube lie outside the previous band: this tube's inner tube "
+                f"(inner = {inner_width / h:g} grid spacings) is as wide as the previous solution's whole band (outer = "
+                f"{prev_outer:g}) or wider. Build both tubes with the same widths (tube.moved keeps them), or solve cold "
+                "(leave out warm=)"
+            )
         raise WarmStartRefused(
             f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved farther than "
             f"the previous solution's outer − inner = {prev_outer - inner_width / h:g} grid spacings since it. Move in "

@@ -319,6 +319,23 @@ class Tube:
         >>> grown = tube.moved(ts.surfaces.Sphere(0.51))
         >>> sol2 = grown.solve([(0, 0, 0.51)], warm=sol)
         """
+        d = self.grid.ndim
+        if isinstance(surface, tuple) and len(surface) == 2 and all(np.ndim(a) == 2 for a in surface):
+            raise TypeError(
+                "moved: got a pair of arrays, which looks like a mesh's vertices and triangles; pass the moved mesh "
+                "as ts.surfaces.from_mesh((vertices, triangles))"
+            )
+        if (
+            isinstance(surface, np.ndarray)
+            and surface.ndim == 2
+            and surface.shape[1] == d
+            and tuple(surface.shape) != tuple(self.grid.shape)
+        ):
+            raise TypeError(
+                f"moved: got an array of shape {surface.shape}, which looks like points, not a φ array of the grid's "
+                f"shape {tuple(self.grid.shape)}; pass moved samples as ts.surfaces.from_points(points) (a mesh's moved "
+                "vertices as ts.surfaces.from_mesh((vertices, triangles)))"
+            )
         if isinstance(surface, np.ndarray) and tuple(surface.shape) != tuple(self.grid.shape):
             raise ValueError(
                 f"moved: the φ array has shape {tuple(surface.shape)}, the tube's grid {tuple(self.grid.shape)}; a moved "

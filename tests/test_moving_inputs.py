@@ -1,0 +1,62 @@
+"""Moving surfaces: what the caller is told (review of stop 68): evolve's φ checked as ts.Tube
+checks it, tube.moved given a mesh's or a cloud's arrays, a warm start from a narrower band, and
+the previous solve's tolerance a hair looser through the speed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+from tubesweep.moving import WarmStartRefused
+
+GRID = ts.Grid((-1, -1, -1), (1, 1, 1), (31, 31, 31))
+
+
+def sphere_phi(r: float = 0.5) -> np.ndarray:
+    return np.linalg.norm(np.stack(GRID.meshgrid(), -1), axis=-1) - r
+
+
+def test_evolve_refuses_a_complex_phi_and_names_nan_as_its_own_requirement():
+    law = lambda u: np.full_like(u, 0.1)  # noqa: E731
+    # a complex φ was cast to real with only numpy's ComplexWarning (ts.Tube refuses it)
+    with pytest.raises(TypeError, match="evolve: phi must hold real numbers"):
+        ts.evolve(sphere_phi() + 1j, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    # NaN far from the surface: the refusal blamed redistance=True, an option never passed
+    phi = sphere_phi()
+    phi = np.where(np.abs(phi) > 0.4, np.nan, phi)
+    with pytest.raises(ValueError, match=r"evolve: phi is NaN or inf at \d+ of 29791 nodes .* re-distances φ at every"):
+        ts.evolve(phi, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+
+
+def test_moved_given_a_mesh_s_or_a_cloud_s_arrays_names_the_surface_to_build():
+    v, f = ts.surfaces.Sphere(0.5).triangulation(20)
+    tube = ts.Tube(ts.surfaces.from_mesh((v, f)), GRID)
+    with pytest.raises(TypeError, match=r"from_mesh\(\(vertices, triangles\)\)"):
+        tube.moved((1.01 * v, f))
+    with pytest.raises(TypeError, match=r"shape \(\d+, 3\), which looks like points.*from_points\(points\)"):
+        tube.moved(1.01 * v)
+
+
+def test_a_warm_start_from_a_band_narrower_than_the_new_inner_tube_says_so():
+    phi = sphere_phi()
+    prev = ts.Tube(phi, GRID).solve([(0, 0, 0.5)])
+    # the same surface: the refusal blamed a move, by "outer − inner = -1 grid spacings"
+    with pytest.raises(
+        WarmStartRefused, match=r"inner tube \(inner = 5 grid spacings\) is as wide as .* \(outer = 4\)"
+    ):
+        ts.Tube(phi, GRID, inner=5, outer=8).solve([(0, 0, 0.5)], warm=prev)
+
+
+def test_a_speed_changed_by_a_hair_keeps_the_local_start():
+    # the default tolerance scales with the mean slowness: speed 1.000001 made the previous one
+    # "looser" (printed as the same number) and every node started
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), GRID)
+    prev = tube.solve([(0, 0, 0.5)])
+    warm = tube.solve([(0, 0, 0.5)], speed=1.000001, warm=prev)
+    assert warm.stats.order2["warm"]["all_started"] is None
+    cold = tube.solve([(0, 0, 0.5)], speed=1.000001)
+    assert np.max(np.abs(warm.values - cold.values)) < 10 * cold.stats.order2["tol"]
+    slower = tube.solve([(0, 0, 0.5)], speed=1.5, warm=prev)
+    assert "looser than this one's" in slower.stats.order2["warm"]["all_started"]
+    assert "by more than 10%" in slower.stats.order2["warm"]["all_started"]
