@@ -307,3 +307,20 @@ def test_a_stall_away_from_any_narrow_gap_does_not_mention_one():
     with pytest.warns(RuntimeWarning, match="stopped before reaching a source") as caught:
         sol.geodesic_path((0.0934, 0.4672, -0.1516))
     assert not any("gap narrower" in str(w.message) for w in caught)
+
+
+def test_the_paths_and_labels_bench_runs_at_both_orders_at_a_small_size(capsys):
+    # benches/paths_and_labels.py, the figures of docs/paths-and-labels.md, at N = 31
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    import paths_and_labels
+
+    assert paths_and_labels.main([31], "auto") == 0
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if line.startswith("| 31 | 0.06667 |"))
+    # second order: the longest path within a hundredth of a spacing of the great circle's length
+    assert float(row.split("|")[4]) < 0.01
+    labels = next(line for line in out.splitlines() if line.startswith("| 31 |") and " of " in line)
+    assert labels.split("|")[3].strip().startswith("0 of ")  # none wrong away from a boundary
