@@ -308,7 +308,9 @@ def test_parts_of_a_mesh_closer_than_a_spacing_are_said():
     with pytest.warns(RuntimeWarning, match=r"about 14% of the mesh's area lies within a grid spacing of another part"):
         sol = ts.solve(mesh, g, [v[np.argmax(v[:, 2])]])
     # what it warns of: the bottom centre (exact polyhedral geodesic 1.005) several spacings short
-    assert 1.005 - sol.on_mesh(v[[np.argmin(v[:, 2])]])[0] > 5 * g.spacing
+    # (3.2; 9 before the facing test also read the mesh's inside and cut the band across more of
+    # the rim)
+    assert 1.005 - sol.on_mesh(v[[np.argmin(v[:, 2])]])[0] > 2 * g.spacing
     # and a Tube says it once, at construction (kept per spacing on the surface)
     with pytest.warns(RuntimeWarning, match="within a grid spacing of another part"):
         ts.Tube(mesh, g)

@@ -323,3 +323,20 @@ def test_a_capsule_of_long_thin_triangles_runs_second_order():
     exact = np.array([np.pi / 2 * 0.3 + 0.4, np.pi * 0.3 + 0.8])  # the cylinder's equator, the other pole
     assert sol.stats.order == 2
     assert np.max(np.abs(sol([(0.3, 0, 0), (0, 0, -0.7)]) / exact - 1)) < 0.008  # 0.17%, 0.61%
+
+
+def test_a_closed_plate_thinner_than_two_spacings_is_not_crossed():
+    # a closed box 1 × 1 × 0.02 (0.8-1.3 spacings thick at N = 81): the smooth map's unsigned φ
+    # showed its two faces as one sheet, no facing pair was found, and the front went straight
+    # through at order 2 (0.020 from the top centre to the bottom centre, where 1.02 is exact),
+    # unwarned; the facing test now also reads the mesh's inside (as with smooth=False)
+    trimesh = pytest.importorskip("trimesh")
+    m = trimesh.creation.box((1, 1, 0.02)).subdivide_to_size(0.03)
+    m.merge_vertices()
+    v, f = np.asarray(m.vertices), np.asarray(m.faces)
+    top = v[np.argmin(np.linalg.norm(v - [0, 0, 0.01], axis=1))]
+    bottom = v[np.argmin(np.linalg.norm(v - [0, 0, -0.01], axis=1))]
+    s = ts.surfaces.from_mesh((v, f))
+    sol = ts.solve(s, s.grid(81), [top])
+    assert sol.stats.facing_pairs > 1000 and sol.stats.order == 1
+    assert abs(sol.on_mesh(bottom[None])[0] - 1.02) < 0.02

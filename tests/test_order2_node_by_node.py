@@ -281,3 +281,17 @@ def test_a_crease_whose_normal_reverses_is_not_given_a_bound_of_1e15():
     # (the inner tube thinned at the crease, as for any level set: 2.5Δx for a re-distanced φ;
     # 0.746 in the paper's tube)
     assert re.search(r"arrives early by 0\.125 or more: the normal reverses there", crease)
+
+
+def test_a_callable_quartic_torus_re_distanced_runs_second_order():
+    # (|x|² + R² − r²)² − 4R²(x² + y²) as a callable: its Newton projection's moves stalled at
+    # 1.45e-12, just above the settling threshold, at nodes of the tube, which was refused for
+    # "sharp edges or corners" at N = 61 (18 s); the callable's threshold is now 1e-10
+    big, small = 0.5, 0.2
+    quartic = lambda p: (np.sum(p * p, axis=1) + big**2 - small**2) ** 2 - 4 * big**2 * (p[:, 0] ** 2 + p[:, 1] ** 2)  # noqa: E731
+    g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    sol = ts.solve(ts.LevelSet(quartic, redistance=True), g, [(big + small, 0, 0)])
+    assert sol.stats.order == 2
+    t = np.linspace(0.2, 1.0, 10)
+    outer = np.c_[(big + small) * np.cos(t), (big + small) * np.sin(t), 0 * t]  # the outer equator
+    assert np.max(np.abs(sol(outer) - (big + small) * t)) < 0.02 * g.spacing  # 0.004Δx

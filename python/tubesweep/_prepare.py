@@ -276,16 +276,23 @@ def _warn_if_tubes_touch(
         node, neighbour, gap = node[keep], neighbour[keep], gap[keep]
     ridge = _ridge_pairs(grid, band, linear, roles, phi, kink)
     if ridge[0].size:
-        node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip((node, neighbour, gap), ridge))
-        # a pair found both ways counts once (the smaller gap)
-        order = np.lexsort((gap, neighbour, node))
-        node, neighbour, gap = node[order], neighbour[order], gap[order]
-        first = np.ones(node.size, bool)
-        first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
-        node, neighbour, gap = node[first], neighbour[first], gap[first]
+        node, neighbour, gap = _union_pairs((node, neighbour, gap), ridge)  # (a pair found both ways once)
     if warn:
         warn_facing_pairs(grid, linear, roles, (node, neighbour, gap), inner, note)
     return node, neighbour, gap
+
+
+def _union_pairs(
+    a: Tuple[np.ndarray, np.ndarray, np.ndarray], b: Tuple[np.ndarray, np.ndarray, np.ndarray]
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The facing pairs ``(node, neighbour, gap)`` of ``a`` and ``b``, a pair in both once (the
+    smaller gap)."""
+    node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip(a, b))
+    order = np.lexsort((gap, neighbour, node))
+    node, neighbour, gap = node[order], neighbour[order], gap[order]
+    first = np.ones(node.size, bool)
+    first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
+    return node[first], neighbour[first], gap[first]
 
 
 def warn_facing_pairs(
@@ -427,6 +434,7 @@ def _prepare_tube(
         # node: see docs/architecture.md).
         phi = geom.signed.astype(np.float32)
         kink = geom.kink
+        inside = geom.inside
         direction: Optional[np.ndarray] = None
         if reusable:
             # kept for every solve: the solver gets copies of its directions
@@ -471,7 +479,9 @@ def _prepare_tube(
                 + (
                     "; or sample the callable φ on the grid and pass the array (LevelSet(phi_array, redistance=True) "
                     "locates the zero level set cell by cell, edges and corners included: a cube's distance at N = 61, "
-                    "refused as a callable, solves as an array)"
+                    "refused as a callable, solves as an array). A callable φ that is flat across its zero level set "
+                    "(∇φ = 0 there, as (|x| − 0.5)³) is refused so too, its Newton projection stalling: sampled on the "
+                    "grid it solves at order 2"
                     if getattr(surf, "_array", True) is None
                     else ""
                 )
@@ -505,19 +515,21 @@ def _prepare_tube(
     directions = direction if direction is not None else geom.direction
     cuts = cuts_shortcuts(surf)
     gap_note = getattr(surf, "_gap_note", None)
+    note = gap_note(h) if gap_note is not None else ""
+    noise = float(getattr(surf, "_noise", 0.0))
     facing = _warn_if_tubes_touch(
-        grid,
-        band,
-        linear,
-        roles,
-        phi,
-        directions,
-        inner,
-        kink,
-        float(getattr(surf, "_noise", 0.0)),
-        warn=not cuts,
-        note=gap_note(h) if gap_note is not None else "",
+        grid, band, linear, roles, phi, directions, inner, kink, noise, warn=not cuts and inside is None, note=note
     )
+    if inside is not None:
+        # an unsigned φ with a known inside (BandGeometry.inside): the pairs of the signed φ too
+        signed_phi = np.where(inside, -phi, phi)
+        facing = _union_pairs(
+            facing,
+            _warn_if_tubes_touch(grid, band, linear, roles, signed_phi, directions, inner, kink, noise, warn=False),
+        )
+        del signed_phi
+        if not cuts:
+            warn_facing_pairs(grid, linear, roles, facing, inner, note)
     cut_edges = 0
     pieces = None
     cut_facing = facing

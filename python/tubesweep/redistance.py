@@ -52,6 +52,12 @@ def _gradient(phi: Callable[[np.ndarray], np.ndarray], y: np.ndarray, eps: float
 #: move (relative to ``max(1, max |x|)``) below which a point has settled.
 NEWTON_STEPS, ORTHOGONALITY_STEPS, SETTLED = 6, 30, 1e-12
 
+#: :data:`SETTLED` for a callable φ, whose gradient comes from differences of its values: their
+#: rounding stalls the moves just above 1e-12 where φ is flat across the surface (the sphere
+#: φ = (|x| − 0.5)³ at N = 41, the torus quartic at N = 61: moves of 1.45e-12 that never settled,
+#: and the band refused for "sharp edges"; at 1e-10 both run order 2, the torus 0.004Δx off).
+CALLABLE_SETTLED = 1e-10
+
 #: The most orthogonality iterations of a second projection of the band's candidates that did not
 #: settle in :data:`ORTHOGONALITY_STEPS` but lie within 1.5 × the band's half-width of a point on
 #: the zero level set (:func:`redistanced_band`). The iterations converge linearly, by about the
@@ -143,7 +149,11 @@ def _project(
             SETTLED,
         )
     return project_to_level_set(
-        lambda p: surface.phi(p, grid), x, GRADIENT_STEP * grid.spacing, orthogonality_steps=orthogonality_steps
+        lambda p: surface.phi(p, grid),
+        x,
+        GRADIENT_STEP * grid.spacing,
+        orthogonality_steps=orthogonality_steps,
+        tol=CALLABLE_SETTLED,
     )
 
 

@@ -128,7 +128,19 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
     ok = norm > DIRECTION_EPS * grid_h
     direction = np.zeros((len(linear), 3))
     direction[ok] = (x[ok] - cp[ok]) / norm[ok, None]
-    return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True)
+    inside = None
+    if surface.signed:
+        # the nodes inside the mesh (the exact closest feature's pseudo-normal), for the facing
+        # test's second case ("across", tubesweep_core::band::facing_sheets), which needs them to
+        # find gaps of one to two spacings that the unsigned φ shows as one sheet (a closed plate
+        # 0.02 thick at N = 81, 0.8 spacings: the front crossed it, 0.020 where 1.02 is exact,
+        # unwarned at order 2). φ itself stays unsigned: the facing test of the unsigned φ also
+        # reads a rough mesh's bumps (``order2_obstacle``). Searched from the smooth closest
+        # points, which lie within a quarter triangle of the mesh, the tree is pruned at once
+        # (from the nodes it cost half the smooth map's time)
+        _, foot, face, feature = surface.closest(cp)
+        inside = np.einsum("ij,ij->i", x - foot, surface._pseudonormal(face, feature)) < 0
+    return BandGeometry(linear, norm, norm.copy(), direction.astype(np.float32), consumable=True, inside=inside)
 
 
 def median_size(surface: Any) -> float:
