@@ -370,3 +370,18 @@ def test_a_triangle_naming_a_vertex_twice_leaves_a_closed_mesh_closed():
     assert mesh.closed and mesh.signed and mesh.boundary_edges == 0
     # a real hole still opens it
     assert not from_mesh((v, f[1:])).closed
+
+
+def test_a_byte_order_mark_and_an_off_header_that_undercounts_are_not_read_silently(tmp_path):
+    # an OBJ saved with a UTF-8 byte-order mark lost its first vertex (every face shifted by one,
+    # a garbage mesh that still read as closed); an OFF header declaring half the faces dropped
+    # the rest, unwarned
+    v, f = icosphere(1)
+    obj = "".join(f"v {a} {b} {c}\n" for a, b, c in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
+    (tmp_path / "bom.obj").write_bytes(b"\xef\xbb\xbf" + obj.encode())
+    m = from_mesh(tmp_path / "bom.obj")
+    assert len(m.vertices) == len(v) and np.allclose(m.vertices[m.faces], v[f])
+    body = "".join(f"{a} {b} {c}\n" for a, b, c in v) + "".join(f"3 {a} {b} {c}\n" for a, b, c in f)
+    (tmp_path / "short.off").write_text(f"OFF\n{len(v)} {len(f) // 2} 0\n" + body)
+    with pytest.raises(ValueError, match=r"declares \d+ vertices and \d+ faces .* but the file holds \d+; correct"):
+        from_mesh(tmp_path / "short.off")

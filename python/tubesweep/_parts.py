@@ -130,10 +130,23 @@ def source_parts(
     if surface is not None and getattr(surface, "_node_parts", None) is not None:
         from .surfaces._mesh_parts import face_parts, point_parts
 
-        if face_parts(surface) is not None:  # (the labels are the pieces: part_labels)
+        pieces = face_parts(surface)
+        if pieces is not None:  # (the labels are the pieces: part_labels)
             own = point_parts(surface, np.asarray(sources, dtype=float).reshape(-1, grid.ndim))
             if np.all(own >= 0):
-                return np.unique(own).astype(np.uint32)
+                sourced = np.unique(own).astype(np.uint32)
+                if not np.any(np.isin(labels, sourced)):
+                    # every value would be inf: the sources' pieces own no node of the inner tube
+                    # (an icosphere whose 20,480 triangles were each shrunk apart: all inf,
+                    # converged=True, unwarned)
+                    count = int(np.max(pieces)) + 1
+                    raise ValueError(
+                        f"the sources lie on {sourced.size} of the mesh's {count} separate pieces, and no node of the "
+                        "inner tube belongs to them: pieces smaller than the grid resolves (its spacing is "
+                        f"{grid.spacing:.4g}), which no path joins to the rest. Join the mesh's pieces (e.g. "
+                        "trimesh's merge_vertices, or a mesh whose triangles share their vertices), or refine the grid"
+                    )
+                return sourced
     at = parts_at(grid, band, labels, np.asarray(sources, dtype=float).reshape(-1, grid.ndim))
     found = at != NO_PART
     if not np.all(np.any(found, axis=1)):

@@ -33,7 +33,9 @@ def _open_text(path: Path) -> List[str]:
             f"{path}: not a text mesh file (it holds binary data); tubesweep reads text OBJ and OFF files, "
             "and PLY and STL (text or binary)"
         )
-    text = raw.decode("utf-8", errors="replace")
+    # (a byte-order mark, as Windows editors write it, is not part of the first line: its 'v'
+    # record was dropped and every face index shifted by one, unwarned)
+    text = raw.decode("utf-8-sig", errors="replace")
     # a backslash at the end of a line continues it (OBJ)
     return text.replace("\\\r\n", " ").replace("\\\n", " ").splitlines()
 
@@ -122,9 +124,11 @@ def read_off_file(path: Path) -> Tuple[np.ndarray, np.ndarray]:
         nv, nf = int(counts[0]), int(counts[1])
     except (IndexError, ValueError):
         raise ValueError(f"{path}: the OFF header must give the numbers of vertices and faces") from None
-    if nv < 0 or nf < 0 or len(rest) < nv + nf:
+    if nv < 0 or nf < 0 or len(rest) != nv + nf:
+        # (more records than declared: the rest were dropped, unwarned; an OFF file holds no other records)
         raise ValueError(
-            f"{path}: the header declares {nv} vertices and {nf} faces but the file holds {len(rest)} records"
+            f"{path}: the header declares {nv} vertices and {nf} faces ({nv + nf} records) but the file holds "
+            f"{len(rest)}; correct the header's counts"
         )
     verts = []
     for line_no, tokens in rest[:nv]:
