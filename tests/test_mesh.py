@@ -385,3 +385,18 @@ def test_a_byte_order_mark_and_an_off_header_that_undercounts_are_not_read_silen
     (tmp_path / "short.off").write_text(f"OFF\n{len(v)} {len(f) // 2} 0\n" + body)
     with pytest.raises(ValueError, match=r"declares \d+ vertices and \d+ faces .* but the file holds \d+; correct"):
         from_mesh(tmp_path / "short.off")
+
+
+def test_a_dict_and_a_truncated_binary_stl_are_named(tmp_path):
+    v, f = icosphere(1)
+    with pytest.raises(TypeError, match=r"got a dict with keys \['faces', 'vertices'\]"):
+        from_mesh({"vertices": v, "faces": f})
+    # a binary STL cut in half: "no triangles found (is it a point cloud?)"
+    import struct
+
+    tri = v[f].astype(np.float32)
+    records = b"".join(struct.pack("<12fH", 0, 0, 0, *t.ravel(), 0) for t in tri)
+    data = b"\0" * 80 + struct.pack("<I", len(f)) + records
+    (tmp_path / "cut.stl").write_bytes(data[: len(data) // 2])
+    with pytest.raises(ValueError, match=r"no triangles found; its header declares \d+ triangles.*cut short"):
+        from_mesh(tmp_path / "cut.stl")

@@ -78,7 +78,11 @@ def _early(angle: float, size: float, reckoned: str) -> str:
     ``size`` (``reckoned`` says how), or, beyond :data:`REVERSED`, that much or more as it can
     cross over between two sheets facing each other."""
     if angle <= REVERSED:
-        return f"arrives early by up to about {size:.3g} {reckoned}"
+        return (
+            f"arrives early by up to about {size:.3g} {reckoned} where the crease is convex (the tube cuts the "
+            "corner); across a concave crease, with the inner tube thinned there, it can also arrive late, by a "
+            "fraction of a spacing (two spheres joined by min: 0.43·Δx on average)"
+        )
     return (
         f"arrives early by {size:.3g} or more: the normal reverses there, two sheets face each other across a gap "
         "narrower than the tube, and a front can cross over"

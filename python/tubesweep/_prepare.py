@@ -282,6 +282,34 @@ def _warn_if_tubes_touch(
     return node, neighbour, gap
 
 
+def _specks(surf: Any, grid: Grid) -> str:
+    """For a refused re-distanced φ array: its nodes whose sign differs from all their axis
+    neighbours', named first (a bubble smaller than a cell: one node of the other sign 6 spacings
+    off a sphere was refused for "sharp edges", with no place given); "" when there are none."""
+    arr = getattr(surf, "_array", None)
+    if arr is None:
+        return ""
+    negative = np.asarray(arr) < 0
+    alone = np.ones(negative.shape, bool)
+    for axis in range(negative.ndim):
+        for step in (1, -1):
+            alone &= np.roll(negative, step, axis) != negative
+    for axis in range(negative.ndim):  # (np.roll wraps around: the box's faces are not judged)
+        edge = [slice(None)] * negative.ndim
+        for end in (0, -1):
+            edge[axis] = end  # type: ignore[call-overload]
+            alone[tuple(edge)] = False
+    nodes = np.flatnonzero(alone)
+    if nodes.size == 0:
+        return ""
+    where = tuple(round(float(c), 6) for c in grid.node_points(nodes[:1])[0])
+    return (
+        f"φ changes sign at {nodes.size} isolated node(s) whose neighbours all have the other sign (e.g. at {where}): "
+        "surfaces smaller than a grid cell, which the tube cannot hold; remove such specks (noise in a segmentation, "
+        "e.g. with scipy.ndimage.binary_opening) and solve again. "
+    )
+
+
 def _union_pairs(
     a: Tuple[np.ndarray, np.ndarray, np.ndarray], b: Tuple[np.ndarray, np.ndarray, np.ndarray]
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -420,9 +448,16 @@ def _prepare_tube(
                 warnings.filterwarnings("ignore", message="φ's slope nearly vanishes", category=RuntimeWarning)
             geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
+            given = isinstance(surf, LevelSet) and not surf.redistance
             raise ValueError(
                 "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
                 "and that φ is in the grid's units"
+                + (
+                    " (a φ that changes sign but is not a distance, e.g. a mask's ±0.5 or 0/1 values: "
+                    "LevelSet(phi, redistance=True), or LevelSet.from_mask(mask, grid) for a mask)"
+                    if given
+                    else ""
+                )
             )
         roles = _tube_roles(geom, inner_width, method)
         linear = geom.linear
@@ -472,7 +507,8 @@ def _prepare_tube(
             # solve stops here. With a given bound below |∇φ| the candidates depend on the
             # layer's width and a later widening can still bring them in: widened as for any φ.
             raise ValueError(
-                f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
+                _specks(surf, grid)
+                + f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
                 "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
                 "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
                 "there (round the edges over more than the tube's width), pass a signed distance function, or refine the grid"

@@ -231,7 +231,17 @@ def read_with_library(path: Path) -> Tuple[np.ndarray, np.ndarray]:
             "STL and OFF files"
         ) from None
     if f.size == 0 or f.ndim != 2:
-        raise ValueError(f"{path}: no triangles found (is it a point cloud?)")
+        truncated = ""
+        if path.suffix.lower() == ".stl":
+            data = path.read_bytes()
+            if len(data) >= 84 and not data.lstrip()[:5].lower() == b"solid":
+                (n,) = struct.unpack("<I", data[80:84])
+                if len(data) < 84 + 50 * n:
+                    truncated = (
+                        f" its header declares {n} triangles, {84 + 50 * n} bytes, but the file holds {len(data)}: it "
+                        "is cut short (an interrupted download or copy?)"
+                    )
+        raise ValueError(f"{path}: no triangles found" + (f";{truncated}" if truncated else " (is it a point cloud?)"))
     suffix = path.suffix.lower()
     if suffix == ".ply":
         nv, nf = _ply_counts(path)

@@ -766,6 +766,11 @@ def from_mesh(
         v, f = read_mesh(mesh)
         name = Path(str(mesh)[:-3] if str(mesh).lower().endswith(".gz") else mesh).stem
     else:
+        if isinstance(mesh, dict):  # (unpacked, its two keys were taken for the arrays: "got str")
+            raise TypeError(
+                f"mesh must be a file path or a pair (vertices, faces); got a dict with keys {sorted(map(str, mesh))}: "
+                "pass (mesh['vertices'], mesh['faces'])"
+            )
         try:
             v, f = mesh
         except (TypeError, ValueError):

@@ -1,0 +1,56 @@
+"""What a level set's user is told where φ is not what the solver needs (review of stop 68): a
+speck of the other sign, a mask passed as φ, a φ flattened away from the surface, a concave
+crease."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+
+GRID = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+H = GRID.spacing
+
+
+def distance() -> np.ndarray:
+    return np.linalg.norm(np.stack(GRID.meshgrid(), -1), axis=-1) - 0.5
+
+
+def test_a_speck_of_the_other_sign_is_named_with_its_place():
+    # one node 6 spacings off the sphere flipped to -0.5Δx: refused for "sharp edges", no place
+    phi = distance()
+    phi[51, 30, 30] = -0.5 * H
+    with pytest.warns(RuntimeWarning):  # (the widenings of the extension layer on the way)
+        with pytest.raises(ValueError, match=r"φ changes sign at 1 isolated node\(s\) .* at \(0\.7, 0\.0, 0\.0\)"):
+            ts.solve(ts.LevelSet(phi, redistance=True), GRID, [(-0.5, 0, 0)])
+
+
+def test_a_mask_passed_as_phi_is_pointed_to_from_mask():
+    phi = np.where(distance() < 0, -0.5, 0.5)
+    with pytest.raises(ValueError, match=r"the band is empty.*LevelSet\.from_mask\(mask, grid\)"):
+        ts.solve(ts.LevelSet(phi), GRID, [(-0.5, 0, 0)])
+
+
+def test_first_order_nodes_where_phi_is_not_a_distance_are_told_to_re_distance():
+    # φ = 5.5Δx·tanh(d/5.5Δx): 44% of the inner tube "φ not a distance", and the warning said a
+    # finer grid would help
+    phi = 5.5 * H * np.tanh(distance() / (5.5 * H))
+    with pytest.warns(
+        RuntimeWarning, match=r"\(44%\) ran the first-order .* not a distance there: LevelSet\(phi, redist"
+    ):
+        sol = ts.solve(ts.LevelSet(phi), GRID, [(-0.5, 0, 0)])
+    assert sol.stats.order == 2
+
+
+def test_a_concave_crease_is_not_said_to_make_fronts_only_early():
+    # two spheres joined by min: at order 2 the front arrives late there (+0.43Δx on average,
+    # benches/experiments/creases.py); the warning said "early by up to 1.5Δx"
+    x = np.stack(GRID.meshgrid(), -1)
+    phi = np.minimum(np.linalg.norm(x + [0.3, 0, 0], axis=-1), np.linalg.norm(x - [0.3, 0, 0], axis=-1)) - 0.45
+    with pytest.warns(RuntimeWarning, match=r"where the crease is convex .* concave crease.* late"):
+        sol = ts.solve(ts.LevelSet(phi), GRID, [(-0.75, 0, 0)])
+    beta = np.linspace(0.05, np.arccos(-0.3 / 0.45) - 0.1, 40)  # the far sphere's meridian
+    exact = 0.45 * (2 * np.arccos(-0.3 / 0.45) - beta)
+    late = sol(np.c_[0.3 + 0.45 * np.cos(beta), 0.45 * np.sin(beta), 0 * beta]) - exact
+    assert 0 < np.mean(late) < H  # late, by a fraction of a spacing
