@@ -400,3 +400,12 @@ def test_a_dict_and_a_truncated_binary_stl_are_named(tmp_path):
     (tmp_path / "cut.stl").write_bytes(data[: len(data) // 2])
     with pytest.raises(ValueError, match=r"no triangles found; its header declares \d+ triangles.*cut short"):
         from_mesh(tmp_path / "cut.stl")
+
+
+def test_a_zero_area_needle_on_a_closed_mesh_leaves_it_closed_and_signed():
+    # [a, b, mid(a, b)] laid on a closed icosphere made it open and unsigned, the refusal of
+    # signed=True blaming flipped faces
+    v, f = icosphere(2)
+    a, b = f[0, 0], f[0, 1]
+    m = from_mesh((np.r_[v, [(v[a] + v[b]) / 2]], np.r_[f, [[a, b, len(v)]]]))
+    assert m.closed and m.signed and m.signed_distance([[0.0, 0.0, 0.0]])[0] < 0

@@ -79,8 +79,9 @@ def warn_thin_parts(share: float, where: Optional[np.ndarray], h: float, inner: 
     warnings.warn(
         f"about {share:.0%} of the mesh's area lies within a grid spacing of another part of it that faces it (a part "
         f"thinner than a spacing, e.g. near ({at})): there the tube cannot keep the two sides apart and the front "
-        "crosses between them, so distances past such parts can come out short by several grid spacings (a flat "
-        "ellipsoid 0.05 thick at N = 41–81: 17–6 spacings at its far side). A grid spacing below the part's thickness "
+        "crosses between them, so distances past such parts can come out short by as much as the way around the part "
+        "(the front goes straight through: a flat ellipsoid 0.05 thick at N = 41–81, 17–6 spacings at its far side; "
+        "a plate under a spacing thick, nearly the whole way round its edge). A grid spacing below the part's thickness "
         f"divided by {2 * inner + 2:g} (now {h:.3g}) resolves it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),

@@ -245,11 +245,23 @@ class MeshSurface(Surface):
         # a triangle naming a vertex twice has no edges of its own: not counted ([0, 0, 1] made a
         # closed sphere mesh open, unsigned)
         proper = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
-        counts = np.bincount(edge_ids[proper].ravel(), minlength=len(counts))
-        fp = f[proper]
-        e_dir = np.concatenate([fp[:, [0, 1]], fp[:, [1, 2]], fp[:, [2, 0]]])
-        #: edges two faces run the same way (faces flipped against their neighbours)
-        flipped = len(e_dir) - len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1]))
+
+        def edges_of(use: np.ndarray) -> Tuple[np.ndarray, int]:
+            # the faces' edge counts, and the edges two faces run the same way (faces flipped
+            # against their neighbours)
+            fp = f[use]
+            e_dir = np.concatenate([fp[:, [0, 1]], fp[:, [1, 2]], fp[:, [2, 0]]])
+            flips = len(e_dir) - len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1]))
+            return np.bincount(edge_ids[use].ravel(), minlength=len(counts)), flips
+
+        counts, flipped = edges_of(proper)
+        if not (np.all(counts[counts > 0] == 2) and flipped == 0) and not np.all(good[proper]):
+            # a zero-area "needle" (a vertex on the middle of an edge: [a, b, mid(a, b)]) laid on a
+            # closed mesh made it open and unsigned, blamed on flipped faces; without the
+            # zero-area triangles it is closed (where they fill a T-junction, it is closed with them)
+            counts_good, flipped_good = edges_of(proper & good)
+            if np.all(counts_good[counts_good > 0] == 2) and flipped_good == 0:
+                counts, flipped = counts_good, flipped_good
         directed_unique = flipped == 0
         self.closed = bool(np.all(counts[counts > 0] == 2) and directed_unique)
         self.boundary_edges = int(np.count_nonzero(counts == 1))
