@@ -30,6 +30,10 @@ def test_a_mask_passed_as_phi_is_pointed_to_from_mask():
     phi = np.where(distance() < 0, -0.5, 0.5)
     with pytest.raises(ValueError, match=r"the band is empty.*LevelSet\.from_mask\(mask, grid\)"):
         ts.solve(ts.LevelSet(phi), GRID, [(-0.5, 0, 0)])
+    # (a φ that does not change sign is not told so: re-distancing cannot help it)
+    with pytest.raises(ValueError, match="the band is empty") as refused:
+        ts.solve(ts.LevelSet(np.abs(phi) + 1.0), GRID, [(-0.5, 0, 0)])
+    assert "from_mask" not in str(refused.value)
 
 
 def test_first_order_nodes_where_phi_is_not_a_distance_are_told_to_re_distance():
@@ -54,3 +58,7 @@ def test_a_concave_crease_is_not_said_to_make_fronts_only_early():
     exact = 0.45 * (2 * np.arccos(-0.3 / 0.45) - beta)
     late = sol(np.c_[0.3 + 0.45 * np.cos(beta), 0.45 * np.sin(beta), 0 * beta]) - exact
     assert 0 < np.mean(late) < H  # late, by a fraction of a spacing
+    # the paper's tube (order=1, not thinned) makes it early there: no word of late
+    with pytest.warns(RuntimeWarning, match="creases") as caught:
+        ts.solve(ts.LevelSet(phi), GRID, [(-0.75, 0, 0)], order=1)
+    assert not any("late" in str(w.message) for w in caught)

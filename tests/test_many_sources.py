@@ -574,7 +574,7 @@ def test_dask_checks_as_locally_and_a_runaway_row_falls_back_alone(client):
     # threads and a speed array of the wrong shape were not checked on the client (an IndexError
     # on the workers); each chunk chose its own order and stats["order"] was the first chunk's
     tube = ts.Tube(ts.surfaces.Sphere(R), ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3))
-    src = [(0.5, 0, 0), (-0.5, 0, 0), (0, 0, 0.5)]
+    src = [(-0.5, 0, 0), (0, 0, 0.5), (0.5, 0, 0)]  # the last one runs away at second order
     with pytest.raises(ValueError, match="threads must be a non-negative integer"):
         tube.solve_many(src, client=client, threads=-1)
     with pytest.raises(ValueError, match=r"speed array must have the grid's shape \(41, 41, 41\); got \(3, 3\)"):
@@ -587,8 +587,12 @@ def test_dask_checks_as_locally_and_a_runaway_row_falls_back_alone(client):
     with pytest.warns(RuntimeWarning, match="on the workers: .*ran away"):
         remote, rst = tube.solve_many(src, at=at, speed=speed, client=client, chunk_size=1, return_stats=True)
     assert np.array_equal(bits(remote), bits(local))
-    assert rst["orders"].tolist() == st["orders"].tolist() == [1, 2, 2] and rst["order"] == st["order"] == 1
+    assert rst["orders"].tolist() == st["orders"].tolist() == [2, 2, 1] and rst["order"] == st["order"] == 1
+    # numbered among all the sources, not within the chunk; the tube's stats come back too
+    assert "sources [2]" in rst["order_fallback"] and "sources [2]" in st["order_fallback"]
+    assert rst["first_order_nodes"] == st["first_order_nodes"] and rst["inner_nodes"] == st["inner_nodes"]
+    assert np.array_equal(rst["converged"], st["converged"]) and rst["converged"].all()
     # a point of at off the band is named once (not again from the workers)
     with pytest.warns(RuntimeWarning, match="points of at lie off the band") as caught:
-        tube.solve_many(src[1:], at=[(0, 0, 0)], client=client)
+        tube.solve_many(src[:2], at=[(0, 0, 0)], client=client)
     assert len(caught) == 1

@@ -73,11 +73,14 @@ def _per_crease(per_inner_width: float, inner: float, spacing: float, thinned: f
     )
 
 
-def _early(angle: float, size: float, reckoned: str) -> str:
+def _early(angle: float, size: float, reckoned: str, thinned: bool = False) -> str:
     """How early a front arrives after a crease whose normal turns by ``angle`` degrees: up to
     ``size`` (``reckoned`` says how), or, beyond :data:`REVERSED`, that much or more as it can
-    cross over between two sheets facing each other."""
+    cross over between two sheets facing each other. ``thinned``: the inner tube is thinned at
+    the creases (order 2), where a concave one makes the front late instead."""
     if angle <= REVERSED:
+        if not thinned:
+            return f"arrives early by up to about {size:.3g} {reckoned}"
         return (
             f"arrives early by up to about {size:.3g} {reckoned} where the crease is convex (the tube cuts the "
             "corner); across a concave crease, with the inner tube thinned there, it can also arrive late, by a "
@@ -100,7 +103,7 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
     # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
     # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
     size, how = _per_crease(2 * np.tan(np.radians(min(angle, REVERSED)) / 2), inner, spacing, thinned)
-    early = _early(angle, size, f"({how}, first order in Δx)")
+    early = _early(angle, size, f"({how}, first order in Δx)", thinned=bool(thinned))
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
         f"{angle:.0f}°): a front that crosses one {early}, "

@@ -448,14 +448,16 @@ def _prepare_tube(
                 warnings.filterwarnings("ignore", message="φ's slope nearly vanishes", category=RuntimeWarning)
             geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
-            given = isinstance(surf, LevelSet) and not surf.redistance
+            array = getattr(surf, "_array", None) if isinstance(surf, LevelSet) and not surf.redistance else None
+            # (a φ array given as is that changes sign: a surface is there, but φ is not its distance)
+            signs = array is not None and bool(np.any(array < 0) and np.any(array > 0))
             raise ValueError(
                 "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
                 "and that φ is in the grid's units"
                 + (
-                    " (a φ that changes sign but is not a distance, e.g. a mask's ±0.5 or 0/1 values: "
-                    "LevelSet(phi, redistance=True), or LevelSet.from_mask(mask, grid) for a mask)"
-                    if given
+                    " (φ changes sign, but its values near the change are far larger than a distance, e.g. a mask's "
+                    "±0.5: LevelSet(phi, redistance=True), or LevelSet.from_mask(mask, grid) for a mask)"
+                    if signs
                     else ""
                 )
             )

@@ -66,18 +66,27 @@ def _worker_tube(spec: _TubeSpec) -> "Tube":
         return tube
 
 
-def _solve_chunk(spec: _TubeSpec, groups: List[np.ndarray], at: Optional[np.ndarray], options: Dict[str, Any]) -> Any:
-    """One task: the chunk's sources on the worker's cached tube, one solve per thread."""
+#: The stats of a batch that are the tube's (the same for every chunk), sent back with the rows.
+_TUBE_STATS = ("first_order_nodes", "inner_nodes", "first_order_reasons", "creases", "max_curvature", "grad_norm_range")
+
+
+def _solve_chunk(
+    spec: _TubeSpec, groups: List[np.ndarray], at: Optional[np.ndarray], options: Dict[str, Any], number_from: int = 0
+) -> Any:
+    """One task: the chunk's sources on the worker's cached tube, one solve per thread;
+    ``number_from``: the chunk's first source's place among all (for the messages)."""
     import warnings
 
     tube = _worker_tube(spec)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         # (the local solve_many: the client's Tube.solve_many names the points of at off the band, once)
-        values, stats = solve_many(tube, groups, at=at, threads=1, return_stats=True, **options)
+        values, stats = solve_many(
+            tube, groups, at=at, threads=1, return_stats=True, number_from=number_from, **options
+        )
     return (
         values,
-        {k: v for k, v in stats.items() if isinstance(v, np.ndarray)},
+        {k: v for k, v in stats.items() if isinstance(v, np.ndarray) or k in _TUBE_STATS},
         [str(w.message) for w in caught],
         stats.get("order_fallback"),
     )
@@ -176,6 +185,7 @@ def solve_many_on_client(
             groups[a : a + chunk_size],
             at_data,
             opts,
+            a,
             key=f"tubesweep-solve_many-{run}-{a}",
             pure=False,
         ): a
@@ -184,6 +194,7 @@ def solve_many_on_client(
     width = tube.band_points if points is None else len(points)
     out = np.empty((k, width))
     stats: Dict[str, np.ndarray] = {}
+    tube_stats: Dict[str, Any] = {}
     messages: List[str] = []
     reason: Any = None  # why some rows ran the first-order scheme (order="auto")
     done = 0
@@ -204,6 +215,9 @@ def solve_many_on_client(
             out[a:b] = values
             reason = chunk_reason if reason is None else reason
             for name, v in st.items():
+                if not isinstance(v, np.ndarray):
+                    tube_stats.setdefault(name, v)  # the tube's: the same from every chunk
+                    continue
                 stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
             messages.extend(caught)
             done += b - a
@@ -221,7 +235,7 @@ def solve_many_on_client(
             stacklevel=3,
         )
     if return_stats:
-        stats_out: Dict[str, Any] = dict(stats)
+        stats_out: Dict[str, Any] = {**tube_stats, **stats}
         # each row's order; "order" the lowest, as locally (chunks may differ where a source ran away)
         stats_out["order"] = int(np.min(stats["orders"]))
         stats_out["order_fallback"] = reason

@@ -168,9 +168,11 @@ def solve_many(
     paper_sweeps: bool = False,
     return_stats: bool = False,
     order: Any = "auto",
+    number_from: int = 0,
 ) -> Any:
     """See :meth:`tubesweep.Tube.solve_many` (the local run; a Dask client goes through
-    :mod:`tubesweep.distributed`)."""
+    :mod:`tubesweep.distributed`). ``number_from``: the first source's number in messages (a Dask
+    chunk's place among the sources)."""
     t0 = time.perf_counter()
     check_flag(return_stats, "return_stats")
     order = _check_order(order)
@@ -223,6 +225,7 @@ def solve_many(
                     max_iterations=max_iterations,
                     progress=cb,
                     threads=nthreads,
+                    number_from=number_from,
                 )
             except so.Order2NotApplicable as e:
                 tube._order2_refusal = str(e)  # depends on the band only: not computed again
@@ -234,28 +237,7 @@ def solve_many(
             if isinstance(e, so.OptionOfOrder1):
                 order = 1  # an option of the first-order scheme: its tube, as ts.solve's and tube.solve's
         else:
-            orders = np.full(len(groups), 2, dtype=np.int8)
-            reason = None
-            failed = np.flatnonzero(st["restart_failed"])
-            if failed.size:
-                # values falling without bound for these sources: no factored solution. tube.solve
-                # raises for each under order=2 and runs the first-order scheme under "auto": so do
-                # their rows (the others keep second order)
-                ran_away = so.Order2RanAway(
-                    st.pop("ran_away") + f" ({failed.size} of {len(groups)} solves, sources {failed[:5].tolist()}"
-                    f"{'…' if failed.size > 5 else ''})"
-                )
-                if order == 2:
-                    raise ran_away
-                lower = Fallback.of(ran_away, order)  # (warned now)
-                reason = lower.reason
-                rows, _ = _first_order_batch(
-                    tube, [groups[i] for i in failed], "auto", lower, **{**first, "cb": None}, numbers=failed
-                )
-                out[failed] = rows
-                orders[failed] = 1
-            else:
-                st.pop("ran_away", None)
+            orders, reason = _runaway_rows(tube, groups, out, st, order, first, number_from)
             if return_stats:
                 # the lowest order of any row ("orders": each row's)
                 st.update(
@@ -266,12 +248,63 @@ def solve_many(
                 )
                 return out, st
             return out
-    out, st = _first_order_batch(tube, groups, order, fallback, **first)
+    numbers = np.arange(len(groups)) + number_from if number_from else None
+    out, st = _first_order_batch(tube, groups, order, fallback, **first, numbers=numbers)
     if return_stats:
         st["seconds_total"] = time.perf_counter() - t0
         st["orders"] = np.ones(len(groups), dtype=np.int8)
         return out, st
     return out
+
+
+def _runaway_rows(
+    tube: "Tube",
+    groups: List[np.ndarray],
+    out: np.ndarray,
+    st: Dict[str, Any],
+    order: Any,
+    first: Dict[str, Any],
+    number_from: int,
+) -> Tuple[np.ndarray, Optional[str]]:
+    """The rows of a second-order batch whose sweeps ran away, as ``tube.solve`` gives each: where
+    the first-order factored restart ran away too (``restart_failed``), ``order=2`` raises and
+    ``"auto"`` solves them with the first-order scheme (their rows of ``out`` and of the per-source
+    stats ``st`` replaced); where it held, the row is that restart's (order 1). Returns each row's
+    order and why some rows are first order (None: none is)."""
+    orders = np.full(len(groups), 2, dtype=np.int8)
+    reason = None
+    restarted = (st["runaway_iteration"] >= 0) & ~st["restart_failed"]
+    if np.any(restarted):
+        orders[restarted] = 1  # (warned by solve_many_order2)
+        reason = so.RAN_AWAY_RESTARTED.replace(
+            "sol.stats.order2['runaway_iteration']", "the stats' 'runaway_iteration'"
+        )
+    text = st.pop("ran_away", None)
+    failed = np.flatnonzero(st["restart_failed"])
+    if failed.size == 0:
+        return orders, reason
+    numbers = failed + number_from
+    ran_away = so.Order2RanAway(
+        f"{text} ({failed.size} of {len(groups)} solves, sources {numbers[:5].tolist()}{'…' if failed.size > 5 else ''})"
+    )
+    if order == 2:
+        raise ran_away
+    warnings.warn(
+        f"{ran_away}; their rows are the first-order solution (the stats' 'order_fallback' keeps this)",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )
+    lower = Fallback(str(ran_away), said=True)
+    rows, sub = _first_order_batch(
+        tube, [groups[i] for i in failed], "auto", lower, **{**first, "cb": None}, numbers=numbers
+    )
+    out[failed] = rows
+    for key, value in sub.items():  # their stats are the first-order solves' (converged, iterations, ...)
+        mine = st.get(key)
+        if isinstance(value, np.ndarray) and isinstance(mine, np.ndarray) and mine.shape[:1] == (len(groups),):
+            mine[failed] = value
+    orders[failed] = 1
+    return orders, lower.reason
 
 
 def _first_order_batch(

@@ -54,6 +54,7 @@ def solve_many_order2(
     max_iterations: int,
     progress: Optional[Callable[[int, int], Any]],
     threads: int,
+    number_from: int = 0,
 ) -> Tuple[np.ndarray, Dict[str, Any]]:
     """The second-order batch (see the module's documentation): ``(values, stats)``, values
     ``(K, band_points)`` or ``(K, M)`` at ``points``. Raises :class:`second_order.Order2NotApplicable`
@@ -162,7 +163,7 @@ def solve_many_order2(
             warnings.warn(
                 f"order=2: {bad.size} of {len(groups)} solves "
                 + what.format(m=max_iterations)
-                + f" (sources {bad[:5].tolist()}{'…' if bad.size > 5 else ''})",
+                + f" (sources {(bad[:5] + number_from).tolist()}{'…' if bad.size > 5 else ''})",
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
@@ -183,8 +184,9 @@ def solve_many_order2(
             default_tol=inputs.default_tol,
         )
         warnings.warn(
-            f"order=2: {large.size} of {len(groups)} solves (sources {large[:5].tolist()}"
-            f"{'…' if large.size > 5 else ''}) fell back to decreases only; in solve {worst}, the largest: {text}",
+            f"order=2: {large.size} of {len(groups)} solves (sources {(large[:5] + number_from).tolist()}"
+            f"{'…' if large.size > 5 else ''}) fell back to decreases only; in solve {worst + number_from}, the largest: "
+            f"{text}",
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )
