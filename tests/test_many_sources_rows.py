@@ -111,3 +111,19 @@ def test_empty_points_and_a_bad_progress_are_refused_before_any_solve():
         ts.distance_matrix(tube, None, [])
     with pytest.raises(TypeError, match="progress must be a callable"):
         ts.farthest_point_sampling(tube, None, 3, progress=3)
+
+
+def test_values_at_points_near_a_source_on_a_phi_array_are_sol_at():
+    # within three spacings of a source the batch read the chord from the point itself, not from
+    # its closest point as sol(points) does: a point 0.005 off the sphere above its source read
+    # 0.005 (sol: 0), points on it up to 7.7e-5 off sol's, on a φ array (analytic surfaces matched)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    phi = np.linalg.norm(np.stack(g.meshgrid(), -1), axis=-1) - 0.5
+    tube = ts.Tube(ts.LevelSet(phi), g)
+    src = np.array([[0.0, 0.0, 0.5]])
+    t = np.linspace(0.01, 0.4, 40)
+    on = 0.5 * np.c_[np.sin(t), 0 * t, np.cos(t)]
+    at = np.concatenate([on, on * (1 + np.linspace(-0.02, 0.02, 40))[:, None]])
+    sol = single(tube, src[0])
+    assert np.array_equal(bits(tube.solve_many(src, at=at)[0]), bits(sol(at)))
+    assert sol(src * 1.01)[0] < 1e-12

@@ -86,16 +86,15 @@ def solve_many_order2(
         plan = own_side_plan(grid, surf, t.band, t.facing, len(t.linear), points, cut=bool(t.cut_edges))
         if plan is not None:
             points = np.ascontiguousarray(np.concatenate([points, plan.corners]))
-        at_feet = points
-        if inputs.exact_feet:
-            # the points' closest points (used within the reach of a source only, as sol(points));
-            # a point the surface cannot project is never within that reach
-            with np.errstate(invalid="ignore", over="ignore"):
-                d_surface, proj = surf.project(points, grid)
-            d_surface = np.asarray(d_surface, dtype=float)
-            proj = np.asarray(proj, dtype=float)
-            keep = (d_surface <= 1e-9 * h) | ~np.all(np.isfinite(proj), axis=1)
-            at_feet = np.ascontiguousarray(np.where(keep[:, None], points, proj))
+        # the points' closest points (used within the reach of a source only), on every kind of
+        # surface, as sol(points) reads them (_factoring.factored_values); a point the surface
+        # cannot project is never within that reach
+        with np.errstate(invalid="ignore", over="ignore"):
+            d_surface, proj = surf.project(points, grid)
+        d_surface = np.asarray(d_surface, dtype=float)
+        proj = np.asarray(proj, dtype=float)
+        keep = (d_surface <= 1e-9 * h) | ~np.all(np.isfinite(proj), axis=1)
+        at_feet = np.ascontiguousarray(np.where(keep[:, None], points, proj))
     try:
         values, st = _native.second_order_solve_many(
             t.band,

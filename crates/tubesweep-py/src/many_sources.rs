@@ -389,12 +389,10 @@ fn run_order2<'py, const D: usize>(
             Some((points, feet)) => Order2Output::AtPoints {
                 lower,
                 points,
-                // beyond a few grid spacings the points' own feet on the surface (as sol(points))
-                feet: if reach > inp.reach_spacings * inp.spacing * (1.0 + 1e-9) {
-                    feet
-                } else {
-                    points
-                },
+                // the points' feet on the surface, as sol(points) reads the chord from them (from
+                // the points themselves within three spacings, a point 0.005 off a sphere sampled
+                // at N = 41 read 0.005 above its source, where sol(points) reads 0)
+                feet,
                 reach,
                 values: &mut values,
             },
