@@ -62,3 +62,12 @@ def test_a_concave_crease_is_not_said_to_make_fronts_only_early():
     with pytest.warns(RuntimeWarning, match="creases") as caught:
         ts.solve(ts.LevelSet(phi), GRID, [(-0.75, 0, 0)], order=1)
     assert not any("late" in str(w.message) for w in caught)
+
+
+def test_a_sphere_that_only_touches_the_box_is_not_said_to_be_cut():
+    # φ = 0 at the node where the sphere touches z = 0.5 counted as a crossing: "the grid box cuts
+    # the surface ... along a curve about 0.105 long", for a surface wholly inside the box
+    g = ts.Grid((-1, -1, -1), (1, 1, 0.5), (61, 61, 46))
+    sol = ts.solve(ts.surfaces.Sphere(0.5), g, [(-0.5, 0, 0)])
+    assert sol.stats.box_cut["surface_cut"] is False
+    assert abs(sol([(0, 0, 0.5)])[0] - np.pi / 4) < 0.1 * g.spacing

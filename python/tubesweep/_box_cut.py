@@ -85,7 +85,9 @@ def box_cut(grid: Grid, linear: np.ndarray, phi: np.ndarray, inner_width: float)
                 for a in range(d - 1):
                     lo = np.take(face, np.arange(face.shape[a] - 1), axis=a)
                     hi = np.take(face, np.arange(1, face.shape[a]), axis=a)
-                    n += int(np.count_nonzero(np.isfinite(lo) & np.isfinite(hi) & ((lo <= 0) != (hi <= 0))))
+                    # (strictly: a surface that only touches the face, φ = 0 at a node and above it around,
+                    # was said to cross it "along a curve about 0.105 long")
+                    n += int(np.count_nonzero(np.isfinite(lo) & np.isfinite(hi) & ((lo < 0) != (hi < 0))))
                 crossed += n
             else:
                 n = int(np.count_nonzero(np.abs(phib[sel]) <= 0.5 * h))
