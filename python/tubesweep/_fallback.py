@@ -36,6 +36,7 @@ from ._creases import thinned_spacings, warn_refused_creases
 from ._prepare import thinned_count
 from .band import band_neighbours
 from .surface import LevelSet
+from .surfaces._mesh_parts import open_only_in_debris
 from ._warn import user_stacklevel
 from .second_order import NOT_A_DISTANCE, NarrowExtension, Order2NotApplicable, warn_fallback
 
@@ -199,7 +200,10 @@ class Fallback:
         """Reads the mean ``|∇φ|`` that :meth:`warn` needs from ``tube`` before the solve, which
         drops the band's linear indices (none when nothing is to be said, or on an open surface)."""
         surface = tube.surface
-        if self.said or getattr(surface, "open_surface", False) or getattr(surface, "closed", True) is False:
+        closed = getattr(surface, "closed", True) is not False or (
+            getattr(surface, "faces", None) is not None and open_only_in_debris(surface)
+        )
+        if self.said or getattr(surface, "open_surface", False) or not closed:
             return
         self.gradient, low, high = gradient_range(tube)
         given = isinstance(surface, LevelSet) and not surface.redistance

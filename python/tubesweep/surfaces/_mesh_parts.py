@@ -29,6 +29,7 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from ..grid import Grid
+from ._mesh_checks import unique_edges
 
 #: Band nodes per query of their nearest faces and neighbours (bounds the memory).
 CHUNK = 1 << 18
@@ -224,3 +225,27 @@ def part_cut_pairs(
         nodes.append(node[crossing])
         neighbours.append(other[crossing])
     return np.concatenate(nodes), np.concatenate(neighbours), part
+
+
+#: Separate pieces holding under this share of a mesh's area are debris (a stray triangle):
+#: a mesh open only in them is closed for ``order="auto"``'s first-order size warning.
+DEBRIS_AREA = 0.01
+
+
+def open_only_in_debris(surface: Any) -> bool:
+    """Whether the mesh's boundary edges all lie on separate pieces of under :data:`DEBRIS_AREA`
+    of its area (computed once): a closed sphere with one stray triangle far away read as open,
+    and its first-order errors (17.8 % at N = 13) went unwarned, as an open surface's."""
+    if "_open_only_in_debris" not in surface.__dict__:
+        parts = face_parts(surface)
+        answer = False
+        if parts is not None:
+            f = surface.faces
+            edge_ids, counts = unique_edges(f)
+            open_faces = np.any(counts[edge_ids] == 1, axis=1)
+            v = surface.vertices
+            area = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+            open_area = float(area[np.isin(parts, np.unique(parts[open_faces]))].sum())
+            answer = open_area < DEBRIS_AREA * float(area.sum())
+        surface.__dict__["_open_only_in_debris"] = answer
+    return bool(surface.__dict__["_open_only_in_debris"])
