@@ -27,6 +27,7 @@ mod box_order2;
 mod convert;
 mod creases;
 mod errors;
+mod geometry_report;
 mod many_sources;
 mod mesh_smooth;
 mod moving;

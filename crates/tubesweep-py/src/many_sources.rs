@@ -458,17 +458,8 @@ fn run_order2<'py, const D: usize>(
             .into_pyarray(py),
     )?;
     d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
-    d.set_item("max_curvature", summary.max_curvature)?;
-    d.set_item("grad_norm_range", (summary.grad_norm_min, summary.grad_norm_max))?;
-    // the tube's geometry, shared by every source: the inner nodes that run the first-order update
-    d.set_item("first_order_nodes", summary.first_order_nodes())?;
-    d.set_item("inner_nodes", summary.inner_nodes)?;
-    let reasons = PyDict::new(py);
-    reasons.set_item("stencil", summary.incomplete_stencils)?;
-    reasons.set_item("gradient", summary.off_distance)?;
-    reasons.set_item("curvature", summary.unresolved_curvature)?;
-    d.set_item("first_order_reasons", reasons)?;
-    d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
+    // the tube's geometry, shared by every source (the inner nodes that run the first-order update)
+    crate::geometry_report::geometry_report(py, &d, &summary)?;
     d.set_item("reach", reach)?;
     Ok((array, d))
 }

@@ -228,18 +228,9 @@ fn run<'py, const D: usize>(
     d.set_item("runaway_iteration", stats.runaway_iteration)?;
     d.set_item("restart_failed", stats.restart_failed)?;
     d.set_item("unreached", stats.unreached)?;
-    d.set_item("max_curvature", summary.max_curvature)?;
-    d.set_item("grad_norm_range", (summary.grad_norm_min, summary.grad_norm_max))?;
     d.set_item("solver_bytes", bytes)?;
-    d.set_item("first_order_nodes", summary.first_order_nodes())?;
-    d.set_item("inner_nodes", summary.inner_nodes)?;
-    let reasons = PyDict::new(py);
-    reasons.set_item("stencil", summary.incomplete_stencils)?;
-    reasons.set_item("gradient", summary.off_distance)?;
-    reasons.set_item("curvature", summary.unresolved_curvature)?;
-    d.set_item("first_order_reasons", reasons)?;
+    crate::geometry_report::geometry_report(py, &d, &summary)?;
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
-    d.set_item("creases", crate::creases::creases_dict(py, &summary.creases)?)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
     if inp.keep_digests {
         d.set_item("digests", digests.into_pyarray(py))?;
