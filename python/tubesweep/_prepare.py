@@ -128,6 +128,9 @@ class _PreparedTube:
     #: their corners (``_creases.creases_in_paper_tube``): a dict as ``order2["creases"]``, None
     #: for other surfaces
     paper_creases: Optional[Dict[str, Any]] = None
+    #: the holes of an open mesh narrower than the band, which it bridges
+    #: (``surfaces._mesh_holes.bridged``), None for other surfaces and meshes without such holes
+    bridged_holes: Optional[Dict[str, Any]] = None
     #: the inner tube's connected components and the checksum of its flags, once a warm start
     #: counted them (``moving.inner_components``)
     inner_components: Optional[Tuple[int, int, np.ndarray]] = None
@@ -594,6 +597,8 @@ def _prepare_tube(
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)
+    holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh: holes the band spans
+    bridged_holes = holes_of(h, outer_eff) if holes_of is not None else None
     # (after the facing test, which reads the paper's inner tube). The paper's tube's creases are
     # not reported on a re-distanced φ, whose kinks include those of its samples (a voxel mask's
     # staircase: a sphere's mask said "creases … turning by up to 84°"), but its crease nodes are
@@ -627,4 +632,5 @@ def _prepare_tube(
         extended,
         paper_creases=paper_creases,
         pieces=pieces,
+        bridged_holes=bridged_holes,
     )

@@ -557,6 +557,7 @@ def _solve_on_tube(
         local_solver=st.get("local_solver", scheme),
         box_cut=tube.box_cut,
         creases=tube.paper_creases,
+        bridged_holes=tube.bridged_holes,
     )
     return Solution(
         grid,

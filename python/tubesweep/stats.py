@@ -127,6 +127,12 @@ class SolveStats:
         the tube touches), ``cut_length`` (3D: the length of the curve along which it crosses them)
         or ``cut_points`` (2D: the crossings), ``inner_on_boundary`` (inner-tube nodes on the
         boundary) and ``gap`` (the smallest |φ| on the boundary).
+    bridged_holes : dict or None
+        On an open triangle mesh, its holes narrower than the band (``2·outer`` grid spacings),
+        which the band spans, with a ``RuntimeWarning``: distances reached across such a hole are
+        those of the surface with the hole filled, up to about half its width shorter than the
+        mesh's geodesics round it. ``count``, ``widest`` (its width), ``where`` (its centre) and
+        ``reach`` (the band's span, ``2·outer·Δx``). None otherwise.
 
     Examples
     --------
@@ -162,6 +168,7 @@ class SolveStats:
     order_fallback: Optional[str] = None
     box_cut: Optional[Dict[str, Any]] = None
     creases: Optional[Dict[str, Any]] = None
+    bridged_holes: Optional[Dict[str, Any]] = None
 
     @property
     def updates_per_second(self) -> float:

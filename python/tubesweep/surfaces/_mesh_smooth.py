@@ -14,6 +14,7 @@ from .._linalg import row_norms
 from ..band import BandGeometry
 from ..closest_point import DIRECTION_EPS
 from ..grid import Grid
+from ._mesh_holes import across_holes
 
 #: Samples in each local fit (as for point clouds, docs/point-clouds.md).
 NEIGHBOURS = 20
@@ -97,7 +98,7 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
         # and where the mesh faces itself across a gap narrower than its tubes that band and first
         # order (order2_obstacle), without the fits' cost
         exact = exact_band()
-        pairs = facing_pairs(grid, exact)
+        pairs = facing_pairs(grid, exact, surface)
         if pairs:
             surface.report = {"facing": pairs, "h": grid_h}
             return exact
@@ -198,10 +199,12 @@ def largest_size(surface: Any) -> float:
     return float(np.max(np.maximum(np.maximum(edges[0], edges[1]), edges[2])))
 
 
-def facing_pairs(grid: Grid, geom: BandGeometry) -> int:
+def facing_pairs(grid: Grid, geom: BandGeometry, surface: Any = None) -> int:
     """Pairs of grid neighbours of the band, both more than 0.75 Δx from the mesh, whose extension
     directions point more than 120° apart: the two sides of a gap narrower than the tubes (across a
-    single sheet two neighbours cannot both be that far from it)."""
+    single sheet two neighbours cannot both be that far from it). Given the mesh (``surface``),
+    pairs over a hole (both closest points on its boundary, ``_mesh_holes.across_holes``) are
+    not counted: a hole is not a gap between sheets."""
     h = grid.spacing
     lin = geom.linear
     if len(lin) == 0:
@@ -215,7 +218,12 @@ def facing_pairs(grid: Grid, geom: BandGeometry) -> int:
         pos = np.minimum(np.searchsorted(lin, nxt), len(lin) - 1)
         hit = (lin[pos] == nxt) & far & far[pos] & ((lin // stride) % grid.shape[k] < grid.shape[k] - 1)
         dots = np.einsum("ij,ij->i", geom.direction[hit], geom.direction[pos[hit]])
-        count += int(np.count_nonzero(dots < -0.5))
+        facing = dots < -0.5
+        if surface is not None and np.any(facing):
+            first = lin[hit][facing]
+            second = lin[pos[hit]][facing]
+            facing = ~across_holes(surface, grid.node_points(first), grid.node_points(second))
+        count += int(np.count_nonzero(facing))
     return count
 
 
@@ -289,6 +297,11 @@ class SmoothMap:
 
     def _cp(self, x: np.ndarray) -> np.ndarray:
         return closest(self, x, self._h)[0]
+
+    def across_holes(self, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+        """For node pairs a facing test found (points ``(M, 3)`` each): whether they lie over a
+        hole of the mesh (``_mesh_holes.across_holes``), not across a gap between sheets."""
+        return across_holes(self, first, second)
 
     def order2_obstacle(self, facing_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
         """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
