@@ -300,10 +300,6 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
         )
     if getattr(surf, "smooth", False):  # a mesh through its smooth map (surfaces/_mesh_smooth.py)
         node, neighbour, _ = tube.facing
-        if node.size:  # pairs over a hole are no gap between sheets (surfaces/_mesh_holes.py)
-            points = grid.node_points(tube.linear[np.concatenate([node, neighbour])])
-            keep = ~surf.across_holes(points[: node.size], points[node.size :])
-            node, neighbour = node[keep], neighbour[keep]
         depth = np.median(np.maximum(np.abs(tube.phi[node]), np.abs(tube.phi[neighbour]))) / h if node.size else np.inf
         obstacle = surf.order2_obstacle(int(node.size), float(depth))
         if obstacle is not None:

@@ -130,21 +130,19 @@ def holes(surface: Any) -> Holes:
     if cached is not None:
         return cached
     found = Holes(np.zeros(0), np.zeros(0), np.zeros((0, 3)), np.zeros(0, np.int64))
-    if not surface.closed:
-        edges = boundary_edges(surface.faces)
-        if len(edges):
-            v = surface.vertices
-            widths, detours, centres, counts = [], [], [], []
-            for loop in _loops(len(v), edges):
-                width, perimeter, centre = _hull_width(v[loop])
-                widths.append(width)
-                detours.append(max(perimeter / 2.0 - width, 0.0))
-                centres.append(centre)
-                counts.append(loop.size)
-            width_a, centre_a = np.asarray(widths), np.asarray(centres)
-            off = surface.closest(centre_a)[0]
-            hole = off > HOLE_CENTRE * width_a
-            found = Holes(width_a[hole], np.asarray(detours)[hole], centre_a[hole], np.asarray(counts, np.int64)[hole])
+    edges = np.zeros((0, 2), np.int64) if surface.closed else boundary_edges(surface.faces)
+    if len(edges):
+        v = surface.vertices
+        widths, detours, centres, counts = [], [], [], []
+        for loop in _loops(len(v), edges):
+            width, perimeter, centre = _hull_width(v[loop])
+            widths.append(width)
+            detours.append(max(perimeter / 2.0 - width, 0.0))
+            centres.append(centre)
+            counts.append(loop.size)
+        width_a, centre_a = np.asarray(widths), np.asarray(centres)
+        hole = surface.closest(centre_a)[0] > HOLE_CENTRE * width_a
+        found = Holes(width_a[hole], np.asarray(detours)[hole], centre_a[hole], np.asarray(counts, np.int64)[hole])
     surface.__dict__["_holes"] = found
     return found
 
@@ -154,7 +152,7 @@ def bridged(surface: Any, h: float, outer: float) -> Optional[dict]:
     ``sol.stats.bridged_holes``: ``count``, ``widest`` (the widest one's width), ``reach`` (the
     band's span, ``2·outer·h``), ``detour`` (the largest :class:`Holes` detour among them: how
     much shorter a distance reached across one can come out), ``where`` (that hole's centre) and
-    ``size`` (the mesh's bounding-box diagonal); None when there are none."""
+    ``size`` (the surface's bounding-box diagonal); None when there are none."""
     found = holes(surface)
     reach = 2.0 * outer * h
     narrow = found.width < reach
@@ -206,6 +204,13 @@ def across_holes(surface: Any, first: np.ndarray, second: np.ndarray) -> np.ndar
         return np.zeros(len(first), bool)
     on_rim = boundary_mask(surface)
     return on_rim(np.asarray(first, float)) & on_rim(np.asarray(second, float))
+
+
+def pairs_over_holes(surface: Any, grid: Any, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """:func:`across_holes` for node pairs given by their linear indices on ``grid``:
+    ``MeshSurface._pairs_over_holes``, read by the tube's preparation (``_prepare``), which leaves
+    such pairs out of the facing pairs (no warning, no cut, not in ``sol.stats.facing_pairs``)."""
+    return across_holes(surface, grid.node_points(first), grid.node_points(second))
 
 
 def boundary_mask(surface: Any) -> Any:

@@ -298,11 +298,6 @@ class SmoothMap:
     def _cp(self, x: np.ndarray) -> np.ndarray:
         return closest(self, x, self._h)[0]
 
-    def across_holes(self, first: np.ndarray, second: np.ndarray) -> np.ndarray:
-        """For node pairs a facing test found (points ``(M, 3)`` each): whether they lie over a
-        hole of the mesh (``_mesh_holes.across_holes``), not across a gap between sheets."""
-        return across_holes(self, first, second)
-
     def order2_obstacle(self, facing_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
         """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
         or None; read by the second-order solve.

@@ -42,7 +42,7 @@ from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
 from ._mesh_checks import thin_parts, unique_edges, warn_repeated_vertices, warn_thin_parts
 from ._mesh_parts import node_parts, part_cut_pairs
-from ._mesh_holes import bridged_holes
+from ._mesh_holes import bridged_holes, pairs_over_holes
 
 __all__ = [
     "from_mesh",
@@ -172,6 +172,7 @@ class MeshSurface(Surface):
     _part_cut_pairs = part_cut_pairs  # the band's edges between separate parts (cut: _shortcuts)
     _node_parts = node_parts  # each node's part, for a band left uncut (_parts)
     _bridged_holes = bridged_holes  # its holes the band spans, warned (stats.bridged_holes)
+    _pairs_over_holes = pairs_over_holes  # facing pairs over a hole: no gap (_prepare)
 
     def __init__(
         self,
