@@ -534,26 +534,3 @@ def test_a_spiral_s_closest_points_stay_on_its_turns_and_its_ends_are_its_rim():
     sol = ts.solve(cloud, g, [pts[-1]], inner=1, outer=3)
     err = np.abs(sol(pts[::20]) - (s[-1] - s[::20])) / s[-1]
     assert sol.stats.converged and err.mean() < 1e-3
-
-
-def test_a_point_cloud_with_holes_is_not_said_to_face_itself():
-    # samples of the sphere of radius 0.6 with the three holes 0.1 wide: node pairs over a hole,
-    # both closest points on the cloud's rim, were warned as "faces itself across gaps narrower
-    # than its tubes at 4 node pair(s)" (and cut)
-    holes = np.array([(0.6, 0.0, 0.0), (0.0, 0.6, 0.0), (0.0, 0.0, -0.6)])
-    rng = np.random.default_rng(0)
-    p = rng.normal(size=(40000, 3))
-    p *= 0.6 / np.linalg.norm(p, axis=1, keepdims=True)
-    p = p[np.min(np.linalg.norm(p[:, None] - holes[None], axis=2), axis=1) > 0.05]
-    cloud = ts.surfaces.from_points(p)
-    assert cloud.open_surface
-    grid = ts.Grid((-0.8,) * 3, (0.8,) * 3, (61,) * 3)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        sol = ts.solve(cloud, grid, [(0.0, 0.0, 0.6)])
-    assert sol.stats.order == 2 and sol.stats.facing_pairs == 0, sol.stats
-    # away from the holes, against the sphere's geodesic distance (the holes lie off those paths)
-    q = p[::40]
-    far = np.min(np.linalg.norm(q[:, None] - holes[None], axis=2), axis=1) > 0.3
-    err = np.abs(sol(q) - 0.6 * np.arccos(np.clip(q[:, 2] / 0.6, -1.0, 1.0)))[far]
-    assert err.mean() < 1e-3, err.mean()

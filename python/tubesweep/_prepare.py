@@ -561,10 +561,6 @@ def _prepare_tube(
     facing = _warn_if_tubes_touch(
         grid, band, linear, roles, phi, directions, inner, kink, noise, warn=not cuts and inside is None, note=note
     )
-    over_holes = getattr(surf, "_pairs_over_holes", None)  # meshes, clouds: pairs over a hole are no gap
-    if over_holes is not None and facing[0].size:
-        keep = ~over_holes(grid, linear[facing[0]], linear[facing[1]])
-        facing = (facing[0][keep], facing[1][keep], facing[2][keep])
     if inside is not None:
         # an unsigned φ with a known inside (BandGeometry.inside): the pairs of the signed φ too
         signed_phi = np.where(inside, -phi, phi)
@@ -575,6 +571,10 @@ def _prepare_tube(
         del signed_phi
         if not cuts:
             warn_facing_pairs(grid, linear, roles, facing, inner, note)
+    over_holes = getattr(surf, "_pairs_over_holes", None)  # a mesh: pairs over a hole are no gap (cut nowhere)
+    if over_holes is not None and facing[0].size:
+        keep = ~over_holes(grid, linear[facing[0]], linear[facing[1]])
+        facing = (facing[0][keep], facing[1][keep], facing[2][keep])
     cut_edges = 0
     pieces = None
     cut_facing = facing

@@ -129,10 +129,13 @@ class SolveStats:
         boundary) and ``gap`` (the smallest |φ| on the boundary).
     bridged_holes : dict or None
         On an open triangle mesh, its holes narrower than the band (``2·outer`` grid spacings),
-        which the band spans, with a ``RuntimeWarning``: distances reached across such a hole are
-        those of the surface with the hole filled, up to about half its width shorter than the
-        mesh's geodesics round it. ``count``, ``widest`` (its width), ``where`` (its centre) and
-        ``reach`` (the band's span, ``2·outer·Δx``). None otherwise.
+        which the band spans: distances reached across such a hole are those of the surface with
+        the hole filled, shorter than the mesh's geodesics round it by up to the hole's detour
+        (for a convex hole half its perimeter less its width: 0.57 widths for a round one, about
+        the length of a slot). ``count``, ``widest`` (the widest one's width), ``reach`` (the
+        band's span, ``2·outer·Δx``), ``detour`` (the largest detour), ``where`` and ``width``
+        (that hole's centre and width), ``size`` (the mesh's bounding-box diagonal); with a
+        ``RuntimeWarning`` when the detour is over 10% of the size. None otherwise.
 
     Examples
     --------

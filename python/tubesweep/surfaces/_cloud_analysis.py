@@ -202,19 +202,6 @@ def widen(analysis: SampleAnalysis, points: np.ndarray) -> SampleAnalysis:
     return analysis
 
 
-def pairs_over_rim(surface: Any, grid: Any, first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """For node pairs of the cloud's last band (linear indices on ``grid``) that a facing test
-    found: whether
-    both nodes' closest points lie on the cloud's rim, so that the pair lies over a hole (or
-    beyond the scan's edge) rather than across a gap between two sheets (``_prepare``; a sphere of
-    40,000 samples with three holes 0.1 wide at N = 61 was warned to face itself across gaps at 4
-    node pairs)."""
-    rim = getattr(surface, "_rim_linear", None)
-    if rim is None or rim.size == 0:
-        return np.zeros(len(first), bool)
-    return np.isin(first, rim) & np.isin(second, rim)
-
-
 def _noise(residual: np.ndarray, radius: np.ndarray) -> float:
     """1.4826 × the median distance of a sample from its fit."""
     return MAD_TO_SIGMA * float(np.nanmedian(residual * radius))

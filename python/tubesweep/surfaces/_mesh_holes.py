@@ -18,11 +18,16 @@ and such pairs sent the whole solve to first order as if the mesh faced itself a
 where second order gives 2.2e-4 to 7.9e-5). :func:`across_holes` tells those pairs apart: both
 nodes' closest points lie on the mesh's boundary.
 
-Each boundary component (boundary edges joined at their vertices) is a loop; its width is the
-smallest width of the convex hull of its vertices in their best-fitting plane (a circle's
-diameter), and it is a hole when the hull's centre lies off the mesh by more than a quarter of
-that width (an open surface's outline around a strip, whose centre lies on the strip, is not; nor
-is a straight crack, whose centre lies on its own edge: a limitation).
+Each boundary component (boundary edges joined at their vertices) is a loop. Only simple loops
+are judged (every vertex on two boundary edges; loops of a single missing triangle, a triangle
+soup's, are left out, as are seams: loops whose vertices mostly come in coincident pairs, an
+export's split). A loop's width is the smallest width of the convex hull of its vertices in their
+best-fitting plane (a circle's diameter), its detour half the hull's perimeter less that width,
+and it is a hole when the centre of its bounding box in that plane lies off the mesh by more
+than a quarter of its width (an open surface's outline around a strip or a notched plate, whose
+centre lies on the surface, is not). A pair over a hole is one whose two closest points lie on
+the same hole: a notch in an outline or two sheets' edges facing each
+other stay gaps. Not judged: loops through a vertex shared by two holes, and straight cracks.
 """
 
 from __future__ import annotations
@@ -35,36 +40,45 @@ import numpy as np
 
 from .._warn import user_stacklevel
 from ._mesh_checks import unique_edges
+from ._mesh_parts import vertex_parts
 
-#: The share of the width by which the hull's centre must lie off the mesh for a loop to be a
-#: hole (an open surface's outer edge around a strip narrower than the tube has its centre on it).
+#: The share of the width by which the centre must lie off the mesh for a loop to be a hole (an
+#: open surface's outline around a strip narrower than the band has its centre on it).
 HOLE_CENTRE = 0.25
 
-
 #: The warning is given when a bridged hole's detour (:class:`Holes`) exceeds this share of the
-#: mesh's size (its bounding box's diagonal, about its largest geodesic distance), as the
-#: first-order size warnings from 10% of the largest distance; ``sol.stats.bridged_holes`` reports
-#: every one. (The bundled bunny's base has a slot 0.0085 wide whose detour, 0.023, is 9.2% of its
-#: size; the errors next to it at n = 60–200 are no larger than elsewhere, 1.5–4.6 spacings.)
+#: mesh's size (its used vertices' bounding-box diagonal, about its largest geodesic distance), as
+#: the first-order size warnings from 10% of the largest distance; ``sol.stats.bridged_holes``
+#: reports every one. (The bundled bunny's base has a slot 0.0085 wide whose detour, 0.023, is
+#: 9.2% of its size; the errors next to it at n = 60–200 are no larger than elsewhere, 1.5–4.6
+#: spacings.)
 WARN_SHARE = 0.1
+
+#: Directions over a half turn at which a loop's width is measured (its hull's width is the
+#: smallest, its perimeter π times the mean: Cauchy's formula).
+DIRECTIONS = 90
 
 
 @dataclass(frozen=True)
 class Holes:
     """The holes of a mesh: per hole its width (the convex hull's smallest width in the loop's
-    plane), its detour (half the hull's perimeter less its width: how much longer a geodesic
-    round the hole is than one across it, at most; 0.57 widths for a round hole), its centre
-    (the hull's centroid, in 3D) and its number of boundary vertices."""
+    plane), its detour (half the hull's perimeter less its width: how much longer a path round
+    a convex hole is than one across it, at most; 0.57 widths for a round hole, about the length
+    of a slot), its centre and its number of boundary vertices; and per boundary vertex its hole
+    (-1 where it lies on none), for :func:`across_holes`."""
 
     width: np.ndarray
     detour: np.ndarray
     centre: np.ndarray
     vertices: np.ndarray
+    vertex_hole: np.ndarray
+    edge_keys: np.ndarray
+    edge_hole: np.ndarray
 
 
 def boundary_edges(faces: np.ndarray) -> np.ndarray:
-    """The mesh's boundary edges ``(E, 2)``: the edges of exactly one triangle (triangles that name a
-    vertex twice left out, as ``MeshSurface`` counts them)."""
+    """The mesh's boundary edges ``(E, 2)``, each sorted: the edges of exactly one triangle
+    (triangles that name a vertex twice left out, as ``MeshSurface`` counts them)."""
     f = np.asarray(faces, dtype=np.int64)
     f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
     if len(f) == 0:
@@ -75,53 +89,37 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
     return np.sort(ends[once], axis=1)
 
 
-def _loops(n_vertices: int, edges: np.ndarray) -> list:
-    """The boundary vertices grouped by connected component of the boundary edges."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    on = np.unique(edges)
-    index = np.full(n_vertices, -1, np.int64)
-    index[on] = np.arange(on.size)
-    a, b = index[edges[:, 0]], index[edges[:, 1]]
-    graph = coo_matrix((np.ones(len(a)), (a, b)), shape=(on.size, on.size))
-    _, label = connected_components(graph, directed=False)
-    order = np.argsort(label, kind="stable")
-    splits = np.flatnonzero(np.diff(label[order])) + 1
-    return [on[g] for g in np.split(order, splits)]
+def _simple_loops(n_vertices: int, edges: np.ndarray) -> list:
+    """The boundary vertices of each simple loop (every vertex on two boundary edges), loops of
+    more than three vertices only."""
+    degree = np.bincount(edges.ravel(), minlength=n_vertices)
+    label = vertex_parts(n_vertices, np.column_stack([edges[:, 0], edges[:, 1], edges[:, 1]]))
+    on = np.flatnonzero(degree > 0)
+    bad = np.zeros(n_vertices, bool)
+    bad[label[on[degree[on] != 2]]] = True  # components through a vertex of another degree
+    on = on[~bad[label[on]]]
+    order = np.argsort(label[on], kind="stable")
+    groups = np.split(on[order], np.flatnonzero(np.diff(label[on][order])) + 1) if on.size else []
+    return [g for g in groups if g.size > 3]
 
 
-def _hull_width(points: np.ndarray) -> tuple:
+def _is_seam(points: np.ndarray) -> bool:
+    """Whether most of a loop's vertices have another at the same coordinates (a split seam)."""
+    _, inverse, counts = np.unique(points, axis=0, return_inverse=True, return_counts=True)
+    return bool(np.count_nonzero(counts[inverse.ravel()] > 1) > 0.5 * len(points))
+
+
+def _width(points: np.ndarray) -> tuple:
     """The smallest width of the convex hull of ``points`` (3D) in their best-fitting plane, its
-    perimeter, and its centroid in 3D."""
-    from scipy.spatial import ConvexHull, QhullError
-
+    perimeter, and the centre of their bounding box in that plane (in 3D)."""
     centre = points.mean(axis=0)
     _, _, vt = np.linalg.svd(points - centre, full_matrices=False)
     flat = (points - centre) @ vt[:2].T
-    try:
-        hull = ConvexHull(flat)
-    except (QhullError, ValueError):  # collinear (a slit of zero width) or fewer than three
-        span = float(np.ptp(flat[:, 0])) if len(flat) else 0.0
-        return 0.0, 2.0 * span, centre
-    ring = flat[hull.vertices]
-    widths = []
-    for i in range(len(ring)):
-        p, q = ring[i], ring[(i + 1) % len(ring)]
-        t = q - p
-        n = np.array([-t[1], t[0]]) / max(float(np.hypot(t[0], t[1])), 1e-300)
-        widths.append(float(np.max(np.abs((ring - p) @ n))))
-    # the centroid of the hull's area (the mean of the ring's vertices leans towards dense ones)
-    x, y = ring[:, 0], ring[:, 1]
-    xs, ys = np.roll(x, -1), np.roll(y, -1)
-    cross = x * ys - xs * y
-    area = cross.sum() / 2.0
-    if abs(area) > 0:
-        c2 = np.array([((x + xs) * cross).sum(), ((y + ys) * cross).sum()]) / (6.0 * area)
-    else:
-        c2 = ring.mean(axis=0)
-    perimeter = float(np.sum(np.hypot(xs - x, ys - y)))
-    return min(widths), perimeter, centre + c2 @ vt[:2]
+    angle = np.arange(DIRECTIONS) * (np.pi / DIRECTIONS)
+    along = flat @ np.stack([np.cos(angle), np.sin(angle)])  # (points, directions)
+    widths = along.max(axis=0) - along.min(axis=0)
+    middle = (flat.max(axis=0) + flat.min(axis=0)) / 2.0
+    return float(widths.min()), float(np.pi * widths.mean()), centre + middle @ vt[:2]
 
 
 def holes(surface: Any) -> Holes:
@@ -129,20 +127,36 @@ def holes(surface: Any) -> Holes:
     cached: Optional[Holes] = surface.__dict__.get("_holes")
     if cached is not None:
         return cached
-    found = Holes(np.zeros(0), np.zeros(0), np.zeros((0, 3)), np.zeros(0, np.int64))
+    v = surface.vertices
     edges = np.zeros((0, 2), np.int64) if surface.closed else boundary_edges(surface.faces)
-    if len(edges):
-        v = surface.vertices
-        widths, detours, centres, counts = [], [], [], []
-        for loop in _loops(len(v), edges):
-            width, perimeter, centre = _hull_width(v[loop])
-            widths.append(width)
-            detours.append(max(perimeter / 2.0 - width, 0.0))
-            centres.append(centre)
-            counts.append(loop.size)
-        width_a, centre_a = np.asarray(widths), np.asarray(centres)
-        hole = surface.closest(centre_a)[0] > HOLE_CENTRE * width_a
-        found = Holes(width_a[hole], np.asarray(detours)[hole], centre_a[hole], np.asarray(counts, np.int64)[hole])
+    widths, detours, centres, counts, members = [], [], [], [], []
+    for loop in _simple_loops(len(v), edges) if len(edges) else []:
+        if _is_seam(v[loop]):
+            continue
+        width, perimeter, centre = _width(v[loop])
+        widths.append(width)
+        detours.append(max(perimeter / 2.0 - width, 0.0))
+        centres.append(centre)
+        counts.append(loop.size)
+        members.append(loop)
+    width_a, centre_a = np.asarray(widths, float), np.asarray(centres, float).reshape(-1, 3)
+    hole = surface.closest(centre_a)[0] > HOLE_CENTRE * width_a if len(widths) else np.zeros(0, bool)
+    vertex_hole = np.full(len(v), -1, np.int64)
+    for k, loop in enumerate(m for m, is_hole in zip(members, hole) if is_hole):
+        vertex_hole[loop] = k
+    n = len(v)
+    keys = edges[:, 0] * n + edges[:, 1]
+    order = np.argsort(keys)
+    edge_hole = vertex_hole[edges[order, 0]]
+    found = Holes(
+        width_a[hole],
+        np.asarray(detours, float)[hole],
+        centre_a[hole],
+        np.asarray(counts, np.int64)[hole],
+        vertex_hole,
+        keys[order],
+        np.where(edge_hole == vertex_hole[edges[order, 1]], edge_hole, -1),
+    )
     surface.__dict__["_holes"] = found
     return found
 
@@ -151,21 +165,23 @@ def bridged(surface: Any, h: float, outer: float) -> Optional[dict]:
     """The holes of ``surface`` that the band of spacing ``h`` and width ``outer`` spans, as
     ``sol.stats.bridged_holes``: ``count``, ``widest`` (the widest one's width), ``reach`` (the
     band's span, ``2·outer·h``), ``detour`` (the largest :class:`Holes` detour among them: how
-    much shorter a distance reached across one can come out), ``where`` (that hole's centre) and
-    ``size`` (the surface's bounding-box diagonal); None when there are none."""
+    much shorter a distance reached across one can come out), ``where`` and ``width`` (that
+    hole's centre and width) and ``size`` (the mesh's used vertices' bounding-box diagonal); None
+    when there are none."""
     found = holes(surface)
     reach = 2.0 * outer * h
     narrow = found.width < reach
     if not np.any(narrow):
         return None
     k = int(np.argmax(found.detour[narrow]))
-    v = surface.vertices
+    v = surface.vertices[surface.used_vertices]
     return {
         "count": int(np.count_nonzero(narrow)),
         "widest": float(np.max(found.width[narrow])),
         "reach": float(reach),
         "detour": float(found.detour[narrow][k]),
         "where": tuple(round(float(c), 6) for c in found.centre[narrow][k]),
+        "width": float(found.width[narrow][k]),
         "size": float(np.linalg.norm(v.max(axis=0) - v.min(axis=0))),
     }
 
@@ -183,14 +199,15 @@ def warn_bridged_holes(info: Optional[dict], h: float, outer: float) -> None:
     :data:`WARN_SHARE` of the mesh's size."""
     if info is None or info["detour"] <= WARN_SHARE * info["size"]:
         return
-    spacing = info["widest"] / (2.0 * outer)
-    finer = f"a grid spacing below {spacing:.3g} (now {h:.3g}) keeps them open, or " if spacing > 0 else ""
+    spacing = info["width"] / (2.0 * outer)
+    finer = f"a grid spacing below {spacing:.3g} (now {h:.3g}) keeps that one open, or " if spacing > 0 else ""
     warnings.warn(
         f"the mesh has {info['count']} hole(s) narrower than its band ({info['reach']:.3g} across at this grid; "
         f"the widest {info['widest']:.3g}): the band bridges them, and a distance reached across one is that of "
-        f"the surface with the hole filled, up to {info['detour']:.3g} ({info['detour'] / info['size']:.0%} of the "
-        f"mesh's size) shorter than the mesh's geodesic round it (near {info['where']}). sol.stats.bridged_holes has "
-        f"them; {finer}fill them first (e.g. trimesh.repair.fill_holes) where they are gaps in a scan",
+        f"the surface with the hole filled, up to about {info['detour']:.3g} ({info['detour'] / info['size']:.0%} of "
+        f"the mesh's size) shorter than the mesh's geodesic round the hole near {info['where']}. "
+        f"sol.stats.bridged_holes has them; {finer}fill them first (e.g. trimesh.repair.fill_holes) where they are "
+        "gaps in a scan",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
@@ -198,12 +215,19 @@ def warn_bridged_holes(info: Optional[dict], h: float, outer: float) -> None:
 
 def across_holes(surface: Any, first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """For node pairs (points ``first[i]``, ``second[i]``, ``(M, 3)``) that a facing test found:
-    whether both nodes' closest points lie on the mesh's boundary, so that the pair lies over a
-    hole (or beyond an outer edge) rather than across a gap between two sheets."""
+    whether both nodes' exact closest points lie on the same hole of the mesh, so that the pair
+    lies over it (across the hole, or at a corner of its rim: the sphere's holes 10.8 spacings
+    wide at N = 161 gave three such pairs) rather than across a gap between two sheets (feature
+    codes of ``closest_points_on_triangles``). An outline taken for a hole (an annulus's outer
+    edge, :data:`HOLE_CENTRE`) would let a notch in it pass for a hole: a limitation."""
     if surface.closed or len(first) == 0:
         return np.zeros(len(first), bool)
-    on_rim = boundary_mask(surface)
-    return on_rim(np.asarray(first, float)) & on_rim(np.asarray(second, float))
+    found = holes(surface)
+    if found.width.size == 0:
+        return np.zeros(len(first), bool)
+    a = _hole_of(surface, found, np.asarray(first, float))
+    b = _hole_of(surface, found, np.asarray(second, float))
+    return (a >= 0) & (a == b)
 
 
 def pairs_over_holes(surface: Any, grid: Any, first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -213,36 +237,25 @@ def pairs_over_holes(surface: Any, grid: Any, first: np.ndarray, second: np.ndar
     return across_holes(surface, grid.node_points(first), grid.node_points(second))
 
 
-def boundary_mask(surface: Any) -> Any:
-    """A function of points ``(M, 3)`` giving whether each one's exact closest point on the mesh
-    lies on a boundary edge or vertex (feature codes of ``closest_points_on_triangles``)."""
+def _hole_of(surface: Any, found: Holes, x: np.ndarray) -> np.ndarray:
+    """The hole whose boundary holds each point's exact closest point, -1 where none does."""
     from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, VERT_A, VERT_B, VERT_C
 
     f = np.asarray(surface.faces, dtype=np.int64)
-    edges = boundary_edges(f)
-    rim_vertex = np.zeros(len(surface.vertices), bool)
-    rim_vertex[edges.ravel()] = True
     n = len(surface.vertices)
-    keys = np.sort(edges[:, 0] * n + edges[:, 1]) if len(edges) else np.zeros(0, np.int64)
-
-    def is_rim_edge(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        if keys.size == 0:
-            return np.zeros(len(a), bool)
-        key = np.minimum(a, b) * n + np.maximum(a, b)
+    _, _, face, code = surface.closest(x)
+    out = np.full(len(x), -1, np.int64)
+    ok = face >= 0
+    tri = f[np.maximum(face, 0)]
+    for c, corner in ((VERT_A, 0), (VERT_B, 1), (VERT_C, 2)):
+        sel = ok & (code == c)
+        out[sel] = found.vertex_hole[tri[sel, corner]]
+    keys = found.edge_keys
+    for c, (i, j) in ((EDGE_AB, (0, 1)), (EDGE_AC, (0, 2)), (EDGE_BC, (1, 2))):
+        sel = ok & (code == c)
+        if keys.size == 0 or not np.any(sel):
+            continue
+        key = np.minimum(tri[sel, i], tri[sel, j]) * n + np.maximum(tri[sel, i], tri[sel, j])
         pos = np.minimum(np.searchsorted(keys, key), keys.size - 1)
-        return np.asarray(keys[pos] == key)
-
-    def on_rim(x: np.ndarray) -> np.ndarray:
-        _, _, face, code = surface.closest(x)
-        out = np.zeros(len(x), bool)
-        ok = face >= 0
-        tri = f[np.maximum(face, 0)]
-        for c, corner in ((VERT_A, 0), (VERT_B, 1), (VERT_C, 2)):
-            sel = ok & (code == c)
-            out[sel] = rim_vertex[tri[sel, corner]]
-        for c, (i, j) in ((EDGE_AB, (0, 1)), (EDGE_AC, (0, 2)), (EDGE_BC, (1, 2))):
-            sel = ok & (code == c)
-            out[sel] = is_rim_edge(tri[sel, i], tri[sel, j])
-        return out
-
-    return on_rim
+        out[sel] = np.where(keys[pos] == key, found.edge_hole[pos], -1)
+    return out

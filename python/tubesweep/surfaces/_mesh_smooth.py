@@ -203,15 +203,15 @@ def facing_pairs(grid: Grid, geom: BandGeometry, surface: Any = None) -> int:
     """Pairs of grid neighbours of the band, both more than 0.75 Δx from the mesh, whose extension
     directions point more than 120° apart: the two sides of a gap narrower than the tubes (across a
     single sheet two neighbours cannot both be that far from it). Given the mesh (``surface``),
-    pairs over a hole (both closest points on its boundary, ``_mesh_holes.across_holes``) are
-    not counted: a hole is not a gap between sheets."""
+    pairs over one of its holes (``_mesh_holes.across_holes``) are not counted: a hole is not a
+    gap between sheets."""
     h = grid.spacing
     lin = geom.linear
     if len(lin) == 0:
         return 0
     dist = geom.distance if geom.distance is not None else np.abs(geom.signed)
     far = dist > 0.75 * h
-    count = 0
+    first, second = [], []
     for k in range(grid.ndim):
         stride = int(np.prod(grid.shape[k + 1 :]))
         nxt = lin + stride
@@ -219,12 +219,12 @@ def facing_pairs(grid: Grid, geom: BandGeometry, surface: Any = None) -> int:
         hit = (lin[pos] == nxt) & far & far[pos] & ((lin // stride) % grid.shape[k] < grid.shape[k] - 1)
         dots = np.einsum("ij,ij->i", geom.direction[hit], geom.direction[pos[hit]])
         facing = dots < -0.5
-        if surface is not None and np.any(facing):
-            first = lin[hit][facing]
-            second = lin[pos[hit]][facing]
-            facing = ~across_holes(surface, grid.node_points(first), grid.node_points(second))
-        count += int(np.count_nonzero(facing))
-    return count
+        first.append(lin[hit][facing])
+        second.append(lin[pos[hit]][facing])
+    a, b = np.concatenate(first), np.concatenate(second)
+    if surface is not None and a.size:
+        return int(np.count_nonzero(~across_holes(surface, grid.node_points(a), grid.node_points(b))))
+    return int(a.size)
 
 
 def order2_obstacle(surface: Any, tube_pairs: int, pair_depth: float = np.inf) -> Optional[str]:

@@ -38,7 +38,7 @@ from .._validate import real_array
 from ..grid import MAX_COORDINATE, Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
-from ._cloud_analysis import analyse, analyse_own, pairs_over_rim, widen
+from ._cloud_analysis import analyse, analyse_own, widen
 from ._cloud_files import read_points
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
@@ -185,7 +185,6 @@ class PointCloudSurface(ClosestPoint):
     #: fits fold where the samples are sparse, and cuts there strand parts of the cloud or bend
     #: its distances (``benches/experiments/cloud_gaps.py``).
     cuts_shortcuts = True
-    _pairs_over_holes = pairs_over_rim  # facing pairs over a hole: no gap (_prepare)
     cuts_medial_edges = False
     #: A gap this many grid spacings wide is resolved where the samples are dense (the fits'
     #: radius FIT_RADIUS·Δx): the grid spacing the narrow-gap warning advises is the gap over it.
@@ -668,7 +667,6 @@ class PointCloudSurface(ClosestPoint):
             + ": leave such samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid",
         )
         self.report["rim_nodes"] = int(np.count_nonzero(feet == 1))
-        self._rim_linear = linear[feet == 1]
         # feet whose fixed point wandered off the samples, from the query and from its nearest
         # sample: projected onto that sample's own fit instead (Foot::NearestFit)
         self.report["nearest_fit_nodes"] = nearest = int(np.count_nonzero(feet == 3))
