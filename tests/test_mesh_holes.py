@@ -85,6 +85,8 @@ def test_a_sphere_with_small_holes_runs_second_order_against_exact_geodesics():
         [tuple(v[source]), tuple(v[np.argmin(v[:, 0])])], at=v[:10], return_stats=True
     )
     assert batch["bridged_holes"] == holes
+    _, info = ts.distance_matrix(surf, grid, v[[source, 0, 100]], info=True)
+    assert info["bridged_holes"] == holes
     # a band narrower than the holes (2·outer·h below 0.0766) leaves them open
     assert _mesh_holes.bridged(surf, 0.0097, 4.0) is not None
     assert _mesh_holes.bridged(surf, 0.0095, 4.0) is None

@@ -102,7 +102,8 @@ def distance_matrix(
         ``diagonal`` (the largest one-way ``u_i(x_i)``, set to 0), ``points`` (the snapped
         points), ``seconds``, ``order`` and ``order_fallback`` (the order run, and why second order
         did not apply), ``unconverged`` (how many of the solves stopped at ``max_iterations``:
-        their rows are the last iterate, and a warning says so).
+        their rows are the last iterate, and a warning says so), ``bridged_holes`` (an open
+        mesh's holes the band spans, as ``sol.stats.bridged_holes``).
 
     Returns
     -------
@@ -177,6 +178,7 @@ def distance_matrix(
             "order": stats.get("order", 1),
             "order_fallback": stats.get("order_fallback"),
             "unconverged": int(np.count_nonzero(~np.asarray(stats["converged"], dtype=bool))),
+            "bridged_holes": stats.get("bridged_holes"),
         }
     return matrix
 
