@@ -64,13 +64,12 @@ class Holes:
     """The holes of a mesh: per hole its width (the convex hull's smallest width in the loop's
     plane), its detour (half the hull's perimeter less its width: how much longer a path round
     a convex hole is than one across it, at most; 0.57 widths for a round hole, about the length
-    of a slot), its centre and its number of boundary vertices; and per boundary vertex its hole
-    (-1 where it lies on none), for :func:`across_holes`."""
+    of a slot) and its centre; and per boundary vertex and boundary edge its hole (-1 where it
+    lies on none), for :func:`across_holes`."""
 
     width: np.ndarray
     detour: np.ndarray
     centre: np.ndarray
-    vertices: np.ndarray
     vertex_hole: np.ndarray
     edge_keys: np.ndarray
     edge_hole: np.ndarray
@@ -129,7 +128,7 @@ def holes(surface: Any) -> Holes:
         return cached
     v = surface.vertices
     edges = np.zeros((0, 2), np.int64) if surface.closed else boundary_edges(surface.faces)
-    widths, detours, centres, counts, members = [], [], [], [], []
+    widths, detours, centres, members = [], [], [], []
     for loop in _simple_loops(len(v), edges) if len(edges) else []:
         if _is_seam(v[loop]):
             continue
@@ -137,7 +136,6 @@ def holes(surface: Any) -> Holes:
         widths.append(width)
         detours.append(max(perimeter / 2.0 - width, 0.0))
         centres.append(centre)
-        counts.append(loop.size)
         members.append(loop)
     width_a, centre_a = np.asarray(widths, float), np.asarray(centres, float).reshape(-1, 3)
     hole = surface.closest(centre_a)[0] > HOLE_CENTRE * width_a if len(widths) else np.zeros(0, bool)
@@ -152,7 +150,6 @@ def holes(surface: Any) -> Holes:
         width_a[hole],
         np.asarray(detours, float)[hole],
         centre_a[hole],
-        np.asarray(counts, np.int64)[hole],
         vertex_hole,
         keys[order],
         np.where(edge_hole == vertex_hole[edges[order, 1]], edge_hole, -1),
