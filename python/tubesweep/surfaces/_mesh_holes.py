@@ -50,8 +50,8 @@ HOLE_CENTRE = 0.25
 #: mesh's size (its used vertices' bounding-box diagonal, about its largest geodesic distance), as
 #: the first-order size warnings from 10% of the largest distance; ``sol.stats.bridged_holes``
 #: reports every one. (The bundled bunny's base has a slot 0.0085 wide whose detour, 0.023, is
-#: 9.2% of its size; the errors next to it at n = 60–200 are no larger than elsewhere, 1.5–4.6
-#: spacings.)
+#: 9.2% of its size; the largest errors next to its holes at n = 60–200, 1.5–4.6 spacings, are
+#: those elsewhere, 1.7–4.5: ``benches/experiments/mesh_holes.py --bunny``.)
 WARN_SHARE = 0.1
 
 #: Directions over a half turn at which a loop's width is measured (its hull's width is the
