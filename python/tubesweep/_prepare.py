@@ -571,10 +571,13 @@ def _prepare_tube(
         del signed_phi
         if not cuts:
             warn_facing_pairs(grid, linear, roles, facing, inner, note)
-    over_holes = getattr(surf, "_pairs_over_holes", None)  # a mesh: pairs over a hole are no gap (cut nowhere)
+    # a mesh or a point cloud: pairs over a hole are no gap (cut nowhere, not warned)
+    over_holes = getattr(surf, "_pairs_over_holes", None)
+    hole_pairs = None
     if over_holes is not None and facing[0].size:
-        keep = ~over_holes(grid, linear[facing[0]], linear[facing[1]])
-        facing = (facing[0][keep], facing[1][keep], facing[2][keep])
+        on_hole = over_holes(grid, linear[facing[0]], linear[facing[1]], facing[2])
+        hole_pairs = (linear[facing[0][on_hole]], linear[facing[1][on_hole]], facing[2][on_hole])
+        facing = (facing[0][~on_hole], facing[1][~on_hole], facing[2][~on_hole])
     cut_edges = 0
     pieces = None
     cut_facing = facing
@@ -601,8 +604,8 @@ def _prepare_tube(
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)
-    holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh: holes the band spans
-    bridged_holes = holes_of(h, outer_eff) if holes_of is not None else None
+    holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh's or a cloud's holes the band spans
+    bridged_holes = holes_of(h, outer_eff, grid, hole_pairs) if holes_of is not None else None
     # (after the facing test, which reads the paper's inner tube). The paper's tube's creases are
     # not reported on a re-distanced φ, whose kinks include those of its samples (a voxel mask's
     # staircase: a sphere's mask said "creases … turning by up to 84°"), but its crease nodes are

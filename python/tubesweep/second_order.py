@@ -38,6 +38,7 @@ from ._validate import (
     speed_values,
 )
 from .stats import SolveStats
+from .surface import LevelSet
 
 __all__ = ["ORDERS", "Order2NotApplicable", "check_order", "FIX_RADIUS", "FACTORED_RADIUS", "default_tol"]
 
@@ -206,7 +207,6 @@ def check_supported(
 ) -> None:
     """Refuses, with the reason and the fix, what ``order=2`` does not do."""
     from .closest_point import ClosestPoint
-    from .surface import LevelSet
 
     if general is not None or scheme != "godunov":
         raise OptionOfOrder1(
@@ -451,26 +451,37 @@ def warn_about(
     fallback = fallback_message(st["fallback_iteration"], st["fallback_change"], tol, values, default_tol=default)
     if fallback is not None:
         warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
-    warn_first_order_nodes(st)
+    warn_first_order_nodes(st, tube.surface)
     warn_creases(
         st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_spacings(tube, thinned_count(tube) > 0)
     )
 
 
-def warn_first_order_nodes(st: Dict[str, Any], where: str = "sol.first_order_points() shows where") -> None:
+def warn_first_order_nodes(
+    st: Dict[str, Any], surface: Any, where: str = "sol.first_order_points() shows where"
+) -> None:
     """The warning that more than :data:`FIRST_ORDER_WARNING` of the inner tube ran the
     first-order update (the native report's ``first_order_nodes``, ``inner_nodes`` and
-    ``first_order_reasons``: the tube's geometry, the same for every source of a batch)."""
+    ``first_order_reasons``: the tube's geometry, the same for every source of a batch), with
+    the cure for ``surface``'s kind."""
     first_order = int(st["first_order_nodes"])
     if first_order > FIRST_ORDER_WARNING * st["inner_nodes"]:
         r = st["first_order_reasons"]
         # (φ not a distance at most of them: a finer grid does not cure that, re-distancing does; a
-        # tanh-flattened φ at N = 61 with 44% such nodes was told to refine the grid)
-        cure = (
-            "Most of them because φ is not a distance there: LevelSet(phi, redistance=True) cures it"
-            if 2 * int(r["gradient"]) > first_order
-            else "A finer grid resolves more of it"
-        )
+        # tanh-flattened φ at N = 61 with 44% such nodes was told to refine the grid. A cloud's or a
+        # mesh's distance is a distance: there its gradient breaks where the closest points jump
+        # between two parts facing each other, and re-distancing a LevelSet was advised for a cloud
+        # of two plates 0.1 apart, benches/experiments/cloud_holes.py)
+        if 2 * int(r["gradient"]) <= first_order:
+            cure = "A finer grid resolves more of it"
+        elif isinstance(surface, LevelSet):
+            cure = "Most of them because φ is not a distance there: LevelSet(phi, redistance=True) cures it"
+        else:
+            cure = (
+                "Most of them because the distance to the surface is not smooth there: the closest points jump "
+                "between parts of the surface that face each other across a gap narrower than the tube "
+                "(sol.narrow_gaps() shows where), which a finer grid resolves where the gap is real"
+            )
         warnings.warn(
             f"order=2: {first_order} of the {st['inner_nodes']} inner-tube nodes "
             f"({100 * first_order / st['inner_nodes']:.0f}%) ran the first-order update, where the grid does not "

@@ -132,10 +132,12 @@ class SolveStats:
         which the band spans: distances reached across such a hole are those of the surface with
         the hole filled, shorter than the mesh's geodesics round it by up to the hole's detour
         (for a convex hole half its perimeter less its width: 0.57 widths for a round one, about
-        the length of a slot). ``count``, ``widest`` (the widest one's width), ``reach`` (the
-        band's span, ``2·outer·Δx``), ``detour`` (the largest detour), ``where`` and ``width``
-        (that hole's centre and width), ``size`` (the mesh's bounding-box diagonal); with a
-        ``RuntimeWarning`` when the detour is over 10% of the size. None otherwise.
+        the length of a slot). On a point cloud, the small holes over which the band's nodes
+        meet (read from the rim round them). ``count``, ``widest`` (the widest one's width),
+        ``reach`` (the band's span, ``2·outer·Δx``), ``detour`` (the largest detour), ``where``
+        and ``width`` (that hole's centre and width), ``size`` (the surface's bounding-box
+        diagonal); with a ``RuntimeWarning`` when the detour is over 10% of the size. None
+        otherwise.
 
     Examples
     --------

@@ -183,9 +183,10 @@ def bridged(surface: Any, h: float, outer: float) -> Optional[dict]:
     }
 
 
-def bridged_holes(surface: Any, h: float, outer: float) -> Optional[dict]:
+def bridged_holes(surface: Any, h: float, outer: float, *_: Any) -> Optional[dict]:
     """:func:`bridged`, warned (:func:`warn_bridged_holes`): ``MeshSurface._bridged_holes``, read
-    by the tube's preparation."""
+    by the tube's preparation (which also passes the grid and the pairs over holes, for a point
+    cloud's: ``_cloud_holes.bridged_holes``)."""
     info = bridged(surface, h, outer)
     warn_bridged_holes(info, h, outer)
     return info
@@ -227,7 +228,7 @@ def across_holes(surface: Any, first: np.ndarray, second: np.ndarray) -> np.ndar
     return (a >= 0) & (a == b)
 
 
-def pairs_over_holes(surface: Any, grid: Any, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+def pairs_over_holes(surface: Any, grid: Any, first: np.ndarray, second: np.ndarray, *_: Any) -> np.ndarray:
     """:func:`across_holes` for node pairs given by their linear indices on ``grid``:
     ``MeshSurface._pairs_over_holes``, read by the tube's preparation (``_prepare``), which leaves
     such pairs out of the facing pairs (no warning, no cut, not in ``sol.stats.facing_pairs``)."""

@@ -39,6 +39,7 @@ from ..grid import MAX_COORDINATE, Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
 from ._cloud_analysis import analyse, analyse_own, widen
+from ._cloud_holes import bridged_holes, pairs_over_holes
 from ._cloud_files import read_points
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
@@ -186,6 +187,8 @@ class PointCloudSurface(ClosestPoint):
     #: its distances (``benches/experiments/cloud_gaps.py``).
     cuts_shortcuts = True
     cuts_medial_edges = False
+    _pairs_over_holes = pairs_over_holes  # facing pairs over a small hole: no gap (_prepare)
+    _bridged_holes = bridged_holes  # the holes over which they lie, warned (stats.bridged_holes)
     #: A gap this many grid spacings wide is resolved where the samples are dense (the fits'
     #: radius FIT_RADIUS·Δx): the grid spacing the narrow-gap warning advises is the gap over it.
     resolving_spacings = RESOLVED_GAP * FIT_RADIUS
