@@ -67,7 +67,7 @@ def sphere_points(samples: int, seed: int) -> np.ndarray:
     return 0.6 * x / np.linalg.norm(x, axis=1, keepdims=True)
 
 
-@pytest.mark.parametrize("case", ["slit", "two plates", "two patches"])
+@pytest.mark.parametrize("case", ["slit", "two plates", "two patches", "plug"])
 def test_gaps_stay_gaps(case):
     rng = np.random.default_rng(3)
     half = 1.0
@@ -78,6 +78,11 @@ def test_gaps_stay_gaps(case):
         pts = rng.uniform(-0.5, 0.5, size=(40000, 3))
         pts[:20000, 2], pts[20000:, 2] = 0.05, -0.05
         pts = pts[np.hypot(pts[:, 0], pts[:, 1]) > 0.06]
+    elif case == "plug":  # a separate disc 0.02 above a plate's hole: the hole's middle is not empty
+        plate = np.random.default_rng(5).uniform(-0.6, 0.6, size=(50000, 3))
+        plate[:, 2] = 0.0
+        r = np.hypot(plate[:, 0], plate[:, 1])
+        pts = np.r_[plate[r > 0.07], plate[r < 0.03] + [0.0, 0.0, 0.02]]
     else:  # two small patches side by side: nothing goes on round the gap
         patch = rng.uniform(-0.1, 0.1, size=(4000, 3))
         patch[:, 2] = 0.0
@@ -105,3 +110,16 @@ def test_curves_are_not_judged():
     assert first.size and len(c.rim) == 2
     over = _cloud_holes.pairs_over_holes(c, g, first, first + 1, np.full(first.size, 0.1))
     assert over.shape == first.shape and not over.any()
+
+
+def test_a_group_whose_closest_points_fail_is_no_hole():
+    # two plates 0.06 apart with aligned holes, a group of pairs straddling the plates at the hole
+    rng = np.random.default_rng(3)
+    p = rng.uniform(-0.5, 0.5, size=(40000, 3))
+    p[:20000, 2], p[20000:, 2] = 0.03, -0.03
+    cloud = ts.surfaces.from_points(p[np.hypot(p[:, 0], p[:, 1]) > 0.06])
+    a = np.array([[0.0, 0.0, 0.02], [0.05, 0.0, 0.02], [0.0, 0.05, -0.02]])
+    nodes = (a, a * [1, 1, -1])
+    assert _cloud_holes._judge(cloud, np.zeros(3), 0.06, 0.05, nodes) is None  # closest points along the normal
+    cloud._closest = lambda x: np.full((len(x), 3), np.nan)  # a fit that fails: not judged a hole either
+    assert _cloud_holes._judge(cloud, np.zeros(3), 0.06, 0.05, nodes) is None

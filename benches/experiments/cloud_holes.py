@@ -11,7 +11,7 @@ the sphere, a notch in a plate's outline, a cylinder slit along its length (a C)
 plates 0.1 apart with aligned holes, two small patches side by side; and a plate with one small
 hole (reported, not warned)::
 
-    .venv/bin/python benches/experiments/cloud_holes.py               # about a minute
+    .venv/bin/python benches/experiments/cloud_holes.py               # about 20 s
     .venv/bin/python benches/experiments/cloud_holes.py --n 61 --radius 0.1
 """
 

@@ -472,21 +472,28 @@ def warn_first_order_nodes(
         # mesh's distance is a distance: there its gradient breaks where the closest points jump
         # between two parts facing each other, and re-distancing a LevelSet was advised for a cloud
         # of two plates 0.1 apart, benches/experiments/cloud_holes.py)
+        given_phi = isinstance(surface, LevelSet) and not getattr(surface, "redistance", False)
+        what, label = (
+            ("φ is not a distance", "φ not a distance")
+            if given_phi
+            else ("the distance to the surface is not smooth", "distance not smooth")
+        )
         if 2 * int(r["gradient"]) <= first_order:
             cure = "A finer grid resolves more of it"
-        elif isinstance(surface, LevelSet):
+        elif given_phi:
             cure = "Most of them because φ is not a distance there: LevelSet(phi, redistance=True) cures it"
         else:
             cure = (
-                "Most of them because the distance to the surface is not smooth there: the closest points jump "
-                "between parts of the surface that face each other across a gap narrower than the tube "
-                "(sol.narrow_gaps() shows where), which a finer grid resolves where the gap is real"
+                "Most of them because the distance to the surface is not smooth there: it has a ridge where parts "
+                "of the surface face each other across a gap narrower than the tube (sol.narrow_gaps() shows "
+                "where), which a finer grid resolves where the gap is real"
             )
         warnings.warn(
             f"order=2: {first_order} of the {st['inner_nodes']} inner-tube nodes "
             f"({100 * first_order / st['inner_nodes']:.0f}%) ran the first-order update, where the grid does not "
-            f"resolve the surface or φ is not a distance ({r['curvature']} unresolved curvature: creases, corners, "
-            f"rims, noise; {r['gradient']} φ not a distance; {r['stencil']} stencils cut by the box or the band). "
+            f"resolve the surface or {what} ({r['curvature']} unresolved curvature: creases, corners, "
+            f"rims, noise; {r['gradient']} {label}; "
+            f"{r['stencil']} stencils cut by the box or the band). "
             f"Errors near them and beyond them are first order; {where}. {cure}",
             RuntimeWarning,
             stacklevel=user_stacklevel(),

@@ -19,7 +19,10 @@ a small hole when
 
 * rim samples lie within ``r = W + 2Δx`` of it (``W`` the group's widest gap): it is at a rim,
 * none lies between ``r`` and ``2r``: the rim closes round it there (a notch in an outline, a
-  slit, a C-shaped part and two sheets' edges facing each other have rims that go on),
+  slit, a C-shaped part and two sheets' edges facing each other have rims that go on; so do
+  holes closer than that to another hole or to the outline, which stay gaps),
+* no sample lies near the middle of those rim samples (:data:`EMPTY`): a separate part lying in
+  the hole (a plug) is no hole,
 * samples lie between ``r`` and ``2r`` in each of :data:`SECTORS` sectors round it in their
   best-fitting plane, and within :data:`FLAT` ``·r`` of a quadric over that plane: one sheet
   goes on all round it (two small parts side by side have nothing round them; two sheets facing
@@ -50,6 +53,9 @@ FLAT = 0.25
 #: ... and the pairs' closest points lie across the hole: their difference makes an angle with
 #: the surface's normal whose cosine is below this (two sheets facing each other: about 1).
 TANGENT = 0.5
+#: ... and no sample lies nearer the middle of its rim samples than this share of their median
+#: distance from it.
+EMPTY = 0.3
 #: At most this many groups are judged (the rest stay gaps): each reads every sample once.
 MAX_GROUPS = 200
 
@@ -80,6 +86,11 @@ def _judge(
         return None
     pts = cloud.points
     d = np.linalg.norm(pts - centre, axis=1)
+    # the hole is empty: no sample near the middle of its rim (a separate part lying over it, a
+    # plug or a coin over a plate's hole, has its own rim there and its samples in the middle)
+    middle = on.mean(axis=0)
+    if np.min(np.linalg.norm(pts[d <= r] - middle, axis=1)) < EMPTY * np.median(np.linalg.norm(on - middle, axis=1)):
+        return None
     ring = pts[(d > r) & (d <= 2.0 * r)]
     if len(ring) < 3 * SECTORS:
         return None
@@ -96,11 +107,13 @@ def _judge(
     # the pairs' closest points lie across the hole, in the surface (two sheets': along its normal)
     normal = vt[2] - (coef[1] * vt[0] + coef[2] * vt[1]) / r
     across = cloud._closest(nodes[1]) - cloud._closest(nodes[0])
+    if not np.all(np.isfinite(across)):
+        return None
     length = np.linalg.norm(across, axis=1)
     wide = length > 0.25 * width
     # (feet found again may fall together where the band's, found from a neighbour's, did not: the
     # sphere's hole at N = 61 above, 0.013 apart for a gap of 0.096; such pairs are not judged)
-    if np.any(wide) and np.median(np.abs(across[wide] @ normal) / length[wide]) > TANGENT * np.linalg.norm(normal):
+    if np.any(np.abs(across[wide] @ normal) > TANGENT * length[wide] * np.linalg.norm(normal)):
         return None
     sector = ((np.arctan2(flat[:, 1], flat[:, 0]) + np.pi) / (2 * np.pi) * SECTORS).astype(np.int64) % SECTORS
     if np.unique(sector).size < SECTORS:
@@ -131,8 +144,10 @@ def pairs_over_holes(cloud: Any, grid: Any, first: np.ndarray, second: np.ndarra
     """Which facing pairs (linear indices ``first``, ``second`` on ``grid``, their gaps ``gap``)
     lie over a small hole of the cloud: ``PointCloudSurface._pairs_over_holes``, read by the
     tube's preparation (``_prepare``), which leaves them out of the facing pairs (no warning, no
-    cut, not in ``sol.stats.facing_pairs``)."""
-    return _holes(cloud, grid, first, second, gap)[0]
+    cut, not in ``sol.stats.facing_pairs``). The holes found are kept for :func:`bridged_holes`."""
+    over, found = _holes(cloud, grid, first, second, gap)
+    cloud.__dict__["_last_holes"] = (grid, first[over], second[over], found)
+    return over
 
 
 def bridged_holes(
@@ -145,7 +160,11 @@ def bridged_holes(
     mesh's, only the holes over which the band's facing test found pairs are listed."""
     if pairs is None or grid is None or len(pairs[0]) == 0:
         return None
-    _, found = _holes(cloud, grid, *pairs)
+    last = cloud.__dict__.get("_last_holes")
+    if last is not None and last[0] == grid and np.array_equal(last[1], pairs[0]) and np.array_equal(last[2], pairs[1]):
+        found = last[3]  # (the judgement of the pairs just made: the same groups)
+    else:
+        _, found = _holes(cloud, grid, *pairs)
     if not found:
         return None
     width, detour, centre = (np.asarray([f[i] for f in found]) for i in range(3))
