@@ -158,9 +158,10 @@ def median_size(surface: Any) -> float:
 
 def sharp_edges(surface: Any) -> Tuple[float, float]:
     """The share of the mesh's edge length (edges between two triangles) whose triangles' normals
-    turn by more than :data:`SHARP_TURN`, and the largest turn in degrees (computed once). On a
-    mesh that is not consistently oriented the flipped neighbours turn by about 180°: it counts
-    as having creases."""
+    turn by more than :data:`SHARP_TURN`, and the largest turn in degrees (computed once). The
+    turn across an edge whose two triangles are not oriented alike is that of their unoriented
+    planes (2% of an icosphere's triangles flipped read as creases of 177° and sent N = 61 to
+    first order, 0.017% → 0.91% mean error, a helper's sweep)."""
     known = getattr(surface, "_sharp_edges", None)
     if known is not None:
         return known
@@ -171,12 +172,13 @@ def sharp_edges(surface: Any) -> Tuple[float, float]:
     # vertices at the same position are one (an STL's triangles each have their own)
     _, same = np.unique(v, axis=0, return_inverse=True)
     g = same.reshape(-1)[f]
-    edges = np.concatenate([np.sort(g[:, [i, j]], axis=1) for i, j in ((0, 1), (1, 2), (2, 0))])
+    directed = np.concatenate([g[:, [i, j]] for i, j in ((0, 1), (1, 2), (2, 0))])
+    edges = np.sort(directed, axis=1)
     ends = np.concatenate([f[:, [i, j]] for i, j in ((0, 1), (1, 2), (2, 0))])
     face = np.tile(np.arange(len(f)), 3)
     all_length = row_norms(v[ends[:, 0]] - v[ends[:, 1]])
     order = np.lexsort((edges[:, 1], edges[:, 0]))
-    edges, face, ends = edges[order], face[order], ends[order]
+    edges, face, ends, directed = edges[order], face[order], ends[order], directed[order]
     pair = np.all(edges[1:] == edges[:-1], axis=1)
     length = row_norms(v[ends[:-1][pair, 0]] - v[ends[:-1][pair, 1]])
     if 4.0 * length.sum() < all_length.sum():
@@ -185,7 +187,10 @@ def sharp_edges(surface: Any) -> Tuple[float, float]:
         surface._sharp_edges = (1.0, float("nan"))
         return surface._sharp_edges
     a, b = face[:-1][pair], face[1:][pair]
-    turn = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", n[a], n[b]), -1.0, 1.0)))
+    # two triangles oriented alike run their shared edge in opposite directions; where they run it
+    # the same way one of them is flipped, and its normal is turned back for the comparison
+    alike = np.where(directed[:-1][pair, 0] == directed[1:][pair, 1], 1.0, -1.0)
+    turn = np.degrees(np.arccos(np.clip(alike * np.einsum("ij,ij->i", n[a], n[b]), -1.0, 1.0)))
     sharp = turn > SHARP_TURN
     surface._sharp_edges = (float(length[sharp].sum() / length.sum()), float(turn.max()))
     return surface._sharp_edges
