@@ -123,3 +123,27 @@ def test_a_group_whose_closest_points_fail_is_no_hole():
     assert _cloud_holes._judge(cloud, np.zeros(3), 0.06, 0.05, nodes) is None  # closest points along the normal
     cloud._closest = lambda x: np.full((len(x), 3), np.nan)  # a fit that fails: not judged a hole either
     assert _cloud_holes._judge(cloud, np.zeros(3), 0.06, 0.05, nodes) is None
+
+
+def c_curve(gap: float, samples: int = 4000) -> np.ndarray:
+    """Samples of the circle of radius 0.5 less an arc whose ends lie ``gap`` apart at (0.5, 0)."""
+    a = np.arcsin(gap)  # half the missing angle: the ends lie 2·0.5·sin(a) apart
+    t = np.linspace(a, 2 * np.pi - a, samples)
+    return 0.5 * np.c_[np.cos(t), np.sin(t)]
+
+
+def test_a_curves_narrow_gap_is_seen_and_warned():
+    # 4,000 samples 0.00079 apart with a gap of 0.01 (13 spacings): the fits' neighbourhoods
+    # (20 samples) reached across it, the curve was taken for closed and solved so (its far end 99%
+    # short), and at N = 121 (the gap one spacing wide) no node pair across it was found either
+    pts = c_curve(0.01)
+    cloud = ts.surfaces.from_points(pts)
+    assert sorted(cloud.rim.tolist()) == [0, len(pts) - 1]
+    with pytest.warns(RuntimeWarning, match=r"two ends of the curve lie 0\.01 apart near \(0\.49997"):
+        sol = ts.solve(cloud, cloud.grid(121), [pts[0]])
+    assert sol.stats.facing_pairs == 0  # (the warning above is the only one)
+    # a gap the tubes do not span: no warning, and the far end's distance is the way round
+    wide = c_curve(0.1)
+    sol = ts.solve(ts.surfaces.from_points(wide), ts.Grid((-1, -1), (1, 1), (161, 161)), [wide[0]])
+    way_round = 0.5 * (2 * np.pi - 2 * np.arcsin(0.1))
+    assert abs(float(sol(wide[-1:])[0]) - way_round) < 1e-3

@@ -38,8 +38,8 @@ from .._validate import real_array
 from ..grid import MAX_COORDINATE, Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
-from ._cloud_analysis import analyse, analyse_own, widen
-from ._cloud_holes import bridged_holes, pairs_over_holes
+from ._cloud_analysis import analyse, analyse_own, lines_advice, widen
+from ._cloud_holes import bridged_holes, pairs_over_holes, warn_close_ends
 from ._cloud_files import read_points
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
@@ -189,6 +189,7 @@ class PointCloudSurface(ClosestPoint):
     cuts_medial_edges = False
     _pairs_over_holes = pairs_over_holes  # facing pairs over a small hole: no gap (_prepare)
     _bridged_holes = bridged_holes  # the holes over which they lie, warned (stats.bridged_holes)
+    _warn_thin_parts = warn_close_ends  # a curve's ends closer than its tubes, warned
     #: A gap this many grid spacings wide is resolved where the samples are dense (the fits'
     #: radius FIT_RADIUS·Δx): the grid spacing the narrow-gap warning advises is the gap over it.
     resolving_spacings = RESOLVED_GAP * FIT_RADIUS
@@ -251,6 +252,12 @@ class PointCloudSurface(ClosestPoint):
             "too close to their neighbours for the outlier test): leave them out (cloud.crease_samples lists them)"
         )
 
+    def _sampling_advice(self) -> str:
+        """The samples in lines (``_cloud_analysis.lines_advice``) and the sharp edges
+        (:meth:`_crease_advice`), the causes of folded closest points that the cloud shows."""
+        lines, crease = getattr(self, "_lines", ""), self._crease_advice()
+        return f"{lines}. Or: {crease}" if lines and crease else lines or crease
+
     #: Why the band of a cloud's closest points may not close, for the band's error (``_prepare``).
     @property
     def band_advice(self) -> str:
@@ -269,7 +276,7 @@ class PointCloudSurface(ClosestPoint):
                 f"{self._sparsest_fit:.3g}, {uneven:.0f} times the median fit "
                 "(sample those parts more densely, or pass a smaller neighbours=)"
             )
-        crease = self._crease_advice()
+        crease = self._sampling_advice()
         if self.smoothing > 0:  # the last band's fits were widened for the noise
             advice = (
                 f"The samples lie off their neighbours' fits by about {self.noise:.3g} (noise, or samples too sparse for "
@@ -420,6 +427,9 @@ class PointCloudSurface(ClosestPoint):
         self._tree = cloud
         self.rim = np.flatnonzero(cloud.rim)
         self.open_surface = rim_count > 0
+        self._lines = lines_advice(rim_count, len(p), self.neighbours) if d == 3 else ""
+        if self._lines:
+            warnings.warn(self._lines, RuntimeWarning, stacklevel=user_stacklevel())
         self.spacing = float(np.median(a.spacing))
         # the fits' radii: the median and the widest (the band's error names uneven sampling)
         self._median_fit = float(np.nanmedian(a.radius))
@@ -652,7 +662,7 @@ class PointCloudSurface(ClosestPoint):
             self._band_cache = None
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
         linear, norm, x, cp, feet = (np.concatenate([q[i] for q in parts]) for i in range(5))
-        crease = self._crease_advice()
+        crease = self._sampling_advice()
         _refuse_undefined_next_to(
             grid,
             np.concatenate(undefined),

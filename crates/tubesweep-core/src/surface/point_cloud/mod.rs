@@ -54,6 +54,14 @@ const BLENDED_HOLE: f64 = 0.6;
 /// near its end: 0.9 and more; a noisy sheet's samples, noise 0.75 of their spacing, reach it
 /// now and then).
 const ANOTHER_SHEET: f64 = 0.85;
+/// On a curve (2D), a neighbour, or a sample found across a gap, fills a gap only when it lies
+/// within this many spacings (the distance to the nearest other sample) of the gap's sample, its
+/// own or the gap's sample's, the larger: where the sampling
+/// only thins, the next sample is about one sparse spacing away; across a gap in an evenly
+/// sampled curve it is many of its spacings away (a C-shaped curve of 2,000 samples of a circle of
+/// radius 0.5, spacing 0.0016, k = 20: gaps up to 0.065, 40 spacings, were filled, and the
+/// distance from one end to the other came out as the gap instead of the way round, unwarned).
+const THIN_SPACINGS: f64 = 4.0;
 /// ... or farther than this many times the fit's misfit (its samples' noise): on a noisy sphere
 /// (noise 0.75 of the spacing) the samples beyond the fit's own stay within it.
 const NOISE_MARGIN: f64 = 4.0;
@@ -270,8 +278,9 @@ impl<const D: usize> PointCloud<D> {
                             .enumerate()
                             .filter_map(|(j, o)| {
                                 let (a, w) = fit.local(o);
-                                (j < own.len() || on_graph(&fit, &a, w, (ANOTHER_SHEET * distance(o, p)).max(noise)))
-                                    .then_some(a)
+                                ((j < own.len() || on_graph(&fit, &a, w, (ANOTHER_SHEET * distance(o, p)).max(noise)))
+                                    && (D != 2 || distance(o, p) <= THIN_SPACINGS * spacing.max(self.spacing_of(o))))
+                                .then_some(a)
                             })
                             .collect();
                         (
@@ -302,8 +311,8 @@ impl<const D: usize> PointCloud<D> {
     /// 2·[`PointCloud::reach`], the sparsest fit's radius: a gap no wider than that is spanned by
     /// the fits anyway), and the
     /// first sample within s/2 of a probe and near the fit (its offset from the fitted graph or
-    /// from the tangent plane, the smaller, under half its distance: [`on_graph`]) joins the
-    /// neighbours. Where the sampling only thins (a scan denser
+    /// from the tangent plane, the smaller, under half its distance: [`on_graph`]; on a curve,
+    /// also within [`THIN_SPACINGS`] spacings of `p`) joins the neighbours. Where the sampling only thins (a scan denser
     /// on one side) the gap closes; beyond a true rim the nearest sample to every probe is the rim
     /// itself, about s away, and the gap stays.
     fn bridged_gap(&self, p: &[f64; D], fit: &Fit<D>, ap: &[f64; 2], mut around: Vec<[f64; 2]>, bridge: f64) -> f64 {
@@ -328,7 +337,10 @@ impl<const D: usize> PointCloud<D> {
                 // continuation follows the graph's curvature, another sheet curving beside it (the
                 // next turn of a spiral past its end) does not
                 let (aq, wq) = fit.local(q);
-                if distance(q, &probe) <= 0.5 * s && on_graph(fit, &aq, wq, 0.5 * distance(q, p)) {
+                if distance(q, &probe) <= 0.5 * s
+                    && on_graph(fit, &aq, wq, 0.5 * distance(q, p))
+                    && (D != 2 || distance(q, p) <= THIN_SPACINGS * self.spacing_of(p).max(self.spacing_of(q)))
+                {
                     found = Some(*q);
                 }
                 s *= 2.0;
@@ -339,6 +351,16 @@ impl<const D: usize> PointCloud<D> {
             closed += 1;
         }
         gap
+    }
+
+    /// The distance from sample `q` to its nearest other sample.
+    fn spacing_of(&self, q: &[f64; D]) -> f64 {
+        self.tree
+            .nearest_n::<SquaredEuclidean>(q, NonZero::new(2).unwrap())
+            .iter()
+            .map(|n| distance(&self.points[n.item as usize], q))
+            .find(|&d| d > 0.0)
+            .unwrap_or(f64::INFINITY)
     }
 
     /// Marks the rim: samples whose gap exceeds [`RIM_GAP`] and (in 3D) with at least

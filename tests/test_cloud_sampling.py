@@ -1,0 +1,47 @@
+"""How a point cloud's samples are laid out: samples in lines (a scanner's) farther apart than
+along them are named (surfaces/_cloud_analysis.lines_advice), with the cure that works."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tubesweep as ts
+
+
+def latitude_rings(rings: int = 30, per_unit: float = 2000.0) -> np.ndarray:
+    """Samples of the sphere of radius 0.5 on ``rings`` circles of latitude (about the y axis),
+    ``per_unit`` samples per unit of a ring's radius: 0.0031 apart along them, 0.052 across."""
+    out = []
+    for th in np.linspace(0, np.pi, rings + 1)[1:-1]:
+        r = 0.5 * np.sin(th)
+        t = np.linspace(0, 2 * np.pi, max(int(per_unit * r), 8), endpoint=False)
+        out.append(np.c_[r * np.cos(t), np.full_like(t, 0.5 * np.cos(th)), r * np.sin(t)])
+    return np.concatenate(out)
+
+
+def test_samples_in_lines_are_named_and_more_neighbours_cure_them():
+    pts = latitude_rings()
+    # each fit's 20 nearest samples lie on one ring: more than half the samples looked like a rim
+    # (a closed sphere taken for an open surface), with no word
+    with pytest.warns(RuntimeWarning, match=r"of the 19071 samples \(5\d%\) see their neighbours on one side only"):
+        cloud = ts.surfaces.from_points(pts)
+    assert cloud.report["rim_samples"] > 0.25 * len(pts)
+    # the cure named: fits over 100 samples span several rings
+    wide = ts.surfaces.from_points(pts, neighbours=100)
+    assert wide.report["rim_samples"] == 0
+    sol = ts.solve(wide, wide.grid(41), [np.array([0.0, 0.0, 0.5])])
+    q = np.random.default_rng(0).normal(size=(2000, 3))
+    q = 0.5 * q / np.linalg.norm(q, axis=1, keepdims=True)
+    exact = 0.5 * np.arccos(np.clip(q @ [0.0, 0.0, 0.5] / 0.25, -1.0, 1.0))
+    assert np.mean(np.abs(sol(q) - exact)) < 5e-4  # 2.8e-4
+
+
+def test_an_open_cloud_is_not_taken_for_lines():
+    # a hemisphere's rim is some 2 % of its samples, a strip 20 times longer than wide some 5 %
+    x = np.random.default_rng(0).normal(size=(20000, 3))
+    x = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
+    strip = np.random.default_rng(1).uniform(0, 1, size=(20000, 3)) * [1.0, 0.05, 0.0]
+    for pts in (x[x[:, 2] > 0], strip):
+        cloud = ts.surfaces.from_points(pts)  # (the test log fails on any warning)
+        assert 0 < cloud.report["rim_samples"] < 0.1 * len(pts)
