@@ -45,3 +45,8 @@ def test_an_open_cloud_is_not_taken_for_lines():
     for pts in (x[x[:, 2] > 0], strip):
         cloud = ts.surfaces.from_points(pts)  # (the test log fails on any warning)
         assert 0 < cloud.report["rim_samples"] < 0.1 * len(pts)
+    # a small patch's rim is a large share of it (here 27%), and no sign of lines
+    rng = np.random.default_rng(0)
+    r, a = np.sqrt(rng.random(100)) * 0.1, rng.uniform(0, 2 * np.pi, 100)
+    patch = ts.surfaces.from_points(np.c_[r * np.cos(a), r * np.sin(a), 0.2 * r**2])
+    assert patch.report["rim_samples"] > 0.25 * 100

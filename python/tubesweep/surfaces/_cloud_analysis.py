@@ -212,13 +212,16 @@ def _noise(residual: np.ndarray, radius: np.ndarray) -> float:
 #: their angular gaps say rim (latitude rings of a sphere 0.026 apart with samples 0.002 along
 #: them: 51% of 57,249 samples; a hemisphere shows 1.9%, a strip 20 times longer than wide 5.5%).
 LINES_RIM_SHARE = 0.25
+#: ... and at least this many samples: a small patch's rim is a large share of it (27–42% of
+#: discs of 60–150 samples; a patch's rim share falls as one over the square root of its size).
+LINES_MIN_SAMPLES = 2000
 
 
 def lines_advice(rim: int, samples: int, neighbours: int) -> str:
     """What a rim of ``rim`` of ``samples`` samples over ``neighbours`` neighbours says when it is
     over :data:`LINES_RIM_SHARE`, or "" (for the warning of ``PointCloudSurface`` and its band's
     error)."""
-    if samples == 0 or rim <= LINES_RIM_SHARE * samples:
+    if samples < LINES_MIN_SAMPLES or rim <= LINES_RIM_SHARE * samples:
         return ""
     return (
         f"{rim} of the {samples} samples ({rim / samples:.0%}) see their neighbours on one side only, as on a rim: the "

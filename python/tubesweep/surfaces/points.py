@@ -400,7 +400,9 @@ class PointCloudSurface(ClosestPoint):
                     f"(farther than {OUTLIER_RATIO} of the fit's radius{apart}; the first at {where})"
                     + (
                         f": more than {MAX_OUTLIER_SHARE:.0%}, so the cloud is not the samples of one smooth surface "
-                        "(too noisy, or too sparse for its curvature)"
+                        "(too noisy, or too sparse for its curvature), or its samples come in lines (a scanner's) much "
+                        "farther apart than along them, so that each fit's nearest samples lie on one line: then pass "
+                        "a larger neighbours= (fits spanning several lines)"
                         if share > MAX_OUTLIER_SHARE
                         else "; pass outliers='remove' to leave them out"
                     )
