@@ -129,7 +129,8 @@ class _PreparedTube:
     #: for other surfaces
     paper_creases: Optional[Dict[str, Any]] = None
     #: the holes of an open mesh narrower than the band, which it bridges
-    #: (``surfaces._mesh_holes.bridged``), None for other surfaces and meshes without such holes
+    #: (``surfaces._mesh_holes.bridged``), or a point cloud's small holes over which its facing
+    #: pairs lie (``surfaces._cloud_holes``); None for other surfaces and where there are none
     bridged_holes: Optional[Dict[str, Any]] = None
     #: the inner tube's connected components and the checksum of its flags, once a warm start
     #: counted them (``moving.inner_components``)

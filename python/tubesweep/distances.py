@@ -103,7 +103,7 @@ def distance_matrix(
         points), ``seconds``, ``order`` and ``order_fallback`` (the order run, and why second order
         did not apply), ``unconverged`` (how many of the solves stopped at ``max_iterations``:
         their rows are the last iterate, and a warning says so), ``bridged_holes`` (an open
-        mesh's holes the band spans, as ``sol.stats.bridged_holes``).
+        mesh's or a point cloud's holes the band spans, as ``sol.stats.bridged_holes``).
 
     Returns
     -------

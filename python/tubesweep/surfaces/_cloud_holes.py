@@ -60,7 +60,7 @@ TANGENT = 0.5
 EMPTY = 0.3
 #: A curve's ends count as two when more than this many of their spacings apart (an end of a
 #: curve may show as two rim samples side by side).
-END_SPACINGS = 4.0
+DISTINCT_ENDS = 4.0
 #: Two ends of a curve closer than this many grid spacings are warned about: the cuts kept a
 #: C-shaped curve's ends apart at 4.2 and 4.8 spacings, not at 3.1 and 3.2 (its far end 0.32 for
 #: 3.1 the way round).
@@ -215,12 +215,15 @@ def warn_close_ends(cloud: Any, h: float, inner: float) -> None:
         return
     p = cloud.points
     ends = p[cloud.rim]
-    # each end's spacing: the distance to its nearest other sample
-    d_all = np.linalg.norm(p[None] - ends[:, None], axis=2)
-    d_all[np.arange(len(ends)), cloud.rim] = np.inf
-    spacing = d_all.min(axis=1)
+    # each end's spacing: the distance to its nearest other sample (one end at a time: no
+    # ends × samples array)
+    spacing = np.empty(len(ends))
+    for k, (end, at) in enumerate(zip(ends, cloud.rim)):
+        dist = np.linalg.norm(p - end, axis=1)
+        dist[at] = np.inf
+        spacing[k] = dist.min()
     d = np.linalg.norm(ends[:, None] - ends[None], axis=2)
-    apart = d > END_SPACINGS * np.maximum(spacing[:, None], spacing[None])
+    apart = d > DISTINCT_ENDS * np.maximum(spacing[:, None], spacing[None])
     reach = END_GAP * h
     close = np.triu(apart & (d < reach), 1)
     if not close.any():

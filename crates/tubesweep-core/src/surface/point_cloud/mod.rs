@@ -319,6 +319,12 @@ impl<const D: usize> PointCloud<D> {
     /// itself, about s away, and the gap stays.
     fn bridged_gap(&self, p: &[f64; D], fit: &Fit<D>, ap: &[f64; 2], mut around: Vec<[f64; 2]>, bridge: f64) -> f64 {
         let (mut gap, mut dir) = gap_and_bisector::<D>(ap, &around);
+        // (a curve's: a sample across the gap closes it only within END_SPACINGS spacings)
+        let p_spacing = if D == 2 && gap > RIM_GAP {
+            self.spacing_of(p)
+        } else {
+            0.0
+        };
         let mut closed = 0;
         while gap > RIM_GAP && closed < 4 {
             let mut t = [0.0; D];
@@ -341,7 +347,7 @@ impl<const D: usize> PointCloud<D> {
                 let (aq, wq) = fit.local(q);
                 if distance(q, &probe) <= 0.5 * s
                     && on_graph(fit, &aq, wq, 0.5 * distance(q, p))
-                    && (D != 2 || distance(q, p) <= END_SPACINGS * self.spacing_of(p).max(self.spacing_of(q)))
+                    && (D != 2 || distance(q, p) <= END_SPACINGS * p_spacing.max(self.spacing_of(q)))
                 {
                     found = Some(*q);
                 }
@@ -653,9 +659,6 @@ fn on_graph<const D: usize>(fit: &Fit<D>, a: &[f64; 2], w: f64, within: f64) -> 
     w.abs().min((w - fit.height(a).0).abs()) * fit.radius <= within
 }
 
-#[cfg(test)]
-mod tests;
-
 /// On a curve: the neighbours `around` (tangent coordinates) of a sample at `ap` without those on
 /// a side whose nearest lies farther than [`END_SPACINGS`] times their mean spacing (the
 /// consecutive distances along the tangent, the largest left out): across a gap in the curve.
@@ -684,3 +687,6 @@ fn beyond_ends(ap: &[f64; 2], around: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
         .filter(|a| (a[0] < ap[0] && below <= reach) || (a[0] > ap[0] && above <= reach) || a[0] == ap[0])
         .collect()
 }
+
+#[cfg(test)]
+mod tests;
