@@ -106,6 +106,28 @@ def gaps() -> None:
               f"{'yes' if hole_warned else 'no'} |")  # fmt: skip
 
 
+def curves() -> None:
+    """A C-shaped curve (a circle of radius 0.5 less an arc, the source at one end): whether its
+    ends are seen (rim samples), the far end's value against the way round, and the warnings."""
+    print("\nC-shaped curves, the source at one end:")
+    print("| samples | gap (sample spacings) | N | gap (grid spacings) | ends seen | far end / way round | warned |")
+    print("|---|---|---|---|---|---|---|")
+    for samples, gap, n in ((4000, 0.01, 121), (4000, 0.03, 121), (4000, 0.04, 121), (1000, 0.02, 121), (1000, 0.03, 81), (4000, 0.1, 161)):  # fmt: skip
+        a = np.arcsin(gap)
+        t = np.linspace(a, 2 * np.pi - a, samples)
+        pts = 0.5 * np.c_[np.cos(t), np.sin(t)]
+        cloud = ts.surfaces.from_points(pts)
+        grid = ts.Grid((-1.0, -1.0), (1.0, 1.0), (n, n))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sol = ts.solve(cloud, grid, [pts[0]])
+        way_round = 0.5 * (2 * np.pi - 2 * a)
+        spacing = 0.5 * (2 * np.pi - 2 * a) / (samples - 1)
+        names = sorted({"ends" if "two ends" in str(w.message) else "gap" if "faces itself" in str(w.message) else "other" for w in caught})  # fmt: skip
+        print(f"| {samples} | {gap / spacing:.0f} | {n} | {gap / grid.spacing:.1f} | {len(cloud.rim)} | "
+              f"{float(sol(pts[-1:])[0]):.4f} / {way_round:.4f} | {', '.join(names) or 'no'} |")  # fmt: skip
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, nargs="+", default=[41, 61, 81, 101])
@@ -113,6 +135,7 @@ def main() -> None:
     args = ap.parse_args()
     sphere(args.n, args.radius)
     gaps()
+    curves()
 
 
 if __name__ == "__main__":
