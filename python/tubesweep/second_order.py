@@ -112,7 +112,8 @@ RAN_AWAY_CONTRAST = 10.0
 
 
 #: Inner-tube nodes whose closest point is within this many grid spacings of a source are fixed
-#: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there).
+#: at ``u₀`` (the chord distance, O(Δx³) from the geodesic there), where fixed nodes join them to
+#: the source along the band's uncut edges (``tubesweep_core::second_order::joined``).
 FIX_RADIUS = 2.0
 
 #: Phase 1 (first order, monotone) stops at this times ``Δx² × mean slowness / ℓ`` (``ℓ`` half the
@@ -700,6 +701,7 @@ def solve_on_tube(
         order2=order2_report(st, tol, surf, h, warm_info, warm_values is not None),
         box_cut=tube.box_cut,
         bridged_holes=tube.bridged_holes,
+        slits=tube.slits,
     )
     # the source of each fixed node: the nearest foot point (a kd-tree in the core: nothing of size
     # fixed nodes × sources)

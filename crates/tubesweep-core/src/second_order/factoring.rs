@@ -4,7 +4,8 @@
 //! constant along the normals, like the exact solution, and removes the source's cone, near which
 //! the second-order differences of u itself are first order at best (and the sweeps cycle).
 //! The inner-tube nodes whose closest point lies within `fix_radius` of a source are fixed at
-//! u = u₀: the chord differs from the geodesic by κ²c³/24, O(Δx³) there.
+//! u = u₀: the chord differs from the geodesic by κ²c³/24, O(Δx³) there; those only that fixed
+//! nodes join to the source along the band's edges ([`super::joined`]: not across a slit).
 
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
@@ -12,6 +13,7 @@ use crate::sweep::NodeRole;
 
 use super::geometry::power_of_two_near;
 use super::implicit::{Implicit, LocalGeometry};
+use super::joined::{keep_joined, FixedNode};
 
 /// u₀ at every node, ∂u₀ at the nodes not in the extension layer, and the roles with the fixed
 /// nodes marked.
@@ -79,6 +81,7 @@ pub fn factor_sources_of<const D: usize>(
     let mut grad_u0 = Vec::with_capacity(roles.iter().filter(|&&r| r != NodeRole::Outer).count());
     let mut out_roles = roles.to_vec();
     let mut fixed_per_source = vec![0usize; sources.len()];
+    let mut fixed = Vec::new();
     let indices = band.indices();
     for i in 0..n {
         let mut x = [0.0; D];
@@ -101,6 +104,15 @@ pub fn factor_sources_of<const D: usize>(
             &mut fixed_per_source,
         );
         u0[i] = node.u0;
+        if let Some((source, chord, grad)) = node.fixed_by {
+            fixed.push(FixedNode {
+                node: i as u32,
+                rank: grad_u0.len() as u32,
+                source,
+                chord,
+                grad_u0: grad,
+            });
+        }
         if inner {
             grad_u0.push(node.grad_u0);
         }
@@ -108,6 +120,7 @@ pub fn factor_sources_of<const D: usize>(
             out_roles[i] = NodeRole::Fixed;
         }
     }
+    keep_joined(band, roles, &fixed, &mut out_roles, &mut grad_u0, &mut fixed_per_source);
     check_sources_fixed(&fixed_per_source, fix_radius)?;
     Ok(Factoring {
         u0,
@@ -155,6 +168,9 @@ pub(crate) struct NodeFactor<const D: usize> {
     pub(crate) grad_u0: [f32; D],
     /// Within `fix_radius` of a source (inner-tube nodes only).
     pub(crate) fixed: bool,
+    /// At a fixed node: the nearest source within `fix_radius`, the chord to it, and the ∇u₀
+    /// over the unit the node takes if [`super::joined::keep_joined`] unfixes it.
+    pub(crate) fixed_by: Option<(u32, f64, [f32; D])>,
 }
 
 /// What the factoring reads at a node besides the sources: its closest point, and at an
@@ -264,20 +280,25 @@ pub(crate) fn factor_at<const D: usize>(
         u0: value,
         grad_u0: [0.0f32; D],
         fixed: false,
+        fixed_by: None,
     };
     let Some(foot) = inner else {
         return node;
     };
     // the nodes within fix_radius of some source are fixed (the nearest's value)
-    let near = sources
-        .iter()
-        .enumerate()
-        .filter(|(_, xs)| (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt() <= fix_radius);
-    for (t, _) in near {
-        fixed_per_source[t] += 1;
-        node.fixed = true;
+    let mut nearest: Option<(u32, f64)> = None;
+    for (t, xs) in sources.iter().enumerate() {
+        let c = (0..D).map(|k| (cp[k] - xs[k]).powi(2)).sum::<f64>().sqrt();
+        if c <= fix_radius {
+            fixed_per_source[t] += 1;
+            node.fixed = true;
+            if nearest.is_none_or(|(_, best)| c < best) {
+                nearest = Some((t as u32, c));
+            }
+        }
     }
-    if !node.fixed && chord > 0.0 {
+    // (∇u₀ also at a fixed node, which keep_joined may unfix; zero there while it is fixed)
+    if chord > 0.0 {
         let nrm = &foot.normal;
         let mut e = [0.0; D];
         for k in 0..D {
@@ -292,6 +313,10 @@ pub(crate) fn factor_at<const D: usize>(
             }
             node.grad_u0[k] = (source_slowness[s] * v / unit) as f32;
         }
+    }
+    if let Some((t, c)) = nearest {
+        node.fixed_by = Some((t, c, node.grad_u0));
+        node.grad_u0 = [0.0f32; D];
     }
     node
 }
@@ -320,6 +345,7 @@ impl<const D: usize> TubeFeet<D> {
 /// One source's factoring from the band's [`TubeFeet`]: u₀, ∇u₀, the roles with the nodes near the
 /// sources fixed; the errors of [`factor_sources_of`].
 pub fn factor_sources_at<const D: usize>(
+    band: &NarrowBand<D>,
     feet: &TubeFeet<D>,
     roles: &[NodeRole],
     sources: &[[f64; D]],
@@ -336,6 +362,7 @@ pub fn factor_sources_at<const D: usize>(
     let mut grad_u0 = Vec::with_capacity(feet.inner.len());
     let mut out_roles = roles.to_vec();
     let mut fixed_per_source = vec![0usize; sources.len()];
+    let mut fixed = Vec::new();
     let mut inner = feet.inner.iter();
     for (i, cp) in feet.closest_points.iter().enumerate() {
         let foot = if roles[i] != NodeRole::Outer {
@@ -353,6 +380,15 @@ pub fn factor_sources_at<const D: usize>(
             &mut fixed_per_source,
         );
         u0.push(node.u0);
+        if let Some((source, chord, grad)) = node.fixed_by {
+            fixed.push(FixedNode {
+                node: i as u32,
+                rank: grad_u0.len() as u32,
+                source,
+                chord,
+                grad_u0: grad,
+            });
+        }
         if foot.is_some() {
             grad_u0.push(node.grad_u0);
         }
@@ -360,6 +396,7 @@ pub fn factor_sources_at<const D: usize>(
             out_roles[i] = NodeRole::Fixed;
         }
     }
+    keep_joined(band, roles, &fixed, &mut out_roles, &mut grad_u0, &mut fixed_per_source);
     check_sources_fixed(&fixed_per_source, fix_radius)?;
     Ok(Factoring {
         u0,

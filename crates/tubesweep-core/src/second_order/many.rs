@@ -165,7 +165,14 @@ fn solve_one<const D: usize>(
     src: BatchSource<'_, D>,
     stop: &AtomicBool,
 ) -> Result<(Vec<f64>, Vec<f64>, SecondOrderStats)> {
-    let factoring = factor_sources_at(tube.feet, tube.roles, src.feet, src.slowness, tube.fix_radius)?;
+    let factoring = factor_sources_at(
+        tube.band,
+        tube.feet,
+        tube.roles,
+        src.feet,
+        src.slowness,
+        tube.fix_radius,
+    )?;
     let mut values = starting_values(&factoring);
     let mut check = |_: &IterationReport| {
         if stop.load(Ordering::Relaxed) {

@@ -9,7 +9,8 @@
 //!   curvature the tube must resolve (h_out·κ < 1);
 //! * [`factoring`]: u = u₀ + w with u₀ the chord distance to the nearest point source, the nodes
 //!   within a small ball of a source fixed at u₀;
-//! * [`setup`]: both in one parallel pass over the band;
+//! * [`setup`]: both in one parallel pass over the band ([`joined`]: the fixed nodes joined to
+//!   their source);
 //! * [`creases`]: where φ's level sets have creases or corners, and the shortcut they cost;
 //! * [`many`]: many sources on one band, the geometry shared, in parallel across the sources;
 //! * [`local`]: the limited BDF2/BDF3 Godunov update (continuous ramps from first to second to third
@@ -26,6 +27,7 @@ pub mod factoring;
 pub mod fingerprint;
 pub mod geometry;
 pub mod implicit;
+mod joined;
 pub mod local;
 mod local_fit;
 pub mod many;

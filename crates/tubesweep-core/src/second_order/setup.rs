@@ -21,6 +21,7 @@ use super::geometry::{
     abs_phi_of, check_tube_inputs, node_geometry, GeometrySummary, NodeGeometry, TubeGeometry, WIDE_FIT,
 };
 use super::implicit::Implicit;
+use super::joined::{keep_joined, FixedNode};
 
 /// Nodes per chunk of the parallel pass.
 const CHUNK: usize = 4096;
@@ -30,8 +31,8 @@ struct Chunk<const D: usize> {
     nodes: Vec<NodeGeometry>,
     grad_u0: Vec<[f32; D]>,
     u0: Vec<f64>,
-    /// The chunk's nodes fixed by a source (band positions).
-    fixed: Vec<u32>,
+    /// The chunk's nodes fixed by a source (ranks within the chunk).
+    fixed: Vec<FixedNode<D>>,
     fixed_per_source: Vec<usize>,
     summary: GeometrySummary,
     /// [`TubeFeet`]'s parts for the chunk (when asked for).
@@ -183,11 +184,17 @@ fn setup<const D: usize>(
                     &mut out.fixed_per_source,
                 );
                 out.u0.push(node.u0);
+                if let Some((source, chord, grad)) = node.fixed_by {
+                    out.fixed.push(FixedNode {
+                        node: i as u32,
+                        rank: out.grad_u0.len() as u32,
+                        source,
+                        chord,
+                        grad_u0: grad,
+                    });
+                }
                 if is_inner {
                     out.grad_u0.push(node.grad_u0);
-                }
-                if node.fixed {
-                    out.fixed.push(i as u32);
                 }
             }
             if keep_feet {
@@ -242,6 +249,7 @@ fn setup<const D: usize>(
     };
     let mut out_roles = roles.to_vec();
     let mut fixed_per_source = vec![0usize; sources.len()];
+    let mut fixed = Vec::new();
     let mut feet = TubeFeet {
         closest_points: Vec::with_capacity(if keep_feet { n } else { 0 }),
         inner: Vec::with_capacity(if keep_feet { n_inner } else { 0 }),
@@ -251,11 +259,15 @@ fn setup<const D: usize>(
         feet.inner.extend_from_slice(&part.feet);
         nodes.extend_from_slice(&part.nodes);
         summary = summary.merge(part.summary);
+        for f in &part.fixed {
+            out_roles[f.node as usize] = NodeRole::Fixed;
+            fixed.push(FixedNode {
+                rank: f.rank + grad_u0.len() as u32,
+                ..*f
+            });
+        }
         u0.extend_from_slice(&part.u0);
         grad_u0.extend_from_slice(&part.grad_u0);
-        for &i in &part.fixed {
-            out_roles[i as usize] = NodeRole::Fixed;
-        }
         for (total, c) in fixed_per_source.iter_mut().zip(&part.fixed_per_source) {
             *total += c;
         }
@@ -269,6 +281,9 @@ fn setup<const D: usize>(
         abs_phi,
         summary,
     };
+    if factor {
+        keep_joined(band, roles, &fixed, &mut out_roles, &mut grad_u0, &mut fixed_per_source);
+    }
     let factoring = factoring_arguments.and_then(|()| {
         check_sources_fixed(&fixed_per_source, fix_radius)?;
         Ok(Factoring {
@@ -394,7 +409,7 @@ mod tests {
                     let f = f.unwrap();
                     assert_eq!(g.nodes, geo.nodes, "{name}");
                     assert_eq!(g.summary, geo.summary, "{name}");
-                    let b = factor_sources_at(&feet, &roles, &sources[..k], &slowness[..k], 2.0 * h).unwrap();
+                    let b = factor_sources_at(&band, &feet, &roles, &sources[..k], &slowness[..k], 2.0 * h).unwrap();
                     assert_eq!(bits(&b.u0), bits(&f.u0), "{name}");
                     assert_eq!(b.grad_u0, f.grad_u0, "{name}");
                     assert_eq!(b.grad_u0_unit, f.grad_u0_unit, "{name}");
@@ -434,7 +449,7 @@ mod tests {
             1,
         )
         .unwrap();
-        let err = factor_sources_at(&feet, &roles, &[[0.0, 0.0, 0.0]], &[1.0], 2.0 * h)
+        let err = factor_sources_at(&band, &feet, &roles, &[[0.0, 0.0, 0.0]], &[1.0], 2.0 * h)
             .err()
             .unwrap();
         assert!(err.to_string().contains("sources[0]"), "{err}");
