@@ -77,6 +77,19 @@ def cut_shortcuts(
     return band.with_edges_cut(node, neighbour)
 
 
+def cut_slits(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
+    """The band without its edges across the slits of ``surf`` (a triangle mesh's
+    ``_slit_cut_pairs``: ``surfaces._mesh_slits``) and the number of edges removed; the band
+    itself and 0 on other surfaces and where there is none."""
+    pairs = getattr(surf, "_slit_cut_pairs", None)
+    if pairs is None:
+        return band, 0
+    node, neighbour = pairs(grid, band, linear)
+    if node.size == 0:
+        return band, 0
+    return band.with_edges_cut(node, neighbour)
+
+
 def cut_between_parts(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int, Optional[np.ndarray]]:
     """The band without its edges between two separate parts of ``surf`` (a triangle mesh's
     ``_part_cut_pairs``: ``surfaces._mesh_parts``), the number of edges removed, and each band

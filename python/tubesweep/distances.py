@@ -103,7 +103,8 @@ def distance_matrix(
         points), ``seconds``, ``order`` and ``order_fallback`` (the order run, and why second order
         did not apply), ``unconverged`` (how many of the solves stopped at ``max_iterations``:
         their rows are the last iterate, and a warning says so), ``bridged_holes`` (an open
-        mesh's or a point cloud's holes the band spans, as ``sol.stats.bridged_holes``).
+        mesh's or a point cloud's holes the band spans, as ``sol.stats.bridged_holes``), ``slits``
+        (an open mesh's slits, as ``sol.stats.slits``).
 
     Returns
     -------
@@ -179,6 +180,7 @@ def distance_matrix(
             "order_fallback": stats.get("order_fallback"),
             "unconverged": int(np.count_nonzero(~np.asarray(stats["converged"], dtype=bool))),
             "bridged_holes": stats.get("bridged_holes"),
+            "slits": stats.get("slits"),
         }
     return matrix
 

@@ -411,4 +411,5 @@ def _first_order_batch(
     stats["order_fallback"] = None if fallback is None else fallback.reason
     stats["creases"] = t.paper_creases
     stats["bridged_holes"] = t.bridged_holes
+    stats["slits"] = t.slits
     return out, stats

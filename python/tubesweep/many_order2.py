@@ -145,6 +145,7 @@ def solve_many_order2(
         )
     st["tol"] = inputs.tol
     st["bridged_holes"] = t.bridged_holes
+    st["slits"] = t.slits
     so.warn_first_order_nodes(st, t.surface, "tube.solve(source).first_order_points() shows where")
     warn_creases(st.get("creases"), t.inner, h, thinned=thinned_spacings(t, thinned_count(t) > 0))
     for name, what in (

@@ -558,6 +558,7 @@ def _solve_on_tube(
         box_cut=tube.box_cut,
         creases=tube.paper_creases,
         bridged_holes=tube.bridged_holes,
+        slits=tube.slits,
     )
     return Solution(
         grid,

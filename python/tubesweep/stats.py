@@ -138,6 +138,14 @@ class SolveStats:
         and ``width`` (that hole's centre and width), ``size`` (the surface's bounding-box
         diagonal); with a ``RuntimeWarning`` when the detour is over 10% of the size. None
         otherwise.
+    slits : dict or None
+        On an open triangle mesh, where its open edges come within 4 grid spacings of each
+        other edge on, across empty space (a cylinder slit along its length): the band joins
+        the two sides and the front can cross, so distances reached across come out short by up
+        to ``detour`` (the way round along the open edges less the gap). ``count`` (vertex pairs
+        across), ``gap``, ``where`` and ``detour`` (the pair with the longest way round), ``size``
+        (the mesh's bounding-box diagonal); with a ``RuntimeWarning`` when the detour is over 10%
+        of the size. None otherwise.
 
     Examples
     --------
@@ -174,6 +182,7 @@ class SolveStats:
     box_cut: Optional[Dict[str, Any]] = None
     creases: Optional[Dict[str, Any]] = None
     bridged_holes: Optional[Dict[str, Any]] = None
+    slits: Optional[Dict[str, Any]] = None
 
     @property
     def updates_per_second(self) -> float:

@@ -1,0 +1,99 @@
+"""Slits in open meshes (python/tubesweep/surfaces/_mesh_slits.py; docs/meshes-and-output.md).
+
+Two cases with exact answers, at several grid sizes and slit widths (in grid spacings):
+
+* a cylinder of radius 0.3 and height 1 slit along its length, the source on the slit's edge:
+  on the far side, from a spacing past its edge half-way round, the distance is the way round
+  (the largest error there, in grid spacings, and the smallest ratio to the exact);
+* a square sheet [−½, ½]² with a slit from its edge to y = 0.1, the source and three points on
+  the two sides: the distance is the straight lines round the slit's end (the largest error in
+  grid spacings);
+
+and the bundled bunny's slit report. Prints ``sol.stats.slits`` (cut edges), the order run and any
+warning. About half a minute.
+
+    python benches/experiments/mesh_slits.py
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import tubesweep as ts
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
+from test_mesh_slits import R, slit_cylinder, slit_sheet  # noqa: E402
+
+
+def solve(surf, grid, source):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        sol = ts.solve(surf, grid, [source])
+    return sol, [str(w.message)[:50] for w in caught]
+
+
+def cylinder() -> None:
+    print("slit cylinder (r = 0.3), source on the slit's edge; far side from a spacing past its edge")
+    print("| N | slit (spacings) | largest error (spacings) | smallest u / exact | cut edges | order | warnings |")
+    print("|---|---|---|---|---|---|---|")
+    for n in (41, 81):
+        h = slit_cylinder(0.01).grid(n).spacing
+        for spacings in (0.6, 1.0, 1.8, 3.0):
+            surf = slit_cylinder(spacings * h)
+            grid = surf.grid(n)
+            a = spacings * h / (2 * R)
+            sol, caught = solve(surf, grid, (R * np.cos(a), R * np.sin(a), 0.0))
+            th = -a - np.linspace(grid.spacing / R, np.pi, 60)
+            exact = R * (2 * np.pi + th - a)
+            u = sol(np.c_[R * np.cos(th), R * np.sin(th), np.zeros_like(th)])
+            slits = sol.stats.slits or {}
+            print(
+                f"| {n} | {spacings:g} | {np.max(np.abs(u - exact)) / grid.spacing:.2f} | {np.min(u / exact):.3f} | "
+                f"{slits.get('cut_edges', 0)} | {sol.stats.order} | {len(caught)} |"
+            )
+
+
+def sheet() -> None:
+    print("\nsquare sheet with a slit to y = 0.1; source (−0.15, −0.3); points x = 0.15, y = −0.3, −0.1, 0.05")
+    print("| N | slit (spacings) | largest error (spacings) | cut edges | order | facing pairs | warnings |")
+    print("|---|---|---|---|---|---|---|")
+    for n in (41, 81, 121):
+        for k in (1, 3):
+            surf, half, end = slit_sheet(k)
+            grid = surf.grid(n)
+            source = np.array([-0.15, -0.3, 0.0])
+            points = np.array([[0.15, y, 0.0] for y in (-0.3, -0.1, 0.05)])
+            sol, caught = solve(surf, grid, source)
+            a, b = np.array([-half, end, 0.0]), np.array([half, end, 0.0])
+            exact = np.linalg.norm(source - a) + 2 * half + np.linalg.norm(points - b, axis=1)
+            err = np.max(np.abs(sol(points) - exact)) / grid.spacing
+            slits = sol.stats.slits or {}
+            print(
+                f"| {n} | {2 * half / grid.spacing:.2f} | {err:.2f} | {slits.get('cut_edges', 0)} | {sol.stats.order} | "
+                f"{sol.stats.facing_pairs} | {len(caught)} |"
+            )
+
+
+def bunny() -> None:
+    print("\nthe bundled bunny: sol.stats.slits")
+    surf = ts.surfaces.from_mesh(ts.data.bunny())
+    for n in (60, 100, 200):
+        sol, caught = solve(surf, surf.grid(n), surf.default_source)
+        s = sol.stats.slits
+        share = f"{s['detour'] / s['size']:.1%}" if s else "-"
+        print(
+            f"n = {n}: {s and {k: s[k] for k in ('count', 'gap', 'detour', 'cut_edges')}} (detour {share} of its size), warnings {len(caught)}"
+        )
+
+
+if __name__ == "__main__":
+    t0 = time.perf_counter()
+    cylinder()
+    sheet()
+    bunny()
+    print(f"\n{time.perf_counter() - t0:.0f} s")
