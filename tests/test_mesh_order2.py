@@ -359,3 +359,34 @@ def test_a_closed_plate_thinner_than_two_spacings_is_not_crossed():
     sol = ts.solve(s, s.grid(81), [top])
     assert sol.stats.facing_pairs > 1000 and sol.stats.order == 1
     assert abs(sol.on_mesh(bottom[None])[0] - 1.02) < 0.02
+
+
+def test_a_mesh_of_slivers_is_named_with_its_cure():
+    # an open cylinder of triangles 0.25 long and 0.007 wide (a CAD export's, subdivided): the
+    # smooth map folded across them, and order 2 was refused as "the mesh faces itself across gaps"
+    # at 1,200 node pairs lying on the surface itself (N = 101); the reason now names the slivers
+    # and the subdivision that lets second order run
+    trimesh = pytest.importorskip("trimesh")
+    from tubesweep.second_order import Order2NotApplicable
+
+    c = trimesh.creation.cylinder(radius=0.3, height=1.0, sections=64).subdivide().subdivide()
+    side = np.abs(c.face_normals[:, 2]) < 0.5
+    used = np.unique(c.faces[side])
+    index = np.full(len(c.vertices), -1)
+    index[used] = np.arange(len(used))
+    v, f = np.asarray(c.vertices)[used], index[c.faces[side]]
+    source = v[np.argmin(np.linalg.norm(v - (0.3, 0.0, 0.0), axis=1))]
+    slivers = ts.surfaces.from_mesh((v, f))
+    grid = slivers.grid(101)
+    with pytest.raises(Order2NotApplicable, match=r"slivers \(the median longest edge is 3\d times.*subdivide_to_size"):
+        # (the band's check also names them where the folded map leaves a node's neighbour out)
+        with pytest.warns(RuntimeWarning, match=rf"closest points fold there.*slivers.*spacing, {grid.spacing:.3g}"):
+            ts.solve(slivers, grid, [source], order=2)
+    v2, f2 = trimesh.remesh.subdivide_to_size(v, f, max_edge=0.03)[:2]
+    fine = ts.surfaces.from_mesh((v2, f2))
+    grid = fine.grid(101)
+    sol = ts.solve(fine, grid, [source])
+    assert sol.stats.order == 2
+    th, z = np.linspace(0.1, np.pi, 30), np.linspace(-0.4, 0.4, 30)  # the unrolled cylinder
+    exact = np.hypot(0.3 * th, z - source[2])
+    assert np.max(np.abs(sol(np.c_[0.3 * np.cos(th), 0.3 * np.sin(th), z]) - exact)) < 0.6 * grid.spacing

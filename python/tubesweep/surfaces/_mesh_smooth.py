@@ -49,6 +49,10 @@ SHARP_SHARE = 0.01
 #: of 0.4–1% of its radius at N = 61, 30–126 pairs of median depth 0.14–0.24 (largest 0.69),
 #: against 1.5–2.0 for the bundled bunny's and Spot's real gaps (smallest 0.7 on Spot).
 SHALLOW_PAIRS = 0.5
+#: A mesh whose triangles' median ratio of the longest edge to the height on it exceeds this is
+#: made of slivers (a CAD export's cylinder, each triangle the full height: 22; the bundled bunny
+#: 2.0, Spot 1.9, an icosphere 1.3), across which the smooth map can fold (:func:`sliver_advice`).
+SLIVER_RATIO = 8.0
 #: Triangles larger than this many grid spacings (longest edge) are fitted
 #: (``tubesweep_core::surface::mesh_smooth::FINE_LOW``).
 FINE = 2.0
@@ -232,6 +236,33 @@ def facing_pairs(grid: Grid, geom: BandGeometry, surface: Any = None) -> int:
     return int(a.size)
 
 
+def sliver_advice(surface: Any) -> str:
+    """What to do about a mesh of slivers (:data:`SLIVER_RATIO`), or "". An open cylinder of 2,048
+    triangles 0.25 long and 0.007 wide (a CAD export's, subdivided) ran first order at N = 101 as
+    "facing itself across gaps" at 1,200 node pairs lying on the surface itself (7 s, 1.07
+    spacings off the unrolled distances), its map folded; subdivided to edges of 0.03
+    (165,888 triangles), second order (1.1 s, 0.51 spacings)."""
+    if "_sliver_ratio" not in surface.__dict__:
+        f = surface.faces[surface._good]
+        v = surface.vertices
+        a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+        longest = np.max(np.stack([row_norms(b - a), row_norms(c - b), row_norms(a - c)]), axis=0)
+        area2 = row_norms(np.cross(b - a, c - a))
+        ok = area2 > 0
+        surface.__dict__["_sliver_ratio"] = float(np.median(longest[ok] ** 2 / area2[ok])) if np.any(ok) else 0.0
+    ratio = surface.__dict__["_sliver_ratio"]
+    if ratio <= SLIVER_RATIO:
+        return ""
+    h = getattr(surface, "report", {}).get("h")
+    size = f"the grid spacing, {h:.3g}" if h else "the grid spacing"
+    return (
+        f"its triangles are slivers (the median longest edge is {ratio:.0f} times the height on it, as in a CAD "
+        "export): the smooth closest-point map can fold across them, which reads as gaps or bumps. Subdividing "
+        f"the long edges to about {size} (e.g. trimesh.remesh.subdivide_to_size(vertices, faces, max_edge=...)) "
+        "lets second order run"
+    )
+
+
 def order2_obstacle(surface: Any, tube_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
     """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants)."""
     report = surface.report
@@ -248,6 +279,9 @@ def order2_obstacle(surface: Any, tube_pairs: int, pair_depth: float = np.inf) -
             "use the grid it resolves, or a mesh whose triangles sample a smooth surface"
         )
     pairs = report.get("facing", 0) or tube_pairs
+    slivers = sliver_advice(surface) if pairs else ""
+    if slivers:
+        return f"the mesh seems to face itself across gaps narrower than its tubes ({pairs} node pairs), but {slivers}"
     if pairs and "facing" not in report and pair_depth < SHALLOW_PAIRS:
         share, turn = sharp_edges(surface)
         if share <= SHARP_SHARE:
@@ -302,6 +336,12 @@ class SmoothMap:
 
     def _cp(self, x: np.ndarray) -> np.ndarray:
         return closest(self, x, self._h)[0]
+
+    @property
+    def unresolved_advice(self) -> Optional[str]:
+        """What the grid may not resolve of this mesh where the second-order sweeps run away: its
+        slivers (:func:`sliver_advice`), or None."""
+        return sliver_advice(self) or None
 
     def order2_obstacle(self, facing_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
         """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
