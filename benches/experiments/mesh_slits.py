@@ -9,8 +9,10 @@ Two cases with exact answers, at several grid sizes and slit widths (in grid spa
   the two sides: the distance is the straight lines round the slit's end (the largest error in
   grid spacings);
 
-and the bundled bunny's slit report. Prints ``sol.stats.slits`` (cut edges), the order run and any
-warning. About half a minute.
+the bundled bunny's slit report; and two icospheres touching at a shared vertex (a pinch,
+python/tubesweep/surfaces/_mesh_pinches.py), the source at the far pole of one, against exact
+polyhedral geodesics through the pinch (pygeodesic), with the pinch's cut and without it. Prints
+``sol.stats.slits`` (cut edges), the order run and any warning. About half a minute.
 
     python benches/experiments/mesh_slits.py
 """
@@ -27,6 +29,7 @@ import numpy as np
 import tubesweep as ts
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
+from test_mesh_pinches import touching_spheres  # noqa: E402
 from test_mesh_slits import R, slit_cylinder, slit_sheet  # noqa: E402
 
 
@@ -91,9 +94,33 @@ def bunny() -> None:
         )
 
 
+def pinch() -> None:
+    from tubesweep.surfaces.mesh import MeshSurface
+
+    print("\ntwo icospheres (642 vertices each) touching at a shared vertex; errors in grid spacings")
+    print("| N | pinch cut | far sphere, mean | far sphere, largest short | near sphere, mean | order |")
+    print("|---|---|---|---|---|---|")
+    vertices, faces, low, exact = touching_spheres()
+    cut = MeshSurface._pinch_cut_pairs
+    for n in (61, 101, 141):
+        for on in (True, False):
+            MeshSurface._pinch_cut_pairs = cut if on else None
+            surf = ts.surfaces.from_mesh((vertices, faces))
+            grid = surf.grid(n)
+            sol, _ = solve(surf, grid, vertices[low])
+            err = (sol.on_mesh(vertices) - exact) / grid.spacing
+            far, near = vertices[:, 2] > 0.1, vertices[:, 2] < -0.1
+            print(
+                f"| {n} | {'yes' if on else 'no'} | {err[far].mean():.2f} | {-err[far].min():.2f} | "
+                f"{err[near].mean():.2f} | {sol.stats.order} |"
+            )
+    MeshSurface._pinch_cut_pairs = cut
+
+
 if __name__ == "__main__":
     t0 = time.perf_counter()
     cylinder()
     sheet()
     bunny()
+    pinch()
     print(f"\n{time.perf_counter() - t0:.0f} s")

@@ -25,7 +25,7 @@ from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
-from ._shortcuts import cut_between_parts, cut_shortcuts, cut_slits, cuts_medial_edges, cuts_shortcuts
+from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cut_slits, cuts_medial_edges, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -605,7 +605,8 @@ def _prepare_tube(
         )
         band, parted, pieces = cut_between_parts(surf, grid, band, linear)
         band, slit_cut = cut_slits(surf, grid, band, linear)
-        cut_edges += parted + slit_cut
+        band, pinched = cut_pinches(surf, grid, band, linear)
+        cut_edges += parted + slit_cut + pinched
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)

@@ -43,6 +43,7 @@ from . import _mesh_smooth as smooth_mesh
 from ._mesh_checks import thin_parts, unique_edges, warn_repeated_vertices, warn_thin_parts
 from ._mesh_parts import node_parts, part_cut_pairs
 from ._mesh_holes import bridged_holes
+from ._mesh_pinches import pinch_cut_pairs
 from ._mesh_slits import pairs_over_openings, slit_cut_pairs, slits
 
 __all__ = [
@@ -176,6 +177,7 @@ class MeshSurface(Surface):
     _pairs_over_holes = pairs_over_openings  # facing pairs over a hole or a slit: no gap (_prepare)
     _slits = slits  # its slits (stats.slits), warned where the band is not cut across them
     _slit_cut_pairs = slit_cut_pairs  # the band's edges across them (cut: _shortcuts)
+    _pinch_cut_pairs = pinch_cut_pairs  # the band's edges between sheets meeting at a point (cut)
 
     def __init__(
         self,
