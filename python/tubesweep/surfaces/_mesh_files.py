@@ -15,7 +15,7 @@ import gzip
 import struct
 import warnings
 from pathlib import Path
-from typing import List, Optional, Tuple
+from typing import List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -274,3 +274,55 @@ def welded(v: np.ndarray, f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     960 boundary edges and the exact map's errors, 2–3 times the merged mesh's)."""
     uniq, inverse = np.unique(v, axis=0, return_inverse=True)
     return np.ascontiguousarray(uniq), np.ascontiguousarray(inverse.reshape(-1)[f], dtype=f.dtype)
+
+
+def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
+    """Vertices (n, 3) float64 and triangles (m, 3) int64 of an OBJ / PLY / STL / OFF file.
+
+    OBJ and OFF (also gzip-compressed, ``.obj.gz``) are read with numpy only, line by line
+    (:mod:`tubesweep.surfaces._mesh_files`: indentation, tabs, comments, polygons and relative
+    indices are fine, and a record that cannot be used is an error or a warning that says how many
+    were dropped); PLY and STL need trimesh or meshio (the ``mesh`` extra), and the counts their
+    headers declare are checked. Vertex indices are those of the file; polygons are
+    fan-triangulated.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    vertices : numpy.ndarray
+        ``(n, 3)`` float64.
+    faces : numpy.ndarray
+        ``(m, 3)`` int64.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    IsADirectoryError
+        If the path is a directory.
+    ValueError
+        If the file holds no triangles or cannot be read as a mesh.
+    ImportError
+        If neither trimesh nor meshio is installed.
+
+    Examples
+    --------
+    >>> import tubesweep as ts
+    >>> from tubesweep.surfaces.mesh import read_mesh
+    >>> v, f = read_mesh(ts.data.spot())
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"mesh file {str(path)!r} is a directory, not a mesh file")
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh file {str(path)!r} does not exist")
+    name = path.name.lower()
+    if name.endswith(".obj") or name.endswith(".obj.gz"):
+        return read_obj_file(path)
+    if name.endswith(".off") or name.endswith(".off.gz"):
+        return read_off_file(path)
+    return read_with_library(path)

@@ -36,7 +36,7 @@ from ..closest_point import ClosestPoint
 from .._validate import check_flag, real_array, real_scalar, whole_indices
 from ..grid import MAX_COORDINATE
 from .._warn import user_stacklevel
-from ._mesh_files import MESH_EXTRA, read_obj_file, read_off_file, read_with_library
+from ._mesh_files import MESH_EXTRA, read_mesh
 from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_B, VERT_C, closest_points_on_triangles
 from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
@@ -62,61 +62,6 @@ __all__ = [
 ]
 
 _MESH_EXTRA = MESH_EXTRA
-
-
-# ---------------------------------------------------------------------------------------------
-# reading
-# ---------------------------------------------------------------------------------------------
-def read_mesh(path: Union[str, Path]) -> Tuple[np.ndarray, np.ndarray]:
-    """Vertices (n, 3) float64 and triangles (m, 3) int64 of an OBJ / PLY / STL / OFF file.
-
-    OBJ and OFF (also gzip-compressed, ``.obj.gz``) are read with numpy only, line by line
-    (:mod:`tubesweep.surfaces._mesh_files`: indentation, tabs, comments, polygons and relative
-    indices are fine, and a record that cannot be used is an error or a warning that says how many
-    were dropped); PLY and STL need trimesh or meshio (the ``mesh`` extra), and the counts their
-    headers declare are checked. Vertex indices are those of the file; polygons are
-    fan-triangulated.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The file.
-
-    Returns
-    -------
-    vertices : numpy.ndarray
-        ``(n, 3)`` float64.
-    faces : numpy.ndarray
-        ``(m, 3)`` int64.
-
-    Raises
-    ------
-    FileNotFoundError
-        If the file does not exist.
-    IsADirectoryError
-        If the path is a directory.
-    ValueError
-        If the file holds no triangles or cannot be read as a mesh.
-    ImportError
-        If neither trimesh nor meshio is installed.
-
-    Examples
-    --------
-    >>> import tubesweep as ts
-    >>> from tubesweep.surfaces.mesh import read_mesh
-    >>> v, f = read_mesh(ts.data.spot())
-    """
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(f"mesh file {str(path)!r} is a directory, not a mesh file")
-    if not path.is_file():
-        raise FileNotFoundError(f"mesh file {str(path)!r} does not exist")
-    name = path.name.lower()
-    if name.endswith(".obj") or name.endswith(".obj.gz"):
-        return read_obj_file(path)
-    if name.endswith(".off") or name.endswith(".off.gz"):
-        return read_off_file(path)
-    return read_with_library(path)
 
 
 # ---------------------------------------------------------------------------------------------
