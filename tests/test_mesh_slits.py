@@ -1,7 +1,8 @@
 """Slits in an open mesh (surfaces/_mesh_slits.py): where the mesh's open edges come within a few
-grid spacings of each other edge on (a cylinder slit along its length, a sheet with a narrow cut),
-the band is cut across (``sol.stats.slits``), the front goes round the slit's end, and no source
-fixes nodes on the far side (``tubesweep_core::second_order::joined``)."""
+grid spacings of each other edge on (a cylinder slit along its length, a sheet with a narrow
+cut), ``sol.stats.slits`` reports them, a slit narrow enough for the band to join its sides is
+warned about, and at second order no source fixes nodes on the far side of a slit that the band
+keeps apart (``tubesweep_core::second_order::joined``)."""
 
 from __future__ import annotations
 
@@ -29,7 +30,8 @@ def slit_cylinder(gap: float, around: int = 160, along: int = 40) -> ts.surfaces
 
 def slit_sheet(k: int, m: int = 80, tip: float = 0.1):
     """A square sheet [−½, ½]² of m×m vertices with the k columns of cells round x = 0 removed
-    below y = tip (a slit k mesh spacings wide); the slit's half-width and its end's y."""
+    below y = tip (a slit k mesh spacings wide; k odd: straight edges); the slit's half-width and
+    its end's y."""
     x = (np.arange(m) - (m - 1) / 2) / (m - 1)
     xx, yy = np.meshgrid(x, x, indexing="ij")
     v = np.c_[xx.ravel(), yy.ravel(), np.zeros(m * m)]
@@ -42,44 +44,39 @@ def slit_sheet(k: int, m: int = 80, tip: float = 0.1):
     return ts.surfaces.from_mesh((v, f[keep])), k / (m - 1) / 2, end
 
 
-@pytest.mark.parametrize("spacings", [0.6, 1.0, 1.8])
-def test_the_far_side_of_a_slit_cylinder(spacings):
-    # before: the band joined the sides (below 1.6 spacings) or the source fixed nodes across
-    # the slit (1.6–2.1): the far side came out 95–99% short, unwarned
+def far_side(surf, grid, spacings):
+    """A solve from the slit's edge and the largest error on its far side (from a spacing past
+    the edge half-way round), in grid spacings, against the way round."""
+    a = spacings * grid.spacing / (2 * R)
+    sol = ts.solve(surf, grid, [(R * np.cos(a), R * np.sin(a), 0.0)])
+    th = -a - np.linspace(grid.spacing / R, np.pi, 40)
+    u = sol(np.c_[R * np.cos(th), R * np.sin(th), np.zeros_like(th)])
+    return sol, np.max(np.abs(u - R * (2 * np.pi + th - a))) / grid.spacing
+
+
+def test_a_slit_the_band_joins_is_warned():
+    n = 41
+    h = slit_cylinder(0.01).grid(n).spacing
+    surf = slit_cylinder(1.0 * h)
+    grid = surf.grid(n)
+    with pytest.warns(RuntimeWarning, match=r"within 0\.0\d+ of each other .* a slit.*below 0\.0\d+ \(now 0\.0"):
+        sol, err = far_side(surf, grid, 1.0)
+    slits = sol.stats.slits
+    assert slits is not None and slits["gap"] < 1.01 * grid.spacing and slits["detour"] > 2.0, slits
+    assert err > 20  # the front crossed: the far side as near as the slit's width (a known limit)
+
+
+@pytest.mark.parametrize("spacings", [1.8, 3.0])
+def test_a_slit_the_band_keeps_apart(spacings):
+    # at 1.6-2.1 spacings the medial cuts kept the sides apart at first order, but the second-order
+    # source fixed the nodes across the slit at the chord: 98% short (tubesweep_core's joined.rs)
     n = 41
     h = slit_cylinder(0.01).grid(n).spacing
     surf = slit_cylinder(spacings * h)
-    grid = surf.grid(n)
-    a = spacings * h / (2 * R)  # the source on the slit's edge
-    sol = ts.solve(surf, grid, [(R * np.cos(a), R * np.sin(a), 0.0)])  # (the test log fails on any warning)
+    sol, err = far_side(surf, surf.grid(n), spacings)  # (the test log fails on any warning)
     assert sol.stats.order == 2
-    slits = sol.stats.slits
-    assert slits is not None and slits["cut_edges"] > 0, slits
-    assert slits["detour"] > 2.0 and slits["gap"] < 1.01 * spacings * grid.spacing, slits
-    # on the far side, from a spacing past its edge half-way round: the way round the cylinder
-    th = -a - np.linspace(grid.spacing / R, np.pi, 40)
-    exact = R * (2 * np.pi + th - a)
-    u = sol(np.c_[R * np.cos(th), R * np.sin(th), np.zeros_like(th)])
-    assert np.max(np.abs(u - exact)) < 0.3 * grid.spacing, np.max(np.abs(u - exact)) / grid.spacing
-
-
-@pytest.mark.parametrize("n,k", [(41, 1), (41, 3), (81, 1), (81, 3)])
-def test_the_way_round_the_end_of_a_slit_in_a_sheet(n, k):
-    surf, half, end = slit_sheet(k)
-    grid = surf.grid(n)
-    source = np.array([-0.15, -0.3, 0.0])
-    points = np.array([[0.15, y, 0.0] for y in (-0.3, -0.1, 0.05)])
-    sol = ts.solve(surf, grid, [source])
-    assert sol.stats.order == 2  # (the slit's sides are not two sheets facing each other)
-    assert sol.stats.facing_pairs == 0
-    # exact: the straight lines round the slit's two corners at its end
-    corner_a, corner_b = np.array([-half, end, 0.0]), np.array([half, end, 0.0])
-    exact = np.linalg.norm(source - corner_a) + 2 * half + np.linalg.norm(points - corner_b, axis=1)
-    err = np.abs(sol(points) - exact) / grid.spacing
-    assert np.max(err) < 0.45, err  # (uncut: 0.55–0.6 short, some 13–35 spacings)
-    # and where the end is out of the way, the straight line
-    plain = ts.solve(surf, grid, [(-0.15, 0.3, 0.0)])
-    assert plain([(0.15, 0.3, 0.0)])[0] == pytest.approx(0.3, abs=0.05 * grid.spacing)
+    assert sol.stats.slits is not None and sol.stats.slits["gap"] > 1.5 * surf.grid(n).spacing
+    assert err < 0.3, err
 
 
 def test_a_bunny_slot_is_reported_and_not_warned():
@@ -109,17 +106,20 @@ def u_channel(gap: float, depth: float = 0.5, steps: int = 40) -> ts.surfaces.Me
 def test_no_slit_where_there_is_none():
     # a channel's open edges lie 0.03 apart, far apart along their loop, across empty space: but
     # its walls face each other along their normals (the facing tests' and the cuts' business)
-    channel = u_channel(0.03)
-    assert _mesh_slits.find(channel, 0.02) is None
+    assert _mesh_slits.find(u_channel(0.03), 0.02) is None
     # the same edges edge on: a slit
     assert _mesh_slits.find(slit_cylinder(0.03), 0.02) is not None
-    # closed meshes, sheets with no close open edges
+    # a sheet's slit; closed meshes and sheets with no close open edges have none
+    assert _mesh_slits.find(slit_sheet(1)[0], 0.02) is not None
     assert _mesh_slits.find(ts.surfaces.from_mesh(ts.data.spot()), 0.01) is None
     assert _mesh_slits.find(slit_sheet(0)[0], 0.02) is None
 
 
 def test_the_warning_names_the_slit_and_the_spacing():
-    info = {"count": 12, "gap": 0.02, "where": (0.3, 0.0, 0.0), "detour": 1.8, "size": 1.3, "cut_edges": 0}
-    with pytest.warns(RuntimeWarning, match=r"within 0\.02 .* a slit.*\(138% of the mesh's size.*below 0\.005"):
-        _mesh_slits.warn_slits(info, 0.01)
-    _mesh_slits.warn_slits({**info, "detour": 0.1}, 0.01)  # 8%: no warning (the log fails on one)
+    info = {"count": 12, "gap": 0.02, "where": (0.3, 0.0, 0.0), "detour": 1.8, "size": 1.3}
+    with pytest.warns(RuntimeWarning, match=r"within 0\.02 .* a slit.*\(138% of the mesh's size.*below 0\.0125 "):
+        _mesh_slits.warn_slits(info, 0.015)
+    # no warning (the test log fails on one): the way round under 10% of the size, or the slit
+    # 1.6 spacings wide or more
+    _mesh_slits.warn_slits({**info, "detour": 0.1}, 0.015)
+    _mesh_slits.warn_slits(info, 0.012)

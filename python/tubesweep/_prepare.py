@@ -25,7 +25,7 @@ from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
-from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cut_slits, cuts_medial_edges, cuts_shortcuts
+from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
 #: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
@@ -133,7 +133,7 @@ class _PreparedTube:
     #: pairs lie (``surfaces._cloud_holes``); None for other surfaces and where there are none
     bridged_holes: Optional[Dict[str, Any]] = None
     #: an open mesh's slits (``surfaces._mesh_slits``), None for other surfaces and where there
-    #: are none
+    #: are none (warned where the band joins their sides)
     slits: Optional[Dict[str, Any]] = None
     #: the inner tube's connected components and the checksum of its flags, once a warm start
     #: counted them (``moving.inner_components``)
@@ -582,7 +582,7 @@ def _prepare_tube(
         on_hole = over_holes(grid, linear[facing[0]], linear[facing[1]], facing[2])
         hole_pairs = (linear[facing[0][on_hole]], linear[facing[1][on_hole]], facing[2][on_hole])
         facing = (facing[0][~on_hole], facing[1][~on_hole], facing[2][~on_hole])
-    cut_edges = slit_cut = 0
+    cut_edges = 0
     pieces = None
     cut_facing = facing
     resolved = getattr(surf, "resolved_gap", None)  # a cloud: the gaps its fits keep apart
@@ -604,16 +604,15 @@ def _prepare_tube(
             band, roles == ROLE_INNER, phi, directions, h, cut_facing, medial=cuts_medial_edges(surf)
         )
         band, parted, pieces = cut_between_parts(surf, grid, band, linear)
-        band, slit_cut = cut_slits(surf, grid, band, linear)
         band, pinched = cut_pinches(surf, grid, band, linear)
-        cut_edges += parted + slit_cut + pinched
+        cut_edges += parted + pinched
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)
     holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh's or a cloud's holes the band spans
     bridged_holes = holes_of(h, outer_eff, grid, hole_pairs) if holes_of is not None else None
-    slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, cut across (warned if not)
-    slits = slits_of(h, slit_cut if cuts else None) if slits_of is not None else None
+    slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, which the band may join
+    slits = slits_of(h) if slits_of is not None else None
     # (after the facing test, which reads the paper's inner tube). The paper's tube's creases are
     # not reported on a re-distanced φ, whose kinks include those of its samples (a voxel mask's
     # staircase: a sphere's mask said "creases … turning by up to 84°"), but its crease nodes are

@@ -77,21 +77,11 @@ def cut_shortcuts(
     return band.with_edges_cut(node, neighbour)
 
 
-def cut_slits(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
-    """The band without its edges across the slits of ``surf`` (a triangle mesh's
-    ``_slit_cut_pairs``: ``surfaces._mesh_slits``) and the number of edges removed; the band
-    itself and 0 on other surfaces and where there is none."""
-    return _cut_by(getattr(surf, "_slit_cut_pairs", None), grid, band, linear)
-
-
 def cut_pinches(surf: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
     """The band without its edges between two sheets of ``surf`` that meet at a point only, but
     round that point (a triangle mesh's ``_pinch_cut_pairs``: ``surfaces._mesh_pinches``), and
     the number of edges removed; the band itself and 0 on other surfaces and where there is none."""
-    return _cut_by(getattr(surf, "_pinch_cut_pairs", None), grid, band, linear)
-
-
-def _cut_by(pairs: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[Any, int]:
+    pairs = getattr(surf, "_pinch_cut_pairs", None)
     if pairs is None:
         return band, 0
     node, neighbour = pairs(grid, band, linear)

@@ -140,11 +140,12 @@ class SolveStats:
         otherwise.
     slits : dict or None
         On an open triangle mesh, where its open edges come within 4 grid spacings of each
-        other edge on, across empty space (a cylinder slit along its length): the band joins
-        the two sides and the front can cross, so distances reached across come out short by up
-        to ``detour`` (the way round along the open edges less the gap). ``count`` (vertex pairs
-        across), ``gap``, ``where`` and ``detour`` (the pair with the longest way round), ``size``
-        (the mesh's bounding-box diagonal); with a ``RuntimeWarning`` when the detour is over 10%
+        other edge on, across empty space (a cylinder slit along its length, a comb's teeth):
+        ``count`` (vertex pairs across), ``gap`` (the narrowest), ``where`` and ``detour`` (the
+        pair with the longest way round along the open edges, less its gap), ``size`` (the
+        mesh's bounding-box diagonal). Where a slit is narrower than about 1.5 grid spacings the
+        band joins its sides and distances reached across come out short, by up to ``detour``:
+        a ``RuntimeWarning`` says so when ``gap`` is under 1.6 spacings and the detour over 10%
         of the size. None otherwise.
 
     Examples

@@ -13,7 +13,13 @@ so the two spheres are one piece and nothing cut them apart.
 triangles lie on more than one of these sheets. :func:`pinch_cut_pairs` labels each band node
 with the sheet of its nearest face and gives the band edges between two sheets of one piece,
 except where both nodes' closest points lie within :data:`PINCH_REACH` grid spacings of a pinch
-(the way through it); the tube's preparation cuts them (``_shortcuts.cut_pinches``).
+(the way through it); the tube's preparation cuts them (``_shortcuts.cut_pinches``). Near the
+pinch the answer is first order (the far sphere above: 2.4, 1.5 and 1.0 spacings short on
+average at n = 61, 101 and 141, ``benches/experiments/mesh_slits.py``).
+
+A limit: sheets that share a vertex and also cross each other elsewhere (shells never
+booleaned, which ``_mesh_parts`` keeps as one piece so that the front crosses where they
+intersect) are cut apart there too.
 """
 
 from __future__ import annotations

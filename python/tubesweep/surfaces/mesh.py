@@ -42,9 +42,9 @@ from .analytic import finite_center, size_parameter
 from . import _mesh_smooth as smooth_mesh
 from ._mesh_checks import thin_parts, unique_edges, warn_repeated_vertices, warn_thin_parts
 from ._mesh_parts import node_parts, part_cut_pairs
-from ._mesh_holes import bridged_holes
+from ._mesh_holes import bridged_holes, pairs_over_holes
 from ._mesh_pinches import pinch_cut_pairs
-from ._mesh_slits import pairs_over_openings, slit_cut_pairs, slits
+from ._mesh_slits import slits
 
 __all__ = [
     "from_mesh",
@@ -119,9 +119,8 @@ class MeshSurface(Surface):
     _part_cut_pairs = part_cut_pairs  # the band's edges between separate parts (cut: _shortcuts)
     _node_parts = node_parts  # each node's part, for a band left uncut (_parts)
     _bridged_holes = bridged_holes  # its holes the band spans, warned (stats.bridged_holes)
-    _pairs_over_holes = pairs_over_openings  # facing pairs over a hole or a slit: no gap (_prepare)
-    _slits = slits  # its slits (stats.slits), warned where the band is not cut across them
-    _slit_cut_pairs = slit_cut_pairs  # the band's edges across them (cut: _shortcuts)
+    _pairs_over_holes = pairs_over_holes  # facing pairs over a hole: no gap (_prepare)
+    _slits = slits  # its slits (stats.slits), warned where the band joins their sides
     _pinch_cut_pairs = pinch_cut_pairs  # the band's edges between sheets meeting at a point (cut)
 
     def __init__(
