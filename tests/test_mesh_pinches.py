@@ -62,3 +62,31 @@ def test_the_front_goes_through_the_pinch(n):
     assert np.mean(err[b]) > np.mean(err[a]) - 2.5, (np.mean(err[b]), np.mean(err[a]))
     assert np.min(err[b]) > -5.0, np.min(err[b])
     assert sol.stats.cut_edges > 0
+
+
+def test_meshes_solve_without_scipy(tmp_path):
+    # scipy is an optional extra: a mesh given as arrays solves with numpy alone, pinch included
+    # (two octahedra sharing a vertex; scipy blocked in a fresh interpreter)
+    script = tmp_path / "no_scipy.py"
+    script.write_text(
+        "import sys\n"
+        "sys.modules['scipy'] = None\n"
+        "import numpy as np\n"
+        "import tubesweep as ts\n"
+        "o = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], float) * 0.4\n"
+        "f = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])\n"
+        "a = o + (0, 0, -0.4)  # its top vertex (4) at the origin\n"
+        "b = -o + (0, 0, 0.4)  # its bottom vertex (4) at the origin\n"
+        "v = np.r_[a, np.delete(b, 4, axis=0)]\n"
+        "fb = f[:, ::-1].copy()\n"
+        "fb = np.where(fb == 4, 4, np.where(fb > 4, fb - 1, fb) + 6)\n"
+        "s = ts.surfaces.from_mesh((v, np.r_[f, fb]))\n"
+        "sol = ts.solve(s, s.grid(41), [a[5]])\n"
+        "print(sol.stats.cut_edges > 0, np.isfinite(sol.on_mesh(v)).all(), 'scipy' in sys.modules and sys.modules['scipy'] is not None)\n"
+    )
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["True", "True", "False"], done.stdout + done.stderr[-2000:]

@@ -88,6 +88,15 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
     return np.sort(ends[once], axis=1)
 
 
+def boundary_edges_of(surface: Any) -> np.ndarray:
+    """:func:`boundary_edges` of ``surface`` (a ``MeshSurface``), computed once and kept (the
+    holes and the slits read them)."""
+    if "_boundary_edges" not in surface.__dict__:
+        surface.__dict__["_boundary_edges"] = boundary_edges(surface.faces)
+    edges: np.ndarray = surface.__dict__["_boundary_edges"]
+    return edges
+
+
 def _simple_loops(n_vertices: int, edges: np.ndarray) -> list:
     """The boundary vertices of each simple loop (every vertex on two boundary edges), loops of
     more than three vertices only."""
@@ -127,7 +136,7 @@ def holes(surface: Any) -> Holes:
     if cached is not None:
         return cached
     v = surface.vertices
-    edges = np.zeros((0, 2), np.int64) if surface.closed else boundary_edges(surface.faces)
+    edges = np.zeros((0, 2), np.int64) if surface.closed else boundary_edges_of(surface)
     widths, detours, centres, members = [], [], [], []
     for loop in _simple_loops(len(v), edges) if len(edges) else []:
         if _is_seam(v[loop]):

@@ -57,6 +57,16 @@ def vertex_parts(n_vertices: int, faces: np.ndarray) -> np.ndarray:
         label = new
 
 
+def merged_vertices(surface: Any) -> np.ndarray:
+    """Per vertex of ``surface`` an index shared by the vertices at the same coordinates (a seam
+    of an export, a triangle soup), computed once and kept."""
+    if "_merged_vertices" not in surface.__dict__:
+        _, same = np.unique(surface.vertices, axis=0, return_inverse=True)
+        surface.__dict__["_merged_vertices"] = same.ravel().astype(np.int64)
+    merged: np.ndarray = surface.__dict__["_merged_vertices"]
+    return merged
+
+
 def face_parts(surface: Any) -> Optional[np.ndarray]:
     """Per face of ``surface`` (a ``MeshSurface``) its separate piece, numbered 0, 1, ..., or
     None when the mesh is one piece; computed once and kept. Triangles are joined through shared
@@ -64,8 +74,7 @@ def face_parts(surface: Any) -> Optional[np.ndarray]:
     soup), and two pieces whose surfaces may touch or cross (:func:`apart`) count as one."""
     if "_face_parts" not in surface.__dict__:
         faces = surface.faces
-        _, same = np.unique(surface.vertices, axis=0, return_inverse=True)
-        merged = same.ravel()[faces]
+        merged = merged_vertices(surface)[faces]
         label = vertex_parts(int(merged.max()) + 1, merged)[merged[:, 0]]
         _, parts = np.unique(label, return_inverse=True)
         parts = parts.ravel().astype(np.int64)

@@ -29,7 +29,7 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from ._mesh_checks import unique_edges
-from ._mesh_parts import CHUNK, face_parts
+from ._mesh_parts import CHUNK, face_parts, merged_vertices, vertex_parts
 
 #: Band edges between two sheets stay where both nodes' closest points lie within this many grid
 #: spacings of a pinch vertex (the nodes round the point where the sheets meet).
@@ -50,24 +50,16 @@ def _find(surface: Any) -> Optional[Tuple[np.ndarray, np.ndarray]]:
     faces = np.asarray(surface.faces, dtype=np.int64)
     if len(faces) == 0:
         return None
-    _, same = np.unique(surface.vertices, axis=0, return_inverse=True)
-    merged = same.ravel()[faces]
+    same = merged_vertices(surface)
+    merged = same[faces]
     good = (merged[:, 0] != merged[:, 1]) & (merged[:, 1] != merged[:, 2]) & (merged[:, 0] != merged[:, 2])
     if not np.any(good):
         return None
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     ids, _ = unique_edges(merged[good])  # (faces, 3) edge ids
-    # triangles and edges as the two kinds of nodes of one graph: sheets are its components
+    # a triangle joins its three edges: the sheets are the parts of that graph (numpy only)
     n_edges = int(ids.max()) + 1
-    n_good = int(np.count_nonzero(good))
-    rows = n_edges + np.repeat(np.arange(n_good), 3)
-    graph = coo_matrix((np.ones(rows.size, np.int8), (rows, ids.ravel())), shape=(n_edges + n_good,) * 2)
-    count, label = connected_components(graph, directed=False)
-    if count == 1:
-        return None
-    _, sheet_good = np.unique(label[n_edges:], return_inverse=True)
+    label = vertex_parts(n_edges, ids)
+    _, sheet_good = np.unique(label[ids[:, 0]], return_inverse=True)
     sheet = np.full(len(faces), -1, np.int64)
     sheet[good] = sheet_good.ravel()
     if sheet_good.max(initial=0) == 0:
@@ -82,35 +74,35 @@ def _find(surface: Any) -> Optional[Tuple[np.ndarray, np.ndarray]]:
     if pinch_vertex.size == 0:
         return None
     representative = np.zeros(int(same.max()) + 1, np.int64)
-    representative[same.ravel()] = np.arange(len(surface.vertices))
+    representative[same] = np.arange(len(surface.vertices))
     return sheet, np.asarray(surface.vertices, float)[representative[pinch_vertex]]
 
 
 def pinch_cut_pairs(surface: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
     """The band edges (``node``, ``neighbour``: band positions, ``node < neighbour``) between nodes
-    whose nearest faces lie on two sheets of one piece, but not where both closest points lie
-    within :data:`PINCH_REACH` spacings of a pinch: ``MeshSurface._pinch_cut_pairs``, read by
-    the tube's preparation. Empty where the mesh has no pinch."""
+    whose nearest faces lie on two sheets of one piece, but not those round a pinch: where both
+    closest points lie within :data:`PINCH_REACH` spacings of the same pinch, or, where no edge
+    between the two sheets comes that close (a coarse mesh), the edges that come closest to it
+    (so that the way through the pinch stays open). ``MeshSurface._pinch_cut_pairs``, read by the
+    tube's preparation. Empty where the mesh has no pinch."""
     empty = np.zeros(0, np.int64)
     found = pinches(surface)
     n = len(linear)
     if found is None or n == 0:
         return empty, empty
-    from scipy.spatial import cKDTree
-
     sheet, points = found
     piece = face_parts(surface)
     h = float(grid.spacing)
     node_sheet = np.empty(n, np.int64)
     node_piece = np.zeros(n, np.int64)
-    near = np.zeros(n, bool)
-    tree = cKDTree(points)
+    pinch = np.empty(n, np.int64)  # the nearest pinch to each node's closest point, and how far
+    far = np.empty(n)
     for s in range(0, n, CHUNK):
         _, cp, face, _ = surface.closest(grid.node_points(linear[s : s + CHUNK]))
         node_sheet[s : s + CHUNK] = np.where(face >= 0, sheet[np.maximum(face, 0)], -1)
         if piece is not None:
             node_piece[s : s + CHUNK] = np.where(face >= 0, piece[np.maximum(face, 0)], -1)
-        near[s : s + CHUNK] = np.isfinite(tree.query(cp, distance_upper_bound=PINCH_REACH * h)[0])
+        pinch[s : s + CHUNK], far[s : s + CHUNK] = _nearest(cp, points)
     firsts, seconds = [], []
     for s in range(0, n, CHUNK):
         at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
@@ -119,13 +111,42 @@ def pinch_cut_pairs(surface: Any, grid: Any, band: Any, linear: np.ndarray) -> T
         b = nb.ravel()
         keep = (b < n) & (b > a)
         a, b = a[keep], b[keep]
-        cut = (
+        between = (
             (node_sheet[a] != node_sheet[b])
             & (node_sheet[a] >= 0)
             & (node_sheet[b] >= 0)
             & (node_piece[a] == node_piece[b])
-            & ~(near[a] & near[b])
         )
-        firsts.append(a[cut])
-        seconds.append(b[cut])
-    return np.concatenate(firsts), np.concatenate(seconds)
+        firsts.append(a[between])
+        seconds.append(b[between])
+    a, b = np.concatenate(firsts), np.concatenate(seconds)
+    if a.size == 0:
+        return a, b
+    # each edge's reach from its pinch: the farther closest point (∞ when their nearest pinches
+    # differ); per pinch and pair of sheets, the edges within PINCH_REACH spacings stay, or the
+    # closest ones where none is that close
+    reach = np.where(pinch[a] == pinch[b], np.maximum(far[a], far[b]), np.inf)
+    lo, hi = np.minimum(node_sheet[a], node_sheet[b]), np.maximum(node_sheet[a], node_sheet[b])
+    _, group = np.unique(np.stack([pinch[a], lo, hi], axis=1), axis=0, return_inverse=True)
+    group = group.ravel()
+    closest_in_group = np.full(int(group.max()) + 1, np.inf)
+    np.minimum.at(closest_in_group, group, reach)
+    limit = np.maximum(PINCH_REACH * h, closest_in_group[group] * (1.0 + 1e-9))
+    cut = ~(reach <= limit)
+    return a[cut], b[cut]
+
+
+def _nearest(x: np.ndarray, points: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """The nearest of ``points`` (the pinches: few) to each point of ``x``, and its distance; in
+    blocks of them (numpy only)."""
+    best = np.full(len(x), np.inf)
+    which = np.zeros(len(x), np.int64)
+    block = max(1, (1 << 22) // max(len(x), 1))
+    for s in range(0, len(points), block):
+        d2 = np.sum((x[:, None, :] - points[None, s : s + block, :]) ** 2, axis=2)
+        k = np.argmin(d2, axis=1)
+        d = np.sqrt(d2[np.arange(len(x)), k])
+        better = d < best
+        best[better] = d[better]
+        which[better] = k[better] + s
+    return which, best

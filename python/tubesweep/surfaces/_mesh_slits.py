@@ -43,7 +43,7 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from .._warn import user_stacklevel
-from ._mesh_holes import WARN_SHARE, boundary_edges, holes
+from ._mesh_holes import WARN_SHARE, boundary_edges_of, holes
 
 #: Boundary vertices closer than this many grid spacings are judged (the cuts kept a slit's sides
 #: apart from 3.2 spacings on).
@@ -107,7 +107,7 @@ def _slit_pairs(surface: Any, h: float) -> Optional[Tuple[np.ndarray, np.ndarray
 def _search(surface: Any, h: float) -> Optional[Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
     if surface.closed:
         return None
-    edges = boundary_edges(surface.faces)
+    edges = boundary_edges_of(surface)
     if len(edges) == 0:
         return None
     v = surface.vertices
