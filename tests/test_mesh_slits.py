@@ -116,10 +116,35 @@ def test_no_slit_where_there_is_none():
 
 
 def test_the_warning_names_the_slit_and_the_spacing():
-    info = {"count": 12, "gap": 0.02, "where": (0.3, 0.0, 0.0), "detour": 1.8, "size": 1.3}
+    info = {
+        "count": 12,
+        "gap": 0.02,
+        "where": (0.3, 0.0, 0.0),
+        "detour": 1.8,
+        "size": 1.3,
+        "joined": 3,
+        "spacing": 0.0125,
+    }
     with pytest.warns(RuntimeWarning, match=r"within 0\.02 .* a slit.*\(138% of the mesh's size.*below 0\.0125 "):
         _mesh_slits.warn_slits(info, 0.015)
-    # no warning (the test log fails on one): the way round under 10% of the size, or the slit
-    # 1.6 spacings wide or more
+    # no warning (the test log fails on one): the way round under 10% of the size, or no pair
+    # narrower than the band keeps apart
     _mesh_slits.warn_slits({**info, "detour": 0.1}, 0.015)
-    _mesh_slits.warn_slits(info, 0.012)
+    _mesh_slits.warn_slits({**info, "joined": 0}, 0.015)
+
+
+def test_the_band_keeps_a_slit_apart_from_a_width_that_depends_on_its_direction():
+    # along an axis from 1.6 spacings, diagonally in a grid plane from 2.6 (a slit cylinder
+    # turned by 45 degrees about its axis came out 3-10 spacings short at 2.0-2.3, unwarned)
+    s = np.sqrt(0.5)
+    np.testing.assert_allclose(
+        _mesh_slits.apart_spacings(np.array([[1.0, 0, 0], [0, s, s], [0, 0, -1.0]])), [1.6, 2.6, 1.6]
+    )
+    n = 81
+    h = slit_cylinder(0.01).grid(n).spacing
+    surf = slit_cylinder(2.0 * h)
+    v = surf.vertices @ np.array([[s, -s, 0], [s, s, 0], [0, 0, 1.0]]).T  # the slit turned by 45 degrees
+    turned = ts.surfaces.from_mesh((v, surf.faces))
+    info = _mesh_slits.find(turned, turned.grid(n).spacing)
+    assert info is not None and info["joined"] > 0 and info["spacing"] < 0.85 * turned.grid(n).spacing, info
+    assert _mesh_slits.find(surf, surf.grid(n).spacing)["joined"] == 0  # the same slit along an axis

@@ -143,10 +143,11 @@ class SolveStats:
         other edge on, across empty space (a cylinder slit along its length, a comb's teeth):
         ``count`` (vertex pairs across), ``gap`` (the narrowest), ``where`` and ``detour`` (the
         pair with the longest way round along the open edges, less its gap), ``size`` (the
-        mesh's bounding-box diagonal). Where a slit is narrower than about 1.5 grid spacings the
-        band joins its sides and distances reached across come out short, by up to ``detour``:
-        a ``RuntimeWarning`` says so when ``gap`` is under 1.6 spacings and the detour over 10%
-        of the size. None otherwise.
+        mesh's bounding-box diagonal), ``joined`` (the pairs narrower than the band keeps apart:
+        1.6 grid spacings across a grid axis, 2.6 diagonally) and ``spacing`` (the grid spacing
+        that keeps them all apart). Where the band joins a slit's sides, distances reached
+        across come out short, by up to ``detour``: a ``RuntimeWarning`` says so when the detour
+        is over 10% of the size. None otherwise.
 
     Examples
     --------

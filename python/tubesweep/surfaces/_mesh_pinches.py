@@ -31,6 +31,9 @@ import numpy as np
 from ._mesh_checks import unique_edges
 from ._mesh_parts import CHUNK, face_parts, merged_vertices, vertex_parts
 
+#: Two sheets whose open edges leave a shared vertex in directions this close (cosine) meet along
+#: a seam there, not at a point (:func:`_joined_at_seams`).
+SEAM_COS = 0.98
 #: Band edges between two sheets stay where both nodes' closest points lie within this many grid
 #: spacings of a pinch vertex (the nodes round the point where the sheets meet).
 PINCH_REACH = 0.5
@@ -55,15 +58,23 @@ def _find(surface: Any) -> Optional[Tuple[np.ndarray, np.ndarray]]:
     good = (merged[:, 0] != merged[:, 1]) & (merged[:, 1] != merged[:, 2]) & (merged[:, 0] != merged[:, 2])
     if not np.any(good):
         return None
-    ids, _ = unique_edges(merged[good])  # (faces, 3) edge ids
+    tri = merged[good]
+    ids, counts = unique_edges(tri)  # (faces, 3) edge ids: AB, AC, BC
     # a triangle joins its three edges: the sheets are the parts of that graph (numpy only)
     n_edges = int(ids.max()) + 1
     label = vertex_parts(n_edges, ids)
     _, sheet_good = np.unique(label[ids[:, 0]], return_inverse=True)
-    sheet = np.full(len(faces), -1, np.int64)
-    sheet[good] = sheet_good.ravel()
+    sheet_good = sheet_good.ravel()
     if sheet_good.max(initial=0) == 0:
         return None
+    representative = np.zeros(int(same.max()) + 1, np.int64)
+    representative[same] = np.arange(len(surface.vertices))
+    position = np.asarray(surface.vertices, float)[representative]  # per merged vertex
+    sheet_good = _joined_at_seams(tri, ids, counts, sheet_good, position)
+    if sheet_good.max(initial=0) == 0:
+        return None
+    sheet = np.full(len(faces), -1, np.int64)
+    sheet[good] = sheet_good
     # a pinch: a (merged) vertex whose triangles lie on several sheets
     corner = merged[good].ravel()
     of = np.repeat(sheet_good.ravel(), 3)
@@ -73,9 +84,47 @@ def _find(surface: Any) -> Optional[Tuple[np.ndarray, np.ndarray]]:
     pinch_vertex = np.unique(corner[change])
     if pinch_vertex.size == 0:
         return None
-    representative = np.zeros(int(same.max()) + 1, np.int64)
-    representative[same] = np.arange(len(surface.vertices))
-    return sheet, np.asarray(surface.vertices, float)[representative[pinch_vertex]]
+    return sheet, position[pinch_vertex]
+
+
+def _joined_at_seams(
+    tri: np.ndarray, ids: np.ndarray, counts: np.ndarray, sheet: np.ndarray, position: np.ndarray
+) -> np.ndarray:
+    """``sheet`` (per triangle of ``tri``, merged vertices) with the sheets joined that meet along
+    a seam: patches of one surface meshed apart, sharing vertices but no edges (T-junctions: a
+    CAD export's cap with fewer segments than its side, a box's faces divided 6 and 7 times),
+    where an open edge of one runs along an open edge of the other from a shared vertex
+    (:data:`SEAM_COS`). Without this a cube of such faces was cut along its edges but at its
+    corners: 28 spacings off, or unreached, at N = 41 and 81 (a helper's review)."""
+    slots = ((0, 1), (0, 2), (1, 2))
+    open_slot = counts[ids] == 1
+    face, slot = np.nonzero(open_slot)
+    if face.size == 0:
+        return sheet
+    ends = np.array(slots)[slot]
+    p = tri[face, ends[:, 0]]
+    q = tri[face, ends[:, 1]]
+    # each open edge from both its ends: (vertex, sheet, unit direction along the edge)
+    vertex = np.r_[p, q]
+    of = np.r_[sheet[face], sheet[face]]
+    d = np.r_[position[q] - position[p], position[p] - position[q]]
+    d = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    order = np.argsort(vertex, kind="stable")
+    vertex, of, d = vertex[order], of[order], d[order]
+    firsts, seconds = [], []
+    longest = int(np.max(np.unique(vertex, return_counts=True)[1]))
+    for k in range(1, longest):
+        same = (vertex[k:] == vertex[:-k]) & (of[k:] != of[:-k])
+        same &= np.einsum("ij,ij->i", d[k:], d[:-k]) > SEAM_COS
+        firsts.append(of[:-k][same])
+        seconds.append(of[k:][same])
+    a, b = np.concatenate(firsts), np.concatenate(seconds)
+    if a.size == 0:
+        return sheet
+    n = int(sheet.max()) + 1
+    joined = vertex_parts(n, np.stack([a, b, b], axis=1))
+    _, out = np.unique(joined[sheet], return_inverse=True)
+    return out.ravel()
 
 
 def pinch_cut_pairs(surface: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:

@@ -18,8 +18,9 @@ face each other across a gap (the walls of a slot) are left to the facing tests,
 band between them (the bundled bunny's base has a slot 0.0065 wide whose way round is 20% of its
 size, its errors next to it those elsewhere; its pairs' sides turn their normals 0.16–0.89
 towards the gap, a slit cylinder's 0.02–0.07). The slits are reported (``sol.stats.slits``) and
-warned about where the narrowest is under :data:`WARN_SPACINGS` and the way round over
-``WARN_SHARE`` of the mesh's size, with the grid spacing that keeps the sides apart.
+warned about where the band joins their sides (narrower than :data:`WARN_SPACINGS` across a grid
+axis, up to :data:`DIAGONAL_SPACINGS` more diagonally) and the way round is over ``WARN_SHARE``
+of the mesh's size, with the grid spacing that keeps the sides apart.
 
 *Not kept*: cutting the band across a slit, by the places of the nodes' closest points along the
 boundary loop (the edges whose two places lie more than their distance apart along it). It gave
@@ -56,10 +57,16 @@ OFF_MESH = 0.25
 #: ... and the gap's direction makes an angle with both sides' normals whose cosine is below this
 #: (17°: in their tangent planes; sides facing each other are the facing tests').
 EDGE_ON = 0.3
-#: The warning is given where the narrowest slit is narrower than this many grid spacings (the
-#: medial cuts, ``_shortcuts.MEDIAL_JUMP``, keep a slit's sides apart from 1.5 spacings: the slit
-#: cylinder came out 95–99% short at 1.5, right from 1.6 on, at first and at second order).
+#: The warning is given where a slit is narrower than this many grid spacings across an axis of
+#: the grid (the medial cuts, ``_shortcuts.MEDIAL_JUMP``, keep a slit's sides apart from 1.5
+#: spacings: the slit cylinder came out 95–99% short at 1.5, right from 1.6 on, at first and at
+#: second order),
 WARN_SPACINGS = 1.6
+#: ... and this many more diagonally in a grid plane (the cylinder turned by 45° about its axis:
+#: its far edge's vertices read 4.1–15.5 spacings short with slits of 1.8–2.3 spacings, their cells
+#: straddling the slit, 0.20 at 3, ``benches/experiments/mesh_slits.py``; a helper's review: 0.7
+#: at 2.6, and turned by 22.5° right at 2.0).
+DIAGONAL_SPACINGS = 1.0
 #: Meshes with more boundary vertices than this are not judged (the loops are walked in Python).
 MAX_BOUNDARY = 200_000
 
@@ -77,7 +84,9 @@ def find(surface: Any, h: float) -> Optional[dict]:
     with the longest way round: ``gap`` (the narrowest pair's distance), ``where`` (that pair's
     midpoint), ``detour`` (the way between them along their boundary loop less their distance:
     how much shorter a distance reached across can come out), ``count`` (vertex pairs) and
-    ``size`` (the used vertices' bounding-box diagonal); None when there is none."""
+    ``size`` (the used vertices' bounding-box diagonal), ``joined`` (the pairs narrower than the
+    band keeps apart in their direction, :func:`apart_spacings`) and ``spacing`` (the grid spacing
+    below which it keeps them all apart); None when there is none."""
     found = _slit_pairs(surface, h)
     if found is None:
         return None
@@ -85,13 +94,32 @@ def find(surface: Any, h: float) -> Optional[dict]:
     v = surface.vertices
     k = int(np.argmax(along - d))
     used = v[surface.used_vertices]
+    # the width across: each vertex's nearest partner (the pairs slanting along the slit are wider
+    # and lie diagonally in the grid)
+    order = np.argsort(d, kind="stable")
+    first = np.zeros(d.size, bool)
+    for end in (a, b):
+        _, at = np.unique(end[order], return_index=True)
+        first[order[at]] = True
+    across = d[first]
+    apart = apart_spacings((v[b[first]] - v[a[first]]) / across[:, None])
     return {
         "count": int(d.size),
         "gap": float(d.min()),
         "where": tuple(round(float(c), 6) for c in 0.5 * (v[a[k]] + v[b[k]])),
         "detour": float(along[k] - d[k]),
         "size": float(np.linalg.norm(used.max(axis=0) - used.min(axis=0))),
+        "joined": int(np.count_nonzero(across < apart * h)),
+        "spacing": float(np.min(across / apart)),
     }
+
+
+def apart_spacings(direction: np.ndarray) -> np.ndarray:
+    """Per unit ``direction`` across a slit, the width in grid spacings from which the band keeps
+    its sides apart: :data:`WARN_SPACINGS` along an axis, :data:`WARN_SPACINGS` +
+    :data:`DIAGONAL_SPACINGS` diagonally in a grid plane (in between as ``1 − max |u_k|``)."""
+    t = (1.0 - np.max(np.abs(direction), axis=1)) / (1.0 - np.sqrt(0.5))
+    return WARN_SPACINGS + DIAGONAL_SPACINGS * t
 
 
 def _slit_pairs(surface: Any, h: float) -> Optional[Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
@@ -148,17 +176,17 @@ def _search(surface: Any, h: float) -> Optional[Tuple[np.ndarray, np.ndarray, np
 
 
 def warn_slits(info: Optional[dict], h: float) -> None:
-    """The warning for :func:`find`'s slits, when the narrowest is under :data:`WARN_SPACINGS`
-    grid spacings ``h`` and the way round over ``WARN_SHARE`` of the mesh's size (as for its
-    holes)."""
-    if info is None or info["gap"] >= WARN_SPACINGS * h or info["detour"] <= WARN_SHARE * info["size"]:
+    """The warning for :func:`find`'s slits, when the band joins the sides of some (``joined``)
+    and the way round is over ``WARN_SHARE`` of the mesh's size (as for its holes)."""
+    if info is None or not info["joined"] or info["detour"] <= WARN_SHARE * info["size"]:
         return
     warnings.warn(
         f"the mesh's open edges come within {info['gap']:.3g} of each other across empty space "
-        f"({info['gap'] / h:.2g} grid spacings: a slit, near {info['where']}): the band joins the two sides and the "
-        f"front can cross the slit, so distances reached across it can come out short, by up to about "
+        f"({info['gap'] / h:.2g} grid spacings: a slit, near {info['where']}): the band joins the two sides, so the "
+        "front can cross the slit and values read next to its edges mix both sides: distances across it can come out "
+        "short, by up to about "
         f"{info['detour']:.3g} ({info['detour'] / info['size']:.0%} of the mesh's size: the way round along its "
-        f"open edges). sol.stats.slits has it; a grid spacing below {info['gap'] / WARN_SPACINGS:.3g} (now {h:.3g}) "
+        f"open edges). sol.stats.slits has it; a grid spacing below {info['spacing']:.3g} (now {h:.3g}) "
         "keeps the sides apart; if the surface is closed there, close the slit in the mesh",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
