@@ -128,3 +128,24 @@ def test_meshes_solve_without_scipy(tmp_path):
     done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["True", "True", "False"], done.stdout + done.stderr[-2000:]
+
+
+def test_a_coarse_cap_on_a_finer_side_is_no_pinch():
+    # a cylinder of 64 side segments whose caps are fans of 8 or 4: the caps' rim chords turn
+    # 20-34 degrees away from the side's, so the seam was taken for 16 or 8 pinches; both ends of
+    # each cap chord lie on the side, which makes it a seam
+    side, rows = 64, 8
+    th = np.linspace(0, 2 * np.pi, side, endpoint=False)
+    z = np.linspace(-0.5, 0.5, rows + 1)
+    v = np.c_[0.5 * np.cos(np.tile(th, rows + 1)), 0.5 * np.sin(np.tile(th, rows + 1)), np.repeat(z, side)]
+    i, j = np.meshgrid(np.arange(rows), np.arange(side), indexing="ij")
+    a, b = (i * side + j).ravel(), (i * side + (j + 1) % side).ravel()
+    faces = [np.c_[a, b, b + side], np.c_[a, b + side, a + side]]
+    v = np.r_[v, [[0, 0, -0.5], [0, 0, 0.5]]]
+    bottom, top = len(v) - 2, len(v) - 1
+    for cap in (8, 4):
+        k = np.arange(cap) * (side // cap)
+        k1 = (k + side // cap) % side
+        fans = np.r_[np.c_[np.full(cap, bottom), k1, k], np.c_[np.full(cap, top), rows * side + k, rows * side + k1]]
+        surf = ts.surfaces.from_mesh((v, np.r_[faces[0], faces[1], fans]))
+        assert _mesh_pinches.pinches(surf) is None, cap

@@ -94,8 +94,10 @@ def _joined_at_seams(
     a seam: patches of one surface meshed apart, sharing vertices but no edges (T-junctions: a
     CAD export's cap with fewer segments than its side, a box's faces divided 6 and 7 times),
     where an open edge of one runs along an open edge of the other from a shared vertex
-    (:data:`SEAM_COS`). Without this a cube of such faces was cut along its edges but at its
-    corners: 28 spacings off, or unreached, at N = 41 and 81 (a helper's review)."""
+    (:data:`SEAM_COS`), or where both ends of an open edge of one are vertices of the other (a
+    coarse patch's chord along a finer one's curved rim turns away from the finer chords by up
+    to half the angle between them). Without this a cube of such faces was cut along its edges
+    but at its corners: 28 spacings off, or unreached, at N = 41 and 81 (a helper's review)."""
     slots = ((0, 1), (0, 2), (1, 2))
     open_slot = counts[ids] == 1
     face, slot = np.nonzero(open_slot)
@@ -118,10 +120,26 @@ def _joined_at_seams(
         same &= np.einsum("ij,ij->i", d[k:], d[:-k]) > SEAM_COS
         firsts.append(of[:-k][same])
         seconds.append(of[k:][same])
+    # an open edge of sheet s whose two ends both lie on sheet t: (edge, t) found from both ends
+    n = int(sheet.max()) + 1
+    on = np.unique(np.stack([tri.ravel(), np.repeat(sheet, 3)], axis=1), axis=0)  # (vertex, sheet)
+    start = np.searchsorted(on[:, 0], np.arange(int(tri.max()) + 2))
+    edge_sheet = sheet[face]
+    keys = []
+    for end in (p, q):
+        count = start[end + 1] - start[end]
+        edge = np.repeat(np.arange(end.size), count)
+        other = on[
+            np.repeat(start[end], count) + np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count), 1
+        ]
+        keep = other != edge_sheet[edge]
+        keys.append(np.unique(edge[keep] * n + other[keep]))
+    both = np.intersect1d(keys[0], keys[1], assume_unique=True)
+    firsts.append(edge_sheet[both // n])
+    seconds.append(both % n)
     a, b = np.concatenate(firsts), np.concatenate(seconds)
     if a.size == 0:
         return sheet
-    n = int(sheet.max()) + 1
     joined = vertex_parts(n, np.stack([a, b, b], axis=1))
     _, out = np.unique(joined[sheet], return_inverse=True)
     return out.ravel()
