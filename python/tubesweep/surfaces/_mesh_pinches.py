@@ -31,9 +31,15 @@ import numpy as np
 from ._mesh_checks import unique_edges
 from ._mesh_parts import CHUNK, face_parts, merged_vertices, vertex_parts
 
-#: Two sheets whose open edges leave a shared vertex in directions this close (cosine) meet along
-#: a seam there, not at a point (:func:`_joined_at_seams`).
-SEAM_COS = 0.98
+#: Two sheets whose open edges leave a shared vertex along each other, the shorter one's far end
+#: within this share of the longer one's length of it, meet along a seam there, not at a point
+#: (:func:`_joined_at_seams`; a cube's faces divided 6 and 7 times: 0; two bowls whose rims touch
+#: at a vertex leave it along one tangent, their next vertices some 5% of an edge apart).
+SEAM_ON = 1e-3
+#: Two sheets sharing this many vertices or more are joined (a curved seam whose vertices are
+#: shared in part: a cylinder's caps of 8 segments on a side of 36; several contacts are left to
+#: the band, as before pinches were judged).
+SHARED_VERTICES = 3
 #: Band edges between two sheets stay where both nodes' closest points lie within this many grid
 #: spacings of a pinch vertex (the nodes round the point where the sheets meet).
 PINCH_REACH = 0.5
@@ -106,20 +112,18 @@ def _joined_at_seams(
     ends = np.array(slots)[slot]
     p = tri[face, ends[:, 0]]
     q = tri[face, ends[:, 1]]
-    # each open edge from both its ends: (vertex, sheet, unit direction along the edge)
+    # each open edge from both its ends: (vertex, sheet, vector along the edge)
     vertex = np.r_[p, q]
     of = np.r_[sheet[face], sheet[face]]
     d = np.r_[position[q] - position[p], position[p] - position[q]]
-    d = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
     order = np.argsort(vertex, kind="stable")
     vertex, of, d = vertex[order], of[order], d[order]
     firsts, seconds = [], []
     longest = int(np.max(np.unique(vertex, return_counts=True)[1]))
     for k in range(1, longest):
         same = (vertex[k:] == vertex[:-k]) & (of[k:] != of[:-k])
-        same &= np.einsum("ij,ij->i", d[k:], d[:-k]) > SEAM_COS
-        firsts.append(of[:-k][same])
-        seconds.append(of[k:][same])
+        firsts.append(of[:-k][same & _overlap(d[k:], d[:-k])])
+        seconds.append(of[k:][same & _overlap(d[k:], d[:-k])])
     # an open edge of sheet s whose two ends both lie on sheet t: (edge, t) found from both ends
     n = int(sheet.max()) + 1
     on = np.unique(np.stack([tri.ravel(), np.repeat(sheet, 3)], axis=1), axis=0)  # (vertex, sheet)
@@ -137,12 +141,46 @@ def _joined_at_seams(
     both = np.intersect1d(keys[0], keys[1], assume_unique=True)
     firsts.append(edge_sheet[both // n])
     seconds.append(both % n)
+    # two sheets sharing SHARED_VERTICES vertices or more meet along a seam or at several points:
+    # not cut (as before pinches were judged)
+    pair = np.unique(on[:, 0], return_index=True, return_counts=True)
+    many = pair[2] > 1
+    if np.any(many):
+        starts, counts_at = pair[1][many], pair[2][many]
+        rows = np.repeat(starts, counts_at) + np.arange(int(counts_at.sum())) - np.repeat(np.cumsum(counts_at) - counts_at, counts_at)
+        group = np.repeat(np.arange(starts.size), counts_at)
+        sheets_at = on[rows, 1]
+        # the pairs of sheets at each shared vertex (vertices on few sheets: a short double loop)
+        ii, jj = [], []
+        most = int(counts_at.max())
+        for x in range(1, most):
+            ok = np.r_[group[x:] == group[:-x]] if x < group.size else np.zeros(0, bool)
+            ii.append(sheets_at[:-x][ok])
+            jj.append(sheets_at[x:][ok])
+        si, sj = np.concatenate(ii), np.concatenate(jj)
+        key, shared = np.unique(np.minimum(si, sj) * n + np.maximum(si, sj), return_counts=True)
+        joined_many = key[shared >= SHARED_VERTICES]
+        firsts.append(joined_many // n)
+        seconds.append(joined_many % n)
     a, b = np.concatenate(firsts), np.concatenate(seconds)
     if a.size == 0:
         return sheet
     joined = vertex_parts(n, np.stack([a, b, b], axis=1))
     _, out = np.unique(joined[sheet], return_inverse=True)
     return out.ravel()
+
+
+def _overlap(d1: np.ndarray, d2: np.ndarray) -> np.ndarray:
+    """Whether two open edges leaving one vertex (vectors ``d1``, ``d2``) run along each other:
+    the shorter one's far end lies on the longer one (a straight seam), not merely in the same
+    direction (two bowls whose rims touch at a point leave it along one tangent)."""
+    l1, l2 = np.linalg.norm(d1, axis=1), np.linalg.norm(d2, axis=1)
+    short = np.where((l1 <= l2)[:, None], d1, d2)
+    long_ = np.where((l1 <= l2)[:, None], d2, d1)
+    long_len2 = np.maximum(np.einsum("ij,ij->i", long_, long_), 1e-300)
+    t = np.clip(np.einsum("ij,ij->i", short, long_) / long_len2, 0.0, 1.0)
+    off = np.linalg.norm(short - t[:, None] * long_, axis=1)
+    return (np.einsum("ij,ij->i", short, long_) > 0.0) & (off <= SEAM_ON * np.sqrt(long_len2))
 
 
 def pinch_cut_pairs(surface: Any, grid: Any, band: Any, linear: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
