@@ -147,14 +147,18 @@ def _joined_at_seams(
     many = pair[2] > 1
     if np.any(many):
         starts, counts_at = pair[1][many], pair[2][many]
-        rows = np.repeat(starts, counts_at) + np.arange(int(counts_at.sum())) - np.repeat(np.cumsum(counts_at) - counts_at, counts_at)
+        rows = (
+            np.repeat(starts, counts_at)
+            + np.arange(int(counts_at.sum()))
+            - np.repeat(np.cumsum(counts_at) - counts_at, counts_at)
+        )
         group = np.repeat(np.arange(starts.size), counts_at)
         sheets_at = on[rows, 1]
         # the pairs of sheets at each shared vertex (vertices on few sheets: a short double loop)
         ii, jj = [], []
         most = int(counts_at.max())
         for x in range(1, most):
-            ok = np.r_[group[x:] == group[:-x]] if x < group.size else np.zeros(0, bool)
+            ok = group[x:] == group[:-x]
             ii.append(sheets_at[:-x][ok])
             jj.append(sheets_at[x:][ok])
         si, sj = np.concatenate(ii), np.concatenate(jj)
