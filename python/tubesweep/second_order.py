@@ -23,6 +23,7 @@ from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._parts import drop_unsourced, part_labels, source_parts
 from ._prepare import ROLE_OUTER, thinned_count
+from ._result_check import stranded_nodes
 from .mask import mask_advice
 from .moving import values_checksum
 from ._stagnation import fallback_message
@@ -630,6 +631,29 @@ def run_native(
     return values, u0, roles_out, st
 
 
+def split_at_creases(tube: Any, values: np.ndarray) -> Optional[str]:
+    """Why second order's values on ``tube`` (its inner tube thinned at creases) cannot stand, or
+    None: where a thin part meets creases (a neck between two balls), the thinning can take its
+    whole inner tube away, and the sweeps, whose extension nodes only read nodes nearer the
+    surface, stop there: nodes of the paper's inner tube left at inf next to reached ones
+    (``_result_check.stranded_nodes``). Two balls joined by a cylinder of radius 1.9 spacings at
+    N = 41 left the far ball at inf with no warning (a helper's review); the paper's scheme
+    reaches it. O(unreached) when some nodes are unreached, nothing otherwise."""
+    if thinned_count(tube) == 0 or np.all(np.isfinite(values)):
+        return None
+    paper = tube.roles != ROLE_OUTER
+    paper[tube.crease_nodes] = True
+    stranded = stranded_nodes(tube.grid, tube.band, values, paper)
+    if stranded.size == 0:
+        return None
+    where = tuple(round(float(c), 4) for c in tube.grid.node_points(tube.linear[stranded[:1]])[0])
+    return (
+        f"the inner tube, thinned at the creases of φ's level sets, splits near {where}: a part thinner than a few "
+        f"grid spacings meets creases there, and the second-order sweeps left {stranded.size} nodes beyond it "
+        "unreached. order=1, the paper's scheme on its own tube, reaches them; a finer grid resolves the part"
+    )
+
+
 def solve_on_tube(
     tube: Any,
     src: np.ndarray,
@@ -675,6 +699,9 @@ def solve_on_tube(
         raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf))
     if parts is not None:
         drop_unsourced(values, parts, sourced)
+    split = split_at_creases(tube, values)
+    if split is not None:
+        raise Order2NotApplicable(split)
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
