@@ -148,6 +148,13 @@ def test_refusals_name_the_cause(first):
         moved.solve([(r, 0.0, 0.0)], warm=sol)
     with pytest.raises(WarmStartRefused, match="the older solution has 2 source"):
         moved.solve(pole(r), warm=(tube.solve([(0.0, 0.0, 0.5), (0.5, 0.0, 0.0)]), sol))
+    # an older solution of another problem (a review took both in without a word): its source at
+    # the other pole, or its surface far from the previous one's at the same source
+    with pytest.raises(WarmStartRefused, match=r"warm=\(older, previous\): a source of one lies 1 \(20\.00 grid"):
+        moved.solve(pole(r), warm=(tube.solve([(0.0, 0.0, -0.5)]), sol))
+    stretched = ts.Tube(ts.surfaces.Ellipsoid(0.5 + 6 * H, 0.5, 0.5), GRID).solve(pole(0.5))
+    with pytest.raises(WarmStartRefused, match=r"nodes of the previous solution's inner tube lie outside the older"):
+        moved.solve(pole(r), warm=(stretched, sol))
     with pytest.raises(WarmStartRefused, match="1 source"):
         moved.solve([(0.0, 0.0, r), (r, 0.0, 0.0)], warm=sol)
     far = 0.5 + 3.0 * H  # farther than outer − inner = 2 spacings

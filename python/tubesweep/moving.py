@@ -271,6 +271,8 @@ def carried_values(
             f"warm: the topology changed: {changed}; carried values on a part that lost its source would never "
             "settle. Solve cold (leave out warm=) across the change, then warm again"
         )
+    if older is not None:
+        _check_older(older, warm, old_linear, slack, h)
     # the sources as a set, in any order: each one's nearest previous source, and the other way
     old_feet = np.ascontiguousarray(old_feet, dtype=float)
     moved = np.linalg.norm(old_feet[_native.nearest_feet(old_feet, feet)] - feet, axis=1)
@@ -330,3 +332,35 @@ def _unpropagated_drift(warm: Any, digests: np.ndarray, tol: float) -> Tuple[np.
         digests = np.array(digests, dtype=np.uint64, copy=True)
         digests[drifted] = ~digests[drifted]
     return digests, anchor, count
+
+
+def _check_older(older: Any, previous: Any, previous_linear: np.ndarray, slack: float, h: float) -> None:
+    """Refuses ``warm=(older, previous)`` whose ``older`` is not the step before ``previous`` of the
+    same problem: its sources farther from the previous ones, or the previous inner tube farther
+    outside its band, than two steps may move (2·(outer − inner) spacings). Such a pair (a torus's
+    solution, a source at the other pole, a sphere 6 spacings smaller) was taken without a word and
+    only cost time (a review of issue 47)."""
+    from ._prepare import ROLE_OUTER
+
+    reach = 2.0 * slack * (1 + 1e-9)
+    a = np.ascontiguousarray(older._factoring[1], dtype=float)
+    b = np.ascontiguousarray(previous._factoring[1], dtype=float)
+    far = max(
+        float(np.max(np.linalg.norm(a[_native.nearest_feet(a, b)] - b, axis=1))),
+        float(np.max(np.linalg.norm(b[_native.nearest_feet(b, a)] - a, axis=1))),
+    )
+    if far > reach:
+        raise WarmStartRefused(
+            f"warm=(older, previous): a source of one lies {far:.4g} ({far / h:.2f} grid spacings) from the nearest of "
+            f"the other's, farther than two steps may move (2·(outer − inner) = {reach / h:g} spacings): the pair must "
+            "be the two previous steps of this problem, older first. Pass warm=previous alone, or the right pair"
+        )
+    position = _native.carry_band_values(_linear(older), np.zeros(len(older.values)), previous_linear)
+    outside = int(np.count_nonzero((previous.roles != ROLE_OUTER) & ~np.isfinite(position)))
+    if outside:
+        raise WarmStartRefused(
+            f"warm=(older, previous): {outside} nodes of the previous solution's inner tube lie outside the older "
+            "one's band: the surface moved farther between them than two steps may, or they are of different "
+            "surfaces. The pair must be the two previous steps of this problem, older first. Pass warm=previous alone, "
+            "or the right pair"
+        )
