@@ -635,23 +635,31 @@ def split_at_creases(tube: Any, values: np.ndarray) -> Optional[str]:
     """Why second order's values on ``tube`` (its inner tube thinned at creases) cannot stand, or
     None: where a thin part meets creases (a neck between two balls), the thinning can take its
     whole inner tube away, and the sweeps, whose extension nodes only read nodes nearer the
-    surface, stop there: nodes of the paper's inner tube left at inf next to reached ones
-    (``_result_check.stranded_nodes``). Two balls joined by a cylinder of radius 1.9 spacings at
-    N = 41 left the far ball at inf with no warning (a helper's review); the paper's scheme
-    reaches it. O(unreached) when some nodes are unreached, nothing otherwise."""
+    surface, stop there: nodes next to the surface (within half a cell's diagonal of it, a layer
+    that follows the surface and joins only what the surface joins) left at inf next to reached
+    ones of that layer (``_result_check.stranded_nodes``). Two balls joined by a cylinder of
+    radius 1.9 spacings at N = 41 left the far ball at inf with no warning (a helper's review);
+    the paper's scheme reaches it. (The paper's inner tube, with the thinned nodes, would also join
+    two curves a few spacings apart, a thin ring's, whose unsourced one rightly stays at inf.)
+    O(unreached) when some nodes are unreached, nothing otherwise."""
     if thinned_count(tube) == 0 or np.all(np.isfinite(values)):
         return None
-    paper = tube.roles != ROLE_OUTER
-    paper[tube.crease_nodes] = True
-    stranded = stranded_nodes(tube.grid, tube.band, values, paper)
+    layer = np.abs(np.asarray(tube.phi, dtype=float)) <= SURFACE_LAYER * tube.grid.spacing
+    stranded = stranded_nodes(tube.grid, tube.band, values, layer)
     if stranded.size == 0:
         return None
     where = tuple(round(float(c), 4) for c in tube.grid.node_points(tube.linear[stranded[:1]])[0])
     return (
         f"the inner tube, thinned at the creases of φ's level sets, splits near {where}: a part thinner than a few "
-        f"grid spacings meets creases there, and the second-order sweeps left {stranded.size} nodes beyond it "
-        "unreached. order=1, the paper's scheme on its own tube, reaches them; a finer grid resolves the part"
+        f"grid spacings meets creases there, and the second-order sweeps left {stranded.size} nodes next to the "
+        "surface beyond it unreached. order=1, the paper's scheme on its own tube, reaches them; a finer grid resolves "
+        "the part"
     )
+
+
+#: :func:`split_at_creases` follows the surface through the nodes within this many grid spacings
+#: of it (half a cell's diagonal: every cell the surface crosses has a corner that close).
+SURFACE_LAYER = 0.5 * math.sqrt(3.0)
 
 
 def solve_on_tube(
