@@ -71,3 +71,16 @@ def test_a_sphere_that_only_touches_the_box_is_not_said_to_be_cut():
     sol = ts.solve(ts.surfaces.Sphere(0.5), g, [(-0.5, 0, 0)])
     assert sol.stats.box_cut["surface_cut"] is False
     assert abs(sol([(0, 0, 0.5)])[0] - np.pi / 4) < 0.1 * g.spacing
+
+
+def test_a_union_of_overlapping_balls_is_named_among_the_causes():
+    # min(d1, d2) of two overlapping balls is no distance inside their overlap (|∇φ| = 0 on the
+    # middle plane): "refine the grid" alone could not help (a helper's sweep)
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    x = np.stack(grid.meshgrid(), axis=-1)
+    phi = np.minimum(np.linalg.norm(x - (0, 0, 0.3), axis=-1), np.linalg.norm(x - (0, 0, -0.3), axis=-1)) - 0.35
+    with pytest.raises(ValueError, match=r"a union min\(φ₁, φ₂\) of overlapping parts.*redistance=True"):
+        ts.solve(ts.LevelSet(phi), grid, [(0, 0, 0.65)])
+    with pytest.warns(RuntimeWarning, match="creases or corners"):  # (where the balls meet)
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(0, 0, 0.65)])
+    assert sol.stats.converged

@@ -516,7 +516,8 @@ class LevelSet(Surface):
                 "the grid is too coarse for the surface: the tube (outer × grid spacing on each side) reaches a point "
                 "where ∇φ vanishes, such as the middle of a gap between two parts of the surface that face each other, "
                 "the centre of a sphere not much larger than the tube or the core of a thin tube; refine the grid. "
-                "Otherwise use ts.LevelSet(phi, redistance=True) (on the command line: --redistance), which "
+                "Otherwise (a union min(φ₁, φ₂) of overlapping parts, for one, is no distance inside their overlap, "
+                "whatever the grid) use ts.LevelSet(phi, redistance=True) (on the command line: --redistance), which "
                 "re-distances φ in the band"
             )
         if lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH:
