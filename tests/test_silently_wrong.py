@@ -339,3 +339,25 @@ def test_a_thin_ring_keeps_second_order():
     exact = outer * np.minimum(np.abs(t - np.pi), 2 * np.pi - np.abs(t - np.pi))
     assert np.max(np.abs(sol(outer * np.c_[np.cos(t), np.sin(t)]) - exact)) < 0.1 * h
     assert not np.any(np.isfinite(sol(0.5 * np.c_[np.cos(t), np.sin(t)])))  # no source reaches it
+
+
+def test_a_level_set_plate_thinner_than_two_spacings_is_warned():
+    # an oblate spheroid 0.6 × 0.6 × 0.03, 1.2 spacings thick at N = 41: no node pair across it lies
+    # far enough from the surface for the gap test, and the front crossed it (the far pole 1.18
+    # short, 23.5 spacings) with warnings that pointed elsewhere (a helper's sweep)
+    x, y, z = G41.meshgrid()
+    f = (x**2 + y**2) / 0.36 + (z / 0.03) ** 2 - 1
+    for surface in (ts.LevelSet(f, redistance=True), ts.LevelSet.from_mask(f < 0, G41)):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sol = ts.solve(surface, G41, [(0, 0, -0.03)])
+        thin = [str(w.message) for w in caught if "at most two grid spacings thick" in str(w.message)]
+        assert len(thin) == 1 and "divided by 6 (now 0.05)" in thin[0], [str(w.message)[:80] for w in caught]
+        assert sol.stats.facing_pairs == 0
+    # a sphere's voxel mask of radius 5 spacings (its staircase: 2% of the nodes look thin) is not
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3)
+    r = np.linalg.norm(np.stack(grid.meshgrid(), axis=-1), axis=-1)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ts.solve(ts.LevelSet.from_mask(r < 0.5, grid), grid, [(0, 0, 0.5)])
+    assert not any("at most two grid spacings thick" in str(w.message) for w in caught)

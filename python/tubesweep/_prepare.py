@@ -25,6 +25,7 @@ from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
+from ._thin_level_set import thin_share, warn_thin
 from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
@@ -609,6 +610,8 @@ def _prepare_tube(
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)
+    elif isinstance(surf, LevelSet) and not facing[0].size:  # (where gaps are found, they are said)
+        warn_thin(*thin_share(grid, band, linear, phi), h, inner)
     holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh's or a cloud's holes the band spans
     bridged_holes = holes_of(h, outer_eff, grid, hole_pairs) if holes_of is not None else None
     slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, which the band may join

@@ -1,0 +1,101 @@
+"""Parts of a level set's inside thinner than two grid spacings (a plate, a flat ellipsoid, a thin
+wall of a voxel mask), warned about like a mesh's thin parts (``surfaces._mesh_checks``).
+
+Where the inside of the surface is a slab at most two nodes thick along a grid axis, the tube's
+two sides are one: the front crosses the slab, and the narrow-gap test, which looks for pairs of
+nodes farther than 0.75Δx from the surface on either side, finds none (an oblate spheroid of
+radius 0.6 and thickness 0.06, 1.2 spacings at N = 41: the far pole 1.18 short, 23.5 spacings,
+with the gap warning only from N = 61 on and two warnings that pointed elsewhere; a helper's
+sweep). :func:`thin_share` reads φ on the band: an inside node (φ < 0) whose neighbour on one side
+along an axis and, on the other, its neighbour or the one after it are outside, with φ rising
+on both sides by more than :data:`BEND` spacings over the run (a slab's two faces; a node just
+inside a convex surface also has outside neighbours along a tangent, but φ rises there only by
+about h²/R: a sphere of radius 5 spacings gave 2% of its surface, falsely), and with
+:data:`SHEET` such neighbours.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any, Optional, Tuple
+
+import numpy as np
+
+from .grid import Grid
+from ._warn import user_stacklevel
+
+#: The warning is given from this share of the nodes next to the surface (the spheroid 1.2
+#: spacings thick: 41%; spheres, tori, a box and their voxel masks at N = 21–81: none).
+THIN_SHARE = 0.05
+#: ... and where φ rises on both sides of the run by more than this many grid spacings together
+#: (across a slab of thickness t < 2h at least 2h − t; grazing a convex surface of radius R about
+#: h²/R).
+BEND = 0.75
+#: ... counted where at least this many of a thin node's neighbours are thin too (a sheet of them:
+#: a noisy sphere's bumps, 0.3 spacings of noise, re-distanced, showed 5% alone).
+SHEET = 2
+#: Band nodes per block of the neighbour lookups (bounds the memory).
+CHUNK = 1 << 18
+
+
+def thin_share(grid: Grid, band: Any, linear: np.ndarray, phi: np.ndarray) -> Tuple[float, Optional[np.ndarray]]:
+    """The share of the band nodes next to the surface (within half a cell's diagonal) that lie
+    on an inside slab at most two nodes thick along an axis (module notes), and a point there
+    (None where there is none). O(band)."""
+    n = len(linear)
+    h = grid.spacing
+    phi = np.asarray(phi, dtype=float)
+    near = np.abs(phi) <= 0.5 * math.sqrt(grid.ndim) * h
+    outside = np.r_[phi > 0, False]  # (position n: no neighbour)
+    value = np.r_[phi, 0.0]
+    thin = np.zeros(n, bool)
+    for s in range(0, n, CHUNK):
+        at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
+        inside = phi[at] < 0
+        if not np.any(inside):
+            continue
+        nb = band.neighbours_of_nodes(at).reshape(len(at), grid.ndim, 2)
+        nb = np.where(nb < n, nb, n)
+        for k in range(grid.ndim):
+            lo, hi = nb[:, k, 0], nb[:, k, 1]
+            # the next ones along the axis, where the neighbour is in the band
+            lo2 = band.neighbours_of_nodes(np.where(lo < n, lo, 0)).reshape(len(at), grid.ndim, 2)[:, k, 0]
+            hi2 = band.neighbours_of_nodes(np.where(hi < n, hi, 0)).reshape(len(at), grid.ndim, 2)[:, k, 1]
+            lo2 = np.where((lo < n) & (lo2 < n), lo2, n)
+            hi2 = np.where((hi < n) & (hi2 < n), hi2, n)
+            here = phi[at]
+            one = outside[lo] & outside[hi] & (value[lo] + value[hi] - 2 * here > BEND * h)
+            # a run of two inside nodes: this one and the one above (or below) it
+            up = (hi < n) & ~outside[hi] & outside[lo] & outside[hi2]
+            up &= value[lo] + value[hi2] - here - value[np.minimum(hi, n)] > BEND * h
+            down = (lo < n) & ~outside[lo] & outside[hi] & outside[lo2]
+            down &= value[hi] + value[lo2] - here - value[np.minimum(lo, n)] > BEND * h
+            thin[at] |= inside & (one | up | down)
+    # a plate's thin nodes lie in a sheet; a bump of noise or a mask's corner is one or two alone
+    at = np.flatnonzero(thin)
+    if at.size:
+        nb = band.neighbours_of_nodes(at).reshape(at.size, -1)
+        flagged = np.r_[thin, False]
+        thin[at] = np.count_nonzero(flagged[np.where(nb < n, nb, n)], axis=1) >= SHEET
+    total = int(np.count_nonzero(near))
+    hits = near & thin
+    if total == 0 or not np.any(hits):
+        return 0.0, None
+    return float(np.count_nonzero(hits)) / total, grid.node_points(linear[np.flatnonzero(hits)[:1]])[0]
+
+
+def warn_thin(share: float, where: Optional[np.ndarray], h: float, inner: float) -> None:
+    """A RuntimeWarning when :func:`thin_share` is over :data:`THIN_SHARE`."""
+    if share < THIN_SHARE or where is None:
+        return
+    at = ", ".join(f"{float(x):.3g}" for x in where)
+    warnings.warn(
+        f"about {share:.0%} of the surface lies on a part of φ's inside at most two grid spacings thick (a plate or a "
+        f"thin wall, e.g. near ({at})): there the tube cannot keep the two sides apart and the front crosses between "
+        "them, so distances past such parts can come out short by as much as the way around the part (a flat "
+        "spheroid 1.2 spacings thick: its far pole 23 spacings short). A grid spacing below the part's thickness "
+        f"divided by {2 * inner + 2:g} (now {h:.3g}) resolves it",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )
