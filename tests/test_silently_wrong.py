@@ -347,6 +347,8 @@ def test_a_level_set_plate_thinner_than_two_spacings_is_warned():
     # short, 23.5 spacings) with warnings that pointed elsewhere (a helper's sweep)
     x, y, z = G41.meshgrid()
     f = (x**2 + y**2) / 0.36 + (z / 0.03) ** 2 - 1
+    t = np.linspace(0, np.pi, 20001)
+    meridian = np.trapezoid(np.hypot(0.6 * np.cos(t), 0.03 * np.sin(t)), t)  # pole to pole: 1.206
     for surface in (ts.LevelSet(f, redistance=True), ts.LevelSet.from_mask(f < 0, G41)):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -354,6 +356,8 @@ def test_a_level_set_plate_thinner_than_two_spacings_is_warned():
         thin = [str(w.message) for w in caught if "at most two grid spacings thick" in str(w.message)]
         assert len(thin) == 1 and "divided by 6 (now 0.05)" in thin[0], [str(w.message)[:80] for w in caught]
         assert sol.stats.facing_pairs == 0
+        # what it warns of: the front goes through, the far pole 23.5-23.6 spacings short
+        assert 23 < (meridian - sol([(0, 0, 0.03)])[0]) / G41.spacing < 24
     # a sphere's voxel mask of radius 5 spacings (its staircase: 2% of the nodes look thin) is not
     grid = ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3)
     r = np.linalg.norm(np.stack(grid.meshgrid(), axis=-1), axis=-1)

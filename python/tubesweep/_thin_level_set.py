@@ -52,11 +52,12 @@ def thin_share(grid: Grid, band: Any, linear: np.ndarray, phi: np.ndarray) -> Tu
     thin = np.zeros(n, bool)
     for s in range(0, n, CHUNK):
         at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
-        inside = phi[at] < 0
-        if not np.any(inside):
+        at = at[phi[at] < 0]  # (inside nodes only)
+        if at.size == 0:
             continue
         nb = band.neighbours_of_nodes(at).reshape(len(at), grid.ndim, 2)
         nb = np.where(nb < n, nb, n)
+        here = phi[at]
         for k in range(grid.ndim):
             lo, hi = nb[:, k, 0], nb[:, k, 1]
             # the next ones along the axis, where the neighbour is in the band
@@ -64,14 +65,13 @@ def thin_share(grid: Grid, band: Any, linear: np.ndarray, phi: np.ndarray) -> Tu
             hi2 = band.neighbours_of_nodes(np.where(hi < n, hi, 0)).reshape(len(at), grid.ndim, 2)[:, k, 1]
             lo2 = np.where((lo < n) & (lo2 < n), lo2, n)
             hi2 = np.where((hi < n) & (hi2 < n), hi2, n)
-            here = phi[at]
             one = outside[lo] & outside[hi] & (value[lo] + value[hi] - 2 * here > BEND * h)
             # a run of two inside nodes: this one and the one above (or below) it
             up = (hi < n) & ~outside[hi] & outside[lo] & outside[hi2]
-            up &= value[lo] + value[hi2] - here - value[np.minimum(hi, n)] > BEND * h
+            up &= value[lo] + value[hi2] - here - value[hi] > BEND * h
             down = (lo < n) & ~outside[lo] & outside[hi] & outside[lo2]
-            down &= value[hi] + value[lo2] - here - value[np.minimum(lo, n)] > BEND * h
-            thin[at] |= inside & (one | up | down)
+            down &= value[hi] + value[lo2] - here - value[lo] > BEND * h
+            thin[at] |= one | up | down
     # a plate's thin nodes lie in a sheet; a bump of noise or a mask's corner is one or two alone
     at = np.flatnonzero(thin)
     if at.size:

@@ -32,6 +32,19 @@ EVAL_CHUNK = 1 << 18
 KINK_FRACTION = 0.35
 
 
+def band_edges(band: Any, n: int, chunk: int = 1 << 18) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
+    """The edges of ``band`` (``n`` nodes) in its own neighbour table (a cut edge is none), each
+    once, as pairs of band positions ``(node, neighbour)`` with ``node < neighbour``, ``chunk``
+    nodes at a time."""
+    for s in range(0, n, chunk):
+        at = np.arange(s, min(s + chunk, n), dtype=np.int64)
+        nb = band.neighbours_of_nodes(at).reshape(len(at), -1)
+        node = np.repeat(at, nb.shape[1])
+        other = nb.ravel()
+        keep = (other < n) & (other > node)
+        yield node[keep], other[keep]
+
+
 def band_neighbours(
     grid: Grid, band: Any, linear: np.ndarray, nodes: np.ndarray
 ) -> Iterator[Tuple[np.ndarray, np.ndarray, np.ndarray]]:

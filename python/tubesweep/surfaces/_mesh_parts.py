@@ -28,6 +28,7 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
+from ..band import band_edges
 from ..grid import Grid
 from ._mesh_checks import unique_edges
 
@@ -221,15 +222,8 @@ def part_cut_pairs(
     part = node_parts(surface, grid, linear) if len(linear) else None
     if part is None:
         return empty, empty, None
-    n = len(linear)
     nodes, neighbours = [], []
-    for s in range(0, n, CHUNK):
-        at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
-        nb = band.neighbours_of_nodes(at).reshape(len(at), -1)
-        node = np.repeat(at, nb.shape[1])
-        other = nb.ravel()
-        keep = (other < n) & (other > node)
-        node, other = node[keep], other[keep]
+    for node, other in band_edges(band, len(linear), CHUNK):
         crossing = part[node] != part[other]
         nodes.append(node[crossing])
         neighbours.append(other[crossing])

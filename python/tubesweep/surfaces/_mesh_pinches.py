@@ -28,6 +28,7 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
+from ..band import band_edges
 from ._mesh_checks import unique_edges
 from ._mesh_parts import CHUNK, face_parts, merged_vertices, vertex_parts
 
@@ -213,13 +214,7 @@ def pinch_cut_pairs(surface: Any, grid: Any, band: Any, linear: np.ndarray) -> T
             node_piece[s : s + CHUNK] = np.where(face >= 0, piece[np.maximum(face, 0)], -1)
         pinch[s : s + CHUNK], far[s : s + CHUNK] = _nearest(cp, points)
     firsts, seconds = [], []
-    for s in range(0, n, CHUNK):
-        at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
-        nb = band.neighbours_of_nodes(at).reshape(len(at), -1)
-        a = np.repeat(at, nb.shape[1])
-        b = nb.ravel()
-        keep = (b < n) & (b > a)
-        a, b = a[keep], b[keep]
+    for a, b in band_edges(band, n, CHUNK):
         between = (
             (node_sheet[a] != node_sheet[b])
             & (node_sheet[a] >= 0)

@@ -104,15 +104,7 @@ pub fn factor_sources_of<const D: usize>(
             &mut fixed_per_source,
         );
         u0[i] = node.u0;
-        if let Some((source, chord, grad)) = node.fixed_by {
-            fixed.push(FixedNode {
-                node: i as u32,
-                rank: grad_u0.len() as u32,
-                source,
-                chord,
-                grad_u0: grad,
-            });
-        }
+        fixed.extend(node.fixed_node(i, grad_u0.len()));
         if inner {
             grad_u0.push(node.grad_u0);
         }
@@ -171,6 +163,19 @@ pub(crate) struct NodeFactor<const D: usize> {
     /// At a fixed node: the nearest source within `fix_radius`, the chord to it, and the ∇u₀
     /// over the unit the node takes if [`super::joined::keep_joined`] unfixes it.
     pub(crate) fixed_by: Option<(u32, f64, [f32; D])>,
+}
+
+impl<const D: usize> NodeFactor<D> {
+    /// The [`FixedNode`] of band position `node`, its ∇u₀ entry at `rank`, when a source fixed it.
+    pub(crate) fn fixed_node(&self, node: usize, rank: usize) -> Option<FixedNode<D>> {
+        self.fixed_by.map(|(source, chord, grad_u0)| FixedNode {
+            node: node as u32,
+            rank: rank as u32,
+            source,
+            chord,
+            grad_u0,
+        })
+    }
 }
 
 /// What the factoring reads at a node besides the sources: its closest point, and at an
@@ -380,15 +385,7 @@ pub fn factor_sources_at<const D: usize>(
             &mut fixed_per_source,
         );
         u0.push(node.u0);
-        if let Some((source, chord, grad)) = node.fixed_by {
-            fixed.push(FixedNode {
-                node: i as u32,
-                rank: grad_u0.len() as u32,
-                source,
-                chord,
-                grad_u0: grad,
-            });
-        }
+        fixed.extend(node.fixed_node(i, grad_u0.len()));
         if foot.is_some() {
             grad_u0.push(node.grad_u0);
         }

@@ -184,15 +184,7 @@ fn setup<const D: usize>(
                     &mut out.fixed_per_source,
                 );
                 out.u0.push(node.u0);
-                if let Some((source, chord, grad)) = node.fixed_by {
-                    out.fixed.push(FixedNode {
-                        node: i as u32,
-                        rank: out.grad_u0.len() as u32,
-                        source,
-                        chord,
-                        grad_u0: grad,
-                    });
-                }
+                out.fixed.extend(node.fixed_node(i, out.grad_u0.len()));
                 if is_inner {
                     out.grad_u0.push(node.grad_u0);
                 }
