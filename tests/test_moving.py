@@ -268,9 +268,15 @@ def test_evolve_refuses_more_bad_input_up_front(tmp_path):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: None, dt=0.05, steps=1)
     with pytest.raises(TypeError, match="must return real numbers"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: (0.1 + 0j) * u, dt=0.05, steps=1)
-    # a checkpoint's folder is checked before the first solve, under the name given
-    with pytest.raises(ValueError, match="the folder of checkpoint=.*nodir.*does not exist"):
-        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=tmp_path / "nodir/a.npz")
+    # a checkpoint's folder is made before the first solve (as Evolution.export makes its own);
+    # one that cannot be made (a file stands in its way) is refused then, under the name given
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(ValueError, match="the folder of checkpoint=.*afile/sub/a.npz.*cannot be created"):
+        ts.evolve(
+            phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=tmp_path / "afile/sub/a.npz"
+        )
+    ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=tmp_path / "new/dir/a.npz")
+    assert sorted(np.load(tmp_path / "new/dir/a.npz").files) == ["phi", "sources", "step", "t"]
     # a .pvd beside frames whose names need escaping is well-formed XML
     import xml.etree.ElementTree as ET
 

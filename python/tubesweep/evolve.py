@@ -305,7 +305,7 @@ def evolve(
         Called as ``progress(step, steps, t)`` after each step.
     checkpoint : str or Path, optional
         A ``.npz`` file rewritten at each kept frame with ``phi``, ``t``, ``step`` and
-        ``sources`` (written beside it and renamed, so that an interrupted write leaves the last
+        ``sources`` (its folder made if missing; written beside it and renamed, so that an interrupted write leaves the last
         one whole): ``evolve(c["phi"], grid, c["sources"], speed, ..., t0=float(c["t"]))``
         continues from it. From a checkpoint written at a multiple of ``every`` steps, a run
         continued with the same ``dt``, ``every`` and a ``checkpoint`` repeats the uninterrupted
@@ -391,11 +391,16 @@ def evolve(
         )
     if checkpoint is not None and Path(checkpoint).is_dir():
         raise ValueError(f"evolve: checkpoint={str(checkpoint)!r} is a folder; give a file name ending in .npz")
-    if checkpoint is not None and not Path(checkpoint).resolve().parent.is_dir():
-        raise ValueError(
-            f"evolve: the folder of checkpoint={str(checkpoint)!r} does not exist; create it first (the checkpoint is "
-            "written after the first step's solve)"
-        )
+    if checkpoint is not None:
+        # the folder is made now, as Evolution.export makes its own, so that a path that cannot
+        # be written fails before the first solve rather than after it
+        try:
+            Path(checkpoint).resolve().parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(
+                f"evolve: the folder of checkpoint={str(checkpoint)!r} cannot be created ({exc.strerror or exc}); "
+                "give a path in a folder you can write to"
+            ) from None
     if not callable(speed):
         raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
     if progress is not None and not callable(progress):
