@@ -64,6 +64,42 @@ def test_a_concave_crease_is_not_said_to_make_fronts_only_early():
     assert not any("late" in str(w.message) for w in caught)
 
 
+def test_a_union_re_distanced_reports_its_crease_at_every_resolution():
+    # two spheres of radius 0.5, centres 0.6 apart, joined by min and re-distanced: at N = 61 the
+    # tube was thinned at the crease (the far sphere late by 0.27Δx on average) while no crease
+    # node was found and nothing was said (N = 41 and 81 warned); a node next to the crease's edge
+    # fitted |∇φ| ≈ 1 and its neighbour, where φ has the kink, turned by less than 40°
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    x = np.stack(grid.meshgrid(), axis=-1)
+    phi = np.minimum(np.linalg.norm(x + [0.3, 0, 0], axis=-1), np.linalg.norm(x - [0.3, 0, 0], axis=-1)) - 0.5
+    with pytest.warns(RuntimeWarning, match=r"creases or corners \(12 tube nodes, the normal turning by up to 90°\)"):
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.8, 0, 0)])
+    assert sol.stats.order == 2 and sol.stats.order2["creases"]["nodes"] == 12
+    assert sol.stats.crease_thinned == 612
+    crease = np.arccos(-0.3 / 0.5)  # the crease's polar angle on either sphere
+    beta = np.linspace(0.05, crease - 0.1, 40)  # the far sphere's meridian
+    late = sol(np.c_[0.3 + 0.5 * np.cos(beta), 0.5 * np.sin(beta), 0 * beta]) - 0.5 * (2 * crease - beta)
+    assert 0.2 * grid.spacing < np.mean(late) < 0.35 * grid.spacing  # late, as the warning says
+    # the paper's tube (order=1): 3.2Δx early beyond the crease, and nothing was said (the paper's
+    # tube's creases were not sought on any re-distanced φ, for a raw mask's staircase)
+    with pytest.warns(RuntimeWarning, match=r"\(4 tube nodes, the faces turning by up to 65°\): in the paper's tube"):
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.8, 0, 0)], order=1)
+    early = sol(np.c_[0.3 + 0.5 * np.cos(beta), 0.5 * np.sin(beta), 0 * beta]) - 0.5 * (2 * crease - beta)
+    assert -3.5 * grid.spacing < np.mean(early) < -3.0 * grid.spacing
+    # a raw mask's staircase is no crease (a sphere's said "turning by up to 84°")
+    mask = ts.LevelSet.from_mask(np.linalg.norm(x, axis=-1) < 0.6, grid)
+    assert ts.solve(mask, grid, [(0, 0, 0.6)], order=1).stats.creases is None
+    assert (
+        ts.solve(
+            ts.LevelSet(np.where(np.linalg.norm(x, axis=-1) < 0.6, -1.0, 1.0), redistance=True),
+            grid,
+            [(0, 0, 0.6)],
+            order=1,
+        ).stats.creases
+        is None
+    )
+
+
 def test_a_sphere_that_only_touches_the_box_is_not_said_to_be_cut():
     # φ = 0 at the node where the sphere touches z = 0.5 counted as a crossing: "the grid box cuts
     # the surface ... along a curve about 0.105 long", for a surface wholly inside the box
