@@ -172,14 +172,10 @@ def creases_in_paper_tube(
     }
 
 
-def warn_paper_tube_creases(
-    creases: Optional[dict], inner: float, spacing: float, *, redistanced: bool = False
-) -> None:
+def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: float) -> None:
     """A RuntimeWarning when the first-order scheme runs on the paper's tube (``order=1``) of a
     level set with creases (:func:`creases_in_paper_tube`): a front crossing one cuts its corner
-    and arrives early by about 2·tan(θ/2)·inner·Δx (the cube at N = 41: 4.25Δx per edge). What
-    the thinned tube leaves is said for a re-distanced φ (``redistanced``) as
-    :func:`thinned_spacings` reckons it."""
+    and arrives early by about 2·tan(θ/2)·inner·Δx (the cube at N = 41: 4.25Δx per edge)."""
     if not creases or not creases.get("nodes"):
         return
     angle = float(creases["angle_degrees"])
@@ -189,7 +185,7 @@ def warn_paper_tube_creases(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the faces turning by up to "
         f"{angle:.0f}°): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "
         f"Second order's tube (order='auto', the default, or order=2, with outer ≥ inner + 2) is thinned there, which "
-        f"leaves about {THINNED_SHORTCUT_REDISTANCED if redistanced else THINNED_SHORTCUT:g}Δx per crease; rounding the edges over more than the tube's width "
+        f"leaves about {THINNED_SHORTCUT:g}Δx per crease; rounding the edges over more than the tube's width "
         "(outer·Δx) leaves none. sol.stats.creases has the figures",
         RuntimeWarning,
         stacklevel=user_stacklevel(),

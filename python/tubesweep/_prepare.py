@@ -152,18 +152,6 @@ _BAND_BYTES_PER_NODE = 110
 _BAND_ESTIMATE_POINTS = 17
 
 
-def _raw_mask(surface: LevelSet, linear: np.ndarray) -> bool:
-    """Whether ``surface`` is a voxel mask re-distanced as it is, unsmoothed: from
-    :meth:`LevelSet.from_mask` with ``smooth=0``, or a φ that takes two values only at the band's
-    nodes (``linear``), such as ``np.where(mask, -1, 1)``. Its zero level set is a staircase."""
-    if not getattr(surface, "redistance", False):
-        return False
-    if surface._mask_smoothing is not None:
-        return surface._mask_smoothing == 0.0
-    given = getattr(surface, "_array", None)
-    return given is not None and np.unique(np.asarray(given).ravel()[linear]).size <= 2
-
-
 def thinned_at_creases(tube: _PreparedTube) -> _PreparedTube:
     """``tube`` with its crease nodes (``_PreparedTube.crease_nodes``) made extension nodes: the
     tube of ``order=2`` and of ``order="auto"`` on a level set with creases (docs/second-order.md).
@@ -629,11 +617,8 @@ def _prepare_tube(
     slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, which the band may join
     slits = slits_of(h) if slits_of is not None else None
     # (after the facing test, which reads the paper's inner tube). The paper's tube's creases are
-    # not reported on a raw voxel mask re-distanced, whose kinks include those of its staircase (a
-    # sphere's mask said "creases … turning by up to 84°"; :func:`_raw_mask`), but they are on any
-    # other re-distanced φ (a union min(φ₁, φ₂) of two spheres 74° apart at their crease, at
-    # order=1 2.4–3.3Δx early on average beyond it at N = 41–161 with no word; a sphere, a noisy one,
-    # tanh(d), a mask smoothed over half a voxel: none), and the crease nodes of both are
+    # not reported on a re-distanced φ, whose kinks include those of its samples (a voxel mask's
+    # staircase: a sphere's mask said "creases … turning by up to 84°"), but its crease nodes are
     # thinned all the same: a closed cylinder r = 0.35, h = 0.8, bottom centre, re-distanced
     # from its distance function came out 9.4, 8.1, 9.9Δx short at N = 41, 61, 81 in the paper's
     # tube (2.4, 2.5, 3.5Δx thinned), its voxel mask 7.3–7.9Δx (4.1–4.2Δx), a sphere's voxel mask
@@ -641,7 +626,7 @@ def _prepare_tube(
     extended = np.empty(0, np.int64)
     paper_creases = None
     if method == "two-layer" and isinstance(surf, LevelSet):
-        if not _raw_mask(surf, linear):
+        if not getattr(surf, "redistance", False):
             paper_creases = creases_in_paper_tube(band, roles == ROLE_INNER, phi, directions, h)
         if creases:
             extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)

@@ -388,7 +388,7 @@ def _first_order_batch(
     if fallback is not None:
         fallback.warn(out, t)
     if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut
-        warn_paper_tube_creases(t.paper_creases, t.inner, h, redistanced=bool(getattr(t.surface, "redistance", False)))
+        warn_paper_tube_creases(t.paper_creases, t.inner, h)
     # a part without a source keeps inf (``_parts``), read as the single solve reads it
     out = drop_unsourced_rows(out, t, groups, None if points is None else read_at, band)
     if plan is not None:

@@ -389,9 +389,7 @@ def _solve_on_tube(
     cut_edges = tube.cut_edges
     crease_thinned = thinned_count(tube)
     if crease_thinned == 0:  # the paper's tube: its creases' corners are cut
-        warn_paper_tube_creases(
-            tube.paper_creases, tube.inner, grid.spacing, redistanced=bool(getattr(surf, "redistance", False))
-        )
+        warn_paper_tube_creases(tube.paper_creases, tube.inner, grid.spacing)
     if scheme == "lxf" and cut_edges:
         # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
         # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
