@@ -88,6 +88,24 @@ def test_bad_input_is_a_clear_error_with_exit_code_2(tmp_path, capsys):
     assert "farther than the inner tube" in capsys.readouterr().err
 
 
+def test_a_refusal_names_the_flag_typed(tmp_path, capsys):
+    # the library's refusals name its own arguments (shape, sources, ...): on the command line the
+    # error line leads with the flag the user typed
+    for argv, head in (
+        (["--n", "2"], "error: --n: shape[0] = 2: every axis needs at least 3 nodes"),
+        (["--n", "21", "--source", "5", "5", "5"], "error: --source: sources[0] = (5.0, 5.0, 5.0) lies outside"),
+        (["--n", "21", "--tol=-1"], "error: --tol: tol must be a positive finite number"),
+        (["--n", "21", "--max-iterations", "0"], "error: --max-iterations: max_iterations must be an integer"),
+    ):
+        assert main(["solve", "--surface", "sphere", "--out", str(tmp_path / "o"), *argv]) == 2
+        assert capsys.readouterr().err.strip().startswith(head), argv
+    # a phi file's shape is no flag's
+    np.save(tmp_path / "phi.npy", np.zeros((2, 5, 5)))
+    phi = ["--phi", str(tmp_path / "phi.npy"), "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]
+    assert main(["solve", *phi, "--source", "0", "0", "0", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.strip() == "error: shape[0] = 2: every axis needs at least 3 nodes"
+
+
 def test_travel_time(tmp_path):
     assert (
         main(["travel-time", "--n", "41", "--dim", "2", "--source", "0.1", "0", "--out", str(tmp_path), "--quiet"]) == 0

@@ -1,5 +1,5 @@
 """pyplot for the reproduction figures (matplotlib is imported lazily: it is an optional
-dependency, ``pip install tubesweep[plot]``). Solutions are drawn by :mod:`tubesweep._plot`."""
+dependency, ``pip install 'tubesweep[plot]'`` (``'.[plot]'`` in a checkout)). Solutions are drawn by :mod:`tubesweep._plot`."""
 
 from __future__ import annotations
 
@@ -13,5 +13,7 @@ def _plt() -> Any:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise ImportError("pictures need matplotlib: pip install 'tubesweep[plot]'") from None
+        raise ImportError(
+            "pictures need matplotlib: pip install 'tubesweep[plot]', or pip install '.[plot]' in a checkout"
+        ) from None
     return plt

@@ -27,7 +27,9 @@ def _need_matplotlib() -> Any:
     try:
         import matplotlib
     except ImportError:
-        raise ImportError("plotting needs the optional package 'matplotlib': pip install 'tubesweep[plot]'") from None
+        raise ImportError(
+            "plotting needs the optional package 'matplotlib': pip install 'tubesweep[plot]', or pip install '.[plot]' in a checkout"
+        ) from None
     return matplotlib
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from . import __version__
 from ._progress import make_progress
 from .cli_distances import add_distances_parser, cmd_distances
-from ._cli_exit import exit_status
+from ._cli_exit import exit_status, flag_named
 from ._paths import writable
 
 EPILOG = """examples:
@@ -663,10 +663,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 0
     with warnings.catch_warnings():
         warnings.showwarning = _warning_line
-        return _run(parser, args)
+        return _run(parser, args, list(sys.argv[1:] if argv is None else argv))
 
 
-def _run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+def _run(parser: argparse.ArgumentParser, args: argparse.Namespace, argv: Sequence[str]) -> int:
     try:
         if args.command == "solve":
             return cmd_solve(args)
@@ -690,7 +690,7 @@ def _run(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
         # that trimesh/meshio cannot read; Warning: a warning turned into an error (-W error);
         # EOFError: a file that ends early (numpy.load of an empty file; zipfile.BadZipFile is an
         # Exception, caught where files are read)
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {flag_named(str(e), argv)}", file=sys.stderr)
         return 2
     parser.print_help()
     return 1

@@ -56,7 +56,7 @@ def add_distances_parser(sub: Any) -> None:
         "--scheduler",
         metavar="ADDRESS",
         help="a Dask scheduler's address (e.g. tcp://10.0.0.5:8786): the solves run on its workers "
-        "(pip install tubesweep[distributed])",
+        "(pip install 'tubesweep[distributed]', or pip install '.[distributed]' in a checkout)",
     )
     p.add_argument(
         "--n",
@@ -201,7 +201,7 @@ def _client(address: Optional[str]) -> Any:
         from distributed import Client
     except ImportError:
         raise ImportError(
-            "--scheduler needs Dask's distributed scheduler: pip install tubesweep[distributed]"
+            "--scheduler needs Dask's distributed scheduler: pip install 'tubesweep[distributed]', or pip install '.[distributed]' in a checkout"
         ) from None
     return Client(address)
 

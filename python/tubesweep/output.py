@@ -8,8 +8,8 @@
   ``.ply`` / ``.obj`` (meshio) or ``.vtp`` (VTK XML PolyData, written here), for ParaView.
 * :func:`plot` — a matplotlib :class:`~matplotlib.figure.Figure` (in :mod:`tubesweep._plot`).
 
-Optional dependencies are imported lazily: ``pip install 'tubesweep[mesh]'`` (meshio,
-scikit-image) and ``pip install 'tubesweep[plot]'`` (matplotlib).
+Optional dependencies are imported lazily: ``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout) (meshio,
+scikit-image) and ``pip install 'tubesweep[plot]'`` (``'.[plot]'`` in a checkout) (matplotlib).
 """
 
 from __future__ import annotations
@@ -225,7 +225,7 @@ def export(
         A :func:`tubesweep.solve` result.
     path : str or pathlib.Path
         Ending in ``.vtu``, ``.vtp``, ``.vtk``, ``.ply`` or ``.obj``. ``.vtp`` is VTK XML PolyData
-        written here; the others go through meshio (``pip install 'tubesweep[mesh]'``); ``.obj``
+        written here; the others go through meshio (``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout)); ``.obj``
         keeps no point data.
     mesh : (vertices, faces), optional
         The mesh to write instead of :func:`triangulate`'s.

@@ -383,7 +383,7 @@ class Tube:
         threads : int
             Solves at once, each on one thread (0: all cores).
         client : dask.distributed.Client, optional
-            Run the solves on a cluster (``pip install tubesweep[distributed]``).
+            Run the solves on a cluster (``pip install 'tubesweep[distributed]'`` (``'.[distributed]'`` in a checkout)).
         chunk_size : int, optional
             Sources per cluster task.
         return_stats : bool
@@ -424,7 +424,7 @@ class Tube:
         every solve with ``KeyboardInterrupt`` (no partial result). The other options are those of
         :meth:`solve` (``hamiltonian`` 'godunov' or 'lxf' only).
 
-        With ``client`` (a ``dask.distributed.Client``; ``pip install tubesweep[distributed]``) the
+        With ``client`` (a ``dask.distributed.Client``; ``pip install 'tubesweep[distributed]'`` (``'.[distributed]'`` in a checkout)) the
         sources go to the cluster's workers in chunks of ``chunk_size``: each worker builds this
         tube once and reuses it for all its chunks, and only the values (at ``at``) come back;
         the result equals the local one bit for bit. ``return_stats`` also returns a dict of

@@ -117,6 +117,31 @@ impl PyPointCloud {
         ))
     }
 
+    /// The `k` samples nearest to each of the samples `which`, nearest first, (len(which), k)
+    /// (`tubesweep_core::surface::point_cloud::PointCloud::nearest_samples`).
+    fn nearest_samples<'py>(
+        &self,
+        py: Python<'py>,
+        which: PyReadonlyArray1<'_, i64>,
+        k: usize,
+    ) -> PyResult<Bound<'py, PyArray2<u32>>> {
+        let w = c_slice(&which, "which")?;
+        if let Some(&bad) = w.iter().find(|&&i| i < 0) {
+            return Err(PyValueError::new_err(format!(
+                "which must hold sample indices ≥ 0; got {bad}"
+            )));
+        }
+        let w: Vec<usize> = w.iter().map(|&i| i as usize).collect();
+        let cloud = &self.cloud;
+        let near = py
+            .detach(|| match cloud {
+                Cloud::Two(c) => c.nearest_samples(&w, k),
+                Cloud::Three(c) => c.nearest_samples(&w, k),
+            })
+            .map_err(to_pyerr)?;
+        near.into_pyarray(py).reshape([w.len(), k])
+    }
+
     /// Sets the samples' noise (`tubesweep_core::surface::point_cloud::PointCloud::set_noise`).
     fn set_noise(&mut self, noise: f64) -> PyResult<()> {
         match &mut self.cloud {

@@ -34,7 +34,9 @@ def _plt():
         import matplotlib.pyplot as plt
         from mpl_toolkits.mplot3d.art3d import Poly3DCollection
     except ImportError:
-        raise ImportError("fig9 needs matplotlib: pip install 'tubesweep[plot]'") from None
+        raise ImportError(
+            "fig9 needs matplotlib: pip install 'tubesweep[plot]', or pip install '.[plot]' in a checkout"
+        ) from None
     return plt, Poly3DCollection
 
 

@@ -66,7 +66,9 @@ def _plt() -> Any:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise ImportError("figures need matplotlib: pip install 'tubesweep[plot]'") from None
+        raise ImportError(
+            "figures need matplotlib: pip install 'tubesweep[plot]', or pip install '.[plot]' in a checkout"
+        ) from None
     return plt
 
 

@@ -128,12 +128,11 @@ class SampleAnalysis:
         which = np.flatnonzero(candidate)
         if which.size == 0:
             return candidate
-        from scipy.spatial import cKDTree
-
         k = min(self.neighbours + 1, len(points))
-        _, near = cKDTree(points).query(points[which], k=k)
-        # (the sample itself is among its nearest, and a candidate)
-        clustered = candidate[np.asarray(near).reshape(len(which), k)].sum(axis=1) > CREASE_CLUSTER
+        # (the native cloud's kd-tree, of these same points; the sample itself is among its
+        # nearest, and a candidate)
+        near = self.cloud.nearest_samples(which.astype(np.int64), k)
+        clustered = candidate[near.astype(np.int64)].sum(axis=1) > CREASE_CLUSTER
         out = np.zeros_like(candidate)
         out[which[clustered]] = True
         return out

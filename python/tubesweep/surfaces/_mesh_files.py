@@ -21,7 +21,7 @@ import numpy as np
 
 from .._warn import user_stacklevel
 
-MESH_EXTRA = "pip install 'tubesweep[mesh]'"
+MESH_EXTRA = "pip install 'tubesweep[mesh]', or pip install '.[mesh]' in a checkout"
 
 
 def _open_text(path: Path) -> List[str]:

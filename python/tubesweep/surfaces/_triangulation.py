@@ -51,7 +51,9 @@ def marching_cubes(
     try:
         from skimage.measure import marching_cubes as _mc
     except ImportError as exc:  # pragma: no cover - optional dependency
-        raise ImportError("triangulating an implicit surface needs scikit-image: pip install tubesweep[mesh]") from exc
+        raise ImportError(
+            "triangulating an implicit surface needs scikit-image: pip install 'tubesweep[mesh]', or pip install '.[mesh]' in a checkout"
+        ) from exc
     lo = np.asarray(box[0], dtype=float)
     hi = np.asarray(box[1], dtype=float)
     axes = [np.linspace(lo[k], hi[k], n) for k in range(3)]

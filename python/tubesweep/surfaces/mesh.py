@@ -17,7 +17,7 @@ the Rust core (``tubesweep_core::surface::mesh``, exposed as ``tubesweep._native
 tree of boxes over the triangles, searched nearer-child-first and pruned by box distance, with a
 search radius so that far-away points cost almost nothing; queries run in parallel.
 
-Reading files needs the optional ``mesh`` extra: ``pip install 'tubesweep[mesh]'`` (trimesh or
+Reading files needs the optional ``mesh`` extra: ``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout) (trimesh or
 meshio). ``(V, F)`` arrays need nothing beyond numpy.
 """
 
@@ -716,7 +716,7 @@ def from_mesh(
         ``signed=True`` is asked of an open mesh, or ``normalize`` meets a mesh of no extent.
     ImportError
         If reading the file needs trimesh or meshio and neither is installed
-        (``pip install 'tubesweep[mesh]'``).
+        (``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout)).
 
     Examples
     --------

@@ -220,6 +220,31 @@ impl<const D: usize> PointCloud<D> {
         &self.points
     }
 
+    /// The `k` samples nearest to each sample of `which` (itself among them), nearest first, `k`
+    /// per sample in one flat list (in parallel): the neighbourhoods in which the samples that
+    /// their fits miss are counted as a sharp edge's.
+    pub fn nearest_samples(&self, which: &[usize], k: usize) -> Result<Vec<u32>> {
+        if k == 0 || k > self.points.len() {
+            return Err(Error::invalid("k", "between 1 and the number of samples"));
+        }
+        if let Some(&bad) = which.iter().find(|&&i| i >= self.points.len()) {
+            return Err(Error::invalid(
+                "which",
+                format!("sample indices below {} (got {bad})", self.points.len()),
+            ));
+        }
+        let k = NonZero::new(k).unwrap();
+        Ok(which
+            .par_iter()
+            .flat_map_iter(|&i| {
+                self.tree
+                    .nearest_n::<SquaredEuclidean>(&self.points[i], k)
+                    .into_iter()
+                    .map(|n| n.item)
+            })
+            .collect())
+    }
+
     /// Sets the samples' noise (from [`PointCloud::analyse`]'s residuals): a foot that lies farther
     /// than the nearest sample by more than the noise allows is found again ([`FARTHER_FOOT`]).
     pub fn set_noise(&mut self, noise: f64) -> Result<()> {

@@ -145,3 +145,23 @@ fn a_cloud_of_fewer_than_twice_the_neighbours_answers_without_panicking() {
         assert!((r - 0.5).abs() < 0.05, "{n} samples: |foot| = {r}");
     }
 }
+
+/// The nearest samples of a sample: itself first, then the others by distance (the brute-force
+/// order on a small cloud); k out of range and an index beyond the cloud are refused.
+#[test]
+fn nearest_samples_are_the_sample_then_the_nearest_others() {
+    let points = sphere(400, 0.5);
+    let cloud = PointCloud::new(points.clone(), DEFAULT_NEIGHBOURS).unwrap();
+    let which = [0usize, 17, 399];
+    let near = cloud.nearest_samples(&which, 6).unwrap();
+    assert_eq!(near.len(), 18);
+    for (row, &i) in which.iter().enumerate() {
+        let mut order: Vec<usize> = (0..points.len()).collect();
+        order.sort_by(|&a, &b| distance(&points[i], &points[a]).total_cmp(&distance(&points[i], &points[b])));
+        let got: Vec<usize> = near[6 * row..6 * row + 6].iter().map(|&j| j as usize).collect();
+        assert_eq!(got, order[..6].to_vec(), "sample {i}");
+    }
+    assert!(cloud.nearest_samples(&which, 0).is_err());
+    assert!(cloud.nearest_samples(&which, 401).is_err());
+    assert!(cloud.nearest_samples(&[400], 3).is_err());
+}
