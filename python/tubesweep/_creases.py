@@ -61,12 +61,19 @@ def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
     return float(per_inner_width) * float(inner) * float(spacing)
 
 
-def _per_crease(per_inner_width: float, inner: float, spacing: float, thinned: float) -> Tuple[float, str]:
+def _per_crease(
+    per_inner_width: float, inner: float, spacing: float, thinned: float, *, scaled: bool = True
+) -> Tuple[float, str]:
     """How early a front arrives per crease crossed, and how that was reckoned: ``thinned``
-    spacings on the tube thinned at the creases (:func:`thinned_spacings`; 0: not thinned), else
-    :func:`shortcut` (``per_inner_width``: 2·tan(θ/2) at the largest turn θ of the normal)."""
+    spacings on the tube thinned at the creases (:func:`thinned_spacings`; 0: not thinned), times
+    tan(θ/2) where the faces turn by more than 90° (``per_inner_width``: 2·tan(θ/2) at the
+    largest turn θ of the normal; two spheres joined by max at 120° or cut by max(d₁, −d₂) at
+    124°, re-distanced, N = 41–161: up to 5.4–6.1Δx beyond the crease where 2.5Δx was said, a
+    helper's review), else :func:`shortcut`. ``scaled=False``: ``thinned`` spacings alone (where
+    the normal reverses, two sheets facing each other, no angle bounds it)."""
     if thinned:
-        return thinned * float(spacing), f"{thinned:g}·Δx with the inner tube thinned there"
+        factor = thinned * (max(1.0, float(per_inner_width) / 2) if scaled else 1.0)
+        return factor * float(spacing), f"{factor:.2g}·Δx with the inner tube thinned there"
     return (
         shortcut(per_inner_width, inner, spacing),
         f"2·tan(θ/2)·inner·Δx = {per_inner_width:.3g}·inner·Δx at the largest turn θ, the inner tube not thinned there",
@@ -81,10 +88,12 @@ def _early(angle: float, size: float, reckoned: str, thinned: bool = False) -> s
     if angle <= REVERSED:
         if not thinned:
             return f"arrives early by up to about {size:.3g} {reckoned}"
+        # (early across a concave crease too where the grid meets it at a slant: two spheres
+        # joined by min at 75–120°, turned at random, 0.6–2.2Δx early on average, a helper's review)
         return (
-            f"arrives early by up to about {size:.3g} {reckoned} where the crease is convex (the tube cuts the "
-            "corner); across a concave crease, with the inner tube thinned there, it can also arrive late, by a "
-            "fraction of a spacing (two spheres joined by min: 0.43·Δx on average)"
+            f"arrives early by up to about {size:.3g} {reckoned}, where the tube cuts the crease's corner; across a concave "
+            "crease it can instead arrive late, by a fraction of a spacing (two spheres joined by min, the grid "
+            "aligned with them: 0.43·Δx on average)"
         )
     return (
         f"arrives early by {size:.3g} or more: the normal reverses there, two sheets face each other across a gap "
@@ -102,7 +111,9 @@ def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinn
     # 2·tan(θ/2) capped at θ = 150° as the core's (Creases::shortcut_per_inner_width): at 180° the
     # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
     # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
-    size, how = _per_crease(2 * np.tan(np.radians(min(angle, REVERSED)) / 2), inner, spacing, thinned)
+    size, how = _per_crease(
+        2 * np.tan(np.radians(min(angle, REVERSED)) / 2), inner, spacing, thinned, scaled=angle <= REVERSED
+    )
     early = _early(angle, size, f"({how}, first order in Δx)", thinned=bool(thinned))
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
