@@ -96,13 +96,14 @@ def test_a_refusal_names_the_flag_typed(tmp_path, capsys):
         (["--n", "21", "--source", "5", "5", "5"], "error: --source: sources[0] = (5.0, 5.0, 5.0) lies outside"),
         (["--n", "21", "--tol=-1"], "error: --tol: tol must be a positive finite number"),
         (["--n", "21", "--max-iterations", "0"], "error: --max-iterations: max_iterations must be an integer"),
+        (["--n", "21", "--max-it", "0"], "error: --max-iterations: max_iterations must be an integer"),  # (abbreviated)
     ):
         assert main(["solve", "--surface", "sphere", "--out", str(tmp_path / "o"), *argv]) == 2
         assert capsys.readouterr().err.strip().startswith(head), argv
     # a phi file's shape is no flag's
     np.save(tmp_path / "phi.npy", np.zeros((2, 5, 5)))
     phi = ["--phi", str(tmp_path / "phi.npy"), "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]
-    assert main(["solve", *phi, "--source", "0", "0", "0", "--out", str(tmp_path / "o")]) == 2
+    assert main(["solve", *phi, "--source", "0", "0", "0", "--out", str(tmp_path / "o"), "--n", "21"]) == 2
     assert capsys.readouterr().err.strip() == "error: shape[0] = 2: every axis needs at least 3 nodes"
 
 

@@ -102,6 +102,20 @@ def test_a_crease_sharper_than_a_right_angle_is_said_to_cost_more():
     assert -4.4 * grid.spacing < np.min(early) and np.mean(early) < -3.0 * grid.spacing  # -3.9, -3.7
 
 
+def test_a_thin_rim_refused_as_an_edge_is_also_told_to_refine_the_grid():
+    # the ellipsoid 0.6/0.5/0.15 re-distanced at N = 61: its rim's radius of curvature (0.0375)
+    # is about a spacing, and the refusal names it among convex edges; "round the edges" alone
+    # was wrong advice for a smooth surface (a review)
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    x = np.stack(grid.meshgrid(), -1)
+    phi = 0.15 * (np.sqrt((x[..., 0] / 0.6) ** 2 + (x[..., 1] / 0.5) ** 2 + (x[..., 2] / 0.15) ** 2) - 1)
+    with pytest.warns(RuntimeWarning, match="equidistant from two parts"):
+        with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+            with pytest.warns(RuntimeWarning, match=r"or refine the grid until they are \(a thin part's rim"):
+                sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(0.6, 0, 0)])
+    assert sol.stats.order == 1
+
+
 def test_a_sphere_that_only_touches_the_box_is_not_said_to_be_cut():
     # φ = 0 at the node where the sphere touches z = 0.5 counted as a crossing: "the grid box cuts
     # the surface ... along a curve about 0.105 long", for a surface wholly inside the box

@@ -4,6 +4,9 @@ than across the neck where the sheets come close."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -122,9 +125,6 @@ def test_meshes_solve_without_scipy(tmp_path):
         "sol = ts.solve(s, s.grid(41), [a[5]])\n"
         "print(sol.stats.cut_edges > 0, np.isfinite(sol.on_mesh(v)).all(), 'scipy' in sys.modules and sys.modules['scipy'] is not None)\n"
     )
-    import subprocess
-    import sys
-
     done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == ["True", "True", "False"], done.stdout + done.stderr[-2000:]

@@ -268,14 +268,20 @@ def test_evolve_refuses_more_bad_input_up_front(tmp_path):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: None, dt=0.05, steps=1)
     with pytest.raises(TypeError, match="must return real numbers"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: (0.1 + 0j) * u, dt=0.05, steps=1)
-    # a checkpoint's folder is made before the first solve (as Evolution.export makes its own);
-    # one that cannot be made (a file stands in its way) is refused then, under the name given
+    # a checkpoint's missing folder is made at its first write (as Evolution.export makes its
+    # own); one that cannot be made (a file stands in its way) is refused before the first solve,
+    # under the name given, and a refused call leaves nothing behind
     (tmp_path / "afile").write_text("")
-    with pytest.raises(ValueError, match="the folder of checkpoint=.*afile/sub/a.npz.*cannot be created"):
+    with pytest.raises(ValueError, match=r"checkpoint=.*afile/sub/a\.npz.*afile is a file, not a folder"):
         ts.evolve(
             phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=tmp_path / "afile/sub/a.npz"
         )
-    ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=tmp_path / "new/dir/a.npz")
+    with pytest.raises(TypeError, match="speed must be a callable"):
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], None, dt=0.05, steps=1, checkpoint=tmp_path / "none/a.npz")
+    assert not (tmp_path / "none").exists()
+    # (the path as given is where it is written: through a folder that does not exist yet too)
+    where = tmp_path / "x/../new/dir/a.npz"
+    ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=1, checkpoint=where)
     assert sorted(np.load(tmp_path / "new/dir/a.npz").files) == ["phi", "sources", "step", "t"]
     # a .pvd beside frames whose names need escaping is well-formed XML
     import xml.etree.ElementTree as ET
@@ -558,7 +564,8 @@ def test_evolve_names_phi_progress_and_checkpoint_faults(tmp_path):
     (tmp_path / "run.npz").mkdir()
     with pytest.raises(ValueError, match=r"checkpoint=.*run\.npz' is a folder"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=1, checkpoint=tmp_path / "run.npz")
-    # a checkpoint that cannot be written mid-run (its folder removed) stops the run with its frames
+    # a checkpoint that cannot be written mid-run (its folder replaced by a file) stops the run
+    # with its frames
     folder = tmp_path / "gone"
     folder.mkdir()
     calls = []
@@ -566,6 +573,7 @@ def test_evolve_names_phi_progress_and_checkpoint_faults(tmp_path):
     def remove_folder(step, steps, t):
         calls.append(step)
         shutil.rmtree(folder)  # with the checkpoint of step 0
+        folder.write_text("")  # (a missing folder is made again)
 
     with pytest.raises(ts.EvolutionStopped, match=r"step 1 .*the checkpoint .* could not be written") as info:
         ts.evolve(

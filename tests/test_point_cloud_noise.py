@@ -6,6 +6,9 @@ runs; noise too large for the grid is warned of with the spacing that resolves i
 import pickle
 import re
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -166,9 +169,6 @@ def test_a_noisy_box_finds_its_sharp_edges_without_scipy(tmp_path):
         "sol = ts.solve(box, box.grid(31), [box.points[0]])\n"
         "print(box.report['crease_samples'], np.isfinite(sol(box.points[:100])).all())\n"
     )
-    import subprocess
-    import sys
-
     done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split() == [str(box.report["crease_samples"]), "True"], done.stdout + done.stderr[-2000:]

@@ -38,10 +38,31 @@ _FLAGS = (
 )
 
 
-def flag_named(message: str, argv: Sequence[str]) -> str:
+#: Inputs whose array sets the grid's shape: with one of them ``--n`` is not what a shape is about.
+_SHAPE_FROM_FILE = ("--phi", "--mask")
+
+
+def _typed(flag: str, argv: Sequence[str], options: Sequence[str]) -> bool:
+    """Whether ``flag`` is among ``argv``, also as ``--flag=value`` or as an abbreviation that
+    argparse takes for it (a prefix of no other of the command's ``options``)."""
+    for a in argv:
+        name = a.split("=", 1)[0]
+        if not name.startswith("--"):
+            continue
+        if name == flag or (flag.startswith(name) and [o for o in options if o.startswith(name)] == [flag]):
+            return True
+    return False
+
+
+def flag_named(message: str, argv: Sequence[str], options: Sequence[str] = ()) -> str:
     """``message`` led by the flag it is about (``--n: shape[0] = 2: ...``) when it begins with
-    the library's name for what that flag sets and the flag is among ``argv``."""
+    the library's name for what that flag sets and the flag is among ``argv`` (``options``: the
+    command's long options, for abbreviations); ``--n`` not where ``--phi`` or ``--mask`` gave
+    the shape."""
     for pattern, flag in _FLAGS:
-        if pattern.match(message) and any(a == flag or a.startswith(flag + "=") for a in argv):
-            return f"{flag}: {message}"
+        if not pattern.match(message) or not _typed(flag, argv, options or [flag]):
+            continue
+        if flag == "--n" and any(_typed(f, argv, options or [f]) for f in _SHAPE_FROM_FILE):
+            continue
+        return f"{flag}: {message}"
     return message

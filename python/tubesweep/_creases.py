@@ -139,8 +139,9 @@ def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: 
     warnings.warn(
         f"order=1 ran: φ's level sets have convex creases or corners over much of the tube, where a front cuts the "
         f"corner and arrives early by up to about {size:.3g} per crease it crosses ({how}: first order in Δx). "
-        "sol.stats.order_fallback says more; round the edges over more than the tube's width (outer·Δx) for second "
-        "order and no shortcut",
+        "sol.stats.order_fallback says more; round the edges over more than the tube's width (outer·Δx), or refine "
+        "the grid until they are (a thin part's rim tighter than the tube counts as such an edge), for second order "
+        "and no shortcut",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )

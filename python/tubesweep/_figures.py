@@ -1,5 +1,6 @@
 """pyplot for the reproduction figures (matplotlib is imported lazily: it is an optional
-dependency, ``pip install 'tubesweep[plot]'`` (``'.[plot]'`` in a checkout)). Solutions are drawn by :mod:`tubesweep._plot`."""
+dependency: ``pip install 'tubesweep[plot]'``, or ``pip install '.[plot]'`` in a checkout).
+Solutions are drawn by :mod:`tubesweep._plot`."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Where output is written: checked before the work whose result would go there (the command line's
-``--out`` and ``--export``; ``ts.evolve``'s checkpoint keeps its own up-front checks)."""
+``--out`` and ``--export``; ``ts.evolve``'s checkpoint)."""
 
 from __future__ import annotations
 

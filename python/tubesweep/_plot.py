@@ -112,7 +112,7 @@ def plot(
     Raises
     ------
     ImportError
-        If matplotlib is not installed (``pip install 'tubesweep[plot]'`` (``'.[plot]'`` in a checkout)).
+        If matplotlib is not installed (``pip install 'tubesweep[plot]'``, or ``pip install '.[plot]'`` in a checkout).
     ValueError
         For a bad ``levels``, ``up``, ``color`` or ``paths``, or a travel-time array without
         a matching ``grid``.

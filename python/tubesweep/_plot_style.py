@@ -28,7 +28,8 @@ def _need_matplotlib() -> Any:
         import matplotlib
     except ImportError:
         raise ImportError(
-            "plotting needs the optional package 'matplotlib': pip install 'tubesweep[plot]', or pip install '.[plot]' in a checkout"
+            "plotting needs the optional package 'matplotlib': pip install 'tubesweep[plot]', "
+            "or pip install '.[plot]' in a checkout"
         ) from None
     return matplotlib
 

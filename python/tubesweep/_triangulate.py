@@ -23,7 +23,8 @@ def _need(module: str, extra: str, what: str) -> Any:
         return importlib.import_module(module)
     except ImportError:
         raise ImportError(
-            f"{what} needs the optional package {module.split('.')[0]!r}: pip install 'tubesweep[{extra}]', or pip install '.[{extra}]' in a checkout"
+            f"{what} needs the optional package {module.split('.')[0]!r}: pip install 'tubesweep[{extra}]', "
+            f"or pip install '.[{extra}]' in a checkout"
         ) from None
 
 

@@ -666,6 +666,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return _run(parser, args, list(sys.argv[1:] if argv is None else argv))
 
 
+def _long_options(parser: argparse.ArgumentParser, command: Optional[str]) -> List[str]:
+    """The long options of ``command``'s parser (for the abbreviations argparse accepts)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) and command in action.choices:
+            return [o for o in action.choices[command]._option_string_actions if o.startswith("--")]
+    return []
+
+
 def _run(parser: argparse.ArgumentParser, args: argparse.Namespace, argv: Sequence[str]) -> int:
     try:
         if args.command == "solve":
@@ -690,7 +698,7 @@ def _run(parser: argparse.ArgumentParser, args: argparse.Namespace, argv: Sequen
         # that trimesh/meshio cannot read; Warning: a warning turned into an error (-W error);
         # EOFError: a file that ends early (numpy.load of an empty file; zipfile.BadZipFile is an
         # Exception, caught where files are read)
-        print(f"error: {flag_named(str(e), argv)}", file=sys.stderr)
+        print(f"error: {flag_named(str(e), argv, _long_options(parser, args.command))}", file=sys.stderr)
         return 2
     parser.print_help()
     return 1

@@ -201,7 +201,8 @@ def _client(address: Optional[str]) -> Any:
         from distributed import Client
     except ImportError:
         raise ImportError(
-            "--scheduler needs Dask's distributed scheduler: pip install 'tubesweep[distributed]', or pip install '.[distributed]' in a checkout"
+            "--scheduler needs Dask's distributed scheduler: pip install 'tubesweep[distributed]', "
+            "or pip install '.[distributed]' in a checkout"
         ) from None
     return Client(address)
 

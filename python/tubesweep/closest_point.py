@@ -99,7 +99,7 @@ class ClosestPoint(Surface):
         2 or 3; by default the grid's dimension.
     lipschitz : float
         Lipschitz bound of ``x ↦ |x − cp(x)|`` used by the coarse-to-fine band search
-        (:func:`tubesweep.surface.coarse_to_fine_candidates`). A distance function has constant 1; a larger
+        (:func:`tubesweep.band.coarse_to_fine_candidates`). A distance function has constant 1; a larger
         value only makes the search visit more blocks.
 
     Raises

@@ -93,7 +93,8 @@ def distance_matrix(
     points : (M, d) points on the surface; each is snapped to its closest point on the surface,
         and a point farther than the inner tube (``inner`` grid spacings) is refused.
     client : dask.distributed.Client, optional — run the M solves on the cluster
-        (``pip install 'tubesweep[distributed]'`` (``'.[distributed]'`` in a checkout); see :meth:`Tube.solve_many`).
+        (``pip install 'tubesweep[distributed]'``, or ``pip install '.[distributed]'`` in a
+        checkout; see :meth:`Tube.solve_many`).
     threads : solves run at once locally (0: all cores), each on one thread.
     progress : callable ``(done, M')``, optional (M' the distinct points).
     order : ``"auto"`` (the default: second order where it applies, as :func:`tubesweep.solve`), 1 or 2.

@@ -1,5 +1,5 @@
 """Many sources on a Dask cluster: :meth:`Tube.solve_many` and :func:`distance_matrix` with
-``client=`` (``pip install 'tubesweep[distributed]'`` (``'.[distributed]'`` in a checkout)).
+``client=`` (``pip install 'tubesweep[distributed]'``, or ``pip install '.[distributed]'`` in a checkout).
 
 The sources are split into chunks, one Dask task each. The tube goes to every worker once, as a
 small description (its surface, grid and widths: no band arrays), scattered with ``broadcast``;
@@ -110,8 +110,8 @@ def as_client(client: Any) -> Any:
         from distributed import Client
     except ImportError:
         raise ImportError(
-            "client= needs Dask's distributed scheduler: pip install 'tubesweep[distributed]', or pip install '.[distributed]' in a checkout "
-            "(dask, distributed and cloudpickle)"
+            "client= needs Dask's distributed scheduler (dask, distributed and cloudpickle): "
+            "pip install 'tubesweep[distributed]', or pip install '.[distributed]' in a checkout"
         ) from None
     if not isinstance(client, Client):
         raise TypeError(

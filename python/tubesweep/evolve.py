@@ -26,6 +26,7 @@ from typing import Any, Callable, List, Optional, Union
 import numpy as np
 from xml.sax.saxutils import quoteattr
 
+from ._paths import writable
 from ._validate import as_grid, as_sources, real_array, real_scalar
 from ._box_cut import cut_extent
 from ._sources import check_on_surface
@@ -217,6 +218,7 @@ def _write_checkpoint(path: Path, **arrays: Any) -> None:
     """``numpy.savez`` to a file beside ``path``, then renamed onto it: a write interrupted by a
     crash or a kill leaves the previous checkpoint whole."""
     partial = path.with_name(path.name + ".partial.npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
     np.savez(partial, **arrays)
     os.replace(partial, path)
 
@@ -305,7 +307,7 @@ def evolve(
         Called as ``progress(step, steps, t)`` after each step.
     checkpoint : str or Path, optional
         A ``.npz`` file rewritten at each kept frame with ``phi``, ``t``, ``step`` and
-        ``sources`` (its folder made if missing; written beside it and renamed, so that an interrupted write leaves the last
+        ``sources`` (its folder made if missing, a leading ``~`` expanded; written beside it and renamed, so that an interrupted write leaves the last
         one whole): ``evolve(c["phi"], grid, c["sources"], speed, ..., t0=float(c["t"]))``
         continues from it. From a checkpoint written at a multiple of ``every`` steps, a run
         continued with the same ``dt``, ``every`` and a ``checkpoint`` repeats the uninterrupted
@@ -392,15 +394,10 @@ def evolve(
     if checkpoint is not None and Path(checkpoint).is_dir():
         raise ValueError(f"evolve: checkpoint={str(checkpoint)!r} is a folder; give a file name ending in .npz")
     if checkpoint is not None:
-        # the folder is made now, as Evolution.export makes its own, so that a path that cannot
-        # be written fails before the first solve rather than after it
-        try:
-            Path(checkpoint).resolve().parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise ValueError(
-                f"evolve: the folder of checkpoint={str(checkpoint)!r} cannot be created ({exc.strerror or exc}); "
-                "give a path in a folder you can write to"
-            ) from None
+        # a missing folder is made at the first write, as Evolution.export makes its own; one that
+        # could not be (a file in the way, no permission) is refused now, before the first solve
+        checkpoint = Path(checkpoint).expanduser()
+        writable(checkpoint, f"evolve: checkpoint={str(checkpoint)!r}:")
     if not callable(speed):
         raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
     if progress is not None and not callable(progress):

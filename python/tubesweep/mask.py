@@ -111,7 +111,8 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
             from scipy.ndimage import gaussian_filter
         except ImportError:  # pragma: no cover - scipy is a test dependency
             raise ImportError(
-                "smooth needs the optional package 'scipy': pip install 'tubesweep[mesh]', or pip install '.[mesh]' in a checkout"
+                "smooth needs the optional package 'scipy': pip install 'tubesweep[mesh]', "
+                "or pip install '.[mesh]' in a checkout"
             ) from None
         phi = 0.5 - gaussian_filter(inside.astype(np.float64), sigma=sigma, mode="nearest")
         if not (np.any(phi <= 0) and np.any(phi > 0)):

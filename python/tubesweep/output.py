@@ -8,8 +8,9 @@
   ``.ply`` / ``.obj`` (meshio) or ``.vtp`` (VTK XML PolyData, written here), for ParaView.
 * :func:`plot` — a matplotlib :class:`~matplotlib.figure.Figure` (in :mod:`tubesweep._plot`).
 
-Optional dependencies are imported lazily: ``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout) (meshio,
-scikit-image) and ``pip install 'tubesweep[plot]'`` (``'.[plot]'`` in a checkout) (matplotlib).
+Optional dependencies are imported lazily: meshio and scikit-image (the ``mesh`` extra) and
+matplotlib (the ``plot`` extra): ``pip install 'tubesweep[mesh,plot]'``, or ``pip install
+'.[mesh,plot]'`` in a checkout.
 """
 
 from __future__ import annotations
@@ -225,8 +226,8 @@ def export(
         A :func:`tubesweep.solve` result.
     path : str or pathlib.Path
         Ending in ``.vtu``, ``.vtp``, ``.vtk``, ``.ply`` or ``.obj``. ``.vtp`` is VTK XML PolyData
-        written here; the others go through meshio (``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout)); ``.obj``
-        keeps no point data.
+        written here; the others go through meshio (``pip install 'tubesweep[mesh]'``, or
+        ``pip install '.[mesh]'`` in a checkout); ``.obj`` keeps no point data.
     mesh : (vertices, faces), optional
         The mesh to write instead of :func:`triangulate`'s.
     point_data : dict, optional

@@ -383,7 +383,8 @@ class Tube:
         threads : int
             Solves at once, each on one thread (0: all cores).
         client : dask.distributed.Client, optional
-            Run the solves on a cluster (``pip install 'tubesweep[distributed]'`` (``'.[distributed]'`` in a checkout)).
+            Run the solves on a cluster (``pip install 'tubesweep[distributed]'``, or
+            ``pip install '.[distributed]'`` in a checkout).
         chunk_size : int, optional
             Sources per cluster task.
         return_stats : bool
@@ -424,10 +425,11 @@ class Tube:
         every solve with ``KeyboardInterrupt`` (no partial result). The other options are those of
         :meth:`solve` (``hamiltonian`` 'godunov' or 'lxf' only).
 
-        With ``client`` (a ``dask.distributed.Client``; ``pip install 'tubesweep[distributed]'`` (``'.[distributed]'`` in a checkout)) the
-        sources go to the cluster's workers in chunks of ``chunk_size``: each worker builds this
-        tube once and reuses it for all its chunks, and only the values (at ``at``) come back;
-        the result equals the local one bit for bit. ``return_stats`` also returns a dict of
+        With ``client`` (a ``dask.distributed.Client``: ``pip install 'tubesweep[distributed]'``, or
+        ``pip install '.[distributed]'`` in a checkout) the sources go to the cluster's workers in
+        chunks of ``chunk_size``: each worker builds this tube once and reuses it for all its
+        chunks, and only the values (at ``at``) come back; the result equals the local one bit
+        for bit. ``return_stats`` also returns a dict of
         per-source arrays (iterations, converged, last_change, ...).
 
         Examples

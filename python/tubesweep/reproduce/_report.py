@@ -2,7 +2,7 @@
 CSV / Markdown / PNG writers that put our numbers next to the paper's.
 
 Everything here is plain numpy and the standard library except the PNG writers, which import
-matplotlib lazily (``pip install 'tubesweep[plot]'`` (``'.[plot]'`` in a checkout)).
+matplotlib lazily (``pip install 'tubesweep[plot]'``, or ``pip install '.[plot]'`` in a checkout).
 """
 
 from __future__ import annotations

@@ -131,5 +131,6 @@ def _read_ply(path: Path) -> np.ndarray:
             raise ValueError(f"{path.name!r} is not a readable PLY file: {e}") from None
     except ImportError:
         raise ImportError(
-            "reading .ply points needs plyfile, trimesh or meshio: pip install 'tubesweep[mesh]', or pip install '.[mesh]' in a checkout"
+            "reading .ply points needs plyfile, trimesh or meshio: pip install 'tubesweep[mesh]', "
+            "or pip install '.[mesh]' in a checkout"
         ) from None

@@ -52,7 +52,8 @@ def marching_cubes(
         from skimage.measure import marching_cubes as _mc
     except ImportError as exc:  # pragma: no cover - optional dependency
         raise ImportError(
-            "triangulating an implicit surface needs scikit-image: pip install 'tubesweep[mesh]', or pip install '.[mesh]' in a checkout"
+            "triangulating an implicit surface needs scikit-image: pip install 'tubesweep[mesh]', "
+            "or pip install '.[mesh]' in a checkout"
         ) from exc
     lo = np.asarray(box[0], dtype=float)
     hi = np.asarray(box[1], dtype=float)

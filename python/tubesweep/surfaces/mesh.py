@@ -12,13 +12,14 @@ through the closest-point function ``cp(x) = argmin_{z ∈ Σ} |x − z|`` evalu
   (sign from the angle-weighted pseudo-normal of the closest feature, Bærentzen & Aanæs 2005).
 
 Closest points are computed exactly and only at the nodes of the band, which is found
-coarse-to-fine like :func:`tubesweep.surface.discover_band`. The spatial index is an AABB tree in
+coarse-to-fine like :func:`tubesweep.band.discover_band`. The spatial index is an AABB tree in
 the Rust core (``tubesweep_core::surface::mesh``, exposed as ``tubesweep._native.TriangleTree``): a binary
 tree of boxes over the triangles, searched nearer-child-first and pruned by box distance, with a
 search radius so that far-away points cost almost nothing; queries run in parallel.
 
-Reading files needs the optional ``mesh`` extra: ``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout) (trimesh or
-meshio). ``(V, F)`` arrays need nothing beyond numpy.
+Reading files needs trimesh or meshio, the optional ``mesh`` extra: ``pip install
+'tubesweep[mesh]'``, or ``pip install '.[mesh]'`` in a checkout. ``(V, F)`` arrays need nothing
+beyond numpy.
 """
 
 from __future__ import annotations
@@ -716,7 +717,7 @@ def from_mesh(
         ``signed=True`` is asked of an open mesh, or ``normalize`` meets a mesh of no extent.
     ImportError
         If reading the file needs trimesh or meshio and neither is installed
-        (``pip install 'tubesweep[mesh]'`` (``'.[mesh]'`` in a checkout)).
+        (``pip install 'tubesweep[mesh]'``, or ``pip install '.[mesh]'`` in a checkout).
 
     Examples
     --------

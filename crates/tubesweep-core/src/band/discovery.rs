@@ -1,5 +1,5 @@
 //! Band discovery helpers: the block bookkeeping of the coarse-to-fine search for the band of a
-//! surface given by a distance-like function (`tubesweep.surface.coarse_to_fine_candidates`).
+//! surface given by a distance-like function (`tubesweep.band.coarse_to_fine_candidates`).
 //!
 //! The search keeps blocks of 2^L nodes per axis near the surface and splits them level by level;
 //! the level-set function is usually a Python callable, so the loop over levels stays in Python and

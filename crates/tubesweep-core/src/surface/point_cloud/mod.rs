@@ -220,12 +220,16 @@ impl<const D: usize> PointCloud<D> {
         &self.points
     }
 
-    /// The `k` samples nearest to each sample of `which` (itself among them), nearest first, `k`
-    /// per sample in one flat list (in parallel): the neighbourhoods in which the samples that
-    /// their fits miss are counted as a sharp edge's.
+    /// The `k` samples nearest to each sample of `which` (itself among them: first, unless
+    /// another sample lies at the same place), nearest first, `k` per sample in one flat list
+    /// (in parallel): the neighbourhoods in which the samples that their fits miss are counted as
+    /// a sharp edge's.
     pub fn nearest_samples(&self, which: &[usize], k: usize) -> Result<Vec<u32>> {
         if k == 0 || k > self.points.len() {
-            return Err(Error::invalid("k", "between 1 and the number of samples"));
+            return Err(Error::invalid(
+                "k",
+                format!("between 1 and the number of samples, {}; got {k}", self.points.len()),
+            ));
         }
         if let Some(&bad) = which.iter().find(|&&i| i >= self.points.len()) {
             return Err(Error::invalid(
