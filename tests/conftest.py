@@ -1,3 +1,6 @@
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -36,3 +39,21 @@ def first_order_size():
         assert len(messages) == len(sized), messages
 
     return context
+
+
+@pytest.fixture
+def without_scipy(tmp_path):
+    """``without_scipy(body)``: runs ``body`` in a fresh interpreter in which scipy (an optional
+    extra) cannot be imported, after ``import numpy as np`` and ``import tubesweep as ts``; asserts
+    it exits cleanly and returns its printed words."""
+
+    def run(body: str) -> list:
+        script = tmp_path / "no_scipy.py"
+        script.write_text(
+            "import sys\nsys.modules['scipy'] = None\nimport numpy as np\nimport tubesweep as ts\n" + body
+        )
+        done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+        return done.stdout.split()
+
+    return run

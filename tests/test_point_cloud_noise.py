@@ -6,9 +6,6 @@ runs; noise too large for the grid is warned of with the spacing that resolves i
 import pickle
 import re
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
@@ -150,7 +147,7 @@ def test_a_noisy_box_keeps_its_sharp_edges_and_a_noisy_sphere_has_none():
         assert sphere.report["crease_samples"] < 50 and sphere._crease_advice() == "", noise  # 34, 20
 
 
-def test_a_noisy_box_finds_its_sharp_edges_without_scipy(tmp_path):
+def test_a_noisy_box_finds_its_sharp_edges_without_scipy(tmp_path, without_scipy):
     # scipy is an optional extra: the sharp-edge count of a noisy cloud asked scipy's kd-tree
     # (ModuleNotFoundError without it); now the cloud's own kd-tree, the same samples found
     rng = np.random.default_rng(1)
@@ -159,19 +156,12 @@ def test_a_noisy_box_finds_its_sharp_edges_without_scipy(tmp_path):
     p = p + 0.001 * np.random.default_rng(2).normal(size=p.shape)
     np.save(tmp_path / "box.npy", p)
     box = ts.surfaces.from_points(p)
-    script = tmp_path / "no_scipy.py"
-    script.write_text(
-        "import sys\n"
-        "sys.modules['scipy'] = None\n"
-        "import numpy as np\n"
-        "import tubesweep as ts\n"
+    printed = without_scipy(
         f"box = ts.surfaces.from_points(np.load({str(tmp_path / 'box.npy')!r}))\n"
         "sol = ts.solve(box, box.grid(31), [box.points[0]])\n"
         "print(box.report['crease_samples'], np.isfinite(sol(box.points[:100])).all())\n"
     )
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert done.stdout.split() == [str(box.report["crease_samples"]), "True"], done.stdout + done.stderr[-2000:]
+    assert printed == [str(box.report["crease_samples"]), "True"], printed
     assert box.report["crease_samples"] == 185  # as with scipy's kd-tree
 
 

@@ -1,7 +1,8 @@
-"""The command line's exit status for a solve reported not converged (``tubesweep solve``,
-``travel-time``, ``distances``): stopped at its iteration limit, or with values it could not
-settle (a warning says which). Its files are written, but a script must not take them for the
-answer, so the command says so on stderr and exits non-zero."""
+"""The command line's ``error:`` lines and exit status: for a solve reported not converged
+(``tubesweep solve``, ``travel-time``, ``distances``: stopped at its iteration limit, or with
+values it could not settle, a warning says which) its files are written, but a script must not
+take them for the answer, so the command says so on stderr and exits non-zero; a refused input's
+line names the flag the user typed (:func:`flag_named`)."""
 
 from __future__ import annotations
 
