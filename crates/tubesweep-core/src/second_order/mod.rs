@@ -38,6 +38,7 @@ pub mod setup;
 pub mod solver;
 mod stagnation;
 pub mod start;
+mod symmetric;
 pub mod warm;
 
 pub use factoring::{factor_sources, factor_sources_of, Factoring};

@@ -1,0 +1,122 @@
+"""What a point cloud's errors and warnings say about it (:class:`CloudAdvice`, a part of
+:class:`~tubesweep.surfaces.points.PointCloudSurface`): the causes of folded closest points that the
+cloud shows (samples in lines, sharp edges, samples a little off their neighbours' surface, uneven
+sampling, noise) and their cures, for the band's error and the second-order runaway's message
+(``_prepare``, ``second_order``)."""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+#: Samples farther apart (median nearest-neighbour distance) than this many grid spacings: refused.
+SPARSE_FACTOR = 3.0
+#: More than this share of samples that their neighbours' fits miss (``points.CREASE_RESIDUAL``): the
+#: cloud has sharp edges, named in its errors and warnings.
+CREASE_SHARE = 0.005
+#: A widest fit more than this many times the median one: the sampling is uneven enough that a
+#: fold of the closest points may come from parts sampled too sparsely for their curvature.
+UNEVEN_FITS = 4.0
+
+
+class CloudAdvice:
+    """The messages of a :class:`~tubesweep.surfaces.points.PointCloudSurface` (which sets the
+    attributes read here: ``points``, ``spacing``, ``noise``, ``smoothing`` and the analysis's
+    ``_median_fit``, ``_sparsest_fit``, ``_creases``, ``_lines``)."""
+
+    points: Any
+    spacing: float
+    noise: float
+    smoothing: float
+    _median_fit: float
+    _sparsest_fit: float
+    _creases: Any
+
+    def _uneven(self) -> Optional[float]:
+        """How many times the median fit the widest one spans, when above :data:`UNEVEN_FITS`
+        (parts may be sampled too sparsely), else None."""
+        ratio = self._sparsest_fit / self._median_fit
+        return ratio if ratio > UNEVEN_FITS else None
+
+    def _crease_advice(self) -> str:
+        """The cloud's sharp edges and their cure, or "" when it has none (:data:`CREASE_SHARE`)."""
+        count, where = self._creases
+        if count <= CREASE_SHARE * len(self.points) or where is None:
+            return ""
+        at = ", ".join(f"{float(c):.4g}" for c in where)
+        return (
+            f"the cloud has sharp edges or corners ({count} samples that their fits miss, e.g. at ({at})), which the "
+            f"local fits (about {self._median_fit:.2g} across) cannot follow: the closest points bounce between the "
+            "faces there. Give the surface as a mesh (from_mesh: meshes keep their creases and run first order "
+            "there); a larger neighbours= rounds the edges over more samples, which helps only where the fits then "
+            "span several grid spacings. If the surface is smooth there, those samples lie off it (scan outliers "
+            "too close to their neighbours for the outlier test): leave them out (cloud.crease_samples lists them)"
+        )
+
+    def _sampling_advice(self) -> str:
+        """The samples in lines (``_cloud_analysis.lines_advice``) and the sharp edges
+        (:meth:`_crease_advice`), the causes of folded closest points that the cloud shows."""
+        lines, crease = getattr(self, "_lines", ""), self._crease_advice()
+        return f"{lines}. Or: {crease}" if lines and crease else lines or crease
+
+    #: Why the band of a cloud's closest points may not close, for the band's error (``_prepare``).
+    @property
+    def band_advice(self) -> str:
+        """What folds a cloud's closest points so that the tube is not enclosed (for the error of
+        ``_prepare._prepare_tube``): samples a little off the surface, or, where the sampling is
+        uneven, parts sampled too sparsely for their curvature."""
+        advice = (
+            "Some samples lie off their neighbours' surface by about half a grid spacing (too little for the outlier "
+            "test, too much for the local fits to smooth out), which folds the closest points there: leave such "
+            "samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid"
+        )
+        uneven = self._uneven()
+        if uneven is not None:
+            advice += (
+                f". Or parts of the cloud are sampled too sparsely for their curvature: the widest fit spans "
+                f"{self._sparsest_fit:.3g}, {uneven:.0f} times the median fit "
+                "(sample those parts more densely, or pass a smaller neighbours=)"
+            )
+        crease = self._sampling_advice()
+        if self.smoothing > 0:  # the last band's fits were widened for the noise
+            advice = (
+                f"The samples lie off their neighbours' fits by about {self.noise:.3g} (noise, or samples too sparse for "
+                f"the surface's curvature; the fits reached {self.smoothing:.3g} to smooth it out, and the grid resolves "
+                "the surface finer than that): use a coarser grid, or denser or less noisy samples. "
+                f"Or: {advice[0].lower()}{advice[1:]}"
+            )
+        return f"{sentence(crease)}. Or: {advice}" if crease else advice
+
+    def _gap_note(self, h: float) -> str:
+        """For the warning of parts that face each other across narrow gaps (``_prepare.warn_facing_pairs``)
+        on a grid of spacing ``h``: where the samples lie more than a grid spacing apart, such a gap
+        can be a fold of the fits between them, and a finer grid only makes the samples sparser
+        against it (150 samples of a sphere 2.7 spacings apart at N = 81: 5 pairs, 0.05% of the
+        surface, and the advice to refine the grid ran into the sparse-sample refusal)."""
+        if not self.spacing > h:
+            return ""
+        return (
+            f"; here the cloud's samples lie {self.spacing / h:.1f} grid spacings apart, so such a gap may be a fold of "
+            f"its fits between them, which a finer grid does not cure (it is refused below a spacing of "
+            f"{self.spacing / SPARSE_FACTOR:.3g}): more samples there do"
+        )
+
+    #: What of a cloud the grid may not resolve, for the message of a second-order runaway
+    #: (``second_order.ran_away_message``) and of a widened extension layer (``_prepare``).
+    @property
+    def unresolved_advice(self) -> str:
+        """Where a cloud's closest points fold or bend more than the grid resolves: samples a little
+        off their neighbours' surface, or, where the sampling is uneven, parts sampled too sparsely."""
+        advice = "samples a little off their neighbours' surface, which a larger neighbours= smooths out"
+        uneven = self._uneven()
+        if uneven is not None:
+            advice = (
+                f"parts of the cloud sampled too sparsely for the grid, where a fit spans up to {self._sparsest_fit:.3g}, "
+                f"{uneven:.0f} times the median fit, and denser samples cure it; or " + advice
+            )
+        crease = self._crease_advice()
+        return f"{crease}; or {advice}" if crease else advice
+
+
+def sentence(text: str) -> str:
+    """``text`` with its first letter capitalised (the rest as it is: names such as ``neighbours=``)."""
+    return text[:1].upper() + text[1:]
