@@ -40,6 +40,13 @@ THINNED_SHORTCUT = 1.5
 #: N = 61, 1.9Δx per edge (review scratch ``/tmp/reviewA``).
 THINNED_SHORTCUT_REDISTANCED = 2.5
 
+#: In the paper's tube (``order=1``) of a re-distanced φ a front comes out up to this many times
+#: 2·tan(θ/2)·inner·Δx early per crease (the zero set between the nodes adds its own error): two
+#: spheres of radius 0.5, centres 0.8 apart (faces at 106°), joined by min and re-distanced,
+#: 1.31, 1.32 and 1.48 times it at the worst point beyond the crease at N = 41, 61, 81
+#: (``tests/test_level_set_messages.py``)
+PAPER_TUBE_REDISTANCED = 1.5
+
 
 def thinned_spacings(tube: Any, thinned: bool) -> float:
     """How many spacings a front gains per crease on ``tube`` (a prepared tube) thinned there
@@ -101,28 +108,49 @@ def _early(angle: float, size: float, reckoned: str, thinned: bool = False) -> s
     )
 
 
-def warn_creases(creases: Optional[dict], inner: float, spacing: float, *, thinned: float) -> None:
+def warn_creases(
+    creases: Optional[dict], inner: float, spacing: float, *, thinned: float, redistanced: bool = False
+) -> None:
     """A RuntimeWarning when the second-order solve found creases (``sol.stats.order2["creases"]``):
     the shortcut per crease, ``thinned`` spacings where the inner tube was thinned there
-    (:func:`thinned_spacings`), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle."""
+    (:func:`thinned_spacings`), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle.
+    ``redistanced``: the directions come from φ's closest points (a re-distanced φ), where the
+    normal turns between neighbours by the faces' angle; otherwise from central differences of φ,
+    which average the faces' normals next to a crease (:func:`faces_angle`)."""
     if not creases or not creases.get("nodes"):
         return
     angle = float(creases["angle_degrees"])
+    faces = angle if redistanced else faces_angle(creases)
+    if thinned and faces > 90 and not redistanced:
+        thinned = max(thinned, THINNED_SHORTCUT_REDISTANCED)
     # 2·tan(θ/2) capped at θ = 150° as the core's (Creases::shortcut_per_inner_width): at 180° the
     # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
     # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
     size, how = _per_crease(
-        2 * np.tan(np.radians(min(angle, REVERSED)) / 2), inner, spacing, thinned, scaled=angle <= REVERSED
+        2 * np.tan(np.radians(min(faces, REVERSED)) / 2), inner, spacing, thinned, scaled=angle <= REVERSED
     )
     early = _early(angle, size, f"({how}, first order in Δx)", thinned=bool(thinned))
+    turning = f"{angle:.0f}°" + (f", the faces by up to {faces:.0f}°" if faces > angle + 5 else "")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
-        f"{angle:.0f}°): a front that crosses one {early}, "
+        f"{turning}): a front that crosses one {early}, "
         "and the nodes there run the first-order update. sol.first_order_points() shows where; rounding the edges "
         "over more than the tube's width (outer·Δx), or a finer grid, reduces it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
+
+
+def faces_angle(creases: dict) -> float:
+    """The faces' angle at the creases of a φ whose directions come from its central differences
+    (a φ = max(φ₁, φ₂) given as it is): the widest turn of the normal across a crease node
+    (``faces_angle_degrees``), where neighbours turn by about half of it next to the crease. A
+    lens of two spheres whose faces meet at 113°, N = 61–101: 52–61° between neighbours, and
+    beyond the crease 2.2–3.3Δx early on average (3.5 at worst) where the warning said 1.5Δx; at
+    120°, N = 101: 90°, 4.0Δx (4.4) where it said 1.5Δx (a helper's review). Beyond a right angle
+    the thinned tube's shortcut then is that of a re-distanced φ, :data:`THINNED_SHORTCUT_REDISTANCED`,
+    times tan(θ/2)."""
+    return max(float(creases["angle_degrees"]), float(creases.get("faces_angle_degrees", 0.0)))
 
 
 def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: float) -> bool:
@@ -180,7 +208,33 @@ def creases_in_paper_tube(
     return {
         "nodes": int(nodes),
         "angle_degrees": float(angle),
+        "faces_angle_degrees": float(angle),
         "shortcut_per_inner_width": 2 * float(np.tan(np.radians(min(angle, REVERSED)) / 2)) if nodes else 0.0,
+    }
+
+
+def creases_of_redistanced(
+    band: Any, roles: np.ndarray, phi: np.ndarray, direction: np.ndarray, spacing: float, outer_width: float
+) -> Dict[str, Any]:
+    """As :func:`creases_in_paper_tube` for a re-distanced φ (a voxel mask, ``redistance=True``),
+    whose sampled zero set has kinks of its own (a mask's staircase, noise): the crease test of the
+    second-order geometry, behind its gates (curvature or gradient unresolved by central
+    differences, no crease on a φ found noisy), with the faces' angle
+    (``tubesweep_core::second_order::creases::creases_of_redistanced``). ``roles``: the paper's
+    tube; ``outer_width``: its half-width (outer·Δx)."""
+    nodes, angle = band.creases_of_redistanced(
+        np.ascontiguousarray(roles, dtype=np.uint8),
+        np.ascontiguousarray(phi, dtype=np.float64),
+        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(roles), -1),
+        float(spacing),
+        float(outer_width),
+    )
+    return {
+        "nodes": int(nodes),
+        "angle_degrees": float(angle),
+        "faces_angle_degrees": float(angle),
+        "shortcut_per_inner_width": 2 * float(np.tan(np.radians(min(angle, REVERSED)) / 2)) if nodes else 0.0,
+        "redistanced": True,
     }
 
 
@@ -192,7 +246,11 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
         return
     angle = float(creases["angle_degrees"])
     size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
-    early = _early(angle, size, "per crease it crosses (2·tan(θ/2)·inner·Δx, first order in Δx)")
+    reckoned = "2·tan(θ/2)·inner·Δx"
+    if creases.get("redistanced"):
+        size *= PAPER_TUBE_REDISTANCED
+        reckoned = f"{PAPER_TUBE_REDISTANCED:g}·2·tan(θ/2)·inner·Δx on a re-distanced φ"
+    early = _early(angle, size, f"per crease it crosses ({reckoned}, first order in Δx)")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the faces turning by up to "
         f"{angle:.0f}°): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "

@@ -287,6 +287,14 @@ class Band:
         direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
         spacing: float,
     ) -> Tuple[int, float]: ...
+    def creases_of_redistanced(  # the second-order geometry's crease test, for order=1 on a re-distanced φ
+        self,
+        roles: npt.NDArray[np.uint8],
+        phi: npt.NDArray[np.float64],
+        direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
+        spacing: float,
+        outer_width: float,
+    ) -> Tuple[int, float]: ...
     def medial_edges(
         self,
         inner: npt.NDArray[np.bool_],

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 import time
 import warnings
 from typing import Any, Dict, Optional, Tuple
@@ -24,7 +25,7 @@ from .band import BandGeometry, _evaluate, band_neighbours
 from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
-from ._creases import crease_nodes_to_extend, creases_in_paper_tube
+from ._creases import crease_nodes_to_extend, creases_in_paper_tube, creases_of_redistanced
 from ._thin_level_set import thin_share, warn_thin
 from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
@@ -152,6 +153,62 @@ _BAND_BYTES_PER_NODE = 110
 _BAND_ESTIMATE_POINTS = 17
 
 
+#: Rounds of :func:`_not_stranding` before it gives up thinning the tube at all.
+_RECONNECT_ROUNDS = 8
+
+
+def unstranded(tube: _PreparedTube) -> _PreparedTube:
+    """``tube`` (thinned at its creases, :func:`thinned_at_creases`) for the first-order scheme of
+    ``order="auto"``: with the crease nodes next to a speck of the inner tube that the thinning
+    cut off given back to it (:func:`_not_stranding`). Such a speck keeps +∞ where no source lies
+    in it, and the first-order sweeps, unlike the second-order ones
+    (``second_order.split_at_creases``), do not say so. On a noisy φ re-distanced the ridge test
+    finds "creases" over much of the tube, and ``"auto"`` runs first order there: a sphere with
+    noise of 0.4Δx at N = 61 had 5,468 of 12,574 inner nodes thinned, leaving 122 specks of 1 to 3
+    nodes beside the main piece, and +∞ at 4 of 2,000 points on the sphere with
+    ``converged=True`` (a helper's review). Whole parts that the thinning parts stay apart (a
+    cube's corner whose tube reached across a narrow gap to a sphere). ``tube`` itself when
+    nothing is cut off."""
+    if thinned_count(tube) == 0:
+        return tube
+    paper = tube.roles.copy()
+    paper[tube.crease_nodes] = ROLE_INNER
+    keep = _not_stranding(tube.band, paper, tube.crease_nodes, tube.inner)
+    if keep.size == tube.crease_nodes.size:
+        return tube
+    paper[keep] = ROLE_OUTER
+    return dataclasses.replace(tube, roles=paper, crease_nodes=keep)
+
+
+def _not_stranding(band: Any, roles: np.ndarray, extended: np.ndarray, inner: float) -> np.ndarray:
+    """The crease nodes ``extended`` (band positions) that can be taken out of the paper's inner
+    tube (``roles``) without leaving a speck of it on its own: a piece of no more nodes than a
+    node's inner-tube stencil holds, (2·inner + 1)^d, which no part of a surface that the grid
+    resolves is (a sphere of radius 3Δx holds some 400). The thinned nodes next to a speck are kept
+    in the tube, round by round; after :data:`_RECONNECT_ROUNDS` rounds none is thinned."""
+    if extended.size == 0:
+        return extended
+    speck = int((2 * math.floor(inner) + 1) ** band.ndim)
+    thinned = roles == ROLE_INNER
+    thinned[extended] = False
+    kept = np.zeros(len(roles), dtype=bool)
+    kept[extended] = True
+    for _ in range(_RECONNECT_ROUNDS):
+        labels = _native.band_component_labels(band, thinned)
+        names, sizes = np.unique(labels[thinned], return_counts=True)
+        stranded = np.flatnonzero(thinned & np.isin(labels, names[sizes <= speck]))
+        if stranded.size == 0:
+            return np.flatnonzero(kept)
+        around = band.neighbours_of_nodes(stranded.astype(np.int64)).reshape(-1)
+        around = around[(around >= 0) & (around < len(roles))]
+        back = around[kept[around]]
+        if back.size == 0:  # specks of the paper's tube itself
+            return np.flatnonzero(kept)
+        kept[back] = False
+        thinned[back] = True
+    return np.empty(0, np.int64)
+
+
 def thinned_at_creases(tube: _PreparedTube) -> _PreparedTube:
     """``tube`` with its crease nodes (``_PreparedTube.crease_nodes``) made extension nodes: the
     tube of ``order=2`` and of ``order="auto"`` on a level set with creases (docs/second-order.md).
@@ -161,6 +218,26 @@ def thinned_at_creases(tube: _PreparedTube) -> _PreparedTube:
     roles = tube.roles.copy()
     roles[tube.crease_nodes] = ROLE_OUTER
     return dataclasses.replace(tube, roles=roles)
+
+
+def paper_creases_of(tube: _PreparedTube) -> Optional[Dict[str, Any]]:
+    """The creases of ``tube``'s level set in the paper's tube (:attr:`_PreparedTube.paper_creases`),
+    found on first use for a re-distanced φ of a :class:`~tubesweep.Tube` (whose geometry is kept):
+    the second-order geometry's test (``_creases.creases_of_redistanced``) costs its pass, which
+    only a solve on the paper's tube needs."""
+    surf = tube.surface
+    if (
+        tube.paper_creases is None
+        and tube.geom is not None
+        and tube.method == "two-layer"
+        and isinstance(surf, LevelSet)
+        and getattr(surf, "redistance", False)
+    ):
+        h = tube.grid.spacing
+        tube.paper_creases = creases_of_redistanced(
+            tube.band, tube.roles, tube.geom.signed, tube.geom.direction, h, tube.outer_eff * h
+        )
+    return tube.paper_creases
 
 
 def thinned_count(tube: _PreparedTube) -> int:
@@ -616,10 +693,12 @@ def _prepare_tube(
     bridged_holes = holes_of(h, outer_eff, grid, hole_pairs) if holes_of is not None else None
     slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, which the band may join
     slits = slits_of(h) if slits_of is not None else None
-    # (after the facing test, which reads the paper's inner tube). The paper's tube's creases are
-    # not reported on a re-distanced φ, whose kinks include those of its samples (a voxel mask's
-    # staircase: a sphere's mask said "creases … turning by up to 84°"), but its crease nodes are
-    # thinned all the same: a closed cylinder r = 0.35, h = 0.8, bottom centre, re-distanced
+    # (after the facing test, which reads the paper's inner tube). On a re-distanced φ, whose kinks
+    # include those of its samples (a voxel mask's staircase: a sphere's mask said "creases …
+    # turning by up to 84°" to the plain test), the paper's tube's creases are those of the
+    # second-order geometry's test (:func:`paper_creases_of`), which costs its pass: run for the
+    # one call at order=1 here, for a Tube when an order=1 solve needs it. Crease nodes are thinned
+    # all the same: a closed cylinder r = 0.35, h = 0.8, bottom centre, re-distanced
     # from its distance function came out 9.4, 8.1, 9.9Δx short at N = 41, 61, 81 in the paper's
     # tube (2.4, 2.5, 3.5Δx thinned), its voxel mask 7.3–7.9Δx (4.1–4.2Δx), a sphere's voxel mask
     # 3.5e-2 off on average at N = 41 (1.7e-2)
@@ -628,6 +707,8 @@ def _prepare_tube(
     if method == "two-layer" and isinstance(surf, LevelSet):
         if not getattr(surf, "redistance", False):
             paper_creases = creases_in_paper_tube(band, roles == ROLE_INNER, phi, directions, h)
+        elif not creases and not reusable:  # the one call at order=1
+            paper_creases = creases_of_redistanced(band, roles, phi, directions, h, outer_eff * h)
         if creases:
             extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)
     return _PreparedTube(

@@ -30,11 +30,11 @@ from ._validate import (
     first_order_tol,
     checked_point_speeds,
     speed_at_points,
-    speed_values,
+    speed_on_surface,
 )
 from ._creases import warn_paper_tube_creases
 from ._warn import user_stacklevel
-from ._prepare import ROLE_INNER, thinned_count, uncut_band, warn_facing_pairs
+from ._prepare import ROLE_INNER, paper_creases_of, thinned_count, uncut_band, warn_facing_pairs
 from ._parts import drop_unsourced_rows
 from ._sheet_readout import own_side_plan
 from ._fallback import Fallback
@@ -103,8 +103,8 @@ def fixed_nodes(
     """The band positions and values each source fixes, concatenated, and the offsets (K + 1,)
     of each source's run: ``_fix_sources`` of a single solve, source by source. ``uncut``: the
     band before its cut (``_prepare.uncut_band``; the Lax–Friedrichs scheme), to fix them on;
-    ``order`` other than 1: on the tube thinned at creases (``Tube._tube_order2``)."""
-    t = tube._tube if order == 1 else tube._tube_order2
+    ``order`` other than 1: on the tube thinned at creases (``Tube._tube_first_auto``)."""
+    t = tube._tube if order == 1 else tube._tube_first_auto
     band, connected = (uncut, False) if uncut is not None else (t.band, t.cut_edges > 0)
     grid, surf = t.grid, t.surface
     inner_width = t.inner * grid.spacing
@@ -333,15 +333,14 @@ def _first_order_batch(
     t = tube._tube
     grid = t.grid
     if order != 1:
-        t = tube._tube_order2  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
+        t = tube._tube_first_auto  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
     if fallback is not None:
         fallback.measure(t)
     linear = t.linear
-    x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
-    speed_nodes = speed_values(speed, grid, x, linear)
-    del x
-    slowness: Any = 1.0 / speed_nodes
     h = grid.spacing
+    assert t.geom is not None  # a Tube keeps its geometry
+    speed_nodes = speed_on_surface(speed, grid, linear, t.phi, t.geom.direction, t.inner * h)
+    slowness: Any = 1.0 / speed_nodes
     tol = first_order_tol(tol, h, float(np.mean(slowness)), max(grid.shape))  # the first-order scheme's default
     check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
     # the Lax–Friedrichs scheme runs on the band before its cut (``_shortcuts``), with the warning
@@ -359,7 +358,7 @@ def _first_order_batch(
         )
     read_at = points if plan is None else np.ascontiguousarray(np.concatenate([points, plan.corners]))
     missing_policy = "infinity" if (t.method == "naive" and scheme == "godunov") else "extrapolate"
-    directions = t.geom.directions_for_solver()  # type: ignore[union-attr]  # a copy: the tube's stay as they are
+    directions = t.geom.directions_for_solver()  # a copy: the tube's stay as they are
     setup = time.perf_counter() - t0
     out, st = _native.solve_many_on_band(
         band,
@@ -388,7 +387,7 @@ def _first_order_batch(
     if fallback is not None:
         fallback.warn(out, t)
     if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut
-        warn_paper_tube_creases(t.paper_creases, t.inner, h)
+        warn_paper_tube_creases(paper_creases_of(t), t.inner, h)
     # a part without a source keeps inf (``_parts``), read as the single solve reads it
     out = drop_unsourced_rows(out, t, groups, None if points is None else read_at, band)
     if plan is not None:

@@ -147,7 +147,13 @@ def solve_many_order2(
     st["bridged_holes"] = t.bridged_holes
     st["slits"] = t.slits
     so.warn_first_order_nodes(st, t.surface, "tube.solve(source).first_order_points() shows where")
-    warn_creases(st.get("creases"), t.inner, h, thinned=thinned_spacings(t, thinned_count(t) > 0))
+    warn_creases(
+        st.get("creases"),
+        t.inner,
+        h,
+        thinned=thinned_spacings(t, thinned_count(t) > 0),
+        redistanced=bool(getattr(t.surface, "redistance", False)),
+    )
     for name, what in (
         (
             "converged",

@@ -36,7 +36,7 @@ from ._validate import (
     checked_point_speeds,
     tolerance_slowness,
     speed_at_points,
-    speed_values,
+    speed_on_surface,
 )
 from .stats import SolveStats
 from .surface import LevelSet
@@ -307,9 +307,7 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
         if obstacle is not None:
             raise Order2NotApplicable(obstacle)
     linear = tube.linear
-    x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
-    speed_nodes = speed_values(speed, grid, x, linear)
-    del x
+    speed_nodes = speed_on_surface(speed, grid, linear, geom.signed, geom.direction, tube.inner * h)
     slowness: Any = 1.0 / speed_nodes
     mean_slowness = float(np.mean(slowness))
     # the tolerances' slowness: the mean unless an obstacle pulls it up (_validate.tolerance_slowness)
@@ -455,7 +453,11 @@ def warn_about(
         warnings.warn("order=2: " + fallback, RuntimeWarning, stacklevel=user_stacklevel())
     warn_first_order_nodes(st, tube.surface)
     warn_creases(
-        st.get("creases"), tube.inner, tube.grid.spacing, thinned=thinned_spacings(tube, thinned_count(tube) > 0)
+        st.get("creases"),
+        tube.inner,
+        tube.grid.spacing,
+        thinned=thinned_spacings(tube, thinned_count(tube) > 0),
+        redistanced=bool(getattr(tube.surface, "redistance", False)),
     )
 
 

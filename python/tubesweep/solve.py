@@ -22,8 +22,8 @@ from ._validate import (
     first_order_tol,
     checked_point_speeds,
     speed_at_points,
+    speed_on_surface,
     progress_callback,
-    speed_values,
     warn_unconverged,
 )
 from ._fallback import Fallback
@@ -42,9 +42,11 @@ from ._prepare import (
     ROLE_RTOL,
     _PreparedTube,
     _prepare_tube,
+    paper_creases_of,
     thinned_at_creases,
     thinned_count,
     uncut_band,
+    unstranded,
     warn_facing_pairs,
 )
 from ._sources import SOURCE_RADIUS, _fix_sources
@@ -118,7 +120,10 @@ def solve(
         (Godunov-type) local solver by default, or with the general Lax–Friedrichs update of
         Sect. 5.1 when built with ``scheme="lxf"``.
     speed : float, ndarray of ``grid.shape``, or callable ``F(points) -> (M,)``
-        The speed F > 0 (1: geodesic distance).
+        The speed F > 0 (1: geodesic distance). It lives on the surface: a callable is evaluated
+        at the tube nodes' closest points (extended constantly along the normals, as the solution
+        is); an array is read at the nodes, and one that varies along the normals by more than 1%
+        across the inner tube is warned of (the front runs along the tube's faster side).
     flow : callable ``v(points (M, d)) -> (M, d)`` or array of ``grid.shape + (d,)``, optional
         Ambient flow of a moving medium: solves ``|∇u| = |1 − v·∇u| / F`` (Sect. 6.3) with the
         upwind local solver (shorthand for ``hamiltonian=ts.hamiltonians.MovingMedium(flow)``;
@@ -294,6 +299,7 @@ def solve(
     if tube is None:
         tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
     if fallback is not None:
+        tube = unstranded(tube)  # no piece of the thinned inner tube cut off (first-order sweeps)
         fallback.measure(tube)
     sol = _solve_on_tube(
         tube,
@@ -318,6 +324,12 @@ def solve(
         fallback.warn(sol.values, tube)
         return with_fallback(sol, fallback.reason)
     return sol
+
+
+def _directions_of(tube: _PreparedTube) -> np.ndarray:
+    """The tube's unit directions away from the surface, per band node: the solver's own copy (one
+    call) or the kept geometry's (a :class:`Tube`, a general Hamiltonian)."""
+    return tube.direction if tube.direction is not None else tube.geom.direction  # type: ignore[union-attr]
 
 
 def _check_source_radius(source_radius: Any, source_init: str, grid: Optional[Grid] = None) -> None:
@@ -389,7 +401,7 @@ def _solve_on_tube(
     cut_edges = tube.cut_edges
     crease_thinned = thinned_count(tube)
     if crease_thinned == 0:  # the paper's tube: its creases' corners are cut
-        warn_paper_tube_creases(tube.paper_creases, tube.inner, grid.spacing)
+        warn_paper_tube_creases(paper_creases_of(tube), tube.inner, grid.spacing)
     if scheme == "lxf" and cut_edges:
         # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
         # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
@@ -404,9 +416,8 @@ def _solve_on_tube(
     inner_width = tube.inner * h
     roles = tube.roles.copy() if reuse else tube.roles
     linear = tube.linear
-    # node coordinates only for a speed given as a callable (an array is read at the nodes)
-    x = grid.node_points(linear) if callable(speed) else np.empty((len(linear), 0))
-    speed_nodes = speed_values(speed, grid, x, linear)
+    # a callable at the nodes' closest points (an array is read at the nodes)
+    speed_nodes = speed_on_surface(speed, grid, linear, tube.phi, _directions_of(tube), inner_width)
     slowness: Any = 1.0 / speed_nodes
 
     def slowness_at(p: np.ndarray) -> np.ndarray:
@@ -443,7 +454,6 @@ def _solve_on_tube(
             f"spacings (h = {h:.4g}) of a source, so its value is the source's initialisation and nothing is solved; "
             f"refine the grid"
         )
-    del x
     method = tube.method
     missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
     phi = tube.phi

@@ -104,8 +104,9 @@ class SolveStats:
         second order is decided node by node) and ``first_order_reasons`` (how many for each
         reason: ``curvature``, ``gradient``, ``stencil``; ``sol.first_order_points()`` shows where),
         ``geometry_fitted`` (whether the derivatives of a noisy φ came from least-squares fits),
-        ``creases`` (the crease nodes found, the largest turn of the normal and the shortcut per
-        crease), on a mesh ``mesh_map`` (the mesh's smooth map: how it was fitted), and with
+        ``creases`` (the crease nodes found, ``angle_degrees`` the largest turn of the normal
+        between neighbours there, ``faces_angle_degrees`` the widest across a node, which sizes
+        the warning on a φ given as it is, and the shortcut per crease), on a mesh ``mesh_map`` (the mesh's smooth map: how it was fitted), and with
         ``warm=`` a ``warm`` dict: ``carried`` (nodes started from the previous values),
         ``new_nodes`` (nodes new to the band), ``unreached_before``, ``all_started``,
         ``restarted`` (why the warm sweeps started again cold, None when they did not), ``changed``
@@ -114,12 +115,15 @@ class SolveStats:
         ``warm_refused="cold"``, ``refused`` (why): docs/moving-surfaces.md.
     creases : dict or None
         For the first-order scheme (``order=1``, and ``order="auto"`` where it ran it) on a level
-        set given as a distance: the creases and corners of its level sets in the tube, as
-        ``order2["creases"]`` (``nodes``, ``angle_degrees``: the faces' angle, ``shortcut_per_inner_width``:
-        2·tan(θ/2)). In the paper's tube (``order=1``) a front crossing one arrives early by about
+        set: the creases and corners of its level sets in the tube, as
+        ``order2["creases"]`` (``nodes``, ``angle_degrees``: the faces' angle, ``faces_angle_degrees``
+        likewise, ``shortcut_per_inner_width``: 2·tan(θ/2)). In the paper's tube (``order=1``) a front crossing one arrives early by about
         ``shortcut_per_inner_width·inner·Δx``, with a ``RuntimeWarning`` (the cube at N = 41: 4.25Δx
-        per edge); ``crease_thinned`` counts the nodes ``"auto"`` took out of the tube there. None
-        for other surfaces and with ``order=2`` (see ``order2``).
+        per edge; up to 1.5 times that on a re-distanced φ, for which the dict says
+        ``redistanced: True``: found by the second-order geometry's test, which a voxel mask's
+        staircase does not trip, and computed for ``order=1`` only); ``crease_thinned`` counts the
+        nodes ``"auto"`` took out of the tube there. None for other surfaces and with ``order=2``
+        (see ``order2``).
     box_cut : dict or None
         On surfaces, where the grid box cuts the tube (None where the band stays inside it):
         ``surface_cut`` (the surface itself crosses the box's boundary, with a ``RuntimeWarning``:

@@ -31,7 +31,7 @@ from ._validate import as_grid, as_sources, check_infinity, check_tolerance, pro
 from .grid import Grid
 from .moving import check_warm_refused
 from ._fallback import Fallback
-from ._prepare import _prepare_tube, thinned_at_creases
+from ._prepare import _prepare_tube, _PreparedTube, thinned_at_creases, unstranded
 from .solution import Solution
 from .solve import _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
@@ -106,6 +106,7 @@ class Tube:
         self._phi_at_band = None if array is None else array.reshape(-1)[self._tube.linear].copy()
         # why order=2 refused this band's geometry (a crease, an unresolved curvature, ...), once found
         self._order2_refusal: Optional[str] = None
+        self._first_auto: Optional[_PreparedTube] = None  # "auto"'s first-order tube, once needed
 
     def _check_phi_unchanged(self) -> None:
         if self._phi_at_band is not None and not np.array_equal(
@@ -129,6 +130,14 @@ class Tube:
             warnings.simplefilter("ignore", RuntimeWarning)
             self.__init__(state["surface"], state["grid"], inner=inner, outer=outer, method=method)  # type: ignore[misc]
         self._token = state["token"]
+
+    @property
+    def _tube_first_auto(self) -> _PreparedTube:
+        """The tube of ``order="auto"``'s first-order scheme: thinned at creases as order 2's, with
+        no piece of the inner tube cut off (``_prepare.unstranded``); computed once."""
+        if self._first_auto is None:
+            self._first_auto = unstranded(self._tube_order2)
+        return self._first_auto
 
     @property
     def method(self) -> str:
@@ -263,9 +272,9 @@ class Tube:
             raise refusal_for_order1(None if fallback is None else fallback.reason)
         _check_source_radius(source_radius, source_init, self.grid)
         if fallback is not None:
-            fallback.measure(self._tube_order2)
+            fallback.measure(self._tube_first_auto)
         sol = _solve_on_tube(
-            self._tube if paper_tube else self._tube_order2,
+            self._tube if paper_tube else self._tube_first_auto,
             src,
             general,
             scheme,
@@ -284,7 +293,7 @@ class Tube:
         if fallback is not None:
             from .second_order import with_fallback
 
-            fallback.warn(sol.values, self._tube_order2)
+            fallback.warn(sol.values, self._tube_first_auto)
             return with_fallback(sol, fallback.reason)
         return sol
 

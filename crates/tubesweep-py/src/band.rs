@@ -17,6 +17,7 @@ use tubesweep_core::band::NarrowBand;
 use tubesweep_core::solution::interpolate::interpolate;
 use tubesweep_core::solution::nearest_source::nearest_source_labels;
 use tubesweep_core::sweep::default_row_prefetch_above;
+use tubesweep_core::sweep::NodeRole;
 use tubesweep_core::SolveOptions;
 
 pub(crate) enum AnyBand {
@@ -334,6 +335,36 @@ impl PyBand {
         Ok((c.nodes, c.angle))
     }
 
+    /// The creases of a re-distanced level set in the paper's tube (`order=1`, see
+    /// `tubesweep_core::second_order::creases::creases_of_redistanced`: the second-order
+    /// geometry's test): `roles` per node (the paper's tube), `phi` φ (signed), `direction` (K, d)
+    /// the outward directions, `outer_width` the tube's half-width. Returns the crease nodes'
+    /// count and the faces' largest angle there, in degrees.
+    fn creases_of_redistanced(
+        &self,
+        py: Python<'_>,
+        roles: PyReadonlyArray1<'_, u8>,
+        phi: PyReadonlyArray1<'_, f64>,
+        direction: PyReadonlyArray2<'_, f32>,
+        spacing: f64,
+        outer_width: f64,
+    ) -> PyResult<(usize, f64)> {
+        let d = self.ndim();
+        if direction.shape()[1] != d {
+            return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
+        }
+        let (roles, phi, dir) = (
+            node_roles(roles.as_slice()?)?,
+            phi.as_slice()?,
+            c_slice(&direction, "direction")?,
+        );
+        let c = match &self.band {
+            AnyBand::D2(b) => redistanced_creases(py, b, roles, phi, dir, spacing, outer_width),
+            AnyBand::D3(b) => redistanced_creases(py, b, roles, phi, dir, spacing, outer_width),
+        }?;
+        Ok((c.nodes, c.angle))
+    }
+
     /// The edges between neighbours whose closest points lie more than `jump` grid spacings
     /// apart, one of them in the inner tube (`tubesweep_core::band::medial_edges`): `inner` per
     /// node, `phi` its signed or unsigned distance, `direction` (K, d) its outward direction.
@@ -632,6 +663,31 @@ impl PyBand {
         }
         Ok((inner.as_slice()?, phi.as_slice()?, c_slice(direction, "direction")?))
     }
+}
+
+/// [`PyBand::creases_of_redistanced`] on a band of dimension D.
+fn redistanced_creases<const D: usize>(
+    py: Python<'_>,
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    phi: &[f64],
+    direction: &[f32],
+    spacing: f64,
+    outer_width: f64,
+) -> PyResult<tubesweep_core::second_order::creases::Creases> {
+    let n = band.len();
+    if roles.len() != n || phi.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "roles and phi must have one entry per band node ({n}); got {} and {}",
+            roles.len(),
+            phi.len()
+        )));
+    }
+    let dirs = node_vectors::<f32, D>(direction, n, "direction")?;
+    py.detach(|| {
+        tubesweep_core::second_order::creases::creases_of_redistanced(band, roles, phi, dirs, spacing, outer_width)
+    })
+    .map_err(to_pyerr)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -13,6 +13,7 @@ pub(crate) fn creases_dict<'py>(
     let d = PyDict::new(py);
     d.set_item("nodes", creases.nodes)?;
     d.set_item("angle_degrees", creases.angle)?;
+    d.set_item("faces_angle_degrees", creases.faces_angle)?;
     d.set_item("shortcut_per_inner_width", creases.shortcut_per_inner_width())?;
     Ok(d)
 }

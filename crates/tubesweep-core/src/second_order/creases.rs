@@ -29,7 +29,7 @@ use crate::band::NarrowBand;
 use crate::error::Result;
 use crate::sweep::NodeRole;
 
-use super::geometry::{NodeGeometry, Unresolved};
+use super::geometry::{tube_geometry, NodeGeometry, Unresolved};
 use super::implicit::Implicit;
 use super::GRAD_NORM_TOLERANCE;
 
@@ -59,6 +59,12 @@ pub struct Creases {
     /// ([`creases_of`]); [`creases_of_level_set`] also reads it from the neighbour on one side to
     /// the one on the other (the faces' angle: 90° on the cube, where neighbours turn by 55°).
     pub angle: f64,
+    /// The faces' largest angle, in degrees: the widest turn of the normal across a crease node,
+    /// from the neighbour on one side to the one on the other, or to a neighbour. Where the
+    /// directions come from central differences of φ (a φ = max(φ₁, φ₂) given as it is), they
+    /// average the two faces' normals next to the crease and neighbours turn by about half of
+    /// it: a lens whose faces meet at 113° turned by 52–61° between neighbours (a review).
+    pub faces_angle: f64,
 }
 
 impl Creases {
@@ -80,6 +86,34 @@ pub fn creases_of<const D: usize>(
     directions: &[[f32; D]],
     nodes: &[NodeGeometry],
 ) -> Creases {
+    let found = crease_nodes_of(band, roles, surface, spacing, directions, nodes);
+    let smallest = found.iter().map(|&(_, c, _)| c).fold(1.0f64, f64::min);
+    let widest = found.iter().map(|&(_, _, w)| w).fold(1.0f64, f64::min);
+    creases_from(found.len(), smallest, widest)
+}
+
+/// The creases found: `nodes` of them, the smallest cosine of a turn to a neighbour there
+/// `smallest`, of a turn across a node `widest`.
+fn creases_from(nodes: usize, smallest: f64, widest: f64) -> Creases {
+    let mut found = Creases::default();
+    if nodes > 0 {
+        found.nodes = nodes;
+        found.angle = smallest.clamp(-1.0, 1.0).acos().to_degrees();
+        found.faces_angle = widest.clamp(-1.0, 1.0).acos().to_degrees();
+    }
+    found
+}
+
+/// The crease nodes of [`creases_of`] (band positions) with the cosines of the largest turn of
+/// the normal from each to an axis neighbour and across it ([`widest_turn`]).
+fn crease_nodes_of<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    spacing: f64,
+    directions: &[[f32; D]],
+    nodes: &[NodeGeometry],
+) -> Vec<(usize, f64, f64)> {
     let normal = |i: usize| {
         let s = if surface.phi(i) < 0.0 { -1.0 } else { 1.0 };
         let mut n = [0.0f64; D];
@@ -90,8 +124,7 @@ pub fn creases_of<const D: usize>(
     };
     let threshold = CREASE_ANGLE.to_radians().cos();
     let sentinel = band.sentinel();
-    let mut found = Creases::default();
-    let mut smallest = 1.0f64;
+    let mut found = Vec::new();
     let mut k = 0usize;
     for (i, role) in roles.iter().enumerate() {
         if *role == NodeRole::Outer {
@@ -133,14 +166,61 @@ pub fn creases_of<const D: usize>(
                     .any(|&j| j != sentinel && near_kink(j as usize))
         };
         if cos_min < threshold && kink() {
-            found.nodes += 1;
-            smallest = smallest.min(cos_min);
+            // (a node on the surface has no direction: left out of the faces' angle)
+            let faces_normal = |j: usize| Some(normal(j)).filter(|n| n.iter().any(|&c| c != 0.0));
+            found.push((i, cos_min, widest_turn(band, i, cos_min, faces_normal)));
         }
     }
-    if found.nodes > 0 {
-        found.angle = smallest.clamp(-1.0, 1.0).acos().to_degrees();
-    }
     found
+}
+
+/// The creases of a re-distanced level set in the paper's tube, for the first-order scheme
+/// (`order=1`), found by the second-order geometry's own test ([`creases_of`] behind the gates of
+/// [`tube_geometry`]: a node whose curvature or gradient the central differences do not resolve,
+/// and no crease on a φ found noisy). [`creases_of_level_set`], without those gates, reads the
+/// kinks of a re-distanced φ's samples as creases (a voxel mask's staircase, the bumps of noise);
+/// the gates keep them out, and the angle reported is the faces' (the widest turn across a crease
+/// node, as [`creases_of_level_set`] reports it). `roles`: the paper's tube (inner and extension
+/// nodes), `outer_width` its half-width (outer·Δx), which the curvature gate reads. Costs the
+/// geometry pass of a second-order solve (36 bytes per inner node while it runs).
+pub fn creases_of_redistanced<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    phi: &[f64],
+    directions: &[[f32; D]],
+    spacing: f64,
+    outer_width: f64,
+) -> Result<Creases> {
+    let geometry = tube_geometry(band, roles, phi, directions, spacing, outer_width)?;
+    if geometry.summary.fitted_everywhere {
+        return Ok(Creases::default());
+    }
+    let surface = Implicit::LevelSet(phi);
+    let found = crease_nodes_of(band, roles, &surface, spacing, directions, &geometry.nodes);
+    let widest = found.iter().map(|&(_, _, w)| w).fold(1.0f64, f64::min);
+    Ok(creases_from(found.len(), widest, widest))
+}
+
+/// The cosine of the faces' angle at crease node `i`: the widest turn of the normal from one side
+/// of the node to the other along an axis, or to a neighbour (`cos_min`). Across a crease the
+/// central differences average the faces' normals at the nodes next to it, so neighbours turn by
+/// less: the cube's 90° edges by 55°.
+fn widest_turn<const D: usize>(
+    band: &NarrowBand<D>,
+    i: usize,
+    cos_min: f64,
+    normal: impl Fn(usize) -> Option<[f64; D]>,
+) -> f64 {
+    let sentinel = band.sentinel();
+    let mut widest = cos_min;
+    for pair in band.neighbours_of(i).iter() {
+        if pair[0] != sentinel && pair[1] != sentinel {
+            if let (Some(nm), Some(np)) = (normal(pair[0] as usize), normal(pair[1] as usize)) {
+                widest = widest.min((0..D).map(|c| nm[c] * np[c]).sum());
+            }
+        }
+    }
+    widest
 }
 
 /// The cosine of the largest turn of the normal from node `i` to its axis neighbours in the band
@@ -216,17 +296,8 @@ pub fn creases_of_level_set<const D: usize>(
         if cos_min >= threshold {
             return 2.0;
         }
-        // the faces' angle: the widest turn from one side of the node to the other (across a
-        // crease the central differences average the faces' normals at the nodes next to it, so
-        // neighbours turn by less: the cube's 90° edges by 55°, the bound 2·tan(θ/2) halved)
-        let mut widest = cos_min;
-        for pair in band.neighbours_of(i).iter() {
-            if pair[0] != sentinel && pair[1] != sentinel {
-                if let (Some(nm), Some(np)) = (normal(pair[0] as usize), normal(pair[1] as usize)) {
-                    widest = widest.min((0..D).map(|c| nm[c] * np[c]).sum());
-                }
-            }
-        }
+        // the faces' angle (the bound 2·tan(θ/2) halved with the neighbours' turn)
+        let widest = widest_turn(band, i, cos_min, normal);
         // a stencil node outside the band counts as a kink, as in creases_of
         let kink =
             gradient(i).is_none_or(|g| (g.iter().map(|c| c * c).sum::<f64>().sqrt() - 1.0).abs() > GRAD_NORM_TOLERANCE);
@@ -247,11 +318,7 @@ pub fn creases_of_level_set<const D: usize>(
             }
         })
         .reduce(|| (0, 1.0), |a, b| (a.0 + b.0, a.1.min(b.1)));
-    let mut found = Creases { nodes, angle: 0.0 };
-    if nodes > 0 {
-        found.angle = smallest.clamp(-1.0, 1.0).acos().to_degrees();
-    }
-    Ok(found)
+    Ok(creases_from(nodes, smallest, smallest))
 }
 
 #[cfg(test)]
@@ -260,7 +327,11 @@ mod tests {
 
     #[test]
     fn a_right_angle_costs_two_inner_widths() {
-        let c = Creases { nodes: 1, angle: 90.0 };
+        let c = Creases {
+            nodes: 1,
+            angle: 90.0,
+            faces_angle: 90.0,
+        };
         assert!((c.shortcut_per_inner_width() - 2.0).abs() < 1e-12);
         assert_eq!(Creases::default().shortcut_per_inner_width(), 0.0);
     }

@@ -204,6 +204,7 @@ impl GeometrySummary {
             creases: Creases {
                 nodes: self.creases.nodes + other.creases.nodes,
                 angle: self.creases.angle.max(other.creases.angle),
+                faces_angle: self.creases.faces_angle.max(other.creases.faces_angle),
             },
         }
     }
