@@ -390,3 +390,48 @@ def test_a_mesh_of_slivers_is_named_with_its_cure():
     th, z = np.linspace(0.1, np.pi, 30), np.linspace(-0.4, 0.4, 30)  # the unrolled cylinder
     exact = np.hypot(0.3 * th, z - source[2])
     assert np.max(np.abs(sol(np.c_[0.3 * np.cos(th), 0.3 * np.sin(th), z]) - exact)) < 0.6 * grid.spacing
+
+
+def _cad_cylinder(sections: int) -> tuple:
+    """A closed cylinder (radius 0.3, height 1) as a CAD export triangulates it: two triangles per
+    side facet, running the whole height, and fans over the caps."""
+    t = 2 * np.pi * np.arange(sections) / sections
+    ring = np.c_[0.3 * np.cos(t), 0.3 * np.sin(t)]
+    vertices = np.r_[np.c_[ring, -0.5 + 0 * t], np.c_[ring, 0.5 + 0 * t], [[0, 0, -0.5], [0, 0, 0.5]]]
+    i, j = np.arange(sections), (np.arange(sections) + 1) % sections
+    n = sections
+    faces = np.r_[
+        np.c_[i, j, n + j], np.c_[i, n + j, n + i], np.c_[2 * n + 0 * i, j, i], np.c_[2 * n + 1 + 0 * i, n + i, n + j]
+    ]
+    return vertices, faces
+
+
+def test_a_mesh_whose_smooth_map_folds_is_told_of_its_exact_map_not_of_phi():
+    # a CAD cylinder of 256 sections (facets 88 times longer than high) at N = 101: the smooth
+    # map's band did not close, and the refusal said "φ is far from a distance function (use
+    # ts.LevelSet(phi, redistance=True))" (a review); it now names the slivers and smooth=False
+    surface = ts.surfaces.from_mesh(_cad_cylinder(256))
+    advice = surface.band_advice
+    assert advice.startswith(
+        "the mesh's smooth closest-point map folds across its triangles: from_mesh(..., smooth=False)"
+    )
+    assert re.search(r"Here its triangles are slivers \(the median longest edge is \d+ times the height on it", advice)
+    assert "φ" not in advice
+    # the exact map has no such advice (and no word of φ either: it is no level set)
+    assert getattr(ts.surfaces.from_mesh(_cad_cylinder(256), smooth=False), "band_advice", None) is None
+    # and the solve runs on the exact map at first order instead of refusing: 1.4 spacings off the
+    # unrolled distances at worst, as with smooth=False
+    grid = surface.grid(101)
+    with pytest.warns(
+        RuntimeWarning, match="had a neighbour outside the band with outer = [4-7]\\.0: the closest points fold"
+    ):
+        with pytest.warns(
+            RuntimeWarning, match=r"even with outer = 8\.0: the mesh's smooth .* exact closest points are used"
+        ):
+            sol = ts.solve(surface, grid, [(0.3, 0, 0)])
+    assert sol.stats.order == 1 and "folds across its triangles on this grid" in sol.stats.order_fallback
+    theta, z = np.linspace(-np.pi, np.pi, 200), np.linspace(-0.3, 0.3, 200)
+    error = sol(np.c_[0.3 * np.cos(theta), 0.3 * np.sin(theta), z]) - np.hypot(0.3 * theta, z)
+    assert np.max(np.abs(error)) < 1.5 * grid.spacing  # 1.42
+    with pytest.raises(ts.second_order.Order2NotApplicable, match="folds across its triangles on this grid"):
+        ts.solve(surface, grid, [(0.3, 0, 0)], order=2)

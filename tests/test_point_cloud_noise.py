@@ -203,3 +203,33 @@ def test_a_noisy_cloud_sampled_unevenly_stays_closed():
     p = p[rng.uniform(size=len(p)) < np.where(p[:, 2] > 0, 1.0, 1 / 15)]
     cloud = ts.surfaces.from_points(p + 0.006 * rng.normal(size=p.shape))
     assert cloud.report["rim_samples"] == 0 and not cloud.open_surface and cloud.order2_refusal is None
+
+
+def test_noise_beyond_a_grid_spacing_is_refused_before_the_band_is_searched():
+    # a sphere's samples with noise of 1.07–1.28 grid spacings at N = 61: the band was searched for
+    # 8–9 minutes and then refused (a review); 0.97 spacings solved (0.47 spacings off at worst)
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(20000, 3))
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    noisy = 0.6 * x / np.linalg.norm(x, axis=1, keepdims=True) + 1.5 * grid.spacing * rng.normal(size=x.shape)
+    cloud = ts.surfaces.from_points(noisy)
+    assert cloud.noise > grid.spacing
+    with pytest.raises(
+        ValueError, match=r"too noisy for this grid: .* \(1\.3 grid spacings\), .* Use a grid spacing ≥ 0\.0"
+    ):
+        ts.solve(cloud, grid, [(0, 0, 0.6)])
+
+
+def test_stray_points_left_in_are_named_when_the_fits_fail():
+    # 0.5% of a sphere's 20,000 samples replaced by points spread over the box (a scanner's
+    # strays): 32 are left out, the rest fit one another in pairs, and the solve was refused
+    # blaming samples "about half a grid spacing" off their neighbours' surface, where they lie
+    # 0.6 to 27 spacings off (a review); the refusal now names the strays that remain
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=(20000, 3))
+    samples = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
+    samples[:100] = rng.uniform(-0.9, 0.9, size=(100, 3))
+    with pytest.warns(RuntimeWarning, match=r"32 of 20000 samples lie off the surface their neighbours fit"):
+        cloud = ts.surfaces.from_points(samples)
+    with pytest.raises(ValueError, match=r"32 samples were left out as outliers already: stray points that remain"):
+        ts.solve(cloud, ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3), [(0, 0, 0.5)])

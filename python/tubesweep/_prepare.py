@@ -611,9 +611,21 @@ def _prepare_tube(
             )
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
-            # a surface kind's own cause (a point cloud's), or φ's for a level set not re-distanced
+            # a mesh's smooth map that folds: its exact closest points on this grid (first order)
+            fold = getattr(surf, "fold_to_exact", None)
+            if fold is not None and fold(h):
+                warnings.warn(
+                    f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: "
+                    f"{getattr(surf, 'band_advice')}. The exact closest points are used on this grid instead, "
+                    "and order=1 runs there",
+                    RuntimeWarning,
+                    stacklevel=user_stacklevel(),
+                )
+                return _prepare_tube(surf, grid, inner, outer, method, keep_geometry, reusable, creases)
+            # a surface kind's own cause (a point cloud's, a mesh's), or φ's for a level set not
+            # re-distanced (a mesh's smooth map failing here was told to re-distance its φ: a review)
             cause = getattr(surf, "band_advice", None)
-            if cause is None and not redistanced:
+            if cause is None and isinstance(surf, LevelSet) and not redistanced:
                 cause = "φ is far from a distance function (use ts.LevelSet(phi, redistance=True))"
             raise ValueError(
                 f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "

@@ -84,6 +84,11 @@ def band(surface: Any, grid: Grid, half_width: float, exact_band: Callable[[], B
     surface.check_grid(grid)
     grid_h = grid.spacing
     surface._band_cache = None
+    if getattr(surface, "_folded_h", None) == grid_h:
+        # the smooth map folded on this grid (SmoothMap.fold_to_exact): the exact map, first order
+        surface._h = grid_h
+        surface.report = {"folded": True, "h": grid_h}
+        return exact_band()
     size = median_size(surface)
     # the map's length scale: the grid's spacing, or on a coarse mesh without creases of its own
     # the spacing that resolves its triangles
@@ -266,6 +271,13 @@ def sliver_advice(surface: Any) -> str:
 def order2_obstacle(surface: Any, tube_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
     """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants)."""
     report = surface.report
+    if report.get("folded"):
+        slivers = sliver_advice(surface)
+        return (
+            "the mesh's smooth closest-point map folds across its triangles on this grid (its band did not close)"
+            + (f": {slivers}" if slivers else "")
+            + "; order=1 runs on its exact closest points"
+        )
     if "coarse" in report:
         turn = report["sharp_turn"]
         creases = (
@@ -336,6 +348,30 @@ class SmoothMap:
 
     def _cp(self, x: np.ndarray) -> np.ndarray:
         return closest(self, x, self._h)[0]
+
+    def fold_to_exact(self, h: float) -> bool:
+        """Called when the band of the smooth map at grid spacing ``h`` does not close even widened
+        (``_prepare``): from then on the band at that spacing is the exact map's, and
+        ``order2_obstacle`` refuses second order there. True the first time, False when the exact
+        map was in use already."""
+        if getattr(self, "_folded_h", None) == h:
+            return False
+        self._folded_h = h
+        return True
+
+    @property
+    def band_advice(self) -> str:
+        """Why the band of the smooth map may not close (for the band's error, ``_prepare``): the
+        map folds across the mesh's triangles (slivers, :func:`sliver_advice`), where the exact
+        closest points do not. A CAD cylinder of 256 sections (triangles 88 times longer than
+        high) at N = 101 was refused with the advice to re-distance φ (a review); with
+        ``smooth=False`` it runs first order, 1.4 spacings off the unrolled distances at worst."""
+        slivers = sliver_advice(self)
+        return (
+            "the mesh's smooth closest-point map folds across its triangles: from_mesh(..., smooth=False) takes the "
+            "mesh's exact closest points instead, which do not fold (the first-order scheme)"
+            + (f". Here {slivers}" if slivers else "")
+        )
 
     @property
     def unresolved_advice(self) -> Optional[str]:

@@ -73,6 +73,11 @@ FIT_SAMPLES = 400
 #: ... but at most this many grid spacings (a wider fit flattens the surface's curvature): beyond
 #: it the grid resolves the surface finer than its noise allows, which is warned of
 MAX_SMOOTHING = 8.0
+#: Noise above this many grid spacings is refused before the band is searched: a sphere of 20,000
+#: samples (radius 0.6) at N = 61 solved with noise of 0.62, 0.80 and 0.97 spacings (largest errors
+#: 0.33–0.47 spacings, 62–82 s), and with 1.07, 1.18 and 1.28 searched the band for 8–9 minutes
+#: and then refused it (a review; scratch ``/tmp/s73/noise``)
+NOISE_REFUSED = 1.0
 #: A noisy cloud's rim of fewer samples than this is a step of its density, not a hole: 1 sample
 #: at the equator of a sphere with noise 0.006, sampled 15 times more densely above it
 #: (``tests/test_point_cloud_noise.py``); holes in noisy scans showed 4 and more
@@ -493,15 +498,24 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         return (self.neighbours + 1) * (rho / self._median_fit) ** (self.points.shape[1] - 1)
 
     def _warn_noise_unresolved(self, h: float) -> None:
-        """Warns when the noise needs fits wider than MAX_SMOOTHING·h (once per grid spacing)."""
+        """Warns when the noise needs fits wider than MAX_SMOOTHING·h (once per grid spacing), and
+        refuses the grid when the noise exceeds :data:`NOISE_REFUSED` grid spacings."""
         if not self._noise_reach(h) > MAX_SMOOTHING * h or getattr(self, "_noise_warned", None) == h:
             return
-        self._noise_warned = h
         # the averaging reach r·c·h^(−2/e) (e = d − 1) is MAX_SMOOTHING·h at h = (r·c / MAX_SMOOTHING)^(e/(e+2))
         e = self.points.shape[1] - 1
         averaged = (self._median_fit * self._averaging() / MAX_SMOOTHING) ** (e / (e + 2)) if e == 2 else 0.0
         coarser = max(NOISE_SPAN * self.noise / MAX_SMOOTHING, averaged)
         coarser = _round_up(coarser * (1 + 1e-9))  # (printed rounded to the nearest, it can fall short)
+        if self.noise > NOISE_REFUSED * h:
+            raise ValueError(
+                f"the samples are too noisy for this grid: they lie off their neighbours' fits by about {self.noise:.3g} "
+                f"({self.noise / h:.2g} grid spacings), more than the widest fits ({MAX_SMOOTHING:g} grid spacings) "
+                "smooth out, and the closest points fold (the band would be searched for minutes and then not close). "
+                f"Use a grid spacing ≥ {coarser:.3g} (now {h:.3g}; e.g. surface.grid(n) with a smaller n), or denser or "
+                "less noisy samples"
+            )
+        self._noise_warned = h
         warnings.warn(
             f"the samples are noisy for this grid: they lie off their neighbours' fits by about {self.noise:.3g} "
             f"({self.noise / h:.2g} grid spacings; noise, or samples too sparse for the surface's curvature), and fits "
@@ -588,7 +602,8 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
                 if self.noise > NOISY * h
                 else ""
             )
-            + ": leave such samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid",
+            + ": leave such samples out, pass a larger neighbours= to from_points (smoother fits), or use a coarser grid"
+            + self._strays_note(),
         )
         self.report["rim_nodes"] = int(np.count_nonzero(feet == 1))
         # feet whose fixed point wandered off the samples, from the query and from its nearest
