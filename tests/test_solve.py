@@ -456,5 +456,8 @@ def test_a_speed_array_that_varies_along_the_normals_is_warned_with_its_share():
         sol = ts.solve(ts.LevelSet(radius - 0.5), grid, [(-0.5, 0, 0)], speed=np.exp(3 * (radius - 0.5)))
     far = exact > 0.2
     assert 0.1 < np.max(np.abs(sol(points) - exact)[far] / exact[far]) < 0.18  # 0.128
-    # an array constant along the normals is not warned of, nor is a callable
-    ts.solve(ts.LevelSet(radius - 0.5), grid, [(-0.5, 0, 0)], speed=1 + 0 * radius)
+    # an array constant along the normals is not warned of, even one varying fast along the surface
+    # (whose interpolation at the closest points misses 1.4% here: a review)
+    x = np.stack(grid.meshgrid(), -1)[..., 0]
+    along = 1 + 0.5 * np.sin(8 * x / np.maximum(radius, 1e-9))
+    ts.solve(ts.LevelSet(radius - 0.5), grid, [(-0.5, 0, 0)], speed=along)

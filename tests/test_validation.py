@@ -166,17 +166,27 @@ def test_a_small_grid_in_small_units_needs_a_tol_in_those_units_and_the_default_
         assert abs(u / s - u1) < 1e-6
 
 
-@pytest.mark.parametrize("value, match", [(np.nan, "speed is nan"), (-1.0, "speed is -1.0"), (0.0, "speed is 0.0")])
-def test_a_speed_callable_is_checked_at_the_source_too(value, match):
-    # the callable is also evaluated at the source and at closest points, which used to go unchecked;
-    # on a surface the nodes' own values are read at their closest points, so the node on the
-    # surface at the source meets it first
-    def speed(p):
-        return np.where(np.linalg.norm(p - [-0.5, 0, 0], axis=1) < 1e-12, value, 1.0)
+@pytest.mark.parametrize(
+    "value, match, at_node",
+    [
+        (np.nan, "speed is nan", "speed is NaN or inf at"),
+        (-1.0, "speed is -1.0", "speed must be positive; got -1 at"),
+        (0.0, "speed is 0.0", "speed must be positive; got 0 at"),
+    ],
+)
+def test_a_speed_callable_is_checked_at_the_source_too(value, match, at_node):
+    # the callable is also evaluated at the source and at closest points, which used to go unchecked
+    def bad_at(source):
+        return lambda p: np.where(np.linalg.norm(p - source, axis=1) < 1e-12, value, 1.0)
 
-    at_node = r"speed (is NaN or inf|must be positive; got -?[01]) at \(-0\.5, 0\.0, 0\.0\)"
-    with pytest.raises(ValueError, match=at_node):
-        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=speed)
+    # a source between the nodes: only the source's own value is bad
+    source = 0.5 * np.array([-np.cos(0.3), np.sin(0.3), 0.0])
+    with pytest.raises(ValueError, match=match):
+        ts.solve(SPHERE, G3, [tuple(source)], speed=bad_at(source))
+    # on a node of the surface: the nodes' own values are read at their closest points, and that
+    # node's meets it first
+    with pytest.raises(ValueError, match=at_node + r" \(-0\.5, 0\.0, 0\.0\)"):
+        ts.solve(SPHERE, G3, [(-0.5, 0, 0)], speed=bad_at(np.array([-0.5, 0, 0])))
 
     def speed2(p):
         return np.where(np.linalg.norm(p - [0.013, 0.011], axis=1) < 1e-12, value, 1.0)

@@ -127,9 +127,9 @@ def warn_creases(
     # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
     # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
     size, how = _per_crease(
-        2 * np.tan(np.radians(min(faces, REVERSED)) / 2), inner, spacing, thinned, scaled=angle <= REVERSED
+        2 * np.tan(np.radians(min(faces, REVERSED)) / 2), inner, spacing, thinned, scaled=faces <= REVERSED
     )
-    early = _early(angle, size, f"({how}, first order in Δx)", thinned=bool(thinned))
+    early = _early(faces, size, f"({how}, first order in Δx)", thinned=bool(thinned))
     turning = f"{angle:.0f}°" + (f", the faces by up to {faces:.0f}°" if faces > angle + 5 else "")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
@@ -247,15 +247,17 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
     angle = float(creases["angle_degrees"])
     size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
     reckoned = "2·tan(θ/2)·inner·Δx"
+    thinned = THINNED_SHORTCUT
     if creases.get("redistanced"):
         size *= PAPER_TUBE_REDISTANCED
         reckoned = f"{PAPER_TUBE_REDISTANCED:g}·2·tan(θ/2)·inner·Δx on a re-distanced φ"
+        thinned = THINNED_SHORTCUT_REDISTANCED
     early = _early(angle, size, f"per crease it crosses ({reckoned}, first order in Δx)")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the faces turning by up to "
         f"{angle:.0f}°): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "
         f"Second order's tube (order='auto', the default, or order=2, with outer ≥ inner + 2) is thinned there, which "
-        f"leaves about {THINNED_SHORTCUT:g}Δx per crease; rounding the edges over more than the tube's width "
+        f"leaves about {thinned:g}Δx per crease; rounding the edges over more than the tube's width "
         "(outer·Δx) leaves none. sol.stats.creases has the figures",
         RuntimeWarning,
         stacklevel=user_stacklevel(),

@@ -126,9 +126,10 @@ class _PreparedTube:
     #: nodes (``_creases.crease_nodes_to_extend``; band positions); their roles are changed only
     #: by :func:`thinned_at_creases`, so that ``order=1`` keeps the paper's tube
     crease_nodes: np.ndarray = dataclasses.field(default_factory=lambda: np.empty(0, np.int64))
-    #: the creases of a level set given as a distance in the paper's tube, where ``order=1`` cuts
-    #: their corners (``_creases.creases_in_paper_tube``): a dict as ``order2["creases"]``, None
-    #: for other surfaces
+    #: the creases of a level set in the paper's tube, where ``order=1`` cuts their corners
+    #: (``_creases.creases_in_paper_tube``, or for a re-distanced φ ``creases_of_redistanced``,
+    #: found on first use for a Tube: :func:`paper_creases_of`): a dict as ``order2["creases"]``,
+    #: None for other surfaces and until then
     paper_creases: Optional[Dict[str, Any]] = None
     #: the holes of an open mesh narrower than the band, which it bridges
     #: (``surfaces._mesh_holes.bridged``), or a point cloud's small holes over which its facing
@@ -617,7 +618,7 @@ def _prepare_tube(
                 warnings.warn(
                     f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: "
                     f"{getattr(surf, 'band_advice')}. The exact closest points are used on this grid instead, "
-                    "and order=1 runs there",
+                    "with the first-order scheme (order=2 is refused there)",
                     RuntimeWarning,
                     stacklevel=user_stacklevel(),
                 )

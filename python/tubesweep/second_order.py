@@ -303,7 +303,7 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
     if getattr(surf, "smooth", False):  # a mesh through its smooth map (surfaces/_mesh_smooth.py)
         node, neighbour, _ = tube.facing
         depth = np.median(np.maximum(np.abs(tube.phi[node]), np.abs(tube.phi[neighbour]))) / h if node.size else np.inf
-        obstacle = surf.order2_obstacle(int(node.size), float(depth))
+        obstacle = surf.order2_obstacle(int(node.size), float(depth), h)
         if obstacle is not None:
             raise Order2NotApplicable(obstacle)
     linear = tube.linear

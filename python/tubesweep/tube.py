@@ -271,10 +271,11 @@ class Tube:
 
             raise refusal_for_order1(None if fallback is None else fallback.reason)
         _check_source_radius(source_radius, source_init, self.grid)
+        solved = self._tube if paper_tube else self._tube_first_auto  # the tube the sweeps run on
         if fallback is not None:
-            fallback.measure(self._tube_first_auto)
+            fallback.measure(solved)
         sol = _solve_on_tube(
-            self._tube if paper_tube else self._tube_first_auto,
+            solved,
             src,
             general,
             scheme,
@@ -293,7 +294,7 @@ class Tube:
         if fallback is not None:
             from .second_order import with_fallback
 
-            fallback.warn(sol.values, self._tube_first_auto)
+            fallback.warn(sol.values, solved)
             return with_fallback(sol, fallback.reason)
         return sol
 

@@ -64,8 +64,9 @@ def closest(surface: Any, x: np.ndarray, h: Optional[float]) -> Tuple[np.ndarray
     """The smooth map's closest points of ``x`` (M, 3) for grid spacing ``h`` (None: the exact
     closest points) and the map of each (codes of :data:`KINDS`)."""
     x = np.ascontiguousarray(np.asarray(x, dtype=float).reshape(-1, 3))
-    # before any band, or on a mesh coarse against the grid: the exact closest points
-    if h is None or "coarse" in surface.report or "facing" in surface.report:
+    # before any band, on a mesh coarse against the grid, or where the smooth map folded: the exact
+    # closest points
+    if h is None or "coarse" in surface.report or "facing" in surface.report or "folded" in surface.report:
         _, cp, _, _ = surface.closest(x)
         return cp, np.full(len(x), 1, np.uint8)
     mode = "auto"
@@ -268,10 +269,15 @@ def sliver_advice(surface: Any) -> str:
     )
 
 
-def order2_obstacle(surface: Any, tube_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
-    """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants)."""
+def order2_obstacle(
+    surface: Any, tube_pairs: int, pair_depth: float = np.inf, spacing: Optional[float] = None
+) -> Optional[str]:
+    """Why ``order=2`` does not run on this mesh's tube, or None (see the module constants).
+    ``spacing``: the tube's grid spacing, where the smooth map folded (:meth:`SmoothMap.fold_to_exact`)
+    whatever the last band's report says (a band on another grid since overwrote it: a review)."""
     report = surface.report
-    if report.get("folded"):
+    folded = getattr(surface, "_folded_h", None)
+    if (folded is not None and folded == spacing) or (spacing is None and report.get("folded")):
         slivers = sliver_advice(surface)
         return (
             "the mesh's smooth closest-point map folds across its triangles on this grid (its band did not close)"
@@ -354,8 +360,9 @@ class SmoothMap:
         (``_prepare``): from then on the band at that spacing is the exact map's, and
         ``order2_obstacle`` refuses second order there. True the first time, False when the exact
         map was in use already."""
-        if getattr(self, "_folded_h", None) == h:
-            return False
+        report = getattr(self, "report", {})
+        if getattr(self, "_folded_h", None) == h or "coarse" in report or "facing" in report:
+            return False  # the exact map's band already
         self._folded_h = h
         return True
 
@@ -379,7 +386,9 @@ class SmoothMap:
         slivers (:func:`sliver_advice`), or None."""
         return sliver_advice(self) or None
 
-    def order2_obstacle(self, facing_pairs: int, pair_depth: float = np.inf) -> Optional[str]:
+    def order2_obstacle(
+        self, facing_pairs: int, pair_depth: float = np.inf, spacing: Optional[float] = None
+    ) -> Optional[str]:
         """Why ``order=2`` does not run on the last band's tube (a coarse mesh, or facing sheets),
         or None; read by the second-order solve.
 
@@ -391,6 +400,9 @@ class SmoothMap:
         pair_depth : float
             Their median depth: the larger |φ| of each pair's two nodes, in grid spacings (pairs
             hugging the mesh are its bumps, not a gap).
+        spacing : float, optional
+            The tube's grid spacing: where the smooth map folded on it, second order is refused
+            whatever band was built since.
 
         Returns
         -------
@@ -405,7 +417,7 @@ class SmoothMap:
         >>> spot.order2_obstacle(0)[:36]
         'the mesh is coarse against the grid:'
         """
-        return order2_obstacle(self, facing_pairs, pair_depth)
+        return order2_obstacle(self, facing_pairs, pair_depth, spacing)
 
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """The band nodes within ``half_width`` of the smooth map's surface, their closest points

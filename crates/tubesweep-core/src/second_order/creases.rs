@@ -29,7 +29,7 @@ use crate::band::NarrowBand;
 use crate::error::Result;
 use crate::sweep::NodeRole;
 
-use super::geometry::{tube_geometry, NodeGeometry, Unresolved};
+use super::geometry::{geometry_pass, NodeGeometry, Unresolved};
 use super::implicit::Implicit;
 use super::GRAD_NORM_TOLERANCE;
 
@@ -176,7 +176,7 @@ fn crease_nodes_of<const D: usize>(
 
 /// The creases of a re-distanced level set in the paper's tube, for the first-order scheme
 /// (`order=1`), found by the second-order geometry's own test ([`creases_of`] behind the gates of
-/// [`tube_geometry`]: a node whose curvature or gradient the central differences do not resolve,
+/// [`super::geometry::tube_geometry`]: a node whose curvature or gradient the central differences do not resolve,
 /// and no crease on a φ found noisy). [`creases_of_level_set`], without those gates, reads the
 /// kinks of a re-distanced φ's samples as creases (a voxel mask's staircase, the bumps of noise);
 /// the gates keep them out, and the angle reported is the faces' (the widest turn across a crease
@@ -191,12 +191,12 @@ pub fn creases_of_redistanced<const D: usize>(
     spacing: f64,
     outer_width: f64,
 ) -> Result<Creases> {
-    let geometry = tube_geometry(band, roles, phi, directions, spacing, outer_width)?;
-    if geometry.summary.fitted_everywhere {
+    let surface = Implicit::LevelSet(phi);
+    let (nodes, summary) = geometry_pass(band, roles, &surface, directions, spacing, outer_width, false)?;
+    if summary.fitted_everywhere {
         return Ok(Creases::default());
     }
-    let surface = Implicit::LevelSet(phi);
-    let found = crease_nodes_of(band, roles, &surface, spacing, directions, &geometry.nodes);
+    let found = crease_nodes_of(band, roles, &surface, spacing, directions, &nodes);
     let widest = found.iter().map(|&(_, _, w)| w).fold(1.0f64, f64::min);
     Ok(creases_from(found.len(), widest, widest))
 }

@@ -9,6 +9,8 @@
 //! inverse. The principal curvatures at the foot point follow from the eigenvalues λ of D²φ at
 //! height φ, κ = λ / (1 − φλ); the tube must stay inside the focal distance, h_out·κ < 1.
 
+use rayon::prelude::*;
+
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::NodeRole;
@@ -478,39 +480,7 @@ pub fn tube_geometry_of<const D: usize>(
     spacing: f64,
     outer_width: f64,
 ) -> Result<TubeGeometry> {
-    let n = band.len();
-    check_tube_inputs(n, roles, surface, directions, spacing, outer_width)?;
-    let inner = roles.iter().filter(|&&r| r != NodeRole::Outer).count();
-    let pass = |fitted: bool| {
-        let mut summary = GeometrySummary {
-            fitted_everywhere: fitted,
-            ..GeometrySummary::empty()
-        };
-        let mut nodes = Vec::with_capacity(inner);
-        for i in 0..n {
-            if roles[i] != NodeRole::Outer {
-                let mut local = surface.local(band, i, spacing);
-                nodes.push(node_geometry(
-                    surface.phi(i),
-                    &directions[i],
-                    &mut local,
-                    outer_width,
-                    &mut summary,
-                    || surface.local_fitted(band, i, spacing, WIDE_FIT && fitted),
-                ));
-            }
-        }
-        (nodes, summary)
-    };
-    let (mut nodes, mut summary) = pass(false);
-    if summary.noisy() {
-        let (fitted_nodes, fitted_summary) = pass(true);
-        if summary.fit_is_kept(&fitted_summary, outer_width, spacing, surface.is_closest_point()) {
-            (nodes, summary) = (fitted_nodes, fitted_summary);
-        }
-    }
-    nodes.shrink_to_fit();
-    summary.finish();
+    let (nodes, mut summary) = geometry_pass(band, roles, surface, directions, spacing, outer_width, true)?;
     if !surface.is_closest_point() && !summary.fitted_everywhere {
         summary.creases = creases_of(band, roles, surface, spacing, directions, &nodes);
     }
@@ -521,6 +491,73 @@ pub fn tube_geometry_of<const D: usize>(
         summary,
     })
 }
+
+/// The pass of [`tube_geometry_of`] without the creases: every inner node's geometry (in band
+/// order) and the summary, the nodes fitted everywhere when φ is noisy. In parallel over runs of
+/// [`GEOMETRY_CHUNK`] band nodes; the summary merges maxima, minima and counts, so it and the
+/// nodes are the same whatever the split. `fit_noise` false: where φ is noisy the summary says
+/// `fitted_everywhere` without the fitted pass (for a crease report, which a noisy φ skips).
+pub(crate) fn geometry_pass<const D: usize>(
+    band: &NarrowBand<D>,
+    roles: &[NodeRole],
+    surface: &Implicit<'_, D>,
+    directions: &[[f32; D]],
+    spacing: f64,
+    outer_width: f64,
+    fit_noise: bool,
+) -> Result<(Vec<NodeGeometry>, GeometrySummary)> {
+    let n = band.len();
+    check_tube_inputs(n, roles, surface, directions, spacing, outer_width)?;
+    let empty = |fitted: bool| GeometrySummary {
+        fitted_everywhere: fitted,
+        ..GeometrySummary::empty()
+    };
+    let pass = |fitted: bool| {
+        let parts: Vec<(Vec<NodeGeometry>, GeometrySummary)> = (0..n.div_ceil(GEOMETRY_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut summary = empty(fitted);
+                let mut nodes = Vec::new();
+                for i in c * GEOMETRY_CHUNK..((c + 1) * GEOMETRY_CHUNK).min(n) {
+                    if roles[i] != NodeRole::Outer {
+                        let mut local = surface.local(band, i, spacing);
+                        nodes.push(node_geometry(
+                            surface.phi(i),
+                            &directions[i],
+                            &mut local,
+                            outer_width,
+                            &mut summary,
+                            || surface.local_fitted(band, i, spacing, WIDE_FIT && fitted),
+                        ));
+                    }
+                }
+                (nodes, summary)
+            })
+            .collect();
+        let inner = parts.iter().map(|p| p.0.len()).sum();
+        let mut nodes = Vec::with_capacity(inner);
+        let mut summary = empty(fitted);
+        for (part, s) in parts {
+            nodes.extend(part);
+            summary = summary.merge(s);
+        }
+        (nodes, summary)
+    };
+    let (mut nodes, mut summary) = pass(false);
+    if summary.noisy() && !fit_noise {
+        summary.fitted_everywhere = true;
+    } else if summary.noisy() {
+        let (fitted_nodes, fitted_summary) = pass(true);
+        if summary.fit_is_kept(&fitted_summary, outer_width, spacing, surface.is_closest_point()) {
+            (nodes, summary) = (fitted_nodes, fitted_summary);
+        }
+    }
+    summary.finish();
+    Ok((nodes, summary))
+}
+
+/// Band nodes per task of [`geometry_pass`].
+const GEOMETRY_CHUNK: usize = 4096;
 
 /// One role, φ and direction per band node (`n`), and a positive finite spacing: what the
 /// geometry ([`tube_geometry_of`]) and the one-pass set-up ([`super::tube_setup_of`]) read.
