@@ -205,6 +205,12 @@ def creases_in_paper_tube(
         np.ascontiguousarray(direction, dtype=np.float32).reshape(len(inner), -1),
         float(spacing),
     )
+    return _paper_creases(nodes, angle)
+
+
+def _paper_creases(nodes: int, angle: float) -> Dict[str, Any]:
+    """The stats dict of the paper's tube's creases (``sol.stats.creases``): ``nodes`` crease
+    nodes whose faces turn by up to ``angle`` degrees."""
     return {
         "nodes": int(nodes),
         "angle_degrees": float(angle),
@@ -229,13 +235,7 @@ def creases_of_redistanced(
         float(spacing),
         float(outer_width),
     )
-    return {
-        "nodes": int(nodes),
-        "angle_degrees": float(angle),
-        "faces_angle_degrees": float(angle),
-        "shortcut_per_inner_width": 2 * float(np.tan(np.radians(min(angle, REVERSED)) / 2)) if nodes else 0.0,
-        "redistanced": True,
-    }
+    return {**_paper_creases(nodes, angle), "redistanced": True}
 
 
 def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: float) -> None:

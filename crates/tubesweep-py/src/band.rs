@@ -675,15 +675,8 @@ fn redistanced_creases<const D: usize>(
     spacing: f64,
     outer_width: f64,
 ) -> PyResult<tubesweep_core::second_order::creases::Creases> {
-    let n = band.len();
-    if roles.len() != n || phi.len() != n {
-        return Err(PyValueError::new_err(format!(
-            "roles and phi must have one entry per band node ({n}); got {} and {}",
-            roles.len(),
-            phi.len()
-        )));
-    }
-    let dirs = node_vectors::<f32, D>(direction, n, "direction")?;
+    // (roles and phi per node: checked by the core)
+    let dirs = node_vectors::<f32, D>(direction, band.len(), "direction")?;
     py.detach(|| {
         tubesweep_core::second_order::creases::creases_of_redistanced(band, roles, phi, dirs, spacing, outer_width)
     })

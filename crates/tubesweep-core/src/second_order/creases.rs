@@ -196,9 +196,12 @@ pub fn creases_of_redistanced<const D: usize>(
     if summary.fitted_everywhere {
         return Ok(Creases::default());
     }
-    let found = crease_nodes_of(band, roles, &surface, spacing, directions, &nodes);
-    let widest = found.iter().map(|&(_, _, w)| w).fold(1.0f64, f64::min);
-    Ok(creases_from(found.len(), widest, widest))
+    // reported at the faces' angle, as creases_of_level_set reports it
+    let found = creases_of(band, roles, &surface, spacing, directions, &nodes);
+    Ok(Creases {
+        angle: found.faces_angle,
+        ..found
+    })
 }
 
 /// The cosine of the faces' angle at crease node `i`: the widest turn of the normal from one side
