@@ -153,6 +153,12 @@ def faces_angle(creases: dict) -> float:
     return max(float(creases["angle_degrees"]), float(creases.get("faces_angle_degrees", 0.0)))
 
 
+def refused_for_creases(reason: str) -> bool:
+    """Whether ``order="auto"`` ran the first-order scheme for convex creases (``reason``, the
+    refusal's text), which :func:`warn_refused_creases` says."""
+    return _CONVEX_CREASES.search(reason) is not None
+
+
 def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: float) -> bool:
     """A RuntimeWarning when ``order="auto"`` ran the first-order scheme because of convex creases:
     the shortcut per crease, ``thinned`` spacings on the tube thinned at them
@@ -160,7 +166,7 @@ def warn_refused_creases(reason: str, inner: float, spacing: float, *, thinned: 
     paper's tube; a re-distanced φ kept it until its crease nodes were thinned too: the box
     max|x| − 0.5 re-distanced at N = 41 came out 4.8Δx short per edge there, 1.16Δx thinned);
     whether it warned."""
-    if _CONVEX_CREASES.search(reason) is None:
+    if not refused_for_creases(reason):
         return False
     given = _PER_INNER_WIDTH.search(reason)  # 2·tan(θ/2) at the largest turn θ, as the refusal gives it
     size, how = _per_crease(float(given.group(1)) if given else 2.0, inner, spacing, thinned)
@@ -221,21 +227,38 @@ def _paper_creases(nodes: int, angle: float) -> Dict[str, Any]:
 
 def creases_of_redistanced(
     band: Any, roles: np.ndarray, phi: np.ndarray, direction: np.ndarray, spacing: float, outer_width: float
-) -> Dict[str, Any]:
+) -> Tuple[Dict[str, Any], bool]:
     """As :func:`creases_in_paper_tube` for a re-distanced φ (a voxel mask, ``redistance=True``),
     whose sampled zero set has kinks of its own (a mask's staircase, noise): the crease test of the
     second-order geometry, behind its gates (curvature or gradient unresolved by central
     differences, no crease on a φ found noisy), with the faces' angle
     (``tubesweep_core::second_order::creases::creases_of_redistanced``). ``roles``: the paper's
-    tube; ``outer_width``: its half-width (outer·Δx)."""
-    nodes, angle = band.creases_of_redistanced(
+    tube; ``outer_width``: its half-width (outer·Δx). And whether φ was found noisy (then no
+    crease was looked for)."""
+    nodes, angle, noisy = band.creases_of_redistanced(
         np.ascontiguousarray(roles, dtype=np.uint8),
         np.ascontiguousarray(phi, dtype=np.float64),
         np.ascontiguousarray(direction, dtype=np.float32).reshape(len(roles), -1),
         float(spacing),
         float(outer_width),
     )
-    return {**_paper_creases(nodes, angle), "redistanced": True}
+    return {**_paper_creases(nodes, angle), "redistanced": True}, bool(noisy)
+
+
+def where_creases(creases: dict) -> str:
+    """How many nodes a crease report holds and how far their faces turn, for a warning; for the
+    creases found through a smoothing (``_coarse_creases``, a voxel mask or a noisy φ), the turn
+    read and the faces' angle that it stands for."""
+    nodes, angle = creases["nodes"], float(creases["angle_degrees"])
+    turn = creases.get("smoothed_turn_degrees")
+    if turn is None:
+        return f"{nodes} tube nodes, the faces turning by up to {angle:.0f}°"
+    return (
+        f"{nodes} tube nodes next to the surface, where its normal, read through a smoothing of φ over about a "
+        f"spacing (φ kinks at the grid's scale, a voxel mask's staircase or noise), turns by up to {turn:.0f}° "
+        f"within two spacings: faces meeting at about {angle:.0f}°, the smoothing reading them as 0.6–0.75 of that, or "
+        "a part whose radius of curvature is below about four spacings, which acts as a crease"
+    )
 
 
 def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: float) -> None:
@@ -254,8 +277,7 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
         thinned = THINNED_SHORTCUT_REDISTANCED
     early = _early(angle, size, f"per crease it crosses ({reckoned}, first order in Δx)")
     warnings.warn(
-        f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the faces turning by up to "
-        f"{angle:.0f}°): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "
+        f"φ's level sets have creases or corners ({where_creases(creases)}): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "
         f"Second order's tube (order='auto', the default, or order=2, with outer ≥ inner + 2) is thinned there, which "
         f"leaves about {thinned:g}Δx per crease; rounding the edges over more than the tube's width "
         "(outer·Δx) leaves none. sol.stats.creases has the figures",

@@ -28,17 +28,18 @@ from __future__ import annotations
 import dataclasses
 import re
 import warnings
-from typing import Any, Optional, Tuple
+from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
-from ._creases import thinned_spacings, warn_refused_creases
+from ._coarse_creases import paper_creases
+from ._creases import refused_for_creases, shortcut, thinned_spacings, warn_refused_creases, where_creases
 from ._prepare import thinned_count
 from .band import band_neighbours
 from .surface import LevelSet
 from .surfaces._mesh_parts import open_only_in_debris
 from ._warn import user_stacklevel
-from .second_order import NOT_A_DISTANCE, NarrowExtension, Order2NotApplicable, warn_fallback
+from .second_order import NOISY_PHI, NOT_A_DISTANCE, NarrowExtension, Order2NotApplicable, warn_fallback
 
 #: The first-order scheme's error where fronts meet, in grid spacings (the sphere's antipode:
 #: 2.7–3.1Δx at N = 12–20).
@@ -190,6 +191,9 @@ class Fallback:
     gradient: Optional[float] = None
     #: widths that leave second order no room (``second_order.NarrowExtension``), said after the solve
     narrow: bool = False
+    #: the creases of a re-distanced φ that its kinks hide from the crease tests, found through a
+    #: smoothing (``_coarse_creases.paper_creases``; :meth:`measure`): ``sol.stats.creases``
+    creases: Optional[Dict[str, Any]] = None
 
     @classmethod
     def of(cls, refusal: Order2NotApplicable, order: Any) -> "Fallback":
@@ -205,6 +209,11 @@ class Fallback:
         )
         if self.said or getattr(surface, "open_surface", False) or not closed:
             return
+        if isinstance(surface, LevelSet) and NOISY_PHI in self.reason and not refused_for_creases(self.reason):
+            # a voxel mask or a noisy φ, whose kinks run the first-order scheme and hide a crease
+            # from the crease tests: two balls fused at 122° as a voxel mask, 4–5Δx early beyond
+            # the crease at N = 41–81 with no warning (tests/test_coarse_creases.py)
+            self.creases = paper_creases(tube.grid, tube.band, tube.phi)
         self.gradient, low, high = gradient_range(tube)
         given = isinstance(surface, LevelSet) and not surface.redistance
         if given:
@@ -235,4 +244,23 @@ class Fallback:
                 stacklevel=user_stacklevel(),
             )
             return
+        if self.creases is not None:
+            warn_smoothed_creases(self.creases, tube.inner, tube.grid.spacing)
+            return
         warn_first_order(self.reason, values, tube, self.gradient, said=self.said)
+
+
+def warn_smoothed_creases(creases: Dict[str, Any], inner: float, spacing: float) -> None:
+    """After ``order="auto"`` ran the first-order scheme on a re-distanced φ whose creases were
+    found through a smoothing (:attr:`Fallback.creases`): a front crossing one cuts its corner, by
+    up to ``2·tan(θ/2)·inner·Δx`` (the tube's crease nodes thinned where the ridge test found
+    them, which leaves less: ``tests/test_coarse_creases.py``)."""
+    size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
+    warnings.warn(
+        f"order='auto' ran the first-order scheme, and φ's level sets have creases or corners "
+        f"({where_creases(creases)}): a front that crosses one cuts the corner and arrives early by up to about "
+        f"{size:.3g} per crease (2·tan(θ/2)·inner·Δx, first order in Δx). sol.stats.creases has the figures and "
+        "sol.stats.order_fallback why order 2 did not apply; a finer grid lowers the error in proportion",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )

@@ -25,7 +25,8 @@ from .band import BandGeometry, _evaluate, band_neighbours
 from .surface import LevelSet, Surface
 from ._warn import user_stacklevel
 from ._box_cut import box_cut, warn_box_cut
-from ._creases import crease_nodes_to_extend, creases_in_paper_tube, creases_of_redistanced
+from ._coarse_creases import creases_of_redistanced
+from ._creases import crease_nodes_to_extend, creases_in_paper_tube
 from ._thin_level_set import thin_share, warn_thin
 from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
@@ -236,7 +237,7 @@ def paper_creases_of(tube: _PreparedTube) -> Optional[Dict[str, Any]]:
     ):
         h = tube.grid.spacing
         tube.paper_creases = creases_of_redistanced(
-            tube.band, tube.roles, tube.geom.signed, tube.geom.direction, h, tube.outer_eff * h
+            tube.grid, tube.band, tube.roles, tube.geom.signed, tube.geom.direction, tube.outer_eff * h
         )
     return tube.paper_creases
 
@@ -721,7 +722,7 @@ def _prepare_tube(
         if not getattr(surf, "redistance", False):
             paper_creases = creases_in_paper_tube(band, roles == ROLE_INNER, phi, directions, h)
         elif not creases and not reusable:  # the one call at order=1
-            paper_creases = creases_of_redistanced(band, roles, phi, directions, h, outer_eff * h)
+            paper_creases = creases_of_redistanced(grid, band, roles, phi, directions, outer_eff * h)
         if creases:
             extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)
     return _PreparedTube(

@@ -408,7 +408,7 @@ def _first_order_batch(
     stats["setup_seconds"] = setup
     stats["order"] = 1
     stats["order_fallback"] = None if fallback is None else fallback.reason
-    stats["creases"] = t.paper_creases
+    stats["creases"] = t.paper_creases if fallback is None or fallback.creases is None else fallback.creases
     stats["bridged_holes"] = t.bridged_holes
     stats["slits"] = t.slits
     return out, stats

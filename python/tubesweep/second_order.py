@@ -178,10 +178,13 @@ def check_order(order: Any) -> Union[int, str]:
     return int(order)
 
 
-def with_fallback(sol: Any, reason: str) -> Any:
+def with_fallback(sol: Any, reason: str, creases: Optional[dict] = None) -> Any:
     """``sol`` (an ``order=1`` solution) with ``stats.order_fallback`` set to why ``order=2`` did
-    not apply."""
+    not apply, and ``stats.creases`` to ``creases`` where the fallback found some
+    (``_fallback.Fallback.creases``)."""
     sol.stats = dataclasses.replace(sol.stats, order_fallback=reason)
+    if creases is not None:
+        sol.stats = dataclasses.replace(sol.stats, creases=creases)
     return sol
 
 
@@ -405,6 +408,10 @@ RAN_AWAY_RESTARTED = (
 #: The refusal of a tube whose φ is mostly not a signed distance says this
 #: (``tubesweep_core::second_order::check_geometry_of``): its cure is in the user's hands.
 NOT_A_DISTANCE = "redistance=True) re-distances φ"
+
+#: The refusal of a tube whose φ was found noisy says this (``tubesweep_core::second_order::NOISY_PHI``):
+#: the first-order fallback then looks for the creases that the noise hides (``_coarse_creases``).
+NOISY_PHI = "reads as noisy at the grid's scale"
 
 
 def warn_fallback(e: Order2NotApplicable, order: Any) -> bool:

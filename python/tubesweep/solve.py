@@ -322,7 +322,7 @@ def solve(
         from .second_order import with_fallback
 
         fallback.warn(sol.values, tube)
-        return with_fallback(sol, fallback.reason)
+        return with_fallback(sol, fallback.reason, fallback.creases)
     return sol
 
 

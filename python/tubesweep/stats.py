@@ -122,7 +122,12 @@ class SolveStats:
         per edge; up to 1.5 times that on a re-distanced φ, for which the dict says
         ``redistanced: True``: found by the second-order geometry's test, which a voxel mask's
         staircase does not trip, and computed for ``order=1`` only); ``crease_thinned`` counts the
-        nodes ``"auto"`` took out of the tube there. None for other surfaces and with ``order=2``
+        nodes ``"auto"`` took out of the tube there. On a voxel mask or a noisy φ, whose kinks hide
+        creases from that test, they are found on φ smoothed over about a spacing, for ``order=1``
+        and where ``"auto"`` ran first order on a re-distanced φ (with a ``RuntimeWarning`` giving
+        ``shortcut_per_inner_width·inner·Δx``): ``smoothed_turn_degrees`` is the turn of the
+        smoothed normal within two spacings, and the faces' angle is read back from it (the
+        smoothing reads a crease as 0.6–0.75 of its angle). None for other surfaces and with ``order=2``
         (see ``order2``).
     box_cut : dict or None
         On surfaces, where the grid box cuts the tube (None where the band stays inside it):

@@ -295,7 +295,7 @@ class Tube:
             from .second_order import with_fallback
 
             fallback.warn(sol.values, solved)
-            return with_fallback(sol, fallback.reason)
+            return with_fallback(sol, fallback.reason, fallback.creases)
         return sol
 
     def moved(self, surface: Any) -> "Tube":

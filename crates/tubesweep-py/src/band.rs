@@ -339,7 +339,8 @@ impl PyBand {
     /// `tubesweep_core::second_order::creases::creases_of_redistanced`: the second-order
     /// geometry's test): `roles` per node (the paper's tube), `phi` φ (signed), `direction` (K, d)
     /// the outward directions, `outer_width` the tube's half-width. Returns the crease nodes'
-    /// count and the faces' largest angle there, in degrees.
+    /// count, the faces' largest angle there in degrees, and whether φ was found noisy (then no
+    /// crease is looked for: 0 and 0.0).
     fn creases_of_redistanced(
         &self,
         py: Python<'_>,
@@ -348,7 +349,7 @@ impl PyBand {
         direction: PyReadonlyArray2<'_, f32>,
         spacing: f64,
         outer_width: f64,
-    ) -> PyResult<(usize, f64)> {
+    ) -> PyResult<(usize, f64, bool)> {
         let d = self.ndim();
         if direction.shape()[1] != d {
             return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
@@ -362,7 +363,7 @@ impl PyBand {
             AnyBand::D2(b) => redistanced_creases(py, b, roles, phi, dir, spacing, outer_width),
             AnyBand::D3(b) => redistanced_creases(py, b, roles, phi, dir, spacing, outer_width),
         }?;
-        Ok((c.nodes, c.angle))
+        Ok(c.map_or((0, 0.0, true), |c| (c.nodes, c.angle, false)))
     }
 
     /// The edges between neighbours whose closest points lie more than `jump` grid spacings
@@ -674,7 +675,7 @@ fn redistanced_creases<const D: usize>(
     direction: &[f32],
     spacing: f64,
     outer_width: f64,
-) -> PyResult<tubesweep_core::second_order::creases::Creases> {
+) -> PyResult<Option<tubesweep_core::second_order::creases::Creases>> {
     // (roles and phi per node: checked by the core)
     let dirs = node_vectors::<f32, D>(direction, band.len(), "direction")?;
     py.detach(|| {

@@ -182,7 +182,8 @@ fn crease_nodes_of<const D: usize>(
 /// the gates keep them out, and the angle reported is the faces' (the widest turn across a crease
 /// node, as [`creases_of_level_set`] reports it). `roles`: the paper's tube (inner and extension
 /// nodes), `outer_width` its half-width (outer·Δx), which the curvature gate reads. Costs the
-/// geometry pass of a second-order solve (36 bytes per inner node while it runs).
+/// geometry pass of a second-order solve (36 bytes per inner node while it runs). None where φ
+/// is found noisy and no crease is looked for (the caller may look through a smoothing instead).
 pub fn creases_of_redistanced<const D: usize>(
     band: &NarrowBand<D>,
     roles: &[NodeRole],
@@ -190,18 +191,18 @@ pub fn creases_of_redistanced<const D: usize>(
     directions: &[[f32; D]],
     spacing: f64,
     outer_width: f64,
-) -> Result<Creases> {
+) -> Result<Option<Creases>> {
     let surface = Implicit::LevelSet(phi);
     let (nodes, summary) = geometry_pass(band, roles, &surface, directions, spacing, outer_width, false)?;
     if summary.fitted_everywhere {
-        return Ok(Creases::default());
+        return Ok(None);
     }
     // reported at the faces' angle, as creases_of_level_set reports it
     let found = creases_of(band, roles, &surface, spacing, directions, &nodes);
-    Ok(Creases {
+    Ok(Some(Creases {
         angle: found.faces_angle,
         ..found
-    })
+    }))
 }
 
 /// The cosine of the faces' angle at crease node `i`: the widest turn of the normal from one side

@@ -67,6 +67,11 @@ pub const MAX_FIRST_ORDER_FRACTION: f64 = 0.5;
 /// the tube is refused and `order="auto"` runs the paper's scheme.
 pub const MAX_CREASE_FRACTION: f64 = 0.05;
 
+/// How a refusal says that φ was found noisy (its derivatives all from least-squares fits,
+/// `geometry::NOISY_FRACTION`): the first-order fallback of `order="auto"` reads it and looks for
+/// the creases that the noise hides through a smoothing (python/tubesweep/_coarse_creases.py).
+pub const NOISY_PHI: &str = "reads as noisy at the grid's scale";
+
 /// Refuses a tube on which second order cannot run: when more than
 /// [`MAX_FIRST_ORDER_FRACTION`] of the inner-tube nodes are unresolved (an incomplete stencil of
 /// φ, φ not a signed distance, or a principal curvature κ with `outer_width`·κ ≥ 1, where B is
@@ -147,6 +152,12 @@ pub fn check_geometry_of(
              too coarse: spacing {spacing:.4}, outer·Δx = {outer_width:.4})",
             summary.unresolved_curvature,
             if closest_point { "an open surface's rim, " } else { "" }
+        ));
+    }
+    if summary.fitted_everywhere && !closest_point {
+        // (read by the first-order fallback, which then looks for creases through a smoothing)
+        reasons.push(format!(
+            "φ {NOISY_PHI} (its derivatives came from least-squares fits over three steps)"
         ));
     }
     let (count, _, _) = summary.gradient_moments;
