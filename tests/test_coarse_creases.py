@@ -100,3 +100,45 @@ def test_masks_of_smooth_objects_report_no_crease():
                 order=order,
             )
             assert sol.stats.order == 1 and (sol.stats.creases is None or sol.stats.creases["nodes"] == 0)
+
+
+def test_a_mask_smoothed_over_a_voxel_says_its_rounded_crease_at_second_order():
+    # the fused balls as a mask with smooth=1: the smoothing rounds the crease, which the crease
+    # test, comparing neighbours, read at N = 41 as none (4.6Δx early at worst beyond it with no
+    # warning, second order) and at N = 61, 140°, as 75° (2.5Δx said, 3.3Δx measured)
+    grid, d, source, points, exact = _fused_balls(41, 122)
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"creases or corners \(176 tube nodes next to the surface, .* turns by up to 69° within two spacings: "
+        r"faces meeting at about 115°.* arrives early by up to about 0\.313 \(2·tan\(θ/2\)·inner·Δx",
+    ):
+        sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source])
+    creases = sol.stats.order2["creases"]
+    assert sol.stats.order == 2 and creases["smoothing_only"] and creases["nodes"] == 176
+    early = sol(points) - exact
+    assert -0.313 < np.min(early) < -4.5 * grid.spacing  # -4.58Δx
+    grid, d, source, points, exact = _fused_balls(61, 140)
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"\(12 tube nodes, the normal turning by up to 75°, the faces by up to 136° \(read through a smoothing "
+        r"of φ\)\): a front that crosses one arrives early by up to about 0\.208 \(6\.2·Δx with the inner tube",
+    ):
+        sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source])
+    assert sol.stats.order2["creases"]["smoothed_turn_degrees"] == pytest.approx(81.83, abs=0.01)
+    early = sol(points) - exact
+    assert -0.208 < np.min(early) < -3.2 * grid.spacing  # -3.32Δx
+
+
+def test_order_1_on_a_mask_smoothed_over_a_voxel_reads_its_crease_s_faces_through_the_smoothing():
+    # N = 61, 122°: the crease test read the rounded crease's faces at 84° and said 5.4Δx, where
+    # the front came out 8.3Δx early at worst
+    grid, d, source, points, exact = _fused_balls(61, 122)
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"\(64 tube nodes next to the surface, .* faces meeting at about 127°.* in the paper's tube \(order=1\) "
+        r"a front crossing one cuts the corner and arrives early by up to about 0\.399 per crease it crosses",
+    ):
+        sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source], order=1)
+    assert sol.stats.creases["smoothed_turn_degrees"] == pytest.approx(76.02, abs=0.01)
+    early = sol(points) - exact
+    assert -0.399 < np.min(early) < -8 * grid.spacing  # -8.30Δx

@@ -12,21 +12,27 @@ Here φ is smoothed first, over a few nodes of the band (:data:`PASSES` passes o
 along each axis, about a Gaussian of 1.15 spacings), which takes out the staircase but not a crease:
 the normals of the smoothed φ next to the surface are compared with those of the nodes up to
 :data:`REACH` nodes away along each axis, and a node whose normal turns by more than :data:`TURN`
-within that reach, beside a face (a node there turning by less than :data:`FACE`), is a crease
-node. A smooth surface turns by about 2√3/ρ radians over that reach (ρ its radius of curvature in
+within that reach, beside a face (a node there turning by less than :data:`FACE`) and away from
+a thin part (no node there whose normal reverses within one node more), is a crease node. A
+smooth surface turns by about 2√3/ρ radians over that reach (ρ its radius of curvature in
 spacings, plus the staircase's 8–12°): 20–28° on a ball of 20–10 voxels in radius, 58° on a
 torus's tube of 5. A part whose curvature radius is below about four spacings, which the tube does
 not resolve either, reads as a crease where it lies beside flatter faces (a thin ellipsoid's rim)
 and as none where it turns so all over (a small sphere). The smoothing rounds a crease, so the turn
 read is below the faces' angle: two fused balls whose faces meet at 90° read below :data:`TURN`
-(their shortcut is about the first-order scheme's own error), at 106° 60–71°, at 122° 75–84°
-(:data:`READ_SHARE`; ``tests/test_coarse_creases.py``). O(band): a few gathers over the band, and
+(and go unsaid: ``benches/experiments/mask_creases.py``), at 106° 60–71°, at 122° 75–84°
+(:data:`READ_SHARE`; ``tests/test_coarse_creases.py``).
+
+Used for the paper's tube (``order=1``) and the first-order fallback of ``"auto"`` on a φ found
+noisy, and for second order's report on a re-distanced φ where nodes ran the first-order update
+for an unresolved curvature (a crease that a smoothing rounded: :func:`widened_for_order2`). O(band): a few gathers over the band, and
 the reach's (2·REACH + 1)^d − 1 steps along the neighbour table for the nodes next to the surface
 only (20–50 ms at N = 81).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from typing import Any, Dict, Iterator, Optional, Tuple
 
@@ -35,7 +41,15 @@ import numpy as np
 from ._creases import REVERSED
 from ._creases import creases_of_redistanced as fine_creases_of_redistanced
 
-__all__ = ["smoothed_turning", "coarse_creases", "paper_creases", "creases_of_redistanced"]
+__all__ = [
+    "smoothed_turning",
+    "coarse_creases",
+    "paper_creases",
+    "creases_of_redistanced",
+    "passes_for",
+    "widened",
+    "widened_for_order2",
+]
 
 #: Passes of the 3-node mean along each axis before the normals are read.
 PASSES = 2
@@ -46,58 +60,77 @@ TURN = 60.0
 #: A crease node lies beside a face, a node within :data:`REACH` whose normal turns by less than
 #: this (degrees): a ball ten voxels in radius turns by 28°, one of four by 50° or more.
 FACE = 35.0
+#: A normal that turns by more than this (degrees) within :data:`REACH` + 1 nodes reverses: two sides
+#: of a thin part, no crease.
+SHEETS = 120.0
 #: Nodes this close to the surface (spacings) carry the normals that are compared.
 NEAR = 0.75
 
 
-def smoothed_turning(grid: Any, band: Any, phi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+def smoothed_turning(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Tuple[np.ndarray, np.ndarray]:
     """The band positions of the nodes within :data:`NEAR` spacings of φ's zero level set (``phi``:
-    one value per band node) where the smoothed φ has a
-    normal, and at each the largest angle (degrees) between its normal and those of such nodes up to
-    :data:`REACH` nodes away along each axis."""
-    return _turning(grid, np.asarray(band.neighbours()), phi)
+    one value per band node) where the smoothed φ has a normal, and at each the largest angle
+    (degrees) between its normal and those of such nodes up to :data:`REACH` nodes away along each
+    axis; ``passes`` of the smoothing (:func:`passes_for`)."""
+    table = np.asarray(band.neighbours())
+    normals = _Normals.of(grid, table, phi, passes)
+    return normals.at, normals.turning(np.arange(normals.at.size), REACH)
 
 
-def _turning(grid: Any, table: np.ndarray, phi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-    """:func:`smoothed_turning` on the band's neighbour table ``table``: (K, d, 2), the minus and
-    plus neighbours' band positions, K where absent."""
-    h = float(grid.spacing)
-    count, ndim = table.shape[0], table.shape[1]
-    # the mean over the neighbours in the band (fewer at its edge, far from the surface)
-    smoothed = np.asarray(phi, dtype=np.float64).copy()
-    for _ in range(PASSES):
-        for k in range(ndim):
-            minus, plus = table[:, k, 0], table[:, k, 1]
-            padded = np.append(smoothed, 0.0)
-            smoothed = (padded[minus] + smoothed + padded[plus]) / (1.0 + (minus < count) + (plus < count))
-    padded = np.append(smoothed, np.nan)
-    at = np.flatnonzero(np.abs(np.asarray(phi, dtype=np.float64)) <= NEAR * h)
-    gradient = np.stack([padded[table[at, k, 1]] - padded[table[at, k, 0]] for k in range(ndim)], axis=1)
-    norm = np.linalg.norm(gradient, axis=1)
-    has = np.isfinite(norm) & (norm > 0)
-    at, gradient, norm = at[has], gradient[has], norm[has]
-    if at.size == 0:
-        return at, np.zeros(0)
-    normal = gradient / norm[:, None]
-    slot = np.full(count + 1, -1, dtype=np.int32)  # each band node's row of `normal`, -1 for none
-    slot[at] = np.arange(at.size, dtype=np.int32)
-    closest = np.ones(at.size)  # the smallest cosine of the turn
-    for pos in _within_reach(table, at):
-        other = slot[pos]
-        pair = np.flatnonzero(other >= 0)
-        cosine = np.einsum("ij,ij->i", normal[pair], normal[other[pair]])
-        closest[pair] = np.minimum(closest[pair], cosine)  # (each node once per offset)
-    return at, np.degrees(np.arccos(np.clip(closest, -1.0, 1.0)))
+@dataclasses.dataclass
+class _Normals:
+    """The unit normals of the smoothed φ at the nodes next to the surface: ``at`` their band
+    positions, ``normal`` one row each, ``slot`` each band node's row (-1 for none, and for the
+    position past the band); ``table`` the band's neighbour table, (K, d, 2): the minus and plus
+    neighbours' band positions, K where absent."""
+
+    table: np.ndarray
+    at: np.ndarray
+    normal: np.ndarray
+    slot: np.ndarray
+
+    @classmethod
+    def of(cls, grid: Any, table: np.ndarray, phi: np.ndarray, passes: int) -> "_Normals":
+        h = float(grid.spacing)
+        count, ndim = table.shape[0], table.shape[1]
+        # the mean over the neighbours in the band (fewer at its edge, far from the surface)
+        smoothed = np.asarray(phi, dtype=np.float64).copy()
+        for _ in range(passes):
+            for k in range(ndim):
+                minus, plus = table[:, k, 0], table[:, k, 1]
+                padded = np.append(smoothed, 0.0)
+                smoothed = (padded[minus] + smoothed + padded[plus]) / (1.0 + (minus < count) + (plus < count))
+        padded = np.append(smoothed, np.nan)
+        at = np.flatnonzero(np.abs(np.asarray(phi, dtype=np.float64)) <= NEAR * h)
+        gradient = np.stack([padded[table[at, k, 1]] - padded[table[at, k, 0]] for k in range(ndim)], axis=1)
+        norm = np.linalg.norm(gradient, axis=1)
+        has = np.isfinite(norm) & (norm > 0)
+        at = at[has]
+        slot = np.full(count + 1, -1, dtype=np.int32)
+        slot[at] = np.arange(at.size, dtype=np.int32)
+        return cls(table, at, gradient[has] / norm[has, None], slot)
+
+    def turning(self, rows: np.ndarray, reach: int) -> np.ndarray:
+        """At the nodes ``rows`` (rows of :attr:`normal`), the largest angle (degrees) between
+        their normal and those of the nodes up to ``reach`` nodes away along each axis."""
+        closest = np.ones(rows.size)  # the smallest cosine of the turn
+        mine = self.normal[rows]
+        for pos in _within_reach(self.table, self.at[rows], reach):
+            other = self.slot[pos]
+            pair = np.flatnonzero(other >= 0)
+            cosine = np.einsum("ij,ij->i", mine[pair], self.normal[other[pair]])
+            closest[pair] = np.minimum(closest[pair], cosine)  # (each node once per offset)
+        return np.degrees(np.arccos(np.clip(closest, -1.0, 1.0)))
 
 
-def _within_reach(table: np.ndarray, at: np.ndarray) -> Iterator[np.ndarray]:
-    """For each offset of at most :data:`REACH` nodes along each axis (but none), the band position
-    of the node that far from each of the nodes ``at`` (``len(table)`` where it is not in the band),
+def _within_reach(table: np.ndarray, at: np.ndarray, reach: int) -> Iterator[np.ndarray]:
+    """For each offset of at most ``reach`` nodes along each axis (but none), the band position of
+    the node that far from each of the nodes ``at`` (``len(table)`` where it is not in the band),
     walked one axis step at a time along the neighbour table ``table`` (the nodes on the way lie
-    within REACH·√d spacings of the surface, inside the tube)."""
+    within reach·√d spacings of the surface, inside the tube)."""
     count, ndim = table.shape[0], table.shape[1]
     walked = {(0,) * ndim: at}
-    for offset in sorted(itertools.product(range(-REACH, REACH + 1), repeat=ndim), key=lambda o: sum(map(abs, o))):
+    for offset in sorted(itertools.product(range(-reach, reach + 1), repeat=ndim), key=lambda o: sum(map(abs, o))):
         if not any(offset):
             continue
         k = next(i for i in range(ndim) if offset[i])
@@ -110,25 +143,36 @@ def _within_reach(table: np.ndarray, at: np.ndarray) -> Iterator[np.ndarray]:
         yield pos
 
 
-def coarse_creases(grid: Any, band: Any, phi: np.ndarray) -> Tuple[int, float]:
+def coarse_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Tuple[int, float]:
     """How many nodes next to the surface turn by more than :data:`TURN` within :data:`REACH`
-    (:func:`smoothed_turning`) beside a face: with a node within that reach that turns by less than
-    :data:`FACE`. A part whose whole surface turns more is small, its curvature unresolved rather
-    than creased (a sphere shrinking to nothing, 1.4–4 spacings in radius, reads 60–180° all over).
-    And the largest such turn in degrees (0, 0.0 when there is none)."""
+    (:func:`smoothed_turning`) beside a face and away from a thin part, and the largest such turn in
+    degrees (0, 0.0 when there is none). Beside a face: with a node within that reach that turns by
+    less than :data:`FACE` (a part whose whole surface turns more is small, its curvature unresolved
+    rather than creased: a sphere shrinking to nothing, 1.4–4 spacings in radius, reads 60–180° all
+    over). Away from a thin part: no node within that reach whose normal reverses (turns by more
+    than :data:`SHEETS`) within one node more, as across a part thinner than about six spacings,
+    whose two sides are not a crease (a dumbbell's neck 2.4 spacings in radius read as one at 90°;
+    creases of up to 140° turn by at most 104° within three nodes)."""
     table = np.asarray(band.neighbours())
-    at, turning = _turning(grid, table, phi)
-    crease = turning > TURN
-    if not np.any(crease):
+    normals = _Normals.of(grid, table, phi, passes)
+    if normals.at.size == 0:
+        return 0, 0.0
+    turning = normals.turning(np.arange(normals.at.size), REACH)
+    rows = np.flatnonzero(turning > TURN)
+    if rows.size == 0:
         return 0, 0.0
     face = np.zeros(len(table) + 1, dtype=bool)
-    face[at[turning < FACE]] = True
-    beside = np.zeros(int(np.count_nonzero(crease)), dtype=bool)
-    for pos in _within_reach(table, at[crease]):
+    face[normals.at[turning < FACE]] = True
+    sheet = np.zeros(len(table) + 1, dtype=bool)
+    sheet[normals.at[rows[normals.turning(rows, REACH + 1) > SHEETS]]] = True
+    beside, thin = np.zeros(rows.size, dtype=bool), np.zeros(rows.size, dtype=bool)
+    for pos in _within_reach(table, normals.at[rows], REACH):
         beside |= face[pos]
-    if not np.any(beside):
+        thin |= sheet[pos]
+    kept = beside & ~thin
+    if not np.any(kept):
         return 0, 0.0
-    return int(np.count_nonzero(beside)), float(turning[crease][beside].max())
+    return int(np.count_nonzero(kept)), float(turning[rows[kept]].max())
 
 
 #: The smoothing reads a crease whose faces meet at θ as a turn of about this share of θ or more:
@@ -138,12 +182,12 @@ def coarse_creases(grid: Any, band: Any, phi: np.ndarray) -> Tuple[int, float]:
 READ_SHARE = 0.6
 
 
-def paper_creases(grid: Any, band: Any, phi: np.ndarray) -> Optional[Dict[str, Any]]:
+def paper_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Optional[Dict[str, Any]]:
     """The creases that :func:`coarse_creases` finds, as ``sol.stats.creases`` (see
     ``_creases.creases_of_redistanced``): ``angle_degrees`` and ``faces_angle_degrees`` the
     faces' angle read back from the smoothed turn (its :data:`READ_SHARE`, at most
     ``_creases.REVERSED``), ``smoothed_turn_degrees`` the turn itself; None where there are none."""
-    nodes, turn = coarse_creases(grid, band, phi)
+    nodes, turn = coarse_creases(grid, band, phi, passes)
     if not nodes:
         return None
     faces = min(turn / READ_SHARE, REVERSED)
@@ -151,17 +195,95 @@ def paper_creases(grid: Any, band: Any, phi: np.ndarray) -> Optional[Dict[str, A
         "nodes": nodes,
         "angle_degrees": faces,
         "faces_angle_degrees": faces,
-        "shortcut_per_inner_width": 2 * float(np.tan(np.radians(faces) / 2)),
+        "shortcut_per_inner_width": _per_inner_width(faces),
         "redistanced": True,
         "smoothed_turn_degrees": turn,
     }
 
 
 def creases_of_redistanced(
-    grid: Any, band: Any, roles: np.ndarray, phi: np.ndarray, direction: np.ndarray, outer_width: float
+    grid: Any,
+    band: Any,
+    roles: np.ndarray,
+    phi: np.ndarray,
+    direction: np.ndarray,
+    outer_width: float,
+    surface: Any,
 ) -> Dict[str, Any]:
-    """The paper's tube's creases on a re-distanced φ: the second-order geometry's test
-    (``_creases.creases_of_redistanced``), or where it stands down on a φ it finds noisy (a voxel
-    mask's staircase, noise) this module's test through a smoothing (:func:`paper_creases`)."""
-    found, noisy = fine_creases_of_redistanced(band, roles, phi, direction, grid.spacing, outer_width)
-    return (paper_creases(grid, band, phi) or found) if noisy else found
+    """The paper's tube's creases on a re-distanced φ (``surface``'s): the second-order geometry's
+    test (``_creases.creases_of_redistanced``), widened where this module's test through a
+    smoothing reads a rounded crease (:func:`widened`), and where the first finds none or stands
+    down on a φ it finds noisy (a voxel mask's staircase, noise), this module's (a voxel mask
+    smoothed over a voxel, two balls fused at 122–140°, N = 41–61: 7.3–10Δx early at worst with
+    ``order=1`` and no warning or 5.4Δx said)."""
+    found, noisy, between = fine_creases_of_redistanced(band, roles, phi, direction, grid.spacing, outer_width)
+    coarse = paper_creases(grid, band, phi, passes_for(surface))
+    if coarse is None:
+        return found
+    if noisy or not found["nodes"]:
+        return coarse
+    merged = widened(found, coarse, between)
+    # (the paper's tube's report gives the faces' angle as its angle, and its shortcut from it)
+    faces = float(merged["faces_angle_degrees"])
+    return {**merged, "angle_degrees": faces, "shortcut_per_inner_width": _per_inner_width(faces)}
+
+
+def widened(found: Dict[str, Any], coarse: Dict[str, Any], between: Optional[float] = None) -> Dict[str, Any]:
+    """A crease report of the neighbours' test (``found``, with crease nodes) widened by the one
+    through a smoothing (``coarse``, :func:`paper_creases`) where the crease is rounded: a sharp
+    crease turns the normal between neighbours by more than the smoothed normal turns within two
+    spacings (two balls fused at 122°, re-distanced from their distance: 118° against 82°); a
+    rounded one by less, only about half its angle between neighbours (the same balls as a voxel
+    mask with ``smooth=1``: 48°), and its faces' angle is the smoothing's
+    (``smoothed_turn_degrees`` says so). ``between``: the turn between neighbours, where
+    ``found["angle_degrees"]`` is not it (the paper's tube's report)."""
+    turn = coarse["smoothed_turn_degrees"]
+    if turn <= (float(found["angle_degrees"]) if between is None else between):
+        return found
+    faces = max(float(found["faces_angle_degrees"]), coarse["faces_angle_degrees"])
+    return {
+        **found,
+        "faces_angle_degrees": faces,
+        "shortcut_per_inner_width": _per_inner_width(faces),
+        "smoothed_turn_degrees": turn,
+    }
+
+
+def _per_inner_width(faces: float) -> float:
+    """2·tan(θ/2) at the faces' angle θ (degrees), capped at ``_creases.REVERSED``."""
+    return 2 * float(np.tan(np.radians(min(faces, REVERSED)) / 2))
+
+
+def passes_for(surface: Any) -> int:
+    """The smoothing passes that take out ``surface``'s kinks at the grid's scale: one on a voxel
+    mask smoothed over a voxel or more (``from_mask(smooth=σ)``, whose steps are gone but whose
+    creases the user's smoothing rounded already: two passes more read two balls fused at 122° at
+    62–80° where one reads 69–76°, and at 106° nothing), else :data:`PASSES`."""
+    smoothing = getattr(surface, "_mask_smoothing", None)
+    return 1 if smoothing is not None and smoothing >= 1.0 else PASSES
+
+
+def widened_for_order2(st: Dict[str, Any], tube: Any) -> None:
+    """Second order's crease report (``st["creases"]``, the native report's, for
+    ``sol.stats.order2``) on a re-distanced φ, read through a smoothing as well where nodes ran
+    the first-order update for an unresolved curvature. A crease that a smoothing rounded (a voxel
+    mask with ``smooth=1``) turns by about half its angle between neighbours, which the crease test
+    reads: two balls fused at 140°, N = 61, 75° read, the warning's 2.5Δx against 3.3Δx measured;
+    at N = 41 the test found none, and the front came out 4.6Δx (122°) and 6.0Δx (140°) early with
+    no warning (``tests/test_coarse_creases.py``). Where the smoothed normal turns more, the faces'
+    angle read back from it widens the report (:func:`widened`); where only the
+    smoothing finds creases, they are reported with ``smoothing_only`` (the inner tube not thinned
+    at them, the warning's figure is the paper's tube's). Computed once per tube."""
+    surface = tube.surface
+    if not getattr(surface, "redistance", False) or not st["first_order_reasons"]["curvature"]:
+        return
+    if tube.smoothed_creases is None:
+        tube.smoothed_creases = (paper_creases(tube.grid, tube.band, tube.phi, passes_for(surface)),)
+    coarse = tube.smoothed_creases[0]
+    if coarse is None:
+        return
+    found = st.get("creases")
+    if found and found.get("nodes"):
+        st["creases"] = widened(found, coarse)
+    else:
+        st["creases"] = {**{k: v for k, v in coarse.items() if k != "redistanced"}, "smoothing_only": True}

@@ -116,11 +116,17 @@ def warn_creases(
     (:func:`thinned_spacings`), else the paper's tube's ``2·tan(θ/2)·inner·Δx`` at the largest angle.
     ``redistanced``: the directions come from φ's closest points (a re-distanced φ), where the
     normal turns between neighbours by the faces' angle; otherwise from central differences of φ,
-    which average the faces' normals next to a crease (:func:`faces_angle`)."""
+    which average the faces' normals next to a crease (:func:`faces_angle`). Creases read through a
+    smoothing (``_coarse_creases.widened_for_order2``: ``smoothed_turn_degrees``) are sized by the
+    faces' angle read back from it, and where only the smoothing found them (``smoothing_only``)
+    the inner tube was not thinned at them."""
     if not creases or not creases.get("nodes"):
         return
+    if creases.get("smoothing_only"):
+        _warn_smoothed_only(creases, inner, spacing)
+        return
     angle = float(creases["angle_degrees"])
-    faces = angle if redistanced else faces_angle(creases)
+    faces = faces_angle(creases) if not redistanced or "smoothed_turn_degrees" in creases else angle
     if thinned and faces > 90 and not redistanced:
         thinned = max(thinned, THINNED_SHORTCUT_REDISTANCED)
     # 2·tan(θ/2) capped at θ = 150° as the core's (Creases::shortcut_per_inner_width): at 180° the
@@ -130,12 +136,28 @@ def warn_creases(
         2 * np.tan(np.radians(min(faces, REVERSED)) / 2), inner, spacing, thinned, scaled=faces <= REVERSED
     )
     early = _early(faces, size, f"({how}, first order in Δx)", thinned=bool(thinned))
-    turning = f"{angle:.0f}°" + (f", the faces by up to {faces:.0f}°" if faces > angle + 5 else "")
+    smoothed = " (read through a smoothing of φ)" if "smoothed_turn_degrees" in creases else ""
+    turning = f"{angle:.0f}°" + (f", the faces by up to {faces:.0f}°{smoothed}" if faces > angle + 5 else "")
     warnings.warn(
         f"φ's level sets have creases or corners ({creases['nodes']} tube nodes, the normal turning by up to "
         f"{turning}): a front that crosses one {early}, "
         "and the nodes there run the first-order update. sol.first_order_points() shows where; rounding the edges "
         "over more than the tube's width (outer·Δx), or a finer grid, reduces it",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )
+
+
+def _warn_smoothed_only(creases: dict, inner: float, spacing: float) -> None:
+    """:func:`warn_creases` for creases that only the test through a smoothing found: their nodes
+    ran the first-order update (their curvature unresolved) and the inner tube was not thinned at
+    them, so a front crossing one cuts the corner by up to 2·tan(θ/2)·inner·Δx."""
+    angle = float(creases["angle_degrees"])
+    size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
+    early = _early(angle, size, "(2·tan(θ/2)·inner·Δx, first order in Δx)")
+    warnings.warn(
+        f"φ's level sets have creases or corners ({where_creases(creases)}): a front that crosses one {early}, and the "
+        "nodes there run the first-order update. sol.first_order_points() shows where; a finer grid reduces it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
@@ -227,22 +249,23 @@ def _paper_creases(nodes: int, angle: float) -> Dict[str, Any]:
 
 def creases_of_redistanced(
     band: Any, roles: np.ndarray, phi: np.ndarray, direction: np.ndarray, spacing: float, outer_width: float
-) -> Tuple[Dict[str, Any], bool]:
+) -> Tuple[Dict[str, Any], bool, float]:
     """As :func:`creases_in_paper_tube` for a re-distanced φ (a voxel mask, ``redistance=True``),
     whose sampled zero set has kinks of its own (a mask's staircase, noise): the crease test of the
     second-order geometry, behind its gates (curvature or gradient unresolved by central
     differences, no crease on a φ found noisy), with the faces' angle
     (``tubesweep_core::second_order::creases::creases_of_redistanced``). ``roles``: the paper's
     tube; ``outer_width``: its half-width (outer·Δx). And whether φ was found noisy (then no
-    crease was looked for)."""
-    nodes, angle, noisy = band.creases_of_redistanced(
+    crease was looked for), and the largest turn between neighbours at the crease nodes (degrees),
+    which tells a sharp crease (as wide as the faces' angle) from a rounded one."""
+    nodes, angle, noisy, between = band.creases_of_redistanced(
         np.ascontiguousarray(roles, dtype=np.uint8),
         np.ascontiguousarray(phi, dtype=np.float64),
         np.ascontiguousarray(direction, dtype=np.float32).reshape(len(roles), -1),
         float(spacing),
         float(outer_width),
     )
-    return {**_paper_creases(nodes, angle), "redistanced": True}, bool(noisy)
+    return {**_paper_creases(nodes, angle), "redistanced": True}, bool(noisy), float(between)
 
 
 def where_creases(creases: dict) -> str:
@@ -255,7 +278,7 @@ def where_creases(creases: dict) -> str:
         return f"{nodes} tube nodes, the faces turning by up to {angle:.0f}°"
     return (
         f"{nodes} tube nodes next to the surface, where its normal, read through a smoothing of φ over about a "
-        f"spacing (φ kinks at the grid's scale, a voxel mask's staircase or noise), turns by up to {turn:.0f}° "
+        f"spacing, turns by up to {turn:.0f}° "
         f"within two spacings: faces meeting at about {angle:.0f}°, the smoothing reading them as 0.6–0.75 of that, or "
         "a part whose radius of curvature is below about four spacings, which acts as a crease"
     )
@@ -276,10 +299,16 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
         reckoned = f"{PAPER_TUBE_REDISTANCED:g}·2·tan(θ/2)·inner·Δx on a re-distanced φ"
         thinned = THINNED_SHORTCUT_REDISTANCED
     early = _early(angle, size, f"per crease it crosses ({reckoned}, first order in Δx)")
+    if "smoothed_turn_degrees" in creases:  # (a voxel mask, a noisy φ: "auto" may run first order)
+        instead = "order='auto' (the default) thins the tube there, which leaves less, and says how much"
+    else:
+        instead = (
+            f"Second order's tube (order='auto', the default, or order=2, with outer ≥ inner + 2) is thinned there, "
+            f"which leaves about {thinned:g}Δx per crease"
+        )
     warnings.warn(
-        f"φ's level sets have creases or corners ({where_creases(creases)}): in the paper's tube (order=1) a front crossing one cuts the corner and {early}. "
-        f"Second order's tube (order='auto', the default, or order=2, with outer ≥ inner + 2) is thinned there, which "
-        f"leaves about {thinned:g}Δx per crease; rounding the edges over more than the tube's width "
+        f"φ's level sets have creases or corners ({where_creases(creases)}): in the paper's tube (order=1) a front "
+        f"crossing one cuts the corner and {early}. {instead}; rounding the edges over more than the tube's width "
         "(outer·Δx) leaves none. sol.stats.creases has the figures",
         RuntimeWarning,
         stacklevel=user_stacklevel(),

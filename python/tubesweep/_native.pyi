@@ -294,7 +294,7 @@ class Band:
         direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
         spacing: float,
         outer_width: float,
-    ) -> Tuple[int, float, bool]: ...
+    ) -> Tuple[int, float, bool, float]: ...
     def medial_edges(
         self,
         inner: npt.NDArray[np.bool_],

@@ -145,6 +145,9 @@ class _PreparedTube:
     #: each band node's piece of a triangle mesh of separate pieces (``surfaces._mesh_parts``, from
     #: the band's cut), None on other surfaces
     pieces: Optional[np.ndarray] = None
+    #: the creases of a re-distanced φ read through a smoothing for second order, once read
+    #: (``_coarse_creases.widened_for_order2``): a 1-tuple of the dict or None
+    smoothed_creases: Optional[Tuple[Optional[Dict[str, Any]]]] = None
 
 
 # The memory a solve adds per band node at its peak, for the check below: 57–58 B for `ts.solve` at
@@ -237,7 +240,7 @@ def paper_creases_of(tube: _PreparedTube) -> Optional[Dict[str, Any]]:
     ):
         h = tube.grid.spacing
         tube.paper_creases = creases_of_redistanced(
-            tube.grid, tube.band, tube.roles, tube.geom.signed, tube.geom.direction, tube.outer_eff * h
+            tube.grid, tube.band, tube.roles, tube.geom.signed, tube.geom.direction, tube.outer_eff * h, surf
         )
     return tube.paper_creases
 
@@ -722,7 +725,7 @@ def _prepare_tube(
         if not getattr(surf, "redistance", False):
             paper_creases = creases_in_paper_tube(band, roles == ROLE_INNER, phi, directions, h)
         elif not creases and not reusable:  # the one call at order=1
-            paper_creases = creases_of_redistanced(grid, band, roles, phi, directions, outer_eff * h)
+            paper_creases = creases_of_redistanced(grid, band, roles, phi, directions, outer_eff * h, surf)
         if creases:
             extended = crease_nodes_to_extend(band, roles == ROLE_INNER, phi, directions, h)
     return _PreparedTube(

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple
 import numpy as np
 
 from . import _native
+from ._coarse_creases import widened_for_order2
 from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
 from ._parts import drop_unsourced_rows
@@ -147,6 +148,7 @@ def solve_many_order2(
     st["bridged_holes"] = t.bridged_holes
     st["slits"] = t.slits
     so.warn_first_order_nodes(st, t.surface, "tube.solve(source).first_order_points() shows where")
+    widened_for_order2(st, t)  # a rounded crease read through a smoothing
     warn_creases(
         st.get("creases"),
         t.inner,

@@ -19,6 +19,7 @@ import numpy as np
 
 from . import _native
 from ._box_cut import box_reason
+from ._coarse_creases import widened_for_order2
 from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._parts import drop_unsourced, part_labels, source_parts
@@ -719,6 +720,7 @@ def solve_on_tube(
     split = split_at_creases(tube, values)
     if split is not None:
         raise Order2NotApplicable(split)
+    widened_for_order2(st, tube)  # a rounded crease read through a smoothing
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)

@@ -339,8 +339,8 @@ impl PyBand {
     /// `tubesweep_core::second_order::creases::creases_of_redistanced`: the second-order
     /// geometry's test): `roles` per node (the paper's tube), `phi` φ (signed), `direction` (K, d)
     /// the outward directions, `outer_width` the tube's half-width. Returns the crease nodes'
-    /// count, the faces' largest angle there in degrees, and whether φ was found noisy (then no
-    /// crease is looked for: 0 and 0.0).
+    /// count, the faces' largest angle there in degrees, whether φ was found noisy (then no crease
+    /// is looked for: 0, 0.0 and 0.0), and the largest turn between neighbours there in degrees.
     fn creases_of_redistanced(
         &self,
         py: Python<'_>,
@@ -349,7 +349,7 @@ impl PyBand {
         direction: PyReadonlyArray2<'_, f32>,
         spacing: f64,
         outer_width: f64,
-    ) -> PyResult<(usize, f64, bool)> {
+    ) -> PyResult<(usize, f64, bool, f64)> {
         let d = self.ndim();
         if direction.shape()[1] != d {
             return Err(PyValueError::new_err(format!("direction must have shape (K, {d})")));
@@ -363,7 +363,7 @@ impl PyBand {
             AnyBand::D2(b) => redistanced_creases(py, b, roles, phi, dir, spacing, outer_width),
             AnyBand::D3(b) => redistanced_creases(py, b, roles, phi, dir, spacing, outer_width),
         }?;
-        Ok(c.map_or((0, 0.0, true), |c| (c.nodes, c.angle, false)))
+        Ok(c.map_or((0, 0.0, true, 0.0), |c| (c.nodes, c.faces_angle, false, c.angle)))
     }
 
     /// The edges between neighbours whose closest points lie more than `jump` grid spacings

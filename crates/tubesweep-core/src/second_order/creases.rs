@@ -179,8 +179,9 @@ fn crease_nodes_of<const D: usize>(
 /// [`super::geometry::tube_geometry`]: a node whose curvature or gradient the central differences do not resolve,
 /// and no crease on a φ found noisy). [`creases_of_level_set`], without those gates, reads the
 /// kinks of a re-distanced φ's samples as creases (a voxel mask's staircase, the bumps of noise);
-/// the gates keep them out, and the angle reported is the faces' (the widest turn across a crease
-/// node, as [`creases_of_level_set`] reports it). `roles`: the paper's tube (inner and extension
+/// the gates keep them out. The paper's tube's report gives the faces' angle (`faces_angle`, the
+/// widest turn across a crease node, as [`creases_of_level_set`] reports it); `angle`, the turn
+/// between neighbours, tells a sharp crease (as wide) from a rounded one (narrower). `roles`: the paper's tube (inner and extension
 /// nodes), `outer_width` its half-width (outer·Δx), which the curvature gate reads. Costs the
 /// geometry pass of a second-order solve (36 bytes per inner node while it runs). None where φ
 /// is found noisy and no crease is looked for (the caller may look through a smoothing instead).
@@ -197,12 +198,7 @@ pub fn creases_of_redistanced<const D: usize>(
     if summary.fitted_everywhere {
         return Ok(None);
     }
-    // reported at the faces' angle, as creases_of_level_set reports it
-    let found = creases_of(band, roles, &surface, spacing, directions, &nodes);
-    Ok(Some(Creases {
-        angle: found.faces_angle,
-        ..found
-    }))
+    Ok(Some(creases_of(band, roles, &surface, spacing, directions, &nodes)))
 }
 
 /// The cosine of the faces' angle at crease node `i`: the widest turn of the normal from one side
