@@ -58,14 +58,14 @@ def test_auto_on_a_mask_with_a_crease_says_how_early_the_front_arrives_beyond_it
         with pytest.warns(
             RuntimeWarning,
             match=r"order='auto' ran the first-order scheme, and φ's level sets have creases or corners \(216 tube "
-            r"nodes next to the surface, .* turns by up to 77° within two spacings: faces meeting at about 129°.*"
-            r"arrives early by up to about 0\.418 per crease",
+            r"nodes next to the surface where .* turns by 76° within two spacings, taken for faces whose normals differ by up to "
+            r"127°.* arrives early by up to about 0\.405 \(8\.1·Δx\) per crease",
         ):
             sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid), grid, [source])
     assert sol.stats.order == 1 and sol.stats.creases["nodes"] == 216
-    assert sol.stats.creases["smoothed_turn_degrees"] == pytest.approx(77.32, abs=0.01)
+    assert sol.stats.creases["smoothed_turn_degrees"] == pytest.approx(76.46, abs=0.01)
     early = sol(points) - exact
-    assert -0.418 < np.min(early) < -4.5 * grid.spacing and np.mean(early) < -3.5 * grid.spacing
+    assert -0.405 < np.min(early) < -4.5 * grid.spacing and np.mean(early) < -3.5 * grid.spacing
 
 
 def test_order_1_on_a_noisy_phi_with_a_crease_says_how_early_the_front_arrives_beyond_it():
@@ -76,9 +76,9 @@ def test_order_1_on_a_noisy_phi_with_a_crease_says_how_early_the_front_arrives_b
     with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
         with pytest.warns(
             RuntimeWarning,
-            match=r"creases or corners \([0-9]+ tube nodes next to the surface, .* faces meeting at about 1[01][0-9]°.*"
-            r"in the paper's tube \(order=1\) a front crossing one cuts the corner and arrives early by up to about "
-            r"0\.2[0-9]+ per crease it crosses",
+            match=r"creases or corners \(130 tube nodes next to the surface where .* faces whose normals differ by up to "
+            r"107°.* in the paper's tube \(order=1\) a front crossing one cuts the corner and arrives early by up to about "
+            r"0\.27 \(8\.1·Δx\) per crease it crosses",
         ):
             sol = ts.solve(ts.LevelSet(noisy, redistance=True), grid, [source], order=1)
     said = 1.5 * sol.stats.creases["shortcut_per_inner_width"] * 2 * grid.spacing
@@ -109,24 +109,24 @@ def test_a_mask_smoothed_over_a_voxel_says_its_rounded_crease_at_second_order():
     grid, d, source, points, exact = _fused_balls(41, 122)
     with pytest.warns(
         RuntimeWarning,
-        match=r"creases or corners \(176 tube nodes next to the surface, .* turns by up to 69° within two spacings: "
-        r"faces meeting at about 115°.* arrives early by up to about 0\.313 \(2·tan\(θ/2\)·inner·Δx",
+        match=r"creases or corners \(176 tube nodes next to the surface where .* turns by 67° within two spacings, taken for "
+        r"faces whose normals differ by up to 111°.* arrives early by up to about 0\.293 \(5\.9·Δx, 2·tan\(θ/2\)",
     ):
         sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source])
     creases = sol.stats.order2["creases"]
     assert sol.stats.order == 2 and creases["smoothing_only"] and creases["nodes"] == 176
     early = sol(points) - exact
-    assert -0.313 < np.min(early) < -4.5 * grid.spacing  # -4.58Δx
+    assert -0.293 < np.min(early) < -4.5 * grid.spacing  # -4.58Δx
     grid, d, source, points, exact = _fused_balls(61, 140)
     with pytest.warns(
         RuntimeWarning,
-        match=r"\(12 tube nodes, the normal turning by up to 75°, the faces by up to 136° \(read through a smoothing "
-        r"of φ\)\): a front that crosses one arrives early by up to about 0\.208 \(6\.2·Δx with the inner tube",
+        match=r"\(12 tube nodes, the normal turning by up to 75°, the faces by up to 133° \(read through a smoothing "
+        r"of φ\)\): a front that crosses one arrives early by up to about 0\.191 \(5\.7·Δx with the inner tube",
     ):
         sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source])
-    assert sol.stats.order2["creases"]["smoothed_turn_degrees"] == pytest.approx(81.83, abs=0.01)
+    assert sol.stats.order2["creases"]["smoothed_turn_degrees"] == pytest.approx(79.72, abs=0.01)
     early = sol(points) - exact
-    assert -0.208 < np.min(early) < -3.2 * grid.spacing  # -3.32Δx
+    assert -0.191 < np.min(early) < -3.2 * grid.spacing  # -3.32Δx
 
 
 def test_order_1_on_a_mask_smoothed_over_a_voxel_reads_its_crease_s_faces_through_the_smoothing():
@@ -135,10 +135,35 @@ def test_order_1_on_a_mask_smoothed_over_a_voxel_reads_its_crease_s_faces_throug
     grid, d, source, points, exact = _fused_balls(61, 122)
     with pytest.warns(
         RuntimeWarning,
-        match=r"\(64 tube nodes next to the surface, .* faces meeting at about 127°.* in the paper's tube \(order=1\) "
-        r"a front crossing one cuts the corner and arrives early by up to about 0\.399 per crease it crosses",
+        match=r"\(64 tube nodes next to the surface where .* faces whose normals differ by up to 119°.* in the paper's "
+        r"tube \(order=1\) a front crossing one cuts the corner and arrives early by up to about 0\.342 \(10·Δx\) per "
+        r"crease it crosses",
     ):
         sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source], order=1)
-    assert sol.stats.creases["smoothed_turn_degrees"] == pytest.approx(76.02, abs=0.01)
+    assert sol.stats.creases["smoothed_turn_degrees"] == pytest.approx(71.61, abs=0.01)
     early = sol(points) - exact
-    assert -0.399 < np.min(early) < -8 * grid.spacing  # -8.30Δx
+    assert -0.342 < np.min(early) < -8 * grid.spacing  # -8.30Δx
+
+
+def test_a_closed_cylinder_s_mask_says_its_rims_and_a_thin_capsule_s_says_no_crease():
+    # a closed cylinder (r = 0.5, height 0.8) as a voxel mask at N = 61: "auto" refused it for its
+    # unresolved curvature, not for noise, and said nothing of its rims (2.9Δx early across two,
+    # a helper's review); a capsule four voxels in radius, smooth, read as creased at N = 81
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    x = np.stack(grid.meshgrid(), axis=-1)
+    cylinder = np.maximum(np.hypot(x[..., 0], x[..., 1]) - 0.5, np.abs(x[..., 2]) - 0.4) < 0
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"order='auto' ran the first-order scheme, and φ's level sets have creases or corners \(1374 tube nodes "
+        r".* arrives early by up to about 0\.274 \(8\.2·Δx\) per crease",
+    ):
+        sol = ts.solve(ts.LevelSet.from_mask(cylinder, grid), grid, [(0, 0, -0.4)])
+    t = np.linspace(0.05, 0.45, 30)  # the top cap, across two rims from the bottom centre
+    early = 0.5 + 0.8 + (0.5 - t) - sol(np.c_[t, 0 * t, 0 * t + 0.4])
+    assert 2.5 * grid.spacing < np.max(early) < 2 * 0.274  # 2.90Δx
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (81,) * 3)
+    x = np.stack(grid.meshgrid(), axis=-1)
+    axis = np.clip(x[..., 2], -0.6, 0.6)
+    capsule = np.sqrt(x[..., 0] ** 2 + x[..., 1] ** 2 + (x[..., 2] - axis) ** 2) < 0.1
+    sol = ts.solve(ts.LevelSet.from_mask(capsule, grid), grid, [(0, 0, -0.7)])
+    assert sol.stats.order == 1 and sol.stats.creases is None

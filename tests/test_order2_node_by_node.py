@@ -96,9 +96,11 @@ def test_convex_creases_are_said_with_the_shortcut_they_cost(n, fewer):
     measured = (2.0 - sol([(0.0, 0.0, 0.5)])[0]) / 2  # two edges crossed
     assert sol.stats.order == 1 and 0 < measured <= said
     # order=1 keeps the paper's tube and says what it costs there: 2·tan(45°)·inner·Δx = 4Δx
-    with pytest.warns(RuntimeWarning, match=r"in the paper's tube \(order=1\).*about ([0-9.]+) per crease") as rec:
+    with pytest.warns(
+        RuntimeWarning, match=r"in the paper's tube \(order=1\).*about ([0-9.]+) \(4·Δx\) per crease"
+    ) as rec:
         paper_sol = ts.solve(ts.LevelSet(phi), g, [(0.0, 0.0, -0.5)], order=1)
-    said_paper = float(re.search(r"about ([0-9.]+) per crease", str(rec[0].message)).group(1))
+    said_paper = float(re.search(r"about ([0-9.]+) \(4·Δx\) per crease", str(rec[0].message)).group(1))
     assert said_paper == pytest.approx(4 * g.spacing, rel=0.02)
     paper = (2.0 - paper_sol([(0.0, 0.0, 0.5)])[0]) / 2
     assert 0.7 * said_paper < paper < 1.2 * said_paper

@@ -58,11 +58,15 @@ REACH = 2
 #: A turn of the smoothed normal (degrees) within :data:`REACH` beyond which a node is a crease node.
 TURN = 60.0
 #: A crease node lies beside a face, a node within :data:`REACH` whose normal turns by less than
-#: this (degrees): a ball ten voxels in radius turns by 28°, one of four by 50° or more.
-FACE = 35.0
+#: this (degrees): faces of balls ten voxels in radius keep nodes below it beside their crease; a
+#: capsule four voxels in radius, whose nodes turn by 29–61° with their place in the grid, had
+#: some below 35° beside ones over 60° and read as creased (a helper's review).
+FACE = 25.0
 #: A normal that turns by more than this (degrees) within :data:`REACH` + 1 nodes reverses: two sides
 #: of a thin part, no crease.
 SHEETS = 120.0
+#: The crease nodes' turn that stands for the faces' angle: this percentile of them.
+TURN_PERCENTILE = 90.0
 #: Nodes this close to the surface (spacings) carry the normals that are compared.
 NEAR = 0.75
 
@@ -145,8 +149,8 @@ def _within_reach(table: np.ndarray, at: np.ndarray, reach: int) -> Iterator[np.
 
 def coarse_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Tuple[int, float]:
     """How many nodes next to the surface turn by more than :data:`TURN` within :data:`REACH`
-    (:func:`smoothed_turning`) beside a face and away from a thin part, and the largest such turn in
-    degrees (0, 0.0 when there is none). Beside a face: with a node within that reach that turns by
+    (:func:`smoothed_turning`) beside a face and away from a thin part, and their turn in degrees
+    (the :data:`TURN_PERCENTILE` of them; 0, 0.0 when there is none). Beside a face: with a node within that reach that turns by
     less than :data:`FACE` (a part whose whole surface turns more is small, its curvature unresolved
     rather than creased: a sphere shrinking to nothing, 1.4–4 spacings in radius, reads 60–180° all
     over). Away from a thin part: no node within that reach whose normal reverses (turns by more
@@ -172,7 +176,9 @@ def coarse_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) 
     kept = beside & ~thin
     if not np.any(kept):
         return 0, 0.0
-    return int(np.count_nonzero(kept)), float(turning[rows[kept]].max())
+    # (a high percentile, not the largest: a cube's corners, where three faces meet, turn more
+    # than its edges, and a few nodes read its 90° edges as 124–150°, a helper's review)
+    return int(np.count_nonzero(kept)), float(np.percentile(turning[rows[kept]], TURN_PERCENTILE))
 
 
 #: The smoothing reads a crease whose faces meet at θ as a turn of about this share of θ or more:

@@ -154,7 +154,7 @@ def _warn_smoothed_only(creases: dict, inner: float, spacing: float) -> None:
     them, so a front crossing one cuts the corner by up to 2·tan(θ/2)·inner·Δx."""
     angle = float(creases["angle_degrees"])
     size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
-    early = _early(angle, size, "(2·tan(θ/2)·inner·Δx, first order in Δx)")
+    early = _early(angle, size, f"({size / spacing:.2g}·Δx, 2·tan(θ/2)·inner·Δx, first order in Δx)")
     warnings.warn(
         f"φ's level sets have creases or corners ({where_creases(creases)}): a front that crosses one {early}, and the "
         "nodes there run the first-order update. sol.first_order_points() shows where; a finer grid reduces it",
@@ -277,10 +277,9 @@ def where_creases(creases: dict) -> str:
     if turn is None:
         return f"{nodes} tube nodes, the faces turning by up to {angle:.0f}°"
     return (
-        f"{nodes} tube nodes next to the surface, where its normal, read through a smoothing of φ over about a "
-        f"spacing, turns by up to {turn:.0f}° "
-        f"within two spacings: faces meeting at about {angle:.0f}°, the smoothing reading them as 0.6–0.75 of that, or "
-        "a part whose radius of curvature is below about four spacings, which acts as a crease"
+        f"{nodes} tube nodes next to the surface where its normal, read through a smoothing of φ over about a "
+        f"spacing, turns by {turn:.0f}° within two spacings, taken for faces whose normals differ by up to "
+        f"{angle:.0f}° (a cube's 90° edges read about 75°), or a part curved more tightly than about four spacings"
     )
 
 
@@ -298,7 +297,7 @@ def warn_paper_tube_creases(creases: Optional[dict], inner: float, spacing: floa
         size *= PAPER_TUBE_REDISTANCED
         reckoned = f"{PAPER_TUBE_REDISTANCED:g}·2·tan(θ/2)·inner·Δx on a re-distanced φ"
         thinned = THINNED_SHORTCUT_REDISTANCED
-    early = _early(angle, size, f"per crease it crosses ({reckoned}, first order in Δx)")
+    early = _early(angle, size, f"({size / spacing:.2g}·Δx) per crease it crosses ({reckoned}, first order in Δx)")
     if "smoothed_turn_degrees" in creases:  # (a voxel mask, a noisy φ: "auto" may run first order)
         instead = "order='auto' (the default) thins the tube there, which leaves less, and says how much"
     else:

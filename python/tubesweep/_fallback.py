@@ -209,10 +209,13 @@ class Fallback:
         )
         if self.said or getattr(surface, "open_surface", False) or not closed:
             return
-        if isinstance(surface, LevelSet) and NOISY_PHI in self.reason and not refused_for_creases(self.reason):
+        redistanced = isinstance(surface, LevelSet) and (surface.redistance or NOISY_PHI in self.reason)
+        if redistanced and not refused_for_creases(self.reason):
             # a voxel mask or a noisy φ, whose kinks run the first-order scheme and hide a crease
             # from the crease tests: two balls fused at 122° as a voxel mask, 4–5Δx early beyond
-            # the crease at N = 41–81 with no warning (tests/test_coarse_creases.py)
+            # the crease at N = 41–81 with no warning (tests/test_coarse_creases.py); refused for
+            # an unresolved curvature rather than for noise, a closed cylinder's mask at N = 61–101
+            # (3.2–5.2Δx across its two rims) and fused discs' in 2D (6–8Δx), a helper's review
             self.creases = paper_creases(tube.grid, tube.band, tube.phi)
         self.gradient, low, high = gradient_range(tube)
         given = isinstance(surface, LevelSet) and not surface.redistance
@@ -253,14 +256,16 @@ class Fallback:
 def warn_smoothed_creases(creases: Dict[str, Any], inner: float, spacing: float) -> None:
     """After ``order="auto"`` ran the first-order scheme on a re-distanced φ whose creases were
     found through a smoothing (:attr:`Fallback.creases`): a front crossing one cuts its corner, by
-    up to ``2·tan(θ/2)·inner·Δx`` (the tube's crease nodes thinned where the ridge test found
-    them, which leaves less: ``tests/test_coarse_creases.py``)."""
+    up to ``2·tan(θ/2)·inner·Δx``, the paper's tube's figure: the tube is thinned where the ridge
+    test finds crease nodes, which leaves less, but on a voxel mask not steadily (two fused balls'
+    masks 3.5–7.2Δx early at N = 41–81 where 4.8–15Δx is said, ``benches/experiments/mask_creases.py``;
+    a cube's or a closed cylinder's 90° edges 1–3 times below it, a helper's review)."""
     size = shortcut(creases["shortcut_per_inner_width"], inner, spacing)
     warnings.warn(
         f"order='auto' ran the first-order scheme, and φ's level sets have creases or corners "
         f"({where_creases(creases)}): a front that crosses one cuts the corner and arrives early by up to about "
-        f"{size:.3g} per crease (2·tan(θ/2)·inner·Δx, first order in Δx). sol.stats.creases has the figures and "
-        "sol.stats.order_fallback why order 2 did not apply; a finer grid lowers the error in proportion",
+        f"{size:.3g} ({size / spacing:.2g}·Δx) per crease (2·tan(θ/2)·inner·Δx, first order in Δx). sol.stats.creases has the figures and "
+        "sol.stats.order_fallback why order 2 did not apply; a finer grid lowers it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )
