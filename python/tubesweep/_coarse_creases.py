@@ -23,18 +23,18 @@ read is below the faces' angle: two fused balls whose faces meet at 90° read be
 (and go unsaid: ``benches/experiments/mask_creases.py``), at 106° 60–71°, at 122° 75–84°
 (:data:`READ_SHARE`; ``tests/test_coarse_creases.py``).
 
-Used for the paper's tube (``order=1``) and the first-order fallback of ``"auto"`` on a φ found
-noisy, and for second order's report on a re-distanced φ where nodes ran the first-order update
-for an unresolved curvature (a crease that a smoothing rounded: :func:`widened_for_order2`). O(band): a few gathers over the band, and
-the reach's (2·REACH + 1)^d − 1 steps along the neighbour table for the nodes next to the surface
-only (20–50 ms at N = 81).
+Used for the paper's tube (``order=1``) and the first-order fallback of ``"auto"`` on a
+re-distanced φ, and for second order's report on one where nodes ran the first-order update for
+an unresolved curvature (a crease that a smoothing rounded: :func:`widened_for_order2`). The
+per-node work is the core's (``tubesweep_core::second_order::smoothed_creases``, in parallel):
+O(band) for the smoothing, the reach's (2·REACH + 1)^d − 1 steps along the neighbour table for
+the nodes next to the surface (17 ms for two fused balls' mask at N = 121 on two cores, whose
+solve takes 0.5 s; 118 ms in numpy before).
 """
 
 from __future__ import annotations
 
-import dataclasses
-import itertools
-from typing import Any, Dict, Iterator, Optional, Tuple
+from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
@@ -75,110 +75,33 @@ def smoothed_turning(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES
     """The band positions of the nodes within :data:`NEAR` spacings of φ's zero level set (``phi``:
     one value per band node) where the smoothed φ has a normal, and at each the largest angle
     (degrees) between its normal and those of such nodes up to :data:`REACH` nodes away along each
-    axis; ``passes`` of the smoothing (:func:`passes_for`)."""
-    table = np.asarray(band.neighbours())
-    normals = _Normals.of(grid, table, phi, passes)
-    return normals.at, normals.turning(np.arange(normals.at.size), REACH)
-
-
-@dataclasses.dataclass
-class _Normals:
-    """The unit normals of the smoothed φ at the nodes next to the surface: ``at`` their band
-    positions, ``normal`` one row each, ``slot`` each band node's row (-1 for none, and for the
-    position past the band); ``table`` the band's neighbour table, (K, d, 2): the minus and plus
-    neighbours' band positions, K where absent."""
-
-    table: np.ndarray
-    at: np.ndarray
-    normal: np.ndarray
-    slot: np.ndarray
-
-    @classmethod
-    def of(cls, grid: Any, table: np.ndarray, phi: np.ndarray, passes: int) -> "_Normals":
-        h = float(grid.spacing)
-        count, ndim = table.shape[0], table.shape[1]
-        # the mean over the neighbours in the band (fewer at its edge, far from the surface)
-        smoothed = np.asarray(phi, dtype=np.float64).copy()
-        for _ in range(passes):
-            for k in range(ndim):
-                minus, plus = table[:, k, 0], table[:, k, 1]
-                padded = np.append(smoothed, 0.0)
-                smoothed = (padded[minus] + smoothed + padded[plus]) / (1.0 + (minus < count) + (plus < count))
-        padded = np.append(smoothed, np.nan)
-        at = np.flatnonzero(np.abs(np.asarray(phi, dtype=np.float64)) <= NEAR * h)
-        gradient = np.stack([padded[table[at, k, 1]] - padded[table[at, k, 0]] for k in range(ndim)], axis=1)
-        norm = np.linalg.norm(gradient, axis=1)
-        has = np.isfinite(norm) & (norm > 0)
-        at = at[has]
-        slot = np.full(count + 1, -1, dtype=np.int32)
-        slot[at] = np.arange(at.size, dtype=np.int32)
-        return cls(table, at, gradient[has] / norm[has, None], slot)
-
-    def turning(self, rows: np.ndarray, reach: int) -> np.ndarray:
-        """At the nodes ``rows`` (rows of :attr:`normal`), the largest angle (degrees) between
-        their normal and those of the nodes up to ``reach`` nodes away along each axis."""
-        closest = np.ones(rows.size)  # the smallest cosine of the turn
-        mine = self.normal[rows]
-        for pos in _within_reach(self.table, self.at[rows], reach):
-            other = self.slot[pos]
-            pair = np.flatnonzero(other >= 0)
-            cosine = np.einsum("ij,ij->i", mine[pair], self.normal[other[pair]])
-            closest[pair] = np.minimum(closest[pair], cosine)  # (each node once per offset)
-        return np.degrees(np.arccos(np.clip(closest, -1.0, 1.0)))
-
-
-def _within_reach(table: np.ndarray, at: np.ndarray, reach: int) -> Iterator[np.ndarray]:
-    """For each offset of at most ``reach`` nodes along each axis (but none), the band position of
-    the node that far from each of the nodes ``at`` (``len(table)`` where it is not in the band),
-    walked one axis step at a time along the neighbour table ``table`` (the nodes on the way lie
-    within reach·√d spacings of the surface, inside the tube)."""
-    count, ndim = table.shape[0], table.shape[1]
-    walked = {(0,) * ndim: at}
-    for offset in sorted(itertools.product(range(-reach, reach + 1), repeat=ndim), key=lambda o: sum(map(abs, o))):
-        if not any(offset):
-            continue
-        k = next(i for i in range(ndim) if offset[i])
-        back = tuple((v - 1 if v > 0 else v + 1) if i == k else v for i, v in enumerate(offset))
-        start = walked[back]
-        pos = np.full(at.size, count)
-        inside = start < count
-        pos[inside] = table[start[inside], k, 1 if offset[k] > 0 else 0]
-        walked[offset] = pos
-        yield pos
+    axis; ``passes`` of the smoothing (:func:`passes_for`). In the core
+    (``tubesweep_core::second_order::smoothed_creases``)."""
+    at, turning = band.smoothed_turning(_values(phi), float(grid.spacing), int(passes), REACH, NEAR)
+    return np.asarray(at), np.asarray(turning)
 
 
 def coarse_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Tuple[int, float]:
     """How many nodes next to the surface turn by more than :data:`TURN` within :data:`REACH`
     (:func:`smoothed_turning`) beside a face and away from a thin part, and their turn in degrees
-    (the :data:`TURN_PERCENTILE` of them; 0, 0.0 when there is none). Beside a face: with a node within that reach that turns by
-    less than :data:`FACE` (a part whose whole surface turns more is small, its curvature unresolved
-    rather than creased: a sphere shrinking to nothing, 1.4–4 spacings in radius, reads 60–180° all
-    over). Away from a thin part: no node within that reach whose normal reverses (turns by more
-    than :data:`SHEETS`) within one node more, as across a part thinner than about six spacings,
-    whose two sides are not a crease (a dumbbell's neck 2.4 spacings in radius read as one at 90°;
-    creases of up to 140° turn by at most 104° within three nodes)."""
-    table = np.asarray(band.neighbours())
-    normals = _Normals.of(grid, table, phi, passes)
-    if normals.at.size == 0:
-        return 0, 0.0
-    turning = normals.turning(np.arange(normals.at.size), REACH)
-    rows = np.flatnonzero(turning > TURN)
-    if rows.size == 0:
-        return 0, 0.0
-    face = np.zeros(len(table) + 1, dtype=bool)
-    face[normals.at[turning < FACE]] = True
-    sheet = np.zeros(len(table) + 1, dtype=bool)
-    sheet[normals.at[rows[normals.turning(rows, REACH + 1) > SHEETS]]] = True
-    beside, thin = np.zeros(rows.size, dtype=bool), np.zeros(rows.size, dtype=bool)
-    for pos in _within_reach(table, normals.at[rows], REACH):
-        beside |= face[pos]
-        thin |= sheet[pos]
-    kept = beside & ~thin
-    if not np.any(kept):
-        return 0, 0.0
-    # (a high percentile, not the largest: a cube's corners, where three faces meet, turn more
-    # than its edges, and a few nodes read its 90° edges as 124–150°, a helper's review)
-    return int(np.count_nonzero(kept)), float(np.percentile(turning[rows[kept]], TURN_PERCENTILE))
+    (the :data:`TURN_PERCENTILE` of them; 0, 0.0 when there is none). Beside a face: with a node
+    within that reach that turns by less than :data:`FACE` (a part whose whole surface turns more is
+    small, its curvature unresolved rather than creased: a sphere shrinking to nothing, 1.4–4
+    spacings in radius, reads 60–180° all over). Away from a thin part: no node within that reach
+    whose normal reverses (turns by more than :data:`SHEETS`) within one node more, as across a part
+    thinner than about six spacings, whose two sides are not a crease (a dumbbell's neck 2.4
+    spacings in radius read as one at 90°; creases of up to 140° turn by at most 104° within three
+    nodes). The percentile, not the largest: a cube's corners, where three faces meet, turn more
+    than its edges, and a few nodes read its 90° edges as 124–150° (a helper's review). In the core
+    (``tubesweep_core::second_order::smoothed_creases``, O(band))."""
+    nodes, turn = band.smoothed_creases(
+        _values(phi), float(grid.spacing), int(passes), REACH, NEAR, TURN, FACE, SHEETS, TURN_PERCENTILE
+    )
+    return int(nodes), float(turn)
+
+
+def _values(phi: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(phi, dtype=np.float64)
 
 
 #: The smoothing reads a crease whose faces meet at θ as a turn of about this share of θ or more:

@@ -273,6 +273,21 @@ class Band:
         spacing: float,
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
     def neighbours_of_nodes(self, positions: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
+    def smoothed_turning(
+        self, phi: npt.NDArray[np.float64], spacing: float, passes: int, reach: int, near: float
+    ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+    def smoothed_creases(
+        self,
+        phi: npt.NDArray[np.float64],
+        spacing: float,
+        passes: int,
+        reach: int,
+        near: float,
+        turn: float,
+        face: float,
+        sheets: float,
+        percentile: float,
+    ) -> Tuple[int, float]: ...
     def crease_ridge_nodes(
         self,
         inner: npt.NDArray[np.bool_],

@@ -310,6 +310,74 @@ impl PyBand {
         Ok(out.into_pyarray(py))
     }
 
+    /// The turns of φ's normals read through a smoothing
+    /// (`tubesweep_core::second_order::smoothed_creases`): `phi` per node, `passes` of the 3-node
+    /// mean, normals compared up to `reach` nodes away at the nodes with |φ| ≤ `near`·`spacing`.
+    /// Returns those nodes' band positions and their turns in degrees.
+    #[allow(clippy::type_complexity)]
+    fn smoothed_turning<'py>(
+        &self,
+        py: Python<'py>,
+        phi: PyReadonlyArray1<'py, f64>,
+        spacing: f64,
+        passes: usize,
+        reach: usize,
+        near: f64,
+    ) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<f64>>)> {
+        let ph = phi.as_slice()?;
+        let (at, turns) = py
+            .detach(|| {
+                with_band!(self, b, {
+                    tubesweep_core::second_order::smoothed_creases::smoothed_normals(b, ph, spacing, passes, near).map(
+                        |normals| {
+                            let rows: Vec<usize> = (0..normals.at.len()).collect();
+                            let turns = normals.turning(b, &rows, reach);
+                            (normals.at.iter().map(|&i| i as i64).collect::<Vec<i64>>(), turns)
+                        },
+                    )
+                })
+            })
+            .map_err(to_pyerr)?;
+        Ok((at.into_pyarray(py), turns.into_pyarray(py)))
+    }
+
+    /// The crease nodes found through a smoothing and their turn in degrees
+    /// (`tubesweep_core::second_order::smoothed_creases::smoothed_creases`, the thresholds as its
+    /// `SmoothedCreaseTest`'s).
+    #[allow(clippy::too_many_arguments)]
+    fn smoothed_creases(
+        &self,
+        py: Python<'_>,
+        phi: PyReadonlyArray1<'_, f64>,
+        spacing: f64,
+        passes: usize,
+        reach: usize,
+        near: f64,
+        turn: f64,
+        face: f64,
+        sheets: f64,
+        percentile: f64,
+    ) -> PyResult<(usize, f64)> {
+        let ph = phi.as_slice()?;
+        let test = tubesweep_core::second_order::smoothed_creases::SmoothedCreaseTest {
+            passes,
+            reach,
+            near,
+            turn,
+            face,
+            sheets,
+            percentile,
+        };
+        py.detach(|| {
+            with_band!(
+                self,
+                b,
+                tubesweep_core::second_order::smoothed_creases::smoothed_creases(b, ph, spacing, &test)
+            )
+        })
+        .map_err(to_pyerr)
+    }
+
     /// The creases of a level set in the paper's tube (`order=1`, see
     /// `tubesweep_core::second_order::creases::creases_of_level_set`): `inner` per node, `phi` φ
     /// (signed), `direction` (K, d) the outward directions. Returns the crease nodes' count and the

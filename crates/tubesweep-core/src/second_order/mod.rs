@@ -35,6 +35,7 @@ mod phase;
 mod pipeline;
 mod rows;
 pub mod setup;
+pub mod smoothed_creases;
 pub mod solver;
 mod stagnation;
 pub mod start;

@@ -1,0 +1,311 @@
+//! Creases read through a smoothing: the test for a re-distanced φ whose own kinks hide its
+//! creases from [`super::creases`] (a voxel mask's staircase, noise, or a crease that a smoothing
+//! rounded). python/tubesweep/_coarse_creases.py holds the thresholds and what they were
+//! measured on; this is its per-node work.
+//!
+//! φ is smoothed over the band (passes of the 3-node mean along each axis, over the neighbours
+//! present), its normals are read by central differences at the nodes next to the surface, and at
+//! each such node the largest angle to the normals of such nodes up to `reach` nodes away along
+//! each axis is its turn. A crease node turns by more than `turn` degrees beside a face (a node
+//! within the reach turning by less than `face`) and away from a thin part (no node within the
+//! reach whose normal reverses, turning by more than `sheets` within one node more). Across a
+//! crease the paper's tube (its Eq. (3)) lets the front cut the corner; the report sizes that.
+//! O(band) for the smoothing, O(nodes next to the surface × (2·reach + 1)^D) for the turns, in
+//! parallel.
+
+use rayon::prelude::*;
+
+use crate::band::NarrowBand;
+use crate::error::{Error, Result};
+
+/// The thresholds of [`smoothed_creases`], in degrees but for `near` (grid spacings).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SmoothedCreaseTest {
+    /// Passes of the 3-node mean along each axis.
+    pub passes: usize,
+    /// How far (nodes along each axis) normals are compared.
+    pub reach: usize,
+    /// Nodes with |φ| at most this many grid spacings carry the normals compared.
+    pub near: f64,
+    /// A turn above this marks a crease node.
+    pub turn: f64,
+    /// A node turning by less than this is a face.
+    pub face: f64,
+    /// A turn above this within `reach + 1` nodes is a reversal: two sides of a thin part.
+    pub sheets: f64,
+    /// The percentile of the crease nodes' turns reported.
+    pub percentile: f64,
+}
+
+/// The unit normals of the smoothed φ at the nodes next to the surface.
+pub struct SmoothedNormals<const D: usize> {
+    /// Their band positions, increasing.
+    pub at: Vec<usize>,
+    normal: Vec<[f64; D]>,
+    /// Each band node's row of `normal`, `u32::MAX` for none.
+    slot: Vec<u32>,
+}
+
+/// The normals of φ (`phi`, one value per band node) smoothed by `passes` passes, at the nodes
+/// with |φ| ≤ `near`·`spacing` whose axis neighbours are all in the band.
+pub fn smoothed_normals<const D: usize>(
+    band: &NarrowBand<D>,
+    phi: &[f64],
+    spacing: f64,
+    passes: usize,
+    near: f64,
+) -> Result<SmoothedNormals<D>> {
+    let n = band.len();
+    if phi.len() != n {
+        return Err(Error::invalid(
+            "phi",
+            format!("one value per band node is needed ({n} nodes, {} values)", phi.len()),
+        ));
+    }
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(Error::invalid("spacing", format!("must be positive; got {spacing}")));
+    }
+    let sentinel = band.sentinel();
+    let mut smoothed = phi.to_vec();
+    for _ in 0..passes {
+        for k in 0..D {
+            let previous = smoothed;
+            smoothed = (0..n)
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(|i| {
+                    let [minus, plus] = band.neighbours_of(i)[k];
+                    let (mut total, mut count) = (previous[i], 1.0);
+                    for j in [minus, plus] {
+                        if j != sentinel {
+                            total += previous[j as usize];
+                            count += 1.0;
+                        }
+                    }
+                    total / count
+                })
+                .collect();
+        }
+    }
+    let found: Vec<(usize, [f64; D])> = (0..n)
+        .into_par_iter()
+        .with_min_len(4096)
+        .filter_map(|i| {
+            if !(phi[i].abs() <= near * spacing) {
+                return None;
+            }
+            let mut gradient = [0.0; D];
+            for (k, pair) in band.neighbours_of(i).iter().enumerate() {
+                if pair[0] == sentinel || pair[1] == sentinel {
+                    return None;
+                }
+                gradient[k] = smoothed[pair[1] as usize] - smoothed[pair[0] as usize];
+            }
+            let norm = gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return None;
+            }
+            Some((i, gradient.map(|g| g / norm)))
+        })
+        .collect();
+    let mut slot = vec![u32::MAX; n];
+    for (row, &(i, _)) in found.iter().enumerate() {
+        slot[i] = row as u32;
+    }
+    let (at, normal) = found.into_iter().unzip();
+    Ok(SmoothedNormals { at, normal, slot })
+}
+
+/// The offsets of at most `reach` nodes along each axis but none, each reached from an earlier
+/// one (`back`, an index into this list, 0 for the node itself) by one step along `axis` to
+/// `side` (0 minus, 1 plus): the walk along the neighbour table.
+fn walk(reach: usize, dims: usize) -> Vec<(usize, usize, usize)> {
+    let width = 2 * reach as i64 + 1;
+    let mut offsets: Vec<Vec<i64>> = (0..width.pow(dims as u32))
+        .map(|mut code| {
+            (0..dims)
+                .map(|_| {
+                    let v = code % width - reach as i64;
+                    code /= width;
+                    v
+                })
+                .collect()
+        })
+        .collect();
+    offsets.sort_by_key(|o| o.iter().map(|v| v.abs()).sum::<i64>());
+    let index = |o: &[i64]| offsets.iter().position(|p| p.as_slice() == o).unwrap_or(0);
+    (1..offsets.len())
+        .map(|i| {
+            let o = &offsets[i];
+            let axis = o.iter().position(|&v| v != 0).unwrap_or(0);
+            let mut back = o.clone();
+            back[axis] -= o[axis].signum();
+            (index(&back), axis, usize::from(o[axis] > 0))
+        })
+        .collect()
+}
+
+impl<const D: usize> SmoothedNormals<D> {
+    /// At the rows `rows` (of [`Self::at`]), the largest angle in degrees between their normal and
+    /// those of the nodes up to `reach` nodes away along each axis (0 where none has a normal).
+    pub fn turning(&self, band: &NarrowBand<D>, rows: &[usize], reach: usize) -> Vec<f64> {
+        let steps = walk(reach, D);
+        let sentinel = band.sentinel();
+        rows.par_iter()
+            .with_min_len(256)
+            .map(|&row| {
+                let mine = self.normal[row];
+                let mut position = vec![sentinel; steps.len() + 1];
+                position[0] = self.at[row] as u32;
+                let mut closest = 1.0_f64;
+                for (i, &(back, axis, side)) in steps.iter().enumerate() {
+                    let from = position[back];
+                    if from == sentinel {
+                        continue;
+                    }
+                    let to = band.neighbours_of(from as usize)[axis][side];
+                    position[i + 1] = to;
+                    if to == sentinel || self.slot[to as usize] == u32::MAX {
+                        continue;
+                    }
+                    let other = self.normal[self.slot[to as usize] as usize];
+                    closest = closest.min((0..D).map(|c| mine[c] * other[c]).sum());
+                }
+                closest.clamp(-1.0, 1.0).acos().to_degrees()
+            })
+            .collect()
+    }
+
+    /// Whether any node up to `reach` nodes from each of `rows` has `flag` (per band position).
+    fn near_any(&self, band: &NarrowBand<D>, rows: &[usize], reach: usize, flag: &[bool]) -> Vec<bool> {
+        let steps = walk(reach, D);
+        let sentinel = band.sentinel();
+        rows.par_iter()
+            .with_min_len(256)
+            .map(|&row| {
+                let mut position = vec![sentinel; steps.len() + 1];
+                position[0] = self.at[row] as u32;
+                for (i, &(back, axis, side)) in steps.iter().enumerate() {
+                    let from = position[back];
+                    if from == sentinel {
+                        continue;
+                    }
+                    let to = band.neighbours_of(from as usize)[axis][side];
+                    position[i + 1] = to;
+                    if to != sentinel && flag[to as usize] {
+                        return true;
+                    }
+                }
+                false
+            })
+            .collect()
+    }
+}
+
+/// The crease nodes that `test` finds on φ (see the module documentation) and their turn (its
+/// `percentile`), in degrees; (0, 0.0) where there is none.
+pub fn smoothed_creases<const D: usize>(
+    band: &NarrowBand<D>,
+    phi: &[f64],
+    spacing: f64,
+    test: &SmoothedCreaseTest,
+) -> Result<(usize, f64)> {
+    let normals = smoothed_normals(band, phi, spacing, test.passes, test.near)?;
+    let all: Vec<usize> = (0..normals.at.len()).collect();
+    let turning = normals.turning(band, &all, test.reach);
+    let rows: Vec<usize> = all.iter().copied().filter(|&r| turning[r] > test.turn).collect();
+    if rows.is_empty() {
+        return Ok((0, 0.0));
+    }
+    let mut face = vec![false; band.len()];
+    for (r, &t) in turning.iter().enumerate() {
+        face[normals.at[r]] = t < test.face;
+    }
+    let mut sheet = vec![false; band.len()];
+    for (&r, &t) in rows.iter().zip(&normals.turning(band, &rows, test.reach + 1)) {
+        sheet[normals.at[r]] = t > test.sheets;
+    }
+    let beside = normals.near_any(band, &rows, test.reach, &face);
+    let thin = normals.near_any(band, &rows, test.reach, &sheet);
+    let mut kept: Vec<f64> = rows
+        .iter()
+        .zip(beside.iter().zip(&thin))
+        .filter(|(_, (&b, &t))| b && !t)
+        .map(|(&r, _)| turning[r])
+        .collect();
+    if kept.is_empty() {
+        return Ok((0, 0.0));
+    }
+    kept.sort_by(f64::total_cmp);
+    // the percentile as numpy's default (linear between the closest ranks)
+    let rank = test.percentile.clamp(0.0, 100.0) / 100.0 * (kept.len() - 1) as f64;
+    let low = rank.floor() as usize;
+    let high = (low + 1).min(kept.len() - 1);
+    Ok((kept.len(), kept[low] + (rank - low as f64) * (kept[high] - kept[low])))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn band_of(n: usize, phi: impl Fn([f64; 3]) -> f64, width: f64) -> (NarrowBand<3>, Vec<f64>, f64) {
+        let h = 2.0 / (n - 1) as f64;
+        let mut linear = Vec::new();
+        let mut values = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    let x = [-1.0 + i as f64 * h, -1.0 + j as f64 * h, -1.0 + k as f64 * h];
+                    let v = phi(x);
+                    if v.abs() <= width * h {
+                        linear.push(((i * n + j) * n + k) as u64);
+                        values.push(v);
+                    }
+                }
+            }
+        }
+        (NarrowBand::from_sorted_linear([n, n, n], &linear).unwrap(), values, h)
+    }
+
+    const TEST: SmoothedCreaseTest = SmoothedCreaseTest {
+        passes: 2,
+        reach: 2,
+        near: 0.75,
+        turn: 60.0,
+        face: 25.0,
+        sheets: 120.0,
+        percentile: 90.0,
+    };
+
+    #[test]
+    fn the_walk_reaches_every_offset_once_from_one_already_reached() {
+        let steps = walk(2, 3);
+        assert_eq!(steps.len(), 124);
+        assert!(steps.iter().enumerate().all(|(i, &(back, _, _))| back <= i));
+    }
+
+    #[test]
+    fn a_sphere_has_no_crease_and_two_fused_balls_have_one() {
+        let (band, phi, h) = band_of(41, |x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 0.5, 4.0);
+        assert_eq!(smoothed_creases(&band, &phi, h, &TEST).unwrap(), (0, 0.0));
+        let normals = smoothed_normals(&band, &phi, h, 2, 0.75).unwrap();
+        let all: Vec<usize> = (0..normals.at.len()).collect();
+        let most = normals.turning(&band, &all, 2).into_iter().fold(0.0, f64::max);
+        assert!(most > 10.0 && most < 25.0, "{most}"); // a ball ten spacings in radius
+        let c = 0.5 * 61f64.to_radians().sin(); // faces at 122°
+        let fused = |x: [f64; 3]| {
+            let a = ((x[0] + c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
+            let b = ((x[0] - c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
+            a.min(b) - 0.5
+        };
+        let (band, phi, h) = band_of(41, fused, 4.0);
+        let (nodes, turn) = smoothed_creases(&band, &phi, h, &TEST).unwrap();
+        assert!(nodes > 50 && turn > 60.0 && turn < 0.75 * 122.0, "{nodes} {turn}");
+    }
+
+    #[test]
+    fn phi_of_the_wrong_length_is_refused() {
+        let (band, phi, h) = band_of(21, |x| x[2], 2.0);
+        assert!(smoothed_creases(&band, &phi[1..], h, &TEST).is_err());
+    }
+}
