@@ -287,7 +287,7 @@ class Band:
         face: float,
         sheets: float,
         percentile: float,
-    ) -> Tuple[int, float]: ...
+    ) -> Tuple[int, float, float]: ...
     def crease_ridge_nodes(
         self,
         inner: npt.NDArray[np.bool_],

@@ -341,7 +341,8 @@ impl PyBand {
         Ok((at.into_pyarray(py), turns.into_pyarray(py)))
     }
 
-    /// The crease nodes found through a smoothing and their turn in degrees
+    /// The crease nodes found through a smoothing, their turn in degrees and the share of them
+    /// beside a convex edge
     /// (`tubesweep_core::second_order::smoothed_creases::smoothed_creases`, the thresholds as its
     /// `SmoothedCreaseTest`'s).
     #[allow(clippy::too_many_arguments)]
@@ -357,7 +358,7 @@ impl PyBand {
         face: f64,
         sheets: f64,
         percentile: f64,
-    ) -> PyResult<(usize, f64)> {
+    ) -> PyResult<(usize, f64, f64)> {
         let ph = phi.as_slice()?;
         let test = tubesweep_core::second_order::smoothed_creases::SmoothedCreaseTest {
             passes,
@@ -375,6 +376,7 @@ impl PyBand {
                 tubesweep_core::second_order::smoothed_creases::smoothed_creases(b, ph, spacing, &test)
             )
         })
+        .map(|c| (c.nodes, c.turn, c.convex))
         .map_err(to_pyerr)
     }
 
