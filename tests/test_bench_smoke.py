@@ -433,3 +433,18 @@ def test_point_clouds_bench_quick(capsys):
     if HAVE["potpourri3d"]:
         assert all("heat" in r for r in rows)
     assert "| sphere | 3,000 | 31 |" in capsys.readouterr().out
+
+
+def test_mask_creases_bench_says_more_than_the_fronts_gain_beyond_the_crease(capsys):
+    """benches/experiments/mask_creases.py at a small size: two balls fused at 122° as a voxel mask,
+    raw and smoothed over a voxel, with "auto" and order=1: every row has a crease warning whose
+    figure covers the worst early arrival measured beyond the crease (tubesweep._coarse_creases)."""
+    import mask_creases
+
+    argv = ["--n", "41", "--angles", "122", "--kinds", "mask", "smooth1", "--orders", "auto", "1"]
+    assert mask_creases.main(argv) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:] if line.strip()]
+    assert len(rows) == 4
+    for row in rows:
+        worst, said = float(row[5]), float(row[7])
+        assert 4.0 < worst < said and len(row) == 8  # (no "**": the figure covers the worst)

@@ -15,6 +15,7 @@ warning; ``**``: the worst beyond what was said)::
 from __future__ import annotations
 
 import argparse
+from typing import List, Optional
 import re
 import warnings
 
@@ -36,13 +37,13 @@ def _surface(kind: str, d: np.ndarray, grid: ts.Grid) -> ts.Surface:
     return ts.LevelSet(d, redistance=True)
 
 
-def main() -> None:
+def main(argv: Optional[List[str]] = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--n", type=int, nargs="+", default=[41, 61])
     parser.add_argument("--angles", type=float, nargs="+", default=[90, 106, 122, 140])
     parser.add_argument("--kinds", nargs="+", default=["mask", "smooth1", "smooth1.5", "noisy", "exact"])
     parser.add_argument("--orders", nargs="+", default=["auto", "1"])
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     r = 0.5
     print("N  angle kind       order ran  worst  mean   said")
     for n in args.n:
@@ -74,7 +75,8 @@ def main() -> None:
                         f"{early.mean():6.2f} {figure}{flag}",
                         flush=True,
                     )
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())
