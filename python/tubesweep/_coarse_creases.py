@@ -38,7 +38,7 @@ from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
-from ._creases import REVERSED
+from ._creases import REVERSED, per_inner_width
 from ._creases import creases_of_redistanced as fine_creases_of_redistanced
 
 __all__ = [
@@ -132,7 +132,7 @@ def paper_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -
         "nodes": nodes,
         "angle_degrees": faces,
         "faces_angle_degrees": faces,
-        "shortcut_per_inner_width": _per_inner_width(faces),
+        "shortcut_per_inner_width": per_inner_width(faces),
         "redistanced": True,
         "smoothed_turn_degrees": turn,
     }
@@ -162,7 +162,7 @@ def creases_of_redistanced(
     merged = widened(found, coarse, between)
     # (the paper's tube's report gives the faces' angle as its angle, and its shortcut from it)
     faces = float(merged["faces_angle_degrees"])
-    return {**merged, "angle_degrees": faces, "shortcut_per_inner_width": _per_inner_width(faces)}
+    return {**merged, "angle_degrees": faces, "shortcut_per_inner_width": per_inner_width(faces)}
 
 
 def widened(found: Dict[str, Any], coarse: Dict[str, Any], between: Optional[float] = None) -> Dict[str, Any]:
@@ -181,14 +181,9 @@ def widened(found: Dict[str, Any], coarse: Dict[str, Any], between: Optional[flo
     return {
         **found,
         "faces_angle_degrees": faces,
-        "shortcut_per_inner_width": _per_inner_width(faces),
+        "shortcut_per_inner_width": per_inner_width(faces),
         "smoothed_turn_degrees": turn,
     }
-
-
-def _per_inner_width(faces: float) -> float:
-    """2·tan(θ/2) at the faces' angle θ (degrees), capped at ``_creases.REVERSED``."""
-    return 2 * float(np.tan(np.radians(min(faces, REVERSED)) / 2))
 
 
 def passes_for(surface: Any) -> int:

@@ -62,6 +62,12 @@ def thinned_spacings(tube: Any, thinned: bool) -> float:
 REVERSED = 150.0
 
 
+def per_inner_width(angle: float) -> float:
+    """2·tan(θ/2) at the faces' angle θ (degrees), θ capped at :data:`REVERSED` as the core's
+    ``Creases::shortcut_per_inner_width``: how early a front arrives per crease, in inner·Δx."""
+    return 2 * float(np.tan(np.radians(min(float(angle), REVERSED)) / 2))
+
+
 def shortcut(per_inner_width: float, inner: float, spacing: float) -> float:
     """How early a front arrives after crossing one crease: ``per_inner_width`` (2·tan(θ/2))
     times the inner tube's half-width ``inner·Δx``."""
@@ -132,9 +138,7 @@ def warn_creases(
     # 2·tan(θ/2) capped at θ = 150° as the core's (Creases::shortcut_per_inner_width): at 180° the
     # normal reverses, two sheets face each other across a gap (two spheres a 0.02 gap apart said
     # "up to about 3.27e+15"), and a front that crosses over is early by more than any such bound
-    size, how = _per_crease(
-        2 * np.tan(np.radians(min(faces, REVERSED)) / 2), inner, spacing, thinned, scaled=faces <= REVERSED
-    )
+    size, how = _per_crease(per_inner_width(faces), inner, spacing, thinned, scaled=faces <= REVERSED)
     early = _early(faces, size, f"({how}, first order in Δx)", thinned=bool(thinned))
     smoothed = " (read through a smoothing of φ)" if "smoothed_turn_degrees" in creases else ""
     turning = f"{angle:.0f}°" + (f", the faces by up to {faces:.0f}°{smoothed}" if faces > angle + 5 else "")
@@ -243,7 +247,7 @@ def _paper_creases(nodes: int, angle: float) -> Dict[str, Any]:
         "nodes": int(nodes),
         "angle_degrees": float(angle),
         "faces_angle_degrees": float(angle),
-        "shortcut_per_inner_width": 2 * float(np.tan(np.radians(min(angle, REVERSED)) / 2)) if nodes else 0.0,
+        "shortcut_per_inner_width": per_inner_width(angle) if nodes else 0.0,
     }
 
 

@@ -163,59 +163,73 @@ fn walk(reach: usize, dims: usize) -> Vec<(usize, usize, usize)> {
         .collect()
 }
 
+/// Visits the band positions of the nodes reached from `start` along `steps` ([`walk`]), in
+/// order, until `visit` returns false; `position` is the walk's buffer (one entry per step and one
+/// for `start`), reused from node to node.
+fn walk_from<const D: usize>(
+    band: &NarrowBand<D>,
+    steps: &[(usize, usize, usize)],
+    start: u32,
+    position: &mut [u32],
+    mut visit: impl FnMut(usize) -> bool,
+) {
+    let sentinel = band.sentinel();
+    position[0] = start;
+    for (i, &(back, axis, side)) in steps.iter().enumerate() {
+        let from = position[back];
+        let to = if from == sentinel {
+            sentinel
+        } else {
+            band.neighbours_of(from as usize)[axis][side]
+        };
+        position[i + 1] = to;
+        if to != sentinel && !visit(to as usize) {
+            return;
+        }
+    }
+}
+
 impl<const D: usize> SmoothedNormals<D> {
     /// At the rows `rows` (of [`Self::at`]), the largest angle in degrees between their normal and
     /// those of the nodes up to `reach` nodes away along each axis (0 where none has a normal).
     pub fn turning(&self, band: &NarrowBand<D>, rows: &[usize], reach: usize) -> Vec<f64> {
         let steps = walk(reach, D);
-        let sentinel = band.sentinel();
         rows.par_iter()
             .with_min_len(256)
-            .map(|&row| {
-                let mine = self.normal[row];
-                let mut position = vec![sentinel; steps.len() + 1];
-                position[0] = self.at[row] as u32;
-                let mut closest = 1.0_f64;
-                for (i, &(back, axis, side)) in steps.iter().enumerate() {
-                    let from = position[back];
-                    if from == sentinel {
-                        continue;
-                    }
-                    let to = band.neighbours_of(from as usize)[axis][side];
-                    position[i + 1] = to;
-                    if to == sentinel || self.slot[to as usize] == u32::MAX {
-                        continue;
-                    }
-                    let other = self.normal[self.slot[to as usize] as usize];
-                    closest = closest.min((0..D).map(|c| mine[c] * other[c]).sum());
-                }
-                closest.clamp(-1.0, 1.0).acos().to_degrees()
-            })
+            .map_init(
+                || vec![0u32; steps.len() + 1],
+                |position, &row| {
+                    let mine = self.normal[row];
+                    let mut closest = 1.0_f64;
+                    walk_from(band, &steps, self.at[row] as u32, position, |to| {
+                        if let Some(&slot) = self.slot.get(to).filter(|&&s| s != u32::MAX) {
+                            let other = self.normal[slot as usize];
+                            closest = closest.min((0..D).map(|c| mine[c] * other[c]).sum());
+                        }
+                        true
+                    });
+                    closest.clamp(-1.0, 1.0).acos().to_degrees()
+                },
+            )
             .collect()
     }
 
     /// Whether any node up to `reach` nodes from each of `rows` has `flag` (per band position).
     fn near_any(&self, band: &NarrowBand<D>, rows: &[usize], reach: usize, flag: &[bool]) -> Vec<bool> {
         let steps = walk(reach, D);
-        let sentinel = band.sentinel();
         rows.par_iter()
             .with_min_len(256)
-            .map(|&row| {
-                let mut position = vec![sentinel; steps.len() + 1];
-                position[0] = self.at[row] as u32;
-                for (i, &(back, axis, side)) in steps.iter().enumerate() {
-                    let from = position[back];
-                    if from == sentinel {
-                        continue;
-                    }
-                    let to = band.neighbours_of(from as usize)[axis][side];
-                    position[i + 1] = to;
-                    if to != sentinel && flag[to as usize] {
-                        return true;
-                    }
-                }
-                false
-            })
+            .map_init(
+                || vec![0u32; steps.len() + 1],
+                |position, &row| {
+                    let mut found = false;
+                    walk_from(band, &steps, self.at[row] as u32, position, |to| {
+                        found = flag[to];
+                        !found
+                    });
+                    found
+                },
+            )
             .collect()
     }
 }
