@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import tubesweep as ts
-from tubesweep._coarse_creases import READ_SHARE, TURN, smoothed_turning
+from tubesweep._coarse_creases import READ_SHARE, TURN, TURN_CONCAVE, faces_of_turn, smoothed_turning
 from tubesweep._prepare import _prepare_tube
 
 
@@ -91,15 +91,36 @@ def test_masks_of_smooth_objects_report_no_crease():
     x = np.stack(grid.meshgrid(), axis=-1)
     ellipsoid = np.sqrt((x[..., 0] / 0.8) ** 2 + (x[..., 1] / 0.5) ** 2 + (x[..., 2] / 0.3) ** 2) < 1
     torus = np.hypot(np.hypot(x[..., 0], x[..., 1]) - 0.5, x[..., 2]) < 0.2
-    for mask in (ellipsoid, torus):
+    # two balls at 90° joined by a smooth minimum blending over 6 voxels: a concave neck, no crease
+    c = 0.5 * np.sin(np.radians(45))
+    a, b = (np.linalg.norm(x + [s * c, 0, 0], axis=-1) - 0.5 for s in (1, -1))
+    blend = np.clip(0.5 + 0.5 * (b - a) / 0.2, 0, 1)
+    neck = b * (1 - blend) + a * blend - 0.2 * blend * (1 - blend) < 0
+    for mask, source in ((ellipsoid, (0, 0, 0.3)), (torus, (0.7, 0, 0)), (neck, (-c - 0.5, 0, 0))):
         for order in ("auto", 1):
-            sol = ts.solve(
-                ts.LevelSet.from_mask(mask, grid),
-                grid,
-                [(0, 0, 0.3) if mask is ellipsoid else (0.7, 0, 0)],
-                order=order,
-            )
+            sol = ts.solve(ts.LevelSet.from_mask(mask, grid), grid, [source], order=order)
             assert sol.stats.order == 1 and (sol.stats.creases is None or sol.stats.creases["nodes"] == 0)
+
+
+def test_a_concave_crease_is_read_from_a_lower_turn_than_a_convex_edge():
+    # two balls fused at 90° as a voxel mask, N = 41: the smoothing reads their concave crease as a
+    # turn of 49°, below TURN, which a torus's tube five voxels in radius reaches (52–58°, convex);
+    # "auto" came out 2.9Δx early at worst beyond the crease with no warning
+    grid, d, source, points, exact = _fused_balls(41, 90)
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"order='auto' ran the first-order scheme, and φ's level sets have creases or corners \(184 tube nodes "
+        r".* turns by 49° within two spacings, taken for faces whose normals differ by up to 99° .* or a concave part "
+        r"curved more tightly than about three spacings\): .* early by up to about 0\.233 \(4\.7·Δx\) per crease",
+    ):
+        sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid), grid, [source])
+    creases = sol.stats.creases
+    assert creases["concave"] and TURN_CONCAVE < creases["smoothed_turn_degrees"] < TURN
+    early = exact - sol(points)
+    assert 2.5 * grid.spacing < np.max(early) < 0.233  # 2.93Δx
+    # the faces' angle read back: 90° for a concave turn of 45°, 100° for 50–60°, turn/0.6 above
+    assert [round(faces_of_turn(t, False)) for t in (45, 50, 55, 60, 72)] == [90, 100, 100, 100, 120]
+    assert faces_of_turn(60, True) == pytest.approx(80)
 
 
 def test_a_mask_smoothed_over_a_voxel_says_its_rounded_crease_at_second_order():

@@ -12,16 +12,20 @@ Here φ is smoothed first, over a few nodes of the band (:data:`PASSES` passes o
 along each axis, about a Gaussian of 1.15 spacings), which takes out the staircase but not a crease:
 the normals of the smoothed φ next to the surface are compared with those of the nodes up to
 :data:`REACH` nodes away along each axis, and a node whose normal turns by more than :data:`TURN`
-within that reach, beside a face (a node there turning by less than :data:`FACE`) and away from
-a thin part (no node there whose normal reverses within one node more), is a crease node. A
-smooth surface turns by about 2√3/ρ radians over that reach (ρ its radius of curvature in
-spacings, plus the staircase's 8–12°): 20–28° on a ball of 20–10 voxels in radius, 58° on a
-torus's tube of 5. A part whose curvature radius is below about four spacings, which the tube does
-not resolve either, reads as a crease where it lies beside flatter faces (a thin ellipsoid's rim)
-and as none where it turns so all over (a small sphere). The smoothing rounds a crease, so the turn
-read is below the faces' angle: two fused balls whose faces meet at 90° read below :data:`TURN`
-(and go unsaid: ``benches/experiments/mask_creases.py``), at 106° 60–71°, at 122° 75–84°
-(:data:`READ_SHARE`; ``tests/test_coarse_creases.py``).
+within that reach (:data:`TURN_CONCAVE` beside a concave crease), beside a face (a node there
+turning by less than :data:`FACE`) and away from a thin part (no node there whose normal reverses
+within one node more), is a crease node. A smooth surface turns by about 2√3/ρ radians over that
+reach (ρ its radius of curvature in spacings, plus the staircase's 8–12°): 20–28° on a ball of
+20–10 voxels in radius, 58° on a torus's tube of 5. A convex part whose curvature radius is below
+about four spacings (a concave one, about three: a gyroid-like φ's necks at N = 41), which the
+tube does not resolve either, reads as a crease where it lies beside flatter faces (a thin
+ellipsoid's rim) and as none where it turns so all over (a small sphere). The smoothing rounds a crease, so the turn
+read is below the faces' angle: two fused balls whose faces meet at 90° read 45–55°, at 106°
+60–71°, at 122° 75–84° (:data:`READ_SHARE`; ``tests/test_coarse_creases.py``). Those 90° are as
+much as a smooth convex part turns (a torus's tube five voxels in radius: 52–58°), but every smooth
+part read above :data:`TURN_CONCAVE` was convex, so a concave crease (the smoothed φ's Laplacian
+not positive, as between fused parts) is one from that lower turn (below it, two balls fused at
+80° still go unsaid: ``benches/experiments/mask_creases.py``).
 
 Used for the paper's tube (``order=1``) and the first-order fallback of ``"auto"`` on a
 re-distanced φ, and for second order's report on one where nodes ran the first-order update for
@@ -47,6 +51,7 @@ __all__ = [
     "paper_creases",
     "creases_of_redistanced",
     "passes_for",
+    "faces_of_turn",
     "widened",
     "widened_for_order2",
 ]
@@ -57,6 +62,17 @@ PASSES = 2
 REACH = 2
 #: A turn of the smoothed normal (degrees) within :data:`REACH` beyond which a node is a crease node.
 TURN = 60.0
+#: The same beside a concave crease (the smoothed φ's Laplacian not positive at the node). Smooth
+#: parts read above it were all convex (voxel masks, ``smooth=1`` and φ re-distanced, N = 41–81: a
+#: torus's tube of five voxels 43–58°, an ellipsoid's rim of two to three 47–50°, a capsule of six
+#: 41–44°, a thin ellipsoid's rim; noisy spheres and tori; a 2D star), smooth concave necks none
+#: (two balls at 90° joined by a smooth minimum blending over 4–12 voxels read nothing above 38°;
+#: over 2 voxels, 40°), and two balls fused at 90° read 45–55°, at 80° 39–43°. For ``order=1`` and
+#: the first-order fallback of ``"auto"``, where those balls came out 2.2–4.5Δx early; second
+#: order's report (:func:`widened_for_order2`) keeps :data:`TURN` for them (0.9–2.2Δx early there,
+#: and a gyroid-like φ's smooth concave necks at N = 41 read 48°, their values within 0.4Δx of a
+#: finer solve's).
+TURN_CONCAVE = 40.0
 #: A crease node lies beside a face, a node within :data:`REACH` whose normal turns by less than
 #: this (degrees): faces of balls ten voxels in radius keep nodes below it beside their crease; a
 #: capsule four voxels in radius, whose nodes turn by 29–61° with their place in the grid, had
@@ -81,11 +97,15 @@ def smoothed_turning(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES
     return np.asarray(at), np.asarray(turning)
 
 
-def coarse_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Tuple[int, float, float]:
+def coarse_creases(
+    grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES, turn_concave: float = TURN_CONCAVE
+) -> Tuple[int, float, float]:
     """How many nodes next to the surface turn by more than :data:`TURN` within :data:`REACH`
-    (:func:`smoothed_turning`) beside a face and away from a thin part, and their turn in degrees
-    (the :data:`TURN_PERCENTILE` of them), and the share of them beside a convex edge (0, 0.0, 0.0
-    when there is none). Beside a face: with a node
+    (:func:`smoothed_turning`; :data:`TURN_CONCAVE` beside a concave crease) beside a face and
+    away from a thin part, and their turn in degrees (the :data:`TURN_PERCENTILE` of them), and
+    the share of them beside a convex edge (0, 0.0, 0.0 when there is none). Where some turn by
+    more than :data:`TURN`, only those are counted (the flanks of a sharp concave crease read
+    lower). Beside a face: with a node
     within that reach that turns by less than :data:`FACE` (a part whose whole surface turns more is
     small, its curvature unresolved rather than creased: a sphere shrinking to nothing, 1.4–4
     spacings in radius, reads 60–180° all over). Away from a thin part: no node within that reach
@@ -96,7 +116,7 @@ def coarse_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) 
     than its edges, and a few nodes read its 90° edges as 124–150° (a helper's review). In the core
     (``tubesweep_core::second_order::smoothed_creases``, O(band))."""
     nodes, turn, convex = band.smoothed_creases(
-        _values(phi), float(grid.spacing), int(passes), REACH, NEAR, TURN, FACE, SHEETS, TURN_PERCENTILE
+        _values(phi), float(grid.spacing), int(passes), REACH, NEAR, TURN, turn_concave, FACE, SHEETS, TURN_PERCENTILE
     )
     return int(nodes), float(turn), float(convex)
 
@@ -111,6 +131,12 @@ def _values(phi: np.ndarray) -> np.ndarray:
 #: corners (``tests/test_coarse_creases.py``).
 READ_SHARE = 0.6
 
+#: Below :data:`TURN` (only concave creases read there) the share falls to this at
+#: :data:`TURN_CONCAVE`: two balls fused at 80°, 90° and 100° read 39–43°, 45–55° and 46–60° (shares
+#: 0.49–0.54, 0.50–0.61, 0.46–0.60; masks, ``smooth=1``, N = 41–81), so a turn read there is taken
+#: for the faces' angle :func:`faces_of_turn` gives, 80–100°.
+READ_SHARE_LOW = 0.5
+
 #: The same beside convex edges (most crease nodes where the smoothed φ's Laplacian is positive),
 #: which the smoothing reads higher: a cube's 90° edges as 66–82° (mask, ``smooth=1``, noisy,
 #: re-distanced, N = 41–81), a closed cylinder's rims as 77° (a helper's review: read at
@@ -118,16 +144,34 @@ READ_SHARE = 0.6
 READ_SHARE_CONVEX = 0.75
 
 
-def paper_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -> Optional[Dict[str, Any]]:
+def faces_of_turn(turn: float, convex: bool) -> float:
+    """The faces' angle (degrees) that a smoothed turn of ``turn`` degrees stands for: the turn over
+    :data:`READ_SHARE_CONVEX` beside convex edges; beside a concave crease over :data:`READ_SHARE`
+    from :data:`TURN` up, and below it over a share that falls linearly to :data:`READ_SHARE_LOW`
+    at :data:`TURN_CONCAVE` + 10° and stays there (the turns between 50° and 60° all stand for
+    100°); at most ``_creases.REVERSED``."""
+    if convex:
+        share = READ_SHARE_CONVEX
+    else:
+        low_end = TURN_CONCAVE + 10.0
+        share = READ_SHARE_LOW + (READ_SHARE - READ_SHARE_LOW) * float(
+            np.clip((turn - low_end) / (TURN - low_end), 0.0, 1.0)
+        )
+    return min(turn / share, REVERSED)
+
+
+def paper_creases(
+    grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES, turn_concave: float = TURN_CONCAVE
+) -> Optional[Dict[str, Any]]:
     """The creases that :func:`coarse_creases` finds, as ``sol.stats.creases`` (see
     ``_creases.creases_of_redistanced``): ``angle_degrees`` and ``faces_angle_degrees`` the
     faces' angle read back from the smoothed turn (its :data:`READ_SHARE`, or
     :data:`READ_SHARE_CONVEX` beside convex edges, at most
     ``_creases.REVERSED``), ``smoothed_turn_degrees`` the turn itself; None where there are none."""
-    nodes, turn, convex = coarse_creases(grid, band, phi, passes)
+    nodes, turn, convex = coarse_creases(grid, band, phi, passes, turn_concave)
     if not nodes:
         return None
-    faces = min(turn / (READ_SHARE_CONVEX if convex > 0.5 else READ_SHARE), REVERSED)
+    faces = faces_of_turn(turn, convex > 0.5)
     return {
         "nodes": nodes,
         "angle_degrees": faces,
@@ -135,6 +179,7 @@ def paper_creases(grid: Any, band: Any, phi: np.ndarray, passes: int = PASSES) -
         "shortcut_per_inner_width": per_inner_width(faces),
         "redistanced": True,
         "smoothed_turn_degrees": turn,
+        "concave": convex <= 0.5,
     }
 
 
@@ -183,6 +228,7 @@ def widened(found: Dict[str, Any], coarse: Dict[str, Any], between: Optional[flo
         "faces_angle_degrees": faces,
         "shortcut_per_inner_width": per_inner_width(faces),
         "smoothed_turn_degrees": turn,
+        "concave": coarse["concave"],
     }
 
 
@@ -210,7 +256,9 @@ def widened_for_order2(st: Dict[str, Any], tube: Any) -> None:
     if not getattr(surface, "redistance", False) or not st["first_order_reasons"]["curvature"]:
         return
     if tube.smoothed_creases is None:
-        tube.smoothed_creases = (paper_creases(tube.grid, tube.band, tube.phi, passes_for(surface)),)
+        # (concave creases from TURN too: the nodes there ran first order already, two balls fused at
+        # 90–106° came out 0.9–2.2Δx early, and a gyroid-like φ's concave necks at N = 41, smooth, read 48°)
+        tube.smoothed_creases = (paper_creases(tube.grid, tube.band, tube.phi, passes_for(surface), TURN),)
     coarse = tube.smoothed_creases[0]
     if coarse is None:
         return

@@ -280,10 +280,16 @@ def where_creases(creases: dict) -> str:
     turn = creases.get("smoothed_turn_degrees")
     if turn is None:
         return f"{nodes} tube nodes, the faces turning by up to {angle:.0f}°"
+    # (a smooth part read as creased: convex, tighter than about four spacings; concave, three)
+    tight = (
+        "a concave part curved more tightly than about three"
+        if creases.get("concave")
+        else "a part curved more tightly than about four"
+    )
     return (
         f"{nodes} tube nodes next to the surface where its normal, read through a smoothing of φ over about a "
         f"spacing, turns by {turn:.0f}° within two spacings, taken for faces whose normals differ by up to "
-        f"{angle:.0f}° (a cube's 90° edges read about 75°), or a part curved more tightly than about four spacings"
+        f"{angle:.0f}° (a cube's 90° edges read about 75°), or {tight} spacings"
     )
 
 

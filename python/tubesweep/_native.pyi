@@ -284,6 +284,7 @@ class Band:
         reach: int,
         near: float,
         turn: float,
+        turn_concave: float,
         face: float,
         sheets: float,
         percentile: float,

@@ -6,7 +6,8 @@
 //! φ is smoothed over the band (passes of the 3-node mean along each axis, over the neighbours
 //! present), its normals are read by central differences at the nodes next to the surface, and at
 //! each such node the largest angle to the normals of such nodes up to `reach` nodes away along
-//! each axis is its turn. A crease node turns by more than `turn` degrees beside a face (a node
+//! each axis is its turn. A crease node turns by more than `turn` degrees (`turn_concave` where
+//! the smoothed φ's Laplacian is not positive: beside a concave crease) beside a face (a node
 //! within the reach turning by less than `face`) and away from a thin part (no node within the
 //! reach whose normal reverses, turning by more than `sheets` within one node more). Across a
 //! crease the paper's tube (its Eq. (3)) lets the front cut the corner; the report sizes that.
@@ -27,8 +28,13 @@ pub struct SmoothedCreaseTest {
     pub reach: usize,
     /// Nodes with |φ| at most this many grid spacings carry the normals compared.
     pub near: f64,
-    /// A turn above this marks a crease node.
+    /// A turn above this marks a crease node beside a convex edge (the smoothed φ's Laplacian
+    /// positive there).
     pub turn: f64,
+    /// The same beside a concave crease (the Laplacian zero or negative). Lower than `turn`: a
+    /// smooth part that turns this much within the reach is convex (a thin tube, a capsule, an
+    /// ellipsoid's rim), and the smoothing reads a concave crease lower than a convex edge.
+    pub turn_concave: f64,
     /// A node turning by less than this is a face.
     pub face: f64,
     /// A turn above this within `reach + 1` nodes is a reversal: two sides of a thin part.
@@ -258,7 +264,14 @@ pub fn smoothed_creases<const D: usize>(
     let normals = smoothed_normals(band, phi, spacing, test.passes, test.near)?;
     let all: Vec<usize> = (0..normals.at.len()).collect();
     let turning = normals.turning(band, &all, test.reach);
-    let rows: Vec<usize> = all.iter().copied().filter(|&r| turning[r] > test.turn).collect();
+    let rows: Vec<usize> = all
+        .iter()
+        .copied()
+        .filter(|&r| {
+            let convex = normals.laplacian[r] > 0.0;
+            turning[r] > if convex { test.turn } else { test.turn_concave }
+        })
+        .collect();
     if rows.is_empty() {
         return Ok(SmoothedCreases::default());
     }
@@ -281,6 +294,11 @@ pub fn smoothed_creases<const D: usize>(
     if kept_rows.is_empty() {
         return Ok(SmoothedCreases::default());
     }
+    // where some turn by more than `turn`, those are the crease's report (its count and its turn
+    // as before `turn_concave` came in: the flanks of a sharp concave crease read lower turns and
+    // would pull its percentile down); else the concave ones that read between the two
+    let above: Vec<usize> = kept_rows.iter().copied().filter(|&r| turning[r] > test.turn).collect();
+    let kept_rows = if above.is_empty() { kept_rows } else { above };
     let convex = kept_rows.iter().filter(|&&r| normals.laplacian[r] > 0.0).count() as f64 / kept_rows.len() as f64;
     let mut kept: Vec<f64> = kept_rows.iter().map(|&r| turning[r]).collect();
     kept.sort_by(f64::total_cmp);
@@ -323,6 +341,7 @@ mod tests {
         reach: 2,
         near: 0.75,
         turn: 60.0,
+        turn_concave: 40.0,
         face: 25.0,
         sheets: 120.0,
         percentile: 90.0,
@@ -363,6 +382,39 @@ mod tests {
         let (band, phi, h) = band_of(41, cube, 4.0);
         let found = smoothed_creases(&band, &phi, h, &TEST).unwrap();
         assert!(found.nodes > 100 && found.convex > 0.8, "{found:?}"); // convex edges
+    }
+
+    #[test]
+    fn a_concave_crease_reads_from_the_lower_turn_and_a_thin_tube_does_not() {
+        // two balls fused at 90°: the concave crease turns by less than `turn` within the reach
+        let c = 0.5 * 45f64.to_radians().sin();
+        let fused = |x: [f64; 3]| {
+            let a = ((x[0] + c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
+            let b = ((x[0] - c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
+            a.min(b) - 0.5
+        };
+        let (band, phi, h) = band_of(41, fused, 4.0);
+        let found = smoothed_creases(&band, &phi, h, &TEST).unwrap();
+        assert!(
+            found.nodes > 100 && found.turn > 45.0 && found.turn < 55.0 && found.convex == 0.0,
+            "{found:?}"
+        ); // 192 nodes, 49.9°
+        let convex_only = SmoothedCreaseTest {
+            turn_concave: TEST.turn,
+            ..TEST
+        };
+        assert_eq!(
+            smoothed_creases(&band, &phi, h, &convex_only).unwrap(),
+            SmoothedCreases::default()
+        );
+        // a torus whose tube is 5 spacings in radius turns by up to ~58° within the reach, all
+        // of it convex: no crease
+        let torus = |x: [f64; 3]| ((x[0] * x[0] + x[1] * x[1]).sqrt() - 0.5).hypot(x[2]) - 0.25;
+        let (band, phi, h) = band_of(41, torus, 4.0);
+        assert_eq!(
+            smoothed_creases(&band, &phi, h, &TEST).unwrap(),
+            SmoothedCreases::default()
+        );
     }
 
     #[test]
