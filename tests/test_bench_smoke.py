@@ -448,3 +448,33 @@ def test_mask_creases_bench_says_more_than_the_fronts_gain_beyond_the_crease(cap
     for row in rows:
         worst, said = float(row[5]), float(row[7])
         assert 4.0 < worst < said and len(row) == 8  # (no "**": the figure covers the worst)
+
+
+def test_mask_creases_bench_says_concave_creases_at_90_degrees(capsys):
+    """The same at 90°: the concave crease reads below the convex edges' turn and is said from the
+    lower one (tubesweep._coarse_creases.TURN_CONCAVE); the figure covers the worst early arrival."""
+    import mask_creases
+
+    argv = ["--n", "41", "--angles", "90", "--kinds", "mask", "--orders", "auto", "1"]
+    assert mask_creases.main(argv) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()[1:] if line.strip()]
+    assert len(rows) == 2
+    for row in rows:
+        worst, said = float(row[5]), float(row[7])
+        assert 2.5 < worst < said and len(row) == 8  # 2.93 < 4.66 ("auto"), 4.28 < 6.98 (order=1)
+
+
+def test_limit_cycles_bench_ends_a_cylinder_s_cycle_by_its_fallback(capsys):
+    """benches/experiments/limit_cycles.py --cylinder 61: the closed cylinder with its caps on grid
+    planes cycles and the fallback to decreases only ends it within a few iterations, the values
+    then settled to under a tenth of a spacing; moved off the planes it converges."""
+    import limit_cycles
+
+    limit_cycles.cylinder(61, False)
+    out = capsys.readouterr().out.splitlines()
+    on, moved = out[0], out[2]
+    fallback = int(on.split("fallback at ")[1])
+    iterations = int(on.split(": ")[1].split(" iterations")[0])
+    assert iterations - fallback <= 5  # 33 iterations, the fallback at 31
+    assert 0 < float(out[1].split()[-1]) < 0.1 * 2 / 60  # 0.0024
+    assert moved.endswith("fallback at None") and out[3].split()[-1] == "None"

@@ -10,8 +10,19 @@ rule had its margin (``second_order/solver.rs``, ``UPWIND_MARGIN``) the mask cyc
 201 (period 1, changes of 5.5876847e-7; perturbed by 1e-12, of 6.0078673e-7) and the test ended
 those solves at 38 and 40 iterations; now they converge in 29 and 30.
 
+``--cylinder N``: a closed cylinder (radius 0.5, height 0.8, its exact signed distance) with its
+caps on grid planes (N odd, (N − 1)/2 a multiple of 5), the source at the centre of the top cap,
+and the same cylinder moved up by 0.3 spacings. Whether the sweeps cycle depends on how the flat
+caps and the rims lie against the grid, with no pattern found: at N = 61 the caps on the planes
+cycle (changes of 0.07Δx) and the moved cylinder converges; at N = 101 the reverse (changes of
+5e-6). The fallback to decreases only ends such a cycle, with a warning above 100 tolerances.
+Scratch runs: a half ball whose flat base lies within a tenth of a spacing above a grid plane
+cycles at N = 61–101 (changes of 0.3–0.4Δx: nodes below the base near a plane through the axis
+and the source swap values, period 2, which the inner update's margin does not end). Not resolved.
+
     .venv/bin/python benches/experiments/limit_cycles.py [N ...] [--star N] [--perturb E] [--changes]
     # default 191 201, star 801, no perturbation
+    .venv/bin/python benches/experiments/limit_cycles.py 0 --star 0 --cylinder 61 --changes
 """
 
 from __future__ import annotations
@@ -34,6 +45,26 @@ def _report(name: str, sol, changes, show: bool) -> None:
     )
     if show:
         print("  " + "; ".join(f"{it}: {ch!r}" for it, ch, _ in changes))
+
+
+def cylinder(n: int, show: bool) -> None:
+    grid = ts.Grid((-1.0,) * 3, (1.0,) * 3, (n,) * 3)
+    x = np.stack(grid.meshgrid(), axis=-1)
+    h = grid.spacing
+    for label, up in (("on grid planes", 0.0), ("0.3 spacings above them", 0.3 * h)):
+        d = np.stack([np.hypot(x[..., 0], x[..., 1]) - 0.5, np.abs(x[..., 2] - up) - 0.4], axis=-1)
+        phi = np.linalg.norm(np.maximum(d, 0), axis=-1) + np.minimum(d.max(axis=-1), 0)
+        changes: list = []
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sol = ts.solve(
+                ts.LevelSet(phi),
+                grid,
+                [(0.0, 0.0, 0.4 + up)],
+                progress=lambda it, ch, n_up: changes.append((it, ch, n_up)),
+            )
+        _report(f"closed cylinder N={n}, caps {label}", sol, changes, show)
+        print(f"  fallback_change {sol.stats.order2['fallback_change']}", flush=True)
 
 
 def main(ns, star_n: int, perturb: float, show: bool) -> None:
@@ -69,7 +100,11 @@ if __name__ == "__main__":
     args = sys.argv[1:]
     show = "--changes" in args
     args = [a for a in args if a != "--changes"]
-    star_n, perturb = 801, 0.0
+    star_n, perturb, cylinder_n = 801, 0.0, 0
+    if "--cylinder" in args:
+        i = args.index("--cylinder")
+        cylinder_n = int(args[i + 1])
+        args = args[:i] + args[i + 2 :]
     if "--perturb" in args:
         i = args.index("--perturb")
         perturb = float(args[i + 1])
@@ -78,4 +113,6 @@ if __name__ == "__main__":
         i = args.index("--star")
         star_n = int(args[i + 1])
         args = args[:i] + args[i + 2 :]
-    main([int(a) for a in args] or [191, 201], star_n, perturb, show)
+    main([n for n in (int(a) for a in args) if n] if args else [191, 201], star_n, perturb, show)
+    if cylinder_n:
+        cylinder(cylinder_n, show)
