@@ -22,9 +22,10 @@ tube does not resolve either, reads as a crease where it lies beside flatter fac
 ellipsoid's rim) and as none where it turns so all over (a small sphere). The smoothing rounds a crease, so the turn
 read is below the faces' angle: two fused balls whose faces meet at 90° read 45–55°, at 106°
 60–71°, at 122° 75–84° (:data:`READ_SHARE`; ``tests/test_coarse_creases.py``). Those 90° are as
-much as a smooth convex part turns (a torus's tube five voxels in radius: 52–58°), but every smooth
-part read above :data:`TURN_CONCAVE` was convex, so a concave crease (the smoothed φ's Laplacian
-not positive, as between fused parts) is one from that lower turn (below it, two balls fused at
+much as a smooth convex part turns (a torus's tube five voxels in radius: 52–58°), but the smooth
+parts read above :data:`TURN_CONCAVE` were convex or small (a smooth crotch of a tree of tubes), so
+a concave crease (the smoothed φ's Laplacian not positive, as between fused parts) of
+:data:`MIN_CONCAVE_NODES` nodes or more is one from that lower turn (below it, two balls fused at
 80° still go unsaid: ``benches/experiments/mask_creases.py``).
 
 Used for the paper's tube (``order=1``) and the first-order fallback of ``"auto"`` on a
@@ -62,17 +63,25 @@ PASSES = 2
 REACH = 2
 #: A turn of the smoothed normal (degrees) within :data:`REACH` beyond which a node is a crease node.
 TURN = 60.0
-#: The same beside a concave crease (the smoothed φ's Laplacian not positive at the node). Smooth
-#: parts read above it were all convex (voxel masks, ``smooth=1`` and φ re-distanced, N = 41–81: a
-#: torus's tube of five voxels 43–58°, an ellipsoid's rim of two to three 47–50°, a capsule of six
-#: 41–44°, a thin ellipsoid's rim; noisy spheres and tori; a 2D star), smooth concave necks none
-#: (two balls at 90° joined by a smooth minimum blending over 4–12 voxels read nothing above 38°;
-#: over 2 voxels, 40°), and two balls fused at 90° read 45–55°, at 80° 39–43°. For ``order=1`` and
+#: The same beside a concave crease (the smoothed φ's Laplacian not positive at the node), with
+#: :data:`MIN_CONCAVE_NODES` at least where none turns by more than :data:`TURN`. The smooth parts
+#: read above it that are large were convex (voxel masks, ``smooth=1`` and φ re-distanced,
+#: N = 41–81: a torus's tube of five voxels 43–58°, an ellipsoid's rim of two to three 47–50°, a
+#: capsule of six 41–44°, a thin ellipsoid's rim; noisy spheres and tori; a 2D star); smooth
+#: concave necks read nothing above 38° (two balls at 90° joined by a smooth minimum blending over
+#: 4–12 voxels; over 2 voxels, 40°) unless tighter than about two spacings (a peanut's neck, 43–47°
+#: at 60–120 nodes, 2.6–2.8Δx early beyond it with ``"auto"`` against 1.4Δx elsewhere: a crease at
+#: that grid); two balls fused at 90° read 45–55°, at 80° 39–43°. For ``order=1`` and
 #: the first-order fallback of ``"auto"``, where those balls came out 2.2–4.5Δx early; second
 #: order's report (:func:`widened_for_order2`) keeps :data:`TURN` for them (0.9–2.2Δx early there,
 #: and a gyroid-like φ's smooth concave necks at N = 41 read 48°, their values within 0.4Δx of a
 #: finer solve's).
 TURN_CONCAVE = 40.0
+#: A crease read from :data:`TURN_CONCAVE` alone holds this many nodes at least: the crotch of a
+#: tree of tubes blended by a smooth minimum reads 43–50° at 1–18 nodes, where the answer beyond it
+#: is no earlier than elsewhere (a helper's review: 3.7–4.7Δx said with ``"auto"``, N = 61–81), and
+#: noise of half a spacing on a torus made one node of 41°; the creases above hold 60–360.
+MIN_CONCAVE_NODES = 30
 #: A crease node lies beside a face, a node within :data:`REACH` whose normal turns by less than
 #: this (degrees): faces of balls ten voxels in radius keep nodes below it beside their crease; a
 #: capsule four voxels in radius, whose nodes turn by 29–61° with their place in the grid, had
@@ -105,7 +114,7 @@ def coarse_creases(
     away from a thin part, and their turn in degrees (the :data:`TURN_PERCENTILE` of them), and
     the share of them beside a convex edge (0, 0.0, 0.0 when there is none). Where some turn by
     more than :data:`TURN`, only those are counted (the flanks of a sharp concave crease read
-    lower). Beside a face: with a node
+    lower); where none does, at least :data:`MIN_CONCAVE_NODES`. Beside a face: with a node
     within that reach that turns by less than :data:`FACE` (a part whose whole surface turns more is
     small, its curvature unresolved rather than creased: a sphere shrinking to nothing, 1.4–4
     spacings in radius, reads 60–180° all over). Away from a thin part: no node within that reach
@@ -118,6 +127,8 @@ def coarse_creases(
     nodes, turn, convex = band.smoothed_creases(
         _values(phi), float(grid.spacing), int(passes), REACH, NEAR, TURN, turn_concave, FACE, SHEETS, TURN_PERCENTILE
     )
+    if turn <= TURN and nodes < MIN_CONCAVE_NODES:  # (read from the concave turn alone)
+        return 0, 0.0, 0.0
     return int(nodes), float(turn), float(convex)
 
 

@@ -127,7 +127,7 @@ class SolveStats:
         and where ``"auto"`` ran first order on a re-distanced φ (with a ``RuntimeWarning`` giving
         ``shortcut_per_inner_width·inner·Δx``): ``smoothed_turn_degrees`` is the turn of the
         smoothed normal within two spacings, and the faces' angle is read back from it (the
-        smoothing reads a crease as 0.5–0.75 of its angle); ``concave`` says whether most of
+        smoothing reads a crease as 0.5–0.75 of its angle); ``concave`` (with it) says whether most of
         those nodes lie beside a concave crease (between fused parts: read from a lower turn). None for other surfaces and with ``order=2``
         (see ``order2``).
     box_cut : dict or None
