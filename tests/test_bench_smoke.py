@@ -464,17 +464,15 @@ def test_mask_creases_bench_says_concave_creases_at_90_degrees(capsys):
         assert 2.5 < worst < said and len(row) == 8  # 2.93 < 4.66 ("auto"), 4.28 < 6.98 (order=1)
 
 
-def test_limit_cycles_bench_ends_a_cylinder_s_cycle_by_its_fallback(capsys):
+def test_limit_cycles_bench_s_cylinders_converge_without_the_fallback(capsys):
     """benches/experiments/limit_cycles.py --cylinder 61: the closed cylinder with its caps on grid
-    planes cycles and the fallback to decreases only ends it within a few iterations, the values
-    then settled to under a tenth of a spacing; moved off the planes it converges."""
+    planes cycled until its fallback to decreases only (33 iterations, the fallback at 31) before
+    the BDF2 ramp closed at a kink through the node; now it and the cylinder moved off the planes
+    converge at once."""
     import limit_cycles
 
     limit_cycles.cylinder(61, False)
     out = capsys.readouterr().out.splitlines()
-    on, moved = out[0], out[2]
-    fallback = int(on.split("fallback at ")[1])
-    iterations = int(on.split(": ")[1].split(" iterations")[0])
-    assert iterations - fallback <= 5  # 33 iterations, the fallback at 31
-    assert 0 < float(out[1].split()[-1]) < 0.1 * 2 / 60  # 0.0024
-    assert moved.endswith("fallback at None") and out[3].split()[-1] == "None"
+    for line, change in ((out[0], out[1]), (out[2], out[3])):
+        assert line.endswith("fallback at None") and change.split()[-1] == "None"
+        assert int(line.split(": ")[1].split(" iterations")[0]) <= 18  # 14 and 17

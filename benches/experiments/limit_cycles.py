@@ -12,13 +12,13 @@ those solves at 38 and 40 iterations; now they converge in 29 and 30.
 
 ``--cylinder N``: a closed cylinder (radius 0.5, height 0.8, its exact signed distance) with its
 caps on grid planes (N odd, (N − 1)/2 a multiple of 5), the source at the centre of the top cap,
-and the same cylinder moved up by 0.3 spacings. Whether the sweeps cycle depends on how the flat
-caps and the rims lie against the grid, with no pattern found: at N = 61 the caps on the planes
-cycle (changes of 0.07Δx) and the moved cylinder converges; at N = 101 the reverse (changes of
-5e-6). The fallback to decreases only ends such a cycle, with a warning above 100 tolerances.
-Scratch runs: a half ball whose flat base lies within a tenth of a spacing above a grid plane
-cycles at N = 61–101 (changes of 0.3–0.4Δx: nodes below the base near a plane through the axis
-and the source swap values, period 2, which the inner update's margin does not end). Not resolved.
+and the same cylinder moved up by 0.3 spacings. Before the BDF2 ramp closed at a kink through the
+node (``second_order/local.rs``, ``KINK2``), whether these cycled depended on how the flat caps
+and the rims lie against the grid: at N = 61 the caps on the planes cycled (33 iterations, the
+fallback at 31, changes of 0.07Δx) and the moved cylinder converged (13); at N = 101 the reverse
+(109 iterations, changes of 5e-6). A node beside the rim read the flat fan of nodes beyond it,
+which all take the rim's value, with the ramp t = (u₁ − u₂)/ε in the middle of its range, and
+swung with the nodes that read it back. Now all four converge in 14–18 iterations.
 
     .venv/bin/python benches/experiments/limit_cycles.py [N ...] [--star N] [--perturb E] [--changes]
     # default 191 201, star 801, no perturbation

@@ -23,7 +23,7 @@ impl Side {
 }
 
 /// The neighbours one side of a node reads, along one axis: w = u − u₀ at distance 1, 2 and 3
-/// (NaN when missing or not read), the node's own current w (`w0`, for the kink test), and the
+/// (NaN when missing or not read), the node's own current w (`w0`, for the kink tests), and the
 /// steps of u along the run towards the node, `d1` = u1 − u2 and `d2` = u2 − u3 (NaN when not
 /// read), which the ramps of [`reconstruct`] read.
 #[derive(Clone, Copy, Debug)]
@@ -43,13 +43,27 @@ pub struct Upwind {
 /// spheroid's figures move by under 1%.
 pub const KINK: f64 = 0.5;
 
+/// Above this |Δ²w| through the node (w₀ − 2w₁ + w₂) over ε the BDF2 ramp t starts to close; it is
+/// closed at twice this. A smooth run keeps it far below: the errors of `tubesweep reproduce
+/// second-order` move by under 1% with it (the six-fold star's fitted orders 2.19 / 2.15 at 20, as
+/// without; at 12 1.99 / 2.02, at 8 1.26 / 1.34), and the Möbius band's (`tests/test_closest_point.py`)
+/// by under 10% (at 16 its max at N = 161 rose from 0.0035 to 0.0048). Across a kink between the
+/// node and its run it is O(Δx/ε): a closed cylinder whose caps lie on grid planes (N = 61) and
+/// half balls whose base lies just above one (N = 61–101) had a node beside the rim read the flat
+/// fan of nodes beyond it (d₁ ≈ ε, t in the middle of its ramp, |Δ²w| ≈ 33ε) and swing with the
+/// nodes that read it back, a limit cycle of up to 0.4Δx that only the fallback to decreases only
+/// ended; with it they converge in 13–18 iterations instead of 26–109 (at 24 one took 48, at 32
+/// some still cycled) (`benches/experiments/limit_cycles.py --cylinder`).
+pub const KINK2: f64 = 20.0;
+
 /// The limited one-sided difference of one side (`minus`: the neighbours at −e_k), as a
 /// [`Side`]. Two ramps of width ε = σᵢΔx²/ℓ (`inv_eps` = 1/ε;
 /// [`super::solver::SecondOrderOptions::ramp_length`]: the same for a problem in any units or at
 /// any speed scale) raise the order step by step along an upwind run of neighbours:
 ///
-/// * t = clip(d₁/ε, 0, 1), from first order (t = 0, where the side is not upwind or the
-///   gradient along the axis vanishes) to BDF2 (t = 1), the scheme "S2" of the design note
+/// * t = clip(d₁/ε, 0, 1)·clip(2 − |w₀ − 2w₁ + w₂|/(K₂ ε), 0, 1) (K₂ = [`KINK2`]), from first
+///   order (t = 0, where the side is not upwind or the gradient along the axis vanishes, or a kink
+///   lies between the node and its run) to BDF2 (t = 1), the scheme "S2" of the design note
 ///   `second-order-tube.md` (Sect. 2, "Inner update");
 /// * t₃ = clip(d₂/ε, 0, 1)·clip(2 − |Δ²w₁ − Δ²w₂|/(K ε), 0, 1) (K = [`KINK`]), from BDF2 to
 ///   BDF3: it removes BDF2's O(Δx²) truncation error of w, which the characteristics accumulate
@@ -70,11 +84,17 @@ pub const KINK: f64 = 0.5;
 /// to w. `second`: false forces t = 0 (first order).
 #[inline(always)]
 pub fn reconstruct(n: &Upwind, du0: f64, spacing: f64, inv_eps: f64, minus: bool, second: bool) -> Side {
-    let t = if second && n.w2.is_finite() {
+    let mut t = if second && n.w2.is_finite() {
         (n.d1 * inv_eps).clamp(0.0, 1.0)
     } else {
         0.0
     };
+    if t > 0.0 && n.w0.is_finite() {
+        // a kink between the node and its run: BDF2 only where w's second difference through the
+        // node is O(ε) ([`KINK2`])
+        let jump = (n.w0 - 2.0 * n.w1 + n.w2).abs() * (inv_eps * (1.0 / KINK2));
+        t *= (2.0 - jump).clamp(0.0, 1.0);
+    }
     let half = 0.5 * t;
     // (t = 0 without w2, which may be NaN; t₃ = 0 without w3 (d2 NaN) or w0)
     let mut b = if t > 0.0 {
@@ -462,11 +482,24 @@ mod tests {
         assert!((s.c - 11.0 / 6.0).abs() < 1e-15);
         let bdf2 = reconstruct(&Upwind { d2: f64::NAN, ..side }, 0.0, h, e, true, true);
         assert!(((bdf2.c * f(0.3) - bdf2.b) / h - exact).abs() > 1e-3);
-        // a kink: the second differences of w disagree by more than 2ε: BDF2 again
+        // a kink: the second differences of w disagree by 5ε, beyond 2·KINK·ε: BDF2 again
         let kinked = Upwind {
-            w0: f(0.3) + 0.5,
+            w0: f(0.3) + 0.05,
             ..side
         };
         assert_eq!(reconstruct(&kinked, 0.0, h, e, true, true).c, 1.5);
+        // and where the second difference through the node passes 2·KINK2·ε (here 50ε): first
+        // order, as across the rim of a cylinder into the flat fan beyond it
+        let sharper = Upwind {
+            w0: f(0.3) + 0.5,
+            ..side
+        };
+        assert_eq!(reconstruct(&sharper, 0.0, h, e, true, true).c, 1.0);
+        let between = Upwind {
+            w0: f(0.3) + 30.0 / e,
+            ..side
+        };
+        let c = reconstruct(&between, 0.0, h, e, true, true).c;
+        assert!(c > 1.0 && c < 1.5, "{c}"); // the ramp half closed
     }
 }

@@ -65,12 +65,13 @@
 //! extension nodes right after each node they read, or ordering by u + c|φ|, did worse.
 //!
 //! Why the warm start reaches the cold solve's fixed point (to the path dependence that the
-//! second-order fixed point has anyway: the BDF3 kink test reads the node's own value, so two cold
-//! solves that differ only in their window differ by a few stopping tolerances, see
+//! second-order fixed point has anyway: the kink tests of the BDF2 and BDF3 ramps read the
+//! node's own value, so two cold solves that differ only in their window differ by a few stopping
+//! tolerances, see
 //! [`super::solver`]'s tests). The cold solve's phase 1 (when it runs)
 //! is monotone — a value is only replaced by a smaller one — so a start below the solution would stick
 //! there; phase 2 is plain assignment u_i ← S_i(u), S_i the limited update, which reads the node's
-//! own value only to choose which sides are upwind and in the kink test, neither of which moves
+//! own value only to choose which sides are upwind and in the kink tests, none of which moves
 //! the fixed point (see [`super::solver`]'s `Sweeper::inner`). The warm solve runs phase 2 alone.
 //! A value too *high* comes down as soon as an upwind neighbour is right (the Godunov update is
 //! the smallest root over the upwind sides); a value too *low* cannot hold itself up: the
