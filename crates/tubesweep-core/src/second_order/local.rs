@@ -34,6 +34,10 @@ pub struct Upwind {
     pub w0: f64,
     pub d1: f64,
     pub d2: f64,
+    /// The node's own w for the BDF2 ramp's kink test ([`KINK2`]), NaN where that test does not
+    /// apply: with several sources u₀ is the chord to the nearest one, whose bisector kinks w
+    /// where u is smooth.
+    pub w0_kink: f64,
 }
 
 /// Above this |Δ²w₁ − Δ²w₂|/ε (the second differences of w at the first and second neighbours,
@@ -54,6 +58,10 @@ pub const KINK: f64 = 0.5;
 /// nodes that read it back, a limit cycle of up to 0.4Δx that only the fallback to decreases only
 /// ended; with it they converge in 13–18 iterations instead of 26–109 (at 24 one took 48, at 32
 /// some still cycled) (`benches/experiments/limit_cycles.py --cylinder`).
+/// Not with several sources ([`Upwind::w0_kink`]): between the bisector of the chords to two
+/// sources (u₀'s kink) and the meeting line of their fronts w is kinked where u is smooth, and
+/// there the test took BDF2 away (a helper's review: the six-fold star with two sources at
+/// N = 401, max error 1.7e-3 → 3.1e-3).
 pub const KINK2: f64 = 20.0;
 
 /// The limited one-sided difference of one side (`minus`: the neighbours at −e_k), as a
@@ -89,10 +97,10 @@ pub fn reconstruct(n: &Upwind, du0: f64, spacing: f64, inv_eps: f64, minus: bool
     } else {
         0.0
     };
-    if t > 0.0 && n.w0.is_finite() {
+    if t > 0.0 && n.w0_kink.is_finite() {
         // a kink between the node and its run: BDF2 only where w's second difference through the
         // node is O(ε) ([`KINK2`])
-        let jump = (n.w0 - 2.0 * n.w1 + n.w2).abs() * (inv_eps * (1.0 / KINK2));
+        let jump = (n.w0_kink - 2.0 * n.w1 + n.w2).abs() * (inv_eps * (1.0 / KINK2));
         t *= (2.0 - jump).clamp(0.0, 1.0);
     }
     let half = 0.5 * t;
@@ -413,6 +421,7 @@ mod tests {
             w0: f64::NAN,
             d1: w1 - w2,
             d2: f64::NAN,
+            w0_kink: f64::NAN,
         }
     }
 
@@ -475,6 +484,7 @@ mod tests {
             w0: f(0.3),
             d1: f(0.2) - f(0.1),
             d2: f(0.1) - f(0.0),
+            w0_kink: f(0.3),
         };
         let exact = 1.0 + 0.75 * 0.09;
         let s = reconstruct(&side, 0.0, h, e, true, true);
@@ -485,6 +495,7 @@ mod tests {
         // a kink: the second differences of w disagree by 5ε, beyond 2·KINK·ε: BDF2 again
         let kinked = Upwind {
             w0: f(0.3) + 0.05,
+            w0_kink: f(0.3) + 0.05,
             ..side
         };
         assert_eq!(reconstruct(&kinked, 0.0, h, e, true, true).c, 1.5);
@@ -492,14 +503,22 @@ mod tests {
         // order, as across the rim of a cylinder into the flat fan beyond it
         let sharper = Upwind {
             w0: f(0.3) + 0.5,
+            w0_kink: f(0.3) + 0.5,
             ..side
         };
         assert_eq!(reconstruct(&sharper, 0.0, h, e, true, true).c, 1.0);
         let between = Upwind {
             w0: f(0.3) + 30.0 / e,
+            w0_kink: f(0.3) + 30.0 / e,
             ..side
         };
         let c = reconstruct(&between, 0.0, h, e, true, true).c;
         assert!(c > 1.0 && c < 1.5, "{c}"); // the ramp half closed
+                                            // with several sources (w0_kink NaN) the BDF2 ramp has no kink test: BDF2 as before
+        let several = Upwind {
+            w0_kink: f64::NAN,
+            ..sharper
+        };
+        assert_eq!(reconstruct(&several, 0.0, h, e, true, true).c, 1.5);
     }
 }

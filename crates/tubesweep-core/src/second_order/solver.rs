@@ -174,6 +174,8 @@ pub(super) struct Sweeper<'a, const D: usize> {
     extension_limit: f64,
     /// [`UNRESOLVED_EXTENSION_FROM`] in `abs_phi`'s units.
     unresolved_extension_from: f32,
+    /// More than one source: the BDF2 ramp's kink test is off ([`super::local::Upwind::w0_kink`]).
+    several_sources: bool,
 }
 
 /// An inner-tube node whose geometry is not resolved and which lies this many grid spacings or
@@ -310,6 +312,7 @@ impl<const D: usize> Sweeper<'_, D> {
                     w0: wi,
                     d1: f64::NAN,
                     d2: f64::NAN,
+                    w0_kink: if self.several_sources { f64::NAN } else { wi },
                 };
                 let upwind = second && u1 < skip_from;
                 if upwind {
@@ -593,6 +596,7 @@ pub(super) fn sweep_second_order_from<const D: usize>(
         extension_limit: options.extension_limit,
         unresolved_extension_from: (UNRESOLVED_EXTENSION_FROM * spacing / super::geometry::power_of_two_near(spacing))
             as f32,
+        several_sources: factoring.fixed_per_source.len() > 1,
     };
     let roles = sw.roles;
     // per row, the nodes before it that are not in the extension layer (the rows cover the band
