@@ -32,8 +32,10 @@ pub struct SmoothedCreaseTest {
     /// positive there).
     pub turn: f64,
     /// The same beside a concave crease (the Laplacian zero or negative). Lower than `turn`: a
-    /// smooth part that turns this much within the reach is convex (a thin tube, a capsule, an
-    /// ellipsoid's rim), and the smoothing reads a concave crease lower than a convex edge.
+    /// smooth part that turns this much within the reach is mostly convex (a thin tube, a
+    /// capsule, an ellipsoid's rim) or small (the smooth crotch of a tree of tubes, which the
+    /// caller leaves out by a least count of nodes: python/tubesweep/_coarse_creases.py,
+    /// `MIN_CONCAVE_NODES`), and the smoothing reads a concave crease lower than a convex edge.
     pub turn_concave: f64,
     /// A node turning by less than this is a face.
     pub face: f64,
