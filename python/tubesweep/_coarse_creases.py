@@ -75,11 +75,11 @@ TURN = 60.0
 #: the first-order fallback of ``"auto"``, where those balls came out 2.2–4.5Δx early; second
 #: order's report (:func:`widened_for_order2`) keeps :data:`TURN` for them (0.9–2.2Δx early there,
 #: and a gyroid-like φ's smooth concave necks at N = 41 read 48°, their values within 0.4Δx of a
-#: finer solve's).
+#: finer solve's: a scratch run).
 TURN_CONCAVE = 40.0
 #: A crease read from :data:`TURN_CONCAVE` alone holds this many nodes at least: the crotch of a
 #: tree of tubes blended by a smooth minimum reads 43–50° at 1–18 nodes, where the answer beyond it
-#: is no earlier than elsewhere (a helper's review: 3.7–4.7Δx said with ``"auto"``, N = 61–81), and
+#: is no earlier than elsewhere (a helper's review, scratch runs: 3.7–4.7Δx said with ``"auto"``, N = 61–81), and
 #: noise of half a spacing on a torus made one node of 41°; the creases above hold 60–360.
 MIN_CONCAVE_NODES = 30
 #: A crease node lies beside a face, a node within :data:`REACH` whose normal turns by less than
@@ -125,10 +125,18 @@ def coarse_creases(
     than its edges, and a few nodes read its 90° edges as 124–150° (a helper's review). In the core
     (``tubesweep_core::second_order::smoothed_creases``, O(band))."""
     nodes, turn, convex = band.smoothed_creases(
-        _values(phi), float(grid.spacing), int(passes), REACH, NEAR, TURN, turn_concave, FACE, SHEETS, TURN_PERCENTILE
+        _values(phi),
+        float(grid.spacing),
+        int(passes),
+        REACH,
+        NEAR,
+        TURN,
+        turn_concave,
+        MIN_CONCAVE_NODES,
+        FACE,
+        SHEETS,
+        TURN_PERCENTILE,
     )
-    if turn <= TURN and nodes < MIN_CONCAVE_NODES:  # (read from the concave turn alone)
-        return 0, 0.0, 0.0
     return int(nodes), float(turn), float(convex)
 
 

@@ -285,6 +285,7 @@ class Band:
         near: float,
         turn: float,
         turn_concave: float,
+        min_concave_nodes: int,
         face: float,
         sheets: float,
         percentile: float,

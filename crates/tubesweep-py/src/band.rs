@@ -330,8 +330,7 @@ impl PyBand {
                 with_band!(self, b, {
                     tubesweep_core::second_order::smoothed_creases::smoothed_normals(b, ph, spacing, passes, near).map(
                         |normals| {
-                            let rows: Vec<usize> = (0..normals.at.len()).collect();
-                            let turns = normals.turning(b, &rows, reach);
+                            let turns = normals.turning_all(b, reach);
                             (normals.at.iter().map(|&i| i as i64).collect::<Vec<i64>>(), turns)
                         },
                     )
@@ -356,6 +355,7 @@ impl PyBand {
         near: f64,
         turn: f64,
         turn_concave: f64,
+        min_concave_nodes: usize,
         face: f64,
         sheets: f64,
         percentile: f64,
@@ -367,6 +367,7 @@ impl PyBand {
             near,
             turn,
             turn_concave,
+            min_concave_nodes,
             face,
             sheets,
             percentile,

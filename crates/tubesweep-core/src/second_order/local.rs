@@ -60,8 +60,8 @@ pub const KINK: f64 = 0.5;
 /// some still cycled) (`benches/experiments/limit_cycles.py --cylinder`).
 /// Not with several sources ([`Upwind::w0_kink`]): between the bisector of the chords to two
 /// sources (u₀'s kink) and the meeting line of their fronts w is kinked where u is smooth, and
-/// there the test took BDF2 away (a helper's review: the six-fold star with two sources at
-/// N = 401, max error 1.7e-3 → 3.1e-3).
+/// there the test took BDF2 away (a helper's review, scratch runs: the six-fold star with two
+/// sources at N = 401, max error 1.7e-3 → 3.1e-3).
 pub const KINK2: f64 = 20.0;
 
 /// The limited one-sided difference of one side (`minus`: the neighbours at −e_k), as a

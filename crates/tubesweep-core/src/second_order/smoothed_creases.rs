@@ -37,6 +37,9 @@ pub struct SmoothedCreaseTest {
     /// caller leaves out by a least count of nodes: python/tubesweep/_coarse_creases.py,
     /// `MIN_CONCAVE_NODES`), and the smoothing reads a concave crease lower than a convex edge.
     pub turn_concave: f64,
+    /// A crease read from `turn_concave` alone (no node above `turn`) holds this many nodes at
+    /// least, else it is none: small smooth concave parts read that high too.
+    pub min_concave_nodes: usize,
     /// A node turning by less than this is a face.
     pub face: f64,
     /// A turn above this within `reach + 1` nodes is a reversal: two sides of a thin part.
@@ -222,6 +225,12 @@ impl<const D: usize> SmoothedNormals<D> {
             .collect()
     }
 
+    /// [`Self::turning`] at every node that has a normal, in the order of [`Self::at`].
+    pub fn turning_all(&self, band: &NarrowBand<D>, reach: usize) -> Vec<f64> {
+        let all: Vec<usize> = (0..self.at.len()).collect();
+        self.turning(band, &all, reach)
+    }
+
     /// Whether any node up to `reach` nodes from each of `rows` has `flag` (per band position).
     fn near_any(&self, band: &NarrowBand<D>, rows: &[usize], reach: usize, flag: &[bool]) -> Vec<bool> {
         let steps = walk(reach, D);
@@ -264,11 +273,8 @@ pub fn smoothed_creases<const D: usize>(
     test: &SmoothedCreaseTest,
 ) -> Result<SmoothedCreases> {
     let normals = smoothed_normals(band, phi, spacing, test.passes, test.near)?;
-    let all: Vec<usize> = (0..normals.at.len()).collect();
-    let turning = normals.turning(band, &all, test.reach);
-    let rows: Vec<usize> = all
-        .iter()
-        .copied()
+    let turning = normals.turning_all(band, test.reach);
+    let rows: Vec<usize> = (0..normals.at.len())
         .filter(|&r| {
             let convex = normals.laplacian[r] > 0.0;
             turning[r] > if convex { test.turn } else { test.turn_concave }
@@ -298,8 +304,12 @@ pub fn smoothed_creases<const D: usize>(
     }
     // where some turn by more than `turn`, those are the crease's report (its count and its turn
     // as before `turn_concave` came in: the flanks of a sharp concave crease read lower turns and
-    // would pull its percentile down); else the concave ones that read between the two
+    // would pull its percentile down); else the concave ones that read between the two, if there
+    // are `min_concave_nodes` of them
     let above: Vec<usize> = kept_rows.iter().copied().filter(|&r| turning[r] > test.turn).collect();
+    if above.is_empty() && kept_rows.len() < test.min_concave_nodes {
+        return Ok(SmoothedCreases::default());
+    }
     let kept_rows = if above.is_empty() { kept_rows } else { above };
     let convex = kept_rows.iter().filter(|&&r| normals.laplacian[r] > 0.0).count() as f64 / kept_rows.len() as f64;
     let mut kept: Vec<f64> = kept_rows.iter().map(|&r| turning[r]).collect();
@@ -344,6 +354,7 @@ mod tests {
         near: 0.75,
         turn: 60.0,
         turn_concave: 40.0,
+        min_concave_nodes: 30,
         face: 25.0,
         sheets: 120.0,
         percentile: 90.0,
@@ -356,6 +367,16 @@ mod tests {
         assert!(steps.iter().enumerate().all(|(i, &(back, _, _))| back <= i));
     }
 
+    /// Two balls of radius 0.5 joined by `min`, their faces meeting at `faces_degrees`.
+    fn fused_balls(faces_degrees: f64) -> impl Fn([f64; 3]) -> f64 {
+        let c = 0.5 * (0.5 * faces_degrees).to_radians().sin();
+        move |x: [f64; 3]| {
+            let a = ((x[0] + c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
+            let b = ((x[0] - c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
+            a.min(b) - 0.5
+        }
+    }
+
     #[test]
     fn a_sphere_has_no_crease_and_two_fused_balls_have_one() {
         let (band, phi, h) = band_of(41, |x| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt() - 0.5, 4.0);
@@ -364,16 +385,9 @@ mod tests {
             SmoothedCreases::default()
         );
         let normals = smoothed_normals(&band, &phi, h, 2, 0.75).unwrap();
-        let all: Vec<usize> = (0..normals.at.len()).collect();
-        let most = normals.turning(&band, &all, 2).into_iter().fold(0.0, f64::max);
+        let most = normals.turning_all(&band, 2).into_iter().fold(0.0, f64::max);
         assert!(most > 10.0 && most < 25.0, "{most}"); // a ball ten spacings in radius
-        let c = 0.5 * 61f64.to_radians().sin(); // faces at 122°
-        let fused = |x: [f64; 3]| {
-            let a = ((x[0] + c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
-            let b = ((x[0] - c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
-            a.min(b) - 0.5
-        };
-        let (band, phi, h) = band_of(41, fused, 4.0);
+        let (band, phi, h) = band_of(41, fused_balls(122.0), 4.0);
         let found = smoothed_creases(&band, &phi, h, &TEST).unwrap();
         assert!(
             found.nodes > 50 && found.turn > 60.0 && found.turn < 0.75 * 122.0,
@@ -389,13 +403,7 @@ mod tests {
     #[test]
     fn a_concave_crease_reads_from_the_lower_turn_and_a_thin_tube_does_not() {
         // two balls fused at 90°: the concave crease turns by less than `turn` within the reach
-        let c = 0.5 * 45f64.to_radians().sin();
-        let fused = |x: [f64; 3]| {
-            let a = ((x[0] + c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
-            let b = ((x[0] - c).powi(2) + x[1] * x[1] + x[2] * x[2]).sqrt();
-            a.min(b) - 0.5
-        };
-        let (band, phi, h) = band_of(41, fused, 4.0);
+        let (band, phi, h) = band_of(41, fused_balls(90.0), 4.0);
         let found = smoothed_creases(&band, &phi, h, &TEST).unwrap();
         assert!(
             found.nodes > 100 && found.turn > 45.0 && found.turn < 55.0 && found.convex == 0.0,
