@@ -13,7 +13,9 @@
 //!    ([`NodeSet`]) are ordered by their number of face steps from a crossed cell's corner (as
 //!    many as a node within the half-width can be away). A corner takes the nearest crossing on
 //!    its own edges (failing those, the nearest edge crossing of its crossed cells) as its
-//!    starting point, a node of a later layer the nearest closest point of the nodes around it
+//!    starting point, or where `|φ|/|∇φ|` says the zero level set is far nearer (a rim that
+//!    grazes the node, its edges crossed only at zero nodes a spacing away: [`grazing_starts`])
+//!    the nearest zero-set point between it and its cells' corners of the other sign, a node of a later layer the nearest closest point of the nodes around it
 //!    (face, edge and corner neighbours) of the layers before (and the normal there): next to its
 //!    own closest point, so the refinement is short, and a node whose start lies more than a
 //!    spacing beyond the half-width, or which lies high above the tangent plane there
@@ -157,6 +159,19 @@ const BEYOND_MARGIN: f64 = 0.1;
 /// The most Newton steps that take a point back onto the zero level set after a tangential move.
 const NEWTON_STEPS: usize = 4;
 
+/// A crossed cell's corner looks for a start nearer than the crossings on its edges
+/// ([`grazing_starts`]) where `|φ|/|∇φ|` there is this many times nearer than all of them: on a
+/// smooth φ an edge crossing is within about √D times the distance along the normal.
+const GRAZING_RATIO: f64 = 2.0;
+
+/// A face neighbour whose φ is within this fraction of the node's lies on the zero level set
+/// ([`grazing_starts`]).
+const ZERO_NEIGHBOUR: f64 = 1e-6;
+
+/// Halvings of a segment in [`grazing_starts`]: to 2⁻⁵⁰ of its length, far within
+/// [`ON_ZERO_SET`].
+const BISECTIONS: usize = 50;
+
 /// Newton steps from `z` onto the zero level set of the multilinear interpolant, with its exact
 /// gradient in the cell that holds the point (quadratic convergence within a cell; the points kept
 /// in the grid's box), until `|φ| ≤ within · |∇φ|` (`z` within about `within` of the zero level
@@ -206,6 +221,91 @@ fn normal_gradient<const D: usize>(field: &SampledField<'_, D>, y: &[f64; D], ep
     } else {
         field.gradient(y, eps)
     }
+}
+
+/// Points of the zero level set near the node `x` (a D-index `node`, a crossed cell's corner)
+/// next to a node where φ vanishes and where `|φ|/|∇φ|` there (central differences with step `eps`) is [`GRAZING_RATIO`] times nearer
+/// than the nearest crossing on its edges (`edge`, squared), none elsewhere: the zero level set on
+/// the segments from the node to the corners of the other sign of the cells around it, and along
+/// its normal as far as that crossing, by bisection of the interpolant (continuous along a
+/// segment, which changes sign between its ends).
+fn grazing_starts<const D: usize>(
+    field: &SampledField<'_, D>,
+    node: [usize; D],
+    x: &[f64; D],
+    edge: f64,
+    eps: f64,
+) -> Vec<[f64; D]> {
+    let here = field.sample(node);
+    let shape = field.shape();
+    // a face neighbour on the zero level set (a rim on the grid's nodes; φ there a millionth of
+    // the node's or less: rounding left 1e-16 on the cylinder's caps): a φ with noise has none,
+    // and there the nodes keep their edges' crossings (with noise of 0.3Δx some nodes near small
+    // folds of the zero set found them nearer, and facing sheets were then read there)
+    let on_zero = |v: f64| v.abs() <= ZERO_NEIGHBOUR * here.abs();
+    let zero_neighbour = (0..D).any(|a| {
+        let mut near = node;
+        let below = node[a] > 0 && {
+            near[a] = node[a] - 1;
+            on_zero(field.sample(near))
+        };
+        near[a] = node[a] + 1;
+        below || (near[a] < shape[a] && on_zero(field.sample(near)))
+    });
+    if here == 0.0 || !zero_neighbour {
+        return Vec::new();
+    }
+    let g = normal_gradient(field, x, eps);
+    let g2 = sum_of_squares(&g);
+    if !(g2 > 1e-300) || here * here / g2 * GRAZING_RATIO * GRAZING_RATIO >= edge {
+        return Vec::new();
+    }
+    let other_sign = |v: f64| if here > 0.0 { v < 0.0 } else { v > 0.0 };
+    let bisect = |mut a: [f64; D], mut b: [f64; D]| -> [f64; D] {
+        for _ in 0..BISECTIONS {
+            let mid: [f64; D] = std::array::from_fn(|k| 0.5 * (a[k] + b[k]));
+            if other_sign(field.value(&mid)) {
+                b = mid;
+            } else {
+                a = mid;
+            }
+        }
+        std::array::from_fn(|k| 0.5 * (a[k] + b[k]))
+    };
+    let mut found = Vec::new();
+    // the corners of the cells around the node: offsets −1, 0, +1 along each axis
+    for around in 0..3usize.pow(D as u32) {
+        let mut corner = node;
+        let mut inside = true;
+        let mut code = around;
+        for a in 0..D {
+            match code % 3 {
+                0 if node[a] > 0 => corner[a] -= 1,
+                2 if node[a] + 1 < shape[a] => corner[a] += 1,
+                1 => {}
+                _ => inside = false,
+            }
+            code /= 3;
+        }
+        if inside && corner != node && other_sign(field.sample(corner)) {
+            let end: [f64; D] = std::array::from_fn(|a| field.coordinate(a, corner[a]));
+            found.push(bisect(*x, end));
+        }
+    }
+    // along the normal, as far as the nearest edge crossing
+    let reach = edge.sqrt() / g2.sqrt() * here.signum();
+    let mut end: [f64; D] = std::array::from_fn(|k| x[k] - reach * g[k]);
+    field.clamp_to_box(&mut end);
+    if other_sign(field.value(&end)) {
+        found.push(bisect(*x, end));
+    }
+    found
+}
+
+/// `|a − b|²`.
+#[inline]
+fn squared_distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    (0..D).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum()
 }
 
 /// `g / |g|`, or None where `g` vanishes.
@@ -553,7 +653,22 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     }
                 };
                 if depth == 0 {
-                    crossings_at_corner(field, idx, |q| consider(q, usize::MAX));
+                    let mut edge = f64::INFINITY;
+                    crossings_at_corner(field, idx, |q| {
+                        edge = edge.min(squared_distance(&x, &q));
+                        consider(q, usize::MAX);
+                    });
+                    // a node far nearer the surface than any crossing on its edges, by φ/|∇φ|:
+                    // next to a rim that the grid's nodes lie on, where φ vanishes at nodes and the
+                    // surface grazes the node's edges (a closed cylinder's exact distance with its
+                    // caps on grid planes: the node beside the rim, 0.02Δx off the surface, started
+                    // from the zero node a spacing away and stalled there, 0.7–1Δx too far). The
+                    // zero level set between the node and the corners of the other sign of its
+                    // cells, and along the normal, by bisection (on a smooth φ an edge crossing is
+                    // within about √D·|φ|/|∇φ|, and none is looked for)
+                    for q in grazing_starts(field, idx, &x, edge, options.eps) {
+                        consider(q, usize::MAX);
+                    }
                 } else {
                     // only the points are read here; the normal and curvature of the nearest below
                     set.neighbours_around(split(p), |q| {

@@ -217,3 +217,31 @@ fn plateaus_and_a_flat_phi_far_from_the_surface_are_no_obstacle() {
     bad.half_width = f64::NAN;
     assert!(redistanced_band_of_samples(&field, bad).is_err());
 }
+
+#[test]
+fn a_node_grazed_by_a_rim_on_the_grid_starts_from_the_zero_set_beside_it() {
+    // a closed cylinder's exact distance (radius 0.4, caps at z = ±0.32 on grid planes, N = 51):
+    // φ vanishes at the cap's nodes, and a node beside the rim on the cap's plane, a few hundredths
+    // of a spacing outside it, has no crossing on its edges nearer than the zero node a spacing
+    // away; started from there its iterations stalled at up to 0.51Δx (0.98Δx at N = 101). The
+    // zero set of the interpolant lies 0.24Δx from it there (its rim is cut off within the cell)
+    let (r, half) = (0.4, 0.32);
+    let exact = |x: &[f64; 3]| {
+        let (dr, dz) = ((x[0] * x[0] + x[1] * x[1]).sqrt() - r, x[2].abs() - half);
+        dr.max(dz).min(0.0) + (dr.max(0.0).powi(2) + dz.max(0.0).powi(2)).sqrt()
+    };
+    let n = 51;
+    let (samples, h) = sampled::<3>(n, exact);
+    let field = SampledField::new(&samples, [n; 3], [-1.0; 3], h).unwrap();
+    let band = redistanced_band_of_samples(&field, options(h)).unwrap();
+    let (mut grazed, mut worst) = (0, 0.0f64);
+    for (&l, &s) in band.linear.iter().zip(&band.signed) {
+        let e = exact(&node::<3>(n, h, l as usize));
+        if e.abs() < 0.1 * h {
+            grazed += 1;
+            worst = worst.max((s - e).abs());
+        }
+    }
+    assert!(grazed > 500, "{grazed}");
+    assert!(worst < 0.3 * h, "{}", worst / h);
+}
