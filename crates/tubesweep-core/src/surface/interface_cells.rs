@@ -221,8 +221,16 @@ pub(crate) fn crossings_at_corner<const D: usize>(
                 other[a] -= 1;
             }
             let sign = if up { 1.0 } else { -1.0 };
-            if let Some(q) = crossing_on_edge(field, node, here, field.sample(other), a, sign) {
+            let there = field.sample(other);
+            if let Some(q) = crossing_on_edge(field, node, here, there, a, sign) {
                 visit(q);
+                own = true;
+            } else if there.abs() <= ON_SURFACE * here.abs() && beside_other_sign(field, other, there) {
+                // a neighbour on the zero level set whose rounding left it on the node's side (a
+                // box's exact distance, its edges on nodes, φ = +5.6e-17 there: no crossing on
+                // the node's edges, and a node a spacing beyond an edge started from a face's
+                // crossing √2 spacings away and stayed there, 0.41Δx too far at N = 61)
+                visit(std::array::from_fn(|b| field.coordinate(b, other[b])));
                 own = true;
             }
         }
@@ -247,6 +255,27 @@ pub(crate) fn crossings_at_corner<const D: usize>(
             edge_crossings(field, lowest, &mut visit);
         }
     }
+}
+
+/// A sample whose |φ| is within this fraction of a neighbour's lies on the zero level set, for the
+/// neighbour's crossings ([`crossings_at_corner`]): rounding of a φ that vanishes at the node.
+pub(crate) const ON_SURFACE: f64 = 1e-6;
+
+/// Whether the node `node` (φ = `value` there) has a face neighbour of the other sign: the zero
+/// level set passes between them, and through the node where `value` is rounding's.
+#[inline]
+fn beside_other_sign<const D: usize>(field: &SampledField<'_, D>, node: [usize; D], value: f64) -> bool {
+    let shape = field.shape();
+    (0..D).any(|a| {
+        [node[a].checked_sub(1), Some(node[a] + 1).filter(|&i| i < shape[a])]
+            .into_iter()
+            .flatten()
+            .any(|i| {
+                let mut near = node;
+                near[a] = i;
+                (field.sample(near) > 0.0) != (value > 0.0)
+            })
+    })
 }
 
 /// Where the interpolant's zero level set crosses the grid edge from `node` (φ = `value` there)

@@ -245,3 +245,33 @@ fn a_node_grazed_by_a_rim_on_the_grid_starts_from_the_zero_set_beside_it() {
     assert!(grazed > 500, "{grazed}");
     assert!(worst < 0.3 * h, "{}", worst / h);
 }
+
+#[test]
+fn a_neighbour_on_the_zero_set_by_rounding_is_a_crossing_of_the_node_s_edge() {
+    // a box's exact distance (half-sides 0.5, 0.4, 0.3, its faces and edges on the nodes at
+    // N = 61): rounding left φ = +5.6e-17 on some edge nodes, so a node a spacing beyond such an
+    // edge saw no crossing on its own edges and started from a face's, √2 spacings away, where it
+    // stayed: 112 nodes 0.41Δx too far. Now only a node diagonal to a corner, 0.32Δx
+    let b = [0.5, 0.4, 0.3];
+    let exact = |x: &[f64; 3]| {
+        let q: [f64; 3] = std::array::from_fn(|k| x[k].abs() - b[k]);
+        let outside = q.iter().map(|v| v.max(0.0).powi(2)).sum::<f64>().sqrt();
+        outside + q[0].max(q[1]).max(q[2]).min(0.0)
+    };
+    let n = 61;
+    let (samples, h) = sampled::<3>(n, exact);
+    let field = SampledField::new(&samples, [n; 3], [-1.0; 3], h).unwrap();
+    let band = redistanced_band_of_samples(&field, options(h)).unwrap();
+    let errors: Vec<f64> = band
+        .linear
+        .iter()
+        .zip(&band.signed)
+        .map(|(&l, &s)| (s - exact(&node::<3>(n, h, l as usize))).abs() / h)
+        .collect();
+    let off = errors.iter().filter(|&&e| e > 0.1).count();
+    let worst = errors.iter().cloned().fold(0.0, f64::max);
+    assert!(
+        off <= 1 && worst < 0.35,
+        "{off} nodes off by more than 0.1Δx, worst {worst}"
+    );
+}
