@@ -196,12 +196,13 @@ pub fn crossed_cells(shape: &[usize], samples: &[f64]) -> Result<Vec<u64>> {
 /// The points where the zero level set of `field`'s interpolant crosses the edges at the node
 /// `node` (a D-index), a corner of a crossed cell, passed to `visit`: those on the node's own
 /// edges (one step along an axis), or, where none of them crosses, those on the edges of the
-/// crossed cells the node is a corner of ([`edge_crossings`]).
+/// crossed cells the node is a corner of ([`edge_crossings`]). A face neighbour on the zero level
+/// set by rounding is passed too, marked `true` (see below); the others `false`.
 #[inline]
 pub(crate) fn crossings_at_corner<const D: usize>(
     field: &SampledField<'_, D>,
     node: [usize; D],
-    mut visit: impl FnMut([f64; D]),
+    mut visit: impl FnMut([f64; D], bool),
 ) {
     let shape = field.shape();
     let here = field.sample(node);
@@ -223,15 +224,14 @@ pub(crate) fn crossings_at_corner<const D: usize>(
             let sign = if up { 1.0 } else { -1.0 };
             let there = field.sample(other);
             if let Some(q) = crossing_on_edge(field, node, here, there, a, sign) {
-                visit(q);
+                visit(q, false);
                 own = true;
             } else if there.abs() <= ON_SURFACE * here.abs() && beside_other_sign(field, other, there) {
                 // a neighbour on the zero level set whose rounding left it on the node's side (a
                 // box's exact distance, its edges on nodes, φ = +5.6e-17 there: no crossing on
                 // the node's edges, and a node a spacing beyond an edge started from a face's
                 // crossing √2 spacings away and stayed there, 0.41Δx too far at N = 61)
-                visit(std::array::from_fn(|b| field.coordinate(b, other[b])));
-                own = true;
+                visit(std::array::from_fn(|b| field.coordinate(b, other[b])), true);
             }
         }
     }
@@ -252,7 +252,7 @@ pub(crate) fn crossings_at_corner<const D: usize>(
             }
         }
         if inside {
-            edge_crossings(field, lowest, &mut visit);
+            edge_crossings(field, lowest, |q| visit(q, false));
         }
     }
 }

@@ -652,10 +652,22 @@ pub fn redistanced_band_of_samples<const D: usize>(
                         start = Some((q, from));
                     }
                 };
+                // a crossed cell's corner: also the nearest start of the plain rule (its edges'
+                // crossings) where one that the rules for nodes on the zero level set add (below)
+                // is nearer, refined too, the nearer closest point kept: where those starts lead
+                // to a local closest point farther than the plain one (a flat cap a spacing above
+                // a node 0.79 spacings inside a cylinder's side) the node is as before
+                let mut plain: Option<[f64; D]> = None;
                 if depth == 0 {
-                    let mut edge = f64::INFINITY;
-                    crossings_at_corner(field, idx, |q| {
-                        edge = edge.min(squared_distance(&x, &q));
+                    let (mut edge, mut added) = (f64::INFINITY, f64::INFINITY);
+                    crossings_at_corner(field, idx, |q, on_zero| {
+                        let s = squared_distance(&x, &q);
+                        if on_zero {
+                            added = added.min(s);
+                        } else if s < edge {
+                            edge = s;
+                            plain = Some(q);
+                        }
                         consider(q, usize::MAX);
                     });
                     // a node far nearer the surface than any crossing on its edges, by φ/|∇φ|:
@@ -667,7 +679,11 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     // cells, and along the normal, by bisection (on a smooth φ an edge crossing is
                     // within about √D·|φ|/|∇φ|, and none is looked for)
                     for q in grazing_starts(field, idx, &x, edge, options.eps) {
+                        added = added.min(squared_distance(&x, &q));
                         consider(q, usize::MAX);
+                    }
+                    if added >= edge {
+                        plain = None; // the plain start is the nearest: refined once
                     }
                 } else {
                     // only the points are read here; the normal and curvature of the nearest below
@@ -696,7 +712,14 @@ pub fn redistanced_band_of_samples<const D: usize>(
                         return None;
                     }
                 }
-                Some((p as u32, refine(field, &x, start, normal, &options, keep)))
+                let mut foot = refine(field, &x, start, normal, &options, keep);
+                if let Some(q) = plain {
+                    let other = refine(field, &x, q, None, &options, keep);
+                    if squared_distance(&x, &other.y) < squared_distance(&x, &foot.y) {
+                        foot = other;
+                    }
+                }
+                Some((p as u32, foot))
             })
             .collect();
         // the layer's closest points kept, and the next layer: the face neighbours not yet reached
