@@ -68,7 +68,7 @@ use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
-use super::interface_cells::{crossed_cells, crossings_at_corner, Lattice, NodeSet};
+use super::interface_cells::{at_rounding, crossed_cells, crossings_at_corner, Lattice, NodeSet};
 use super::redistance::{sum_of_squares, SampledField};
 
 /// The re-distanced band.
@@ -678,6 +678,13 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     // zero level set between the node and the corners of the other sign of its
                     // cells, and along the normal, by bisection (on a smooth φ an edge crossing is
                     // within about √D·|φ|/|∇φ|, and none is looked for)
+                    // a node on the zero level set itself, its φ rounding's (a CSG union's corner
+                    // on a node, φ = +1e-17, its face neighbours outside or on the surface: it
+                    // started from its cells' crossings 1.41Δx away, a helper's review)
+                    if at_rounding(field, idx, field.sample(idx)) {
+                        added = 0.0;
+                        consider(x, usize::MAX);
+                    }
                     for q in grazing_starts(field, idx, &x, edge, options.eps) {
                         added = added.min(squared_distance(&x, &q));
                         consider(q, usize::MAX);
