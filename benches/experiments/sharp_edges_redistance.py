@@ -4,8 +4,9 @@ faces and rims lie on grid nodes (docs/surfaces.md, "How good it is"): a box (ha
 distances and re-distanced (``ts.LevelSet(d, redistance=True).band(grid, 4Δx)``). Printed per
 shape and N: the largest error of the band against the exact distance and the number of nodes off
 by more than 0.1Δx, in all and at the nodes within 0.1Δx of the surface (those beside a rim, which
-the edges of their cells cross only at nodes where φ vanishes). The interpolant's zero set cuts an
-edge off within its cells, so errors of about 0.3–0.4Δx remain next to the edges.
+the edges of their cells cross only at nodes where φ vanishes). The interpolant's zero set cuts a
+curved rim off within its cells, so errors of about 0.3–0.4Δx remain next to the cylinder's rims;
+the box's straight edges, along grid lines, it keeps.
 
     .venv/bin/python benches/experiments/sharp_edges_redistance.py [N ...]   # default 61 101
 """

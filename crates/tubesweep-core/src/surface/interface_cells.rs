@@ -255,6 +255,16 @@ pub(crate) fn crossings_at_corner<const D: usize>(
         }
         if inside {
             edge_crossings(field, lowest, |q| visit(q, false));
+            // and the cell's corners on the zero level set by rounding (a box's corner node,
+            // diagonal to a node a spacing beyond its two faces, whose own edges cross nowhere:
+            // started √3 spacings away, 0.32Δx too far)
+            for c in 0..1usize << D {
+                let corner: [usize; D] = std::array::from_fn(|b| lowest[b] + (c >> (D - 1 - b) & 1));
+                let v = field.sample(corner);
+                if corner != node && v.abs() <= ON_SURFACE * here.abs() && at_rounding(field, corner, v) {
+                    visit(std::array::from_fn(|b| field.coordinate(b, corner[b])), true);
+                }
+            }
         }
     }
 }
