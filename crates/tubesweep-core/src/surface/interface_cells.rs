@@ -197,13 +197,17 @@ pub fn crossed_cells(shape: &[usize], samples: &[f64]) -> Result<Vec<u64>> {
 /// `node` (a D-index), a corner of a crossed cell, passed to `visit`: those on the node's own
 /// edges (one step along an axis), or, where none of them crosses, those on the edges of the
 /// crossed cells the node is a corner of ([`edge_crossings`]). A face neighbour on the zero level
-/// set by rounding is passed too, marked `true` (see below); the others `false`.
+/// set by rounding is passed too, marked `true` (see below), and so are the crossed cells' corners
+/// on it where the node's own edges cross nowhere; the others `false`. Returned: whether a face
+/// neighbour's |φ| is within [`ON_SURFACE`] of the node's, and whether the node's is of a
+/// neighbour's (read here with the samples, for the caller's tests of nodes on the zero set).
 #[inline]
 pub(crate) fn crossings_at_corner<const D: usize>(
     field: &SampledField<'_, D>,
     node: [usize; D],
     mut visit: impl FnMut([f64; D], bool),
-) {
+) -> NearZero {
+    let mut near_zero = NearZero::default();
     let shape = field.shape();
     let here = field.sample(node);
     let mut own = false;
@@ -223,6 +227,8 @@ pub(crate) fn crossings_at_corner<const D: usize>(
             }
             let sign = if up { 1.0 } else { -1.0 };
             let there = field.sample(other);
+            near_zero.neighbour |= there.abs() <= ON_SURFACE * here.abs();
+            near_zero.node |= here.abs() <= ON_SURFACE * there.abs();
             if let Some(q) = crossing_on_edge(field, node, here, there, a, sign) {
                 visit(q, false);
                 own = true;
@@ -238,7 +244,7 @@ pub(crate) fn crossings_at_corner<const D: usize>(
         }
     }
     if own {
-        return;
+        return near_zero;
     }
     for around in 0..1usize << D {
         let mut lowest = node;
@@ -254,19 +260,19 @@ pub(crate) fn crossings_at_corner<const D: usize>(
             }
         }
         if inside {
-            edge_crossings(field, lowest, |q| visit(q, false));
-            // and the cell's corners on the zero level set by rounding (a box's corner node,
-            // diagonal to a node a spacing beyond its two faces, whose own edges cross nowhere:
-            // started √3 spacings away, 0.32Δx too far)
-            for c in 0..1usize << D {
-                let corner: [usize; D] = std::array::from_fn(|b| lowest[b] + (c >> (D - 1 - b) & 1));
-                let v = field.sample(corner);
-                if corner != node && v.abs() <= ON_SURFACE * here.abs() && at_rounding(field, corner, v) {
-                    visit(std::array::from_fn(|b| field.coordinate(b, corner[b])), true);
-                }
-            }
+            edge_crossings(field, lowest, here.abs(), &mut visit);
         }
     }
+    near_zero
+}
+
+/// What [`crossings_at_corner`] read of the samples next to a node.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct NearZero {
+    /// A face neighbour's |φ| is within [`ON_SURFACE`] of the node's.
+    pub neighbour: bool,
+    /// The node's |φ| is within [`ON_SURFACE`] of a face neighbour's.
+    pub node: bool,
 }
 
 /// A sample whose |φ| is within this fraction of a neighbour's lies on the zero level set, for the
@@ -326,9 +332,18 @@ fn crossing_on_edge<const D: usize>(
 }
 
 /// The points where the zero level set of `field`'s interpolant crosses the edges of the cell
-/// whose lowest corner is the node `lowest` (a D-index), passed to `visit`.
+/// whose lowest corner is the node `lowest` (a D-index), passed to `visit` marked `false`; and
+/// the cell's corners on the zero level set by rounding (|φ| within [`ON_SURFACE`] of `scale`, the
+/// node's, and [`at_rounding`]), marked `true`: a box's corner node, diagonal to a node a spacing
+/// beyond two of its faces, whose own edges cross nowhere (it started √3 spacings away, 0.32Δx too
+/// far).
 #[inline]
-fn edge_crossings<const D: usize>(field: &SampledField<'_, D>, lowest: [usize; D], mut visit: impl FnMut([f64; D])) {
+fn edge_crossings<const D: usize>(
+    field: &SampledField<'_, D>,
+    lowest: [usize; D],
+    scale: f64,
+    mut visit: impl FnMut([f64; D], bool),
+) {
     let mut values = [0.0f64; 8];
     for (c, v) in values.iter_mut().enumerate().take(1 << D) {
         let mut node = lowest;
@@ -341,15 +356,18 @@ fn edge_crossings<const D: usize>(field: &SampledField<'_, D>, lowest: [usize; D
         return;
     }
     for c in 0..1usize << D {
+        let corner: [usize; D] = std::array::from_fn(|b| lowest[b] + (c >> (D - 1 - b) & 1));
         for a in 0..D {
             let bit = 1 << (D - 1 - a);
             if c & bit != 0 {
                 continue;
             }
-            let corner: [usize; D] = std::array::from_fn(|b| lowest[b] + (c >> (D - 1 - b) & 1));
             if let Some(p) = crossing_on_edge(field, corner, values[c], values[c | bit], a, 1.0) {
-                visit(p);
+                visit(p, false);
             }
+        }
+        if values[c].abs() <= ON_SURFACE * scale && at_rounding(field, corner, values[c]) {
+            visit(std::array::from_fn(|b| field.coordinate(b, corner[b])), true);
         }
     }
 }

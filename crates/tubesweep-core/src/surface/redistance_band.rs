@@ -164,10 +164,6 @@ const NEWTON_STEPS: usize = 4;
 /// smooth φ an edge crossing is within about √D times the distance along the normal.
 const GRAZING_RATIO: f64 = 2.0;
 
-/// A face neighbour whose φ is within this fraction of the node's lies on the zero level set
-/// ([`grazing_starts`]).
-const ZERO_NEIGHBOUR: f64 = 1e-6;
-
 /// Halvings of a segment in [`grazing_starts`]: to 2⁻⁵⁰ of its length, far within
 /// [`ON_ZERO_SET`].
 const BISECTIONS: usize = 50;
@@ -234,24 +230,16 @@ fn grazing_starts<const D: usize>(
     node: [usize; D],
     x: &[f64; D],
     edge: f64,
+    zero_neighbour: bool,
     eps: f64,
 ) -> Vec<[f64; D]> {
     let here = field.sample(node);
     let shape = field.shape();
-    // a face neighbour on the zero level set (a rim on the grid's nodes; φ there a millionth of
-    // the node's or less: rounding left 1e-16 on the cylinder's caps): a φ with noise has none,
-    // and there the nodes keep their edges' crossings (with noise of 0.3Δx some nodes near small
-    // folds of the zero set found them nearer, and facing sheets were then read there)
-    let on_zero = |v: f64| v.abs() <= ZERO_NEIGHBOUR * here.abs();
-    let zero_neighbour = (0..D).any(|a| {
-        let mut near = node;
-        let below = node[a] > 0 && {
-            near[a] = node[a] - 1;
-            on_zero(field.sample(near))
-        };
-        near[a] = node[a] + 1;
-        below || (near[a] < shape[a] && on_zero(field.sample(near)))
-    });
+    // a face neighbour on the zero level set (`zero_neighbour`: a rim on the grid's nodes; φ there
+    // a millionth of the node's or less, `interface_cells::ON_SURFACE`: rounding left 1e-16 on the cylinder's
+    // caps): a φ with noise has none, and there the nodes keep their edges' crossings (with noise
+    // of 0.3Δx some nodes near small folds of the zero set found them nearer, and facing sheets
+    // were then read there)
     if here == 0.0 || !zero_neighbour {
         return Vec::new();
     }
@@ -660,7 +648,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 let mut plain: Option<[f64; D]> = None;
                 if depth == 0 {
                     let (mut edge, mut added) = (f64::INFINITY, f64::INFINITY);
-                    crossings_at_corner(field, idx, |q, on_zero| {
+                    let near_zero = crossings_at_corner(field, idx, |q, on_zero| {
                         let s = squared_distance(&x, &q);
                         if on_zero {
                             added = added.min(s);
@@ -681,11 +669,11 @@ pub fn redistanced_band_of_samples<const D: usize>(
                     // a node on the zero level set itself, its φ rounding's (a CSG union's corner
                     // on a node, φ = +1e-17, its face neighbours outside or on the surface: it
                     // started from its cells' crossings 1.41Δx away, a helper's review)
-                    if at_rounding(field, idx, field.sample(idx)) {
+                    if near_zero.node && at_rounding(field, idx, field.sample(idx)) {
                         added = 0.0;
                         consider(x, usize::MAX);
                     }
-                    for q in grazing_starts(field, idx, &x, edge, options.eps) {
+                    for q in grazing_starts(field, idx, &x, edge, near_zero.neighbour, options.eps) {
                         added = added.min(squared_distance(&x, &q));
                         consider(q, usize::MAX);
                     }
