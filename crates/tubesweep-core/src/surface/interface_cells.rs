@@ -16,7 +16,7 @@
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 
-use super::redistance::SampledField;
+use super::redistance::{sum_of_squares, SampledField};
 
 /// A 2D or 3D grid seen as 3D: a 2D grid `(n0, n1)` is the single slab `(1, n0, n1)`.
 #[derive(Debug, Clone, Copy)]
@@ -290,7 +290,7 @@ pub(crate) const AT_ROUNDING: f64 = 1e-12;
 pub(crate) fn at_rounding<const D: usize>(field: &SampledField<'_, D>, node: [usize; D], value: f64) -> bool {
     let x: [f64; D] = std::array::from_fn(|a| field.coordinate(a, node[a]));
     let g = field.half_step_gradient(&x);
-    value * value <= (AT_ROUNDING * field.spacing()).powi(2) * g.iter().map(|v| v * v).sum::<f64>()
+    value * value <= (AT_ROUNDING * field.spacing()).powi(2) * sum_of_squares(&g)
 }
 
 /// Whether the node `node` (φ = `value` there) has a face neighbour of the other sign: the zero

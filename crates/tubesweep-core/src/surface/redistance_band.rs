@@ -293,7 +293,11 @@ fn grazing_starts<const D: usize>(
 /// `|a − b|²`.
 #[inline]
 fn squared_distance<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
-    (0..D).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum()
+    let mut s = 0.0;
+    for k in 0..D {
+        s += (a[k] - b[k]) * (a[k] - b[k]);
+    }
+    s
 }
 
 /// `g / |g|`, or None where `g` vanishes.
@@ -445,10 +449,7 @@ fn refine<const D: usize>(
                 mid[k] = 0.5 * (y[k] + previous[k]);
             }
             if let Some((g, _)) = onto_zero_set(field, &mut mid, ON_ZERO_SET * h, options.eps) {
-                let mut s = 0.0;
-                for k in 0..D {
-                    s += (x[k] - mid[k]) * (x[k] - mid[k]);
-                }
+                let s = squared_distance(x, &mid);
                 if let (true, Some(n)) = (s < best_d2, unit(g)) {
                     best = Foot {
                         y: mid,
@@ -601,11 +602,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
     let prune = options.half_width + PRUNE_MARGIN * h;
     let distance = |p: usize, y: &[f64; D]| {
         let (_, x) = node_of(p);
-        let mut s = 0.0;
-        for k in 0..D {
-            s += (x[k] - y[k]) * (x[k] - y[k]);
-        }
-        s.sqrt()
+        squared_distance(&x, y).sqrt()
     };
     // (ties on the band's edge: rounding)
     let keep = options.half_width * (1.0 + 1e-9);
@@ -630,15 +627,14 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 // the nearest start: a point and the neighbour it comes from (usize::MAX: none)
                 let mut start = None;
                 let mut nearest = f64::INFINITY;
+                // (returns the squared distance of `q`)
                 let mut consider = |q: [f64; D], from: usize| {
-                    let mut s = 0.0;
-                    for k in 0..D {
-                        s += (x[k] - q[k]) * (x[k] - q[k]);
-                    }
+                    let s = squared_distance(&x, &q);
                     if s < nearest {
                         nearest = s;
                         start = Some((q, from));
                     }
+                    s
                 };
                 // a crossed cell's corner: also the nearest start of the plain rule (its edges'
                 // crossings) where one that the rules for nodes on the zero level set add (below)
@@ -649,14 +645,13 @@ pub fn redistanced_band_of_samples<const D: usize>(
                 if depth == 0 {
                     let (mut edge, mut added) = (f64::INFINITY, f64::INFINITY);
                     let near_zero = crossings_at_corner(field, idx, |q, on_zero| {
-                        let s = squared_distance(&x, &q);
+                        let s = consider(q, usize::MAX);
                         if on_zero {
                             added = added.min(s);
                         } else if s < edge {
                             edge = s;
                             plain = Some(q);
                         }
-                        consider(q, usize::MAX);
                     });
                     // a node far nearer the surface than any crossing on its edges, by φ/|∇φ|:
                     // next to a rim that the grid's nodes lie on, where φ vanishes at nodes and the
@@ -674,8 +669,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
                         consider(x, usize::MAX);
                     }
                     for q in grazing_starts(field, idx, &x, edge, near_zero.neighbour, options.eps) {
-                        added = added.min(squared_distance(&x, &q));
-                        consider(q, usize::MAX);
+                        added = added.min(consider(q, usize::MAX));
                     }
                     if added >= edge {
                         plain = None; // the plain start is the nearest: refined once
@@ -759,11 +753,7 @@ pub fn redistanced_band_of_samples<const D: usize>(
             let mut apart = false;
             set.face_neighbours_if(dist <= 0.5 * options.half_width, split(p), |q| {
                 if let Some(other) = foot_of(q) {
-                    let mut s = 0.0;
-                    for k in 0..D {
-                        s += (other.y[k] - y[k]) * (other.y[k] - y[k]);
-                    }
-                    apart |= s > (MEDIAL_GAP * h) * (MEDIAL_GAP * h);
+                    apart |= squared_distance(&other.y, y) > (MEDIAL_GAP * h) * (MEDIAL_GAP * h);
                 }
             });
             let good = dist > 1e-9 * h;
