@@ -91,7 +91,13 @@ def test_the_front_goes_through_the_pinch(n):
     vertices, faces, low, exact = touching_spheres()
     surf = ts.surfaces.from_mesh((vertices, faces))
     grid = surf.grid(n)
-    sol = ts.solve(surf, grid, [vertices[low]])
+    if n == 61:
+        # the spheres lie within 1.6 spacings of each other round the pinch over 3 % of their area
+        # (1.5 % at n = 101): said as a narrow gap, whose shortcut is B's 1.8 spacings beyond A's error
+        with pytest.warns(RuntimeWarning, match="3% of the mesh's area lies within about a grid spacing of another"):
+            sol = ts.solve(surf, grid, [vertices[low]])
+    else:
+        sol = ts.solve(surf, grid, [vertices[low]])
     err = (sol.on_mesh(vertices) - exact) / grid.spacing
     b, a = vertices[:, 2] > 0.1, vertices[:, 2] < -0.1
     # before: B 8.1 (n = 61) and 8.9 (n = 101) spacings short on average, up to 10.1 and 10.8,

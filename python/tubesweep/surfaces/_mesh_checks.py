@@ -11,15 +11,30 @@ import numpy as np
 
 from .._warn import user_stacklevel
 
-#: The share of a mesh's area within a grid spacing of another part facing it above which the
-#: solve warns: a flat ellipsoid 0.5 × 0.5 × 0.025 gives 32 %, 14 % and 7.9 % at N = 41, 61, 81
-#: (its far side 17, 9 and 6 spacings short), twice as thick 5.7 % at N = 41 (2.8 spacings) and
-#: none beyond; a box plate 0.08 thick, the icosphere, Spot and the bunny at n = 50–200 at most
-#: 0.95 % (``benches/experiments/thin_parts_meshes.py``).
+#: The share of a mesh's area within about a grid spacing of another part facing it
+#: (:data:`THIN_REACH`, :data:`GAP_REACH`) above which the solve warns: a flat ellipsoid
+#: 0.5 × 0.5 × 0.025 gives 40 %, 18 % and 9.7 % at N = 41, 61, 81 (its far side 5.0, 3.2 and 1.9
+#: spacings short), twice as thick 7.8 % at N = 41 (0.8 spacings) and 0.7 % or none beyond; the
+#: bunny at n = 50 1.5 %, at n = 100–200, Spot and the icosphere at n = 50–200 at most 0.13 %
+#: (``benches/experiments/thin_parts_meshes.py``; scratch for the bundled meshes).
 THIN_SHARE = 0.02
 
 #: At most this many faces are tested (evenly strided): the share is an estimate of area.
 THIN_FACES = 20000
+
+#: Parts up to this many grid spacings thick (or gaps this narrow) count as thin. The band is cut
+#: between two facing parts only when they lie more than a spacing apart: a box plate and a slot
+#: in a block, aligned with the grid or shifted by 0.3 spacings, at N = 41, 61 and 101, were
+#: crossed (the plate's bottom 29–72 spacings short) up to 1.00 spacing and solved within 1.4
+#: spacings from 1.02 (``benches/experiments/thin_parts_meshes.py --plates``); a margin of 5 %.
+THIN_REACH = 1.05
+
+#: Gaps up to this many grid spacings wide count as narrow (probed on the side the normal points
+#: to): a slot's mouth is crossed in the tube above it where the closest points of two nodes
+#: beside each other jump across it by less than ``_shortcuts.MEDIAL_JUMP`` = 1.5 spacings (a slot
+#: 0.3 deep in a block at N = 61, aligned with the grid: 25.6 spacings short up to 1.35 spacings
+#: wide, 17.8 at 1.5, within 2.4 from 1.75; shifted by 0.3 spacings: crossed at 1.2, not at 1.35).
+GAP_REACH = 1.6
 
 
 def unique_edges(f: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
@@ -49,23 +64,25 @@ def warn_repeated_vertices(v: np.ndarray, f: np.ndarray, boundary_edges: int) ->
 
 
 def thin_parts(mesh: Any, h: float) -> Tuple[float, Optional[np.ndarray]]:
-    """The share of the mesh's area (of up to :data:`THIN_FACES` faces) that lies within a grid
-    spacing ``h`` of another part facing it, and a point there (None when there is none): a face
-    whose point half a spacing behind its centre, on either side, lies within 0.45h of a face
-    whose normal is opposite to its own (a plate thinner than a spacing, two sheets closer than
-    one). There the tube's two sides are one and the front crosses between them; the narrow gaps
-    that the band is cut across (``_shortcuts``) are only found from about a spacing up."""
+    """The share of the mesh's area (of up to :data:`THIN_FACES` faces) that lies within
+    :data:`THIN_REACH` grid spacings ``h`` of another part facing it, and a point there (None when
+    there is none): a face whose point ``q = THIN_REACH·h/2`` behind its centre, on either side,
+    lies as near to a face whose normal is opposite to its own as to itself (a plate of thickness
+    t ≤ 2q: its other side lies |t − q| ≤ q from that point; two sheets closer than 2q). There the
+    tube's two sides are one and the front crosses between them; the narrow gaps that the band is
+    cut across (``_shortcuts``) are only found from a spacing up."""
     good = mesh._good[:: max(1, -(-len(mesh._good) // THIN_FACES))]
     v, f = mesh.vertices, mesh.faces[good]
     a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
     centre, normal = (a + b + c) / 3.0, mesh.face_normals[good]
     thin = np.zeros(len(good), bool)
-    for side in (1.0, -1.0):
-        d, _, face, _ = mesh.closest(centre - side * 0.5 * h * normal, max_distance=0.5 * h)
+    for side, reach in ((1.0, THIN_REACH), (-1.0, GAP_REACH)):
+        q = 0.5 * reach * h
+        d, _, face, _ = mesh.closest(centre - side * q * normal, max_distance=q)
         found = face >= 0
         opposite = np.einsum("ij,ij->i", mesh.face_normals[np.maximum(face, 0)], normal) < -0.5
-        thin |= found & (d < 0.45 * h) & opposite
+        thin |= found & (d <= q) & opposite
     total = float(area.sum())
     share = float(area[thin].sum()) / total if total > 0 else 0.0
     return share, (centre[np.argmax(thin)] if np.any(thin) else None)
@@ -77,11 +94,13 @@ def warn_thin_parts(share: float, where: Optional[np.ndarray], h: float, inner: 
         return
     at = ", ".join(f"{float(x):.3g}" for x in where)
     warnings.warn(
-        f"about {share:.0%} of the mesh's area lies within a grid spacing of another part of it that faces it (a part "
-        f"thinner than a spacing, e.g. near ({at})): there the tube cannot keep the two sides apart and the front "
-        "crosses between them, so distances past such parts can come out short by as much as the way around the part "
-        "(the front goes straight through: a flat ellipsoid 0.05 thick at N = 41–81, 17–6 spacings at its far side; "
-        "a plate under a spacing thick, nearly the whole way round its edge). A grid spacing below the part's thickness "
+        f"about {share:.0%} of the mesh's area lies within about a grid spacing of another part of it that faces it (a "
+        f"part thinner than {THIN_REACH:g} spacings or a gap narrower than {GAP_REACH:g}, e.g. near ({at})): there the "
+        "tube cannot keep the two sides apart and the front can cross between them, so distances past such parts can "
+        "come out short by as much as the way around the part "
+        "(a plate a spacing thick from its top's centre to its bottom's: nearly the whole way round its edge; a slot "
+        "1.5 spacings wide and 0.3 deep, from one side of it to the other: up to twice its depth). A grid spacing below "
+        "the part's thickness or the gap's width "
         f"divided by {2 * inner + 2:g} (now {h:.3g}) resolves it",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
