@@ -422,3 +422,33 @@ def test_a_rim_on_the_grid_s_nodes_is_redistanced_from_the_zero_set_beside_its_n
     assert sol.stats.creases["faces_angle_degrees"] == pytest.approx(90)
     # the cap's centre, 0.9 away: 4.6Δx short at first order, within the 6Δx that the warning says
     assert 0.9 - 6 * grid.spacing < sol([(0, 0, 0.4)])[0] < 0.9 - 4 * grid.spacing
+
+
+def test_points_next_to_a_mask_project_onto_its_surface_nearby():
+    # Newton's steps on a mask's plateaus went back and forth between two nodes and ended where they
+    # started, settled: a fifth of the nodes next to a ball's mask projected onto themselves at
+    # distance 0, and a point 0.6 spacings off it on a grid plane onto the surface 6.4 spacings
+    # away (ts.distance_matrix then gave another point's row, 1.530 for 1.259); a long step from a
+    # plateau's edge landed 19.6 spacings away (a helper's review)
+    grid = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    h = grid.spacing
+    x, y, z = grid.meshgrid()
+    ball = ts.LevelSet.from_mask(x**2 + y**2 + z**2 < 0.25, grid)
+    nodes = np.stack([x, y, z], -1).reshape(-1, 3)
+    nodes = nodes[np.abs(np.linalg.norm(nodes, axis=1) - 0.5) < 0.6 * h]
+    rng = np.random.default_rng(0)
+    points = rng.normal(size=(3000, 3))
+    points *= (0.5 + rng.uniform(-0.6, 0.6, (3000, 1)) * h) / np.linalg.norm(points, axis=1)[:, None]
+    points[:1500, 1] = np.round(points[:1500, 1] / h) * h  # on the grid's planes
+    for p, nearest in ((nodes, 0.1 * h), (points, 0.0)):
+        d, cp = ball.project(p, grid)
+        np.testing.assert_array_equal(d, np.linalg.norm(cp - p, axis=1))
+        assert np.min(d) >= nearest  # a node is never on the mask's surface (midway between nodes)
+        assert np.max(d) < 1.6 * h  # the staircase lies within a voxel's diagonal of the ball
+        r = np.linalg.norm(cp, axis=1)
+        assert np.all(np.abs(r - 0.5) < 0.6 * h)  # on the staircase round the ball, not across it
+    q = np.array([0.4164, 0.3, 0.0016])
+    targets = np.array([[0, 0, 0.5], [0, 0, -0.5], [-0.5, 0, 0]])
+    matrix = ts.distance_matrix(ts.Tube(ball, grid), None, np.r_[[q], targets])
+    exact = 0.5 * np.arccos(targets @ q / np.linalg.norm(q) / 0.5)
+    assert np.max(np.abs(matrix[0, 1:] - exact)) < 0.5 * h, (matrix[0, 1:], exact)

@@ -442,41 +442,69 @@ CROSSING_REACH = 4
 
 def redistanced_project(surface, points: np.ndarray, grid):
     """Unsigned distance and closest points of ``points`` on the zero level set of φ. Where the
-    projection did not reach it — ∇φ vanished on the way, as on a voxel mask's plateau or at a
-    ball's centre — the distance is that of the nearest of a sampled φ's sign changes within
-    :data:`CROSSING_REACH` cells (:func:`_nearest_crossing`), +∞ beyond them or for a callable φ
-    (a source there was taken for one on the surface, 0 from it); the closest point stays where
-    the projection ended. Where only the orthogonality
-    iterations did not settle (next to a crease) but Newton's step reached φ = 0
-    (:data:`REACHED`), the projection's distance is kept."""
+    projection did not reach it — ∇φ vanished on the way, as at a ball's centre, or Newton's steps
+    on a voxel mask's plateaus went back and forth between two nodes and ended where they started
+    (settled, at φ = ±½: a point 0.6 spacings off a ball's mask was placed 6.4 spacings away, and
+    a fifth of the nodes next to it at distance 0 on themselves; a helper's review) — the closest
+    point and distance are those of the nearest of a sampled φ's sign changes within
+    :data:`CROSSING_REACH` cells (:func:`_nearest_crossing`); where there is none, or for a
+    callable φ, the distance is +∞ (a source there was taken for one on the surface, 0 from it)
+    and the closest point stays where the projection ended. A projection reached the zero level
+    set when φ at its end is below :data:`REACHED` of φ at its start (next to a crease only the
+    orthogonality iterations fail to settle), or at the round-off of the sampled φ."""
     x = np.asarray(points, dtype=float)
     cp, signed, converged = _project(surface, grid, x)
     distance = np.abs(signed)
-    unsettled = np.flatnonzero(~np.asarray(converged, dtype=bool))
-    if unsettled.size:
-        start = np.abs(surface.phi(x[unsettled], grid))
-        end = np.abs(surface.phi(cp[unsettled], grid))
-        moved = np.any(cp[unsettled] != x[unsettled], axis=1)
-        lost = unsettled[~(moved & (end <= REACHED * start))]
-        for i in lost:
-            distance[i] = _nearest_crossing(surface, grid, x[i]) if surface.is_dense else np.inf
+    # a callable φ is smooth: only its projections that did not settle are looked at
+    check = np.arange(len(x)) if surface.is_dense else np.flatnonzero(~np.asarray(converged, dtype=bool))
+    start = np.abs(surface.phi(x[check], grid))
+    end = np.abs(surface.phi(cp[check], grid))
+    round_off = 1e-12 * _sample_scale(surface) if surface.is_dense else 0.0
+    moved = np.any(cp[check] != x[check], axis=1)
+    reached = np.ones(len(x), dtype=bool)
+    reached[check] = (end <= round_off) | (moved & (end <= REACHED * start))
+    for i in np.flatnonzero(~reached):
+        crossing = _nearest_crossing(surface, grid, x[i]) if surface.is_dense else None
+        if crossing is None:
+            distance[i] = np.inf
+        else:
+            distance[i], cp[i] = crossing
+    if surface.is_dense:
+        # a step from where a mask's plateau begins is long (its slope small) and can land on the
+        # zero level set far away (a point 0.6 spacings off a ball's mask, 19.6 spacings): beyond a
+        # spacing, the nearest sign change is taken where it is nearer
+        for i in np.flatnonzero(reached & (distance > grid.spacing)):
+            crossing = _nearest_crossing(surface, grid, x[i])
+            if crossing is not None and crossing[0] < distance[i]:
+                distance[i], cp[i] = crossing
     return distance, cp
 
 
-def _nearest_crossing(surface, grid, x: np.ndarray) -> float:
+def _sample_scale(surface) -> float:
+    """The largest |φ| of a sampled φ (kept on the surface, keyed by the array as
+    :func:`_scaled_samples`): the scale of its round-off."""
+    array = surface._array
+    kept = getattr(surface, "_sample_scale", None)
+    if kept is None or kept[0] is not array:
+        kept = (array, float(np.max(np.abs(array), initial=0.0)))
+        surface._sample_scale = kept
+    return kept[1]
+
+
+def _nearest_crossing(surface, grid, x: np.ndarray) -> Optional[Tuple[float, np.ndarray]]:
     """The distance from ``x`` to the nearest point of the zero level set on a sampled φ's edges
-    within :data:`CROSSING_REACH` cells (linear along each grid edge whose ends differ in sign);
-    +∞ when there is none."""
+    within :data:`CROSSING_REACH` cells (linear along each grid edge whose ends differ in sign),
+    and that point; None when there is none."""
     array = surface._array
     h = grid.spacing
     centre = np.rint(grid.continuous_index(x[None])[0]).astype(np.int64)
     lo = np.maximum(centre - CROSSING_REACH, 0)
     hi = np.minimum(centre + CROSSING_REACH + 1, np.asarray(array.shape))
     if np.any(hi <= lo):
-        return np.inf
+        return None
     block = array[tuple(slice(a, b) for a, b in zip(lo, hi))]
     origin = np.asarray(grid.lower, dtype=float) + lo * h
-    best = np.inf
+    best: Optional[Tuple[float, np.ndarray]] = None
     for k in range(block.ndim):
         a = np.take(block, np.arange(block.shape[k] - 1), axis=k)
         b = np.take(block, np.arange(1, block.shape[k]), axis=k)
@@ -487,5 +515,8 @@ def _nearest_crossing(surface, grid, x: np.ndarray) -> float:
         t = a[crossing] / (a[crossing] - b[crossing])
         pts = origin + idx * h
         pts[:, k] += t * h
-        best = min(best, float(np.min(np.linalg.norm(pts - x, axis=1))))
+        d = np.linalg.norm(pts - x, axis=1)
+        j = int(np.argmin(d))
+        if best is None or d[j] < best[0]:
+            best = (float(d[j]), pts[j])
     return best
