@@ -10,6 +10,7 @@ import pytest
 import tubesweep as ts
 from conftest import FIRST_ORDER_SIZE
 from tubesweep._fallback import FIRST_ORDER_SPACINGS, SIZE_WARNING, first_order_share
+from tubesweep.second_order import Order2NotApplicable
 
 R = 0.5
 SIZE = r"errors up to about (\d+)% of the distances"
@@ -208,3 +209,44 @@ def test_an_ellipsoid_s_algebraic_distance_is_named_as_not_a_distance_with_the_e
             sol = ts.solve(ts.LevelSet(phi), g, [(a, 0, 0)])
     assert sol.stats.order == 1
     assert re.search(r"^surface: order=2: \d+ of .* \(9\d%\) .* have \|∇φ\| off 1", sol.stats.order_fallback)
+
+
+def test_the_star_s_tips_crossed_twice_are_said_with_the_error_where_fronts_meet():
+    # the six-pointed star at N = 61 from one point: pairs 120° apart 5.9Δx (12.8%) short, the
+    # largest error 8.4Δx, and no warning (a helper's review): its tips (94 unresolved nodes, 4 of
+    # them thinned by the crease test) were sized as thinned creases, 1.5Δx each; as tips, 3.5Δx
+    star = ts.surfaces.Star()
+    grid = ts.Grid(*star.default_box, (61, 61))
+    th = np.linspace(0, 2 * np.pi, 7)[:-1]
+    points = star.project(np.c_[0.5 * np.cos(th), 0.5 * np.sin(th)], grid)[1]
+    with pytest.warns(RuntimeWarning, match=FIRST_ORDER_SIZE) as record:
+        sol = ts.solve(star, grid, [points[1]])
+    message = str(record[0].message)
+    share = _stated_share(record)
+    per_tip = float(re.search(r"up to about ([\d.]+) more", message).group(1))
+    exact = star.geodesic_distance(points, points[1])
+    short = exact - sol(points)
+    largest = float(np.max(sol.values[np.isfinite(sol.values)]))
+    assert sol.stats.order == 1 and np.max(short) > 5 * grid.spacing
+    assert np.max(short) < share * largest + 2 * per_tip  # what it says covers what it measures
+
+
+def test_a_re_distanced_phi_rough_at_the_grid_s_scale_is_told_to_smooth_not_to_re_distance():
+    # a sphere's φ with noise of a spacing, given with redistance=True: the refusal and the warning
+    # said "pass redistance=True", which it had (a helper's review); smoothing φ first runs second
+    # order (N = 81: 0.15Δx off at worst over four points, where this runs first order, 1.2Δx off)
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    x, y, z = grid.meshgrid()
+    phi = np.sqrt(x**2 + y**2 + z**2) - R + grid.spacing * np.random.default_rng(1).standard_normal(x.shape)
+    gaps = "faces itself across gaps narrower than its tubes"  # (the noise's bumps face each other)
+    with pytest.raises(Order2NotApplicable) as refused, pytest.warns(RuntimeWarning, match=gaps):
+        ts.solve(ts.LevelSet(phi, redistance=True), grid, [(R, 0, 0)], order=2)
+    said = str(refused.value)
+    assert "pass redistance=True" not in said and "re-distanced already (redistance=True)" in said
+    assert "scipy.ndimage.gaussian_filter(phi, 1)" in said
+    with pytest.warns(RuntimeWarning, match=gaps), pytest.warns(RuntimeWarning, match=FIRST_ORDER_SIZE) as record:
+        sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(R, 0, 0)])
+    (message,) = [str(w.message) for w in record if str(w.message).startswith(FIRST_ORDER_SIZE)]
+    assert "rough at the grid's scale" in message and "smoothing φ over a spacing or two" in message
+    assert "LevelSet(φ, redistance=True)" not in message.split("(why order 2")[0]
+    assert sol.stats.order == 1

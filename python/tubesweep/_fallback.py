@@ -37,6 +37,7 @@ from ._creases import refused_for_creases, shortcut, thinned_spacings, warn_refu
 from ._prepare import thinned_count
 from .band import band_neighbours
 from .surface import LevelSet
+from .mask import ROUGH_REDISTANCED
 from .surfaces._mesh_parts import open_only_in_debris
 from ._warn import user_stacklevel
 from .second_order import NOISY_PHI, NOT_A_DISTANCE, NarrowExtension, Order2NotApplicable, warn_fallback
@@ -70,6 +71,8 @@ GRADIENT_SPREAD = 1.2
 #: A fallback for curvatures the tube does not resolve (the second-order geometry's refusal,
 #: with the share of the inner tube: "(22%) have a principal curvature the tube does not resolve")
 _UNRESOLVED = re.compile(r"\((\d+)%\)[^()]*curvature the tube does not resolve")
+#: ... and how many nodes (``tubesweep_core::second_order::check_geometry_of``)
+_UNRESOLVED_NODES = re.compile(r"(\d+) of the \d+ inner-tube nodes \(\d+%\) have a principal curvature the tube")
 
 #: Unresolved curvature on less than this share of the inner tube is edges, tips or corners,
 #: crossed as creases are (``RoundedCube()`` at N = 41–61: 19–22%; the ellipsoid's tips at N = 41:
@@ -138,15 +141,24 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
         return
     unresolved = _UNRESOLVED.search(reason)
     edges_only = unresolved is not None and int(unresolved.group(1)) < 100 * EDGES_SHARE
-    # (the inner tube thinned at the edges: _creases.thinned_spacings per edge, as at a crease)
-    per_edge = thinned_spacings(tube, True) if thinned else UNRESOLVED_SHORTCUT
+    # (the inner tube thinned at the edges: _creases.thinned_spacings per edge, as at a crease;
+    # the star's tips, 94 unresolved nodes of which the crease test thinned 4 at N = 61, are not)
+    nodes = _UNRESOLVED_NODES.search(reason)
+    at_edges = thinned and (nodes is None or 2 * thinned_count(tube) >= int(nodes.group(1)))
+    per_edge = thinned_spacings(tube, True) if at_edges else UNRESOLVED_SHORTCUT
     crossing = per_edge * spacing / gradient if edges_only else 0.0
-    not_a_distance = NOT_A_DISTANCE in reason
+    rough = ROUGH_REDISTANCED in reason  # (a re-distanced φ: mask.mask_advice)
+    not_a_distance = NOT_A_DISTANCE in reason or rough
     if share < SIZE_WARNING and 2 * crossing < SIZE_WARNING * largest and not not_a_distance:
         return
     size = f"up to about {100 * share:.0f}% of the distances" if share < 1 else "as large as the distances"
     if not not_a_distance:
         scaled = ""
+    elif rough:
+        scaled = (
+            f"; the re-distanced φ reads |∇φ| = {gradient:.3g} on average through central differences, its zero level "
+            "set rough at the grid's scale, which widens the tube and the errors by 1/|∇φ|"
+        )
     elif gradient == 1.0:
         scaled = "; φ is not a distance (its |∇φ| is 1 on average but spreads over the tube)"
     else:
@@ -160,7 +172,9 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
         if crossing
         else ""
     )
-    if not_a_distance:
+    if rough:
+        cure = "smoothing φ over a spacing or two before re-distancing, or a coarser grid, lowers them"
+    elif not_a_distance:
         cure = (
             "LevelSet(φ, redistance=True) removes that scaling"
             if gradient != 1.0

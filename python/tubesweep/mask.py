@@ -7,14 +7,15 @@ the level set function in the band is the signed distance to it, found by the su
 of :mod:`tubesweep.redistance` (``LevelSet(phi, redistance=True)``).
 
 A mask knows its surface only to about half a voxel: on the sphere of radius 0.5 in [−1, 1]³ the
-travel times along a meridian are off by about one grid spacing at N = 61 and 121 (falling at
-first order), and a Gaussian smoothing of the mask (``smooth=σ`` in voxels) removes the voxel steps
-at the price of moving curved parts inward by about ``σ² κ / 2`` (κ the sum of the principal
+travel times along a meridian are off by about one grid spacing at N = 61 and half of one at
+N = 121 (falling at first order), and a Gaussian smoothing of the mask (``smooth=σ`` in voxels)
+removes the voxel steps at the price of moving curved parts inward by about ``σ² κ / 2`` (κ the sum of the principal
 curvatures, ``σ`` in length units): docs/surfaces.md has the measured figures.
 """
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -125,10 +126,30 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
     return phi
 
 
+#: What the second-order geometry says of a φ whose |∇φ| is off 1 (``tubesweep_core::second_order``'s
+#: ``check_geometry_of``): advice that a re-distanced φ has taken already.
+PASS_REDISTANCE = "φ is not a signed distance there: pass redistance=True"
+_REDISTANCE_CURE = re.compile(r"ts\.LevelSet\(phi, redistance=True\) re-distances φ( \(or divide φ by [^)]*\))?")
+
+#: ... and what :func:`mask_advice` says instead for a re-distanced φ (``_fallback`` reads it).
+ROUGH_REDISTANCED = "φ was re-distanced already (redistance=True) and still is not a distance at the grid's scale"
+
+
 def mask_advice(surface: Any, reason: str) -> str:
     """``reason`` (why ``order=2`` does not apply) with the advice for a raw voxel mask: its
     staircase is the unresolved curvature, and smoothing it (``smooth=1``) is the fix, not a finer
-    grid (docs/surfaces.md, "From a voxel mask")."""
+    grid (docs/surfaces.md, "From a voxel mask"). For a re-distanced φ (a mask too), the advice to
+    re-distance φ becomes what does help: its zero level set is rough at the grid's scale (a
+    sphere's φ with noise of a spacing at N = 81 was told to "pass redistance=True", which it had;
+    a helper's review)."""
+    if getattr(surface, "redistance", False):
+        reason = reason.replace(PASS_REDISTANCE, "the re-distanced φ is not a signed distance there")
+        reason = _REDISTANCE_CURE.sub(
+            f"{ROUGH_REDISTANCED}: its zero level set is rough at the grid's scale (noise of about a spacing or more); "
+            "smoothing φ over a spacing or two before re-distancing (scipy.ndimage.gaussian_filter(phi, 1)) or a "
+            "coarser grid",
+            reason,
+        )
     if getattr(surface, "_mask_smoothing", None) != 0.0 or "curvature the tube does not resolve" not in reason:
         return reason
     return (
