@@ -148,6 +148,16 @@ def test_distance_matrix_bad_input(tube, grid):
 # ---------------------------------------------------------------------------------- sampling
 
 
+def test_farthest_point_sampling_says_each_warning_once():
+    # a box's mask: its crease warning came once per solve, 13 times for k = 12 (a helper's review)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    x, y, z = g.meshgrid()
+    box = ts.LevelSet.from_mask((abs(x) < 0.5) & (abs(y) < 0.4) & (abs(z) < 0.3), g)
+    with pytest.warns(RuntimeWarning, match="creases or corners") as caught:
+        pts, radii = ts.farthest_point_sampling(box, g, 12)
+    assert len(caught) == 1 and pts.shape == (12, 3) and np.all(np.diff(radii[1:]) <= 1e-12)
+
+
 def test_farthest_point_sampling_on_the_sphere(tube):
     pts, radii = ts.farthest_point_sampling(tube, None, 6, start=[0, 0, R], order=1)
     assert pts.shape == (6, 3) and radii.shape == (6,)
@@ -171,6 +181,12 @@ def test_farthest_point_sampling_on_the_sphere(tube):
     assert exact[:2, :2].min() > 0.999 * np.pi * R
     with pytest.raises(ValueError, match="k must be"):
         ts.farthest_point_sampling(tube, None, 0)
+    # a tube's widths are its own: others were ignored without a word (a helper's review)
+    with pytest.raises(ValueError, match=r"outer=6: this ts.Tube was built with outer=4"):
+        ts.farthest_point_sampling(tube, None, 2, outer=6)
+    with pytest.raises(ValueError, match=r"inner=3: this ts.Tube was built with inner=2"):
+        ts.distance_matrix(tube, None, pts[:2], inner=3)
+    assert ts.distance_matrix(tube, None, pts[:2], inner=2, outer=4).shape == (2, 2)
     with pytest.raises(ValueError, match=r"start\[0\].*farther"):
         ts.farthest_point_sampling(tube, None, 2, start=[0, 0, 0])
     # without start: the first point is the farthest from an arbitrary one, then as above
@@ -592,6 +608,15 @@ def test_dask_checks_as_locally_and_a_runaway_row_falls_back_alone(client):
     assert "sources [2]" in rst["order_fallback"] and "sources [2]" in st["order_fallback"]
     assert rst["first_order_nodes"] == st["first_order_nodes"] and rst["inner_nodes"] == st["inner_nodes"]
     assert np.array_equal(rst["converged"], st["converged"]) and rst["converged"].all()
+    # two chunks' runaways said once for the batch, as locally (each chunk named only its own
+    # sources: "1 of 1 solves, sources [0]", source 2 never named; a helper's review)
+    two = np.where(np.linalg.norm(x - [-0.5, 0, 0], axis=-1) < 0.15, 1e-2, speed)
+    with pytest.warns(RuntimeWarning, match=r"ran away.*\(2 of 3 solves, sources \[0, 2\]\)"):
+        _, st = tube.solve_many(src, at=at, speed=two, return_stats=True)
+    with pytest.warns(RuntimeWarning, match=r"on the workers: .*ran away.*\(2 of 3 solves, sources \[0, 2\]\)") as said:
+        _, rst = tube.solve_many(src, at=at, speed=two, client=client, chunk_size=1, return_stats=True)
+    assert len([w for w in said if "ran away" in str(w.message)]) == 1
+    assert rst["order_fallback"] == st["order_fallback"] and "(2 of 3 solves, sources [0, 2])" in st["order_fallback"]
     # a point of at off the band is named once (not again from the workers)
     with pytest.warns(RuntimeWarning, match="points of at lie off the band") as caught:
         tube.solve_many(src[:2], at=[(0, 0, 0)], client=client)

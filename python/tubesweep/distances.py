@@ -15,12 +15,15 @@ solve per chosen point.
 
 from __future__ import annotations
 
+import re
 import time
-from typing import Any, Callable, Optional, Tuple, Union
+import warnings
+from typing import Any, Callable, Dict, Optional, Tuple, Union
 
 import numpy as np
 
 from ._sources import how_far
+from ._warn import user_stacklevel
 from ._validate import as_points, check_flag
 from .many import check_many_progress
 from ._prepare import ROLE_INNER
@@ -30,14 +33,23 @@ from .tube import Tube
 __all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]
 
 
-def _as_tube(surface: Any, grid: Any, inner: float, outer: float) -> Tube:
+def _as_tube(surface: Any, grid: Any, inner: Optional[float], outer: Optional[float]) -> Tube:
+    """``surface`` itself when it is a :class:`Tube` (``grid``, ``inner`` and ``outer`` left out or
+    its own: they were ignored before, a helper's review), else its tube on ``grid`` (widths 2 and 4
+    grid spacings unless given)."""
     if isinstance(surface, Tube):
         if grid is not None and grid != surface.grid:
             raise ValueError("grid: this ts.Tube was built on another grid; pass grid=None (or the tube's grid)")
+        for name, given, own in (("inner", inner, surface.inner), ("outer", outer, surface.outer)):
+            if given is not None and float(given) != float(own):
+                raise ValueError(
+                    f"{name}={given!r}: this ts.Tube was built with {name}={own:g}, which its solves use; leave "
+                    f"{name} out, or build the tube with it (ts.Tube(surface, grid, {name}={given!r}))"
+                )
         return surface
     if grid is None:
         raise ValueError("grid is required (a ts.Grid) unless surface is a ts.Tube")
-    return Tube(surface, grid, inner=inner, outer=outer)
+    return Tube(surface, grid, inner=2.0 if inner is None else inner, outer=4.0 if outer is None else outer)
 
 
 def snap_to_surface(tube: Tube, points: Any, name: str = "points") -> np.ndarray:
@@ -72,8 +84,8 @@ def distance_matrix(
     points: Any,
     *,
     client: Any = None,
-    inner: float = 2.0,
-    outer: float = 4.0,
+    inner: Optional[float] = None,
+    outer: Optional[float] = None,
     hamiltonian: str = "godunov",
     source_init: str = "exact",
     tol: Optional[float] = None,
@@ -96,6 +108,8 @@ def distance_matrix(
         (``pip install 'tubesweep[distributed]'``, or ``pip install '.[distributed]'`` in a
         checkout; see :meth:`Tube.solve_many`).
     threads : solves run at once locally (0: all cores), each on one thread.
+    inner, outer : the tube's half-widths in grid spacings (2 and 4 unless given); a
+        :class:`ts.Tube` has its own, and other values are refused.
     progress : callable ``(done, M')``, optional (M' the distinct points).
     order : ``"auto"`` (the default: second order where it applies, as :func:`tubesweep.solve`), 1 or 2.
     info : also return a dict: ``asymmetry`` (the largest ``|D[i, j] − D[j, i]|`` of the one-way
@@ -197,8 +211,8 @@ def farthest_point_sampling(
     k: int,
     *,
     start: Any = None,
-    inner: float = 2.0,
-    outer: float = 4.0,
+    inner: Optional[float] = None,
+    outer: Optional[float] = None,
     tol: Optional[float] = None,
     threads: int = 0,
     progress: Optional[Callable[[int, int], Any]] = None,
@@ -222,7 +236,10 @@ def farthest_point_sampling(
         How many points.
     start : array_like, optional
         The first point, on the surface.
-    inner, outer, tol, threads
+    inner, outer : float, optional
+        The tube's half-widths in grid spacings (2 and 4 unless given); a :class:`ts.Tube` has its
+        own, and other values are refused.
+    tol, threads
         As for :func:`tubesweep.solve`.
     progress : callable, optional
         Called as ``progress(done, k)``.
@@ -275,8 +292,11 @@ def farthest_point_sampling(
             f"{inner_pos.size} inner-tube nodes): pass k ≤ {distinct} or refine the grid"
         )
 
+    said = _SaidOnce()
+
     def distances_from(p: np.ndarray) -> np.ndarray:
-        return tube.solve([p], tol=tol, threads=threads, order=order).values[inner_pos]
+        with said:
+            return tube.solve([p], tol=tol, threads=threads, order=order).values[inner_pos]
 
     if start is None:
         seed = candidates[int(np.flatnonzero(usable)[0])]
@@ -311,4 +331,28 @@ def farthest_point_sampling(
         # the discrete distances near a chosen point are of the size of the scheme's error, not 0:
         # the radius is at least 0
         radii.append(max(float(score[best]), 0.0))
+    said.say()
     return np.array(points), np.array(radii)
+
+
+class _SaidOnce:
+    """The warnings of a sampling's solves, each kind said once after them (the first solve's
+    figures), not once per point: a box's mask gave its crease warning 13 times for k = 12 (a
+    helper's review). A kind is the text with its numbers left out."""
+
+    def __init__(self) -> None:
+        self.caught: Dict[str, warnings.WarningMessage] = {}
+
+    def __enter__(self) -> None:
+        self._context = warnings.catch_warnings(record=True)
+        self._record = self._context.__enter__()
+        warnings.simplefilter("always")
+
+    def __exit__(self, *exc: Any) -> None:
+        self._context.__exit__(*exc)
+        for w in self._record:
+            self.caught.setdefault(re.sub(r"[-+]?\d[\d.,e+-]*", "#", str(w.message)), w)
+
+    def say(self) -> None:
+        for w in self.caught.values():
+            warnings.warn(w.message, w.category, stacklevel=user_stacklevel())

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional
 
 import numpy as np
 
+from ._chunk_messages import merged
 from ._validate import as_points, check_flag, check_threads, speed_values
 from .many import check_many_progress, fixed_nodes, solve_many, source_groups
 
@@ -65,6 +66,9 @@ def _worker_tube(spec: _TubeSpec) -> "Tube":
         _WORKER_TUBES.move_to_end(spec.token)
         return tube
 
+
+#: At most this many warnings from the workers, each said once (the last one counts the rest).
+WORKER_WARNINGS = 5
 
 #: The stats of a batch that are the tube's (the same for every chunk), sent back with the rows.
 _TUBE_STATS = ("first_order_nodes", "inner_nodes", "first_order_reasons", "creases", "max_curvature", "grad_norm_range")
@@ -196,7 +200,7 @@ def solve_many_on_client(
     stats: Dict[str, np.ndarray] = {}
     tube_stats: Dict[str, Any] = {}
     messages: List[str] = []
-    reason: Any = None  # why some rows ran the first-order scheme (order="auto")
+    reasons: List[str] = []  # why some rows ran the first-order scheme (order="auto"), per chunk
     done = 0
     try:
         for fut in as_completed(futures):
@@ -213,7 +217,8 @@ def solve_many_on_client(
                     "(docs/many-sources.md, 'What to size')"
                 ) from e
             out[a:b] = values
-            reason = chunk_reason if reason is None else reason
+            if chunk_reason is not None:
+                reasons.append(chunk_reason)
             for name, v in st.items():
                 if not isinstance(v, np.ndarray):
                     tube_stats.setdefault(name, v)  # the tube's: the same from every chunk
@@ -226,18 +231,22 @@ def solve_many_on_client(
     finally:
         client.cancel(list(futures))
         del spec, at_data, opts
+    messages = merged(messages, k)  # (in the order the chunks came back)
     if messages:
         import warnings
 
-        warnings.warn(
-            f"on the workers: {messages[0]}" + (f" (and {len(messages) - 1} more)" if len(messages) > 1 else ""),
-            RuntimeWarning,
-            stacklevel=3,
-        )
+        # each once, as the batch on this machine says them; a few at most
+        for i, message in enumerate(messages[:WORKER_WARNINGS]):
+            more = len(messages) - WORKER_WARNINGS if i == WORKER_WARNINGS - 1 else 0
+            warnings.warn(
+                f"on the workers: {message}" + (f" (and {more} more)" if more > 0 else ""),
+                RuntimeWarning,
+                stacklevel=3,
+            )
     if return_stats:
         stats_out: Dict[str, Any] = {**tube_stats, **stats}
         # each row's order; "order" the lowest, as locally (chunks may differ where a source ran away)
         stats_out["order"] = int(np.min(stats["orders"]))
-        stats_out["order_fallback"] = reason
+        stats_out["order_fallback"] = "; ".join(merged(reasons, k)) if reasons else None
         return out, stats_out
     return out
