@@ -16,11 +16,13 @@ curvatures, ``σ`` in length units): docs/surfaces.md has the measured figures.
 from __future__ import annotations
 
 import re
-from typing import Any
+import warnings
+from typing import Any, Optional, Tuple
 
 import numpy as np
 
 from ._validate import real_scalar
+from ._warn import user_stacklevel
 from .grid import Grid
 
 __all__ = ["level_set_function_of_mask"]
@@ -121,9 +123,50 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
                 f"smooth = {sigma:g} voxels erases the object (no voxel stays above one half after smoothing): "
                 "use a smaller smooth, or none"
             )
+        warn_one_voxel_parts_smoothed_away(inside, phi <= 0, grid, sigma)
     else:
         phi = np.where(inside, -0.5, 0.5)
     return phi
+
+
+def _one_voxel_sheet(inside: np.ndarray, after: np.ndarray) -> Tuple[int, Optional[Tuple[int, ...]]]:
+    """The voxels of ``inside`` that lie between two of the other side along an axis (a gap one
+    voxel wide in the object, or a wall one voxel thick) and that ``after`` puts on the other side,
+    where they form a sheet (at least 2(d − 1) such neighbours: a crease's ring has 2); their
+    number and one of them."""
+    sheet = np.zeros(inside.shape, dtype=bool)
+    for axis in range(inside.ndim):  # (the object does not touch the box: rolling wraps nothing in)
+        sheet |= inside & ~np.roll(inside, 1, axis) & ~np.roll(inside, -1, axis)
+    sheet &= after != inside
+    neighbours = np.zeros(inside.shape, dtype=np.int8)
+    for axis in range(inside.ndim):
+        neighbours += np.roll(sheet, 1, axis).astype(np.int8) + np.roll(sheet, -1, axis).astype(np.int8)
+    sheet &= neighbours >= 2 * (inside.ndim - 1)
+    count = int(np.count_nonzero(sheet))
+    return count, (tuple(int(i) for i in np.argwhere(sheet)[0]) if count else None)
+
+
+def warn_one_voxel_parts_smoothed_away(inside: np.ndarray, smoothed: np.ndarray, grid: Grid, sigma: float) -> None:
+    """A RuntimeWarning where the smoothing closed a gap one voxel wide (a slot: the smoothed mask
+    stays above one half across it) or opened a wall one voxel thick, over a sheet of voxels: the
+    surface then has no gap or no wall there, and paths run across it (a ball with a slot one
+    voxel wide through half of it, N = 61, ``smooth=1``: 29 spacings short beyond the slot, points
+    in it off the band; a helper's review)."""
+    for what, count_at in (
+        ("closed a gap one voxel wide", _one_voxel_sheet(~inside, ~smoothed)),
+        ("opened a wall one voxel thick", _one_voxel_sheet(inside, smoothed)),
+    ):
+        count, at = count_at
+        if at is None:
+            continue
+        where = ", ".join(f"{c:.3g}" for c in np.asarray(grid.lower, dtype=float) + np.asarray(at) * grid.spacing)
+        warnings.warn(
+            f"smooth = {sigma:g} voxels {what} over {count} voxels (e.g. at index {at}, near ({where})): the smoothed "
+            "surface has no such gap or wall there, and paths run across it. Pass a smaller smooth (a one-voxel part "
+            "keeps its side up to smooth = 0.75), or smooth=0 (the voxels' steps, first order)",
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
+        )
 
 
 #: What the second-order geometry says of a φ whose |∇φ| is off 1 (``tubesweep_core::second_order``'s
