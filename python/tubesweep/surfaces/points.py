@@ -620,6 +620,7 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
+        self._warn_creases(grid)
         # the map's noise near the surface (for the facing-sheets test): |cp(cp(x)) − cp(x)|, and
         # the fitted surface's own wiggle, the samples' noise averaged over a fit's samples (their
         # count within ρ, over the Wendland weights' and the quadric's share: 1/18; at noise
