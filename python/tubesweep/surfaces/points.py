@@ -159,7 +159,8 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         noise: at sharp edges or corners, or samples off a smooth surface that the outlier test
         kept (``report["crease_samples"]`` counts them).
     open_surface : bool
-        True when the cloud has a rim (``order="auto"`` then runs first order).
+        True when the cloud has a rim (second order then runs first order at the rim's nodes and
+        beyond them, docs/point-clouds.md).
     report : dict
         Samples given, repeated (or within ``NEAR_REPEAT`` of the fits' median radius of another),
         outliers, rim samples, the spacing (median distance to the
