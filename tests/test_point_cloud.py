@@ -459,6 +459,24 @@ def test_a_cloud_s_sharp_edges_are_said_with_how_early_a_front_arrives_beyond_th
     assert np.all(exact - first(q) > 3.5 * g.spacing) and np.all(exact - first(q) < said)  # 4.1–4.5Δx
 
 
+def test_strays_the_outlier_test_kept_are_named_before_sharp_edges():
+    # 1 % of a sphere's 20,000 samples spread over its box: 77 left out, 118 kept, and the refusal
+    # led with "sharp edges or corners ... give the surface as a mesh" (a helper's review); most of
+    # the samples their fits miss lie far from every other sample, as no edge's do
+    rng = np.random.default_rng(5)
+    x = np.random.default_rng(3).normal(size=(20000, 3))
+    p = np.r_[0.5 * x / np.linalg.norm(x, axis=1, keepdims=True), rng.uniform(-0.8, 0.8, size=(200, 3))]
+    with pytest.warns(RuntimeWarning, match="lie off the surface their neighbours fit"):
+        cloud = ts.surfaces.from_points(p)
+    said = cloud._crease_advice()
+    assert said.startswith(f"{cloud._strays[0]} of the {cloud.report['crease_samples']} samples") and "stray" in said
+    # leaving out the samples it lists lets the solve run (it was refused)
+    with pytest.warns(RuntimeWarning, match="23 of 20017 samples lie off the surface"):  # now left out
+        kept = ts.surfaces.from_points(np.delete(cloud.points, cloud.crease_samples, axis=0))
+    sol = ts.solve(kept, ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3), [(0, 0, 0.5)])
+    assert sol.stats.order == 2
+
+
 def test_a_sparse_cloud_solves_without_a_false_gap_and_the_gap_note_names_the_sampling():
     # 150 samples of a sphere, 2.7 grid spacings apart at N = 81: the fitted surface wiggles by
     # its misfit between the samples, and 5 node pairs within 0.14Δx of it on either side read as

@@ -25,6 +25,11 @@ CREASE_SHARE = 0.005
 #: cylinder, from its side to its caps' centres across one rim: 4.1–4.5 at first order, 1.0–1.2 at
 #: second (``tests/test_point_cloud.py``).
 CREASE_SPACINGS = 5.0
+#: Samples their fits miss that lie farther than this many median spacings from every other sample
+#: are strays the outlier test kept rather than a sharp edge's (whose samples are as dense as the
+#: rest): 1 % of a sphere's 20,000 samples spread over its box, 118 of them kept, read as "sharp
+#: edges or corners" first (a helper's review); their spacings 20 times the median or more.
+STRAY_SPACINGS = 5.0
 #: A widest fit more than this many times the median one: the sampling is uneven enough that a
 #: fold of the closest points may come from parts sampled too sparsely for their curvature.
 UNEVEN_FITS = 4.0
@@ -42,6 +47,7 @@ class CloudAdvice:
     _median_fit: float
     _sparsest_fit: float
     _creases: Any
+    _strays: Any
 
     def _uneven(self) -> Optional[float]:
         """How many times the median fit the widest one spans, when above :data:`UNEVEN_FITS`
@@ -50,10 +56,20 @@ class CloudAdvice:
         return ratio if ratio > UNEVEN_FITS else None
 
     def _crease_advice(self) -> str:
-        """The cloud's sharp edges and their cure, or "" when it has none (:data:`CREASE_SHARE`)."""
+        """The cloud's sharp edges and their cure, or "" when it has none (:data:`CREASE_SHARE`);
+        strays first where most of those samples lie far from every other (:data:`STRAY_SPACINGS`)."""
         count, where = self._creases
         if count <= CREASE_SHARE * len(self.points) or where is None:
             return ""
+        strays, stray = getattr(self, "_strays", (0, None))
+        if stray is not None and 2 * strays >= count:
+            at = ", ".join(f"{float(c):.4g}" for c in stray)
+            return (
+                f"{strays} of the {count} samples that their fits miss lie more than {STRAY_SPACINGS:g} times the "
+                f"median spacing from every other sample (e.g. at ({at})): stray points off the surface that the "
+                "outlier test kept. Leave them out (cloud.crease_samples lists the samples their fits miss); if the "
+                "surface has sharp edges there instead, give it as a mesh (from_mesh)"
+            )
         at = ", ".join(f"{float(c):.4g}" for c in where)
         return (
             f"the cloud has sharp edges or corners ({count} samples that their fits miss, e.g. at ({at})), which the "

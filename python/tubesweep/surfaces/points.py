@@ -41,7 +41,7 @@ from .._warn import user_stacklevel
 from ._cloud_analysis import analyse, analyse_own, lines_advice, widen
 from ._cloud_holes import bridged_holes, pairs_over_holes, warn_close_ends
 from ._cloud_files import read_points
-from ._cloud_advice import SPARSE_FACTOR, CloudAdvice, sentence
+from ._cloud_advice import SPARSE_FACTOR, STRAY_SPACINGS, CloudAdvice, sentence
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
 
@@ -358,6 +358,8 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         # sharp edges and corners: samples their fit misses by far more than the noise
         crease = a.creases(CREASE_RESIDUAL, p)
         self._creases = (int(np.count_nonzero(crease)), p[int(np.argmax(crease))] if np.any(crease) else None)
+        stray = crease & (np.asarray(a.spacing) > STRAY_SPACINGS * self.spacing)  # (kept outliers: _cloud_advice)
+        self._strays = (int(np.count_nonzero(stray)), p[int(np.argmax(stray))] if np.any(stray) else None)
         #: the samples their fits miss (indices into ``points``): at sharp edges, or off the surface
         self.crease_samples = np.flatnonzero(crease)
         q05, q95 = np.quantile(a.radius, [0.05, 0.95])
