@@ -450,7 +450,8 @@ def test_a_cloud_s_sharp_edges_are_said_with_how_early_a_front_arrives_beyond_th
     g = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
     q, exact = np.array([[0, 0, -0.4], [0, 0, 0.4], [-0.2, 0, -0.4]]), np.array([0.8, 0.8, 1.0])  # across one rim
     with pytest.warns(
-        RuntimeWarning, match=r"sharp edges or corners .* early by up to about ([\d.]+) \(5·Δx\) for each"
+        RuntimeWarning,
+        match=r"sharp edges or corners, or samples off .* early by up to about ([\d.]+) \(5·Δx\) for each",
     ) as w:
         default = ts.solve(cloud, g, [(0.4, 0, 0)])
     said = float(re.search(r"early by up to about ([\d.]+)", str(w[0].message)).group(1))
@@ -475,6 +476,27 @@ def test_strays_the_outlier_test_kept_are_named_before_sharp_edges():
         kept = ts.surfaces.from_points(np.delete(cloud.points, cloud.crease_samples, axis=0))
     sol = ts.solve(kept, ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3), [(0, 0, 0.5)])
     assert sol.stats.order == 2
+
+
+def test_a_curve_sampled_unevenly_at_random_keeps_its_sparse_samples():
+    # an ellipse sampled 20 times more sparsely on its left half: the random gaps there cut it into
+    # groups smaller than a fit, 52 exact samples were left out as strays, 4 taken for a rim, and
+    # the solve read NaN at 15 of the cloud's own samples (a helper's review)
+    rng = np.random.default_rng(7)
+    t = rng.uniform(0, 2 * np.pi, 8000)
+    t = t[(np.cos(t) > 0) | (rng.uniform(size=8000) < 0.05)]
+    p = np.c_[0.6 * np.cos(t), 0.35 * np.sin(t)]
+    cloud = ts.surfaces.from_points(p)
+    # (a sample at the density step may still read as an end, here one: first order beside it)
+    assert cloud.report["outliers"] == 0 and cloud.report["rim_samples"] <= 1
+    sol = ts.solve(cloud, ts.Grid((-1, -1), (1, 1), (121, 121)), [(0.6, 0.0)])
+    assert sol.stats.order == 2 and np.all(np.isfinite(sol(p)))
+    # against the arclength from the source, both ways round
+    s = np.linspace(0, 2 * np.pi, 200001)
+    length = np.r_[0, np.cumsum(np.hypot(np.diff(0.6 * np.cos(s)), np.diff(0.35 * np.sin(s))))]
+    along = np.interp(np.mod(t, 2 * np.pi), s, length)
+    exact = np.minimum(along, length[-1] - along)
+    assert np.max(np.abs(sol(p) - exact)) < 0.1 * sol.grid.spacing
 
 
 def test_a_sparse_cloud_solves_without_a_false_gap_and_the_gap_note_names_the_sampling():

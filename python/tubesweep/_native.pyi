@@ -398,7 +398,11 @@ class PointCloud:
     def set_noise(self, noise: float) -> None: ...
     def mark_rim(self, gap: npt.NDArray[np.float64]) -> int: ...
     def isolated(
-        self, spacing: npt.NDArray[np.float64], median_radius: float, min_size: int
+        self,
+        spacing: npt.NDArray[np.float64],
+        radius: npt.NDArray[np.float64],
+        median_radius: float,
+        min_size: int,
     ) -> npt.NDArray[np.bool_]: ...
     def closest(
         self, points: npt.NDArray[np.float64], rho: float = 0.0, trust: float = 0.0

@@ -163,19 +163,21 @@ impl PyPointCloud {
     }
 
     /// Per sample, whether it lies in a group of fewer than `min_size` samples apart from the rest
-    /// (`tubesweep_core::surface::point_cloud::isolated`); `spacing` from `analyse`.
+    /// (`tubesweep_core::surface::point_cloud::isolated`); `spacing` and `radius` from `analyse`.
     fn isolated<'py>(
         &self,
         py: Python<'py>,
         spacing: PyReadonlyArray1<'py, f64>,
+        radius: PyReadonlyArray1<'py, f64>,
         median_radius: f64,
         min_size: usize,
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let s = c_slice(&spacing, "spacing")?;
+        let r = c_slice(&radius, "radius")?;
         let flags = py
             .detach(|| match &self.cloud {
-                Cloud::Two(c) => c.isolated(s, median_radius, min_size),
-                Cloud::Three(c) => c.isolated(s, median_radius, min_size),
+                Cloud::Two(c) => c.isolated(s, r, median_radius, min_size),
+                Cloud::Three(c) => c.isolated(s, r, median_radius, min_size),
             })
             .map_err(to_pyerr)?;
         Ok(flags.into_pyarray(py))

@@ -91,13 +91,17 @@ class CloudAdvice:
         self._creases_warned = grid
         at = ", ".join(f"{float(c):.4g}" for c in where)
         early = CREASE_SPACINGS * grid.spacing
+        strays, _ = getattr(self, "_strays", (0, None))
+        if 2 * strays >= count:
+            return  # (strays the outlier test kept: said by the errors they cause, _crease_advice)
         warnings.warn(
-            f"the cloud has sharp edges or corners ({count} samples that their fits miss, e.g. at ({at})): the local "
-            "fits round them off and the closest points bounce between the faces there, so a front arrives early by up "
-            f"to about {early:.3g} ({CREASE_SPACINGS:g}·Δx) for each edge it crosses (a noise-free box's edges and a "
-            "closed cylinder's rims at N = 61: 3.7–4.5Δx per edge at first order, 1.0–1.9Δx at second), first order in "
-            "Δx. Give such a surface as a mesh (from_mesh), whose creases run first order on a band cut at them; "
-            "cloud.crease_samples lists the samples",
+            f"the cloud has sharp edges or corners, or samples off its surface ({count} samples that their fits miss, "
+            f"e.g. at ({at}); cloud.crease_samples lists them). At an edge the local fits round it off and the closest "
+            f"points bounce between its faces, so a front arrives early by up to about {early:.3g} "
+            f"({CREASE_SPACINGS:g}·Δx) for each edge it crosses (a noise-free box's edges and a closed cylinder's rims "
+            "at N = 61: 3.7–4.5Δx per edge at first order, 1.0–1.9Δx at second), first order in Δx: give such a "
+            "surface as a mesh (from_mesh), whose creases run first order on a band cut at them. Samples off a smooth "
+            "surface (dents, scan artefacts) bend it only there: leave them out",
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )

@@ -301,7 +301,8 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         a = widen(a, p)
         # a few samples apart from the rest fit one another and pass the residual test; a group
         # smaller than one fit cannot be a piece of surface (tubesweep_core's point_cloud::isolated)
-        isolated = a.cloud.isolated(a.spacing, float(np.nanmedian(a.radius)), need)
+        radius = np.ascontiguousarray(a.radius, dtype=np.float64)
+        isolated = a.cloud.isolated(a.spacing, radius, float(np.nanmedian(radius)), need)
         bad = a.outliers(OUTLIER_RATIO) | isolated
         self.outliers = p[bad]
         if bad.any():

@@ -102,7 +102,7 @@ fn a_small_group_of_stray_samples_is_isolated_and_the_surface_is_not() {
     let mut r = a.radius.clone();
     r.sort_by(f64::total_cmp);
     let flags = cloud
-        .isolated(&a.spacing, r[r.len() / 2], DEFAULT_NEIGHBOURS + 2)
+        .isolated(&a.spacing, &a.radius, r[r.len() / 2], DEFAULT_NEIGHBOURS + 2)
         .unwrap();
     assert_eq!(flags.iter().filter(|&&f| f).count(), 3);
     assert!(flags[3000..].iter().all(|&f| f));
@@ -111,7 +111,9 @@ fn a_small_group_of_stray_samples_is_isolated_and_the_surface_is_not() {
     two.extend(sphere(2000, 0.5).iter().map(|q| [q[0] + 3.0, q[1], q[2]]));
     let cloud = PointCloud::new(two, DEFAULT_NEIGHBOURS).unwrap();
     let a = cloud.analyse();
-    let flags = cloud.isolated(&a.spacing, 0.0, DEFAULT_NEIGHBOURS + 2).unwrap();
+    let flags = cloud
+        .isolated(&a.spacing, &a.radius, 0.0, DEFAULT_NEIGHBOURS + 2)
+        .unwrap();
     assert!(flags.iter().all(|&f| !f));
 }
 
@@ -164,4 +166,36 @@ fn nearest_samples_are_the_sample_then_the_nearest_others() {
     assert!(cloud.nearest_samples(&which, 0).is_err());
     assert!(cloud.nearest_samples(&which, 401).is_err());
     assert!(cloud.nearest_samples(&[400], 3).is_err());
+}
+
+#[test]
+fn a_sparsely_sampled_stretch_of_a_curve_is_not_isolated_by_its_random_gaps() {
+    // an ellipse 0.6 × 0.35, its right half sampled 20 times more densely than its left, at
+    // random: the left half's gaps often exceed three times both neighbours' spacings, and its
+    // samples fell apart into groups smaller than a fit, taken for strays (a helper's review)
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut uniform = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut pts: Vec<[f64; 2]> = Vec::new();
+    while pts.len() < 4200 {
+        let t = uniform() * std::f64::consts::TAU;
+        if t.cos() > 0.0 || uniform() < 0.05 {
+            pts.push([0.6 * t.cos(), 0.35 * t.sin()]);
+        }
+    }
+    let cloud = PointCloud::new(pts, DEFAULT_NEIGHBOURS).unwrap();
+    let a = cloud.analyse();
+    let mut r = a.radius.clone();
+    r.sort_by(f64::total_cmp);
+    let median = r[r.len() / 2];
+    let need = DEFAULT_NEIGHBOURS + 2;
+    let with_radii = cloud.isolated(&a.spacing, &a.radius, median, need).unwrap();
+    assert_eq!(with_radii.iter().filter(|&&f| f).count(), 0);
+    // (by the spacings and the median radius alone, part of the sparse half is cut off)
+    let without = cloud.isolated(&a.spacing, &[], median, need).unwrap();
+    assert!(without.iter().filter(|&&f| f).count() > 10);
 }
