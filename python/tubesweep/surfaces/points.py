@@ -164,8 +164,9 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
     report : dict
         Samples given, repeated (or within ``NEAR_REPEAT`` of the fits' median radius of another),
         outliers, rim samples, the spacing (median distance to the
-        nearest sample), the density's range (the ratio of the 95th to the 5th percentile of the
-        fit's radius) and, after a solve, the band nodes whose closest point lies on the rim
+        nearest sample), the density's range (``density_ratio``: the 95th over the 5th percentile
+        of the fits' radii, to the power of the dimension; a part sparser than the rest that holds
+        under 5 % of the samples does not show in it) and, after a solve, the band nodes whose closest point lies on the rim
         (``rim_nodes``) and those whose closest point came from their nearest sample's fit, where
         the fits found none (``nearest_fit_nodes``: first order there at best, warned of above
         0.1 % of the band).
