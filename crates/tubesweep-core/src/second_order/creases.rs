@@ -215,12 +215,18 @@ fn widest_turn<const D: usize>(
     let mut widest = cos_min;
     for pair in band.neighbours_of(i).iter() {
         if pair[0] != sentinel && pair[1] != sentinel {
-            if let (Some(nm), Some(np)) = (normal(pair[0] as usize), normal(pair[1] as usize)) {
-                widest = widest.min((0..D).map(|c| nm[c] * np[c]).sum());
+            if let Some(cos) = cos_between(&normal, pair[0], pair[1]) {
+                widest = widest.min(cos);
             }
         }
     }
     widest
+}
+
+/// The cosine of the turn between the normals at nodes `p` and `q` (None where either has none).
+fn cos_between<const D: usize>(normal: &impl Fn(usize) -> Option<[f64; D]>, p: u32, q: u32) -> Option<f64> {
+    let (np, nq) = (normal(p as usize)?, normal(q as usize)?);
+    Some((0..D).map(|c| np[c] * nq[c]).sum())
 }
 
 /// [`widest_turn`] (`widest`) widened by the turns across node `i` between its diagonal
@@ -250,10 +256,8 @@ fn widest_turn_diagonally<const D: usize>(
                 // i + e_a + (side? −e_b : +e_b) against i − e_a + (side? +e_b : −e_b)
                 let p = step(here[a][1], b, 1 - side);
                 let q = step(here[a][0], b, side);
-                if let (Some(p), Some(q)) = (p, q) {
-                    if let (Some(np), Some(nq)) = (normal(p as usize), normal(q as usize)) {
-                        widest = widest.min((0..D).map(|c| np[c] * nq[c]).sum());
-                    }
+                if let Some(cos) = p.zip(q).and_then(|(p, q)| cos_between(&normal, p, q)) {
+                    widest = widest.min(cos);
                 }
             }
         }
