@@ -24,7 +24,9 @@ def test_samples_in_lines_are_named_and_more_neighbours_cure_them():
     pts = latitude_rings()
     # each fit's 20 nearest samples lie on one ring: more than half the samples looked like a rim
     # (a closed sphere taken for an open surface), with no word
-    with pytest.warns(RuntimeWarning, match=r"of the 19071 samples \(5\d%\) see their neighbours on one side only"):
+    with pytest.warns(
+        RuntimeWarning, match=r"of the 19071 samples \((5\d|[6-9]\d|100)%\) see their neighbours on one side only"
+    ):
         cloud = ts.surfaces.from_points(pts)
     assert cloud.report["rim_samples"] > 0.25 * len(pts)
     # the cure named: fits over 100 samples span several rings
@@ -50,3 +52,30 @@ def test_an_open_cloud_is_not_taken_for_lines():
     r, a = np.sqrt(rng.random(100)) * 0.1, rng.uniform(0, 2 * np.pi, 100)
     patch = ts.surfaces.from_points(np.c_[r * np.cos(a), r * np.sin(a), 0.2 * r**2])
     assert patch.report["rim_samples"] > 0.25 * 100
+
+
+def sliced_sphere(dz: float = 0.06, ds: float = 0.003) -> np.ndarray:
+    """The sphere of radius 0.5 scanned in slices ``dz`` apart (samples ``ds`` apart along them),
+    as a CT segmentation's contours are: nothing above the last slice (z = 0.49) nor below the
+    first (z = −0.47), caps of radius 0.10 and 0.17 left unsampled."""
+    out = []
+    for z in np.arange(-0.5 + dz / 2, 0.5, dz):
+        r = np.sqrt(0.25 - z * z)
+        t = np.arange(max(8, int(2 * np.pi * r / ds))) * 2 * np.pi / max(8, int(2 * np.pi * r / ds))
+        out.append(np.c_[r * np.cos(t), r * np.sin(t), np.full_like(t, z)])
+    return np.concatenate(out)
+
+
+def test_a_sliced_scan_with_unsampled_caps_solves_at_second_order():
+    # refused before ("cp returned NaN ... samples off their neighbours' surface"): a node on the
+    # axis of the last slice saw its ring's samples all at one distance, which weighed nothing,
+    # and the feet over the wider cap, 1.25 fits' radii from every sample, were taken as off the
+    # samples though the rim test bridged it. The caps are bridged by the fits now
+    pts = sliced_sphere()
+    cloud = ts.surfaces.from_points(pts, neighbours=100)  # (the test log fails on any warning)
+    assert cloud.report["rim_samples"] == 0
+    sol = ts.solve(cloud, cloud.grid(41), [(0.0, 0.0, 0.5)])
+    assert sol.stats.order == 2 and sol.stats.order_fallback is None
+    exact = 0.5 * np.arccos(np.clip(pts[:, 2] / 0.5, -1.0, 1.0))
+    err = np.abs(sol(pts) - exact) / sol.grid.spacing
+    assert np.mean(err) < 0.03 and np.max(err) < 0.15  # 0.015, 0.089

@@ -7,6 +7,8 @@ band of zeros reported as ``order=2``) and returns the paper's first-order schem
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -91,17 +93,21 @@ def test_a_cloud_with_samples_pulled_in_no_longer_creeps_into_zeros():
     # away and crept for 85 s into a band of zeros labelled order 2; then a converged second-order
     # solve under warnings of widened layers and a fold taken for facing sheets (feet that wandered
     # off the samples); now only the note of the samples that the fits miss, which an edge's and a
-    # dent's are alike (max error against the sphere 0.094, the dents included; order 1: 0.137)
+    # dent's are alike (max error against the sphere 0.094, the dents included; order 1: 0.137).
+    # Since feet up to 1.5 fits' radii from every sample count as on the samples (the caps a
+    # sliced scan leaves unsampled, tests/test_cloud_sampling.py), one node's closest point folds
+    # here and the extension layer is widened once, with its own warning (max error 0.093)
     x = np.random.default_rng(0).normal(size=(5000, 3))
     p = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
     p[:50] *= 0.97
     cloud = ts.surfaces.from_points(np.r_[p, [[-0.5, 0, 0]]])
     g = ts.Grid((-1.0,) * 3, (1.0,) * 3, (41,) * 3)
-    with pytest.warns(
-        RuntimeWarning, match=r"sharp edges or corners, or samples off its surface \(138 samples"
-    ) as said:
+    with pytest.warns(RuntimeWarning) as said:
         sol = ts.solve(cloud, g, [(-0.5, 0, 0)])
-    assert len(said) == 1
+    messages = sorted(str(w.message) for w in said)
+    assert len(messages) == 2
+    assert messages[0].startswith("1 inner-tube nodes had a neighbour outside the band with outer = 4.0")
+    assert re.match(r"the cloud has sharp edges or corners, or samples off its surface \(138 samples", messages[1])
     assert sol.stats.converged and sol.stats.order2["runaway_iteration"] is None and sol.stats.facing_pairs == 0
     q = np.random.default_rng(1).normal(size=(400, 3))
     q = 0.5 * q / np.linalg.norm(q, axis=1, keepdims=True)

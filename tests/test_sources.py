@@ -55,11 +55,15 @@ def test_the_sources_batched_fix_the_nodes_a_loop_over_them_fixes(speed):
 
 
 def test_a_source_whose_closest_point_is_not_defined_is_refused_by_name():
-    # a sphere of samples, the source at its centre: the fits find no surface there; the message
-    # said "is nan from the surface" (and a surface whose projection gave NaN passed the check)
+    # a sphere of samples, the source at its centre: the message said "is nan from the surface"
+    # (and a surface whose projection gave NaN passed the check); the fits found no surface there
+    # (every sample at one distance weighed nothing), and since they weigh alike, the centre's
+    # closest point lies among the samples, half the sphere's radius away
     x = np.random.default_rng(0).normal(size=(3000, 3))
     cloud = ts.surfaces.from_points(0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
-    with pytest.raises(ValueError, match=r"sources\[0\] = \(0\.0, 0\.0, 0\.0\) is far from the surface \(its closest"):
+    with pytest.raises(
+        ValueError, match=r"sources\[0\] = \(0\.0, 0\.0, 0\.0\) is 0\.5 from the surface, farther than the inner tube"
+    ):
         ts.solve(cloud, ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3), [(0.0, 0.0, 0.0)])
 
     class Undefined(ts.surfaces.Sphere):

@@ -75,6 +75,14 @@ const FARTHER_FOOT: f64 = 0.02;
 /// ... (without the noise a scan's noise of 0.3Δx set the check off at most nodes of a sphere, for
 /// 1.7 times the band's set-up time).
 const NOISY_FOOT: f64 = 3.0;
+/// A foot farther than this many times [`PointCloud::reach`] from every sample lies off the
+/// samples. The rim test bridges a hole whose far side a probe at up to twice the reach finds
+/// within half that distance ([`PointCloud::bridged_gap`]): its middle lies up to 1.5 reaches
+/// from the samples.
+const BRIDGED_REACH: f64 = 1.5;
+/// A neighbourhood whose samples all lie at its radius from the centre (ties) reaches this
+/// fraction farther ([`PointCloud::neighbourhood`]).
+const TIED_RADIUS: f64 = 1e-6;
 /// Queries per block of [`PointCloud::closest_points`].
 const BLOCK: usize = 256;
 /// Iterations of the fixed point c ← foot(x; fit at c).
@@ -309,8 +317,10 @@ impl<const D: usize> PointCloud<D> {
                             .enumerate()
                             .filter_map(|(j, o)| {
                                 let (a, w) = fit.local(o);
-                                (j < own.len() || on_graph(&fit, &a, w, (ANOTHER_SHEET * distance(o, p)).max(noise)))
-                                    .then_some(a)
+                                (j < own.len()
+                                    || (distance(o, p) <= 0.5 * bridge
+                                        && on_graph(&fit, &a, w, (ANOTHER_SHEET * distance(o, p)).max(noise))))
+                                .then_some(a)
                             })
                             .collect();
                         let around = if D == 2 { beyond_ends(&ap, around) } else { around };
@@ -483,6 +493,12 @@ impl<const D: usize> PointCloud<D> {
                 break;
             }
         }
+        // samples tied at the radius (c on the axis of a ring of samples: a sliced scan's last
+        // slice around its unsampled cap) would all weigh nothing and leave no fit: the radius
+        // then reaches just past them, so that they weigh alike
+        if radius > rho && cache.points.iter().filter(|e| e.0 < radius).count() <= basis_len(D) {
+            radius *= 1.0 + TIED_RADIUS;
+        }
         out.clear();
         let mut rim = false;
         for e in cache.points.iter().filter(|e| e.0 < radius) {
@@ -496,7 +512,8 @@ impl<const D: usize> PointCloud<D> {
     /// point), with a cache of candidate neighbours shared by nearby queries. The answer is the
     /// fixed point to [`TOLERANCE`], whatever the start near it.
     ///
-    /// Every point of the surface lies within `reach` of a sample. Far from the samples the fit
+    /// Every point of the surface lies within `reach` of a sample, or [`BRIDGED_REACH`] times that
+    /// over a hole the rim test bridges. Far from the samples the fit
     /// around c spans a wide cap and can hold a fixed point of its own off the samples (a noisy
     /// sphere's: feet 0.12–0.23 off it, a quarter of the radius, three times the reach, which put
     /// nodes far outside into the inner tube and ended the solve after a minute of widened
@@ -567,7 +584,7 @@ impl<const D: usize> PointCloud<D> {
     }
 
     /// The fixed point c ← the projection of `x` onto the fit centred at c, from `start`, and
-    /// whether its foot lies farther than `reach` from every sample (the last neighbourhood bounds
+    /// whether its foot lies farther than [`BRIDGED_REACH`] times `reach` from every sample (the last neighbourhood bounds
     /// that distance from above; only past the bound is the tree asked), and whether its fit
     /// blends two sheets (a foot in a hole of its samples, [`BLENDED_HOLE`]: midway between the turns of a
     /// spiral 8 spacings apart, the graph through both turns' samples held a node 4 spacings from
@@ -612,7 +629,7 @@ impl<const D: usize> PointCloud<D> {
         }
         let bound = nb.iter().map(|s| distance(s, &foot)).fold(f64::INFINITY, f64::min);
         let nearest = || self.tree.nearest_one::<SquaredEuclidean>(&foot).distance.sqrt();
-        let off_samples = bound > self.reach && nearest() > self.reach;
+        let off_samples = bound > BRIDGED_REACH * self.reach && nearest() > BRIDGED_REACH * self.reach;
         let blended = !off_samples && bound > BLENDED_HOLE * last_radius && nearest() > BLENDED_HOLE * last_radius;
         (
             foot,

@@ -199,3 +199,62 @@ fn a_sparsely_sampled_stretch_of_a_curve_is_not_isolated_by_its_random_gaps() {
     let without = cloud.isolated(&a.spacing, &[], median, need).unwrap();
     assert!(without.iter().filter(|&&f| f).count() > 10);
 }
+
+/// A sphere of radius 0.5 sampled on circles of latitude `dz` apart (`ds` apart along them),
+/// the slices of a scan, with no sample above the last slice nor below the first (its caps).
+fn sliced_sphere(dz: f64, ds: f64) -> Vec<[f64; 3]> {
+    let mut pts = Vec::new();
+    let mut z = -0.5 + 0.5 * dz;
+    while z < 0.5 {
+        let r = (0.25 - z * z).sqrt();
+        let m = ((std::f64::consts::TAU * r / ds) as usize).max(8);
+        for i in 0..m {
+            let t = std::f64::consts::TAU * i as f64 / m as f64;
+            pts.push([r * t.cos(), r * t.sin(), z]);
+        }
+        z += dz;
+    }
+    pts
+}
+
+#[test]
+fn a_point_on_the_axis_of_a_ring_of_samples_has_a_closest_point() {
+    // slices 0.06 apart, the last at z = 0.49 (a ring of radius 0.0995 around the unsampled
+    // cap): every sample of that ring lies at the same distance from a point on its axis, and
+    // their fit weighed them all zero and failed (NaN, which refused the cloud's solve)
+    let cloud = PointCloud::new(sliced_sphere(0.06, 0.003), 100).unwrap();
+    for z in [0.5, 0.52] {
+        let (c, f) = cloud.closest_point(&[0.0, 0.0, z], 0.0);
+        assert_eq!(f, Foot::Interior, "at z = {z}");
+        // the cap is bridged by the fits over the last slices (flat to within 1e-3)
+        assert!(distance(&c, &[0.0, 0.0, 0.49]) < 1e-3, "{c:?}");
+    }
+}
+
+#[test]
+fn a_cap_left_unsampled_within_one_and_a_half_reaches_is_bridged_a_wider_one_is_a_rim() {
+    // the first slice at z = -0.47 rings a cap of radius 0.17, 1.25 times the widest fit (0.136
+    // over 100 neighbours): its middle is found on the fits' bridge (before, a foot that far from
+    // every sample was taken as off the samples and projected onto a ring sample's own fit,
+    // folding the closest points)
+    let mut cloud = PointCloud::new(sliced_sphere(0.06, 0.003), 100).unwrap();
+    let a = cloud.analyse();
+    assert_eq!(cloud.mark_rim(&a.gap).unwrap(), 0);
+    let reach = cloud.reach();
+    assert!(0.17 > reach && 0.17 < BRIDGED_REACH * reach, "{reach}");
+    let (c, f) = cloud.closest_point(&[0.01, 0.0, -0.5], 0.0);
+    assert_eq!(f, Foot::Interior);
+    assert!(distance(&c, &[0.01, 0.0, -0.47]) < 2e-3, "{c:?}");
+    // slices only within |z| ≤ 0.4: caps of radius 0.3, over twice the reach, are rims (the
+    // nearest samples around a last slice's sample, along its own ring, hid the cap: the ring's
+    // far samples, beyond the reach, no longer close the gap)
+    let pts: Vec<[f64; 3]> = sliced_sphere(0.06, 0.003)
+        .into_iter()
+        .filter(|p| p[2].abs() <= 0.4)
+        .collect();
+    let mut cloud = PointCloud::new(pts.clone(), 100).unwrap();
+    let a = cloud.analyse();
+    let rim = cloud.mark_rim(&a.gap).unwrap();
+    let last = pts.iter().filter(|p| p[2].abs() > 0.34).count();
+    assert_eq!(rim, last, "{rim} of {last}");
+}
