@@ -682,17 +682,19 @@ impl<const D: usize> PointCloud<D> {
     }
 
     /// A lower bound of the distance from each point to the surface: the distance to the nearest
-    /// sample less [`PointCloud::reach`] (for the coarse-to-fine band search).
+    /// sample less [`BRIDGED_REACH`] times [`PointCloud::reach`] (for the coarse-to-fine band
+    /// search: the fits' bridge over a hole lies that far from the samples).
     pub fn distance_lower_bounds(&self, x: &[[f64; D]]) -> Vec<f64> {
         x.par_iter()
             .map(|p| {
                 let n = self.tree.nearest_one::<SquaredEuclidean>(p);
-                (n.distance.sqrt() - self.reach).max(0.0)
+                (n.distance.sqrt() - BRIDGED_REACH * self.reach).max(0.0)
             })
             .collect()
     }
 
-    /// An upper bound of the distance from a point of the surface to its nearest sample.
+    /// The widest fit's radius: an upper bound of the distance from a point of the surface to
+    /// its nearest sample, but over a hole the rim test bridges ([`BRIDGED_REACH`] times it).
     pub fn reach(&self) -> f64 {
         self.reach
     }
