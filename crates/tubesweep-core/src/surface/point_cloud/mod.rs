@@ -310,7 +310,9 @@ impl<const D: usize> PointCloud<D> {
                         let residual = distance(&fit.lift(&a), p) / fit.radius;
                         let (ap, _) = fit.local(p);
                         // the fit's own neighbours, and those beyond near its graph: samples of
-                        // another sheet close by (the next turn past a spiral's end) fill no gap
+                        // another sheet close by (the next turn past a spiral's end) fill no gap,
+                        // nor do those beyond half the bridge (the widest fit's radius: around a
+                        // sliced scan's last slice, the far side of its own ring hid the cap)
                         let noise = NOISE_MARGIN * fit.misfit(own, p, radius);
                         let around: Vec<[f64; 2]> = others
                             .iter()
@@ -584,8 +586,9 @@ impl<const D: usize> PointCloud<D> {
     }
 
     /// The fixed point c ← the projection of `x` onto the fit centred at c, from `start`, and
-    /// whether its foot lies farther than [`BRIDGED_REACH`] times `reach` from every sample (the last neighbourhood bounds
-    /// that distance from above; only past the bound is the tree asked), and whether its fit
+    /// whether its foot lies farther than [`BRIDGED_REACH`] times `reach` from every sample (the
+    /// last neighbourhood bounds that distance from above; only past the bound is the tree
+    /// asked), and whether its fit
     /// blends two sheets (a foot in a hole of its samples, [`BLENDED_HOLE`]: midway between the turns of a
     /// spiral 8 spacings apart, the graph through both turns' samples held a node 4 spacings from
     /// either at 0.15 spacings from its "surface"), and the last neighbourhood's radius.
