@@ -40,6 +40,12 @@ def how_far(distance: float) -> str:
     return f"is {distance:.4g} from the surface"
 
 
+def beyond_inner_tube(label: str, point: Any, distance: float) -> str:
+    """The start of the messages that refuse a point off the surface: ``"label = (x, y, z) is d
+    from the surface, farther than the inner tube"`` (each message goes on with its own cure)."""
+    return f"{label} = {tuple(float(c) for c in point)} {how_far(float(distance))}, farther than the inner tube"
+
+
 def check_on_surface(sources: np.ndarray, dist: np.ndarray, inner_width: float) -> None:
     """Refuses a source farther from the surface than the inner tube (``dist``: the sources'
     distances to their closest points, ``inner_width``: inner·Δx)."""
@@ -48,8 +54,8 @@ def check_on_surface(sources: np.ndarray, dist: np.ndarray, inner_width: float) 
     if far.size:
         i = int(far[0])
         raise ValueError(
-            f"sources[{i}] = {tuple(float(x) for x in sources[i])} {how_far(float(dist[i]))}, farther than the inner "
-            f"tube (inner·Δx = {inner_width:.4g}); put the source on the surface or increase `inner`"
+            f"{beyond_inner_tube(f'sources[{i}]', sources[i], dist[i])} (inner·Δx = {inner_width:.4g}); put the source "
+            "on the surface or increase `inner`"
         )
 
 

@@ -22,7 +22,7 @@ from typing import Any, Callable, Dict, Optional, Tuple, Union
 
 import numpy as np
 
-from ._sources import how_far
+from ._sources import beyond_inner_tube
 from ._warn import user_stacklevel
 from ._validate import as_points, check_flag
 from .many import check_many_progress
@@ -71,8 +71,7 @@ def snap_to_surface(tube: Tube, points: Any, name: str = "points") -> np.ndarray
     if bad.size:
         i = int(bad[0])
         raise ValueError(
-            f"{name}[{i}] = {tuple(float(x) for x in p[i])} {how_far(float(dist[i]))}, farther than the "
-            f"inner tube (inner·Δx = {limit:.4g}){f' ({bad.size} points in all)' if bad.size > 1 else ''}: points must "
+            f"{beyond_inner_tube(f'{name}[{i}]', p[i], dist[i])} (inner·Δx = {limit:.4g}){f' ({bad.size} points in all)' if bad.size > 1 else ''}: points must "
             "lie on the surface (they are snapped to it from within the inner tube); move them onto it"
         )
     return np.ascontiguousarray(proj, dtype=float)

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any, List, Optional, Tuple
 import numpy as np
 
 from ._validate import as_points
-from ._sources import SOURCE_RADIUS, how_far
+from ._sources import SOURCE_RADIUS, beyond_inner_tube
 from ._warn import user_stacklevel
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -261,8 +261,8 @@ def trace_paths(
     if far.size:
         i = int(far[0])
         raise ValueError(
-            f"starts[{i}] = {tuple(float(v) for v in p[i])} {how_far(float(dist[i]))}, farther than the "
-            f"inner tube ({sol.inner:g} grid spacings = {sol.inner * h:.4g}); start the path on the surface"
+            f"{beyond_inner_tube(f'starts[{i}]', p[i], dist[i])} ({sol.inner:g} grid spacings = {sol.inner * h:.4g}); "
+            "start the path on the surface"
         )
     u = sol(x)
     for i in np.flatnonzero(~np.isfinite(u)):  # type: ignore[assignment]

@@ -29,7 +29,7 @@ from .mask import mask_advice
 from .moving import values_checksum
 from ._stagnation import fallback_message
 from ._warn import user_stacklevel
-from ._sources import how_far
+from ._sources import beyond_inner_tube
 from ._validate import (
     FRONT_WINDOW,
     check_threads as _threads,
@@ -355,9 +355,8 @@ def source_feet(
     for i, (dd, s) in enumerate(zip(dist, src)):
         if not dd <= inner_width * (1 + 1e-6):
             raise ValueError(
-                f"{names[i] if names else f'sources[{i}]'} = {tuple(float(c) for c in s)} {how_far(dd)}, "
-                f"farther than the inner tube (inner·Δx = {inner_width:.4g}); put the source on the surface or increase "
-                "`inner`"
+                f"{beyond_inner_tube(names[i] if names else f'sources[{i}]', s, dd)} (inner·Δx = {inner_width:.4g}); "
+                "put the source on the surface or increase `inner`"
             )
     h = grid.spacing
     # a source given on the surface is kept as given (its foot point differs by rounding only)
