@@ -4,7 +4,7 @@ source (docs/source-initialisation.md)."""
 from __future__ import annotations
 
 import warnings
-from typing import Any, Callable, Tuple
+from typing import Any, Callable, List, Optional, Tuple
 
 import numpy as np
 
@@ -46,15 +46,18 @@ def beyond_inner_tube(label: str, point: Any, distance: float) -> str:
     return f"{label} = {tuple(float(c) for c in point)} {how_far(float(distance))}, farther than the inner tube"
 
 
-def check_on_surface(sources: np.ndarray, dist: np.ndarray, inner_width: float) -> None:
+def check_on_surface(
+    sources: np.ndarray, dist: np.ndarray, inner_width: float, names: Optional[List[str]] = None
+) -> None:
     """Refuses a source farther from the surface than the inner tube (``dist``: the sources'
-    distances to their closest points, ``inner_width``: inner·Δx)."""
+    distances to their closest points, ``inner_width``: inner·Δx; ``names[i]`` names source i in
+    the message, ``sources[i]`` by default)."""
     # (NaN too: a closest point the surface could not give)
     far = np.flatnonzero(~(np.asarray(dist, dtype=float) <= inner_width * (1 + 1e-6)))
     if far.size:
         i = int(far[0])
         raise ValueError(
-            f"{beyond_inner_tube(f'sources[{i}]', sources[i], dist[i])} (inner·Δx = {inner_width:.4g}); put the source "
+            f"{beyond_inner_tube(names[i] if names else f'sources[{i}]', sources[i], dist[i])} (inner·Δx = {inner_width:.4g}); put the source "
             "on the surface or increase `inner`"
         )
 

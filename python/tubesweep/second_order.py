@@ -29,7 +29,7 @@ from .mask import mask_advice
 from .moving import values_checksum
 from ._stagnation import fallback_message
 from ._warn import user_stacklevel
-from ._sources import beyond_inner_tube
+from ._sources import check_on_surface
 from ._validate import (
     FRONT_WINDOW,
     check_threads as _threads,
@@ -352,12 +352,7 @@ def source_feet(
     """The sources' foot points on the surface and the slowness at each; a source farther from
     the surface than the inner tube is refused (``names[i]`` names source i in the message)."""
     dist, proj = surf.project(src, grid)
-    for i, (dd, s) in enumerate(zip(dist, src)):
-        if not dd <= inner_width * (1 + 1e-6):
-            raise ValueError(
-                f"{beyond_inner_tube(names[i] if names else f'sources[{i}]', s, dd)} (inner·Δx = {inner_width:.4g}); "
-                "put the source on the surface or increase `inner`"
-            )
+    check_on_surface(src, dist, inner_width, names)
     h = grid.spacing
     # a source given on the surface is kept as given (its foot point differs by rounding only)
     on = np.linalg.norm(proj - src, axis=1) <= 1e-9 * h

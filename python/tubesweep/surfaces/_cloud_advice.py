@@ -55,22 +55,34 @@ class CloudAdvice:
         ratio = self._sparsest_fit / self._median_fit
         return ratio if ratio > UNEVEN_FITS else None
 
+    def _said_creases(self) -> Optional[str]:
+        """Where the cloud's sharp edges are named, ``"x, y, z"`` of one of their samples, or None
+        when it has none (:data:`CREASE_SHARE`)."""
+        count, where = self._creases
+        if count <= CREASE_SHARE * len(self.points) or where is None:
+            return None
+        return _where(where)
+
+    def _mostly_strays(self) -> bool:
+        """Most of the samples that their fits miss lie far from every other (:data:`STRAY_SPACINGS`)."""
+        strays, stray = getattr(self, "_strays", (0, None))
+        return stray is not None and 2 * strays >= self._creases[0]
+
     def _crease_advice(self) -> str:
         """The cloud's sharp edges and their cure, or "" when it has none (:data:`CREASE_SHARE`);
         strays first where most of those samples lie far from every other (:data:`STRAY_SPACINGS`)."""
-        count, where = self._creases
-        if count <= CREASE_SHARE * len(self.points) or where is None:
+        at = self._said_creases()
+        if at is None:
             return ""
-        strays, stray = getattr(self, "_strays", (0, None))
-        if stray is not None and 2 * strays >= count:
-            at = ", ".join(f"{float(c):.4g}" for c in stray)
+        count = self._creases[0]
+        if self._mostly_strays():
+            strays, stray = self._strays
             return (
                 f"{strays} of the {count} samples that their fits miss lie more than {STRAY_SPACINGS:g} times the "
-                f"median spacing from every other sample (e.g. at ({at})): stray points off the surface that the "
+                f"median spacing from every other sample (e.g. at ({_where(stray)})): stray points off the surface that the "
                 "outlier test kept. Leave them out (cloud.crease_samples lists the samples their fits miss); if the "
                 "surface has sharp edges there instead, give it as a mesh (from_mesh)"
             )
-        at = ", ".join(f"{float(c):.4g}" for c in where)
         return (
             f"the cloud has sharp edges or corners ({count} samples that their fits miss, e.g. at ({at})), which the "
             f"local fits (about {self._median_fit:.2g} across) cannot follow: the closest points bounce between the "
@@ -85,15 +97,14 @@ class CloudAdvice:
         with how early a front arrives beyond them (:data:`CREASE_SPACINGS`): named before only
         when a solve failed or its closest points were not found (a box), and a closed cylinder's
         cloud was 3.8 spacings short at second order, 7.4 at first, with no word of it."""
-        count, where = self._creases
-        if count <= CREASE_SHARE * len(self.points) or where is None or getattr(self, "_creases_warned", None) == grid:
+        at = self._said_creases()
+        if at is None or getattr(self, "_creases_warned", None) == grid:
             return
         self._creases_warned = grid
-        at = ", ".join(f"{float(c):.4g}" for c in where)
-        early = CREASE_SPACINGS * grid.spacing
-        strays, _ = getattr(self, "_strays", (0, None))
-        if 2 * strays >= count:
+        if self._mostly_strays():
             return  # (strays the outlier test kept: said by the errors they cause, _crease_advice)
+        count = self._creases[0]
+        early = CREASE_SPACINGS * grid.spacing
         warnings.warn(
             f"the cloud has sharp edges or corners, or samples off its surface ({count} samples that their fits miss, "
             f"e.g. at ({at}); cloud.crease_samples lists them). At an edge the local fits round it off and the closest "
@@ -184,6 +195,11 @@ class CloudAdvice:
             )
         crease = self._crease_advice()
         return f"{crease}; or {advice}" if crease else advice
+
+
+def _where(point: Any) -> str:
+    """A sample's coordinates for a message: ``"x, y, z"`` to four digits."""
+    return ", ".join(f"{float(c):.4g}" for c in point)
 
 
 def sentence(text: str) -> str:

@@ -319,9 +319,9 @@ impl<const D: usize> PointCloud<D> {
                             .enumerate()
                             .filter_map(|(j, o)| {
                                 let (a, w) = fit.local(o);
+                                let d = distance(o, p);
                                 (j < own.len()
-                                    || (distance(o, p) <= 0.5 * bridge
-                                        && on_graph(&fit, &a, w, (ANOTHER_SHEET * distance(o, p)).max(noise))))
+                                    || (d <= 0.5 * bridge && on_graph(&fit, &a, w, (ANOTHER_SHEET * d).max(noise))))
                                 .then_some(a)
                             })
                             .collect();
@@ -495,17 +495,21 @@ impl<const D: usize> PointCloud<D> {
                 break;
             }
         }
-        // samples tied at the radius (c on the axis of a ring of samples: a sliced scan's last
-        // slice around its unsampled cap) would all weigh nothing and leave no fit: the radius
-        // then reaches just past them, so that they weigh alike
-        if radius > rho && cache.points.iter().filter(|e| e.0 < radius).count() <= basis_len(D) {
-            radius *= 1.0 + TIED_RADIUS;
-        }
-        out.clear();
         let mut rim = false;
-        for e in cache.points.iter().filter(|e| e.0 < radius) {
-            out.push(self.points[e.1 as usize]);
-            rim |= self.rim_zone[e.1 as usize];
+        for tied in [false, true] {
+            out.clear();
+            rim = false;
+            for e in cache.points.iter().filter(|e| e.0 < radius) {
+                out.push(self.points[e.1 as usize]);
+                rim |= self.rim_zone[e.1 as usize];
+            }
+            // samples tied at the radius (c on the axis of a ring of samples: a sliced scan's last
+            // slice around its unsampled cap) would all weigh nothing and leave no fit: the radius
+            // then reaches just past them, so that they weigh alike
+            if tied || radius <= rho || out.len() > basis_len(D) {
+                break;
+            }
+            radius *= 1.0 + TIED_RADIUS;
         }
         (radius, rim)
     }
