@@ -370,12 +370,12 @@ def test_front_window_surfaces_bench_runs_and_the_window_keeps_the_solutions(cap
     solutions agree to far below the tolerance's scale, and the window is left at its default."""
     import front_window_surfaces
 
-    default = sys.modules["tubesweep.solve"].FRONT_WINDOW
+    default = sys.modules["tubesweep._first_order"].FRONT_WINDOW
     assert front_window_surfaces.main(["--n", "41", "--repeats", "1"]) == 0
     rows = [line for line in capsys.readouterr().out.splitlines()[2:] if line.strip()]
     assert [r.split()[0] for r in rows] == list(front_window_surfaces.NAMES)
     assert all(float(r.split()[-1]) < 1e-9 for r in rows)
-    assert sys.modules["tubesweep.solve"].FRONT_WINDOW == default
+    assert sys.modules["tubesweep._first_order"].FRONT_WINDOW == default
 
 
 def test_oblique_planes_bench_axis_aligned_surfaces_settle_at_once_and_tilted_ones_do_not():

@@ -25,7 +25,7 @@ import tubesweep as ts
 def whole_band_sweeps() -> None:
     """Switches the front window off (``FRONT_WINDOW`` of ``tubesweep/_validate.py``, read by
     ``ts.solve``) for the rest of this process."""
-    sys.modules["tubesweep.solve"].FRONT_WINDOW = 0.0  # type: ignore[attr-defined]
+    sys.modules["tubesweep._first_order"].FRONT_WINDOW = 0.0  # type: ignore[attr-defined]
 
 
 def residual_by_angle(n: int) -> None:

@@ -46,7 +46,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--windows", help="comma-separated values of FRONT_WINDOW to compare (default: its default)")
     a = ap.parse_args(argv)
     warnings.simplefilter("ignore")
-    solve_module = sys.modules["tubesweep.solve"]
+    solve_module = sys.modules["tubesweep._first_order"]
     default = solve_module.FRONT_WINDOW
     windows = [float(w) for w in a.windows.split(",")] if a.windows else [default]
     print(

@@ -9,7 +9,7 @@ Usage::
 
 Sections:
 
-* ``disc``: a disc smaller than a grid cell (``solve._check_surface_spans_two_cells`` off): the
+* ``disc``: a disc smaller than a grid cell (``_prepare._check_surface_spans_two_cells`` off): the
   distance across the disc against the exact ``√2·r``;
 * ``metric``: ``Metric(1e30·I)`` with the default ``tol`` (the Hamiltonian's tolerance check
   off): iterations, the share of the band left unreached, and whether it reported convergence;
@@ -43,10 +43,11 @@ import numpy as np  # noqa: E402
 
 import tubesweep as ts  # noqa: E402
 
-# the modules themselves (``tubesweep.solve`` the attribute is the function)
-euclidean, geodesic_paths, hamiltonians, redistance, solve = (
+# the modules themselves (``tubesweep.solve`` the attribute is the function; the tube's checks
+# live in ``_prepare``)
+euclidean, geodesic_paths, hamiltonian_solve, redistance, prepare = (
     importlib.import_module(f"tubesweep.{m}")
-    for m in ("euclidean", "geodesic_paths", "hamiltonians", "redistance", "solve")
+    for m in ("euclidean", "geodesic_paths", "_hamiltonian_solve", "redistance", "_prepare")
 )
 
 SPOT = ts.data.spot()
@@ -70,7 +71,7 @@ def disc() -> None:
     grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
     h = grid.spacing
     print("disc (check off): r/h  u(0, r, 0)  exact √2·r  relative error")
-    with patched(solve, "_check_surface_spans_two_cells", lambda *a: None):
+    with patched(prepare, "_check_surface_spans_two_cells", lambda *a: None):
         for k in (0.02, 0.5, 1.0, 2.0):
             r = k * h
             u = ts.solve(ts.surfaces.Disc(radius=r), grid, [(r, 0, 0), (-r, 0, 0)], order=1)([(0, r, 0)])[0]
@@ -79,7 +80,7 @@ def disc() -> None:
 
 def metric() -> None:
     grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
-    with patched(hamiltonians, "check_tolerance_scale", lambda *a, **k: None):
+    with patched(hamiltonian_solve, "check_tolerance_scale", lambda *a, **k: None):
         sol = ts.solve(
             ts.surfaces.Sphere(0.5), grid, [(-0.5, 0, 0)], hamiltonian=ts.hamiltonians.Metric(1e30 * np.eye(3))
         )
@@ -139,7 +140,7 @@ def retry(rounds: int) -> None:
 def sharp_box(sizes: tuple, rounds: int) -> None:
     """The box's |x|_∞ − 0.5 re-distanced, source at the top face's centre: the nodes next to its
     edges cannot be projected onto the zero level set, so the inner tube lacks neighbours. With
-    the early stop patched out (``solve._lacking_neighbours`` made to report new nodes at every
+    the early stop patched out (``_prepare._lacking_neighbours`` made to report new nodes at every
     widening, as before the stop) the solve widens the layer four times before its error; now it
     stops at the first widening that brings none of them in. The two alternate, ``rounds`` times;
     the medians of the time to the error and their ratio are printed."""
@@ -156,8 +157,8 @@ def sharp_box(sizes: tuple, rounds: int) -> None:
         times: dict = {"widening to the end": [], "now": []}
         outcome: dict = {}
         for _ in range(rounds):
-            for label, patch in (("widening to the end", fresh), ("now", solve._lacking_neighbours)):
-                with patched(solve, "_lacking_neighbours", patch), warnings.catch_warnings():
+            for label, patch in (("widening to the end", fresh), ("now", prepare._lacking_neighbours)):
+                with patched(prepare, "_lacking_neighbours", patch), warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     t = time.perf_counter()
                     try:

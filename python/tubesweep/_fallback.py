@@ -40,7 +40,7 @@ from .surface import LevelSet
 from .mask import ROUGH_REDISTANCED
 from .surfaces._mesh_parts import open_only_in_debris
 from ._warn import user_stacklevel
-from .second_order import NOISY_PHI, NOT_A_DISTANCE, NarrowExtension, Order2NotApplicable, warn_fallback
+from .second_order import NOISY_PHI, NOT_A_DISTANCE, NarrowExtension, OptionOfOrder1, Order2NotApplicable, warn_fallback
 
 #: The first-order scheme's error where fronts meet, in grid spacings (the sphere's antipode:
 #: 2.7–3.1Δx at N = 12–20).
@@ -208,11 +208,19 @@ class Fallback:
     #: the creases of a re-distanced φ that its kinks hide from the crease tests, found through a
     #: smoothing (``_coarse_creases.paper_creases``; :meth:`measure`): ``sol.stats.creases``
     creases: Optional[Dict[str, Any]] = None
+    #: an option only the first-order scheme has (``second_order.OptionOfOrder1``): the caller chose
+    #: that scheme, whose tube is the paper's (not thinned at creases)
+    option_of_order1: bool = False
 
     @classmethod
     def of(cls, refusal: Order2NotApplicable, order: Any) -> "Fallback":
         """The fallback for ``refusal``, warned about now when the refusal's kind asks for it."""
-        return cls(str(refusal), warn_fallback(refusal, order), narrow=isinstance(refusal, NarrowExtension))
+        return cls(
+            str(refusal),
+            warn_fallback(refusal, order),
+            narrow=isinstance(refusal, NarrowExtension),
+            option_of_order1=isinstance(refusal, OptionOfOrder1),
+        )
 
     def measure(self, tube: Any) -> None:
         """Reads the mean ``|∇φ|`` that :meth:`warn` needs from ``tube`` before the solve, which

@@ -12,6 +12,7 @@ from .grid import Grid
 from .surface import Surface
 from ._prepare import ROLE_INNER
 from ._warn import user_stacklevel
+from ._validate import checked_point_speeds, speed_at_points
 
 #: With ``source_init="exact"``, inner-tube nodes whose closest point lies within this many grid
 #: spacings of a source are fixed to the exact local distance ``|cp(x) − x_s|`` times the mean
@@ -60,6 +61,24 @@ def check_on_surface(
             f"{beyond_inner_tube(names[i] if names else f'sources[{i}]', sources[i], dist[i])} (inner·Δx = {inner_width:.4g}); put the source "
             "on the surface or increase `inner`"
         )
+
+
+def slowness_on_surface(speed: Any, grid: Grid) -> Callable[[np.ndarray], np.ndarray]:
+    """The slowness at points on the surface (a source, the closest points of the nodes near it)
+    for the exact initialisation: a callable speed evaluated there, a constant one inverted, an
+    array interpolated."""
+
+    def at(p: np.ndarray) -> np.ndarray:
+        if callable(speed):
+            return 1.0 / speed_at_points(speed, p, "a source or the closest point of a node near it")
+        if np.ndim(speed) == 0:
+            return np.full(len(p), 1.0 / float(speed))
+        from .euclidean import _interp_dense
+
+        f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
+        return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
+
+    return at
 
 
 def _fix_sources(

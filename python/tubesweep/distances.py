@@ -27,7 +27,7 @@ from ._warn import user_stacklevel
 from ._validate import as_points, check_flag
 from .many import check_many_progress
 from ._prepare import ROLE_INNER
-from .solve import _check_order
+from .second_order import check_order
 from .tube import Tube
 
 __all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]
@@ -272,7 +272,7 @@ def farthest_point_sampling(
     """
     if not (isinstance(k, (int, np.integer)) and not isinstance(k, bool) and k >= 1):
         raise ValueError(f"k must be a positive whole number of points; got {k!r}")
-    order = _check_order(order)
+    order = check_order(order)
     check_many_progress(progress)  # before the first solve
     tube = _as_tube(surface, grid, inner, outer)
     t = tube._tube

@@ -28,8 +28,6 @@ from ._validate import (
     check_tolerance,
     check_tolerance_scale,
     first_order_tol,
-    checked_point_speeds,
-    speed_at_points,
     speed_on_surface,
 )
 from ._creases import warn_paper_tube_creases
@@ -38,10 +36,11 @@ from ._prepare import ROLE_INNER, paper_creases_of, thinned_count, uncut_band, w
 from ._parts import drop_unsourced_rows
 from ._sheet_readout import own_side_plan
 from ._fallback import Fallback
-from ._sources import SOURCE_RADIUS, _fix_sources
+from ._sources import SOURCE_RADIUS, _fix_sources, slowness_on_surface
 from .many_order2 import renamed, solve_many_order2
 from . import second_order as so
-from .solve import _check_order, _check_source_init, _resolve_scheme
+from ._request import check_source_init, resolve_scheme
+from .second_order import check_order
 
 if TYPE_CHECKING:  # pragma: no cover
     from .tube import Tube
@@ -81,22 +80,6 @@ def _non_empty(groups: List[np.ndarray]) -> List[np.ndarray]:
     return groups
 
 
-def _slowness_at(speed: Any, grid: Any) -> Callable[[np.ndarray], np.ndarray]:
-    """The slowness at points (a source, the closest points near it), as ``ts.solve`` takes it."""
-
-    def at(p: np.ndarray) -> np.ndarray:
-        if callable(speed):
-            return 1.0 / speed_at_points(speed, p, "a source or the closest point of a node near it")
-        if np.ndim(speed) == 0:
-            return np.full(len(p), 1.0 / float(speed))
-        from .euclidean import _interp_dense
-
-        f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
-        return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
-
-    return at
-
-
 def fixed_nodes(
     tube: "Tube", groups: List[np.ndarray], speed: Any, source_init: str, uncut: Any = None, order: Any = 1
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -108,7 +91,7 @@ def fixed_nodes(
     band, connected = (uncut, False) if uncut is not None else (t.band, t.cut_edges > 0)
     grid, surf = t.grid, t.surface
     inner_width = t.inner * grid.spacing
-    slowness_at = _slowness_at(speed, grid)
+    slowness_at = slowness_on_surface(speed, grid)
     n_inner = int(np.count_nonzero(t.roles == ROLE_INNER))
     positions, values, offsets = [], [], [0]
     for k, g in enumerate(groups):
@@ -175,14 +158,14 @@ def solve_many(
     chunk's place among the sources)."""
     t0 = time.perf_counter()
     check_flag(return_stats, "return_stats")
-    order = _check_order(order)
+    order = check_order(order)
     tube._check_phi_unchanged()
     t = tube._tube
     grid = t.grid
     groups = source_groups(sources, grid.ndim)
     if len(groups) == 0:
         raise ValueError("sources is empty: give at least one source (a point, or a group of points)")
-    general, scheme = _resolve_scheme(hamiltonian, None, False)
+    general, scheme = resolve_scheme(hamiltonian, None, False)
     if general is not None:
         raise ValueError(
             "solve_many takes hamiltonian='godunov' or 'lxf'; for a ts.hamiltonians object solve each "
@@ -190,7 +173,7 @@ def solve_many(
         )
     check_tolerance(tol, max_iterations)
     cb = check_many_progress(progress)
-    _check_source_init(source_init)
+    check_source_init(source_init)
     if not isinstance(paper_sweeps, (bool, np.bool_)):
         raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
     nthreads = check_threads(threads)

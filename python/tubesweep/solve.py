@@ -4,54 +4,18 @@
 from __future__ import annotations
 
 import time
-from typing import Any, Callable, Optional, Tuple, Union
+from typing import Any, Callable, List, Optional, Union
 
-import numpy as np
-
-from ._validate import (
-    ACTIVATION_FRACTION,
-    FRONT_WINDOW,
-    check_threads as _threads,
-    check_infinity as _infinity,
-    as_grid,
-    as_sources,
-    check_hamiltonian,
-    check_tolerance,
-    check_tolerance_scale,
-    FIRST_ORDER_TOL,
-    first_order_tol,
-    checked_point_speeds,
-    speed_at_points,
-    speed_on_surface,
-    progress_callback,
-    warn_unconverged,
-)
-from ._fallback import Fallback
-from ._result_check import check_values
+from ._first_order import first_order
+from ._order_choice import order2_on, refuse_warm_for_order1, second_order_or_fallback
+from ._prepare import METHODS, ROLE_RTOL, _PreparedTube, _prepare_tube, thinned_at_creases, unstranded
+from ._request import SOURCE_INITS, SolveRequest, check_source_radius
+from ._sources import SOURCE_RADIUS
+from ._validate import FIRST_ORDER_TOL, as_grid
 from .grid import Grid
-from .moving import check_warm_refused
-from .stats import SolveStats
-from .surface import as_surface
-from ._creases import warn_paper_tube_creases
-from ._parts import drop_unsourced, on_sourced_parts, part_labels, source_parts
-from ._prepare import (
-    METHODS,
-    ROLE_FIXED,
-    ROLE_INNER,
-    ROLE_OUTER,
-    ROLE_RTOL,
-    _PreparedTube,
-    _prepare_tube,
-    paper_creases_of,
-    thinned_at_creases,
-    thinned_count,
-    uncut_band,
-    unstranded,
-    warn_facing_pairs,
-)
-from ._sources import SOURCE_RADIUS, _fix_sources
-from . import _hamiltonian_solve
+from .second_order import check_order
 from .solution import Solution
+from .surface import as_surface
 
 __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_RADIUS"]
 
@@ -59,12 +23,6 @@ __all__ = ["solve", "Solution", "METHODS", "SOURCE_INITS", "ROLE_RTOL", "SOURCE_
 #: the grid of 1 or more (below, that share of them: ``_validate.first_order_tol``; ``order=2``
 #: has its own, ``second_order.default_tol``).
 DEFAULT_TOL = FIRST_ORDER_TOL
-
-SOURCE_INITS = ("exact", "node")
-
-
-# band nodes at which a solution samples its surface's φ array, to notice a later change
-_PHI_SAMPLE = 4096
 
 
 def solve(
@@ -245,346 +203,51 @@ def solve(
     >>> sol.stats.order, ts.solve(sphere, grid, sources=[(-0.5, 0, 0)], order=1)([(0, 0.5, 0)])  # doctest: +ELLIPSIS
     (2, array([0.77...]))
     """
-    t0 = time.perf_counter()
-    order = _check_order(order)
+    started = time.perf_counter()
+    order = check_order(order)
     grid = as_grid(grid)
     surf = as_surface(surface)
     surf.check_grid(grid)
-    src = as_sources(sources, grid)
-    general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-    check_tolerance(tol, max_iterations)
-    cb = progress_callback(progress)
-    _check_source_init(source_init)
-    _infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
-    check_warm_refused(warm_refused)
-    tube: Optional[_PreparedTube] = None
-    fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
-    if order != 1:
-        from . import second_order as _so
+    req = SolveRequest.checked(
+        grid,
+        sources,
+        order=order,
+        hamiltonian=hamiltonian,
+        flow=flow,
+        allow_supersonic=allow_supersonic,
+        speed=speed,
+        source_init=source_init,
+        source_radius=source_radius,
+        tol=tol,
+        max_iterations=max_iterations,
+        progress=progress,
+        infinity=infinity,
+        threads=threads,
+        paper_sweeps=paper_sweeps,
+        warm=warm,
+        warm_refused=warm_refused,
+        started=started,
+    )
+    # the second-order tube (thinned at creases, its geometry kept), built by the attempt: with
+    # order="auto" refused by its geometry or its sweeps, the first-order scheme runs on it as on
+    # a Tube's (the same values)
+    built: List[_PreparedTube] = []
 
-        try:
-            if source_radius is not None:
-                raise _so.OptionOfOrder1(
-                    "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
-                )
-            _so.check_supported(surf, general, scheme, method, source_init, paper_sweeps)
-            _so.check_widths(inner, outer)
-            tube = thinned_at_creases(_prepare_tube(surf, grid, inner, outer, method, keep_geometry=True, creases=True))
-            return _so.solve_on_tube(
-                tube,
-                src,
-                speed,
-                tol,
-                max_iterations,
-                cb,
-                threads,
-                t0,
-                warm=warm,
-                warm_refused=warm_refused,
-            )
-        except _so.Order2NotApplicable as e:
-            if order == 2:
-                raise
-            fallback = Fallback.of(e, order)
-    if warm is not None and warm_refused == "raise":
-        from .moving import refusal_for_order1
+    def order2() -> Solution:
+        built.append(
+            thinned_at_creases(_prepare_tube(surf, grid, inner, outer, method, keep_geometry=True, creases=True))
+        )
+        return order2_on(built[0], req)
 
-        raise refusal_for_order1(None if fallback is None else fallback.reason)
-    _check_source_radius(source_radius, source_init, grid)
+    sol, fallback = second_order_or_fallback(req, surf, method, inner, outer, order2)
+    if sol is not None:
+        return sol
+    refuse_warm_for_order1(req, fallback)
+    check_source_radius(source_radius, source_init, grid)
     # the one call keeps nothing for later: the float64 geometry is dropped before the sweeps
-    # (unless a general Hamiltonian needs it) and the directions become the extension weights;
-    # with order="auto" refused by the second-order geometry, the tube it built is solved on as a
-    # Tube's is (the same values)
-    reuse = tube is not None
-    if tube is None:
-        tube = _prepare_tube(surf, grid, inner, outer, method, keep_geometry=general is not None)
+    # (unless a general Hamiltonian needs it) and the directions become the extension weights
+    reuse = bool(built)
+    tube = built[0] if built else _prepare_tube(surf, grid, inner, outer, method, keep_geometry=req.general is not None)
     if fallback is not None:
         tube = unstranded(tube)  # no piece of the thinned inner tube cut off (first-order sweeps)
-        fallback.measure(tube)
-    sol = _solve_on_tube(
-        tube,
-        src,
-        general,
-        scheme,
-        speed,
-        source_init,
-        tol,
-        max_iterations,
-        cb,
-        infinity,
-        threads,
-        paper_sweeps,
-        t0,
-        reuse=reuse,
-        source_radius=source_radius,
-    )
-    if fallback is not None:
-        from .second_order import with_fallback
-
-        fallback.warn(sol.values, tube)
-        return with_fallback(sol, fallback.reason, fallback.creases)
-    return sol
-
-
-def _directions_of(tube: _PreparedTube) -> np.ndarray:
-    """The tube's unit directions away from the surface, per band node: the solver's own copy (one
-    call) or the kept geometry's (a :class:`Tube`, a general Hamiltonian)."""
-    return tube.direction if tube.direction is not None else tube.geom.direction  # type: ignore[union-attr]
-
-
-def _check_source_radius(source_radius: Any, source_init: str, grid: Optional[Grid] = None) -> None:
-    """``source_radius``: a positive distance, with ``source_init="exact"``, below the grid's
-    diagonal (the chord's validity within it is checked with the surface, ``_sources``)."""
-    if source_radius is None:
-        return
-    if isinstance(source_radius, bool) or not isinstance(source_radius, (int, float, np.integer, np.floating)):
-        raise TypeError(f"source_radius must be a number (a distance) or None; got {source_radius!r}")
-    if not (np.isfinite(source_radius) and source_radius > 0):
-        raise ValueError(f"source_radius must be a positive finite distance; got {source_radius!r}")
-    if grid is not None:
-        diagonal = float(np.linalg.norm(np.asarray(grid.upper, float) - np.asarray(grid.lower, float)))
-        if source_radius > diagonal:
-            raise ValueError(
-                f"source_radius = {source_radius:g} exceeds the grid's diagonal ({diagonal:.4g}): it is the radius of the "
-                "ball around each source whose nodes are fixed to the straight (chord) distance, which is the "
-                "distance along the surface only where the surface is flat. Use a few grid spacings "
-                f"(h = {grid.spacing:.4g}) up to a small fraction of the surface's size, or leave it out"
-            )
-    if source_init != "exact":
-        raise ValueError(
-            "source_radius applies to source_init='exact' (the nodes near a source fixed to the exact time)"
-        )
-
-
-def _check_order(order: Any) -> Union[int, str]:
-    from .second_order import check_order
-
-    return check_order(order)
-
-
-def _resolve_scheme(hamiltonian: Any, flow: Any, allow_supersonic: bool) -> Tuple[Any, str]:
-    from . import hamiltonians as _hams
-
-    general = _hams.resolve(hamiltonian, flow, allow_supersonic)
-    scheme = check_hamiltonian(hamiltonian) if general is None else general.label
-    return general, scheme
-
-
-def _check_source_init(source_init: str) -> None:
-    if source_init not in SOURCE_INITS:
-        raise ValueError(f"source_init must be one of {SOURCE_INITS}; got {source_init!r}")
-
-
-def _solve_on_tube(
-    tube: _PreparedTube,
-    src: np.ndarray,
-    general: Any,
-    scheme: str,
-    speed: Any,
-    source_init: str,
-    tol: Optional[float],
-    max_iterations: int,
-    cb: Any,
-    infinity: Any,
-    threads: int,
-    paper_sweeps: bool,
-    t0: float,
-    reuse: bool,
-    source_radius: Optional[float] = None,
-) -> "Solution":
-    """Fixes the sources on the prepared tube and sweeps. With ``reuse`` the tube is left as it
-    was (its roles and directions are copied); without, its arrays are consumed and dropped
-    before the sweeps."""
-    if not isinstance(paper_sweeps, (bool, np.bool_)):
-        raise TypeError(f"paper_sweeps must be True or False; got {paper_sweeps!r}")
-    grid, surf, band = tube.grid, tube.surface, tube.band
-    cut_edges = tube.cut_edges
-    crease_thinned = thinned_count(tube)
-    if crease_thinned == 0:  # the paper's tube: its creases' corners are cut
-        warn_paper_tube_creases(paper_creases_of(tube), tube.inner, grid.spacing)
-    if scheme == "lxf" and cut_edges:
-        # the Lax–Friedrichs update extrapolates a missing neighbour and does not settle beside
-        # edges cut inside the tube (``_shortcuts``): it runs on the whole band, and the narrow
-        # gaps the cut would have closed are warned about
-        band, cut_edges = uncut_band(tube), 0
-        warn_facing_pairs(grid, tube.linear, tube.roles, tube.facing, tube.inner)
-    # the parts of the surface (before the sweeps consume the tube): a part without a source
-    # keeps inf whatever reached it across a narrow gap (``_parts``)
-    parts = part_labels(tube, band)
-    sourced = None if parts is None else source_parts(grid, band, parts, src, surf)
-    h = grid.spacing
-    inner_width = tube.inner * h
-    roles = tube.roles.copy() if reuse else tube.roles
-    linear = tube.linear
-    # a callable at the nodes' closest points (an array is read at the nodes)
-    speed_nodes = speed_on_surface(speed, grid, linear, tube.phi, _directions_of(tube), inner_width)
-    slowness: Any = 1.0 / speed_nodes
-
-    def slowness_at(p: np.ndarray) -> np.ndarray:
-        if callable(speed):
-            return 1.0 / speed_at_points(speed, p, "a source or the closest point of a node near it")
-        if np.ndim(speed) == 0:
-            return np.full(len(p), 1.0 / float(speed))
-        from .euclidean import _interp_dense
-
-        f = _interp_dense(np.asarray(speed, dtype=float), grid, p)
-        return 1.0 / checked_point_speeds(f, p, "interpolated from the speed array next to a source")
-
-    # (the default: 1e-10 of the travel time across the grid, at most 1e-10; a Hamiltonian's own
-    # travel times set it in _hamiltonian_solve)
-    given_tol = tol
-    tol = first_order_tol(tol, h, float(np.mean(slowness)), max(grid.shape))
-    if general is None:
-        check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
-    # the exact initialisation's radius in grid spacings
-    radius = SOURCE_RADIUS if source_radius is None else max(SOURCE_RADIUS, float(source_radius) / h)
-    positions, fixed_vals, fixed_sources = _fix_sources(
-        surf, grid, band, linear, roles, src, slowness_at, source_init, inner_width, radius, cut_edges > 0
-    )
-    roles[positions] = ROLE_FIXED
-    if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER) and radius > SOURCE_RADIUS:
-        raise ValueError(
-            f"source_radius = {source_radius:g} covers the whole inner tube: every node lies within it of the source, so "
-            f"its value is the source's initialisation and nothing is solved; use a smaller source_radius (a few "
-            f"grid spacings, h = {h:.4g}, up to a small fraction of the surface's size) or leave it out"
-        )
-    if tube.method != "naive" and len(src) == 1 and not np.any(roles == ROLE_INNER):
-        raise ValueError(
-            f"the grid is too coarse for this surface: every node of the inner tube lies within {radius:g} grid "
-            f"spacings (h = {h:.4g}) of a source, so its value is the source's initialisation and nothing is solved; "
-            f"refine the grid"
-        )
-    method = tube.method
-    missing_policy = "infinity" if (method == "naive" and scheme == "godunov") else "extrapolate"
-    phi = tube.phi
-    array = getattr(surf, "_array", None)
-    phi_sample = None
-    if array is not None:
-        # a φ array is used in place: a sample of it at the band's nodes, for the solution to
-        # notice a change before it projects points with it (geodesic paths)
-        pick = linear[:: max(1, len(linear) // _PHI_SAMPLE)].copy()  # not a view: `linear` is dropped
-        phi_sample = (pick, array.reshape(-1)[pick].copy())
-    if general is None:
-        # The linear indices are dropped before the sweeps and the fixed nodes go to the solver
-        # sparsely; the directions are converted to the extension weights in place (no second
-        # K×d buffer).
-        if reuse:
-            directions = tube.geom.directions_for_solver()  # type: ignore[union-attr]  # a copy: the tube's stay as they are
-        else:
-            directions = tube.direction  # overwritten by the solver (a copy unless the geometry is consumable)
-            tube.direction = tube.linear = tube.roles = None  # type: ignore[assignment]
-        del linear
-        setup = time.perf_counter() - t0
-        values, st = band.solve(
-            roles,
-            positions,
-            fixed_vals,
-            h,
-            slowness,
-            directions,
-            scheme,
-            missing_policy,
-            float(tol),
-            int(max_iterations),
-            _infinity(infinity),
-            cb,
-            _threads(threads),
-            True,
-            ACTIVATION_FRACTION * float(tol),
-            not paper_sweeps,
-            not paper_sweeps,
-            0.0 if paper_sweeps else FRONT_WINDOW,
-        )
-        del directions
-    else:
-        setup = time.perf_counter() - t0
-        values, st, tol = _hamiltonian_solve.solve_band(
-            general,
-            surf,
-            grid,
-            tube.geom,
-            band,
-            roles,
-            positions,
-            fixed_vals,
-            src,
-            speed_nodes,
-            source_init == "exact",
-            radius,
-            given_tol,
-            max_iterations,
-            _infinity(infinity),
-            cb,
-            _threads(threads),
-            ACTIVATION_FRACTION,
-            not paper_sweeps,
-        )
-    warn_unconverged(st, tol, max_iterations)
-    values[values >= st["infinity"]] = np.inf  # never reached (another component of the surface)
-    if parts is not None:
-        drop_unsourced(values, parts, sourced)
-    # no NaN, and no inf next to a reached node in a solve reported converged (the inner tube of a
-    # part without a source is unreachable: next to a reached part across a narrow gap, not stranded)
-    reachable = on_sourced_parts(parts, sourced)
-    check_values(
-        grid,
-        band,
-        values,
-        (roles != ROLE_OUTER) if reachable is None else (roles != ROLE_OUTER) & reachable,
-        st,
-        _infinity(infinity),
-        reachability=general is None or general.label == "isotropic",
-    )
-    n_outer = int(np.count_nonzero(roles == ROLE_OUTER))
-    # held per node during the sweeps: values (f64), role, active flag and coupling mask, φ (f32),
-    # extension weights (d × f32), per-node slowness (f64) when the speed varies; per row a lower
-    # bound of its values (8 bytes, for the front window), and with the window a byte per node
-    # marking the layer nodes in upwind 2-cycles; the fixed values are sparse. (With the rim
-    # left to the end the core also holds a role copy and a rim mask, then the rim mask and a
-    # byte of dependency counts, 2 bytes per node.)
-    windowed = grid.ndim == 3 and scheme == "godunov" and not paper_sweeps and FRONT_WINDOW > 0
-    per_node = 8 + 1 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0) + (1 if windowed else 0)
-    stats = SolveStats(
-        iterations=st["iterations"],
-        sweeps=st["sweeps"],
-        updates=st["updates"],
-        converged=st["converged"],
-        last_change=st["last_change"],
-        seconds=st["seconds"],
-        band_points=len(roles),
-        inner_points=len(roles) - n_outer,
-        outer_points=n_outer,
-        fixed_points=len(positions),
-        setup_seconds=setup,
-        band_bytes=band.nbytes + per_node * len(roles) + 8 * band.n_rows,
-        window_edge=st["window_edge"],
-        facing_pairs=int(tube.facing[0].size),
-        narrowest_gap=float(np.min(tube.facing[2])) if tube.facing[2].size else float("inf"),
-        cut_edges=cut_edges,
-        crease_thinned=crease_thinned,
-        thin_strip_iterations=(int(st["thin_strip_iterations"][0]), int(st["thin_strip_iterations"][1])),
-        prefetch_iterations=int(st["prefetch_iterations"]),
-        local_solver=st.get("local_solver", scheme),
-        box_cut=tube.box_cut,
-        creases=tube.paper_creases,
-        bridged_holes=tube.bridged_holes,
-        slits=tube.slits,
-    )
-    return Solution(
-        grid,
-        band,
-        values,
-        roles,
-        phi,
-        stats,
-        src,
-        surf,
-        scheme,
-        method,
-        tube.inner,
-        tube.outer_eff,
-        (positions, fixed_sources),
-        general is None or general.label == "isotropic",
-        tube.facing,
-        phi_sample,
-    )
+    return first_order(req, tube, fallback, reuse)

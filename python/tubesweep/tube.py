@@ -27,13 +27,14 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._validate import as_grid, as_sources, check_infinity, check_tolerance, progress_callback
+from . import second_order as _so
+from ._first_order import first_order
+from ._order_choice import order2_on, refuse_warm_for_order1, second_order_or_fallback
+from ._request import SolveRequest, check_source_radius
+from ._validate import as_grid
 from .grid import Grid
-from .moving import check_warm_refused
-from ._fallback import Fallback
 from ._prepare import _prepare_tube, _PreparedTube, thinned_at_creases, unstranded
 from .solution import Solution
-from .solve import _check_order, _check_source_init, _check_source_radius, _resolve_scheme, _solve_on_tube
 from .surface import Surface, as_surface
 from ._warn import user_stacklevel
 
@@ -216,87 +217,54 @@ class Tube:
         >>> [round(float(tube.solve([p])([(0, 0, 0.5)])[0]), 2) for p in [(0.5, 0, 0), (0, 0.5, 0)]]
         [0.79, 0.79]
         """
-        t0 = time.perf_counter()
+        started = time.perf_counter()
         self._check_phi_unchanged()
-        order = _check_order(order)
-        src = as_sources(sources, self.grid)
-        general, scheme = _resolve_scheme(hamiltonian, flow, allow_supersonic)
-        check_tolerance(tol, max_iterations)
-        cb = progress_callback(progress)
-        _check_source_init(source_init)
-        check_infinity(infinity)  # checked whichever order runs (order=2 has no use for it)
-        check_warm_refused(warm_refused)
-        fallback: Optional[Fallback] = None  # order="auto" running the first-order scheme, and why
-        paper_tube = order == 1  # the paper's tube, not thinned at creases: the first-order scheme chosen
-        if order != 1:
-            from . import second_order as _so
-
-            try:
-                if source_radius is not None:
-                    raise _so.OptionOfOrder1(
-                        "source_radius applies to order=1 (order=2 factors the point source itself); leave it out"
-                    )
-                _so.check_supported(self.surface, general, scheme, self._tube.method, source_init, paper_sweeps)
-                _so.check_widths(self._args[0], self._args[1])
-                if self._order2_refusal is not None:  # this band's geometry, refused before
-                    raise _so.Order2NotApplicable(self._order2_refusal)
-                try:
-                    return _so.solve_on_tube(
-                        self._tube_order2,
-                        src,
-                        speed,
-                        tol,
-                        max_iterations,
-                        cb,
-                        threads,
-                        t0,
-                        warm=warm,
-                        warm_refused=warm_refused,
-                        keep_digests=True,  # a tube's solutions start warm solves on its moved tubes
-                    )
-                except _so.Order2RanAway:
-                    raise  # depends on the speed and the sources: not kept as the band's refusal
-                except _so.Order2NotApplicable as e:
-                    self._order2_refusal = str(e)  # depends on the band only: not computed again
-                    raise
-            except _so.Order2NotApplicable as e:
-                if order == 2:
-                    raise
-                fallback = Fallback.of(e, order)
-                # an option of the first-order scheme: its tube, as ts.solve's (which refuses such
-                # an option before it builds the thinned one)
-                paper_tube = isinstance(e, _so.OptionOfOrder1)
-        if warm is not None and warm_refused == "raise":
-            from .moving import refusal_for_order1
-
-            raise refusal_for_order1(None if fallback is None else fallback.reason)
-        _check_source_radius(source_radius, source_init, self.grid)
-        solved = self._tube if paper_tube else self._tube_first_auto  # the tube the sweeps run on
-        if fallback is not None:
-            fallback.measure(solved)
-        sol = _solve_on_tube(
-            solved,
-            src,
-            general,
-            scheme,
-            speed,
-            source_init,
-            tol,
-            max_iterations,
-            cb,
-            infinity,
-            threads,
-            paper_sweeps,
-            t0,
-            reuse=True,
+        req = SolveRequest.checked(
+            self.grid,
+            sources,
+            order=order,
+            hamiltonian=hamiltonian,
+            flow=flow,
+            allow_supersonic=allow_supersonic,
+            speed=speed,
+            source_init=source_init,
             source_radius=source_radius,
+            tol=tol,
+            max_iterations=max_iterations,
+            progress=progress,
+            infinity=infinity,
+            threads=threads,
+            paper_sweeps=paper_sweeps,
+            warm=warm,
+            warm_refused=warm_refused,
+            started=started,
         )
-        if fallback is not None:
-            from .second_order import with_fallback
+        sol, fallback = second_order_or_fallback(
+            req, self.surface, self._tube.method, self._args[0], self._args[1], lambda: self._solve_order2(req)
+        )
+        if sol is not None:
+            return sol
+        refuse_warm_for_order1(req, fallback)
+        check_source_radius(source_radius, source_init, self.grid)
+        # the tube the sweeps run on: the paper's where the first-order scheme was chosen (order=1,
+        # or an option only it has, which ts.solve refuses before it builds the thinned one)
+        paper_tube = fallback is None or fallback.option_of_order1
+        return first_order(req, self._tube if paper_tube else self._tube_first_auto, fallback, reuse=True)
 
-            fallback.warn(sol.values, solved)
-            return with_fallback(sol, fallback.reason, fallback.creases)
-        return sol
+    def _solve_order2(self, req: SolveRequest) -> Solution:
+        """The second-order solve on this tube; a refusal of its geometry is kept and raised again
+        by later solves without computing it again (a runaway depends on the speed and the
+        sources: not kept)."""
+        if self._order2_refusal is not None:  # this band's geometry, refused before
+            raise _so.Order2NotApplicable(self._order2_refusal)
+        try:
+            # (the digests kept: a tube's solutions start warm solves on its moved tubes)
+            return order2_on(self._tube_order2, req, keep_digests=True)
+        except _so.Order2RanAway:
+            raise
+        except _so.Order2NotApplicable as e:
+            self._order2_refusal = str(e)  # depends on the band only: not computed again
+            raise
 
     def moved(self, surface: Any) -> "Tube":
         """The tube of this surface after it moved: the same grid, widths and method, the band of
@@ -468,7 +436,7 @@ class Tube:
                     max_iterations=max_iterations,
                     infinity=infinity,
                     paper_sweeps=paper_sweeps,
-                    order=_check_order(order),
+                    order=_so.check_order(order),
                 ),
                 threads=threads,
                 return_stats=return_stats,
