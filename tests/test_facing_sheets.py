@@ -1,5 +1,5 @@
 """Parts of a surface that face each other across a gap narrower than the tubes
-(``_prepare._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``): on a level set the solve
+(``_facing._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``): on a level set the solve
 warns, says where and how narrow, and records it in ``SolveStats``; a triangle mesh's band is cut
 there (``_shortcuts``), its front goes round and its points are read from their own side; surfaces
 the grid resolves give no pair."""

@@ -1,5 +1,5 @@
 """Parts of a surface that face each other across a gap narrower than the tubes: where the solve
-warns (``_prepare._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``) and what the answer is
+warns (``_facing._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``) and what the answer is
 there, against exact distances.
 
 Usage::

@@ -10,7 +10,7 @@ printed, with the whole solve's ``sol.stats.setup_seconds`` and ``sol.stats.seco
 The pieces are those of ``LevelSet.band`` for a callable φ (docs/architecture.md): the
 coarse-to-fine band search (candidates, then φ at them and the filter), the band structure,
 the rim places, φ there, the outward directions and the check for gaps narrower than the tubes
-(the kinks of φ, then ``_prepare._warn_if_tubes_touch``); then the whole of it for the surface's φ
+(the kinks of φ, then ``_facing._warn_if_tubes_touch``); then the whole of it for the surface's φ
 as a plain callable, and for the library surface itself, whose band is found in Rust in one
 call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENBLAS_NUM_THREADS=1`` as
 ``make bench`` does (see README).
@@ -19,7 +19,6 @@ call (``_native.analytic_level_set_band``, the same nodes and bits). Set ``OPENB
 from __future__ import annotations
 
 import argparse
-import importlib
 import os
 import sys
 import time
@@ -34,7 +33,8 @@ import tubesweep as ts  # noqa: E402
 from tubesweep import _native  # noqa: E402
 from tubesweep.band import _kinks, coarse_to_fine_candidates, discover_band  # noqa: E402
 
-solve_module = importlib.import_module("tubesweep._prepare")  # the roles and the checks of the tube
+from tubesweep._facing import _warn_if_tubes_touch  # noqa: E402
+from tubesweep._roles import ROLE_INNER, ROLE_OUTER  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benches/: problems.py, methods.py
 from problems import PROBLEMS  # noqa: E402
@@ -69,7 +69,7 @@ def main() -> int:
     direction = np.empty((len(linear), grid.ndim), np.float32)
     norm = band.outward_directions(h, values, 0, len(linear), rim_phi, direction)
     phi32 = values.astype(np.float32)
-    roles = np.where(np.abs(values) <= 2 * h, solve_module.ROLE_INNER, solve_module.ROLE_OUTER).astype(np.uint8)
+    roles = np.where(np.abs(values) <= 2 * h, ROLE_INNER, ROLE_OUTER).astype(np.uint8)
     kink = _kinks(norm, grid, linear, band)
     r = a.repeats
     rows: Dict[str, float] = {
@@ -88,8 +88,8 @@ def main() -> int:
         "gaps narrower than the tubes: the kinks of φ (surface._kinks)": median_ms(
             lambda: _kinks(norm, grid, linear, band), r
         ),
-        "gaps narrower than the tubes: the pairs (_prepare._warn_if_tubes_touch)": median_ms(
-            lambda: solve_module._warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r
+        "gaps narrower than the tubes: the pairs (_facing._warn_if_tubes_touch)": median_ms(
+            lambda: _warn_if_tubes_touch(grid, band, linear, roles, phi32, direction, 2.0, kink), r
         ),
         "LevelSet.band of the same φ as a callable, all of the above": median_ms(
             lambda: ts.LevelSet(fn, lipschitz=surf.lipschitz).band(grid, width), r

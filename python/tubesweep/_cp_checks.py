@@ -17,7 +17,7 @@ surface that are not the nearest. Three tests, on a few thousand points (O(1) ex
 
 The noise of the map near the surface (the 90th percentile of ``|cp(cp(x)) − cp(x)|`` at the band's
 sample) is returned: nodes closer to the surface than a few times it have unreliable directions,
-and the facing-sheets test leaves them out (``_prepare._warn_if_tubes_touch``) instead of reading a
+and the facing-sheets test leaves them out (``_facing._warn_if_tubes_touch``) instead of reading a
 noisy map as a surface that faces itself across gaps.
 """
 

@@ -16,16 +16,9 @@ from . import _hamiltonian_solve
 from ._creases import warn_paper_tube_creases
 from ._fallback import Fallback
 from ._parts import drop_unsourced, on_sourced_parts, part_labels, source_parts
-from ._prepare import (
-    ROLE_FIXED,
-    ROLE_INNER,
-    ROLE_OUTER,
-    _PreparedTube,
-    paper_creases_of,
-    thinned_count,
-    uncut_band,
-    warn_facing_pairs,
-)
+from ._facing import warn_facing_pairs
+from ._prepare import _PreparedTube, paper_creases_of, thinned_count, uncut_band
+from ._roles import ROLE_FIXED, ROLE_INNER, ROLE_OUTER
 from ._request import SolveRequest
 from ._result_check import check_values
 from ._sources import SOURCE_RADIUS, _fix_sources, slowness_on_surface

@@ -1,7 +1,7 @@
 """Parts of the surface that no path joins: a value only from a source on the node's own part.
 
 Where two parts of the surface face each other across a gap narrower than the tubes
-(``_prepare._warn_if_tubes_touch``), the two-layer method (Algorithm 3) lets a node read a
+(``_facing._warn_if_tubes_touch``), the two-layer method (Algorithm 3) lets a node read a
 neighbour whose closest point lies on the other part, so the front can cross the gap. Where the
 band is cut there (``_shortcuts``, triangle meshes) it cannot; elsewhere a part that carries no
 source was given finite, too short travel times: two spheres 6 grid spacings apart as a
@@ -37,6 +37,7 @@ from . import _native
 from ._interpolation import cell_corners
 from .grid import Grid
 from ._shortcuts import cuts_medial_edges
+from ._roles import ROLE_OUTER
 
 #: The label of a node of no part (an extension node).
 NO_PART = np.iinfo(np.uint32).max
@@ -52,8 +53,6 @@ def part_labels(tube: Any, band: Any = None) -> Optional[np.ndarray]:
     the cuts; a point cloud's band is cut only between facing sheets, which leaves each sheet's
     inner tube whole, and the Lax–Friedrichs scheme runs on the uncut band, where a mesh's
     separate pieces label its inner tube: ``surfaces._mesh_parts``)."""
-    from ._prepare import ROLE_OUTER
-
     band = tube.band if band is None else band
     cut = band is tube.band and tube.cut_edges > 0
     part = tube.pieces

@@ -23,20 +23,15 @@ from ._validate import (
 from .grid import Grid
 from .band import BandGeometry, _evaluate, band_neighbours
 from .surface import LevelSet, Surface
-from ._warn import user_stacklevel
+from ._warn import user_stacklevel, where_node
+from ._roles import ROLE_INNER, ROLE_OUTER, tube_roles
+from ._facing import facing_gaps
 from ._box_cut import box_cut, warn_box_cut
 from ._coarse_creases import creases_of_redistanced
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
 from ._thin_level_set import thin_share, warn_thin
-from ._shortcuts import cut_between_parts, cut_pinches, cut_shortcuts, cuts_medial_edges, cuts_shortcuts
 
 METHODS = ("two-layer", "naive")
-#: A node belongs to the inner tube when ``|φ| ≤ inner·Δx·(1 + ROLE_RTOL)``. The relative
-#: tolerance makes nodes that sit exactly on the inner radius (up to rounding, common on
-#: symmetric grids) consistently inner.
-ROLE_RTOL = 1e-9
-
-ROLE_FIXED, ROLE_INNER, ROLE_OUTER = 0, 1, 2
 
 
 def _widening_message(
@@ -67,32 +62,7 @@ def _widening_message(
     return f"{text}. {widen}" if advice is None else f"{text}: {advice}. {widen}"
 
 
-def _where(grid: Grid, node: Any) -> str:
-    """A grid node's position, for a message: ``(x, y, z)`` to four digits."""
-    return "(" + ", ".join(f"{float(v):.4g}" for v in grid.node_points(np.array([int(node)]))[0]) + ")"
-
-
-def _percent(share: float) -> str:
-    """A share as a short percentage: '0.1%', '12%', or '< 0.01%'."""
-    if share < 1e-4:
-        return "< 0.01%"
-    return f"{100 * share:.2g}%" if share < 0.1 else f"{100 * share:.0f}%"
-
-
 _MAX_WIDENINGS = 4
-_ROLE_CHUNK = 1 << 18
-
-
-def _tube_roles(geom: BandGeometry, inner_width: float, method: str) -> np.ndarray:
-    """Roles of the band nodes: inner tube where ``|φ| ≤ inner·Δx`` (every node for the naive
-    method), else extension layer; chunk by chunk, without K-sized temporaries."""
-    roles = np.full(len(geom.linear), ROLE_INNER if method == "naive" else ROLE_OUTER, np.uint8)
-    if method != "naive":
-        limit = inner_width * (1 + ROLE_RTOL)
-        for lo in range(0, len(roles), _ROLE_CHUNK):
-            part = roles[lo : lo + _ROLE_CHUNK]
-            part[geom.unsigned(lo, lo + _ROLE_CHUNK) <= limit] = ROLE_INNER
-    return roles
 
 
 @dataclasses.dataclass
@@ -306,72 +276,6 @@ def _lacking_neighbours(grid: Grid, band: Any, linear: np.ndarray, missing: np.n
     return np.unique(np.concatenate(lacking))
 
 
-def _ridge_pairs(
-    grid: Grid, band: Any, linear: np.ndarray, roles: np.ndarray, phi: np.ndarray, kink: Optional[np.ndarray]
-) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The pairs of neighbouring band nodes of which one straddles a kink of a level set's φ (a
-    ridge between facing parts, ``BandGeometry.kink``) and one lies in the inner tube, with the
-    gap ``2|φ|`` at the kink's node. There the central differences give no reliable direction,
-    so the directions' tests of ``Band.facing_sheet_pairs`` can miss the pair (two spheres
-    ``min(d₁, d₂)`` 5 spacings apart were crossed without a word)."""
-    empty = np.empty(0, np.int64)
-    if kink is None or not np.any(kink):
-        return empty, empty, np.empty(0)
-    at = np.flatnonzero(kink)
-    nodes, neighbours = [], []
-    for _, _, pos in band_neighbours(grid, band, linear, at):
-        ok = pos >= 0
-        a, b = at[ok], pos[ok]
-        ok = (roles[a] == ROLE_INNER) | (roles[b] == ROLE_INNER)
-        a, b = a[ok], b[ok]
-        nodes.append(np.minimum(a, b))
-        neighbours.append(np.maximum(a, b))
-    node, neighbour = np.concatenate(nodes), np.concatenate(neighbours)
-    gap = 2.0 * np.abs(phi[np.where(kink[node], node, neighbour)]).astype(float)
-    return node, neighbour, gap
-
-
-def _warn_if_tubes_touch(
-    grid: Grid,
-    band: Any,
-    linear: np.ndarray,
-    roles: np.ndarray,
-    phi: np.ndarray,
-    direction: np.ndarray,
-    inner: float,
-    kink: Optional[np.ndarray] = None,
-    noise: float = 0.0,
-    warn: bool = True,
-    note: str = "",
-) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Warns where two parts of the surface face each other across a gap so narrow that the inner
-    tube of one touches the band of the other (``_native.Band.facing_sheet_pairs``,
-    ``tubesweep_core::band::facing_sheets``): the eikonal equation crosses the gap there and the travel
-    times beyond it come out too short, a shortcut the surface does not have. Returns the pairs'
-    band positions and their gaps. ``warn=False`` where the band is cut across the pairs
-    (``_shortcuts``): the front does not cross them, and ``stats.facing_pairs`` reports them."""
-    h = grid.spacing
-    node, neighbour, gap = band.facing_sheet_pairs(
-        roles == ROLE_INNER,
-        np.ascontiguousarray(phi, dtype=np.float32),
-        np.ascontiguousarray(direction, dtype=np.float32).reshape(len(linear), grid.ndim),
-        h,
-    )
-    if noise > 0 and node.size:
-        # a noisy closest-point map (``_cp_checks``): nodes within a few times its noise of the
-        # surface have directions the noise can turn around, which the facing test would read as
-        # two sheets (at noise 0.01 spacings, 13 pairs on a sphere); they are left out
-        clear = 4.0 * noise
-        keep = (np.abs(phi[node]) > clear) & (np.abs(phi[neighbour]) > clear)
-        node, neighbour, gap = node[keep], neighbour[keep], gap[keep]
-    ridge = _ridge_pairs(grid, band, linear, roles, phi, kink)
-    if ridge[0].size:
-        node, neighbour, gap = _union_pairs((node, neighbour, gap), ridge)  # (a pair found both ways once)
-    if warn:
-        warn_facing_pairs(grid, linear, roles, (node, neighbour, gap), inner, note)
-    return node, neighbour, gap
-
-
 def _specks(surf: Any, grid: Grid) -> str:
     """For a refused re-distanced φ array: its nodes whose sign differs from all their axis
     neighbours', named first (a bubble smaller than a cell: one node of the other sign 6 spacings
@@ -397,54 +301,6 @@ def _specks(surf: Any, grid: Grid) -> str:
         f"φ changes sign at {nodes.size} isolated node(s) whose neighbours all have the other sign (e.g. at {where}): "
         "surfaces smaller than a grid cell, which the tube cannot hold; remove such specks (noise in a segmentation, "
         "e.g. with scipy.ndimage.binary_opening) and solve again. "
-    )
-
-
-def _union_pairs(
-    a: Tuple[np.ndarray, np.ndarray, np.ndarray], b: Tuple[np.ndarray, np.ndarray, np.ndarray]
-) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The facing pairs ``(node, neighbour, gap)`` of ``a`` and ``b``, a pair in both once (the
-    smaller gap)."""
-    node, neighbour, gap = (np.concatenate([x, y]) for x, y in zip(a, b))
-    order = np.lexsort((gap, neighbour, node))
-    node, neighbour, gap = node[order], neighbour[order], gap[order]
-    first = np.ones(node.size, bool)
-    first[1:] = (node[1:] != node[:-1]) | (neighbour[1:] != neighbour[:-1])
-    return node[first], neighbour[first], gap[first]
-
-
-def warn_facing_pairs(
-    grid: Grid,
-    linear: np.ndarray,
-    roles: np.ndarray,
-    facing: Tuple[np.ndarray, np.ndarray, np.ndarray],
-    inner: float,
-    note: str = "",
-    resolving: Optional[float] = None,
-) -> None:
-    """The warning of :func:`_warn_if_tubes_touch` for the pairs ``facing`` (band positions of the
-    nodes and their neighbours, and the gaps), if there are any; ``note`` ends it (a point
-    cloud's, ``PointCloudSurface._gap_note`` and ``_unresolved_gap_note``). A gap ``resolving`` grid
-    spacings wide is resolved (default ``2·inner + 2``: the tubes of the two sides apart)."""
-    node, neighbour, gap = facing
-    if node.size == 0:
-        return
-    h = grid.spacing
-    narrowest = int(np.argmin(gap))
-    where = _where(grid, linear[node[narrowest]])
-    needed = float(gap[narrowest]) / (2 * inner + 2 if resolving is None else resolving)
-    # how much of the surface: the inner-tube nodes of the pairs among all inner-tube nodes
-    inner_nodes = roles == ROLE_INNER
-    touched = np.unique(np.concatenate([node, neighbour]))
-    share = np.count_nonzero(inner_nodes[touched]) / max(int(np.count_nonzero(inner_nodes)), 1)
-    warnings.warn(
-        f"the surface faces itself across gaps narrower than its tubes at {node.size} node pair(s), about "
-        f"{_percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near {where}). Distances "
-        "reached across such a gap can come out too short; elsewhere the result holds. sol.narrow_gaps() shows where; "
-        f"a grid spacing below {needed:.3g} (now {h:.3g}) resolves a real gap, while a crease or scan artefact stays "
-        f"narrower than any grid{note}",
-        RuntimeWarning,
-        stacklevel=user_stacklevel(),
     )
 
 
@@ -483,23 +339,9 @@ def _check_surface_spans_two_cells(
         )
 
 
-def _prepare_tube(
-    surf: Surface,
-    grid: Grid,
-    inner: float,
-    outer: float,
-    method: str,
-    keep_geometry: bool,
-    reusable: bool = False,
-    creases: bool = False,
-) -> _PreparedTube:
-    """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
-    single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
-    keeps the geometry unmodified for many solves (:class:`Tube`). ``creases`` (a level set given
-    as a distance, the two-layer method): the inner-tube nodes on the overlap side of a crease are
-    found (``_creases.crease_nodes_to_extend``), for :func:`thinned_at_creases` to make them
-    extension nodes (``order=2`` and ``"auto"``); the roles themselves stay the paper's."""
-    t0 = time.perf_counter()
+def _checked_widths(inner: float, outer: float, method: str) -> Tuple[float, float]:
+    """``inner`` and ``outer`` as finite numbers of grid spacings that leave the inner tube at least
+    one spacing and the extension layer room for every inner node's neighbours, or the error."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
     widths = []
@@ -519,11 +361,108 @@ def _prepare_tube(
             f"outer = {outer} must exceed inner = {inner} by at least 1 grid spacing so that the extension layer "
             "holds every neighbour of the inner tube (the paper uses inner=2, outer=4)"
         )
+    return inner, outer
+
+
+def _empty_band_message(surf: Surface) -> str:
+    """Why the band is empty: the surface does not pass through the grid or φ is not in its units
+    (or, for a φ array given as is that changes sign, far larger than a distance near the change)."""
+    array = getattr(surf, "_array", None) if isinstance(surf, LevelSet) and not surf.redistance else None
+    # (a φ array given as is that changes sign: a surface is there, but φ is not its distance)
+    signs = array is not None and bool(np.any(array < 0) and np.any(array > 0))
+    return (
+        "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
+        "and that φ is in the grid's units"
+        + (
+            " (φ changes sign, but its values near the change are far larger than a distance, e.g. a mask's "
+            "±0.5: LevelSet(phi, redistance=True), or LevelSet.from_mask(mask, grid) for a mask)"
+            if signs
+            else ""
+        )
+    )
+
+
+def _unprojected_message(surf: Surface, grid: Grid, count: int) -> str:
+    """Why ``count`` nodes next to a re-distanced φ's inner tube stay out of the band however wide
+    its layer: the projection cannot place them on the zero level set."""
+    return (
+        _specks(surf, grid)
+        + f"{count} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
+        "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
+        "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
+        "there (round the edges over more than the tube's width), pass a signed distance function, or refine the grid"
+        + (
+            "; or sample the callable φ on the grid and pass the array (LevelSet(phi_array, redistance=True) "
+            "locates the zero level set cell by cell, edges and corners included: a cube's distance at N = 61, "
+            "refused as a callable, solves as an array). A callable φ that is flat across its zero level set "
+            "(∇φ = 0 there, as (|x| − 0.5)³) is refused so too, its Newton projection stalling: sampled on the "
+            "grid it solves at order 2"
+            if getattr(surf, "_array", True) is None
+            else ""
+        )
+    )
+
+
+def _unclosed_message(
+    surf: Surface, grid: Grid, first: int, missing: int, outer: float, given_bound: Optional[float]
+) -> str:
+    """Why the extension layer does not enclose the inner tube after the widenings (``missing``
+    inner nodes lack a neighbour, the first at linear index ``first``): the surface kind's own
+    cause, φ far from a distance, a grid too coarse, or a ``lipschitz`` bound given too low."""
+    redistanced = bool(getattr(surf, "redistance", False))
+    # a surface kind's own cause (a point cloud's, a mesh's), or φ's for a level set not
+    # re-distanced (a mesh's smooth map failing here was told to re-distance its φ: a review)
+    cause = getattr(surf, "band_advice", None)
+    if cause is None and isinstance(surf, LevelSet) and not redistanced:
+        cause = "φ is far from a distance function (use ts.LevelSet(phi, redistance=True))"
+    return (
+        f"the extension layer does not enclose the inner tube even with outer = {outer}: {missing} "
+        f"inner nodes lack a neighbour (the first near {where_node(grid, first)}). "
+        + (f"{cause}, or " if cause else "")
+        + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
+        "than the tube: refine the grid)"
+        + (
+            ""
+            if given_bound is None
+            else f", or the lipschitz bound given, {given_bound:g}, is below |∇φ| near "
+            "the surface and keeps nodes from the band's candidates (leave it out to have it estimated)"
+        )
+    )
+
+
+@dataclasses.dataclass
+class _Band:
+    """The band the widenings settled on (:func:`_widened_band`): the surface's band geometry (None
+    once consumed), the nodes' linear indices and roles, the native band, φ in single precision,
+    the kinks and inside of the geometry, the directions for the solver (when consumed) and the
+    extension layer's width in grid spacings."""
+
+    geom: Any
+    linear: np.ndarray
+    roles: np.ndarray
+    band: Any
+    phi: np.ndarray
+    kink: Optional[np.ndarray]
+    inside: Optional[np.ndarray]
+    direction: Optional[np.ndarray]
+    outer: float
+
+
+def _widened_band(
+    surf: Surface,
+    grid: Grid,
+    inner: float,
+    outer_eff: float,
+    method: str,
+    keep_geometry: bool,
+    reusable: bool,
+) -> Optional[_Band]:
+    """The band of ``surf`` within ``outer_eff`` grid spacings with its roles, widened (a warning
+    each time) while inner-tube nodes lack a neighbour in it, or the error when that does not
+    close it. None where a mesh's smooth map folds on this grid and its exact closest points are
+    to be used instead (``fold_to_exact``: build the tube again)."""
     h = grid.spacing
     inner_width = inner * h
-    outer_eff = float(outer) if method == "two-layer" else float(inner)
-
-    _check_band_memory(surf, grid, outer_eff * h)
     # a re-distanced band, and the bound on |∇φ| its candidates were found with when the user gave it
     redistanced = bool(getattr(surf, "redistance", False))
     given_bound = getattr(surf, "lipschitz", None) if redistanced else None
@@ -538,20 +477,8 @@ def _prepare_tube(
                 warnings.filterwarnings("ignore", message="φ's slope nearly vanishes", category=RuntimeWarning)
             geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
-            array = getattr(surf, "_array", None) if isinstance(surf, LevelSet) and not surf.redistance else None
-            # (a φ array given as is that changes sign: a surface is there, but φ is not its distance)
-            signs = array is not None and bool(np.any(array < 0) and np.any(array > 0))
-            raise ValueError(
-                "the band is empty: no grid node lies within the tube; check that the surface passes through the grid "
-                "and that φ is in the grid's units"
-                + (
-                    " (φ changes sign, but its values near the change are far larger than a distance, e.g. a mask's "
-                    "±0.5: LevelSet(phi, redistance=True), or LevelSet.from_mask(mask, grid) for a mask)"
-                    if signs
-                    else ""
-                )
-            )
-        roles = _tube_roles(geom, inner_width, method)
+            raise ValueError(_empty_band_message(surf))
+        roles = tube_roles(geom, inner_width, method)
         linear = geom.linear
         if attempt == 0:
             _check_surface_spans_two_cells(surf, grid, linear, roles, inner)
@@ -598,22 +525,7 @@ def _prepare_tube(
             # elsewhere (a circle 3 spacings in radius came out far short at its antipode), so the
             # solve stops here. With a given bound below |∇φ| the candidates depend on the
             # layer's width and a later widening can still bring them in: widened as for any φ.
-            raise ValueError(
-                _specks(surf, grid)
-                + f"{lacking.size} nodes next to the inner tube could not be projected onto φ's zero level set, and a wider "
-                "extension layer does not bring them in: the zero level set has sharp edges or corners there, or the "
-                "surface is not much larger than the tube (its radius of curvature about the tube's width). Smooth φ "
-                "there (round the edges over more than the tube's width), pass a signed distance function, or refine the grid"
-                + (
-                    "; or sample the callable φ on the grid and pass the array (LevelSet(phi_array, redistance=True) "
-                    "locates the zero level set cell by cell, edges and corners included: a cube's distance at N = 61, "
-                    "refused as a callable, solves as an array). A callable φ that is flat across its zero level set "
-                    "(∇φ = 0 there, as (|x| − 0.5)³) is refused so too, its Newton projection stalling: sampled on the "
-                    "grid it solves at order 2"
-                    if getattr(surf, "_array", True) is None
-                    else ""
-                )
-            )
+            raise ValueError(_unprojected_message(surf, grid, lacking.size))
         previously_lacking = lacking
         if attempt == _MAX_WIDENINGS:
             # a mesh's smooth map that folds: its exact closest points on this grid (first order)
@@ -626,88 +538,54 @@ def _prepare_tube(
                     RuntimeWarning,
                     stacklevel=user_stacklevel(),
                 )
-                return _prepare_tube(surf, grid, inner, outer, method, keep_geometry, reusable, creases)
-            # a surface kind's own cause (a point cloud's, a mesh's), or φ's for a level set not
-            # re-distanced (a mesh's smooth map failing here was told to re-distance its φ: a review)
-            cause = getattr(surf, "band_advice", None)
-            if cause is None and isinstance(surf, LevelSet) and not redistanced:
-                cause = "φ is far from a distance function (use ts.LevelSet(phi, redistance=True))"
-            raise ValueError(
-                f"the extension layer does not enclose the inner tube even with outer = {outer_eff}: {missing.size} "
-                f"inner nodes lack a neighbour (the first near {_where(grid, linear[missing[0]])}). "
-                + (f"{cause}, or " if cause else "")
-                + "the grid is too coarse for the surface (the tube reaches across it, e.g. a sphere not much larger "
-                "than the tube: refine the grid)"
-                + (
-                    ""
-                    if given_bound is None
-                    else f", or the lipschitz bound given, {given_bound:g}, is below |∇φ| near "
-                    "the surface and keeps nodes from the band's candidates (leave it out to have it estimated)"
-                )
-            )
+                return None
+            raise ValueError(_unclosed_message(surf, grid, linear[missing[0]], missing.size, outer_eff, given_bound))
         warnings.warn(
             _widening_message(missing, phi, h, inner, outer_eff, surf), RuntimeWarning, stacklevel=user_stacklevel()
         )
         outer_eff += 1.0
+    return _Band(geom, linear, roles, band, phi, kink, inside, direction, outer_eff)
+
+
+def _prepare_tube(
+    surf: Surface,
+    grid: Grid,
+    inner: float,
+    outer: float,
+    method: str,
+    keep_geometry: bool,
+    reusable: bool = False,
+    creases: bool = False,
+) -> _PreparedTube:
+    """The band of ``surf`` (Algorithm 3's inner tube and extension layer, or Algorithm 2's
+    single tube) with its roles, widened while inner nodes lack a neighbour in it. ``reusable``
+    keeps the geometry unmodified for many solves (:class:`Tube`). ``creases`` (a level set given
+    as a distance, the two-layer method): the inner-tube nodes on the overlap side of a crease are
+    found (``_creases.crease_nodes_to_extend``), for :func:`thinned_at_creases` to make them
+    extension nodes (``order=2`` and ``"auto"``); the roles themselves stay the paper's."""
+    t0 = time.perf_counter()
+    inner, outer = _checked_widths(inner, outer, method)
+    h = grid.spacing
+    inner_width = inner * h
+    layer = float(outer) if method == "two-layer" else float(inner)  # the band's half-width in spacings
+    _check_band_memory(surf, grid, layer * h)
+    b = _widened_band(surf, grid, inner, layer, method, keep_geometry, reusable)
+    if b is None:  # a mesh's smooth map that folds: its exact closest points on this grid
+        return _prepare_tube(surf, grid, inner, outer, method, keep_geometry, reusable, creases)
+    linear, roles, phi, outer_eff = b.linear, b.roles, b.phi, b.outer
     # a surface that leaves the grid box: the distances are those of the part inside (warned)
     cut = box_cut(grid, linear, phi, inner_width)
     warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
-    directions = direction if direction is not None else geom.direction
-    cuts = cuts_shortcuts(surf)
-    gap_note = getattr(surf, "_gap_note", None)
-    note = gap_note(h) if gap_note is not None else ""
-    noise = float(getattr(surf, "_noise", 0.0))
-    facing = _warn_if_tubes_touch(
-        grid, band, linear, roles, phi, directions, inner, kink, noise, warn=not cuts and inside is None, note=note
-    )
-    if inside is not None:
-        # an unsigned φ with a known inside (BandGeometry.inside): the pairs of the signed φ too
-        signed_phi = np.where(inside, -phi, phi)
-        facing = _union_pairs(
-            facing,
-            _warn_if_tubes_touch(grid, band, linear, roles, signed_phi, directions, inner, kink, noise, warn=False),
-        )
-        del signed_phi
-        if not cuts:
-            warn_facing_pairs(grid, linear, roles, facing, inner, note)
-    # a mesh or a point cloud: pairs over a hole are no gap (cut nowhere, not warned)
-    over_holes = getattr(surf, "_pairs_over_holes", None)
-    hole_pairs = None
-    if over_holes is not None and facing[0].size:
-        on_hole = over_holes(grid, linear[facing[0]], linear[facing[1]], facing[2])
-        hole_pairs = (linear[facing[0][on_hole]], linear[facing[1][on_hole]], facing[2][on_hole])
-        facing = (facing[0][~on_hole], facing[1][~on_hole], facing[2][~on_hole])
-    cut_edges = 0
-    pieces = None
-    cut_facing = facing
-    resolved = getattr(surf, "resolved_gap", None)  # a cloud: the gaps its fits keep apart
-    if cuts and resolved is not None:
-        node, neighbour, gap = facing
-        narrow = gap < resolved(h)
-        cut_facing = (node[~narrow], neighbour[~narrow], gap[~narrow])
-        warn_facing_pairs(
-            grid,
-            linear,
-            roles,
-            (node[narrow], neighbour[narrow], gap[narrow]),
-            inner,
-            getattr(surf, "_unresolved_gap_note")(h) + (gap_note(h) if gap_note is not None else ""),
-            resolving=float(getattr(surf, "resolving_spacings")),
-        )
-    if cuts:
-        band, cut_edges = cut_shortcuts(
-            band, roles == ROLE_INNER, phi, directions, h, cut_facing, medial=cuts_medial_edges(surf)
-        )
-        band, parted, pieces = cut_between_parts(surf, grid, band, linear)
-        band, pinched = cut_pinches(surf, grid, band, linear)
-        cut_edges += parted + pinched
+    directions = b.direction if b.direction is not None else b.geom.direction
+    gaps = facing_gaps(surf, grid, b.band, linear, roles, phi, directions, inner, b.kink, b.inside)
+    band, facing = gaps.band, gaps.facing
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)
     elif isinstance(surf, LevelSet) and not facing[0].size:  # (where gaps are found, they are said)
         warn_thin(*thin_share(grid, band, linear, phi), h, inner)
     holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh's or a cloud's holes the band spans
-    bridged_holes = holes_of(h, outer_eff, grid, hole_pairs) if holes_of is not None else None
+    bridged_holes = holes_of(h, outer_eff, grid, gaps.over_holes) if holes_of is not None else None
     slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, which the band may join
     slits = slits_of(h) if slits_of is not None else None
     # (after the facing test, which reads the paper's inner tube). On a re-distanced φ, whose kinks
@@ -734,19 +612,19 @@ def _prepare_tube(
         float(inner),
         outer_eff,
         method,
-        geom,
+        b.geom,
         linear,
         roles,
         band,
         phi,
-        direction,
+        b.direction,
         time.perf_counter() - t0,
         facing,
         cut,
-        cut_edges,
+        gaps.cut_edges,
         extended,
         paper_creases=paper_creases,
-        pieces=pieces,
+        pieces=gaps.pieces,
         bridged_holes=bridged_holes,
         slits=slits,
     )

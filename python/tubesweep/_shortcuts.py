@@ -6,7 +6,7 @@ of one grid spacing in the tube for the step between the two nodes' closest poin
 surface. Three kinds of edges break that:
 
 * across a gap narrower than the tubes, between two parts of the surface that face each other
-  (``_prepare._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``): the front would
+  (``_facing._warn_if_tubes_touch``, ``tubesweep_core::band::facing_sheets``): the front would
   cross the gap;
 * on a triangle mesh, above each concave edge, where the exact closest points of two neighbours
   lie on the two faces far apart (``tubesweep_core::band::medial_edges``): the front would cut

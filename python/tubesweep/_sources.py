@@ -10,7 +10,7 @@ import numpy as np
 
 from .grid import Grid
 from .surface import Surface
-from ._prepare import ROLE_INNER
+from ._roles import ROLE_INNER
 from ._warn import user_stacklevel
 from ._validate import checked_point_speeds, speed_at_points
 

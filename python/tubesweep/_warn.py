@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import Any
+
+import numpy as np
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__)) + os.sep
 
@@ -22,3 +25,15 @@ def user_stacklevel() -> int:
         frame = frame.f_back  # type: ignore[assignment]
         level += 1
     return level
+
+
+def where_node(grid: Any, node: Any) -> str:
+    """A grid node's position, for a message: ``(x, y, z)`` to four digits."""
+    return "(" + ", ".join(f"{float(v):.4g}" for v in grid.node_points(np.array([int(node)]))[0]) + ")"
+
+
+def percent(share: float) -> str:
+    """A share as a short percentage: '0.1%', '12%', or '< 0.01%'."""
+    if share < 1e-4:
+        return "< 0.01%"
+    return f"{100 * share:.2g}%" if share < 0.1 else f"{100 * share:.0f}%"

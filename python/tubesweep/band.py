@@ -108,7 +108,7 @@ class BandGeometry:
         For a level set, the nodes whose central differences of φ straddle a kink where φ's
         gradient turns by more than about 140° (``|∇φ|`` below :data:`KINK_FRACTION` of the
         band's typical value): a ridge between two parts of the surface that face each other,
-        where the direction is not reliable (see ``_prepare._warn_if_tubes_touch``). None otherwise.
+        where the direction is not reliable (see ``_facing._warn_if_tubes_touch``). None otherwise.
     inside : (K,) bool or None
         For a closest-point surface whose ``signed`` is unsigned but which has an inside (a closed
         mesh's smooth map), the nodes inside it: the facing test runs once more with φ signed by

@@ -246,7 +246,7 @@ class ClosestPoint(Surface):
         diff = np.concatenate(parts_diff)
         _refuse_undefined_next_to(grid, np.concatenate(undefined), linear)
         # a sample of the band: idempotence and the nearest-point property near the surface, and
-        # the map's noise there (for the facing-sheets test, _prepare._warn_if_tubes_touch)
+        # the map's noise there (for the facing-sheets test, _facing._warn_if_tubes_touch)
         pick = np.linspace(0, len(linear) - 1, min(len(linear), BAND_SAMPLE)).astype(np.int64)
         xs = grid.node_points(linear[pick])
         self._noise = check_band_sample(lambda p: _evaluate_cp(self._cp, p, finite=False), xs, xs - diff[pick], grid)

@@ -26,7 +26,7 @@ from ._sources import beyond_inner_tube
 from ._warn import user_stacklevel
 from ._validate import as_points, check_flag
 from .many import check_many_progress
-from ._prepare import ROLE_INNER
+from ._roles import ROLE_INNER
 from .second_order import check_order
 from .tube import Tube
 

@@ -32,7 +32,9 @@ from ._validate import (
 )
 from ._creases import warn_paper_tube_creases
 from ._warn import user_stacklevel
-from ._prepare import ROLE_INNER, paper_creases_of, thinned_count, uncut_band, warn_facing_pairs
+from ._facing import warn_facing_pairs
+from ._prepare import paper_creases_of, thinned_count, uncut_band
+from ._roles import ROLE_INNER
 from ._parts import drop_unsourced_rows
 from ._sheet_readout import own_side_plan
 from ._fallback import Fallback

@@ -26,6 +26,7 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from . import _native
+from ._roles import ROLE_OUTER
 
 __all__ = ["WarmStartRefused", "WARM_REFUSED"]
 
@@ -130,8 +131,6 @@ def inner_components(band: Any, roles: np.ndarray, known: Optional[Tuple[Any, ..
     component label)``: ``known``, kept from an earlier call, is used when the flags' checksum
     matches (a warm solve's tube is the next step's previous tube: its components are labelled
     once)."""
-    from ._prepare import ROLE_OUTER
-
     inner = np.ascontiguousarray(roles != ROLE_OUTER)
     crc = zlib.crc32(inner.view(np.uint8).data)
     if known is not None and known[1] == crc:
@@ -154,8 +153,6 @@ def _topology_change(
     that shares no inner node with the other tube (moved farther than the inner tube is wide,
     within outer − inner) is not held against it. ``old_position``: each of ``tube``'s band nodes'
     position in ``warm``'s band (+∞ when new to it), as ``carried_values`` merged them."""
-    from ._prepare import ROLE_OUTER
-
     if old[0] != new[0]:
         return (
             f"the inner tube has {new[0]} connected component(s), the previous one had {old[0]} (a part pinched off "
@@ -198,8 +195,6 @@ def carried_values(
     the nodes whose update changed, when the previous values are the converged, unedited values of
     a solve at a tolerance no looser than ``tol``) and the report. Raises :class:`WarmStartRefused` when the
     previous solution does not fit (see the module)."""
-    from ._prepare import ROLE_OUTER
-
     grid = tube.grid
     older = None
     if isinstance(warm, (tuple, list)):
@@ -340,8 +335,6 @@ def _check_older(older: Any, previous: Any, previous_linear: np.ndarray, slack: 
     outside its band, than two steps may move (2·(outer − inner) spacings). Such a pair (a torus's
     solution, a source at the other pole, a sphere 6 spacings smaller) was taken without a word and
     only cost time (a review of issue 47)."""
-    from ._prepare import ROLE_OUTER
-
     reach = 2.0 * slack * (1 + 1e-9)
     a = np.ascontiguousarray(older._factoring[1], dtype=float)
     b = np.ascontiguousarray(previous._factoring[1], dtype=float)

@@ -23,7 +23,8 @@ from ._coarse_creases import widened_for_order2
 from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_RADIUS, factored_reach
 from ._parts import drop_unsourced, part_labels, source_parts
-from ._prepare import ROLE_OUTER, thinned_count
+from ._prepare import thinned_count
+from ._roles import ROLE_OUTER
 from ._result_check import stranded_nodes
 from .mask import mask_advice
 from .moving import values_checksum

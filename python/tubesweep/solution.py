@@ -20,7 +20,7 @@ from ._sheet_readout import own_side_plan
 from .grid import Grid
 from .stats import SolveStats
 from .surface import Surface
-from ._prepare import ROLE_OUTER
+from ._roles import ROLE_OUTER
 from ._warn import user_stacklevel
 
 

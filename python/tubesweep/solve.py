@@ -8,7 +8,8 @@ from typing import Any, Callable, List, Optional, Union
 
 from ._first_order import first_order
 from ._order_choice import order2_on, refuse_warm_for_order1, second_order_or_fallback
-from ._prepare import METHODS, ROLE_RTOL, _PreparedTube, _prepare_tube, thinned_at_creases, unstranded
+from ._prepare import METHODS, _PreparedTube, _prepare_tube, thinned_at_creases, unstranded
+from ._roles import ROLE_RTOL
 from ._request import SOURCE_INITS, SolveRequest, check_source_radius
 from ._sources import SOURCE_RADIUS
 from ._validate import FIRST_ORDER_TOL, as_grid

@@ -167,7 +167,7 @@ class CloudAdvice:
         )
 
     def _gap_note(self, h: float) -> str:
-        """For the warning of parts that face each other across narrow gaps (``_prepare.warn_facing_pairs``)
+        """For the warning of parts that face each other across narrow gaps (``_facing.warn_facing_pairs``)
         on a grid of spacing ``h``: where the samples lie more than a grid spacing apart, such a gap
         can be a fold of the fits between them, and a finer grid only makes the samples sparser
         against it (150 samples of a sphere 2.7 spacings apart at N = 81: 5 pairs, 0.05% of the

@@ -2,7 +2,7 @@
 
 A scan has holes: the sensor's blind spots, a part that shadowed another. Where such a hole is
 narrower than the band (``2·outer`` grid spacings), the band spans it, and the facing-sheets test
-(``_prepare._warn_if_tubes_touch``) finds node pairs over it whose closest points lie on the two
+(``_facing._warn_if_tubes_touch``) finds node pairs over it whose closest points lie on the two
 sides of the hole: it took them for two sheets facing each other across a gap and warned "the
 surface faces itself across gaps" (a sphere of radius 0.6 sampled 40,000 times, three holes 0.1
 wide: 5 pairs at N = 61, 2 at N = 81, ``benches/experiments/cloud_holes.py``). A hole is no gap

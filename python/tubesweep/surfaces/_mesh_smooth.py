@@ -396,7 +396,7 @@ class SmoothMap:
         ----------
         facing_pairs : int
             The node pairs of the tube whose sides face each other across a narrow gap (the
-            tube's own check, ``_prepare._warn_if_tubes_touch``).
+            tube's own check, ``_facing._warn_if_tubes_touch``).
         pair_depth : float
             Their median depth: the larger |φ| of each pair's two nodes, in grid spacings (pairs
             hugging the mesh are its bumps, not a gap).
