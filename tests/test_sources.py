@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import tubesweep as ts
-from tubesweep._prepare import ROLE_INNER, _prepare_tube
+from tubesweep._prepare import _prepare_tube
+from tubesweep._roles import ROLE_INNER
 from tubesweep._sources import SOURCE_RADIUS, _fix_sources
 
 

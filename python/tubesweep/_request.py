@@ -1,6 +1,6 @@
 """The check stage of a solve (``ts.solve``, ``Tube.solve``): the arguments that do not depend on
 the surface, validated once into a :class:`SolveRequest` that the later stages read (surface →
-tube → scheme, ``_order_choice`` and ``solve._solve_on_tube`` → :class:`~tubesweep.Solution`)."""
+tube → scheme, ``_order_choice`` and ``_first_order.solve_on_tube`` → :class:`~tubesweep.Solution`)."""
 
 from __future__ import annotations
 

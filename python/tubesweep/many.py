@@ -219,7 +219,7 @@ def solve_many(
             if order == 2:
                 raise
             fallback = Fallback.of(e, order)
-            if isinstance(e, so.OptionOfOrder1):
+            if fallback.option_of_order1:
                 order = 1  # an option of the first-order scheme: its tube, as ts.solve's and tube.solve's
         else:
             orders, reason = _runaway_rows(tube, groups, out, st, order, first, number_from)

@@ -31,7 +31,7 @@
 //! Algorithms 1, 2 and 3 are the same sweeps over different bands and roles: the whole box with
 //! every node inner (Algorithm 1, `tubesweep.travel_time`), one tube of inner nodes (Algorithm 2,
 //! `method="naive"`), the inner tube and the extension layer (Algorithm 3, the default); the roles
-//! are set by the caller (`tubesweep.solve`'s `_tube_roles`).
+//! are set by the caller (`tubesweep._roles.tube_roles`).
 
 /// Calls `$this.$method::<S, P, W, K>($args)` with the row loop specialised for the problem:
 /// the scheme `S` (the built-in upwind solvers each their own, [`crate::scheme::upwind::Builtin`]), a per-node slowness `P`, the front window `W` and the active flags `K`
