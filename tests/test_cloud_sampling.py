@@ -96,10 +96,11 @@ def sliced_torus(dz: float = 0.04, ds: float = 0.0075) -> np.ndarray:
 
 
 def test_a_noise_free_cloud_s_runaway_is_not_blamed_on_noise():
-    # a sliced torus whose fits of 40 samples span too few slices at its last ones (with these
-    # samples, 0.0075 apart along the rings: at 0.003 apart, 60 neighbours solve at second order
-    # and 80–100 run away): the samples lie on their fits (noise ~6e-7), and the message blamed
-    # "samples a little off their neighbours' surface", which a larger neighbours= was to smooth out
+    # a sliced torus, its strips over the tube's top and bottom unsampled, runs away at second
+    # order with fits of 40 samples 0.0075 apart along the rings (at 0.003 apart, 60 neighbours
+    # solve at second order and 80–100 run away): the samples lie on their fits (noise ~6e-7),
+    # and the message blamed "samples a little off their neighbours' surface", which a larger
+    # neighbours= was to smooth out
     cloud = ts.surfaces.from_points(sliced_torus(), neighbours=40)
     assert cloud.noise < 1e-6
     with pytest.warns(RuntimeWarning, match="ran away") as said:

@@ -190,15 +190,15 @@ class CloudAdvice:
     @property
     def unresolved_advice(self) -> str:
         """Where a cloud's closest points fold or bend more than the grid resolves: samples a little
-        off their neighbours' surface, or on a noise-free cloud (:data:`NOISE_FREE`) fits bending
-        between unevenly spread samples; where the sampling is uneven, parts sampled too sparsely."""
+        off their neighbours' surface, or on a noise-free cloud (:data:`NOISE_FREE`) the fits over
+        unevenly spread samples; where the sampling is uneven, parts sampled too sparsely."""
         advice = "samples a little off their neighbours' surface, which a larger neighbours= smooths out"
         if self.noise < NOISE_FREE * self._median_fit:
             advice = (
-                "fits bending between unevenly spread samples, not noise, since the samples lie on their neighbours' "
-                f"fits to {self.noise:.2g}: as at the last lines of a scan taken in lines or slices, where a fit spans "
-                "too few of them to tell the surface's shape across them; another neighbours=, whose fits span another "
-                "number of lines, or denser samples there cure it"
+                "the fits over unevenly spread samples, not noise, since the samples lie on their neighbours' fits to "
+                f"{self.noise:.2g}: a scan taken in lines or slices, or rims and gaps left unsampled, where the closest "
+                "points of neighbouring nodes come from fits over different samples; another neighbours=, whose fits "
+                "span another number of lines, or denser samples there cure it"
             )
         uneven = self._uneven()
         if uneven is not None:
