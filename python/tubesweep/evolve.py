@@ -21,7 +21,7 @@ import dataclasses
 import os
 import warnings
 from pathlib import Path
-from typing import Any, Callable, List, Optional, Union
+from typing import Any, Callable, List, Optional, Tuple, Union
 
 import numpy as np
 from xml.sax.saxutils import quoteattr
@@ -263,6 +263,193 @@ def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) 
     return v
 
 
+def _fresh_nodes_filled(
+    arr: np.ndarray, linear: np.ndarray, signed: np.ndarray, previous_band: Optional[np.ndarray]
+) -> np.ndarray:
+    """φ with the band's nodes that lay beyond the previous band, which hold a bound, given their
+    re-distanced values ``signed`` instead (a copy: the solved tube's LevelSet keeps the array it
+    was given); ``arr`` itself where there are none."""
+    if previous_band is None:
+        return arr
+    fresh = ~np.isin(linear, previous_band)
+    if not np.any(fresh):
+        return arr
+    arr = arr.copy()
+    arr.reshape(-1)[linear[fresh]] = signed[fresh]
+    return arr
+
+
+def _warm_start(older: Optional[Solution], prev: Optional[Solution]) -> Any:
+    """The warm start of a step's surface solve (``Tube.solve(warm=...)``): none at the first step;
+    extrapolated from the two previous steps where both ran second order; a step that fell back to
+    first order starts the next one cold and the one after from it alone. (A step that writes a
+    checkpoint solves cold and the next one starts from it alone: a run continued from the
+    checkpoint, cold with no older step, then repeats the uninterrupted one bit for bit; warm, its
+    first solve differed by 2.9 tolerances, its φ by 5e-8 after four more steps. A warm solve costs
+    as much as a cold one here, docs/moving-surfaces.md.)"""
+    if prev is None:
+        return None
+    pair = older is not None and getattr(older, "order", 1) == 2
+    return (older, prev) if pair else prev
+
+
+def _count_start(out: Evolution, sol: Solution) -> None:
+    """Counts the step's solve as warm (its warm start used to the end) or cold."""
+    info = (sol.stats.order2 or {}).get("warm")
+    if info is not None and "refused" not in info and info.get("restarted") is None:
+        out.warm_starts += 1
+    else:
+        out.cold_starts += 1
+
+
+def _record(
+    out: Evolution, step: int, t: float, arr: np.ndarray, sol: Solution, checkpoint: Optional[Path], sources: Any
+) -> None:
+    """A frame kept (t, φ, the solution) and, with ``checkpoint``, written there with the step's
+    ``sources`` as given to its projection, or :class:`EvolutionStopped` when it cannot be."""
+    out.times.append(t)
+    out.phis.append(arr)
+    out.solutions.append(sol)
+    if checkpoint is None:
+        return
+    try:
+        _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=sources)
+    except OSError as e:
+        raise EvolutionStopped(
+            f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "
+            f"be written ({e})",
+            out,
+            step,
+            t,
+        ) from e
+
+
+def _law(
+    speed: Callable[[np.ndarray], Any],
+    u: np.ndarray,
+    step: int,
+    t: float,
+    out: Evolution,
+    dt: float,
+    limit: float,
+) -> Tuple[np.ndarray, float]:
+    """The normal speed V = speed(u) at the band's nodes and its largest magnitude, or the error
+    (raised as it is at step 0, as :class:`EvolutionStopped` with the frames so far ``out``
+    after): the law's own errors, its values checked (:func:`_speed_values`), and the CFL
+    condition Δt·max|V| ≤ ``limit`` = cfl·Δx."""
+    try:
+        v = _speed_values(speed, u, step)
+    except Exception as e:  # the law's own errors too: the frames so far are kept
+        if step == 0:
+            raise
+        if isinstance(e, (ValueError, TypeError)) and str(e).startswith("evolve:"):
+            raise EvolutionStopped(str(e), out, step, t) from e
+        raise EvolutionStopped(
+            f"evolve stopped at step {step} (t = {t:.6g}): speed(u) raised {type(e).__name__}: {e}",
+            out,
+            step,
+            t,
+        ) from e
+    vmax = float(np.max(np.abs(v)))
+    if dt * vmax > limit:
+        message = (
+            f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
+            f"cfl·Δx = {limit:.4g} (max|V| = {vmax:.4g}); take dt ≤ {limit / vmax:.4g}"
+        )
+        if step == 0:
+            raise ValueError(message)
+        raise EvolutionStopped(message, out, step, t)
+    return v, vmax
+
+
+@dataclasses.dataclass
+class _Inputs:
+    """:func:`evolve`'s arguments, checked: the grid, φ as a C-ordered copy, the sources, and the
+    time stepping (``dt``, ``steps``, ``cfl``, ``every``, ``t0``, the checkpoint's path or None)."""
+
+    grid: Any
+    arr: np.ndarray
+    src: np.ndarray
+    dt: float
+    steps: int
+    cfl: float
+    every: int
+    t0: float
+    checkpoint: Optional[Path]
+
+
+def _checked_inputs(
+    phi: Any,
+    grid: Any,
+    sources: Any,
+    speed: Any,
+    dt: Any,
+    steps: Any,
+    cfl: Any,
+    every: Any,
+    progress: Any,
+    checkpoint: Any,
+    t0: Any,
+) -> _Inputs:
+    """:func:`evolve`'s arguments checked in order, or the first one's error (the argument named,
+    and the fix)."""
+    grid = as_grid(grid)
+    if isinstance(phi, Surface) or callable(phi):
+        raise TypeError(
+            f"evolve: phi must be an array of φ at the grid's nodes, which evolve advances; got {type(phi).__name__}. "
+            "For a surface or a φ function pass its values, e.g. surface.signed_distance(grid.node_points("
+            "np.arange(grid.size))).reshape(grid.shape)"
+        )
+    # a copy in C order: the caller's array is left alone, and the band's nodes are written
+    # through its flat view (of a Fortran-ordered array, a copy that dropped the step's motion)
+    arr = np.array(real_array(phi, "evolve: phi"), dtype=float, order="C")
+    if arr.shape != tuple(grid.shape):
+        raise ValueError(f"evolve: phi must be an array of the grid's shape {tuple(grid.shape)}; got {arr.shape}")
+    unfinite = np.flatnonzero(~np.isfinite(arr.reshape(-1)))
+    if unfinite.size:
+        # (each step re-distances φ, LevelSet(phi, redistance=True), which reads it at every node)
+        where = tuple(round(float(c), 6) for c in grid.node_points(unfinite[:1])[0])
+        raise ValueError(
+            f"evolve: phi is NaN or inf at {unfinite.size} of {arr.size} nodes (the first at {where}); evolve "
+            "re-distances φ at every step, which reads every node. Replace them by a value of their side's sign "
+            "farther from the surface than the band (e.g. np.where(np.isfinite(phi), phi, ±1))"
+        )
+    src = as_sources(sources, grid)
+    dt = real_scalar(dt, "evolve: dt", "a positive time step")
+    if not (np.isfinite(dt) and dt > 0):
+        raise ValueError(f"evolve: dt must be a positive time step; got {dt!r}")
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise ValueError(f"evolve: steps must be a positive integer; got {steps!r}")
+    cfl = real_scalar(cfl, "evolve: cfl", "a number in (0, 1]")
+    if not 0 < cfl <= 1:
+        raise ValueError(
+            f"evolve: cfl must be in (0, 1] (the surface moves at most cfl grid spacings per step); got {cfl!r}"
+        )
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
+        raise ValueError(f"evolve: every must be a positive integer; got {every!r}")
+    t0 = real_scalar(t0, "evolve: t0", "the time of phi")
+    if not np.isfinite(t0):
+        raise ValueError(f"evolve: t0 must be a finite time; got {t0!r}")
+    if checkpoint is not None and Path(checkpoint).suffix.lower() != ".npz":
+        raise ValueError(
+            f"evolve: checkpoint is written with numpy.savez and must end in .npz; got {str(checkpoint)!r}"
+        )
+    if checkpoint is not None and Path(checkpoint).is_dir():
+        raise ValueError(f"evolve: checkpoint={str(checkpoint)!r} is a folder; give a file name ending in .npz")
+    if checkpoint is not None:
+        # a missing folder is made at the first write, as Evolution.export makes its own; one that
+        # could not be (a file in the way, no permission) is refused now, before the first solve
+        checkpoint = Path(checkpoint).expanduser()
+        writable(checkpoint, f"evolve: checkpoint={str(checkpoint)!r}:")
+    if not callable(speed):
+        raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(
+            f"evolve: progress must be None or a callable progress(step, steps, t); got {type(progress).__name__}"
+        )
+    return _Inputs(grid, arr, src, dt, int(steps), cfl, int(every), t0, checkpoint)
+
+
 def evolve(
     phi: Any,
     grid: Any,
@@ -350,60 +537,9 @@ def evolve(
     >>> round(float(ev.solutions[-1].sources[0][2]), 2)  # the pole, at 0.5 + 2 * 0.05 * 0.2
     0.52
     """
-    grid = as_grid(grid)
-    if isinstance(phi, Surface) or callable(phi):
-        raise TypeError(
-            f"evolve: phi must be an array of φ at the grid's nodes, which evolve advances; got {type(phi).__name__}. "
-            "For a surface or a φ function pass its values, e.g. surface.signed_distance(grid.node_points("
-            "np.arange(grid.size))).reshape(grid.shape)"
-        )
-    # a copy in C order: the caller's array is left alone, and the band's nodes are written
-    # through its flat view (of a Fortran-ordered array, a copy that dropped the step's motion)
-    arr = np.array(real_array(phi, "evolve: phi"), dtype=float, order="C")
-    if arr.shape != tuple(grid.shape):
-        raise ValueError(f"evolve: phi must be an array of the grid's shape {tuple(grid.shape)}; got {arr.shape}")
-    unfinite = np.flatnonzero(~np.isfinite(arr.reshape(-1)))
-    if unfinite.size:
-        # (each step re-distances φ, LevelSet(phi, redistance=True), which reads it at every node)
-        where = tuple(round(float(c), 6) for c in grid.node_points(unfinite[:1])[0])
-        raise ValueError(
-            f"evolve: phi is NaN or inf at {unfinite.size} of {arr.size} nodes (the first at {where}); evolve "
-            "re-distances φ at every step, which reads every node. Replace them by a value of their side's sign "
-            "farther from the surface than the band (e.g. np.where(np.isfinite(phi), phi, ±1))"
-        )
-    src = as_sources(sources, grid)
-    dt = real_scalar(dt, "evolve: dt", "a positive time step")
-    if not (np.isfinite(dt) and dt > 0):
-        raise ValueError(f"evolve: dt must be a positive time step; got {dt!r}")
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
-        raise ValueError(f"evolve: steps must be a positive integer; got {steps!r}")
-    cfl = real_scalar(cfl, "evolve: cfl", "a number in (0, 1]")
-    if not 0 < cfl <= 1:
-        raise ValueError(
-            f"evolve: cfl must be in (0, 1] (the surface moves at most cfl grid spacings per step); got {cfl!r}"
-        )
-    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1:
-        raise ValueError(f"evolve: every must be a positive integer; got {every!r}")
-    t0 = real_scalar(t0, "evolve: t0", "the time of phi")
-    if not np.isfinite(t0):
-        raise ValueError(f"evolve: t0 must be a finite time; got {t0!r}")
-    if checkpoint is not None and Path(checkpoint).suffix.lower() != ".npz":
-        raise ValueError(
-            f"evolve: checkpoint is written with numpy.savez and must end in .npz; got {str(checkpoint)!r}"
-        )
-    if checkpoint is not None and Path(checkpoint).is_dir():
-        raise ValueError(f"evolve: checkpoint={str(checkpoint)!r} is a folder; give a file name ending in .npz")
-    if checkpoint is not None:
-        # a missing folder is made at the first write, as Evolution.export makes its own; one that
-        # could not be (a file in the way, no permission) is refused now, before the first solve
-        checkpoint = Path(checkpoint).expanduser()
-        writable(checkpoint, f"evolve: checkpoint={str(checkpoint)!r}:")
-    if not callable(speed):
-        raise TypeError(f"evolve: speed must be a callable speed(u) -> V; got {type(speed).__name__}")
-    if progress is not None and not callable(progress):
-        raise TypeError(
-            f"evolve: progress must be None or a callable progress(step, steps, t); got {type(progress).__name__}"
-        )
+    inputs = _checked_inputs(phi, grid, sources, speed, dt, steps, cfl, every, progress, checkpoint, t0)
+    grid, arr, src, dt, steps, cfl = inputs.grid, inputs.arr, inputs.src, inputs.dt, inputs.steps, inputs.cfl
+    every, t0, checkpoint = inputs.every, inputs.t0, inputs.checkpoint
     h = grid.spacing
     out = Evolution([], [], [])
     tube: Optional[Any] = None
@@ -432,17 +568,7 @@ def evolve(
                     # (the checkpoint keeps the sources before this projection: a continued run
                     # projects them again, onto the same surface, to the same bits)
                     unprojected, src = src, np.ascontiguousarray(feet)
-                    # extrapolated from the two previous steps where both ran second order; a step that
-                    # fell back to first order starts the next one cold and the one after from it alone
-                    pair = older is not None and getattr(older, "order", 1) == 2
-                    warm: Any = None if prev is None else ((older, prev) if pair else prev)
-                    # a step that writes a checkpoint solves cold, and the next one starts from it
-                    # alone: a run continued from the checkpoint (cold, with no older step) then
-                    # repeats the uninterrupted one bit for bit (warm, its first solve differed by
-                    # 2.9 tolerances, its φ by 5e-8 after four more steps); a warm solve costs as
-                    # much as a cold one here (docs/moving-surfaces.md)
-                    if checkpointed(step):
-                        warm = None
+                    warm = None if checkpointed(step) else _warm_start(older, prev)
                     sol = tube.solve(src, warm=warm, warm_refused="cold", tol=tol)
                     cut = sol.stats.box_cut
                     if step == 0:
@@ -468,63 +594,18 @@ def evolve(
                     step,
                     t,
                 )
-            # the band's nodes that lay beyond the previous band hold a bound: their re-distanced
-            # values take its place (a copy: the solved tube's LevelSet keeps the array it was given)
             linear = tube._tube.linear
             geom = tube._tube.geom
             assert geom is not None  # a Tube keeps its geometry
             signed = np.asarray(geom.signed, dtype=float)  # the band's re-distanced φ
-            if previous_band is not None:
-                fresh = ~np.isin(linear, previous_band)
-                if np.any(fresh):
-                    arr = arr.copy()
-                    arr.reshape(-1)[linear[fresh]] = signed[fresh]
+            arr = _fresh_nodes_filled(arr, linear, signed, previous_band)
             previous_band = linear
-            info = (sol.stats.order2 or {}).get("warm")
-            if info is not None and "refused" not in info and info.get("restarted") is None:
-                out.warm_starts += 1
-            else:
-                out.cold_starts += 1
+            _count_start(out, sol)
             if step % every == 0 or step == steps:
-                out.times.append(t)
-                out.phis.append(arr)
-                out.solutions.append(sol)
-                if checkpoint is not None:
-                    try:
-                        _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=unprojected)
-                    except OSError as e:
-                        raise EvolutionStopped(
-                            f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "
-                            f"be written ({e})",
-                            out,
-                            step,
-                            t,
-                        ) from e
+                _record(out, step, t, arr, sol, checkpoint, unprojected)
             if step == steps:
                 break
-            u = sol.values
-            try:
-                v = _speed_values(speed, u, step)
-            except Exception as e:  # the law's own errors too: the frames so far are kept
-                if step == 0:
-                    raise
-                if isinstance(e, (ValueError, TypeError)) and str(e).startswith("evolve:"):
-                    raise EvolutionStopped(str(e), out, step, t) from e
-                raise EvolutionStopped(
-                    f"evolve stopped at step {step} (t = {t:.6g}): speed(u) raised {type(e).__name__}: {e}",
-                    out,
-                    step,
-                    t,
-                ) from e
-            vmax = float(np.max(np.abs(v)))
-            if dt * vmax > cfl * h:
-                message = (
-                    f"evolve: the CFL condition fails at step {step} (t = {t:.6g}): dt·max|V| = {dt * vmax:.4g} > "
-                    f"cfl·Δx = {cfl * h:.4g} (max|V| = {vmax:.4g}); take dt ≤ {cfl * h / vmax:.4g}"
-                )
-                if step == 0:
-                    raise ValueError(message)
-                raise EvolutionStopped(message, out, step, t)
+            v, vmax = _law(speed, sol.values, step, t, out, dt, cfl * h)
             new = np.sign(arr) * np.maximum(np.abs(arr) - dt * vmax, h)  # a bound beyond the band
             new.reshape(-1)[linear] = _advanced(arr, linear, signed, dt * v, h)
             arr = new
