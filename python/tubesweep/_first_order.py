@@ -285,13 +285,8 @@ def _stats(
     # byte of dependency counts, 2 bytes per node.)
     windowed = grid.ndim == 3 and req.scheme == "godunov" and not req.paper_sweeps and FRONT_WINDOW > 0
     per_node = 8 + 1 + 1 + 1 + 4 + 4 * grid.ndim + (8 if np.ndim(slowness) else 0) + (1 if windowed else 0)
-    return SolveStats(
-        iterations=st["iterations"],
-        sweeps=st["sweeps"],
-        updates=st["updates"],
-        converged=st["converged"],
-        last_change=st["last_change"],
-        seconds=st["seconds"],
+    return SolveStats.of_sweeps(
+        st,
         band_points=len(roles),
         inner_points=len(roles) - n_outer,
         outer_points=n_outer,

@@ -111,13 +111,8 @@ def travel_time_general(
     u = values.reshape(grid.shape)
     if not return_stats:
         return u
-    stats = SolveStats(
-        iterations=st["iterations"],
-        sweeps=st["sweeps"],
-        updates=st["updates"],
-        converged=st["converged"],
-        last_change=st["last_change"],
-        seconds=st["seconds"],
+    stats = SolveStats.of_sweeps(
+        st,
         band_points=grid.size,
         inner_points=grid.size - len(lin),
         outer_points=0,

@@ -370,13 +370,8 @@ def travel_time(
     u = values.reshape(grid.shape)
     if not (return_stats or return_solution):
         return u
-    stats = SolveStats(
-        iterations=st["iterations"],
-        sweeps=st["sweeps"],
-        updates=st["updates"],
-        converged=st["converged"],
-        last_change=st["last_change"],
-        seconds=st["seconds"],
+    stats = SolveStats.of_sweeps(
+        st,
         band_points=grid.size,
         inner_points=grid.size - len(lin),
         outer_points=0,
@@ -468,13 +463,8 @@ def _order2(
     u = values.reshape(grid.shape)
     if not (return_stats or return_solution):
         return u
-    stats = SolveStats(
-        iterations=st["iterations"],
-        sweeps=st["sweeps"],
-        updates=st["updates"],
-        converged=st["converged"],
-        last_change=st["last_change"],
-        seconds=st["seconds"],
+    stats = SolveStats.of_sweeps(
+        st,
         band_points=grid.size,
         inner_points=grid.size - len(lin),
         outer_points=0,

@@ -280,13 +280,14 @@ def _fresh_nodes_filled(
 
 
 def _warm_start(older: Optional[Solution], prev: Optional[Solution]) -> Any:
-    """The warm start of a step's surface solve (``Tube.solve(warm=...)``): none at the first step;
-    extrapolated from the two previous steps where both ran second order; a step that fell back to
-    first order starts the next one cold and the one after from it alone. (A step that writes a
-    checkpoint solves cold and the next one starts from it alone: a run continued from the
-    checkpoint, cold with no older step, then repeats the uninterrupted one bit for bit; warm, its
-    first solve differed by 2.9 tolerances, its φ by 5e-8 after four more steps. A warm solve costs
-    as much as a cold one here, docs/moving-surfaces.md.)"""
+    """The warm start of a step's surface solve (``Tube.solve(warm=...)``) from the previous
+    step's solution ``prev`` and the one before, ``older``: none at the first step; extrapolated
+    from the two where both ran second order; a step that fell back to first order starts the next
+    one cold and the one after from it alone. (:func:`evolve` solves a step that writes a
+    checkpoint cold, and passes no ``older`` to the next: a run continued from the checkpoint, cold
+    with no older step, then repeats the uninterrupted one bit for bit; warm, its first solve
+    differed by 2.9 tolerances, its φ by 5e-8 after four more steps. A warm solve costs as much as
+    a cold one here, docs/moving-surfaces.md.)"""
     if prev is None:
         return None
     pair = older is not None and getattr(older, "order", 1) == 2
@@ -313,7 +314,7 @@ def _record(
     if checkpoint is None:
         return
     try:
-        _write_checkpoint(Path(checkpoint), phi=arr, t=t, step=step, sources=sources)
+        _write_checkpoint(checkpoint, phi=arr, t=t, step=step, sources=sources)
     except OSError as e:
         raise EvolutionStopped(
             f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "

@@ -719,13 +719,9 @@ def solve_on_tube(
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
-    stats = SolveStats(
-        iterations=st["iterations"],
+    stats = SolveStats.of_sweeps(
+        st,
         sweeps=st["iterations"] * 2**d,
-        updates=st["updates"],
-        converged=st["converged"],
-        last_change=st["last_change"],
-        seconds=st["seconds"],
         band_points=len(roles_out),
         inner_points=len(roles_out) - n_outer,
         outer_points=n_outer,

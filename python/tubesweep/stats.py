@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, asdict
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Dict, Mapping, Optional, Tuple
 
 
 @dataclass(frozen=True)
@@ -195,6 +195,16 @@ class SolveStats:
     creases: Optional[Dict[str, Any]] = None
     bridged_holes: Optional[Dict[str, Any]] = None
     slits: Optional[Dict[str, Any]] = None
+
+    @classmethod
+    def of_sweeps(cls, st: Mapping[str, Any], **rest: Any) -> "SolveStats":
+        """The stats of a solve from the core's report ``st`` of its sweeps (``iterations``,
+        ``sweeps``, ``updates``, ``converged``, ``last_change``, ``seconds``) and the other fields
+        by name (``sweeps=`` among them where the report has none)."""
+        taken = {
+            k: st[k] for k in ("iterations", "sweeps", "updates", "converged", "last_change", "seconds") if k in st
+        }
+        return cls(**{**taken, **rest})
 
     @property
     def updates_per_second(self) -> float:
