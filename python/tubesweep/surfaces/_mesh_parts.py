@@ -117,7 +117,8 @@ def _joined_where_touching(surface: Any, parts: np.ndarray) -> np.ndarray:
         a, b = (i, j) if starts[i + 1] - starts[i] <= starts[j + 1] - starts[j] else (j, i)
         if b not in trees:
             trees[b] = _piece_tree(surface, order[starts[b] : starts[b + 1]])
-        if not apart(tri[order[starts[a] : starts[a + 1]]], trees[b], lo[b], hi[b]):
+        faces = order[starts[a] : starts[a + 1]]
+        if not apart(tri[faces], edge[faces] / np.sqrt(3.0), trees[b], lo[b], hi[b]):
             root[ri] = rj
     label = np.array([find(k) for k in range(count)])
     _, joined = np.unique(label[parts], return_inverse=True)
@@ -153,19 +154,20 @@ def _piece_tree(surface: Any, faces: np.ndarray) -> Any:
 #: Subdivisions per edge of a triangle sampled near another piece (:func:`apart`): pieces closer
 #: than 1/(8√3) of their triangles' longest edge, 7 %, count as touching.
 SAMPLES_PER_EDGE = 8
+_I, _J = np.meshgrid(np.arange(SAMPLES_PER_EDGE + 1), np.arange(SAMPLES_PER_EDGE + 1), indexing="ij")
+#: The samples' barycentric weights (S, 3).
+_BARYCENTRIC = np.stack([_I, _J, SAMPLES_PER_EDGE - _I - _J], axis=-1)[_I + _J <= SAMPLES_PER_EDGE] / SAMPLES_PER_EDGE
 
 
-def apart(tri: np.ndarray, tree: Any, lo: np.ndarray, hi: np.ndarray) -> bool:
+def apart(tri: np.ndarray, bound: np.ndarray, tree: Any, lo: np.ndarray, hi: np.ndarray) -> bool:
     """Whether the triangles ``tri`` (T, 3, 3) of one piece are provably apart from the piece
     whose ``tree`` and box (``lo``, ``hi``) are given: every point of a triangle lies within its
-    longest edge over √3 of one of its vertices (the circumradius of an acute triangle, half the
+    ``bound``, its longest edge over √3, of one of its vertices (the circumradius of an acute triangle, half the
     longest edge of an obtuse one), so a triangle whose vertices are all farther than that from
     the other piece is apart; a nearer one is sampled at :data:`SAMPLES_PER_EDGE` subdivisions
     per edge, each sample standing for the points within its sub-triangles' bound. Two shells
     that cross or touch (a union never booleaned) are one piece, and their front passes between
     them."""
-    edge = np.max(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2), axis=1)
-    bound = edge / np.sqrt(3.0)
     # triangles whose box comes within their bound of the other piece's box
     gap = np.max(np.maximum(tri.min(axis=1) - hi, lo - tri.max(axis=1)), axis=1)
     tri, bound = tri[gap <= bound], bound[gap <= bound]
@@ -175,13 +177,9 @@ def apart(tri: np.ndarray, tree: Any, lo: np.ndarray, hi: np.ndarray) -> bool:
     near = d.reshape(-1, 3).min(axis=1) <= bound
     if not np.any(near):
         return True
-    m = SAMPLES_PER_EDGE
-    i, j = np.meshgrid(np.arange(m + 1), np.arange(m + 1), indexing="ij")
-    keep = i + j <= m
-    w = np.stack([i[keep], j[keep], m - i[keep] - j[keep]], axis=1) / m  # barycentric samples
-    samples = np.einsum("sk,tkc->tsc", w, tri[near])
+    samples = np.einsum("sk,tkc->tsc", _BARYCENTRIC, tri[near])
     d, _, _, _ = tree.closest(np.ascontiguousarray(samples.reshape(-1, 3)), float(bound[near].max()))
-    return bool(np.all(d.reshape(len(samples), -1).min(axis=1) > bound[near] / m))
+    return bool(np.all(d.reshape(len(samples), -1).min(axis=1) > bound[near] / SAMPLES_PER_EDGE))
 
 
 def _nearest_pieces(surface: Any, parts: np.ndarray, count: int, points_of: Any) -> np.ndarray:
