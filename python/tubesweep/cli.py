@@ -528,12 +528,20 @@ def cmd_solve(args: argparse.Namespace) -> int:
         fig = plot(
             sol,
             up=up,
-            title=f"{name}: geodesic distance from the red star ({args.hamiltonian}, grid {'×'.join(map(str, grid.shape))})",
+            title=f"{name}: geodesic distance from the red star ({_scheme_words(s.order, args.hamiltonian)}, "
+            f"grid {'×'.join(map(str, grid.shape))})",
             paths=paths,
         )
         fig.savefig(out / "solution.png", dpi=110, bbox_inches="tight")
         print(f"wrote {out / 'solution.png'}")
     return exit_status(s.converged, *_unconverged(s.iterations, args.max_iterations))
+
+
+def _scheme_words(order: int, hamiltonian: str) -> str:
+    """The scheme that ran, for a picture's title: "second order", "first order", or the first
+    order with its local solver when that is not the default Godunov update ("first order, lxf")."""
+    words = "second order" if order == 2 else "first order"
+    return words if hamiltonian == "godunov" else f"{words}, {hamiltonian}"
 
 
 def _unconverged(iterations: int, max_iterations: int) -> tuple:
