@@ -33,13 +33,16 @@ print(
 
 from matplotlib.figure import Figure  # noqa: E402
 
-fig = Figure(figsize=(9.5, 4.2))
-for k, (M, name) in enumerate(((D, "tubesweep"), (exact, "great circles"))):
-    ax = fig.add_subplot(1, 2, k + 1)
-    m = ax.imshow(M, cmap="viridis", vmin=0, vmax=np.pi * 0.5)
-    ax.set_title(f"geodesic distances: {name}")
+fig = Figure(figsize=(10.5, 4.2))
+ax = fig.add_subplot(1, 2, 1)
+fig.colorbar(ax.imshow(D, cmap="viridis", vmin=0, vmax=np.pi * 0.5), ax=ax, shrink=0.8, label="geodesic distance")
+ax.set_title("the distance matrix (tubesweep)")
+ax = fig.add_subplot(1, 2, 2)
+error = np.abs(D - exact) / grid.spacing
+fig.colorbar(ax.imshow(error, cmap="magma", vmin=0), ax=ax, shrink=0.8, label="grid spacings")
+ax.set_title("its error against great circles")
+for ax in fig.axes[::2]:
     ax.set_xlabel("point")
     ax.set_ylabel("point")
-fig.colorbar(m, ax=fig.axes, shrink=0.8, label="geodesic distance")
 fig.savefig(args.out / "distance_matrix.png", dpi=110, bbox_inches="tight")
 print(f"wrote {args.out / 'distance_matrix.png'}")

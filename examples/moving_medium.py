@@ -38,11 +38,14 @@ print(
 ahead = 0.5 * np.array([[0.0, np.sqrt(0.5), np.sqrt(0.5)]])  # a quarter turn downstream
 print(f"a quarter turn downstream: {sol(ahead)[0]:.3f} with the flow, {still(ahead)[0]:.3f} in still medium")
 
-fig = ts.plot(
-    sol,
-    views=((85, -90),),
-    label="travel time",
-    title=f"travel time on a sphere turning anticlockwise about z (seen from above), ω = {omega:g}",
-)
+import matplotlib.pyplot as plt  # noqa: E402 (after the solve: the picture only)
+
+levels = np.arange(0.15, 1.6, 0.15)  # the same iso-lines in both panels
+fig = plt.figure(figsize=(10, 5))
+for k, (s, name) in enumerate(((still, "still medium"), (sol, f"turning anticlockwise about z, ω = {omega:g}"))):
+    ax = fig.add_subplot(1, 2, k + 1, projection="3d", computed_zorder=False)
+    ts.plot(s, ax=ax, views=((85, -90),), levels=levels, colorbar=False, label="travel time")
+    ax.set_title(f"{name}\n(seen from above)", fontsize=10)
+fig.suptitle("travel time from the red star on a sphere: the turning medium carries the fronts anticlockwise")
 fig.savefig(args.out / "moving_medium.png", dpi=110, bbox_inches="tight")
 print(f"wrote {args.out / 'moving_medium.png'}")

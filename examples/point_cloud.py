@@ -42,15 +42,22 @@ equator = np.c_[0.7 * np.cos(t), 0.7 * np.sin(t), 0 * t]
 error = np.abs(sol(equator) - 0.7 * np.abs(t))
 print(f"error along the outer equator: mean {error.mean():.2e}, max {error.max():.2e}")
 
-fig = plt.figure(figsize=(8, 5))
-ax = fig.add_subplot(projection="3d", computed_zorder=False)  # the star drawn over the samples
-art = ax.scatter(*samples.T, c=sol(samples), s=2.5, cmap="viridis", depthshade=False)
-ax.scatter(*source, color="red", marker="*", s=250, depthshade=False, zorder=3)
-ax.view_init(elev=35, azim=-25)  # the source in front, the far side of the ring behind
-ax.set_box_aspect((1.4, 1.4, 0.4))
-ax.set_axis_off()
-fig.colorbar(art, ax=ax, shrink=0.6, label="geodesic distance")
-ax.set_title("20,000 samples of a torus, coloured by the distance from the red star")
+u = sol(samples)
+normal = np.c_[np.cos(phi) * np.cos(theta), np.cos(phi) * np.sin(theta), np.sin(phi)]  # for the picture only
+fig = plt.figure(figsize=(11, 4.6))
+for k, azim in enumerate((-25, 155)):  # the source's side, then the far side of the ring
+    ax = fig.add_subplot(1, 2, k + 1, projection="3d", computed_zorder=False)  # the star drawn over the samples
+    e, a = np.radians(35), np.radians(azim)
+    front = normal @ (np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)) > 0  # (matplotlib draws no depth)
+    art = ax.scatter(*samples[front].T, c=u[front], s=16, cmap="viridis", vmin=0, vmax=np.nanmax(u), depthshade=False)
+    if k == 0:
+        ax.scatter(*source, color="red", marker="*", s=250, depthshade=False, zorder=3)
+    ax.view_init(elev=35, azim=azim)
+    ax.set_box_aspect((1.4, 1.4, 0.4), zoom=1.35)
+    ax.set_axis_off()
+    ax.set_title(f"seen from azimuth {azim}°, elevation 35°", fontsize=10)
+fig.colorbar(art, ax=fig.axes, shrink=0.6, label="geodesic distance")
+fig.suptitle("20,000 samples of a torus (no triangles), coloured by the distance from the red star")
 args.out.mkdir(parents=True, exist_ok=True)
 fig.savefig(args.out / "point_cloud.png", dpi=110, bbox_inches="tight")
 print(f"wrote {args.out / 'point_cloud.png'}")
