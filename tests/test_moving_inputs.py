@@ -60,3 +60,32 @@ def test_a_speed_changed_by_a_hair_keeps_the_local_start():
     slower = tube.solve([(0, 0, 0.5)], speed=1.5, warm=prev)
     assert "looser than this one's" in slower.stats.order2["warm"]["all_started"]
     assert "by more than 10%" in slower.stats.order2["warm"]["all_started"]
+
+
+def test_evolve_takes_a_boolean_mask_and_a_level_set_of_an_array_and_says_what_to_pass_otherwise():
+    # a review: ts.evolve(mask) told the user to pass ts.LevelSet.from_mask(mask, grid), which was
+    # then refused with advice to call a signed_distance the LevelSet does not have
+    law = lambda u: np.full_like(u, 0.1)  # noqa: E731
+    mask = sphere_phi() < 0
+    # (a mask of 7.5 voxels' radius: the paper's first-order scheme, warned)
+    with pytest.warns(RuntimeWarning, match="ran the paper's first-order scheme"):
+        by_mask = ts.evolve(mask, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    with pytest.warns(RuntimeWarning, match="ran the paper's first-order scheme"):
+        by_phi = ts.evolve(0.5 - mask.astype(float), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    assert np.array_equal(by_mask.phis[-1], by_phi.phis[-1])
+    assert np.array_equal(by_mask.solutions[-1].values, by_phi.solutions[-1].values)
+    by_level_set = ts.evolve(ts.LevelSet(sphere_phi()), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    by_array = ts.evolve(sphere_phi(), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    assert np.array_equal(by_level_set.phis[-1], by_array.phis[-1])
+    # the mask's surface lies half a spacing inside the sphere at most; after one step of 0.1·0.05
+    # outwards the antipode's distance is about π·0.505
+    u = by_mask.solutions[-1]([(0, 0, -0.5)])[0]
+    assert abs(u - np.pi * 0.505) < 2 * GRID.spacing
+    from_mask = ts.LevelSet.from_mask(mask, GRID, smooth=1)
+    assert ts.evolve(from_mask, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1).times == [0.0, 0.05]
+    with pytest.raises(ValueError, match=r"holds only the values 0 and 1, a mask.*mask\.astype\(bool\)"):
+        ts.evolve(mask.astype(float), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    with pytest.raises(TypeError, match=r"got Sphere\. Pass its values: surface\.signed_distance\("):
+        ts.evolve(ts.surfaces.Sphere(0.5), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    with pytest.raises(TypeError, match=r"got function\. Pass its values: phi_function\("):
+        ts.evolve(lambda p: np.linalg.norm(p, axis=1) - 0.5, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)

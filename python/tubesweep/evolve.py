@@ -379,6 +379,35 @@ class _Inputs:
     checkpoint: Optional[Path]
 
 
+def _phi_array(phi: Any) -> Any:
+    """The φ array that :func:`evolve` advances, from what the user gave: an array as it is, a
+    boolean mask (True inside) as 0.5 − mask (re-distanced at the first step, as any φ far from a
+    distance), a :class:`LevelSet` of an array (``LevelSet.from_mask`` too) as its array; a
+    TypeError for a callable or another surface, a ValueError for a 0/1 array that is not boolean
+    (a mask or a φ ≥ 0?), each saying what to pass."""
+    if isinstance(phi, LevelSet) and getattr(phi, "_array", None) is not None:
+        return phi._array
+    if isinstance(phi, Surface) or callable(phi):
+        values = (
+            "surface.signed_distance(grid.node_points(np.arange(grid.size))).reshape(grid.shape)"
+            if hasattr(phi, "signed_distance")
+            else "phi_function(grid.node_points(np.arange(grid.size))).reshape(grid.shape), φ < 0 inside"
+        )
+        raise TypeError(
+            f"evolve: phi must be an array of φ at the grid's nodes, which evolve advances; got {type(phi).__name__}. "
+            f"Pass its values: {values} (a LevelSet of an array, a boolean mask and any array of φ are taken as they are)"
+        )
+    arr = np.asarray(phi)
+    if arr.dtype == bool:
+        return 0.5 - arr  # True inside: negative there, as φ
+    if arr.size and arr.dtype.kind in "iuf" and np.isin(arr, (0, 1)).all():
+        raise ValueError(
+            "evolve: phi holds only the values 0 and 1, a mask, not a φ with a sign change: pass the mask as a "
+            "boolean array (True inside: mask.astype(bool)), or φ = 0.5 − mask (negative inside)"
+        )
+    return phi
+
+
 def _checked_inputs(
     phi: Any,
     grid: Any,
@@ -395,15 +424,9 @@ def _checked_inputs(
     """:func:`evolve`'s arguments checked in order, or the first one's error (the argument named,
     and the fix)."""
     grid = as_grid(grid)
-    if isinstance(phi, Surface) or callable(phi):
-        raise TypeError(
-            f"evolve: phi must be an array of φ at the grid's nodes, which evolve advances; got {type(phi).__name__}. "
-            "For a surface or a φ function pass its values, e.g. surface.signed_distance(grid.node_points("
-            "np.arange(grid.size))).reshape(grid.shape)"
-        )
     # a copy in C order: the caller's array is left alone, and the band's nodes are written
     # through its flat view (of a Fortran-ordered array, a copy that dropped the step's motion)
-    arr = np.array(real_array(phi, "evolve: phi"), dtype=float, order="C")
+    arr = np.array(real_array(_phi_array(phi), "evolve: phi"), dtype=float, order="C")
     if arr.shape != tuple(grid.shape):
         raise ValueError(f"evolve: phi must be an array of the grid's shape {tuple(grid.shape)}; got {arr.shape}")
     unfinite = np.flatnonzero(~np.isfinite(arr.reshape(-1)))
@@ -471,8 +494,10 @@ def evolve(
 
     Parameters
     ----------
-    phi : numpy.ndarray
-        φ on ``grid`` (a signed distance, or any φ with a sign change: it is re-distanced).
+    phi : numpy.ndarray or LevelSet
+        φ on ``grid`` (a signed distance, or any φ with a sign change: it is re-distanced), a
+        boolean mask of the grid's shape (True inside), or a :class:`LevelSet` of an array
+        (``LevelSet.from_mask`` too).
     grid : Grid
         The grid.
     sources : array_like
