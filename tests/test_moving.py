@@ -556,7 +556,10 @@ def test_a_fortran_ordered_phi_evolves_as_its_c_ordered_copy():
 def test_evolve_names_phi_progress_and_checkpoint_faults(tmp_path):
     phi = sphere_phi(GRID31)
     law = lambda u: 0 * u  # noqa: E731
-    for surface in (ts.surfaces.Sphere(0.5), lambda p: np.linalg.norm(p, axis=1) - 0.5):  # (a LevelSet's array is taken)
+    for surface in (
+        ts.surfaces.Sphere(0.5),
+        lambda p: np.linalg.norm(p, axis=1) - 0.5,
+    ):  # (a LevelSet's array is taken)
         with pytest.raises(TypeError, match=r"evolve: phi must be an array of φ at the grid's nodes"):
             ts.evolve(surface, GRID31, [(0, 0, 0.5)], law, dt=0.05, steps=1)
     with pytest.raises(TypeError, match=r"evolve: progress must be None or a callable"):

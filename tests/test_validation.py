@@ -504,3 +504,24 @@ def test_a_callable_phi_undefined_over_a_region_that_reaches_the_surface_is_name
 
     with pytest.raises(ValueError, match=r"phi callable returned NaN or inf at \(0\.3"):
         ts.solve(phi, G3, [(-0.5, 0, 0)])
+
+
+def test_a_solution_or_an_array_in_the_wrong_place_and_a_wide_tube_are_named():
+    # a review: a Solution as the surface read as "phi callable returned NaN or inf", an array
+    # where a tube's grid goes as numpy's "truth value of an array is ambiguous", and a tube too
+    # wide for the sphere was told only to refine the grid
+    g = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+    sphere = ts.surfaces.Sphere(0.5)
+    sol = ts.solve(sphere, g, [(0.5, 0, 0)])
+    with pytest.raises(TypeError, match=r"surface is a Solution \(a solve's result\).*sol\.surface"):
+        ts.solve(sol, g, [(0.5, 0, 0)])
+    tube = ts.Tube(sphere, g)
+    points = 0.5 * np.eye(3)
+    with pytest.raises(TypeError, match=r"grid must be a ts\.Grid or None .* got ndarray.*farthest_point_sampling\(tube, None, k\)"):  # fmt: skip
+        ts.farthest_point_sampling(tube, points, 4)
+    with pytest.raises(TypeError, match=r"grid must be a ts\.Grid or None .* got ndarray"):
+        ts.distance_matrix(tube, points, points)
+    with pytest.raises(ValueError, match=r"refine the grid, or narrow the tube \(outer=30 now, 4 by default\)"):
+        ts.solve(sphere, g, [(0.5, 0, 0)], outer=30)
+    with pytest.raises(ValueError, match=r"refine the grid, or narrow the tube \(outer=30 now"):
+        ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, g, [(0.5, 0, 0)], outer=30)

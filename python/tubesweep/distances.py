@@ -28,6 +28,7 @@ from ._validate import as_points, check_flag
 from .many import check_many_progress
 from ._roles import ROLE_INNER
 from .second_order import check_order
+from .grid import Grid
 from .tube import Tube
 
 __all__ = ["distance_matrix", "farthest_point_sampling", "snap_to_surface"]
@@ -38,6 +39,11 @@ def _as_tube(surface: Any, grid: Any, inner: Optional[float], outer: Optional[fl
     its own: they were ignored before, a helper's review), else its tube on ``grid`` (widths 2 and 4
     grid spacings unless given)."""
     if isinstance(surface, Tube):
+        if grid is not None and not isinstance(grid, Grid):
+            raise TypeError(
+                f"grid must be a ts.Grid or None (with a ts.Tube, None: the tube's grid); got {type(grid).__name__}. "
+                "With a tube the call is distance_matrix(tube, None, points) or farthest_point_sampling(tube, None, k)"
+            )
         if grid is not None and grid != surface.grid:
             raise ValueError("grid: this ts.Tube was built on another grid; pass grid=None (or the tube's grid)")
         for name, given, own in (("inner", inner, surface.inner), ("outer", outer, surface.outer)):

@@ -22,6 +22,7 @@ import numpy as np
 
 from .band import EVAL_CHUNK, BandGeometry, _evaluate, _kinks, discover_band
 from .grid import Grid
+from .stats import SolveStats
 from ._validate import check_flag, real_array, real_scalar
 from ._warn import user_stacklevel
 
@@ -428,7 +429,7 @@ class LevelSet(Surface):
             linear = ulinear.view(np.int64)
             if linear.size == 0:
                 return BandGeometry(linear, values, values, direction)
-            self._check_distance_like(*_norm_bounds(values, norm, half_width)[:2])
+            self._check_distance_like(*_norm_bounds(values, norm, half_width)[:2], half_width / grid.spacing)
             return BandGeometry(
                 linear,
                 None,
@@ -478,7 +479,7 @@ class LevelSet(Surface):
                 "surface, but must be finite within the tube and one grid spacing beyond it"
             )
         # bounded in single precision, as the library surfaces' band call returns |∇φ|
-        self._check_distance_like(*_norm_bounds(values, norms, half_width)[:2])
+        self._check_distance_like(*_norm_bounds(values, norms, half_width)[:2], half_width / grid.spacing)
         # distance = |φ|, not stored
         kink = _kinks(norms, grid, linear, native_band)
         del norms
@@ -496,15 +497,17 @@ class LevelSet(Surface):
         its kind and parameters for ``tubesweep._native.analytic_level_set_band``; else None."""
         return None
 
-    def _check_distance_like(self, lo: float, hi: float) -> None:
-        """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface."""
+    def _check_distance_like(self, lo: float, hi: float, outer: float) -> None:
+        """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface;
+        ``outer``: the band's half-width in grid spacings (a narrower tube is a cure when wide)."""
+        narrower = f", or narrow the tube (outer={outer:g} now, 4 by default)" if outer > 4.0 + 1e-9 else ""
         if (lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH) and self._native_phi() is not None:
             # a library surface's φ is an exact distance: only the grid can be at fault
             raise ValueError(
                 f"the grid is too coarse for this surface: its tube (outer × grid spacing on each side) reaches a point "
                 f"where φ's gradient vanishes (|∇φ| ranges over [{lo:.3g}, {hi:.3g}] near the surface, ≈ 1 expected), "
                 "such as the centre of a sphere not much larger than the tube or the core of a thin torus: refine the "
-                "grid, or make the surface larger than a few grid spacings"
+                f"grid{narrower}, or make the surface larger than a few grid spacings"
             )
         if lo < GRAD_ERROR_LOW and abs(hi - 1.0) <= 0.1:
             # as steep as a distance at most and at best, but flat somewhere: most likely a distance whose tube
@@ -515,7 +518,7 @@ class LevelSet(Surface):
                 "a distance, "
                 "the grid is too coarse for the surface: the tube (outer × grid spacing on each side) reaches a point "
                 "where ∇φ vanishes, such as the middle of a gap between two parts of the surface that face each other, "
-                "the centre of a sphere not much larger than the tube or the core of a thin tube; refine the grid. "
+                f"the centre of a sphere not much larger than the tube or the core of a thin tube; refine the grid{narrower}. "
                 "Otherwise (a union min(φ₁, φ₂) of overlapping parts, for one, is no distance inside their overlap, "
                 "whatever the grid) use ts.LevelSet(phi, redistance=True) (on the command line: --redistance), which "
                 "re-distances φ in the band"
@@ -529,7 +532,7 @@ class LevelSet(Surface):
                 "function, the grid is too coarse for the surface: the tube (outer × grid spacing on each side) "
                 "reaches a point where ∇φ vanishes, such as the centre of a sphere not much larger than the tube, "
                 "the core of a thin tube, or the middle of a gap between two parts of the surface that face each "
-                "other; refine the grid"
+                f"other; refine the grid{narrower}"
             )
         if lo < GRAD_WARN_LOW or hi > GRAD_WARN_HIGH:
             warnings.warn(
@@ -574,6 +577,13 @@ def as_surface(surface: Any) -> Surface:
             "loaded with ts.surfaces.from_mesh(path) (OBJ, PLY, STL, OFF), e.g. "
             "ts.solve(ts.surfaces.from_mesh(path), grid, sources); the library's surfaces are classes, e.g. "
             "ts.surfaces.Sphere(0.5)"
+        )
+    if isinstance(getattr(surface, "stats", None), SolveStats):
+        # a solution is callable (its values at points), and was taken for φ: "φ returned NaN"
+        raise TypeError(
+            f"surface is a {type(surface).__name__} (a solve's result), not a surface: pass the surface to solve on"
+            + (" (this solution's is sol.surface)" if hasattr(surface, "surface") else "")
+            + ": a φ, a ts.LevelSet, a library surface, a mesh or a cloud"
         )
     if callable(surface) or isinstance(surface, (np.ndarray, list, tuple)) or hasattr(surface, "__array__"):
         return LevelSet(surface)
