@@ -575,7 +575,7 @@ class DoubleTorus(LevelSet):
     def default_source(self) -> np.ndarray:
         return np.array([-(self.offset + self.R + self.r), 0.0, 0.0])
 
-    def _check_distance_like(self, lo: float, hi: float) -> None:
+    def _check_distance_like(self, lo: float, hi: float, outer: float) -> None:
         # φ is 1-Lipschitz with |∇φ| = 1 a.e. by construction; central differences straddling a
         # crease (where the min switches torus) shorten the gradient to ≈ 0.5 there, which the
         # generic near-distance check would report. Nothing to check.
