@@ -256,6 +256,19 @@ def test_a_sigma_below_the_hamiltonian_s_bound_is_refused_with_the_bound():
     # exactly the bound is admissible, and gives the per-node default's answer up to viscosity
     ok = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(sigma=1.0))
     assert ok.stats.converged and np.all(np.isfinite(ok(c.sample(200))))
+    # far above the bound the viscosity grows the error in proportion, converged=True (a review:
+    # 70% off on a sphere at sigma = 100, unwarned): warned, with the factor
+    with pytest.warns(
+        RuntimeWarning, match=r"sigma = \[10\.0, 10\.0\] is 10 times the smallest viscosity .*\(\[1\.0, 1\.0\]"
+    ):
+        wide = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Isotropic(sigma=10.0))
+    pts = c.sample(200)
+    exact = c.geodesic_distance(pts, (-R, 0))
+    assert np.max(np.abs(wide(pts) - exact)) > 3 * np.max(np.abs(ok(pts) - exact))
+    # the identity metric's exact bound, 1, reads 1.00000006 from its single-precision copy: σ = 1
+    # was refused
+    same = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(2), sigma=1.0))
+    assert np.max(np.abs(same(pts) - ok(pts))) < 1e-6
 
 
 def test_metric_on_a_surface_has_two_readings_each_converging_to_its_own_exact_value():

@@ -328,9 +328,14 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
         Cow::Borrowed(metric)
     };
     // the smallest admissible constant viscosities: the default (exact) σ of every node, per axis
+    // (reported back: a σ far above it adds viscosity, and error, in proportion)
+    let mut sigma_needed: Option<[f64; D]> = None;
     if let Some(sig) = inputs.sigma {
         let needed = required_sigma::<D>(&inputs, flow, &lxf_metric, n);
-        if let Some(k) = (0..D).find(|&k| sig[k] < needed[k]) {
+        sigma_needed = Some(needed);
+        // (a relative slack of 1e-6: the identity metric's bound reads 1.00000006 from its f32 copy,
+        // and σ = 1, its exact bound, was refused)
+        if let Some(k) = (0..D).find(|&k| sig[k] < needed[k] * (1.0 - 1e-6)) {
             return Err(PyValueError::new_err(format!(
                 "sigma[{k}] = {} is below max |∂H/∂p_{k}| = {} over the band (Sect. 5.1): the Lax–Friedrichs update would \
                  not be monotone and the values would blow up; pass sigma of at least {:?}, or leave sigma out for the \
@@ -404,7 +409,11 @@ pub(crate) fn solve_general_generic<'py, const D: usize>(
         scheme,
         missing,
     };
-    run_sweeps(py, &problem, fixed, &options, progress)
+    let (values, stats) = run_sweeps(py, &problem, fixed, &options, progress)?;
+    if let Some(needed) = sigma_needed {
+        stats.set_item("sigma_needed", needed.to_vec())?;
+    }
+    Ok((values, stats))
 }
 
 /// The bytes of the sweeps' arrays that the rows of an iteration must hold for the next
