@@ -472,3 +472,28 @@ def test_smoothing_that_closes_a_one_voxel_gap_or_removes_a_one_voxel_wall_is_sa
         warnings.simplefilter("error")
         for mask, smooth in ((slot, 0.75), (fin, 0.75), (fused, 1.5), (x**2 + y**2 + z**2 < 0.25, 1.5)):
             ts.LevelSet.from_mask(mask, grid, smooth=smooth)
+
+
+def test_small_cavities_inside_a_mask_are_warned_with_the_fill_that_cures_them():
+    # a review: 24 single voxels left out of a ball (a segmentation's holes) gave the antipode 1.20
+    # instead of 1.52 at N = 53 (the fronts through the ball, from cavity to cavity), converged,
+    # warned only of narrow gaps and creases with a finer grid as the cure
+    ndimage = pytest.importorskip("scipy.ndimage")
+    g = ts.Grid((-1.3,) * 3, (1.3,) * 3, (53,) * 3)
+    X, Y, Z = g.meshgrid()
+    R = np.sqrt(X**2 + Y**2 + Z**2)
+    holes = (np.random.default_rng(1).random(R.shape) < 0.01) & (R < 0.4)
+    mask = (R < 0.5) & ~holes
+    with pytest.warns(RuntimeWarning) as said:
+        holed = ts.solve(ts.LevelSet.from_mask(mask, g), g, [(-0.5, 0, 0)])
+    cavities = [str(w.message) for w in said if str(w.message).startswith("mask: ")]
+    assert len(cavities) == 1 and "24 cavities of at most 4 voxels across" in cavities[0]
+    assert "binary_fill_holes(mask)" in cavities[0]
+    assert holed([(0.5, 0, 0)])[0] < 1.3  # short: through the ball
+    # filled, the cavities go and so does every warning (the test log is kept quiet: any would fail
+    # here): the clean ball's answer, π·0.5 ≈ 1.571 less the voxels' first-order error
+    filled = ts.solve(ts.LevelSet.from_mask(ndimage.binary_fill_holes(mask), g), g, [(-0.5, 0, 0)])
+    assert abs(filled([(0.5, 0, 0)])[0] - np.pi * 0.5) < 0.1
+    # smooth=1 closes cavities of one voxel: no warning of them
+    smoothed = ts.LevelSet.from_mask(mask, g, smooth=1)
+    assert ts.solve(smoothed, g, [(-0.5, 0, 0)])([(0.5, 0, 0)])[0] == pytest.approx(np.pi * 0.5, abs=0.05)
