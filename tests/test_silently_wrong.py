@@ -235,6 +235,29 @@ def test_a_tube_cut_by_the_box_around_a_surface_inside_it_is_recorded_and_named(
         assert "the grid box cuts the tube" in str(e) and "redistance" not in str(e)
 
 
+def test_a_mesh_just_inside_the_box_is_not_said_to_cross_it_and_one_that_crosses_is():
+    # a review: an icosphere 0.005 inside the box (a quarter of a spacing) was warned of crossing
+    # all six faces "along a curve about 4.48 long" (an unsigned distance within half a spacing of
+    # the boundary read as a crossing); the closest points of those nodes all lie inside the box
+    trimesh = pytest.importorskip("trimesh")
+    m = trimesh.creation.icosphere(4, 0.5)
+    mesh = ts.surfaces.from_mesh((np.asarray(m.vertices), np.asarray(m.faces)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        sol = ts.solve(mesh, ts.Grid((-0.505,) * 3, (0.505,) * 3, (51,) * 3), [mesh.vertices[0]])
+    cut = sol.stats.box_cut
+    assert not cut["surface_cut"] and len(cut["faces"]) == 6 and 0.004 < cut["gap"] < 0.006
+    assert cut["cut_length"] == 0.0
+    with pytest.warns(RuntimeWarning, match=r"the grid box cuts the surface: it crosses the box's boundary x = -0\.45"):
+        cut = ts.solve(mesh, ts.Grid((-0.45,) * 3, (0.45,) * 3, (51,) * 3), [mesh.vertices[0]]).stats.box_cut
+    assert cut["surface_cut"] and len(cut["faces"]) == 6
+    # an open closest-point surface cut by the box's top: that face only
+    with pytest.warns(RuntimeWarning, match=r"crosses the box's boundary z = 0\.3 along"):
+        cut = ts.solve(ts.surfaces.Hemisphere(0.5), ts.Grid((-0.6, -0.6, -0.2), (0.6, 0.6, 0.3), (49, 49, 21)),
+                       [(0.5, 0, 0.0)]).stats.box_cut  # fmt: skip
+    assert cut["faces"] == ["z = 0.3"]
+
+
 def test_a_plane_or_a_sampled_phi_crossing_the_box_is_recorded_without_a_warning():
     x, y, z = G41.meshgrid()
     with warnings.catch_warnings():

@@ -28,14 +28,18 @@ def _face_name(grid: Grid, axis: int, upper: bool) -> str:
     return f"{_AXES[axis]} = {float(bound):g}"
 
 
-def box_cut(grid: Grid, linear: np.ndarray, phi: np.ndarray, inner_width: float) -> Optional[Dict[str, Any]]:
+def box_cut(
+    grid: Grid, linear: np.ndarray, phi: np.ndarray, inner_width: float, directions: Optional[np.ndarray] = None
+) -> Optional[Dict[str, Any]]:
     """How the grid box cuts the band of ``linear`` (sorted linear indices, ``phi`` their φ: signed
-    for a level set, the unsigned distance for a closest-point surface), or None when no band node
-    lies on the box's boundary.
+    for a level set, the unsigned distance for a closest-point surface, ``directions`` their unit
+    (x − cp(x))/|x − cp(x)| where known), or None when no band node lies on the box's boundary.
 
     Returns a dict: ``surface_cut`` (the surface itself crosses the boundary: φ changes sign between
     neighbouring nodes of a boundary face, or for an unsigned distance a boundary node lies within
-    half a spacing of the surface), ``faces`` (the faces it crosses, or that the tube touches),
+    half a spacing of the surface and, where the directions are given, some such node's closest
+    point lies on the face or beyond it: a closed mesh 0.005 inside the box was said to cross all
+    six faces), ``faces`` (the faces it crosses, or that the tube touches),
     ``cut_length`` (3D: the length of the curve along which the surface crosses them, from the
     number of face cells crossed, times π/4 for the average direction) or ``cut_points`` (2D: the
     number of crossings), ``inner_on_boundary`` (inner-tube nodes on the boundary faces) and
@@ -90,7 +94,18 @@ def box_cut(grid: Grid, linear: np.ndarray, phi: np.ndarray, inner_width: float)
                     n += int(np.count_nonzero(np.isfinite(lo) & np.isfinite(hi) & ((lo < 0) != (hi < 0))))
                 crossed += n
             else:
-                n = int(np.count_nonzero(np.abs(phib[sel]) <= 0.5 * h))
+                close = sel & (np.abs(phib) <= 0.5 * h)
+                n = int(np.count_nonzero(close))
+                if n and directions is not None:
+                    # the closest points of those nodes: on the face or beyond it where the surface
+                    # goes on outside the box, all inside where it only comes near
+                    bound = float((grid.upper if upper else grid.lower)[k])
+                    x_k = float(grid.lower[k]) + idx[close][:, k] * h
+                    cp_k = x_k - np.abs(phib[close]) * np.asarray(directions[b[close], k], dtype=float)
+                    slack = 1e-9 * h
+                    beyond = cp_k >= bound - slack if upper else cp_k <= bound + slack
+                    if not np.any(beyond):
+                        n = 0
                 near += n
             if n:
                 faces.append(_face_name(grid, k, upper))

@@ -574,9 +574,9 @@ def _prepare_tube(
         return _prepare_tube(surf, grid, inner, outer, method, keep_geometry, reusable, creases)
     linear, roles, phi, outer_eff = b.linear, b.roles, b.phi, b.outer
     # a surface that leaves the grid box: the distances are those of the part inside (warned)
-    cut = box_cut(grid, linear, phi, inner_width)
-    warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
     directions = b.direction if b.direction is not None else b.geom.direction
+    cut = box_cut(grid, linear, phi, inner_width, directions)
+    warn_box_cut(cut, int(np.count_nonzero(roles != ROLE_OUTER)), surf, grid)
     gaps = facing_gaps(surf, grid, b.band, linear, roles, phi, directions, inner, b.kink, b.inside)
     band, facing = gaps.band, gaps.facing
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
