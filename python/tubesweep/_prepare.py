@@ -460,7 +460,22 @@ def _widened_band(
     """The band of ``surf`` within ``outer_eff`` grid spacings with its roles, widened (a warning
     each time) while inner-tube nodes lack a neighbour in it, or the error when that does not
     close it. None where a mesh's smooth map folds on this grid and its exact closest points are
-    to be used instead (``fold_to_exact``: build the tube again)."""
+    to be used instead (``fold_to_exact``: build the tube again). A surface with a ``widening``
+    context (a point cloud) keeps what it computed for the band's nodes while it is widened."""
+    with getattr(surf, "widening", contextlib.nullcontext)():
+        return _widening(surf, grid, inner, outer_eff, method, keep_geometry, reusable)
+
+
+def _widening(
+    surf: Surface,
+    grid: Grid,
+    inner: float,
+    outer_eff: float,
+    method: str,
+    keep_geometry: bool,
+    reusable: bool,
+) -> Optional[_Band]:
+    """:func:`_widened_band`'s attempts."""
     h = grid.spacing
     inner_width = inner * h
     # a re-distanced band, and the bound on |∇φ| its candidates were found with when the user gave it

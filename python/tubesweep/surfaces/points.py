@@ -26,9 +26,10 @@ where.
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from pathlib import Path
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Dict, Iterator, Optional, Tuple, Union
 
 import numpy as np
 
@@ -41,6 +42,7 @@ from .._warn import user_stacklevel
 from ._cloud_analysis import analyse, analyse_own, lines_advice, widen
 from ._cloud_holes import bridged_holes, pairs_over_holes, warn_close_ends
 from ._cloud_files import read_points
+from ._cloud_widening import closest_with, keep_feet, known_feet
 from ._cloud_advice import SPARSE_FACTOR, STRAY_SPACINGS, CloudAdvice, sentence
 
 __all__ = ["from_points", "read_points", "PointCloudSurface"]
@@ -426,6 +428,7 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         state["_thinned"] = None
         state["_cp"] = None
         state["_band_cache"] = None
+        state["_widening_feet"] = None
         return state
 
     def __setstate__(self, state: dict) -> None:
@@ -531,6 +534,16 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
             stacklevel=user_stacklevel(),
         )
 
+    @contextlib.contextmanager
+    def widening(self) -> Iterator[None]:
+        """While the tube's preparation widens the band: the feet found kept for the wider bands
+        (:mod:`._cloud_widening`)."""
+        self._widening_feet: Optional[dict] = {}
+        try:
+            yield
+        finally:
+            self._widening_feet = None
+
     def band(self, grid: Grid, half_width: float) -> BandGeometry:
         """The band nodes within ``half_width`` of the cloud's surface, found coarse-to-fine (a lower
         bound of the distance from the nearest sample), their closest points computed once, in Rust
@@ -580,12 +593,17 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         candidates = coarse_to_fine_candidates(grid, half_width, 1.0, lambda p, reach: self._far_distance(p))
         parts: list = []
         undefined = []
+        known = known_feet(self, grid)
         for s0 in range(0, len(candidates), CHUNK):
             lin = candidates[s0 : s0 + CHUNK]
             x = grid.node_points(lin)
-            cp, feet = fits.closest(np.ascontiguousarray(x), self.smoothing, half_width)
+            cp, feet = closest_with(known, fits, lin, x, self.smoothing, half_width)
             norm = row_norms(x - cp)
             keep = norm <= half_width  # False where the fit failed (NaN)
+            if known is not None:  # (widening: every node's foot found is kept, nearer or farther)
+                known = keep_feet(known, grid, self.smoothing, lin[np.isfinite(norm)], cp[np.isfinite(norm)],
+                                   feet[np.isfinite(norm)])  # fmt: skip
+                self._widening_feet = known
             undefined.append(lin[~np.isfinite(norm)])
             parts.append((lin[keep], norm[keep], x[keep], cp[keep], feet[keep]))
         if not parts or sum(len(q[0]) for q in parts) == 0:

@@ -1,0 +1,53 @@
+"""A point cloud's band while the tube's preparation widens it (``_prepare._widened_band``,
+``PointCloudSurface.widening``): the closest points found for the nodes of a narrower band are
+kept, and a wider band computes only its new nodes' (each widening computed every node again: a
+sparsely sampled hemisphere's refusal at N = 61 took 17 s over five bands, 4.6 s with the feet
+kept; ``tests/test_point_cloud.py``). Kept for one preparation only, so that two solves of a cloud
+compute the same bits: a node's foot depends, within the fits' tolerance, on the nodes computed
+before it in its block (``tubesweep_core::surface::point_cloud``'s ``closest_points``)."""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Tuple
+
+import numpy as np
+
+from ..grid import Grid
+
+
+def known_feet(cloud: Any, grid: Grid) -> Optional[dict]:
+    """The feet kept while ``cloud`` widens its band, for this grid and smoothing ({} while
+    widening with none yet), or None outside a widening."""
+    known: Optional[dict] = getattr(cloud, "_widening_feet", None)
+    if known is None:
+        return None
+    if known and (known["grid"] != grid or known["smoothing"] != cloud.smoothing):
+        return {}
+    return known
+
+
+def closest_with(
+    known: Optional[dict], fits: Any, lin: np.ndarray, x: np.ndarray, rho: float, trust: float
+) -> Tuple[np.ndarray, np.ndarray]:
+    """The fits' closest points and feet of the nodes ``lin`` (at ``x``), those in ``known`` (a
+    narrower band's, ``PointCloudSurface.widening``) taken from it, the others computed."""
+    if not known or not len(known["linear"]):
+        return fits.closest(np.ascontiguousarray(x), rho, trust)
+    pos = np.minimum(np.searchsorted(known["linear"], lin), len(known["linear"]) - 1)
+    hit = known["linear"][pos] == lin
+    cp = np.empty_like(x)
+    feet = np.empty(len(lin), dtype=known["feet"].dtype)
+    cp[hit], feet[hit] = known["cp"][pos[hit]], known["feet"][pos[hit]]
+    miss = ~hit
+    if np.any(miss):
+        cp[miss], feet[miss] = fits.closest(np.ascontiguousarray(x[miss]), rho, trust)
+    return cp, feet
+
+
+def keep_feet(known: dict, grid: Grid, smoothing: float, lin: np.ndarray, cp: np.ndarray, feet: np.ndarray) -> dict:
+    """``known`` with the feet of the nodes ``lin`` added (sorted by node, each node once)."""
+    if known:
+        lin, cp, feet = (np.concatenate([known[k], v]) for k, v in (("linear", lin), ("cp", cp), ("feet", feet)))
+    order = np.argsort(lin, kind="stable")
+    lin, first = np.unique(lin[order], return_index=True)
+    return {"grid": grid, "smoothing": smoothing, "linear": lin, "cp": cp[order][first], "feet": feet[order][first]}
