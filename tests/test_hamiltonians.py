@@ -269,6 +269,11 @@ def test_a_sigma_below_the_hamiltonian_s_bound_is_refused_with_the_bound():
     # was refused
     same = ts.solve(c, g, [(-R, 0)], hamiltonian=ts.hamiltonians.Metric(np.eye(2), sigma=1.0))
     assert np.max(np.abs(same(pts) - ok(pts))) < 1e-6
+    # in the box too (a review: 41% off at (0.9, 0) with sigma = (1, 10), unwarned)
+    box = ts.Grid((-1, -1), (1, 1), (41, 41))
+    with pytest.warns(RuntimeWarning, match=r"sigma = \[1\.0, 10\.0\] is 10 times the smallest viscosity"):
+        u = ts.travel_time(box, [(0, 0)], hamiltonian=ts.hamiltonians.Isotropic(sigma=[1, 10]))
+    assert u[40, 20] > 1.2  # exact 0.9
 
 
 def test_metric_on_a_surface_has_two_readings_each_converging_to_its_own_exact_value():

@@ -83,8 +83,10 @@ def test_evolve_takes_a_boolean_mask_and_a_level_set_of_an_array_and_says_what_t
     assert abs(u - np.pi * 0.505) < 2 * GRID.spacing
     from_mask = ts.LevelSet.from_mask(mask, GRID, smooth=1)
     assert ts.evolve(from_mask, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1).times == [0.0, 0.05]
-    with pytest.raises(ValueError, match=r"holds only the values 0 and 1, a mask.*mask\.astype\(bool\)"):
+    with pytest.raises(ValueError, match=r"holds only the values 0 and 1, a mask.*mask > 0"):
         ts.evolve(mask.astype(float), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+    with pytest.raises(ValueError, match=r"evolve: phi holds only the values 0 and 255, a mask"):
+        ts.evolve(mask.astype(np.uint8) * 255, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
     with pytest.raises(TypeError, match=r"got Sphere\. Pass its values: surface\.signed_distance\("):
         ts.evolve(ts.surfaces.Sphere(0.5), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
     with pytest.raises(TypeError, match=r"got function\. Pass its values: phi_function\("):

@@ -50,9 +50,15 @@ def _mean_cell_time(ham: Hamiltonian, prep: _Prepared, n_nodes: int, grid: Grid)
 WIDE_SIGMA = 2.0
 
 
-def _warn_wide_sigma(sigma: np.ndarray, needed: np.ndarray) -> None:
-    """The warning for a ``sigma=`` of at least :data:`WIDE_SIGMA` times ``needed`` (per axis, the
-    largest |∂H/∂p_k| over the band, the least viscosity that keeps the update monotone)."""
+def warn_wide_sigma(st: dict, given: Any) -> None:
+    """The warning for a ``sigma=`` (``given``) of at least :data:`WIDE_SIGMA` times the bound the
+    binding checked it against (``st["sigma_needed"]``, taken out of the sweeps' report: per axis,
+    the largest |∂H/∂p_k| over the band, the least viscosity that keeps the update monotone); on
+    surfaces (:func:`solve_band`) and in the box (``anisotropic_box``)."""
+    if st.get("sigma_needed") is None:
+        return
+    sigma = np.asarray(given, dtype=float)
+    needed = np.asarray(st.pop("sigma_needed"), dtype=float)
     ratio = float(np.max(sigma / np.maximum(needed, 1e-300)))
     if ratio < WIDE_SIGMA:
         return
@@ -142,9 +148,7 @@ def solve_band(
         scheme=prep.scheme,
     )
     st = dict(st)
-    needed = st.pop("sigma_needed", None)
-    if needed is not None:
-        _warn_wide_sigma(np.asarray(prep.sigma, dtype=float), np.asarray(needed, dtype=float))
+    warn_wide_sigma(st, prep.sigma)
     # "upwind" for the moving medium and metrics, Eq. (3) itself for the isotropic Hamiltonian
     st["local_solver"] = "lxf" if prep.scheme == "lxf" else ("godunov" if prep.kind == "isotropic" else "upwind")
     st.update(prep.extra if "inverse" not in prep.extra else {})

@@ -11,6 +11,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
+from ._hamiltonian_solve import warn_wide_sigma
 from ._result_check import check_values
 from ._validate import ACTIVATION_FRACTION, check_tolerance_scale, first_order_tol, warn_unconverged
 from .grid import Grid
@@ -105,6 +106,8 @@ def travel_time_general(
         defer_outer_rim=True,
         scheme=prep.scheme,
     )
+    st = dict(st)
+    warn_wide_sigma(st, prep.sigma)
     warn_unconverged(st, tol, max_iterations)
     values[values >= st["infinity"]] = np.inf
     check_values(grid, band, values, None, st, infinity, reachability=False)  # no NaN (as ts.solve for these H)

@@ -400,11 +400,14 @@ def _phi_array(phi: Any) -> Any:
     arr = np.asarray(phi)
     if arr.dtype == bool:
         return 0.5 - arr  # True inside: negative there, as φ
-    if arr.size and arr.dtype.kind in "iuf" and np.isin(arr, (0, 1)).all():
-        raise ValueError(
-            "evolve: phi holds only the values 0 and 1, a mask, not a φ with a sign change: pass the mask as a "
-            "boolean array (True inside: mask.astype(bool)), or φ = 0.5 − mask (negative inside)"
-        )
+    if arr.size and arr.dtype.kind in "iuf":
+        distinct = np.unique(arr)
+        if distinct.size <= 2 and distinct[0] >= 0:  # (0 and 1, 0 and 255: a mask)
+            shown = " and ".join(f"{v:g}" for v in distinct.tolist())
+            raise ValueError(
+                f"evolve: phi holds only the values {shown}, a mask, not a φ with a sign change: pass the mask as a "
+                "boolean array (True inside, e.g. mask > 0), or φ = 0.5 − (mask > 0) (negative inside)"
+            )
     return phi
 
 

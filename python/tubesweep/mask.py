@@ -130,58 +130,67 @@ def level_set_function_of_mask(mask: Any, grid: Grid, smooth: float = 0.0) -> np
     return phi
 
 
-#: Cavities (outside voxels enclosed by the object) at most this many voxels across are warned
-#: about: a surface of their own whose tube (2 + 4 spacings around it) meets the outer surface's
-#: and the other cavities', so that fronts run through the object. A ball of radius 0.5 at N = 53
-#: with 24 single voxels left out of it within 0.4 of its centre: the antipode 1.20 from the source
-#: instead of 1.52 (1.05 at N = 41, the straight chord), converged, warned only of narrow gaps and
-#: creases (a review).
-SMALL_CAVITY = 4
+#: Cavities (outside voxels enclosed by the object) of at most this many voxels, within
+#: :data:`CAVITY_REACH` spacings of the object's outer surface, are warned about: a surface of their
+#: own whose tube (2 + 4 spacings around it) meets the outer surface's and the other cavities', so
+#: that fronts run through the object. A ball of radius 0.5 at N = 53 with 24 single voxels left
+#: out of it within 0.4 of its centre: the antipode 1.20 from the source instead of 1.52 (1.05 at
+#: N = 41, the straight chord), converged, warned only of narrow gaps and creases (a review).
+SMALL_CAVITY = 64
+#: ... the reach: two tubes of the default outer width (4 spacings) meet across 8.
+CAVITY_REACH = 8.0
 
 
 def small_cavities(inside: np.ndarray) -> Tuple[int, int, Optional[Tuple[int, ...]]]:
-    """The outside voxels of ``inside`` that no path of outside voxels along the axes joins to the
-    box's faces, in connected parts (cavities): how many parts at most :data:`SMALL_CAVITY`
-    voxels across, how many parts in all, and a voxel of the first small one. (0, 0, None) without
-    scipy, which finds the parts."""
+    """The outside voxels of ``inside`` that no path of outside voxels (through faces, edges or
+    corners: a pit of a rough surface that opens to the outside at an edge is no cavity) joins to
+    the box's faces, in connected parts (cavities): how many parts of at most
+    :data:`SMALL_CAVITY` voxels lie within :data:`CAVITY_REACH` spacings of the outside, how many
+    parts in all, and a voxel of the first such part. (0, 0, None) without scipy, which finds
+    them."""
     try:
         from scipy import ndimage
     except ImportError:  # pragma: no cover - scipy is a test dependency
         return 0, 0, None
-    labels, count = ndimage.label(~inside)
+    labels, count = ndimage.label(~inside, structure=np.ones((3,) * inside.ndim, dtype=bool))
     if count <= 1:
         return 0, 0, None
     faces = np.zeros(count + 1, dtype=bool)
     for axis in range(inside.ndim):
         for end in (0, -1):
             faces[np.take(labels, end, axis=axis)] = True
-    small, first = 0, None
-    enclosed = 0
-    for k, box in enumerate(ndimage.find_objects(labels), start=1):
-        if box is None or faces[k]:
-            continue
-        enclosed += 1
-        if max(sl.stop - sl.start for sl in box) <= SMALL_CAVITY:
-            small += 1
-            if first is None:
-                first = tuple(int(sl.start) for sl in box)
-    return small, enclosed, first
+    faces[0] = False
+    enclosed = np.flatnonzero(~faces[1:]) + 1
+    if enclosed.size == 0:
+        return 0, 0, None
+    sizes = np.bincount(labels.ravel(), minlength=count + 1)
+    small = enclosed[sizes[enclosed] <= SMALL_CAVITY]
+    if small.size == 0:
+        return 0, int(enclosed.size), None
+    # each small cavity's nearest voxel to the outside (the outer surface's side)
+    far = ndimage.distance_transform_edt(~faces[labels])
+    nearest = ndimage.minimum(far, labels, small)
+    near = small[np.asarray(nearest) <= CAVITY_REACH]
+    if near.size == 0:
+        return 0, int(enclosed.size), None
+    at = tuple(int(i) for i in np.argwhere(labels == near[0])[0])
+    return int(near.size), int(enclosed.size), at
 
 
 def warn_small_cavities(inside: np.ndarray, grid: Grid) -> None:
-    """A RuntimeWarning for the mask's cavities of at most :data:`SMALL_CAVITY` voxels across
+    """A RuntimeWarning for the mask's small cavities near its outer surface
     (:func:`small_cavities`), with how many and where, and the cure."""
     small, enclosed, at = small_cavities(inside)
     if not small or at is None:
         return
     where = ", ".join(f"{c:.3g}" for c in np.asarray(grid.lower, dtype=float) + np.asarray(at) * grid.spacing)
     warnings.warn(
-        f"mask: {small} cavit{'y' if small == 1 else 'ies'} of at most {SMALL_CAVITY} voxels across inside the object "
-        f"({enclosed} enclosed in all; e.g. at index {at}, near ({where})): outside voxels that no path of outside "
-        "voxels joins to the box's faces. Each is a surface of its own, whose tube meets the outer surface's and the "
-        "other cavities', so fronts run through the object there and distances come out short. If they are holes of "
-        "the segmentation, fill them: LevelSet.from_mask(scipy.ndimage.binary_fill_holes(mask), grid) (smooth=1 "
-        "closes those of one voxel)",
+        f"mask: {small} cavit{'y' if small == 1 else 'ies'} of at most {SMALL_CAVITY} voxels inside the object within "
+        f"{CAVITY_REACH:g} voxels of its outer surface ({enclosed} enclosed in all; e.g. at index {at}, near "
+        f"({where})): outside voxels that no path of outside voxels joins to the box's faces. Each is a surface of its "
+        "own, whose tube meets the outer surface's and the other cavities', so fronts can run through the object there "
+        "and distances come out short. If they are holes of the segmentation, fill them: "
+        "LevelSet.from_mask(scipy.ndimage.binary_fill_holes(mask), grid) (smooth=1 closes those of one voxel)",
         RuntimeWarning,
         stacklevel=user_stacklevel(),
     )

@@ -1,5 +1,5 @@
 """A point cloud's band while the tube's preparation widens it (``_prepare._widened_band``,
-``PointCloudSurface.widening``): the closest points found for the nodes of a narrower band are
+``PointCloudSurface.band_widening``): the closest points found for the nodes of a narrower band are
 kept, and a wider band computes only its new nodes' (each widening computed every node again: a
 sparsely sampled hemisphere's refusal at N = 61 took 17 s over five bands, 4.6 s with the feet
 kept; ``tests/test_point_cloud.py``). Kept for one preparation only, so that two solves of a cloud
@@ -30,7 +30,7 @@ def closest_with(
     known: Optional[dict], fits: Any, lin: np.ndarray, x: np.ndarray, rho: float, trust: float
 ) -> Tuple[np.ndarray, np.ndarray]:
     """The fits' closest points and feet of the nodes ``lin`` (at ``x``), those in ``known`` (a
-    narrower band's, ``PointCloudSurface.widening``) taken from it, the others computed."""
+    narrower band's, ``PointCloudSurface.band_widening``) taken from it, the others computed."""
     if not known or not len(known["linear"]):
         return fits.closest(np.ascontiguousarray(x), rho, trust)
     pos = np.minimum(np.searchsorted(known["linear"], lin), len(known["linear"]) - 1)
@@ -44,10 +44,14 @@ def closest_with(
     return cp, feet
 
 
-def keep_feet(known: dict, grid: Grid, smoothing: float, lin: np.ndarray, cp: np.ndarray, feet: np.ndarray) -> dict:
-    """``known`` with the feet of the nodes ``lin`` added (sorted by node, each node once)."""
-    if known:
-        lin, cp, feet = (np.concatenate([known[k], v]) for k, v in (("linear", lin), ("cp", cp), ("feet", feet)))
+def keep_feet(known: dict, grid: Grid, smoothing: float, computed: list) -> dict:
+    """``known`` with the feet ``computed`` in one band search added ((nodes, closest points, feet)
+    per chunk), sorted by node, each node once."""
+    parts = [(known["linear"], known["cp"], known["feet"])] if known else []
+    parts += computed
+    if not parts:
+        return {}
+    lin, cp, feet = (np.concatenate([q[i] for q in parts]) for i in range(3))
     order = np.argsort(lin, kind="stable")
     lin, first = np.unique(lin[order], return_index=True)
     return {"grid": grid, "smoothing": smoothing, "linear": lin, "cp": cp[order][first], "feet": feet[order][first]}

@@ -535,7 +535,7 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         )
 
     @contextlib.contextmanager
-    def widening(self) -> Iterator[None]:
+    def band_widening(self) -> Iterator[None]:
         """While the tube's preparation widens the band: the feet found kept for the wider bands
         (:mod:`._cloud_widening`)."""
         self._widening_feet: Optional[dict] = {}
@@ -594,18 +594,20 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         parts: list = []
         undefined = []
         known = known_feet(self, grid)
+        computed: list = []
         for s0 in range(0, len(candidates), CHUNK):
             lin = candidates[s0 : s0 + CHUNK]
             x = grid.node_points(lin)
             cp, feet = closest_with(known, fits, lin, x, self.smoothing, half_width)
             norm = row_norms(x - cp)
             keep = norm <= half_width  # False where the fit failed (NaN)
+            found = np.isfinite(norm)
             if known is not None:  # (widening: every node's foot found is kept, nearer or farther)
-                known = keep_feet(known, grid, self.smoothing, lin[np.isfinite(norm)], cp[np.isfinite(norm)],
-                                   feet[np.isfinite(norm)])  # fmt: skip
-                self._widening_feet = known
-            undefined.append(lin[~np.isfinite(norm)])
+                computed.append((lin[found], cp[found], feet[found]))
+            undefined.append(lin[~found])
             parts.append((lin[keep], norm[keep], x[keep], cp[keep], feet[keep]))
+        if known is not None:
+            self._widening_feet = keep_feet(known, grid, self.smoothing, computed)
         if not parts or sum(len(q[0]) for q in parts) == 0:
             self._band_cache = None
             return BandGeometry(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
