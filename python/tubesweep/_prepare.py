@@ -460,9 +460,9 @@ def _widened_band(
     """The band of ``surf`` within ``outer_eff`` grid spacings with its roles, widened (a warning
     each time) while inner-tube nodes lack a neighbour in it, or the error when that does not
     close it. None where a mesh's smooth map folds on this grid and its exact closest points are
-    to be used instead (``fold_to_exact``: build the tube again). A surface with a ``band_widening``
+    to be used instead (``fold_to_exact``: build the tube again). A surface with a ``_band_widening``
     context (a point cloud) keeps what it computed for the band's nodes while it is widened."""
-    with getattr(surf, "band_widening", contextlib.nullcontext)():
+    with getattr(surf, "_band_widening", contextlib.nullcontext)():
         return _widening(surf, grid, inner, outer_eff, method, keep_geometry, reusable)
 
 

@@ -1,5 +1,5 @@
 """A point cloud's band while the tube's preparation widens it (``_prepare._widened_band``,
-``PointCloudSurface.band_widening``): the closest points found for the nodes of a narrower band are
+``PointCloudSurface._band_widening``): the closest points found for the nodes of a narrower band are
 kept, and a wider band computes only its new nodes' (each widening computed every node again: a
 sparsely sampled hemisphere's refusal at N = 61 took 17 s over five bands, 4.6 s with the feet
 kept; ``tests/test_point_cloud.py``). Kept for one preparation only, so that two solves of a cloud
@@ -30,7 +30,7 @@ def closest_with(
     known: Optional[dict], fits: Any, lin: np.ndarray, x: np.ndarray, rho: float, trust: float
 ) -> Tuple[np.ndarray, np.ndarray]:
     """The fits' closest points and feet of the nodes ``lin`` (at ``x``), those in ``known`` (a
-    narrower band's, ``PointCloudSurface.band_widening``) taken from it, the others computed."""
+    narrower band's, ``PointCloudSurface._band_widening``) taken from it, the others computed."""
     if not known or not len(known["linear"]):
         return fits.closest(np.ascontiguousarray(x), rho, trust)
     pos = np.minimum(np.searchsorted(known["linear"], lin), len(known["linear"]) - 1)

@@ -535,7 +535,7 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         )
 
     @contextlib.contextmanager
-    def band_widening(self) -> Iterator[None]:
+    def _band_widening(self) -> Iterator[None]:
         """While the tube's preparation widens the band: the feet found kept for the wider bands
         (:mod:`._cloud_widening`)."""
         self._widening_feet: Optional[dict] = {}
