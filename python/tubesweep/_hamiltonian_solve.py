@@ -46,7 +46,7 @@ def _mean_cell_time(ham: Hamiltonian, prep: _Prepared, n_nodes: int, grid: Grid)
 #: A constant ``sigma=`` this many times the smallest admissible one is warned about: its numerical
 #: viscosity grows the errors in proportion (the sphere at N = 41 with the identity metric, the
 #: quarter-way point: 4.8% off at σ = 1, 12% at 2, 17% at 3, 29% at 10 and 49% at 100, where the
-#: antipode came out at 0.46 instead of 1.57).
+#: antipode came out at 0.46 instead of 1.57; ``benches/experiments/wide_sigma.py``).
 WIDE_SIGMA = 2.0
 
 

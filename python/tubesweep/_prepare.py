@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import math
 import time
 import warnings
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Callable, Dict, Optional, Tuple, TypeVar
 
 import numpy as np
 
@@ -448,6 +449,22 @@ class _Band:
     outer: float
 
 
+_T = TypeVar("_T")
+
+
+def _keeping_band_work(attempts: Callable[..., _T]) -> Callable[..., _T]:
+    """``attempts`` run within the surface's ``_band_widening`` context where it has one (a point
+    cloud keeps what it computed for the band's nodes while the band is widened)."""
+
+    @functools.wraps(attempts)
+    def run(surf: Surface, *args: Any) -> _T:
+        with getattr(surf, "_band_widening", contextlib.nullcontext)():
+            return attempts(surf, *args)
+
+    return run
+
+
+@_keeping_band_work
 def _widened_band(
     surf: Surface,
     grid: Grid,
@@ -460,22 +477,7 @@ def _widened_band(
     """The band of ``surf`` within ``outer_eff`` grid spacings with its roles, widened (a warning
     each time) while inner-tube nodes lack a neighbour in it, or the error when that does not
     close it. None where a mesh's smooth map folds on this grid and its exact closest points are
-    to be used instead (``fold_to_exact``: build the tube again). A surface with a ``_band_widening``
-    context (a point cloud) keeps what it computed for the band's nodes while it is widened."""
-    with getattr(surf, "_band_widening", contextlib.nullcontext)():
-        return _widening(surf, grid, inner, outer_eff, method, keep_geometry, reusable)
-
-
-def _widening(
-    surf: Surface,
-    grid: Grid,
-    inner: float,
-    outer_eff: float,
-    method: str,
-    keep_geometry: bool,
-    reusable: bool,
-) -> Optional[_Band]:
-    """:func:`_widened_band`'s attempts."""
+    to be used instead (``fold_to_exact``: build the tube again)."""
     h = grid.spacing
     inner_width = inner * h
     # a re-distanced band, and the bound on |∇φ| its candidates were found with when the user gave it

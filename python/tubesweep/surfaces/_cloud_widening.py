@@ -1,8 +1,8 @@
 """A point cloud's band while the tube's preparation widens it (``_prepare._widened_band``,
 ``PointCloudSurface._band_widening``): the closest points found for the nodes of a narrower band are
 kept, and a wider band computes only its new nodes' (each widening computed every node again: a
-sparsely sampled hemisphere's refusal at N = 61 took 17 s over five bands, 4.6 s with the feet
-kept; ``tests/test_point_cloud.py``). Kept for one preparation only, so that two solves of a cloud
+sparsely sampled sphere's refusal at N = 61, five bands: median 16.6 s, 4.0 s with the feet kept,
+``benches/experiments/cloud_widening.py``). Kept for one preparation only, so that two solves of a cloud
 compute the same bits: a node's foot depends, within the fits' tolerance, on the nodes computed
 before it in its block (``tubesweep_core::surface::point_cloud``'s ``closest_points``)."""
 
