@@ -42,6 +42,24 @@ def first_order_size():
 
 
 @pytest.fixture
+def experiment():
+    """``experiment(name)``: the module ``benches/experiments/<name>.py`` (the scenes some tests
+    share with the experiments that measured them), loaded from its file."""
+    import importlib.util
+    from pathlib import Path
+
+    def load(name: str):
+        path = Path(__file__).resolve().parents[1] / "benches" / "experiments" / f"{name}.py"
+        spec = importlib.util.spec_from_file_location(name, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+
+    return load
+
+
+@pytest.fixture
 def without_scipy(tmp_path):
     """``without_scipy(body)``: runs ``body`` in a fresh interpreter in which scipy (an optional
     extra) cannot be imported, after ``import numpy as np`` and ``import tubesweep as ts``; asserts

@@ -318,24 +318,13 @@ def test_parts_of_a_mesh_closer_than_a_spacing_are_said():
         ts.Tube(mesh, g)
 
 
-def _cells_surface():
-    """``benches/experiments/thin_parts_meshes.py``'s closed surface of a union of box cells."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "benches" / "experiments" / "thin_parts_meshes.py"
-    spec = importlib.util.spec_from_file_location("thin_parts_meshes", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.cells_surface
-
-
 @pytest.mark.parametrize(
     "kind, width, crossed",
     [("plate", 1.0, True), ("plate", 1.1, False), ("slot", 1.5, True), ("slot", 1.75, False)],
 )
-def test_plates_and_slots_about_a_spacing_across_are_said_where_the_front_crosses_them(kind, width, crossed):
+def test_plates_and_slots_about_a_spacing_across_are_said_where_the_front_crosses_them(
+    kind, width, crossed, experiment
+):
     # the band is cut between facing parts only from a spacing apart, and a slot's mouth is spanned
     # by the tube above it while the closest points jump across it by less than 1.5 spacings: a
     # plate 0.96–1.0 spacings thick and slots 0.96–1.5 wide were crossed without a word (a helper's
@@ -343,7 +332,7 @@ def test_plates_and_slots_about_a_spacing_across_are_said_where_the_front_crosse
     grid = ts.Grid((-0.2,) * 3, (1.2,) * 3, (41,) * 3)
     h = grid.spacing
     w = width * h
-    cells_surface = _cells_surface()
+    cells_surface = experiment("thin_parts_meshes").cells_surface
     if kind == "plate":
         mesh = cells_surface([[0, 1], [0, 1], [0, w]], np.ones((1, 1, 1), bool))
         source, probe, exact = (0.5, 0.5, w), (0.5, 0.5, 0.0), 1.0 + w

@@ -187,6 +187,11 @@ def facing_gaps(
         on_hole = over_holes(grid, linear[facing[0]], linear[facing[1]], facing[2])
         hole_pairs = (linear[facing[0][on_hole]], linear[facing[1][on_hole]], facing[2][on_hole])
         facing = (facing[0][~on_hole], facing[1][~on_hole], facing[2][~on_hole])
+    # an open mesh: pairs at a notch of its rim are no gap either (left out altogether)
+    at_notches = getattr(surf, "_pairs_at_notches", None)
+    if at_notches is not None and facing[0].size:
+        notch = at_notches(grid, linear[facing[0]], linear[facing[1]], facing[2])
+        facing = (facing[0][~notch], facing[1][~notch], facing[2][~notch])
     cut_edges = 0
     pieces = None
     cut_facing = facing

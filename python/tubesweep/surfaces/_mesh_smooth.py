@@ -15,6 +15,7 @@ from ..band import BandGeometry
 from ..closest_point import DIRECTION_EPS
 from ..grid import Grid
 from ._mesh_holes import across_holes
+from ._mesh_notches import pairs_at_notches
 
 #: Samples in each local fit (as for point clouds, docs/point-clouds.md).
 NEIGHBOURS = 20
@@ -218,8 +219,8 @@ def facing_pairs(grid: Grid, geom: BandGeometry, surface: Any = None) -> int:
     """Pairs of grid neighbours of the band, both more than 0.75 Δx from the mesh, whose extension
     directions point more than 120° apart: the two sides of a gap narrower than the tubes (across a
     single sheet two neighbours cannot both be that far from it). Given the mesh (``surface``),
-    pairs over one of its holes (``_mesh_holes.across_holes``) are not counted: a hole is not a
-    gap between sheets."""
+    pairs over one of its holes (``_mesh_holes.across_holes``) and at a notch of its rim
+    (``_mesh_notches.pairs_at_notches``) are not counted: neither is a gap between sheets."""
     h = grid.spacing
     lin = geom.linear
     if len(lin) == 0:
@@ -238,7 +239,9 @@ def facing_pairs(grid: Grid, geom: BandGeometry, surface: Any = None) -> int:
         second.append(lin[pos[hit]][facing])
     a, b = np.concatenate(first), np.concatenate(second)
     if surface is not None and a.size:
-        return int(np.count_nonzero(~across_holes(surface, grid.node_points(a), grid.node_points(b))))
+        gap = ~across_holes(surface, grid.node_points(a), grid.node_points(b))
+        gap[gap] = ~pairs_at_notches(surface, grid, a[gap], b[gap])
+        return int(np.count_nonzero(gap))
     return int(a.size)
 
 

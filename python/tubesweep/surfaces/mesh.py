@@ -46,6 +46,7 @@ from ._mesh_parts import node_parts, part_cut_pairs
 from ._mesh_holes import bridged_holes, pairs_over_holes
 from ._mesh_pinches import pinch_cut_pairs
 from ._mesh_slits import slits
+from ._mesh_notches import pairs_at_notches
 
 __all__ = [
     "from_mesh",
@@ -121,6 +122,7 @@ class MeshSurface(Surface):
     _node_parts = node_parts  # each node's part, for a band left uncut (_parts)
     _bridged_holes = bridged_holes  # its holes the band spans, warned (stats.bridged_holes)
     _pairs_over_holes = pairs_over_holes  # facing pairs over a hole: no gap (_prepare)
+    _pairs_at_notches = pairs_at_notches  # facing pairs at a notch of the rim: no gap (_facing)
     _slits = slits  # its slits (stats.slits), warned where the band joins their sides
     _pinch_cut_pairs = pinch_cut_pairs  # the band's edges between sheets meeting at a point (cut)
 

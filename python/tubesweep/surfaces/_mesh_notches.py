@@ -1,0 +1,133 @@
+"""Facing pairs at a notch of an open mesh's rim: no gap.
+
+The facing tests (``_mesh_smooth.facing_pairs``, the tube's ``Band.facing_sheet_pairs``) take two
+neighbouring band nodes whose directions turn against each other for the two sides of a narrow
+gap, and one such pair sends a mesh's whole solve to first order ("the second-order sweeps can run
+away across such a gap"). Where an open mesh's boundary zigzags at the grid's scale (a disc
+triangulated on a jittered lattice, its triangles kept inside a circle: a scan's or a cut's rim),
+a node beyond a notch's corner, its direction along the surface, and a node above the next
+triangle, its direction along the normal, pass that test: the disc tilted in the box had one pair
+at every N from 61 to 121 and ran first order, its mean error away from the rim 0.007–0.011,
+against under 1e-4 at second order (``benches/experiments/rim_notches.py``).
+
+Across a real gap the two nodes' closest points lie far apart along the mesh (the sheets join,
+if at all, round the gap's far end); at a notch they lie on neighbouring triangles. A pair is no
+gap where one of its closest points lies on the boundary and the mesh joins the two by a path
+along its edges (from the one closest point to a vertex of its triangle, along edges, to a
+vertex of the other's triangle, to the other) of at most :data:`NOTCH_REACH` grid spacings:
+the solution differs across it by no more than that path, so the second-order sweeps have nothing
+to run away with. Such pairs are left out of the facing pairs (no cut, no warning, not in
+``sol.stats.facing_pairs``).
+"""
+
+from __future__ import annotations
+
+import heapq
+from typing import Any, Dict, List, Tuple
+
+import numpy as np
+
+from ..grid import Grid
+from ._mesh_checks import unique_edges
+from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, VERT_A, VERT_B, VERT_C
+
+#: The longest path along the mesh between a pair's two closest points, in grid spacings, for which
+#: the pair is a notch's and no gap (the solution differs across it by no more)...
+NOTCH_REACH = 3.0
+#: ... or, where longer, in units of the distance between the two closest points: a slot of width
+#: w and depth d is joined round its end by about 2d + w, so this takes bays up to half as deep as
+#: they are wide (a notch the grid resolves) for notches, and slots deeper than that for gaps.
+NOTCH_RATIO = 2.0
+
+
+def _boundary_table(surface: Any) -> np.ndarray:
+    """``(F, 7)`` bool: whether each face's feature (the codes of
+    :func:`~tubesweep.surfaces.mesh.closest_points_on_triangles`) lies on the mesh's boundary (a
+    boundary edge, or a vertex of one); computed once per mesh."""
+    table = surface.__dict__.get("_boundary_features")
+    if table is None:
+        f = np.asarray(surface.faces, dtype=np.int64)
+        ids, counts = unique_edges(f)
+        edge_on = counts[ids] == 1  # (F, 3): AB, AC, BC
+        ends = np.stack([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]], axis=1)
+        vertex_on = np.zeros(len(surface.vertices), dtype=bool)
+        vertex_on[ends[edge_on].ravel()] = True
+        table = np.zeros((len(f), 7), dtype=bool)
+        for code, k in ((VERT_A, 0), (VERT_B, 1), (VERT_C, 2)):
+            table[:, code] = vertex_on[f[:, k]]
+        for code, k in ((EDGE_AB, 0), (EDGE_AC, 1), (EDGE_BC, 2)):
+            table[:, code] = edge_on[:, k]
+        surface.__dict__["_boundary_features"] = table
+    return table
+
+
+def _edge_graph(surface: Any) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mesh's vertex graph in CSR form (offsets, neighbours, edge lengths); computed once."""
+    graph = surface.__dict__.get("_edge_graph")
+    if graph is None:
+        f = np.asarray(surface.faces, dtype=np.int64)
+        e = np.concatenate([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]])
+        e = np.unique(np.sort(e, axis=1), axis=0)
+        e = e[e[:, 0] != e[:, 1]]
+        both = np.concatenate([e, e[:, ::-1]])
+        both = both[np.argsort(both[:, 0], kind="stable")]
+        v = surface.vertices
+        offsets = np.searchsorted(both[:, 0], np.arange(len(v) + 1))
+        length = np.linalg.norm(v[both[:, 0]] - v[both[:, 1]], axis=1)
+        graph = (offsets, both[:, 1], length)
+        surface.__dict__["_edge_graph"] = graph
+    return graph
+
+
+def _joined_within(surface: Any, c1: np.ndarray, f1: int, c2: np.ndarray, f2: int, limit: float) -> bool:
+    """Whether the mesh joins ``c1`` (on face ``f1``) and ``c2`` (on face ``f2``) by a path through
+    the faces' vertices along edges of at most ``limit`` (a bounded Dijkstra search)."""
+    if f1 == f2:
+        return bool(np.linalg.norm(c1 - c2) <= limit)
+    offsets, neighbours, length = _edge_graph(surface)
+    v = surface.vertices
+    faces = surface.faces
+    goal = {int(k): float(np.linalg.norm(v[k] - c2)) for k in faces[f2]}
+    best: Dict[int, float] = {}
+    heap: List[Tuple[float, int]] = []
+    for k in faces[f1]:
+        d = float(np.linalg.norm(v[k] - c1))
+        if d <= limit and d < best.get(int(k), np.inf):
+            best[int(k)] = d
+            heapq.heappush(heap, (d, int(k)))
+    while heap:
+        d, k = heapq.heappop(heap)
+        if d > best.get(k, np.inf):
+            continue
+        if k in goal and d + goal[k] <= limit:
+            return True
+        for s in range(offsets[k], offsets[k + 1]):
+            j = int(neighbours[s])
+            dj = d + float(length[s])
+            if dj <= limit and dj < best.get(j, np.inf):
+                best[j] = dj
+                heapq.heappush(heap, (dj, j))
+    return False
+
+
+def pairs_at_notches(surface: Any, grid: Grid, first: np.ndarray, second: np.ndarray, *_: Any) -> np.ndarray:
+    """For facing node pairs given by their linear indices on ``grid``: whether each lies at a
+    notch of the mesh's rim (see the module): one of its two exact closest points on the
+    boundary, and the two joined along the mesh within :data:`NOTCH_REACH` spacings or
+    :data:`NOTCH_RATIO` times their distance, whichever is longer.
+    ``MeshSurface._pairs_at_notches``, read by the tube's preparation (``_facing``), which leaves
+    such pairs out of the facing pairs. All False on a closed mesh."""
+    out = np.zeros(len(first), dtype=bool)
+    if getattr(surface, "closed", True) or len(first) == 0:
+        return out
+    _, c1, f1, k1 = surface.closest(grid.node_points(first))
+    _, c2, f2, k2 = surface.closest(grid.node_points(second))
+    table = _boundary_table(surface)
+    found = (f1 >= 0) & (f2 >= 0)
+    on_rim = np.zeros(len(first), dtype=bool)
+    on_rim[found] = table[f1[found], k1[found]] | table[f2[found], k2[found]]
+    apart = np.linalg.norm(c1 - c2, axis=1)
+    limit = np.maximum(NOTCH_REACH * grid.spacing, NOTCH_RATIO * apart)
+    for i in np.flatnonzero(on_rim):
+        out[i] = _joined_within(surface, c1[i], int(f1[i]), c2[i], int(f2[i]), float(limit[i]))
+    return out
