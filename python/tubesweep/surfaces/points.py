@@ -35,13 +35,13 @@ import numpy as np
 
 from ..closest_point import DIRECTION_EPS, ClosestPoint, _refuse_undefined_next_to
 from .._linalg import row_norms
-from .._validate import real_array
-from ..grid import MAX_COORDINATE, Grid
+from ..grid import Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
 from ._cloud_analysis import analyse, analyse_own, lines_advice, widen
 from ._cloud_holes import bridged_holes, pairs_over_holes, warn_close_ends
 from ._cloud_files import read_points
+from ._cloud_input import checked_points
 from ._cloud_widening import closest_with, keep_feet, known_feet
 from ._cloud_advice import SPARSE_FACTOR, STRAY_SPACINGS, CloudAdvice, sentence
 
@@ -107,40 +107,6 @@ CHUNK = 1 << 20
 #: across it): two sphere clouds 5 spacings apart at N = 61 (fits of 3 spacings) are, 4.6 and 4.8
 #: apart still crossed (``benches/experiments/cloud_gaps.py``)
 RESOLVED_GAP = 5.0 / 3.0
-
-
-def _checked_points(points: Any, name: str = "points") -> np.ndarray:
-    what = f"{name} must be an array of shape (M, 3) (or (M, 2) for a curve) of numbers"
-    try:
-        a = np.asarray(points)
-    except ValueError:  # ragged nesting
-        raise TypeError(f"{what}; got {type(points).__name__}") from None
-    not_numbers = (str, bytes, bool, np.bool_)
-    if a.dtype.kind in "USb" or (a.dtype == object and any(isinstance(x, not_numbers) for x in a.reshape(-1))):
-        # strings (even of digits), bytes and booleans are not coordinates
-        raise TypeError(f"{what}; got dtype {a.dtype}")
-    try:
-        p = real_array(a, name)
-    except TypeError as e:
-        raise TypeError(f"{what}: {e}") from None
-    if p.ndim != 2 or p.shape[1] not in (2, 3):
-        raise ValueError(f"{name} must have shape (M, 3) (or (M, 2) for a curve); got {p.shape}")
-    if p.shape[0] == 0:
-        raise ValueError(f"{name} is empty: a point cloud needs samples of the surface")
-    finite = np.isfinite(p).all(axis=1)
-    if not finite.all():
-        bad = np.flatnonzero(~finite)
-        raise ValueError(
-            f"{name} holds {bad.size} points with NaN or inf (the first, index {int(bad[0])}: "
-            f"{tuple(float(x) for x in p[bad[0]])}); drop them, e.g. {name}[np.isfinite({name}).all(axis=1)]"
-        )
-    big = float(np.max(np.abs(p)))
-    if big > MAX_COORDINATE:
-        raise ValueError(
-            f"{name} has coordinates up to {big:.3g}; they must lie within ±{MAX_COORDINATE:g} (the solver keeps "
-            "distances in single precision): rescale the cloud"
-        )
-    return np.ascontiguousarray(p)
 
 
 class PointCloudSurface(CloudAdvice, ClosestPoint):
@@ -243,7 +209,7 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         outliers: str = "remove",
         name: str = "point cloud",
     ):
-        p = _checked_points(points)
+        p = checked_points(points)
         d = p.shape[1]
         if isinstance(neighbours, bool) or not isinstance(neighbours, (int, np.integer)):
             raise TypeError(f"neighbours must be a whole number; got {neighbours!r}")
@@ -255,7 +221,7 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         if outliers not in ("remove", "raise"):
             raise ValueError(f"outliers must be 'remove' or 'raise'; got {outliers!r}")
         if normals is not None:
-            n = _checked_points(normals, "normals")
+            n = checked_points(normals, "normals")
             if n.shape != p.shape:
                 raise ValueError(f"normals must have the points' shape {p.shape}; got {n.shape}")
         given = len(p)
