@@ -21,9 +21,7 @@ differs across it by no more than that path, so the second-order sweeps have not
 with. Such pairs are left out of the facing pairs (no cut, no warning, not in
 ``sol.stats.facing_pairs``). The path is searched for only between closest points on one piece
 of the mesh, with the straight line as the bound on the rest of the way, and the verdicts are
-kept per grid: a helper's review timed rolled sheets, louvres and accordions of 20,000–240,000
-vertices with 900–19,000 facing pairs at 5–15 times the solve's time before these three limits,
-within 0.1–0.5 s of it after (``/tmp/review81``, scratch).
+kept per grid (a review's timings before and after these limits: docs/development/history-notes.md).
 """
 
 from __future__ import annotations
