@@ -521,7 +521,10 @@ def test_a_solution_or_an_array_in_the_wrong_place_and_a_wide_tube_are_named():
         ts.farthest_point_sampling(tube, points, 4)
     with pytest.raises(TypeError, match=r"grid must be a ts\.Grid or None .* got ndarray"):
         ts.distance_matrix(tube, points, points)
-    with pytest.raises(ValueError, match=r"refine the grid, or narrow the tube \(outer=30 now, 4 by default\)"):
+    with pytest.raises(
+        ValueError,
+        match=r"refine the grid, or narrow the tube \(its band reaches 30 grid spacings .*4 by default, set by outer=",
+    ):
         ts.solve(sphere, g, [(0.5, 0, 0)], outer=30)
-    with pytest.raises(ValueError, match=r"refine the grid, or narrow the tube \(outer=30 now"):
+    with pytest.raises(ValueError, match=r"refine the grid, or narrow the tube \(its band reaches 30 grid spacings"):
         ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, g, [(0.5, 0, 0)], outer=30)

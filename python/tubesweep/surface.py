@@ -500,7 +500,15 @@ class LevelSet(Surface):
     def _check_distance_like(self, lo: float, hi: float, outer: float) -> None:
         """``lo``, ``hi``: the range of |∇φ| at the nodes within half the band of the surface;
         ``outer``: the band's half-width in grid spacings (a narrower tube is a cure when wide)."""
-        narrower = f", or narrow the tube (outer={outer:g} now, 4 by default)" if outer > 4.0 + 1e-9 else ""
+        # (the band's reach, not the caller's outer: it may have widened by itself, and with the
+        # single-tube method inner sets it)
+        narrower = (
+            f", or narrow the tube (its band reaches {outer:g} grid spacings from the surface now: 4 by default, "
+            "set by outer=, or by inner= with the single-tube method; it also widens by itself where inner-tube "
+            "nodes lack neighbours)"
+            if outer > 4.0 + 1e-9
+            else ""
+        )
         if (lo < GRAD_ERROR_LOW or hi > GRAD_ERROR_HIGH) and self._native_phi() is not None:
             # a library surface's φ is an exact distance: only the grid can be at fault
             raise ValueError(
