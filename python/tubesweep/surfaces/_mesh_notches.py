@@ -32,7 +32,7 @@ from typing import Any, Dict, List, Tuple
 import numpy as np
 
 from ..grid import Grid
-from ._mesh_checks import unique_edges
+from ._mesh_holes import boundary_edges_of
 from ._mesh_parts import vertex_parts
 from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, VERT_A, VERT_B, VERT_C
 
@@ -52,15 +52,16 @@ EDGE_ON = 30.0
 def _boundary_table(surface: Any) -> np.ndarray:
     """``(F, 7)`` bool: whether each face's feature (the codes of
     :func:`~tubesweep.surfaces.mesh.closest_points_on_triangles`) lies on the mesh's boundary (a
-    boundary edge, or a vertex of one); computed once per mesh."""
+    boundary edge, or a vertex of one: ``_mesh_holes.boundary_edges_of``); computed once per mesh."""
     table = surface.__dict__.get("_boundary_features")
     if table is None:
         f = np.asarray(surface.faces, dtype=np.int64)
-        ids, counts = unique_edges(f)
-        edge_on = counts[ids] == 1  # (F, 3): AB, AC, BC
-        ends = np.stack([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]], axis=1)
-        vertex_on = np.zeros(len(surface.vertices), dtype=bool)
-        vertex_on[ends[edge_on].ravel()] = True
+        boundary = boundary_edges_of(surface)  # (E, 2), each sorted
+        n = len(surface.vertices)
+        ends = np.sort(np.stack([f[:, [0, 1]], f[:, [0, 2]], f[:, [1, 2]]], axis=1), axis=2)
+        edge_on = np.isin(ends[:, :, 0] * n + ends[:, :, 1], boundary[:, 0] * n + boundary[:, 1])  # AB, AC, BC
+        vertex_on = np.zeros(n, dtype=bool)
+        vertex_on[boundary.ravel()] = True
         table = np.zeros((len(f), 7), dtype=bool)
         for code, k in ((VERT_A, 0), (VERT_B, 1), (VERT_C, 2)):
             table[:, code] = vertex_on[f[:, k]]
@@ -154,9 +155,8 @@ def pairs_at_notches(surface: Any, grid: Grid, first: np.ndarray, second: np.nda
     # EDGE_ON of both triangles' planes; across a gap between two sheets, along their normals
     way = (c2 - c1) / np.maximum(apart, 1e-300)[:, None]
     normals = surface.face_normals
-    for f, found_face in ((f1, found), (f2, found)):
-        along = np.abs(np.einsum("ij,ij->i", normals[np.maximum(f, 0)], way))
-        on_rim &= ~found_face | (along <= np.sin(np.radians(EDGE_ON)))
+    for f in (f1, f2):  # (on_rim is False already where a closest point was not found)
+        on_rim &= np.abs(np.einsum("ij,ij->i", normals[np.maximum(f, 0)], way)) <= np.sin(np.radians(EDGE_ON))
     limit = np.maximum(NOTCH_REACH * grid.spacing, NOTCH_RATIO * apart)
     # the verdicts on this grid, kept: the smooth map's facing test and the tube's meet many of the
     # same node pairs
