@@ -8,6 +8,12 @@ the rim's vertices and the others, with the notch test (``after``) and without i
 
     .venv/bin/python benches/experiments/rim_notches.py
     .venv/bin/python benches/experiments/rim_notches.py --n 61 91 121
+    .venv/bin/python benches/experiments/rim_notches.py --rolled     # the test's cost, a few seconds
+
+``--rolled``: what the notch test costs where many facing pairs lie next to a rim: a sheet
+rolled 1.6 turns (an Archimedean spiral from radius 0.08, 0.08 between turns, 0.5 wide, meshed at
+0.006: about 20,000 vertices) at N = 61, the time of ``ts.solve`` with the test and without it,
+alternated over five rounds (medians, and their ratio).
 """
 
 from __future__ import annotations
@@ -43,6 +49,48 @@ def jagged_disc(spacing: float = 0.02, seed: int = 1):
     return v, f, source, rim
 
 
+def rolled_sheet(start: float = 0.08, pitch: float = 0.08, turns: float = 1.6, step: float = 0.006):
+    """Vertices, faces and a source vertex (on the outer rim) of a sheet rolled along an Archimedean
+    spiral r = start + pitch·θ/2π, 0.5 wide along y, meshed at about ``step``."""
+    angles = [0.0]
+    while angles[-1] < 2 * np.pi * turns:
+        angles.append(angles[-1] + step / (start + pitch * angles[-1] / (2 * np.pi)))
+    theta = np.array(angles)
+    r = start + pitch * theta / (2 * np.pi)
+    y = np.linspace(-0.25, 0.25, int(0.5 / step) + 1)
+    ring, across = len(theta), len(y)
+    v = np.column_stack([np.repeat(r * np.cos(theta), across), np.tile(y, ring), np.repeat(r * np.sin(theta), across)])
+    i = np.arange(ring * across).reshape(ring, across)
+    a, b, c, d = i[:-1, :-1].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel(), i[:-1, 1:].ravel()
+    return v, np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])]), int(i[-1, across // 2])
+
+
+def rolled(rounds: int = 5) -> None:
+    """The ``--rolled`` timing (see the module)."""
+    import time
+
+    import tubesweep as ts
+    from tubesweep.surfaces import _mesh_notches
+
+    v, f, source = rolled_sheet()
+    grid = ts.Grid((-0.7,) * 3, (0.7,) * 3, (61,) * 3)
+    reach, ratio = _mesh_notches.NOTCH_REACH, _mesh_notches.NOTCH_RATIO
+    times: dict = {"without": [], "with": []}
+    for _ in range(rounds):
+        for label, settings in (("without", (0.0, 0.0)), ("with", (reach, ratio))):
+            _mesh_notches.NOTCH_REACH, _mesh_notches.NOTCH_RATIO = settings
+            mesh = ts.surfaces.from_mesh((v, f))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                start = time.perf_counter()
+                sol = ts.solve(mesh, grid, [v[source]])
+                times[label].append(time.perf_counter() - start)
+    _mesh_notches.NOTCH_REACH, _mesh_notches.NOTCH_RATIO = reach, ratio
+    without, with_test = np.median(times["without"]), np.median(times["with"])
+    print(f"rolled sheet, {len(v)} vertices, N = 61: order {sol.stats.order}, {sol.stats.facing_pairs} facing pairs; "
+          f"ts.solve median {without:.3f} s without the notch test, {with_test:.3f} s with it ({with_test / without:.2f}x)")  # fmt: skip
+
+
 def main() -> None:
     import pygeodesic.geodesic as geodesic
 
@@ -51,7 +99,11 @@ def main() -> None:
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, nargs="+", default=[41, 61, 71, 81, 91, 111, 121])
+    ap.add_argument("--rolled", action="store_true", help="the notch test's cost on a rolled sheet instead")
     args = ap.parse_args()
+    if args.rolled:
+        rolled()
+        return
     v, f, source, rim = jagged_disc()
     exact, _ = geodesic.PyGeodesicAlgorithmExact(v, f).geodesicDistances(np.array([source]), None)
     reach, ratio = _mesh_notches.NOTCH_REACH, _mesh_notches.NOTCH_RATIO
