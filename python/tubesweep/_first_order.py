@@ -22,6 +22,7 @@ from ._roles import ROLE_FIXED, ROLE_INNER, ROLE_OUTER
 from ._request import SolveRequest
 from ._result_check import check_values
 from ._sources import SOURCE_RADIUS, _fix_sources, slowness_on_surface
+from ._wide_tube import tube_shortcut, warn_wide_tube
 from ._validate import (
     ACTIVATION_FRACTION,
     FRONT_WINDOW,
@@ -46,7 +47,11 @@ def first_order(req: SolveRequest, tube: _PreparedTube, fallback: Optional[Fallb
     ``sol.stats.order_fallback``."""
     if fallback is not None:
         fallback.measure(tube)
+    shortcut = tube_shortcut(tube)  # an inner tube wider than the paper's (before the sweeps consume it)
     sol = solve_on_tube(tube, req, reuse)
+    if shortcut is not None:
+        sol.stats = dataclasses.replace(sol.stats, tube_shortcut=shortcut)
+        warn_wide_tube(shortcut, tube.inner, tube.grid.spacing)
     if fallback is None:
         return sol
     fallback.warn(sol.values, tube)

@@ -32,6 +32,7 @@ from ._validate import (
 )
 from ._creases import warn_paper_tube_creases
 from ._warn import user_stacklevel
+from ._wide_tube import tube_shortcut, warn_wide_tube
 from ._facing import warn_facing_pairs
 from ._prepare import paper_creases_of, thinned_count, uncut_band
 from ._roles import ROLE_INNER
@@ -321,6 +322,8 @@ def _first_order_batch(
         t = tube._tube_first_auto  # "auto"'s first order: on the tube thinned at creases, as ts.solve's
     if fallback is not None:
         fallback.measure(t)
+    shortcut = tube_shortcut(t)  # an inner tube wider than the paper's
+    warn_wide_tube(shortcut, t.inner, grid.spacing)
     linear = t.linear
     h = grid.spacing
     assert t.geom is not None  # a Tube keeps its geometry
@@ -396,4 +399,5 @@ def _first_order_batch(
     stats["creases"] = t.paper_creases if fallback is None or fallback.creases is None else fallback.creases
     stats["bridged_holes"] = t.bridged_holes
     stats["slits"] = t.slits
+    stats["tube_shortcut"] = shortcut
     return out, stats
