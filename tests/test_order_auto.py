@@ -92,7 +92,7 @@ def _cases():
         (SPHERE, g41, SRC, {"source_init": "node"}, "source_init"),
         (SPHERE, g41, SRC, {"paper_sweeps": True}, "paper_sweeps"),
         (SPHERE, g41, SRC, {"method": "naive", "max_iterations": 20}, "two-layer"),
-        (SPHERE, g41, SRC, {"inner": 2.5, "outer": 4}, "outer ≥ inner"),
+        (SPHERE, g41, SRC, {"inner": 2, "outer": 3.5}, "outer ≥ inner"),
     ]
 
 

@@ -528,3 +528,30 @@ def test_a_solution_or_an_array_in_the_wrong_place_and_a_wide_tube_are_named():
         ts.solve(sphere, g, [(0.5, 0, 0)], outer=30)
     with pytest.raises(ValueError, match=r"refine the grid, or narrow the tube \(its band reaches 30 grid spacings"):
         ts.solve(lambda p: np.linalg.norm(p, axis=1) - 0.5, g, [(0.5, 0, 0)], outer=30)
+
+
+def test_a_second_order_solution_refuses_values_near_a_source_after_its_phi_array_changed():
+    x = np.stack(G3.meshgrid(), -1)
+    phi = np.linalg.norm(x, axis=-1) - 0.5
+    sol = ts.solve(phi, G3, [(-0.5, 0, 0)])
+    near = [(-0.5 * np.cos(0.05), 0.5 * np.sin(0.05), 0.0)]  # exactly 0.025 from the source
+    assert sol.stats.order == 2 and abs(sol(near)[0] - 0.025) < 1e-4
+    phi[...] = np.linalg.norm(x - [0.2, 0, 0], axis=-1) - 0.5  # a buffer reused: read 0.20 here, silently
+    for interpolation in ("linear", "cubic"):
+        with pytest.raises(ValueError, match="was changed after the solve"):
+            sol(near, interpolation=interpolation)
+    first = ts.solve(ts.LevelSet(phi.copy()), G3, [(-0.3, 0, 0)], order=1)  # no projection: free to change
+    before = first(near)
+    phi -= 0.1
+    assert np.array_equal(first(near), before, equal_nan=True)
+
+
+@pytest.mark.parametrize("as_array", [True, False])
+def test_a_phi_without_a_zero_level_set_is_named_so(as_array):
+    x = np.stack(G3.meshgrid(), -1)
+    phi = np.linalg.norm(x, axis=-1) + 0.1  # positive everywhere: no surface
+    surface = ts.LevelSet(phi) if as_array else (lambda p: np.linalg.norm(p, axis=1) + 0.1)
+    with pytest.raises(ValueError, match=r"φ has no zero level set on the grid: it is > 0 at every node"):
+        ts.solve(surface, G3, [(-0.5, 0, 0)])
+    with pytest.raises(ValueError, match=r"it is < 0 at every node"):
+        ts.solve(ts.LevelSet(-phi) if as_array else (lambda p: -np.linalg.norm(p, axis=1) - 0.1), G3, [(-0.5, 0, 0)])

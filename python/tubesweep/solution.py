@@ -259,7 +259,9 @@ class Solution:
         ------
         ValueError
             If the points do not have the grid's dimension or are not finite, or
-            ``interpolation`` is not one of the two.
+            ``interpolation`` is not one of the two; or if the φ array of the surface was
+            changed after a second-order solve (its values near a source are read through the
+            points' projections onto the surface).
 
         Examples
         --------
@@ -270,6 +272,8 @@ class Solution:
         >>> v = sol([(0.0, 0.5, 0.0)], interpolation="cubic")
         """
         p = as_points(points, self.grid.ndim, "points")
+        if self._factoring is not None:  # the factored form near a source projects onto the surface
+            self._check_surface_unchanged()
         out = self._read(p, interpolation)
         # a band cut across narrow gaps, or a mesh of separate pieces: each point read from its own
         # side of the gap (at second order its cell's corners read as any point: the factored form

@@ -165,6 +165,24 @@ def _norm_bounds(values: np.ndarray, norm: np.ndarray, half_width: float) -> Tup
     return lo_all, hi_all, False
 
 
+def _check_sign_change(values: np.ndarray, grid: Grid) -> None:
+    """Refuses a band whose φ keeps one sign (``values``: φ at its nodes, within the tube's reach
+    of where φ is smallest in magnitude) and stays farther from 0 than 1.5 half cell diagonals (a
+    surface between the nodes of a φ as steep as 1.5 at most, the band search's default bound): φ
+    has no zero level set on the grid, so there is no surface (a φ of r + 0.1 was told that it is
+    no distance function, a helper's review). Nearer, a surface may lie between the nodes (a
+    sphere of radius 0.5 at N = 4), which the checks that follow call a grid too coarse."""
+    reach = 1.5 * 0.5 * np.sqrt(grid.ndim) * grid.spacing
+    if values.size and (np.all(values > 0) or np.all(values < 0)) and np.min(np.abs(values)) > reach:
+        sign = "> 0" if values[0] > 0 else "< 0"
+        closest = float(np.min(np.abs(values)))
+        raise ValueError(
+            f"surface: φ has no zero level set on the grid: it is {sign} at every node (|φ| ≥ {closest:.3g} within "
+            "the tube's reach), so there is no surface to solve on. Pass a φ that is negative inside the surface and "
+            "positive outside, on a grid that holds the surface"
+        )
+
+
 class LevelSet(Surface):
     """A curve or surface given as the zero level set of φ, close to a signed distance function.
 
@@ -175,8 +193,8 @@ class LevelSet(Surface):
         evaluated for a callable (found coarse-to-fine, never the whole box). A C-ordered float64
         array is used in place, not copied (no second array of the grid's size): do not change it
         while a solution or a :class:`~tubesweep.Tube` built from it is in use (a Tube refuses to
-        solve after a change, and a solution to trace geodesic paths, whose projections use it);
-        pass ``phi.copy()`` to keep it free.
+        solve after a change, and a solution to trace geodesic paths or, at second order, to read
+        values at points, whose projections use it); pass ``phi.copy()`` to keep it free.
     lipschitz : float, optional
         Bound on ``|∇φ|`` used by the coarse-to-fine band search (1 for an exact distance; the
         default 1.5 leaves room for near-distance functions). With ``redistance=True`` the default
@@ -429,6 +447,7 @@ class LevelSet(Surface):
             linear = ulinear.view(np.int64)
             if linear.size == 0:
                 return BandGeometry(linear, values, values, direction)
+            _check_sign_change(values, grid)
             self._check_distance_like(*_norm_bounds(values, norm, half_width)[:2], half_width / grid.spacing)
             return BandGeometry(
                 linear,
@@ -478,6 +497,7 @@ class LevelSet(Surface):
                 f"{half_width / grid.spacing:g} grid spacings of the surface) is not finite. φ may be NaN far from the "
                 "surface, but must be finite within the tube and one grid spacing beyond it"
             )
+        _check_sign_change(values, grid)
         # bounded in single precision, as the library surfaces' band call returns |∇φ|
         self._check_distance_like(*_norm_bounds(values, norms, half_width)[:2], half_width / grid.spacing)
         # distance = |φ|, not stored
