@@ -52,6 +52,34 @@ def test_the_memory_guard_runs_before_the_box_or_a_dense_copy_is_allocated():
         sol.to_dense()
 
 
+def test_the_band_estimate_of_a_mesh_too_coarse_for_its_smooth_map_still_guards_memory():
+    # a cube of 12 triangles: the smooth map's fits need 22 samples, the estimate failed and was
+    # skipped, and n = 3000 aborted the process in an allocation (a helper's review)
+    v = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+    f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1]])
+    f = np.concatenate([f, [[2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]]])
+    cube = ts.surfaces.from_mesh((v, f))
+    with pytest.raises(MemoryError, match=r"the band \(about .* nodes"):
+        ts.solve(cube, cube.grid(n=40000), [v[0]])
+
+
+def test_the_memory_guard_reads_the_process_s_address_space_limit():
+    # under ulimit -v the machine's free memory is not what the process can get: a sphere at
+    # N = 4000 aborted in an allocation under an 8 GB limit with 23 GB free (a helper's review)
+    import subprocess
+    import sys
+
+    code = (
+        "import resource\n"
+        "from tubesweep._validate import available_memory_bytes\n"
+        "size = int(open('/proc/self/status').read().split('VmSize:')[1].split()[0]) * 1024\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (size + 2**30, resource.getrlimit(resource.RLIMIT_AS)[1]))\n"
+        "print(available_memory_bytes())\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert 0 < int(out) <= 2**30
+
+
 # ----------------------------------------------------------------------------- 2. numeric range
 @pytest.mark.parametrize("infinity", [1e101, 1e155, 1e308, np.inf, np.nan, 0.0, -1.0])
 def test_an_infinity_out_of_range_is_refused(infinity):

@@ -423,7 +423,17 @@ def speed_values(speed: Any, grid: Grid, points: np.ndarray, linear: Optional[np
 
 
 def available_memory_bytes() -> Optional[int]:
-    """Memory the machine can still give us, from /proc/meminfo (None when unknown)."""
+    """Memory the process can still get: the least of the machine's available memory
+    (/proc/meminfo), the address space left under the process's limit (``ulimit -v``,
+    RLIMIT_AS, against its VmSize) and the memory left in its control group (cgroup v2
+    ``memory.max`` or v1 ``memory.limit_in_bytes``, as in containers and batch jobs); None when
+    none is known. (The machine's alone let a sphere at N = 4000 under ``ulimit -v 8000000``
+    abort in an allocation instead of raising ``MemoryError``: a helper's review.)"""
+    found = [v for v in (_machine_available(), _address_space_left(), _cgroup_left()) if v is not None]
+    return min(found) if found else None
+
+
+def _machine_available() -> Optional[int]:
     try:
         with open("/proc/meminfo") as f:
             for line in f:
@@ -435,6 +445,45 @@ def available_memory_bytes() -> Optional[int]:
         return int(os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
     except (ValueError, OSError, AttributeError):
         return None
+
+
+def _address_space_left() -> Optional[int]:
+    """RLIMIT_AS's soft limit less the process's VmSize (None without a limit, or off Linux)."""
+    try:
+        import resource  # (POSIX only)
+
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if soft == resource.RLIM_INFINITY or soft < 0:
+            return None
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmSize:"):
+                    return max(0, int(soft) - int(line.split()[1]) * 1024)
+    except (ImportError, OSError, ValueError):
+        pass
+    return None
+
+
+def _cgroup_left() -> Optional[int]:
+    """The memory left in the process's control group (v2, then v1), None without a limit."""
+    for limit_file, usage_file in (
+        ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+        ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"),
+    ):
+        try:
+            with open(limit_file) as f:
+                text = f.read().strip()
+            if text == "max":
+                return None
+            limit = int(text)
+            if limit >= 2**60:  # v1's "no limit"
+                return None
+            with open(usage_file) as f:
+                usage = int(f.read().strip())
+            return max(0, limit - usage)
+        except (OSError, ValueError):
+            continue
+    return None
 
 
 def check_memory(nbytes: float, what: str, fix: str) -> None:

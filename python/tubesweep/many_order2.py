@@ -163,7 +163,7 @@ def solve_many_order2(
         ),
         (
             "runaway_iteration",
-            "ran away (a travel time fell below zero): their rows are the first-order factored solution (order 1); a finer grid or order=1 avoids it",
+            "ran away (a travel time fell below zero): their rows are the first-order factored solution (order 1); order=1 avoids it, and so may a finer grid where this one barely resolves the surface",
         ),
     ):
         bad = np.flatnonzero(~st["converged"]) if name == "converged" else np.flatnonzero(st[name] >= 0)

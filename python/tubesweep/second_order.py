@@ -447,7 +447,7 @@ def warn_about(
         warnings.warn(
             f"order=2: the second-order sweeps ran away at their iteration {st['runaway_iteration']} (a travel time "
             "fell below zero) and were abandoned: the values returned are the first-order factored solution (order 1). "
-            "sol.stats.order2['runaway_iteration'] records it; a finer grid or order=1 avoids it",
+            "sol.stats.order2['runaway_iteration'] records it; order=1 avoids it, and so may a finer grid where this one barely resolves the surface",
             RuntimeWarning,
             stacklevel=user_stacklevel(),
         )

@@ -478,6 +478,32 @@ class SmoothMap:
             return cache[1].copy()  # the band's nodes again (the second-order geometry)
         return closest(self, p, self._h)[0]
 
+    def exact_project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
+        """The exact map's distances and closest points on the mesh's triangles (as
+        ``smooth=False``'s :meth:`project`), for estimates that need no fit.
+
+        Parameters
+        ----------
+        points : numpy.ndarray
+            ``(M, 3)`` points.
+        grid : Grid
+            The grid.
+
+        Returns
+        -------
+        distance, closest : numpy.ndarray
+            ``(M,)`` and ``(M, 3)``.
+
+        Examples
+        --------
+        >>> import tubesweep as ts
+        >>> spot = ts.surfaces.from_mesh(ts.data.spot())
+        >>> d, cp = spot.exact_project(spot.vertices[:2], spot.grid(100))
+        >>> float(d.max()) < 1e-12
+        True
+        """
+        return super().project(points, grid)  # type: ignore[misc]
+
     def project(self, points: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray]:
         """The smooth map's closest points for ``grid`` and the distances to them.
 
