@@ -272,3 +272,25 @@ def test_an_export_that_cannot_be_written_names_the_path_given(sphere_sol, tmp_p
     target = tmp_path / "afile" / "x.vtp"
     with pytest.raises(FileExistsError, match=rf"cannot write {re.escape(str(target))}: its folder"):
         ts.export(sphere_sol, target)
+
+
+def test_export_and_triangulate_refuse_what_is_not_a_surface_solution(tmp_path):
+    # a box solution raised "AttributeError: 'BoxSolution' object has no attribute 'surface'"
+    box = ts.travel_time(ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), [(0, 0, 0)], return_solution=True)
+    with pytest.raises(TypeError, match=r"export: sol must be a solution on a surface .* got BoxSolution: .*np.save"):
+        ts.export(box, tmp_path / "b.vtu")
+    with pytest.raises(TypeError, match=r"triangulate: sol must be a solution on a surface .* got BoxSolution"):
+        ts.triangulate(box)
+    with pytest.raises(TypeError, match=r"got int$"):
+        ts.export(5, tmp_path / "x.vtp")
+    assert not any(tmp_path.iterdir())
+
+
+def test_on_mesh_leaves_points_beyond_the_tube_nan_with_the_warning():
+    # the sphere's centre, 7.5 spacings inside, read 0.29 from a band node 3.5 spacings away
+    g = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+    sol = ts.solve(ts.surfaces.Sphere(0.5), g, [(-0.5, 0, 0)])
+    with pytest.warns(RuntimeWarning, match="on_mesh: 2 of 4 vertices lie off the band"):
+        u = sol.on_mesh([(0.0, 0.0, 0.0), (0.9, 0.0, 0.0), (0.5, 0.0, 0.0), (0.2, 0.0, 0.0)])
+    assert np.isnan(u[0]) and np.isnan(u[1])
+    assert abs(u[2] - np.pi / 2) < 0.03 and abs(u[3] - np.pi / 2) < 0.05  # the antipode; (0.2, 0, 0): 4.5 spacings in

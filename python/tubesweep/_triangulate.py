@@ -72,6 +72,23 @@ def _checked_mesh(mesh: Tuple[Any, Any]) -> Tuple[np.ndarray, np.ndarray]:
     return v, f
 
 
+def check_surface_solution(sol: Any, what: str) -> None:
+    """Refuses anything but a solution on a surface (:func:`tubesweep.solve`, ``Tube.solve``) as
+    ``sol`` of ``what``: a ``ts.travel_time`` box solution or a number raised AttributeError."""
+    if hasattr(sol, "surface") and hasattr(sol, "on_mesh"):
+        return
+    box = hasattr(sol, "values") and hasattr(sol, "grid")
+    raise TypeError(
+        f"{what}: sol must be a solution on a surface (from ts.solve or Tube.solve); got {type(sol).__name__}"
+        + (
+            ": a solution over the whole box has no surface to mesh; save its values (np.save(path, sol.values)) "
+            "or solve on a surface"
+            if box
+            else ""
+        )
+    )
+
+
 def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np.ndarray, np.ndarray]:
     """A mesh of the surface a solution lives on.
 
@@ -97,6 +114,8 @@ def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np
 
     Raises
     ------
+    TypeError
+        If ``sol`` is not a solution on a surface (a ``ts.travel_time`` box solution, say).
     ValueError
         For a surface with neither a triangulation nor a level set (a bare closest-point function:
         pass ``mesh=``), or a ``mesh`` whose faces index vertices that are not there.
@@ -114,6 +133,7 @@ def triangulate(sol: Any, *, mesh: Optional[Tuple[Any, Any]] = None) -> Tuple[np
     """
     if mesh is not None:
         return _checked_mesh(mesh)
+    check_surface_solution(sol, "triangulate")
     surf = sol.surface
     tri = getattr(surf, "triangulation", None)
     if callable(tri):

@@ -24,7 +24,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ._validate import real_array
-from ._triangulate import _need, triangulate
+from ._triangulate import _need, check_surface_solution, triangulate
 
 __all__ = ["triangulate", "export", "plot", "read_vtp", "EXPORT_FORMATS"]
 
@@ -240,6 +240,8 @@ def export(
 
     Raises
     ------
+    TypeError
+        If ``sol`` is not a solution on a surface (a ``ts.travel_time`` box solution, say).
     ValueError
         For an unknown suffix, a 2D curve as ``.ply``, or point data of the wrong length or name.
     ImportError
@@ -255,6 +257,7 @@ def export(
     >>> ts.export(sol, "sphere.vtp")  # doctest: +SKIP
     PosixPath('sphere.vtp')
     """
+    check_surface_solution(sol, "export")
     path = Path(path)
     suffix = export_format(path)
     cloud = mesh is None and hasattr(sol.surface, "rim") and hasattr(sol.surface, "points")
