@@ -303,6 +303,7 @@ def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
         (["--source", "-0.5", "0", "0", "--source", "1", "1"], "--source needs 3 coordinates"),
         (["--lower", "-1", "-1", "-1"], "give both --lower and --upper"),
         (["--padding", "3"], "--padding applies to --mesh only"),
+        (["--normalize"], "--normalize applies to --mesh only"),
         (["--path-from", "0", "0", "0"], "farther than the inner tube"),
     ],
 )
@@ -485,3 +486,12 @@ def test_a_solve_that_stops_at_max_iterations_writes_its_files_and_exits_3(tmp_p
     from tubesweep.cli import _unconverged
 
     assert _unconverged(24, 10000) == ("the solve ended", "see the warning above for why")
+
+
+@pytest.mark.parametrize("flag", [["--padding", "2"], ["--normalize"]])
+def test_distances_refuses_mesh_options_for_a_library_surface(tmp_path, capsys, flag):
+    # both were ignored for a --surface, silently (a helper's review)
+    out = tmp_path / "d.npy"
+    argv = ["distances", "--surface", "sphere", "--n", "21", "--sample", "5", "--out", str(out), *flag]
+    assert main(argv) == 2
+    assert f"{flag[0]} applies to --mesh only" in capsys.readouterr().err and not out.exists()

@@ -39,7 +39,9 @@ def _surface_names() -> List[str]:
     return sorted(REGISTRY)
 
 
-def _add_solver_options(p: argparse.ArgumentParser) -> None:
+def _add_solver_options(p: argparse.ArgumentParser, box: bool = False) -> None:
+    """The options every solving command takes; ``box``: the whole box's first-order sweeps
+    (``travel-time``, which has no --order: its help spoke of second order and --order auto)."""
     p.add_argument(
         "--hamiltonian",
         choices=["godunov", "lxf"],
@@ -50,9 +52,13 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
         "--tol",
         type=float,
         default=None,
-        help="stop when no value changes by more than this in an iteration (default: 1e-10 of the travel time across the grid, at most 1e-10, "
-        "at first order, about 5e-4 spacing² at second order; at first order about 1e-3 × the grid spacing is as accurate "
-        "and faster)",
+        help="stop when no value changes by more than this in an iteration (default: 1e-10 of the travel time across the grid, at most 1e-10"
+        + (
+            "; about 1e-3 × the grid spacing is as accurate and faster)"
+            if box
+            else ", at first order, about 5e-4 spacing² at second order; at first order about 1e-3 × the grid spacing is "
+            "as accurate and faster)"
+        ),
     )
     p.add_argument(
         "--max-iterations",
@@ -66,8 +72,12 @@ def _add_solver_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--quiet",
         action="store_true",
-        help="no progress bar and no notes (such as why order 1 ran where order 2 was asked for or chosen "
-        "by --order auto); the summary line, warnings and errors are still printed",
+        help=(
+            "no progress bar; the summary line, warnings and errors are still printed"
+            if box
+            else "no progress bar and no notes (such as why order 1 ran where order 2 was asked for or chosen "
+            "by --order auto); the summary line, warnings and errors are still printed"
+        ),
     )
 
 
@@ -252,7 +262,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="a source point, --dim coordinates (repeatable; default: the origin)",
     )
     t.add_argument("--speed", type=float, default=1.0, help="constant speed F > 0 (default: 1)")
-    _add_solver_options(t)
+    _add_solver_options(t, box=True)
 
     d = sub.add_parser("demo", help="run the built-in examples, print a table and write pictures")
     d.add_argument("--out", type=Path, default=Path("out/demo"), help="output folder (default: out/demo)")
@@ -424,6 +434,8 @@ def cmd_solve(args: argparse.Namespace) -> int:
         raise UsageError("--redistance applies to --phi only (library surfaces and meshes are distances already)")
     if args.padding is not None and not (args.mesh or args.points):
         raise UsageError("--padding applies to --mesh only (a --surface or --phi grid is given by its box)")
+    if args.normalize and not args.mesh:
+        raise UsageError("--normalize applies to --mesh only (it was ignored for a --surface, --phi or --points)")
     bad_arity = [len(p) for p in args.path_from or [] if len(p) != grid.ndim]
     if bad_arity:
         raise UsageError(f"--path-from needs {grid.ndim} coordinates on a {grid.ndim}D grid; got {bad_arity[0]}")

@@ -64,7 +64,9 @@ def add_distances_parser(sub: Any) -> None:
         default=None,
         help="nodes per axis (--surface, default 101) or along the mesh's longest side (--mesh, default 200)",
     )
-    p.add_argument("--padding", type=float, default=8.0, help="--mesh: empty grid spacings around the mesh (default 8)")
+    p.add_argument(
+        "--padding", type=float, default=None, help="--mesh: empty grid spacings around the mesh (default 8)"
+    )
     p.add_argument("--normalize", action="store_true", help="--mesh: centre the mesh and scale its longest side to 1")
     p.add_argument("--lower", type=float, nargs="+", help="grid lower corner (--phi; optional for --surface)")
     p.add_argument("--upper", type=float, nargs="+", help="grid upper corner")
@@ -131,7 +133,15 @@ def _surface_and_grid(args: argparse.Namespace) -> Any:
         from . import data
 
         surface = from_mesh(data.mesh_file(args.mesh), normalize=args.normalize)  # a file, or bunny / spot
-        return surface, surface.grid(200 if args.n is None else args.n, padding=args.padding)
+        return surface, surface.grid(
+            200 if args.n is None else args.n, padding=8.0 if args.padding is None else args.padding
+        )
+    if args.padding is not None or args.normalize:
+        # (ignored before for a --surface or --phi, silently: a helper's review)
+        raise ValueError(
+            f"{'--padding' if args.padding is not None else '--normalize'} applies to --mesh only (a --surface or "
+            "--phi grid is given by its box)"
+        )
     if args.surface:
         from .surfaces import REGISTRY
 

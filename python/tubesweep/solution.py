@@ -505,7 +505,7 @@ class Solution:
         start : array_like
             ``(d,)`` a point on the surface (within the inner tube).
         step : float
-            Step length in grid spacings (default 0.5, at least 0.01).
+            Step length in grid spacings (default 0.5, from 0.01 to 1).
         max_steps : int, optional
             The most steps to take (default: 8·(the grid's points per axis, summed)/step, more than any
             path within the grid needs).
