@@ -301,3 +301,12 @@ def test_metric_on_a_surface_has_two_readings_each_converging_to_its_own_exact_v
     )
     with pytest.raises(ValueError, match="restrict must be 'gradient'"):
         ts.hamiltonians.Metric(np.eye(3), restrict="induced")
+
+
+def test_a_ragged_metric_and_strengths_that_do_not_match_the_vortices_are_named():
+    # numpy's "inhomogeneous shape" and broadcast errors, which named neither argument (a helper's review)
+    with pytest.raises(ValueError, match=r"M must be a \(d, d\) matrix.*got list that is no array of numbers"):
+        ts.hamiltonians.Metric([[1, 0], [0]])
+    with pytest.raises(ValueError, match=r"strengths must be a number or one finite number per vortex \(1\)"):
+        ts.flows.point_vortices([(0, 0, 0.5)], [1, 2])
+    assert ts.flows.point_vortices([(0, 0, 0.5), (0, 0.5, 0)], 3.0) is not None

@@ -555,3 +555,11 @@ def test_a_phi_without_a_zero_level_set_is_named_so(as_array):
         ts.solve(surface, G3, [(-0.5, 0, 0)])
     with pytest.raises(ValueError, match=r"it is < 0 at every node"):
         ts.solve(ts.LevelSet(-phi) if as_array else (lambda p: -np.linalg.norm(p, axis=1) - 0.1), G3, [(-0.5, 0, 0)])
+
+
+def test_a_phi_callable_that_is_nowhere_finite_and_a_mask_path_are_named():
+    # "the band is empty ... check that the surface passes through the grid", and "mask has shape ()"
+    with pytest.raises(ValueError, match=r"the φ callable returned NaN or inf at every point of a 5\^3 lattice"):
+        ts.solve(lambda p: np.full(len(p), np.nan), G3, [(0.5, 0, 0)])
+    with pytest.raises(TypeError, match=r"mask must be an array of the grid's shape; got the path 'mask.npy'"):
+        ts.LevelSet.from_mask("mask.npy", G3)

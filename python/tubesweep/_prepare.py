@@ -368,9 +368,26 @@ def _checked_widths(inner: float, outer: float, method: str) -> Tuple[float, flo
     return inner, outer
 
 
-def _empty_band_message(surf: Surface) -> str:
+def _empty_band_message(surf: Surface, grid: Grid) -> str:
     """Why the band is empty: the surface does not pass through the grid or φ is not in its units
-    (or, for a φ array given as is that changes sign, far larger than a distance near the change)."""
+    (or, for a φ array given as is that changes sign, far larger than a distance near the change;
+    or a φ callable that is not finite at any node of a coarse lattice of the box: one returning
+    NaN everywhere was told to check that the surface passes through the grid, a helper's review)."""
+    fn = getattr(surf, "_fn", None) if isinstance(surf, LevelSet) else None
+    if fn is not None:
+        axes = [np.linspace(lo, hi, 5) for lo, hi in zip(grid.lower, grid.upper)]
+        lattice = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, grid.ndim)
+        with np.errstate(all="ignore"):
+            try:
+                values = np.asarray(fn(lattice), dtype=float).reshape(-1)
+            except Exception:  # (its own errors were raised during the band search)
+                values = np.zeros(1)
+        if values.size and not np.any(np.isfinite(values)):
+            return (
+                f"the band is empty: the φ callable returned NaN or inf at every point of a 5^{grid.ndim} lattice of "
+                f"the grid box (e.g. {values[0]} at {tuple(float(c) for c in lattice[0])}): it must return finite "
+                "values near the surface"
+            )
     array = getattr(surf, "_array", None) if isinstance(surf, LevelSet) and not surf.redistance else None
     # (a φ array given as is that changes sign: a surface is there, but φ is not its distance)
     signs = array is not None and bool(np.any(array < 0) and np.any(array > 0))
@@ -497,7 +514,7 @@ def _widened_band(
                 warnings.filterwarnings("ignore", message="φ's slope nearly vanishes", category=RuntimeWarning)
             geom = surf.band(grid, outer_eff * h)
         if geom.linear.size == 0:
-            raise ValueError(_empty_band_message(surf))
+            raise ValueError(_empty_band_message(surf, grid))
         roles = tube_roles(geom, inner_width, method)
         linear = geom.linear
         if attempt == 0:

@@ -71,7 +71,9 @@ def point_vortices(centers: Any, strengths: Any, *, core: float = 0.0) -> Flow:
         raise ValueError(
             f"centers must have shape (N, 3) (point vortices live on a sphere in 3D); got {np.shape(centers)}"
         )
-    s = np.broadcast_to(real_array(strengths, "strengths"), (c.shape[0],)).copy() if np.ndim(strengths) <= 1 else None
+    given = real_array(strengths, "strengths")
+    # (one per vortex or one for all: [1, 2] for one vortex raised numpy's broadcast error)
+    s = np.broadcast_to(given, (c.shape[0],)).copy() if given.ndim == 0 or given.shape == (c.shape[0],) else None
     if s is None or not np.all(np.isfinite(s)):
         raise ValueError(
             f"strengths must be a number or one finite number per vortex ({c.shape[0]}); got {strengths!r}"

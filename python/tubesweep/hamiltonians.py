@@ -575,7 +575,7 @@ class Metric(Hamiltonian):
     Raises
     ------
     ValueError
-        If ``M`` is not symmetric positive definite or has the wrong shape.
+        If ``M`` is not symmetric positive definite, has the wrong shape or is no array of numbers.
 
     Examples
     --------
@@ -607,6 +607,14 @@ class Metric(Hamiltonian):
             raise ValueError(
                 "restrict='length' takes the surface's tangent plane from its normals: it needs tangential=True"
             )
+        if not callable(M):
+            try:
+                np.asarray(M, dtype=float)
+            except (TypeError, ValueError) as err:  # (numpy's "inhomogeneous shape" before: a helper's review)
+                raise ValueError(
+                    "M must be a (d, d) matrix, an array of shape grid.shape + (d, d) or a callable; got "
+                    f"{type(M).__name__} that is no array of numbers ({err})"
+                ) from None
         self.M = M
         self.restrict = restrict
         self.tangential = bool(tangential)

@@ -15,6 +15,8 @@ curvatures, ``σ`` in length units): docs/surfaces.md has the measured figures.
 
 from __future__ import annotations
 
+import os
+
 import re
 import warnings
 from typing import Any, Optional, Tuple
@@ -33,6 +35,12 @@ def _checked_mask(mask: Any, grid: Grid) -> np.ndarray:
     if not isinstance(grid, Grid):
         raise TypeError(
             f"grid must be a ts.Grid (the grid whose nodes are the mask's voxels); got {type(grid).__name__}"
+        )
+    if isinstance(mask, (str, bytes, os.PathLike)):
+        # ("mask has shape ()" before: a helper's review)
+        raise TypeError(
+            f"mask must be an array of the grid's shape; got the path {os.fspath(mask)!r}: load it first "
+            "(np.load for .npy, or an image reader such as skimage.io.imread or nibabel for a volume)"
         )
     arr = np.asarray(mask)
     if arr.shape != grid.shape:

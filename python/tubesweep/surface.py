@@ -313,6 +313,8 @@ class LevelSet(Surface):
             If the mask's shape is not the grid's, it holds values other than 0 and 1, it is all
             inside or all outside, the object touches the grid's boundary, or ``smooth`` is negative
             or erases the object.
+        TypeError
+            If the mask is a file's path rather than an array, or ``grid`` is not a ``ts.Grid``.
 
         Examples
         --------
