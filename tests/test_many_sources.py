@@ -621,3 +621,12 @@ def test_dask_checks_as_locally_and_a_runaway_row_falls_back_alone(client):
     with pytest.warns(RuntimeWarning, match="points of at lie off the band") as caught:
         tube.solve_many(src[:2], at=[(0, 0, 0)], client=client)
     assert len(caught) == 1
+
+
+def test_a_single_flat_point_is_named_as_one_source_to_wrap():
+    # "sources[0] must have shape (M, 3); got shape ()" (a helper's review)
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3))
+    for flat in ((-0.5, 0, 0), np.array([-0.5, 0, 0])):
+        with pytest.raises(ValueError, match=r"got one point .*: pass \[point\] for a single source"):
+            tube.solve_many(flat)
+    assert tube.solve_many([(-0.5, 0, 0)]).shape[0] == 1

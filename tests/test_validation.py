@@ -563,3 +563,11 @@ def test_a_phi_callable_that_is_nowhere_finite_and_a_mask_path_are_named():
         ts.solve(lambda p: np.full(len(p), np.nan), G3, [(0.5, 0, 0)])
     with pytest.raises(TypeError, match=r"mask must be an array of the grid's shape; got the path 'mask.npy'"):
         ts.LevelSet.from_mask("mask.npy", G3)
+
+
+def test_sources_of_true_and_false_are_refused():
+    # taken as 1.0 and 0.0 (Grid refuses bools): a helper's review
+    with pytest.raises(TypeError, match="sources must hold coordinates"):
+        ts.solve(ts.surfaces.Sphere(0.5), G3, [(True, False, False)])
+    with pytest.raises(TypeError, match="sources must hold coordinates"):
+        ts.solve(ts.surfaces.Sphere(0.5), G3, np.array([[True, False, False]]))

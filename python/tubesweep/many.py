@@ -57,6 +57,11 @@ def source_groups(sources: Any, ndim: int) -> List[np.ndarray]:
     points may mix them (a group is one multi-source solve: the distance to the nearest of its
     points)."""
     if isinstance(sources, np.ndarray) and sources.dtype != object:
+        if sources.ndim == 1:
+            raise ValueError(
+                f"sources must be K points (K, {ndim}) or a list of points and groups; got one point of shape "
+                f"{sources.shape}: pass [point] for a single source"
+            )
         if sources.ndim == 2:
             p = as_points(sources, ndim, "sources")
             return [p[i : i + 1] for i in range(len(p))]
@@ -70,6 +75,12 @@ def source_groups(sources: Any, ndim: int) -> List[np.ndarray]:
         raise TypeError(
             f"sources must be an array (K, {ndim}) or a list of points ({ndim},) and groups (P, {ndim}); "
             f"got {type(sources).__name__}"
+        )
+    if len(sources) and all(np.ndim(g) == 0 for g in sources):
+        # one flat point ("sources[0] must have shape (M, 3); got shape ()" before: a helper's review)
+        raise ValueError(
+            f"sources must be K points (K, {ndim}) or a list of points and groups; got one point of {len(sources)} "
+            f"numbers: pass [point] for a single source"
         )
     return _non_empty([as_points(g, ndim, f"sources[{k}]") for k, g in enumerate(sources)])
 
