@@ -189,3 +189,11 @@ def test_a_box_solution_is_drawn_as_its_field():
     assert "slice z = 0" in fig3.axes[0].get_title()
     with pytest.raises(ValueError, match="carries its own grid"):
         ts.plot(sol, grid=ts.Grid((-1, -1), (1, 1), (31, 31)))
+
+
+def test_views_that_are_not_pairs_are_named():
+    # "not enough values to unpack" (a helper's review)
+    s = ts.surfaces.Sphere(0.5)
+    sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), [s.default_source])
+    with pytest.raises(ValueError, match=r"views must be a sequence of \(elevation, azimuth\) pairs"):
+        ts.plot(sol, views=[(1,)])

@@ -571,3 +571,9 @@ def test_sources_of_true_and_false_are_refused():
         ts.solve(ts.surfaces.Sphere(0.5), G3, [(True, False, False)])
     with pytest.raises(TypeError, match="sources must hold coordinates"):
         ts.solve(ts.surfaces.Sphere(0.5), G3, np.array([[True, False, False]]))
+
+
+def test_a_negative_linear_index_is_named_as_such():
+    # reported as "linear index 18446744073709551615" (its uint64 view): a helper's review
+    with pytest.raises(ValueError, match=r"linear indices must lie in \[0, 125\) \(grid.size\); got -1"):
+        ts.Grid((-1,) * 3, (1,) * 3, (5,) * 3).node_points([-1])

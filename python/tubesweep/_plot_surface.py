@@ -78,6 +78,20 @@ VIEW_TILT = 20.0
 ELONGATED = 1.5
 
 
+def _checked_views(views: Any) -> Tuple[Tuple[float, float], ...]:
+    """``views`` as (elevation, azimuth) pairs of finite degrees, or a ValueError naming it
+    ("not enough values to unpack" before: a helper's review)."""
+    try:
+        pairs = np.asarray(views, dtype=float)
+    except (TypeError, ValueError):
+        pairs = np.empty((0, 0))
+    if pairs.ndim != 2 or pairs.shape[1] != 2 or len(pairs) == 0 or not np.all(np.isfinite(pairs)):
+        raise ValueError(
+            f"views must be a sequence of (elevation, azimuth) pairs in degrees, e.g. [(20, -60), (20, 120)]; got {views!r}"
+        )
+    return tuple((float(e), float(a)) for e, a in pairs)
+
+
 def _default_views(sol: Any, v: Optional[np.ndarray], perm: List[int]) -> Tuple[Tuple[float, float], ...]:
     """Two views (elevation, azimuth) from opposite sides: the first at the azimuth of the first
     source seen from the centre of the surface's bounding box, the second at the opposite azimuth,
@@ -144,6 +158,8 @@ def _plot_surface(
         v, f = None, None  # a bare closest-point surface: drawn as its points
     if views is None:
         views = _default_views(sol, v, perm)
+    else:
+        views = _checked_views(views)
     if ax is not None:
         axes = [ax]
         fig = ax.figure

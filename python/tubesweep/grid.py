@@ -296,7 +296,11 @@ class Grid:
         from . import _native
 
         lin = np.ascontiguousarray(linear, dtype=np.int64)
-        # a negative index turns into one above every node: refused there like any outside one
+        if lin.size and lin.min() < 0:  # (reported as 18446744073709551615 by the core: a helper's review)
+            raise ValueError(
+                f"linear indices must lie in [0, {self.size}) (grid.size); got {int(lin.min())}: NumPy's negative "
+                "indexing does not apply here"
+            )
         return _native.node_points(
             list(self._shape), lin.view(np.uint64), [float(x) for x in self._lower], self._spacing
         )
