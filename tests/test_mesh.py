@@ -409,3 +409,11 @@ def test_a_zero_area_needle_on_a_closed_mesh_leaves_it_closed_and_signed():
     a, b = f[0, 0], f[0, 1]
     m = from_mesh((np.r_[v, [(v[a] + v[b]) / 2]], np.r_[f, [[a, b, len(v)]]]))
     assert m.closed and m.signed and m.signed_distance([[0.0, 0.0, 0.0]])[0] < 0
+
+
+def test_a_mesh_too_small_for_its_squares_is_told_to_rescale():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    f = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
+    with pytest.raises(ValueError, match=r"degenerate \(zero area\): the mesh spans only 1e-200.*normalize=True"):
+        ts.surfaces.from_mesh((v * 1e-200, f))
+    assert ts.surfaces.from_mesh((v * 1e-200, f), normalize=True).vertices.max() > 0.1

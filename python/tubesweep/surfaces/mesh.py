@@ -189,7 +189,14 @@ class MeshSurface(Surface):
         extent = float(np.ptp(v[np.unique(f)], axis=0).max())
         good = area2 > 1e-12 * max(extent, 1e-300) ** 2
         if not np.any(good):
-            raise ValueError("every triangle of the mesh is degenerate (zero area)")
+            # (a mesh at 1e-200 was refused with no hint of its scale: a helper's review)
+            tiny = (
+                f": the mesh spans only {extent:.3g}, where the squares of its edges underflow; rescale it, e.g. "
+                "from_mesh(..., normalize=True) or vertices * a factor"
+                if 0 < extent < 1e-100
+                else ""
+            )
+            raise ValueError("every triangle of the mesh is degenerate (zero area)" + tiny)
         self._good = np.flatnonzero(good)  # tree triangles → mesh faces
         self._tree: Any = None
         self._band_normals: Optional[Tuple[np.ndarray, Optional[np.ndarray]]] = None
