@@ -156,7 +156,7 @@ def test_a_mask_smoothed_over_a_voxel_says_its_rounded_crease_at_second_order():
     grid, d, source, points, exact = _fused_balls(61, 140)
     with pytest.warns(
         RuntimeWarning,
-        match=r"\(12 tube nodes, the normal turning by up to 75°, the faces by up to 133° \(read through a smoothing "
+        match=r"\(24 tube nodes, the normal turning by up to 75°, the faces by up to 133° \(read through a smoothing "
         r"of φ\)\): a front that crosses one arrives early by up to about 0\.191 \(5\.7·Δx with the inner tube",
     ):
         sol = ts.solve(ts.LevelSet.from_mask(d < 0, grid, smooth=1), grid, [source])
@@ -171,7 +171,7 @@ def test_order_1_on_a_mask_smoothed_over_a_voxel_reads_its_crease_s_faces_throug
     grid, d, source, points, exact = _fused_balls(61, 122)
     with pytest.warns(
         RuntimeWarning,
-        match=r"\(64 tube nodes next to the surface where .* faces whose normals differ by up to 119°.* in the paper's "
+        match=r"\(104 tube nodes next to the surface where .* faces whose normals differ by up to 119°.* in the paper's "
         r"tube \(order=1\) a front crossing one cuts the corner and arrives early by up to about 0\.342 \(10·Δx\) per "
         r"crease it crosses",
     ):

@@ -72,9 +72,9 @@ def test_a_union_re_distanced_reports_its_crease_at_every_resolution():
     grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
     x = np.stack(grid.meshgrid(), axis=-1)
     phi = np.minimum(np.linalg.norm(x + [0.3, 0, 0], axis=-1), np.linalg.norm(x - [0.3, 0, 0], axis=-1)) - 0.5
-    with pytest.warns(RuntimeWarning, match=r"creases or corners \(12 tube nodes, the normal turning by up to 90°\)"):
+    with pytest.warns(RuntimeWarning, match=r"creases or corners \(48 tube nodes, the normal turning by up to 90°\)"):
         sol = ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.8, 0, 0)])
-    assert sol.stats.order == 2 and sol.stats.order2["creases"]["nodes"] == 12
+    assert sol.stats.order == 2 and sol.stats.order2["creases"]["nodes"] == 48
     assert sol.stats.crease_thinned == 612
     crease = np.arccos(-0.3 / 0.5)  # the crease's polar angle on either sphere
     beta = np.linspace(0.05, crease - 0.1, 40)  # the far sphere's meridian

@@ -74,7 +74,9 @@ def test_two_spheres_joined_by_min_are_second_order_away_from_the_crease():
     top = math.acos(-0.6) - 0.2
     lone = ts.solve(ts.LevelSet(sphere_phi(g)), g, [(-0.5, 0.0, 0.0)])
     assert meridian_error(sol, top=top) <= 2 * meridian_error(lone, top=top)
-    one = ts.solve(ts.LevelSet(phi), g, [(-0.5, 0.0, 0.0)], order=1)
+    # the paper's tube cuts the crease's corner, said (3Δx: 3.1Δx on the meridian beyond it)
+    with pytest.warns(RuntimeWarning, match=r"faces turning by up to 73°\): in the paper's tube .* \(3·Δx\)"):
+        one = ts.solve(ts.LevelSet(phi), g, [(-0.5, 0.0, 0.0)], order=1)
     assert meridian_error(sol, top=top) < meridian_error(one, top=top) / 100
 
 

@@ -575,5 +575,7 @@ def test_sources_of_true_and_false_are_refused():
 
 def test_a_negative_linear_index_is_named_as_such():
     # reported as "linear index 18446744073709551615" (its uint64 view): a helper's review
-    with pytest.raises(ValueError, match=r"linear indices must lie in \[0, 125\) \(grid.size\); got -1"):
+    with pytest.raises(
+        ValueError, match=r"linear indices must lie in \[0, 125\) \(grid.size\): -1 is outside the grid"
+    ):
         ts.Grid((-1,) * 3, (1,) * 3, (5,) * 3).node_points([-1])

@@ -1,5 +1,5 @@
-"""Creases whose faces meet at a shallow angle, in a φ given as it is (an open question, docs/
-second-order.md, "Creases"): two spheres of radius 0.5 cut by ``max`` (a lens) whose normals turn
+"""Creases whose faces meet at a shallow angle, in a φ given as it is (docs/second-order.md,
+"Shallow creases"): two spheres of radius 0.5 cut by ``max`` (a lens) whose normals turn
 by 40° or 60° at the rim, off the grid's symmetry by a small shift, the source at one cap's apex;
 the error beyond the crease against the exact distance along the meridian, R·(2β − ψ), in grid
 spacings, with what the solve reports (crease nodes, warnings). And regular polygons in 2D

@@ -298,8 +298,8 @@ class Grid:
         lin = np.ascontiguousarray(linear, dtype=np.int64)
         if lin.size and lin.min() < 0:  # (reported as 18446744073709551615 by the core: a helper's review)
             raise ValueError(
-                f"linear indices must lie in [0, {self.size}) (grid.size); got {int(lin.min())}: NumPy's negative "
-                "indexing does not apply here"
+                f"linear indices must lie in [0, {self.size}) (grid.size): {int(lin.min())} is outside the grid "
+                "(NumPy's negative indexing does not apply here)"
             )
         return _native.node_points(
             list(self._shape), lin.view(np.uint64), [float(x) for x in self._lower], self._spacing

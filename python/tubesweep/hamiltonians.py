@@ -609,7 +609,7 @@ class Metric(Hamiltonian):
             )
         if not callable(M):
             try:
-                np.asarray(M, dtype=float)
+                np.asarray(M)  # (complex values are refused where M is read, naming M)
             except (TypeError, ValueError) as err:  # (numpy's "inhomogeneous shape" before: a helper's review)
                 raise ValueError(
                     "M must be a (d, d) matrix, an array of shape grid.shape + (d, d) or a callable; got "

@@ -16,7 +16,9 @@
 //! curvature resolved by the grid turn it by much less) and where φ has a kink: |∇φ| by central
 //! differences off 1 by more than [`GRAD_NORM_TOLERANCE`] (across a kink they average the two
 //! faces' gradients, |∇φ| ≈ cos(θ/2), where a smooth surface that the grid barely resolves, such
-//! as the tip of the spheroid 0.25/0.25/0.5 at N = 41, keeps |∇φ| ≈ 1).
+//! as the tip of the spheroid 0.25/0.25/0.5 at N = 41, keeps |∇φ| ≈ 1); or, for shallower
+//! creases, whose neighbours turn by less, by more than [`SHALLOW_CREASE_ANGLE`] degrees where
+//! φ's central differences are shorter than its one-sided ones ([`kink_ratio`] under [`KINK_RATIO`]).
 //! Closest-point maps are left out (beyond the rim of an open surface the directions turn
 //! around the rim, which is not a crease), and so is a noisy φ (`fitted_everywhere`: its normals
 //! turn by tens of degrees between neighbours where the noise spikes; the sphere with noise of
@@ -39,6 +41,57 @@ use super::GRAD_NORM_TOLERANCE;
 /// creases of the library and the tests (the double torus: 54–56°, two spheres joined by `min`
 /// and the cube: 90°).
 pub const CREASE_ANGLE: f64 = 40.0;
+
+/// A shallower crease is found where the normal turns by more than this many degrees between
+/// neighbours and φ's central differences are shorter than its one-sided ones by [`KINK_RATIO`]
+/// ([`kink_ratio`]): next to a crease the central differences average the two faces' gradients
+/// and neighbours turn by about half the faces' angle, so faces meeting at 60° (a lens of two
+/// spheres cut by `max`) turned by 35°, under [`CREASE_ANGLE`], and went unreported while the
+/// front cut their corner (1.2–1.4Δx early on average at N = 81–121 at second order, 2.2–2.4Δx at
+/// first: a helper's review; `benches/experiments/shallow_creases.py`).
+pub const SHALLOW_CREASE_ANGLE: f64 = 20.0;
+
+/// [`kink_ratio`] below which φ has a kink at a node: cos(θ/2) across a crease whose faces meet
+/// at θ (0.92–0.94 next to the 60° lens and union at N = 61–121, 0.96 at 40°, which stays
+/// unreported), while a smooth φ that the grid resolves reads within a few thousandths of 1 (the
+/// sphere, the torus (0.5, 0.2), the quadric of the ellipsoid (0.8, 0.5, 0.3) from N = 31 on;
+/// coarser grids, where they dip below it, turn their normals by over [`CREASE_ANGLE`] anyway).
+/// Scale-free, unlike the test of |∇φ| against 1, so a φ that is no distance does not read as
+/// kinked everywhere.
+pub const KINK_RATIO: f64 = 0.95;
+
+/// Whether the unit normal `normal` is ∇φ/|∇φ| of the central differences `gradient` (within
+/// 0.5°): the directions of a φ given as it is, not those of its closest points.
+fn central_differences_agree<const D: usize>(gradient: &[f64; D], normal: &[f64; D]) -> bool {
+    let norm = gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
+    norm > 0.0 && (0..D).map(|k| gradient[k] * normal[k]).sum::<f64>() / norm > 0.5f64.to_radians().cos()
+}
+
+/// |∇φ| by central differences at node `i` over the mean of its forward and backward differences'
+/// norms (`phi`: φ per node; None where an axis neighbour is not in the band): 1 for a linear φ,
+/// 1 − O((κΔx)²) for a smooth one, about cos(θ/2) next to a crease whose faces meet at θ.
+pub fn kink_ratio<const D: usize>(
+    band: &NarrowBand<D>,
+    i: usize,
+    spacing: f64,
+    phi: impl Fn(usize) -> f64,
+) -> Option<f64> {
+    let sentinel = band.sentinel();
+    let here = phi(i);
+    let (mut central, mut forward, mut backward) = (0.0f64, 0.0f64, 0.0f64);
+    for pair in band.neighbours_of(i).iter() {
+        if pair[0] == sentinel || pair[1] == sentinel {
+            return None;
+        }
+        let fwd = (phi(pair[1] as usize) - here) / spacing;
+        let bwd = (here - phi(pair[0] as usize)) / spacing;
+        central += 0.25 * (fwd + bwd) * (fwd + bwd);
+        forward += fwd * fwd;
+        backward += bwd * bwd;
+    }
+    let one_sided = 0.5 * (forward.sqrt() + backward.sqrt());
+    (one_sided > 0.0).then(|| central.sqrt() / one_sided)
+}
 
 /// Crease nodes lie within this many grid spacings of the surface (|φ| ≤ 0.75Δx), where a
 /// crease's kink of φ meets the surface: further out, the normals of a smooth surface the grid
@@ -123,6 +176,7 @@ fn crease_nodes_of<const D: usize>(
         n
     };
     let threshold = CREASE_ANGLE.to_radians().cos();
+    let shallow = SHALLOW_CREASE_ANGLE.to_radians().cos();
     let sentinel = band.sentinel();
     let mut found = Vec::new();
     let mut k = 0usize;
@@ -165,7 +219,16 @@ fn crease_nodes_of<const D: usize>(
                     .flatten()
                     .any(|&j| j != sentinel && near_kink(j as usize))
         };
-        if cos_min < threshold && kink() {
+        // (only where the directions are φ's central differences, which blur a crease: directions
+        // from closest points, a re-distanced φ's, turn by the faces' angle between neighbours)
+        let shallow_kink = || {
+            cos_min < shallow
+                && surface
+                    .local(band, i, spacing)
+                    .is_some_and(|l| central_differences_agree(&l.gradient, &normal(i)))
+                && kink_ratio(band, i, spacing, |j| surface.phi(j)).is_some_and(|r| r < KINK_RATIO)
+        };
+        if (cos_min < threshold && kink()) || shallow_kink() {
             // (a node on the surface has no direction: left out of the faces' angle)
             let faces_normal = |j: usize| Some(normal(j)).filter(|n| n.iter().any(|&c| c != 0.0));
             found.push((i, cos_min, widest_turn(band, i, cos_min, faces_normal)));
@@ -329,21 +392,30 @@ pub fn creases_of_level_set<const D: usize>(
         (norm > 0.0).then(|| g.map(|c| c / norm))
     };
     let threshold = CREASE_ANGLE.to_radians().cos();
+    let shallow = SHALLOW_CREASE_ANGLE.to_radians().cos();
     // the smallest cosine at a crease node, per node (2: not one)
     let turn_at = |i: usize| -> f64 {
         if !inner[i] || (phi[i] as f64).abs() > CREASE_REACH * spacing {
             return 2.0;
         }
         let cos_min = smallest_turn(band, i, normal);
-        if cos_min >= threshold {
+        let shallow_kink = || {
+            cos_min < shallow
+                && gradient(i)
+                    .zip(normal(i))
+                    .is_some_and(|(g, n)| central_differences_agree(&g, &n))
+                && kink_ratio(band, i, spacing, |j| phi[j] as f64).is_some_and(|r| r < KINK_RATIO)
+        };
+        if cos_min >= threshold && !shallow_kink() {
             return 2.0;
         }
         // the faces' angle (the bound 2·tan(θ/2) halved with the neighbours' turn), also across
         // the node diagonally, where the central differences blur the faces less
         let widest = widest_turn_diagonally(band, i, widest_turn(band, i, cos_min, normal), normal);
         // a stencil node outside the band counts as a kink, as in creases_of
-        let kink =
-            gradient(i).is_none_or(|g| (g.iter().map(|c| c * c).sum::<f64>().sqrt() - 1.0).abs() > GRAD_NORM_TOLERANCE);
+        let kink = shallow_kink()
+            || gradient(i)
+                .is_none_or(|g| (g.iter().map(|c| c * c).sum::<f64>().sqrt() - 1.0).abs() > GRAD_NORM_TOLERANCE);
         if kink {
             widest
         } else {
