@@ -202,3 +202,21 @@ def test_a_crease_of_phi_given_as_it_is_is_sized_by_its_faces_angle():
     beta = np.linspace(0.05, crease - 3 * H / rho, 40)  # the far part's meridian
     early = sol(np.c_[c - rho * np.cos(beta), rho * np.sin(beta), 0 * beta]) - rho * (2 * crease - beta)
     assert -4.5 * H < np.min(early) < -3 * H and np.mean(early) < -3 * H  # -3.5, -3.3
+
+
+@pytest.mark.parametrize("power", ["cube", "square"])
+def test_a_callable_flat_at_its_zero_set_is_refused_before_projecting(power):
+    # (|x| − 0.5)³ at N = 41 took 36–40 s and 13,659 calls of φ, then was refused for "sharp edges
+    # or corners" (d·|d|: 27 s); now refused at once with the cure (a helper's review)
+    def phi(p):
+        d = np.linalg.norm(p, axis=1) - 0.5
+        return d**3 if power == "cube" else d * np.abs(d)
+
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    with pytest.raises(
+        ValueError, match=r"slope nearly vanishes on its zero level set \(\|∇φ\| there is 0\.\d+ .*np\.cbrt"
+    ):
+        ts.solve(ts.LevelSet(phi, redistance=True), grid, [(-0.5, 0, 0)])
+    # a quadric, no distance but not flat there, is re-distanced as before
+    sol = ts.solve(ts.LevelSet(lambda p: (p**2).sum(axis=1) - 0.25, redistance=True), grid, [(-0.5, 0, 0)])
+    assert sol.stats.order == 2 and abs(sol([(0.5, 0, 0)])[0] - np.pi / 2) < 0.02
