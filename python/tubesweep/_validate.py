@@ -107,19 +107,18 @@ def whole_indices(value: Any, name: str) -> np.ndarray:
     return f.astype(np.int64)
 
 
-def _all_bools(value: Any) -> bool:
-    """Whether ``value`` is a (nested) sequence of Python or NumPy booleans only."""
+def _bool_valued(value: Any) -> bool:
+    """Whether ``value`` (an array, or a nested sequence) holds Python or NumPy booleans only."""
     try:
-        a = np.asarray(value)
+        return np.asarray(value).dtype == bool
     except ValueError:  # ragged: real_array names it
         return False
-    return a.dtype == bool and a.size > 0
 
 
 def as_points(points: Any, ndim: int, name: str) -> np.ndarray:
     """Converts to a float (M, ndim) array; rejects complex values, True/False, NaN/inf and wrong
     shapes."""
-    if isinstance(points, np.ndarray) and points.dtype == bool or _all_bools(points):
+    if _bool_valued(points):
         # (taken as 1.0 and 0.0 before, where Grid refuses bools)
         raise TypeError(f"{name} must hold coordinates (numbers); got True/False values")
     try:
