@@ -1,12 +1,14 @@
 """Why ``order="auto"`` runs first order on Spot and the bunny at n = 200 (docs/point-clouds.md,
 "Meshes"): the same solves with the mesh's gates lifted (``surfaces._mesh_smooth``: the coarse-mesh
-and facing-gap tests), with the fitted map (the default's) and with the exact map everywhere.
-Prints, beside the default's solve (the gates in place), the order, the second-order sweeps'
-runaway iteration, the mean error against MMP relative to the largest distance, and the time (each
-solve once, timed from the surface built from the mesh's arrays: the map's set-up and the solve). About half a minute per mesh on two
-cores.
+and facing-gap tests), with the fitted map (the default's) and with the exact map everywhere,
+beside the default's solve (the gates in place) and, with ``--finer``, the default on a finer grid.
+Prints the order, the second-order sweeps' runaway iteration, the mean error against MMP relative
+to the largest distance, and the time: the median of ``--repeats`` interleaved rounds, each timed
+from the surface built from the mesh's arrays (the map's set-up and the solve), and its ratio to
+the default's median. About two minutes per mesh on two cores (``--finer 400``: five more).
 
     .venv/bin/python benches/experiments/mesh_order2_gates.py --meshes spot,bunny --n 200
+    .venv/bin/python benches/experiments/mesh_order2_gates.py --meshes spot --finer 400
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--meshes", default="spot,bunny")
     ap.add_argument("--n", type=int, default=200)
+    ap.add_argument("--finer", type=int, default=None, help="also the default (gates in place) on this grid")
+    ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args()
     import pygeodesic.geodesic as geodesic
 
@@ -38,6 +42,36 @@ def main() -> None:
         else:
             _mesh_smooth.COARSE, _mesh_smooth.facing_pairs, _mesh_smooth.order2_obstacle = gates
 
+    def run(v: np.ndarray, f: np.ndarray, src: int, mode: str, n: int) -> tuple:
+        """One solve: the mean error's values, the order, the runaway iteration and the time."""
+        lift(mode not in ("default", "finer"))
+        surf = ts.surfaces.from_mesh((v, f))
+        grid = surf.grid(n)
+        t = time.perf_counter()
+        if mode in ("auto", "exact"):
+            native = surf.smooth_map
+
+            class Forced:
+                def closest(self, x, h, max_distance=np.inf, _mode="auto"):  # type: ignore[no-untyped-def]
+                    return native.closest(x, h, max_distance, mode)
+
+            surf._h = grid.spacing
+            surf._smooth_map = (_mesh_smooth.SAMPLE_SPACING * grid.spacing, Forced())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the narrow gaps, as in benches/mesh_order2.py
+            sol = ts.solve(surf, grid, [v[src]])
+        seconds = time.perf_counter() - t
+        lift(False)
+        return sol.on_mesh(v), sol.stats.order, (sol.stats.order2 or {}).get("runaway_iteration"), seconds
+
+    modes = [("default", args.n), ("auto", args.n), ("exact", args.n)]
+    if args.finer:
+        modes.append(("finer", args.finer))
+    label = {
+        "default": "default (gates in place)",
+        "auto": "gates lifted, map=fitted",
+        "exact": "gates lifted, map=exact",
+    }
     for name in args.meshes.split(","):
         base = ts.surfaces.from_mesh(ts.data.path(name), smooth=False)
         used = np.unique(base.faces)
@@ -47,40 +81,22 @@ def main() -> None:
         src = int(np.argmax(((v - v.mean(0)) ** 2).sum(1)))
         alg = geodesic.PyGeodesicAlgorithmExact(v, f.astype(np.int32))
         exact, _ = alg.geodesicDistances(np.array([src], np.int32), None)
-        for mode in ("default", "auto", "exact"):
-            lift(mode != "default")
-            surf = ts.surfaces.from_mesh((v, f))
-            grid = surf.grid(args.n)
-            if mode == "default":
-                t = time.perf_counter()
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")  # the narrow gaps, as in benches/mesh_order2.py
-                    sol = ts.solve(surf, grid, [v[src]])
-                seconds = time.perf_counter() - t
-                err = np.abs(sol.on_mesh(v) - exact) / np.max(exact)
-                print(
-                    f"{name} n={args.n} default (gates in place): order {sol.stats.order}, mean error "
-                    f"{100 * err.mean():.3f} %, {seconds:.1f} s"
-                )
-                continue
-            t = time.perf_counter()
-            native = surf.smooth_map
-
-            class Forced:
-                def closest(self, x, h, max_distance=np.inf, _mode="auto"):  # type: ignore[no-untyped-def]
-                    return native.closest(x, h, max_distance, mode)
-
-            surf._h = grid.spacing
-            surf._smooth_map = (_mesh_smooth.SAMPLE_SPACING * grid.spacing, Forced())
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                sol = ts.solve(surf, grid, [v[src]])
-            seconds = time.perf_counter() - t
-            err = np.abs(sol.on_mesh(v) - exact) / np.max(exact)
-            o2 = sol.stats.order2 or {}
+        results: dict = {}
+        times: dict = {m: [] for m, _ in modes}
+        for _ in range(args.repeats):  # interleaved rounds
+            for mode, n in modes:
+                values, order, runaway, seconds = run(v, f, src, mode, n)
+                results[mode] = (values, order, runaway)
+                times[mode].append(seconds)
+        base_time = float(np.median(times["default"]))
+        for mode, n in modes:
+            values, order, runaway = results[mode]
+            err = np.abs(values - exact) / np.max(exact)
+            median = float(np.median(times[mode]))
             print(
-                f"{name} n={args.n} gates lifted, map={'fitted' if mode == 'auto' else 'exact'}: order {sol.stats.order}, runaway at "
-                f"{o2.get('runaway_iteration')}, mean error {100 * err.mean():.3f} %, {seconds:.1f} s"
+                f"{name} n={n} {label.get(mode, 'default (gates in place)')}: order {order}, runaway at {runaway}, "
+                f"mean error {100 * err.mean():.3f} %, {median:.1f} s (median of {args.repeats}), "
+                f"{median / base_time:.2f}x the default at n={args.n}"
             )
 
 
