@@ -36,7 +36,7 @@ BEND = 0.75
 #: a noisy sphere's bumps, 0.3 spacings of noise, re-distanced, showed 5% alone).
 SHEET = 2
 #: Band nodes per block of the neighbour lookups (bounds the memory).
-CHUNK = 1 << 18
+CHUNK = 1 << 16
 #: A node this many spacings from the surface or nearer lies on it (a face on the grid's nodes).
 ON_SURFACE = 1e-9
 
@@ -48,15 +48,23 @@ def thin_share(grid: Grid, band: Any, linear: np.ndarray, phi: np.ndarray) -> Tu
     counts once as outside and once as inside: a plate two spacings thick whose faces lie on the
     grid's planes is one inside node between two nodes on its faces, and one a spacing thick there
     is two nodes on its faces (re-distanced at N = 61: 25 and 24 spacings short across the plate,
-    unwarned; in 2D 48; a helper's review). O(band)."""
+    unwarned; in 2D 48; a helper's review). O(band): the neighbours of the inside nodes are looked
+    up once, for the three readings of the nodes on the surface together (looked up per reading
+    and per axis, the test took longer than the sweeps of the sphere at N = 121)."""
     n = len(linear)
     h = grid.spacing
     phi = np.asarray(phi, dtype=float)
     near = np.abs(phi) <= 0.5 * math.sqrt(grid.ndim) * h
     zero = np.abs(phi) <= ON_SURFACE * h
-    thin = _slab_nodes(band, grid.ndim, h, phi, phi > 0, ~zero & (phi < 0))
-    thin |= _slab_nodes(band, grid.ndim, h, phi, (phi > 0) | zero, phi < 0)
-    thin |= _slab_nodes(band, grid.ndim, h, phi, ~zero & (phi > 0), (phi < 0) | zero)
+    neg, pos = phi < 0, phi > 0
+    thin = np.zeros(n, bool)
+    for s in range(0, n, CHUNK):
+        at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
+        at = at[neg[at] | zero[at]]  # (inside in one of the readings)
+        if at.size:
+            thin[at] = _slab_nodes(
+                band, grid.ndim, h, phi, at, ((pos, ~zero & neg), (pos | zero, neg), (~zero & pos, neg | zero))
+            )
     # a plate's thin nodes lie in a sheet; a bump of noise or a mask's corner is one or two alone
     at = np.flatnonzero(thin)
     if at.size:
@@ -77,36 +85,54 @@ def thin_share(grid: Grid, band: Any, linear: np.ndarray, phi: np.ndarray) -> Tu
     return float(np.count_nonzero(hits)) / total, grid.node_points(linear[np.flatnonzero(hits)[:1]])[0]
 
 
-def _slab_nodes(band: Any, ndim: int, h: float, phi: np.ndarray, out: np.ndarray, inside: np.ndarray) -> np.ndarray:
-    """The ``inside`` band nodes on a run of one or two of them along an axis between ``out``
-    nodes, with φ rising by more than :data:`BEND` spacings over the run (module notes)."""
+def _slab_nodes(band: Any, ndim: int, h: float, phi: np.ndarray, at: np.ndarray, readings: Any) -> np.ndarray:
+    """Which of the band nodes ``at`` are, in one of the ``readings`` (pairs of masks: outside,
+    inside), an inside node on a run of one or two of them along an axis between outside nodes,
+    with φ rising by more than :data:`BEND` spacings over the run (module notes)."""
     n = len(phi)
-    outside = np.r_[out, False]  # (position n: no neighbour)
-    value = np.r_[phi, 0.0]
-    thin = np.zeros(n, bool)
-    for s in range(0, n, CHUNK):
-        at = np.arange(s, min(s + CHUNK, n), dtype=np.int64)
-        at = at[inside[at]]
-        if at.size == 0:
-            continue
-        nb = band.neighbours_of_nodes(at).reshape(len(at), ndim, 2)
-        nb = np.where(nb < n, nb, n)
-        here = phi[at]
-        for k in range(ndim):
-            lo, hi = nb[:, k, 0], nb[:, k, 1]
-            # the next ones along the axis, where the neighbour is in the band
-            lo2 = band.neighbours_of_nodes(np.where(lo < n, lo, 0)).reshape(len(at), ndim, 2)[:, k, 0]
-            hi2 = band.neighbours_of_nodes(np.where(hi < n, hi, 0)).reshape(len(at), ndim, 2)[:, k, 1]
-            lo2 = np.where((lo < n) & (lo2 < n), lo2, n)
-            hi2 = np.where((hi < n) & (hi2 < n), hi2, n)
-            one = outside[lo] & outside[hi] & (value[lo] + value[hi] - 2 * here > BEND * h)
+    value = np.r_[phi, 0.0]  # (position n: no neighbour)
+    nb = band.neighbours_of_nodes(at).reshape(len(at), ndim, 2)
+    nb = np.where(nb < n, nb, n)
+    # outside in some reading (and position n: no neighbour, never outside)
+    maybe_out = np.r_[np.logical_or.reduce([out for out, _ in readings]), False]
+    # a thin node has an outside neighbour: the others (most of the inside) are not
+    full = np.zeros(len(at), bool)
+    keep = np.flatnonzero(np.any(maybe_out[nb.reshape(len(at), -1)], axis=1))
+    at, nb = at[keep], nb[keep]
+    # the next node along the axis beyond a neighbour, looked up only where a run of two can
+    # start: its other neighbour may be outside (one lookup for all axes)
+    rows, ends, sides = [], [], []
+    for k in range(ndim):
+        for j in (0, 1):
+            r = np.flatnonzero(maybe_out[nb[:, k, 1 - j]] & (nb[:, k, j] < n))
+            rows.append(r)
+            ends.append(nb[r, k, j])
+            sides.append(np.full(r.size, 2 * k + j))
+    ends_all = np.concatenate(ends)
+    beyond = band.neighbours_of_nodes(ends_all).reshape(len(ends_all), 2 * ndim)
+    second = np.full((2 * ndim, len(at)), n, dtype=np.int64)
+    start = 0
+    for r, side in zip(rows, range(2 * ndim)):
+        b = beyond[start : start + r.size, side]
+        second[side, r] = np.where(b < n, b, n)
+        start += r.size
+    here = phi[at]
+    thin = np.zeros(len(at), bool)
+    for k in range(ndim):
+        lo, hi = nb[:, k, 0], nb[:, k, 1]
+        lo2, hi2 = second[2 * k], second[2 * k + 1]
+        one_rise = value[lo] + value[hi] - 2 * here > BEND * h
+        up_rise = value[lo] + value[hi2] - here - value[hi] > BEND * h
+        down_rise = value[hi] + value[lo2] - here - value[lo] > BEND * h
+        for out, inside in readings:
+            outside = np.r_[out, False]
+            one = outside[lo] & outside[hi] & one_rise
             # a run of two inside nodes: this one and the one above (or below) it
-            up = (hi < n) & ~outside[hi] & outside[lo] & outside[hi2]
-            up &= value[lo] + value[hi2] - here - value[hi] > BEND * h
-            down = (lo < n) & ~outside[lo] & outside[hi] & outside[lo2]
-            down &= value[hi] + value[lo2] - here - value[lo] > BEND * h
-            thin[at] |= one | up | down
-    return thin
+            up = (hi < n) & ~outside[hi] & outside[lo] & outside[hi2] & up_rise
+            down = (lo < n) & ~outside[lo] & outside[hi] & outside[lo2] & down_rise
+            thin |= inside[at] & (one | up | down)
+    full[keep] = thin
+    return full
 
 
 def warn_thin(share: float, where: Optional[np.ndarray], h: float, inner: float) -> None:
