@@ -220,3 +220,20 @@ def test_a_callable_flat_at_its_zero_set_is_refused_before_projecting(power):
     # a quadric, no distance but not flat there, is re-distanced as before
     sol = ts.solve(ts.LevelSet(lambda p: (p**2).sum(axis=1) - 0.25, redistance=True), grid, [(-0.5, 0, 0)])
     assert sol.stats.order == 2 and abs(sol([(0.5, 0, 0)])[0] - np.pi / 2) < 0.02
+
+
+def test_a_callable_that_flattens_away_from_its_zero_set_is_re_distanced_exactly():
+    # 0.05·tanh(d/0.05): |∇φ| = 1 on the sphere but 1e-3 two spacings off, where full Newton steps
+    # leapt across the sphere (to the antipode, or back and forth along an axis, "settling" at the
+    # node itself): refused after 30–40 s for sharp edges (a review). The steps are now damped.
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (31,) * 3)
+
+    def flattened(p):
+        return 0.05 * np.tanh((np.linalg.norm(p, axis=1) - 0.5) / 0.05)
+
+    sol = ts.solve(ts.LevelSet(flattened, redistance=True), grid, [(-0.5, 0, 0)])
+    exact = ts.solve(ts.LevelSet(lambda p: np.linalg.norm(p, axis=1) - 0.5, redistance=True), grid, [(-0.5, 0, 0)])
+    assert sol.stats.order == 2 and sol.stats.converged
+    np.testing.assert_array_equal(sol.indices, exact.indices)
+    # the same band distances to 1e-13 Δx; the values to the stopping tolerance (5e-4 Δx² = 2.2e-6)
+    assert np.max(np.abs(sol.values - exact.values)) < 5e-7

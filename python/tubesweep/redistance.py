@@ -75,9 +75,14 @@ def project_to_level_set(
     orthogonality_steps: int = ORTHOGONALITY_STEPS,
     tol: float = SETTLED,
     box: Optional[Tuple[np.ndarray, np.ndarray]] = None,
+    max_step: Optional[float] = None,
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closest points of ``x`` (M, d) on ``{φ = 0}`` by Newton projection and orthogonality
     iterations (see the module docstring).
+
+    Without ``box`` (a callable φ) the Newton steps are damped (:func:`_damped`), each first cut
+    to ``max_step`` when given (the band's: twice its half-width, farther than any of its nodes'
+    closest points).
 
     ``box`` (lower, upper corners): where φ is known, for a φ sampled on a grid; the Newton steps
     then keep the points in it (clamped before the first step and after each), as the Rust
@@ -99,11 +104,23 @@ def project_to_level_set(
     def newton(y: np.ndarray, steps: int) -> Tuple[np.ndarray, np.ndarray]:
         good = np.ones(len(y), bool)
         y = into_box(y)
+        if box is not None:  # a sampled φ: the steps stay in the box (and match the Rust bits)
+            for _ in range(steps):
+                g = _gradient(phi, y, eps)
+                n2 = np.sum(g * g, axis=1)
+                good &= n2 > 1e-24
+                y = into_box(y - np.where(good, phi(y) / np.where(good, n2, 1.0), 0.0)[:, None] * g)
+            return y, good
+        f = phi(y)
         for _ in range(steps):
             g = _gradient(phi, y, eps)
             n2 = np.sum(g * g, axis=1)
             good &= n2 > 1e-24
-            y = into_box(y - np.where(good, phi(y) / np.where(good, n2, 1.0), 0.0)[:, None] * g)
+            step = np.where(good, f / np.where(good, n2, 1.0), 0.0)[:, None] * g
+            if max_step is not None:
+                length = np.linalg.norm(step, axis=1)
+                step *= np.minimum(1.0, max_step / np.maximum(length, 1e-300))[:, None]
+            y, f = _damped(phi, y, f, step, eps)
         return y, good
 
     y, good = newton(y, newton_steps)
@@ -131,9 +148,45 @@ def project_to_level_set(
 #: Finite-difference step for ∇φ of a sampled φ, in grid spacings.
 SAMPLED_GRADIENT_STEP = 0.5
 
+#: The most halvings of a Newton step of a callable φ that does not decrease |φ| (:func:`_damped`).
+NEWTON_HALVINGS = 40
+
+
+def _damped(
+    phi: Callable[[np.ndarray], np.ndarray], y: np.ndarray, f: np.ndarray, step: np.ndarray, eps: float
+) -> Tuple[np.ndarray, np.ndarray]:
+    """``y − t·step`` and φ there (``step`` is changed), a damped Newton step: t = 1, halved (at
+    most :data:`NEWTON_HALVINGS` times, else the point stays) where the step is longer than the
+    gradient's step ``eps`` and |φ| does not fall by the Armijo fraction, ``|φ(y − t·step)| ≤
+    (1 − 10⁻⁴ t)|φ(y)|``. A callable φ that flattens away from its zero level set
+    (0.05·tanh(d/0.05)) has |∇φ| ≈ 0 a few spacings off, where a full step φ/|∇φ| leaps far
+    across the surface, and a capped one can swing between two points of equal |φ|: the
+    projection never settled, or settled on the node itself (distance 0), and the band was
+    refused for sharp edges (a review). Near the surface Newton's steps decrease |φ| at once and
+    are taken whole."""
+    new = y - step
+    fn = phi(new)
+    t = np.ones(len(y))
+
+    def short(i: np.ndarray) -> np.ndarray:
+        with np.errstate(invalid="ignore"):
+            return (~(np.abs(fn[i]) <= (1.0 - 1e-4 * t[i]) * np.abs(f[i]))) & (np.linalg.norm(step[i], axis=1) > eps)
+
+    worse = np.flatnonzero(short(np.arange(len(y))))
+    for _ in range(NEWTON_HALVINGS):
+        if worse.size == 0:
+            break
+        step[worse] *= 0.5
+        t[worse] *= 0.5
+        new[worse] = y[worse] - step[worse]
+        fn[worse] = phi(new[worse])
+        worse = worse[short(worse)]
+    new[worse], fn[worse] = y[worse], f[worse]
+    return new, fn
+
 
 def _project(
-    surface, grid, x: np.ndarray, orthogonality_steps: int = ORTHOGONALITY_STEPS
+    surface, grid, x: np.ndarray, orthogonality_steps: int = ORTHOGONALITY_STEPS, max_step: Optional[float] = None
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`project_to_level_set` of the points ``x`` (M, d) for the surface's φ: in Rust for a
     sampled φ (the same iterations and bits), in NumPy for a callable."""
@@ -154,6 +207,7 @@ def _project(
         GRADIENT_STEP * grid.spacing,
         orthogonality_steps=orthogonality_steps,
         tol=CALLABLE_SETTLED,
+        max_step=max_step,
     )
 
 
@@ -306,13 +360,14 @@ def redistanced_band(surface, grid, half_width: float):
         return BandGeometry(cand, np.zeros(0), np.zeros(0), np.zeros((0, d), np.float32))
     _refuse_flat_callable(surface, grid, cand)
     x = grid.node_points(cand)
-    cp, signed, ok = _project(surface, grid, x)
+    reach = 2.0 * half_width  # (no closest point of a band node is farther: longer Newton steps leap across)
+    cp, signed, ok = _project(surface, grid, x, max_step=reach)
     # candidates that did not settle but lie near the band (their last iterate on the zero level
     # set within 1.5 half-widths): projected again with more steps (ORTHOGONALITY_RETRY_STEPS)
     unsettled = np.flatnonzero(~ok)
     retry = unsettled[_on_zero_set_within(surface, grid, x[unsettled], cp[unsettled], 1.5 * half_width)]
     if retry.size:
-        cp[retry], signed[retry], ok[retry] = _project(surface, grid, x[retry], ORTHOGONALITY_RETRY_STEPS)
+        cp[retry], signed[retry], ok[retry] = _project(surface, grid, x[retry], ORTHOGONALITY_RETRY_STEPS, reach)
     _warn_if_band_nodes_unprojected(surface, grid, x, cp, ok, half_width)
     keep = ok & (np.abs(signed) <= half_width * (1 + 1e-9))  # ties on the band edge: rounding
     lin, x, cp, signed = cand[keep], x[keep], cp[keep], signed[keep]
