@@ -163,7 +163,7 @@ def _gradient(
         shifted[2 * k, :, k] += h
         shifted[2 * k + 1] = x
         shifted[2 * k + 1, :, k] -= h
-    u = sol(shifted.reshape(-1, d)).reshape(2 * d, m)
+    u = sol._at(shifted.reshape(-1, d)).reshape(2 * d, m)
     g = np.empty((m, d))
     clean = None
     if cells is not None and target is not None:
@@ -264,7 +264,7 @@ def trace_paths(
             f"{beyond_inner_tube(f'starts[{i}]', p[i], dist[i])} ({sol.inner:g} grid spacings = {sol.inner * h:.4g}); "
             "start the path on the surface"
         )
-    u = sol(x)
+    u = sol._at(x)
     for i in np.flatnonzero(~np.isfinite(u)):  # type: ignore[assignment]
         raise ValueError(
             f"starts[{int(i)}] = {tuple(float(v) for v in p[i])} "
@@ -308,7 +308,7 @@ def trace_paths(
             break
         g, gn = g[~bad], gn[~bad]
         nxt = _onto_surface(sol, cur[active] - (s / gn)[:, None] * g)
-        un = sol(nxt)
+        un = sol._at(nxt)
         lost = ~np.isfinite(un)
         stalled.extend(int(i) for i in active[lost])
         keep = ~lost

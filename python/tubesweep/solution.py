@@ -253,7 +253,10 @@ class Solution:
         Returns
         -------
         numpy.ndarray
-            ``(M,)`` values; NaN where the cell's corners leave the band.
+            ``(M,)`` values; NaN where the cell's corners leave the band (points farther from the
+            surface than about the tube's outer width less a cell, or outside the grid), with a
+            ``RuntimeWarning`` that counts them; +∞ where a corner was not reached (a part of the
+            surface no source reaches).
 
         Raises
         ------
@@ -271,6 +274,25 @@ class Solution:
         >>> u = sol([(0.0, 0.5, 0.0), (0.5, 0.0, 0.0)])  # exact π/4 and π/2
         >>> v = sol([(0.0, 0.5, 0.0)], interpolation="cubic")
         """
+        out = self._at(points, interpolation)
+        off = np.isnan(out)
+        if np.any(off):
+            i = int(np.flatnonzero(off)[0])
+            q = np.atleast_2d(np.asarray(points, dtype=float))[i]
+            warnings.warn(
+                f"sol(points): {int(np.count_nonzero(off))} of {len(out)} points lie where the band does not reach "
+                f"(the first, points[{i}] = {tuple(round(float(c), 6) for c in q)}): NaN there. The band holds the "
+                f"solution within {self.outer:g} grid spacings of the surface; read points on or near it "
+                "(surface.project(points, grid) gives their closest points), or sol.on_mesh(points) for a mesh's "
+                "vertices",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )
+        return out
+
+    def _at(self, points: Any, interpolation: str = "linear") -> np.ndarray:
+        """:meth:`__call__` without its warning about the points off the band (for the readers
+        that handle NaN themselves: :meth:`on_mesh`, geodesic paths, the export of a cloud)."""
         p = as_points(points, self.grid.ndim, "points")
         if self._factoring is not None:  # the factored form near a source projects onto the surface
             self._check_surface_unchanged()
@@ -325,7 +347,7 @@ class Solution:
         >>> u = sol.on_mesh(spot.vertices)  # doctest: +SKIP
         """
         p = as_points(vertices, self.grid.ndim, "vertices")
-        out = self(p)
+        out = self._at(p)
         bad = np.flatnonzero(~np.isfinite(out))
         if bad.size:
             pos = self._nearest_reached(p[bad])
