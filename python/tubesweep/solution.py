@@ -282,9 +282,10 @@ class Solution:
             warnings.warn(
                 f"sol(points): {int(np.count_nonzero(off))} of {len(out)} points lie where the band does not reach "
                 f"(the first, points[{i}] = {tuple(round(float(c), 6) for c in q)}): NaN there. The band holds the "
-                f"solution within {self.outer:g} grid spacings of the surface; read points on or near it "
-                "(surface.project(points, grid) gives their closest points), or sol.on_mesh(points) for a mesh's "
-                "vertices",
+                f"solution within {self.outer:g} grid spacings of the surface and a point reads the corners of its "
+                f"cell, so points within about {max(self.outer - 1.0, 0.5):g} spacings read values; read points on or "
+                "near the surface (surface.project(points, grid) gives their closest points), or sol.on_mesh(points), "
+                "which reads the nearest node's value a little farther out",
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
