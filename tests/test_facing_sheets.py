@@ -354,3 +354,31 @@ def test_plates_and_slots_about_a_spacing_across_are_said_where_the_front_crosse
     # the first-order scheme's own error is warned of as ever (the box's edges: order=1)
     others = [str(w.message) for w in caught if w not in said]
     assert all("first-order" in m or "order=1" in m for m in others), others
+
+
+def test_a_thin_part_is_said_whichever_way_its_faces_are_wound():
+    # a plate 0.016 thick with its bottom wound like its top: the thin-part test looked for faces
+    # whose normal is opposite to their own and found none (no warning, the bottom's centre 98%
+    # short); the normals are now oriented across the mesh's edges first (a review)
+    import trimesh
+    from tubesweep.surfaces._mesh_checks import oriented_normals
+
+    box = trimesh.creation.box(extents=(1, 1, 0.016))
+    for _ in range(4):
+        box = box.subdivide()
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
+    turned = f.copy()
+    bottom = box.triangles_center[:, 2] < 0
+    turned[bottom] = turned[bottom][:, ::-1]
+    consistent, mixed = ts.surfaces.from_mesh((v, f)), ts.surfaces.from_mesh((v, turned))
+    assert not mixed.closed and mixed._flipped_edges > 0
+    # oriented as the consistent mesh is (most faces keep the winding given)
+    np.testing.assert_array_equal(oriented_normals(mixed), consistent.face_normals)
+    grid = mixed.grid(61)
+    for mesh in (consistent, mixed):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sol = ts.solve(mesh, grid, [(0.0, 0.0, 0.008)])
+        said = [str(w.message) for w in caught]
+        assert any("about 97% of the mesh's area lies within about a grid spacing" in m for m in said), said
+        assert sol([(0.0, 0.0, -0.008)])[0] < 0.1  # (what it warns of: exact about 1.016)

@@ -417,3 +417,25 @@ def test_a_mesh_too_small_for_its_squares_is_told_to_rescale():
     with pytest.raises(ValueError, match=r"degenerate \(zero area\): the mesh spans only 1e-200.*normalize=True"):
         ts.surfaces.from_mesh((v * 1e-200, f))
     assert ts.surfaces.from_mesh((v * 1e-200, f), normalize=True).vertices.max() > 0.1
+
+
+def test_a_trimesh_object_is_taken_and_transposed_or_one_based_faces_are_named(tmp_path):
+    import trimesh
+
+    v, f = icosphere(2)
+    mesh = trimesh.Trimesh(v, f, process=False)
+    taken = from_mesh(mesh)
+    np.testing.assert_array_equal(taken.vertices, v)
+    np.testing.assert_array_equal(taken.faces, f)
+    with pytest.raises(ValueError, match=r"got \(3, 320\) \(the triangles as columns: pass faces.T\)"):
+        from_mesh((v, f.T))
+    with pytest.raises(
+        ValueError, match=r"contain 1\.\.162 \(numbered from 1, as OBJ files write them\? pass faces - 1\)"
+    ):
+        from_mesh((v, f + 1))
+    with pytest.raises(TypeError, match="or a mesh object with .vertices and .faces .trimesh.; got int"):
+        from_mesh(3)
+    # a cloud saved with its points as columns
+    np.save(tmp_path / "columns.npy", v.T)
+    with pytest.raises(ValueError, match=r"shape \(3, 162\).*the points as columns.*np.save\(path, points.T\)"):
+        ts.surfaces.from_points(tmp_path / "columns.npy")

@@ -80,6 +80,11 @@ def read_points(path: Union[str, Path]) -> np.ndarray:
         )
     if data.shape[0] == 0:
         raise ValueError(f"{path.name!r} holds no points")
+    if ext == ".npy" and data.shape[0] in (2, 3) and data.shape[1] > 3:
+        raise ValueError(
+            f"{path.name!r} holds an array of shape {data.shape}: {data.shape[0]} rows of {data.shape[1]} numbers, the "
+            "points as columns; points are rows (one x, y, z a row): np.save(path, points.T)"
+        )
     return np.ascontiguousarray(data[:, : min(3, data.shape[1])], dtype=float)
 
 

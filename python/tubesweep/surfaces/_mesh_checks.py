@@ -75,17 +75,58 @@ def thin_parts(mesh: Any, h: float) -> Tuple[float, Optional[np.ndarray]]:
     v, f = mesh.vertices, mesh.faces[good]
     a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    centre, normal = (a + b + c) / 3.0, mesh.face_normals[good]
+    # faces wound against their neighbours face the other way here: a plate whose bottom was wound
+    # like its top had "no part facing it", unwarned, 98% short across it (a review)
+    normals = mesh.face_normals if not getattr(mesh, "_flipped_edges", 0) else oriented_normals(mesh)
+    centre, normal = (a + b + c) / 3.0, normals[good]
     thin = np.zeros(len(good), bool)
     for side, reach in ((1.0, THIN_REACH), (-1.0, GAP_REACH)):
         q = 0.5 * reach * h
         d, _, face, _ = mesh.closest(centre - side * q * normal, max_distance=q)
         found = face >= 0
-        opposite = np.einsum("ij,ij->i", mesh.face_normals[np.maximum(face, 0)], normal) < -0.5
+        opposite = np.einsum("ij,ij->i", normals[np.maximum(face, 0)], normal) < -0.5
         thin |= found & (d <= q) & opposite
     total = float(area.sum())
     share = float(area[thin].sum()) / total if total > 0 else 0.0
     return share, (centre[np.argmax(thin)] if np.any(thin) else None)
+
+
+def oriented_normals(mesh: Any) -> np.ndarray:
+    """The mesh's face normals, each turned so that faces sharing an edge (shared by exactly two)
+    run it in opposite directions, as consistently wound faces do; in each connected piece the
+    orientation most of its faces were given is kept (a piece that cannot be oriented, a Möbius
+    band, keeps an arbitrary one). The sign of each face is read from the connected components of
+    the graph with two nodes per face (as given, turned): an edge whose faces run it alike joins
+    each face as given to the other turned. O(faces)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = mesh.faces
+    n = len(f)
+    # each face's directed edges a→b, b→c, c→a, keyed by their undirected edge
+    heads = np.concatenate([f[:, 0], f[:, 1], f[:, 2]])
+    tails = np.concatenate([f[:, 1], f[:, 2], f[:, 0]])
+    face = np.tile(np.arange(n), 3)
+    forward = heads < tails
+    key = np.minimum(heads, tails) * (int(f.max()) + 1) + np.maximum(heads, tails)
+    order = np.argsort(key, kind="stable")
+    key, face, forward = key[order], face[order], forward[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    counts = np.diff(np.r_[starts, len(key)])
+    pair = starts[counts == 2]  # edges of exactly two faces (the others join nothing)
+    i, j = face[pair], face[pair + 1]
+    alike = forward[pair] == forward[pair + 1]  # run the same way: one of the two is turned
+    rows = np.r_[i, i + n]
+    cols = np.r_[np.where(alike, j + n, j), np.where(alike, j, j + n)]
+    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(2 * n, 2 * n))
+    _, label = connected_components(graph, directed=False)
+    keep, turn = label[:n], label[n:]
+    sign = np.where(keep <= turn, 1.0, -1.0)
+    # per piece, the orientation most of its faces were given (by area-free count)
+    piece = np.minimum(keep, turn)
+    given = np.bincount(piece, weights=sign, minlength=2 * n)
+    sign *= np.where(given[piece] < 0, -1.0, 1.0)
+    return mesh.face_normals * sign[:, None]
 
 
 def warn_thin_parts(share: float, where: Optional[np.ndarray], h: float, inner: float) -> None:

@@ -142,12 +142,26 @@ class MeshSurface(Surface):
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices must have shape (n, 3); got {v.shape} ({v.ndim} dimensions)")
         if f.ndim != 2 or f.shape[1] != 3:
-            raise ValueError(f"faces must be triangles, shape (m, 3); got {f.shape} (triangulate polygons first)")
+            raise ValueError(
+                f"faces must be triangles, shape (m, 3); got {f.shape} "
+                + (
+                    "(the triangles as columns: pass faces.T)"
+                    if f.ndim == 2 and f.shape[0] == 3 and f.shape[1] != 3
+                    else "(triangulate polygons first)"
+                )
+            )
         v, f = np.ascontiguousarray(v), np.ascontiguousarray(f)
         if f.size == 0:
             raise ValueError("the mesh has no faces")
         if f.min() < 0 or f.max() >= len(v):
-            raise ValueError(f"faces index vertices 0..{len(v) - 1} but contain {int(f.min())}..{int(f.max())}")
+            raise ValueError(
+                f"faces index vertices 0..{len(v) - 1} but contain {int(f.min())}..{int(f.max())}"
+                + (
+                    " (numbered from 1, as OBJ files write them? pass faces - 1)"
+                    if f.min() == 1 and f.max() == len(v)
+                    else ""
+                )
+            )
         finite = np.all(np.isfinite(v), axis=1)
         if not np.all(finite):
             bad = np.flatnonzero(~finite)
@@ -225,6 +239,7 @@ class MeshSurface(Surface):
             if np.all(counts_good[counts_good > 0] == 2) and flipped_good == 0:
                 counts, flipped = counts_good, flipped_good
         directed_unique = flipped == 0
+        self._flipped_edges = int(flipped)  # (thin_parts orients the normals where this is not 0)
         self.closed = bool(np.all(counts[counts > 0] == 2) and directed_unique)
         self.boundary_edges = int(np.count_nonzero(counts == 1))
         if self.boundary_edges:
@@ -683,9 +698,10 @@ def from_mesh(
 
     Parameters
     ----------
-    mesh : str, pathlib.Path or (vertices, faces)
-        An OBJ / PLY / STL / OFF file (or ``.obj.gz``, e.g. :func:`tubesweep.data.bunny`), or a
-        pair of arrays ``(vertices (n, 3), faces (m, 3))``.
+    mesh : str, pathlib.Path, (vertices, faces) or a mesh object
+        An OBJ / PLY / STL / OFF file (or ``.obj.gz``, e.g. :func:`tubesweep.data.bunny`), a
+        pair of arrays ``(vertices (n, 3), faces (m, 3))``, or an object with ``.vertices`` and
+        ``.faces`` (a ``trimesh.Trimesh``).
     normalize : bool
         Move the centre of the bounding box to ``center`` and scale the longest side to ``size``.
         The applied map is kept as ``surface.offset`` / ``surface.scale``.
@@ -745,10 +761,15 @@ def from_mesh(
                 f"mesh must be a file path or a pair (vertices, faces); got a dict with keys {sorted(map(str, mesh))}: "
                 "pass (mesh['vertices'], mesh['faces'])"
             )
+        if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):  # a trimesh.Trimesh (or alike)
+            mesh = (np.asarray(mesh.vertices), np.asarray(mesh.faces))
         try:
             v, f = mesh
         except (TypeError, ValueError):
-            raise TypeError("mesh must be a file path or a pair (vertices, faces)") from None
+            raise TypeError(
+                "mesh must be a file path, a pair (vertices, faces) or a mesh object with .vertices and .faces "
+                f"(trimesh); got {type(mesh).__name__}"
+            ) from None
         v = real_array(v, "vertices")
         f = whole_indices(f, "faces")
         name = "mesh"
