@@ -762,7 +762,7 @@ def from_mesh(
                 "pass (mesh['vertices'], mesh['faces'])"
             )
         if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):  # a trimesh.Trimesh (or alike)
-            mesh = (np.asarray(mesh.vertices), np.asarray(mesh.faces))
+            mesh = (np.asarray(getattr(mesh, "vertices")), np.asarray(getattr(mesh, "faces")))
         try:
             v, f = mesh
         except (TypeError, ValueError):
