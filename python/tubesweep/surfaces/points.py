@@ -38,7 +38,7 @@ from .._linalg import row_norms
 from ..grid import Grid
 from ..band import BandGeometry, coarse_to_fine_candidates
 from .._warn import user_stacklevel
-from ._cloud_analysis import analyse, analyse_own, lines_advice, widen
+from ._cloud_analysis import CURVE_NEIGHBOURS, CURVE_SPREAD, analyse, analyse_own, curve_spread, lines_advice, widen
 from ._cloud_holes import bridged_holes, pairs_over_holes, warn_close_ends
 from ._cloud_files import read_points
 from ._cloud_input import checked_points
@@ -251,6 +251,15 @@ class PointCloudSurface(CloudAdvice, ClosestPoint):
         self.name = name
         self.neighbours = int(neighbours)
         a = analyse_own(p, self.neighbours)
+        if d == 3:
+            spread = curve_spread(a.cloud, p, self.neighbours)
+            if spread < CURVE_SPREAD:
+                raise ValueError(
+                    f"the points lie along a curve, not on a surface: around each sample, its "
+                    f"{CURVE_NEIGHBOURS * self.neighbours} nearest spread across by {np.sqrt(spread):.2g} of their "
+                    "spread along (the median). A cloud in 3D must sample a surface; a plane curve is given as (M, 2) "
+                    "points (tubesweep has no geodesics along a space curve: they are its arclength)"
+                )
         for _ in range(8):  # chains of near repeats: each round keeps one of each nearest pair
             near = a.spacing < NEAR_REPEAT * np.median(a.radius)
             if not near.any():
