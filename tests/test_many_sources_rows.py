@@ -127,3 +127,36 @@ def test_values_at_points_near_a_source_on_a_phi_array_are_sol_at():
     sol = single(tube, src[0])
     assert np.array_equal(bits(tube.solve_many(src, at=at)[0]), bits(sol(at)))
     assert sol(src * 1.01)[0] < 1e-12
+
+
+def test_a_tube_split_at_creases_falls_back_in_the_batch_as_in_a_single_solve():
+    # two balls joined by a neck 1.9 spacings thick: thinned at its creases the inner tube splits,
+    # which tube.solve finds from its band values and solves at first order; solve_many, whose
+    # rows at `at` cannot show it, read inf on the far ball, converged, unwarned, until a
+    # tube.solve had refused the tube; ts.distance_matrix too (a review)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    x = np.stack(g.meshgrid(), -1)
+    balls = np.minimum(np.linalg.norm(x - (-0.45, 0, 0), axis=-1), np.linalg.norm(x - (0.45, 0, 0), axis=-1)) - 0.35
+    neck = np.maximum(np.hypot(x[..., 1], x[..., 2]) - 0.095, np.abs(x[..., 0]) - 0.45)
+    phi = ts.LevelSet(np.minimum(balls, neck), redistance=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rows, st = ts.Tube(phi, g).solve_many([(-0.8, 0, 0)], at=[(0.8, 0, 0)], return_stats=True)
+        single = ts.Tube(phi, g).solve([(-0.8, 0, 0)])
+        matrix = ts.distance_matrix(phi, g, [(-0.8, 0, 0), (0.8, 0, 0)])
+    assert any("crease" in str(w.message) for w in caught)  # (its creases are said, and the first order)
+    assert single.stats.order == 1 and "splits" in single.stats.order_fallback
+    assert st["order"] == 1 and "splits" in st["order_fallback"]
+    assert rows[0, 0] == single([(0.8, 0, 0)])[0] and 1.8 < rows[0, 0] < 1.9
+    assert np.all(np.isfinite(matrix)) and abs(matrix[0, 1] - rows[0, 0]) < 1e-6
+
+
+def test_an_infinity_below_the_travel_times_is_refused_by_the_batch_as_by_a_single_solve():
+    # solve_many(order=1, infinity=1.0) on the sphere: the far pole read inf, converged, unwarned
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3))
+    for at in ([(0.5, 0, 0), (0, 0, -0.5)], None):
+        with pytest.raises(ValueError, match=r"infinity=1 is not above the travel times: the front stopped"):
+            tube.solve_many([(0, 0, 0.5)], at=at, order=1, infinity=1.0)
+    # above them it stands, equal to the single solve
+    rows = tube.solve_many([(0, 0, 0.5)], at=[(0, 0, -0.5)], order=1, infinity=10.0)
+    assert rows[0, 0] == tube.solve([(0, 0, 0.5)], order=1, infinity=10.0)([(0, 0, -0.5)])[0]

@@ -141,6 +141,25 @@ def fixed_nodes(
     )
 
 
+def _check_split_at_creases(
+    tube: "Tube", groups: List[np.ndarray], st: Dict[str, Any], speed: Any, tol: Optional[float], max_iterations: int
+) -> None:
+    """Raises :class:`second_order.Order2NotApplicable` where the inner tube, thinned at creases,
+    splits (``second_order.split_at_creases``, which a single solve's band values show and the
+    batch's rows at ``at`` do not): two balls joined by a thin neck read inf beyond it in every row,
+    silently, until a ``tube.solve`` had refused the tube (a review). Only where creases thinned
+    the tube and a row left nodes unreached (also a part no source is on): the single solve of that
+    row's source decides, its warnings already given by the batch."""
+    if thinned_count(tube._tube_order2) == 0:
+        return
+    unreached = np.flatnonzero(np.asarray(st.get("unreached", 0)) > 0)
+    if unreached.size == 0:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the batch has said what this solve would)
+        tube.solve(groups[int(unreached[0])], order=2, speed=speed, tol=tol, max_iterations=max_iterations)
+
+
 def check_many_progress(progress: Any) -> Optional[Callable[[int, int], Any]]:
     if progress is None or progress is False:
         return None
@@ -224,6 +243,7 @@ def solve_many(
                     threads=nthreads,
                     number_from=number_from,
                 )
+                _check_split_at_creases(tube, groups, st, speed, tol, max_iterations)
             except so.Order2NotApplicable as e:
                 tube._order2_refusal = str(e)  # depends on the band only: not computed again
                 raise
@@ -383,6 +403,25 @@ def _first_order_batch(
         None if points is None else [float(v) for v in grid.lower],
     )
     del directions
+    unreached = np.flatnonzero(np.any(np.isinf(out), axis=1)) if inf is not None else []
+    if len(unreached):
+        # a user's infinity below the travel times stops the fronts where they meet it: refused as
+        # tube.solve refuses it (rows of inf at reachable points, converged, unwarned: a review);
+        # the single solve of a row with inf in it decides (also a part no source is on)
+        k = int(unreached[0])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # (the batch says what this solve would)
+            tube.solve(
+                groups[k],
+                order=order,
+                hamiltonian=scheme,
+                speed=speed,
+                source_init=source_init,
+                tol=tol,
+                max_iterations=max_iterations,
+                infinity=inf,
+                paper_sweeps=paper_sweeps,
+            )
     if fallback is not None:
         fallback.warn(out, t)
     if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut
