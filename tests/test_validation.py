@@ -579,3 +579,22 @@ def test_a_negative_linear_index_is_named_as_such():
         ValueError, match=r"linear indices must lie in \[0, 125\) \(grid.size\): -1 is outside the grid"
     ):
         ts.Grid((-1,) * 3, (1,) * 3, (5,) * 3).node_points([-1])
+
+
+def test_masked_arrays_with_masked_entries_are_refused_naming_the_argument():
+    # np.asarray drops a mask: a speed masked where it was set to 0.01 was taken as 0.01 there
+    # (35 instead of 0.785), a masked source row used as a point (a review)
+    g = ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3)
+    x = np.stack(g.meshgrid(), -1)
+    sphere = ts.surfaces.Sphere(0.5)
+    speed = np.ma.masked_array(np.ones(g.shape), mask=x[..., 2] > 0.3)
+    with pytest.raises(ValueError, match=r"speed array is a masked array with \d+ masked entries.*speed.filled"):
+        ts.solve(sphere, g, [(0, 0, 0.5)], speed=speed)
+    points = np.ma.masked_array(0.5 * np.eye(3), mask=[[0, 0, 0], [1, 1, 1], [0, 0, 0]])
+    with pytest.raises(ValueError, match=r"sources is a masked array with 3 masked entries"):
+        ts.solve(sphere, g, points)
+    phi = np.ma.masked_array(np.linalg.norm(x, axis=-1) - 0.5, mask=x[..., 0] > 0.9)
+    with pytest.raises(ValueError, match=r"phi array is a masked array"):
+        ts.LevelSet(phi)
+    # nothing masked: taken as the plain array
+    assert ts.solve(sphere, g, np.ma.masked_array([[0.0, 0.0, 0.5]])).stats.converged

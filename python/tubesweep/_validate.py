@@ -46,7 +46,14 @@ def as_grid(grid: Any) -> Grid:
 
 def real_array(value: Any, name: str) -> np.ndarray:
     """``value`` as a float64 array; complex values are refused (NumPy would drop the imaginary
-    part with only a ``ComplexWarning``) with a ``TypeError`` that names the argument."""
+    part with only a ``ComplexWarning``) with a ``TypeError`` that names the argument. A masked
+    array with masked entries is refused (``np.asarray`` drops the mask: a speed masked where it
+    was set to 0.01 was taken as 0.01 there, silently; a review)."""
+    if np.ma.isMaskedArray(value) and np.ma.count_masked(value):
+        raise ValueError(
+            f"{name} is a masked array with {int(np.ma.count_masked(value))} masked entries, whose values would be "
+            f"taken as they are; fill them ({name.split()[0]}.filled(value)) or pass the entries to use as a plain array"
+        )
     try:
         a = np.asarray(value)
     except ValueError:  # ragged nesting
