@@ -275,3 +275,17 @@ def test_an_open_cloud_or_mesh_falling_back_to_order_1_is_warned_of_too():
     with pytest.warns(RuntimeWarning, match=r"first-order scheme.*Δx = 0\.15.*errors up to about \d+%"):
         sol = ts.solve(hemisphere, grid, [(0.0, 0.0, 0.5)])
     assert sol.stats.order == 1
+
+
+def test_a_surface_bent_more_tightly_than_its_length_says_is_warned_of_its_bends():
+    # a capsule 5.8 spacings across and 1.1 long, as a cloud, at N = 81: first order (the grid
+    # does not resolve it), 3Δx is 5% of its longest distance, and no warning was given while its
+    # far side came out 51% short (the tube cuts across the bend; a review)
+    trimesh = pytest.importorskip("trimesh")
+    capsule = trimesh.creation.capsule(height=1.0, radius=0.05, count=[64, 64])
+    cloud = ts.surfaces.from_points(trimesh.sample.sample_surface_even(capsule, 30000, seed=0)[0])
+    with pytest.warns(
+        RuntimeWarning, match=r"errors of 19% of the distances or more along paths that turn round the surface"
+    ):
+        sol = ts.solve(cloud, cloud.grid(81), [(0.05, 0, 0)])
+    assert sol.stats.order == 1 and sol([(-0.05, 0, 0)])[0] < 0.6 * np.pi * 0.05  # (what it warns of)

@@ -33,6 +33,7 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from ._coarse_creases import paper_creases
+from ._curvature import SHORTCUT_FACTOR, typical_curvature
 from ._creases import refused_for_creases, shortcut, thinned_spacings, warn_refused_creases, where_creases
 from ._prepare import thinned_count
 from .band import band_neighbours
@@ -52,6 +53,11 @@ FIRST_ORDER_SPACINGS = 3.0
 #: errors 4.6–6.8Δx at N = 41–61 where two edges were crossed, 2.3–3.4Δx per edge; thinned (edges
 #: rounded over less than three spacings) :data:`~tubesweep._creases.THINNED_SHORTCUT` instead.
 UNRESOLVED_SHORTCUT = 3.5
+
+#: The tube's cut across the surface's bends (:attr:`Fallback.bend`) is the size stated where it is
+#: at least this many times the share that the distances' length gives (a capsule 5.8 spacings
+#: across and 1.1 long: 5.2; a sphere: 1.5).
+BEND_OVER_SHARE = 2.0
 
 #: The warning fires when the estimated error is at least this share of the distances: a surface
 #: whose farthest path is 30 grid spacings long or more is not warned about for the 3Δx alone.
@@ -120,7 +126,9 @@ def first_order_share(values: Any, spacing: float, gradient: float = 1.0) -> Tup
     return FIRST_ORDER_SPACINGS * float(spacing) / (largest * gradient), largest
 
 
-def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[float], *, said: bool) -> None:
+def warn_first_order(
+    reason: str, values: Any, tube: Any, gradient: Optional[float], *, said: bool, bend: float = 0.0
+) -> None:
     """After ``order="auto"`` ran the first-order scheme on ``tube`` for ``reason``: the crease
     warning when creases caused it, else a RuntimeWarning when its errors are a large share of
     the distances (:data:`SIZE_WARNING`; ``gradient`` from :meth:`Fallback.measure`), or φ is not a
@@ -128,7 +136,8 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     fallback was warned about already, a runaway, or the caller chose an option of the
     first-order scheme: ``second_order.warn_fallback``), nor on an open level set (``gradient``
     None: near a rim the distance curves whatever the surface does; an open mesh's, cloud's or
-    closest-point surface's φ is the distance, ``gradient`` 1)."""
+    closest-point surface's φ is the distance, ``gradient`` 1). ``bend``: the share by which the
+    tube cuts across the surface's bends (:attr:`Fallback.bend`), the estimate where it is larger."""
     spacing = tube.grid.spacing
     thinned = thinned_count(tube) > 0
     if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned_spacings(tube, thinned)):
@@ -140,6 +149,8 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     share, largest = first_order_share(values, spacing, gradient)
     if largest <= 0:
         return
+    # a surface bent more tightly than the distances are long (a capsule 5.8 spacings across, 1.1
+    # long: 3Δx is 5% of the largest distance, but round it 50% short, unwarned; a review)
     unresolved = _UNRESOLVED.search(reason)
     edges_only = unresolved is not None and int(unresolved.group(1)) < 100 * EDGES_SHARE
     # (the inner tube thinned at the edges: _creases.thinned_spacings per edge, as at a crease;
@@ -148,11 +159,24 @@ def warn_first_order(reason: str, values: Any, tube: Any, gradient: Optional[flo
     at_edges = thinned and (nodes is None or 2 * thinned_count(tube) >= int(nodes.group(1)))
     per_edge = thinned_spacings(tube, True) if at_edges else UNRESOLVED_SHORTCUT
     crossing = per_edge * spacing / gradient if edges_only else 0.0
+    # (on a sphere the bend reads 1.5 times the 3Δx of the share, both about right: the bend is
+    # taken where the surface bends more tightly than its length says, twice the share or more,
+    # and not where edges or tips are the cause, sized per crossing below)
+    bent = not edges_only and bend > BEND_OVER_SHARE * share
+    share = bend if bent else share
     rough = ROUGH_REDISTANCED in reason  # (a re-distanced φ: mask.mask_advice)
     not_a_distance = NOT_A_DISTANCE in reason or rough
     if share < SIZE_WARNING and 2 * crossing < SIZE_WARNING * largest and not not_a_distance:
         return
     size = f"up to about {100 * share:.0f}% of the distances" if share < 1 else "as large as the distances"
+    if bent:
+        # (the mean curvature's: round a cylinder, whose other curvature is 0, paths turn twice as
+        # sharply, and a capsule's far side came out 51% short where 19% was stated)
+        size = (
+            f"of {100 * share:.0f}% of the distances or more along paths that turn round the surface (it bends "
+            f"on a scale of about {SHORTCUT_FACTOR * tube.inner / max(bend, 1e-300):.2g} grid spacings, one over its "
+            "mean curvature, not much wider than the tube, which cuts across the bend)"
+        )
     if not not_a_distance:
         scaled = ""
     elif rough:
@@ -212,6 +236,9 @@ class Fallback:
     #: an option only the first-order scheme has (``second_order.OptionOfOrder1``): the caller chose
     #: that scheme, whose tube is the paper's (not thinned at creases)
     option_of_order1: bool = False
+    #: the share by which the tube cuts across the surface's bends, ``SHORTCUT``·inner·Δx·κ over
+    #: |∇φ| (κ: ``_curvature.typical_curvature``; :meth:`measure`)
+    bend: float = 0.0
 
     @classmethod
     def of(cls, refusal: Order2NotApplicable, order: Any) -> "Fallback":
@@ -240,6 +267,7 @@ class Fallback:
             # review.)
             if not isinstance(surface, LevelSet):
                 self.gradient = 1.0
+                self._measure_bend(tube)
             return
         redistanced = isinstance(surface, LevelSet) and (surface.redistance or NOISY_PHI in self.reason)
         if redistanced and not refused_for_creases(self.reason):
@@ -250,6 +278,7 @@ class Fallback:
             # (3.2–5.2Δx across its two rims) and fused discs' in 2D (6–8Δx), a helper's review
             self.creases = paper_creases(tube.grid, tube.band, tube.phi)
         self.gradient, low, high = gradient_range(tube)
+        self._measure_bend(tube)
         given = isinstance(surface, LevelSet) and not surface.redistance
         if given:
             # the spread over the whole tube: a φ that flattens away from the surface (ε·tanh(d/ε),
@@ -264,6 +293,11 @@ class Fallback:
                 f"; |∇φ| ranges over [{low:.3g}, {high:.3g}] in the tube, so φ is not a distance, which reads as "
                 "curvature: LevelSet(φ, redistance=True) re-distances it and may run second order"
             )
+
+    def _measure_bend(self, tube: Any) -> None:
+        """:attr:`bend` on ``tube`` (before the solve: it reads the band's linear indices)."""
+        kappa = typical_curvature(tube)
+        self.bend = SHORTCUT_FACTOR * tube.inner * tube.grid.spacing * kappa / max(self.gradient or 1.0, 1e-300)
 
     def warn(self, values: Any, tube: Any) -> None:
         """After the solve on ``tube``: the crease or size warning for its ``values``
@@ -282,7 +316,7 @@ class Fallback:
         if self.creases is not None:
             warn_smoothed_creases(self.creases, tube.inner, tube.grid.spacing)
             return
-        warn_first_order(self.reason, values, tube, self.gradient, said=self.said)
+        warn_first_order(self.reason, values, tube, self.gradient, said=self.said, bend=self.bend)
 
 
 def warn_smoothed_creases(creases: Dict[str, Any], inner: float, spacing: float) -> None:
