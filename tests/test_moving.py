@@ -624,6 +624,15 @@ def test_errors_of_the_speed_law_and_of_progress_keep_the_frames():
     with pytest.raises(ts.EvolutionStopped, match=r"at step 2 .*progress raised KeyError") as info:
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=4, progress=failing_progress)
     assert info.value.evolution.times == [0.0, 0.05]  # (called when φ has moved to step 2, before its solve)
+
+    def interrupted(step, steps, t):
+        if step == 2:
+            raise KeyboardInterrupt
+
+    # Ctrl-C stays an interrupt, with the frames on it (they were lost: a review)
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u: 0 * u, dt=0.05, steps=4, progress=interrupted)
+    assert stopped.value.evolution.times == [0.0, 0.05]
     # a law written as speed(u, t): the call's own TypeError said only "missing 1 required positional argument"
     with pytest.raises(TypeError, match=r"evolve: speed is called as speed\(u\), with the band's values alone"):
         ts.evolve(phi, GRID31, [(0, 0, 0.5)], lambda u, t: 0 * u, dt=0.05, steps=2)

@@ -651,5 +651,9 @@ def evolve(
                         t,
                     ) from e
         return out
+    except KeyboardInterrupt as e:
+        # Ctrl-C: the frames so far ride on the interrupt, as on EvolutionStopped (they were lost)
+        e.evolution = out  # type: ignore[attr-defined]
+        raise
     finally:
         said.say()
