@@ -160,3 +160,17 @@ def test_an_infinity_below_the_travel_times_is_refused_by_the_batch_as_by_a_sing
     # above them it stands, equal to the single solve
     rows = tube.solve_many([(0, 0, 0.5)], at=[(0, 0, -0.5)], order=1, infinity=10.0)
     assert rows[0, 0] == tube.solve([(0, 0, 0.5)], order=1, infinity=10.0)([(0, 0, -0.5)])[0]
+
+
+def test_a_batch_too_large_for_memory_is_refused_before_any_source_is_set_up(monkeypatch):
+    # at order=1 the allocation refused it, after minutes of per-source set-up (120,000 sources:
+    # 172 s; a review); now the K rows are checked first
+    import tubesweep._validate as validate
+
+    tube = ts.Tube(ts.surfaces.Sphere(0.5), ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3))
+    monkeypatch.setattr(validate, "available_memory_bytes", lambda: 10_000_000)
+    sources = 0.5 * np.eye(3)[np.arange(600) % 3]
+    for order in (1, "auto"):
+        with pytest.raises(MemoryError, match=rf"solve_many's 600 rows of {tube.band_points} values needs about"):
+            tube.solve_many(sources, order=order)
+    assert tube.solve_many(sources, at=[(0.5, 0, 0)], order=1).shape == (600, 1)  # K × M fits

@@ -18,6 +18,7 @@ import numpy as np
 
 from . import _native
 from ._validate import (
+    check_memory,
     check_flag,
     ACTIVATION_FRACTION,
     FRONT_WINDOW,
@@ -212,6 +213,14 @@ def solve_many(
     nthreads = check_threads(threads)
     inf = check_infinity(infinity)
     points = None if at is None else as_points(at, grid.ndim, "at")
+    # the K rows, checked before any source is set up (at order=1 a batch too large for memory
+    # was refused by the allocation after minutes of per-source set-up: 120,000 sources, 172 s)
+    width = len(points) if points is not None else len(t.linear)
+    check_memory(
+        8.0 * len(groups) * width,
+        f"solve_many's {len(groups)} rows of {width} values",
+        "pass at= the points you need (K × M values), or fewer sources per call",
+    )
     first = dict(
         points=points,
         scheme=scheme,
