@@ -305,8 +305,24 @@ def export(
     meshio = _need("meshio", "mesh", f"writing {suffix} files")
     kind = {1: "vertex", 2: "line", 3: "triangle", 4: "quad"}[cells.shape[1]]
     export_format(path, curve=kind == "line")
-    if suffix == ".ply" and len(pts) < 2**31:
-        cells = cells.astype(np.int32)  # PLY has no 64-bit integers
+    if suffix == ".ply":
+        if len(pts) < 2**31:
+            cells = cells.astype(np.int32)  # PLY has no 64-bit integers
+        # PLY's vertex properties are scalars: meshio skipped a vector field (a cloud's normals,
+        # dropped with only a line on stdout; a review); its components are written instead, the
+        # normals as PLY's nx, ny, nz
+        flat: Dict[str, np.ndarray] = {}
+        for name, a in data.items():
+            if a.ndim == 2:
+                names = (
+                    ["nx", "ny", "nz"]
+                    if name == "normals" and a.shape[1] == 3
+                    else [f"{name}_{i}" for i in range(a.shape[1])]
+                )
+                flat.update({c: np.ascontiguousarray(a[:, i]) for i, c in enumerate(names)})
+            else:
+                flat[name] = a
+        data = flat
     m = meshio.Mesh(pts, [] if kind == "vertex" else [(kind, cells)], point_data={} if suffix == ".obj" else data)
     meshio.write(str(path), m, file_format={".vtk": "vtk", ".vtu": "vtu", ".ply": "ply", ".obj": "obj"}[suffix])
     return path
