@@ -252,31 +252,6 @@ def test_a_re_distanced_phi_rough_at_the_grid_s_scale_is_told_to_smooth_not_to_r
     assert sol.stats.order == 1
 
 
-def test_an_open_cloud_or_mesh_falling_back_to_order_1_is_warned_of_too():
-    # open surfaces were left out of the size warning (their φ near a rim cannot be read through
-    # differences): a sphere cloud with 40 samples far away (a small open piece that stretched
-    # its grid) came out 44% short, a hemisphere cloud at h = 0.15 24%, unwarned (a review). A
-    # mesh's, a cloud's or a closest-point surface's φ is the distance itself: |∇φ| = 1
-    rng = np.random.default_rng(0)
-    x = rng.normal(size=(8000, 3))
-    sphere = 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True)
-    with pytest.warns(RuntimeWarning, match="2 of 8039 samples lie off the surface"):
-        cloud = ts.surfaces.from_points(np.r_[sphere, 50 + 0.01 * rng.normal(size=(40, 3))])
-    assert cloud.open_surface
-    with pytest.warns(
-        RuntimeWarning, match=r"order='auto' ran the paper's first-order scheme.*Δx = 1\.15.*as large as"
-    ):
-        sol = ts.solve(cloud, cloud.grid(61), [sphere[0]])
-    assert sol.stats.order == 1 and np.pi / 2 - sol([-sphere[0]])[0] > 0.5  # (what it warns of)
-    # the hemisphere as a cloud on a coarse grid (h = 0.15)
-    top = sphere[sphere[:, 2] > -0.1]
-    hemisphere = ts.surfaces.from_points(top)
-    grid = ts.Grid((-3,) * 3, (3,) * 3, (41,) * 3)
-    with pytest.warns(RuntimeWarning, match=r"first-order scheme.*Δx = 0\.15.*errors up to about \d+%"):
-        sol = ts.solve(hemisphere, grid, [(0.0, 0.0, 0.5)])
-    assert sol.stats.order == 1
-
-
 def test_a_surface_bent_more_tightly_than_its_length_says_is_warned_of_its_bends():
     # a capsule 5.8 spacings across and 1.1 long, as a cloud, at N = 81: first order (the grid
     # does not resolve it), 3Δx is 5% of its longest distance, and no warning was given while its

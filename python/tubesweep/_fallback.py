@@ -127,16 +127,21 @@ def first_order_share(values: Any, spacing: float, gradient: float = 1.0) -> Tup
 
 
 def warn_first_order(
-    reason: str, values: Any, tube: Any, gradient: Optional[float], *, said: bool, bend: float = 0.0
+    reason: str,
+    values: Any,
+    tube: Any,
+    gradient: Optional[float],
+    *,
+    said: bool,
+    bend: float = 0.0,
 ) -> None:
     """After ``order="auto"`` ran the first-order scheme on ``tube`` for ``reason``: the crease
     warning when creases caused it, else a RuntimeWarning when its errors are a large share of
     the distances (:data:`SIZE_WARNING`; ``gradient`` from :meth:`Fallback.measure`), or φ is not a
     distance (whose cure, ``redistance=True``, the reason names). Nothing when ``said`` (the
     fallback was warned about already, a runaway, or the caller chose an option of the
-    first-order scheme: ``second_order.warn_fallback``), nor on an open level set (``gradient``
-    None: near a rim the distance curves whatever the surface does; an open mesh's, cloud's or
-    closest-point surface's φ is the distance, ``gradient`` 1). ``bend``: the share by which the
+    first-order scheme: ``second_order.warn_fallback``), nor on an open surface (``gradient`` None:
+    near a rim the distance curves whatever the surface does). ``bend``: the share by which the
     tube cuts across the surface's bends (:attr:`Fallback.bend`), the estimate where it is larger."""
     spacing = tube.grid.spacing
     thinned = thinned_count(tube) > 0
@@ -173,7 +178,8 @@ def warn_first_order(
         # (the mean curvature's: round a cylinder, whose other curvature is 0, paths turn twice as
         # sharply, and a capsule's far side came out 51% short where 19% was stated)
         size = (
-            f"of {100 * share:.0f}% of the distances or more along paths that turn round the surface (it bends "
+            ("as large as the distances" if share >= 1 else f"of {100 * share:.0f}% of the distances or more")
+            + " along paths that turn round the surface (it bends "
             f"on a scale of about {SHORTCUT_FACTOR * tube.inner / max(bend, 1e-300):.2g} grid spacings, one over its "
             "mean curvature, not much wider than the tube, which cuts across the bend)"
         )
@@ -223,7 +229,7 @@ class Fallback:
     ``sol.stats.order_fallback``); ``said``, whether nothing more is to be said after the solve
     (warned already, or an option the caller chose: ``second_order.warn_fallback``);
     ``gradient``, the tube's mean ``|∇φ|`` for the size warning (:meth:`measure`; None on an open
-    level set)."""
+    surface)."""
 
     reason: str
     said: bool
@@ -257,17 +263,10 @@ class Fallback:
         closed = getattr(surface, "closed", True) is not False or (
             getattr(surface, "faces", None) is not None and open_only_in_debris(surface)
         )
-        if self.said:
-            return
-        if getattr(surface, "open_surface", False) or not closed:
-            # a mesh's, a cloud's or a closest-point surface's φ is the distance itself (|∇φ| = 1),
-            # which near a rim cannot be read through φ's differences; a level set's is unknown.
-            # (Not said at all, a hemisphere cloud at h = 0.15 was 24% off at first order and a
-            # sphere cloud with 40 samples far away, an open piece stretching its grid, 44%: a
-            # review.)
-            if not isinstance(surface, LevelSet):
-                self.gradient = 1.0
-                self._measure_bend(tube)
+        if self.said or getattr(surface, "open_surface", False) or not closed:
+            # (an open surface's first-order errors are not sized: its φ near a rim cannot be read
+            # through differences, 3Δx would be a false alarm on a flat patch, and the bend estimate
+            # reads a small patch's rim as a tight bend: a disc one spacing across said 75%)
             return
         redistanced = isinstance(surface, LevelSet) and (surface.redistance or NOISY_PHI in self.reason)
         if redistanced and not refused_for_creases(self.reason):
