@@ -154,8 +154,6 @@ def warn_first_order(
     share, largest = first_order_share(values, spacing, gradient)
     if largest <= 0:
         return
-    # a surface bent more tightly than the distances are long (a capsule 5.8 spacings across, 1.1
-    # long: 3Δx is 5% of the largest distance, but round it 50% short, unwarned; a review)
     unresolved = _UNRESOLVED.search(reason)
     edges_only = unresolved is not None and int(unresolved.group(1)) < 100 * EDGES_SHARE
     # (the inner tube thinned at the edges: _creases.thinned_spacings per edge, as at a crease;
@@ -164,7 +162,9 @@ def warn_first_order(
     at_edges = thinned and (nodes is None or 2 * thinned_count(tube) >= int(nodes.group(1)))
     per_edge = thinned_spacings(tube, True) if at_edges else UNRESOLVED_SHORTCUT
     crossing = per_edge * spacing / gradient if edges_only else 0.0
-    # (on a sphere the bend reads 1.5 times the 3Δx of the share, both about right: the bend is
+    # a surface bent more tightly than the distances are long (a capsule 5.8 spacings across, 1.1
+    # long: 3Δx is 5% of the largest distance, but round it 51% short, unwarned; a review).
+    # (On a sphere the bend reads 1.5 times the 3Δx of the share, both about right: the bend is
     # taken where the surface bends more tightly than its length says, twice the share or more,
     # and not where edges or tips are the cause, sized per crossing below)
     bent = not edges_only and bend > BEND_OVER_SHARE * share
@@ -242,7 +242,7 @@ class Fallback:
     #: an option only the first-order scheme has (``second_order.OptionOfOrder1``): the caller chose
     #: that scheme, whose tube is the paper's (not thinned at creases)
     option_of_order1: bool = False
-    #: the share by which the tube cuts across the surface's bends, ``SHORTCUT``·inner·Δx·κ over
+    #: the share by which the tube cuts across the surface's bends, ``SHORTCUT_FACTOR``·inner·Δx·κ over
     #: |∇φ| (κ: ``_curvature.typical_curvature``; :meth:`measure`)
     bend: float = 0.0
 
