@@ -106,13 +106,12 @@ def _slab_nodes(
     at, nb = at[keep], nb[keep]
     # the next node along the axis beyond a neighbour, looked up only where a run of two can
     # start: its other neighbour may be outside (one lookup for all axes)
-    rows, ends, sides = [], [], []
+    rows, ends = [], []
     for k in range(ndim):
         for j in (0, 1):
             r = np.flatnonzero(maybe_out[nb[:, k, 1 - j]] & (nb[:, k, j] < n))
             rows.append(r)
             ends.append(nb[r, k, j])
-            sides.append(np.full(r.size, 2 * k + j))
     ends_all = np.concatenate(ends)
     beyond = band.neighbours_of_nodes(ends_all).reshape(len(ends_all), 2 * ndim)
     second = np.full((2 * ndim, len(at)), n, dtype=np.int64)

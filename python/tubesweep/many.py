@@ -154,11 +154,20 @@ def _check_split_at_creases(
     if thinned_count(tube._tube_order2) == 0:
         return
     unreached = np.flatnonzero(np.asarray(st.get("unreached", 0)) > 0)
-    if unreached.size == 0:
-        return
+    if unreached.size:
+        _single_solve_decides(
+            tube, groups[int(unreached[0])], order=2, speed=speed, tol=tol, max_iterations=max_iterations
+        )
+
+
+def _single_solve_decides(tube: "Tube", group: np.ndarray, **options: Any) -> None:
+    """``tube.solve(group, **options)`` for what it raises: a row of the batch that the batch's
+    own output cannot judge (it holds no band values, or only the rows at ``at``) is judged by
+    the single solve of its source, which refuses as the batch should. Its warnings are the
+    batch's, already given."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # (the batch has said what this solve would)
-        tube.solve(groups[int(unreached[0])], order=2, speed=speed, tol=tol, max_iterations=max_iterations)
+        warnings.simplefilter("ignore")
+        tube.solve(group, **options)
 
 
 def check_many_progress(progress: Any) -> Optional[Callable[[int, int], Any]]:
@@ -417,20 +426,18 @@ def _first_order_batch(
         # a user's infinity below the travel times stops the fronts where they meet it: refused as
         # tube.solve refuses it (rows of inf at reachable points, converged, unwarned: a review);
         # the single solve of a row with inf in it decides (also a part no source is on)
-        k = int(unreached[0])
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # (the batch says what this solve would)
-            tube.solve(
-                groups[k],
-                order=order,
-                hamiltonian=scheme,
-                speed=speed,
-                source_init=source_init,
-                tol=tol,
-                max_iterations=max_iterations,
-                infinity=inf,
-                paper_sweeps=paper_sweeps,
-            )
+        _single_solve_decides(
+            tube,
+            groups[int(unreached[0])],
+            order=order,
+            hamiltonian=scheme,
+            speed=speed,
+            source_init=source_init,
+            tol=tol,
+            max_iterations=max_iterations,
+            infinity=inf,
+            paper_sweeps=paper_sweeps,
+        )
     if fallback is not None:
         fallback.warn(out, t)
     if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut

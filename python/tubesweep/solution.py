@@ -274,11 +274,12 @@ class Solution:
         >>> u = sol([(0.0, 0.5, 0.0), (0.5, 0.0, 0.0)])  # exact π/4 and π/2
         >>> v = sol([(0.0, 0.5, 0.0)], interpolation="cubic")
         """
-        out = self._at(points, interpolation)
+        p = as_points(points, self.grid.ndim, "points")
+        out = self._at(p, interpolation)
         off = np.isnan(out)
         if np.any(off):
             i = int(np.flatnonzero(off)[0])
-            q = np.atleast_2d(np.asarray(points, dtype=float))[i]
+            q = p[i]
             warnings.warn(
                 f"sol(points): {int(np.count_nonzero(off))} of {len(out)} points lie where the band does not reach "
                 f"(the first, points[{i}] = {tuple(round(float(c), 6) for c in q)}): NaN there. The band holds the "
@@ -293,7 +294,7 @@ class Solution:
 
     def _at(self, points: Any, interpolation: str = "linear") -> np.ndarray:
         """:meth:`__call__` without its warning about the points off the band (for the readers
-        that handle NaN themselves: :meth:`on_mesh`, geodesic paths, the export of a cloud)."""
+        that handle NaN themselves: :meth:`on_mesh` and geodesic paths)."""
         p = as_points(points, self.grid.ndim, "points")
         if self._factoring is not None:  # the factored form near a source projects onto the surface
             self._check_surface_unchanged()

@@ -103,17 +103,15 @@ def oriented_normals(mesh: Any) -> np.ndarray:
 
     f = mesh.faces
     n = len(f)
-    # each face's directed edges a→b, b→c, c→a, keyed by their undirected edge
-    heads = np.concatenate([f[:, 0], f[:, 1], f[:, 2]])
-    tails = np.concatenate([f[:, 1], f[:, 2], f[:, 0]])
-    face = np.tile(np.arange(n), 3)
-    forward = heads < tails
-    key = np.minimum(heads, tails) * (int(f.max()) + 1) + np.maximum(heads, tails)
-    order = np.argsort(key, kind="stable")
-    key, face, forward = key[order], face[order], forward[order]
-    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-    counts = np.diff(np.r_[starts, len(key)])
-    pair = starts[counts == 2]  # edges of exactly two faces (the others join nothing)
+    edge_ids, counts = unique_edges(f)  # per face: its edges AB, AC, BC
+    # whether the face runs each edge from its smaller vertex: a→b, c→a, b→c
+    forward = np.c_[f[:, 0] < f[:, 1], f[:, 2] < f[:, 0], f[:, 1] < f[:, 2]].ravel()
+    ids = edge_ids.ravel()
+    face = np.repeat(np.arange(n), 3)
+    order = np.argsort(ids, kind="stable")
+    ids, face, forward = ids[order], face[order], forward[order]
+    pair = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])  # each edge's first entry
+    pair = pair[counts[ids[pair]] == 2]  # edges of exactly two faces (the others join nothing)
     i, j = face[pair], face[pair + 1]
     alike = forward[pair] == forward[pair + 1]  # run the same way: one of the two is turned
     rows = np.r_[i, i + n]
