@@ -235,8 +235,8 @@ def lines_advice(rim: int, samples: int, neighbours: int) -> str:
 #: by less than this share of their spread along (the median of the second over the largest
 #: eigenvalue of their covariance) samples a curve, not a surface: a circle or a helix of 3000
 #: samples over 20 neighbours 4.5e-4, the circle with noise of 0.6% of its radius 0.018; a
-#: sphere 0.80, a hemisphere 0.78, a strip 20 times longer than wide 0.70, a sphere sampled in
-#: latitude rings 13 sample spacings apart 0.73 (scratch measurements, tests/test_point_cloud.py).
+#: sphere 0.80, a hemisphere 0.78, a strip 20 times longer than wide 0.69, a sphere sampled in
+#: latitude rings 13 sample spacings apart 0.73 (``benches/experiments/cloud_curves.py``).
 CURVE_SPREAD = 0.05
 #: ... neighbourhoods this many times the fits' (a scanner's lines are reached across).
 CURVE_NEIGHBOURS = 4
