@@ -264,3 +264,55 @@ def test_a_surface_bent_more_tightly_than_its_length_says_is_warned_of_its_bends
     ):
         sol = ts.solve(cloud, cloud.grid(81), [(0.05, 0, 0)])
     assert sol.stats.order == 1 and sol([(-0.05, 0, 0)])[0] < 0.6 * np.pi * 0.05  # (what it warns of)
+
+
+def _box(a: float, b: float, h: float) -> ts.Grid:
+    n = int(round((b - a) / h)) + 1
+    return ts.Grid([a] * 3, [a + (n - 1) * h] * 3, [n] * 3)
+
+
+def _great_circle_errors(sol, points, pole):
+    exact = R * np.arccos(np.clip(points @ np.asarray(pole) / R**2, -1, 1))
+    u = sol(points)
+    return float(np.max(np.abs(u - exact)) / exact.max())
+
+
+def test_an_open_surface_bent_on_the_tube_s_scale_is_warned_of_its_bends():
+    # the hemisphere at Δx = 0.2 (2.5 spacings in radius) runs first order, off by 14.5% of its
+    # largest distance; an open surface's errors were not sized at all (a review: a hemisphere cloud
+    # 24% off, a sphere cloud with a stray patch 44% short, neither warned)
+    pole = (0.0, 0.0, R)
+    with pytest.warns(RuntimeWarning, match=r"on an open surface that bends on a scale of about") as record:
+        sol = ts.solve(ts.surfaces.Hemisphere(), _box(-0.9, 0.9, 0.2), [pole])
+    (w,) = [w for w in record if "open surface that bends" in str(w.message)]
+    stated = int(re.search(r"errors of roughly (\d+)% of the distances", str(w.message)).group(1)) / 100
+    th, ph = np.meshgrid(np.linspace(0.05, 1.45, 15), np.linspace(0, 2 * np.pi, 24, endpoint=False))
+    points = R * np.c_[(np.sin(th) * np.cos(ph)).ravel(), (np.sin(th) * np.sin(ph)).ravel(), np.cos(th).ravel()]
+    error = _great_circle_errors(sol, points, pole)
+    assert sol.stats.order == 1 and 0.1 < error < stated < 3 * error, (error, stated)
+
+
+def test_a_sphere_cloud_with_a_stray_patch_is_warned_of_its_bends_as_an_open_surface():
+    i = np.arange(2000) + 0.5
+    polar, turn = np.arccos(1 - 2 * i / 2000), np.pi * (1 + 5**0.5) * i
+    sphere = R * np.c_[np.cos(turn) * np.sin(polar), np.sin(turn) * np.sin(polar), np.cos(polar)]
+    patch = np.c_[np.random.default_rng(0).uniform(-0.1, 0.1, (60, 2)), np.zeros(60)] + [2.0, 0, 0]
+    cloud = ts.surfaces.from_points(np.r_[sphere, patch])
+    assert cloud.open_surface  # (the patch's rim)
+    with pytest.warns(RuntimeWarning, match=r"open surface that bends") as record:
+        sol = ts.solve(cloud, cloud.grid(31), [(0.0, 0.0, R)])
+    stated = int(re.search(r"errors of roughly (\d+)% of the distances", str(record[-1].message)).group(1)) / 100
+    error = _great_circle_errors(sol, sphere[::7], (0.0, 0.0, R))
+    assert sol.stats.order == 1 and 0.3 < error and error / 3 < stated < 3 * error, (error, stated)
+
+
+@pytest.mark.parametrize("surface", [ts.surfaces.PlanePatch(half_size=0.25), ts.surfaces.Disc(radius=0.3)])
+def test_a_flat_open_surface_s_first_order_fallback_is_not_sized_as_a_bend(surface):
+    # (its rim fans the directions out, which typical_curvature read as a sphere 1.4 spacings wide)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sol = ts.solve(surface, _box(-0.6, 0.6, 0.1), [(0.0, 0.0, 0.0)])
+    t = np.linspace(-0.25, 0.25, 11)
+    points = np.c_[t, 0 * t, 0 * t]
+    exact = np.abs(t)
+    assert sol.stats.order == 1 and np.max(np.abs(sol(points) - exact)) < 0.1 * 0.36

@@ -17,10 +17,16 @@ tube's width that a path crosses and where the tube is not thinned (``RoundedCub
 thinned as at a crease, ``band::crease_ridges``, and N = 41–61 come out 2.7–5.9% short). ``benches/experiments/fallback_size.py`` prints the errors against what the warning
 says; ``tests/test_fallback.py``.
 
+On an open surface (a hemisphere, a scan with holes, a cloud with a stray patch) no fronts need
+meet around it, and a flat patch's first-order errors are a few per cent, so only its bends are
+sized: by their curvature read on the concave side, where a rim's fan of directions does not
+reach (``_curvature.concave_curvature``), :data:`OPEN_BEND` times the closed surfaces' estimate
+(the hemisphere of radius 0.5 at Δx = 0.15–0.2, 8–15% off, said 19–25%; a sphere cloud with a
+stray patch, 31–33% short, said 26–32%; plane patches and discs, nothing:
+``benches/experiments/open_fallback_size.py``).
+
 Not warned about: an option the caller chose that only the first-order scheme has
-(``second_order.OptionOfOrder1``: the caller chose that scheme), and open surfaces, where the
-first-order errors are smaller (no fronts meet around them; the hemisphere at N = 16–21, 7.6–9.5%
-at most).
+(``second_order.OptionOfOrder1``: the caller chose that scheme).
 """
 
 from __future__ import annotations
@@ -33,7 +39,7 @@ from typing import Any, Dict, Optional, Tuple
 import numpy as np
 
 from ._coarse_creases import paper_creases
-from ._curvature import SHORTCUT_FACTOR, typical_curvature
+from ._curvature import SHORTCUT_FACTOR, concave_curvature, typical_curvature
 from ._creases import refused_for_creases, shortcut, thinned_spacings, warn_refused_creases, where_creases
 from ._prepare import thinned_count
 from .band import band_neighbours
@@ -58,6 +64,12 @@ UNRESOLVED_SHORTCUT = 3.5
 #: at least this many times the share that the distances' length gives (a capsule 5.8 spacings
 #: across and 1.1 long: 5.2; a sphere: 1.5).
 BEND_OVER_SHARE = 2.0
+
+#: An open surface's bends are sized at this share of a closed one's estimate (SHORTCUT_FACTOR·inner·Δx·κ):
+#: paths over a hemisphere turn by at most a quarter circle, and the first-order errors measured
+#: were 0.3–0.6 times that estimate on a hemisphere, 0.5 round a sphere with a stray patch
+#: (``benches/experiments/open_fallback_size.py``)
+OPEN_BEND = 0.5
 
 #: The warning fires when the estimated error is at least this share of the distances: a surface
 #: whose farthest path is 30 grid spacings long or more is not warned about for the 3Δx alone.
@@ -140,14 +152,17 @@ def warn_first_order(
     the distances (:data:`SIZE_WARNING`; ``gradient`` from :meth:`Fallback.measure`), or φ is not a
     distance (whose cure, ``redistance=True``, the reason names). Nothing when ``said`` (the
     fallback was warned about already, a runaway, or the caller chose an option of the
-    first-order scheme: ``second_order.warn_fallback``), nor on an open surface (``gradient`` None:
-    near a rim the distance curves whatever the surface does). ``bend``: the share by which the
-    tube cuts across the surface's bends (:attr:`Fallback.bend`), the estimate where it is larger."""
+    first-order scheme: ``second_order.warn_fallback``). On an open surface (``gradient`` None: near
+    a rim the distance curves whatever the surface does) only ``bend`` is sized. ``bend``: the share
+    by which the tube cuts across the surface's bends (:attr:`Fallback.bend`), the estimate where it
+    is larger."""
     spacing = tube.grid.spacing
     thinned = thinned_count(tube) > 0
     if said or warn_refused_creases(reason, tube.inner, spacing, thinned=thinned_spacings(tube, thinned)):
         return
     if gradient is None:
+        if bend >= SIZE_WARNING:
+            _warn_open_bend(reason, values, tube, bend)
         return
     if abs(gradient - 1.0) < GRADIENT_READ:
         gradient = 1.0  # a distance, read through central differences
@@ -223,6 +238,24 @@ def warn_first_order(
     )
 
 
+def _warn_open_bend(reason: str, values: Any, tube: Any, bend: float) -> None:
+    """:func:`warn_first_order` on an open surface whose bends cost a share ``bend`` of the
+    distances (:attr:`Fallback.bend`, read on the concave side)."""
+    spacing = tube.grid.spacing
+    largest = float(np.max(values[np.isfinite(values)], initial=0.0))
+    scale = SHORTCUT_FACTOR * OPEN_BEND * tube.inner / bend
+    size = "as large as the distances" if bend >= 1 else f"of roughly {100 * bend:.0f}% of the distances"
+    warnings.warn(
+        f"order='auto' ran the paper's first-order scheme on an open surface that bends on a scale of about "
+        f"{scale:.2g} grid spacings (one over its mean curvature), not much wider than the tube, which cuts across "
+        f"the bends: here Δx = {spacing:.3g} and distances up to {largest:.3g}, so errors {size} along paths over "
+        "the bends (an estimate good to a factor of two or three). A finer grid lowers them (why order 2 did not "
+        f"apply, kept in sol.stats.order_fallback: {reason})",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )
+
+
 @dataclasses.dataclass
 class Fallback:
     """``order="auto"`` running the first-order scheme: ``reason``, the refusal's text (kept in
@@ -243,7 +276,8 @@ class Fallback:
     #: that scheme, whose tube is the paper's (not thinned at creases)
     option_of_order1: bool = False
     #: the share by which the tube cuts across the surface's bends, ``SHORTCUT_FACTOR``·inner·Δx·κ over
-    #: |∇φ| (κ: ``_curvature.typical_curvature``; :meth:`measure`)
+    #: |∇φ| (κ: ``_curvature.typical_curvature``; :meth:`measure`); on an open surface :data:`OPEN_BEND`
+    #: times that, κ read on the concave side (``_curvature.concave_curvature``)
     bend: float = 0.0
 
     @classmethod
@@ -263,10 +297,15 @@ class Fallback:
         closed = getattr(surface, "closed", True) is not False or (
             getattr(surface, "faces", None) is not None and open_only_in_debris(surface)
         )
-        if self.said or getattr(surface, "open_surface", False) or not closed:
-            # (an open surface's first-order errors are not sized: its φ near a rim cannot be read
-            # through differences, 3Δx would be a false alarm on a flat patch, and the bend estimate
+        if self.said:
+            return
+        if getattr(surface, "open_surface", False) or not closed:
+            # (only its bends are sized, read on their concave side: its φ near a rim cannot be read
+            # through differences, 3Δx would be a false alarm on a flat patch, and typical_curvature
             # reads a small patch's rim as a tight bend: a disc one spacing across said 75%)
+            if getattr(surface, "faces", None) is None and not getattr(surface, "redistance", False):
+                kappa = concave_curvature(tube)
+                self.bend = OPEN_BEND * SHORTCUT_FACTOR * tube.inner * tube.grid.spacing * kappa
             return
         redistanced = isinstance(surface, LevelSet) and (surface.redistance or NOISY_PHI in self.reason)
         if redistanced and not refused_for_creases(self.reason):
