@@ -69,6 +69,21 @@ def test_on_mesh_is_finite_on_the_surface_and_falls_back_near_the_band_edge(sphe
         assert np.isnan(sol.on_mesh([[0.0, 0.0, 0.0]]))[0]
 
 
+def test_on_mesh_names_a_mesh_s_own_vertices_that_no_face_uses():
+    # (it asked "are they this surface's vertices? pass surface.vertices", which they were)
+    trimesh = pytest.importorskip("trimesh")
+    sphere = trimesh.creation.icosphere(subdivisions=3, radius=0.5)
+    vertices = np.r_[sphere.vertices, [[3.0, 3.0, 3.0]], sphere.vertices[:1] * 0.2]
+    mesh = ts.surfaces.from_mesh((vertices, sphere.faces))
+    sol = ts.solve(mesh, mesh.grid(41), [sphere.vertices[0]])
+    with pytest.warns(RuntimeWarning, match=r"on_mesh: 2 of 644 vertices are used by no face of the mesh") as caught:
+        u = sol.on_mesh(mesh.vertices)
+    assert len(caught) == 1 and "pass surface.vertices" not in str(caught[0].message)
+    assert np.isnan(u[-2:]).all() and np.isfinite(u[:-2]).all()
+    with pytest.warns(RuntimeWarning, match=r"on_mesh: 2 of 2 vertices lie off the band"):
+        sol.on_mesh(vertices[-2:])  # (not the mesh's own array: the general advice)
+
+
 @pytest.mark.parametrize("suffix", [".vtu", ".vtk", ".ply"])
 def test_export_round_trip_with_meshio(sphere_sol, tmp_path, suffix):
     meshio = pytest.importorskip("meshio")

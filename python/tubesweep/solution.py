@@ -355,7 +355,7 @@ class Solution:
             pos = self._nearest_reached(p[bad])
             pos[self._beyond_tube(p[bad], pos)] = -1
             out[bad] = np.where(pos >= 0, self.values[np.maximum(pos, 0)], np.nan)
-            self._warn_off_band(p[bad[pos < 0]], len(p))
+            self._warn_off_band(p[bad[pos < 0]], len(p), self._faceless(p, bad[pos < 0]))
         return out
 
     def _beyond_tube(self, p: np.ndarray, pos: np.ndarray) -> np.ndarray:
@@ -374,11 +374,22 @@ class Solution:
         beyond[at] = distance > (self.outer + 0.5) * self.grid.spacing
         return beyond
 
-    def _warn_off_band(self, p: np.ndarray, total: int) -> None:
+    def _faceless(self, vertices: np.ndarray, which: np.ndarray) -> np.ndarray:
+        """Whether each of ``vertices[which]`` is a vertex of this solution's mesh that none of its
+        faces uses, where ``vertices`` are the mesh's own (all False otherwise)."""
+        faces, own = getattr(self.surface, "faces", None), getattr(self.surface, "vertices", None)
+        if faces is None or own is None or np.shape(own) != vertices.shape or not np.array_equal(own, vertices):
+            return np.zeros(len(which), dtype=bool)
+        used = np.zeros(len(vertices), dtype=bool)
+        used[np.asarray(faces).reshape(-1)] = True
+        return ~used[which]
+
+    def _warn_off_band(self, p: np.ndarray, total: int, faceless: Optional[np.ndarray] = None) -> None:
         """A RuntimeWarning when points that :meth:`on_mesh` leaves NaN are off the band (their
         nearest grid node is not in it, or they lie outside the box), not merely on a part of the
         surface no source reaches: they are not on this surface (a mesh's own vertices after
-        ``from_mesh(..., normalize=True)`` moved it, a mesh on another scale)."""
+        ``from_mesh(..., normalize=True)`` moved it, a mesh on another scale), or they are the
+        mesh's own vertices that no face uses (``faceless``, per point)."""
         if p.size == 0:
             return
         g = self.grid
@@ -389,7 +400,16 @@ class Solution:
             idx = np.rint(ci[inside]).astype(np.int64)
             off[inside] = self._band.find(np.ascontiguousarray(idx)) < 0
         n = int(np.count_nonzero(off))
-        if n:
+        unused = 0 if faceless is None else int(np.count_nonzero(off & faceless))
+        if unused:
+            others = f"; the other {n - unused} lie off the band too" if n > unused else ""
+            warnings.warn(
+                f"on_mesh: {unused} of {total} vertices are used by no face of the mesh and lie off the surface's band: "
+                f"NaN there{others} (trimesh's Trimesh.remove_unreferenced_vertices() drops such vertices)",
+                RuntimeWarning,
+                stacklevel=user_stacklevel(),
+            )
+        elif n:
             warnings.warn(
                 f"on_mesh: {n} of {total} vertices lie off the band (farther from the surface than the tube, or outside "
                 "the grid box): NaN there. Are they this surface's vertices? from_mesh(..., normalize=True) moves the "
