@@ -39,7 +39,7 @@ def test_the_facing_gaps_warning_is_short_says_how_much_and_points_at_the_users_
     assert len(text) < 450
     share = float(re.search(r"about ([0-9.]+)% of the surface", text).group(1))
     assert 0 < share < 5
-    assert "elsewhere the result holds" in text and "sol.narrow_gaps()" in text
+    assert "distances not reached across one hold" in text and "sol.narrow_gaps()" in text
     assert sol.stats.facing_pairs > 0
 
 

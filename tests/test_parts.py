@@ -128,3 +128,24 @@ def test_a_thin_inner_tube_or_a_corner_across_a_narrow_gap_drops_nothing_reachab
     sol = quiet(ts.solve, shell, g, [(outer_r, 0, 0)], inner=1, outer=3, order=1)
     assert sol.stats.facing_pairs > 0
     assert np.isfinite(sol([point])[0]) and np.isinf(sol([inner_r * point / outer_r])[0])
+
+
+def test_points_on_the_reached_part_read_its_values_beside_an_unreached_one():
+    # a shell three spacings thick, re-distanced, the source on its outer sphere: its inner sphere
+    # is a part no source reaches, and 36 of 20,000 points on the outer sphere read +inf through a
+    # corner of the inner sphere's tube weighing 0.001 (a helper's review)
+    grid = ts.Grid((-1,) * 3, (1,) * 3, (61,) * 3)
+    h = grid.spacing
+    r = np.linalg.norm(np.stack(grid.meshgrid(), -1), axis=-1)
+    shell = np.abs(r - (0.5 - 1.5 * h)) - 1.5 * h
+    with pytest.warns(RuntimeWarning, match="faces itself across gaps"):
+        sol = ts.solve(ts.LevelSet(shell, redistance=True), grid, [(-0.5, 0, 0)])
+    x = np.random.default_rng(0).normal(size=(20000, 3))
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    exact = 0.5 * np.arccos(np.clip(-x[:, 0], -1, 1))
+    for interpolation in ("linear", "cubic"):
+        u = sol(0.5 * x, interpolation=interpolation)
+        assert np.all(np.isfinite(u)) and np.max(np.abs(u - exact)) < 0.01 * np.pi * 0.5
+    # the inner sphere's points still read +inf, and the band's nodes there are unreached
+    assert np.all(np.isinf(sol((0.5 - 3 * h) * x[:500])))
+    assert np.count_nonzero(np.isinf(sol.values)) > 1000

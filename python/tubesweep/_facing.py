@@ -123,7 +123,8 @@ def warn_facing_pairs(
     warnings.warn(
         f"the surface faces itself across gaps narrower than its tubes at {node.size} node pair(s), about "
         f"{percent(share)} of the surface (the narrowest {float(gap[narrowest]):.3g} wide, near {where}). Distances "
-        "reached across such a gap can come out too short; elsewhere the result holds. sol.narrow_gaps() shows where; "
+        "reached across such a gap can come out too short, by up to the way round between its sides; "
+        "distances not reached across one hold. sol.narrow_gaps() shows where; "
         f"a grid spacing below {needed:.3g} (now {h:.3g}) resolves a real gap, while a crease or scan artefact stays "
         f"narrower than any grid{note}",
         RuntimeWarning,

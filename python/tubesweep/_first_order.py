@@ -29,6 +29,7 @@ from ._validate import (
     check_infinity,
     check_threads,
     check_tolerance_scale,
+    tolerance_slowness,
     first_order_tol,
     speed_on_surface,
     warn_unconverged,
@@ -93,7 +94,9 @@ def solve_on_tube(tube: _PreparedTube, req: SolveRequest, reuse: bool) -> Soluti
     # travel times set it in _hamiltonian_solve)
     tol = first_order_tol(req.tol, h, float(np.mean(slowness)), max(grid.shape))
     if req.general is None:
-        check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
+        check_tolerance_scale(
+            tol, h, float(np.mean(slowness)), max(grid.shape), front_slowness=tolerance_slowness(slowness)
+        )
     fixed = _fix(tube, band, roles, req, cut_edges)
     phi, phi_sample = tube.phi, _phi_sample(surf, tube.linear)
     if req.general is None:
@@ -138,7 +141,7 @@ def solve_on_tube(tube: _PreparedTube, req: SolveRequest, reuse: bool) -> Soluti
         reachability=req.general is None or req.general.label == "isotropic",
     )
     stats = _stats(tube, band, roles, fixed, st, slowness, req, setup, cut_edges, crease_thinned)
-    return Solution(
+    sol = Solution(
         grid,
         band,
         values,
@@ -156,6 +159,8 @@ def solve_on_tube(tube: _PreparedTube, req: SolveRequest, reuse: bool) -> Soluti
         tube.facing,
         phi_sample,
     )
+    sol._parts = parts
+    return sol
 
 
 def _directions_of(tube: _PreparedTube) -> np.ndarray:

@@ -187,12 +187,18 @@ def drop_unsourced_points(values: np.ndarray, corner_parts: np.ndarray, sourced:
 
 
 def drop_unsourced_rows(
-    rows: np.ndarray, tube: Any, groups: Any, points: Optional[np.ndarray], band: Any = None
+    rows: np.ndarray,
+    tube: Any,
+    groups: Any,
+    points: Optional[np.ndarray],
+    band: Any = None,
+    labels: Optional[np.ndarray] = None,
 ) -> np.ndarray:
     """The rows of ``Tube.solve_many`` (one per source group: band values, or the values read at
     ``points``, before any own-side reading of them) with inf on the parts of the surface other
-    than their sources', as each single solve's; ``band`` the band the sweeps ran on."""
-    parts = part_labels(tube, band)
+    than their sources', as each single solve's; ``band`` the band the sweeps ran on, ``labels``
+    its :func:`part_labels` where the caller has them."""
+    parts = part_labels(tube, band) if labels is None else labels
     if parts is None:
         return rows
     grid, band = tube.grid, tube.band if band is None else band

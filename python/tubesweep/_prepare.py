@@ -36,7 +36,13 @@ METHODS = ("two-layer", "naive")
 
 
 def _widening_message(
-    missing: np.ndarray, phi: np.ndarray, h: float, inner: float, outer: float, surface: Any = None
+    missing: np.ndarray,
+    phi: np.ndarray,
+    h: float,
+    inner: float,
+    outer: float,
+    surface: Any = None,
+    grid: Optional[Grid] = None,
 ) -> str:
     """Why inner-tube nodes (band positions ``missing``) lack a neighbour in the band of half-width
     ``outer`` spacings. For a distance function a neighbour lies at most one spacing farther from
@@ -56,6 +62,11 @@ def _widening_message(
         )
     advice = getattr(surface, "unresolved_advice", None)
     cause = "φ is not close to a distance function there" if advice is None else "the closest points fold there"
+    bound = _low_lipschitz(surface, grid)
+    if bound:
+        # (a re-distanced φ is a distance: a bound below its gradient left nodes out of the search,
+        # blamed on φ; a helper's review)
+        cause = f"the band search missed them{bound}"
     text = (
         f"{missing.size} inner-tube nodes had a neighbour outside the band with outer = {outer}: {cause} (at "
         f"{int(np.count_nonzero(~far))} of them the neighbour is more than one spacing farther out)"
@@ -368,6 +379,30 @@ def _checked_widths(inner: float, outer: float, method: str) -> Tuple[float, flo
     return inner, outer
 
 
+def _low_lipschitz(surf: Any, grid: Optional[Grid]) -> str:
+    """A note when ``surf`` is a callable φ whose given ``lipschitz`` lies below its gradient (the
+    band search skips cells where |φ| exceeds the bound times their size, and so misses nodes),
+    else ''."""
+    given = getattr(surf, "lipschitz", None)
+    if grid is None or not isinstance(surf, LevelSet) or surf._fn is None or given is None:
+        return ""
+    if surf.redistance is False and given == 1.5:  # (the default bound, not a user's)
+        return ""
+    from .redistance import estimate_lipschitz
+
+    try:
+        steepest = estimate_lipschitz(surf, grid) / 1.25
+    except ValueError:
+        return ""
+    if steepest <= given:
+        return ""
+    return (
+        f": lipschitz={given:g} is below φ's gradient (|∇φ| reads up to {steepest:.3g} over the box), and the band "
+        "search skips the cells where |φ| exceeds lipschitz times their size; pass a larger lipschitz"
+        + (" or leave it None (estimated then)" if surf.redistance else "")
+    )
+
+
 def _empty_band_message(surf: Surface, grid: Grid) -> str:
     """Why the band is empty: the surface does not pass through the grid or φ is not in its units
     (or, for a φ array given as is that changes sign, far larger than a distance near the change;
@@ -388,6 +423,9 @@ def _empty_band_message(surf: Surface, grid: Grid) -> str:
                 f"the grid box (e.g. {values[0]} at {tuple(float(c) for c in lattice[0])}): it must return finite "
                 "values near the surface"
             )
+        bound = _low_lipschitz(surf, grid)
+        if bound:
+            return f"the band is empty{bound}"
     array = getattr(surf, "_array", None) if isinstance(surf, LevelSet) and not surf.redistance else None
     # (a φ array given as is that changes sign: a surface is there, but φ is not its distance)
     signs = array is not None and bool(np.any(array < 0) and np.any(array > 0))
@@ -578,7 +616,9 @@ def _widened_band(
                 return None
             raise ValueError(_unclosed_message(surf, grid, linear[missing[0]], missing.size, outer_eff, given_bound))
         warnings.warn(
-            _widening_message(missing, phi, h, inner, outer_eff, surf), RuntimeWarning, stacklevel=user_stacklevel()
+            _widening_message(missing, phi, h, inner, outer_eff, surf, grid),
+            RuntimeWarning,
+            stacklevel=user_stacklevel(),
         )
         outer_eff += 1.0
     return _Band(geom, linear, roles, band, phi, kink, inside, direction, outer_eff)
@@ -619,8 +659,11 @@ def _prepare_tube(
     thin_parts = getattr(surf, "_warn_thin_parts", None)  # a mesh: parts closer than a spacing
     if thin_parts is not None:
         thin_parts(h, inner)
-    elif isinstance(surf, LevelSet) and not facing[0].size:  # (where gaps are found, they are said)
-        warn_thin(*thin_share(grid, band, linear, phi), h, inner)
+    elif isinstance(surf, LevelSet):
+        # (also where facing gaps were found and said, from a larger share: the gap warning gives no
+        # size, and a plate 1.2 spacings thick tilted off the grid's planes showed 14% of its
+        # surface as gaps and was crossed, its far side 0.05 for a distance of 1.0; a review)
+        warn_thin(*thin_share(grid, band, linear, phi), h, inner, gaps=bool(facing[0].size))
     holes_of = getattr(surf, "_bridged_holes", None)  # an open mesh's or a cloud's holes the band spans
     bridged_holes = holes_of(h, outer_eff, grid, gaps.over_holes) if holes_of is not None else None
     slits_of = getattr(surf, "_slits", None)  # an open mesh's slits, which the band may join

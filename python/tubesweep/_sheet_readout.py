@@ -15,6 +15,16 @@ is no farther from ``p`` than ``c`` itself (up to a quarter spacing): projecting
 through ``p`` brings a node nearer to ``p``, while the closest point of a node of the other sheet
 lies across the gap, farther from ``p`` than the node, which lies between the two.
 
+A surface of separate parts facing each other across a narrow gap (``_parts``: a level set's band
+is not cut there) keeps a part no source reaches at +∞. A single solve reads a point whose cell
+mixes reached and unreached corners from the reached ones where they carry half the cell's weight
+or more (the core's interpolation, ``REACHED_SHARE``: a shell three spacings thick read +∞ at 36
+of 20,000 points of its outer sphere, the source's, through a corner weighing 0.001), while a
+batch sets a part without a source to +∞ only after reading the points
+(``_parts.drop_unsourced_points``). So the points whose cell holds corners of a part and of
+another part or the extension layer are read from their corners in both, by the same rule
+(:meth:`OwnSidePlan.apply`), and the two give the same bits.
+
 The plan (which points, which corners, their weights) depends on the geometry only; the corner
 values are read by interpolation at the corners themselves, so that a single solve and a batch
 (``Tube.solve_many(at=...)``, which reads its rows in the core) give the same bits.
@@ -28,6 +38,7 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from ._interpolation import cell_corners
+from ._parts import NO_PART
 from .grid import Grid
 from .surfaces._mesh_parts import face_parts, point_parts
 
@@ -73,21 +84,25 @@ def own_side_plan(
     n_nodes: int,
     points: np.ndarray,
     cut: bool = True,
+    labels: Optional[np.ndarray] = None,
 ) -> Optional[OwnSidePlan]:
     """The :class:`OwnSidePlan` of ``points`` on a band of ``n_nodes`` nodes whose pairs across
     narrow gaps are ``facing`` (when the band is ``cut`` across them), and on a triangle mesh of
     separate pieces (``surfaces._mesh_parts``, cut band or not) with the corners on another
-    piece than the point's nearest face left out; None when no point's cell holds a node of a
-    pair or spans two pieces."""
+    piece than the point's nearest face left out; with the band's part ``labels``
+    (``_parts.part_labels``), also the points whose cell holds corners of two parts, all their
+    corners kept. None when no point's cell holds a node of a pair or spans two pieces or parts."""
     node, neighbour, _ = facing
     use_facing = cut and node.size > 0
     node_parts = getattr(surface, "_node_parts", None)
     pieces = node_parts is not None and face_parts(surface) is not None
-    if not (use_facing or pieces) or len(points) == 0:
+    if not (use_facing or pieces or labels is not None) or len(points) == 0:
         return None
     d, h = grid.ndim, grid.spacing
     corners, pos, weight = cell_corners(grid, band, points)
     chosen = np.zeros(len(points), bool)
+    if labels is not None:
+        chosen |= _mixes_parts(labels, pos, weight)
     if use_facing:
         paired = np.zeros(n_nodes + 1, bool)
         paired[node] = True
@@ -108,6 +123,7 @@ def own_side_plan(
     corner_points = grid.points(corners[rows].reshape(-1, d))
     own = pos[rows] >= 0
     if use_facing:
+        # (the points chosen only for their parts keep every corner: a level set's band is not cut)
         _, corner_cp = surface.project(corner_points, grid)
         _, foot = surface.project(points[rows], grid)
         at = corner_points.reshape(rows.size, -1, d)
@@ -117,3 +133,19 @@ def own_side_plan(
     if pieces:
         own &= same_piece[rows]
     return OwnSidePlan(rows, np.ascontiguousarray(corner_points), np.where(own, weight[rows], 0.0))
+
+
+def _mixes_parts(labels: np.ndarray, pos: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Which cells (rows of ``pos``, band positions of their corners, −1 off the band) have
+    corners of nonzero ``weight`` on a part of ``labels`` and others on another part or on none
+    (extension nodes, ``NO_PART``): a batch sets the corners of a part without a source to +∞
+    only after reading the points (``_parts.drop_unsourced_points``), so such a point is read
+    from its corners, as the single solve's is."""
+    n = len(labels)
+    lab = np.append(labels, NO_PART)[np.where(pos >= 0, pos, n)].astype(np.int64)
+    weighted = weight > 0
+    on_part = (lab != NO_PART) & weighted
+    low = np.where(on_part, lab, np.iinfo(np.int64).max).min(axis=1)
+    high = np.where(on_part, lab, -1).max(axis=1)
+    off_part = np.any(weighted & (lab == NO_PART) & (pos >= 0), axis=1)
+    return (high >= 0) & ((low != high) | off_part)

@@ -28,6 +28,7 @@ from ._validate import (
     check_threads,
     check_tolerance,
     check_tolerance_scale,
+    tolerance_slowness,
     first_order_tol,
     speed_on_surface,
 )
@@ -37,7 +38,7 @@ from ._wide_tube import tube_shortcut, warn_wide_tube
 from ._facing import warn_facing_pairs
 from ._prepare import paper_creases_of, thinned_count, uncut_band
 from ._roles import ROLE_INNER
-from ._parts import drop_unsourced_rows
+from ._parts import drop_unsourced_rows, part_labels
 from ._sheet_readout import own_side_plan
 from ._fallback import Fallback
 from ._sources import SOURCE_RADIUS, _fix_sources, slowness_on_surface
@@ -379,7 +380,9 @@ def _first_order_batch(
     speed_nodes = speed_on_surface(speed, grid, linear, t.phi, t.geom.direction, t.inner * h)
     slowness: Any = 1.0 / speed_nodes
     tol = first_order_tol(tol, h, float(np.mean(slowness)), max(grid.shape))  # the first-order scheme's default
-    check_tolerance_scale(tol, h, float(np.mean(slowness)), max(grid.shape))
+    check_tolerance_scale(
+        tol, h, float(np.mean(slowness)), max(grid.shape), front_slowness=tolerance_slowness(slowness)
+    )
     # the Lax–Friedrichs scheme runs on the band before its cut (``_shortcuts``), with the warning
     uncut = scheme == "lxf" and t.cut_edges > 0
     band = uncut_band(t) if uncut else t.band
@@ -389,9 +392,17 @@ def _first_order_batch(
     # on a band cut across narrow gaps, points next to a gap read from their own side: the values
     # at their cells' corners come back as extra points
     plan = None
+    labels = part_labels(t, band)  # (a point whose cell spans two parts reads its reached corners)
     if points is not None:
         plan = own_side_plan(
-            grid, t.surface, band, t.facing, len(t.linear), points, cut=bool(t.cut_edges) and not uncut
+            grid,
+            t.surface,
+            band,
+            t.facing,
+            len(t.linear),
+            points,
+            cut=bool(t.cut_edges) and not uncut,
+            labels=labels,
         )
     read_at = points if plan is None else np.ascontiguousarray(np.concatenate([points, plan.corners]))
     missing_policy = "infinity" if (t.method == "naive" and scheme == "godunov") else "extrapolate"
@@ -443,7 +454,7 @@ def _first_order_batch(
     if thinned_count(t) == 0:  # the paper's tube: its creases' corners are cut
         warn_paper_tube_creases(paper_creases_of(t), t.inner, h)
     # a part without a source keeps inf (``_parts``), read as the single solve reads it
-    out = drop_unsourced_rows(out, t, groups, None if points is None else read_at, band)
+    out = drop_unsourced_rows(out, t, groups, None if points is None else read_at, band, labels)
     if plan is not None:
         m = len(points)  # type: ignore[arg-type]
         out = plan.apply(np.ascontiguousarray(out[:, :m]), out[:, m:])

@@ -23,7 +23,7 @@ from . import _native
 from ._coarse_creases import widened_for_order2
 from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
-from ._parts import drop_unsourced_rows
+from ._parts import drop_unsourced_rows, part_labels
 from ._prepare import thinned_count
 from ._sheet_readout import own_side_plan
 from .mask import mask_advice
@@ -84,7 +84,9 @@ def solve_many_order2(
         points = np.ascontiguousarray(points, dtype=float)
         # on a band cut across narrow gaps (or a mesh of separate pieces), points next to a gap
         # read from their own side (as sol(points)): their cells' corners are read as extra points
-        plan = own_side_plan(grid, surf, t.band, t.facing, len(t.linear), points, cut=bool(t.cut_edges))
+        plan = own_side_plan(
+            grid, surf, t.band, t.facing, len(t.linear), points, cut=bool(t.cut_edges), labels=part_labels(t)
+        )
         if plan is not None:
             points = np.ascontiguousarray(np.concatenate([points, plan.corners]))
         # the points' closest points (used within the reach of a source only), on every kind of

@@ -323,7 +323,7 @@ def tube_inputs(tube: Any, speed: Any, tol: Optional[float]) -> TubeInputs:
         tol = default
     # travel times too large or too small for the local updates' squares, a tol not small against
     # them: refused as for order=1 (they came out inf, or 1.5x off, reported converged)
-    check_tolerance_scale(tol, h, mean_slowness, max(grid.shape))
+    check_tolerance_scale(tol, h, mean_slowness, max(grid.shape), front_slowness=tol_slowness)
     offsets = None
     if isinstance(surf, ClosestPoint):
         # x − cp(x) at the band nodes in float64 (the band keeps only float32 directions): n and
@@ -772,6 +772,7 @@ def solve_on_tube(
         tube.facing,
         phi_sample,
     )
+    sol._parts = parts
     sol._factoring = (
         u0,
         feet,

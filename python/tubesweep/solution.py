@@ -107,6 +107,10 @@ class Solution:
         self._facing = facing if facing is not None else (empty, empty, np.empty(0))
         # for a φ array: its values at a sample of the band's nodes (linear indices, values)
         self._phi_sample = phi_sample
+        # the surface's parts per band node where two face each other across a narrow gap
+        # (``_parts.part_labels``; None otherwise): a point whose cell holds corners of two reads
+        # its reached corners (``_sheet_readout``)
+        self._parts: Optional[np.ndarray] = None
         # order=2 with point sources: (u₀ per node, the sources' foot points, their slowness)
         self._factoring: Optional[Tuple[np.ndarray, np.ndarray, np.ndarray, float]] = None
         self._first_order_positions: Optional[np.ndarray] = None
@@ -255,8 +259,9 @@ class Solution:
         numpy.ndarray
             ``(M,)`` values; NaN where the cell's corners leave the band (points farther from the
             surface than about the tube's outer width less a cell, or outside the grid), with a
-            ``RuntimeWarning`` that counts them; +∞ where a corner was not reached (a part of the
-            surface no source reaches).
+            ``RuntimeWarning`` that counts them; +∞ on a part of the surface no source reaches
+            (where the cell's reached corners carry less than half its weight; where they carry
+            more, the value is theirs, renormalised).
 
         Raises
         ------
@@ -303,7 +308,14 @@ class Solution:
         # side of the gap (at second order its cell's corners read as any point: the factored form
         # near a source)
         plan = own_side_plan(
-            self.grid, self.surface, self._band, self._facing, len(self.values), p, cut=bool(self.stats.cut_edges)
+            self.grid,
+            self.surface,
+            self._band,
+            self._facing,
+            len(self.values),
+            p,
+            cut=bool(self.stats.cut_edges),
+            labels=getattr(self, "_parts", None),  # (a solution pickled before it had parts)
         )
         if plan is not None:
             out = plan.apply(out, self._read(plan.corners, "linear"))
