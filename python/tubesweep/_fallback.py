@@ -242,7 +242,7 @@ def _warn_open_bend(reason: str, values: Any, tube: Any, bend: float) -> None:
     """:func:`warn_first_order` on an open surface whose bends cost a share ``bend`` of the
     distances (:attr:`Fallback.bend`, read on the concave side)."""
     spacing = tube.grid.spacing
-    largest = float(np.max(values[np.isfinite(values)], initial=0.0))
+    _, largest = first_order_share(values, spacing)
     scale = SHORTCUT_FACTOR * OPEN_BEND * tube.inner / bend
     size = "as large as the distances" if bend >= 1 else f"of roughly {100 * bend:.0f}% of the distances"
     warnings.warn(

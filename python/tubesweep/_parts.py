@@ -113,8 +113,14 @@ def parts_at(grid: Grid, band: Any, labels: np.ndarray, points: np.ndarray, weig
     where a corner is not in the band; with ``weighted``, also where its multilinear weight is 0,
     computed as the core's interpolation computes it: :func:`~tubesweep._interpolation.cell_corners`)."""
     _, pos, weight = cell_corners(grid, band, points)
+    return corner_parts(labels, pos, weight if weighted else None)
+
+
+def corner_parts(labels: np.ndarray, pos: np.ndarray, weight: Optional[np.ndarray] = None) -> np.ndarray:
+    """The parts of ``labels`` at band positions ``pos`` (cells' corners, −1 off the band: NO_PART),
+    and NO_PART where ``weight``, when given, is 0."""
     out = np.append(labels, np.uint32(NO_PART))[np.where(pos >= 0, pos, len(labels))]
-    if weighted:
+    if weight is not None:
         out[weight == 0.0] = NO_PART
     return out
 

@@ -29,6 +29,7 @@ from ._roles import ROLE_INNER, ROLE_OUTER, tube_roles
 from ._facing import facing_gaps
 from ._box_cut import box_cut, warn_box_cut
 from ._coarse_creases import creases_of_redistanced
+from .redistance import LIPSCHITZ_MARGIN, estimate_lipschitz
 from ._creases import crease_nodes_to_extend, creases_in_paper_tube
 from ._thin_level_set import thin_share, warn_thin
 
@@ -388,10 +389,8 @@ def _low_lipschitz(surf: Any, grid: Optional[Grid]) -> str:
         return ""
     if surf.redistance is False and given == 1.5:  # (the default bound, not a user's)
         return ""
-    from .redistance import estimate_lipschitz
-
     try:
-        steepest = estimate_lipschitz(surf, grid) / 1.25
+        steepest = estimate_lipschitz(surf, grid) / LIPSCHITZ_MARGIN
     except ValueError:
         return ""
     if steepest <= given:

@@ -38,7 +38,7 @@ from typing import Any, Optional, Tuple
 import numpy as np
 
 from ._interpolation import cell_corners
-from ._parts import NO_PART
+from ._parts import NO_PART, corner_parts
 from .grid import Grid
 from .surfaces._mesh_parts import face_parts, point_parts
 
@@ -141,11 +141,9 @@ def _mixes_parts(labels: np.ndarray, pos: np.ndarray, weight: np.ndarray) -> np.
     (extension nodes, ``NO_PART``): a batch sets the corners of a part without a source to +∞
     only after reading the points (``_parts.drop_unsourced_points``), so such a point is read
     from its corners, as the single solve's is."""
-    n = len(labels)
-    lab = np.append(labels, NO_PART)[np.where(pos >= 0, pos, n)].astype(np.int64)
-    weighted = weight > 0
-    on_part = (lab != NO_PART) & weighted
+    lab = corner_parts(labels, pos, weight).astype(np.int64)
+    on_part = lab != NO_PART
     low = np.where(on_part, lab, np.iinfo(np.int64).max).min(axis=1)
     high = np.where(on_part, lab, -1).max(axis=1)
-    off_part = np.any(weighted & (lab == NO_PART) & (pos >= 0), axis=1)
+    off_part = np.any((weight > 0) & ~on_part & (pos >= 0), axis=1)
     return (high >= 0) & ((low != high) | off_part)

@@ -80,13 +80,12 @@ def solve_many_order2(
     feet, src_slowness = so.source_feet(surf, grid, every, t.inner * h, speed, names)
     at_feet = None
     plan = None
+    labels = part_labels(t)  # (read once: the plan and the parts without a source)
     if points is not None:
         points = np.ascontiguousarray(points, dtype=float)
         # on a band cut across narrow gaps (or a mesh of separate pieces), points next to a gap
         # read from their own side (as sol(points)): their cells' corners are read as extra points
-        plan = own_side_plan(
-            grid, surf, t.band, t.facing, len(t.linear), points, cut=bool(t.cut_edges), labels=part_labels(t)
-        )
+        plan = own_side_plan(grid, surf, t.band, t.facing, len(t.linear), points, cut=bool(t.cut_edges), labels=labels)
         if plan is not None:
             points = np.ascontiguousarray(np.concatenate([points, plan.corners]))
         # the points' closest points (used within the reach of a source only), on every kind of
@@ -135,7 +134,7 @@ def solve_many_order2(
         raise
     st = dict(st)
     # a part without a source keeps inf (``_parts``), read as the single solve reads it
-    values = drop_unsourced_rows(values, t, groups, points)
+    values = drop_unsourced_rows(values, t, groups, points, labels=labels)
     if plan is not None:
         m = len(points) - len(plan.corners)  # type: ignore[arg-type]
         values = plan.apply(np.ascontiguousarray(values[:, :m]), values[:, m:])

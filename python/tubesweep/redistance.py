@@ -211,6 +211,10 @@ def _project(
     )
 
 
+#: :func:`estimate_lipschitz`'s bound over the largest |∇φ| it reads.
+LIPSCHITZ_MARGIN = 1.25
+
+
 def estimate_lipschitz(surface, grid, n: int = 17) -> float:
     """1.25 × the largest |∇φ| on an n^d lattice over the grid box (central differences; for an
     array, over all its nodes), at least 1e-12: the bound on |∇φ| that finds the candidate band
@@ -218,7 +222,7 @@ def estimate_lipschitz(surface, grid, n: int = 17) -> float:
     :func:`redistanced_band`)."""
     if surface.is_dense:
         # the largest |∇φ| of numpy.gradient over every node, in one pass with nothing stored
-        return max(1.25 * _native.max_gradient_norm_of_samples(surface._array, grid.spacing), 1e-12)
+        return max(LIPSCHITZ_MARGIN * _native.max_gradient_norm_of_samples(surface._array, grid.spacing), 1e-12)
     axes = [np.linspace(lo, hi, n) for lo, hi in zip(grid.lower, grid.upper)]
     pts = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, grid.ndim)
     step = (grid.upper[0] - grid.lower[0]) / (n - 1) * 0.25
@@ -234,7 +238,7 @@ def estimate_lipschitz(surface, grid, n: int = 17) -> float:
             f"box (a {n}^{grid.ndim} lattice): pass lipschitz= (a bound on |∇φ|, e.g. 1.5 for a distance) so that φ is "
             "evaluated near its surface only, or make φ finite over the box"
         ) from None
-    return max(1.25 * float(np.max(np.linalg.norm(g, axis=1))), 1e-12)
+    return max(LIPSCHITZ_MARGIN * float(np.max(np.linalg.norm(g, axis=1))), 1e-12)
 
 
 #: Passes of :func:`_narrowed_by_candidate_gradients`.
