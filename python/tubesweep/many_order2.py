@@ -25,6 +25,7 @@ from ._creases import thinned_spacings, warn_creases
 from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
 from ._parts import drop_unsourced_rows, part_labels
 from ._prepare import thinned_count
+from ._runaway import first_order_errors, runaway_cause
 from ._sheet_readout import own_side_plan
 from .mask import mask_advice
 from ._stagnation import FALLBACK_WARNING, fallback_message
@@ -143,7 +144,11 @@ def solve_many_order2(
         # values falling without bound for these sources: no factored solution; the caller raises
         # (order=2) or solves them at first order ("auto"), with this text (second_order.Order2RanAway)
         st["ran_away"] = so.ran_away_message(
-            int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness, t.surface
+            int(st["runaway_iteration"][failed[0]]),
+            inputs.slowness,
+            src_slowness,
+            t.surface,
+            redone=bool(st["runaway_first_iteration"][failed[0]] >= 0),
         )
     st["tol"] = inputs.tol
     st["bridged_holes"] = t.bridged_holes
@@ -177,6 +182,7 @@ def solve_many_order2(
                 RuntimeWarning,
                 stacklevel=user_stacklevel(),
             )
+    warn_runaway_rows(st, failed, len(groups), number_from, runaway_cause(inputs.slowness, src_slowness, t.surface))
     # the stagnation fallbacks large enough to warn of (``_stagnation``), as the single solve does
     large = np.flatnonzero(
         (st["fallback_iteration"] >= 0)
@@ -201,3 +207,23 @@ def solve_many_order2(
             stacklevel=user_stacklevel(),
         )
     return values, st
+
+
+def warn_runaway_rows(st: Dict[str, Any], failed: np.ndarray, k: int, number_from: int, cause: str) -> None:
+    """The warning of a batch's solves whose sweeps ran away and were solved again with the
+    runaway's nodes at first order (``_runaway``; the stats' ``runaway_nodes`` per row), the
+    rows that ran away again left to the caller."""
+    redone = np.setdiff1d(np.flatnonzero((st["runaway_first_iteration"] >= 0) & (st["runaway_iteration"] < 0)), failed)
+    if not redone.size:
+        return
+    most = int(np.max(st["runaway_nodes"][redone]))
+    share = 100.0 * most / max(int(st["inner_nodes"]), 1)
+    warnings.warn(
+        f"order=2: the second-order sweeps of {redone.size} of {k} solves (sources "
+        f"{(redone[:5] + number_from).tolist()}{'…' if redone.size > 5 else ''}) ran away: the factored update is not "
+        f"causal {cause}. They were solved again from their sources with up to {most} inner-tube nodes ({share:.2g}% "
+        "of them) at the paper's first-order update, second order elsewhere: their errors are "
+        f"{first_order_errors(cause)}. The stats' 'runaway_nodes' (return_stats=True) counts them per solve",
+        RuntimeWarning,
+        stacklevel=user_stacklevel(),
+    )

@@ -26,6 +26,7 @@ from ._parts import drop_unsourced, part_labels, source_parts
 from ._prepare import thinned_count
 from ._roles import ROLE_OUTER
 from ._result_check import stranded_nodes
+from ._runaway import runaway_cause, runaway_report, warn_runaway
 from .mask import mask_advice
 from .moving import values_checksum
 from ._stagnation import fallback_message
@@ -87,31 +88,17 @@ class Order2RanAway(Order2NotApplicable):
     first-order scheme, which is not factored."""
 
 
-def ran_away_message(iteration: Any, slowness: Any, src_slowness: np.ndarray, surface: Any = None) -> str:
-    """:class:`Order2RanAway`'s text: where it ran away, and how much faster than the sources the
-    fastest part of the band is; at a constant speed, what of the ``surface`` the grid may not
-    resolve (its ``unresolved_advice`` where it has one: a point cloud's sampling)."""
-    fastest = float(np.min(slowness))
-    contrast = float(np.max(src_slowness)) / fastest if fastest > 0 else float("inf")
-    if contrast >= RAN_AWAY_CONTRAST:
-        cause = f"where the speed is much higher than at the sources (here up to {contrast:.3g} times)"
-    else:
-        speed = "a constant speed" if contrast <= 1.0 + 1e-9 else f"a speed at most {contrast:.3g} times the sources'"
-        what = getattr(surface, "unresolved_advice", None) or (
-            "a dent, bump or noise that the grid does not resolve: a finer grid or a smoother φ may avoid it"
-        )
-        cause = f"on this band, with {speed}: the surface is the likely cause ({what})"
+def ran_away_message(
+    iteration: Any, slowness: Any, src_slowness: np.ndarray, surface: Any = None, redone: bool = False
+) -> str:
+    """:class:`Order2RanAway`'s text: where it ran away, and why (``_runaway.runaway_cause``);
+    ``redone``: solved again with the runaway's nodes at first order, which ran away too."""
+    again = " (and again with the nodes where they ran away at first order)" if redone else ""
     return (
         f"order=2: the second-order sweeps ran away at their iteration {iteration} (travel times fell below zero) and "
-        f"the first-order factored restart did too: the factored update is not causal {cause}. order=1, the paper's "
-        "scheme, which is not factored, solves it"
+        f"the first-order factored restart did too{again}: the factored update is not causal "
+        f"{runaway_cause(slowness, src_slowness, surface)}. order=1, the paper's scheme, which is not factored, solves it"
     )
-
-
-#: :func:`ran_away_message` names the speed as the cause of a runaway from this ratio of the
-#: sources' slowness to the smallest in the band on (a fast region of 70–1000 times ran away on
-#: the sphere at N = 41; 3–50 did not).
-RAN_AWAY_CONTRAST = 10.0
 
 
 #: Inner-tube nodes whose closest point is within this many grid spacings of a source are fixed
@@ -471,7 +458,8 @@ def warn_first_order_nodes(
     first-order update (the native report's ``first_order_nodes``, ``inner_nodes`` and
     ``first_order_reasons``: the tube's geometry, the same for every source of a batch), with
     the cure for ``surface``'s kind."""
-    first_order = int(st["first_order_nodes"])
+    # (the nodes where the sweeps ran away are said apart: _runaway.warn_runaway)
+    first_order = int(st["first_order_nodes"]) - int(st["first_order_reasons"].get("runaway", 0))
     if first_order > FIRST_ORDER_WARNING * st["inner_nodes"]:
         r = st["first_order_reasons"]
         # (φ not a distance at most of them: a finer grid does not cure that, re-distancing does; a
@@ -568,6 +556,11 @@ def keep_for_warm_starts(
         sol._digested = "the previous solve did not converge"
     elif st["runaway_iteration"] is not None:
         sol._digested = "the previous solve's second-order sweeps ran away (its values are first order)"
+    elif st.get("runaway_first_iteration") is not None:
+        # the digests stand for the tube's updates, not for those of the nodes put at first order
+        sol._digested = (
+            "the previous solve's second-order sweeps ran away and were solved again with nodes at first order"
+        )
     else:
         sol._digests = st["digests"]
         sol._digested = (float(tol), values_checksum(sol.values))
@@ -709,7 +702,8 @@ def solve_on_tube(
         keep_digests or warm is not None,
     )
     if st["restart_failed"]:
-        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf))
+        redone = st["runaway_first_iteration"] is not None
+        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf, redone))
     if parts is not None:
         drop_unsourced(values, parts, sourced)
     split = split_at_creases(tube, values)
@@ -717,6 +711,8 @@ def solve_on_tube(
         raise Order2NotApplicable(split)
     widened_for_order2(st, tube)  # a rounded crease read through a smoothing
     warn_about(st, tube, max_iterations, tol, values, inputs.default_tol)
+    runaway = runaway_report(st, tube)  # solved again with the runaway's nodes at first order
+    warn_runaway(runaway, int(st["inner_nodes"]), runaway_cause(inputs.slowness, src_slowness, surf))
     n_outer = int(np.count_nonzero(roles_out == ROLE_OUTER))
     positions = np.flatnonzero(roles_out == 0)
     stats = SolveStats.of_sweeps(
@@ -735,7 +731,7 @@ def solve_on_tube(
         # a runaway's values are the first-order factored restart's (warn_about says so)
         order=2 if st["runaway_iteration"] is None else 1,
         order_fallback=None if st["runaway_iteration"] is None else RAN_AWAY_RESTARTED,
-        order2=order2_report(st, tol, surf, h, warm_info, warm_values is not None),
+        order2={**order2_report(st, tol, surf, h, warm_info, warm_values is not None), "runaway": runaway},
         box_cut=tube.box_cut,
         bridged_holes=tube.bridged_holes,
         slits=tube.slits,

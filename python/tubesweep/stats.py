@@ -102,7 +102,11 @@ class SolveStats:
         curvature found in the tube), ``grad_norm_range`` (|∇φ| in the inner tube),
         ``inner_nodes``, ``first_order_nodes`` (the inner-tube nodes that ran the first-order update:
         second order is decided node by node) and ``first_order_reasons`` (how many for each
-        reason: ``curvature``, ``gradient``, ``stencil``; ``sol.first_order_points()`` shows where),
+        reason: ``curvature``, ``gradient``, ``stencil``, ``runaway``; ``sol.first_order_points()`` shows
+        where), ``runaway`` (when the sweeps ran away and were solved again with the nodes where they
+        did at first order: ``iteration``, the first attempt's phase-2 iteration at which they ran
+        away, ``nodes``, the inner-tube nodes so put, and ``near``, where the values fell farthest;
+        None otherwise),
         ``geometry_fitted`` (whether the derivatives of a noisy φ came from least-squares fits),
         ``creases`` (the crease nodes found, ``angle_degrees`` the largest turn of the normal
         between neighbours there, ``faces_angle_degrees`` the widest across a node, which sizes

@@ -458,8 +458,14 @@ fn run_order2<'py, const D: usize>(
             .into_pyarray(py),
     )?;
     d.set_item("unreached", col(&|s| s.unreached as i64).into_pyarray(py))?;
+    // per row, the inner-tube nodes that a runaway left at first order (solved again with them so)
+    d.set_item("runaway_nodes", col(&|s| s.demoted_nodes as i64).into_pyarray(py))?;
+    d.set_item(
+        "runaway_first_iteration",
+        col(&|s| s.demoted_runaway_iteration.map_or(-1, |v| v as i64)).into_pyarray(py),
+    )?;
     // the tube's geometry, shared by every source (the inner nodes that run the first-order update)
-    crate::geometry_report::geometry_report(py, &d, &summary)?;
+    crate::geometry_report::geometry_report(py, &d, &summary, 0)?;
     d.set_item("reach", reach)?;
     Ok((array, d))
 }

@@ -8,7 +8,7 @@ use tubesweep_core::band::NarrowBand;
 use tubesweep_core::second_order::fingerprint::node_fingerprints;
 use tubesweep_core::second_order::warm::WarmStart;
 use tubesweep_core::second_order::{
-    check_geometry_of, first_order_start, starting_values, sweep_second_order, tube_setup_of, Implicit,
+    check_geometry_of, first_order_start, starting_values, sweep_second_order_reporting, tube_setup_of, Implicit,
     SecondOrderOptions,
 };
 use tubesweep_core::sweep::{NodeRole, Slowness};
@@ -117,7 +117,7 @@ fn run<'py, const D: usize>(
         } else {
             Vec::new()
         };
-        let stats = if let Some(carried) = inp.warm {
+        let (stats, demoted) = if let Some(carried) = inp.warm {
             // a warm start (tubesweep_core::second_order::warm): phase 2 from the carried values
             let start = WarmStart {
                 carried,
@@ -136,8 +136,10 @@ fn run<'py, const D: usize>(
                 &inp.options,
                 &mut callback,
             )?;
+            let stats = w.stats;
+            let demoted = w.demoted.clone();
             warm_report = Some(w);
-            w.stats
+            (stats, demoted)
         } else {
             let mut first_seconds = 0.0;
             let mut first_iterations = 0;
@@ -159,7 +161,7 @@ fn run<'py, const D: usize>(
                 first_seconds = st.seconds;
                 first_iterations = st.iterations;
             }
-            let mut stats = sweep_second_order(
+            let (mut stats, demoted) = sweep_second_order_reporting(
                 band,
                 &geometry,
                 &factoring,
@@ -174,7 +176,7 @@ fn run<'py, const D: usize>(
                 stats.first_order_iterations += first_iterations;
                 stats.seconds += first_seconds;
             }
-            stats
+            (stats, demoted)
         };
         // what the solve holds besides the band and the arrays it borrows from the tube (φ,
         // the directions, the roles given): the inner nodes' geometry and ∂u₀, u₀, |φ|, the
@@ -189,13 +191,16 @@ fn run<'py, const D: usize>(
             + 4 * (band.n_rows() + 1)
             + if inp.keep_digests { digests.capacity() * 8 } else { 0 };
         let roles_out: Vec<u8> = factoring.roles.iter().map(|&r| r as u8).collect();
-        // where the update ran first order (band positions), node by node
-        let first_order: Vec<u32> = (0..n)
+        // where the update ran first order (band positions), node by node: the geometry's, and
+        // where the sweeps ran away (tubesweep_core::second_order::demotion)
+        let mut first_order: Vec<u32> = (0..n)
             .filter(|&i| roles[i] != NodeRole::Outer)
             .zip(&geometry.nodes)
             .filter(|(_, g)| g.first_order() != 0)
             .map(|(i, _)| i as u32)
+            .chain(demoted.iter().copied())
             .collect();
+        first_order.sort_unstable();
         Ok::<_, tubesweep_core::Error>((
             values,
             factoring.u0,
@@ -229,7 +234,10 @@ fn run<'py, const D: usize>(
     d.set_item("restart_failed", stats.restart_failed)?;
     d.set_item("unreached", stats.unreached)?;
     d.set_item("solver_bytes", bytes)?;
-    crate::geometry_report::geometry_report(py, &d, &summary)?;
+    crate::geometry_report::geometry_report(py, &d, &summary, stats.demoted_nodes)?;
+    // where and when the sweeps ran away, when they were solved again with those nodes at first order
+    d.set_item("runaway_at", stats.demoted_at)?;
+    d.set_item("runaway_first_iteration", stats.demoted_runaway_iteration)?;
     d.set_item("geometry_fitted", summary.fitted_everywhere)?;
     d.set_item("first_order_positions", first_order.into_pyarray(py))?;
     if inp.keep_digests {

@@ -51,6 +51,24 @@ impl NodeGeometry {
         }
     }
 
+    /// A resolved node's geometry (tests).
+    #[cfg(test)]
+    pub(super) fn resolved_for_tests() -> Self {
+        NodeGeometry {
+            normal: [0.6, 0.8, 0.0],
+            packed_b: [1.2, 0.1, 0.0, 1.1, 0.0, 1.0],
+        }
+    }
+
+    /// This node's geometry at first order (B = I, its normal kept), for `reason`.
+    pub(super) fn at_first_order<const D: usize>(&self, reason: Unresolved) -> Self {
+        let mut identity = [0.0f32; 6];
+        for k in 0..D {
+            identity[sym(k, k)] = 1.0;
+        }
+        Self::first_order_node(self.normal, identity, reason)
+    }
+
     /// Why the node runs the paper's first-order update (Eq. (3), B = I) instead of the
     /// second-order one: 0 where the local geometry is resolved, else one of the
     /// [`Unresolved`] reasons. Decided node by node ([`node_geometry`]): a crease, a corner, a
@@ -85,6 +103,8 @@ pub enum Unresolved {
     /// A principal curvature κ with `outer_width`·κ ≥ 1, or I − φD²φ singular: a crease, a
     /// corner, noise, a curvature the tube does not resolve, or beyond an open surface's rim.
     Curvature = 3,
+    /// The sweeps ran away here ([`super::demotion`]): the factored update is not causal.
+    Runaway = 4,
 }
 
 /// Index of entry (k, l) of a packed symmetric matrix.

@@ -16,13 +16,16 @@
 //! * [`local`]: the limited BDF2/BDF3 Godunov update (continuous ramps from first to second to third
 //!   order, Newton's method for the unequal steps) and the second-order extension update;
 //! * [`solver`]: phase 1 (first order, monotone) then phase 2 (second order, assignment), with
-//!   the stagnation safeguard;
+//!   the stagnation safeguard ([`attempt`]), and where they run away, once more with the
+//!   runaway's nodes at first order ([`demotion`]);
 //! * [`warm`]: phase 2 from a moved surface's previous values (warm starts).
 //!
 //! The first-order solver ([`crate::sweep`]) is untouched: `order=1` is the paper's scheme.
 
 mod active;
+mod attempt;
 pub mod creases;
+mod demotion;
 pub mod factoring;
 pub mod fingerprint;
 pub mod geometry;
@@ -46,7 +49,7 @@ pub use factoring::{factor_sources, factor_sources_of, Factoring};
 pub use geometry::{tube_geometry, tube_geometry_of, GeometrySummary, NodeGeometry, TubeGeometry, Unresolved};
 pub use implicit::Implicit;
 pub use setup::tube_setup_of;
-pub use solver::{sweep_second_order, SecondOrderOptions, SecondOrderStats};
+pub use solver::{sweep_second_order, sweep_second_order_reporting, SecondOrderOptions, SecondOrderStats};
 pub use stagnation::STALL_RATIO;
 pub use start::first_order_start;
 

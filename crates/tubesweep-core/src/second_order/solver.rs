@@ -28,18 +28,16 @@
 //! value (first order: mean error 6.8e-4 instead of 3.4e-5 on the sphere at N = 201).
 
 use std::sync::atomic::{AtomicU8, Ordering};
-use std::time::Instant;
 
 use crate::band::{NarrowBand, NeighbourTable};
 use crate::error::{Error, Result};
 use crate::sweep::sweep_state::{Accumulator, SharedValues};
 use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 
+use super::attempt::{attempt, Attempts};
 use super::factoring::Factoring;
 use super::geometry::{NodeGeometry, TubeGeometry};
 use super::local::{corrected_slowness_squared, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
-use super::phase::{run_phase, RunPhase};
-use super::pipeline::Pipeline;
 
 /// Stopping rules of the two phases.
 #[derive(Debug, Clone, Copy)]
@@ -105,6 +103,16 @@ pub struct SecondOrderStats {
     /// solution, and the caller needs another scheme (the Python package: the paper's first
     /// order).
     pub restart_failed: bool,
+    /// Inner-tube nodes that a runaway left at first order ([`super::demotion`]): the first
+    /// attempt ran away (at phase-2 iteration `demoted_runaway_iteration`), and the solve was done
+    /// again from the sources with these nodes' update the paper's (unfactored, B = I). 0 when
+    /// nothing ran away.
+    pub demoted_nodes: usize,
+    /// The band index of the node found farthest below the chord from the sources, or falling
+    /// most where the restart crept (where the runaway was), when nodes were demoted.
+    pub demoted_at: Option<usize>,
+    /// The first attempt's phase-2 iteration at which it ran away, when nodes were demoted.
+    pub demoted_runaway_iteration: Option<usize>,
 }
 
 /// A phase-2 value below `-RUNAWAY_FLOOR·σ̄·Δx` is a runaway: the solution is non-negative and
@@ -128,7 +136,7 @@ pub(super) const WOKE: u8 = 2;
 pub(super) struct Limits {
     pub(super) second: bool,
     pub(super) decreases_only: bool,
-    threshold: f64,
+    pub(super) threshold: f64,
     pub(super) window: f64,
     pub(super) settled: f64,
     /// A value changed to below this ends the phase as a runaway (phase 2 only; −∞ otherwise).
@@ -137,7 +145,7 @@ pub(super) struct Limits {
 
 impl Limits {
     /// The first phase's: first order, monotone, to `tol`.
-    fn first_order(tol: f64) -> Self {
+    pub(super) fn first_order(tol: f64) -> Self {
         Limits {
             second: false,
             decreases_only: true,
@@ -176,6 +184,10 @@ pub(super) struct Sweeper<'a, const D: usize> {
     unresolved_extension_from: f32,
     /// More than one source: the BDF2 ramp's kink test is off ([`super::local::Upwind::w0_kink`]).
     several_sources: bool,
+    /// Per band node, whether its extension update extends u instead of w ([`super::demotion`]:
+    /// where u₀ is not constant along the normals, extending w lowers u by u₀'s step at every
+    /// pass); empty: nowhere.
+    extends_u: &'a [bool],
 }
 
 /// An inner-tube node whose geometry is not resolved and which lies this many grid spacings or
@@ -196,6 +208,49 @@ pub(super) const UNRESOLVED_EXTENSION_FROM: f64 = 1.0;
 /// the O(Δx²∂²u₀) by which a side's first-order value on w differs from u1 where the chord u₀
 /// curves by up to about 10/ℓ along an axis.
 const UPWIND_MARGIN: f64 = 10.0;
+
+impl<'a, const D: usize> Sweeper<'a, D> {
+    /// The sweeps' view of the tube: `geometry` per inner-tube node (the tube's, or with a
+    /// runaway's nodes at first order), the factoring, the options' ramp and extension limit;
+    /// `extends_u`: the nodes whose extension update extends u ([`super::demotion`]).
+    pub(super) fn new(
+        band: &'a NarrowBand<D>,
+        (geometry, abs_phi): (&'a [NodeGeometry], &'a [f32]),
+        (factoring, directions, slowness): (&'a Factoring<D>, &'a [[f32; D]], Slowness<'a>),
+        spacing: f64,
+        options: &SecondOrderOptions,
+        extends_u: &'a [bool],
+    ) -> Self {
+        let ramp_constant = match slowness {
+            Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
+            Slowness::PerNode(_) => f64::NAN,
+        };
+        Sweeper {
+            table: band.neighbour_table(),
+            roles: &factoring.roles,
+            geometry,
+            directions,
+            u0: &factoring.u0,
+            grad_u0: &factoring.grad_u0,
+            grad_u0_unit: factoring.grad_u0_unit,
+            slowness,
+            spacing,
+            ramp_scale: options.ramp_length / (spacing * spacing),
+            ramp_constant,
+            inv_sigma_constant: match slowness {
+                Slowness::Constant(s) => 1.0 / s,
+                Slowness::PerNode(_) => f64::NAN,
+            },
+            margin_constant: UPWIND_MARGIN / ramp_constant,
+            abs_phi,
+            extension_limit: options.extension_limit,
+            unresolved_extension_from: (UNRESOLVED_EXTENSION_FROM * spacing
+                / super::geometry::power_of_two_near(spacing)) as f32,
+            several_sources: factoring.fixed_per_source.len() > 1,
+            extends_u,
+        }
+    }
+}
 
 impl<const D: usize> Sweeper<'_, D> {
     #[inline(always)]
@@ -375,6 +430,17 @@ impl<const D: usize> Sweeper<'_, D> {
         let abs_phi_of = |j: usize| unsafe { *self.abs_phi.get_unchecked(j) };
         let direction = unsafe { self.directions.get_unchecked(i) };
         let abs_phi = abs_phi_of(i);
+        // w at a neighbour, or u there less u₀ here where this node extends u
+        let on_u = !self.extends_u.is_empty() && self.extends_u[i];
+        let value = |j: usize| {
+            let w = w.get(j);
+            if on_u {
+                // SAFETY: `j` and `i` are band nodes, and u₀ has one value per node
+                w + unsafe { *self.u0.get_unchecked(j) - *self.u0.get_unchecked(i) }
+            } else {
+                w
+            }
+        };
         let limit = self.extension_limit * self.sigma(i) * self.spacing;
         let (mut num, mut den) = (0.0, 0.0);
         for k in 0..D {
@@ -393,7 +459,7 @@ impl<const D: usize> Sweeper<'_, D> {
             if !(phi1 < abs_phi) {
                 continue;
             }
-            let w1 = w.get(j1);
+            let w1 = value(j1);
             if !w1.is_finite() {
                 // not reached: nor is this node (+∞, which a start's carried value gives way to)
                 return Some(f64::INFINITY);
@@ -403,7 +469,7 @@ impl<const D: usize> Sweeper<'_, D> {
                 let j2 = unsafe { table.neighbour_unchecked(j1, k, side) };
                 if j2 != sentinel {
                     let j2 = j2 as usize;
-                    let w2 = w.get(j2);
+                    let w2 = value(j2);
                     if w2.is_finite() && abs_phi_of(j2) < phi1 {
                         let t = (2.0 - (w1 - w2).abs() / limit).clamp(0.0, 1.0);
                         if t >= 1.0 {
@@ -522,31 +588,58 @@ pub fn sweep_second_order<const D: usize>(
     control: &mut dyn FnMut(&IterationReport) -> Control,
 ) -> Result<SecondOrderStats> {
     let sw = (geometry, factoring, directions, slowness);
-    sweep_second_order_from(band, sw, spacing, values, options, None, control)
+    let mut demoted = Vec::new();
+    sweep_second_order_from(band, sw, spacing, values, options, None, control, Some(&mut demoted))
+}
+
+/// [`sweep_second_order`], and the band positions of the inner-tube nodes that a runaway left at
+/// first order ([`super::demotion`]; empty when nothing ran away).
+#[allow(clippy::too_many_arguments)]
+pub fn sweep_second_order_reporting<const D: usize>(
+    band: &NarrowBand<D>,
+    geometry: &TubeGeometry,
+    factoring: &Factoring<D>,
+    directions: &[[f32; D]],
+    slowness: Slowness<'_>,
+    spacing: f64,
+    values: &mut [f64],
+    options: &SecondOrderOptions,
+    control: &mut dyn FnMut(&IterationReport) -> Control,
+) -> Result<(SecondOrderStats, Vec<u32>)> {
+    let sw = (geometry, factoring, directions, slowness);
+    let mut demoted = Vec::new();
+    let stats = sweep_second_order_from(band, sw, spacing, values, options, None, control, Some(&mut demoted))?;
+    Ok((stats, demoted))
 }
 
 /// [`sweep_second_order`] whose first phase starts from the nodes `changed` marks and the nodes
 /// that read them (a warm start on a surface that moved in part, [`super::warm::sweep_warm`]):
 /// the others hold a fixed point of their unchanged update, and the window starts at the
 /// smallest value among the active nodes instead of at the fixed nodes.
+///
+/// `demoted`: where the sweeps run away, the solve is done again from the sources with the
+/// runaway's nodes at first order ([`super::demotion`]), and the band positions of the inner-tube
+/// nodes so demoted go here; None: a runaway's values are the first-order restart's (a warm
+/// start, which starts again cold instead).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn sweep_second_order_from<const D: usize>(
     band: &NarrowBand<D>,
     (geometry, factoring, directions, slowness): (&TubeGeometry, &Factoring<D>, &[[f32; D]], Slowness<'_>),
     spacing: f64,
     values: &mut [f64],
     options: &SecondOrderOptions,
-    mut changed: Option<&[bool]>,
+    changed: Option<&[bool]>,
     control: &mut dyn FnMut(&IterationReport) -> Control,
+    demoted: Option<&mut Vec<u32>>,
 ) -> Result<SecondOrderStats> {
-    let start = Instant::now();
     let n = band.len();
-    let (abs_phi, geometry) = (&geometry.abs_phi[..], &geometry.nodes[..]);
+    let abs_phi = &geometry.abs_phi[..];
     let n_inner = factoring.roles.iter().filter(|&&r| r != NodeRole::Outer).count();
     if values.len() != n
         || abs_phi.len() != n
         || factoring.u0.len() != n
         || directions.len() != n
-        || geometry.len() != n_inner
+        || geometry.nodes.len() != n_inner
         || factoring.grad_u0.len() != n_inner
     {
         return Err(Error::invalid(
@@ -571,162 +664,17 @@ pub(super) fn sweep_second_order_from<const D: usize>(
             format!("one flag per band node ({n}) is needed"),
         ));
     }
-    let ramp_constant = match slowness {
-        Slowness::Constant(s) => options.ramp_length / (spacing * spacing) / s,
-        Slowness::PerNode(_) => f64::NAN,
+    let tube = (&geometry.nodes[..], abs_phi);
+    let sw = (factoring, directions, slowness);
+    let Some(demoted) = demoted else {
+        return attempt(band, tube, sw, spacing, values, options, changed, control, (&[], None));
     };
-    let sw = Sweeper {
-        table: band.neighbour_table(),
-        roles: &factoring.roles,
-        geometry,
-        directions,
-        u0: &factoring.u0,
-        grad_u0: &factoring.grad_u0,
-        grad_u0_unit: factoring.grad_u0_unit,
-        slowness,
+    let run = Attempts {
+        band,
+        tube,
+        sw,
         spacing,
-        ramp_scale: options.ramp_length / (spacing * spacing),
-        ramp_constant,
-        inv_sigma_constant: match slowness {
-            Slowness::Constant(s) => 1.0 / s,
-            Slowness::PerNode(_) => f64::NAN,
-        },
-        margin_constant: UPWIND_MARGIN / ramp_constant,
-        abs_phi,
-        extension_limit: options.extension_limit,
-        unresolved_extension_from: (UNRESOLVED_EXTENSION_FROM * spacing / super::geometry::power_of_two_near(spacing))
-            as f32,
-        several_sources: factoring.fixed_per_source.len() > 1,
+        options,
     };
-    let roles = sw.roles;
-    // per row, the nodes before it that are not in the extension layer (the rows cover the band
-    // in order): the index of a node's geometry, counted along the row as the sweeps walk it
-    let mut row_inner = Vec::with_capacity(band.n_rows() + 1);
-    let mut count = 0u32;
-    for r in 0..band.n_rows() {
-        let (s, e) = band.row_range(r);
-        row_inner.push(count);
-        count += roles[s..e].iter().filter(|&&r| r != NodeRole::Outer).count() as u32;
-    }
-    row_inner.push(count);
-    let sigma_mean = match slowness {
-        Slowness::Constant(s) => s,
-        Slowness::PerNode(s) => s.iter().sum::<f64>() / n.max(1) as f64,
-    };
-    let unit = if options.window_first > 0.0 || options.window_second > 0.0 {
-        let fixed = roles
-            .iter()
-            .enumerate()
-            .filter(|(_, &r)| r == NodeRole::Fixed)
-            .map(|(i, _)| i);
-        let hops = crate::sweep::grid_hops::max_grid_hops(band, fixed);
-        spacing * sigma_mean * (hops as f64).sqrt()
-    } else {
-        0.0
-    };
-    // one flag per node, and a sink for the sentinel ([`Sweeper::activate`])
-    let active: Vec<AtomicU8> = (0..=n).map(|_| AtomicU8::new(0)).collect();
-    // the sweeps hold w = u − u₀ (the extension update reads no u₀, the inner one only to form u
-    // for its ramps and the metric); the fixed nodes' given values are put back as they were
-    let fixed_values: Vec<(usize, f64)> = roles
-        .iter()
-        .enumerate()
-        .filter(|(_, &r)| r == NodeRole::Fixed)
-        .map(|(i, _)| (i, values[i]))
-        .collect();
-    let mut pipeline = Pipeline::new(band, options.threads)?;
-    for (v, &u0) in values.iter_mut().zip(sw.u0) {
-        *v -= u0;
-    }
-    let mut stats = SecondOrderStats {
-        last_change: f64::INFINITY,
-        ..Default::default()
-    };
-    let mut iteration = 0;
-    // one phase: the active flags from its start ([`Sweeper::start_flags`]), the thread choice's
-    // timings forgotten after an earlier phase (an update of the other phase costs differently)
-    let mut phase =
-        |values: &mut [f64], lim: Limits, width: f64, iteration: &mut usize, stats: &mut SecondOrderStats| {
-            if *iteration > 0 {
-                pipeline.new_phase();
-            }
-            let first = match changed.take() {
-                Some(c) => Some(sw.start_flags_changed(&active, values, c)),
-                None => {
-                    sw.start_flags(&active, values);
-                    None
-                }
-            };
-            let (run, state) = (
-                RunPhase {
-                    sw: &sw,
-                    band,
-                    active: &active,
-                    row_inner: &row_inner,
-                    options,
-                },
-                &mut pipeline,
-            );
-            run_phase(&run, values, state, lim, width, first, iteration, stats, control)
-        };
-    // the phases; w back to u whatever their outcome (an interrupted solve's values included)
-    let mut phases = || -> Result<()> {
-        if options.own_first_phase && options.tol_first.is_finite() {
-            let lim = Limits::first_order(options.tol_first);
-            phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
-            stats.first_order_iterations = iteration;
-        }
-        let lim = Limits {
-            second: true,
-            decreases_only: false,
-            threshold: options.tol,
-            window: f64::INFINITY,
-            settled: options.tol,
-            floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
-        };
-        let before = iteration;
-        stats.converged = phase(values, lim, options.window_second * unit, &mut iteration, &mut stats)?;
-        stats.second_order_iterations = iteration - before;
-        if stats.runaway_iteration.is_some() {
-            // the second-order iterate is lost: the first phase again, from the sources (monotone,
-            // so it converges), to the second phase's tolerance: its first-order values are the result
-            for (v, &r) in values.iter_mut().zip(roles) {
-                if r != NodeRole::Fixed {
-                    *v = f64::INFINITY;
-                }
-            }
-            // guarded as phase 2 is: where the factored update is not causal (a region far faster
-            // than the sources) these sweeps creep down too; the caller then has no values
-            let lim = Limits {
-                floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
-                ..Limits::first_order(options.tol.min(options.tol_first))
-            };
-            let runaway = stats.runaway_iteration;
-            let before = iteration;
-            stats.converged = phase(values, lim, options.window_first * unit, &mut iteration, &mut stats)?;
-            stats.first_order_iterations += iteration - before;
-            if stats.runaway_iteration != runaway {
-                // the first-order restart ran away as well: no values to return
-                stats.runaway_iteration = runaway;
-                stats.restart_failed = true;
-                stats.converged = false;
-            }
-        }
-        Ok(())
-    };
-    let outcome = phases();
-    for (v, &u0) in values.iter_mut().zip(sw.u0) {
-        *v += u0;
-    }
-    for (i, v) in fixed_values {
-        values[i] = v;
-    }
-    outcome?;
-    stats.unreached = values
-        .iter()
-        .zip(roles)
-        .filter(|(v, &r)| r != NodeRole::Fixed && !v.is_finite())
-        .count();
-    stats.seconds = start.elapsed().as_secs_f64();
-    Ok(stats)
+    super::demotion::solve_demoting(&run, values, changed, control, demoted)
 }

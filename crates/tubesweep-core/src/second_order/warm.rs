@@ -91,7 +91,7 @@ use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 use super::factoring::Factoring;
 use super::fingerprint::changed_nodes;
 use super::geometry::TubeGeometry;
-use super::solver::{sweep_second_order, sweep_second_order_from, SecondOrderOptions, SecondOrderStats};
+use super::solver::{sweep_second_order_from, sweep_second_order_reporting, SecondOrderOptions, SecondOrderStats};
 
 /// The previous values on the new band: node `new_linear[i]` takes `old_values[j]` where
 /// `old_linear[j]` is the same grid node, +∞ where the node is new to the band. Both index lists
@@ -193,7 +193,7 @@ pub enum WarmRestart {
 }
 
 /// What [`sweep_warm`] did.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct WarmStats {
     pub stats: SecondOrderStats,
     /// Nodes that started from a carried value (the others: +∞, or u₀ at the fixed nodes).
@@ -205,6 +205,9 @@ pub struct WarmStats {
     pub changed: Option<usize>,
     /// Nodes whose start was extrapolated in time from two previous solutions.
     pub extrapolated: usize,
+    /// The inner-tube nodes that a runaway of the cold solve left at first order (band
+    /// positions, [`super::demotion`]; the warm sweeps themselves start again cold instead).
+    pub demoted: Vec<u32>,
 }
 
 /// Where a warm solve starts ([`sweep_warm`]).
@@ -307,6 +310,7 @@ pub fn sweep_warm<const D: usize>(
         &warm_options,
         changed.as_ref().map(|(flags, _)| &flags[..]),
         control,
+        None,
     )?;
     let restarted = if stats.runaway_iteration.is_some() {
         Some(WarmRestart::Runaway)
@@ -323,10 +327,11 @@ pub fn sweep_warm<const D: usize>(
             restarted,
             changed,
             extrapolated,
+            demoted: Vec::new(),
         });
     }
     *values = super::starting_values(factoring);
-    let mut cold = sweep_second_order(
+    let (mut cold, demoted) = sweep_second_order_reporting(
         band,
         geometry,
         factoring,
@@ -346,12 +351,14 @@ pub fn sweep_warm<const D: usize>(
         restarted,
         changed,
         extrapolated,
+        demoted,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::second_order::sweep_second_order;
 
     #[test]
     fn carried_values_follow_the_grid_nodes() {
