@@ -423,6 +423,18 @@ impl<const D: usize> Sweeper<'_, D> {
     /// the sphere at N = 101 from a first phase stopped at 64Δx² went to −1e11.
     #[inline(always)]
     fn outer(&self, w: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
+        // compiled apart for the nodes that extend u ([`super::demotion`]; none unless a runaway
+        // was found), so that the others' update carries no test of the kind
+        if !self.extends_u.is_empty() && self.extends_u[i] {
+            self.outer_of::<true>(w, i, second)
+        } else {
+            self.outer_of::<false>(w, i, second)
+        }
+    }
+
+    /// [`Self::outer`] on w, or with `ON_U` on u less u₀ at this node.
+    #[inline(always)]
+    fn outer_of<const ON_U: bool>(&self, w: &SharedValues<'_>, i: usize, second: bool) -> Option<f64> {
         let table = self.table;
         let sentinel = table.sentinel();
         // SAFETY (here and below): `i` is a band node, and so is every neighbour the table gives;
@@ -431,10 +443,9 @@ impl<const D: usize> Sweeper<'_, D> {
         let direction = unsafe { self.directions.get_unchecked(i) };
         let abs_phi = abs_phi_of(i);
         // w at a neighbour, or u there less u₀ here where this node extends u
-        let on_u = !self.extends_u.is_empty() && self.extends_u[i];
         let value = |j: usize| {
             let w = w.get(j);
-            if on_u {
+            if ON_U {
                 // SAFETY: `j` and `i` are band nodes, and u₀ has one value per node
                 w + unsafe { *self.u0.get_unchecked(j) - *self.u0.get_unchecked(i) }
             } else {
