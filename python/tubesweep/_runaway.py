@@ -47,7 +47,7 @@ def first_order_errors(cause: str) -> str:
     """What the nodes put at first order do to the errors, for a runaway of ``cause``
     (:func:`runaway_cause`): in a fast region, first order in its short travel times."""
     if cause.startswith("where the speed"):
-        return "first order in the travel times there, which are that many times shorter"
+        return "first order there, most of them in the fast region, whose travel times are that many times shorter"
     return "first order there and downstream of them"
 
 

@@ -22,7 +22,7 @@ import numpy as np
 from . import _native
 from ._coarse_creases import widened_for_order2
 from ._creases import thinned_spacings, warn_creases
-from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS
+from ._factoring import FACTORED_CURVATURE_RADII, FACTORED_RADIUS, undercut_sources
 from ._parts import drop_unsourced_rows, part_labels
 from ._prepare import thinned_count
 from ._runaway import first_order_errors, runaway_cause
@@ -79,6 +79,12 @@ def solve_many_order2(
     every = np.ascontiguousarray(np.concatenate(srcs), dtype=float)
     offsets = np.concatenate([[0], np.cumsum([len(s) for s in srcs])]).astype(np.int64)
     feet, src_slowness = so.source_feet(surf, grid, every, t.inner * h, speed, names)
+    for k in range(len(srcs)):  # a row's several points factored at their own speeds (_factoring)
+        undercut = undercut_sources(
+            feet[offsets[k] : offsets[k + 1]], src_slowness[offsets[k] : offsets[k + 1]], so.FIX_RADIUS * h
+        )
+        if undercut is not None:
+            raise so.Order2NotApplicable(f"sources[{k}]: {undercut}")
     at_feet = None
     plan = None
     labels = part_labels(t)  # (read once: the plan and the parts without a source)

@@ -21,7 +21,7 @@ from . import _native
 from ._box_cut import box_reason
 from ._coarse_creases import widened_for_order2
 from ._creases import thinned_spacings, warn_creases
-from ._factoring import FACTORED_RADIUS, factored_reach
+from ._factoring import FACTORED_RADIUS, factored_reach, undercut_sources
 from ._parts import drop_unsourced, part_labels, source_parts
 from ._prepare import thinned_count
 from ._roles import ROLE_OUTER
@@ -684,6 +684,9 @@ def solve_on_tube(
     inputs = tube_inputs(tube, speed, tol)
     tol = inputs.tol
     feet, src_slowness = source_feet(surf, grid, src, tube.inner * h, speed)
+    undercut = undercut_sources(feet, src_slowness, FIX_RADIUS * h)
+    if undercut is not None:
+        raise Order2NotApplicable(undercut)
     warm_values, warm_more, warm_info = warm_start(warm, tube, feet, tol, warm_refused)
     anchors = warm_more.pop("_anchors", None)  # (moving._ANCHOR)
     parts = part_labels(tube)  # a part without a source keeps inf (``_parts``)

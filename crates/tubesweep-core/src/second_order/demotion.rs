@@ -108,8 +108,9 @@ impl Demotion {
 /// run away, once more from the sources with the runaway's nodes at first order
 /// ([`Demotion::of`]), phase 1 included, within the iterations left, the progress counting on;
 /// `demoted` gets the band positions of the inner-tube nodes so put. The first attempt's result
-/// stands (`demoted` empty) when no node was found, when more than [`DEMOTED_SHARE`] of the inner
-/// tube would be put at first order, or when the second attempt runs away too.
+/// stands (`demoted` empty) when no node was found, when its restart stopped at the iteration
+/// limit, when more than [`DEMOTED_SHARE`] of the inner tube would be put at first order, or when
+/// the second attempt runs away too.
 pub(super) fn solve_demoting<const D: usize>(
     run: &Attempts<'_, '_, D>,
     values: &mut [f64],
@@ -121,7 +122,10 @@ pub(super) fn solve_demoting<const D: usize>(
     let mut found = Demotion::default();
     let first = run.run(None, values, options, changed, control, (&[], Some(&mut found)))?;
     demoted.clear();
-    if first.runaway_iteration.is_none() || found.count == 0 {
+    // (a restart stopped by max_iterations found its nodes from a partial iterate, and leaves
+    // fewer iterations than it had for a second attempt)
+    let stopped = !first.converged && !first.restart_failed;
+    if first.runaway_iteration.is_none() || found.count == 0 || stopped {
         return Ok(first);
     }
     let (factoring, _, _) = run.sw;
