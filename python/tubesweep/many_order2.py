@@ -150,11 +150,7 @@ def solve_many_order2(
         # values falling without bound for these sources: no factored solution; the caller raises
         # (order=2) or solves them at first order ("auto"), with this text (second_order.Order2RanAway)
         st["ran_away"] = so.ran_away_message(
-            int(st["runaway_iteration"][failed[0]]),
-            inputs.slowness,
-            src_slowness,
-            t.surface,
-            redone=bool(st["runaway_first_iteration"][failed[0]] >= 0),
+            int(st["runaway_iteration"][failed[0]]), inputs.slowness, src_slowness, t.surface
         )
     st["tol"] = inputs.tol
     st["bridged_holes"] = t.bridged_holes

@@ -88,15 +88,11 @@ class Order2RanAway(Order2NotApplicable):
     first-order scheme, which is not factored."""
 
 
-def ran_away_message(
-    iteration: Any, slowness: Any, src_slowness: np.ndarray, surface: Any = None, redone: bool = False
-) -> str:
-    """:class:`Order2RanAway`'s text: where it ran away, and why (``_runaway.runaway_cause``);
-    ``redone``: solved again with the runaway's nodes at first order, which ran away too."""
-    again = " (and again with the nodes where they ran away at first order)" if redone else ""
+def ran_away_message(iteration: Any, slowness: Any, src_slowness: np.ndarray, surface: Any = None) -> str:
+    """:class:`Order2RanAway`'s text: where it ran away, and why (``_runaway.runaway_cause``)."""
     return (
         f"order=2: the second-order sweeps ran away at their iteration {iteration} (travel times fell below zero) and "
-        f"the first-order factored restart did too{again}: the factored update is not causal "
+        f"the first-order factored restart did too: the factored update is not causal "
         f"{runaway_cause(slowness, src_slowness, surface)}. order=1, the paper's scheme, which is not factored, solves it"
     )
 
@@ -705,8 +701,7 @@ def solve_on_tube(
         keep_digests or warm is not None,
     )
     if st["restart_failed"]:
-        redone = st["runaway_first_iteration"] is not None
-        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf, redone))
+        raise Order2RanAway(ran_away_message(st["runaway_iteration"], inputs.slowness, src_slowness, surf))
     if parts is not None:
         drop_unsourced(values, parts, sourced)
     split = split_at_creases(tube, values)
