@@ -162,11 +162,7 @@ fn run<'py, const D: usize>(
                 first_iterations = st.iterations;
             }
             let (mut stats, demoted) = sweep_second_order_reporting(
-                band,
-                &geometry,
-                &factoring,
-                directions,
-                slowness,
+                (band, &geometry, &factoring, directions, slowness),
                 inp.spacing,
                 &mut values,
                 &inp.options,

@@ -16,6 +16,16 @@ use super::phase::{run_phase, RunPhase};
 use super::pipeline::Pipeline;
 use super::solver::{Limits, SecondOrderOptions, SecondOrderStats, Sweeper, RUNAWAY_FLOOR};
 
+/// Every node that is not fixed back to +∞ (the fixed nodes keep their values): a start from the
+/// sources.
+pub(super) fn from_the_sources(values: &mut [f64], roles: &[NodeRole]) {
+    for (v, &r) in values.iter_mut().zip(roles) {
+        if r != NodeRole::Fixed {
+            *v = f64::INFINITY;
+        }
+    }
+}
+
 /// What each attempt of [`super::demotion::solve_demoting`] reads besides the values.
 pub(super) struct Attempts<'r, 'a, const D: usize> {
     pub(super) band: &'r NarrowBand<D>,
@@ -55,7 +65,7 @@ impl<const D: usize> Attempts<'_, '_, D> {
 /// runaway's nodes at first order, [`super::demotion`], whose extension nodes `extends_u` marks);
 /// with `found`, where a runaway was is found there.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn attempt<const D: usize>(
+fn attempt<const D: usize>(
     band: &NarrowBand<D>,
     (geometry, abs_phi): (&[NodeGeometry], &[f32]),
     (factoring, directions, slowness): (&Factoring<D>, &[[f32; D]], Slowness<'_>),
@@ -91,6 +101,8 @@ pub(super) fn attempt<const D: usize>(
         Slowness::Constant(s) => s,
         Slowness::PerNode(s) => s.iter().sum::<f64>() / n.max(1) as f64,
     };
+    // a value this far below zero is a runaway (phase 2 and the restart after it)
+    let floor = RUNAWAY_FLOOR * sigma_mean * spacing;
     let unit = if options.window_first > 0.0 || options.window_second > 0.0 {
         let fixed = roles
             .iter()
@@ -171,7 +183,7 @@ pub(super) fn attempt<const D: usize>(
             threshold: options.tol,
             window: f64::INFINITY,
             settled: options.tol,
-            floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
+            floor: -floor,
         };
         let before = iteration;
         stats.converged = phase(
@@ -186,15 +198,11 @@ pub(super) fn attempt<const D: usize>(
         if stats.runaway_iteration.is_some() {
             // the second-order iterate is lost: the first phase again, from the sources (monotone,
             // so it converges), to the second phase's tolerance: its first-order values are the result
-            for (v, &r) in values.iter_mut().zip(roles) {
-                if r != NodeRole::Fixed {
-                    *v = f64::INFINITY;
-                }
-            }
+            from_the_sources(values, roles);
             // guarded as phase 2 is: where the factored update is not causal (a region far faster
             // than the sources) these sweeps creep down too; the caller then has no values
             let lim = Limits {
-                floor: -RUNAWAY_FLOOR * sigma_mean * spacing,
+                floor: -floor,
                 ..Limits::first_order(options.tol.min(options.tol_first))
             };
             let runaway = stats.runaway_iteration;
@@ -233,7 +241,7 @@ pub(super) fn attempt<const D: usize>(
                 } else {
                     None
                 };
-                *found = Demotion::of(values, crept.as_deref(), roles, RUNAWAY_FLOOR * sigma_mean * spacing);
+                *found = Demotion::of(values, crept.as_deref(), roles, floor);
             }
         }
         Ok(())

@@ -11,7 +11,7 @@
 use crate::error::Result;
 use crate::sweep::{Control, IterationReport, NodeRole};
 
-use super::attempt::Attempts;
+use super::attempt::{from_the_sources, Attempts};
 use super::geometry::{NodeGeometry, Unresolved};
 use super::solver::{SecondOrderOptions, SecondOrderStats};
 
@@ -136,11 +136,7 @@ pub(super) fn solve_demoting<const D: usize>(
     }
     // the first attempt's values, returned as they are if the second runs away too
     let first_values = values.to_vec();
-    for (v, &r) in values.iter_mut().zip(&factoring.roles) {
-        if r != NodeRole::Fixed {
-            *v = f64::INFINITY;
-        }
-    }
+    from_the_sources(values, &factoring.roles);
     let used = first.first_order_iterations + first.second_order_iterations;
     let again = SecondOrderOptions {
         max_iterations: options.max_iterations.saturating_sub(used),

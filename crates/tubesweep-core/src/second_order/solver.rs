@@ -34,7 +34,7 @@ use crate::error::{Error, Result};
 use crate::sweep::sweep_state::{Accumulator, SharedValues};
 use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
 
-use super::attempt::{attempt, Attempts};
+use super::attempt::Attempts;
 use super::factoring::Factoring;
 use super::geometry::{NodeGeometry, TubeGeometry};
 use super::local::{corrected_slowness_squared, godunov_closed_form, godunov_first_order, reconstruct, Side, Upwind};
@@ -598,20 +598,21 @@ pub fn sweep_second_order<const D: usize>(
     options: &SecondOrderOptions,
     control: &mut dyn FnMut(&IterationReport) -> Control,
 ) -> Result<SecondOrderStats> {
-    let sw = (geometry, factoring, directions, slowness);
-    let mut demoted = Vec::new();
-    sweep_second_order_from(band, sw, spacing, values, options, None, control, Some(&mut demoted))
+    let sw = (band, geometry, factoring, directions, slowness);
+    Ok(sweep_second_order_reporting(sw, spacing, values, options, control)?.0)
 }
 
 /// [`sweep_second_order`], and the band positions of the inner-tube nodes that a runaway left at
 /// first order ([`super::demotion`]; empty when nothing ran away).
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::type_complexity)]
 pub fn sweep_second_order_reporting<const D: usize>(
-    band: &NarrowBand<D>,
-    geometry: &TubeGeometry,
-    factoring: &Factoring<D>,
-    directions: &[[f32; D]],
-    slowness: Slowness<'_>,
+    (band, geometry, factoring, directions, slowness): (
+        &NarrowBand<D>,
+        &TubeGeometry,
+        &Factoring<D>,
+        &[[f32; D]],
+        Slowness<'_>,
+    ),
     spacing: f64,
     values: &mut [f64],
     options: &SecondOrderOptions,
@@ -675,17 +676,15 @@ pub(super) fn sweep_second_order_from<const D: usize>(
             format!("one flag per band node ({n}) is needed"),
         ));
     }
-    let tube = (&geometry.nodes[..], abs_phi);
-    let sw = (factoring, directions, slowness);
-    let Some(demoted) = demoted else {
-        return attempt(band, tube, sw, spacing, values, options, changed, control, (&[], None));
-    };
     let run = Attempts {
         band,
-        tube,
-        sw,
+        tube: (&geometry.nodes[..], abs_phi),
+        sw: (factoring, directions, slowness),
         spacing,
         options,
+    };
+    let Some(demoted) = demoted else {
+        return run.run(None, values, options, changed, control, (&[], None));
     };
     super::demotion::solve_demoting(&run, values, changed, control, demoted)
 }

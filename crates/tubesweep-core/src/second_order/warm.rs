@@ -332,11 +332,7 @@ pub fn sweep_warm<const D: usize>(
     }
     *values = super::starting_values(factoring);
     let (mut cold, demoted) = sweep_second_order_reporting(
-        band,
-        geometry,
-        factoring,
-        directions,
-        slowness,
+        (band, geometry, factoring, directions, slowness),
         spacing,
         values,
         cold_options,
