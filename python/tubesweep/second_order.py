@@ -369,11 +369,22 @@ def warm_start(
     from .moving import WarmStartRefused, carried_values
 
     try:
-        return carried_values(warm, tube, feet, tube.inner * tube.grid.spacing, float(tol))
+        carried, more, info = carried_values(warm, tube, feet, tube.inner * tube.grid.spacing, float(tol))
     except WarmStartRefused as e:
         if warm_refused != "cold":
             raise
         return None, {}, {"refused": str(e)}
+    if (warm.stats.order2 or {}).get("runaway") is not None:
+        # its sweeps ran away where the factored update is not causal; the warm sweeps (no nodes
+        # put at first order) run away there again before starting cold (the circle with a fast
+        # half: 215 iterations against a cold solve's 176, the same values): start cold at once
+        return None, {}, {**info, "carried": 0, "restarted": PREVIOUS_RUNAWAY}
+    return carried, more, info
+
+
+#: ``sol.stats.order2["warm"]["restarted"]`` of a warm solve that started cold at once because the
+#: previous solve's sweeps ran away (``sol.stats.order2["runaway"]``).
+PREVIOUS_RUNAWAY = "previous_runaway"
 
 
 #: ``sol.stats.order_fallback`` of a solve whose second-order sweeps ran away and whose first-order

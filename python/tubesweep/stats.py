@@ -113,7 +113,9 @@ class SolveStats:
         the warning on a φ given as it is, and the shortcut per crease), on a mesh ``mesh_map`` (the mesh's smooth map: how it was fitted), and with
         ``warm=`` a ``warm`` dict: ``carried`` (nodes started from the previous values),
         ``new_nodes`` (nodes new to the band), ``unreached_before``, ``all_started``,
-        ``restarted`` (why the warm sweeps started again cold, None when they did not), ``changed``
+        ``restarted`` (why the warm sweeps started again cold, None when they did not:
+        ``"runaway"``, ``"stagnation"``, or ``"previous_runaway"`` when the previous solve's sweeps
+        ran away and this one started cold at once, ``carried`` then 0), ``changed``
         (the nodes whose update changed, where the sweeps started), ``extrapolated`` (whether
         two previous solutions gave the start) or, for a start refused with
         ``warm_refused="cold"``, ``refused`` (why): docs/moving-surfaces.md.
