@@ -457,3 +457,25 @@ def test_sources_at_speeds_far_apart_are_not_factored_at_second_order():
     # at one speed, or far enough apart for their speeds, both are factored at second order
     assert ts.solve(sphere, g, src).stats.order == 2
     assert ts.solve(sphere, g, src, speed=np.where(g.meshgrid()[0] > 0, 1.0005, 1.0)).stats.order == 2
+
+
+@pytest.mark.parametrize("cap", [3, 12])
+def test_max_iterations_bounds_both_phases_of_a_curve_together(cap):
+    # in 2D the first-order start (9 iterations on this circle, its deferred rim's pass one of
+    # them) and the second-order sweeps (17) share max_iterations; before, each phase had its own,
+    # and the start reported one iteration more than the cap by itself
+    g = ts.Grid((-1.0, -1.0), (1.0, 1.0), (201, 201))
+    x, y = g.meshgrid()
+    surf = ts.LevelSet(np.hypot(x, y) - 0.5)
+    src = [(-0.5, 0.0), (0.5, 0.0)]
+    with pytest.warns(RuntimeWarning, match=f"did not converge in max_iterations={cap}"):
+        sol = ts.solve(surf, g, src[1:], max_iterations=cap, order=2)
+    o = sol.stats.order2
+    assert sol.stats.iterations == cap and not sol.stats.converged
+    assert o["first_order_iterations"] + o["second_order_iterations"] == cap
+    assert (o["second_order_iterations"] > 0) == (cap > 10)
+    # a batch's rows likewise, each the single solve's bit for bit
+    with pytest.warns(RuntimeWarning, match=f"2 of 2 solves did not converge in max_iterations={cap}"):
+        rows, st = ts.Tube(surf, g).solve_many(src, max_iterations=cap, order=2, return_stats=True)
+    assert list(st["iterations"]) == [cap, cap]
+    np.testing.assert_array_equal(rows[1], sol.values)

@@ -374,7 +374,8 @@ def warm_start(
         if warm_refused != "cold":
             raise
         return None, {}, {"refused": str(e)}
-    if (warm.stats.order2 or {}).get("runaway") is not None:
+    previous = warm[1] if isinstance(warm, (tuple, list)) else warm  # (older, previous)
+    if (previous.stats.order2 or {}).get("runaway") is not None:
         # its sweeps ran away where the factored update is not causal; the warm sweeps (no nodes
         # put at first order) run away there again before starting cold (the circle with a fast
         # half: 215 iterations against a cold solve's 176, the same values): start cold at once

@@ -152,7 +152,8 @@ fn run<'py, const D: usize>(
                     slowness,
                     inp.spacing,
                     inp.options.tol_first,
-                    inp.options.max_iterations,
+                    // (the deferred outer rim's pass counts as one more iteration)
+                    inp.options.max_iterations.saturating_sub(1),
                     inp.threads,
                     inp.front_window,
                     &mut values,
@@ -161,11 +162,16 @@ fn run<'py, const D: usize>(
                 first_seconds = st.seconds;
                 first_iterations = st.iterations;
             }
+            // max_iterations bounds both phases together
+            let options = tubesweep_core::second_order::SecondOrderOptions {
+                max_iterations: inp.options.max_iterations.saturating_sub(first_iterations),
+                ..inp.options
+            };
             let (mut stats, demoted) = sweep_second_order_reporting(
                 (band, &geometry, &factoring, directions, slowness),
                 inp.spacing,
                 &mut values,
-                &inp.options,
+                &options,
                 &mut callback,
             )?;
             if !inp.options.own_first_phase {

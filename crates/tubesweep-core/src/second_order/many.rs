@@ -191,13 +191,21 @@ fn solve_one<const D: usize>(
             tube.slowness,
             tube.spacing,
             options.tol_first,
-            options.max_iterations,
+            // (the deferred outer rim's pass counts as one more iteration)
+            options.max_iterations.saturating_sub(1),
             1,
             tube.front_window,
             &mut values,
             &mut check,
         )?);
     }
+    // max_iterations bounds both phases together, as in the single solve
+    let options = SecondOrderOptions {
+        max_iterations: options
+            .max_iterations
+            .saturating_sub(first.as_ref().map_or(0, |st| st.iterations)),
+        ..*options
+    };
     let mut stats = sweep_second_order(
         tube.band,
         tube.geometry,
@@ -206,11 +214,11 @@ fn solve_one<const D: usize>(
         tube.slowness,
         tube.spacing,
         &mut values,
-        options,
+        &options,
         &mut check,
     )?;
     if let Some(st) = first {
-        stats.first_order_iterations = st.iterations;
+        stats.first_order_iterations += st.iterations;
         stats.seconds += st.seconds;
     }
     values.truncate(tube.band.len());
