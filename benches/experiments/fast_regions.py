@@ -5,10 +5,12 @@ and mean error of the circle of radius 0.5 against its exact travel times, at N 
 Cases (the speed is constant along the circle's normals, so the exact travel time is the
 integral of the slowness along the arc from the source at (−0.5, 0)): the right half ``c`` times
 faster (c = 3, 30, 100: a jump), and a speed rising smoothly along the circle as
-``c^((x + 0.5))`` (c = 30, x the foot point's abscissa). The kink tests of the second-order
-differences (``second_order/local.rs``, ``KINK2``, ``KINK``) read the smaller of w's and u's
-differences; on w alone, which carries u₀'s curvature at the source's slowness where u is
-nearly flat, they closed BDF2 in the fast region and the errors converged at first order::
+``c^((x + 0.5))`` (c = 30, x the foot point's abscissa). From a contrast of about 30 the errors
+converge at first order (still 2–40 times below ``order=1``'s): where u is nearly flat, w = u − u₀
+carries u₀'s curvature at the source's slowness, which the BDF2 ramp's kink test
+(``second_order/local.rs``, ``KINK2``, scaled by the node's slowness) takes for a kink, so the fast
+region runs BDF2's first-order fallback. Attempts to scale that test otherwise, and why none was
+kept: docs/development/history-notes.md::
 
     .venv/bin/python benches/experiments/fast_regions.py
 

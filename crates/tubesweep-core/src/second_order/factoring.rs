@@ -27,9 +27,6 @@ pub struct Factoring<const D: usize> {
     pub grad_u0: Vec<[f32; D]>,
     /// A power of two near the largest source slowness: ∇u₀ = `grad_u0` × this, exactly.
     pub grad_u0_unit: f64,
-    /// The largest source slowness σ_s: the scale of u₀'s second differences, which the BDF2
-    /// ramp's kink test reads ([`super::local::reconstruct`]'s `inv_eps_kink`).
-    pub largest_source_slowness: f64,
     pub roles: Vec<NodeRole>,
     /// Nodes fixed by each source.
     pub fixed_per_source: Vec<usize>,
@@ -121,7 +118,6 @@ pub fn factor_sources_of<const D: usize>(
         u0,
         grad_u0,
         grad_u0_unit: unit,
-        largest_source_slowness: largest_slowness(source_slowness),
         roles: out_roles,
         fixed_per_source,
     })
@@ -143,12 +139,7 @@ pub(crate) fn check_source_arguments<const D: usize>(sources: &[[f64; D]], sourc
 
 /// [`Factoring::grad_u0_unit`]: a power of two near the largest source slowness.
 pub(crate) fn grad_u0_unit_of(source_slowness: &[f64]) -> f64 {
-    power_of_two_near(largest_slowness(source_slowness))
-}
-
-/// [`Factoring::largest_source_slowness`].
-pub(crate) fn largest_slowness(source_slowness: &[f64]) -> f64 {
-    source_slowness.iter().fold(0.0f64, |a, &b| a.max(b))
+    power_of_two_near(source_slowness.iter().fold(0.0f64, |a, &b| a.max(b)))
 }
 
 /// The error for a source that fixed no inner-tube node.
@@ -408,7 +399,6 @@ pub fn factor_sources_at<const D: usize>(
         u0,
         grad_u0,
         grad_u0_unit: unit,
-        largest_source_slowness: largest_slowness(source_slowness),
         roles: out_roles,
         fixed_per_source,
     })

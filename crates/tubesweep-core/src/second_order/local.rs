@@ -38,11 +38,6 @@ pub struct Upwind {
     /// apply: with several sources u₀ is the chord to the nearest one, whose bisector kinks w
     /// where u is smooth.
     pub w0_kink: f64,
-    /// How much the slowness jumps along the run: the largest of |σ₁ − σ₀| and |σ₂ − σ₁| over
-    /// the smallest of the three (0 for a constant slowness and at the nodes no faster than the
-    /// source). u's gradient follows σ, so a jump of the speed is a kink of u, which the BDF2
-    /// ramp closes at ([`SPEED_JUMP`]).
-    pub sigma_jump: f64,
 }
 
 /// Above this |Δ²w₁ − Δ²w₂|/ε (the second differences of w at the first and second neighbours,
@@ -69,32 +64,15 @@ pub const KINK: f64 = 0.5;
 /// sources at N = 401, max error 1.7e-3 → 3.1e-3).
 pub const KINK2: f64 = 20.0;
 
-/// Above this relative jump of the slowness along a run ([`Upwind::sigma_jump`], read at the
-/// nodes faster than the source) the BDF2 ramp starts to close; it is closed at twice this. A
-/// jump of the speed is a kink of u, which the kink test on w sees only where it is large
-/// against ε: across a circle's speed jump of 1.5 the largest error at N = 101 was 3.3e-3, now
-/// 3.9e-4 (`tests/test_runaway.py`). A speed resolved by the grid changes by a few percent per
-/// step (30^x: 7% at Δx = 0.02). The test reads the speed, not the values, so it cannot start a
-/// limit cycle. Not at nodes slower than the source: beside a region 100 times slower (an
-/// obstacle) closing the ramp stalled the sweeps.
-pub const SPEED_JUMP: f64 = 0.1;
-
 /// The limited one-sided difference of one side (`minus`: the neighbours at −e_k), as a
 /// [`Side`]. Two ramps of width ε = σᵢΔx²/ℓ (`inv_eps` = 1/ε;
 /// [`super::solver::SecondOrderOptions::ramp_length`]: the same for a problem in any units or at
 /// any speed scale) raise the order step by step along an upwind run of neighbours:
 ///
-/// * t = clip(d₁/ε, 0, 1)·clip(2 − |w₀ − 2w₁ + w₂|/(K₂ ε_k), 0, 1)·clip(2 − j_σ/J, 0, 1)
-///   (K₂ = [`KINK2`], J = [`SPEED_JUMP`], j_σ = [`Upwind::sigma_jump`]), from first
+/// * t = clip(d₁/ε, 0, 1)·clip(2 − |w₀ − 2w₁ + w₂|/(K₂ ε), 0, 1) (K₂ = [`KINK2`]), from first
 ///   order (t = 0, where the side is not upwind or the gradient along the axis vanishes, or a kink
-///   lies between the node and its run, or a jump of the speed) to BDF2 (t = 1), the scheme "S2"
-///   of the design note `second-order-tube.md` (Sect. 2, "Inner update"). ε_k (`inv_eps_kink` =
-///   1/ε_k) is ε at the larger of the node's and the source's slowness: where the speed is far
-///   higher than at the source, u is nearly flat while u₀ climbs at the source's slowness, so w
-///   carries u₀'s curvature, O(σ_s Δx²/r) per second difference, which at the node's ε closed
-///   BDF2 all over such a region (a circle's half 30 times faster than the source's: errors
-///   converging at first order, 2.4e-3 at N = 201; now 1.1e-4, second order:
-///   `benches/experiments/fast_regions.py`);
+///   lies between the node and its run) to BDF2 (t = 1), the scheme "S2" of the design note
+///   `second-order-tube.md` (Sect. 2, "Inner update");
 /// * t₃ = clip(d₂/ε, 0, 1)·clip(2 − |Δ²w₁ − Δ²w₂|/(K ε), 0, 1) (K = [`KINK`]), from BDF2 to
 ///   BDF3: it removes BDF2's O(Δx²) truncation error of w, which the characteristics accumulate
 ///   (0.26Δx² on the sphere's circle x = 0, docs/second-order.md), and is closed where the
@@ -113,14 +91,7 @@ pub const SPEED_JUMP: f64 = 0.1;
 /// formulas (3/2, 11/6 at t = 1, t₃ = 1) of the paper's one-sided differences (Eq. (5)) applied
 /// to w. `second`: false forces t = 0 (first order).
 #[inline(always)]
-pub fn reconstruct(
-    n: &Upwind,
-    du0: f64,
-    spacing: f64,
-    (inv_eps, inv_eps_kink): (f64, f64),
-    minus: bool,
-    second: bool,
-) -> Side {
+pub fn reconstruct(n: &Upwind, du0: f64, spacing: f64, inv_eps: f64, minus: bool, second: bool) -> Side {
     let mut t = if second && n.w2.is_finite() {
         (n.d1 * inv_eps).clamp(0.0, 1.0)
     } else {
@@ -129,11 +100,8 @@ pub fn reconstruct(
     if t > 0.0 && n.w0_kink.is_finite() {
         // a kink between the node and its run: BDF2 only where w's second difference through the
         // node is O(ε) ([`KINK2`])
-        let jump = (n.w0_kink - 2.0 * n.w1 + n.w2).abs() * (inv_eps_kink * (1.0 / KINK2));
+        let jump = (n.w0_kink - 2.0 * n.w1 + n.w2).abs() * (inv_eps * (1.0 / KINK2));
         t *= (2.0 - jump).clamp(0.0, 1.0);
-    }
-    if t > 0.0 && n.sigma_jump > 0.0 {
-        t *= (2.0 - n.sigma_jump * (1.0 / SPEED_JUMP)).clamp(0.0, 1.0);
     }
     let half = 0.5 * t;
     // (t = 0 without w2, which may be NaN; t₃ = 0 without w3 (d2 NaN) or w0)
@@ -454,7 +422,6 @@ mod tests {
             d1: w1 - w2,
             d2: f64::NAN,
             w0_kink: f64::NAN,
-            sigma_jump: 0.0,
         }
     }
 
@@ -482,23 +449,23 @@ mod tests {
         let h = 0.1;
         let e = 1.0 / (h * h);
         let f = |x: f64| x * x;
-        let s = reconstruct(&up(f(0.2), f(0.1)), 0.0, h, (e, e), true, true);
+        let s = reconstruct(&up(f(0.2), f(0.1)), 0.0, h, e, true, true);
         assert!(((s.c * f(0.3) - s.b) / h - 0.6).abs() < 1e-12);
         // the ramp: a side that is not upwind (u2 > u1) is first order
-        let s = reconstruct(&up(0.2, 0.3), 0.0, h, (e, e), true, true);
+        let s = reconstruct(&up(0.2, 0.3), 0.0, h, e, true, true);
         assert_eq!((s.c, s.b), (1.0, 0.2));
         // and so is a side whose second neighbour is missing (NaN), or the first-order phase
         assert_eq!(
-            reconstruct(&up(0.2, f64::NAN), 0.0, h, (e, e), true, true),
+            reconstruct(&up(0.2, f64::NAN), 0.0, h, e, true, true),
             Side { c: 1.0, b: 0.2 }
         );
         assert_eq!(
-            reconstruct(&up(0.2, 0.1), 0.0, h, (e, e), true, false),
+            reconstruct(&up(0.2, 0.1), 0.0, h, e, true, false),
             Side { c: 1.0, b: 0.2 }
         );
         // the factored part: u = u0 = x (w = 0, u rising towards the node by Δx > ε) gives
         // the difference 1, at BDF2
-        let s = reconstruct(&Upwind { d1: h, ..up(0.0, 0.0) }, 1.0, h, (e, e), true, true);
+        let s = reconstruct(&Upwind { d1: h, ..up(0.0, 0.0) }, 1.0, h, e, true, true);
         assert_eq!(s.c, 1.5);
         assert!(((s.c * 0.0 - s.b) / h - 1.0).abs() < 1e-12);
     }
@@ -518,13 +485,12 @@ mod tests {
             d1: f(0.2) - f(0.1),
             d2: f(0.1) - f(0.0),
             w0_kink: f(0.3),
-            sigma_jump: 0.0,
         };
         let exact = 1.0 + 0.75 * 0.09;
-        let s = reconstruct(&side, 0.0, h, (e, e), true, true);
+        let s = reconstruct(&side, 0.0, h, e, true, true);
         assert!(((s.c * f(0.3) - s.b) / h - exact).abs() < 1e-12);
         assert!((s.c - 11.0 / 6.0).abs() < 1e-15);
-        let bdf2 = reconstruct(&Upwind { d2: f64::NAN, ..side }, 0.0, h, (e, e), true, true);
+        let bdf2 = reconstruct(&Upwind { d2: f64::NAN, ..side }, 0.0, h, e, true, true);
         assert!(((bdf2.c * f(0.3) - bdf2.b) / h - exact).abs() > 1e-3);
         // a kink: the second differences of w disagree by 5ε, beyond 2·KINK·ε: BDF2 again
         let kinked = Upwind {
@@ -532,7 +498,7 @@ mod tests {
             w0_kink: f(0.3) + 0.05,
             ..side
         };
-        assert_eq!(reconstruct(&kinked, 0.0, h, (e, e), true, true).c, 1.5);
+        assert_eq!(reconstruct(&kinked, 0.0, h, e, true, true).c, 1.5);
         // and where the second difference through the node passes 2·KINK2·ε (here 50ε): first
         // order, as across the rim of a cylinder into the flat fan beyond it
         let sharper = Upwind {
@@ -540,45 +506,19 @@ mod tests {
             w0_kink: f(0.3) + 0.5,
             ..side
         };
-        assert_eq!(reconstruct(&sharper, 0.0, h, (e, e), true, true).c, 1.0);
+        assert_eq!(reconstruct(&sharper, 0.0, h, e, true, true).c, 1.0);
         let between = Upwind {
             w0: f(0.3) + 30.0 / e,
             w0_kink: f(0.3) + 30.0 / e,
             ..side
         };
-        let c = reconstruct(&between, 0.0, h, (e, e), true, true).c;
+        let c = reconstruct(&between, 0.0, h, e, true, true).c;
         assert!(c > 1.0 && c < 1.5, "{c}"); // the ramp half closed
                                             // with several sources (w0_kink NaN) the BDF2 ramp has no kink test: BDF2 as before
         let several = Upwind {
             w0_kink: f64::NAN,
             ..sharper
         };
-        assert_eq!(reconstruct(&several, 0.0, h, (e, e), true, true).c, 1.5);
-    }
-
-    #[test]
-    fn the_kink_test_reads_w_at_the_sources_scale_and_the_ramp_closes_at_a_speed_jump() {
-        // a straight run of w (BDF2 exact) with a second difference of 25ε through the node, ε
-        // the node's: its kink test closes the ramp a quarter; at the scale of a source 30
-        // times slower (w = u − u₀ carries u₀'s curvature at the source's slowness) it is open
-        let h = 0.1;
-        let e = 1.0 / (h * h);
-        let run = Upwind {
-            d1: 1.0,
-            w0: 0.3 + 25.0 / e,
-            w0_kink: 0.3 + 25.0 / e,
-            ..up(0.2, 0.1)
-        };
-        assert!((reconstruct(&run, 0.0, h, (e, e), true, true).c - 1.375).abs() < 1e-12);
-        assert_eq!(reconstruct(&run, 0.0, h, (e, e / 30.0), true, true).c, 1.5);
-        // a jump of the slowness along the run: a kink of u, the ramp closing from 10% to 20%
-        for (jump, c) in [(0.05, 1.5), (0.15, 1.25), (0.25, 1.0)] {
-            let side = Upwind {
-                sigma_jump: jump,
-                ..run
-            };
-            let got = reconstruct(&side, 0.0, h, (e, e / 30.0), true, true).c;
-            assert!((got - c).abs() < 1e-12, "{jump}: {got}");
-        }
+        assert_eq!(reconstruct(&several, 0.0, h, e, true, true).c, 1.5);
     }
 }

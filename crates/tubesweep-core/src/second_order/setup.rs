@@ -282,7 +282,6 @@ fn setup<const D: usize>(
             u0,
             grad_u0,
             grad_u0_unit: unit,
-            largest_source_slowness: super::factoring::largest_slowness(source_slowness),
             roles: out_roles,
             fixed_per_source,
         })

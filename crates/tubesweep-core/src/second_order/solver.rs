@@ -184,9 +184,6 @@ pub(super) struct Sweeper<'a, const D: usize> {
     unresolved_extension_from: f32,
     /// More than one source: the BDF2 ramp's kink test is off ([`super::local::Upwind::w0_kink`]).
     several_sources: bool,
-    /// [`Factoring::largest_source_slowness`]: where a node's slowness is below it, the BDF2
-    /// ramp's kink test takes its ε at this slowness ([`super::local::KINK2`]).
-    source_slowness: f64,
     /// Per band node, whether its extension update extends u instead of w ([`super::demotion`]:
     /// where u₀ is not constant along the normals, extending w lowers u by u₀'s step at every
     /// pass); empty: nowhere.
@@ -250,7 +247,6 @@ impl<'a, const D: usize> Sweeper<'a, D> {
             unresolved_extension_from: (UNRESOLVED_EXTENSION_FROM * spacing
                 / super::geometry::power_of_two_near(spacing)) as f32,
             several_sources: factoring.fixed_per_source.len() > 1,
-            source_slowness: factoring.largest_source_slowness,
             extends_u,
         }
     }
@@ -321,23 +317,11 @@ impl<const D: usize> Sweeper<'_, D> {
         let u0 = |j: usize| unsafe { *self.u0.get_unchecked(j) };
         let ui = wi + u0(i);
         let sigma = self.sigma(i);
-        let (inv_eps, inv_sigma, margin, inv_eps_kink) = match self.slowness {
-            Slowness::Constant(_) => (
-                self.ramp_constant,
-                self.inv_sigma_constant,
-                self.margin_constant,
-                self.ramp_constant,
-            ),
+        let (inv_eps, inv_sigma, margin) = match self.slowness {
+            Slowness::Constant(_) => (self.ramp_constant, self.inv_sigma_constant, self.margin_constant),
             Slowness::PerNode(_) => {
                 let inv_eps = self.ramp_scale / sigma;
-                // the kink test's ε at the source's slowness where the node is faster (a
-                // region far faster than the source: w = u − u₀ carries u₀'s curvature there)
-                let inv_eps_kink = if sigma < self.source_slowness {
-                    self.ramp_scale / self.source_slowness
-                } else {
-                    inv_eps
-                };
-                (inv_eps, 1.0 / sigma, UPWIND_MARGIN / inv_eps, inv_eps_kink)
+                (inv_eps, 1.0 / sigma, UPWIND_MARGIN / inv_eps)
             }
         };
         // the sides whose first neighbour lies this high or higher are taken at first order
@@ -384,7 +368,6 @@ impl<const D: usize> Sweeper<'_, D> {
                     d1: f64::NAN,
                     d2: f64::NAN,
                     w0_kink: if self.several_sources { f64::NAN } else { wi },
-                    sigma_jump: 0.0,
                 };
                 let upwind = second && u1 < skip_from;
                 if upwind {
@@ -394,16 +377,6 @@ impl<const D: usize> Sweeper<'_, D> {
                         up.w2 = w.get(j2);
                         let u2 = up.w2 + u0(j2);
                         up.d1 = u1 - u2;
-                        // (at a node faster than the source: into an obstacle, a region
-                        // slower than the source, closing the ramp stalled the sweeps, a
-                        // sphere with a bubble 100 times slower beside it at N = 41)
-                        let faster = sigma < self.source_slowness;
-                        if let (true, Slowness::PerNode(per_node)) = (faster, self.slowness) {
-                            // SAFETY: j1 and j2 are band nodes
-                            let (s1, s2) = unsafe { (*per_node.get_unchecked(j1), *per_node.get_unchecked(j2)) };
-                            let low = sigma.min(s1).min(s2);
-                            up.sigma_jump = (s1 - sigma).abs().max((s2 - s1).abs()) / low;
-                        }
                         // the third neighbour only where the BDF3 ramp can open: an upwind run
                         // (u2 < u1), the node reached (the kink test needs its value)
                         if u1 > u2 && ui.is_finite() {
@@ -416,7 +389,7 @@ impl<const D: usize> Sweeper<'_, D> {
                         }
                     }
                 }
-                sides[k][side] = reconstruct(&up, du0, h, (inv_eps, inv_eps_kink), side == 0, upwind);
+                sides[k][side] = reconstruct(&up, du0, h, inv_eps, side == 0, upwind);
             }
             // the direction of ∇u for the metric: central differences, one-sided at a gap
             grad[k] = match (near[0].is_finite(), near[1].is_finite()) {
