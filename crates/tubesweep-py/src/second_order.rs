@@ -152,8 +152,7 @@ fn run<'py, const D: usize>(
                     slowness,
                     inp.spacing,
                     inp.options.tol_first,
-                    // (the deferred outer rim's pass counts as one more iteration)
-                    inp.options.max_iterations.saturating_sub(1),
+                    inp.options.max_iterations,
                     inp.threads,
                     inp.front_window,
                     &mut values,

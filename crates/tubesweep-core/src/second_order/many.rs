@@ -191,8 +191,7 @@ fn solve_one<const D: usize>(
             tube.slowness,
             tube.spacing,
             options.tol_first,
-            // (the deferred outer rim's pass counts as one more iteration)
-            options.max_iterations.saturating_sub(1),
+            options.max_iterations,
             1,
             tube.front_window,
             &mut values,

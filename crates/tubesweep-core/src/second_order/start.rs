@@ -50,8 +50,9 @@ fn isotropic_slowness<const D: usize>(
         .collect()
 }
 
-/// Runs the first-order driver; `values` gets its solution (+∞ where not reached, u₀ at the
-/// fixed nodes). `directions`: the outward unit directions sgn(φ) n per node.
+/// Runs the first-order driver for at most `max_iterations` (its deferred rim's pass included);
+/// `values` gets its solution (+∞ where not reached, u₀ at the fixed nodes). `directions`: the
+/// outward unit directions sgn(φ) n per node.
 #[allow(clippy::too_many_arguments)]
 pub fn first_order_start<const D: usize>(
     band: &NarrowBand<D>,
@@ -79,7 +80,8 @@ pub fn first_order_start<const D: usize>(
     };
     let options = SolveOptions {
         tol,
-        max_iterations,
+        // the deferred outer rim's pass counts as one more iteration: `max_iterations` in all
+        max_iterations: max_iterations.saturating_sub(1),
         infinity: None,
         threads,
         skip_inactive: true,
