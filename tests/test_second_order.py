@@ -219,6 +219,27 @@ def test_a_slow_descent_on_a_fine_circle_is_not_taken_for_a_stall():
     assert np.abs(sol(pts) - exact)[far].max() < 4e-7
 
 
+def test_phase_2_of_a_curve_runs_behind_its_front_window():
+    # from the first-order start every node was updated in every iteration while the changes fell
+    # by a few percent per iteration: 195 updates per band node at N = 2001, and at N = 10001 the
+    # sweeps stalled, ran away and returned the first-order solution (max error 1e-4, warned).
+    # Behind the window (second_order.WINDOWS_2D): 35 per node, and second order at N = 10001
+    circle = ts.surfaces.Circle(0.5)
+    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
+    src = np.array([0.5, 0.0])
+    exact = circle.geodesic_distance(pts, src)
+    far = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    sol = ts.solve(circle, box(2001, 2), [src])
+    assert sol.stats.order == 2 and sol.stats.converged
+    assert sol.stats.updates < 40 * len(sol.values), sol.stats.updates / len(sol.values)
+    assert np.abs(sol(pts) - exact)[far].max() < 3e-7
+    fine = ts.solve(circle, box(10001, 2), [src])
+    assert fine.stats.order == 2 and fine.stats.converged
+    assert fine.stats.order2["fallback_iteration"] is None and fine.stats.order2["runaway_iteration"] is None
+    assert np.abs(fine(pts) - exact)[far].max() < 3e-7
+
+
 def test_the_2d_default_tol_follows_the_fine_curve_creep():
     # phase 2's changes fall ever more slowly on a fine curve: stopping at a change of 1e-3 Δx²
     # left the circle at N = 1601 1.8e-7 from the fixed point and its mean error 15% above the

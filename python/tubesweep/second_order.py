@@ -138,17 +138,29 @@ EXTENSION_LIMIT = 2.0
 #: scheme with the isotropic part of the metric correction, exact on a curve, from the fixed
 #: nodes: ``tubesweep_core::second_order::start``) or on the second-order module's own sweeps
 #: (``True``: the factored scheme, whose changes fall by only a few percent per iteration on a
-#: fine curve). The driver's start halves the 2D solve's updates (0.46–0.61 on the circle, the
-#: star, an ellipse, three sources, a speed field, a smoothed mask and a closest-point circle at
-#: N = 201–1601) and 2D order=2 takes 0.6–0.7 of the time, with errors as small against the exact
-#: distances (far max and mean within 4% on the star at N = 201–1601 and the circle at 101–801;
-#: the circle's far max at N = 1601 4.3e-7 instead of 5.3e-7: ``benches/experiments/first_phase_2d.py``).
+#: fine curve). Without front windows in 2D, the driver's start halved the 2D solve's updates
+#: (0.46–0.61 on the circle, the star, an ellipse, three sources, a speed field, a smoothed mask
+#: and a closest-point circle at N = 201–1601) and 2D order=2 took 0.6–0.7 of the time, with errors
+#: as small against the exact distances (far max and mean within 4% on the star at N = 201–1601
+#: and the circle at 101–801; the circle's far max at N = 1601 4.3e-7 instead of 5.3e-7:
+#: ``benches/experiments/first_phase_2d.py``); with phase 2 behind its window (``WINDOWS_2D``) it
+#: still takes 0.55–0.68 of the updates of the own phase behind both windows at N = 801 and 4001.
 _OWN_FIRST_PHASE = {2: False, 3: True}
 
 # the front windows of the two phases in 3D (factors of the first-order driver's width; 0: none):
 # on the sphere at N = 201, 30 million updates without them, 10 million with them (7 million
 # with the activation thresholds at the phases' tolerances), the same errors
 WINDOWS = (2.0, 2.0)
+
+# in 2D phase 1 runs on the first-order driver (``_OWN_FIRST_PHASE``), and phase 2 behind the same
+# window as in 3D: from the first-order start every node was updated in every iteration while
+# the changes fell by a few percent per iteration, 39–950 updates per band node at N = 201–4001
+# (iterations and updates growing about as N); behind the window 13–78, 0.08–0.58 of them (the
+# seven cases of ``benches/experiments/window_2d.py``; the errors against the exact distances of
+# the star at N = 201–1601 and the circle at 101–1601 within 3%). The circle at N = 10001–16001
+# without it fell into the stagnation fallback, ran away and returned the first-order solution
+# (max error 1e-4); behind it second order (1.6e-7 at N = 10001, 0.5 s instead of 5.7 s)
+WINDOWS_2D = (0.0, WINDOWS[1])
 
 
 def check_order(order: Any) -> Union[int, str]:
@@ -618,8 +630,8 @@ def run_native(
             front_window=FRONT_WINDOW if d == 3 else 0.0,
             own_first_phase=_OWN_FIRST_PHASE[d],
             offsets=inputs.offsets,
-            window_first=WINDOWS[0] if d == 3 else 0.0,
-            window_second=WINDOWS[1] if d == 3 else 0.0,
+            window_first=(WINDOWS if d == 3 else WINDOWS_2D)[0],
+            window_second=(WINDOWS if d == 3 else WINDOWS_2D)[1],
             ramp_length=inputs.length,
             extension_limit=EXTENSION_LIMIT,
             warm=warm_values,
