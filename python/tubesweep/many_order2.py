@@ -104,6 +104,7 @@ def solve_many_order2(
         proj = np.asarray(proj, dtype=float)
         keep = (d_surface <= 1e-9 * h) | ~np.all(np.isfinite(proj), axis=1)
         at_feet = np.ascontiguousarray(np.where(keep[:, None], points, proj))
+    windows = so.windows_of(d, inputs.slowness)
     try:
         values, st = _native.second_order_solve_many(
             t.band,
@@ -126,8 +127,8 @@ def solve_many_order2(
             front_window=FRONT_WINDOW if d == 3 else 0.0,
             own_first_phase=so._OWN_FIRST_PHASE[grid.ndim],
             cp_offsets=inputs.offsets,
-            window_first=(so.WINDOWS if d == 3 else so.WINDOWS_2D)[0],
-            window_second=(so.WINDOWS if d == 3 else so.WINDOWS_2D)[1],
+            window_first=windows[0],
+            window_second=windows[1],
             ramp_length=inputs.length,
             extension_limit=so.EXTENSION_LIMIT,
             at=points,
