@@ -162,9 +162,9 @@ WINDOWS = (2.0, 2.0)
 # (max error 1e-4); behind it second order (1.6e-7 at N = 10001, 0.5 s instead of 5.7 s)
 WINDOWS_2D = (0.0, WINDOWS[1])
 
-#: ...except where the speed is high against the rest of the curve: where the 90th percentile of
-#: the slowness over the band is more than this many times its smallest value, phase 2 runs
-#: without its window in 2D. There (a region 20–30 times faster than the source's side), the BDF2
+#: Where the 90th percentile of the band's slowness is more than this many times its smallest
+#: value (part of the curve far faster than most of it), 2D phase 2 runs without its window
+#: (``windows_of``). There (a region 20–30 times faster than the source's side), the BDF2
 #: ramp's kink test leaves the fast region's nodes first order and they do not settle (changes of
 #: 1e-9 at a tolerance of 2e-12 at N = 4001); the window's edge waits on them and crept for
 #: 1300–3400 iterations, 3–18 times the updates of the solve without it, and a source on a sharp
