@@ -159,13 +159,19 @@ def test_oblate_spheroid_against_geographiclib():
     assert fars[-1] < 5e-4 and means[-1] < 1e-4, (fars, means)
 
 
-def test_circle_is_second_order():
+def circle_on_its_points(src):
+    """The circle R = 0.5, 2000 points on it, the exact distances from ``src`` and the points
+    at least 0.1 from the source and from the cut locus."""
     circle = ts.surfaces.Circle(0.5)
     t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
     pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
-    src = np.array([-0.5, 0.0])
     exact = circle.geodesic_distance(pts, src)
-    far = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    return circle, pts, exact, (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+
+
+def test_circle_is_second_order():
+    src = np.array([-0.5, 0.0])
+    circle, pts, exact, far = circle_on_its_points(src)
     ns = [101, 201, 401]
     errs = []
     for n in ns:
@@ -208,12 +214,8 @@ def test_a_slow_descent_on_a_fine_circle_is_not_taken_for_a_stall():
     # 2D, N = 4001: phase 2's change falls by 1-3% per iteration and rises for ~12 iterations on
     # the way; the stagnation test compared single changes and switched to decreases only at
     # iteration 39, which left the far max error at 3.5e-6 (2.0e-7 converged), with no warning
-    circle = ts.surfaces.Circle(0.5)
-    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
-    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
     src = np.array([0.5, 0.0])
-    exact = circle.geodesic_distance(pts, src)
-    far = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    circle, pts, exact, far = circle_on_its_points(src)
     sol = ts.solve(circle, box(4001, 2), [src])
     assert sol.stats.order == 2 and sol.stats.converged and sol.stats.order2["fallback_iteration"] is None
     assert np.abs(sol(pts) - exact)[far].max() < 4e-7
@@ -224,12 +226,8 @@ def test_phase_2_of_a_curve_runs_behind_its_front_window():
     # by a few percent per iteration: 195 updates per band node at N = 2001, and at N = 10001 the
     # sweeps stalled, ran away and returned the first-order solution (max error 1e-4, warned).
     # Behind the window (second_order.WINDOWS_2D): 35 per node, and second order at N = 10001
-    circle = ts.surfaces.Circle(0.5)
-    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
-    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
     src = np.array([0.5, 0.0])
-    exact = circle.geodesic_distance(pts, src)
-    far = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    circle, pts, exact, far = circle_on_its_points(src)
     sol = ts.solve(circle, box(2001, 2), [src])
     assert sol.stats.order == 2 and sol.stats.converged
     assert sol.stats.updates < 40 * len(sol.values), sol.stats.updates / len(sol.values)
@@ -240,7 +238,7 @@ def test_phase_2_of_a_curve_runs_behind_its_front_window():
     assert np.abs(fine(pts) - exact)[far].max() < 3e-7
 
 
-def test_a_curve_much_faster_than_elsewhere_runs_phase_2_without_its_window():
+def test_a_curve_much_faster_than_elsewhere_runs_phase_2_without_its_window(monkeypatch):
     # a region 20-30 times faster than the rest does not settle at second order (the kink test),
     # and the window's edge waited on it for thousands of iterations: there phase 2 runs as it
     # did without the window, bit for bit; at 10 times the window stays (errors 50-250 times
@@ -258,12 +256,9 @@ def test_a_curve_much_faster_than_elsewhere_runs_phase_2_without_its_window():
     for f in (10.0, 30.0):
         speed = lambda x, f=f: np.where(x[:, 0] > 0, f, 1.0)  # noqa: E731
         default = ts.solve(circle, g, src, speed=speed, order=2)
-        saved = so.WINDOWS_2D
-        so.WINDOWS_2D = (0.0, 0.0)
-        try:
+        with monkeypatch.context() as m:
+            m.setattr(so, "WINDOWS_2D", (0.0, 0.0))
             unwindowed = ts.solve(circle, g, src, speed=speed, order=2)
-        finally:
-            so.WINDOWS_2D = saved
         sols[f] = np.array_equal(default.values, unwindowed.values)
     assert sols == {10.0: False, 30.0: True}
 
@@ -275,11 +270,8 @@ def test_the_2d_default_tol_follows_the_fine_curve_creep():
     assert so.default_tol(2 / 400, 1.0, 1.0, 2) == 1e-3 * (2 / 400) ** 2
     assert so.default_tol(2 / 1600, 1.0, 1.0, 2) == pytest.approx(0.25 * 1e-3 * (2 / 1600) ** 2, rel=1e-12)
     assert so.default_tol(2 / 1600, 1.0, 1.0, 3) == 5e-4 * (2 / 1600) ** 2
-    circle = ts.surfaces.Circle(0.5)
-    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
-    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
     src = np.array([0.5, 0.0])
-    exact = circle.geodesic_distance(pts, src)
+    circle, pts, exact, _ = circle_on_its_points(src)
     g = box(1601, 2)
     mean = {}
     for name, tol in (("default", None), ("dx2 rule", 1e-3 * g.spacing**2), ("converged", 1e-5 * g.spacing**2)):
@@ -388,11 +380,8 @@ def test_closest_point_surfaces_are_second_order():
     with pytest.warns(RuntimeWarning, match="1 of 1 points lie where the band does not reach"):
         assert np.isnan(sol([(0.0, 0.0, 0.0)])[0])
     circle = ts.ClosestPoint(lambda x: 0.5 * x / np.linalg.norm(x, axis=1, keepdims=True))
-    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
-    pts = 0.5 * np.stack([np.cos(t), np.sin(t)], 1)
     src = np.array([-0.5, 0.0])
-    exact = ts.surfaces.Circle(0.5).geodesic_distance(pts, src)
-    cfar = (exact >= 0.1) & (exact <= 0.5 * np.pi - 0.1)
+    _, pts, exact, cfar = circle_on_its_points(src)
     ns = [101, 201, 401]
     errs = []
     for n in ns:

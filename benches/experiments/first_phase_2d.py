@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import time
 import warnings
+from typing import Any, Callable, Sequence, Tuple
 
 import numpy as np
 
@@ -48,6 +49,24 @@ def cases():
     yield "circle, closest points", lambda n: (cp, [(0.5, 0.0)], {})
 
 
+def print_errors(use: Callable[[Any], None], variants: Sequence[Tuple[Any, str]]) -> None:
+    """The far max and mean errors against the exact distances of ``tubesweep reproduce
+    second-order``'s star and circle, a column per variant (``use(value)`` switches to it)."""
+    print("errors against the exact distances (far max, mean)")
+    for name, make, ns in (
+        ("star", star_case, (201, 401, 801, 1601)),
+        ("circle", circle_case, (101, 201, 401, 801, 1601)),
+    ):
+        case = make()
+        for n in ns:
+            row = []
+            for value, label in variants:
+                use(value)
+                r = measure(case, n, 2)
+                row.append(f"{label} {r['far_max']:.3e} {r['mean']:.3e} ({r['iterations']} it)")
+            print(f"{name:7s} N={n:5d}  " + " | ".join(row), flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sizes", default="201,801,1601")
@@ -73,21 +92,11 @@ def main() -> None:
                     f"updates {b.stats.updates / a.stats.updates:.2f} | max |own − driver| {d / a.stats.order2['tol']:.0f} tol",
                     flush=True,
                 )
-        print("errors against the exact distances (far max, mean)")
-        for name, make, ns in (
-            ("star", star_case, (201, 401, 801, 1601)),
-            ("circle", circle_case, (101, 201, 401, 801, 1601)),
-        ):
-            case = make()
-            for n in ns:
-                row = []
-                for own in (True, False):
-                    so._OWN_FIRST_PHASE[2] = own
-                    r = measure(case, n, 2)
-                    row.append(
-                        f"{'own' if own else 'driver'} {r['far_max']:.3e} {r['mean']:.3e} ({r['iterations']} it)"
-                    )
-                print(f"{name:7s} N={n:5d}  " + " | ".join(row), flush=True)
+
+        def use(own: bool) -> None:
+            so._OWN_FIRST_PHASE[2] = own
+
+        print_errors(use, ((True, "own"), (False, "driver")))
     finally:
         so._OWN_FIRST_PHASE.update(saved)
 

@@ -20,9 +20,8 @@ import numpy as np
 
 import tubesweep as ts
 from tubesweep import second_order as so
-from tubesweep.reproduce.second_order import circle_case, measure, star_case
 
-from first_phase_2d import cases, grid  # the same seven 2D cases
+from first_phase_2d import cases, grid, print_errors  # the same seven 2D cases
 
 
 def _set(window: bool) -> None:
@@ -62,21 +61,7 @@ def main() -> None:
                     f"{b.stats.updates / a.stats.updates:.2f} | max |none − window| {d / b.stats.order2['tol']:.0f} tol",
                     flush=True,
                 )
-        print("errors against the exact distances (far max, mean)")
-        for name, make, ns in (
-            ("star", star_case, (201, 401, 801, 1601)),
-            ("circle", circle_case, (101, 201, 401, 801, 1601)),
-        ):
-            case = make()
-            for n in ns:
-                row = []
-                for window in (False, True):
-                    _set(window)
-                    r = measure(case, n, 2)
-                    row.append(
-                        f"{'window' if window else 'none'} {r['far_max']:.3e} {r['mean']:.3e} ({r['iterations']} it)"
-                    )
-                print(f"{name:7s} N={n:5d}  " + " | ".join(row), flush=True)
+        print_errors(_set, ((False, "none"), (True, "window")))
     finally:
         so.WINDOWS_2D = saved
 
