@@ -224,8 +224,8 @@ def test_a_slow_descent_on_a_fine_circle_is_not_taken_for_a_stall():
 def test_phase_2_of_a_curve_runs_behind_its_front_window():
     # from the first-order start every node was updated in every iteration while the changes fell
     # by a few percent per iteration: 195 updates per band node at N = 2001, and at N = 10001 the
-    # sweeps stalled, ran away and returned the first-order solution (max error 1e-4, warned).
-    # Behind the window (second_order.WINDOWS_2D): 35 per node, and second order at N = 10001
+    # sweeps stalled, ran away and returned the first-order solution (warned). Behind the window
+    # (second_order.WINDOWS_2D): 35 per node, and second order at N = 10001
     src = np.array([0.5, 0.0])
     circle, pts, exact, far = circle_on_its_points(src)
     sol = ts.solve(circle, box(2001, 2), [src])
@@ -241,8 +241,8 @@ def test_phase_2_of_a_curve_runs_behind_its_front_window():
 def test_a_curve_much_faster_than_elsewhere_runs_phase_2_without_its_window(monkeypatch):
     # a region 20-30 times faster than the rest does not settle at second order (the kink test),
     # and the window's edge waited on it for thousands of iterations: there phase 2 runs as it
-    # did without the window, bit for bit; at 10 times the window stays (errors 50-250 times
-    # smaller at N = 4001 than without it)
+    # did without the window, bit for bit; at 10 times the window stays (mean errors 50-250 times
+    # smaller at N = 4001 than without it: benches/experiments/window_2d.py --fast 10,30)
     assert so.windows_of(3, 1.0) == so.WINDOWS and so.windows_of(2, 1.0) == so.WINDOWS_2D
     slow = np.ones(1000)
     slow[:50] = 100.0  # a slow obstacle on 5% of the band keeps the window

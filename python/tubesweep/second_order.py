@@ -143,8 +143,7 @@ EXTENSION_LIMIT = 2.0
 #: and a closest-point circle at N = 201–1601) and 2D order=2 took 0.6–0.7 of the time, with errors
 #: as small against the exact distances (far max and mean within 4% on the star at N = 201–1601
 #: and the circle at 101–801; the circle's far max at N = 1601 4.3e-7 instead of 5.3e-7:
-#: ``benches/experiments/first_phase_2d.py``); with phase 2 behind its window (``WINDOWS_2D``) it
-#: still takes 0.55–0.68 of the updates of the own phase behind both windows at N = 801 and 4001.
+#: ``benches/experiments/first_phase_2d.py``, measured before phase 2 had its window in 2D).
 _OWN_FIRST_PHASE = {2: False, 3: True}
 
 # the front windows of the two phases in 3D (factors of the first-order driver's width; 0: none):
@@ -153,26 +152,25 @@ _OWN_FIRST_PHASE = {2: False, 3: True}
 WINDOWS = (2.0, 2.0)
 
 # in 2D phase 1 runs on the first-order driver (``_OWN_FIRST_PHASE``), and phase 2 behind the same
-# window as in 3D: from the first-order start every node was updated in every iteration while
-# the changes fell by a few percent per iteration, 39–950 updates per band node at N = 201–4001
-# (iterations and updates growing about as N); behind the window 13–78, 0.08–0.58 of them (the
-# seven cases of ``benches/experiments/window_2d.py``; the errors against the exact distances of
-# the star at N = 201–1601 and the circle at 101–1601 within 3%). The circle at N = 10001–16001
-# without it fell into the stagnation fallback, ran away and returned the first-order solution
-# (max error 1e-4); behind it second order (1.6e-7 at N = 10001, 0.5 s instead of 5.7 s)
+# window as in 3D. From the first-order start without it, every node was updated in every
+# iteration while the changes fell by a few percent per iteration: on the circle 39 / 164 / 1497
+# updates per band node at N = 201 / 1601 / 10001, and at N = 10001 the sweeps stalled, ran away
+# and returned the first-order solution. Behind the window 16 / 32 / 64, second order at 10001;
+# 0.08–0.58 of the updates on the seven cases of ``benches/experiments/window_2d.py`` at
+# N = 201–4001, the errors against the exact distances of the star at N = 201–1601 and the circle
+# at 101–1601 within 3% (``window_2d.py --sizes 201,801,1601,4001`` and ``--sizes 10001``)
 WINDOWS_2D = (0.0, WINDOWS[1])
 
 #: Where the 90th percentile of the band's slowness is more than this many times its smallest
 #: value (part of the curve far faster than most of it), 2D phase 2 runs without its window
-#: (``windows_of``). There (a region 20–30 times faster than the source's side), the BDF2
-#: ramp's kink test leaves the fast region's nodes first order and they do not settle (changes of
-#: 1e-9 at a tolerance of 2e-12 at N = 4001); the window's edge waits on them and crept for
-#: 1300–3400 iterations, 3–18 times the updates of the solve without it, and a source on a sharp
-#: jump fell into the stagnation fallback with a warning where the solve without it converged
-#: (a helper's review of the window). At 10 times the window is kept: the same or fewer
-#: updates, errors 50–250 times smaller on a smooth 10× region at N = 4001. Only the slowness
-#: decides (not the sources), so that a batch's rows equal the single solves bit for bit; a slow
-#: obstacle on under a tenth of the band keeps the window
+#: (``windows_of``). There the BDF2 ramp's kink test leaves the fast region's nodes first order,
+#: they do not settle, and the window's edge waits on them: a circle whose speed rises smoothly to
+#: 30 times, at N = 4001, took 2600–3400 iterations and 14–26 times the updates of the solve
+#: without the window, and still fell into the stagnation fallback. At 10 times the window is
+#: kept: 0.8–1.6 times the updates, mean errors 50–250 times smaller and no fallback
+#: (``window_2d.py --fast 10,30``). Only the slowness decides (not the sources), so that a
+#: batch's rows equal the single solves bit for bit; a slow obstacle on under a tenth of the band
+#: keeps the window
 WINDOW_2D_CONTRAST = 12.0
 
 
