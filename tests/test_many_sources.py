@@ -2,6 +2,7 @@
 and the Dask client (issue 33; pickling: issue 35 item 8)."""
 
 import pickle
+import sys
 
 import numpy as np
 import pytest
@@ -414,6 +415,25 @@ def test_bench_script_runs(tmp_path):
     ).stdout
     assert "solve_many(threads=2)" in out and "x the loop" in out
     assert "potpourri3d heat method" in out and "pygeodesic exact MMP" in out
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="VmHWM is Linux's")
+def test_the_bench_memory_of_a_child_is_its_own_not_its_parents():
+    """The memory part's children report their own peak: ``ru_maxrss`` carries the parent's
+    high-water mark over the fork (after the other parts it read the bench process's 100 MB for
+    every run), VmHWM does not. A parent holding 240 MB starts a child that holds nothing."""
+    import subprocess
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    import many_sources
+
+    held = np.ones(30_000_000)  # 240 MB resident in this process
+    held[::512] = 2.0
+    child = many_sources._PEAK_OF_THIS_PROCESS + "print(peak_kb())"
+    out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, check=True)
+    assert int(out.stdout) < 100 * 1024  # a bare interpreter: about 9 MB (ru_maxrss: 254 MB)
+    assert held.sum() > 0
 
 
 # ---------------------------------------------------------------------------------- order (issue 46)
