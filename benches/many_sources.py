@@ -242,20 +242,16 @@ def part_orders(quick: bool) -> None:
     )
 
 
-# A child's peak resident memory: its own VmHWM (Linux). ``ru_maxrss`` is not it: Linux carries the
-# parent's high-water mark at the fork over to the child (a child of a 240 MB process read 254 MB
-# there against a VmHWM of 9 MB), so after the other parts it read the bench process's size.
-_PEAK_OF_THIS_PROCESS = r"""
+# A child's peak resident memory: its own VmHWM (Linux; run.py's reader, imported first in every
+# child, the baseline's too). ``ru_maxrss`` is not it: Linux carries the parent's high-water mark
+# at the fork over to the child (a child of a 240 MB process read 254 MB there against a VmHWM of
+# 9 MB), so after the other parts it read the bench process's size.
+_PEAK_OF_THIS_PROCESS = f"""
+import resource, sys
+sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
+from run import _status_kb
 def peak_kb():
-    import resource
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1])
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return _status_kb("VmHWM") or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 """
 
 _MEMORY_CHILD = (
