@@ -244,8 +244,9 @@ def part_orders(quick: bool) -> None:
 
 # A child's peak resident memory: its own VmHWM (Linux; run.py's reader, imported first in every
 # child, the baseline's too). ``ru_maxrss`` is not it: Linux carries the parent's high-water mark
-# at the fork over to the child (a child of a 240 MB process read 254 MB there against a VmHWM of
-# 9 MB), so after the other parts it read the bench process's size.
+# at the fork over to the child (a child of a large process reads at least the parent's size), so
+# after the other parts it read the bench process's size
+# (tests/test_many_sources.py::test_the_bench_memory_of_a_child_is_its_own_not_its_parents).
 _PEAK_OF_THIS_PROCESS = f"""
 import resource, sys
 sys.path.insert(0, {str(Path(__file__).resolve().parent)!r})
