@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from typing import Any, Optional, Tuple
+from typing import Any, Callable, Optional, Tuple
 
 import numpy as np
 
@@ -157,7 +157,7 @@ def facing_gaps(
     directions: np.ndarray,
     inner: float,
     kink: Optional[np.ndarray],
-    inside: Optional[np.ndarray],
+    inside: Optional[Callable[[np.ndarray], np.ndarray]],
 ) -> Gaps:
     """The pairs of band nodes across gaps narrower than the tubes (:func:`_warn_if_tubes_touch`;
     with an unsigned φ's known inside, the signed φ's too), warned of where the band is not cut
@@ -172,8 +172,18 @@ def facing_gaps(
         grid, band, linear, roles, phi, directions, inner, kink, noise, warn=not cuts and inside is None, note=note
     )
     if inside is not None:
-        # an unsigned φ with a known inside (BandGeometry.inside): the pairs of the signed φ too
-        signed_phi = np.where(inside, -phi, phi)
+        # an unsigned φ with a known inside (BandGeometry.inside): the pairs of the signed φ too,
+        # signed where the "across" test can read the sign (Band.across_candidates; elsewhere
+        # the signed φ's pairs are the unsigned φ's: the same pairs as signed everywhere)
+        at = band.across_candidates(
+            roles == ROLE_INNER,
+            np.ascontiguousarray(phi, dtype=np.float32),
+            np.ascontiguousarray(directions, dtype=np.float32).reshape(len(linear), grid.ndim),
+            h,
+        )
+        signed_phi = phi.copy()
+        if at.size:
+            signed_phi[at[inside(at)]] *= -1
         facing = _union_pairs(
             facing,
             _warn_if_tubes_touch(grid, band, linear, roles, signed_phi, directions, inner, kink, noise, warn=False),

@@ -101,6 +101,7 @@ def ellipsoid_signed_distance(
     points: npt.NDArray[np.float64], centre: List[float], axes: List[float]
 ) -> npt.NDArray[np.float64]: ...
 def star_signed_distance(points: npt.NDArray[np.float64], r0: float, eps: float) -> npt.NDArray[np.float64]: ...
+def mesh_vertex_parts(n_vertices: int, faces: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
 def solve_many_on_band(  # crates/tubesweep-py/src/many_sources.rs: K solves, in parallel across the sources
     band: "Band",
     roles: npt.NDArray[np.uint8],  # (n,) without fixed nodes
@@ -272,6 +273,13 @@ class Band:
         direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
         spacing: float,
     ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+    def across_candidates(
+        self,
+        inner: npt.NDArray[np.bool_],
+        phi: npt.NDArray[np.float32],  # unsigned
+        direction: npt.NDArray[np.float32],  # (K, d) C-contiguous
+        spacing: float,
+    ) -> npt.NDArray[np.int64]: ...
     def neighbours_of_nodes(self, positions: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]: ...
     def smoothed_turning(
         self, phi: npt.NDArray[np.float64], spacing: float, passes: int, reach: int, near: float

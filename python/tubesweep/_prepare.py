@@ -501,7 +501,7 @@ class _Band:
     band: Any
     phi: np.ndarray
     kink: Optional[np.ndarray]
-    inside: Optional[np.ndarray]
+    inside: Optional[Callable[[np.ndarray], np.ndarray]]
     direction: Optional[np.ndarray]
     outer: float
 

@@ -109,11 +109,12 @@ class BandGeometry:
         gradient turns by more than about 140° (``|∇φ|`` below :data:`KINK_FRACTION` of the
         band's typical value): a ridge between two parts of the surface that face each other,
         where the direction is not reliable (see ``_facing._warn_if_tubes_touch``). None otherwise.
-    inside : (K,) bool or None
+    inside : callable or None
         For a closest-point surface whose ``signed`` is unsigned but which has an inside (a closed
-        mesh's smooth map), the nodes inside it: the facing test runs once more with φ signed by
-        it, which finds gaps of one to two spacings that an unsigned φ shows as one sheet. None
-        otherwise.
+        mesh's smooth map): given band positions (int64), whether those nodes lie inside it. The
+        facing test runs once more with φ signed by it, which finds gaps of one to two spacings
+        that an unsigned φ shows as one sheet; it asks only for the few nodes whose sign that test
+        can read (``_facing.facing_gaps``). None otherwise.
     """
 
     linear: np.ndarray
@@ -123,7 +124,7 @@ class BandGeometry:
     consumable: bool = False
     native_band: Any = None
     kink: Optional[np.ndarray] = None
-    inside: Optional[np.ndarray] = None
+    inside: Optional[Callable[[np.ndarray], np.ndarray]] = None
 
     def directions_for_solver(self) -> np.ndarray:
         """``direction`` as the C-ordered float32 array the solver overwrites with the extension

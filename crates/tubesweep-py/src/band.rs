@@ -285,6 +285,29 @@ impl PyBand {
         Ok((node.into_pyarray(py), neighbour.into_pyarray(py), gap.into_pyarray(py)))
     }
 
+    /// The band positions whose φ's sign the *across* test of `facing_sheet_pairs` can read
+    /// (`tubesweep_core::band::facing_sheets::across_candidates`; `phi` unsigned).
+    fn across_candidates<'py>(
+        &self,
+        py: Python<'py>,
+        inner: PyReadonlyArray1<'py, bool>,
+        phi: PyReadonlyArray1<'py, f32>,
+        direction: PyReadonlyArray2<'py, f32>,
+        spacing: f64,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let (inn, ph, dir) = self.node_fields(&inner, &phi, &direction)?;
+        let nodes = py
+            .detach(|| {
+                with_band!(
+                    self,
+                    b,
+                    tubesweep_core::band::facing_sheets::across_candidates(b, inn, ph, dir, spacing)
+                )
+            })
+            .map_err(to_pyerr)?;
+        Ok(nodes.into_iter().map(|n| n as i64).collect::<Vec<_>>().into_pyarray(py))
+    }
+
     /// The inner-tube nodes on the overlap side of a crease that become extension nodes (see
     /// `tubesweep_core::band::crease_ridges`): `inner` per node, `phi` φ (signed), `direction`
     /// (K, d) the outward directions. Returns their band positions.

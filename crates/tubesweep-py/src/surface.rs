@@ -505,6 +505,25 @@ pub(crate) fn redistanced_band_of_samples<'py>(
     ))
 }
 
+/// Per vertex the smallest vertex index of its connected part, the vertices joined by the edges
+/// of the faces (m, 3). See `tubesweep_core::surface::mesh_parts::vertex_parts`.
+#[pyfunction]
+pub(crate) fn mesh_vertex_parts<'py>(
+    py: Python<'py>,
+    n_vertices: usize,
+    faces: PyReadonlyArray2<'py, i64>,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    if faces.shape()[1] != 3 {
+        return Err(PyValueError::new_err("faces must have shape (m, 3)"));
+    }
+    let f = c_slice(&faces, "faces")?;
+    let triangles: Vec<[i64; 3]> = f.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let labels = py
+        .detach(|| tubesweep_core::surface::mesh_parts::vertex_parts(n_vertices, &triangles))
+        .map_err(to_pyerr)?;
+    Ok(labels.into_pyarray(py))
+}
+
 /// Adds this file's classes and functions to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyTriangleTree>()?;
@@ -518,5 +537,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mobius_closest_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(open_surface_closest_points, m)?)?;
     m.add_function(wrap_pyfunction!(star_signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_vertex_parts, m)?)?;
     Ok(())
 }

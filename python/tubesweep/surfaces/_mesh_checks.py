@@ -9,6 +9,7 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
+from .._distinct import distinct_rows, used_vertices
 from .._warn import user_stacklevel
 
 #: The share of a mesh's area within about a grid spacing of another part facing it
@@ -51,8 +52,8 @@ def warn_repeated_vertices(v: np.ndarray, f: np.ndarray, boundary_edges: int) ->
     repeat them (equal coordinates under other indices, a triangle soup as STL writes it): read as
     given, its shared edges are boundaries, and a closed surface loses its smooth map (a closed
     icosphere's errors 2–3 times the merged mesh's)."""
-    used = np.unique(f)
-    repeated = len(used) - len(np.unique(v[used], axis=0))
+    used = used_vertices(f, len(v))
+    repeated = len(used) - len(distinct_rows(v[used])[0])
     if repeated > 0.1 * len(used):
         warnings.warn(
             f"{repeated} of the mesh's {len(used)} vertices repeat another's coordinates under another index, so the "

@@ -28,6 +28,8 @@ from typing import Any, Optional, Tuple
 
 import numpy as np
 
+from .. import _native
+from .._distinct import distinct_rows
 from ..band import band_edges
 from ..grid import Grid
 from ._mesh_checks import unique_edges
@@ -38,32 +40,17 @@ CHUNK = 1 << 18
 
 def vertex_parts(n_vertices: int, faces: np.ndarray) -> np.ndarray:
     """Per vertex the smallest vertex index of its connected part (vertices joined by the
-    triangles' edges): label propagation with pointer jumping, O(edges · log) in NumPy."""
-    f = np.asarray(faces, dtype=np.int64)
-    a = np.concatenate([f[:, 0], f[:, 1], f[:, 2]])
-    b = np.concatenate([f[:, 1], f[:, 2], f[:, 0]])
-    label = np.arange(n_vertices, dtype=np.int64)
-    while True:
-        low = np.minimum(label[a], label[b])
-        new = label.copy()
-        for ends in (a, b, label[a], label[b]):  # the ends, and their roots (hooking)
-            np.minimum.at(new, ends, low)
-        while True:  # pointer jumping: every vertex to its root
-            jumped = new[new]
-            if np.array_equal(jumped, new):
-                break
-            new = jumped
-        if np.array_equal(new, label):
-            return label
-        label = new
+    triangles' edges; a row ``[a, b, b]`` is the edge ab alone): union–find in Rust,
+    ``tubesweep_core::surface::mesh_parts``, O(faces)."""
+    f = np.ascontiguousarray(np.asarray(faces, dtype=np.int64).reshape(-1, 3))
+    return np.asarray(_native.mesh_vertex_parts(int(n_vertices), f))
 
 
 def merged_vertices(surface: Any) -> np.ndarray:
     """Per vertex of ``surface`` an index shared by the vertices at the same coordinates (a seam
     of an export, a triangle soup), computed once and kept."""
     if "_merged_vertices" not in surface.__dict__:
-        _, same = np.unique(surface.vertices, axis=0, return_inverse=True)
-        surface.__dict__["_merged_vertices"] = same.ravel().astype(np.int64)
+        surface.__dict__["_merged_vertices"] = distinct_rows(surface.vertices)[1]
     merged: np.ndarray = surface.__dict__["_merged_vertices"]
     return merged
 
@@ -146,8 +133,6 @@ def _box_pairs(lo: np.ndarray, hi: np.ndarray, longest: np.ndarray) -> list:
 
 
 def _piece_tree(surface: Any, faces: np.ndarray) -> Any:
-    from .. import _native
-
     return _native.TriangleTree(surface.vertices, np.ascontiguousarray(surface.faces[faces]))
 
 

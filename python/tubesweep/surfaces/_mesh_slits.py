@@ -43,6 +43,7 @@ from typing import Any, Dict, Optional, Tuple
 
 import numpy as np
 
+from .._distinct import distinct
 from .._warn import user_stacklevel
 from ._mesh_holes import WARN_SHARE, boundary_edges_of, holes
 
@@ -139,7 +140,7 @@ def _search(surface: Any, h: float) -> Optional[Tuple[np.ndarray, np.ndarray, np
     if len(edges) == 0:
         return None
     v = surface.vertices
-    on = np.unique(edges)
+    on = distinct(edges)
     if on.size > MAX_BOUNDARY:
         return None
     loop, s, length = _loops(surface, edges)

@@ -36,6 +36,8 @@ from ..surface import Surface
 from ..closest_point import ClosestPoint
 from .._validate import check_flag, real_array, real_scalar, whole_indices
 from ..grid import MAX_COORDINATE
+from .. import _distinct
+from .._distinct import distinct, distinct_rows
 from .._warn import user_stacklevel
 from ._mesh_files import MESH_EXTRA, read_mesh
 from ._triangle_projection import EDGE_AB, EDGE_AC, EDGE_BC, FACE, VERT_A, VERT_B, VERT_C, closest_points_on_triangles
@@ -180,7 +182,7 @@ class MeshSurface(Surface):
             )
         # a triangle listed twice (the same three vertices) adds nothing to the surface, but would
         # count its edges twice and make a closed mesh look open: kept once, with a warning
-        _, first = np.unique(np.sort(f, axis=1), axis=0, return_index=True)
+        first, _ = distinct_rows(np.sort(f, axis=1))
         #: the number of repeated triangles dropped from ``faces``
         self.duplicate_faces = int(len(f) - len(first))
         if self.duplicate_faces:
@@ -200,7 +202,7 @@ class MeshSurface(Surface):
         a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
         cross = np.cross(b - a, c - a)
         area2 = np.linalg.norm(cross, axis=1)
-        extent = float(np.ptp(v[np.unique(f)], axis=0).max())
+        extent = float(np.ptp(v[_distinct.used_vertices(f, len(v))], axis=0).max())
         good = area2 > 1e-12 * max(extent, 1e-300) ** 2
         if not np.any(good):
             # (a mesh at 1e-200 was refused with no hint of its scale: a helper's review)
@@ -227,7 +229,7 @@ class MeshSurface(Surface):
             # against their neighbours)
             fp = f[use]
             e_dir = np.concatenate([fp[:, [0, 1]], fp[:, [1, 2]], fp[:, [2, 0]]])
-            flips = len(e_dir) - len(np.unique(e_dir[:, 0] * len(v) + e_dir[:, 1]))
+            flips = len(e_dir) - len(distinct(e_dir[:, 0] * len(v) + e_dir[:, 1]))
             return np.bincount(edge_ids[use].ravel(), minlength=len(counts)), flips
 
         counts, flipped = edges_of(proper)
@@ -504,7 +506,7 @@ class MeshSurface(Surface):
     # ------------------------------------------------------------------ conveniences
     @property
     def used_vertices(self) -> np.ndarray:
-        return np.unique(self.faces)
+        return _distinct.used_vertices(self.faces, len(self.vertices))
 
     @property
     def default_source_vertex(self) -> int:
@@ -784,7 +786,7 @@ def from_mesh(
         target = finite_center(center, 3)
         if f.size == 0 or f.min() < 0 or f.max() >= len(v) or v.ndim != 2 or v.shape[1] != 3:
             return kind(v, f, signed=signed, name=name)  # raises with the mesh's own message
-        used = v[np.unique(f)]
+        used = v[_distinct.used_vertices(f, len(v))]
         lo, hi = used.min(0), used.max(0)
         if not float((hi - lo).max()) > 0:
             raise ValueError(

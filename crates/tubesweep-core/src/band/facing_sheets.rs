@@ -137,20 +137,14 @@ pub fn facing_sheet_pairs<const D: usize>(
                 continue;
             }
             let tb = pb.abs() / spacing;
-            // the chord cp(a) − cp(b) in grid spacings: (a − b) − t_a n_a + t_b n_b, a − b = −e_k
-            let chord: [f64; D] = std::array::from_fn(|j| if j == k { -1.0 } else { 0.0 } - ta * na[j] + tb * nb[j]);
-            let chord2 = dot(&chord, &chord);
+            let (chord2, runs_across) = chord_across(k, ta, &na, tb, &nb);
             // facing: on one side, pointing against each other, each on its own side of the
             // other's closest point
             let facing =
                 same_side && ta > MIN_OFF_SURFACE && tb > MIN_OFF_SURFACE && ta + na[k] > 0.0 && tb - nb[k] > 0.0;
             // across: on opposite sides of the surface yet pointing the same way, so that the
             // inside node's closest point and the outside node's lie on different sheets
-            let across = opposite_sides && chord2 > MIN_ACROSS * MIN_ACROSS && {
-                let (ca, cb) = (dot(&chord, &na), dot(&chord, &nb));
-                let min2 = ACROSS_COSINE * ACROSS_COSINE * chord2;
-                ca * ca >= min2 && cb * cb >= min2
-            };
+            let across = opposite_sides && runs_across;
             if facing || across {
                 out.push(FacingPair {
                     node: a,
@@ -172,6 +166,69 @@ pub fn facing_sheet_pairs<const D: usize>(
         })
         .collect();
     Ok(parts.concat())
+}
+
+/// The squared chord `|cp(a) − cp(b)|²` in grid spacings of neighbours `a` and `b = a + h·e_k`
+/// (`t = |φ|/h`, `n` their directions: `(a − b) − t_a n_a + t_b n_b`), and whether it passes the
+/// *across* test's conditions that do not read φ's sign: longer than [`MIN_ACROSS`] spacings and
+/// within 30° of both directions ([`ACROSS_COSINE`]).
+#[inline]
+fn chord_across<const D: usize>(k: usize, ta: f64, na: &[f64; D], tb: f64, nb: &[f64; D]) -> (f64, bool) {
+    let dot = |u: &[f64; D], v: &[f64; D]| -> f64 { (0..D).map(|j| u[j] * v[j]).sum() };
+    let chord: [f64; D] = std::array::from_fn(|j| if j == k { -1.0 } else { 0.0 } - ta * na[j] + tb * nb[j]);
+    let chord2 = dot(&chord, &chord);
+    let across = chord2 > MIN_ACROSS * MIN_ACROSS && {
+        let (ca, cb) = (dot(&chord, na), dot(&chord, nb));
+        let min2 = ACROSS_COSINE * ACROSS_COSINE * chord2;
+        ca * ca >= min2 && cb * cb >= min2
+    };
+    (chord2, across)
+}
+
+/// The band positions (sorted) of the nodes of every neighbour pair (one of them in the inner
+/// tube) that the *across* test takes once φ's signs differ: directions pointing the same way and
+/// [`chord_across`]. Reads `|phi|` only. Where an unsigned φ's inside is known but costly to find
+/// (a closed mesh's smooth map: an exact closest point per node), only these nodes need it: the
+/// pairs of [`facing_sheet_pairs`] with φ signed by the inside at these nodes alone are those with
+/// φ signed everywhere, once joined with the unsigned φ's (a *facing* pair of a signed φ is one
+/// of the unsigned φ's, and an *across* pair has both nodes here).
+pub fn across_candidates<const D: usize>(
+    band: &NarrowBand<D>,
+    inner: &[bool],
+    phi: &[f32],
+    direction: &[f32],
+    spacing: f64,
+) -> Result<Vec<usize>> {
+    check_node_fields(band, inner, phi, direction, spacing)?;
+    let sentinel = band.sentinel();
+    let dir = |n: usize| -> [f64; D] { std::array::from_fn(|k| direction[D * n + k] as f64) };
+    const BLOCK: usize = 1 << 14;
+    let mut nodes: Vec<usize> = (0..band.len().div_ceil(BLOCK))
+        .into_par_iter()
+        .flat_map_iter(|blk| {
+            let mut out = Vec::new();
+            for a in blk * BLOCK..((blk + 1) * BLOCK).min(band.len()) {
+                let (ta, na) = ((phi[a] as f64).abs() / spacing, dir(a));
+                for (k, pair) in band.neighbours_of(a).iter().enumerate() {
+                    let b = pair[1];
+                    if b == sentinel || !(inner[a] || inner[b as usize]) {
+                        continue;
+                    }
+                    let b = b as usize;
+                    let nb = dir(b);
+                    if (0..D).map(|j| na[j] * nb[j]).sum::<f64>() > 0.0
+                        && chord_across(k, ta, &na, (phi[b] as f64).abs() / spacing, &nb).1
+                    {
+                        out.extend([a, b]);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    Ok(nodes)
 }
 
 #[cfg(test)]
@@ -230,6 +287,47 @@ mod tests {
             let (ia, ib) = (band.index_of(p.node), band.index_of(p.neighbour));
             assert_eq!((ia[0], ib[0]), (5, 6));
             assert!((p.gap - 0.175).abs() < 1e-6, "gap {}", p.gap);
+        }
+    }
+
+    #[test]
+    fn signs_at_the_across_candidates_alone_give_the_pairs_of_signs_everywhere() {
+        // strips 1.1 to 1.9 spacings thick: the across pairs need the signs; with them at the
+        // candidates alone (others outside), joined with the unsigned φ's pairs, the same pairs
+        let h = 0.1;
+        for top in [0.52, 0.56, 0.6] {
+            let (band, phi, dir) = two_lines(10, h, 0.415, top);
+            let inner: Vec<bool> = phi.iter().map(|&p| (p as f64).abs() <= 2.0 * h + 1e-6).collect();
+            let unsigned: Vec<f32> = phi.iter().map(|p| p.abs()).collect();
+            let key = |p: &FacingPair| (p.node, p.neighbour);
+            let mut everywhere: Vec<_> = facing_sheet_pairs(&band, &inner, &phi, &dir, h)
+                .unwrap()
+                .iter()
+                .map(key)
+                .collect();
+            let at = across_candidates(&band, &inner, &unsigned, &dir, h).unwrap();
+            assert!(
+                !at.is_empty() && at.len() < band.len() / 4,
+                "top {top}: {} candidates",
+                at.len()
+            );
+            let mut partly = unsigned.clone();
+            for &n in &at {
+                partly[n] = phi[n];
+            }
+            let mut joined: Vec<_> = facing_sheet_pairs(&band, &inner, &unsigned, &dir, h)
+                .unwrap()
+                .iter()
+                .chain(facing_sheet_pairs(&band, &inner, &partly, &dir, h).unwrap().iter())
+                .map(key)
+                .collect();
+            for v in [&mut everywhere, &mut joined] {
+                v.sort_unstable();
+                v.dedup();
+            }
+            let unsigned_only = facing_sheet_pairs(&band, &inner, &unsigned, &dir, h).unwrap().len();
+            assert!(everywhere.len() > unsigned_only, "top {top}: the signs add pairs");
+            assert_eq!(joined, everywhere, "top {top}");
         }
     }
 

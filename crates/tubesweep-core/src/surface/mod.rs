@@ -11,6 +11,7 @@
 pub mod analytic;
 pub mod interface_cells;
 pub mod mesh;
+pub mod mesh_parts;
 pub mod mesh_smooth;
 pub mod mobius;
 pub mod open_surfaces;
