@@ -25,7 +25,7 @@ MODULES = [
     "tubesweep.flows", "tubesweep.hamiltonians", "tubesweep.surfaces.analytic", "tubesweep.surfaces.closed",
     "tubesweep.surfaces.curves", "tubesweep.surfaces.open", "tubesweep.surfaces.mesh", "tubesweep.distances",
     "tubesweep.solution", "tubesweep.band", "tubesweep._triangulate",
-    "tubesweep.box_solution", "tubesweep.evolve",
+    "tubesweep.box_solution", "tubesweep.evolve", "tubesweep.checkpoint",
 ]  # fmt: skip
 
 

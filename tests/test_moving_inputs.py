@@ -91,3 +91,55 @@ def test_evolve_takes_a_boolean_mask_and_a_level_set_of_an_array_and_says_what_t
         ts.evolve(ts.surfaces.Sphere(0.5), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
     with pytest.raises(TypeError, match=r"got function\. Pass its values: phi_function\("):
         ts.evolve(lambda p: np.linalg.norm(p, axis=1) - 0.5, GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1)
+
+
+def test_a_checkpoint_is_continued_only_on_its_own_grid_dt_and_every(tmp_path):
+    # φ is an array of the grid's nodes: continued on [-1.1, 1.1]³ of the same shape, a review's
+    # run put the surface at radius 0.573 instead of 0.51, without a word
+    law = lambda u: np.full_like(u, 0.1)  # noqa: E731
+    path = tmp_path / "run.npz"
+    ts.evolve(sphere_phi(), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=2, every=2, checkpoint=path)
+    other = ts.Grid((-1.1, -1.1, -1.1), (1.1, 1.1, 1.1), (31, 31, 31))
+    with pytest.raises(ValueError, match=r"written on the grid from \(-1.0, -1.0, -1.0\) to \(1.0, 1.0, 1.0\) with "):
+        ts.read_checkpoint(path, other)
+    with pytest.raises(ValueError, match=r"written with dt = 0.05, not dt = 0.1"):
+        ts.read_checkpoint(path, GRID, dt=0.1)
+    with pytest.raises(ValueError, match=r"written with every = 2, not every = 1"):
+        ts.read_checkpoint(path, GRID, every=1)
+    c = ts.read_checkpoint(path, GRID, dt=0.05, every=2)
+    assert c.step == 2 and c.t == pytest.approx(0.1) and c.phi.shape == GRID.shape
+    # a checkpoint of an earlier version (no grid): read, with a warning that it cannot be checked
+    old = tmp_path / "old.npz"
+    np.savez(old, phi=c.phi, t=c.t, step=c.step, sources=c.sources)
+    with pytest.warns(RuntimeWarning, match="holds no grid, dt or every"):
+        assert np.array_equal(ts.read_checkpoint(old, other).phi, c.phi)
+    np.savez(tmp_path / "x.npz", a=1)
+    with pytest.raises(ValueError, match="not a checkpoint of ts.evolve"):
+        ts.read_checkpoint(tmp_path / "x.npz", GRID)
+
+
+def test_a_source_carried_exactly_as_far_as_the_surface_may_move_is_taken():
+    # a sphere off the nodes grown by exactly outer − inner = 2 spacings, its pole carried with it:
+    # the pole's projection onto the discrete surface lay 0.004 spacings beyond the limit, and the
+    # refusal said the source had left the surface's path
+    h = GRID.spacing
+    c = np.array([0.0123, 0.0271, -0.0089])
+    r0 = np.linalg.norm(np.stack(GRID.meshgrid(), -1) - c, axis=-1)
+    tube = ts.Tube(r0 - 0.5, GRID)
+    sol = tube.solve([tuple(c + [0, 0, 0.5])])
+    r = 0.5 + 2.0 * h
+    warm = tube.moved(r0 - r).solve([tuple(c + [0, 0, r])], warm=sol)
+    assert "refused" not in warm.stats.order2["warm"] and warm.stats.order == 2
+    cold = ts.solve(r0 - r, GRID, [tuple(c + [0, 0, r])])
+    assert np.max(np.abs(warm.values - cold.values)) <= 10 * cold.stats.order2["tol"]
+
+
+def test_a_progress_that_cannot_take_step_steps_t_is_refused_before_the_first_solve():
+    law = lambda u: np.full_like(u, 0.1)  # noqa: E731
+    with pytest.raises(
+        TypeError, match=r"progress is called as progress\(step, steps, t\), which its signature \(step\)"
+    ):
+        ts.evolve(sphere_phi(), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1, progress=lambda step: None)
+    seen = []
+    ts.evolve(sphere_phi(), GRID, [(0, 0, 0.5)], law, dt=0.05, steps=1, progress=lambda *a: seen.append(a))
+    assert seen == [(1, 1, pytest.approx(0.05))]

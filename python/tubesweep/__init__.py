@@ -24,6 +24,7 @@ from . import flows, hamiltonians
 from .closest_point import ClosestPoint
 from .box_solution import BoxSolution
 from .euclidean import travel_time
+from .checkpoint import Checkpoint, read_checkpoint
 from .evolve import Evolution, EvolutionStopped, evolve
 from .grid import Grid
 from .output import export, plot, triangulate
@@ -48,6 +49,8 @@ __all__ = [
     "Surface",
     "data",
     "evolve",
+    "read_checkpoint",
+    "Checkpoint",
     "Evolution",
     "EvolutionStopped",
     "export",

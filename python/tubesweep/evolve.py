@@ -18,7 +18,7 @@ node it should (work O(N^d) per step there, a few array operations).
 from __future__ import annotations
 
 import dataclasses
-import os
+import inspect
 import warnings
 from pathlib import Path
 from typing import Any, Callable, List, Optional, Tuple, Union
@@ -27,6 +27,7 @@ import numpy as np
 from xml.sax.saxutils import quoteattr
 
 from ._paths import writable
+from .checkpoint import write_checkpoint
 from ._validate import as_grid, as_sources, real_array, real_scalar
 from ._box_cut import cut_extent
 from ._sources import check_on_surface
@@ -214,15 +215,6 @@ def _warn_left_box(cut: dict) -> None:
     )
 
 
-def _write_checkpoint(path: Path, **arrays: Any) -> None:
-    """``numpy.savez`` to a file beside ``path``, then renamed onto it: a write interrupted by a
-    crash or a kill leaves the previous checkpoint whole."""
-    partial = path.with_name(path.name + ".partial.npz")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez(partial, **arrays)
-    os.replace(partial, path)
-
-
 def _speed_values(speed: Callable[[np.ndarray], Any], u: np.ndarray, step: int) -> np.ndarray:
     try:
         raw = speed(u.copy())  # a copy: a law that writes to u leaves the solution alone
@@ -303,18 +295,18 @@ def _count_start(out: Evolution, sol: Solution) -> None:
         out.cold_starts += 1
 
 
-def _record(
-    out: Evolution, step: int, t: float, arr: np.ndarray, sol: Solution, checkpoint: Optional[Path], sources: Any
-) -> None:
-    """A frame kept (t, φ, the solution) and, with ``checkpoint``, written there with the step's
-    ``sources`` as given to its projection, or :class:`EvolutionStopped` when it cannot be."""
+def _record(out: Evolution, step: int, t: float, arr: np.ndarray, sol: Solution, inputs: _Inputs, sources: Any) -> None:
+    """A frame kept (t, φ, the solution) and, with ``inputs.checkpoint``, written there with the
+    step's ``sources`` as given to its projection (and the grid, ``dt`` and ``every``, which
+    :func:`~tubesweep.read_checkpoint` checks), or :class:`EvolutionStopped` when it cannot be."""
     out.times.append(t)
     out.phis.append(arr)
     out.solutions.append(sol)
+    checkpoint = inputs.checkpoint
     if checkpoint is None:
         return
     try:
-        _write_checkpoint(checkpoint, phi=arr, t=t, step=step, sources=sources)
+        write_checkpoint(checkpoint, inputs.grid, inputs.dt, inputs.every, phi=arr, t=t, step=step, sources=sources)
     except OSError as e:
         raise EvolutionStopped(
             f"evolve stopped at step {step} (t = {t:.6g}): the checkpoint {str(checkpoint)!r} could not "
@@ -474,6 +466,20 @@ def _checked_inputs(
         raise TypeError(
             f"evolve: progress must be None or a callable progress(step, steps, t); got {type(progress).__name__}"
         )
+    if progress is not None:
+        # a progress that cannot take (step, steps, t) stopped the run after its first step's solve
+        try:
+            signature = inspect.signature(progress)
+        except (TypeError, ValueError):  # a callable without one (some builtins): called as it is
+            signature = None
+        if signature is not None:
+            try:
+                signature.bind(1, int(steps), t0)
+            except TypeError as e:
+                raise TypeError(
+                    f"evolve: progress is called as progress(step, steps, t), which its signature {signature} "
+                    f"does not accept ({e})"
+                ) from None
     return _Inputs(grid, arr, src, dt, int(steps), cfl, int(every), t0, checkpoint)
 
 
@@ -524,7 +530,8 @@ def evolve(
     checkpoint : str or Path, optional
         A ``.npz`` file rewritten at each kept frame with ``phi``, ``t``, ``step`` and
         ``sources`` (its folder made if missing, a leading ``~`` expanded; written beside it and renamed, so that an interrupted write leaves the last
-        one whole): ``evolve(c["phi"], grid, c["sources"], speed, ..., t0=float(c["t"]))``
+        one whole), with the grid, ``dt`` and ``every``: ``c = ts.read_checkpoint(path, grid,
+        dt=dt, every=every)``, then ``evolve(c.phi, grid, c.sources, speed, dt=dt, ..., t0=c.t)``
         continues from it. From a checkpoint written at a multiple of ``every`` steps, a run
         continued with the same ``dt``, ``every`` and a ``checkpoint`` repeats the uninterrupted
         one bit for bit (such a step solves cold; the sources are kept as they were before that
@@ -631,7 +638,7 @@ def evolve(
             previous_band = linear
             _count_start(out, sol)
             if step % every == 0 or step == steps:
-                _record(out, step, t, arr, sol, checkpoint, unprojected)
+                _record(out, step, t, arr, sol, inputs, unprojected)
             if step == steps:
                 break
             v, vmax = _law(speed, sol.values, step, t, out, dt, cfl * h)
