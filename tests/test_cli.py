@@ -105,6 +105,9 @@ def test_a_refusal_names_the_flag_typed(tmp_path, capsys):
     phi = ["--phi", str(tmp_path / "phi.npy"), "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]
     assert main(["solve", *phi, "--source", "0", "0", "0", "--out", str(tmp_path / "o"), "--n", "21"]) == 2
     assert capsys.readouterr().err.strip() == "error: shape[0] = 2: every axis needs at least 3 nodes"
+    # a mesh's grid from --n and --padding: its refusal leads with both (it named neither)
+    assert main(["solve", "--mesh", "bunny", "--n", "2", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.strip().startswith("error: --n 2 --padding 8: n = 2 nodes cannot hold 8.0 spacings")
 
 
 def test_travel_time(tmp_path):

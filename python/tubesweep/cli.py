@@ -369,6 +369,15 @@ def _check_phi_box(phi: np.ndarray, grid: Any, sources: np.ndarray, args: argpar
     )
 
 
+def _grid_of(surface: Any, n: int, padding: Optional[float]) -> Any:
+    """A mesh's or a cloud's ``grid(n, padding)``, its refusal led by the flags that set it."""
+    pad = 8.0 if padding is None else padding
+    try:
+        return surface.grid(n, padding=pad)
+    except ValueError as e:
+        raise UsageError(f"--n {n} --padding {pad:g}: {e}") from None
+
+
 def cmd_solve(args: argparse.Namespace) -> int:
     from .grid import Grid
     from .solve import solve
@@ -393,7 +402,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         n = 200 if args.n is None else args.n
         if args.lower is not None or args.upper is not None:
             raise UsageError("--mesh picks its grid from --n and --padding; do not give --lower/--upper")
-        grid = surface.grid(n, padding=8.0 if args.padding is None else args.padding)
+        grid = _grid_of(surface, n, args.padding)
         name = surface.name
         print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
     elif args.points:
@@ -402,7 +411,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         surface = from_points(args.points)  # type: ignore[assignment]
         if args.lower is not None or args.upper is not None:
             raise UsageError("--points picks its grid from --n and --padding; do not give --lower/--upper")
-        grid = surface.grid(101 if args.n is None else args.n, padding=8.0 if args.padding is None else args.padding)
+        grid = _grid_of(surface, 101 if args.n is None else args.n, args.padding)
         name = surface.name
         print(f"{surface}; grid {grid.shape}, spacing {grid.spacing:.4g}")
     elif args.surface:
