@@ -303,6 +303,48 @@ def test_dask_worker_dies_mid_run(client, grid, tmp_path):
     assert np.array_equal(bits(remote), bits(fragile.solve_many(pts, at=pts)))
 
 
+def test_dask_workers_that_all_die_once_lose_the_shared_inputs_and_the_chunks_are_resubmitted(client, grid, tmp_path):
+    """Each worker dies the first time a chunk runs on it (an out-of-memory kill): the scattered
+    tube, at and options died with them, and the scheduler cancelled every chunk that needed them
+    ("already forgotten", a RuntimeError after 0.1 s); they are scattered again and the chunks
+    resubmitted, and the result is complete."""
+    import os
+
+    def speed(p):
+        from distributed import get_worker
+
+        try:
+            name = get_worker().name
+        except ValueError:  # (on this machine)
+            return np.ones(len(p))
+        marker = tmp_path / f"died_{name}"
+        if not marker.exists():
+            marker.touch()
+            os._exit(1)
+        return np.ones(len(p))
+
+    tube = ts.Tube(ts.surfaces.Sphere(R), grid)
+    pts = sphere_points(6, seed=5)
+    remote = tube.solve_many(pts, at=pts, client=client, chunk_size=2, speed=speed)
+    assert len(list(tmp_path.glob("died_*"))) == 2
+    assert np.array_equal(bits(remote), bits(tube.solve_many(pts, at=pts, speed=speed)))
+
+
+def test_dask_names_a_speed_that_cannot_be_sent(client, tube):
+    import threading
+
+    class Locked:
+        lock = threading.Lock()
+
+        def __call__(self, p):
+            return np.ones(len(p))
+
+    locked = Locked()
+    locked.held = threading.Lock()
+    with pytest.raises(TypeError, match=r"speed: cannot be sent to the Dask workers"):
+        tube.solve_many(sphere_points(2), client=client, speed=locked)
+
+
 def test_dask_failure_is_an_error_not_a_partial_result(client, grid):
     """A chunk that fails on the workers (here φ raises there) ends the call with an error naming
     the chunk's sources; nothing partial comes back."""

@@ -10,9 +10,11 @@ by the same code as locally (``Tube.solve_many`` on the worker, one thread per s
 result equals the local one bit for bit.
 
 A worker that dies mid-run loses its running chunks; the scheduler runs them again elsewhere
-(up to its ``distributed.scheduler.allowed-failures``), and the result is complete. When a chunk
-cannot be completed the call raises ``RuntimeError`` naming the sources of the chunk: a partial
-matrix is never returned.
+(up to its ``distributed.scheduler.allowed-failures``), and the result is complete. Workers that
+all die at once take the scattered inputs with them: those are scattered again and the cancelled
+chunks resubmitted, as many times. When a chunk cannot be completed the call raises
+``RuntimeError`` naming the sources of the chunk (a ``ValueError`` or ``TypeError`` raised on a
+worker keeps its type): a partial matrix is never returned.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from __future__ import annotations
 import math
 import threading
 import uuid
+from concurrent.futures import CancelledError
 from collections import OrderedDict
 from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional
 
@@ -125,6 +128,22 @@ def as_client(client: Any) -> Any:
     return client
 
 
+def _check_sendable(options: Dict[str, Any]) -> None:
+    """A callable option (a speed, a flow) that cloudpickle cannot serialise, named before anything
+    is sent (Dask's own error came after a hundred lines of its serialiser's traceback)."""
+    import cloudpickle
+
+    for name, value in options.items():
+        if callable(value):
+            try:
+                cloudpickle.dumps(value)
+            except Exception as e:
+                raise TypeError(
+                    f"{name}: cannot be sent to the Dask workers ({type(e).__name__}: {e}); pass a function that "
+                    "holds no locks, open files or connections (or solve on this machine: client=None)"
+                ) from None
+
+
 def _default_chunk(k: int, workers: int) -> int:
     # about four chunks per worker thread (the last ones balance the load), at most 64 sources each
     return max(1, min(64, math.ceil(k / (4 * max(1, workers)))))
@@ -144,6 +163,7 @@ def solve_many_on_client(
 ) -> Any:
     """:meth:`Tube.solve_many` on a Dask cluster (see the module's documentation). ``threads`` is
     not used: each worker runs as many chunks at once as it has threads, one thread per solve."""
+    from dask.config import get as dask_config_get
     from distributed import as_completed
 
     client = as_client(client)
@@ -177,24 +197,8 @@ def solve_many_on_client(
     if not (isinstance(chunk_size, (int, np.integer)) and not isinstance(chunk_size, bool) and chunk_size >= 1):
         raise ValueError(f"chunk_size must be a positive whole number of sources per task; got {chunk_size!r}")
     starts = list(range(0, k, int(chunk_size)))
+    _check_sendable(options)
     run = uuid.uuid4().hex[:12]
-    spec = client.scatter(_TubeSpec(tube), broadcast=True, hash=False)
-    at_data = None if points is None else client.scatter(points, broadcast=True, hash=False)
-    # the options go once too: a speed given as an array of the grid's shape is as large as a φ array
-    opts = client.scatter([options], broadcast=True, hash=False)[0]
-    futures = {
-        client.submit(
-            _solve_chunk,
-            spec,
-            groups[a : a + chunk_size],
-            at_data,
-            opts,
-            a,
-            key=f"tubesweep-solve_many-{run}-{a}",
-            pure=False,
-        ): a
-        for a in starts
-    }
     width = tube.band_points if points is None else len(points)
     out = np.empty((k, width))
     stats: Dict[str, np.ndarray] = {}
@@ -202,35 +206,75 @@ def solve_many_on_client(
     messages: List[str] = []
     reasons: List[str] = []  # why some rows ran the first-order scheme (order="auto"), per chunk
     done = 0
-    try:
-        for fut in as_completed(futures):
-            a = futures[fut]
-            b = min(a + chunk_size, k)
-            try:
-                values, st, caught, chunk_reason = fut.result()
-            except (ValueError, TypeError, KeyboardInterrupt):
-                raise
-            except Exception as e:  # a worker that died on every try (KilledWorker), a lost dependency...
-                raise RuntimeError(
-                    f"the Dask cluster could not solve sources {a}..{b - 1}: {type(e).__name__}: {e}. "
-                    "No partial result is returned; check the workers' logs and memory "
-                    "(docs/many-sources.md, 'What to size')"
-                ) from e
-            out[a:b] = values
-            if chunk_reason is not None:
-                reasons.append(chunk_reason)
-            for name, v in st.items():
-                if not isinstance(v, np.ndarray):
-                    tube_stats.setdefault(name, v)  # the tube's: the same from every chunk
+    pending = starts
+    # rounds of the chunks whose shared inputs were lost: the tube, at and the options are
+    # scattered, and when every worker that held them died (each once, an out-of-memory kill) the
+    # scheduler cannot compute them again and cancels the chunks that need them ("already
+    # forgotten"); they are scattered again and those chunks resubmitted, as often as the
+    # scheduler would rerun a chunk whose worker died
+    rounds = 1 + int(dask_config_get("distributed.scheduler.allowed-failures", 3))
+    for round_ in range(rounds):
+        spec = client.scatter(_TubeSpec(tube), broadcast=True, hash=False)
+        at_data = None if points is None else client.scatter(points, broadcast=True, hash=False)
+        # the options go once too: a speed given as an array of the grid's shape is as large as a φ array
+        opts = client.scatter([options], broadcast=True, hash=False)[0]
+        futures = {
+            client.submit(
+                _solve_chunk,
+                spec,
+                groups[a : a + chunk_size],
+                at_data,
+                opts,
+                a,
+                key=f"tubesweep-solve_many-{run}-{round_}-{a}",
+                pure=False,
+            ): a
+            for a in pending
+        }
+        lost: List[int] = []
+        try:
+            for fut in as_completed(futures):
+                a = futures[fut]
+                b = min(a + chunk_size, k)
+                try:
+                    values, st, caught, chunk_reason = fut.result()
+                except (ValueError, TypeError, KeyboardInterrupt):
+                    raise
+                except CancelledError:  # its shared inputs lost with the workers that held them
+                    lost.append(a)
                     continue
-                stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
-            messages.extend(caught)
-            done += b - a
-            if cb is not None:
-                cb(done, k)
-    finally:
-        client.cancel(list(futures))
-        del spec, at_data, opts
+                except Exception as e:  # a worker that died on every try (KilledWorker)...
+                    raise RuntimeError(
+                        f"the Dask cluster could not solve sources {a}..{b - 1}: {type(e).__name__}: {e}. "
+                        "No partial result is returned; check the workers' logs and memory "
+                        "(docs/many-sources.md, 'What to size')"
+                    ) from e
+                out[a:b] = values
+                if chunk_reason is not None:
+                    reasons.append(chunk_reason)
+                for name, v in st.items():
+                    if not isinstance(v, np.ndarray):
+                        tube_stats.setdefault(name, v)  # the tube's: the same from every chunk
+                        continue
+                    stats.setdefault(name, np.empty(k, dtype=v.dtype))[a:b] = v
+                messages.extend(caught)
+                done += b - a
+                if cb is not None:
+                    cb(done, k)
+        finally:
+            client.cancel(list(futures))
+            del spec, at_data, opts
+        if not lost:
+            break
+        pending = sorted(lost)
+    else:
+        a = pending[0]
+        raise RuntimeError(
+            f"the Dask cluster could not solve sources {a}..{min(a + chunk_size, k) - 1} (and {len(pending) - 1} more "
+            f"chunks): the workers holding the shared inputs (the tube, at, the options) died {rounds} times over, "
+            "taking them along. No partial result is returned; check the workers' logs and memory "
+            "(docs/many-sources.md, 'What to size')"
+        )
     messages = merged(messages, k)  # (in the order the chunks came back)
     if messages:
         import warnings
