@@ -345,8 +345,9 @@ class Solution:
         -------
         numpy.ndarray
             ``(M,)`` values; NaN where no band node is near or the point lies farther from the
-            surface than the tube (with a warning), or where the nearest node was not reached (a
-            component of the surface no source reaches, or a solve stopped early).
+            surface than the tube (with a warning); +inf where the nearest node was not reached
+            (a component of the surface no source reaches, or a solve stopped early), as
+            :meth:`__call__` gives there.
 
         Raises
         ------
@@ -366,8 +367,10 @@ class Solution:
         if bad.size:
             pos = self._nearest_reached(p[bad])
             pos[self._beyond_tube(p[bad], pos)] = -1
-            out[bad] = np.where(pos >= 0, self.values[np.maximum(pos, 0)], np.nan)
-            self._warn_off_band(p[bad[pos < 0]], len(p), self._faceless(p, bad[pos < 0]))
+            # +inf on a part of the surface no source reaches (as sol(points) and the band give),
+            # NaN off the band
+            out[bad] = np.where(pos >= 0, self.values[np.maximum(pos, 0)], np.where(pos == -2, np.inf, np.nan))
+            self._warn_off_band(p[bad[pos == -1]], len(p), self._faceless(p, bad[pos == -1]))
         return out
 
     def _beyond_tube(self, p: np.ndarray, pos: np.ndarray) -> np.ndarray:
@@ -376,7 +379,7 @@ class Solution:
         surface, NaN rather than a value read a few spacings away (the sphere's centre, 7.5
         spacings inside, read 0.29: a helper's review). False where the surface cannot project."""
         beyond = np.zeros(len(p), dtype=bool)
-        at = np.flatnonzero(pos >= 0)
+        at = np.flatnonzero(pos != -1)  # (-2: the nearest node unreached, +inf if on the surface)
         if at.size == 0:
             return beyond
         try:
@@ -432,7 +435,7 @@ class Solution:
 
     def _nearest_reached(self, p: np.ndarray) -> np.ndarray:
         """Band position (M,) of the band node nearest to each point within ``outer + 1`` grid
-        spacings of it, -1 where there is none or where that node was not reached (a component
+        spacings of it, -1 where there is none, -2 where that node was not reached (a component
         of the surface no source reaches: the nearest *reached* node would lie on another
         component's band, whose value and source the point does not have). The offsets from the
         point's nearest node are tried in increasing length, and a point is settled once no
@@ -479,7 +482,7 @@ class Solution:
             bp[open_[take]] = pos[take]
             bd[open_[take]] = dist[take]
         found = bp >= 0
-        bp[found & ~np.isfinite(self.values[np.maximum(bp, 0)])] = -1
+        bp[found & ~np.isfinite(self.values[np.maximum(bp, 0)])] = -2
         best[near] = bp
         return best
 
