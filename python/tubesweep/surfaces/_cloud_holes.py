@@ -193,8 +193,8 @@ def bridged_holes(
     if info["detour"] > WARN_SHARE * info["size"]:
         warnings.warn(
             f"the point cloud has {info['count']} hole(s) narrower than its band ({info['reach']:.3g} across at this "
-            f"grid; the widest {info['widest']:.3g}): the band bridges them, and a distance reached across one is that "
-            f"of the surface with the hole filled, up to about {info['detour']:.3g} ({info['detour'] / info['size']:.0%} "
+            f"grid; the widest {info['widest']:.3g}): the band bridges them, and a distance reached across one can be "
+            f"that of the surface with the hole filled (in part where the hole is over about 1.5 spacings wide), up to about {info['detour']:.3g} ({info['detour'] / info['size']:.0%} "
             f"of the cloud's size) shorter than the way round the hole near {info['where']}. sol.stats.bridged_holes has "
             f"them; a grid spacing below {info['width'] / (2.0 * outer):.3g} (now {h:.3g}) keeps that one open, or "
             "sample the missing surface where it is a gap in a scan",

@@ -210,8 +210,8 @@ def warn_bridged_holes(info: Optional[dict], h: float, outer: float) -> None:
     finer = f"a grid spacing below {spacing:.3g} (now {h:.3g}) keeps that one open, or " if spacing > 0 else ""
     warnings.warn(
         f"the mesh has {info['count']} hole(s) narrower than its band ({info['reach']:.3g} across at this grid; "
-        f"the widest {info['widest']:.3g}): the band bridges them, and a distance reached across one is that of "
-        f"the surface with the hole filled, up to about {info['detour']:.3g} ({info['detour'] / info['size']:.0%} of "
+        f"the widest {info['widest']:.3g}): the band bridges them, and a distance reached across one can be that of "
+        f"the surface with the hole filled (in part where the hole is over about 1.5 spacings wide), up to about {info['detour']:.3g} ({info['detour'] / info['size']:.0%} of "
         f"the mesh's size) shorter than the mesh's geodesic round the hole near {info['where']}. "
         f"sol.stats.bridged_holes has them; {finer}fill them first (e.g. trimesh.repair.fill_holes) where they are "
         "gaps in a scan",
