@@ -46,7 +46,14 @@ from .surface import LevelSet
 from .mask import ROUGH_REDISTANCED
 from .surfaces._mesh_parts import open_only_in_debris
 from ._warn import user_stacklevel
-from .second_order import NOISY_PHI, NOT_A_DISTANCE, NarrowExtension, OptionOfOrder1, Order2NotApplicable, warn_fallback
+from ._order2_refusals import (
+    NOISY_PHI,
+    NOT_A_DISTANCE,
+    NarrowExtension,
+    OptionOfOrder1,
+    Order2NotApplicable,
+    warn_fallback,
+)
 
 #: The first-order scheme's error where fronts meet, in grid spacings (the sphere's antipode:
 #: 2.7–3.1Δx at N = 12–20).
