@@ -1,5 +1,6 @@
 """The tubesweep command line."""
 
+import re
 import subprocess
 import sys
 import warnings
@@ -7,6 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
+import tubesweep as ts
 from tubesweep.cli import build_parser, main
 
 
@@ -307,6 +309,7 @@ def test_files_and_arguments_are_checked_before_the_solve(tmp_path, capsys):
         (["--lower", "-1", "-1", "-1"], "give both --lower and --upper"),
         (["--padding", "3"], "--padding applies to --mesh only"),
         (["--normalize"], "--normalize applies to --mesh only"),
+        (["--up", "x"], "--up sets the vertical axis of --png's 3D picture: add --png"),
         (["--path-from", "0", "0", "0"], "farther than the inner tube"),
     ],
 )
@@ -498,3 +501,24 @@ def test_distances_refuses_mesh_options_for_a_library_surface(tmp_path, capsys, 
     argv = ["distances", "--surface", "sphere", "--n", "21", "--sample", "5", "--out", str(out), *flag]
     assert main(argv) == 2
     assert f"{flag[0]} applies to --mesh only" in capsys.readouterr().err and not out.exists()
+
+
+def test_separate_parts_are_said_not_reached_and_phi_flags_it_ignores_are_refused(tmp_path, capsys):
+    # two spheres apart, a source on one: the solve said only converged=True (and a NumPy warning
+    # from the picture's contours), distances printed "largest 0" for a matrix of inf; --n was
+    # ignored with --phi (a review)
+    g = ts.Grid((-1, -1, -1), (1, 1, 1), (41, 41, 41))
+    x, y, z = g.meshgrid()
+    phi = np.minimum(np.sqrt((x + 0.5) ** 2 + y**2 + z**2), np.sqrt((x - 0.5) ** 2 + y**2 + z**2)) - 0.3
+    np.save(tmp_path / "two.npy", phi)
+    box = ["--phi", str(tmp_path / "two.npy"), "--lower", "-1", "-1", "-1", "--upper", "1", "1", "1"]
+    assert main(["solve", *box, "--source", "-0.8", "0", "0", "--png", "--out", str(tmp_path / "o")]) == 0
+    said = capsys.readouterr()
+    assert re.search(r"\n\d+ of the \d+ band nodes are not reached \(u = inf, grey in pictures\)", said.out)
+    assert "warning" not in said.err
+    assert main(["distances", *box, "--sample", "2", "--out", str(tmp_path / "D.npy"), "--quiet"]) == 0
+    assert (
+        "(1 of the 1 pairs lie on parts of the surface that do not join: inf in the matrix)" in capsys.readouterr().out
+    )
+    assert main(["solve", *box, "--source", "-0.8", "0", "0", "--n", "11", "--out", str(tmp_path / "p")]) == 2
+    assert "--n applies to --surface, --mesh and --points: the grid of --phi" in capsys.readouterr().err

@@ -345,6 +345,12 @@ def _check_phi_box(phi: np.ndarray, grid: Any, sources: np.ndarray, args: argpar
     if not off.size:
         return
     i = int(off[0])
+    if not np.isfinite(at_sources[i]):
+        bad = int(np.count_nonzero(~np.isfinite(phi)))
+        raise UsageError(
+            f"--phi {args.phi}: φ is NaN or inf at {bad} of its {phi.size} nodes, among them those around --source "
+            f"{_fmt_point(sources[i])}; φ must be finite near the surface (NaN far from it, outside the band, is allowed)"
+        )
     hints = []
     faces = [np.take(phi, [0, -1], axis=k) for k in range(phi.ndim)]
     if any(np.any(np.abs(f) <= h) or (np.nanmin(f) < 0 < np.nanmax(f)) for f in faces):
@@ -445,6 +451,16 @@ def cmd_solve(args: argparse.Namespace) -> int:
         raise UsageError("--padding applies to --mesh only (a --surface or --phi grid is given by its box)")
     if args.normalize and not args.mesh:
         raise UsageError("--normalize applies to --mesh only (it was ignored for a --surface, --phi or --points)")
+    if args.n is not None and (args.phi or args.mask):
+        raise UsageError(
+            f"--n applies to --surface, --mesh and --points: the grid of {'--phi' if args.phi else '--mask'} takes its "
+            "shape from the array (it was ignored)"
+        )
+    if args.up is not None and (not args.png or grid.ndim != 3):
+        raise UsageError(
+            "--up sets the vertical axis of --png's 3D picture"
+            + ("; a 2D curve's picture has none" if grid.ndim != 3 else ": add --png (it was ignored)")
+        )
     bad_arity = [len(p) for p in args.path_from or [] if len(p) != grid.ndim]
     if bad_arity:
         raise UsageError(f"--path-from needs {grid.ndim} coordinates on a {grid.ndim}D grid; got {bad_arity[0]}")
@@ -525,6 +541,12 @@ def cmd_solve(args: argparse.Namespace) -> int:
     )
     if s.order_fallback is not None and not args.quiet:
         print(f"order=2 does not apply, so order 1 ran: {s.order_fallback}")
+    unreached = int(np.count_nonzero(np.isinf(sol.values)))
+    if unreached and not args.quiet:
+        print(
+            f"{unreached} of the {s.band_points} band nodes are not reached (u = inf, grey in pictures): they lie on parts "
+            "of the surface that no source's part joins; a source on each part reaches it"
+        )
     asked = args.png or args.dense or args.export or args.path_from or args.path_from_vertex
     if args.npz or not asked:
         _write_npz(out / "solution.npz", sol)

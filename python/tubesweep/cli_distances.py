@@ -155,6 +155,8 @@ def _surface_and_grid(args: argparse.Namespace) -> Any:
 
     if args.lower is None or args.upper is None:
         raise ValueError("--phi needs --lower and --upper (the grid's corners)")
+    if args.n is not None:
+        raise ValueError("--n applies to --surface and --mesh: the grid of --phi takes its shape from the array")
     try:
         phi = np.load(args.phi, allow_pickle=False)
     except (ValueError, EOFError, zipfile.BadZipFile):  # an empty file; a zip header without an archive
@@ -251,7 +253,12 @@ def cmd_distances(args: argparse.Namespace) -> int:
             )
         finally:
             bar.close()
-        print(f"{len(points)} points by farthest-point sampling, last radius {radii[-1]:.4g}")
+        apart = (
+            " (inf: some points lie on parts of the surface no other point's front reaches)"
+            if np.isinf(radii[-1])
+            else ""
+        )
+        print(f"{len(points)} points by farthest-point sampling, last radius {radii[-1]:.4g}{apart}")
     bar = _SourcesBar("distances", args.quiet)
     t1 = time.perf_counter()
     try:
@@ -276,9 +283,15 @@ def cmd_distances(args: argparse.Namespace) -> int:
     points_file = args.out.with_name(args.out.stem + "_points.npy")
     np.save(points_file, info["points"])
     m = len(matrix)
+    unreached = int(np.count_nonzero(np.isinf(matrix))) // 2
+    apart = (
+        f" ({unreached} of the {m * (m - 1) // 2} pairs lie on parts of the surface that do not join: inf in the matrix)"
+        if unreached
+        else ""
+    )
     print(
         f"{m} x {m} distances in {seconds:.2f} s ({m / seconds:.1f} sources/s"
-        f"{', on ' + args.scheduler if args.scheduler else ''}); largest {np.max(matrix[np.isfinite(matrix)]):.4g}; "
+        f"{', on ' + args.scheduler if args.scheduler else ''}); largest {np.max(matrix[np.isfinite(matrix)]):.4g}{apart}; "
         f"asymmetry of the one-way estimates removed: {info['asymmetry']:.3g}, their largest diagonal "
         f"{info['diagonal']:.3g}; order {info['order']}"
         + (f" (second order does not apply: {info['order_fallback']})" if info["order_fallback"] else "")
