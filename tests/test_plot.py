@@ -77,6 +77,10 @@ def test_a_travel_time_field_with_its_grid_gets_labelled_contours():
     g3 = ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3)
     fig3 = ts.plot(ts.travel_time(g3, [(0.0, 0.0, 0.0)]), grid=g3)
     assert "slice z = 0" in fig3.axes[0].get_title()
+    # a source off the middle slice: the slice through it (the star was drawn on z = 0, where u
+    # was 0.3 at the star: a review)
+    fig3 = ts.plot(ts.travel_time(g3, [(0.2, 0.1, -0.3)]), grid=g3, sources=[(0.2, 0.1, -0.3)])
+    assert "slice z = -0.3" in fig3.axes[0].get_title()
 
 
 def test_a_closest_point_surface_without_a_mesh_is_drawn_as_its_points():
@@ -197,3 +201,11 @@ def test_views_that_are_not_pairs_are_named():
     sol = ts.solve(s, ts.Grid((-1,) * 3, (1,) * 3, (21,) * 3), [s.default_source])
     with pytest.raises(ValueError, match=r"views must be a sequence of \(elevation, azimuth\) pairs"):
         ts.plot(sol, views=[(1,)])
+
+
+def test_a_flat_surface_is_seen_from_its_face():
+    # a disc was drawn from 20° above, a thin ellipse with its labels stacked; one triangle edge-on
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+    sol = ts.solve(ts.surfaces.Disc(0.6), g, [(0.3, 0.0, 0.0)])
+    fig = ts.plot(sol)
+    assert [round(a.elev) for a in fig.axes[:2]] == [65, 65]

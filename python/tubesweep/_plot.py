@@ -58,7 +58,7 @@ def plot(
     with their values, the sources as red stars, one labelled panel per view. Curves (2D): the
     curve coloured by the distance, with ticks and values where it crosses each iso-value. Travel
     times in the box (an array from :func:`tubesweep.travel_time` with its ``grid``): the field
-    with labelled contours (the middle slice in 3D).
+    with labelled contours (in 3D the slice z through the first source, the middle one without sources).
 
     Parameters
     ----------
@@ -214,8 +214,18 @@ def _plot_field(
     if back is not None and back.shape != u.shape:
         raise ValueError(f"speed must be an array of the grid's shape {tuple(grid.shape)}; got {back.shape}")
     where = ""
+    src3 = (
+        np.atleast_2d(np.asarray(sources, dtype=float))
+        if sources is not None and not isinstance(sources, bool)
+        else np.zeros((0, grid.ndim))
+    )
     if grid.ndim == 3:
+        # the slice through the first source (the middle one without): a source drawn on the
+        # middle slice looked like u = 0 where u was not (a review)
         k = grid.shape[2] // 2
+        if len(src3) and src3.shape[1] == 3:
+            k = int(np.clip(np.rint(grid.continuous_index(src3[:1])[0, 2]), 0, grid.shape[2] - 1))
+            src3 = src3[np.abs(src3[:, 2] - grid.axis(2)[k]) <= 0.5 * grid.spacing]  # the sources in it
         u = u[:, :, k]
         back = None if back is None else back[:, :, k]
         where = f" (slice z = {grid.axis(2)[k]:.3g})"
@@ -250,9 +260,8 @@ def _plot_field(
     for q in _check_paths(paths, 2):
         ax.plot(q[:, 0], q[:, 1], "r-", lw=1.5)
         ax.scatter(q[:1, 0], q[:1, 1], s=30, zorder=4, **_START_STYLE)
-    if sources is not None and not isinstance(sources, bool):
-        src = np.atleast_2d(np.asarray(sources, dtype=float))
-        ax.scatter(src[:, 0], src[:, 1], s=180, zorder=5, **_SOURCE_STYLE)
+    if len(src3):
+        ax.scatter(src3[:, 0], src3[:, 1], s=180, zorder=5, **_SOURCE_STYLE)
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")

@@ -29,7 +29,8 @@ def _iso_segments(v: np.ndarray, f: np.ndarray, u: np.ndarray, level: float) -> 
     for i, j in ((0, 1), (1, 2), (2, 0)):
         a, b = uf[:, i], uf[:, j]
         cross = (a * b < 0) & np.isfinite(a) & np.isfinite(b)
-        t = np.where(cross, a / np.where(cross, a - b, 1.0), np.nan)
+        with np.errstate(invalid="ignore"):  # (inf − inf where a part is unreached: not crossed)
+            t = np.where(cross, a / np.where(cross, a - b, 1.0), np.nan)
         p = v[f[:, i]] + t[:, None] * (v[f[:, j]] - v[f[:, i]])
         pts.append(np.where(cross[:, None], p, np.nan))
     pts = np.stack(pts, axis=1)  # type: ignore[assignment]  # (m, 3 edges, 3)
@@ -92,6 +93,13 @@ def _checked_views(views: Any) -> Tuple[Tuple[float, float], ...]:
     return tuple((float(e), float(a)) for e, a in pairs)
 
 
+#: A surface whose bounding box is thinner than this share of its largest side along one axis is
+#: flat: seen from its face (:func:`_default_views`).
+FLAT = 0.1
+#: The elevation of both views of a flat surface lying in the horizontal plane.
+FLAT_ELEVATION = 65.0
+
+
 def _default_views(sol: Any, v: Optional[np.ndarray], perm: List[int]) -> Tuple[Tuple[float, float], ...]:
     """Two views (elevation, azimuth) from opposite sides: the first at the azimuth of the first
     source seen from the centre of the surface's bounding box, the second at the opposite azimuth,
@@ -104,6 +112,16 @@ def _default_views(sol: Any, v: Optional[np.ndarray], perm: List[int]) -> Tuple[
     d = np.asarray(sol.sources, dtype=float)[:1, perm].reshape(-1)
     d = d - centre if d.size == 3 else np.zeros(3)
     longest = np.argsort(ext)[::-1]
+    thin = int(longest[2])
+    if ext[thin] < FLAT * float(ext.max()):
+        # a flat surface (a disc, a plate, one triangle) seen from its face, not edge-on (a review:
+        # a triangle drawn as a line, a disc's labels stacked on a thin ellipse)
+        if thin == 2:
+            off = float(np.hypot(d[0], d[1])) > 0.05 * float(ext.max() or 1.0)
+            azim = float(np.degrees(np.arctan2(d[1], d[0]))) if off else -60.0
+            return ((FLAT_ELEVATION, azim), (FLAT_ELEVATION, azim + 180.0 if azim <= 0 else azim - 180.0))
+        face = 0.0 if thin == 0 else 90.0
+        return ((VIEW_TILT, face), (VIEW_TILT, face - 180.0))
     k = int(longest[0])
     if k != 2 and ext[k] > ELONGATED * ext[longest[1]]:
         # a surface elongated across the view is seen from the side, turned at most 30° towards the
@@ -198,7 +216,8 @@ def _plot_surface(
         sm.set_array([])
         _colorbar(fig, sm, axes, label, lv)
     if title:
-        fig.suptitle(title)
+        # parts of the surface no source reaches are drawn grey: said once, under the title
+        fig.suptitle(title + ("\n(grey: not reached, u = inf)" if np.any(np.isinf(sol.values)) else ""))
     return fig
 
 
@@ -350,6 +369,11 @@ def _frame(a: Any, v: np.ndarray, ext: np.ndarray, elev: float, azim: float) -> 
     from mpl_toolkits.mplot3d import proj3d
 
     lo, hi = v.min(0), v.max(0)
+    flat = hi - lo <= 1e-9 * max(float((hi - lo).max()), 1e-300)  # a flat surface's own plane: a hair of depth
+    lo, hi = (
+        np.where(flat, lo - 1e-6 * max(float((hi - lo).max()), 1e-300), lo),
+        np.where(flat, hi + 1e-6 * max(float((hi - lo).max()), 1e-300), hi),
+    )
     a.set_xlim(lo[0], hi[0])
     a.set_ylim(lo[1], hi[1])
     a.set_zlim(lo[2], hi[2])
