@@ -209,3 +209,15 @@ def test_a_flat_surface_is_seen_from_its_face():
     sol = ts.solve(ts.surfaces.Disc(0.6), g, [(0.3, 0.0, 0.0)])
     fig = ts.plot(sol)
     assert [round(a.elev) for a in fig.axes[:2]] == [65, 65]
+
+
+def test_parts_no_source_reaches_are_said_grey_under_the_title():
+    g = ts.Grid((-1,) * 3, (1,) * 3, (41,) * 3)
+
+    def two(p):
+        return np.minimum(np.linalg.norm(p - [0.5, 0, 0], axis=1), np.linalg.norm(p + [0.5, 0, 0], axis=1)) - 0.3
+
+    fig = ts.plot(ts.solve(two, g, [(-0.8, 0.0, 0.0)]))
+    assert fig._suptitle.get_text() == "(grey: not reached, u = inf)"
+    fig = ts.plot(ts.solve(ts.surfaces.Sphere(0.5), g, [(0.5, 0.0, 0.0)]))
+    assert fig._suptitle is None or "grey" not in fig._suptitle.get_text()

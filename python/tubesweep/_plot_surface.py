@@ -191,8 +191,9 @@ def _plot_surface(
     src = sol.sources[:, perm]
     if v is None:
         _draw_point_cloud(sol, axes, views, perm, cmap_obj, norm, by_label, sources, src, lines)
+        grey = bool(np.any(np.isinf(sol.values)))
     else:
-        _draw_mesh(
+        grey = _draw_mesh(
             sol,
             v,
             f,  # type: ignore[arg-type]
@@ -215,9 +216,10 @@ def _plot_surface(
         sm = cm.ScalarMappable(norm=norm, cmap=cmap_obj)
         sm.set_array([])
         _colorbar(fig, sm, axes, label, lv)
-    if title:
-        # parts of the surface no source reaches are drawn grey: said once, under the title
-        fig.suptitle(title + ("\n(grey: not reached, u = inf)" if np.any(np.isinf(sol.values)) else ""))
+    # parts of the surface no source reaches are drawn grey: said once, under the title
+    said = [t for t in (title, "(grey: not reached, u = inf)" if grey else "") if t]
+    if said:
+        fig.suptitle("\n".join(said))
     return fig
 
 
@@ -237,7 +239,8 @@ def _draw_mesh(
     lines: List[np.ndarray],
     Poly3DCollection: Any,
     Line3DCollection: Any,
-) -> None:
+) -> bool:
+    """Draws the mesh in each of ``axes``; whether a face was drawn grey (no corner reached)."""
     if f.shape[1] == 4:  # quads as two triangles each: the shading and the iso-lines walk triangles
         f = np.vstack([f[:, [0, 1, 2]], f[:, [0, 2, 3]]])
     u = sol.on_mesh(v)
@@ -322,6 +325,7 @@ def _draw_mesh(
         if sources and np.any(front):
             a.scatter(*src[front].T, s=220, depthshade=False, zorder=5, **_SOURCE_STYLE)
         _frame(a, v, ext, elev, azim)
+    return bool(np.any(~finite.any(axis=1)))
 
 
 def _draw_point_cloud(
