@@ -58,7 +58,8 @@ def plot(
     with their values, the sources as red stars, one labelled panel per view. Curves (2D): the
     curve coloured by the distance, with ticks and values where it crosses each iso-value. Travel
     times in the box (an array from :func:`tubesweep.travel_time` with its ``grid``): the field
-    with labelled contours (in 3D the slice z through the first source, the middle one without sources).
+    with labelled contours (in 3D the slice z through the first of ``sources``, the middle one
+    without them).
 
     Parameters
     ----------

@@ -131,8 +131,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--n",
         type=int,
         default=None,
-        help="nodes per axis for --surface (default: 101); for --mesh, nodes along the longest side of the "
-        "mesh's bounding box, padding included (default: 200)",
+        help="nodes per axis for --surface (default: 101); for --mesh and --points, nodes along the longest side "
+        "of the bounding box, padding included (default: 200 and 101); not for --phi or --mask (their arrays' shape)",
     )
     p.add_argument(
         "--padding", type=float, default=None, help="--mesh: empty grid spacings around the mesh (default 8)"

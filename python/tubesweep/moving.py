@@ -252,9 +252,9 @@ def carried_values(
                 "(leave out warm=)"
             )
         raise WarmStartRefused(
-            f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved farther than "
-            f"the previous solution's outer − inner = {prev_outer - inner_width / h:g} grid spacings since it. Move in "
-            "smaller steps (at most outer − inner spacings per solve), build the tubes of both steps wider "
+            f"warm: {missing} nodes of the new inner tube lie outside the previous band: the surface moved by "
+            f"the previous solution's outer − inner = {prev_outer - inner_width / h:g} grid spacings or more since it. "
+            "Move in smaller steps (less than outer − inner spacings per solve), build the tubes of both steps wider "
             "(ts.Tube(..., outer=6); tube.moved keeps the widths), or solve cold (leave out warm=)"
         )
     old = inner_components(warm._band, warm.roles, getattr(warm, "_inner_components", None))
