@@ -494,3 +494,15 @@ def test_sharp_edges_redistance_bench_s_box_and_cylinder_come_within_their_cells
     assert cylinder["near_max"] < 0.3 and cylinder["max"] < 0.45  # 0.24 and 0.43 (the rims' cells)
     sharp_edges_redistance.main([41])
     assert len(capsys.readouterr().out.splitlines()) == 2
+
+
+def test_mesh_check_passes_bench_finds_each_pass_equal_to_the_one_it_replaced(capsys):
+    """benches/experiments/mesh_check_passes.py with one repeat: each of the four passes gives what
+    the NumPy pass it replaced gives (the script asserts it) and prints its row."""
+    import mesh_check_passes
+
+    assert mesh_check_passes.main(["--repeats", "1"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| ") and "×" in line]
+    assert [r.split(" | ")[0][2:] for r in rows] == [
+        "distinct edge keys", "distinct faces (rows)", "vertices at the same place (rows)", "connected parts"
+    ]  # fmt: skip
