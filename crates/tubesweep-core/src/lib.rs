@@ -33,6 +33,7 @@ pub mod sweep;
 mod test_bands;
 #[cfg(test)]
 mod test_random;
+mod union_find;
 
 pub use band::NarrowBand;
 pub use error::{Error, Result};

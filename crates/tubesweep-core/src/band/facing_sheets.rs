@@ -40,9 +40,9 @@
 //! (two on an unsigned surface) looks like a single sheet to both tests and is in practice not
 //! found. The pair's gap is `|cp(a) − cp(b)|`.
 
+use super::node_blocks::per_node;
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
-use rayon::prelude::*;
 
 /// Nodes closer to the surface than this many grid spacings are not tested by the facing test:
 /// on it (a mesh's nodes within 1e-12 spacings) a node carries a face normal, not a direction
@@ -154,18 +154,7 @@ pub fn facing_sheet_pairs<const D: usize>(
             }
         }
     };
-    const BLOCK: usize = 1 << 14;
-    let parts: Vec<Vec<FacingPair>> = (0..k_nodes.div_ceil(BLOCK))
-        .into_par_iter()
-        .map(|blk| {
-            let mut out = Vec::new();
-            for a in blk * BLOCK..((blk + 1) * BLOCK).min(k_nodes) {
-                pairs_from(a, &mut out);
-            }
-            out
-        })
-        .collect();
-    Ok(parts.concat())
+    Ok(per_node(k_nodes, pairs_from))
 }
 
 /// The squared chord `|cp(a) − cp(b)|²` in grid spacings of neighbours `a` and `b = a + h·e_k`
@@ -202,30 +191,22 @@ pub fn across_candidates<const D: usize>(
     check_node_fields(band, inner, phi, direction, spacing)?;
     let sentinel = band.sentinel();
     let dir = |n: usize| -> [f64; D] { std::array::from_fn(|k| direction[D * n + k] as f64) };
-    const BLOCK: usize = 1 << 14;
-    let mut nodes: Vec<usize> = (0..band.len().div_ceil(BLOCK))
-        .into_par_iter()
-        .flat_map_iter(|blk| {
-            let mut out = Vec::new();
-            for a in blk * BLOCK..((blk + 1) * BLOCK).min(band.len()) {
-                let (ta, na) = ((phi[a] as f64).abs() / spacing, dir(a));
-                for (k, pair) in band.neighbours_of(a).iter().enumerate() {
-                    let b = pair[1];
-                    if b == sentinel || !(inner[a] || inner[b as usize]) {
-                        continue;
-                    }
-                    let b = b as usize;
-                    let nb = dir(b);
-                    if (0..D).map(|j| na[j] * nb[j]).sum::<f64>() > 0.0
-                        && chord_across(k, ta, &na, (phi[b] as f64).abs() / spacing, &nb).1
-                    {
-                        out.extend([a, b]);
-                    }
-                }
+    let mut nodes: Vec<usize> = per_node(band.len(), |a, out: &mut Vec<usize>| {
+        let (ta, na) = ((phi[a] as f64).abs() / spacing, dir(a));
+        for (k, pair) in band.neighbours_of(a).iter().enumerate() {
+            let b = pair[1];
+            if b == sentinel || !(inner[a] || inner[b as usize]) {
+                continue;
             }
-            out
-        })
-        .collect();
+            let b = b as usize;
+            let nb = dir(b);
+            if (0..D).map(|j| na[j] * nb[j]).sum::<f64>() > 0.0
+                && chord_across(k, ta, &na, (phi[b] as f64).abs() / spacing, &nb).1
+            {
+                out.extend([a, b]);
+            }
+        }
+    });
     nodes.sort_unstable();
     nodes.dedup();
     Ok(nodes)

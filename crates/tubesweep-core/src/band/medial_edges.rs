@@ -18,10 +18,10 @@
 //! ([`NarrowBand::cut_edges`]) leaves the front the paths along which closest points move
 //! continuously, near the surface.
 
+use super::node_blocks::per_node;
 use crate::band::facing_sheets::check_node_fields;
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
-use rayon::prelude::*;
 
 /// The jump of the closest point between two neighbours, in grid spacings, above which their
 /// edge is a medial edge: `1 / (1 − |φ|κ) = 1.5` at `|φ|κ = 1/3`, beyond what a resolved smooth
@@ -72,43 +72,34 @@ pub fn medial_edges<const D: usize>(
         let t = (phi[n] as f64).abs() / spacing;
         std::array::from_fn(|j| t * direction[D * n + j] as f64)
     };
-    const BLOCK: usize = 1 << 14;
-    let parts: Vec<Vec<(usize, usize)>> = (0..k_nodes.div_ceil(BLOCK))
-        .into_par_iter()
-        .map(|blk| {
-            let mut out = Vec::new();
-            for a in blk * BLOCK..((blk + 1) * BLOCK).min(k_nodes) {
-                let oa = offset(a);
-                for (k, pair) in band.neighbours_of(a).iter().enumerate() {
-                    let b = pair[1];
-                    if b == sentinel {
-                        continue;
-                    }
-                    let limit2 = if inner[a] || inner[b as usize] {
-                        limit2
-                    } else {
-                        // two extension nodes: the jump a resolved sheet gives that far out
-                        let t = (phi[a] as f64).abs().max((phi[b as usize] as f64).abs()) / spacing;
-                        let lim = 1.0 / (1.0 - t / resolved).max(1.0 / EXTENSION_JUMP_CAP);
-                        lim * lim
-                    };
-                    let ob = offset(b as usize);
-                    // cp(a) − cp(b) = (a − b) − |φ_a| n_a + |φ_b| n_b, a − b = −e_k
-                    let jump2: f64 = (0..D)
-                        .map(|j| {
-                            let c = if j == k { -1.0 } else { 0.0 } - oa[j] + ob[j];
-                            c * c
-                        })
-                        .sum();
-                    if jump2 > limit2 {
-                        out.push((a, b as usize));
-                    }
-                }
+    Ok(per_node(k_nodes, |a, out: &mut Vec<(usize, usize)>| {
+        let oa = offset(a);
+        for (k, pair) in band.neighbours_of(a).iter().enumerate() {
+            let b = pair[1];
+            if b == sentinel {
+                continue;
             }
-            out
-        })
-        .collect();
-    Ok(parts.concat())
+            let limit2 = if inner[a] || inner[b as usize] {
+                limit2
+            } else {
+                // two extension nodes: the jump a resolved sheet gives that far out
+                let t = (phi[a] as f64).abs().max((phi[b as usize] as f64).abs()) / spacing;
+                let lim = 1.0 / (1.0 - t / resolved).max(1.0 / EXTENSION_JUMP_CAP);
+                lim * lim
+            };
+            let ob = offset(b as usize);
+            // cp(a) − cp(b) = (a − b) − |φ_a| n_a + |φ_b| n_b, a − b = −e_k
+            let jump2: f64 = (0..D)
+                .map(|j| {
+                    let c = if j == k { -1.0 } else { 0.0 } - oa[j] + ob[j];
+                    c * c
+                })
+                .sum();
+            if jump2 > limit2 {
+                out.push((a, b as usize));
+            }
+        }
+    }))
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@ pub mod facing_sheets;
 pub mod medial_edges;
 pub mod mesh_band;
 mod narrow_band;
+mod node_blocks;
 pub mod normals;
 pub mod sampled;
 pub mod schedule;

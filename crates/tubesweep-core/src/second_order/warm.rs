@@ -87,6 +87,7 @@
 use crate::band::NarrowBand;
 use crate::error::{Error, Result};
 use crate::sweep::{Control, IterationReport, NodeRole, Slowness};
+use crate::union_find::SmallestRoot;
 
 use super::factoring::Factoring;
 use super::fingerprint::changed_nodes;
@@ -145,15 +146,7 @@ pub fn component_labels<const D: usize>(band: &NarrowBand<D>, select: &[bool]) -
             format!("one flag per band node ({n}) is needed"),
         ));
     }
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            let p = parent[parent[i as usize] as usize];
-            parent[i as usize] = p;
-            i = p;
-        }
-        i
-    }
+    let mut sets = SmallestRoot::new(n);
     let sentinel = band.sentinel();
     for i in 0..n {
         if !select[i] {
@@ -165,21 +158,12 @@ pub fn component_labels<const D: usize>(band: &NarrowBand<D>, select: &[bool]) -
             if j == sentinel || !select[j as usize] {
                 continue;
             }
-            let (a, b) = (root(&mut parent, i as u32), root(&mut parent, j));
-            if a != b {
-                // the smaller root stays: a component's root is its smallest position
-                parent[a.max(b) as usize] = a.min(b);
-            }
+            // the smaller root stays: a component's root is its smallest position
+            sets.join(i as u32, j);
         }
     }
     Ok((0..n)
-        .map(|i| {
-            if select[i] {
-                root(&mut parent, i as u32)
-            } else {
-                u32::MAX
-            }
-        })
+        .map(|i| if select[i] { sets.root(i as u32) } else { u32::MAX })
         .collect())
 }
 

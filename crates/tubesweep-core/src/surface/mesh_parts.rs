@@ -1,10 +1,11 @@
 //! The connected parts of a triangle mesh (the pieces whose tubes the band is cut between, the
 //! sheets that meet at a pinch, the loops of a mesh's boundary: `python/tubesweep/surfaces/
-//! _mesh_parts.py` and its users). Union–find with path halving over the triangles' edges,
+//! _mesh_parts.py` and its users). Union–find over the triangles' edges ([`SmallestRoot`]),
 //! O(faces · α); each part is labelled by its smallest vertex index, so the labels do not depend
 //! on the order of the faces.
 
 use crate::error::{Error, Result};
+use crate::union_find::SmallestRoot;
 
 /// Per vertex `0..n_vertices` the smallest vertex index of its connected part, the vertices joined
 /// by the edges AB, BC and CA of each face `[A, B, C]` (a face `[a, b, b]` is the edge ab alone).
@@ -20,27 +21,13 @@ pub fn vertex_parts(n_vertices: usize, faces: &[[i64; 3]]) -> Result<Vec<i64>> {
             format!("vertex index {bad} outside 0..{n_vertices} (the number of vertices)"),
         ));
     }
-    let mut root: Vec<u32> = (0..n_vertices as u32).collect();
-    fn find(root: &mut [u32], mut k: u32) -> u32 {
-        while root[k as usize] != k {
-            let up = root[root[k as usize] as usize];
-            root[k as usize] = up;
-            k = up;
-        }
-        k
-    }
+    let mut parts = SmallestRoot::new(n_vertices);
     for f in faces {
         for (a, b) in [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])] {
-            let (ra, rb) = (find(&mut root, a as u32), find(&mut root, b as u32));
-            // the larger root under the smaller: every root is its part's smallest index
-            if ra < rb {
-                root[rb as usize] = ra;
-            } else if rb < ra {
-                root[ra as usize] = rb;
-            }
+            parts.join(a as u32, b as u32);
         }
     }
-    Ok((0..n_vertices as u32).map(|k| find(&mut root, k) as i64).collect())
+    Ok((0..n_vertices as u32).map(|k| parts.root(k) as i64).collect())
 }
 
 #[cfg(test)]
